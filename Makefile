@@ -1,0 +1,32 @@
+# Two entry points (README): `make reproduce-all` and `make test`.
+# Both first make sure .venv matches environment.lock (hash-checked install).
+PYTHON ?= python3
+VENV   := .venv
+BIN    := $(VENV)/bin
+STAMP  := $(VENV)/.installed-from-lock
+
+.PHONY: reproduce-all test env clean-env
+
+env: $(STAMP)
+
+# Rebuilt when missing or older than the lock (or pyproject.toml).
+$(STAMP): environment.lock pyproject.toml
+	@$(PYTHON) -c 'import sys; sys.exit(sys.version_info[:2] != (3, 11))' || \
+	  { echo "error: Python 3.11 is required (found $$($(PYTHON) --version 2>&1)); set PYTHON=python3.11"; exit 1; }
+	@$(PYTHON) -c 'import ensurepip' 2>/dev/null || \
+	  { [ "$$(id -u)" = 0 ] && apt-get update -qq && apt-get install -y -qq python3-venv; } || \
+	  { echo "error: the Python venv module is missing: install the Debian package python3-venv"; exit 1; }
+	rm -rf $(VENV)
+	$(PYTHON) -m venv $(VENV)
+	$(BIN)/pip install --quiet --require-hashes -r environment.lock
+	$(BIN)/pip install --quiet --no-deps -e .
+	touch $(STAMP)
+
+reproduce-all: $(STAMP)
+	$(BIN)/snakemake reproduce-all
+
+test: $(STAMP)
+	OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1 $(BIN)/python -m pytest
+
+clean-env:
+	rm -rf $(VENV)

@@ -1,0 +1,102 @@
+"""The coupling matrices B_i of b(v, μ) = ∫_Γ (v2 − v1) μ (paper, eqs. (3.5), (3.11)).
+
+B_i[j, d] = ∫_Γ μ_j φ_d for the multiplier basis μ_j and the Γ dofs φ_d of V_{h,i}; then
+b(v, μ) = μᵀ (B_2 v_2 − B_1 v_1). Both factors are polynomial on every interval of the
+union of all breakpoints (the two trace partitions and G_h), so Gauss–Legendre with
+⌈(k + s + 1)/2⌉ points per union interval is exact.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import ngsolve
+
+from .meshes import GAMMA
+from .multipliers import MultiplierSpace
+
+
+@dataclass(frozen=True)
+class GammaTrace:
+    """The Γ trace of a displacement space V_{h,i} = H1(mesh_i, order=k, dirichlet="dir").
+
+    Attributes
+    ----------
+    fes : ngsolve.H1
+        The displacement space.
+    gamma_dofs : ndarray of int
+        Free NGSolve dofs that live on Γ (endpoint vertices are Dirichlet), sorted.
+    elements : list of (x_first, x_second, dofs)
+        Γ boundary elements: x of the element's first and second vertex and its dofs.
+    breakpoints : ndarray
+        Sorted x of the trace partition.
+    """
+
+    fes: ngsolve.H1
+    gamma_dofs: np.ndarray
+    elements: list
+    breakpoints: np.ndarray
+
+
+def gamma_trace(fes) -> GammaTrace:
+    """Collect the Γ boundary elements, their vertex abscissae and dofs."""
+    mesh, free = fes.mesh, fes.FreeDofs()
+    elements, dofs = [], set()
+    for el in mesh.Elements(ngsolve.BND):
+        if el.mat != GAMMA:
+            continue
+        x0, x1 = (mesh[v].point[0] for v in el.vertices)
+        dn = np.array(fes.GetDofNrs(el))
+        elements.append((x0, x1, dn, el))
+        dofs.update(int(d) for d in dn if d >= 0 and free[int(d)])
+    elements.sort(key=lambda e: min(e[0], e[1]))
+    bps = np.array(sorted({min(e[0], e[1]) for e in elements} | {max(e[0], e[1]) for e in elements}))
+    return GammaTrace(fes, np.array(sorted(dofs), dtype=int), elements, bps)
+
+
+def union_breakpoints(*partitions, tol: float = 1e-12) -> np.ndarray:
+    """Sorted union of several partitions of Γ, merging points closer than ``tol``."""
+    x = np.unique(np.concatenate(partitions))
+    return x[np.concatenate([[True], np.diff(x) > tol])]
+
+
+def quadrature_on(breakpoints: np.ndarray, degree: int):
+    """Gauss–Legendre points and weights exact for polynomials of ``degree`` per interval."""
+    t, w = np.polynomial.legendre.leggauss(degree // 2 + 1)
+    a, b = breakpoints[:-1, None], breakpoints[1:, None]
+    x = 0.5 * (a + b) + 0.5 * (b - a) * t[None, :]
+    return x.ravel(), (0.5 * (b - a) * w[None, :]).ravel()
+
+
+def trace_values(trace: GammaTrace, x: np.ndarray):
+    """Values of the Γ-dof basis functions at points x (interior of trace elements).
+
+    Returns
+    -------
+    rows, cols, vals : arrays for a COO matrix of shape (len(x), len(gamma_dofs)).
+    """
+    position = -np.ones(trace.fes.ndof, dtype=int)
+    position[trace.gamma_dofs] = np.arange(len(trace.gamma_dofs))
+    e = np.clip(np.searchsorted(trace.breakpoints, x, side="right") - 1, 0, len(trace.elements) - 1)
+    rows, cols, vals = [], [], []
+    for i, (xi, ei) in enumerate(zip(x, e)):
+        x0, x1, dn, el = trace.elements[ei]
+        fe = trace.fes.GetFE(el)
+        # the reference coordinate runs from the second vertex (0) to the first (1)
+        shape = np.asarray(fe.CalcShape((xi - x1) / (x0 - x1), 0.0, 0.0))
+        pos = position[dn]
+        keep = pos >= 0
+        rows.append(np.full(keep.sum(), i))
+        cols.append(pos[keep])
+        vals.append(shape[keep])
+    return np.concatenate(rows), np.concatenate(cols), np.concatenate(vals)
+
+
+def coupling_matrix(trace: GammaTrace, space: MultiplierSpace, k: int) -> np.ndarray:
+    """B_i[j, d] = ∫_Γ μ_j φ_d, dense, shape (dim M, number of Γ dofs); exact."""
+    x, w = quadrature_on(union_breakpoints(trace.breakpoints, space.breakpoints), k + space.degree)
+    mu = space.evaluate(x)  # (n_q, dim M)
+    rows, cols, vals = trace_values(trace, x)
+    phi = np.zeros((len(x), len(trace.gamma_dofs)))
+    np.add.at(phi, (rows, cols), vals)
+    return (mu * w[:, None]).T @ phi

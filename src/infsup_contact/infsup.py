@@ -1,0 +1,140 @@
+"""The discrete inf-sup constant β_h of (4.5)/(5.9) and the bottom of its spectrum.
+
+β_h = inf_μ sup_v b(v, μ) / (‖v‖_a ‖μ‖_M), so β_h² is the smallest eigenvalue of the
+generalized symmetric eigenproblem (B A⁻¹ Bᵀ) m = β² G m on the multiplier space,
+with B A⁻¹ Bᵀ the interface operator (:mod:`infsup_contact.interface`) and G the Gram
+matrix of the multiplier norm (:mod:`infsup_contact.norms`).
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.linalg as sla
+import scipy.sparse as sp
+
+from . import meshes, multipliers
+from .coupling import coupling_matrix, union_breakpoints
+from .errors import InputError
+from .interface import interface_operator, side_operator
+from .norms import NORMS, gram
+
+KERNEL_RTOL = 1e-8
+"""An eigenvalue μ² < KERNEL_RTOL · (largest eigenvalue) counts as a numerical zero."""
+
+
+@dataclass(frozen=True)
+class Spectrum:
+    """Bottom of the spectrum of (B A⁻¹ Bᵀ) m = β² G m.
+
+    Attributes
+    ----------
+    beta : float
+        β_h = sqrt(smallest eigenvalue), clipped at 0.
+    kernel_dim : int
+        Eigenvalues below ``KERNEL_RTOL`` times the largest one.
+    smallest_nonzero : float
+        sqrt of the smallest eigenvalue above the numerical kernel (β above the kernel).
+    bottom : ndarray
+        The smallest eigenvalues β² (up to 8), ascending.
+    """
+
+    beta: float
+    kernel_dim: int
+    smallest_nonzero: float
+    bottom: np.ndarray
+
+
+def spectrum(S: np.ndarray, G: np.ndarray, kernel_rtol: float = KERNEL_RTOL) -> Spectrum:
+    """Solve S m = β² G m densely (``scipy.linalg.eigh``) and summarize its bottom."""
+    ev = sla.eigh(S, G, eigvals_only=True, check_finite=False)
+    kernel = int(np.sum(ev < kernel_rtol * ev[-1]))
+    above = ev[kernel] if kernel < len(ev) else np.nan
+    return Spectrum(float(np.sqrt(max(ev[0], 0.0))), kernel, float(np.sqrt(above)), ev[:8].copy())
+
+
+def check_inputs(case, k, family, n1, n2, c1, c2, norm, multiplier_mesh) -> None:
+    """Validate a β_h request; raises :class:`InputError` naming the offending key."""
+    if not isinstance(k, (int, np.integer)) or not 1 <= k <= 4:
+        raise InputError("k", "an integer in 1..4", got=k)
+    for c in case:
+        multipliers.check_case(c, k)
+    meshes.check_mesh_args(family, n1, "N1")
+    meshes.check_mesh_args(family, n2, "N2")
+    for key, c in (("c1", c1), ("c2", c2)):
+        if not c > 0:
+            raise InputError(key, "a positive number", got=c)
+    for nm in norm:
+        if nm not in NORMS:
+            raise InputError("norm", ", ".join(NORMS), got=nm)
+    if multiplier_mesh not in ("omega2", "omega1", "union"):
+        raise InputError("multiplier_mesh", "omega2, omega1, union", got=multiplier_mesh)
+
+
+def common_coarsening(x1: np.ndarray, x2: np.ndarray, tol: float = 1e-12) -> np.ndarray:
+    """Breakpoints shared by two partitions of Γ."""
+    return np.array([x for x in x1 if np.min(np.abs(x2 - x)) < tol])
+
+
+def trace_sum_dimension(k: int, x1: np.ndarray, x2: np.ndarray) -> int:
+    """dim(W1 + W2) = dim W1 + dim W2 − dim(W1 ∩ W2); W1 ∩ W2 lives on the common coarsening."""
+    n1, n2, nc = len(x1) - 1, len(x2) - 1, len(common_coarsening(x1, x2)) - 1
+    return (n1 * k - 1) + (n2 * k - 1) - (nc * k - 1)
+
+
+def beta_rows(family, k, n1, n2, cases=multipliers.CASE_IDS, multiplier_mesh="omega2",
+              c1=1.0, c2=1.0, norms=NORMS, h_route="logkernel", **mesh_kwargs):
+    """β_h for several cases and norms on one mesh pair, reusing the interface operator.
+
+    Returns
+    -------
+    list of dict
+        One row per (case, norm) with the columns of ``infsup-contact beta``.
+    """
+    cases = [c for c in cases if k >= multipliers.CASES[c][4]] if cases is multipliers.CASE_IDS else list(cases)
+    check_inputs(cases, k, family, n1, n2, c1, c2, norms, multiplier_mesh)
+    t0 = time.perf_counter()
+    mesh1, mesh2 = meshes.mesh_pair(family, n1, n2, **mesh_kwargs)
+    t1 = time.perf_counter()
+    sides = [side_operator(m, k) for m in (mesh1, mesh2)]
+    t2 = time.perf_counter()
+    x_mult = meshes.multiplier_breakpoints(mesh1, mesh2, multiplier_mesh)
+    x1, x2 = (s.trace.breakpoints for s in sides)
+    dim_w = trace_sum_dimension(k, x1, x2)
+    rows = []
+    for case in cases:
+        space = multipliers.case_space(case, k, x_mult)
+        tc = time.perf_counter()
+        couplings = [coupling_matrix(s.trace, space, k) for s in sides]
+        S = interface_operator(couplings, sides, (c1, c2))
+        t_coupling = time.perf_counter() - tc
+        for norm in norms:
+            te = time.perf_counter()
+            G, info = gram(space, norm, h_route=h_route)
+            sp_ = spectrum(S, G)
+            rows.append(dict(
+                case=case, k=k, family=family, N1=n1, N2=n2, multiplier_mesh=multiplier_mesh,
+                c1=c1, c2=c2, norm=norm, beta=sp_.beta, kernel_dim=sp_.kernel_dim,
+                structural_kernel_dim=max(space.dim - dim_w, 0),
+                smallest_nonzero=sp_.smallest_nonzero, dim_M=space.dim, dim_W=dim_w,
+                n_max=info["n_max"], nmax_rel_error=info["nmax_rel_error"],
+                ndof=sum(s.ndof for s in sides), t_assemble=t1 - t0 + t_coupling,
+                t_interface=t2 - t1, t_eig=time.perf_counter() - te))
+    return rows
+
+
+def saddle_point_beta(A: sp.spmatrix, B: np.ndarray, G: np.ndarray) -> float:
+    """β_h from the full pencil, the independent route: [[A, Bᵀ], [B, 0]] x = σ [[A, 0], [0, G]] x.
+
+    Eliminating u gives B A⁻¹ Bᵀ m = σ(σ − 1) G m, so β² = σ(σ − 1) for the negative σ
+    closest to 0. Dense; for small meshes (tests and the benchmark's dense route).
+    """
+    A = A.toarray() if sp.issparse(A) else np.asarray(A)
+    n, m = A.shape[0], B.shape[0]
+    lhs = np.block([[A, B.T], [B, np.zeros((m, m))]])
+    rhs = np.block([[A, np.zeros((n, m))], [np.zeros((m, n)), G]])
+    sigma = sla.eigh(lhs, rhs, eigvals_only=True)
+    beta2 = sigma * (sigma - 1.0)
+    neg = sigma[sigma < 0.0]
+    return float(np.sqrt(np.min(neg * (neg - 1.0)))) if len(neg) else 0.0 * beta2[0]

@@ -1,0 +1,161 @@
+"""Meshes of the two membranes Ω1 = (0,1)×(0,1) and Ω2 = (0,1)×(1,2) (paper, Fig. 4).
+
+One NGSolve mesh per subdomain, with boundary names ``gamma`` (Γ = (0,1)×{1}) and
+``dir`` (the rest of ∂Ω_i, where u_i = 0, eq. (3.1)). A family and (N1, N2), the numbers
+of segments on Γ of the Ω1 and Ω2 meshes, address a mesh pair; N1 ≠ N2 is non-matching.
+
+Families
+--------
+structured
+    N × N equal squares, each split by its lower-left → upper-right diagonal.
+perturbed
+    structured, interior nodes moved by a seeded uniform shift of amplitude α·h;
+    Γ nodes move only along x, identically on both sides when N1 = N2.
+unstructured
+    netgen's advancing-front mesher with maxh = 1/N, reproducible (netgen is
+    deterministic for a given geometry and maxh); N is then the segment count on Γ.
+"""
+from __future__ import annotations
+
+import numpy as np
+import ngsolve
+from netgen import meshing
+from netgen.geom2d import SplineGeometry
+
+from .errors import InputError
+
+FAMILIES = ("structured", "perturbed", "unstructured")
+SIDES = (1, 2)
+GAMMA, DIRICHLET = "gamma", "dir"
+
+
+def check_mesh_args(family: str, n: int, key: str = "N") -> None:
+    """Raise :class:`InputError` for an unknown family or a segment count below 1."""
+    if family not in FAMILIES:
+        raise InputError("family", ", ".join(FAMILIES), got=family)
+    if not isinstance(n, (int, np.integer)) or n < 1:
+        raise InputError(key, "an integer >= 1", got=n)
+
+
+def structured_arrays(n: int, side: int):
+    """Vertices and triangles of the structured N×N mesh of Ω_side.
+
+    Returns
+    -------
+    points : ndarray (n_v, 2)
+    triangles : ndarray (n_t, 3) of vertex indices, counter-clockwise
+    """
+    y0 = 0.0 if side == 1 else 1.0
+    s = np.linspace(0.0, 1.0, n + 1)
+    X, Y = np.meshgrid(s, y0 + s, indexing="xy")
+    points = np.column_stack([X.ravel(), Y.ravel()])
+    i, j = np.meshgrid(np.arange(n), np.arange(n), indexing="xy")
+    ll = (j * (n + 1) + i).ravel()
+    lr, ul, ur = ll + 1, ll + n + 1, ll + n + 2
+    # diagonal from lower-left to upper-right: (ll, lr, ur) and (ll, ur, ul)
+    triangles = np.vstack([np.column_stack([ll, lr, ur]), np.column_stack([ll, ur, ul])])
+    return points, triangles
+
+
+def boundary_segments(points: np.ndarray, side: int, tol: float = 1e-12):
+    """Boundary edges of the structured/perturbed square, split into Γ and the rest.
+
+    Returns a list of (v_a, v_b, name) with the domain on the left of a → b.
+    """
+    y0 = 0.0 if side == 1 else 1.0
+    n = int(round(np.sqrt(len(points)))) - 1
+    idx = np.arange((n + 1) ** 2).reshape(n + 1, n + 1)  # idx[row j, col i]
+    bottom, top = idx[0, :], idx[-1, ::-1]
+    right, left = idx[:, -1], idx[::-1, 0]
+    gamma_row = "top" if side == 1 else "bottom"
+    segs = []
+    for name, chain in (("bottom", bottom), ("right", right), ("top", top), ("left", left)):
+        label = GAMMA if name == gamma_row else DIRICHLET
+        segs += [(int(a), int(b), label) for a, b in zip(chain[:-1], chain[1:])]
+    del y0, tol
+    return segs
+
+
+def mesh_from_arrays(points, triangles, segments) -> ngsolve.Mesh:
+    """An NGSolve mesh from vertex/triangle arrays and named boundary segments."""
+    ngmesh = meshing.Mesh(dim=2)
+    pnums = [ngmesh.Add(meshing.MeshPoint(meshing.Pnt(x, y, 0.0))) for x, y in points]
+    ngmesh.Add(meshing.FaceDescriptor(surfnr=1, domin=1, bc=1))
+    ngmesh.SetMaterial(1, "omega")
+    for tri in triangles:
+        ngmesh.Add(meshing.Element2D(1, [pnums[v] for v in tri]))
+    bc_index = {GAMMA: 1, DIRICHLET: 2}
+    for a, b, name in segments:
+        ngmesh.Add(meshing.Element1D([pnums[a], pnums[b]], index=bc_index[name]))
+    for name, nr in bc_index.items():
+        ngmesh.SetBCName(nr - 1, name)
+    return ngsolve.Mesh(ngmesh)
+
+
+def perturb(points: np.ndarray, n: int, side: int, alpha: float, seed: int) -> np.ndarray:
+    """Move interior nodes by U(−αh, αh)², Γ nodes only along x (shared seed per N)."""
+    h = 1.0 / n
+    out = points.copy()
+    idx = np.arange((n + 1) ** 2).reshape(n + 1, n + 1)
+    interior = idx[1:-1, 1:-1].ravel()
+    rng = np.random.default_rng([seed, n, side])
+    out[interior] += rng.uniform(-alpha * h, alpha * h, size=(len(interior), 2))
+    # Γ shift drawn from a stream that depends on N only, so matching meshes stay matching
+    gamma_row = idx[-1, 1:-1] if side == 1 else idx[0, 1:-1]
+    shift = np.random.default_rng([seed, n, 0]).uniform(-alpha * h, alpha * h, size=n - 1)
+    out[gamma_row, 0] += shift
+    return out
+
+
+def unstructured_mesh(n: int, side: int) -> ngsolve.Mesh:
+    """netgen mesh of Ω_side with maxh = 1/N and exactly N equal segments on Γ."""
+    y0 = 0.0 if side == 1 else 1.0
+    geo = SplineGeometry()
+    corners = [(0, y0), (1, y0), (1, y0 + 1), (0, y0 + 1)]
+    pts = [geo.AppendPoint(*c) for c in corners]
+    gamma_edge = 2 if side == 1 else 0  # top edge of Ω1, bottom edge of Ω2
+    for e in range(4):
+        name = GAMMA if e == gamma_edge else DIRICHLET
+        geo.Append(["line", pts[e], pts[(e + 1) % 4]], bc=name, leftdomain=1, rightdomain=0,
+                   maxh=(1.0 / n if e == gamma_edge else 1e99))
+    ngmesh = geo.GenerateMesh(maxh=1.0 / n)
+    return ngsolve.Mesh(ngmesh)
+
+
+def subdomain_mesh(family: str, n: int, side: int, *, alpha: float = 0.2, seed: int = 0) -> ngsolve.Mesh:
+    """The mesh of Ω_side (side = 1 or 2) of a family with N segments on Γ."""
+    check_mesh_args(family, n)
+    if family == "unstructured":
+        return unstructured_mesh(n, side)
+    points, triangles = structured_arrays(n, side)
+    if family == "perturbed":
+        points = perturb(points, n, side, alpha, seed)
+    return mesh_from_arrays(points, triangles, boundary_segments(points, side))
+
+
+def mesh_pair(family: str, n1: int, n2: int, **kwargs):
+    """(mesh of Ω1 with N1 segments on Γ, mesh of Ω2 with N2 segments on Γ)."""
+    check_mesh_args(family, n1, "N1")
+    check_mesh_args(family, n2, "N2")
+    return subdomain_mesh(family, n1, 1, **kwargs), subdomain_mesh(family, n2, 2, **kwargs)
+
+
+def gamma_breakpoints(mesh: ngsolve.Mesh) -> np.ndarray:
+    """Sorted x-coordinates of the mesh vertices on Γ (the trace partition)."""
+    xs = set()
+    for el in mesh.Elements(ngsolve.BND):
+        if el.mat == GAMMA:
+            for v in el.vertices:
+                xs.add(mesh[v].point[0])
+    return np.array(sorted(xs))
+
+
+def multiplier_breakpoints(mesh1, mesh2, choice: str = "omega2", tol: float = 1e-12) -> np.ndarray:
+    """Partition G_h of Γ: the trace of Ω2 (paper's default), of Ω1, or their union."""
+    choices = {"omega2": lambda: gamma_breakpoints(mesh2), "omega1": lambda: gamma_breakpoints(mesh1)}
+    if choice == "union":
+        x = np.union1d(gamma_breakpoints(mesh1), gamma_breakpoints(mesh2))
+        return x[np.concatenate([[True], np.diff(x) > tol])]
+    if choice not in choices:
+        raise InputError("multiplier_mesh", "omega2, omega1, union", got=choice)
+    return choices[choice]()

@@ -1,0 +1,186 @@
+"""Lagrange-multiplier spaces on a 1D partition G_h of Γ = (0, 1).
+
+The spaces are the paper's (5.3) and (5.5):
+
+* ``M^r_s``   — piecewise P_s on G_h, continuous (r = 1) or not (r = 0);
+* ``M^r_{0,s}`` — the same, vanishing at the endpoints x = 0 and x = 1.
+
+The five named cases of Section 5 are fixed triples (s, continuous, vanish) in terms
+of the displacement degree k; see :data:`CASES`.
+
+A space is plain data: the breakpoints, the local degree and the local-to-global dof
+map. Local shape functions are Lagrange polynomials on equispaced nodes of the
+reference interval t ∈ [0, 1] (for s = 0 the constant 1), so a dof is a nodal value and
+the cone "λ_h ≥ 0 at the nodes" is "dof ≥ 0".
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .errors import InputError
+
+CASES = {
+    # case: (paper reference, degree as function of k, continuous, vanish at ends, min k)
+    "T3": ("Thm 3, M^1_{0,k}", lambda k: k, True, True, 1),
+    "R5.2": ("Rem 5.2, M^1_k", lambda k: k, True, False, 1),
+    "T4": ("Thm 4, M^0_{k-2}", lambda k: k - 2, False, False, 2),
+    "R5.4": ("Rem 5.4, M^0_{k-1}", lambda k: k - 1, False, False, 1),
+    "T5": ("Thm 5, M^1_{k-1}", lambda k: k - 1, True, False, 2),
+}
+CASE_IDS = tuple(CASES)
+STABLE_CASES = ("T3", "T4", "T5")
+
+
+@dataclass(frozen=True)
+class MultiplierSpace:
+    """A 1D piecewise-polynomial space on the partition ``breakpoints`` of Γ.
+
+    Attributes
+    ----------
+    breakpoints : ndarray, shape (N + 1,)
+        Nodes 0 = x_0 < ... < x_N = 1 of G_h.
+    degree : int
+        Local polynomial degree s.
+    continuous : bool
+        r = 1 (continuous) or r = 0 (discontinuous).
+    vanish_at_ends : bool
+        Whether μ(0) = μ(1) = 0 is imposed (the spaces (5.5)).
+    dofs : ndarray of int, shape (N, s + 1)
+        Global dof of each local shape function, −1 where a shape function is dropped
+        (the endpoint condition).
+    dim : int
+        Dimension of the space.
+    """
+
+    breakpoints: np.ndarray
+    degree: int
+    continuous: bool
+    vanish_at_ends: bool
+    dofs: np.ndarray
+    dim: int
+
+    @property
+    def n_intervals(self) -> int:
+        return len(self.breakpoints) - 1
+
+    def nodes(self) -> np.ndarray:
+        """Coordinates of the global dofs (the Lagrange nodes), shape (dim,)."""
+        x = np.empty(self.dim)
+        t = reference_nodes(self.degree)
+        a, b = self.breakpoints[:-1], self.breakpoints[1:]
+        pts = a[:, None] + (b - a)[:, None] * t[None, :]
+        mask = self.dofs >= 0
+        x[self.dofs[mask]] = pts[mask]
+        return x
+
+    def evaluate(self, x: np.ndarray) -> np.ndarray:
+        """Dense matrix of all basis functions at points ``x``, shape (len(x), dim).
+
+        A point on a breakpoint is assigned to the interval on its right (the last
+        breakpoint to the last interval); discontinuous spaces are thus right-continuous.
+        """
+        x = np.asarray(x, dtype=float)
+        e = np.clip(np.searchsorted(self.breakpoints, x, side="right") - 1, 0, self.n_intervals - 1)
+        a, b = self.breakpoints[e], self.breakpoints[e + 1]
+        vals = local_shapes(self.degree, (x - a) / (b - a))
+        out = np.zeros((len(x), self.dim))
+        rows = np.repeat(np.arange(len(x)), self.degree + 1)
+        cols = self.dofs[e].ravel()
+        keep = cols >= 0
+        np.add.at(out, (rows[keep], cols[keep]), vals.ravel()[keep])
+        return out
+
+
+def reference_nodes(s: int) -> np.ndarray:
+    """Equispaced Lagrange nodes on [0, 1]; the midpoint for s = 0."""
+    return np.array([0.5]) if s == 0 else np.linspace(0.0, 1.0, s + 1)
+
+
+def local_shapes(s: int, t: np.ndarray) -> np.ndarray:
+    """Lagrange shape functions of degree s at reference points t, shape (len(t), s + 1)."""
+    t = np.asarray(t, dtype=float)
+    nodes = reference_nodes(s)
+    out = np.ones((len(t), s + 1))
+    for a in range(s + 1):
+        for b in range(s + 1):
+            if a != b:
+                out[:, a] *= (t - nodes[b]) / (nodes[a] - nodes[b])
+    return out
+
+
+def local_monomial_coefficients(s: int) -> np.ndarray:
+    """Coefficients C with shape_a(t) = Σ_p C[a, p] t^p, shape (s + 1, s + 1)."""
+    nodes = reference_nodes(s)
+    vander = np.vander(nodes, s + 1, increasing=True)  # V[i, p] = nodes_i^p
+    return np.linalg.inv(vander).T
+
+
+def make_space(breakpoints, degree: int, continuous: bool, vanish_at_ends: bool) -> MultiplierSpace:
+    """Build the general space ``M^r_s`` or ``M^r_{0,s}`` on the partition ``breakpoints``.
+
+    Raises
+    ------
+    InputError
+        For a negative degree, a continuous space of degree 0, or a bad partition.
+    """
+    x = np.asarray(breakpoints, dtype=float)
+    if x.ndim != 1 or len(x) < 2 or not np.all(np.diff(x) > 0):
+        raise InputError("breakpoints", "a strictly increasing array with at least 2 entries")
+    if degree < 0:
+        raise InputError("degree", "an integer s >= 0")
+    if continuous and degree == 0:
+        raise InputError("degree", "s >= 1 for a continuous space (continuous P_0 is only the constants)")
+    n, s = len(x) - 1, degree
+    if continuous:
+        dofs = np.arange(n)[:, None] * s + np.arange(s + 1)[None, :]
+        if vanish_at_ends:
+            dofs = dofs - 1
+            dofs[-1, -1] = -1  # the last node, x = 1; x = 0 became −1 by the shift
+    else:
+        dofs = np.arange(n * (s + 1)).reshape(n, s + 1)
+        if vanish_at_ends and s >= 1:
+            # drop the shape functions that are nonzero at x = 0 and x = 1
+            dofs[0, 0] = dofs[-1, -1] = -1
+            live = np.unique(dofs[dofs >= 0])
+            renum = -np.ones(n * (s + 1), dtype=int)
+            renum[live] = np.arange(len(live))
+            dofs = np.where(dofs >= 0, renum[np.maximum(dofs, 0)], -1)
+        elif vanish_at_ends:
+            raise InputError("vanish_at_ends", "False for discontinuous P_0 (no endpoint nodes)")
+    dim = int(dofs.max()) + 1
+    return MultiplierSpace(x, s, continuous, vanish_at_ends, dofs, dim)
+
+
+def check_case(case: str, k: int) -> None:
+    """Raise :class:`InputError` unless ``case`` is a named case valid for degree ``k``."""
+    if case not in CASES:
+        raise InputError("case", ", ".join(CASE_IDS))
+    ref, _, _, _, kmin = CASES[case]
+    if k < kmin:
+        raise InputError("k", f"k >= {kmin} for case {case} ({ref} needs k >= {kmin})")
+
+
+def case_space(case: str, k: int, breakpoints) -> MultiplierSpace:
+    """The multiplier space of a named case of Section 5 for displacement degree k."""
+    check_case(case, k)
+    _, degree, continuous, vanish, _ = CASES[case]
+    return make_space(breakpoints, degree(k), continuous, vanish)
+
+
+def paper_dimension(case: str, k: int, n_intervals: int) -> int:
+    """dim M_h from the paper's counts (Rem 5.2, Rem 5.4, Thm 5 discussion), N intervals."""
+    n = n_intervals
+    return {"T3": n * k - 1, "R5.2": n * k + 1, "T4": n * (k - 1),
+            "R5.4": n * k, "T5": n * (k - 1) + 1}[case]
+
+
+def trace_dimension(k: int, n_intervals: int) -> int:
+    """dim W_h: traces on Γ of continuous P_k vanishing at Γ's endpoints, N intervals."""
+    return n_intervals * k - 1
+
+
+def structural_kernel_dim(case: str, k: int, n_intervals: int) -> int:
+    """max(dim M − dim W, 0) on matching meshes: 2 for R5.2, 1 for R5.4, 0 otherwise."""
+    return max(paper_dimension(case, k, n_intervals) - trace_dimension(k, n_intervals), 0)

@@ -1,0 +1,29 @@
+"""Shared glue for workflow scripts: thread limits, provenance columns, logging."""
+import hashlib
+import json
+import os
+import sys
+
+
+def limit_threads(n: int) -> None:
+    """Cap BLAS/OpenMP threads at the job's `threads:` (must run before numpy loads)."""
+    for var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
+        os.environ[var] = str(n)
+
+
+def config_hash(cfg) -> str:
+    """Short stable hash of a config (sub)tree."""
+    return hashlib.sha256(json.dumps(cfg, sort_keys=True).encode()).hexdigest()[:12]
+
+
+def add_provenance(frame, cfg):
+    """Provenance columns: package version, git commit, config hash."""
+    from infsup_contact import __version__
+    from infsup_contact.provenance import git_commit
+
+    return frame.assign(package_version=__version__, git_commit=git_commit(), config_hash=config_hash(cfg))
+
+
+def log_to(path):
+    """Send this script's stderr to the rule's log file."""
+    sys.stderr = open(path, "w")

@@ -127,14 +127,14 @@ def beta_rows(family, k, n1, n2, cases=multipliers.CASE_IDS, multiplier_mesh="om
 def saddle_point_beta(A: sp.spmatrix, B: np.ndarray, G: np.ndarray) -> float:
     """β_h from the full pencil, the independent route: [[A, Bᵀ], [B, 0]] x = σ [[A, 0], [0, G]] x.
 
-    Eliminating u gives B A⁻¹ Bᵀ m = σ(σ − 1) G m, so β² = σ(σ − 1) for the negative σ
-    closest to 0. Dense; for small meshes (tests and the benchmark's dense route).
+    Eliminating u gives B A⁻¹ Bᵀ m = σ(σ − 1) G m, so every β² ≥ 0 appears as the root
+    σ = (1 − sqrt(1 + 4β²))/2 ≤ 0 (kernel modes at σ = 0); the other eigenvalues are ≥ 1.
+    Dense; for small meshes (tests and the benchmark's dense route).
     """
     A = A.toarray() if sp.issparse(A) else np.asarray(A)
     n, m = A.shape[0], B.shape[0]
     lhs = np.block([[A, B.T], [B, np.zeros((m, m))]])
     rhs = np.block([[A, np.zeros((n, m))], [np.zeros((m, n)), G]])
     sigma = sla.eigh(lhs, rhs, eigvals_only=True)
-    beta2 = sigma * (sigma - 1.0)
-    neg = sigma[sigma < 0.0]
-    return float(np.sqrt(np.min(neg * (neg - 1.0)))) if len(neg) else 0.0 * beta2[0]
+    low = sigma[sigma < 0.5]
+    return float(np.sqrt(max(np.min(low * (low - 1.0)), 0.0)))

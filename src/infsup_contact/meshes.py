@@ -77,18 +77,17 @@ def boundary_segments(points: np.ndarray, side: int, tol: float = 1e-12):
 
 
 def mesh_from_arrays(points, triangles, segments) -> ngsolve.Mesh:
-    """An NGSolve mesh from vertex/triangle arrays and named boundary segments."""
+    """An NGSolve mesh from vertex/triangle arrays and named boundary segments.
+
+    Uses netgen's vectorized AddPoints / AddRegion / AddElements (no per-element loop).
+    """
     ngmesh = meshing.Mesh(dim=2)
-    pnums = [ngmesh.Add(meshing.MeshPoint(meshing.Pnt(x, y, 0.0))) for x, y in points]
-    ngmesh.Add(meshing.FaceDescriptor(surfnr=1, domin=1, bc=1))
-    ngmesh.SetMaterial(1, "omega")
-    for tri in triangles:
-        ngmesh.Add(meshing.Element2D(1, [pnums[v] for v in tri]))
-    bc_index = {GAMMA: 1, DIRICHLET: 2}
-    for a, b, name in segments:
-        ngmesh.Add(meshing.Element1D([pnums[a], pnums[b]], index=bc_index[name]))
-    for name, nr in bc_index.items():
-        ngmesh.SetBCName(nr - 1, name)
+    ngmesh.AddPoints(np.column_stack([points, np.zeros(len(points))]).astype(float))
+    omega = ngmesh.AddRegion("omega", dim=2)
+    ngmesh.AddElements(dim=2, index=omega, data=np.asarray(triangles, dtype=np.int32), base=0)
+    for name in (GAMMA, DIRICHLET):
+        edges = np.array([(a, b) for a, b, label in segments if label == name], dtype=np.int32)
+        ngmesh.AddElements(dim=1, index=ngmesh.AddRegion(name, dim=1), data=edges, base=0)
     return ngsolve.Mesh(ngmesh)
 
 

@@ -1,0 +1,83 @@
+"""Error measures of a contact solution against the exact (manufactured) solution or a
+reference solution (membranes): energy, L²(Ω), λ in L²(Γ) and in the H^{-1/2}_00 dual
+norm (eq. (3.9), by sine series), contact set, penetration.
+"""
+from __future__ import annotations
+
+import ngsolve
+import numpy as np
+import scipy.fft
+
+from .contact_problem import ContactSolution, gamma_values, lambda_values
+from .norms import sine_coefficients
+
+N_SAMPLE = 4001
+"""Points on Γ for pointwise quantities (penetration, contact set)."""
+
+
+def _gauss_on(breaks: np.ndarray, n: int = 12):
+    t, w = np.polynomial.legendre.leggauss(n)
+    a, b = breaks[:-1, None], breaks[1:, None]
+    return (0.5 * (a + b) + 0.5 * (b - a) * t).ravel(), (0.5 * (b - a) * w).ravel()
+
+
+def energy_and_l2_errors(sol: ContactSolution, exact) -> tuple[float, float]:
+    """‖u − u_h‖_a = (Σ c_i ∫|∇(u_i − u_ih)|²)^{1/2} and ‖u − u_h‖_{L²(Ω)}."""
+    e2 = l2 = 0.0
+    for gf, side, u, gu, c in zip(sol.u, sol.sides, (exact.u1, exact.u2),
+                                  (exact.grad_u1, exact.grad_u2), sol.c):
+        mesh, order = side.trace.fes.mesh, 2 * side.trace.fes.globalorder + 6
+        d = ngsolve.grad(gf) - gu
+        e2 += c * ngsolve.Integrate(d * d, mesh, order=order)
+        l2 += ngsolve.Integrate((gf - u) ** 2, mesh, order=order)
+    return float(np.sqrt(max(e2, 0))), float(np.sqrt(max(l2, 0)))
+
+
+def lambda_l2_error(sol: ContactSolution, lam_exact, kinks=()) -> float:
+    """‖λ − λ_h‖_{L²(Γ)} by Gauss on the multiplier partition refined at ``kinks``."""
+    breaks = np.unique(np.r_[np.linspace(0, 1, 4 * sol.space.n_intervals + 1), sol.space.breakpoints, kinks])
+    x, w = _gauss_on(breaks)
+    return float(np.sqrt(w @ (lam_exact(x) - lambda_values(sol, x)) ** 2))
+
+
+def exact_sine_coefficients(f, n_max: int) -> np.ndarray:
+    """√2 ∫ f sin(nπx), n = 1..n_max, by the DST-I of f on a fine grid (trapezoid rule)."""
+    m = 8 * n_max
+    x = np.arange(1, m) / m
+    return np.sqrt(2.0) * scipy.fft.dst(f(x), type=1)[:n_max] / (2 * m)
+
+
+def lambda_hm12_error(sol: ContactSolution, lam_exact, n_max: int = 2**14) -> float:
+    """‖λ − λ_h‖_M = (Σ e_n²/(nπ))^{1/2}, truncated at n_max and Richardson-extrapolated
+    assuming an n^{-2} tail (λ_h may jump)."""
+    n = np.arange(1, n_max + 1)
+    e = exact_sine_coefficients(lam_exact, n_max) - sol.lam @ sine_coefficients(sol.space, n)
+    partial = np.cumsum(e**2 / (n * np.pi))
+    s_half, s_full = partial[n_max // 2 - 1], partial[-1]
+    return float(np.sqrt(max(s_full + (s_full - s_half) / 3.0, 0.0)))
+
+
+def contact_set(values: np.ndarray, x: np.ndarray, rtol: float = 1e-8) -> np.ndarray:
+    """Mask of sample points where λ_h is positive (relative to its maximum)."""
+    return values > rtol * max(np.abs(values).max(), 1e-300)
+
+
+def contact_set_error(sol: ContactSolution, exact_set: tuple) -> float:
+    """|A Δ A_h|: measure of the symmetric difference, by sampling Γ."""
+    x = (np.arange(N_SAMPLE) + 0.5) / N_SAMPLE
+    a, b = exact_set
+    exact = (x > a) & (x < b)
+    return float(np.mean(exact != contact_set(lambda_values(sol, x), x)))
+
+
+def max_penetration(sol: ContactSolution, n: int = 801) -> float:
+    """max(u_{1,h} − u_{2,h}, 0) sampled along Γ."""
+    x = np.linspace(0, 1, n)[1:-1]
+    u1, u2 = gamma_values(sol, x)
+    return float(max(np.max(u1 - u2), 0.0))
+
+
+def lambda_total_variation(sol: ContactSolution) -> float:
+    """Σ |Δλ_h| over the multiplier nodes in x order: grows when λ_h oscillates."""
+    order = np.argsort(sol.space.nodes())
+    return float(np.abs(np.diff(sol.lam[order])).sum())

@@ -1,0 +1,171 @@
+"""Workflow configuration: bad configs fail at validation, before any job, naming the key.
+
+Every test works in a temporary copy of the workflow (Snakefile, workflow/, config/,
+profiles/ and a symlink src -> the package sources) and only dry-runs it (`-n`), except
+one up-to-date check in which Snakemake finds nothing to do; no job ever runs.
+"""
+from __future__ import annotations
+
+import copy
+import os
+import shutil
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+import yaml
+
+ROOT = Path(__file__).resolve().parents[1]
+SNAKEMAKE = Path(sys.prefix) / "bin" / "snakemake"
+ENV = {**os.environ, "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"}
+CI_CONFIG = yaml.safe_load((ROOT / "config" / "ci.yaml").read_text())
+
+
+@pytest.fixture
+def workdir(tmp_path: Path) -> Path:
+    shutil.copy2(ROOT / "Snakefile", tmp_path / "Snakefile")
+    for d in ("workflow", "config", "profiles"):
+        shutil.copytree(ROOT / d, tmp_path / d, ignore=shutil.ignore_patterns("__pycache__"))
+    (tmp_path / "src").symlink_to(ROOT / "src", target_is_directory=True)
+    return tmp_path
+
+
+def snakemake(workdir: Path, *args: str) -> tuple[int, str]:
+    assert SNAKEMAKE.is_file(), f"snakemake not installed at {SNAKEMAKE}"
+    proc = subprocess.run([str(SNAKEMAKE), *args], cwd=workdir, env=ENV, capture_output=True,
+                          text=True, timeout=120)
+    return proc.returncode, proc.stdout + proc.stderr
+
+
+def produced_tables(workdir: Path) -> list[Path]:
+    return sorted((workdir / "results").rglob("*")) if (workdir / "results").exists() else []
+
+
+# --------------------------------------------------------------- bad configs
+
+def _set(*path, value):
+    def mutate(cfg):
+        node = cfg
+        for key in path[:-1]:
+            node = node[key]
+        node[path[-1]] = value
+    return mutate
+
+
+def _rename_top(cfg):
+    cfg["infsupp"] = cfg.pop("infsup")
+
+
+def _typo_top(cfg):
+    cfg["infsup_typo"] = copy.deepcopy(cfg["infsup"])
+
+
+def _typo_nested(cfg):
+    cfg["infsup"]["familes"] = cfg["infsup"].pop("families")
+
+
+# id: (mutation of config/ci.yaml, substrings that must all appear in the output).
+# The JSON-schema instance path ("instance['infsup'][...]") names the offending key.
+BAD_CONFIGS = {
+    "unknown-case": (_set("infsup", "cases", value={"T9": [1]}),
+                     ["'T9' was unexpected", "instance['infsup']['cases']"]),
+    "unknown-case-added": (_set("infsup", "cases", "T9", value=[2]),
+                           ["'T9' was unexpected", "instance['infsup']['cases']"]),
+    "k-above-4": (_set("infsup", "cases", value={"T3": [5]}),
+                  ["instance['infsup']['cases']['T3']", "maximum of 4"]),
+    "k-zero": (_set("infsup", "cases", value={"T3": [0]}),
+               ["instance['infsup']['cases']['T3']", "minimum of 1"]),
+    "T4-k1": (_set("infsup", "cases", value={"T4": [1]}),
+              ["instance['infsup']['cases']['T4']", "minimum of 2"]),
+    "T4-k1-among-valid": (_set("infsup", "cases", "T4", value=[2, 1]),
+                          ["instance['infsup']['cases']['T4']", "minimum of 2"]),
+    "T5-k1": (_set("infsup", "cases", value={"T5": [1]}),
+              ["instance['infsup']['cases']['T5']", "minimum of 2"]),
+    "c-zero": (_set("infsup", "c", value=[[0, 1]]), ["instance['infsup']['c']"]),
+    "c-negative": (_set("infsup", "c", value=[[1, -2]]), ["instance['infsup']['c']", "-2"]),
+    "N-empty": (_set("infsup", "N", value=[]), ["instance['infsup']['N']", "non-empty"]),
+    "N-float": (_set("infsup", "N", value=[4, 8.5]),
+                ["instance['infsup']['N']", "8.5 is not of type 'integer'"]),
+    "N-string": (_set("infsup", "N", value=["a"]),
+                 ["instance['infsup']['N']", "'a' is not of type 'integer'"]),
+    "unknown-family": (_set("infsup", "families", value=["structured", "hexagonal"]),
+                       ["instance['infsup']['families']", "'hexagonal'"]),
+    "unknown-multiplier-mesh": (_set("infsup", "multiplier_meshes", value=["omega3"]),
+                                ["instance['infsup']['multiplier_meshes']", "'omega3'"]),
+    "unknown-norm": (_set("infsup", "norms", value=["H", "H1"]),
+                     ["instance['infsup']['norms']", "'H1'"]),
+    "top-level-typo": (_typo_top, ["'infsup_typo' was unexpected"]),
+    "top-level-renamed": (_rename_top, ["'infsupp' was unexpected"]),
+    "nested-typo": (_typo_nested, ["'familes' was unexpected"]),
+}
+
+
+@pytest.mark.parametrize("mutate, needles", list(BAD_CONFIGS.values()), ids=list(BAD_CONFIGS))
+def test_bad_config_fails_before_any_job(workdir, mutate, needles):
+    cfg = copy.deepcopy(CI_CONFIG)
+    mutate(cfg)
+    (workdir / "bad.yaml").write_text(yaml.safe_dump(cfg, sort_keys=False))
+
+    rc, out = snakemake(workdir, "-n", "reproduce-all", "--cores", "1",
+                        "--configfile", "bad.yaml")
+
+    assert rc != 0, f"bad config accepted:\n{out}"
+    assert "Error validating config file" in out, out
+    # validation runs while the Snakefile is parsed: no DAG, so no job, was ever built
+    assert "Building DAG of jobs" not in out, out
+    assert produced_tables(workdir) == [], "results/ written for a bad config"
+    for needle in needles:
+        assert needle in out, f"{needle!r} not in the output:\n{out}"
+
+
+# --------------------------------------------------------------- good configs
+
+def test_ci_config_dry_run_lists_beta_jobs(workdir):
+    rc, out = snakemake(workdir, "-n", "reproduce-all", "--cores", "1",
+                        "--configfile", "config/ci.yaml")
+    assert rc == 0, out
+    assert "rule beta_job:" in out
+    assert "beta_job" in out.split("Job stats:")[1].split("total")[0]
+    assert "This was a dry-run" in out
+    assert produced_tables(workdir) == []
+
+
+def test_unknown_target_fails_with_snakemake_message(workdir):
+    rc, out = snakemake(workdir, "-n", "no-such-target", "--cores", "1",
+                        "--configfile", "config/ci.yaml")
+    assert rc != 0
+    assert "MissingRuleException" in out, out
+    assert "No rule to produce no-such-target" in out, out
+
+
+def test_bare_dry_run_uses_default_profile(workdir):
+    rc, out = snakemake(workdir, "-n", "reproduce-all")
+    assert rc == 0, out
+    assert "Using workflow specific profile profiles/default" in out, out
+    assert "beta_job" in out
+
+
+def test_default_profile_provides_cores(workdir):
+    """A dry run needs no cores in Snakemake 9, so check a real (no-op) invocation.
+
+    With its only output present and newer than its inputs, `results/provenance.json`
+    is up to date: Snakemake exits 0 with nothing to do if cores come from the profile,
+    and refuses to start without the profile.
+    """
+    out_file = workdir / "results" / "provenance.json"
+    out_file.parent.mkdir()
+    out_file.write_text("{}\n")
+    newest = max(p.stat().st_mtime for p in (ROOT / "src" / "infsup_contact").glob("*.py"))
+    stamp = max(time.time(), newest + 1)
+    os.utime(out_file, (stamp, stamp))
+
+    rc, out = snakemake(workdir, "results/provenance.json")
+    assert rc == 0, out
+    assert "Nothing to be done" in out, out
+    assert out_file.read_text() == "{}\n", "the provenance job must not have run"
+
+    rc, out = snakemake(workdir, "results/provenance.json", "--workflow-profile", "none")
+    assert rc != 0
+    assert "cores have to be specified" in out, out

@@ -201,7 +201,14 @@ def test_cap_is_reported_honestly():
 def test_gram_dispatch_and_errors():
     space = case_space("T3", 2, UNIFORM7)
     np.testing.assert_array_equal(gram(space, "L2")[0], gram_l2(space))
-    np.testing.assert_array_equal(gram(space, "H")[0], gram_h(space)[0])
+    np.testing.assert_array_equal(gram(space, "H", h_route="series")[0], gram_h(space)[0])
+    # the two H routes are independent (log kernel vs truncated sine series) and agree
+    G_log, info = gram(space, "H")
+    assert info["n_max"] == 0
+    np.testing.assert_allclose(G_log, gram_h(space, rtol=1e-9)[0], rtol=0, atol=1e-8 * np.abs(G_log).max())
+    with pytest.raises(InputError) as err:
+        gram(space, "H", h_route="fourier")
+    assert err.value.key == "h_route"
     with pytest.raises(InputError) as err:
         gram(space, "H1")
     assert err.value.key == "norm" and err.value.got == "H1"

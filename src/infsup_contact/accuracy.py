@@ -81,3 +81,56 @@ def lambda_total_variation(sol: ContactSolution) -> float:
     """Σ |Δλ_h| over the multiplier nodes in x order: grows when λ_h oscillates."""
     order = np.argsort(sol.space.nodes())
     return float(np.abs(np.diff(sol.lam[order])).sum())
+
+
+# --- against a reference solution (membranes: no exact solution) -------------------------
+
+def _element_quadrature(mesh, order: int):
+    """Physical quadrature points and weights of all volume elements of ``mesh``."""
+    pts = np.array([v.point for v in mesh.vertices])
+    tris = np.array([[v.nr for v in el.vertices] for el in mesh.Elements(ngsolve.VOL)])
+    ir = ngsolve.IntegrationRule(ngsolve.TRIG, order)
+    ref = np.array([p[:2] for p in ir.points])
+    w = np.array(ir.weights)
+    p0, p1, p2 = pts[tris[:, 0]], pts[tris[:, 1]], pts[tris[:, 2]]
+    # reference (ξ, η) ↦ p0·(1 − ξ − η) + p1 ξ + p2 η, NGSolve's TRIG has vertices (1,0),(0,1),(0,0)
+    lam = np.column_stack([ref[:, 0], ref[:, 1], 1 - ref[:, 0] - ref[:, 1]])
+    xy = np.einsum("qa,tad->tqd", lam, np.stack([p0, p1, p2], axis=1))
+    area = 0.5 * np.abs(np.cross(p1 - p0, p2 - p0))
+    return xy.reshape(-1, 2), (2.0 * area[:, None] * w[None, :]).ravel()
+
+
+def _values_at(gf, xy):
+    mesh = gf.space.mesh
+    mips = mesh(xy[:, 0], xy[:, 1])
+    return np.asarray(gf(mips)).reshape(len(xy)), np.asarray(ngsolve.grad(gf)(mips)).reshape(len(xy), 2)
+
+
+def energy_and_l2_vs_reference(sol: ContactSolution, ref: ContactSolution) -> tuple[float, float]:
+    """‖u_ref − u_h‖_a and L²(Ω), by quadrature on the reference mesh (exact when nested)."""
+    e2 = l2 = 0.0
+    for gf, gref, c in zip(sol.u, ref.u, sol.c):
+        order = 2 * gref.space.globalorder
+        xy, w = _element_quadrature(gref.space.mesh, order)
+        v, g = _values_at(gf, xy)
+        vr, gr = _values_at(gref, xy)
+        e2 += c * w @ np.sum((g - gr) ** 2, axis=1)
+        l2 += w @ (v - vr) ** 2
+    return float(np.sqrt(e2)), float(np.sqrt(l2))
+
+
+def lambda_errors_vs_reference(sol: ContactSolution, ref: ContactSolution, n_max: int = 2**14):
+    """(‖λ_ref − λ_h‖_{L²(Γ)}, ‖λ_ref − λ_h‖_M), both exact up to the series tail."""
+    breaks = np.union1d(sol.space.breakpoints, ref.space.breakpoints)
+    x, w = _gauss_on(breaks)
+    l2 = float(np.sqrt(w @ (lambda_values(ref, x) - lambda_values(sol, x)) ** 2))
+    n = np.arange(1, n_max + 1)
+    e = ref.lam @ sine_coefficients(ref.space, n) - sol.lam @ sine_coefficients(sol.space, n)
+    partial = np.cumsum(e**2 / (n * np.pi))
+    s_half, s_full = partial[n_max // 2 - 1], partial[-1]
+    return l2, float(np.sqrt(max(s_full + (s_full - s_half) / 3.0, 0.0)))
+
+
+def contact_set_error_vs_reference(sol: ContactSolution, ref: ContactSolution) -> float:
+    x = (np.arange(N_SAMPLE) + 0.5) / N_SAMPLE
+    return float(np.mean(contact_set(lambda_values(ref, x), x) != contact_set(lambda_values(sol, x), x)))

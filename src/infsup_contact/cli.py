@@ -1,6 +1,9 @@
 """Command line: one computation, CSV on stdout.
 
     infsup-contact beta --case all --k 2 --family structured --N1 16 --N2 16
+    infsup-contact contact --scene manufactured --case T3 --k 2 --N1 16 --N2 16
+    infsup-contact rates contact.csv
+    infsup-contact bench --what beta --N 32 64 --k 2
     infsup-contact provenance
 
 Bad input gets one line on stderr and exit code 2; no traceback.
@@ -68,6 +71,92 @@ def _run_beta(args) -> None:
     pd.DataFrame(rows).to_csv(sys.stdout, index=False, float_format="%.12g")
 
 
+def _add_contact(sub) -> None:
+    from .meshes import FAMILIES
+    from .multipliers import CASE_IDS
+
+    p = sub.add_parser("contact", help="solve (4.1) for one case and mesh pair (CSV: one row)")
+    p.add_argument("--scene", required=True, choices=["manufactured", "membranes"])
+    p.add_argument("--case", required=True, choices=[*CASE_IDS, "all"])
+    p.add_argument("--k", type=int, required=True, help="displacement degree, 1..4")
+    p.add_argument("--family", default="structured", choices=FAMILIES)
+    p.add_argument("--N1", type=int, required=True)
+    p.add_argument("--N2", type=int, required=True)
+    p.add_argument("--c1", type=float, default=1.0)
+    p.add_argument("--c2", type=float, default=1.0)
+    p.add_argument("--p", type=float, default=3.0, help="manufactured: λ = x (a − x)₊^p, p > 3/2")
+    p.add_argument("--q", type=float, default=3.0, help="manufactured: g = (x − a)₊^q (1 − x), q > 3/2")
+    p.add_argument("--n-ref", type=int, default=64, help="membranes: reference mesh N (degree k + 1)")
+    p.set_defaults(run=_run_contact)
+
+
+def _run_contact(args) -> None:
+    import pandas as pd
+
+    from .multipliers import CASE_IDS, CASES
+    from .study import contact_row
+
+    if not 1 <= args.k <= 4:
+        raise InputError("k", "an integer in 1..4", got=args.k)
+    cases = [c for c in CASE_IDS if args.k >= CASES[c][4]] if args.case == "all" else [args.case]
+    params = dict(p=args.p, q=args.q) if args.scene == "manufactured" else {}
+    ref = None
+    rows = []
+    for case in cases:
+        if args.scene == "membranes" and ref is None:
+            from .scenes import scene
+            from .study import reference_solution
+            ref = reference_solution(scene("membranes", c1=args.c1, c2=args.c2), args.k, args.n_ref)
+        rows.append(contact_row(args.scene, case, args.k, args.family, args.N1, args.N2,
+                                args.c1, args.c2, reference=ref, scene_params=params))
+    pd.DataFrame(rows).to_csv(sys.stdout, index=False, float_format="%.12g")
+
+
+def _add_rates(sub) -> None:
+    p = sub.add_parser("rates", help="fit convergence rates of a contact table (CSV in, CSV out)")
+    p.add_argument("table", help="CSV written by `infsup-contact contact` or the workflow")
+    p.add_argument("--window", type=int, default=3, help="number of finest meshes in the fit")
+    p.set_defaults(run=_run_rates)
+
+
+def _run_rates(args) -> None:
+    import pandas as pd
+
+    from .rates import rate_table
+
+    try:
+        frame = pd.read_csv(args.table)
+    except (OSError, pd.errors.ParserError) as err:
+        raise InputError("table", "a readable CSV file", got=args.table) from err
+    if args.window < 2:
+        raise InputError("window", "an integer >= 2", got=args.window)
+    rate_table(frame, args.window).to_csv(sys.stdout, index=False, float_format="%.6g")
+
+
+def _add_bench(sub) -> None:
+    p = sub.add_parser("bench", help="speed as ratios in one run (CSV)")
+    p.add_argument("--what", required=True, choices=["beta", "contact"])
+    p.add_argument("--N", type=int, nargs="+", required=True)
+    p.add_argument("--k", type=int, nargs="+", required=True)
+    p.add_argument("--repeats", type=int, default=3)
+    p.set_defaults(run=_run_bench)
+
+
+def _run_bench(args) -> None:
+    import pandas as pd
+
+    from . import bench
+
+    for n in args.N:
+        if n < 1:
+            raise InputError("N", "integers >= 1", got=n)
+    for k in args.k:
+        if not 1 <= k <= 4:
+            raise InputError("k", "integers in 1..4", got=k)
+    fn = bench.bench_beta if args.what == "beta" else bench.bench_contact
+    pd.DataFrame(fn(args.N, args.k, args.repeats)).to_csv(sys.stdout, index=False, float_format="%.6g")
+
+
 def _add_provenance(sub) -> None:
     p = sub.add_parser("provenance", help="versions, git commit, platform, date (JSON)")
     p.set_defaults(run=lambda args: print(__import__("json").dumps(
@@ -78,6 +167,9 @@ def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(prog="infsup-contact", description=__doc__.split("\n\n")[0])
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
     _add_beta(sub)
+    _add_contact(sub)
+    _add_rates(sub)
+    _add_bench(sub)
     _add_provenance(sub)
     return parser
 

@@ -3,6 +3,25 @@ from pathlib import Path
 
 from snakemake.utils import validate
 
+
+
+def _check_before_schema(cfg):
+    """Errors whose reason the schema cannot print; each names its key and the rule."""
+    cases = (cfg.get("infsup") or {}).get("cases") or {}
+    for case, thm in (("T4", "Thm 4"), ("T5", "Thm 5")):
+        ks = cases.get(case) or []
+        if isinstance(ks, list) and any(isinstance(k, (int, float)) and k < 2 for k in ks):
+            raise ValueError(f"config key infsup.cases.{case}: {case} needs k >= 2 ({thm}); got {ks}")
+    ic = cfg.get("infsup") or {}
+    ints = {"infsup.N": ic.get("N") or [], "infsup.nonmatching": sum(ic.get("nonmatching") or [], [])}
+    ints.update({f"infsup.cases.{c}": v for c, v in cases.items() if isinstance(v, list)})
+    for key, values in ints.items():
+        bad = [v for v in values if isinstance(v, float) or isinstance(v, bool)]
+        if bad:
+            raise ValueError(f"config key {key}: expected integers, got {bad}")
+
+
+_check_before_schema(config)
 validate(config, schema="../schemas/config.schema.yaml")
 
 # Source edits must trigger reruns: every compute rule lists the package as input.
@@ -13,6 +32,7 @@ def beta_jobs():
     ic = config["infsup"]
     ks = sorted({k for klist in ic["cases"].values() for k in klist})
     pairs = [(n, n) for n in ic["N"]] + [tuple(p) for p in ic.get("nonmatching", [])]
+    pairs = list(dict.fromkeys(pairs))  # a pair listed twice is one job
     return [(f, k, n1, n2) for f in ic["families"] for k in ks for n1, n2 in pairs]
 
 

@@ -1,0 +1,54 @@
+"""One contact solve → one tidy row (the columns of ``infsup-contact contact``)."""
+from __future__ import annotations
+
+from . import accuracy
+from .contact_problem import ContactSolution, solve_contact
+from .errors import InputError
+from .multipliers import CASES, check_case
+from .scenes import scene as make_scene
+
+REFERENCE_CASE = "T3"
+"""Multipliers of the membranes reference (stable for every k, Thm 3)."""
+
+
+def cone_kind(case: str, k: int) -> str:
+    """λ_h ≥ 0 "pointwise" (s = 0, 1: nodal positivity is positivity, (5.4)) or only "nodal"."""
+    return "pointwise" if CASES[case][1](k) <= 1 else "nodal"
+
+
+def reference_solution(scene, k: int, n_ref: int) -> ContactSolution:
+    """The membranes reference: structured N_ref × N_ref, degree k + 1, T3 multipliers."""
+    return solve_contact(scene, REFERENCE_CASE, k + 1, "structured", n_ref, n_ref, time_floor=False)
+
+
+def contact_row(scene_name: str, case: str, k: int, family: str, n1: int, n2: int,
+                c1: float = 1.0, c2: float = 1.0, reference: ContactSolution | None = None,
+                n_ref: int = 64, time_floor: bool = True, scene_params: dict | None = None, **mesh_kwargs) -> dict:
+    """Solve one instance of (4.1) and measure it; errors vs exact (manufactured) or reference."""
+    if not 1 <= k <= 4:
+        raise InputError("k", "an integer in 1..4", got=k)
+    check_case(case, k)
+    for key, c in (("c1", c1), ("c2", c2)):
+        if not c > 0:
+            raise InputError(key, "a positive number", got=c)
+    sc = make_scene(scene_name, c1=c1, c2=c2, **(scene_params or {}))
+    sol = solve_contact(sc, case, k, family, n1, n2, time_floor=time_floor, **mesh_kwargs)
+    if sc.has_exact:
+        energy, l2 = accuracy.energy_and_l2_errors(sol, sc)
+        lam_l2 = accuracy.lambda_l2_error(sol, sc.lam, kinks=[sc.a])
+        lam_h = accuracy.lambda_hm12_error(sol, sc.lam)
+        cs = accuracy.contact_set_error(sol, sc.contact_set)
+    else:
+        reference = reference or reference_solution(sc, k, n_ref)
+        energy, l2 = accuracy.energy_and_l2_vs_reference(sol, reference)
+        lam_l2, lam_h = accuracy.lambda_errors_vs_reference(sol, reference)
+        cs = accuracy.contact_set_error_vs_reference(sol, reference)
+    p = sol.pdas
+    return dict(
+        scene=scene_name, case=case, k=k, family=family, N1=n1, N2=n2, c1=c1, c2=c2,
+        ndof=sol.ndof, dim_M=sol.space.dim, cone=cone_kind(case, k), iterations=p.iterations,
+        energy_error=energy, l2_error=l2, lambda_l2_error=lam_l2, lambda_hm12_error=lam_h,
+        contact_set_error=cs, complementarity=p.complementarity, min_gap=p.min_gap,
+        min_lambda=p.min_lambda, max_penetration=accuracy.max_penetration(sol),
+        lambda_tv=accuracy.lambda_total_variation(sol), nonunique=bool(p.nonunique),
+        kernel_dim=int(p.kernel_dim_K), t_solve=sol.t_solve, t_linear_solve=sol.t_linear_solve)

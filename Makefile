@@ -4,6 +4,8 @@ PYTHON ?= python3
 VENV   := .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed-from-lock
+# workflow rules call `python` and `infsup-contact`: they must resolve to the venv
+export PATH := $(CURDIR)/$(BIN):$(PATH)
 
 .PHONY: reproduce-all test env clean-env
 

@@ -138,3 +138,48 @@ def bench_beta(ns, ks, repeats: int = 3, dense_max_n: int = 8):
 def _row(what, route, k, n, t, t_ours, diff):
     return dict(what=what, route=route, k=k, N=n, seconds_median=t[0], seconds_min=t[1],
                 seconds_max=t[2], ratio_to_ours=t[0] / t_ours[0], max_abs_diff=diff)
+
+
+# --- contact -----------------------------------------------------------------------------
+
+def _contact_problem(n: int, k: int, case: str = "T3"):
+    """Membranes scene on the structured N×N pair: sides, couplings, loads (c = 1)."""
+    from .contact_problem import load_vector
+    from .scenes import membranes
+
+    sc = membranes()
+    m1, m2 = meshes.mesh_pair("structured", n, n)
+    sides = [side_operator(m, k) for m in (m1, m2)]
+    space = multipliers.case_space(case, k, meshes.multiplier_breakpoints(m1, m2))
+    Bs = [coupling_matrix(s.trace, space, k) for s in sides]
+    F = [load_vector(s, f) for s, f in zip(sides, (sc.f1, sc.f2))]
+    return sc, sides, Bs, F
+
+
+def bench_contact(ns, ks, repeats: int = 3, case: str = "T3"):
+    """PDAS on the Γ-reduced problem (all of it: factorizations, interface, iterations,
+    recovery) against the floor (one sparse saddle-point solve, contact set known) and the
+    same PDAS on the full sparse KKT system."""
+    from .contact import solve_kkt_sparse
+    from .contact_problem import _embed, linear_saddle_time, solve_contact
+    from .scenes import membranes
+
+    rows = []
+    for k in ks:
+        for n in ns:
+            sol, *t_ours = timed(lambda: solve_contact(membranes(), case, k, "structured", n, n,
+                                                       time_floor=False), repeats)
+            _, sides, Bs, F = _contact_problem(n, k, case)
+            floor = [linear_saddle_time(sides, Bs, (1.0, 1.0)) for _ in range(repeats)]
+            t_floor = (float(np.median(floor)), float(np.min(floor)), float(np.max(floor)))
+            A = sp.block_diag([s.stiffness for s in sides]).tocsc()
+            B = sp.csr_matrix(np.hstack([-_embed(sides[0], Bs[0]), _embed(sides[1], Bs[1])]))
+            Fall = np.concatenate(F)
+            (u, lam, its), *t_kkt = timed(lambda: solve_kkt_sparse(A, B, Fall), 1 if n > 64 else repeats)
+            r = _row("contact", "ours", k, n, t_ours, t_ours, 0.0)
+            r["iterations"] = sol.pdas.iterations
+            rows.append(r)
+            rows.append(dict(_row("contact", "floor", k, n, t_floor, t_ours, np.nan), iterations=1))
+            rows.append(dict(_row("contact", "kkt_sparse", k, n, t_kkt, t_ours,
+                                  float(np.abs(lam - sol.lam).max())), iterations=its))
+    return rows

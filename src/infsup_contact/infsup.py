@@ -83,6 +83,14 @@ def trace_sum_dimension(k: int, x1: np.ndarray, x2: np.ndarray) -> int:
     return (n1 * k - 1) + (n2 * k - 1) - (nc * k - 1)
 
 
+def _space(case, k, breakpoints):
+    """A named case, or a general triple ``(label, s, continuous, vanish)`` (eqs. 5.3, 5.5)."""
+    if isinstance(case, str):
+        return multipliers.case_space(case, k, breakpoints)
+    _, s, continuous, vanish = case
+    return multipliers.make_space(breakpoints, s, continuous, vanish)
+
+
 def beta_rows(family, k, n1, n2, cases=multipliers.CASE_IDS, multiplier_mesh="omega2",
               c1=1.0, c2=1.0, norms=NORMS, h_route="logkernel", **mesh_kwargs):
     """β_h for several cases and norms on one mesh pair, reusing the interface operator.
@@ -93,7 +101,7 @@ def beta_rows(family, k, n1, n2, cases=multipliers.CASE_IDS, multiplier_mesh="om
         One row per (case, norm) with the columns of ``infsup-contact beta``.
     """
     cases = [c for c in cases if k >= multipliers.CASES[c][4]] if cases is multipliers.CASE_IDS else list(cases)
-    check_inputs(cases, k, family, n1, n2, c1, c2, norms, multiplier_mesh)
+    check_inputs([c for c in cases if isinstance(c, str)], k, family, n1, n2, c1, c2, norms, multiplier_mesh)
     t0 = time.perf_counter()
     mesh1, mesh2 = meshes.mesh_pair(family, n1, n2, **mesh_kwargs)
     t1 = time.perf_counter()
@@ -104,20 +112,23 @@ def beta_rows(family, k, n1, n2, cases=multipliers.CASE_IDS, multiplier_mesh="om
     dim_w = trace_sum_dimension(k, x1, x2)
     rows = []
     for case in cases:
-        space = multipliers.case_space(case, k, x_mult)
+        space = _space(case, k, x_mult)
         tc = time.perf_counter()
         couplings = [coupling_matrix(s.trace, space, k) for s in sides]
         S = interface_operator(couplings, sides, (c1, c2))
+        S2 = interface_operator(couplings[1:], sides[1:], (c2,))  # sup over (0, v2) only: (5.10)
         t_coupling = time.perf_counter() - tc
         for norm in norms:
             te = time.perf_counter()
             G, info = gram(space, norm, h_route=h_route)
             sp_ = spectrum(S, G)
+            beta_v1_zero = spectrum(S2, G).beta
             rows.append(dict(
-                case=case, k=k, family=family, N1=n1, N2=n2, multiplier_mesh=multiplier_mesh,
+                case=case if isinstance(case, str) else case[0], k=k, family=family, N1=n1, N2=n2, multiplier_mesh=multiplier_mesh,
                 c1=c1, c2=c2, norm=norm, beta=sp_.beta, kernel_dim=sp_.kernel_dim,
                 structural_kernel_dim=max(space.dim - dim_w, 0),
-                smallest_nonzero=sp_.smallest_nonzero, dim_M=space.dim, dim_W=dim_w,
+                smallest_nonzero=sp_.smallest_nonzero, beta_v1_zero=beta_v1_zero,
+                dim_M=space.dim, dim_W=dim_w,
                 n_max=info["n_max"], nmax_rel_error=info["nmax_rel_error"],
                 ndof=sum(s.ndof for s in sides), t_assemble=t1 - t0 + t_coupling,
                 t_interface=t2 - t1, t_eig=time.perf_counter() - te))

@@ -7,14 +7,18 @@ from snakemake.utils import validate
 
 def _check_before_schema(cfg):
     """Errors whose reason the schema cannot print; each names its key and the rule."""
-    cases = (cfg.get("infsup") or {}).get("cases") or {}
-    for case, thm in (("T4", "Thm 4"), ("T5", "Thm 5")):
-        ks = cases.get(case) or []
-        if isinstance(ks, list) and any(isinstance(k, (int, float)) and k < 2 for k in ks):
-            raise ValueError(f"config key infsup.cases.{case}: {case} needs k >= 2 ({thm}); got {ks}")
-    ic = cfg.get("infsup") or {}
-    ints = {"infsup.N": ic.get("N") or [], "infsup.nonmatching": sum(ic.get("nonmatching") or [], [])}
-    ints.update({f"infsup.cases.{c}": v for c, v in cases.items() if isinstance(v, list)})
+    ints = {}
+    for stage in ("infsup", "contact"):
+        sc = cfg.get(stage) or {}
+        cases = sc.get("cases") or {}
+        for case, thm in (("T4", "Thm 4"), ("T5", "Thm 5")):
+            ks = cases.get(case) or []
+            if isinstance(ks, list) and any(isinstance(k, (int, float)) and k < 2 for k in ks):
+                raise ValueError(f"config key {stage}.cases.{case}: {case} needs k >= 2 ({thm}); got {ks}")
+        ints[f"{stage}.N"] = sc.get("N") or []
+        ints.update({f"{stage}.cases.{c}": v for c, v in cases.items() if isinstance(v, list)})
+    pairs = (cfg.get("infsup") or {}).get("nonmatching") or []
+    ints["infsup.nonmatching"] = [v for p in pairs if isinstance(p, list) for v in p]
     for key, values in ints.items():
         bad = [v for v in values if isinstance(v, float) or isinstance(v, bool)]
         if bad:
@@ -38,3 +42,15 @@ def beta_jobs():
 
 def beta_tables(wildcards=None):
     return [f"results/tables/beta/{f}_k{k}_{n1}x{n2}.csv" for f, k, n1, n2 in beta_jobs()]
+
+
+def contact_jobs():
+    """(scene, family, k, N) of every contact job."""
+    cc = config["contact"]
+    ks = sorted({k for klist in cc["cases"].values() for k in klist})
+    return [(s, f, k, n) for s, spec in cc["scenes"].items() for f in cc["families"] for k in ks
+            for n in spec.get("N", cc["N"])]
+
+
+def contact_tables(wildcards=None):
+    return [f"results/tables/contact/{s}_{f}_k{k}_{n}.csv" for s, f, k, n in contact_jobs()]

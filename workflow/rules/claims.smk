@@ -1,0 +1,34 @@
+# Claims stage: the ledger results/claims.csv from the β_h and rate tables plus the two
+# claims that need their own small computation (the (3.13) sign, Rem 5.5 instances).
+
+
+rule claims_extra:
+    output:
+        "results/tables/claims_extra.csv",
+    input:
+        PACKAGE_SOURCES,
+    params:
+        cfg=lambda wc: config["claims"],
+    threads: 1
+    benchmark:
+        "results/benchmarks/rules/claims_extra.tsv"
+    log:
+        "results/logs/claims_extra.log",
+    script:
+        "../scripts/claims_extra.py"
+
+
+rule claims:
+    output:
+        "results/claims.csv",
+    input:
+        beta="results/tables/beta.csv",
+        rates="results/tables/rates.csv",
+        extra="results/tables/claims_extra.csv",
+        src=PACKAGE_SOURCES,
+    params:
+        cfg=lambda wc: config["claims"],
+    log:
+        "results/logs/claims.log",
+    script:
+        "../scripts/claims.py"

@@ -1,0 +1,17 @@
+"""Assemble the claims ledger results/claims.csv from the tables."""
+import sys
+
+sys.path.insert(0, "workflow/scripts")
+from _glue import log_to  # noqa: E402
+
+log_to(snakemake.log[0])  # noqa: F821
+import pandas as pd  # noqa: E402
+
+from infsup_contact.claims import ledger  # noqa: E402
+from infsup_contact.io import write_csv_atomic  # noqa: E402
+
+inp = snakemake.input  # noqa: F821
+table = ledger(pd.read_csv(inp.beta), pd.read_csv(inp.rates), pd.read_csv(inp.extra),
+               snakemake.params.cfg)  # noqa: F821
+write_csv_atomic(snakemake.output[0], table)  # noqa: F821
+print(table[["claim_id", "verdict", "predicted"]].to_string(), file=sys.stderr)

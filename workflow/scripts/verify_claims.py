@@ -1,0 +1,15 @@
+"""Fail unless every claim of the paper has the verdict the paper predicts; print the ledger."""
+import sys
+
+import pandas as pd
+
+ledger = pd.read_csv(snakemake.input[0])  # noqa: F821
+checked = ledger[ledger.predicted.isin(["PASS", "FAIL"])]
+wrong = checked[checked.verdict != checked.predicted]
+with open(snakemake.log[0], "w") as log:  # noqa: F821
+    log.write(ledger.to_string() + "\n")
+print(ledger[["claim_id", "verdict", "predicted"]].to_string(), file=sys.stderr)
+if len(wrong):
+    sys.exit(f"{len(wrong)} claim(s) differ from the paper's prediction: {', '.join(wrong.claim_id)}")
+print(f"verify-claims: {len(checked)} claims as predicted, {len(ledger) - len(checked)} findings listed",
+      file=sys.stderr)

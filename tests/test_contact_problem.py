@@ -1,0 +1,71 @@
+"""The contact problem (4.1) on real meshes: routes agree, the sign of λ, rates, failures."""
+import numpy as np
+import pytest
+import scipy.sparse as sp
+
+from infsup_contact.claims import sign_check
+from infsup_contact.contact import solve_kkt_sparse
+from infsup_contact.contact_problem import _embed, load_vector, solve_contact
+from infsup_contact.scenes import manufactured, membranes
+from infsup_contact.study import contact_row
+
+
+@pytest.mark.parametrize("case,k,n1,n2", [("T3", 1, 6, 6), ("T5", 2, 5, 4), ("T4", 2, 6, 6)])
+def test_gamma_reduced_pdas_equals_full_sparse_kkt(case, k, n1, n2):
+    sc = membranes(c1=1.0, c2=2.0)
+    sol = solve_contact(sc, case, k, "perturbed", n1, n2, time_floor=False)
+    sides = sol.sides
+    Bs = [coupling for coupling in _couplings(sol)]
+    A = sp.block_diag([c * s.stiffness for s, c in zip(sides, sol.c)]).tocsc()
+    B = sp.csr_matrix(np.hstack([-_embed(sides[0], Bs[0]), _embed(sides[1], Bs[1])]))
+    F = np.concatenate([load_vector(s, f) for s, f in zip(sides, (sc.f1, sc.f2))])
+    u, lam, _ = solve_kkt_sparse(A, B, F)
+    assert np.abs(lam - sol.lam).max() <= 1e-10 * max(1.0, np.abs(lam).max())
+    u_ours = np.concatenate([gf.vec.FV().NumPy()[s.free] for gf, s in zip(sol.u, sides)])
+    assert np.abs(u - u_ours).max() <= 1e-10 * np.abs(u).max()
+    assert sol.pdas.complementarity <= 1e-10
+
+
+def _couplings(sol):
+    from infsup_contact.coupling import coupling_matrix
+    return [coupling_matrix(s.trace, sol.space, s.trace.fes.globalorder) for s in sol.sides]
+
+
+def test_sign_of_lambda_is_minus_c_dudy():
+    """λ_h ≈ −c_i ∂u_ih/∂x2 (not +, as (3.13) prints), increasingly so on finer meshes."""
+    coarse, fine = sign_check(n=8), sign_check(n=16)
+    for i in (1, 2):
+        assert fine[f"minus_c{i}"] < 0.15 and fine[f"minus_c{i}"] < 0.6 * coarse[f"minus_c{i}"]
+        assert fine[f"plus_c{i}"] > 1.8  # |λ − (−λ)| / |λ| → 2
+
+
+@pytest.mark.parametrize("case,k,expected", [("T3", 1, 1.0), ("T4", 2, 2.0), ("T5", 2, 2.0)])
+def test_stable_pairs_energy_rate(case, k, expected):
+    ns = [4, 8, 16]
+    rows = [contact_row("manufactured", case, k, "structured", n, n, time_floor=False) for n in ns]
+    err = [r["energy_error"] for r in rows]
+    slope = np.polyfit(np.log(1.0 / np.array(ns)), np.log(err), 1)[0]
+    assert abs(slope - expected) < 0.15, (err, slope)
+    assert max(r["complementarity"] for r in rows) <= 1e-10
+    lam = [r["lambda_hm12_error"] for r in rows]
+    assert lam[-1] < lam[0]
+
+
+def test_unstable_pair_is_flagged_and_oscillates():
+    """R5.4: solved without crash, kernel reported, λ_h's total variation grows (T4 stays)."""
+    rows = {case: [contact_row("manufactured", case, 2, "structured", n, n, time_floor=False)
+                   for n in (8, 16, 32)] for case in ("R5.4", "T4")}
+    assert all(r["kernel_dim"] == 1 for r in rows["R5.4"])
+    assert all(r["kernel_dim"] == 0 for r in rows["T4"])
+    tv_unstable = [r["lambda_tv"] for r in rows["R5.4"]]
+    tv_stable = [r["lambda_tv"] for r in rows["T4"]]
+    assert tv_unstable[-1] > 2 * tv_unstable[0] and tv_unstable[-1] > 5 * tv_stable[-1]
+
+
+def test_r52_active_kernel_gives_nonunique_flag():
+    """Pressing everywhere activates the endpoint modes of R5.2's kernel: λ_h not unique."""
+    sc = membranes(f0=4.0)  # Ω1 pushed up, Ω2 down everywhere: contact on all of Γ
+    sol = solve_contact(sc, "R5.2", 1, "structured", 8, 8, time_floor=False)
+    assert sol.pdas.kernel_dim_K == 2
+    assert sol.pdas.nonunique
+    assert sol.pdas.complementarity <= 1e-10

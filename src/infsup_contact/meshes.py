@@ -158,3 +158,19 @@ def multiplier_breakpoints(mesh1, mesh2, choice: str = "omega2", tol: float = 1e
     if choice not in choices:
         raise InputError("multiplier_mesh", "omega2, omega1, union", got=choice)
     return choices[choice]()
+
+
+def mesh_quality(mesh: ngsolve.Mesh) -> dict:
+    """Element diameters, angles (degrees) and element count of a triangle mesh."""
+    pts = np.array([v.point for v in mesh.vertices])
+    tris = np.array([[v.nr for v in el.vertices] for el in mesh.Elements(ngsolve.VOL)])
+    p = pts[tris]  # (n, 3, 2)
+    edges = np.stack([p[:, 1] - p[:, 0], p[:, 2] - p[:, 1], p[:, 0] - p[:, 2]], axis=1)
+    lengths = np.linalg.norm(edges, axis=2)
+    angles = []
+    for a, b in ((0, 2), (1, 0), (2, 1)):  # angle at vertex between the two incident edges
+        cos = -np.einsum("nd,nd->n", edges[:, a], edges[:, b]) / (lengths[:, a] * lengths[:, b])
+        angles.append(np.degrees(np.arccos(np.clip(cos, -1, 1))))
+    angles = np.stack(angles, axis=1)
+    return dict(h_max=float(lengths.max()), h_min=float(lengths.min()), min_angle=float(angles.min()),
+                max_angle=float(angles.max()), n_elements=int(len(tris)), n_vertices=int(len(pts)))

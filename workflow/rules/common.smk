@@ -31,13 +31,18 @@ validate(config, schema="../schemas/config.schema.yaml")
 # Source edits must trigger reruns: every compute rule lists the package as input.
 PACKAGE_SOURCES = sorted(str(p) for p in Path("src/infsup_contact").glob("*.py"))
 
+def beta_pairs():
+    """(N1, N2) mesh pairs of the β_h study: matching N×N plus the non-matching pairs."""
+    ic = config["infsup"]
+    pairs = [(n, n) for n in ic["N"]] + [tuple(p) for p in ic.get("nonmatching", [])]
+    return list(dict.fromkeys(pairs))  # a pair listed twice is one job
+
+
 def beta_jobs():
-    """(family, k, N1, N2) of every β_h job: matching pairs N×N plus the non-matching pairs."""
+    """(family, k, N1, N2) of every β_h job."""
     ic = config["infsup"]
     ks = sorted({k for klist in ic["cases"].values() for k in klist})
-    pairs = [(n, n) for n in ic["N"]] + [tuple(p) for p in ic.get("nonmatching", [])]
-    pairs = list(dict.fromkeys(pairs))  # a pair listed twice is one job
-    return [(f, k, n1, n2) for f in ic["families"] for k in ks for n1, n2 in pairs]
+    return [(f, k, n1, n2) for f in ic["families"] for k in ks for n1, n2 in beta_pairs()]
 
 
 def beta_tables(wildcards=None):

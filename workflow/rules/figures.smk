@@ -1,0 +1,167 @@
+# Figures stage: one rule per figure, each drawn from tables under results/tables/ only
+# (nothing recomputed), written as results/figures/NAME.pdf and .png. Shared style (one
+# Okabe–Ito colour and one marker per case): src/infsup_contact/plotting.py.
+# Captions for `snakemake --report`: workflow/report/NAME.rst.
+
+FIGURE_NAMES = [
+    "fig1_model_problem",
+    "fig2_beta_H",
+    "fig3_beta_L2",
+    "fig4_families",
+    "fig5_contact_solutions",
+    "fig6_convergence",
+    "fig7_speed_accuracy",
+]
+# Every figure output (pdf and png): inputs of `rule figures` and of reproduce-all.
+FIGURES = [f"results/figures/{name}.{ext}" for name in FIGURE_NAMES for ext in ("pdf", "png")]
+
+# Figure 5: a stable and an unstable pair on the same mesh, membranes scene.
+FIG5 = {"cases": ["T4", "R5.4"], "k": 2, "N": 16, "family": "structured", "scene": "membranes",
+        "per_interval": 9}
+
+PLOT_STYLE = "src/infsup_contact/plotting.py"
+
+
+# NAME → {"pdf": ..., "png": ...}: the outputs marked for the report, caption workflow/report/NAME.rst.
+FIGURE_OUT = {
+    name: {
+        fmt: report(f"results/figures/{name}.{fmt}", caption=f"../report/{name}.rst", category="Figures",
+                    labels={"figure": name, "format": fmt.upper()})
+        for fmt in ("pdf", "png")
+    }
+    for name in FIGURE_NAMES
+}
+
+
+rule figures_all:
+    name: "figures"
+    input:
+        FIGURES,
+
+
+rule fig1_model_problem:
+    output:
+        pdf=FIGURE_OUT["fig1_model_problem"]["pdf"],
+        png=FIGURE_OUT["fig1_model_problem"]["png"],
+    input:
+        style=PLOT_STYLE,
+    log:
+        "results/logs/figures/fig1_model_problem.log",
+    script:
+        "../scripts/fig_model_problem.py"
+
+
+rule fig2_beta_H:
+    output:
+        pdf=FIGURE_OUT["fig2_beta_H"]["pdf"],
+        png=FIGURE_OUT["fig2_beta_H"]["png"],
+    input:
+        beta="results/tables/beta.csv",
+        style=PLOT_STYLE,
+    params:
+        norm="H",
+    log:
+        "results/logs/figures/fig2_beta_H.log",
+    script:
+        "../scripts/fig_beta.py"
+
+
+rule fig3_beta_L2:
+    output:
+        pdf=FIGURE_OUT["fig3_beta_L2"]["pdf"],
+        png=FIGURE_OUT["fig3_beta_L2"]["png"],
+    input:
+        beta="results/tables/beta.csv",
+        style=PLOT_STYLE,
+    params:
+        norm="L2",
+    log:
+        "results/logs/figures/fig3_beta_L2.log",
+    script:
+        "../scripts/fig_beta.py"
+
+
+rule fig4_families:
+    output:
+        pdf=FIGURE_OUT["fig4_families"]["pdf"],
+        png=FIGURE_OUT["fig4_families"]["png"],
+    input:
+        beta="results/tables/beta.csv",
+        style=PLOT_STYLE,
+        meshes="src/infsup_contact/meshes.py",  # the mesh panels are drawn from mesh_pair
+    params:
+        seed=lambda wc: config["infsup"]["seed"],
+        alpha=lambda wc: config["infsup"]["alpha"],
+    log:
+        "results/logs/figures/fig4_families.log",
+    script:
+        "../scripts/fig_families.py"
+
+
+rule gamma_profiles:
+    output:
+        gamma="results/tables/gamma_profiles.csv",
+        field="results/tables/field_values.csv",
+    input:
+        PACKAGE_SOURCES,
+    params:
+        cases=FIG5["cases"],
+        k=FIG5["k"],
+        N=FIG5["N"],
+        family=FIG5["family"],
+        per_interval=FIG5["per_interval"],
+        scene_spec=lambda wc: config["contact"]["scenes"].get(FIG5["scene"], {"kind": FIG5["scene"]}),
+        c=lambda wc: config["contact"]["c"],
+    threads: 1
+    resources:
+        mem_mb=2000,
+        runtime=10,
+    benchmark:
+        "results/benchmarks/rules/gamma_profiles.tsv"
+    log:
+        "results/logs/gamma_profiles.log",
+    script:
+        "../scripts/gamma_profiles_job.py"
+
+
+rule fig5_contact_solutions:
+    output:
+        pdf=FIGURE_OUT["fig5_contact_solutions"]["pdf"],
+        png=FIGURE_OUT["fig5_contact_solutions"]["png"],
+    input:
+        gamma="results/tables/gamma_profiles.csv",
+        field="results/tables/field_values.csv",
+        style=PLOT_STYLE,
+    log:
+        "results/logs/figures/fig5_contact_solutions.log",
+    script:
+        "../scripts/fig_contact_solutions.py"
+
+
+rule fig6_convergence:
+    output:
+        pdf=FIGURE_OUT["fig6_convergence"]["pdf"],
+        png=FIGURE_OUT["fig6_convergence"]["png"],
+    input:
+        contact="results/tables/contact.csv",
+        rates="results/tables/rates.csv",
+        style=PLOT_STYLE,
+    params:
+        scene="manufactured",
+    log:
+        "results/logs/figures/fig6_convergence.log",
+    script:
+        "../scripts/fig_convergence.py"
+
+
+rule fig7_speed_accuracy:
+    output:
+        pdf=FIGURE_OUT["fig7_speed_accuracy"]["pdf"],
+        png=FIGURE_OUT["fig7_speed_accuracy"]["png"],
+    input:
+        table="results/tables/speed_accuracy.csv",  # written by the benchmarks stage
+        style=PLOT_STYLE,
+    log:
+        "results/logs/figures/fig7_speed_accuracy.log",
+    script:
+        "../scripts/fig_speed_accuracy.py"

@@ -25,6 +25,7 @@ $(STAMP): environment.lock pyproject.toml
 	touch $(STAMP)
 
 reproduce-all: $(STAMP)
+	bash workflow/scripts/ensure_tex.sh
 	$(BIN)/snakemake reproduce-all
 
 test: $(STAMP)

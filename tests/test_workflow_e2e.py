@@ -3,6 +3,7 @@
 These run real Snakemake jobs in temporary copies of the workflow (a few minutes in all).
 """
 import os
+import re
 import shutil
 import signal
 import subprocess
@@ -42,11 +43,18 @@ KEY_CLAIMS = ["Thm3-k1-structured-evenN", "Thm3-k2-unstructured-oddN", "Thm4-k2-
               "eq3.13-sign", "rate-T3-k1", "rate-T5-k2"]
 
 
-def test_verify_claims_ci_profile(tmp_path):
-    """`snakemake verify-claims --profile profiles/ci`: every claim as the paper predicts."""
-    wd = _copy_workflow(tmp_path)
+@pytest.fixture(scope="module")
+def ci_run(tmp_path_factory):
+    """One `verify-claims` run on the quick profile, shared by the tests below."""
+    wd = _copy_workflow(tmp_path_factory.mktemp("ci"))
     run = _snakemake(wd, "verify-claims", "--profile", "profiles/ci")
     assert run.returncode == 0, run.stderr[-4000:]
+    return wd
+
+
+def test_verify_claims_ci_profile(ci_run):
+    """`snakemake verify-claims --profile profiles/ci`: every claim as the paper predicts."""
+    wd = ci_run
     ledger = pd.read_csv(wd / "results" / "claims.csv")
     assert list(ledger.columns[:5]) == ["claim_id", "paper_ref", "statement", "evidence", "verdict"]
     assert set(ledger.verdict) <= {"PASS", "FAIL", "INCONCLUSIVE"}
@@ -54,6 +62,42 @@ def test_verify_claims_ci_profile(tmp_path):
     paper = ledger[ledger.predicted != "finding"]
     assert (paper.verdict == paper.predicted).all(), paper[paper.verdict != paper.predicted]
     assert (ledger.predicted == "finding").any(), "the ledger lists findings beyond the paper"
+
+
+HAVE_TEX = shutil.which("latexmk") and shutil.which("pdflatex") and shutil.which("pdftotext")
+
+
+def _pdf_text(path: Path) -> str:
+    return subprocess.run(["pdftotext", str(path), "-"], capture_output=True, text=True, check=True).stdout
+
+
+def _macro(macros: Path, name: str) -> str:
+    """The value of ``\\newcommand{\\name}{value}`` in the generated macros file."""
+    found = re.search(r"\\newcommand\{\\" + name + r"\}\{([^}]*)\}", macros.read_text())
+    assert found, f"macro {name} not generated"
+    return found.group(1)
+
+
+@pytest.mark.skipif(not HAVE_TEX, reason="TeX (latexmk, pdflatex) or pdftotext missing: .ci/run installs them")
+def test_paper_numbers_follow_tables_and_config(ci_run):
+    """`snakemake paper --profile profiles/ci` builds the PDF; its numbers come from the tables,
+    and changing one config value (the rate-fit window) changes the number in the PDF."""
+    wd = ci_run
+    run = _snakemake(wd, "paper", "--profile", "profiles/ci")
+    assert run.returncode == 0, run.stderr[-4000:]
+    pdf, macros = wd / "results/paper/paper.pdf", wd / "results/paper/macros.tex"
+    rates = pd.read_csv(wd / "results/tables/rates.csv")
+    row = rates[(rates.scene == "manufactured") & (rates.case == "T3") & (rates.k == 2)
+                & (rates.measure == "lambda_l2_error") & (rates.family == "structured")].iloc[0]
+    before = _macro(macros, "slopeLambdaLtwoTthreeKtwo")
+    assert float(before) == pytest.approx(row.slope, abs=0.006)
+    assert before in _pdf_text(pdf)
+    cfg = (wd / "config/ci.yaml").read_text()
+    (wd / "config/ci.yaml").write_text(cfg.replace("rate_window: 3", "rate_window: 2"))
+    run = _snakemake(wd, "paper", "--profile", "profiles/ci")
+    assert run.returncode == 0, run.stderr[-4000:]
+    after = _macro(macros, "slopeLambdaLtwoTthreeKtwo")
+    assert after != before and after in _pdf_text(pdf)
 
 
 TARGETS = ["results/tables/beta/structured_k2_8x8.csv", "results/tables/beta/perturbed_k1_6x4.csv",

@@ -1,0 +1,81 @@
+# Paper stage: results tables → results/paper/*.tex (every number of the text) → paper.pdf.
+# Needs TeX (latexmk, pdflatex): workflow/scripts/ensure_tex.sh installs it as root on
+# Debian or prints the one line saying what to install.
+
+PAPER_FIGURES = [
+    f"results/figures/{name}.pdf"
+    for name in (
+        "fig1_model_problem",
+        "fig2_beta_H",
+        "fig3_beta_L2",
+        "fig4_families",
+        "fig5_contact_solutions",
+        "fig6_convergence",
+        "fig7_speed_accuracy",
+    )
+]
+
+
+rule paper_macros:
+    output:
+        macros="results/paper/macros.tex",
+        claims="results/paper/claims_table.tex",
+        rates="results/paper/rates_table.tex",
+        beta="results/paper/beta_table.tex",
+        speed="results/paper/speed_table.tex",
+    input:
+        beta="results/tables/beta.csv",
+        contact="results/tables/contact.csv",
+        rates="results/tables/rates.csv",
+        claims="results/claims.csv",
+        speed="results/tables/speed_accuracy.csv",
+        bench_beta="results/benchmarks/beta.csv",
+        bench_contact="results/benchmarks/contact.csv",
+        provenance="results/provenance.json",
+        tex="paper/paper.tex",
+        src="src/infsup_contact/papertex.py",
+    params:
+        cfg=lambda wc: {key: config[key] for key in ("claims", "contact", "infsup")},
+    log:
+        "results/logs/paper_macros.log",
+    script:
+        "../scripts/paper_macros.py"
+
+
+rule paper_pdf:
+    output:
+        "results/paper/paper.pdf",
+    input:
+        tex="paper/paper.tex",
+        bib="paper/references.bib",
+        generated=rules.paper_macros.output,
+        figures=PAPER_FIGURES,
+    log:
+        "results/logs/paper_pdf.log",
+    params:
+        build="results/paper/build",
+    shell:
+        # ensure_tex.sh: TeX present, installed (root, Debian) or one line on what to install.
+        # Then a fresh build dir; TEXINPUTS finds the generated .tex and the figures; a fixed
+        # SOURCE_DATE_EPOCH makes the PDF bytes reproducible; the copy out is atomic.
+        """
+        bash workflow/scripts/ensure_tex.sh
+        root=$PWD
+        rm -rf {params.build} && mkdir -p {params.build}
+        cp {input.tex} {input.bib} {params.build}/
+        cd {params.build}
+        export TEXINPUTS="$root/results/paper:$root/results/figures:" SOURCE_DATE_EPOCH=0 FORCE_SOURCE_DATE=1
+        if ! latexmk -pdf -interaction=nonstopmode -halt-on-error -file-line-error paper.tex > "$root/{log}" 2>&1; then
+            echo "paper_pdf: LaTeX failed (full log: {log}); first error:" >&2
+            grep -m1 -A3 -E '^([.]/)?paper[.]tex:[0-9]+:|^! ' "$root/{log}" >&2 || true
+            exit 1
+        fi
+        cp paper.pdf "$root/{output}.tmp"
+        mv "$root/{output}.tmp" "$root/{output}"
+        """
+
+
+rule paper_target:
+    name: "paper"
+    input:
+        "results/paper/paper.pdf",

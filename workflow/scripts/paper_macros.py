@@ -1,0 +1,42 @@
+"""Generate results/paper/*.tex (macros and tables) from the result tables, atomically.
+
+Every number, table and verdict of paper/paper.tex comes from these files
+(infsup_contact.papertex, pure functions). Before writing anything, the script checks that
+paper.tex uses only macros and \\input files that the tables provide, so a config without a
+case the text discusses fails here with one line instead of deep inside pdflatex.
+"""
+import json
+import sys
+from pathlib import Path
+
+sys.path.insert(0, "workflow/scripts")
+from _glue import log_to  # noqa: E402
+
+log_to(snakemake.log[0])  # noqa: F821
+import pandas as pd  # noqa: E402
+
+from infsup_contact.io import write_atomic  # noqa: E402
+from infsup_contact.papertex import PaperTexError, check_paper, paper_files  # noqa: E402
+
+inp, out = snakemake.input, snakemake.output  # noqa: F821
+
+
+def read(path):
+    if not Path(path).exists():  # Snakemake checks inputs; this guards direct calls
+        sys.exit(f"paper_macros: {path} is missing (it is written by another stage of the workflow)")
+    return pd.read_csv(path)
+
+
+try:
+    files = paper_files(read(inp.beta), read(inp.contact), read(inp.rates), read(inp.claims),
+                        read(inp.speed), read(inp.bench_beta), read(inp.bench_contact),
+                        snakemake.params.cfg, json.loads(Path(inp.provenance).read_text()))  # noqa: F821
+    check_paper(Path(inp.tex).read_text(), files)
+except PaperTexError as err:
+    print(f"paper_macros: {err}", file=sys.stderr)
+    sys.__stderr__.write(f"paper_macros: {err}\n")
+    sys.exit(1)
+
+for name, text in files.items():
+    write_atomic(Path(out.macros).parent / name, text)
+    print(f"wrote {name}: {len(text.splitlines())} lines", file=sys.stderr)

@@ -78,16 +78,16 @@ def laplace_stiffness(fes) -> sp.csr_matrix:
 def _gamma_last_lu(A: sp.csc_matrix, n_gamma: int):
     """LU of A (Γ = the last n_gamma rows/cols) in a fill-reducing order that keeps Γ last.
 
-    SuperLU accepts no user ordering, so the minimum-degree order of the interior block
-    is taken from a factorization of A_II and the whole matrix is then factorized in
-    that order with Γ appended (``permc_spec="NATURAL"``, symmetric mode, no pivoting:
-    A is SPD). Both factorizations cost about the same.
+    SuperLU accepts no user ordering, so A is permuted beforehand to a nested-dissection
+    order of the interior with Γ appended (``ordering.nested_dissection_gamma_last``) and
+    factorized once as given (``permc_spec="NATURAL"``, symmetric mode, no pivoting: A is
+    SPD), which keeps Γ last: S is the trailing block of the factors.
     """
-    n = A.shape[0]
-    opts = dict(diag_pivot_thresh=0.0, options=dict(SymmetricMode=True))
-    interior = spla.splu(A[: n - n_gamma, : n - n_gamma].tocsc(), permc_spec="MMD_AT_PLUS_A", **opts)
-    order = np.concatenate([np.argsort(interior.perm_c), np.arange(n - n_gamma, n)])
-    lu = spla.splu(A[order][:, order].tocsc(), permc_spec="NATURAL", **opts)
+    from .ordering import nested_dissection_gamma_last
+
+    order = nested_dissection_gamma_last(A, n_gamma)
+    lu = spla.splu(A[order][:, order].tocsc(), permc_spec="NATURAL", diag_pivot_thresh=0.0,
+                   options=dict(SymmetricMode=True))
     return _Reordered(lu, order)
 
 

@@ -1,9 +1,15 @@
-# Benchmarks stage: speed as ratios measured side by side in one job (all cores to itself).
+# Benchmarks stage: speed as ratios measured side by side in one job (all cores to itself,
+# one BLAS thread: the ratios are single-thread ratios), plus the speed–accuracy points.
+# Optional config keys (read with defaults until the schema lists them):
+#   benchmarks.speed_accuracy_repeats (3), benchmarks.speed_accuracy_scene ("manufactured").
+
+_BLAS1 = "export OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1 MKL_NUM_THREADS=1; "
 
 
 rule bench_beta:
     output:
-        "results/benchmarks/beta.csv",
+        table="results/benchmarks/beta.csv",
+        machine="results/benchmarks/machine.json",
     input:
         PACKAGE_SOURCES,
     params:
@@ -14,9 +20,10 @@ rule bench_beta:
     log:
         "results/logs/bench_beta.log",
     shell:
-        "OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1 infsup-contact bench --what beta"
-        " --N {params.N} --k {params.k} --repeats {params.repeats} > {output}.tmp 2> {log}"
-        " && mv {output}.tmp {output}"
+        _BLAS1 + "python -c 'import sys; from infsup_contact.bench import write_machine_info;"
+        " write_machine_info(sys.argv[1])' {output.machine} 2> {log}"
+        " && infsup-contact bench --what beta --N {params.N} --k {params.k} --repeats {params.repeats}"
+        " > {output.table}.tmp 2>> {log} && mv {output.table}.tmp {output.table}"
 
 
 rule bench_contact:
@@ -32,6 +39,22 @@ rule bench_contact:
     log:
         "results/logs/bench_contact.log",
     shell:
-        "OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1 infsup-contact bench --what contact"
-        " --N {params.N} --k {params.k} --repeats {params.repeats} > {output}.tmp 2> {log}"
-        " && mv {output}.tmp {output}"
+        _BLAS1 + "infsup-contact bench --what contact --N {params.N} --k {params.k} --repeats {params.repeats}"
+        " > {output}.tmp 2> {log} && mv {output}.tmp {output}"
+
+
+rule speed_accuracy:
+    output:
+        "results/tables/speed_accuracy.csv",
+    input:
+        contact="results/tables/contact.csv",
+        src=PACKAGE_SOURCES,
+    params:
+        cc=lambda wc: config["contact"],
+        repeats=lambda wc: config["benchmarks"].get("speed_accuracy_repeats", 3),
+        scene=lambda wc: config["benchmarks"].get("speed_accuracy_scene", "manufactured"),
+    threads: workflow.cores
+    log:
+        "results/logs/speed_accuracy.log",
+    script:
+        "../scripts/speed_accuracy_job.py"

@@ -6,8 +6,9 @@ Because b(v, μ) = ∫_Γ (v2 − v1) μ touches only Γ dofs, B A⁻¹ Bᵀ = �
 LU factorization P A Pᵀ = L U whose ordering keeps Γ last, S = L_ΓΓ U_ΓΓ: the Schur
 complement is the trailing block of the factors — no solve with many right-hand sides.
 
-SuperLU takes no user ordering: the minimum-degree order of the interior block is
-computed first and the full matrix factorized in that order with Γ appended.
+SuperLU takes no user ordering beyond a pre-permuted matrix: the interior is ordered by a
+graph nested dissection (:mod:`infsup_contact.ordering`), Γ appended, and the permuted
+matrix factorized once as given.
 
 A_i = c_i K_i with K_i the Laplace stiffness, so X_i = S_i⁻¹ / c_i: one computation per
 (mesh, k) serves every (c1, c2), every multiplier space, both norms and the contact solver.
@@ -23,6 +24,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from .coupling import GammaTrace, gamma_trace
+from .ordering import nested_dissection_gamma_last
 
 
 @dataclass(frozen=True)
@@ -83,8 +85,6 @@ def _gamma_last_lu(A: sp.csc_matrix, n_gamma: int):
     factorized once as given (``permc_spec="NATURAL"``, symmetric mode, no pivoting: A is
     SPD), which keeps Γ last: S is the trailing block of the factors.
     """
-    from .ordering import nested_dissection_gamma_last
-
     order = nested_dissection_gamma_last(A, n_gamma)
     lu = spla.splu(A[order][:, order].tocsc(), permc_spec="NATURAL", diag_pivot_thresh=0.0,
                    options=dict(SymmetricMode=True))

@@ -16,6 +16,9 @@ kernel claims
     equals the paper's dimension count on every matching mesh pair.
 comparison claims
     An inequality checked on every pair of rows it applies to, up to 1e-8 relative.
+rate claims
+    The fitted energy-error slope is at least the rate the solution's regularity allows,
+    minus ``rate_tolerance`` (the regularity gives an upper bound on the error).
 """
 from __future__ import annotations
 
@@ -86,11 +89,13 @@ def sufficiency_claim(beta: pd.DataFrame, atol: float = 1e-6):
         f"{len(beta)} rows; min β_h − β_h(v1 = 0) = {gap.min():.3g}")
 
 
-def nonmatching_claim(beta: pd.DataFrame, finer: bool, rtol: float = 1e-8):
+def nonmatching_claim(beta: pd.DataFrame, finer: bool, families=None, rtol: float = 1e-8):
     """With Ω2 and G_h = trace of Ω2 fixed, β_h(N1, N2) >= β_h(N2, N2), for N1 > N2 (finer Ω1)
-    or N1 < N2 (coarser Ω1)."""
+    or N1 < N2 (coarser Ω1), on the given families (all by default)."""
     keys = ["family", "k", "case", "norm", "multiplier_mesh", "c1", "c2"]
     b = beta[beta.multiplier_mesh == "omega2"]
+    if families is not None:
+        b = b[b.family.isin(families)]
     match = b[b.N1 == b.N2].set_index(keys + ["N2"]).beta
     worst, count = np.inf, 0
     for _, r in b[(b.N1 > b.N2) if finer else (b.N1 < b.N2)].iterrows():
@@ -187,8 +192,15 @@ def ledger(beta: pd.DataFrame, rates: pd.DataFrame, extra: pd.DataFrame, cfg: di
                     "the Ω2-only condition (5.10) is sufficient: β_h >= the inf-sup constant with v1 = 0",
                     sufficiency_claim(beta)))
     rows.append(row("eq5.10-matching-worst-finer-omega1", "§5 before (5.10)",
-                    "for a fixed Ω2 mesh and G_h = trace of Ω2, β_h with a finer non-matching Ω1 is >= the matching value",
-                    nonmatching_claim(beta, finer=True)))
+                    "structured meshes: for a fixed Ω2 mesh and G_h = trace of Ω2, β_h with a finer "
+                    "non-matching Ω1 is >= the matching value",
+                    nonmatching_claim(beta, finer=True, families=["structured"])))
+    others = sorted(set(beta.family) - {"structured"})
+    if others:
+        rows.append(row("finding-matching-worst-finer-omega1-" + "-".join(others), "beyond the paper",
+                        f"the same on {', '.join(others)} meshes, whose finer Ω1 mesh is not a refinement "
+                        "of the matching one", nonmatching_claim(beta, finer=True, families=others),
+                        predicted="finding"))
     rows.append(row("finding-matching-worst-coarser-omega1", "beyond the paper",
                     "the 'matching is the worst case' remark also holds when Ω1 is coarser than Ω2",
                     nonmatching_claim(beta, finer=False), predicted="finding"))
@@ -197,13 +209,16 @@ def ledger(beta: pd.DataFrame, rates: pd.DataFrame, extra: pd.DataFrame, cfg: di
     if rates is not None and len(rates):
         r = rates[(rates.scene == "manufactured") & (rates.measure == "energy_error") & (rates.family == "structured")]
         for _, rr in r[r.case.isin(list(theorems))].iterrows():
-            ok = abs(rr.slope - rr.expected) <= cfg["rate_tolerance"]
+            # the regularity bound is an upper bound on the error: a faster observed rate
+            # (pre-asymptotic, e.g. the small kink term at x = a for k = 3) is consistent with it
+            ok = rr.slope >= rr.expected - cfg["rate_tolerance"]
+            note = "; faster than the bound (pre-asymptotic)" if rr.slope > rr.expected + cfg["rate_tolerance"] else ""
             rows.append(row(f"rate-{rr.case}-k{int(rr.k)}", "(4.8)",
-                            f"{rr.case}, k={int(rr.k)}: energy error converges at the optimal rate "
-                            f"min(k, r−1) = {rr.expected:g} (manufactured, structured)",
+                            f"{rr.case}, k={int(rr.k)}: energy error converges at least at the rate "
+                            f"min(k, r−1) = {rr.expected:g} the regularity allows (manufactured, structured)",
                             (PASS if ok else FAIL,
                              f"slope {rr.slope:.3f} ± {rr.stderr:.3f} over {int(rr.points)} finest meshes, "
-                             f"h_min = {rr.h_min:.4g}; tolerance {cfg['rate_tolerance']}")))
+                             f"h_min = {rr.h_min:.4g}; tolerance {cfg['rate_tolerance']}{note}")))
     return pd.DataFrame(rows, columns=COLUMNS)
 
 
@@ -211,7 +226,9 @@ def findings(beta: pd.DataFrame, cfg: dict) -> list:
     """What the paper does not say but the tables show (verdict of the stated finding)."""
     tol, floor, conf, win = cfg["slope_tolerance"], cfg["beta_floor"], cfg["confidence"], cfg["fit_window"]
     rows = []
-    nm = beta[(beta.N1 != beta.N2) & np.isclose(beta.N1 / beta.N2, 1.5) & (beta.norm == "H")]
+    c1, c2 = beta[["c1", "c2"]].iloc[0].tolist()
+    nm = beta[(beta.N1 != beta.N2) & np.isclose(beta.N1 / beta.N2, 1.5) & (beta.norm == "H")
+              & (beta.c1 == c1) & (beta.c2 == c2)]
     for (fam, mm, case, k), r in nm.groupby(["family", "multiplier_mesh", "case", "k"]):
         if len(r) < 3 or (mm, case) not in {("omega2", "R5.4"), ("omega2", "R5.2"), ("union", "T3")}:
             continue

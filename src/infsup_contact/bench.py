@@ -50,7 +50,12 @@ Contact (:func:`bench_contact`): the membranes scene, case T3, the QP
     The same linear algebra given the assembled stiffness, couplings and loads.
 ``floor``
     One sparse direct solve of the linear saddle-point system with the contact set
-    known (:func:`contact_problem.linear_saddle_time`; SuperLU, COLAMD order).
+    known (:func:`contact_problem.linear_saddle_time`; SuperLU, COLAMD order). COLAMD
+    is a poor order for this symmetric matrix: on fine meshes this floor is slower
+    than ours, so see also ``limit``.
+``limit``
+    One best-order (``MMD_AT_PLUS_A``) sparse LU of each side's stiffness and one solve
+    with it (:func:`contact_limit`): what no route can avoid, like β's ``limit``.
 ``osqp``, ``clarabel``
     The peers through their own Python APIs (:mod:`infsup_contact.peers`), given the
     assembled (A, B, F), one thread, at the loosest tolerance of
@@ -335,12 +340,16 @@ def beta_eigsh(A, B, G, n_kernel: int = 0):
     """Bottom of the full pencil by shift-invert Lanczos around σ = −1e-6.
 
     Kernel modes sit at σ = 0 and small β at σ ≈ −β²: ask for the kernel and 3 more.
+    ``tol=0`` (machine precision). With a kernel next to the shift (R5.2, R5.4) the first
+    nonzero β is found to ~1e-8 only (the kernel's huge shift-inverted eigenvalues cost
+    ARPACK accuracy); the start vector is fixed, so runs are reproducible.
     Returns (kernel β values, first β above the kernel).
     """
     lhs, rhs = _pencil_matrices(A, B, G)
     m = B.shape[0]
+    v0 = np.random.default_rng(0).standard_normal(lhs.shape[0])  # reproducible Lanczos start
     vals = spla.eigsh(lhs, k=min(n_kernel + 3, m), M=rhs, sigma=-1e-6, which="LM",
-                      return_eigenvectors=False)
+                      return_eigenvectors=False, v0=v0)
     return _bottom(_beta2_from_sigma(vals), n_kernel)
 
 
@@ -461,6 +470,19 @@ def contact_core(sides, Bs, F, c=(1.0, 1.0)):
     return np.concatenate(u), pdas.lam, pdas.iterations
 
 
+def contact_limit(sides, F, c=(1.0, 1.0)):
+    """The cost no contact solver avoids: one sparse factorization of each side's stiffness
+    in SuperLU's best order (``MMD_AT_PLUS_A``, symmetric mode) and one solve with it."""
+
+    def run():
+        for s, Fi, ci in zip(sides, F, c):
+            lu = spla.splu(ci * s.stiffness, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
+                           options=dict(SymmetricMode=True))
+            lu.solve(Fi)
+
+    return run
+
+
 def _ours_u(sol) -> np.ndarray:
     return np.concatenate([gf.vec.FV().NumPy()[s.free] for gf, s in zip(sol.u, sol.sides)])
 
@@ -481,6 +503,7 @@ CONTACT_INCLUDES = {
     "ours": "mesh+assembly+loads+Γ-last LU+Schur+interface+PDAS+recovery",
     "ours_core": "Γ-last LU+Schur+interface+PDAS+recovery (assembled A, B, F given)",
     "floor": "one sparse LU solve of the linear saddle-point system (assembled, contact set known)",
+    "limit": "best-order sparse LU of each side's stiffness + one solve (assembled A given)",
     "osqp": "triu/CSC conversion+OSQP setup (scaling, KKT LDL)+ADMM+polishing (assembled A, B, F given)",
     "clarabel": "triu/CSC conversion+Clarabel setup+interior point (assembled A, B, F given)",
     "kkt_sparse": "PDAS with one sparse saddle-point LU per iteration (assembled A, B, F given)",
@@ -489,7 +512,7 @@ CONTACT_INCLUDES = {
 
 def bench_contact(ns, ks, repeats: int = 3, case: str = "T3", peers=("osqp", "clarabel"),
                   peer_options: dict | None = None, tolerances=None, peer_time_limit: float = 600.0,
-                  kkt_max_n: int = 64, budget: float = 300.0):
+                  kkt_max_n: int = 64, budget: float = 300.0, tune_budget: float = 1200.0):
     """Contact solves of the membranes scene: ours against the floor and the peers.
 
     Parameters
@@ -502,6 +525,7 @@ def bench_contact(ns, ks, repeats: int = 3, case: str = "T3", peers=("osqp", "cl
     tolerances : tolerances tried per peer (default :data:`peers.TOLERANCES`); the search
         starts at the tolerance found for the previous N of the same k.
     peer_time_limit : time limit of one peer solve (seconds; passed to the peer).
+    tune_budget : the tolerance search of one peer stops tightening after this many seconds.
     kkt_max_n : the kkt_sparse route runs for N ≤ this.
     budget : a route is not repeated once its accumulated time exceeds this (seconds).
 
@@ -530,16 +554,17 @@ def bench_contact(ns, ks, repeats: int = 3, case: str = "T3", peers=("osqp", "cl
             routes = {"ours": lambda: solve_contact(membranes(), case, k, "structured", n, n,
                                                     time_floor=False),
                       "ours_core": lambda: contact_core(sides, Bs, F, c),
-                      "floor": lambda: linear_saddle_time(sides, Bs, c)}
+                      "floor": lambda: linear_saddle_time(sides, Bs, c),
+                      "limit": contact_limit(sides, F, c)}
             tuned = {}
             for p in peers:
                 solver, opts = peer_mod.SOLVERS[p], dict(peer_options.get(p, {}))
                 opts["time_limit"] = peer_time_limit
                 tol, res, ok, trials = tune_peer(solver, A, B, Fv, u_ref, lam_ref, tolerances,
-                                                 start[p], opts)
+                                                 start[p], opts, time_budget=tune_budget)
                 start[p] = tol if ok else start[p]
                 tuned[p] = (tol, ok, trials)
-                _log(f"  {p}: tolerance {tol:g} reached={ok} trials={[(t[0], f'{t[1]:.1e}', f'{t[2]:.1e}') for t in trials]}")
+                _log(f"  {p}: tolerance {tol:g} reached={ok} trials={[(t[0], f'{t[1]:.1e}', f'{t[2]:.1e}', t[3], round(t[4], 2)) for t in trials]}")
                 routes[p] = _peer_route(solver, A, B, Fv, tol, **opts)
             if n <= kkt_max_n:
                 routes["kkt_sparse"] = lambda: solve_kkt_sparse(A, B, Fv)
@@ -553,7 +578,7 @@ def bench_contact(ns, ks, repeats: int = 3, case: str = "T3", peers=("osqp", "cl
                     u, lam, its = _ours_u(out), out.lam, out.pdas.iterations
                 elif name == "ours_core":
                     u, lam, its = out
-                elif name == "floor":
+                elif name in ("floor", "limit"):
                     u, lam, its = None, None, 1
                 elif name == "kkt_sparse":
                     u, lam, its = out
@@ -577,13 +602,15 @@ def bench_contact(ns, ks, repeats: int = 3, case: str = "T3", peers=("osqp", "cl
     return rows
 
 
-def tune_peer(solver, A, B, F, u_ref, lam_ref, tolerances, start=None, opts=None, rtol: float = RTOL):
+def tune_peer(solver, A, B, F, u_ref, lam_ref, tolerances, start=None, opts=None, rtol: float = RTOL,
+              time_budget: float = np.inf):
     """Loosest tolerance of ``tolerances`` at which a peer reproduces (u_ref, λ_ref) to
     ``rtol`` (relative, max norm), on the normalized problem (max|F| = 1).
 
     The search starts at ``start`` (e.g. the tolerance found on the previous mesh):
     if that reproduces the solution, looser ones are tried until one fails; otherwise
-    tighter ones until one succeeds (or the list ends).
+    tighter ones until one succeeds (or the list ends, or the trials have taken more than
+    ``time_budget`` seconds).
 
     Returns (tol, QpResult, reached, trials); trials are tuples
     (tol, rel. diff u, rel. diff λ, iterations, seconds, status).
@@ -614,6 +641,8 @@ def tune_peer(solver, A, B, F, u_ref, lam_ref, tolerances, start=None, opts=None
             best -= 1
         return tolerances[best], results[best], True, trials
     for j in range(i + 1, len(tolerances)):
+        if sum(t[4] for t in trials) > time_budget:
+            break
         if attempt(j):
             return tolerances[j], results[j], True, trials
     last = max(results) if results else len(tolerances) - 1

@@ -69,3 +69,19 @@ def test_r52_active_kernel_gives_nonunique_flag():
     assert sol.pdas.kernel_dim_K == 2
     assert sol.pdas.nonunique
     assert sol.pdas.complementarity <= 1e-10
+
+
+def test_load_from_exact_solution_equals_quadrature_of_f():
+    """Green's formula: c(∇u, ∇v) − ∫_Γ c ∂u/∂n v equals ∫ f v (smooth case, where f is benign)."""
+    from infsup_contact.contact_problem import load_vector_from_exact
+    from infsup_contact.interface import side_operator
+    from infsup_contact.meshes import mesh_pair
+
+    sc = manufactured(c1=1.0, c2=3.0, p=6.0, q=6.0)  # f smooth enough for its quadrature to be exact-ish
+    for mesh, f, g, c, ny in zip(mesh_pair("perturbed", 6, 6), (sc.f1, sc.f2), (sc.grad_u1, sc.grad_u2),
+                                 (1.0, 3.0), (1.0, -1.0)):
+        side = side_operator(mesh, 2)
+        F_quad, F_green = load_vector(side, f), load_vector_from_exact(side, g, c, ny)
+        F_wrong = load_vector_from_exact(side, g, c, -ny)
+        assert np.abs(F_quad - F_green).max() <= 1e-6 * np.abs(F_quad).max()
+        assert np.abs(F_quad - F_wrong).max() > 1e3 * np.abs(F_quad - F_green).max()

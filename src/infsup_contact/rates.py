@@ -33,15 +33,22 @@ def expected_energy_rate(scene: str, k: int, p: float = 3.0, q: float = 3.0) -> 
     return float(min(k, min(p, q) - 0.5)) if scene == "manufactured" else float("nan")
 
 
-def rate_table(frame: pd.DataFrame, window: int = 3, p: float = 3.0, q: float = 3.0) -> pd.DataFrame:
-    """One row per (scene, case, k, family, measure): slope, stderr, expected (energy)."""
+def rate_table(frame: pd.DataFrame, window: int = 3) -> pd.DataFrame:
+    """One row per (scene, case, k, family, measure): slope, stderr, expected (energy).
+
+    The expectation uses the scene kind (column ``scene_kind`` if present, else ``scene``)
+    and the exponents p, q of the rows (columns ``p``, ``q``; defaults 3).
+    """
     rows = []
     keys = ["scene", "case", "k", "family"]
     for key, grp in frame[frame.N1 == frame.N2].groupby(keys, sort=True):
         h = 1.0 / grp.N2.to_numpy(float)
+        kind = grp["scene_kind"].iloc[0] if "scene_kind" in grp else key[0]
+        p = float(grp["p"].iloc[0]) if "p" in grp else 3.0
+        q = float(grp["q"].iloc[0]) if "q" in grp else 3.0
         for measure in MEASURES:
             slope, se, used = fit_slope(h, grp[measure].to_numpy(float), window)
-            exp = expected_energy_rate(key[0], key[2], p, q) if measure == "energy_error" else np.nan
+            exp = expected_energy_rate(kind, key[2], p, q) if measure == "energy_error" else np.nan
             rows.append(dict(zip(keys, key), measure=measure, slope=slope, stderr=se, points=used,
                              h_min=h.min(), expected=exp))
     return pd.DataFrame(rows)

@@ -45,7 +45,7 @@ def contact_row(scene_name: str, case: str, k: int, family: str, n1: int, n2: in
         cs = accuracy.contact_set_error_vs_reference(sol, reference)
     p = sol.pdas
     return dict(
-        scene=scene_name, case=case, k=k, family=family, N1=n1, N2=n2, c1=c1, c2=c2,
+        scene=scene_name, case=case, k=k, p=getattr(sc, "p", float("nan")), q=getattr(sc, "q", float("nan")), family=family, N1=n1, N2=n2, c1=c1, c2=c2,
         ndof=sol.ndof, dim_M=sol.space.dim, cone=cone_kind(case, k), iterations=p.iterations,
         energy_error=energy, l2_error=l2, lambda_l2_error=lam_l2, lambda_hm12_error=lam_h,
         contact_set_error=cs, complementarity=p.complementarity, min_gap=p.min_gap,

@@ -12,6 +12,7 @@ rule bench_beta:
         machine="results/benchmarks/machine.json",
     input:
         PACKAGE_SOURCES,
+        BENCH_SOURCES,
     params:
         N=lambda wc: config["benchmarks"]["beta_N"],
         k=lambda wc: config["benchmarks"]["beta_k"],
@@ -31,6 +32,7 @@ rule bench_contact:
         "results/benchmarks/contact.csv",
     input:
         PACKAGE_SOURCES,
+        BENCH_SOURCES,
     params:
         N=lambda wc: config["benchmarks"]["contact_N"],
         k=lambda wc: config["benchmarks"]["contact_k"],
@@ -49,6 +51,7 @@ rule speed_accuracy:
     input:
         contact="results/tables/contact.csv",
         src=PACKAGE_SOURCES,
+        bench=BENCH_SOURCES,
     params:
         cc=lambda wc: config["contact"],
         repeats=lambda wc: config["benchmarks"].get("speed_accuracy_repeats", 3),

@@ -32,6 +32,7 @@ validate(config, schema="../schemas/config.schema.yaml")
 # the modules that only draw, typeset or time (their own rules list them).
 PRESENTATION_ONLY = {"plotting.py", "papertex.py", "bench.py", "peers.py"}
 PACKAGE_SOURCES = sorted(str(p) for p in Path("src/infsup_contact").glob("*.py") if p.name not in PRESENTATION_ONLY)
+BENCH_SOURCES = ["src/infsup_contact/bench.py", "src/infsup_contact/peers.py"]
 
 def beta_pairs():
     """(N1, N2) mesh pairs of the β_h study: matching N×N plus the non-matching pairs."""

@@ -161,6 +161,7 @@ rule fig7_speed_accuracy:
     input:
         table="results/tables/speed_accuracy.csv",  # written by the benchmarks stage
         style=PLOT_STYLE,
+        pareto="src/infsup_contact/bench.py",  # pareto_front
     log:
         "results/logs/figures/fig7_speed_accuracy.log",
     script:

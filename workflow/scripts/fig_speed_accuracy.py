@@ -21,6 +21,7 @@ import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 from matplotlib.lines import Line2D  # noqa: E402
 
+from infsup_contact.bench import pareto_front  # noqa: E402
 from infsup_contact.plotting import (CASE_COLORS, K_FILL, LABELS, MEASURES, NEUTRAL, case_label, case_style,  # noqa: E402
                                      ordered_cases, save_figure, style)
 
@@ -30,30 +31,12 @@ MEASURE_ORDER = ("energy_error", "lambda_hm12_error")
 PARETO_COLUMNS = {"energy_error": "pareto_energy", "lambda_hm12_error": "pareto_lambda"}
 
 
-def pareto_front(seconds, error) -> np.ndarray:
-    """Boolean mask of the Pareto-optimal points (minimise both time and error).
-
-    A point is on the front iff no other point is at least as fast and at least as
-    accurate and strictly better in one of the two; non-finite points are never on the
-    front and dominate nothing (the definition of ``infsup_contact.bench.pareto_front``,
-    used only when the table has no ``pareto_*`` column).
-    """
-    t = np.asarray(seconds, dtype=float).reshape(-1)
-    e = np.asarray(error, dtype=float).reshape(-1)
-    ok = np.isfinite(t) & np.isfinite(e)
-    mask = np.zeros(t.shape, dtype=bool)
-    for i in np.flatnonzero(ok):
-        dominated = ok & (t <= t[i]) & (e <= e[i]) & ((t < t[i]) | (e < e[i]))
-        mask[i] = not dominated.any()
-    return mask
-
-
 def front_mask(panel: pd.DataFrame, measure: str) -> np.ndarray:
     """The table's Pareto flag for ``measure`` if it has one, else :func:`pareto_front`."""
     col = PARETO_COLUMNS.get(measure)
     if col in panel.columns:
         return panel[col].astype(str).str.lower().isin(["true", "1"]).to_numpy()
-    return pareto_front(panel.seconds, panel[measure])
+    return pareto_front(panel.seconds.to_numpy(), panel[measure].to_numpy())
 
 
 def _fill_note(ks) -> str:

@@ -439,8 +439,9 @@ def bench_beta(ns, ks, repeats: int = 3, dense_max_size: int = 2500, eigsh_max_n
 
 # ===================================================================== contact
 def _contact_problem(n: int, k: int, case: str = "T3"):
-    """Membranes scene on the structured N×N pair: sides, couplings, loads (c = 1)."""
-    from .contact_problem import load_vector
+    """Membranes scene on the structured N×N pair: sides, couplings, loads (c = 1), as
+    :func:`contact_problem.solve_contact` builds them."""
+    from .contact_problem import load_vectors
     from .scenes import membranes
 
     sc = membranes()
@@ -448,8 +449,7 @@ def _contact_problem(n: int, k: int, case: str = "T3"):
     sides = [side_operator(m, k) for m in (m1, m2)]
     space = multipliers.case_space(case, k, meshes.multiplier_breakpoints(m1, m2))
     Bs = [coupling_matrix(s.trace, space, k) for s in sides]
-    F = [load_vector(s, f) for s, f in zip(sides, (sc.f1, sc.f2))]
-    return sc, sides, Bs, F
+    return sc, sides, Bs, load_vectors(sides, sc)
 
 
 def contact_core(sides, Bs, F, c=(1.0, 1.0)):

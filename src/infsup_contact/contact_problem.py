@@ -134,7 +134,8 @@ def solve_contact(scene, case: str, k: int, family: str, n1: int, n2: int,
     pdas = solve_pdas(K, g0)
     u = []
     for sign, s, Fi, B, ci in zip((-1.0, 1.0), sides, F, Bs, c):
-        rhs = Fi + sign * _embed(s, B).T @ pdas.lam
+        rhs = Fi.copy()
+        rhs[s.ndof - B.shape[1]:] += sign * (B.T @ pdas.lam)  # Γ dofs are the last block
         gf = ngsolve.GridFunction(s.trace.fes)
         gf.vec.FV().NumPy()[s.free] = s.solve(rhs) / ci
         u.append(gf)

@@ -175,3 +175,19 @@ def save_figure(fig, pdf, png) -> None:
 __all__ = ["OKABE_ITO", "CASE_COLORS", "CASE_MARKERS", "CASE_REFS", "K_FILL", "NEUTRAL", "LABELS",
            "MEASURES", "RC", "style", "is_stable", "case_style", "case_label", "ordered_cases",
            "mesh_size", "slope_triangle", "save_figure"]
+
+
+def h_ticks(axes, h, powers_of_two: bool = True) -> None:
+    """Mesh-size ticks 1/N on log axes: at the powers-of-two N of the data (all N if fewer
+    than two are powers of two, or if ``powers_of_two`` is False)."""
+    import matplotlib.pyplot as plt
+    from matplotlib.ticker import FixedLocator, NullFormatter, NullLocator
+
+    ns = sorted({int(round(1 / v)) for v in h})
+    pow2 = [n for n in ns if n & (n - 1) == 0]
+    ticks = pow2 if powers_of_two and len(pow2) >= 2 else ns
+    for ax in np.ravel(axes):
+        ax.xaxis.set_major_locator(FixedLocator([1 / n for n in ticks]))
+        ax.xaxis.set_major_formatter(plt.FixedFormatter([f"1/{n}" for n in ticks]))
+        ax.xaxis.set_minor_locator(NullLocator())
+        ax.xaxis.set_minor_formatter(NullFormatter())

@@ -18,9 +18,8 @@ if "snakemake" in globals():  # run by Snakemake: threads and log before numpy l
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
-from matplotlib.ticker import FixedLocator, NullFormatter, NullLocator  # noqa: E402
 
-from infsup_contact.plotting import (CASE_COLORS, LABELS, NEUTRAL, case_label, case_style,  # noqa: E402
+from infsup_contact.plotting import (h_ticks, CASE_COLORS, LABELS, NEUTRAL, case_label, case_style,  # noqa: E402
                                      mesh_size, ordered_cases, save_figure, slope_triangle, style)
 
 
@@ -40,17 +39,6 @@ def zero_mode_text(kernel_dims) -> str:
     lo, hi = int(min(kernel_dims)), int(max(kernel_dims))
     n = f"{lo}" if lo == hi else f"{lo}–{hi}"
     return f"{n} zero mode" + ("" if hi == 1 else "s")
-
-
-def h_ticks(ax, h):
-    """Ticks 1/N at the powers-of-two N of the data (all N if there are none)."""
-    ns = sorted({int(round(1 / v)) for v in h})
-    pow2 = [n for n in ns if n & (n - 1) == 0]
-    ticks = pow2 if len(pow2) >= 2 else ns
-    ax.xaxis.set_major_locator(FixedLocator([1 / n for n in ticks]))
-    ax.xaxis.set_major_formatter(plt.FixedFormatter([f"1/{n}" for n in ticks]))
-    ax.xaxis.set_minor_locator(NullLocator())
-    ax.xaxis.set_minor_formatter(NullFormatter())
 
 
 def plot_beta(beta: pd.DataFrame, pdf, png, norm: str = "H") -> None:

@@ -18,9 +18,8 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 from matplotlib.lines import Line2D  # noqa: E402
-from matplotlib.ticker import FixedLocator, NullFormatter, NullLocator  # noqa: E402
 
-from infsup_contact.plotting import (CASE_COLORS, LABELS, MEASURES, case_label, case_style,  # noqa: E402
+from infsup_contact.plotting import (h_ticks, CASE_COLORS, LABELS, MEASURES, case_label, case_style,  # noqa: E402
                                      mesh_size, ordered_cases, save_figure, style)
 
 MEASURE_ORDER = ("energy_error", "l2_error", "lambda_l2_error", "lambda_hm12_error")
@@ -79,21 +78,12 @@ def plot_convergence(contact: pd.DataFrame, rates: pd.DataFrame, pdf, png, scene
                         bbox=dict(boxstyle="round,pad=0.2", fc="white", ec="none", alpha=0.8))
                 if i == len(ks) - 1:
                     ax.set_xlabel(LABELS["h"])
-        _h_ticks(axes, sel.h)
+        h_ticks(axes, sel.h, powers_of_two=False)
         allcases = ordered_cases(sel.case.unique())
         proxies = [Line2D([], [], **case_style(c)) for c in allcases]
         fig.legend(proxies, [case_label(c) for c in allcases], loc="outside lower center", ncol=len(allcases),
                    handlelength=2.6, title="stable cases solid, unstable dashed", title_fontsize=7.5)
         save_figure(fig, pdf, png)
-
-
-def _h_ticks(axes, h):
-    ns = sorted({int(round(1 / v)) for v in h})
-    for ax in axes.ravel():
-        ax.xaxis.set_major_locator(FixedLocator([1 / n for n in ns]))
-        ax.xaxis.set_major_formatter(plt.FixedFormatter([f"1/{n}" for n in ns]))
-        ax.xaxis.set_minor_locator(NullLocator())
-        ax.xaxis.set_minor_formatter(NullFormatter())
 
 
 assert CASE_COLORS  # the shared map (used through case_style)

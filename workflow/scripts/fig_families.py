@@ -23,9 +23,8 @@ import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 from matplotlib.collections import LineCollection  # noqa: E402
 from matplotlib.lines import Line2D  # noqa: E402
-from matplotlib.ticker import FixedLocator, NullFormatter, NullLocator  # noqa: E402
 
-from infsup_contact.plotting import (CASE_COLORS, LABELS, NEUTRAL, case_style, mesh_size,  # noqa: E402
+from infsup_contact.plotting import (h_ticks, CASE_COLORS, LABELS, NEUTRAL, case_style, mesh_size,  # noqa: E402
                                      save_figure, style)
 
 FAMILY_ORDER = ("structured", "perturbed", "unstructured")
@@ -162,7 +161,7 @@ def plot_families(beta: pd.DataFrame, meshes, pdf, png, case: str = "T3") -> Non
                     ax.set_ylabel(rf"{case}, k = {k}:  $\beta_h$ (H)")
                 if i == len(ks) - 1:
                     ax.set_xlabel(LABELS["h"])
-        _h_ticks(axes, sel.h)
+        h_ticks(axes, sel.h)
         proxies = [Line2D([], [], **case_style(case, color="#9ecae1", lw=3.0, marker=None))]
         labels = ["matching $N_1=N_2$ (all $G_h$ coincide)"]
         if ratio is not None:
@@ -173,16 +172,6 @@ def plot_families(beta: pd.DataFrame, meshes, pdf, png, case: str = "T3") -> Non
                     labels.append(f"$N_1:N_2$ = {ratio.numerator}:{ratio.denominator}, {text}")
         bottom.legend(proxies, labels, loc="outside lower center", ncol=2, handlelength=3.0, fontsize=7.5)
         save_figure(fig, pdf, png)
-
-
-def _h_ticks(axes, h):
-    ns = sorted({int(round(1 / v)) for v in h})
-    pow2 = [n for n in ns if n & (n - 1) == 0] or ns
-    for ax in axes.ravel():
-        ax.xaxis.set_major_locator(FixedLocator([1 / n for n in pow2]))
-        ax.xaxis.set_major_formatter(plt.FixedFormatter([f"1/{n}" for n in pow2]))
-        ax.xaxis.set_minor_locator(NullLocator())
-        ax.xaxis.set_minor_formatter(NullFormatter())
 
 
 assert CASE_COLORS  # the shared map (used through case_style)

@@ -165,3 +165,39 @@ def test_provenance_json():
     date = dt.datetime.fromisoformat(info["date"])
     assert date.tzinfo is not None, "date must carry a timezone"
     assert abs(dt.datetime.now(dt.timezone.utc) - date) < dt.timedelta(minutes=10)
+
+
+# ------------------------------------------------------------------------ bench
+
+BENCH_COLUMNS = ("what,route,k,N,seconds_median,seconds_min,seconds_max,ratio_to_ours,"
+                 "max_abs_diff").split(",")
+
+
+def test_bench_contact_csv_with_peers_and_floor():
+    frame = csv(run("bench", "--what", "contact", "--N", "4", "--k", "1", "--repeats", "1",
+                    check=True).stdout)
+    assert set(BENCH_COLUMNS) <= set(frame.columns)
+    assert {"ours", "ours_end_to_end", "floor", "limit", "osqp", "clarabel"} <= set(frame.route)
+    solved = frame[frame.route != "limit"]
+    assert (solved.rel_diff_lambda <= 1e-8).all()
+
+
+def test_bench_beta_csv_without_eigsh():
+    frame = csv(run("bench", "--what", "beta", "--N", "4", "--k", "1", "--repeats", "1",
+                    "--eigsh-max-N", "2", check=True).stdout)
+    assert set(BENCH_COLUMNS) <= set(frame.columns)
+    assert "eigsh" not in set(frame.route) and {"ours", "limit", "dense"} <= set(frame.route)
+
+
+@pytest.mark.parametrize("args, key", [
+    (["--what", "contact", "--N", "4", "--k", "1", "--peers", "gurobi"], "peers"),
+    (["--what", "beta", "--N", "0", "--k", "1"], "N"),
+    (["--what", "beta", "--N", "4", "--k", "7"], "k"),
+    (["--what", "beta", "--N", "4", "--k", "1", "--repeats", "0"], "repeats"),
+    (["--what", "gamma", "--N", "4", "--k", "1"], "--what"),
+])
+def test_bench_bad_input_one_line_exit_2(args, key):
+    proc = run("bench", *args)
+    assert proc.returncode == 2 and proc.stdout == ""
+    lines = proc.stderr.splitlines()
+    assert len(lines) == 1 and "Traceback" not in proc.stderr and key in lines[0], proc.stderr

@@ -100,7 +100,8 @@ def synth_speed(contact):
 
 def synth_bench(what):
     rows = []
-    routes = {"beta": ["ours", "limit", "eigsh"], "contact": ["ours", "floor", "kkt_sparse"]}[what]
+    routes = {"beta": ["ours", "limit", "eigsh"],
+              "contact": ["ours", "ours_end_to_end", "floor", "limit", "osqp", "clarabel"]}[what]
     for k in (1, 2):
         for n in (8, 16):
             for i, route in enumerate(routes):
@@ -314,6 +315,15 @@ def test_paper_has_no_typed_results():
     body = re.sub(r"(?<!\\)%.*", "", PAPER.read_text())
     assert not re.findall(r"\d\.\d{3,}", body)
     assert not re.findall(r"\d[eE]-?\d|\\times\s*10\^", body)
+
+
+def test_benchmark_routes_left_out_by_the_config_read_n_a(tables):
+    """peers: [] in the config: the paper still builds and says the peers were not run."""
+    t = dict(tables)
+    t["bench_contact"] = tables["bench_contact"][~tables["bench_contact"].route.isin(["osqp", "clarabel"])]
+    files = pt.paper_files(**t)
+    pt.check_paper(PAPER.read_text(), files)
+    assert re.search(r"\\newcommand\{\\benchContactOsqpRatio\}\{n/a\}", files["macros.tex"])
 
 
 def test_missing_case_is_reported_by_name(tables):

@@ -3,7 +3,9 @@
 Every timing is repeated and reported as median, min and max; the routes of one size
 are run interleaved (repeat 1 of every route, then repeat 2, ...) so that a change in
 machine load hits all of them alike. ``ratio_to_ours`` = route seconds / ``ours``
-seconds and ``ratio_to_ours_core`` = route seconds / ``ours_core`` seconds (medians).
+seconds; β tables add ``ratio_to_ours_core`` (/ ``ours_core``), contact tables
+``ratio_to_limit`` (/ ``limit``: how close a route comes to the unavoidable
+factorization). All ratios are of medians.
 Run with one BLAS thread (``OPENBLAS_NUM_THREADS=1``, the CLI's default).
 
 β_h (:func:`bench_beta`): the problem is β_h of **every valid case × both norms (H, L2)**
@@ -41,18 +43,20 @@ for R5.2 / R5.4, whose kernel values are 0 up to round-off). ``kernel_ok`` says 
 the route's kernel values are all below ``KERNEL_BETA``.
 
 Contact (:func:`bench_contact`): the membranes scene, case T3, the QP
-``min ½uᵀAu − Fᵀu s.t. B u ≥ 0`` (:mod:`infsup_contact.peers`):
+``min ½uᵀAu − Fᵀu s.t. B u ≥ 0`` (:mod:`infsup_contact.peers`). Every route except
+``ours_end_to_end`` gets the same assembled (A, B, F) — exactly what the peers get:
 
 ``ours``
-    End to end (:func:`contact_problem.solve_contact`): meshes, assembly, loads, Γ-last
-    factorizations, interface operator, PDAS on the Γ-reduced problem, recovery of u.
-``ours_core``
-    The same linear algebra given the assembled stiffness, couplings and loads.
+    :func:`reduced_qp.solve_reduced_qp`: the unknowns B touches (Γ) read off B, one
+    factorization per block of A with Γ last, interface operator, PDAS on the Γ-reduced
+    LCP, recovery of u.
+``ours_end_to_end``
+    End to end (:func:`contact_problem.solve_contact`): meshes, NGSolve assembly, loads,
+    and the same linear algebra built side by side.
 ``floor``
     One sparse direct solve of the linear saddle-point system with the contact set
-    known (:func:`contact_problem.linear_saddle_time`; SuperLU, COLAMD order). COLAMD
-    is a poor order for this symmetric matrix: on fine meshes this floor is slower
-    than ours, so see also ``limit``.
+    known (:func:`contact_problem.linear_saddle_solve`: symmetric quasi-definite, SuperLU
+    in minimum-degree order without pivoting); its u and λ are compared too.
 ``limit``
     One best-order (``MMD_AT_PLUS_A``) sparse LU of each side's stiffness and one solve
     with it (:func:`contact_limit`): what no route can avoid, like β's ``limit``.
@@ -97,7 +101,7 @@ BETA_COLUMNS = ("what", "route", "k", "N", "seconds_median", "seconds_min", "sec
                 "ratio_to_ours", "ratio_to_ours_core", "max_abs_diff", "kernel_ok", "repeats",
                 "n_problems", "ndof", "includes")
 CONTACT_COLUMNS = ("what", "route", "k", "N", "seconds_median", "seconds_min", "seconds_max",
-                   "ratio_to_ours", "ratio_to_ours_core", "max_abs_diff", "rel_diff_u",
+                   "ratio_to_ours", "ratio_to_limit", "max_abs_diff", "rel_diff_u",
                    "rel_diff_lambda", "iterations", "tolerance", "accuracy_reached", "repeats",
                    "ndof", "dim_M", "includes")
 
@@ -156,12 +160,12 @@ def _stats(times):
     return float(np.median(times)), float(np.min(times)), float(np.max(times))
 
 
-def _row(what, route, k, n, times, ref_ours, ref_core, **extra):
+def _row(what, route, k, n, times, ref_ours, ref_other, other="ratio_to_ours_core", **extra):
+    """One table row; ``other`` names the second ratio column (route / ``ref_other``)."""
     med, lo, hi = _stats(times)
-    return dict(what=what, route=route, k=k, N=n, seconds_median=med, seconds_min=lo,
-                seconds_max=hi, ratio_to_ours=med / ref_ours,
-                ratio_to_ours_core=med / ref_core if ref_core else np.nan,
-                repeats=len(times), **extra)
+    return {"what": what, "route": route, "k": k, "N": n, "seconds_median": med,
+            "seconds_min": lo, "seconds_max": hi, "ratio_to_ours": med / ref_ours,
+            other: med / ref_other if ref_other else np.nan, "repeats": len(times), **extra}
 
 
 # ------------------------------------------------------------------ machine info
@@ -230,11 +234,10 @@ def _bottom(beta2: np.ndarray, kern: int):
 def _factorize_side(side: SideOperator) -> SideOperator:
     """The Γ-last factorization + Schur complement of an assembled side: the linear
     algebra of :func:`interface.side_operator` without the NGSolve assembly."""
-    from .interface import _gamma_last_lu, schur_from_lu
+    from .interface import gamma_factorization
 
-    ng = len(side.trace.gamma_dofs)
-    lu = _gamma_last_lu(side.stiffness, ng)
-    return SideOperator(side.trace, side.free, side.stiffness, schur_from_lu(lu, ng), lu.solve)
+    fac = gamma_factorization(side.stiffness, len(side.trace.gamma_dofs))
+    return SideOperator(side.trace, side.free, side.stiffness, fac.schur, fac.solve, fac.steklov)
 
 
 class BetaSetup:
@@ -452,24 +455,6 @@ def _contact_problem(n: int, k: int, case: str = "T3"):
     return sc, sides, Bs, load_vectors(sides, sc)
 
 
-def contact_core(sides, Bs, F, c=(1.0, 1.0)):
-    """The linear algebra of :func:`contact_problem.solve_contact` given the assembled
-    stiffness (in ``sides``), couplings and loads: Γ-last factorizations, interface
-    operator, PDAS, recovery of u. Returns (u on all free dofs, λ, PDAS iterations)."""
-    from .contact import solve_pdas
-    from .contact_problem import _embed
-
-    fact = [_factorize_side(s) for s in sides]
-    K = interface_operator(Bs, fact, c)
-    u0 = [s.solve(Fi) / ci for s, Fi, ci in zip(fact, F, c)]
-    ng = [B.shape[1] for B in Bs]
-    g0 = Bs[1] @ u0[1][-ng[1]:] - Bs[0] @ u0[0][-ng[0]:]
-    pdas = solve_pdas(K, g0)
-    u = [s.solve(Fi + sign * _embed(s, B).T @ pdas.lam) / ci
-         for sign, s, Fi, B, ci in zip((-1.0, 1.0), fact, F, Bs, c)]
-    return np.concatenate(u), pdas.lam, pdas.iterations
-
-
 def contact_limit(sides, F, c=(1.0, 1.0)):
     """The cost no contact solver avoids: one sparse factorization of each side's stiffness
     in SuperLU's best order (``MMD_AT_PLUS_A``, symmetric mode) and one solve with it."""
@@ -500,9 +485,9 @@ def _peer_route(solver, A, B, F, tol, **kwargs):
 
 
 CONTACT_INCLUDES = {
-    "ours": "mesh+assembly+loads+Γ-last LU+Schur+interface+PDAS+recovery",
-    "ours_core": "Γ-last LU+Schur+interface+PDAS+recovery (assembled A, B, F given)",
-    "floor": "one sparse LU solve of the linear saddle-point system (assembled, contact set known)",
+    "ours": "Γ from B+LU per block of A (Γ last)+interface+PDAS+recovery (assembled A, B, F given)",
+    "ours_end_to_end": "mesh+assembly+loads+Γ-last LU+Schur+interface+PDAS+recovery",
+    "floor": "one sparse LU solve of the quasi-definite saddle-point system (assembled, contact set known)",
     "limit": "best-order sparse LU of each side's stiffness + one solve (assembled A given)",
     "osqp": "triu/CSC conversion+OSQP setup (scaling, KKT LDL)+ADMM+polishing (assembled A, B, F given)",
     "clarabel": "triu/CSC conversion+Clarabel setup+interior point (assembled A, B, F given)",
@@ -536,7 +521,8 @@ def bench_contact(ns, ks, repeats: int = 3, case: str = "T3", peers=("osqp", "cl
     """
     from . import peers as peer_mod
     from .contact import solve_kkt_sparse
-    from .contact_problem import linear_saddle_time, solve_contact
+    from .contact_problem import linear_saddle_solve, solve_contact
+    from .reduced_qp import solve_reduced_qp
     from .scenes import membranes
 
     peer_options = {"clarabel": {"method": "faer"}} if peer_options is None else peer_options
@@ -551,10 +537,10 @@ def bench_contact(ns, ks, repeats: int = 3, case: str = "T3", peers=("osqp", "cl
             A, B, Fv = peer_mod.contact_qp(sides, Bs, F, c)
             ref = solve_contact(membranes(), case, k, "structured", n, n, time_floor=False)
             u_ref, lam_ref = _ours_u(ref), ref.lam
-            routes = {"ours": lambda: solve_contact(membranes(), case, k, "structured", n, n,
-                                                    time_floor=False),
-                      "ours_core": lambda: contact_core(sides, Bs, F, c),
-                      "floor": lambda: linear_saddle_time(sides, Bs, c),
+            routes = {"ours": lambda: solve_reduced_qp(A, B, Fv),
+                      "ours_end_to_end": lambda: solve_contact(membranes(), case, k, "structured", n, n,
+                                                        time_floor=False),
+                      "floor": lambda: linear_saddle_solve(A, B, Fv, ref.pdas.active),
                       "limit": contact_limit(sides, F, c)}
             tuned = {}
             for p in peers:
@@ -568,27 +554,12 @@ def bench_contact(ns, ks, repeats: int = 3, case: str = "T3", peers=("osqp", "cl
                 routes[p] = _peer_route(solver, A, B, Fv, tol, **opts)
             if n <= kkt_max_n:
                 routes["kkt_sparse"] = lambda: solve_kkt_sparse(A, B, Fv)
-            res = run_interleaved(routes, repeats, budget, self_timed=("floor",))
-            t_ours, t_core = res["ours"][1], res["ours_core"][1]
-            med_ours, med_core = float(np.median(t_ours)), float(np.median(t_core))
+            res = run_interleaved(routes, repeats, budget)
+            med_ours = float(np.median(res["ours"][1]))
+            med_limit = float(np.median(res["limit"][1]))
             common = dict(ndof=A.shape[0], dim_M=B.shape[0])
             for name, (out, times) in res.items():
-                extra = dict(tolerance=np.nan, accuracy_reached=np.nan, tuning="")
-                if name == "ours":
-                    u, lam, its = _ours_u(out), out.lam, out.pdas.iterations
-                elif name == "ours_core":
-                    u, lam, its = out
-                elif name in ("floor", "limit"):
-                    u, lam, its = None, None, 1
-                elif name == "kkt_sparse":
-                    u, lam, its = out
-                else:
-                    u, lam, its = out.u, out.lam, out.iterations
-                    tol, ok, trials = tuned[name]
-                    extra = dict(tolerance=tol, accuracy_reached=ok, settings=json.dumps(out.settings),
-                                 status=out.status,
-                                 tuning="; ".join(f"{t[0]:g}:{t[1]:.1e}/{t[2]:.1e}/{t[3]}it/{t[4]:.3g}s"
-                                                  for t in trials))
+                u, lam, its, extra = _contact_outcome(name, out, tuned)
                 if u is None:
                     diffs = dict(max_abs_diff=np.nan, rel_diff_u=np.nan, rel_diff_lambda=np.nan)
                 else:
@@ -596,10 +567,32 @@ def bench_contact(ns, ks, repeats: int = 3, case: str = "T3", peers=("osqp", "cl
                                                            u_ref, lam_ref)
                     diffs = dict(max_abs_diff=float(np.abs(lam - lam_ref).max(initial=0.0)),
                                  rel_diff_u=du, rel_diff_lambda=dl)
-                rows.append(_row("contact", name, k, n, times, med_ours, med_core, iterations=its,
-                                 includes=CONTACT_INCLUDES[name], **diffs, **extra, **common))
+                rows.append(_row("contact", name, k, n, times, med_ours, med_limit, "ratio_to_limit",
+                                 iterations=its, includes=CONTACT_INCLUDES[name], **diffs, **extra,
+                                 **common))
                 _log(f"  {name:10s} {np.median(times):9.4f} s  its {its}  rel.diff λ {diffs['rel_diff_lambda']:.2e}")
     return rows
+
+
+def _contact_outcome(name, out, tuned):
+    """(u, λ, iterations, extra columns) of one contact route's last result."""
+    extra = dict(tolerance=np.nan, accuracy_reached=np.nan, tuning="")
+    if name == "ours":
+        return out.u, out.lam, out.iterations, extra
+    if name == "ours_end_to_end":
+        return _ours_u(out), out.lam, out.pdas.iterations, extra
+    if name == "floor":
+        return out[0], out[1], 1, extra
+    if name == "limit":
+        return None, None, 1, extra
+    if name == "kkt_sparse":
+        return *out, extra
+    tol, ok, trials = tuned[name]
+    extra = dict(tolerance=tol, accuracy_reached=ok, settings=json.dumps(out.settings),
+                 status=out.status,
+                 tuning="; ".join(f"{t[0]:g}:{t[1]:.1e}/{t[2]:.1e}/{t[3]}it/{t[4]:.3g}s"
+                                  for t in trials))
+    return out.u, out.lam, out.iterations, extra
 
 
 def tune_peer(solver, A, B, F, u_ref, lam_ref, tolerances, start=None, opts=None, rtol: float = RTOL,

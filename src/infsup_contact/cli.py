@@ -139,6 +139,12 @@ def _add_bench(sub) -> None:
     p.add_argument("--N", type=int, nargs="+", required=True)
     p.add_argument("--k", type=int, nargs="+", required=True)
     p.add_argument("--repeats", type=int, default=3)
+    p.add_argument("--peers", nargs="*", default=["osqp", "clarabel"],
+                   help="contact: QP solvers to compare with (osqp, clarabel; none: omit)")
+    p.add_argument("--eigsh-max-N", dest="eigsh_max_n", type=int, default=None,
+                   help="beta: run the shift-invert Lanczos route only for N <= this")
+    p.add_argument("--kkt-max-N", dest="kkt_max_n", type=int, default=64,
+                   help="contact: run the sparse-KKT active-set route only for N <= this")
     p.set_defaults(run=_run_bench)
 
 
@@ -153,8 +159,20 @@ def _run_bench(args) -> None:
     for k in args.k:
         if not 1 <= k <= 4:
             raise InputError("k", "integers in 1..4", got=k)
-    fn = bench.bench_beta if args.what == "beta" else bench.bench_contact
-    pd.DataFrame(fn(args.N, args.k, args.repeats)).to_csv(sys.stdout, index=False, float_format="%.6g")
+    if args.repeats < 1:
+        raise InputError("repeats", "an integer >= 1", got=args.repeats)
+    from .peers import SOLVERS
+
+    peers = [p for p in args.peers if p != "none"]
+    for p in peers:
+        if p not in SOLVERS:
+            raise InputError("peers", ", ".join([*SOLVERS, "none"]), got=p)
+    if args.what == "beta":
+        rows = bench.bench_beta(args.N, args.k, args.repeats, eigsh_max_n=args.eigsh_max_n)
+    else:
+        rows = bench.bench_contact(args.N, args.k, args.repeats, peers=tuple(peers),
+                                   kkt_max_n=args.kkt_max_n)
+    pd.DataFrame(rows).to_csv(sys.stdout, index=False, float_format="%.6g")
 
 
 def _add_provenance(sub) -> None:

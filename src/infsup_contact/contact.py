@@ -152,17 +152,23 @@ def _check_lcp(K, g0):
 
 
 # ------------------------------------------------------------------ linear algebra
-def _nullity(M, cutoff):
-    """Number of eigenvalues of the symmetric M at or below ``cutoff``."""
-    return int(np.sum(sla.eigvalsh(M) <= cutoff)) if M.size else 0
+def _nullity(M, cutoff, definite=False):
+    """Number of eigenvalues of the symmetric M at or below ``cutoff`` (0 if ``definite``)."""
+    return int(np.sum(sla.eigvalsh(M) <= cutoff)) if M.size and not definite else 0
 
 
-def _min_norm_solve(M, rhs, cutoff):
+def _min_norm_solve(M, rhs, cutoff, definite=False):
     """Minimum-norm solution of M z = rhs (M symmetric PSD) and the kernel basis.
 
     Spectral pseudo-inverse: eigen-directions with eigenvalue ≤ cutoff are the
     numerical kernel and get no component (= scipy.linalg.pinvh with that cutoff).
+    ``definite``: M is known to have all eigenvalues above the cutoff (a principal
+    submatrix of a K whose smallest eigenvalue is, by Cauchy interlacing), so the kernel
+    is empty and a Cholesky solve gives the same z at a fraction of the cost.
     """
+    if definite:
+        z = sla.cho_solve(sla.cho_factor(M, check_finite=False), rhs, check_finite=False)
+        return z, np.zeros((len(rhs), 0))
     w, V = sla.eigh(M)
     keep = w > cutoff
     Vr = V[:, keep]
@@ -170,13 +176,13 @@ def _min_norm_solve(M, rhs, cutoff):
     return z, V[:, ~keep]
 
 
-def _solve_on_active(K, g0, active, cutoff):
+def _solve_on_active(K, g0, active, cutoff, definite=False):
     """One PDAS step: λ_𝒜 = min-norm solution of K_𝒜𝒜 λ_𝒜 = −g0_𝒜, λ_ℐ = 0."""
     lam = np.zeros_like(g0)
     if not active.any():
         return lam, 0
     idx = np.flatnonzero(active)
-    lam_a, Z = _min_norm_solve(K[np.ix_(idx, idx)], -g0[idx], cutoff)
+    lam_a, Z = _min_norm_solve(K[np.ix_(idx, idx)], -g0[idx], cutoff, definite)
     lam[idx] = lam_a
     return lam, Z.shape[1]
 
@@ -202,7 +208,7 @@ def _scaling(K, lam_max):
     return c
 
 
-def _pdas_loop(K, g0, c, cutoff, max_iter, tol, lam_max):
+def _pdas_loop(K, g0, c, cutoff, max_iter, tol, lam_max, definite=False):
     """Plain PDAS from λ = 0.  Returns (lam, iterations, history, status).
 
     status is "converged" (active set repeated, or the iterate already passes the KKT
@@ -213,7 +219,7 @@ def _pdas_loop(K, g0, c, cutoff, max_iter, tol, lam_max):
     active = (-c * g0) > 0  # λ⁰ = 0, g⁰ = g0
     seen, history = {active.tobytes()}, []
     for it in range(1, max_iter + 1):
-        lam, nullity = _solve_on_active(K, g0, active, cutoff)
+        lam, nullity = _solve_on_active(K, g0, active, cutoff, definite)
         g = g0 + K @ lam
         new = (lam - c * g) > 0
         history.append(dict(iteration=it, n_active=int(active.sum()), nullity=nullity,
@@ -267,7 +273,7 @@ def _least_distance(G, h):
     return -r[:k] / r[-1]
 
 
-def _min_norm_representative(K, g0, lam, S, cutoff):
+def _min_norm_representative(K, g0, lam, S, cutoff, definite=False):
     """Replace λ by the minimum-norm solution of the LCP (see module docstring).
 
     All solutions are λ = λ* + Z z ≥ 0 (support in S), λ* the min-norm solution of
@@ -277,6 +283,8 @@ def _min_norm_representative(K, g0, lam, S, cutoff):
     """
     idx = np.flatnonzero(S)
     if idx.size == 0:
+        return lam, None, idx
+    if definite:  # K_SS nonsingular: the solution is unique, nothing to choose
         return lam, None, idx
     lam_s, Z = _min_norm_solve(K[np.ix_(idx, idx)], -g0[idx], cutoff)
     if Z.shape[1] == 0:
@@ -378,7 +386,7 @@ def solve_pdas(K, g0, *, max_iter=50, tol=1e-12, kernel_rtol=1e-10) -> PdasResul
     prob = _Lcp.build(*_check_lcp(K, g0), tol, kernel_rtol)
     K, g0 = prob.K, prob.g0
     lam, iters, history, status = _pdas_loop(K, g0, _scaling(K, prob.lam_max), prob.cutoff,
-                                             max_iter, tol, prob.lam_max)
+                                             max_iter, tol, prob.lam_max, prob.definite)
     route = "pdas"
     if status != "converged" or not prob.kkt_ok(lam):
         lam = _nnls_dual(K, g0, prob.cutoff)
@@ -411,6 +419,11 @@ class _Lcp:
                              got=f"min eigenvalue {eigs.min():.3e}")
         return cls(K, g0, eigs, lam_max, kernel_rtol * lam_max, tol)
 
+    @property
+    def definite(self) -> bool:
+        """Every eigenvalue of K above the kernel cutoff: K and all K_𝒜𝒜 are nonsingular."""
+        return bool(self.eigs.size and self.eigs.min() > self.cutoff)
+
     def tolerances(self, lam):
         return _tolerances(self.g0, lam, self.lam_max, self.tol)
 
@@ -432,7 +445,7 @@ def _representative(prob, lam, history):
     """
     gtol, _ = prob.tolerances(lam)
     S = prob.g0 + prob.K @ lam <= gtol  # g is the same for all solutions: S bounds supports
-    lam_mn, Z, idx = _min_norm_representative(prob.K, prob.g0, lam, S, prob.cutoff)
+    lam_mn, Z, idx = _min_norm_representative(prob.K, prob.g0, lam, S, prob.cutoff, prob.definite)
     if Z is None:
         return lam, Z, idx
     ok = prob.kkt_ok(lam_mn)
@@ -445,7 +458,7 @@ def _result(prob, lam, Z, idx, iters, history, route):
     """Assemble the PdasResult: contact set, kernels, uniqueness, KKT measures."""
     g = prob.g0 + prob.K @ lam
     active = lam > prob.tolerances(lam)[1]
-    kdim = _nullity(prob.K[np.ix_(active, active)], prob.cutoff)
+    kdim = _nullity(prob.K[np.ix_(active, active)], prob.cutoff, prob.definite)
     return PdasResult(
         lam=lam, gap=g, active=active, iterations=iters,
         complementarity=float(np.max(np.abs(lam * g), initial=0.0)),

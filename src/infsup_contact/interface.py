@@ -10,6 +10,14 @@ SuperLU takes no user ordering beyond a pre-permuted matrix: the interior is ord
 graph nested dissection (:mod:`infsup_contact.ordering`), Γ appended, and the permuted
 matrix factorized once as given.
 
+On small problems the Python-side ordering costs more than it saves, so
+:func:`gamma_factorization` switches (``route="auto"``) by the work estimate n · n_Γ: up to
+:data:`SOLVES_MAX_WORK` it factorizes with SuperLU's own minimum-degree order and reads
+X = (A⁻¹)_ΓΓ off n_Γ solves with unit vectors (the Steklov inverse directly); above it the
+nested-dissection route. Both give the same X to round-off (tested); the crossover was
+measured on the structured meshes (``results/benchmarks``: at n · n_Γ ≈ 2.5e5 both take
+the same time).
+
 A_i = c_i K_i with K_i the Laplace stiffness, so X_i = S_i⁻¹ / c_i: one computation per
 (mesh, k) serves every (c1, c2), every multiplier space, both norms and the contact solver.
 """
@@ -24,6 +32,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from .coupling import GammaTrace, gamma_trace
+from .errors import InputError
 from .ordering import nested_dissection_gamma_last
 
 
@@ -50,6 +59,7 @@ class SideOperator:
     stiffness: sp.csc_matrix
     schur: np.ndarray
     solve: object
+    steklov: np.ndarray | None = None
 
     @property
     def ndof(self) -> int:
@@ -57,7 +67,14 @@ class SideOperator:
 
     def steklov_inverse(self, c: float = 1.0) -> np.ndarray:
         """X_i = (A_i⁻¹)_ΓΓ = S_i⁻¹ / c_i, symmetric positive definite."""
-        return sla.inv(self.schur, check_finite=False) / c
+        X = self.steklov if self.steklov is not None else sla.inv(self.schur, check_finite=False)
+        return X / c
+
+    def steklov_times(self, M: np.ndarray) -> np.ndarray:
+        """X_i M for c_i = 1: a product with X where it is known, else a solve with S."""
+        if self.steklov is not None:
+            return self.steklov @ M
+        return sla.solve(self.schur, M, assume_a="pos", check_finite=False)
 
 
 def displacement_space(mesh, k: int):
@@ -103,6 +120,66 @@ class _Reordered:
         return out
 
 
+SOLVES_MAX_WORK = 2.0e5
+"""Largest n · n_Γ for which :func:`gamma_factorization` takes the ``"solves"`` route."""
+
+GAMMA_ROUTES = ("auto", "solves", "nested")
+
+
+@dataclass(frozen=True)
+class GammaFactorization:
+    """One factorization of A (Γ = its last n_Γ unknowns) and what Γ needs from it.
+
+    Attributes
+    ----------
+    solve : callable
+        b ↦ A⁻¹ b.
+    schur : ndarray
+        S = A_ΓΓ − A_ΓI A_II⁻¹ A_IΓ.
+    steklov : ndarray or None
+        X = S⁻¹ = (A⁻¹)_ΓΓ where the route computed it directly (``"solves"``).
+    route : str
+        ``"solves"`` or ``"nested"``.
+    """
+
+    solve: object
+    schur: np.ndarray
+    steklov: np.ndarray | None
+    route: str
+
+
+def gamma_factorization(A, n_gamma: int, route: str = "auto") -> GammaFactorization:
+    """Factorize the SPD matrix A once and get its Γ Schur complement (Γ = last n_gamma).
+
+    ``route``:
+
+    ``"nested"``
+        Γ-last nested-dissection order, one LU, S = L_ΓΓ U_ΓΓ (:func:`schur_from_lu`).
+    ``"solves"``
+        SuperLU's minimum-degree order (``MMD_AT_PLUS_A``, symmetric mode), then
+        X = (A⁻¹)_ΓΓ from n_Γ solves with unit vectors and S = X⁻¹.
+    ``"auto"``
+        ``"solves"`` while n · n_Γ ≤ :data:`SOLVES_MAX_WORK`, else ``"nested"``.
+    """
+    if route not in GAMMA_ROUTES:
+        raise InputError("route", ", ".join(GAMMA_ROUTES), got=route)
+    A = sp.csc_matrix(A)
+    n = A.shape[0]
+    if route == "auto":
+        route = "solves" if n * n_gamma <= SOLVES_MAX_WORK else "nested"
+    if route == "nested":
+        lu = _gamma_last_lu(A, n_gamma)
+        return GammaFactorization(lu.solve, schur_from_lu(lu, n_gamma), None, route)
+    lu = spla.splu(A, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
+                   options=dict(SymmetricMode=True))
+    unit = np.zeros((n, n_gamma))
+    unit[np.arange(n - n_gamma, n), np.arange(n_gamma)] = 1.0
+    X = lu.solve(unit)[n - n_gamma:]
+    X = 0.5 * (X + X.T)
+    S = sla.inv(X, check_finite=False) if n_gamma else np.zeros((0, 0))
+    return GammaFactorization(lu.solve, 0.5 * (S + S.T), X, route)
+
+
 def schur_from_lu(lu: "_Reordered", n_gamma: int) -> np.ndarray:
     """S = L_ΓΓ U_ΓΓ: the trailing block of the factors when Γ is pivoted last."""
     n = len(lu.order)
@@ -113,8 +190,9 @@ def schur_from_lu(lu: "_Reordered", n_gamma: int) -> np.ndarray:
     return 0.5 * (S + S.T)
 
 
-def side_operator(mesh, k: int) -> SideOperator:
-    """Factorize K_i once and extract its Γ Schur complement (c = 1)."""
+def side_operator(mesh, k: int, route: str = "auto") -> SideOperator:
+    """Factorize K_i once and extract its Γ Schur complement (c = 1); ``route`` as in
+    :func:`gamma_factorization`."""
     fes = displacement_space(mesh, k)
     trace = gamma_trace(fes)
     free_mask = np.array(fes.FreeDofs(), dtype=bool)
@@ -122,9 +200,8 @@ def side_operator(mesh, k: int) -> SideOperator:
     is_gamma[trace.gamma_dofs] = True
     free = np.concatenate([np.flatnonzero(free_mask & ~is_gamma), trace.gamma_dofs])
     K = laplace_stiffness(fes)[free][:, free].tocsc()
-    n, ng = len(free), len(trace.gamma_dofs)
-    lu = _gamma_last_lu(K, ng)
-    return SideOperator(trace, free, K, schur_from_lu(lu, ng), lu.solve)
+    fac = gamma_factorization(K, len(trace.gamma_dofs), route)
+    return SideOperator(trace, free, K, fac.schur, fac.solve, fac.steklov)
 
 
 def schur_by_solves(side: SideOperator) -> np.ndarray:
@@ -139,5 +216,5 @@ def interface_operator(couplings, sides, c=(1.0, 1.0)) -> np.ndarray:
     """Σ_i B_i X_i B_iᵀ = B A⁻¹ Bᵀ on the multiplier space (dense, symmetric PSD)."""
     out = 0.0
     for B, side, ci in zip(couplings, sides, c):
-        out = out + B @ sla.solve(side.schur, B.T, assume_a="pos") / ci
+        out = out + B @ side.steklov_times(B.T) / ci
     return 0.5 * (out + out.T)

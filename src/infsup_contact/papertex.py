@@ -571,6 +571,10 @@ def speed_table(speed: pd.DataFrame) -> str:
     return "\n".join(lines)
 
 
+BENCH_OPTIONAL_ROUTES = {"beta": ("eigsh", "dense"), "contact": ("osqp", "clarabel", "kkt_sparse")}
+"""Benchmark routes that depend on the configuration (sizes, peers)."""
+
+
 def bench_macros(bench: pd.DataFrame, what: str) -> list[Macro]:
     """Speed ratios route/ours at the largest N (and k) of a benchmark table."""
     _require(bench, ["what", "route", "k", "N", "seconds_median", "ratio_to_ours"], f"benchmarks/{what}.csv")
@@ -593,6 +597,11 @@ def bench_macros(bench: pd.DataFrame, what: str) -> list[Macro]:
             if "max_abs_diff" in r and pd.notna(r.max_abs_diff):
                 out.append(Macro(macro_name("bench", what, r.route, "Diff"), fmt_sci(r.max_abs_diff),
                                  _src(table, "max_abs_diff", **sel)))
+    # routes a config may leave out (peers: [], eigsh_max_N) still get a macro the text can use
+    for route in sorted(set(BENCH_OPTIONAL_ROUTES.get(what, ())) - set(top.route)):
+        for kind in ("Seconds", "Ratio", "Diff"):
+            out.append(Macro(macro_name("bench", what, route, kind), "n/a",
+                             f"{table}: route {route} not run at N={n}, k={k}"))
     return out
 
 

@@ -32,6 +32,8 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.sparse as sp
 
+from .contact_problem import contact_qp  # the assembled QP all peers get
+
 TOLERANCES = tuple(10.0 ** -e for e in range(3, 16))
 """Tolerances tried, loosest first, when tuning a peer to reproduce our solution."""
 
@@ -64,34 +66,6 @@ class QpResult:
     status: str
     tolerance: float
     settings: dict = field(default_factory=dict)
-
-
-def contact_qp(sides, Bs, F, c=(1.0, 1.0)):
-    """Assemble (A, B, F) of the contact QP from the two sides of a contact problem.
-
-    Parameters
-    ----------
-    sides : sequence of two objects with ``stiffness`` (csc, free dofs, Γ last) and
-        ``trace.gamma_dofs`` — :class:`~infsup_contact.interface.SideOperator`.
-    Bs : two dense (m, n_Γ,i) coupling matrices B1, B2.
-    F : two load vectors on the free dofs.
-    c : (c1, c2).
-
-    Returns
-    -------
-    A : csc_matrix (n, n)
-    B : csr_matrix (m, n) = [−B1, B2] embedded
-    F : ndarray (n,)
-    """
-    A = sp.block_diag([ci * s.stiffness for s, ci in zip(sides, c)], format="csc")
-    blocks = []
-    for sign, s, Bi in zip((-1.0, 1.0), sides, Bs):
-        ng = Bi.shape[1]
-        zero = sp.csr_matrix((Bi.shape[0], s.stiffness.shape[0] - ng))
-        blocks += [zero, sp.csr_matrix(sign * np.asarray(Bi))]
-    B = sp.hstack(blocks, format="csr")
-    B.eliminate_zeros()
-    return A, B, np.concatenate([np.asarray(f, dtype=float) for f in F])
 
 
 # ----------------------------------------------------------------------------- OSQP

@@ -1,7 +1,8 @@
 # Benchmarks stage: speed as ratios measured side by side in one job (all cores to itself,
 # one BLAS thread: the ratios are single-thread ratios), plus the speed–accuracy points.
-# Optional config keys (read with defaults until the schema lists them):
-#   benchmarks.speed_accuracy_repeats (3), benchmarks.speed_accuracy_scene ("manufactured").
+# Optional config keys (with their defaults): benchmarks.peers ([osqp, clarabel]),
+# benchmarks.eigsh_max_N (no limit), benchmarks.speed_accuracy_repeats (3),
+# benchmarks.speed_accuracy_scene ("manufactured").
 
 _BLAS1 = "export OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1 MKL_NUM_THREADS=1; "
 
@@ -17,6 +18,8 @@ rule bench_beta:
         N=lambda wc: config["benchmarks"]["beta_N"],
         k=lambda wc: config["benchmarks"]["beta_k"],
         repeats=lambda wc: config["benchmarks"]["repeats"],
+        eigsh=lambda wc: (f"--eigsh-max-N {config['benchmarks']['eigsh_max_N']}"
+                          if "eigsh_max_N" in config["benchmarks"] else ""),
     threads: workflow.cores
     log:
         "results/logs/bench_beta.log",
@@ -24,6 +27,7 @@ rule bench_beta:
         _BLAS1 + "python -c 'import sys; from infsup_contact.bench import write_machine_info;"
         " write_machine_info(sys.argv[1])' {output.machine} 2> {log}"
         " && infsup-contact bench --what beta --N {params.N} --k {params.k} --repeats {params.repeats}"
+        " {params.eigsh}"
         " > {output.table}.tmp 2>> {log} && mv {output.table}.tmp {output.table}"
 
 
@@ -37,11 +41,13 @@ rule bench_contact:
         N=lambda wc: config["benchmarks"]["contact_N"],
         k=lambda wc: config["benchmarks"]["contact_k"],
         repeats=lambda wc: config["benchmarks"]["repeats"],
+        peers=lambda wc: " ".join(config["benchmarks"].get("peers", ["osqp", "clarabel"])) or "none",
     threads: workflow.cores
     log:
         "results/logs/bench_contact.log",
     shell:
         _BLAS1 + "infsup-contact bench --what contact --N {params.N} --k {params.k} --repeats {params.repeats}"
+        " --peers {params.peers}"
         " > {output}.tmp 2> {log} && mv {output}.tmp {output}"
 
 

@@ -317,6 +317,20 @@ def test_paper_has_no_typed_results():
     assert not re.findall(r"\d[eE]-?\d|\\times\s*10\^", body)
 
 
+def test_fastest_for_targets_is_the_cheapest_row_reaching_each_target(tables):
+    speed = tables["speed"]
+    front = pt.fastest_for_targets(speed, "energy_error")
+    assert len(front) and set(front.scene) <= set(speed.scene)
+    for _, r in front.iterrows():
+        ok = speed[(speed.scene == r.scene) & (speed.energy_error <= r.target)]
+        assert r.seconds == ok.seconds.min() and r.error <= r.target
+    decades = np.log10(front.target.to_numpy())
+    assert np.allclose(decades, np.round(decades))
+    table = pt.front_table(speed)
+    assert table.count(r"\\") >= len(front) and "$10^{" in table
+    assert "targets)" in pt.front_winner(speed, "energy_error")
+
+
 def test_benchmark_routes_left_out_by_the_config_read_n_a(tables):
     """peers: [] in the config: the paper still builds and says the peers were not run."""
     t = dict(tables)

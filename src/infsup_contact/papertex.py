@@ -73,7 +73,7 @@ MEASURES = {"energy_error": "Energy", "l2_error": "Ltwo", "lambda_l2_error": "La
             "lambda_hm12_error": "LambdaH"}
 SPEED_COLUMNS = ("scene", "case", "k", "N", "seconds", "energy_error", "lambda_hm12_error")
 GENERATED_FILES = ("macros.tex", "claims_table.tex", "rates_table.tex", "beta_table.tex",
-                   "speed_table.tex")
+                   "speed_table.tex", "front_table.tex")
 MACRO_PREFIXES = ("beta", "smallest", "kernel", "dim", "finest", "coarsest", "n", "slope", "stderr",
                   "expected", "error", "iterations", "max", "contact", "ref", "claim", "speed", "bench",
                   "cfg", "prov")
@@ -545,7 +545,71 @@ def speed_macros(speed: pd.DataFrame) -> list[Macro]:
         if "pareto_energy" in g.columns:
             out.append(Macro(macro_name("speedParetoCount", label), fmt_int(g.pareto_energy.astype(bool).sum()),
                              f"speed_accuracy.csv: rows with pareto_energy | scene={scene}"))
+    for error, name in (("energy_error", "Energy"), ("lambda_hm12_error", "Lambda")):
+        out.append(Macro(macro_name("speedFrontWinner", name), front_winner(speed, error),
+                         f"speed_accuracy.csv: most frequent fastest (case, k) over the {error} targets"))
     return out
+
+
+def front_winner(speed: pd.DataFrame, error: str) -> str:
+    """The (case, k) that is fastest for the most accuracy targets (all scenes), as text;
+    ties list every such pair."""
+    front = fastest_for_targets(speed, error).dropna(subset=["seconds"])
+    if front.empty:
+        return "none"
+    counts = front.groupby(["case", "k"]).size()
+    best = counts[counts == counts.max()].index
+    return " and ".join(f"{case} with $k={int(k)}$" for case, k in best) + \
+        f" ({int(counts.max())} of {len(front)} targets)"
+
+
+ERRORS = {"energy_error": r"$\|u-u_h\|_a$", "lambda_hm12_error": r"$\|\lambda-\lambda_h\|_M$"}
+
+
+def fastest_for_targets(speed: pd.DataFrame, error: str) -> pd.DataFrame:
+    """Per scene and accuracy target 10^-j (every decade the table's errors span): the fastest
+    row whose ``error`` is at most the target — the discretization to pick for that accuracy.
+
+    Returns columns scene, target, case, k, N, seconds, error (NaN row values where no row
+    reaches the target).
+    """
+    out = []
+    for scene, g in speed_selection(speed).groupby("scene", sort=True):
+        err = g[error].to_numpy(dtype=float)
+        err = err[np.isfinite(err) & (err > 0)]
+        if not len(err):
+            continue
+        for j in range(int(np.ceil(-np.log10(err.max()))), int(np.floor(-np.log10(err.min()))) + 1):
+            ok = g[g[error] <= 10.0 ** -j]
+            best = ok.loc[ok.seconds.idxmin()] if len(ok) else None
+            out.append(dict(scene=scene, target=10.0 ** -j, case=best.case if best is not None else None,
+                            k=int(best.k) if best is not None else np.nan,
+                            N=int(best.N) if best is not None else np.nan,
+                            seconds=float(best.seconds) if best is not None else np.nan,
+                            error=float(best[error]) if best is not None else np.nan))
+    return pd.DataFrame(out, columns=["scene", "target", "case", "k", "N", "seconds", "error"])
+
+
+def front_table(speed: pd.DataFrame) -> str:
+    """Tabular: for each scene and accuracy target, the fastest discretization reaching it,
+    once for the energy error and once for the multiplier error in the norm of M."""
+    lines = [r"\begin{tabular}{llrlrrr}", r"\toprule",
+             r"scene & error & target & fastest & $k$ & $N$ & seconds \\", r"\midrule"]
+    first = True
+    for error, label in ERRORS.items():
+        front = fastest_for_targets(speed, error)
+        for scene, g in front.groupby("scene", sort=False):
+            if not first:
+                lines.append(r"\midrule")
+            first = False
+            for _, r in g.iterrows():
+                if r.case is None or pd.isna(r.seconds):
+                    continue
+                target = f"$10^{{{int(round(np.log10(r.target)))}}}$"
+                lines.append(f"{latex_escape(scene)} & {label} & {target} & {r.case} & "
+                             f"{int(r.k)} & {int(r.N)} & {fmt_sci(r.seconds)} \\\\")
+    lines += [r"\bottomrule", r"\end{tabular}", ""]
+    return "\n".join(lines)
 
 
 def speed_table(speed: pd.DataFrame) -> str:
@@ -677,7 +741,8 @@ def paper_files(beta, contact, rates, claims, speed, bench_beta, bench_contact, 
             "claims_table.tex": claims_table(claims),
             "rates_table.tex": rates_table(rates),
             "beta_table.tex": beta_table(beta),
-            "speed_table.tex": speed_table(speed)}
+            "speed_table.tex": speed_table(speed),
+            "front_table.tex": front_table(speed)}
 
 
 # --------------------------------------------------------------------------- checks on paper.tex

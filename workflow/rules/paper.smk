@@ -23,6 +23,7 @@ rule paper_macros:
         rates="results/paper/rates_table.tex",
         beta="results/paper/beta_table.tex",
         speed="results/paper/speed_table.tex",
+        front="results/paper/front_table.tex",
     input:
         beta="results/tables/beta.csv",
         contact="results/tables/contact.csv",

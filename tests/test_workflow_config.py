@@ -139,6 +139,15 @@ def test_ci_config_dry_run_lists_beta_jobs(workdir):
     assert produced_tables(workdir) == []
 
 
+def test_benchmarks_stage_dry_run(workdir):
+    rc, out = snakemake(workdir, "-n", "-p", "benchmarks", "--cores", "1", "--configfile", "config/ci.yaml")
+    assert rc == 0, out
+    stats = out.split("Job stats:")[1].split("total")[0]
+    for rule in ("bench_beta", "bench_contact", "speed_accuracy", "fig7_speed_accuracy"):
+        assert rule in stats, f"{rule} not in the benchmarks stage:\n{stats}"
+    assert "--peers osqp clarabel" in out and "--eigsh-max-N 16" in out   # config → command
+
+
 def test_unknown_target_fails_with_snakemake_message(workdir):
     rc, out = snakemake(workdir, "-n", "no-such-target", "--cores", "1",
                         "--configfile", "config/ci.yaml")

@@ -7,6 +7,15 @@
 _BLAS1 = "export OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1 MKL_NUM_THREADS=1; "
 
 
+rule benchmarks:
+    # `snakemake benchmarks`: the stage on its own (also part of reproduce-all)
+    input:
+        "results/benchmarks/beta.csv",
+        "results/benchmarks/contact.csv",
+        "results/tables/speed_accuracy.csv",
+        "results/figures/fig7_speed_accuracy.pdf",
+
+
 rule bench_beta:
     output:
         table="results/benchmarks/beta.csv",

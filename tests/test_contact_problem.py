@@ -1,11 +1,10 @@
 """The contact problem (4.1) on real meshes: routes agree, the sign of λ, rates, failures."""
 import numpy as np
 import pytest
-import scipy.sparse as sp
 
 from infsup_contact.claims import sign_check
 from infsup_contact.contact import solve_kkt_sparse
-from infsup_contact.contact_problem import _embed, load_vector, solve_contact
+from infsup_contact.contact_problem import contact_qp, load_vector, solve_contact
 from infsup_contact.scenes import manufactured, membranes
 from infsup_contact.study import contact_row
 
@@ -16,9 +15,7 @@ def test_gamma_reduced_pdas_equals_full_sparse_kkt(case, k, n1, n2):
     sol = solve_contact(sc, case, k, "perturbed", n1, n2, time_floor=False)
     sides = sol.sides
     Bs = [coupling for coupling in _couplings(sol)]
-    A = sp.block_diag([c * s.stiffness for s, c in zip(sides, sol.c)]).tocsc()
-    B = sp.csr_matrix(np.hstack([-_embed(sides[0], Bs[0]), _embed(sides[1], Bs[1])]))
-    F = np.concatenate([load_vector(s, f) for s, f in zip(sides, (sc.f1, sc.f2))])
+    A, B, F = contact_qp(sides, Bs, [load_vector(s, f) for s, f in zip(sides, (sc.f1, sc.f2))], sol.c)
     u, lam, _ = solve_kkt_sparse(A, B, F)
     assert np.abs(lam - sol.lam).max() <= 1e-10 * max(1.0, np.abs(lam).max())
     u_ours = np.concatenate([gf.vec.FV().NumPy()[s.free] for gf, s in zip(sol.u, sides)])

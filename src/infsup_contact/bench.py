@@ -234,10 +234,9 @@ def _bottom(beta2: np.ndarray, kern: int):
 def _factorize_side(side: SideOperator) -> SideOperator:
     """The Γ-last factorization + Schur complement of an assembled side: the linear
     algebra of :func:`interface.side_operator` without the NGSolve assembly."""
-    from .interface import gamma_factorization
+    from .interface import factorized_side
 
-    fac = gamma_factorization(side.stiffness, len(side.trace.gamma_dofs))
-    return SideOperator(side.trace, side.free, side.stiffness, fac.schur, fac.solve, fac.steklov)
+    return factorized_side(side.trace, side.free, side.stiffness)
 
 
 class BetaSetup:

@@ -92,13 +92,6 @@ def load_vectors(sides, scene) -> list:
     return [load_vector(s, f) for s, f in zip(sides, (scene.f1, scene.f2))]
 
 
-def _embed(side: SideOperator, B: np.ndarray) -> np.ndarray:
-    """B_i on Γ dofs → columns on all free dofs (Γ dofs are the last block)."""
-    full = np.zeros((B.shape[0], side.ndof))
-    full[:, side.ndof - B.shape[1]:] = B
-    return full
-
-
 def contact_qp(sides, Bs, F, c=(1.0, 1.0)):
     """Assemble (A, B, F) of the contact QP from the two sides of a contact problem.
 
@@ -156,14 +149,14 @@ def linear_saddle_solve(A, B, F, active=None, refine: int = 2):
     B = sp.csr_matrix(B)
     active = np.ones(B.shape[0], dtype=bool) if active is None else np.asarray(active, dtype=bool)
     Ba = B[active]
+    n, m = A.shape[0], Ba.shape[0]
+    exact = sp.bmat([[A, Ba.T], [Ba, sp.csr_matrix((m, m))]], format="csc")
     eps = 1e-12 * abs(A).max()
-    kkt = sp.bmat([[A, Ba.T], [Ba, -eps * sp.identity(Ba.shape[0])]], format="csc")
-    n = A.shape[0]
+    kkt = (exact - sp.diags(np.r_[np.zeros(n), np.full(m, eps)])).tocsc()
     lu = spla.splu(kkt, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
                    options=dict(SymmetricMode=True))
-    rhs = np.concatenate([F, np.zeros(Ba.shape[0])])
+    rhs = np.concatenate([F, np.zeros(m)])
     sol = lu.solve(rhs)
-    exact = kkt + sp.diags(np.r_[np.zeros(n), np.full(Ba.shape[0], eps)], format="csc")
     for _ in range(refine):  # against ε and the growth of an unpivoted factorization
         sol += lu.solve(rhs - exact @ sol)
     lam = np.zeros(B.shape[0])
@@ -171,10 +164,9 @@ def linear_saddle_solve(A, B, F, active=None, refine: int = 2):
     return sol[:n], lam
 
 
-def linear_saddle_time(sides, Bs, c, F=None, active=None) -> float:
+def linear_saddle_time(sides, Bs, c, F, active) -> float:
     """Seconds of :func:`linear_saddle_solve` on the assembled problem of ``sides``
-    (loads ``F`` per side, default ones; contact set ``active``, default all)."""
-    F = [np.ones(s.ndof) for s in sides] if F is None else F
+    (loads ``F`` per side, contact set ``active``)."""
     A, B, Fv = contact_qp(sides, Bs, F, c)
     t = time.perf_counter()
     linear_saddle_solve(A, B, Fv, active)

@@ -71,10 +71,15 @@ class SideOperator:
         return X / c
 
     def steklov_times(self, M: np.ndarray) -> np.ndarray:
-        """X_i M for c_i = 1: a product with X where it is known, else a solve with S."""
-        if self.steklov is not None:
-            return self.steklov @ M
-        return sla.solve(self.schur, M, assume_a="pos", check_finite=False)
+        """X_i M for c_i = 1 (:func:`steklov_times`)."""
+        return steklov_times(self.schur, self.steklov, M)
+
+
+def steklov_times(schur: np.ndarray, steklov: np.ndarray | None, M: np.ndarray) -> np.ndarray:
+    """X M for X = S⁻¹ = (A⁻¹)_ΓΓ: a product where X is known, else a solve with S."""
+    if steklov is not None:
+        return steklov @ M
+    return sla.solve(schur, M, assume_a="pos", check_finite=False)
 
 
 def displacement_space(mesh, k: int):
@@ -147,6 +152,10 @@ class GammaFactorization:
     steklov: np.ndarray | None
     route: str
 
+    def steklov_times(self, M: np.ndarray) -> np.ndarray:
+        """X M (:func:`steklov_times`)."""
+        return steklov_times(self.schur, self.steklov, M)
+
 
 def gamma_factorization(A, n_gamma: int, route: str = "auto") -> GammaFactorization:
     """Factorize the SPD matrix A once and get its Γ Schur complement (Γ = last n_gamma).
@@ -199,7 +208,12 @@ def side_operator(mesh, k: int, route: str = "auto") -> SideOperator:
     is_gamma = np.zeros(fes.ndof, dtype=bool)
     is_gamma[trace.gamma_dofs] = True
     free = np.concatenate([np.flatnonzero(free_mask & ~is_gamma), trace.gamma_dofs])
-    K = laplace_stiffness(fes)[free][:, free].tocsc()
+    return factorized_side(trace, free, laplace_stiffness(fes)[free][:, free].tocsc(), route)
+
+
+def factorized_side(trace: GammaTrace, free: np.ndarray, K, route: str = "auto") -> SideOperator:
+    """The SideOperator of an assembled stiffness K (free dofs, Γ last): one
+    :func:`gamma_factorization`."""
     fac = gamma_factorization(K, len(trace.gamma_dofs), route)
     return SideOperator(trace, free, K, fac.schur, fac.solve, fac.steklov)
 

@@ -22,7 +22,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.linalg as sla
 import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
@@ -120,10 +119,7 @@ class _Part:
         fac = gamma_factorization(A[self.idx][:, self.idx], self.ng, route)
         self.solve, self.route = fac.solve, fac.route
         self.B = B[:, self.idx[len(self.idx) - self.ng:]].toarray()   # B on Γ of this block
-        if fac.steklov is not None:
-            self.K = self.B @ fac.steklov @ self.B.T
-        else:
-            self.K = self.B @ sla.solve(fac.schur, self.B.T, assume_a="pos", check_finite=False)
+        self.K = self.B @ fac.steklov_times(self.B.T)
 
     def gap(self, F) -> np.ndarray:
         """This block's share of g0 = B A⁻¹ F."""

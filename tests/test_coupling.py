@@ -3,10 +3,10 @@ import ngsolve
 import numpy as np
 import pytest
 
-from infsup_contact.coupling import coupling_matrix, gamma_trace
+from infsup_contact.discretization.coupling import coupling_matrix, gamma_trace
 from infsup_contact.interface import displacement_space
-from infsup_contact.meshes import mesh_pair
-from infsup_contact.multipliers import make_space
+from infsup_contact.discretization.meshes import mesh_pair
+from infsup_contact.discretization.multipliers import make_space
 
 
 def _gauss_reference(space, f, n=40):

@@ -8,7 +8,7 @@ import pandas as pd
 import pytest
 
 from infsup_contact import plotting
-from infsup_contact.multipliers import CASE_IDS
+from infsup_contact.discretization.multipliers import CASE_IDS
 
 SCRIPTS = Path(__file__).resolve().parents[1] / "workflow" / "scripts"
 FIGURE_SCRIPTS = ("fig_model_problem", "fig_beta", "fig_families", "fig_contact_solutions",

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from infsup_contact.errors import InputError
-from infsup_contact.meshes import (FAMILIES, gamma_breakpoints, mesh_pair, mesh_quality,
+from infsup_contact.discretization.meshes import (FAMILIES, gamma_breakpoints, mesh_pair, mesh_quality,
                                    multiplier_breakpoints)
 
 

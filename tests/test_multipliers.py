@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 
 from infsup_contact.errors import InputError
-from infsup_contact.multipliers import (CASE_IDS, CASES, case_space, make_space, paper_dimension,
+from infsup_contact.discretization.multipliers import (CASE_IDS, CASES, case_space, make_space, paper_dimension,
                                         structural_kernel_dim)
 
 VALID = [(c, k) for c in CASE_IDS for k in range(1, 5) if k >= CASES[c][4]]

@@ -9,7 +9,7 @@ import numpy as np
 import scipy.fft
 
 from .contact_problem import ContactSolution, gamma_values, lambda_values
-from .norms import sine_coefficients
+from .discretization.norms import sine_coefficients
 
 N_SAMPLE = 4001
 """Points on Γ for pointwise quantities (penetration, contact set)."""

@@ -84,11 +84,11 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from . import meshes, multipliers
-from .coupling import coupling_matrix
+from .discretization import meshes, multipliers
+from .discretization.coupling import coupling_matrix
 from .infsup import beta_rows
 from .interface import SideOperator, interface_operator, side_operator
-from .norms import gram
+from .discretization.norms import gram
 
 NORMS = ("H", "L2")
 KERNEL_BETA = 1e-6

@@ -30,8 +30,8 @@ class _Parser(argparse.ArgumentParser):
 
 
 def _add_beta(sub) -> None:
-    from .meshes import FAMILIES
-    from .multipliers import CASE_IDS
+    from .discretization.meshes import FAMILIES
+    from .discretization.multipliers import CASE_IDS
 
     p = sub.add_parser("beta", help="β_h for one mesh pair (CSV: one row per case × norm)")
     p.add_argument("--case", default="all", choices=[*CASE_IDS, "all"])
@@ -54,7 +54,7 @@ def _run_beta(args) -> None:
     import pandas as pd
 
     from .infsup import beta_rows
-    from .multipliers import CASE_IDS, CASES
+    from .discretization.multipliers import CASE_IDS, CASES
 
     if args.case == "all":
         if not 1 <= args.k <= 4:
@@ -72,8 +72,8 @@ def _run_beta(args) -> None:
 
 
 def _add_contact(sub) -> None:
-    from .meshes import FAMILIES
-    from .multipliers import CASE_IDS
+    from .discretization.meshes import FAMILIES
+    from .discretization.multipliers import CASE_IDS
 
     p = sub.add_parser("contact", help="solve (4.1) for one case and mesh pair (CSV: one row)")
     p.add_argument("--scene", required=True, choices=["manufactured", "membranes"])
@@ -93,7 +93,7 @@ def _add_contact(sub) -> None:
 def _run_contact(args) -> None:
     import pandas as pd
 
-    from .multipliers import CASE_IDS, CASES
+    from .discretization.multipliers import CASE_IDS, CASES
     from .study import contact_row
 
     if not 1 <= args.k <= 4:

@@ -16,9 +16,9 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from . import meshes, multipliers
+from .discretization import meshes, multipliers
 from .contact import PdasResult, solve_pdas
-from .coupling import coupling_matrix
+from .discretization.coupling import coupling_matrix
 from .interface import SideOperator, interface_operator, side_operator
 
 

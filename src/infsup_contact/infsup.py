@@ -14,11 +14,11 @@ import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
 
-from . import meshes, multipliers
-from .coupling import coupling_matrix, union_breakpoints
+from .discretization import meshes, multipliers
+from .discretization.coupling import coupling_matrix, union_breakpoints
 from .errors import InputError
 from .interface import interface_operator, side_operator
-from .norms import NORMS, gram
+from .discretization.norms import NORMS, gram
 
 KERNEL_RTOL = 1e-8
 """An eigenvalue μ² < KERNEL_RTOL · (largest eigenvalue) counts as a numerical zero."""

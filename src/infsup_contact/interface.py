@@ -31,7 +31,7 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from .coupling import GammaTrace, gamma_trace
+from .discretization.coupling import GammaTrace, gamma_trace
 from .errors import InputError
 from .ordering import nested_dissection_gamma_last
 

@@ -31,7 +31,7 @@ validate(config, schema="../schemas/config.schema.yaml")
 # Source edits must trigger reruns: every compute rule lists the package as input, except
 # the modules that only draw, typeset or time (their own rules list them).
 PRESENTATION_ONLY = {"plotting.py", "papertex.py", "bench.py", "peers.py"}
-PACKAGE_SOURCES = sorted(str(p) for p in Path("src/infsup_contact").glob("*.py") if p.name not in PRESENTATION_ONLY)
+PACKAGE_SOURCES = sorted(str(p) for p in Path("src/infsup_contact").rglob("*.py") if p.name not in PRESENTATION_ONLY)
 BENCH_SOURCES = ["src/infsup_contact/bench.py", "src/infsup_contact/peers.py"]
 
 def beta_pairs():

@@ -88,7 +88,7 @@ rule fig4_families:
     input:
         beta="results/tables/beta.csv",
         style=PLOT_STYLE,
-        meshes="src/infsup_contact/meshes.py",  # the mesh panels are drawn from mesh_pair
+        meshes="src/infsup_contact/discretization/meshes.py",  # the mesh panels are drawn from mesh_pair
     params:
         seed=lambda wc: config["infsup"]["seed"],
         alpha=lambda wc: config["infsup"]["alpha"],

@@ -13,7 +13,7 @@ log_to(snakemake.log[0])  # noqa: F821
 import pandas as pd  # noqa: E402
 
 from infsup_contact.io import write_csv_atomic  # noqa: E402
-from infsup_contact.meshes import mesh_pair, mesh_quality  # noqa: E402
+from infsup_contact.discretization.meshes import mesh_pair, mesh_quality  # noqa: E402
 
 family, ic = snakemake.wildcards.family, snakemake.params.ic  # noqa: F821
 kwargs = {"seed": ic["seed"], "alpha": ic["alpha"]} if family == "perturbed" else {}

@@ -19,7 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .errors import InputError
+from ..errors import InputError
 
 CASES = {
     # case: (paper reference, degree as function of k, continuous, vanish at ends, min k)

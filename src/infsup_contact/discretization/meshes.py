@@ -22,7 +22,7 @@ import ngsolve
 from netgen import meshing
 from netgen.geom2d import SplineGeometry
 
-from .errors import InputError
+from ..errors import InputError
 
 FAMILIES = ("structured", "perturbed", "unstructured")
 SIDES = (1, 2)

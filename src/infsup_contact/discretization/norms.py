@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .errors import InputError
+from ..errors import InputError
 from .logkernel import gram_h_logkernel
 from .multipliers import MultiplierSpace, local_monomial_coefficients, local_shapes
 

@@ -57,7 +57,7 @@ from functools import lru_cache
 
 import numpy as np
 
-from .errors import InputError
+from ..errors import InputError
 from .multipliers import MultiplierSpace, local_shapes
 
 __all__ = ["gram_h_logkernel", "log_kernel"]

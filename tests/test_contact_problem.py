@@ -71,7 +71,7 @@ def test_r52_active_kernel_gives_nonunique_flag():
 def test_load_from_exact_solution_equals_quadrature_of_f():
     """Green's formula: c(∇u, ∇v) − ∫_Γ c ∂u/∂n v equals ∫ f v (smooth case, where f is benign)."""
     from infsup_contact.contact_problem import load_vector_from_exact
-    from infsup_contact.interface import side_operator
+    from infsup_contact.models.membranes import side_operator
     from infsup_contact.discretization.meshes import mesh_pair
 
     sc = manufactured(c1=1.0, c2=3.0, p=6.0, q=6.0)  # f smooth enough for its quadrature to be exact-ish

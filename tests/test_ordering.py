@@ -6,12 +6,12 @@ import scipy.sparse.csgraph  # noqa: F401  (sp.csgraph)
 import scipy.sparse.linalg as spla
 
 from infsup_contact.discretization.coupling import gamma_trace
-from infsup_contact.interface import (
+from infsup_contact.models.membranes import (
     displacement_space, laplace_stiffness, schur_by_solves, schur_from_lu, side_operator,
     _gamma_last_lu,
 )
 from infsup_contact.discretization.meshes import mesh_pair
-from infsup_contact.ordering import _Graph, _Twins, nested_dissection_gamma_last
+from infsup_contact.models.ordering import _Graph, _Twins, nested_dissection_gamma_last
 
 SUPERLU_SPD = dict(diag_pivot_thresh=0.0, options=dict(SymmetricMode=True))
 

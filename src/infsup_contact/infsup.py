@@ -17,7 +17,7 @@ import scipy.sparse as sp
 from .discretization import meshes, multipliers
 from .discretization.coupling import coupling_matrix, union_breakpoints
 from .errors import InputError
-from .interface import interface_operator, side_operator
+from .models.membranes import interface_operator, side_operator
 from .discretization.norms import NORMS, gram
 
 KERNEL_RTOL = 1e-8

@@ -31,8 +31,8 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from .discretization.coupling import GammaTrace, gamma_trace
-from .errors import InputError
+from ..discretization.coupling import GammaTrace, gamma_trace
+from ..errors import InputError
 from .ordering import nested_dissection_gamma_last
 
 

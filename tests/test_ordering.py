@@ -6,10 +6,8 @@ import scipy.sparse.csgraph  # noqa: F401  (sp.csgraph)
 import scipy.sparse.linalg as spla
 
 from infsup_contact.discretization.coupling import gamma_trace
-from infsup_contact.models.membranes import (
-    displacement_space, laplace_stiffness, schur_by_solves, schur_from_lu, side_operator,
-    _gamma_last_lu,
-)
+from infsup_contact.models.membranes import displacement_space, laplace_stiffness, side_operator
+from infsup_contact.models.schur import _gamma_last_lu, schur_by_solves, schur_from_lu
 from infsup_contact.discretization.meshes import mesh_pair
 from infsup_contact.models.ordering import _Graph, _Twins, nested_dissection_gamma_last
 

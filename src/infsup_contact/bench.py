@@ -87,7 +87,8 @@ import scipy.sparse.linalg as spla
 from .discretization import meshes, multipliers
 from .discretization.coupling import coupling_matrix
 from .infsup import beta_rows
-from .models.membranes import SideOperator, interface_operator, side_operator
+from .models.schur import SideOperator, interface_operator
+from .models.membranes import side_operator
 from .discretization.norms import gram
 
 NORMS = ("H", "L2")
@@ -234,7 +235,7 @@ def _bottom(beta2: np.ndarray, kern: int):
 def _factorize_side(side: SideOperator) -> SideOperator:
     """The Γ-last factorization + Schur complement of an assembled side: the linear
     algebra of :func:`interface.side_operator` without the NGSolve assembly."""
-    from .models.membranes import factorized_side
+    from .models.schur import factorized_side
 
     return factorized_side(side.trace, side.free, side.stiffness)
 

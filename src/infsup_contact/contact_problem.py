@@ -19,7 +19,8 @@ import scipy.sparse.linalg as spla
 from .discretization import meshes, multipliers
 from .contact import PdasResult, solve_pdas
 from .discretization.coupling import coupling_matrix
-from .models.membranes import SideOperator, interface_operator, side_operator
+from .models.schur import SideOperator, interface_operator
+from .models.membranes import side_operator
 
 
 @dataclass

@@ -17,7 +17,8 @@ import scipy.sparse as sp
 from .discretization import meshes, multipliers
 from .discretization.coupling import coupling_matrix, union_breakpoints
 from .errors import InputError
-from .models.membranes import interface_operator, side_operator
+from .models.schur import interface_operator
+from .models.membranes import side_operator
 from .discretization.norms import NORMS, gram
 
 KERNEL_RTOL = 1e-8

@@ -26,7 +26,7 @@ import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
 from .contact import PdasResult, _check_kkt, solve_pdas
-from .models.membranes import gamma_factorization
+from .models.schur import gamma_factorization
 
 __all__ = ["ReducedQpSolution", "solve_reduced_qp", "touched_columns"]
 

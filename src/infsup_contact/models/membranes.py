@@ -1,85 +1,18 @@
-"""The interface operator: X_i = (A_i⁻¹)_ΓΓ, the discrete Steklov–Poincaré inverse.
+"""The membranes model of the paper's Section 3: −c_i Δu_i = f_i, u_i = 0 on ∂Ω_i∖Γ.
 
-Because b(v, μ) = ∫_Γ (v2 − v1) μ touches only Γ dofs, B A⁻¹ Bᵀ = Σ_i B_i (A_i⁻¹)_ΓΓ B_iᵀ
-(paper, Section 4: the operator behind (4.5)). With the Γ dofs ordered last,
-(A⁻¹)_ΓΓ = S⁻¹ for the Schur complement S = A_ΓΓ − A_ΓI A_II⁻¹ A_IΓ, and for a sparse
-LU factorization P A Pᵀ = L U whose ordering keeps Γ last, S = L_ΓΓ U_ΓΓ: the Schur
-complement is the trailing block of the factors — no solve with many right-hand sides.
-
-SuperLU takes no user ordering beyond a pre-permuted matrix: the interior is ordered by a
-graph nested dissection (:mod:`infsup_contact.ordering`), Γ appended, and the permuted
-matrix factorized once as given.
-
-On small problems the Python-side ordering costs more than it saves, so
-:func:`gamma_factorization` switches (``route="auto"``) by the work estimate n · n_Γ: up to
-:data:`SOLVES_MAX_WORK` it factorizes with SuperLU's own minimum-degree order and reads
-X = (A⁻¹)_ΓΓ off n_Γ solves with unit vectors (the Steklov inverse directly); above it the
-nested-dissection route. Both give the same X to round-off (tested); the crossover was
-measured on the structured meshes (``results/benchmarks``: at n · n_Γ ≈ 2.5e5 both take
-the same time).
-
-A_i = c_i K_i with K_i the Laplace stiffness, so X_i = S_i⁻¹ / c_i: one computation per
-(mesh, k) serves every (c1, c2), every multiplier space, both norms and the contact solver.
+Its side operator is the Laplace stiffness K_i of continuous P_k (eq. (5.1)) with its Γ
+Schur complement (:mod:`infsup_contact.models.schur`); A_i = c_i K_i, so the material
+scale of side i is c_i.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 import ngsolve
-import scipy.linalg as sla
 import scipy.sparse as sp
-import scipy.sparse.linalg as spla
 
-from ..discretization.coupling import GammaTrace, gamma_trace
-from ..errors import InputError
-from .ordering import nested_dissection_gamma_last
-
-
-@dataclass(frozen=True)
-class SideOperator:
-    """Factorized stiffness of one membrane and its Γ Schur complement (c = 1).
-
-    Attributes
-    ----------
-    trace : GammaTrace
-        Γ dofs and trace elements of V_{h,i}.
-    free : ndarray of int
-        Free NGSolve dofs (the unknowns of A_i), Γ dofs included.
-    stiffness : scipy.sparse.csc_matrix
-        K_i restricted to free dofs, in the order of ``free``.
-    schur : ndarray
-        S_i = Schur complement of K_i onto the Γ dofs (order of ``trace.gamma_dofs``).
-    solve : callable
-        b ↦ K_i⁻¹ b on free dofs (reuses the factorization).
-    """
-
-    trace: GammaTrace
-    free: np.ndarray
-    stiffness: sp.csc_matrix
-    schur: np.ndarray
-    solve: object
-    steklov: np.ndarray | None = None
-
-    @property
-    def ndof(self) -> int:
-        return len(self.free)
-
-    def steklov_inverse(self, c: float = 1.0) -> np.ndarray:
-        """X_i = (A_i⁻¹)_ΓΓ = S_i⁻¹ / c_i, symmetric positive definite."""
-        X = self.steklov if self.steklov is not None else sla.inv(self.schur, check_finite=False)
-        return X / c
-
-    def steklov_times(self, M: np.ndarray) -> np.ndarray:
-        """X_i M for c_i = 1 (:func:`steklov_times`)."""
-        return steklov_times(self.schur, self.steklov, M)
-
-
-def steklov_times(schur: np.ndarray, steklov: np.ndarray | None, M: np.ndarray) -> np.ndarray:
-    """X M for X = S⁻¹ = (A⁻¹)_ΓΓ: a product where X is known, else a solve with S."""
-    if steklov is not None:
-        return steklov @ M
-    return sla.solve(schur, M, assume_a="pos", check_finite=False)
+from ..discretization.coupling import gamma_trace
+from .contract import Model
+from .schur import SideOperator, factorized_side
 
 
 def displacement_space(mesh, k: int):
@@ -99,106 +32,6 @@ def laplace_stiffness(fes) -> sp.csr_matrix:
     return sp.csr_matrix((data, cols, rows), shape=(mat.height, mat.width))
 
 
-def _gamma_last_lu(A: sp.csc_matrix, n_gamma: int):
-    """LU of A (Γ = the last n_gamma rows/cols) in a fill-reducing order that keeps Γ last.
-
-    SuperLU accepts no user ordering, so A is permuted beforehand to a nested-dissection
-    order of the interior with Γ appended (``ordering.nested_dissection_gamma_last``) and
-    factorized once as given (``permc_spec="NATURAL"``, symmetric mode, no pivoting: A is
-    SPD), which keeps Γ last: S is the trailing block of the factors.
-    """
-    order = nested_dissection_gamma_last(A, n_gamma)
-    lu = spla.splu(A[order][:, order].tocsc(), permc_spec="NATURAL", diag_pivot_thresh=0.0,
-                   options=dict(SymmetricMode=True))
-    return _Reordered(lu, order)
-
-
-class _Reordered:
-    """An LU of A[order][:, order], solving with A in the original numbering."""
-
-    def __init__(self, lu, order):
-        self.lu, self.order = lu, order
-
-    def solve(self, b):
-        out = np.empty_like(b)
-        out[self.order] = self.lu.solve(b[self.order])
-        return out
-
-
-SOLVES_MAX_WORK = 2.0e5
-"""Largest n · n_Γ for which :func:`gamma_factorization` takes the ``"solves"`` route."""
-
-GAMMA_ROUTES = ("auto", "solves", "nested")
-
-
-@dataclass(frozen=True)
-class GammaFactorization:
-    """One factorization of A (Γ = its last n_Γ unknowns) and what Γ needs from it.
-
-    Attributes
-    ----------
-    solve : callable
-        b ↦ A⁻¹ b.
-    schur : ndarray
-        S = A_ΓΓ − A_ΓI A_II⁻¹ A_IΓ.
-    steklov : ndarray or None
-        X = S⁻¹ = (A⁻¹)_ΓΓ where the route computed it directly (``"solves"``).
-    route : str
-        ``"solves"`` or ``"nested"``.
-    """
-
-    solve: object
-    schur: np.ndarray
-    steklov: np.ndarray | None
-    route: str
-
-    def steklov_times(self, M: np.ndarray) -> np.ndarray:
-        """X M (:func:`steklov_times`)."""
-        return steklov_times(self.schur, self.steklov, M)
-
-
-def gamma_factorization(A, n_gamma: int, route: str = "auto") -> GammaFactorization:
-    """Factorize the SPD matrix A once and get its Γ Schur complement (Γ = last n_gamma).
-
-    ``route``:
-
-    ``"nested"``
-        Γ-last nested-dissection order, one LU, S = L_ΓΓ U_ΓΓ (:func:`schur_from_lu`).
-    ``"solves"``
-        SuperLU's minimum-degree order (``MMD_AT_PLUS_A``, symmetric mode), then
-        X = (A⁻¹)_ΓΓ from n_Γ solves with unit vectors and S = X⁻¹.
-    ``"auto"``
-        ``"solves"`` while n · n_Γ ≤ :data:`SOLVES_MAX_WORK`, else ``"nested"``.
-    """
-    if route not in GAMMA_ROUTES:
-        raise InputError("route", ", ".join(GAMMA_ROUTES), got=route)
-    A = sp.csc_matrix(A)
-    n = A.shape[0]
-    if route == "auto":
-        route = "solves" if n * n_gamma <= SOLVES_MAX_WORK else "nested"
-    if route == "nested":
-        lu = _gamma_last_lu(A, n_gamma)
-        return GammaFactorization(lu.solve, schur_from_lu(lu, n_gamma), None, route)
-    lu = spla.splu(A, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
-                   options=dict(SymmetricMode=True))
-    unit = np.zeros((n, n_gamma))
-    unit[np.arange(n - n_gamma, n), np.arange(n_gamma)] = 1.0
-    X = lu.solve(unit)[n - n_gamma:]
-    X = 0.5 * (X + X.T)
-    S = sla.inv(X, check_finite=False) if n_gamma else np.zeros((0, 0))
-    return GammaFactorization(lu.solve, 0.5 * (S + S.T), X, route)
-
-
-def schur_from_lu(lu: "_Reordered", n_gamma: int) -> np.ndarray:
-    """S = L_ΓΓ U_ΓΓ: the trailing block of the factors when Γ is pivoted last."""
-    n = len(lu.order)
-    tail = slice(n - n_gamma, n)
-    L = lu.lu.L[tail, tail].toarray()
-    U = lu.lu.U[tail, tail].toarray()
-    S = L @ U
-    return 0.5 * (S + S.T)
-
-
 def side_operator(mesh, k: int, route: str = "auto") -> SideOperator:
     """Factorize K_i once and extract its Γ Schur complement (c = 1); ``route`` as in
     :func:`gamma_factorization`."""
@@ -211,24 +44,6 @@ def side_operator(mesh, k: int, route: str = "auto") -> SideOperator:
     return factorized_side(trace, free, laplace_stiffness(fes)[free][:, free].tocsc(), route)
 
 
-def factorized_side(trace: GammaTrace, free: np.ndarray, K, route: str = "auto") -> SideOperator:
-    """The SideOperator of an assembled stiffness K (free dofs, Γ last): one
-    :func:`gamma_factorization`."""
-    fac = gamma_factorization(K, len(trace.gamma_dofs), route)
-    return SideOperator(trace, free, K, fac.schur, fac.solve, fac.steklov)
-
-
-def schur_by_solves(side: SideOperator) -> np.ndarray:
-    """Reference route: S = K_ΓΓ − K_ΓI K_II⁻¹ K_IΓ by a multi-right-hand-side solve."""
-    ng = len(side.trace.gamma_dofs)
-    K = side.stiffness
-    KII, KIG, KGG = K[:-ng, :-ng].tocsc(), K[:-ng, -ng:].toarray(), K[-ng:, -ng:].toarray()
-    return KGG - KIG.T @ spla.splu(KII).solve(KIG)
-
-
-def interface_operator(couplings, sides, c=(1.0, 1.0)) -> np.ndarray:
-    """Σ_i B_i X_i B_iᵀ = B A⁻¹ Bᵀ on the multiplier space (dense, symmetric PSD)."""
-    out = 0.0
-    for B, side, ci in zip(couplings, sides, c):
-        out = out + B @ side.steklov_times(B.T) / ci
-    return 0.5 * (out + out.T)
+MEMBRANES = Model("membranes", side_operator,
+                  "two membranes, −c_i Δu_i = f_i, scalar P_k (the paper's Section 3)")
+"""The paper's model problem through the model seam (:mod:`infsup_contact.models.contract`)."""

@@ -90,9 +90,9 @@ def test_beta_limit_and_core_routes_agree_with_ours():
 @pytest.mark.parametrize("route", ["solves", "nested"])
 def test_reduced_qp_equals_solve_contact(route):
     """The QP-level route (only A, B, F) = the mesh-level route, for both factorizations."""
-    from infsup_contact.contact_problem import solve_contact
+    from infsup_contact.solvers.contact import solve_contact
     from infsup_contact.peers import contact_qp
-    from infsup_contact.reduced_qp import solve_reduced_qp
+    from infsup_contact.solvers.reduced_qp import solve_reduced_qp
     from infsup_contact.scenes import membranes
 
     sc, sides, Bs, F = bench._contact_problem(6, 2)

@@ -4,7 +4,7 @@ import pytest
 import scipy.linalg as sla
 
 from infsup_contact.discretization.coupling import coupling_matrix
-from infsup_contact.infsup import beta_rows, saddle_point_beta, spectrum
+from infsup_contact.solvers.infsup import beta_rows, saddle_point_beta, spectrum
 from infsup_contact.models.schur import interface_operator, schur_by_solves
 from infsup_contact.models.membranes import side_operator
 from infsup_contact.discretization.meshes import mesh_pair, multiplier_breakpoints

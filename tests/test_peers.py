@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 
 from infsup_contact import bench, peers
-from infsup_contact.contact_problem import solve_contact
+from infsup_contact.solvers.contact import solve_contact
 from infsup_contact.scenes import membranes
 
 

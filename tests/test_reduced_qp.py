@@ -3,11 +3,11 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
-from infsup_contact.contact import solve_kkt_sparse
-from infsup_contact.contact_problem import linear_saddle_solve
+from infsup_contact.solvers.pdas import solve_kkt_sparse
+from infsup_contact.solvers.contact import linear_saddle_solve
 from infsup_contact.errors import InputError
 from infsup_contact.models.schur import gamma_factorization
-from infsup_contact.reduced_qp import solve_reduced_qp, touched_columns
+from infsup_contact.solvers.reduced_qp import solve_reduced_qp, touched_columns
 
 from test_pdas import assert_qp_kkt, lap2d, random_problem, thin_obstacle
 

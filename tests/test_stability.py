@@ -7,7 +7,7 @@ above its one-dimensional kernel decays.
 import numpy as np
 import pytest
 
-from infsup_contact.infsup import beta_rows
+from infsup_contact.solvers.infsup import beta_rows
 
 STABLE = [("T3", k) for k in (1, 2, 3, 4)] + [("T4", k) for k in (2, 3, 4)] + [("T5", k) for k in (2, 3, 4)]
 

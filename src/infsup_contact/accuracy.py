@@ -8,7 +8,7 @@ import ngsolve
 import numpy as np
 import scipy.fft
 
-from .contact_problem import ContactSolution, gamma_values, lambda_values
+from .solvers.contact import ContactSolution, gamma_values, lambda_values
 from .discretization.norms import sine_coefficients
 
 N_SAMPLE = 4001

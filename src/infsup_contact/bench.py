@@ -86,7 +86,7 @@ import scipy.sparse.linalg as spla
 
 from .discretization import meshes, multipliers
 from .discretization.coupling import coupling_matrix
-from .infsup import beta_rows
+from .solvers.infsup import beta_rows
 from .models.schur import SideOperator, interface_operator
 from .models.membranes import side_operator
 from .discretization.norms import gram
@@ -444,7 +444,7 @@ def bench_beta(ns, ks, repeats: int = 3, dense_max_size: int = 2500, eigsh_max_n
 def _contact_problem(n: int, k: int, case: str = "T3"):
     """Membranes scene on the structured N×N pair: sides, couplings, loads (c = 1), as
     :func:`contact_problem.solve_contact` builds them."""
-    from .contact_problem import load_vectors
+    from .solvers.contact import load_vectors
     from .scenes import membranes
 
     sc = membranes()
@@ -520,9 +520,9 @@ def bench_contact(ns, ks, repeats: int = 3, case: str = "T3", peers=("osqp", "cl
     the tolerance search: tol, rel. diff u, rel. diff λ, iterations, seconds, status).
     """
     from . import peers as peer_mod
-    from .contact import solve_kkt_sparse
-    from .contact_problem import linear_saddle_solve, solve_contact
-    from .reduced_qp import solve_reduced_qp
+    from .solvers.pdas import solve_kkt_sparse
+    from .solvers.contact import linear_saddle_solve, solve_contact
+    from .solvers.reduced_qp import solve_reduced_qp
     from .scenes import membranes
 
     peer_options = {"clarabel": {"method": "faer"}} if peer_options is None else peer_options
@@ -666,7 +666,7 @@ def time_contact_solve(case: str, k: int, n: int, repeats: int = 3, scene: str =
                        family: str = "structured", scene_params: dict | None = None, c=(1.0, 1.0)):
     """Median, min, max wall time of :func:`contact_problem.solve_contact` (whole call:
     mesh, assembly, interface operator, PDAS, recovery; no floor timing)."""
-    from .contact_problem import solve_contact
+    from .solvers.contact import solve_contact
     from .scenes import scene as make_scene
 
     sc = make_scene(scene, c1=c[0], c2=c[1], **(scene_params or {}))

@@ -53,7 +53,7 @@ def _add_beta(sub) -> None:
 def _run_beta(args) -> None:
     import pandas as pd
 
-    from .infsup import beta_rows
+    from .solvers.infsup import beta_rows
     from .discretization.multipliers import CASE_IDS, CASES
 
     if args.case == "all":

@@ -2,7 +2,7 @@
 from __future__ import annotations
 
 from . import accuracy
-from .contact_problem import ContactSolution, solve_contact
+from .solvers.contact import ContactSolution, solve_contact
 from .errors import InputError
 from .discretization.multipliers import CASES, check_case
 from .scenes import scene as make_scene

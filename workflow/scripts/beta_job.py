@@ -9,7 +9,7 @@ log_to(snakemake.log[0])  # noqa: F821
 
 import pandas as pd  # noqa: E402
 
-from infsup_contact.infsup import beta_rows  # noqa: E402
+from infsup_contact.solvers.infsup import beta_rows  # noqa: E402
 from infsup_contact.io import write_csv_atomic  # noqa: E402
 
 wc, ic = snakemake.wildcards, snakemake.params.ic  # noqa: F821

@@ -55,7 +55,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from scipy.optimize import linprog, nnls
 
-from .errors import InputError
+from ..errors import InputError
 
 _EPS = np.finfo(float).eps
 

@@ -14,12 +14,12 @@ import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
 
-from .discretization import meshes, multipliers
-from .discretization.coupling import coupling_matrix, union_breakpoints
-from .errors import InputError
-from .models.schur import interface_operator
-from .models.membranes import side_operator
-from .discretization.norms import NORMS, gram
+from ..discretization import meshes, multipliers
+from ..discretization.coupling import coupling_matrix, union_breakpoints
+from ..errors import InputError
+from ..models.schur import interface_operator
+from ..models.membranes import side_operator
+from ..discretization.norms import NORMS, gram
 
 KERNEL_RTOL = 1e-8
 """An eigenvalue μ² < KERNEL_RTOL · (largest eigenvalue) counts as a numerical zero."""

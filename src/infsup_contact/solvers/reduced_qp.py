@@ -25,8 +25,8 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
-from .contact import PdasResult, _check_kkt, solve_pdas
-from .models.schur import gamma_factorization
+from .pdas import PdasResult, _check_kkt, solve_pdas
+from ..models.schur import gamma_factorization
 
 __all__ = ["ReducedQpSolution", "solve_reduced_qp", "touched_columns"]
 

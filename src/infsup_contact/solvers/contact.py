@@ -16,11 +16,11 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from .discretization import meshes, multipliers
-from .contact import PdasResult, solve_pdas
-from .discretization.coupling import coupling_matrix
-from .models.schur import SideOperator, interface_operator
-from .models.membranes import side_operator
+from ..discretization import meshes, multipliers
+from .pdas import PdasResult, solve_pdas
+from ..discretization.coupling import coupling_matrix
+from ..models.schur import SideOperator, interface_operator
+from ..models.membranes import side_operator
 
 
 @dataclass

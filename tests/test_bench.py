@@ -93,7 +93,7 @@ def test_reduced_qp_equals_solve_contact(route):
     from infsup_contact.solvers.contact import solve_contact
     from infsup_contact.peers import contact_qp
     from infsup_contact.solvers.reduced_qp import solve_reduced_qp
-    from infsup_contact.scenes import membranes
+    from infsup_contact.study.scenes import membranes
 
     sc, sides, Bs, F = bench._contact_problem(6, 2)
     sol = solve_contact(membranes(), "T3", 2, "structured", 6, 6, time_floor=False)
@@ -107,7 +107,7 @@ def test_reduced_qp_equals_solve_contact(route):
 
 # ------------------------------------------------------------------ speed–accuracy
 def test_speed_accuracy_table_from_contact_rows():
-    from infsup_contact.study import contact_row
+    from infsup_contact.study.contact_rows import contact_row
 
     rows = [contact_row("manufactured", case, k, "structured", n, n, time_floor=False)
             for case, k in (("T3", 1), ("T4", 2)) for n in (4, 6)]

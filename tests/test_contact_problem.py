@@ -2,11 +2,11 @@
 import numpy as np
 import pytest
 
-from infsup_contact.claims import sign_check
+from infsup_contact.study.claims import sign_check
 from infsup_contact.solvers.pdas import solve_kkt_sparse
 from infsup_contact.solvers.contact import contact_qp, load_vector, solve_contact
-from infsup_contact.scenes import manufactured, membranes
-from infsup_contact.study import contact_row
+from infsup_contact.study.scenes import manufactured, membranes
+from infsup_contact.study.contact_rows import contact_row
 
 
 @pytest.mark.parametrize("case,k,n1,n2", [("T3", 1, 6, 6), ("T5", 2, 5, 4), ("T4", 2, 6, 6)])

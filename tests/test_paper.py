@@ -16,7 +16,7 @@ import pytest
 import yaml
 
 from infsup_contact import papertex as pt
-from infsup_contact.claims import REM55_INSTANCES, ledger
+from infsup_contact.study.claims import REM55_INSTANCES, ledger
 
 ROOT = Path(__file__).resolve().parents[1]
 PAPER = ROOT / "paper" / "paper.tex"

@@ -445,7 +445,7 @@ def _contact_problem(n: int, k: int, case: str = "T3"):
     """Membranes scene on the structured N×N pair: sides, couplings, loads (c = 1), as
     :func:`contact_problem.solve_contact` builds them."""
     from .solvers.contact import load_vectors
-    from .scenes import membranes
+    from .study.scenes import membranes
 
     sc = membranes()
     m1, m2 = meshes.mesh_pair("structured", n, n)
@@ -523,7 +523,7 @@ def bench_contact(ns, ks, repeats: int = 3, case: str = "T3", peers=("osqp", "cl
     from .solvers.pdas import solve_kkt_sparse
     from .solvers.contact import linear_saddle_solve, solve_contact
     from .solvers.reduced_qp import solve_reduced_qp
-    from .scenes import membranes
+    from .study.scenes import membranes
 
     peer_options = {"clarabel": {"method": "faer"}} if peer_options is None else peer_options
     tolerances = tuple(tolerances or peer_mod.TOLERANCES)
@@ -667,7 +667,7 @@ def time_contact_solve(case: str, k: int, n: int, repeats: int = 3, scene: str =
     """Median, min, max wall time of :func:`contact_problem.solve_contact` (whole call:
     mesh, assembly, interface operator, PDAS, recovery; no floor timing)."""
     from .solvers.contact import solve_contact
-    from .scenes import scene as make_scene
+    from .study.scenes import scene as make_scene
 
     sc = make_scene(scene, c1=c[0], c2=c[1], **(scene_params or {}))
     _, med, lo, hi = timed(lambda: solve_contact(sc, case, k, family, n, n, time_floor=False), repeats)

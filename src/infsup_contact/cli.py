@@ -94,7 +94,7 @@ def _run_contact(args) -> None:
     import pandas as pd
 
     from .discretization.multipliers import CASE_IDS, CASES
-    from .study import contact_row
+    from .study.contact_rows import contact_row
 
     if not 1 <= args.k <= 4:
         raise InputError("k", "an integer in 1..4", got=args.k)
@@ -104,8 +104,8 @@ def _run_contact(args) -> None:
     rows = []
     for case in cases:
         if args.scene == "membranes" and ref is None:
-            from .scenes import scene
-            from .study import reference_solution
+            from .study.scenes import scene
+            from .study.contact_rows import reference_solution
             ref = reference_solution(scene("membranes", c1=args.c1, c2=args.c2), args.k, args.n_ref)
         rows.append(contact_row(args.scene, case, args.k, args.family, args.N1, args.N2,
                                 args.c1, args.c2, reference=ref, scene_params=params))
@@ -122,7 +122,7 @@ def _add_rates(sub) -> None:
 def _run_rates(args) -> None:
     import pandas as pd
 
-    from .rates import rate_table
+    from .study.rates import rate_table
 
     try:
         frame = pd.read_csv(args.table)

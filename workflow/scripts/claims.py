@@ -7,7 +7,7 @@ from _glue import log_to  # noqa: E402
 log_to(snakemake.log[0])  # noqa: F821
 import pandas as pd  # noqa: E402
 
-from infsup_contact.claims import ledger  # noqa: E402
+from infsup_contact.study.claims import ledger  # noqa: E402
 from infsup_contact.io import write_csv_atomic  # noqa: E402
 
 inp = snakemake.input  # noqa: F821

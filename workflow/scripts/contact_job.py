@@ -10,8 +10,8 @@ log_to(snakemake.log[0])  # noqa: F821
 import pandas as pd  # noqa: E402
 
 from infsup_contact.io import write_csv_atomic  # noqa: E402
-from infsup_contact.scenes import scene as make_scene  # noqa: E402
-from infsup_contact.study import contact_row, reference_solution  # noqa: E402
+from infsup_contact.study.scenes import scene as make_scene  # noqa: E402
+from infsup_contact.study.contact_rows import contact_row, reference_solution  # noqa: E402
 
 wc, cc = snakemake.wildcards, snakemake.params.cc  # noqa: F821
 k, n = int(wc.k), int(wc.n)

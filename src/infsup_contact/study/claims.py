@@ -129,7 +129,7 @@ def sign_check(k: int = 2, n: int = 32, c=(1.0, 3.0), case: str = "T5") -> dict:
     """
     import ngsolve
 
-    from .solvers.contact import lambda_values, solve_contact
+    from ..solvers.contact import lambda_values, solve_contact
     from .scenes import membranes
 
     sol = solve_contact(membranes(c1=c[0], c2=c[1]), case, k, "structured", n, n, time_floor=False)
@@ -241,7 +241,7 @@ def findings(beta: pd.DataFrame, cfg: dict) -> list:
 
 def extra_claims(cfg: dict) -> pd.DataFrame:
     """Claims that need their own small computation: the (3.13) sign and Rem 5.5 instances."""
-    from .solvers.infsup import beta_rows
+    from ..solvers.infsup import beta_rows
 
     tol, floor, conf = cfg["slope_tolerance"], cfg["beta_floor"], cfg["confidence"]
     s = sign_check()

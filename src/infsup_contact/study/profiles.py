@@ -18,7 +18,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from .solvers.contact import ContactSolution, gamma_values, lambda_values, solve_contact
+from ..solvers.contact import ContactSolution, gamma_values, lambda_values, solve_contact
 from .scenes import membranes
 
 GAMMA_COLUMNS = ["case", "k", "N", "x", "quantity", "value"]

@@ -2,9 +2,9 @@
 from __future__ import annotations
 
 from . import accuracy
-from .solvers.contact import ContactSolution, solve_contact
-from .errors import InputError
-from .discretization.multipliers import CASES, check_case
+from ..solvers.contact import ContactSolution, solve_contact
+from ..errors import InputError
+from ..discretization.multipliers import CASES, check_case
 from .scenes import scene as make_scene
 
 REFERENCE_CASE = "T3"

@@ -8,8 +8,8 @@ import ngsolve
 import numpy as np
 import scipy.fft
 
-from .solvers.contact import ContactSolution, gamma_values, lambda_values
-from .discretization.norms import sine_coefficients
+from ..solvers.contact import ContactSolution, gamma_values, lambda_values
+from ..discretization.norms import sine_coefficients
 
 N_SAMPLE = 4001
 """Points on Γ for pointwise quantities (penetration, contact set)."""

@@ -35,7 +35,7 @@ from typing import Callable
 import numpy as np
 from ngsolve import CoefficientFunction, IfPos, cos, pi, sin, x, y
 
-from .errors import InputError
+from ..errors import InputError
 
 SCENES = ("manufactured", "membranes")
 

@@ -7,7 +7,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from infsup_contact import plotting
+from infsup_contact.report import style as plotting
 from infsup_contact.discretization.multipliers import CASE_IDS
 
 SCRIPTS = Path(__file__).resolve().parents[1] / "workflow" / "scripts"

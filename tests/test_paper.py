@@ -15,7 +15,7 @@ import pandas as pd
 import pytest
 import yaml
 
-from infsup_contact import papertex as pt
+from infsup_contact import report as pt
 from infsup_contact.study.claims import REM55_INSTANCES, ledger
 
 ROOT = Path(__file__).resolve().parents[1]

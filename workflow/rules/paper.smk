@@ -34,7 +34,7 @@ rule paper_macros:
         bench_contact="results/benchmarks/contact.csv",
         provenance="results/provenance.json",
         tex="paper/paper.tex",
-        src="src/infsup_contact/papertex.py",
+        src=REPORT_SOURCES,
     params:
         cfg=lambda wc: {key: config[key] for key in ("claims", "contact", "infsup")},
     log:

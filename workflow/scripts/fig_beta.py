@@ -19,7 +19,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 
-from infsup_contact.plotting import (h_ticks, CASE_COLORS, LABELS, NEUTRAL, case_label, case_style,  # noqa: E402
+from infsup_contact.report.style import (h_ticks, CASE_COLORS, LABELS, NEUTRAL, case_label, case_style,  # noqa: E402
                                      mesh_size, ordered_cases, save_figure, slope_triangle, style)
 
 

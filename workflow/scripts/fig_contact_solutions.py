@@ -20,7 +20,7 @@ import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 from matplotlib.ticker import MaxNLocator  # noqa: E402
 
-from infsup_contact.plotting import (CASE_COLORS, LABELS, NEUTRAL, case_label, case_style,  # noqa: E402
+from infsup_contact.report.style import (CASE_COLORS, LABELS, NEUTRAL, case_label, case_style,  # noqa: E402
                                      is_stable, ordered_cases, save_figure, style)
 
 FIELD_CMAP = "PuOr_r"  # diverging, colour-vision-deficiency safe; u1 < 0 < u2 mostly

@@ -19,7 +19,7 @@ import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 from matplotlib.lines import Line2D  # noqa: E402
 
-from infsup_contact.plotting import (h_ticks, CASE_COLORS, LABELS, MEASURES, case_label, case_style,  # noqa: E402
+from infsup_contact.report.style import (h_ticks, CASE_COLORS, LABELS, MEASURES, case_label, case_style,  # noqa: E402
                                      mesh_size, ordered_cases, save_figure, style)
 
 MEASURE_ORDER = ("energy_error", "l2_error", "lambda_l2_error", "lambda_hm12_error")

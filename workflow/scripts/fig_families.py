@@ -24,7 +24,7 @@ import pandas as pd  # noqa: E402
 from matplotlib.collections import LineCollection  # noqa: E402
 from matplotlib.lines import Line2D  # noqa: E402
 
-from infsup_contact.plotting import (h_ticks, CASE_COLORS, LABELS, NEUTRAL, case_style, mesh_size,  # noqa: E402
+from infsup_contact.report.style import (h_ticks, CASE_COLORS, LABELS, NEUTRAL, case_style, mesh_size,  # noqa: E402
                                      save_figure, style)
 
 FAMILY_ORDER = ("structured", "perturbed", "unstructured")

@@ -19,7 +19,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.patches import FancyArrowPatch, Rectangle  # noqa: E402
 
-from infsup_contact.plotting import CASE_COLORS, NEUTRAL, save_figure, style  # noqa: E402
+from infsup_contact.report.style import CASE_COLORS, NEUTRAL, save_figure, style  # noqa: E402
 
 OMEGA_FILL = ("#dedede", "#f2f2f2")  # Ω1, Ω2
 LOAD = NEUTRAL

@@ -1,7 +1,7 @@
 """Generate results/paper/*.tex (macros and tables) from the result tables, atomically.
 
 Every number, table and verdict of paper/paper.tex comes from these files
-(infsup_contact.papertex, pure functions). Before writing anything, the script checks that
+(infsup_contact.report, pure functions). Before writing anything, the script checks that
 paper.tex uses only macros and \\input files that the tables provide, so a config without a
 case the text discusses fails here with one line instead of deep inside pdflatex.
 """
@@ -16,7 +16,7 @@ log_to(snakemake.log[0])  # noqa: F821
 import pandas as pd  # noqa: E402
 
 from infsup_contact.io import write_atomic  # noqa: E402
-from infsup_contact.papertex import PaperTexError, check_paper, paper_files  # noqa: E402
+from infsup_contact.report.paper import PaperTexError, check_paper, paper_files  # noqa: E402
 
 inp, out = snakemake.input, snakemake.output  # noqa: F821
 

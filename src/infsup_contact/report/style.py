@@ -24,7 +24,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from .discretization.multipliers import CASE_IDS, STABLE_CASES  # noqa: E402
+from ..discretization.multipliers import CASE_IDS, STABLE_CASES  # noqa: E402
 
 #: Okabe & Ito (2008), "Color Universal Design".
 OKABE_ITO = MappingProxyType({

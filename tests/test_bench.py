@@ -4,6 +4,7 @@ import pandas as pd
 import pytest
 
 from infsup_contact import bench
+from infsup_contact.bench import beta_routes, contact_routes
 
 BETA_REQUIRED = {"what", "route", "k", "N", "seconds_median", "seconds_min", "seconds_max",
                  "ratio_to_ours", "max_abs_diff"}
@@ -78,12 +79,12 @@ def test_bench_contact_columns_and_agreement():
 
 
 def test_beta_limit_and_core_routes_agree_with_ours():
-    setup = bench.BetaSetup(4, 2)
-    ref = bench.beta_ours(4, 2)
-    core = bench.beta_ours_core(setup)
-    diff, kernel_ok = bench._compare(core, ref)
+    setup = beta_routes.BetaSetup(4, 2)
+    ref = beta_routes.beta_ours(4, 2)
+    core = beta_routes.beta_ours_core(setup)
+    diff, kernel_ok = beta_routes._compare(core, ref)
     assert diff <= 1e-12 and kernel_ok
-    lim = bench.beta_limit(setup)()
+    lim = beta_routes.beta_limit(setup)()
     assert set(lim) == set(ref)
 
 
@@ -91,16 +92,16 @@ def test_beta_limit_and_core_routes_agree_with_ours():
 def test_reduced_qp_equals_solve_contact(route):
     """The QP-level route (only A, B, F) = the mesh-level route, for both factorizations."""
     from infsup_contact.solvers.contact import solve_contact
-    from infsup_contact.peers import contact_qp
+    from infsup_contact.bench.peers import contact_qp
     from infsup_contact.solvers.reduced_qp import solve_reduced_qp
     from infsup_contact.study.scenes import membranes
 
-    sc, sides, Bs, F = bench._contact_problem(6, 2)
+    sc, sides, Bs, F = contact_routes._contact_problem(6, 2)
     sol = solve_contact(membranes(), "T3", 2, "structured", 6, 6, time_floor=False)
     qp = solve_reduced_qp(*contact_qp(sides, Bs, F), route=route)
     assert qp.route == route and qp.n_gamma == sum(B.shape[1] for B in Bs)
     assert np.abs(qp.lam - sol.lam).max() <= 1e-12 * np.abs(sol.lam).max()
-    assert np.abs(qp.u - bench._ours_u(sol)).max() <= 1e-12 * np.abs(qp.u).max()
+    assert np.abs(qp.u - contact_routes._ours_u(sol)).max() <= 1e-12 * np.abs(qp.u).max()
     # the early exit on a passed KKT check may come one step apart on round-off
     assert abs(qp.iterations - sol.pdas.iterations) <= 1
 

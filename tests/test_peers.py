@@ -2,7 +2,8 @@
 import numpy as np
 import pytest
 
-from infsup_contact import bench, peers
+from infsup_contact import bench
+from infsup_contact.bench import contact_routes, peers
 from infsup_contact.solvers.contact import solve_contact
 from infsup_contact.study.scenes import membranes
 
@@ -10,7 +11,7 @@ from infsup_contact.study.scenes import membranes
 @pytest.fixture(scope="module", params=[1, 2], ids=["k1", "k2"])
 def problem(request):
     k, n = request.param, 8
-    sc, sides, Bs, F = bench._contact_problem(n, k)
+    sc, sides, Bs, F = contact_routes._contact_problem(n, k)
     A, B, Fv = peers.contact_qp(sides, Bs, F, (sc.c1, sc.c2))
     sol = solve_contact(membranes(), "T3", k, "structured", n, n, time_floor=False)
     u = np.concatenate([gf.vec.FV().NumPy()[s.free] for gf, s in zip(sol.u, sol.sides)])

@@ -161,7 +161,7 @@ def _run_bench(args) -> None:
             raise InputError("k", "integers in 1..4", got=k)
     if args.repeats < 1:
         raise InputError("repeats", "an integer >= 1", got=args.repeats)
-    from .peers import SOLVERS
+    from .bench.peers import SOLVERS
 
     peers = [p for p in args.peers if p != "none"]
     for p in peers:

@@ -29,10 +29,12 @@ _check_before_schema(config)
 validate(config, schema="../schemas/config.schema.yaml")
 
 # Source edits must trigger reruns: every compute rule lists the package as input, except
-# the modules that only draw, typeset or time (their own rules list them).
-PRESENTATION_ONLY = {"plotting.py", "papertex.py", "bench.py", "peers.py"}
-PACKAGE_SOURCES = sorted(str(p) for p in Path("src/infsup_contact").rglob("*.py") if p.name not in PRESENTATION_ONLY)
-BENCH_SOURCES = ["src/infsup_contact/bench.py", "src/infsup_contact/peers.py"]
+# the stages that only draw, typeset or time (report/, bench/: their own rules list them).
+_PKG = Path("src/infsup_contact")
+PRESENTATION_ONLY = ("report", "bench")
+PACKAGE_SOURCES = sorted(str(p) for p in _PKG.rglob("*.py") if p.relative_to(_PKG).parts[0] not in PRESENTATION_ONLY)
+REPORT_SOURCES = sorted(str(p) for p in (_PKG / "report").glob("*.py"))
+BENCH_SOURCES = sorted(str(p) for p in (_PKG / "bench").glob("*.py"))
 
 def beta_pairs():
     """(N1, N2) mesh pairs of the β_h study: matching N×N plus the non-matching pairs."""

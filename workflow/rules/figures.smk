@@ -1,6 +1,6 @@
 # Figures stage: one rule per figure, each drawn from tables under results/tables/ only
 # (nothing recomputed), written as results/figures/NAME.pdf and .png. Shared style (one
-# Okabe–Ito colour and one marker per case): src/infsup_contact/plotting.py.
+# Okabe–Ito colour and one marker per case): src/infsup_contact/report/style.py.
 # Captions for `snakemake --report`: workflow/report/NAME.rst.
 
 FIGURE_NAMES = [
@@ -19,7 +19,7 @@ FIGURES = [f"results/figures/{name}.{ext}" for name in FIGURE_NAMES for ext in (
 FIG5 = {"cases": ["T4", "R5.4"], "k": 2, "N": 16, "family": "structured", "scene": "membranes",
         "per_interval": 9}
 
-PLOT_STYLE = "src/infsup_contact/plotting.py"
+PLOT_STYLE = "src/infsup_contact/report/style.py"
 
 
 # NAME → {"pdf": ..., "png": ...}: the outputs marked for the report, caption workflow/report/NAME.rst.
@@ -161,7 +161,7 @@ rule fig7_speed_accuracy:
     input:
         table="results/tables/speed_accuracy.csv",  # written by the benchmarks stage
         style=PLOT_STYLE,
-        pareto="src/infsup_contact/bench.py",  # pareto_front
+        pareto="src/infsup_contact/bench/speed_accuracy.py",  # pareto_front
     log:
         "results/logs/figures/fig7_speed_accuracy.log",
     script:

@@ -22,7 +22,7 @@ import pandas as pd  # noqa: E402
 from matplotlib.lines import Line2D  # noqa: E402
 
 from infsup_contact.bench import pareto_front  # noqa: E402
-from infsup_contact.plotting import (CASE_COLORS, K_FILL, LABELS, MEASURES, NEUTRAL, case_label, case_style,  # noqa: E402
+from infsup_contact.report.style import (CASE_COLORS, K_FILL, LABELS, MEASURES, NEUTRAL, case_label, case_style,  # noqa: E402
                                      ordered_cases, save_figure, style)
 
 REQUIRED = ("scene", "case", "k", "N", "seconds")

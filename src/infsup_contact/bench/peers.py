@@ -32,7 +32,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.sparse as sp
 
-from .solvers.contact import contact_qp  # the assembled QP all peers get
+from ..solvers.contact import contact_qp  # the assembled QP all peers get
 
 TOLERANCES = tuple(10.0 ** -e for e in range(3, 16))
 """Tolerances tried, loosest first, when tuning a peer to reproduce our solution."""

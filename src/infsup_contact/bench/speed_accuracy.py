@@ -1,0 +1,91 @@
+"""Speed against accuracy: wall time of contact solves next to their errors, and the Pareto front."""
+from __future__ import annotations
+
+import numpy as np
+
+from .harness import _log, timed
+
+
+def pareto_front(times, errors) -> np.ndarray:
+    """Boolean mask of the Pareto-optimal points when minimizing both time and error.
+
+    A point is on the front iff no other point is at least as fast and at least as
+    accurate and strictly better in one of the two. Points with a non-finite time or
+    error are never on the front and dominate nothing; exact duplicates are both kept.
+    """
+    t = np.asarray(times, dtype=float).reshape(-1)
+    e = np.asarray(errors, dtype=float).reshape(-1)
+    if t.shape != e.shape:
+        raise ValueError(f"times and errors differ in length: {t.shape} vs {e.shape}")
+    ok = np.isfinite(t) & np.isfinite(e)
+    mask = np.zeros(t.shape, dtype=bool)
+    for i in np.flatnonzero(ok):
+        dominated = ok & (t <= t[i]) & (e <= e[i]) & ((t < t[i]) | (e < e[i]))
+        mask[i] = not dominated.any()
+    return mask
+
+
+def time_contact_solve(case: str, k: int, n: int, repeats: int = 3, scene: str = "manufactured",
+                       family: str = "structured", scene_params: dict | None = None, c=(1.0, 1.0)):
+    """Median, min, max wall time of :func:`contact_problem.solve_contact` (whole call:
+    mesh, assembly, interface operator, PDAS, recovery; no floor timing)."""
+    from ..solvers.contact import solve_contact
+    from ..study.scenes import scene as make_scene
+
+    sc = make_scene(scene, c1=c[0], c2=c[1], **(scene_params or {}))
+    _, med, lo, hi = timed(lambda: solve_contact(sc, case, k, family, n, n, time_floor=False), repeats)
+    return med, lo, hi
+
+
+def speed_accuracy_table(errors, repeats: int = 3, timing_scene: str = "manufactured",
+                         timing_params: dict | None = None, c=(1.0, 1.0)):
+    """Speed–accuracy points: the errors of every (scene, case, k, N) with wall times.
+
+    Parameters
+    ----------
+    errors : pandas.DataFrame
+        Contact rows (``infsup-contact contact`` / ``results/tables/contact.csv``) with
+        scene, case, k, family, N1, N2, energy_error, lambda_hm12_error; matching meshes
+        (N1 = N2) are used.
+    repeats : timing repetitions (median reported).
+    timing_scene, timing_params : the scene whose solves are timed; the cost of a
+        discretization (case, k, family, N) does not depend on the load, so one timing
+        serves every scene.
+
+    Returns
+    -------
+    pandas.DataFrame with scene, case, k, family, N, seconds (median), seconds_min,
+    seconds_max, energy_error, lambda_hm12_error, ndof, dim_M, pareto_energy,
+    pareto_lambda (Pareto front per scene and family).
+    """
+    import pandas as pd
+
+    frame = errors[errors.N1 == errors.N2].copy()
+    frame["N"] = frame.N1.astype(int)
+    keys = sorted({(r.case, int(r.k), r.family, int(r.N)) for r in frame.itertuples()},
+                  key=lambda t: (t[2], t[1], t[0], t[3]))
+    timing = {}
+    for case, k, family, n in keys:
+        timing[case, k, family, n] = time_contact_solve(case, k, n, repeats, timing_scene, family,
+                                                        timing_params, c)
+        _log(f"speed-accuracy {family} {case} k={k} N={n}: {timing[case, k, family, n][0]:.4f} s")
+    t = np.array([timing[r.case, int(r.k), r.family, int(r.N)] for r in frame.itertuples()])
+    frame["seconds"], frame["seconds_min"], frame["seconds_max"] = t[:, 0], t[:, 1], t[:, 2]
+    frame["timing_scene"], frame["repeats"] = timing_scene, repeats
+    cols = ["scene", "case", "k", "family", "N", "seconds", "seconds_min", "seconds_max",
+            "energy_error", "lambda_hm12_error"]
+    cols += [c_ for c_ in ("ndof", "dim_M", "cone", "nonunique", "kernel_dim") if c_ in frame.columns]
+    out = frame[cols + ["timing_scene", "repeats"]].reset_index(drop=True)
+    out["pareto_energy"] = False
+    out["pareto_lambda"] = False
+    for _, g in out.groupby(["scene", "family"]):
+        out.loc[g.index, "pareto_energy"] = pareto_front(g.seconds, g.energy_error)
+        out.loc[g.index, "pareto_lambda"] = pareto_front(g.seconds, g.lambda_hm12_error)
+    return pd.DataFrame(out).sort_values(["scene", "family", "k", "case", "N"]).reset_index(drop=True)
+
+
+def fastest_for_accuracy(table, error: str = "energy_error"):
+    """Per scene: the Pareto-front rows (ascending time), i.e. for every accuracy level
+    the cheapest discretization reaching it."""
+    flag = "pareto_energy" if error == "energy_error" else "pareto_lambda"
+    return table[table[flag]].sort_values(["scene", "seconds"])

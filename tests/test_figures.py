@@ -8,7 +8,9 @@ import pandas as pd
 import pytest
 
 from infsup_contact.report import style as plotting
-from infsup_contact.discretization.multipliers import CASE_IDS
+from infsup_contact.discretization.registry import space_ids
+
+CASE_IDS = space_ids()
 
 SCRIPTS = Path(__file__).resolve().parents[1] / "workflow" / "scripts"
 FIGURE_SCRIPTS = ("fig_model_problem", "fig_beta", "fig_families", "fig_contact_solutions",

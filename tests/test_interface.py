@@ -8,7 +8,7 @@ from infsup_contact.solvers.infsup import beta_rows, saddle_point_beta, spectrum
 from infsup_contact.models.schur import interface_operator, schur_by_solves
 from infsup_contact.models.membranes import side_operator
 from infsup_contact.discretization.meshes import mesh_pair, multiplier_breakpoints
-from infsup_contact.discretization.multipliers import case_space
+from infsup_contact.discretization.registry import case_space
 from infsup_contact.discretization.norms import gram
 
 

@@ -3,10 +3,11 @@ import numpy as np
 import pytest
 
 from infsup_contact.errors import InputError
-from infsup_contact.discretization.multipliers import (CASE_IDS, CASES, case_space, make_space, paper_dimension,
-                                        structural_kernel_dim)
+from infsup_contact.discretization.multipliers import make_space
+from infsup_contact.discretization.registry import (PAPER_CASES as CASE_IDS, SPACES, case_space, paper_dimension,
+                                                    structural_kernel_dim)
 
-VALID = [(c, k) for c in CASE_IDS for k in range(1, 5) if k >= CASES[c][4]]
+VALID = [(c, k) for c in CASE_IDS for k in range(1, 5) if k >= SPACES[c].min_k]
 
 
 @pytest.mark.parametrize("case,k", VALID)

@@ -16,6 +16,7 @@ import pytest
 import yaml
 
 from infsup_contact import report as pt
+from infsup_contact.discretization.registry import PAPER_CASES
 from infsup_contact.study.claims import REM55_INSTANCES, ledger
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -133,7 +134,7 @@ def _by_name(t):
 # ----------------------------------------------------------------------------- naming
 
 def test_tokens_and_number_words():
-    assert [pt.token(c) for c in pt.CASES] == ["Tthree", "Rfivetwo", "Tfour", "Rfivefour", "Tfive"]
+    assert [pt.token(c) for c in PAPER_CASES] == ["Tthree", "Rfivetwo", "Tfour", "Rfivefour", "Tfive"]
     assert pt.token("eq3.13-sign") == "EqthreethirteenSign"
     assert pt.token("Thm3-k1-structured-evenN") == "ThmthreeKoneStructuredEvenN"
     assert pt.number_word(64) == "sixtyfour" and pt.number_word(128) == "onehundredtwentyeight"

@@ -31,10 +31,10 @@ class _Parser(argparse.ArgumentParser):
 
 def _add_beta(sub) -> None:
     from .discretization.meshes import FAMILIES
-    from .discretization.multipliers import CASE_IDS
+    from .discretization.registry import space_ids
 
     p = sub.add_parser("beta", help="β_h for one mesh pair (CSV: one row per case × norm)")
-    p.add_argument("--case", default="all", choices=[*CASE_IDS, "all"])
+    p.add_argument("--case", default="all", choices=[*space_ids(), "all"])
     p.add_argument("--k", type=int, required=True, help="displacement degree, 1..4")
     p.add_argument("--family", default="structured", choices=FAMILIES)
     p.add_argument("--N1", type=int, required=True, help="segments on Γ of the Ω1 mesh (>= 1)")
@@ -53,13 +53,13 @@ def _add_beta(sub) -> None:
 def _run_beta(args) -> None:
     import pandas as pd
 
+    from .discretization.registry import ids_valid_for
     from .solvers.infsup import beta_rows
-    from .discretization.multipliers import CASE_IDS, CASES
 
     if args.case == "all":
         if not 1 <= args.k <= 4:
             raise InputError("k", "an integer in 1..4", got=args.k)
-        cases = [c for c in CASE_IDS if args.k >= CASES[c][4]]
+        cases = ids_valid_for(args.k)
     else:
         cases = [args.case]
     norms = ("H", "L2") if args.norm == "all" else (args.norm,)
@@ -73,11 +73,11 @@ def _run_beta(args) -> None:
 
 def _add_contact(sub) -> None:
     from .discretization.meshes import FAMILIES
-    from .discretization.multipliers import CASE_IDS
+    from .discretization.registry import space_ids
 
     p = sub.add_parser("contact", help="solve (4.1) for one case and mesh pair (CSV: one row)")
     p.add_argument("--scene", required=True, choices=["manufactured", "membranes"])
-    p.add_argument("--case", required=True, choices=[*CASE_IDS, "all"])
+    p.add_argument("--case", required=True, choices=[*space_ids(), "all"])
     p.add_argument("--k", type=int, required=True, help="displacement degree, 1..4")
     p.add_argument("--family", default="structured", choices=FAMILIES)
     p.add_argument("--N1", type=int, required=True)
@@ -93,12 +93,12 @@ def _add_contact(sub) -> None:
 def _run_contact(args) -> None:
     import pandas as pd
 
-    from .discretization.multipliers import CASE_IDS, CASES
+    from .discretization.registry import ids_valid_for
     from .study.contact_rows import contact_row
 
     if not 1 <= args.k <= 4:
         raise InputError("k", "an integer in 1..4", got=args.k)
-    cases = [c for c in CASE_IDS if args.k >= CASES[c][4]] if args.case == "all" else [args.case]
+    cases = ids_valid_for(args.k) if args.case == "all" else [args.case]
     params = dict(p=args.p, q=args.q) if args.scene == "manufactured" else {}
     ref = None
     rows = []

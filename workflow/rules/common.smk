@@ -3,6 +3,8 @@ from pathlib import Path
 
 from snakemake.utils import validate
 
+from infsup_contact.discretization.registry import SPACES
+
 
 
 def _check_before_schema(cfg):
@@ -11,10 +13,11 @@ def _check_before_schema(cfg):
     for stage in ("infsup", "contact"):
         sc = cfg.get(stage) or {}
         cases = sc.get("cases") or {}
-        for case, thm in (("T4", "Thm 4"), ("T5", "Thm 5")):
+        for case, spec in SPACES.items():  # degrees each space allows (k < 1: the schema says it)
             ks = cases.get(case) or []
-            if isinstance(ks, list) and any(isinstance(k, (int, float)) and k < 2 for k in ks):
-                raise ValueError(f"config key {stage}.cases.{case}: {case} needs k >= 2 ({thm}); got {ks}")
+            if isinstance(ks, list) and any(isinstance(k, (int, float)) and 1 <= k < spec.min_k for k in ks):
+                raise ValueError(f"config key {stage}.cases.{case}: {case} needs k >= {spec.min_k} "
+                                 f"({spec.paper_ref}); got {ks}")
         ints[f"{stage}.N"] = sc.get("N") or []
         ints.update({f"{stage}.cases.{c}": v for c, v in cases.items() if isinstance(v, list)})
     pairs = (cfg.get("infsup") or {}).get("nonmatching") or []

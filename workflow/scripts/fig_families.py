@@ -24,6 +24,7 @@ import pandas as pd  # noqa: E402
 from matplotlib.collections import LineCollection  # noqa: E402
 from matplotlib.lines import Line2D  # noqa: E402
 
+from infsup_contact.discretization.registry import REFERENCE_SPACE  # noqa: E402
 from infsup_contact.report.style import (h_ticks, CASE_COLORS, LABELS, NEUTRAL, case_style, mesh_size,  # noqa: E402
                                      save_figure, style)
 
@@ -95,7 +96,7 @@ def draw_mesh_pair(ax, pair, title, n1, n2):
             bbox=dict(boxstyle="round,pad=0.1", fc="white", ec="none", alpha=0.8))
 
 
-def select_family_beta(beta: pd.DataFrame, case: str = "T3", ks=(1, 2)) -> pd.DataFrame:
+def select_family_beta(beta: pd.DataFrame, case: str = REFERENCE_SPACE, ks=(1, 2)) -> pd.DataFrame:
     """β_h rows of the lower panels: ``case``, H norm, first (c1, c2), k in ``ks``."""
     sel = beta[(beta.case == case) & (beta.norm == "H") & beta.k.isin(ks)]
     if sel.empty:
@@ -114,7 +115,7 @@ def main_ratio(sel: pd.DataFrame):
     return counts.sort_values(ascending=False, kind="stable").index[0]
 
 
-def plot_families(beta: pd.DataFrame, meshes, pdf, png, case: str = "T3") -> None:
+def plot_families(beta: pd.DataFrame, meshes, pdf, png, case: str = REFERENCE_SPACE) -> None:
     """Mesh panels (top) and β_h per family / multiplier mesh (bottom); save PDF+PNG."""
     sel = select_family_beta(beta, case)
     ks = sorted(sel.k.unique())

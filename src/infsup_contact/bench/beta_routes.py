@@ -39,7 +39,7 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from ..discretization import meshes, multipliers
+from ..discretization import meshes, registry
 from ..discretization.coupling import coupling_matrix
 from ..discretization.norms import gram
 from ..models.membranes import side_operator
@@ -57,7 +57,7 @@ BETA_COLUMNS = ("what", "route", "k", "N", "seconds_median", "seconds_min", "sec
 
 
 def _all_cases(k: int):
-    return [c for c in multipliers.CASE_IDS if k >= multipliers.CASES[c][4]]
+    return registry.ids_valid_for(k, registry.PAPER_CASES)
 
 
 def _bottom(beta2: np.ndarray, kern: int):
@@ -84,8 +84,8 @@ class BetaSetup:
         self.sides = [side_operator(m, k) for m in (m1, m2)]
         x = meshes.multiplier_breakpoints(m1, m2)
         self.cases = _all_cases(k)
-        self.spaces = {c: multipliers.case_space(c, k, x) for c in self.cases}
-        self.kernel = {c: multipliers.structural_kernel_dim(c, k, n) for c in self.cases}
+        self.spaces = {c: registry.case_space(c, k, x) for c in self.cases}
+        self.kernel = {c: registry.structural_kernel_dim(c, k, n) for c in self.cases}
         self.ndof = sum(s.ndof for s in self.sides)
 
     def keys(self):
@@ -123,7 +123,7 @@ def beta_ours(n: int, k: int):
     rows = beta_rows("structured", k, n, n, _all_cases(k), norms=NORMS)
     out = {}
     for r in rows:
-        kern = multipliers.structural_kernel_dim(r["case"], k, n)
+        kern = registry.structural_kernel_dim(r["case"], k, n)
         # beta_rows reports the first value above its numerical kernel; with the
         # structural kernel found (as it is, see the claims) that is the same value
         nz = r["beta"] if kern == 0 else (r["smallest_nonzero"] if r["kernel_dim"] == kern else np.nan)

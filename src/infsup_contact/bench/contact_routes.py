@@ -34,7 +34,8 @@ import time
 import numpy as np
 import scipy.sparse.linalg as spla
 
-from ..discretization import meshes, multipliers
+from ..discretization import meshes, registry
+from ..discretization.registry import REFERENCE_SPACE
 from ..discretization.coupling import coupling_matrix
 from ..models.membranes import side_operator
 from .harness import _log, _row, run_interleaved
@@ -48,7 +49,7 @@ CONTACT_COLUMNS = ("what", "route", "k", "N", "seconds_median", "seconds_min", "
                    "ndof", "dim_M", "includes")
 
 
-def _contact_problem(n: int, k: int, case: str = "T3"):
+def _contact_problem(n: int, k: int, case: str = REFERENCE_SPACE):
     """Membranes scene on the structured N×N pair: sides, couplings, loads (c = 1), as
     :func:`contact_problem.solve_contact` builds them."""
     from ..solvers.contact import load_vectors
@@ -57,7 +58,7 @@ def _contact_problem(n: int, k: int, case: str = "T3"):
     sc = membranes()
     m1, m2 = meshes.mesh_pair("structured", n, n)
     sides = [side_operator(m, k) for m in (m1, m2)]
-    space = multipliers.case_space(case, k, meshes.multiplier_breakpoints(m1, m2))
+    space = registry.case_space(case, k, meshes.multiplier_breakpoints(m1, m2))
     Bs = [coupling_matrix(s.trace, space, k) for s in sides]
     return sc, sides, Bs, load_vectors(sides, sc)
 
@@ -102,7 +103,7 @@ CONTACT_INCLUDES = {
 }
 
 
-def bench_contact(ns, ks, repeats: int = 3, case: str = "T3", peers=("osqp", "clarabel"),
+def bench_contact(ns, ks, repeats: int = 3, case: str = REFERENCE_SPACE, peers=("osqp", "clarabel"),
                   peer_options: dict | None = None, tolerances=None, peer_time_limit: float = 600.0,
                   kkt_max_n: int = 64, budget: float = 300.0, tune_budget: float = 1200.0):
     """Contact solves of the membranes scene: ours against the floor and the peers.

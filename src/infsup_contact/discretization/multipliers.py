@@ -5,8 +5,8 @@ The spaces are the paper's (5.3) and (5.5):
 * ``M^r_s``   — piecewise P_s on G_h, continuous (r = 1) or not (r = 0);
 * ``M^r_{0,s}`` — the same, vanishing at the endpoints x = 0 and x = 1.
 
-The five named cases of Section 5 are fixed triples (s, continuous, vanish) in terms
-of the displacement degree k; see :data:`CASES`.
+The named cases of Section 5 (and every other space) live in the registry,
+:mod:`infsup_contact.discretization.registry`.
 
 A space is plain data: the breakpoints, the local degree and the local-to-global dof
 map. Local shape functions are Lagrange polynomials on equispaced nodes of the
@@ -20,18 +20,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import InputError
-
-CASES = {
-    # case: (paper reference, degree as function of k, continuous, vanish at ends, min k)
-    "T3": ("Thm 3, M^1_{0,k}", lambda k: k, True, True, 1),
-    "R5.2": ("Rem 5.2, M^1_k", lambda k: k, True, False, 1),
-    "T4": ("Thm 4, M^0_{k-2}", lambda k: k - 2, False, False, 2),
-    "R5.4": ("Rem 5.4, M^0_{k-1}", lambda k: k - 1, False, False, 1),
-    "T5": ("Thm 5, M^1_{k-1}", lambda k: k - 1, True, False, 2),
-}
-CASE_IDS = tuple(CASES)
-STABLE_CASES = ("T3", "T4", "T5")
-
 
 @dataclass(frozen=True)
 class MultiplierSpace:
@@ -153,34 +141,6 @@ def make_space(breakpoints, degree: int, continuous: bool, vanish_at_ends: bool)
     return MultiplierSpace(x, s, continuous, vanish_at_ends, dofs, dim)
 
 
-def check_case(case: str, k: int) -> None:
-    """Raise :class:`InputError` unless ``case`` is a named case valid for degree ``k``."""
-    if case not in CASES:
-        raise InputError("case", ", ".join(CASE_IDS))
-    ref, _, _, _, kmin = CASES[case]
-    if k < kmin:
-        raise InputError("k", f"k >= {kmin} for case {case} ({ref} needs k >= {kmin})")
-
-
-def case_space(case: str, k: int, breakpoints) -> MultiplierSpace:
-    """The multiplier space of a named case of Section 5 for displacement degree k."""
-    check_case(case, k)
-    _, degree, continuous, vanish, _ = CASES[case]
-    return make_space(breakpoints, degree(k), continuous, vanish)
-
-
-def paper_dimension(case: str, k: int, n_intervals: int) -> int:
-    """dim M_h from the paper's counts (Rem 5.2, Rem 5.4, Thm 5 discussion), N intervals."""
-    n = n_intervals
-    return {"T3": n * k - 1, "R5.2": n * k + 1, "T4": n * (k - 1),
-            "R5.4": n * k, "T5": n * (k - 1) + 1}[case]
-
-
 def trace_dimension(k: int, n_intervals: int) -> int:
     """dim W_h: traces on Γ of continuous P_k vanishing at Γ's endpoints, N intervals."""
     return n_intervals * k - 1
-
-
-def structural_kernel_dim(case: str, k: int, n_intervals: int) -> int:
-    """max(dim M − dim W, 0) on matching meshes: 2 for R5.2, 1 for R5.4, 0 otherwise."""
-    return max(paper_dimension(case, k, n_intervals) - trace_dimension(k, n_intervals), 0)

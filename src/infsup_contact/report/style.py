@@ -16,6 +16,7 @@ import os
 import tempfile
 from contextlib import contextmanager
 from pathlib import Path
+from collections.abc import Mapping
 from types import MappingProxyType
 
 import matplotlib
@@ -24,32 +25,42 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from ..discretization.multipliers import CASE_IDS, STABLE_CASES  # noqa: E402
+from ..discretization.registry import OKABE_ITO as _OKABE_ITO  # noqa: E402
+from ..discretization.registry import SPACES, space_spec  # noqa: E402
 
-#: Okabe & Ito (2008), "Color Universal Design".
-OKABE_ITO = MappingProxyType({
-    "black": "#000000", "orange": "#E69F00", "sky_blue": "#56B4E9", "bluish_green": "#009E73",
-    "yellow": "#F0E442", "blue": "#0072B2", "vermillion": "#D55E00", "reddish_purple": "#CC79A7",
-})
+#: Okabe & Ito (2008), "Color Universal Design" (the registry's palette).
+OKABE_ITO = MappingProxyType(_OKABE_ITO)
 
-#: case → colour; THE map every figure uses (read-only, one object).
-CASE_COLORS = MappingProxyType({
-    "T3": OKABE_ITO["blue"],
-    "R5.2": OKABE_ITO["orange"],
-    "T4": OKABE_ITO["bluish_green"],
-    "R5.4": OKABE_ITO["vermillion"],
-    "T5": OKABE_ITO["reddish_purple"],
-})
+
+class _RegistryView(Mapping):
+    """case id → one attribute of its registry entry; live, so spaces registered later
+    (dual, user spaces) are drawn like the paper's."""
+
+    def __init__(self, get):
+        self._get = get
+
+    def __getitem__(self, case):
+        if case not in SPACES:
+            raise KeyError(case)
+        return self._get(SPACES[case])
+
+    def __iter__(self):
+        return iter(SPACES)
+
+    def __len__(self):
+        return len(SPACES)
+
+
+#: case → colour; THE map every figure uses (read-only, from the registry).
+CASE_COLORS = _RegistryView(lambda s: s.color)
 #: case → marker.
-CASE_MARKERS = MappingProxyType({"T3": "o", "R5.2": "s", "T4": "^", "R5.4": "D", "T5": "v"})
+CASE_MARKERS = _RegistryView(lambda s: s.marker)
 #: paper reference of each case (legend text).
-CASE_REFS = MappingProxyType({"T3": "Thm 3", "R5.2": "Rem 5.2", "T4": "Thm 4", "R5.4": "Rem 5.4",
-                              "T5": "Thm 5"})
+CASE_REFS = _RegistryView(lambda s: s.paper_ref)
 #: displacement degree → marker fill style.
 K_FILL = MappingProxyType({1: "none", 2: "full", 3: "left", 4: "top"})
 #: colour for things that are not a case (references, Pareto front, meshes).
 NEUTRAL = "#4d4d4d"
-assert tuple(CASE_COLORS) == CASE_IDS
 
 #: axis labels used by every figure.
 LABELS = MappingProxyType({
@@ -94,8 +105,8 @@ def style():
 
 
 def is_stable(case: str) -> bool:
-    """Whether the paper proves the case stable (Thm 3, 4, 5)."""
-    return case in STABLE_CASES
+    """Whether the case is expected stable (the paper's Thm 3, 4, 5; the registry's entry)."""
+    return space_spec(case).stable
 
 
 def case_style(case: str, k: int | None = None, **overrides) -> dict:
@@ -112,14 +123,13 @@ def case_style(case: str, k: int | None = None, **overrides) -> dict:
 
 def case_label(case: str, k: int | None = None) -> str:
     """Legend text: ``T3 (Thm 3)`` or ``T3 (Thm 3), k=2``."""
-    text = f"{case} ({CASE_REFS[case]})"
-    return text if k is None else f"{text}, k={int(k)}"
+    return space_spec(case).label(k)
 
 
 def ordered_cases(cases) -> list:
-    """Cases in the paper's order T3 R5.2 T4 R5.4 T5 (unknown ids last, sorted)."""
+    """Cases in registry order (the paper's T3 R5.2 T4 R5.4 T5 first; unknown ids last, sorted)."""
     cases = set(cases)
-    return [c for c in CASE_IDS if c in cases] + sorted(c for c in cases if c not in CASE_IDS)
+    return [c for c in SPACES if c in cases] + sorted(c for c in cases if c not in SPACES)
 
 
 def mesh_size(frame):

@@ -4,7 +4,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from .texformat import (CASES, MEASURES, SPEED_COLUMNS, VERDICTS, PaperTexError, _require, case_order,
+from .texformat import (MEASURES, SPEED_COLUMNS, VERDICTS, PaperTexError, _require, case_order, case_rank,
                         fmt_fixed, fmt_sci, latex_escape)
 
 
@@ -58,7 +58,7 @@ def rates_table(rates: pd.DataFrame) -> str:
             lines.append(r"\midrule")
         keys = r[r.scene == scene][["case", "k"]].drop_duplicates()
         keys = sorted(map(tuple, keys.values),
-                      key=lambda ck: (int(ck[1]), CASES.index(ck[0]) if ck[0] in CASES else 99, ck[0]))
+                      key=lambda ck: (int(ck[1]), case_rank(ck[0]), ck[0]))
         for case, k in keys:
             exp = slope.loc[(scene, case, k, "energy_error"), "expected"] \
                 if (scene, case, k, "energy_error") in slope.index else np.nan
@@ -125,7 +125,7 @@ def speed_rows(speed: pd.DataFrame) -> pd.DataFrame:
     speed = speed_selection(speed)
     idx = speed.groupby(["scene", "case", "k"]).N.idxmax()
     rows = speed.loc[idx]
-    order = rows.case.map(lambda c: CASES.index(c) if c in CASES else len(CASES))
+    order = rows.case.map(case_rank)
     return rows.assign(_order=order).sort_values(["scene", "k", "_order", "case"]).drop(columns="_order")
 
 

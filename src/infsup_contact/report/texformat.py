@@ -12,7 +12,8 @@ import re
 import numpy as np
 import pandas as pd
 
-CASES = ("T3", "R5.2", "T4", "R5.4", "T5")
+from ..discretization.registry import space_ids
+
 VERDICTS = ("PASS", "FAIL", "INCONCLUSIVE")
 MEASURES = {"energy_error": "Energy", "l2_error": "Ltwo", "lambda_l2_error": "LambdaLtwo",
             "lambda_hm12_error": "LambdaH"}
@@ -137,5 +138,11 @@ def _plain(v) -> str:
     return str(v.item() if isinstance(v, np.generic) else v)
 
 
+def case_rank(case) -> int:
+    """Position of a case in the registry (the paper's order first); unknown ids last."""
+    ids = space_ids()
+    return ids.index(case) if case in ids else len(ids)
+
+
 def case_order(cases) -> list:
-    return sorted(set(cases), key=lambda c: (CASES.index(c) if c in CASES else len(CASES), str(c)))
+    return sorted(set(cases), key=lambda c: (case_rank(c), str(c)))

@@ -16,11 +16,11 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from ..discretization import meshes, multipliers
+from ..discretization import meshes, multipliers, registry
 from .pdas import PdasResult, solve_pdas
 from ..discretization.coupling import coupling_matrix
 from ..models.schur import SideOperator, interface_operator
-from ..models.membranes import side_operator
+from ..models.membranes import MEMBRANES
 
 
 @dataclass
@@ -175,14 +175,16 @@ def linear_saddle_time(sides, Bs, c, F, active) -> float:
 
 
 def solve_contact(scene, case: str, k: int, family: str, n1: int, n2: int,
-                  multiplier_mesh: str = "omega2", time_floor: bool = True, **mesh_kwargs) -> ContactSolution:
-    """Solve (4.1) for a scene (``scenes.scene``) with the multipliers of ``case``."""
-    multipliers.check_case(case, k)
+                  multiplier_mesh: str = "omega2", time_floor: bool = True, model=MEMBRANES,
+                  **mesh_kwargs) -> ContactSolution:
+    """Solve (4.1) for a scene (``scenes.scene``) with the multipliers of ``case`` (a registry
+    id); ``model`` gives the side operators (:mod:`infsup_contact.models.contract`)."""
+    registry.check_case(case, k)
     m1, m2 = meshes.mesh_pair(family, n1, n2, **mesh_kwargs)
     c = (scene.c1, scene.c2)
     t0 = time.perf_counter()
-    sides = [side_operator(m, k) for m in (m1, m2)]
-    space = multipliers.case_space(case, k, meshes.multiplier_breakpoints(m1, m2, multiplier_mesh))
+    sides = [model.side_operator(m, k) for m in (m1, m2)]
+    space = registry.case_space(case, k, meshes.multiplier_breakpoints(m1, m2, multiplier_mesh))
     Bs = [coupling_matrix(s.trace, space, k) for s in sides]
     K = interface_operator(Bs, sides, c)
     F = load_vectors(sides, scene)

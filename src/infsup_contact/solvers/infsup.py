@@ -14,11 +14,11 @@ import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
 
-from ..discretization import meshes, multipliers
+from ..discretization import meshes, multipliers, registry
 from ..discretization.coupling import coupling_matrix, union_breakpoints
 from ..errors import InputError
 from ..models.schur import interface_operator
-from ..models.membranes import side_operator
+from ..models.membranes import MEMBRANES
 from ..discretization.norms import NORMS, gram
 
 KERNEL_RTOL = 1e-8
@@ -60,7 +60,7 @@ def check_inputs(case, k, family, n1, n2, c1, c2, norm, multiplier_mesh) -> None
     if not isinstance(k, (int, np.integer)) or not 1 <= k <= 4:
         raise InputError("k", "an integer in 1..4", got=k)
     for c in case:
-        multipliers.check_case(c, k)
+        registry.check_case(c, k)
     meshes.check_mesh_args(family, n1, "N1")
     meshes.check_mesh_args(family, n2, "N2")
     for key, c in (("c1", c1), ("c2", c2)):
@@ -87,26 +87,30 @@ def trace_sum_dimension(k: int, x1: np.ndarray, x2: np.ndarray) -> int:
 def _space(case, k, breakpoints):
     """A named case, or a general triple ``(label, s, continuous, vanish)`` (eqs. 5.3, 5.5)."""
     if isinstance(case, str):
-        return multipliers.case_space(case, k, breakpoints)
+        return registry.case_space(case, k, breakpoints)
     _, s, continuous, vanish = case
     return multipliers.make_space(breakpoints, s, continuous, vanish)
 
 
-def beta_rows(family, k, n1, n2, cases=multipliers.CASE_IDS, multiplier_mesh="omega2",
-              c1=1.0, c2=1.0, norms=NORMS, h_route="logkernel", **mesh_kwargs):
+def beta_rows(family, k, n1, n2, cases=None, multiplier_mesh="omega2",
+              c1=1.0, c2=1.0, norms=NORMS, h_route="logkernel", model=MEMBRANES, **mesh_kwargs):
     """β_h for several cases and norms on one mesh pair, reusing the interface operator.
+
+    ``cases`` are registry ids (default: every registered space defined for k) or general
+    triples (see :func:`_space`); ``model`` gives the side operators (the model seam,
+    :mod:`infsup_contact.models.contract`).
 
     Returns
     -------
     list of dict
         One row per (case, norm) with the columns of ``infsup-contact beta``.
     """
-    cases = [c for c in cases if k >= multipliers.CASES[c][4]] if cases is multipliers.CASE_IDS else list(cases)
+    cases = registry.ids_valid_for(k) if cases is None else list(cases)
     check_inputs([c for c in cases if isinstance(c, str)], k, family, n1, n2, c1, c2, norms, multiplier_mesh)
     t0 = time.perf_counter()
     mesh1, mesh2 = meshes.mesh_pair(family, n1, n2, **mesh_kwargs)
     t1 = time.perf_counter()
-    sides = [side_operator(m, k) for m in (mesh1, mesh2)]
+    sides = [model.side_operator(m, k) for m in (mesh1, mesh2)]
     t2 = time.perf_counter()
     x_mult = meshes.multiplier_breakpoints(mesh1, mesh2, multiplier_mesh)
     x1, x2 = (s.trace.breakpoints for s in sides)

@@ -26,6 +26,8 @@ import numpy as np
 import pandas as pd
 from scipy import stats
 
+from ..discretization.registry import SIGN_CHECK_SPACE, SPACES
+
 PASS, FAIL, INCONCLUSIVE = "PASS", "FAIL", "INCONCLUSIVE"
 COLUMNS = ["claim_id", "paper_ref", "statement", "evidence", "verdict", "predicted"]
 
@@ -71,7 +73,14 @@ def bounded_claim(rows: pd.DataFrame, tol: float, floor: float, confidence: floa
     return verdict, f"β_h in [{beta.min():.4f}, {beta.max():.4f}] over N = {_ns(rows)}; {text}"
 
 
-def kernel_claim(rows: pd.DataFrame, expected: int):
+def predicted_kernel(spec, rows: pd.DataFrame):
+    """The registry's structural kernel count for a series of matching rows: one integer when
+    it is the same on every row (the paper's R5.2: 2, R5.4: 1), else an array per row."""
+    dims = np.array([spec.structural_kernel(int(k), int(n)) for k, n in zip(rows.k, rows.N2)])
+    return int(dims[0]) if len(set(dims.tolist())) == 1 else dims
+
+
+def kernel_claim(rows: pd.DataFrame, expected):
     """Numerical kernel dimension equals ``expected`` on every row."""
     dims = rows.kernel_dim.to_numpy(int)
     ok = len(dims) > 0 and np.all(dims == expected) and np.all(rows.structural_kernel_dim == expected)
@@ -118,7 +127,7 @@ def row(claim_id, paper_ref, statement, verdict_evidence, predicted=PASS) -> dic
                 verdict=verdict, predicted=predicted)
 
 
-def sign_check(k: int = 2, n: int = 32, c=(1.0, 3.0), case: str = "T5") -> dict:
+def sign_check(k: int = 2, n: int = 32, c=(1.0, 3.0), case: str = SIGN_CHECK_SPACE) -> dict:
     """Eq. (3.13) erratum: compare λ_h with ∓c_i ∂u_{i,h}/∂x2 on Γ (membranes scene, whose
     multiplier is O(1); in the manufactured scene λ is small against ∇u and the comparison
     would measure the boundary-gradient error instead of the sign).
@@ -163,9 +172,11 @@ def ledger(beta: pd.DataFrame, rates: pd.DataFrame, extra: pd.DataFrame, cfg: di
     b = beta[(beta.multiplier_mesh == "omega2") & (beta.N1 == beta.N2)]
     first_c = b[["c1", "c2"]].iloc[0].tolist() if len(b) else [1.0, 1.0]
     b = b[(b.c1 == first_c[0]) & (b.c2 == first_c[1])]
-    theorems = {"T3": "Thm 3", "T4": "Thm 4", "T5": "Thm 5"}
+    stable = [s for s in SPACES.values() if s.stable]
+    unstable = [s for s in SPACES.values() if s.expected == "unstable" and s.dimension is not None]
     for fam, fb in b.groupby("family", sort=False):
-        for case, ref in theorems.items():
+        for spec in stable:
+            case, ref = spec.id, spec.paper_ref
             for k, rk in fb[(fb.case == case) & (fb.norm == "H")].groupby("k"):
                 series = {"even N": rk[rk.N2 % 2 == 0], "odd N": rk[rk.N2 % 2 == 1]}
                 for label, rs in series.items():
@@ -174,13 +185,15 @@ def ledger(beta: pd.DataFrame, rates: pd.DataFrame, extra: pd.DataFrame, cfg: di
                         rows.append(row(f"{ref.replace(' ', '')}-k{k}-{fam}-{label.replace(' ', '')}", ref,
                                         f"{case}, k={k}, {fam}, {label}: β_h bounded away from 0 (H^-1/2_00 norm)",
                                         bounded_claim(rs, tol, floor, conf)))
-        for case, ref, dim in (("R5.2", "Rem 5.2", 2), ("R5.4", "Rem 5.4", 1)):
+        for spec in unstable:
+            case, ref = spec.id, spec.paper_ref
             rc = fb[fb.case == case]
             if len(rc):
+                dim = predicted_kernel(spec, rc)
                 rows.append(row(f"{ref.replace(' ', '')}-{fam}", ref,
                                 f"{case}, {fam}, matching meshes: β_h = 0 with a {dim}-dimensional kernel "
                                 f"(dim M − dim W = {dim})", kernel_claim(rc, dim)))
-        for case in theorems:
+        for case in (s.id for s in stable):
             for k, rk in fb[(fb.case == case) & (fb.norm == "L2")].groupby("k"):
                 rk = finest(rk[rk.N2 % 2 == 0], win)
                 if len(rk) >= 3:
@@ -208,7 +221,7 @@ def ledger(beta: pd.DataFrame, rates: pd.DataFrame, extra: pd.DataFrame, cfg: di
         rows.append(row(e.claim_id, e.paper_ref, e.statement, (e.verdict, e.evidence), e.predicted))
     if rates is not None and len(rates):
         r = rates[(rates.scene == "manufactured") & (rates.measure == "energy_error") & (rates.family == "structured")]
-        for _, rr in r[r.case.isin(list(theorems))].iterrows():
+        for _, rr in r[r.case.isin([s.id for s in stable])].iterrows():
             # the regularity bound is an upper bound on the error: a faster observed rate
             # (pre-asymptotic, e.g. the small kink term at x = a for k = 3) is consistent with it
             ok = rr.slope >= rr.expected - cfg["rate_tolerance"]
@@ -230,7 +243,7 @@ def findings(beta: pd.DataFrame, cfg: dict) -> list:
     nm = beta[(beta.N1 != beta.N2) & np.isclose(beta.N1 / beta.N2, 1.5) & (beta.norm == "H")
               & (beta.c1 == c1) & (beta.c2 == c2)]
     for (fam, mm, case, k), r in nm.groupby(["family", "multiplier_mesh", "case", "k"]):
-        if len(r) < 3 or (mm, case) not in {("omega2", "R5.4"), ("omega2", "R5.2"), ("union", "T3")}:
+        if len(r) < 3 or case not in SPACES or mm not in SPACES[case].finding_meshes:
             continue
         what = {"omega2": "G_h = trace of Ω2", "union": "G_h = common refinement of both traces"}[mm]
         rows.append(row(f"finding-{case}-{mm}-k{k}-{fam}", "beyond the paper",

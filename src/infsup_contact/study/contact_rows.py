@@ -4,21 +4,19 @@ from __future__ import annotations
 from . import accuracy
 from ..solvers.contact import ContactSolution, solve_contact
 from ..errors import InputError
-from ..discretization.multipliers import CASES, check_case
+from ..discretization.registry import REFERENCE_SPACE, check_case, space_spec
 from .scenes import scene as make_scene
 
-REFERENCE_CASE = "T3"
-"""Multipliers of the membranes reference (stable for every k, Thm 3)."""
-
-
 def cone_kind(case: str, k: int) -> str:
-    """λ_h ≥ 0 "pointwise" (s = 0, 1: nodal positivity is positivity, (5.4)) or only "nodal"."""
-    return "pointwise" if CASES[case][1](k) <= 1 else "nodal"
+    """λ_h ≥ 0 "pointwise" (s = 0, 1: nodal positivity is positivity, (5.4)), only "nodal",
+    or on "coefficients" of a non-nodal basis (the registry entry's cone)."""
+    return space_spec(case).cone(k)
 
 
 def reference_solution(scene, k: int, n_ref: int) -> ContactSolution:
-    """The membranes reference: structured N_ref × N_ref, degree k + 1, T3 multipliers."""
-    return solve_contact(scene, REFERENCE_CASE, k + 1, "structured", n_ref, n_ref, time_floor=False)
+    """The membranes reference: structured N_ref × N_ref, degree k + 1, the registry's
+    reference multipliers (stable for every k)."""
+    return solve_contact(scene, REFERENCE_SPACE, k + 1, "structured", n_ref, n_ref, time_floor=False)
 
 
 def contact_row(scene_name: str, case: str, k: int, family: str, n1: int, n2: int,

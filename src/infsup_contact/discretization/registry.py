@@ -1,0 +1,186 @@
+"""One registry of multiplier spaces: every consumer asks it, none special-cases a case id.
+
+An entry (:class:`SpaceSpec`) carries what the suite needs to know about a space besides
+its basis: how to build it on a partition G_h for displacement degree k, the degrees it
+allows, its label and paper reference, what is expected of it (stable, or the dimension of
+its kernel on matching meshes, where a count is known), and its colour and marker in every
+figure. β_h, the contact solver, the ledger, the figures and the paper iterate over the
+registry; a new space (built in, or a user's, :func:`register`) appears in all of them.
+
+The paper's five cases (Section 5, eqs. (5.3)/(5.5)) are registered here, in the paper's order.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Callable
+
+import numpy as np
+
+from ..errors import InputError
+from .multipliers import MultiplierSpace, make_space, trace_dimension
+
+#: Okabe & Ito (2008), "Color Universal Design": distinguishable under the common
+#: colour-vision deficiencies.
+OKABE_ITO = {
+    "black": "#000000", "orange": "#E69F00", "sky_blue": "#56B4E9", "bluish_green": "#009E73",
+    "yellow": "#F0E442", "blue": "#0072B2", "vermillion": "#D55E00", "reddish_purple": "#CC79A7",
+}
+K_RANGE = (1, 4)
+"""Displacement degrees the suite supports."""
+
+
+@dataclass(frozen=True)
+class SpaceSpec:
+    """A multiplier space as the suite knows it.
+
+    Attributes
+    ----------
+    id : str
+        The case id used on the command line, in configs and in tables (``T3``).
+    paper_ref : str
+        Where the space and its verdict come from (``Thm 3``, ``Rem 5.2``).
+    definition : str
+        The space in the paper's notation (``M^1_{0,k}``).
+    build : callable
+        ``build(k, breakpoints) -> MultiplierSpace`` on the partition G_h.
+    degree : callable
+        Local polynomial degree s(k) of the multipliers.
+    min_k : int
+        Smallest displacement degree the space is defined for.
+    expected : str
+        ``"stable"`` (β_h bounded away from 0), ``"unstable"`` or ``"unknown"``.
+    dimension : callable or None
+        ``dimension(k, N) -> int``: dim M_h on N intervals (the paper's counts for its cases),
+        None where no count is stated; it gives the structural kernel
+        (:meth:`structural_kernel`).
+    color, marker : str
+        Matplotlib colour and marker; stable spaces are drawn solid, others dashed.
+    nodal_basis : bool
+        True for Lagrange bases (a coefficient is a nodal value, so for s ≤ 1 the cone
+        "coefficients ≥ 0" is "λ_h ≥ 0 pointwise", (5.4)); False for other bases, whose
+        cone constrains coefficients only.
+    finding_meshes : tuple of str
+        Multiplier meshes (``omega2``, ``union``) on which the ledger records a finding
+        beyond the paper for non-matching pairs.
+    """
+
+    id: str
+    paper_ref: str
+    definition: str
+    build: Callable[[int, np.ndarray], MultiplierSpace]
+    degree: Callable[[int], int]
+    min_k: int = 1
+    expected: str = "unknown"
+    dimension: Callable[[int, int], int] | None = None
+    color: str = "#4d4d4d"
+    marker: str = "x"
+    nodal_basis: bool = True
+    finding_meshes: tuple = field(default=())
+
+    @property
+    def stable(self) -> bool:
+        return self.expected == "stable"
+
+    def valid_for(self, k: int) -> bool:
+        return self.min_k <= k <= K_RANGE[1]
+
+    def structural_kernel(self, k: int, n: int) -> int | None:
+        """max(dim M − dim W, 0) on matching meshes with N intervals (W = the trace space),
+        None without a dimension count."""
+        return None if self.dimension is None else max(self.dimension(k, n) - trace_dimension(k, n), 0)
+
+    def cone(self, k: int) -> str:
+        """``pointwise`` (λ_h ≥ 0 everywhere), ``nodal`` (at the Lagrange nodes) or
+        ``coefficients`` (the basis is not nodal)."""
+        if not self.nodal_basis:
+            return "coefficients"
+        return "pointwise" if self.degree(k) <= 1 else "nodal"
+
+    def label(self, k: int | None = None) -> str:
+        """Legend text: ``T3 (Thm 3)`` or ``T3 (Thm 3), k=2``."""
+        text = f"{self.id} ({self.paper_ref})"
+        return text if k is None else f"{text}, k={int(k)}"
+
+
+SPACES: dict[str, SpaceSpec] = {}
+"""Every registered space by id, in registration order (the paper's first)."""
+
+
+def register(spec: SpaceSpec) -> SpaceSpec:
+    """Add a space to the registry; an id can be registered once."""
+    if spec.id in SPACES and SPACES[spec.id] is not spec:
+        raise InputError("space", f"an id not yet registered ({', '.join(SPACES)})", got=spec.id)
+    SPACES[spec.id] = spec
+    return spec
+
+
+def space_spec(case: str) -> SpaceSpec:
+    """The registry entry of ``case``; :class:`InputError` names the known ids otherwise."""
+    if case not in SPACES:
+        raise InputError("case", ", ".join(SPACES), got=case)
+    return SPACES[case]
+
+
+def space_ids() -> tuple:
+    return tuple(SPACES)
+
+
+def ids_valid_for(k: int, ids=None) -> list:
+    """The registered ids (or ``ids``) defined for displacement degree k."""
+    return [c for c in (space_ids() if ids is None else ids) if SPACES[c].valid_for(k)]
+
+
+def check_case(case: str, k: int) -> None:
+    """Raise :class:`InputError` unless ``case`` is registered and valid for degree ``k``."""
+    spec = space_spec(case)
+    if k < spec.min_k:
+        raise InputError("k", f"k >= {spec.min_k} for case {case} ({spec.paper_ref} needs k >= {spec.min_k})")
+
+
+def case_space(case: str, k: int, breakpoints) -> MultiplierSpace:
+    """The multiplier space of a registered case for displacement degree k on G_h."""
+    check_case(case, k)
+    return SPACES[case].build(k, np.asarray(breakpoints, dtype=float))
+
+
+def paper_dimension(case: str, k: int, n_intervals: int) -> int:
+    """dim M_h from the registry's count (the paper's: Rem 5.2, Rem 5.4, Thm 5), N intervals."""
+    return space_spec(case).dimension(k, n_intervals)
+
+
+def structural_kernel_dim(case: str, k: int, n_intervals: int) -> int:
+    """max(dim M − dim W, 0) on matching meshes: 2 for R5.2, 1 for R5.4, 0 otherwise."""
+    return space_spec(case).structural_kernel(k, n_intervals)
+
+
+def _paper_case(id, ref, definition, s_of_k, continuous, vanish, min_k, dimension, color, marker,
+                finding_meshes=()):
+    def build(k, x):
+        return make_space(x, s_of_k(k), continuous, vanish)
+    return register(SpaceSpec(id, ref, definition, build, s_of_k, min_k,
+                              expected="unstable" if ref.startswith("Rem") else "stable",
+                              dimension=dimension, color=color, marker=marker,
+                              finding_meshes=finding_meshes))
+
+
+# --- the paper's five cases (Section 5), in the paper's order ---------------------------
+_paper_case("T3", "Thm 3", "M^1_{0,k}", lambda k: k, True, True, 1, lambda k, n: n * k - 1,
+            OKABE_ITO["blue"], "o", finding_meshes=("union",))
+_paper_case("R5.2", "Rem 5.2", "M^1_k", lambda k: k, True, False, 1, lambda k, n: n * k + 1,
+            OKABE_ITO["orange"], "s", finding_meshes=("omega2",))
+_paper_case("T4", "Thm 4", "M^0_{k-2}", lambda k: k - 2, False, False, 2, lambda k, n: n * (k - 1),
+            OKABE_ITO["bluish_green"], "^")
+_paper_case("R5.4", "Rem 5.4", "M^0_{k-1}", lambda k: k - 1, False, False, 1, lambda k, n: n * k,
+            OKABE_ITO["vermillion"], "D", finding_meshes=("omega2",))
+_paper_case("T5", "Thm 5", "M^1_{k-1}", lambda k: k - 1, True, False, 2, lambda k, n: n * (k - 1) + 1,
+            OKABE_ITO["reddish_purple"], "v")
+
+PAPER_CASES = tuple(SPACES)
+"""The paper's five case ids, in its order."""
+
+# --- roles the study gives to particular spaces (the one place they are spelled) --------
+REFERENCE_SPACE = "T3"
+"""Multipliers of every reference solution and of the default contact benchmark: stable for
+every k (Thm 3)."""
+SIGN_CHECK_SPACE = "T5"
+"""Multipliers of the (3.13) sign check: continuous, stable, nonzero at Γ's ends."""

@@ -3,7 +3,7 @@ on the structured N × N pair; every route answers all of them. What each time i
 (also in the ``includes`` column):
 
 ``ours``
-    End to end, as ``infsup-contact beta`` runs it (:func:`infsup.beta_rows`): meshes,
+    End to end, as ``infsup-contact beta`` runs it (:func:`infsup_contact.solvers.infsup.beta_rows`): meshes,
     NGSolve assembly, one Γ-last factorization per side + Schur complement, per case the
     couplings and the interface operator, per norm the Gram matrix and the dense ``eigh``
     — plus what ``beta_rows`` reports besides β (β with v1 = 0: a second operator and
@@ -68,7 +68,7 @@ def _bottom(beta2: np.ndarray, kern: int):
 
 def _factorize_side(side: SideOperator) -> SideOperator:
     """The Γ-last factorization + Schur complement of an assembled side: the linear
-    algebra of :func:`interface.side_operator` without the NGSolve assembly."""
+    algebra of :func:`~infsup_contact.models.membranes.side_operator` without the NGSolve assembly."""
     from ..models.schur import factorized_side
 
     return factorized_side(side.trace, side.free, side.stiffness)
@@ -118,7 +118,7 @@ class BetaSetup:
 def beta_ours(n: int, k: int):
     """All valid cases × both norms on the structured N×N pair, from one interface operator.
 
-    Returns {(case, norm): (β, β above the kernel)} from :func:`infsup.beta_rows`.
+    Returns {(case, norm): (β, β above the kernel)} from :func:`infsup_contact.solvers.infsup.beta_rows`.
     """
     rows = beta_rows("structured", k, n, n, _all_cases(k), norms=NORMS)
     out = {}
@@ -133,7 +133,7 @@ def beta_ours(n: int, k: int):
 
 def beta_ours_core(setup: BetaSetup):
     """Γ-reduced route given the assembled stiffness: factorization, couplings,
-    interface operator, Gram, dense eigh (:func:`infsup.spectrum` without the extras)."""
+    interface operator, Gram, dense eigh (:func:`~infsup_contact.solvers.infsup.spectrum` without the extras)."""
     sides = [_factorize_side(s) for s in setup.sides]
     out = {}
     for c in setup.cases:

@@ -1,30 +1,30 @@
 """Contact (:func:`bench_contact`): the membranes scene, case T3, the QP
-``min ½uᵀAu − Fᵀu s.t. B u ≥ 0`` (:mod:`infsup_contact.peers`). Every route except
+``min ½uᵀAu − Fᵀu s.t. B u ≥ 0`` (:mod:`infsup_contact.bench.peers`). Every route except
 ``ours_end_to_end`` gets the same assembled (A, B, F) — exactly what the peers get:
 
 ``ours``
-    :func:`reduced_qp.solve_reduced_qp`: the unknowns B touches (Γ) read off B, one
+    :func:`infsup_contact.solvers.reduced_qp.solve_reduced_qp`: the unknowns B touches (Γ) read off B, one
     factorization per block of A with Γ last, interface operator, PDAS on the Γ-reduced
     LCP, recovery of u.
 ``ours_end_to_end``
-    End to end (:func:`contact_problem.solve_contact`): meshes, NGSolve assembly, loads,
+    End to end (:func:`infsup_contact.solvers.contact.solve_contact`): meshes, NGSolve assembly, loads,
     and the same linear algebra built side by side.
 ``floor``
     One sparse direct solve of the linear saddle-point system with the contact set
-    known (:func:`contact_problem.linear_saddle_solve`: symmetric quasi-definite, SuperLU
+    known (:func:`infsup_contact.solvers.contact.linear_saddle_solve`: symmetric quasi-definite, SuperLU
     in minimum-degree order without pivoting); its u and λ are compared too.
 ``limit``
     One best-order (``MMD_AT_PLUS_A``) sparse LU of each side's stiffness and one solve
     with it (:func:`contact_limit`): what no route can avoid, like β's ``limit``.
 ``osqp``, ``clarabel``
-    The peers through their own Python APIs (:mod:`infsup_contact.peers`), given the
+    The peers through their own Python APIs (:mod:`infsup_contact.bench.peers`), given the
     assembled (A, B, F), one thread, at the loosest tolerance of
     :data:`peers.TOLERANCES` that reproduces our u and λ to ``rtol`` = 1e-8 relative
     (``tolerance``, ``accuracy_reached``). They get the load normalized to max|F| = 1
     (the QP is positively homogeneous in F: u and λ are scaled back), otherwise their
     absolute tolerance floors make the needed tolerances depend on the mesh size.
 ``kkt_sparse``
-    PDAS on the full sparse KKT system (:func:`contact.solve_kkt_sparse`), N ≤ ``kkt_max_n``.
+    PDAS on the full sparse KKT system (:func:`infsup_contact.solvers.pdas.solve_kkt_sparse`), N ≤ ``kkt_max_n``.
 """
 from __future__ import annotations
 
@@ -51,7 +51,7 @@ CONTACT_COLUMNS = ("what", "route", "k", "N", "seconds_median", "seconds_min", "
 
 def _contact_problem(n: int, k: int, case: str = REFERENCE_SPACE):
     """Membranes scene on the structured N×N pair: sides, couplings, loads (c = 1), as
-    :func:`contact_problem.solve_contact` builds them."""
+    :func:`infsup_contact.solvers.contact.solve_contact` builds them."""
     from ..solvers.contact import load_vectors
     from ..study.scenes import membranes
 

@@ -7,7 +7,7 @@ The contact problem is the convex QP
 with A = diag(c1 K1, c2 K2) the stiffness on the free dofs of both membranes, F the
 loads and B = [−B1, B2] the weighted gaps (B_i embedded on the Γ dofs, which are the
 last block of each side). Its KKT conditions are exactly (4.1) in the convention of
-:mod:`infsup_contact.contact`:
+:mod:`infsup_contact.solvers.pdas`:
 
     A u = F + Bᵀ λ,   λ ≥ 0,   B u ≥ 0,   λ∘(B u) = 0,
 

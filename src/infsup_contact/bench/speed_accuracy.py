@@ -27,7 +27,7 @@ def pareto_front(times, errors) -> np.ndarray:
 
 def time_contact_solve(case: str, k: int, n: int, repeats: int = 3, scene: str = "manufactured",
                        family: str = "structured", scene_params: dict | None = None, c=(1.0, 1.0)):
-    """Median, min, max wall time of :func:`contact_problem.solve_contact` (whole call:
+    """Median, min, max wall time of :func:`infsup_contact.solvers.contact.solve_contact` (whole call:
     mesh, assembly, interface operator, PDAS, recovery; no floor timing)."""
     from ..solvers.contact import solve_contact
     from ..study.scenes import scene as make_scene

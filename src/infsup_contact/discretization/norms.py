@@ -283,7 +283,7 @@ def _norm2(A: np.ndarray) -> float:
 # ----------------------------------------------------------------------- dispatch
 H_ROUTES = ("logkernel", "series")
 """Two independent routes to the H^{-1/2}_00 Gram matrix: the closed-form log kernel
-(:mod:`infsup_contact.logkernel`, no truncation, the default) and the sine series."""
+(:mod:`infsup_contact.discretization.logkernel`, no truncation, the default) and the sine series."""
 
 
 def gram(space: MultiplierSpace, norm: str, h_route: str = "logkernel", **kwargs) -> tuple[np.ndarray, dict]:

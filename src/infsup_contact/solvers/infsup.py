@@ -2,8 +2,8 @@
 
 β_h = inf_μ sup_v b(v, μ) / (‖v‖_a ‖μ‖_M), so β_h² is the smallest eigenvalue of the
 generalized symmetric eigenproblem (B A⁻¹ Bᵀ) m = β² G m on the multiplier space,
-with B A⁻¹ Bᵀ the interface operator (:mod:`infsup_contact.interface`) and G the Gram
-matrix of the multiplier norm (:mod:`infsup_contact.norms`).
+with B A⁻¹ Bᵀ the interface operator (:mod:`infsup_contact.models.schur`) and G the Gram
+matrix of the multiplier norm (:mod:`infsup_contact.discretization.norms`).
 """
 from __future__ import annotations
 

@@ -70,9 +70,9 @@ def _typo_nested(cfg):
 # The JSON-schema instance path ("instance['infsup'][...]") names the offending key.
 BAD_CONFIGS = {
     "unknown-case": (_set("infsup", "cases", value={"T9": [1]}),
-                     ["'T9' was unexpected", "instance['infsup']['cases']"]),
+                     ["'T9' was unexpected", "config key infsup.cases"]),
     "unknown-case-added": (_set("infsup", "cases", "T9", value=[2]),
-                           ["'T9' was unexpected", "instance['infsup']['cases']"]),
+                           ["'T9' was unexpected", "config key infsup.cases"]),
     "k-above-4": (_set("infsup", "cases", value={"T3": [5]}),
                   ["instance['infsup']['cases']['T3']", "maximum of 4"]),
     "k-zero": (_set("infsup", "cases", value={"T3": [0]}),

@@ -13,6 +13,10 @@ def _check_before_schema(cfg):
     for stage in ("infsup", "contact"):
         sc = cfg.get(stage) or {}
         cases = sc.get("cases") or {}
+        unknown = [c for c in cases if c not in SPACES] if isinstance(cases, dict) else []
+        if unknown:
+            raise ValueError(f"config key {stage}.cases: {unknown[0]!r} was unexpected; expected registered "
+                             f"spaces: {', '.join(SPACES)}")
         for case, spec in SPACES.items():  # degrees each space allows (k < 1: the schema says it)
             ks = cases.get(case) or []
             if isinstance(ks, list) and any(isinstance(k, (int, float)) and 1 <= k < spec.min_k for k in ks):

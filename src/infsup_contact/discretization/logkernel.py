@@ -292,6 +292,9 @@ def gram_h_logkernel(space: MultiplierSpace, *, quad_scale: int = 1) -> np.ndarr
                 loc[sel] += term[3] * _log_term(aI[sel], bI[sel], aJ[sel], bJ[sel], term,
                                                 s, n_log, n_x, q_piece)
 
+    if space.local_coefficients is not None:  # C_I loc C_Jᵀ for the space's own local basis
+        loc = np.swapaxes(space.to_local_basis(np.swapaxes(space.to_local_basis(loc, iu), 1, 2), ju), 1, 2)
+
     # scatter: block (i, j) = loc, block (j, i) = locᵀ
     dofs = np.asarray(space.dofs)
     rows = dofs[iu][:, :, None]

@@ -12,6 +12,12 @@ A space is plain data: the breakpoints, the local degree and the local-to-global
 map. Local shape functions are Lagrange polynomials on equispaced nodes of the
 reference interval t ∈ [0, 1] (for s = 0 the constant 1), so a dof is a nodal value and
 the cone "λ_h ≥ 0 at the nodes" is "dof ≥ 0".
+
+A space may instead carry its own local basis, per interval a combination of those
+Lagrange shapes (``local_coefficients``: ψ_{e,a} = Σ_b C[e, a, b] L_b): the dual mortar
+bases (:mod:`infsup_contact.discretization.dual`) and users' spaces
+(:func:`local_basis_space`) are built that way, and every consumer (evaluation, Gram
+matrices, coupling) applies C where it would use the shapes.
 """
 from __future__ import annotations
 
@@ -40,6 +46,9 @@ class MultiplierSpace:
         (the endpoint condition).
     dim : int
         Dimension of the space.
+    local_coefficients : ndarray, shape (N, s + 1, s + 1), optional
+        Local basis per interval in terms of the Lagrange shapes, ψ_{e,a} = Σ_b C[e, a, b] L_b;
+        None for the Lagrange basis itself (a dof is then a nodal value).
     """
 
     breakpoints: np.ndarray
@@ -48,6 +57,16 @@ class MultiplierSpace:
     vanish_at_ends: bool
     dofs: np.ndarray
     dim: int
+    local_coefficients: np.ndarray | None = None
+
+    def to_local_basis(self, local: np.ndarray, elements=None) -> np.ndarray:
+        """Values given per Lagrange shape, ``local[e, b, ...]``, turned into values per local
+        basis function: Σ_b C[e, a, b] local[e, b, ...] (identity for a Lagrange basis).
+        ``elements`` selects the rows of C when ``local`` is given for some intervals only."""
+        if self.local_coefficients is None:
+            return local
+        C = self.local_coefficients if elements is None else self.local_coefficients[elements]
+        return np.einsum("eab,eb...->ea...", C, local)
 
     @property
     def n_intervals(self) -> int:
@@ -73,6 +92,8 @@ class MultiplierSpace:
         e = np.clip(np.searchsorted(self.breakpoints, x, side="right") - 1, 0, self.n_intervals - 1)
         a, b = self.breakpoints[e], self.breakpoints[e + 1]
         vals = local_shapes(self.degree, (x - a) / (b - a))
+        if self.local_coefficients is not None:
+            vals = np.einsum("iab,ib->ia", self.local_coefficients[e], vals)
         out = np.zeros((len(x), self.dim))
         rows = np.repeat(np.arange(len(x)), self.degree + 1)
         cols = self.dofs[e].ravel()
@@ -144,3 +165,51 @@ def make_space(breakpoints, degree: int, continuous: bool, vanish_at_ends: bool)
 def trace_dimension(k: int, n_intervals: int) -> int:
     """dim W_h: traces on Γ of continuous P_k vanishing at Γ's endpoints, N intervals."""
     return n_intervals * k - 1
+
+
+def local_basis_space(breakpoints, degree: int, dofs, coefficients=None, *, continuous: bool = False,
+                      vanish_at_ends: bool = False) -> MultiplierSpace:
+    """A space given by its local basis and global numbering — the public way to define one.
+
+    Parameters
+    ----------
+    breakpoints : array_like, shape (N + 1,)
+        The partition G_h of Γ = (0, 1).
+    degree : int
+        Local polynomial degree s.
+    dofs : array_like of int, shape (N, s + 1)
+        Global number of each local basis function (−1: dropped, e.g. at Γ's ends); the
+        numbers used must be 0 .. dim − 1. Sharing a number between neighbouring intervals
+        glues the pieces into one basis function.
+    coefficients : array_like, shape (s + 1, s + 1) or (N, s + 1, s + 1), optional
+        Local basis in terms of the equispaced Lagrange shapes L_b of degree s:
+        ψ_{e,a} = Σ_b C[e, a, b] L_b (one matrix for every interval, or one per interval).
+        Default: the Lagrange shapes themselves.
+    continuous, vanish_at_ends : bool
+        Descriptive flags (what the space is), not constraints.
+
+    Raises
+    ------
+    InputError
+        Naming the argument that is malformed.
+    """
+    x = np.asarray(breakpoints, dtype=float)
+    if x.ndim != 1 or len(x) < 2 or not np.all(np.diff(x) > 0):
+        raise InputError("breakpoints", "a strictly increasing array with at least 2 entries")
+    n, s = len(x) - 1, int(degree)
+    dofs = np.asarray(dofs)
+    if dofs.shape != (n, s + 1) or not np.issubdtype(dofs.dtype, np.integer):
+        raise InputError("dofs", f"an integer array of shape (N, s + 1) = ({n}, {s + 1})", got=dofs.shape)
+    used = np.unique(dofs[dofs >= 0])
+    if not len(used) or not np.array_equal(used, np.arange(len(used))):
+        raise InputError("dofs", "global numbers 0 .. dim − 1, each used (−1 for a dropped function)")
+    C = None
+    if coefficients is not None:
+        C = np.asarray(coefficients, dtype=float)
+        if C.shape == (s + 1, s + 1):
+            C = np.broadcast_to(C, (n, s + 1, s + 1)).copy()
+        if C.shape != (n, s + 1, s + 1) or not np.all(np.isfinite(C)):
+            raise InputError("coefficients", "finite numbers of shape (s + 1, s + 1) or (N, s + 1, s + 1)",
+                             got=C.shape)
+    return MultiplierSpace(x, s, bool(continuous), bool(vanish_at_ends), dofs.astype(int), len(used), C)
+

@@ -63,6 +63,8 @@ def gram_l2(space: MultiplierSpace) -> np.ndarray:
     ref_mass = (vals * w[:, None]).T @ vals         # ∫_0^1 ψ_a ψ_b dt
     h = np.diff(space.breakpoints)
     local = h[:, None, None] * ref_mass[None]       # (N, s+1, s+1)
+    if space.local_coefficients is not None:        # C M Cᵀ per interval
+        local = np.swapaxes(space.to_local_basis(np.swapaxes(space.to_local_basis(local), 1, 2)), 1, 2)
     rows = np.broadcast_to(space.dofs[:, :, None], local.shape)
     cols = np.broadcast_to(space.dofs[:, None, :], local.shape)
     keep = (rows >= 0) & (cols >= 0)
@@ -105,7 +107,7 @@ def sine_coefficients(space: MultiplierSpace, n, switch: float = IBP_SWITCH) -> 
     if n.ndim != 1 or not np.all(np.isfinite(n)) or np.any(n < 0):
         raise InputError("n", "a 1-D array of non-negative sine indices", got=n.shape)
     omega = np.pi * n
-    return np.sqrt(2.0) * _scatter(space, _local_sine_integrals(space, omega, switch))
+    return np.sqrt(2.0) * _scatter(space, space.to_local_basis(_local_sine_integrals(space, omega, switch)))
 
 
 def _local_sine_integrals(space: MultiplierSpace, omega: np.ndarray, switch: float) -> np.ndarray:

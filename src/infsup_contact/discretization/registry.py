@@ -17,6 +17,7 @@ from typing import Callable
 import numpy as np
 
 from ..errors import InputError
+from .dual import dual_space
 from .multipliers import MultiplierSpace, make_space, trace_dimension
 
 #: Okabe & Ito (2008), "Color Universal Design": distinguishable under the common
@@ -62,6 +63,9 @@ class SpaceSpec:
     finding_meshes : tuple of str
         Multiplier meshes (``omega2``, ``union``) on which the ledger records a finding
         beyond the paper for non-matching pairs.
+    claim_tag : str or None
+        Prefix of the space's ledger claim ids; default the paper reference without spaces
+        (``Thm3-k1-structured-evenN``).
     """
 
     id: str
@@ -76,6 +80,11 @@ class SpaceSpec:
     marker: str = "x"
     nodal_basis: bool = True
     finding_meshes: tuple = field(default=())
+    claim_tag: str | None = None
+
+    @property
+    def tag(self) -> str:
+        return self.claim_tag or self.paper_ref.replace(" ", "")
 
     @property
     def stable(self) -> bool:
@@ -177,6 +186,16 @@ _paper_case("T5", "Thm 5", "M^1_{k-1}", lambda k: k - 1, True, False, 2, lambda 
 
 PAPER_CASES = tuple(SPACES)
 """The paper's five case ids, in its order."""
+
+# --- dual (biorthogonal) mortar multipliers (module dual) ---------------------------------
+register(SpaceSpec(
+    "DUAL", "Wohlmuth 2000", "dual basis of M^1_{0,k}", lambda k, x: dual_space(x, k, True), lambda k: k,
+    expected="stable", dimension=lambda k, n: n * k - 1, color=OKABE_ITO["sky_blue"], marker="P",
+    nodal_basis=False, claim_tag="DUAL"))
+register(SpaceSpec(
+    "DUAL-ALL", "dual of Rem 5.2", "dual basis of M^1_k", lambda k, x: dual_space(x, k, False), lambda k: k,
+    expected="unstable", dimension=lambda k, n: n * k + 1, color=OKABE_ITO["black"], marker="X",
+    nodal_basis=False, claim_tag="DUAL-ALL"))
 
 # --- roles the study gives to particular spaces (the one place they are spelled) --------
 REFERENCE_SPACE = "T3"

@@ -182,7 +182,7 @@ def ledger(beta: pd.DataFrame, rates: pd.DataFrame, extra: pd.DataFrame, cfg: di
                 for label, rs in series.items():
                     rs = finest(rs, win)
                     if len(rs) >= 3:
-                        rows.append(row(f"{ref.replace(' ', '')}-k{k}-{fam}-{label.replace(' ', '')}", ref,
+                        rows.append(row(f"{spec.tag}-k{k}-{fam}-{label.replace(' ', '')}", ref,
                                         f"{case}, k={k}, {fam}, {label}: β_h bounded away from 0 (H^-1/2_00 norm)",
                                         bounded_claim(rs, tol, floor, conf)))
         for spec in unstable:
@@ -190,7 +190,7 @@ def ledger(beta: pd.DataFrame, rates: pd.DataFrame, extra: pd.DataFrame, cfg: di
             rc = fb[fb.case == case]
             if len(rc):
                 dim = predicted_kernel(spec, rc)
-                rows.append(row(f"{ref.replace(' ', '')}-{fam}", ref,
+                rows.append(row(f"{spec.tag}-{fam}", ref,
                                 f"{case}, {fam}, matching meshes: β_h = 0 with a {dim}-dimensional kernel "
                                 f"(dim M − dim W = {dim})", kernel_claim(rc, dim)))
         for case in (s.id for s in stable):

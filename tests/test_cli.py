@@ -26,8 +26,8 @@ ENV = {**os.environ, "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"}
 COLUMNS = ("case,k,family,N1,N2,multiplier_mesh,c1,c2,norm,beta,kernel_dim,"
            "structural_kernel_dim,smallest_nonzero,dim_M,dim_W,n_max,nmax_rel_error,ndof,"
            "t_assemble,t_interface,t_eig").split(",")
-ALL_CASES = ("T3", "R5.2", "T4", "R5.4", "T5")
-K1_CASES = ("T3", "R5.2", "R5.4")  # T4 and T5 need k >= 2
+ALL_CASES = ("T3", "R5.2", "T4", "R5.4", "T5", "DUAL", "DUAL-ALL")  # every built-in space
+K1_CASES = ("T3", "R5.2", "R5.4", "DUAL", "DUAL-ALL")  # T4 and T5 need k >= 2
 NORMS = ("H", "L2")
 SMALL = ["--N1", "4", "--N2", "4"]
 

@@ -29,12 +29,35 @@ class _Parser(argparse.ArgumentParser):
         self.exit(2, f"infsup-contact: error: {message}\n")
 
 
+SPACE_HELP = ("a user-defined multiplier space: a file or module and a function returning a "
+              "SpaceSpec (see examples/macro_p0.py); instead of --case")
+
+
+def _cases(args) -> list:
+    """Case ids of a request: --space (loaded, checked, registered), else --case (all: every
+    registered space defined for k)."""
+    from .discretization.registry import ids_valid_for
+    from .discretization.user_spaces import load_user_space
+
+    if args.space is not None:
+        if args.case not in (None,):
+            raise InputError("case", "either --case or --space, not both", got=args.case)
+        return [load_user_space(args.space).id]
+    if args.case in (None, "all"):
+        if not 1 <= args.k <= 4:
+            raise InputError("k", "an integer in 1..4", got=args.k)
+        return ids_valid_for(args.k)
+    return [args.case]
+
+
 def _add_beta(sub) -> None:
     from .discretization.meshes import FAMILIES
     from .discretization.registry import space_ids
 
     p = sub.add_parser("beta", help="β_h for one mesh pair (CSV: one row per case × norm)")
-    p.add_argument("--case", default="all", choices=[*space_ids(), "all"])
+    p.add_argument("--case", default=None, choices=[*space_ids(), "all"],
+                   help="a registered space, or all (the default) for every one defined for k")
+    p.add_argument("--space", metavar="FILE.py:FUNC", help=SPACE_HELP)
     p.add_argument("--k", type=int, required=True, help="displacement degree, 1..4")
     p.add_argument("--family", default="structured", choices=FAMILIES)
     p.add_argument("--N1", type=int, required=True, help="segments on Γ of the Ω1 mesh (>= 1)")
@@ -53,15 +76,9 @@ def _add_beta(sub) -> None:
 def _run_beta(args) -> None:
     import pandas as pd
 
-    from .discretization.registry import ids_valid_for
     from .solvers.infsup import beta_rows
 
-    if args.case == "all":
-        if not 1 <= args.k <= 4:
-            raise InputError("k", "an integer in 1..4", got=args.k)
-        cases = ids_valid_for(args.k)
-    else:
-        cases = [args.case]
+    cases = _cases(args)
     norms = ("H", "L2") if args.norm == "all" else (args.norm,)
     kwargs = {}
     if args.family == "perturbed":
@@ -77,7 +94,8 @@ def _add_contact(sub) -> None:
 
     p = sub.add_parser("contact", help="solve (4.1) for one case and mesh pair (CSV: one row)")
     p.add_argument("--scene", required=True, choices=["manufactured", "membranes"])
-    p.add_argument("--case", required=True, choices=[*space_ids(), "all"])
+    p.add_argument("--case", choices=[*space_ids(), "all"], help="a registered space, or all")
+    p.add_argument("--space", metavar="FILE.py:FUNC", help=SPACE_HELP)
     p.add_argument("--k", type=int, required=True, help="displacement degree, 1..4")
     p.add_argument("--family", default="structured", choices=FAMILIES)
     p.add_argument("--N1", type=int, required=True)
@@ -93,12 +111,11 @@ def _add_contact(sub) -> None:
 def _run_contact(args) -> None:
     import pandas as pd
 
-    from .discretization.registry import ids_valid_for
     from .study.contact_rows import contact_row
 
-    if not 1 <= args.k <= 4:
-        raise InputError("k", "an integer in 1..4", got=args.k)
-    cases = ids_valid_for(args.k) if args.case == "all" else [args.case]
+    if args.case is None and args.space is None:
+        raise InputError("case", "one of --case ID|all or --space FILE.py:FUNC")
+    cases = _cases(args)
     params = dict(p=args.p, q=args.q) if args.scene == "manufactured" else {}
     ref = None
     rows = []

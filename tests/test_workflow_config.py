@@ -26,7 +26,7 @@ CI_CONFIG = yaml.safe_load((ROOT / "config" / "ci.yaml").read_text())
 @pytest.fixture
 def workdir(tmp_path: Path) -> Path:
     shutil.copy2(ROOT / "Snakefile", tmp_path / "Snakefile")
-    for d in ("workflow", "config", "profiles", "paper"):
+    for d in ("workflow", "config", "profiles", "paper", "examples"):
         shutil.copytree(ROOT / d, tmp_path / d, ignore=shutil.ignore_patterns("__pycache__"))
     (tmp_path / "src").symlink_to(ROOT / "src", target_is_directory=True)
     return tmp_path

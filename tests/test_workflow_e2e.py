@@ -19,7 +19,7 @@ BIN = Path(sys.executable).parent
 
 
 def _copy_workflow(dest: Path) -> Path:
-    for name in ("Snakefile", "workflow", "config", "profiles", "src", "paper"):
+    for name in ("Snakefile", "workflow", "config", "profiles", "src", "paper", "examples"):
         src = ROOT / name
         (shutil.copytree if src.is_dir() else shutil.copy)(src, dest / name)
     return dest

@@ -32,6 +32,23 @@ def _check_before_schema(cfg):
             raise ValueError(f"config key {key}: expected integers, got {bad}")
 
 
+def _load_user_spaces(cfg):
+    """Register the user-defined spaces (config key ``spaces``) before any case key is checked."""
+    from infsup_contact.discretization.user_spaces import load_user_space
+    from infsup_contact.errors import InputError
+
+    refs = cfg.get("spaces") or []
+    if not isinstance(refs, list) or not all(isinstance(r, str) for r in refs):
+        raise ValueError(f"config key spaces: expected a list of FILE.py:FUNC or module:FUNC strings; got {refs!r}")
+    for i, ref in enumerate(refs):
+        try:
+            load_user_space(ref)
+        except InputError as err:
+            raise ValueError(f"config key spaces[{i}]: {err}") from None
+    return [r.rpartition(":")[0] for r in refs if r.rpartition(":")[0].endswith(".py")]
+
+
+USER_SPACE_FILES = _load_user_spaces(config)
 _check_before_schema(config)
 validate(config, schema="../schemas/config.schema.yaml")
 
@@ -40,6 +57,7 @@ validate(config, schema="../schemas/config.schema.yaml")
 _PKG = Path("src/infsup_contact")
 PRESENTATION_ONLY = ("report", "bench")
 PACKAGE_SOURCES = sorted(str(p) for p in _PKG.rglob("*.py") if p.relative_to(_PKG).parts[0] not in PRESENTATION_ONLY)
+PACKAGE_SOURCES += USER_SPACE_FILES  # a user's space is code the results depend on
 REPORT_SOURCES = sorted(str(p) for p in (_PKG / "report").glob("*.py"))
 BENCH_SOURCES = sorted(str(p) for p in (_PKG / "bench").glob("*.py"))
 

@@ -24,6 +24,14 @@ def add_provenance(frame, cfg):
     return frame.assign(package_version=__version__, git_commit=git_commit(), config_hash=config_hash(cfg))
 
 
+def register_user_spaces(config) -> None:
+    """Register the config's user-defined spaces (key ``spaces``) in this job's process, so
+    that its case ids resolve here as they did when the config was validated."""
+    from infsup_contact.discretization.user_spaces import load_user_spaces
+
+    load_user_spaces(config.get("spaces") or [])
+
+
 def log_to(path):
     """Send this script's stderr to the rule's log file."""
     sys.stderr = open(path, "w")

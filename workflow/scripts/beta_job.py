@@ -2,10 +2,11 @@
 import sys
 
 sys.path.insert(0, "workflow/scripts")
-from _glue import add_provenance, limit_threads, log_to  # noqa: E402
+from _glue import add_provenance, limit_threads, log_to, register_user_spaces  # noqa: E402
 
 limit_threads(snakemake.threads)  # noqa: F821
 log_to(snakemake.log[0])  # noqa: F821
+register_user_spaces(snakemake.config)  # noqa: F821
 
 import pandas as pd  # noqa: E402
 

@@ -2,9 +2,10 @@
 import sys
 
 sys.path.insert(0, "workflow/scripts")
-from _glue import log_to  # noqa: E402
+from _glue import log_to, register_user_spaces  # noqa: E402
 
 log_to(snakemake.log[0])  # noqa: F821
+register_user_spaces(snakemake.config)  # noqa: F821
 import pandas as pd  # noqa: E402
 
 from infsup_contact.study.claims import ledger  # noqa: E402

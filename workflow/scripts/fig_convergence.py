@@ -9,10 +9,11 @@ import sys
 
 if "snakemake" in globals():  # run by Snakemake: threads and log before numpy loads
     sys.path.insert(0, "workflow/scripts")
-    from _glue import limit_threads, log_to
+    from _glue import limit_threads, log_to, register_user_spaces
 
     limit_threads(snakemake.threads)  # noqa: F821
     log_to(snakemake.log[0])  # noqa: F821
+    register_user_spaces(snakemake.config)  # noqa: F821
 
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402

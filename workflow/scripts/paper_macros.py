@@ -10,9 +10,10 @@ import sys
 from pathlib import Path
 
 sys.path.insert(0, "workflow/scripts")
-from _glue import log_to  # noqa: E402
+from _glue import log_to, register_user_spaces  # noqa: E402
 
 log_to(snakemake.log[0])  # noqa: F821
+register_user_spaces(snakemake.config)  # noqa: F821
 import pandas as pd  # noqa: E402
 
 from infsup_contact.io import write_atomic  # noqa: E402

@@ -191,7 +191,7 @@ PAPER_CASES = tuple(SPACES)
 register(SpaceSpec(
     "DUAL", "Wohlmuth 2000", "dual basis of M^1_{0,k}", lambda k, x: dual_space(x, k, True), lambda k: k,
     expected="stable", dimension=lambda k, n: n * k - 1, color=OKABE_ITO["sky_blue"], marker="P",
-    nodal_basis=False, claim_tag="DUAL"))
+    nodal_basis=False, claim_tag="DUAL", finding_meshes=("omega2", "union")))
 register(SpaceSpec(
     "DUAL-ALL", "dual of Rem 5.2", "dual basis of M^1_k", lambda k, x: dual_space(x, k, False), lambda k: k,
     expected="unstable", dimension=lambda k, n: n * k + 1, color=OKABE_ITO["black"], marker="X",

@@ -108,10 +108,16 @@ def contact_macros(contact: pd.DataFrame) -> list[Macro]:
 
 def claims_macros(claims: pd.DataFrame) -> list[Macro]:
     claims = _claims_checked(claims)
-    paper = claims[claims.predicted != "finding"]
+    beyond = claims.paper_ref.astype(str).str.startswith("beyond the paper")
+    paper = claims[(claims.predicted != "finding") & ~beyond]
     found = claims[claims.predicted == "finding"]
+    ours = claims[(claims.predicted != "finding") & beyond]  # predicted by us, about other spaces
     checked = paper[paper.predicted.isin(["PASS", "FAIL"])]
-    out = [Macro("nClaims", fmt_int(len(paper)), "claims.csv: rows with predicted != finding"),
+    out = [Macro("nClaims", fmt_int(len(paper)), "claims.csv: rows with predicted != finding, paper_ref "
+                 "not 'beyond the paper ...'"),
+           Macro("nBeyondClaims", fmt_int(len(ours)), "claims.csv: predicted rows with paper_ref 'beyond the paper (...)'"),
+           Macro("nBeyondAsPredicted", fmt_int((ours.verdict == ours.predicted).sum()),
+                 "claims.csv: those rows with verdict == predicted"),
            Macro("nClaimsChecked", fmt_int(len(checked)), "claims.csv: rows with predicted PASS or FAIL"),
            Macro("nClaimsAsPredicted", fmt_int((checked.verdict == checked.predicted).sum()),
                  "claims.csv: rows with verdict == predicted"),

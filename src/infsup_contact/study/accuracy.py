@@ -10,6 +10,7 @@ import scipy.fft
 
 from ..solvers.contact import ContactSolution, gamma_values, lambda_values
 from ..discretization.norms import sine_coefficients
+from .profiles import gamma_sample_points
 
 N_SAMPLE = 4001
 """Points on Γ for pointwise quantities (penetration, contact set)."""
@@ -75,6 +76,13 @@ def max_penetration(sol: ContactSolution, n: int = 801) -> float:
     x = np.linspace(0, 1, n)[1:-1]
     u1, u2 = gamma_values(sol, x)
     return float(max(np.max(u1 - u2), 0.0))
+
+
+def lambda_min_pointwise(sol: ContactSolution, per_interval: int = 41) -> float:
+    """min_x λ_h(x) over ``per_interval`` samples per interval of G_h (one-sided at the
+    breakpoints). The cone of (4.1) constrains coefficients; for a non-nodal basis (dual
+    multipliers) or nodal ones of degree ≥ 2, λ_h may dip below 0 between the nodes."""
+    return float(lambda_values(sol, gamma_sample_points(sol.space.breakpoints, per_interval)).min())
 
 
 def lambda_total_variation(sol: ContactSolution) -> float:

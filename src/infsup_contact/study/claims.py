@@ -26,9 +26,12 @@ import numpy as np
 import pandas as pd
 from scipy import stats
 
-from ..discretization.registry import SIGN_CHECK_SPACE, SPACES
+from ..discretization.registry import PAPER_CASES, SIGN_CHECK_SPACE, SPACES
 
 PASS, FAIL, INCONCLUSIVE = "PASS", "FAIL", "INCONCLUSIVE"
+BEYOND = "beyond the paper"
+"""paper_ref of every row the paper does not state: findings (no prediction) and predicted
+claims about spaces it does not treat ("beyond the paper (Wohlmuth 2000)")."""
 COLUMNS = ["claim_id", "paper_ref", "statement", "evidence", "verdict", "predicted"]
 
 
@@ -173,10 +176,14 @@ def ledger(beta: pd.DataFrame, rates: pd.DataFrame, extra: pd.DataFrame, cfg: di
     first_c = b[["c1", "c2"]].iloc[0].tolist() if len(b) else [1.0, 1.0]
     b = b[(b.c1 == first_c[0]) & (b.c2 == first_c[1])]
     stable = [s for s in SPACES.values() if s.stable]
+
+    def ref_of(spec, ref):  # a claim about a space the paper does not treat is beyond the paper
+        return ref if spec.id in PAPER_CASES else f"{BEYOND} ({ref})"
+
     unstable = [s for s in SPACES.values() if s.expected == "unstable" and s.dimension is not None]
     for fam, fb in b.groupby("family", sort=False):
         for spec in stable:
-            case, ref = spec.id, spec.paper_ref
+            case, ref = spec.id, ref_of(spec, spec.paper_ref)
             for k, rk in fb[(fb.case == case) & (fb.norm == "H")].groupby("k"):
                 series = {"even N": rk[rk.N2 % 2 == 0], "odd N": rk[rk.N2 % 2 == 1]}
                 for label, rs in series.items():
@@ -186,18 +193,19 @@ def ledger(beta: pd.DataFrame, rates: pd.DataFrame, extra: pd.DataFrame, cfg: di
                                         f"{case}, k={k}, {fam}, {label}: β_h bounded away from 0 (H^-1/2_00 norm)",
                                         bounded_claim(rs, tol, floor, conf)))
         for spec in unstable:
-            case, ref = spec.id, spec.paper_ref
+            case, ref = spec.id, ref_of(spec, spec.paper_ref)
             rc = fb[fb.case == case]
             if len(rc):
                 dim = predicted_kernel(spec, rc)
                 rows.append(row(f"{spec.tag}-{fam}", ref,
                                 f"{case}, {fam}, matching meshes: β_h = 0 with a {dim}-dimensional kernel "
                                 f"(dim M − dim W = {dim})", kernel_claim(rc, dim)))
-        for case in (s.id for s in stable):
+        for spec in stable:
+            case = spec.id
             for k, rk in fb[(fb.case == case) & (fb.norm == "L2")].groupby("k"):
                 rk = finest(rk[rk.N2 % 2 == 0], win)
                 if len(rk) >= 3:
-                    rows.append(row(f"Rem3.1-{case}-k{k}-{fam}", "Rem 3.1",
+                    rows.append(row(f"Rem3.1-{case}-k{k}-{fam}", ref_of(spec, "Rem 3.1"),
                                     f"{case}, k={k}, {fam}: in the L²(Γ) norm β_h decays like h^(1/2)",
                                     slope_verdict(1 / rk.N2.to_numpy(float), rk.beta.to_numpy(float), 0.5, tol, conf)))
     rows += findings(beta, cfg)

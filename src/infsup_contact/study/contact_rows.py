@@ -47,6 +47,7 @@ def contact_row(scene_name: str, case: str, k: int, family: str, n1: int, n2: in
         ndof=sol.ndof, dim_M=sol.space.dim, cone=cone_kind(case, k), iterations=p.iterations,
         energy_error=energy, l2_error=l2, lambda_l2_error=lam_l2, lambda_hm12_error=lam_h,
         contact_set_error=cs, complementarity=p.complementarity, min_gap=p.min_gap,
-        min_lambda=p.min_lambda, max_penetration=accuracy.max_penetration(sol),
+        min_lambda=p.min_lambda, min_lambda_pointwise=accuracy.lambda_min_pointwise(sol),
+        max_penetration=accuracy.max_penetration(sol),
         lambda_tv=accuracy.lambda_total_variation(sol), nonunique=bool(p.nonunique),
         kernel_dim=int(p.kernel_dim_K), t_solve=sol.t_solve, t_linear_solve=sol.t_linear_solve)

@@ -1,6 +1,8 @@
-"""The study: scenes with known answers, accuracy measures, convergence rates, the claims ledger.
+"""The study: scenes with known answers, accuracy measures, convergence rates, the claims ledger,
+stability verdicts.
 
 ``scenes`` (manufactured and membranes loads), ``accuracy`` and ``contact_rows`` (one solve →
 one tidy row), ``profiles`` (Γ profiles for figures), ``rates`` (fitted slopes), ``claims``
-(the ledger's criterion and every claim). Imports ``solvers`` and the stages below it.
+(the ledger's criterion and every claim), ``verdict`` (one space's stability verdict by the
+ledger's criterion, ``infsup-contact verdict``). Imports ``solvers`` and the stages below it.
 """

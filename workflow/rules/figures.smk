@@ -11,12 +11,17 @@ FIGURE_NAMES = [
     "fig5_contact_solutions",
     "fig6_convergence",
     "fig7_speed_accuracy",
+    "fig8_dual",
 ]
 # Every figure output (pdf and png): inputs of `rule figures` and of reproduce-all.
 FIGURES = [f"results/figures/{name}.{ext}" for name in FIGURE_NAMES for ext in ("pdf", "png")]
 
 # Figure 5: a stable and an unstable pair on the same mesh, membranes scene.
 FIG5 = {"cases": ["T4", "R5.4"], "k": 2, "N": 16, "family": "structured", "scene": "membranes",
+        "per_interval": 9}
+
+# Figure 8: dual mortar multipliers against the paper's T3 (β_h, λ_h on Γ, energy error).
+FIG8 = {"cases": ["T3", "DUAL"], "k": 2, "N": 16, "family": "structured", "scene": "membranes",
         "per_interval": 9}
 
 PLOT_STYLE = "src/infsup_contact/report/style.py"
@@ -166,3 +171,46 @@ rule fig7_speed_accuracy:
         "results/logs/figures/fig7_speed_accuracy.log",
     script:
         "../scripts/fig_speed_accuracy.py"
+
+
+rule dual_profiles:
+    output:
+        gamma="results/tables/gamma_profiles_dual.csv",
+        field="results/tables/field_values_dual.csv",
+    input:
+        PACKAGE_SOURCES,
+    params:
+        cases=FIG8["cases"],
+        k=FIG8["k"],
+        N=FIG8["N"],
+        family=FIG8["family"],
+        per_interval=FIG8["per_interval"],
+        scene_spec=lambda wc: config["contact"]["scenes"].get(FIG8["scene"], {"kind": FIG8["scene"]}),
+        c=lambda wc: config["contact"]["c"],
+    threads: 1
+    resources:
+        mem_mb=2000,
+        runtime=10,
+    benchmark:
+        "results/benchmarks/rules/dual_profiles.tsv"
+    log:
+        "results/logs/dual_profiles.log",
+    script:
+        "../scripts/gamma_profiles_job.py"
+
+
+rule fig8_dual:
+    output:
+        pdf=FIGURE_OUT["fig8_dual"]["pdf"],
+        png=FIGURE_OUT["fig8_dual"]["png"],
+    input:
+        beta="results/tables/beta.csv",
+        contact="results/tables/contact.csv",
+        gamma="results/tables/gamma_profiles_dual.csv",
+        style=PLOT_STYLE,
+    params:
+        cases=FIG8["cases"],
+    log:
+        "results/logs/figures/fig8_dual.log",
+    script:
+        "../scripts/fig_dual.py"

@@ -190,11 +190,11 @@ PAPER_CASES = tuple(SPACES)
 # --- dual (biorthogonal) mortar multipliers (module dual) ---------------------------------
 register(SpaceSpec(
     "DUAL", "Wohlmuth 2000", "dual basis of M^1_{0,k}", lambda k, x: dual_space(x, k, True), lambda k: k,
-    expected="stable", dimension=lambda k, n: n * k - 1, color=OKABE_ITO["sky_blue"], marker="P",
+    expected="stable", dimension=lambda k, n: n * k - 1, color=OKABE_ITO["black"], marker="P",
     nodal_basis=False, claim_tag="DUAL", finding_meshes=("omega2", "union")))
 register(SpaceSpec(
     "DUAL-ALL", "dual of Rem 5.2", "dual basis of M^1_k", lambda k, x: dual_space(x, k, False), lambda k: k,
-    expected="unstable", dimension=lambda k, n: n * k + 1, color=OKABE_ITO["black"], marker="X",
+    expected="unstable", dimension=lambda k, n: n * k + 1, color=OKABE_ITO["sky_blue"], marker="X",
     nodal_basis=False, claim_tag="DUAL-ALL"))
 
 # --- roles the study gives to particular spaces (the one place they are spelled) --------

@@ -100,6 +100,9 @@ def contact_macros(contact: pd.DataFrame) -> list[Macro]:
                                  fmt_sci(r[col]), _src("contact.csv", col, **sel)))
             out.append(Macro(macro_name("iterations", _scene(scene), _family(fam), case, _k(k)),
                              fmt_int(r.iterations), _src("contact.csv", "iterations", **sel)))
+            if "min_lambda_pointwise" in r:
+                out.append(Macro(macro_name("lambdaMin", _scene(scene), _family(fam), case, _k(k)),
+                                 fmt_sci(r.min_lambda_pointwise), _src("contact.csv", "min_lambda_pointwise", **sel)))
     return out
 
 

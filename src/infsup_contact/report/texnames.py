@@ -30,6 +30,7 @@ Prefixes (``<Case>`` = Tthree | Rfivetwo | Tfour | Rfivefour | Tfive, ``<Norm>``
 ``\\stderr...``, ``\\expected...``              its standard error, the expected rate
 ``\\error<Scene><Measure><Case>K<k>``          error at the finest N of the scene
 ``\\iterations<Scene><Case>K<k>``              PDAS iterations at the finest N
+``\\lambdaMin<Scene><Case>K<k>``               min_x λ_h(x) at the finest N (sampled)
 ``\\nClaims[Pass|Fail|Inconclusive]``          ledger counts (findings excluded)
 ``\\nClaimsChecked``, ``\\nClaimsAsPredicted``  claims with a PASS/FAIL prediction, and met
 ``\\nFindings[Pass|Fail|Inconclusive]``        findings beyond the paper
@@ -62,7 +63,7 @@ from dataclasses import dataclass
 
 MACRO_PREFIXES = ("beta", "smallest", "kernel", "dim", "finest", "coarsest", "n", "slope", "stderr",
                   "expected", "error", "iterations", "max", "contact", "ref", "claim", "speed", "bench",
-                  "cfg", "prov")
+                  "cfg", "prov", "lambda")
 """Generated names are one of these prefixes followed by an upper-case letter (so ``\\beta`` or
 ``\\ref`` are not generated names, ``\\betaHTthreeKone`` and ``\\refVerdictThmThree`` are);
 ``paper.tex`` defines no such name itself."""

@@ -8,9 +8,9 @@ import pandas as pd
 import pytest
 
 from infsup_contact.report import style as plotting
-from infsup_contact.discretization.registry import space_ids
+from infsup_contact.discretization.registry import PAPER_CASES
 
-CASE_IDS = space_ids()
+CASE_IDS = (*PAPER_CASES, "DUAL", "DUAL-ALL")  # the built-in spaces (users' spaces register later)
 
 SCRIPTS = Path(__file__).resolve().parents[1] / "workflow" / "scripts"
 FIGURE_SCRIPTS = ("fig_model_problem", "fig_beta", "fig_families", "fig_contact_solutions",
@@ -53,8 +53,8 @@ def assert_written(tmp_path, stem):
 
 
 # ------------------------------------------------------------------ synthetic tables
-CASES_BY_K = {1: ["T3", "R5.2", "R5.4"], 2: ["T3", "R5.2", "T4", "R5.4", "T5"]}
-KERNEL = {"R5.2": 2, "R5.4": 1}
+CASES_BY_K = {1: ["T3", "R5.2", "R5.4", "DUAL", "DUAL-ALL"], 2: ["T3", "R5.2", "T4", "R5.4", "T5", "DUAL", "DUAL-ALL"]}
+KERNEL = {"R5.2": 2, "R5.4": 1, "DUAL-ALL": 2}
 
 
 def beta_table():
@@ -110,15 +110,15 @@ def speed_accuracy_csv(tmp_path, benchmarks_schema=False):
 def test_one_colour_map_for_every_figure(scripts):
     for name, module in scripts.items():
         assert module.CASE_COLORS is plotting.CASE_COLORS, name
-    assert tuple(plotting.CASE_COLORS) == CASE_IDS
-    colours = list(plotting.CASE_COLORS.values())
+    assert tuple(plotting.CASE_COLORS)[:len(CASE_IDS)] == CASE_IDS
+    colours = [plotting.CASE_COLORS[c] for c in CASE_IDS]
     assert len(set(colours)) == len(colours)
     assert set(colours) <= set(plotting.OKABE_ITO.values())  # colour-vision-deficiency safe
-    assert len(set(plotting.CASE_MARKERS.values())) == len(CASE_IDS)
+    assert len({plotting.CASE_MARKERS[c] for c in CASE_IDS}) == len(CASE_IDS)
     for case in CASE_IDS:
         style = plotting.case_style(case, k=2)
         assert style["color"] == plotting.CASE_COLORS[case]
-        assert style["linestyle"] == ("-" if case in ("T3", "T4", "T5") else "--")
+        assert style["linestyle"] == ("-" if case in ("T3", "T4", "T5", "DUAL") else "--")
 
 
 def test_fig1_model_problem(tmp_path, scripts):

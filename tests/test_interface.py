@@ -62,7 +62,7 @@ def test_kernel_dimensions_on_matching_meshes(family, k):
     """Rem 5.2: dim ker = 2 for R5.2; Rem 5.4: 1 for R5.4; stable cases have none."""
     rows = {(r["case"], r["norm"]): r for r in beta_rows(family, k, 6, 6)}
     for (case, norm), r in rows.items():
-        expected = {"R5.2": 2, "R5.4": 1}.get(case, 0)
+        expected = {"R5.2": 2, "R5.4": 1, "DUAL-ALL": 2}.get(case, 0)
         assert r["kernel_dim"] == expected == r["structural_kernel_dim"], (case, norm)
         assert r["dim_M"] - r["dim_W"] == {"R5.2": 2, "R5.4": 1, "T3": 0}.get(case, r["dim_M"] - r["dim_W"])
 

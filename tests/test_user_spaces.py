@@ -15,6 +15,20 @@ ROOT = Path(__file__).resolve().parents[1]
 EXAMPLE = f"{ROOT}/examples/macro_p0.py:space"
 ENV = {**os.environ, "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"}
 
+@pytest.fixture(autouse=True)
+def forget_user_spaces():
+    """Each test registers what it loads; the registry is left as the other tests expect it."""
+    from infsup_contact.discretization import user_spaces
+
+    before = set(SPACES)
+    yield
+    for ref, spec in list(user_spaces._LOADED.items()):
+        if spec.id not in before:
+            del user_spaces._LOADED[ref]
+    for case in set(SPACES) - before:
+        del SPACES[case]
+
+
 HEADER = """
 import numpy as np
 from infsup_contact.discretization.multipliers import local_basis_space, make_space

@@ -2,18 +2,8 @@
 # Needs TeX (latexmk, pdflatex): workflow/scripts/ensure_tex.sh installs it as root on
 # Debian or prints the one line saying what to install.
 
-PAPER_FIGURES = [
-    f"results/figures/{name}.pdf"
-    for name in (
-        "fig1_model_problem",
-        "fig2_beta_H",
-        "fig3_beta_L2",
-        "fig4_families",
-        "fig5_contact_solutions",
-        "fig6_convergence",
-        "fig7_speed_accuracy",
-    )
-]
+# every figure of the figures stage (FIGURE_NAMES, rules/figures.smk) is in the paper
+PAPER_FIGURES = [f"results/figures/{name}.pdf" for name in FIGURE_NAMES]
 
 
 rule paper_macros:

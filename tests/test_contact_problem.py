@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 
 from infsup_contact.study.claims import sign_check
-from infsup_contact.solvers.pdas import solve_kkt_sparse
+from infsup_contact.solvers.kkt import solve_kkt_sparse
 from infsup_contact.solvers.contact import contact_qp, load_vector, solve_contact
 from infsup_contact.study.scenes import manufactured, membranes
 from infsup_contact.study.contact_rows import contact_row

@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
-from infsup_contact.solvers.pdas import solve_kkt_sparse
+from infsup_contact.solvers.kkt import solve_kkt_sparse
 from infsup_contact.solvers.contact import linear_saddle_solve
 from infsup_contact.errors import InputError
 from infsup_contact.models.schur import gamma_factorization

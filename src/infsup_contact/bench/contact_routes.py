@@ -128,7 +128,7 @@ def bench_contact(ns, ks, repeats: int = 3, case: str = REFERENCE_SPACE, peers=(
     the tolerance search: tol, rel. diff u, rel. diff λ, iterations, seconds, status).
     """
     from . import peers as peer_mod
-    from ..solvers.pdas import solve_kkt_sparse
+    from ..solvers.kkt import solve_kkt_sparse
     from ..solvers.contact import linear_saddle_solve, solve_contact
     from ..solvers.reduced_qp import solve_reduced_qp
     from ..study.scenes import membranes

@@ -15,7 +15,7 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 
 from ..discretization import meshes, multipliers, registry
-from ..discretization.coupling import coupling_matrix, union_breakpoints
+from ..discretization.coupling import coupling_matrix
 from ..errors import InputError
 from ..models.schur import interface_operator
 from ..models.membranes import MEMBRANES

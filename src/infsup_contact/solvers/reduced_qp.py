@@ -25,7 +25,8 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 
-from .pdas import PdasResult, _check_kkt, solve_pdas
+from .kkt import _check_kkt
+from .pdas import PdasResult, solve_pdas
 from ..models.schur import gamma_factorization
 
 __all__ = ["ReducedQpSolution", "solve_reduced_qp", "touched_columns"]

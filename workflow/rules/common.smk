@@ -1,56 +1,24 @@
 # Config validation and input functions shared by every stage.
+import sys
 from pathlib import Path
 
+from snakemake.logging import logger
 from snakemake.utils import validate
 
-from infsup_contact.discretization.registry import SPACES
+from infsup_contact import resources
+from infsup_contact.config_checks import ConfigError, check_config, memory_notes
 
-
-
-def _check_before_schema(cfg):
-    """Errors whose reason the schema cannot print; each names its key and the rule."""
-    ints = {}
-    for stage in ("infsup", "contact"):
-        sc = cfg.get(stage) or {}
-        cases = sc.get("cases") or {}
-        unknown = [c for c in cases if c not in SPACES] if isinstance(cases, dict) else []
-        if unknown:
-            raise ValueError(f"config key {stage}.cases: {unknown[0]!r} was unexpected; expected registered "
-                             f"spaces: {', '.join(SPACES)}")
-        for case, spec in SPACES.items():  # degrees each space allows (k < 1: the schema says it)
-            ks = cases.get(case) or []
-            if isinstance(ks, list) and any(isinstance(k, (int, float)) and 1 <= k < spec.min_k for k in ks):
-                raise ValueError(f"config key {stage}.cases.{case}: {case} needs k >= {spec.min_k} "
-                                 f"({spec.paper_ref}); got {ks}")
-        ints[f"{stage}.N"] = sc.get("N") or []
-        ints.update({f"{stage}.cases.{c}": v for c, v in cases.items() if isinstance(v, list)})
-    pairs = (cfg.get("infsup") or {}).get("nonmatching") or []
-    ints["infsup.nonmatching"] = [v for p in pairs if isinstance(p, list) for v in p]
-    for key, values in ints.items():
-        bad = [v for v in values if isinstance(v, float) or isinstance(v, bool)]
-        if bad:
-            raise ValueError(f"config key {key}: expected integers, got {bad}")
-
-
-def _load_user_spaces(cfg):
-    """Register the user-defined spaces (config key ``spaces``) before any case key is checked."""
-    from infsup_contact.discretization.user_spaces import load_user_space
-    from infsup_contact.errors import InputError
-
-    refs = cfg.get("spaces") or []
-    if not isinstance(refs, list) or not all(isinstance(r, str) for r in refs):
-        raise ValueError(f"config key spaces: expected a list of FILE.py:FUNC or module:FUNC strings; got {refs!r}")
-    for i, ref in enumerate(refs):
-        try:
-            load_user_space(ref)
-        except InputError as err:
-            raise ValueError(f"config key spaces[{i}]: {err}") from None
-    return [r.rpartition(":")[0] for r in refs if r.rpartition(":")[0].endswith(".py")]
-
-
-USER_SPACE_FILES = _load_user_spaces(config)
-_check_before_schema(config)
-validate(config, schema="../schemas/config.schema.yaml")
+# Every check a config gets, in one library function (src/infsup_contact/config_checks.py):
+# user spaces, non-finite numbers, the schema, the registry's degrees and the cross-key rules.
+# A bad value stops here with ONE line naming the key — before the DAG, so no job starts.
+try:
+    USER_SPACE_FILES, _notes = check_config(config, Path(workflow.current_basedir.get_path_or_uri(secret_free=True)) / ".." / "schemas" / "config.schema.yaml")
+except ConfigError as _err:
+    print(_err, file=sys.stderr)
+    sys.exit(1)
+validate(config, schema="../schemas/config.schema.yaml")  # cannot fail now; fills the defaults
+for _note in _notes + memory_notes(config, resources.available_bytes()):
+    logger.info(_note)
 
 # Source edits must trigger reruns: every compute rule lists the package as input, except
 # the stages that only draw, typeset or time (report/, bench/: their own rules list them).
@@ -89,3 +57,20 @@ def contact_jobs():
 
 def contact_tables(wildcards=None):
     return [f"results/tables/contact/{s}_{f}_k{k}_{n}.csv" for s, f, k, n in contact_jobs()]
+
+
+def beta_mem_mb(wildcards):
+    """mem_mb of a β_h job: the estimate of src/infsup_contact/resources.py (+25 %)."""
+    ic = config["infsup"]
+    return resources.job_mem_mb(resources.beta_estimate(
+        wildcards.family, int(wildcards.k), int(wildcards.n1), int(wildcards.n2),
+        ic["multiplier_meshes"], ic["norms"]))
+
+
+def contact_mem_mb(wildcards):
+    """mem_mb of a contact job (with the membranes reference where the scene needs one)."""
+    cc = config["contact"]
+    kind = cc["scenes"][wildcards.scene]["kind"]
+    n = int(wildcards.n)
+    return resources.job_mem_mb(resources.contact_estimate(
+        kind, wildcards.family, int(wildcards.k), n, n, cc["reference_N"], len(cc["cases"])))

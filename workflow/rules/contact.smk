@@ -10,7 +10,7 @@ rule contact_job:
         cc=lambda wc: config["contact"],
     threads: 1
     resources:
-        mem_mb=3000,
+        mem_mb=contact_mem_mb,
         runtime=30,
     benchmark:
         "results/benchmarks/rules/contact_job/{scene}_{family}_k{k}_{n}.tsv"

@@ -11,7 +11,7 @@ rule beta_job:
         ic=lambda wc: config["infsup"],
     threads: 1
     resources:
-        mem_mb=2000,
+        mem_mb=beta_mem_mb,
         runtime=30,
     benchmark:
         "results/benchmarks/rules/beta_job/{family}_k{k}_{n1}x{n2}.tsv"

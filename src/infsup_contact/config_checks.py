@@ -1,0 +1,353 @@
+"""Validation of the workflow configuration: one function, one line per error, before any job.
+
+:func:`check_config` is what ``workflow/rules/common.smk`` runs on the loaded config; the
+tests call it directly. In order, it
+
+1. registers the user-defined spaces (key ``spaces``), so that their ids are case ids;
+2. refuses non-finite numbers anywhere (``.nan``/``.inf``: no key gives them a meaning, and a
+   JSON schema lets ``.nan`` through every ``minimum``);
+3. validates against ``workflow/schemas/config.schema.yaml`` — a whole float such as ``4.0``
+   is *not* an integer here, unlike in JSON Schema, because it would reach the jobs as a float;
+4. checks the case ids against the registry and the degrees each space allows;
+5. checks what a schema cannot state, across keys (:data:`CROSS_KEY_RULES`).
+
+Every failure is a :class:`ConfigError` whose message is one line,
+``config key <key>: <what> (got <value>; allowed <allowed>)``. What is allowed but worth
+knowing (a fit window longer than a β series, shrunk explicitly) comes back as notes that the
+workflow logs. Pure functions: no Snakemake, no solver imports.
+"""
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+from .errors import InputError
+
+REFERENCE_MARGIN = 2
+"""contact.reference_N >= REFERENCE_MARGIN × the largest N of every membranes scene.
+
+The reference has degree k + 1 on the structured N_ref mesh, which for N | N_ref contains the
+discrete space of every mesh it measures; the measured energy error is then (Galerkin
+orthogonality, exact for the linear problem on the final active set)
+‖u_ref − u_h‖² = ‖u − u_h‖² − ‖u − u_ref‖². The membranes solution has an energy rate of
+about 1 (free boundary, mixed conditions at Γ's ends), so with N_ref = 2 N the reference error
+is at most half the error of the finest mesh, and the measured error is low by at most
+1 − √(1 − 1/4) ≈ 13 % there and by < 1 % two refinements coarser: the fitted slope moves by
+~0.1 at most. With N_ref = N the finest error is meaningless (the issue's 0.85 for a slope of 1
+came from N_ref < N). See the README, "What is refused"."""
+
+MIN_FIT_POINTS = 3
+"""A slope interval needs at least 3 meshes (one degree of freedom for Student's t)."""
+
+
+class ConfigError(ValueError):
+    """A bad config value; the message is one line naming the key."""
+
+    def __init__(self, key: str, what: str, got=None, allowed: str | None = None):
+        self.key = key
+        detail = "; ".join(p for p in (None if got is None else f"got {show(got)}",
+                                       None if allowed is None else f"allowed {allowed}") if p)
+        super().__init__(f"config key {key}: {what}" + (f" ({detail})" if detail else ""))
+
+
+def show(value, limit: int = 80) -> str:
+    """A short one-line repr of a config value."""
+    text = value if isinstance(value, str) and value.startswith("<") else repr(value)
+    text = " ".join(str(text).split())
+    return text if len(text) <= limit else text[: limit - 1] + "…"
+
+
+def key_path(path) -> str:
+    """``("infsup", "N", 0)`` → ``infsup.N[0]``."""
+    out = ""
+    for part in path:
+        out += f"[{part}]" if isinstance(part, int) else (f".{part}" if out else str(part))
+    return out or "(top level)"
+
+
+# ------------------------------------------------------------------ 1. user spaces
+
+def load_spaces(cfg) -> list:
+    """Register the user spaces of key ``spaces``; their ``.py`` files (workflow inputs)."""
+    from .discretization.user_spaces import load_user_space
+
+    refs = cfg.get("spaces") if isinstance(cfg, dict) else None
+    refs = [] if refs is None else refs
+    if not isinstance(refs, list) or not all(isinstance(r, str) for r in refs):
+        raise ConfigError("spaces", "expected a list of FILE.py:FUNC or module:FUNC strings", got=refs,
+                          allowed="e.g. [examples/macro_p0.py:space]")
+    for i, ref in enumerate(refs):
+        try:
+            load_user_space(ref)
+        except InputError as err:
+            raise ConfigError(f"spaces[{i}]", str(err), got=ref, allowed="FILE.py:FUNC or module:FUNC "
+                              "returning a valid SpaceSpec") from None
+    return [r.rpartition(":")[0] for r in refs if r.rpartition(":")[0].endswith(".py")]
+
+
+# ------------------------------------------------------------------ 2. non-finite numbers
+
+def check_finite(node, path=()) -> None:
+    """No ``.nan``/``.inf`` anywhere: a JSON schema's ``minimum`` lets NaN pass."""
+    if isinstance(node, float) and not math.isfinite(node):
+        raise ConfigError(key_path(path), "not a finite number", got=node,
+                          allowed="finite numbers only (.nan and .inf mean nothing in any key)")
+    if isinstance(node, dict):
+        for key, value in node.items():
+            check_finite(value, (*path, key))
+    elif isinstance(node, list):
+        for i, value in enumerate(node):
+            check_finite(value, (*path, i))
+
+
+# ------------------------------------------------------------------ 3. the schema
+
+def load_schema(path) -> dict:
+    import yaml
+
+    return yaml.safe_load(Path(path).read_text())
+
+
+def _resolve(schema: dict, root: dict) -> dict:
+    ref = schema.get("$ref") if isinstance(schema, dict) else None
+    if ref and ref.startswith("#/"):
+        node = root
+        for part in ref[2:].split("/"):
+            node = node[part]
+        return _resolve(node, root)
+    return schema if isinstance(schema, dict) else {}
+
+
+def _number_range(s: dict) -> str:
+    lo = (f">= {s['minimum']}" if "minimum" in s else
+          f"> {s['exclusiveMinimum']}" if "exclusiveMinimum" in s else "")
+    hi = (f"<= {s['maximum']}" if "maximum" in s else
+          f"< {s['exclusiveMaximum']}" if "exclusiveMaximum" in s else "")
+    if "minimum" in s and "maximum" in s:
+        return f" in {s['minimum']}..{s['maximum']}"
+    if lo and hi:
+        return f" {lo} and {hi}"
+    return f" {lo or hi}" if (lo or hi) else ""
+
+
+def describe(schema: dict, root: dict | None = None) -> str:
+    """What a (sub)schema allows, in words: ``an integer in 1..4``, ``one of H, L2``, …"""
+    root = root or schema
+    s = _resolve(schema, root)
+    if "enum" in s:
+        return "one of " + ", ".join(str(v) for v in s["enum"])
+    t = s.get("type")
+    if t == "integer":
+        return "an integer" + _number_range(s)
+    if t == "number":
+        return "a finite number" + _number_range(s)
+    if t == "string":
+        return "a string" + (f" matching {s['pattern']}" if "pattern" in s else "") + (
+            f" ({s['description']})" if "description" in s else "")
+    if t == "array":
+        lo, hi = s.get("minItems"), s.get("maxItems")
+        size = (f"{lo} " if lo == hi and lo is not None else
+                f"{lo}+ " if lo else f"at most {hi} " if hi else "")
+        uniq = "distinct " if s.get("uniqueItems") else ""
+        items = describe(s.get("items", {}), root) if s.get("items") else "anything"
+        return f"a list of {size}{uniq}items, each {items}"
+    if t == "object":
+        props = list(s.get("properties", {}))
+        extra = s.get("additionalProperties", True)
+        if props and extra is False:
+            return "a mapping with the keys " + ", ".join(props)
+        if isinstance(extra, dict):
+            return f"a mapping of names to {describe(extra, root)}"
+        return "a mapping"
+    return "see workflow/schemas/config.schema.yaml"
+
+
+def _validator(schema: dict):
+    import jsonschema
+
+    base = jsonschema.Draft202012Validator
+    # 4.0 is an integer in JSON Schema; here it is not: it would reach the jobs as a float
+    checker = base.TYPE_CHECKER.redefine(
+        "integer", lambda _checker, x: isinstance(x, int) and not isinstance(x, bool))
+    return jsonschema.validators.extend(base, type_checker=checker)(schema)
+
+
+def schema_error(cfg, schema: dict) -> ConfigError | None:
+    """The most relevant schema violation as a one-line :class:`ConfigError`, or None."""
+    from jsonschema.exceptions import best_match
+
+    err = best_match(_validator(schema).iter_errors(cfg))
+    if err is None:
+        return None
+    path = list(err.absolute_path)
+    sub = _resolve(err.schema, schema)
+    if err.validator == "required":
+        missing = [r for r in err.validator_value if r not in err.instance]
+        name = missing[0] if missing else "?"
+        sub_prop = _resolve(sub.get("properties", {}).get(name, {}), schema)
+        return ConfigError(key_path([*path, name]), "missing (required)",
+                           allowed=describe(sub_prop, schema) if sub_prop else None)
+    if err.validator == "additionalProperties":
+        known = list(sub.get("properties", {}))
+        extra = [key for key in err.instance if key not in known] if isinstance(err.instance, dict) else []
+        name = extra[0] if extra else "?"
+        return ConfigError(key_path([*path, name]), f"unknown key ({name!r} was unexpected)",
+                           allowed=f"the keys of {key_path(path)}: " + ", ".join(known))
+    return ConfigError(key_path(path), err.message, got=err.instance, allowed=describe(sub, schema))
+
+
+# ------------------------------------------------------------------ 4. the registry
+
+def check_cases(cfg) -> None:
+    """Case ids are registered spaces; each k is one the space allows (T4, T5: k >= 2)."""
+    from .discretization.registry import SPACES
+
+    for stage in ("infsup", "contact"):
+        cases = cfg[stage]["cases"]
+        for case, ks in cases.items():
+            if case not in SPACES:
+                raise ConfigError(f"{stage}.cases", f"{case!r} was unexpected", got=case,
+                                  allowed="registered spaces: " + ", ".join(SPACES))
+            spec = SPACES[case]
+            low = [k for k in ks if not spec.valid_for(k)]
+            if low:
+                raise ConfigError(f"{stage}.cases.{case}", f"{case} needs k >= {spec.min_k} ({spec.paper_ref})",
+                                  got=ks, allowed=f"degrees {spec.min_k}..4")
+
+
+# ------------------------------------------------------------------ 5. across keys
+
+def scene_meshes(cfg) -> dict:
+    """Scene name → its mesh sizes N (the scene's own ``N`` or ``contact.N``)."""
+    cc = cfg["contact"]
+    return {name: list(spec.get("N", cc["N"])) for name, spec in cc["scenes"].items()}
+
+
+def check_reference(cfg) -> None:
+    """contact.reference_N >= REFERENCE_MARGIN × the largest N of every membranes scene."""
+    cc = cfg["contact"]
+    for name, spec in cc["scenes"].items():
+        if spec["kind"] != "membranes":
+            continue
+        ns = scene_meshes(cfg)[name]
+        need = REFERENCE_MARGIN * max(ns)
+        if cc["reference_N"] < need:
+            raise ConfigError(
+                "contact.reference_N", f"the membranes reference must be {REFERENCE_MARGIN}x finer than the "
+                f"finest mesh it measures (scene {name} runs N up to {max(ns)}; a coarser reference "
+                "gives errors that are not errors)", got=cc["reference_N"], allowed=f"reference_N >= {need}")
+
+
+def check_rate_window(cfg) -> None:
+    """contact.rate_window <= the number of meshes of every scene: refused, never shrunk."""
+    rw = cfg["contact"]["rate_window"]
+    for name, ns in scene_meshes(cfg).items():
+        if rw > len(ns):
+            raise ConfigError("contact.rate_window", f"longer than the mesh series it fits (scene {name} "
+                              f"has {len(ns)} meshes, N = {ns})", got=rw, allowed=f"2..{len(ns)}")
+
+
+def check_nonmatching(cfg) -> None:
+    """A non-matching pair has N1 ≠ N2 (matching pairs belong in infsup.N)."""
+    for i, pair in enumerate(cfg["infsup"].get("nonmatching", [])):
+        if pair[0] == pair[1]:
+            raise ConfigError(f"infsup.nonmatching[{i}]", "a non-matching pair needs N1 != N2", got=pair,
+                              allowed="[N1, N2] with N1 != N2 (matching meshes go under infsup.N)")
+
+
+def check_membranes_parameters(cfg) -> None:
+    """A membranes scene takes no manufactured-solution parameter (p, q, a)."""
+    for name, spec in cfg["contact"]["scenes"].items():
+        if spec["kind"] == "membranes":
+            extra = [key for key in spec if key not in ("kind", "N")]
+            if extra:
+                raise ConfigError(f"contact.scenes.{name}.{extra[0]}", "a membranes scene takes no such "
+                                  "parameter (p, q, a belong to the manufactured kind)", got=spec[extra[0]],
+                                  allowed="the keys kind, N")
+
+
+def check_speed_accuracy_scene(cfg) -> None:
+    """benchmarks.speed_accuracy_scene names a contact scene or a scene kind."""
+    name = cfg["benchmarks"].get("speed_accuracy_scene", "manufactured")
+    allowed = [*cfg["contact"]["scenes"], *(k for k in ("manufactured", "membranes")
+                                            if k not in cfg["contact"]["scenes"])]
+    if name not in allowed:
+        raise ConfigError("benchmarks.speed_accuracy_scene", "not a scene of contact.scenes nor a scene kind",
+                          got=name, allowed="one of " + ", ".join(allowed))
+
+
+CROSS_KEY_RULES = (check_reference, check_rate_window, check_nonmatching, check_membranes_parameters,
+                   check_speed_accuracy_scene)
+"""The rules a schema cannot state; each raises :class:`ConfigError` naming the key."""
+
+
+def beta_series(cfg) -> dict:
+    """The mesh series the claims ledger fits (per family, case, k and norm alike)."""
+    ic = cfg["infsup"]
+    ns = sorted(ic["N"])
+    three_two = sorted(p[1] for p in ic.get("nonmatching", []) if 2 * p[0] == 3 * p[1])
+    return {"even-N": [n for n in ns if n % 2 == 0], "odd-N": [n for n in ns if n % 2 == 1],
+            "3:2 non-matching (N2)": three_two}
+
+
+def fit_window_notes(cfg) -> list:
+    """claims.fit_window longer than a β series: that series is fitted on all its meshes (an
+    explicit, logged shrink); a series with fewer than 3 meshes gives no slope claim."""
+    win = cfg["claims"]["fit_window"]
+    notes = []
+    for name, ns in beta_series(cfg).items():
+        if not ns:
+            continue
+        if len(ns) < MIN_FIT_POINTS:
+            notes.append(f"config key claims.fit_window: the {name} β series has {len(ns)} meshes ({ns}): "
+                         f"its slope claims are skipped (a slope interval needs {MIN_FIT_POINTS})")
+        elif win > len(ns):
+            notes.append(f"config key claims.fit_window = {win}: the {name} β series has {len(ns)} meshes "
+                         f"({ns}); its fits use all {len(ns)} (shrunk explicitly)")
+    return notes
+
+
+def memory_notes(cfg, available: float | None) -> list:
+    """The largest β and contact jobs against this machine's available memory."""
+    from . import resources as R
+
+    ic, cc = cfg["infsup"], cfg["contact"]
+    notes = []
+    ks = sorted({k for klist in ic["cases"].values() for k in klist})
+    pairs = [(n, n) for n in ic["N"]] + [tuple(p) for p in ic.get("nonmatching", [])]
+    big = max(((R.beta_estimate(f, k, n1, n2, ic["multiplier_meshes"], ic["norms"]), (f, k, n1, n2))
+               for f in ic["families"] for k in ks for n1, n2 in pairs), key=lambda t: t[0].bytes)
+    ck = sorted({k for klist in cc["cases"].values() for k in klist})
+    cbig = max(((R.contact_estimate(spec["kind"], f, k, n, n, cc["reference_N"], len(cc["cases"])),
+                 (s, f, k, n)) for s, spec in cc["scenes"].items() for f in cc["families"] for k in ck
+                for n in scene_meshes(cfg)[s]), key=lambda t: t[0].bytes)
+    for label, (est, job) in (("β", big), ("contact", cbig)):
+        if available is not None and est.bytes > available:
+            notes.append(f"the largest {label} job {job} needs {est.describe()}, more than the "
+                         f"{R.human_bytes(available)} available here: it runs only where that much memory is "
+                         "(its mem_mb says so to the scheduler)")
+    return notes
+
+
+# ------------------------------------------------------------------ all of it
+
+def check_config(cfg, schema) -> tuple[list, list]:
+    """Validate a loaded config (``schema``: dict or path of the YAML schema).
+
+    Returns ``(user_space_files, notes)``; raises :class:`ConfigError` (one line) on the
+    first bad value.
+    """
+    if not isinstance(schema, dict):
+        schema = load_schema(schema)
+    if not isinstance(cfg, dict):
+        raise ConfigError("(top level)", "the config file must be a mapping of keys", got=type(cfg).__name__,
+                          allowed=describe(schema))
+    files = load_spaces(cfg)
+    check_finite(cfg)
+    err = schema_error(cfg, schema)
+    if err is not None:
+        raise err
+    check_cases(cfg)
+    for rule in CROSS_KEY_RULES:
+        rule(cfg)
+    return files, fit_window_notes(cfg)

@@ -1,0 +1,189 @@
+"""Memory and time of a request, estimated from its sizes before anything is allocated.
+
+Pure arithmetic (no numpy, no NGSolve): the command line checks a request against the
+available memory before it imports the solvers, and the workflow gives every β_h and contact
+job its ``mem_mb`` from the same numbers (``workflow/rules/common.smk``).
+
+The model
+---------
+Per membrane with N segments on Γ and degree k, the structured mesh has
+``nd = (N k)(N k − 1)`` free dofs (× 1.3 for the unstructured family, whose netgen meshes
+carry up to 1.24× the dofs). What a side costs grows like the sparse factorization:
+nested-dissection fill is O(nd log nd) in 2D, and the mesh, the stiffness and its copies are
+O(nd), so a side takes ``C · nd · log2(nd)`` bytes while it is kept (both sides are kept
+until the request ends). The dense interface operators — the Schur complement S_i and
+X_i = S_i⁻¹, (N k)² doubles each, plus the trailing blocks of the factors — and the coupling
+matrices (dim M × n_Γ, quadrature points × n_Γ) are added explicitly; so is the Gram matrix
+of the H^{-1/2}_00 norm (the log kernel holds one (s+1)² block and its quadrature per pair
+of multiplier intervals; the sine-series route ~1600 (dim M)² bytes) and the dense
+eigenproblem (a few (dim M)² doubles). The constants were measured with
+``/usr/bin/time -v`` (maximum resident set size) and ``tracemalloc`` on this package (see the
+README, "What is refused"); the estimate is an upper bound within ~10–40 % at sizes where the
+request dominates the interpreter (≥ 100k dofs).
+
+The time is rough (order of magnitude): a sparse LU is O(nd^1.5) in 2D.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+MIB = 1024 ** 2
+
+PROCESS_BYTES = {"beta": 200 * MIB, "contact": 230 * MIB, "bench": 220 * MIB}
+"""Resident memory of the process before the request (Python, NumPy, SciPy, NGSolve, pandas):
+measured 190 MB (``beta``), 220 MB (``contact``), 210 MB (``bench``) on the smallest sizes."""
+
+SIDE_BYTES_PER_DOF_LOG = {"beta": 175.0, "contact": 330.0, "reference": 250.0}
+"""C in C · nd · log2(nd) bytes per side: β_h (mesh, stiffness, Γ-last LU), a contact solve
+(the same plus loads, solutions and the error integrals), the membranes reference solve."""
+
+CONTACT_EXTRA_BYTES = 150 * MIB
+"""Error integration of a contact row (exact solution or reference on the coarse mesh)."""
+
+FAMILY_DOF_FACTOR = {"structured": 1.0, "perturbed": 1.0, "unstructured": 1.3}
+
+BENCH_FACTOR = {"beta": 2.7, "contact": 1.6}
+"""Bench holds each route's own factorization (eigsh: the full pencil; peers: the full KKT)
+next to ours: measured 2.3× (β, N = 128, k = 2) and 1.4× (contact, N = 64, k = 2)."""
+
+SECONDS_PER_DOF15 = {"beta": 5e-8, "contact": 1.6e-7, "eigsh": 1.8e-6, "kkt": 3e-6}
+"""Seconds per nd^1.5 (a 2D sparse LU): measured β N = 256, 512 (k = 1, 2); contact N = 512,
+k = 1 and the membranes reference; bench's eigsh (per case × norm) and sparse-KKT routes."""
+START_SECONDS = 2.5
+"""Start-up: imports of NGSolve, SciPy and pandas."""
+
+
+@dataclass(frozen=True)
+class Estimate:
+    """Peak resident memory (bytes, interpreter included) and wall time (seconds) of a request."""
+
+    bytes: float
+    seconds: float
+
+    @property
+    def mb(self) -> int:
+        """Megabytes (10⁶ B, Snakemake's ``mem_mb``), rounded up."""
+        return int(math.ceil(self.bytes / 1e6))
+
+    def describe(self) -> str:
+        return f"~{human_bytes(self.bytes)} peak memory, ~{human_seconds(self.seconds)}"
+
+
+def human_bytes(n: float) -> str:
+    for unit in ("B", "KiB", "MiB", "GiB", "TiB", "PiB", "EiB"):
+        if n < 1024 or unit == "EiB":
+            return f"{n:.3g} {unit}" if unit != "B" else f"{int(n)} B"
+        n /= 1024
+    return f"{n:.3g} EiB"  # pragma: no cover
+
+
+def human_seconds(s: float) -> str:
+    for unit, size in (("years", 365.25 * 86400), ("days", 86400), ("h", 3600), ("min", 60)):
+        if s >= size:
+            return f"{s / size:.2g} {unit}"
+    return f"{max(s, 1):.2g} s"
+
+
+def side_dofs(family: str, n: int, k: int) -> float:
+    """Free dofs of one membrane: (N k)(N k − 1) on the structured meshes (× family factor)."""
+    nk = float(n) * float(k)
+    return max(nk * (nk - 1.0), 1.0) * FAMILY_DOF_FACTOR.get(family, 1.3)
+
+
+def _side_bytes(nd: float, what: str) -> float:
+    return SIDE_BYTES_PER_DOF_LOG[what] * nd * math.log2(max(nd, 2.0))
+
+
+def _dense_bytes(k: int, ns, n_mult: float, s: int, norms, h_route: str) -> float:
+    """Dense Γ work of one multiplier space: interface operators, couplings, Gram, eigh."""
+    m = n_mult * (s + 1)                        # dim M: at most (s + 1) per interval
+    n_quad = sum(ns) * (k + s + 2) / 2          # quadrature points on the common refinement
+    total = 0.0
+    for n in ns:
+        g = float(n) * k + 1                   # Γ dofs of side i
+        total += 8 * (4 * g * g + g * (m + n_quad) + n_quad * m)
+    total += 8 * 10 * m * m                     # B X Bᵀ, its copies, eigh of two pencils
+    if "H" in norms:
+        if h_route == "series":
+            total += 1600 * m * m
+        else:                                   # log kernel: per pair of intervals
+            total += (600 + 110 * (s + 1) ** 2) * n_mult * (n_mult + 1) / 2
+    return total
+
+
+def _multiplier_intervals(multiplier_mesh: str, n1: int, n2: int) -> float:
+    return {"omega1": n1, "omega2": n2}.get(multiplier_mesh, n1 + n2)
+
+
+def beta_estimate(family: str, k: int, n1: int, n2: int, multiplier_mesh="omega2",
+                  norms=("H", "L2"), h_route: str = "logkernel", process: bool = True) -> Estimate:
+    """One ``beta_rows`` call: both sides kept, then every multiplier space in turn (the
+    largest degree s ≤ k counts: a space of degree s has at most N(s + 1) functions)."""
+    mms = [multiplier_mesh] if isinstance(multiplier_mesh, str) else list(multiplier_mesh)
+    nds = [side_dofs(family, n, k) for n in (n1, n2)]
+    volume = sum(_side_bytes(nd, "beta") for nd in nds)
+    dense = max(_dense_bytes(k, (n1, n2), _multiplier_intervals(mm, n1, n2), k, norms, h_route)
+                for mm in mms)
+    seconds = START_SECONDS + SECONDS_PER_DOF15["beta"] * sum(nd ** 1.5 for nd in nds) * len(mms)
+    return Estimate((PROCESS_BYTES["beta"] if process else 0) + volume + dense, seconds)
+
+
+def contact_estimate(scene: str, family: str, k: int, n1: int, n2: int, n_ref: int | None = None,
+                     n_cases: int = 1, process: bool = True) -> Estimate:
+    """One contact solve per case on (N1, N2); for ``membranes`` first the reference (degree
+    k + 1, structured N_ref × N_ref, kept for the whole request)."""
+    nds = [side_dofs(family, n, k) for n in (n1, n2)]
+    total = sum(_side_bytes(nd, "contact") for nd in nds) + CONTACT_EXTRA_BYTES
+    total += _dense_bytes(k, (n1, n2), n2, k, ("H",), "logkernel")
+    seconds = START_SECONDS + SECONDS_PER_DOF15["contact"] * sum(nd ** 1.5 for nd in nds) * max(n_cases, 1)
+    if scene == "membranes" and n_ref is not None:
+        nd_ref = side_dofs("structured", n_ref, k + 1)
+        total += 2 * _side_bytes(nd_ref, "reference") + _dense_bytes(k + 1, (n_ref, n_ref), n_ref, k + 1,
+                                                                    ("H",), "logkernel")
+        seconds += SECONDS_PER_DOF15["contact"] * 2 * nd_ref ** 1.5
+    return Estimate((PROCESS_BYTES["contact"] if process else 0) + total, seconds)
+
+
+def verdict_estimate(family: str, k: int, ns, norm: str, multiplier_mesh: str = "omega2") -> Estimate:
+    """β_h on matching meshes N × N, one N after the other: the largest N sets the memory."""
+    ests = [beta_estimate(family, k, n, n, multiplier_mesh, (norm,)) for n in ns]
+    return Estimate(max(e.bytes for e in ests), START_SECONDS + sum(e.seconds - START_SECONDS for e in ests))
+
+
+def bench_estimate(what: str, ns, ks, repeats: int = 3, eigsh_max_n=None, kkt_max_n: int = 64,
+                   n_problems: int = 10) -> Estimate:
+    """``bench``: every (N, k) in turn, each route next to ours (factor :data:`BENCH_FACTOR`);
+    β's shift-invert eigsh route and contact's sparse-KKT route dominate the time."""
+    peak, seconds = 0.0, START_SECONDS
+    for n in ns:
+        for k in ks:
+            nd_total = 2 * side_dofs("structured", n, k)
+            if what == "beta":
+                inner = beta_estimate("structured", k, n, n, process=False)
+                if eigsh_max_n is None or n <= eigsh_max_n:
+                    seconds += SECONDS_PER_DOF15["eigsh"] * nd_total ** 1.5 * n_problems
+            else:
+                inner = contact_estimate("manufactured", "structured", k, n, n, process=False)
+                if kkt_max_n is None or n <= kkt_max_n:
+                    seconds += repeats * SECONDS_PER_DOF15["kkt"] * nd_total ** 1.5
+            peak = max(peak, BENCH_FACTOR[what] * inner.bytes)
+            seconds += repeats * 6 * (inner.seconds - START_SECONDS)
+    return Estimate(PROCESS_BYTES["bench"] + peak, seconds)
+
+
+def job_mem_mb(estimate: Estimate, margin: float = 1.25) -> int:
+    """``mem_mb`` of a workflow job: the estimate with a margin, rounded up to 100 MB."""
+    return int(math.ceil(margin * estimate.bytes / 1e8)) * 100
+
+
+def available_bytes(meminfo: str = "/proc/meminfo") -> float | None:
+    """MemAvailable of /proc/meminfo in bytes (None where the file or the field is missing)."""
+    try:
+        with open(meminfo) as fh:
+            for line in fh:
+                if line.startswith("MemAvailable:"):
+                    return float(line.split()[1]) * 1024
+    except (OSError, ValueError, IndexError):
+        return None
+    return None

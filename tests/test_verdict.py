@@ -239,8 +239,8 @@ BAD = {
     "unknown-family": (["--case", "T3", "--k", "1", "--family", "hexagonal"], ["--family", "hexagonal"]),
     "unknown-norm": (["--case", "T3", "--k", "1", "--norm", "H1"], ["--norm", "H1"]),
     "unknown-expect": (["--case", "T3", "--k", "1", "--expect", "maybe"], ["--expect", "maybe"]),
-    "tolerance-zero": (["--case", "T3", "--k", "1", "--slope-tolerance", "0"], ["slope_tolerance"]),
-    "floor-negative": (["--case", "T3", "--k", "1", "--beta-floor", "-1"], ["beta_floor"]),
+    "tolerance-zero": (["--case", "T3", "--k", "1", "--slope-tolerance", "0"], ["slope-tolerance"]),
+    "floor-negative": (["--case", "T3", "--k", "1", "--beta-floor", "-1"], ["beta-floor"]),
     "confidence-one": (["--case", "T3", "--k", "1", "--confidence", "1"], ["confidence"]),
 }
 

@@ -7,8 +7,11 @@
     infsup-contact verdict --case T3 --k 2 --expect stable
     infsup-contact provenance
 
-Bad input gets one line on stderr and exit code 2; no traceback. ``verdict --expect`` exits
-with 1 when the verdict is not the expected one.
+Bad input gets one line on stderr naming the flag and exit code 2; no traceback, and no
+computation: every subcommand validates the whole request first — values, the files it reads
+and its estimated memory against the available memory (``resources.py``) — and ``--dry-run``
+stops right there (exit 0, the estimate on stdout). ``verdict --expect`` exits with 1 when the
+verdict is not the expected one.
 """
 from __future__ import annotations
 
@@ -16,7 +19,8 @@ import argparse
 import os
 import sys
 
-from .errors import InputError
+from .errors import InputError, check_prestress
+from .io import TableError
 
 
 def _threads_default() -> None:
@@ -70,9 +74,29 @@ def _add_beta(sub) -> None:
     p.add_argument("--norm", default="all", choices=["H", "L2", "all"])
     p.add_argument("--h-route", default="logkernel", choices=["logkernel", "series"],
                    help="H^{-1/2}_00 Gram: closed-form log kernel or truncated sine series")
-    p.add_argument("--seed", type=int, default=0, help="seed of the perturbed family")
-    p.add_argument("--alpha", type=float, default=0.2, help="perturbation amplitude / h")
-    p.set_defaults(run=_run_beta)
+    p.add_argument("--seed", type=int, default=0, help="seed of the perturbed family (>= 0)")
+    p.add_argument("--alpha", type=float, default=0.2, help="perturbation amplitude / h, in [0, 0.5)")
+    _add_dry_run(p)
+    p.set_defaults(run=_run_beta, check=_check_beta)
+
+
+def _norms(args) -> tuple:
+    return ("H", "L2") if args.norm == "all" else (args.norm,)
+
+
+def _check_beta(args):
+    from . import resources
+    from .discretization.meshes import check_perturbation
+    from .solvers.infsup import check_inputs
+
+    args.cases = _cases(args)
+    check_inputs([c for c in args.cases if isinstance(c, str)], args.k, args.family, args.N1, args.N2,
+                 args.c1, args.c2, _norms(args), args.multiplier_mesh)
+    check_perturbation(args.alpha, args.seed)
+    est = resources.beta_estimate(args.family, args.k, args.N1, args.N2, args.multiplier_mesh,
+                                  _norms(args), args.h_route)
+    _check_memory(est, *(("N1", args.N1) if args.N1 >= args.N2 else ("N2", args.N2)))
+    return est
 
 
 def _run_beta(args) -> None:
@@ -80,13 +104,11 @@ def _run_beta(args) -> None:
 
     from .solvers.infsup import beta_rows
 
-    cases = _cases(args)
-    norms = ("H", "L2") if args.norm == "all" else (args.norm,)
     kwargs = {}
     if args.family == "perturbed":
         kwargs = dict(seed=args.seed, alpha=args.alpha)
-    rows = beta_rows(args.family, args.k, args.N1, args.N2, cases, args.multiplier_mesh,
-                     args.c1, args.c2, norms, h_route=args.h_route, **kwargs)
+    rows = beta_rows(args.family, args.k, args.N1, args.N2, args.cases, args.multiplier_mesh,
+                     args.c1, args.c2, _norms(args), h_route=args.h_route, **kwargs)
     pd.DataFrame(rows).to_csv(sys.stdout, index=False, float_format="%.12g")
 
 
@@ -106,8 +128,43 @@ def _add_contact(sub) -> None:
     p.add_argument("--c2", type=float, default=1.0)
     p.add_argument("--p", type=float, default=3.0, help="manufactured: λ = x (a − x)₊^p, p > 3/2")
     p.add_argument("--q", type=float, default=3.0, help="manufactured: g = (x − a)₊^q (1 − x), q > 3/2")
-    p.add_argument("--n-ref", type=int, default=64, help="membranes: reference mesh N (degree k + 1)")
-    p.set_defaults(run=_run_contact)
+    p.add_argument("--n-ref", type=int, default=64,
+                   help="membranes: reference mesh N (degree k + 1), at least 2 max(N1, N2)")
+    _add_dry_run(p)
+    p.set_defaults(run=_run_contact, check=_check_contact)
+
+
+def _check_contact(args):
+    from . import resources
+    from .config_checks import REFERENCE_MARGIN
+    from .discretization import meshes, registry
+    from .study.scenes import _exponent
+
+    if args.case is None and args.space is None:
+        raise InputError("case", "one of --case ID|all or --space FILE.py:FUNC")
+    args.cases = _cases(args)
+    if not 1 <= args.k <= 4:
+        raise InputError("k", "an integer in 1..4", got=args.k)
+    for case in args.cases:
+        registry.check_case(case, args.k)
+    meshes.check_mesh_args(args.family, args.N1, "N1")
+    meshes.check_mesh_args(args.family, args.N2, "N2")
+    check_prestress("c1", args.c1)
+    check_prestress("c2", args.c2)
+    _exponent("p", args.p)  # used by the manufactured scene only, but a bad value is bad anyway
+    _exponent("q", args.q)
+    need = REFERENCE_MARGIN * max(args.N1, args.N2)
+    if args.n_ref < 1 or (args.scene == "membranes" and args.n_ref < need):
+        raise InputError("n_ref", f"an integer >= {need} for the membranes scene ({REFERENCE_MARGIN}x the finest "
+                         "mesh: a coarser reference gives errors that are not errors), >= 1 otherwise",
+                         got=args.n_ref)
+    n_ref = args.n_ref if args.scene == "membranes" else None
+    est = resources.contact_estimate(args.scene, args.family, args.k, args.N1, args.N2, n_ref, len(args.cases))
+    alone = resources.contact_estimate(args.scene, args.family, args.k, args.N1, args.N2, None, len(args.cases))
+    if n_ref is not None and est.bytes > 2 * alone.bytes:  # the reference dominates
+        _check_memory(est, "n_ref", args.n_ref)
+    _check_memory(est, *(("N1", args.N1) if args.N1 >= args.N2 else ("N2", args.N2)))
+    return est
 
 
 def _run_contact(args) -> None:
@@ -115,9 +172,7 @@ def _run_contact(args) -> None:
 
     from .study.contact_rows import contact_row
 
-    if args.case is None and args.space is None:
-        raise InputError("case", "one of --case ID|all or --space FILE.py:FUNC")
-    cases = _cases(args)
+    cases = args.cases
     params = dict(p=args.p, q=args.q) if args.scene == "manufactured" else {}
     ref = None
     rows = []
@@ -134,22 +189,36 @@ def _run_contact(args) -> None:
 def _add_rates(sub) -> None:
     p = sub.add_parser("rates", help="fit convergence rates of a contact table (CSV in, CSV out)")
     p.add_argument("table", help="CSV written by `infsup-contact contact` or the workflow")
-    p.add_argument("--window", type=int, default=3, help="number of finest meshes in the fit")
-    p.set_defaults(run=_run_rates)
+    p.add_argument("--window", type=int, default=3,
+                   help="number of finest meshes in the fit (2 .. the meshes of the shortest series)")
+    _add_dry_run(p)
+    p.set_defaults(run=_run_rates, check=_check_rates)
+
+
+def _check_rates(args):
+    from . import resources
+    from .io import read_table
+
+    if args.window < 2:
+        raise InputError("window", "an integer >= 2", got=args.window)
+    frame = read_table(args.table, "contact_input")
+    matching = frame[frame.N1 == frame.N2]
+    if matching.empty:
+        raise TableError(args.table, "no rows with N1 = N2 (rates are fitted over matching meshes)")
+    sizes = matching.groupby(["scene", "case", "k", "family"]).N2.nunique()
+    if args.window > sizes.min():
+        key = sizes.idxmin()
+        raise InputError("window", f"at most {sizes.min()}: the series {'/'.join(map(str, key))} of "
+                         f"{args.table} has {sizes.min()} meshes (a window is never shrunk silently)",
+                         got=args.window)
+    args.frame = frame
+    return resources.Estimate(resources.PROCESS_BYTES["beta"], resources.START_SECONDS)
 
 
 def _run_rates(args) -> None:
-    import pandas as pd
-
     from .study.rates import rate_table
 
-    try:
-        frame = pd.read_csv(args.table)
-    except (OSError, pd.errors.ParserError) as err:
-        raise InputError("table", "a readable CSV file", got=args.table) from err
-    if args.window < 2:
-        raise InputError("window", "an integer >= 2", got=args.window)
-    rate_table(frame, args.window).to_csv(sys.stdout, index=False, float_format="%.6g")
+    rate_table(args.frame, args.window).to_csv(sys.stdout, index=False, float_format="%.6g")
 
 
 def _add_bench(sub) -> None:
@@ -164,7 +233,36 @@ def _add_bench(sub) -> None:
                    help="beta: run the shift-invert Lanczos route only for N <= this")
     p.add_argument("--kkt-max-N", dest="kkt_max_n", type=int, default=64,
                    help="contact: run the sparse-KKT active-set route only for N <= this")
-    p.set_defaults(run=_run_bench)
+    _add_dry_run(p)
+    p.set_defaults(run=_run_bench, check=_check_bench)
+
+
+def _check_bench(args):
+    from . import resources
+    from .bench.peers import SOLVERS
+
+    for key, values, ok, allowed in (("N", args.N, lambda n: n >= 1, "integers >= 1"),
+                                     ("k", args.k, lambda k: 1 <= k <= 4, "integers in 1..4")):
+        for v in values:
+            if not ok(v):
+                raise InputError(key, allowed, got=v)
+        if len(set(values)) < len(values):
+            raise InputError(key, f"{allowed}, each once", got=" ".join(map(str, values)))
+    if args.repeats < 1:
+        raise InputError("repeats", "an integer >= 1", got=args.repeats)
+    for key in ("eigsh_max_n", "kkt_max_n"):
+        value = getattr(args, key)
+        if value is not None and value < 0:
+            raise InputError(key, "an integer >= 0 (0: never)", got=value)
+    args.peer_list = [p for p in args.peers if p != "none"]
+    for p in args.peer_list:
+        if p not in SOLVERS:
+            raise InputError("peers", ", ".join([*SOLVERS, "none"]), got=p)
+    if len(set(args.peer_list)) < len(args.peer_list):
+        raise InputError("peers", "each peer once", got=" ".join(args.peers))
+    est = resources.bench_estimate(args.what, args.N, args.k, args.repeats, args.eigsh_max_n, args.kkt_max_n)
+    _check_memory(est, "N", max(args.N))
+    return est
 
 
 def _run_bench(args) -> None:
@@ -172,20 +270,7 @@ def _run_bench(args) -> None:
 
     from . import bench
 
-    for n in args.N:
-        if n < 1:
-            raise InputError("N", "integers >= 1", got=n)
-    for k in args.k:
-        if not 1 <= k <= 4:
-            raise InputError("k", "integers in 1..4", got=k)
-    if args.repeats < 1:
-        raise InputError("repeats", "an integer >= 1", got=args.repeats)
-    from .bench.peers import SOLVERS
-
-    peers = [p for p in args.peers if p != "none"]
-    for p in peers:
-        if p not in SOLVERS:
-            raise InputError("peers", ", ".join([*SOLVERS, "none"]), got=p)
+    peers = args.peer_list
     if args.what == "beta":
         rows = bench.bench_beta(args.N, args.k, args.repeats, eigsh_max_n=args.eigsh_max_n)
     else:
@@ -230,16 +315,35 @@ def _add_verdict(sub) -> None:
                       ("confidence", "confidence level of the slope interval")):
         p.add_argument("--" + key.replace("_", "-"), dest=key, type=float, default=VERDICT_DEFAULTS[key],
                        help=f"{text} (default {VERDICT_DEFAULTS[key]:g}: claims.{key} in config/config.yaml)")
-    p.set_defaults(run=_run_verdict)
+    _add_dry_run(p)
+    p.set_defaults(run=_run_verdict, check=_check_verdict)
+
+
+def _check_verdict(args):
+    from . import resources
+    from .discretization import meshes, registry
+    from .discretization.user_spaces import load_user_space
+    from .study.verdict import check_criterion, check_mesh_sizes
+
+    args.space_or_case = args.case if args.space is None else load_user_space(args.space)
+    case = args.case if args.space is None else args.space_or_case.id
+    if not 1 <= args.k <= 4:
+        raise InputError("k", "an integer in 1..4", got=args.k)
+    registry.check_case(case, args.k)
+    meshes.check_mesh_args(args.family, 1)
+    ns = check_mesh_sizes(args.N)
+    check_criterion(args.slope_tolerance, args.beta_floor, args.confidence)
+    est = resources.verdict_estimate(args.family, args.k, ns, args.norm, args.multiplier_mesh)
+    _check_memory(est, "N", max(ns))
+    return est
 
 
 def _run_verdict(args) -> int:
     import pandas as pd
 
-    from .discretization.user_spaces import load_user_space
     from .study.verdict import verdict_rows
 
-    space = args.case if args.space is None else load_user_space(args.space)
+    space = args.space_or_case
     out = verdict_rows(space, args.k, args.family, args.N, args.norm,
                        tol=args.slope_tolerance, floor=args.beta_floor, confidence=args.confidence,
                        multiplier_mesh=args.multiplier_mesh)
@@ -256,6 +360,22 @@ def _add_provenance(sub) -> None:
         __import__("infsup_contact.provenance", fromlist=["x"]).provenance(), indent=2)))
 
 
+def _add_dry_run(p) -> None:
+    p.add_argument("--dry-run", action="store_true",
+                   help="validate the request (values, files, estimated memory) and print the "
+                   "memory and time estimate instead of computing")
+
+
+def _check_memory(est, key: str, value) -> None:
+    """InputError naming ``key`` when the estimate exceeds MemAvailable (/proc/meminfo)."""
+    from . import resources
+
+    avail = resources.available_bytes()
+    if avail is not None and est.bytes > avail:
+        raise InputError(key, f"a size whose estimated memory fits in the {resources.human_bytes(avail)} "
+                         f"available (this request: {est.describe()})", got=value)
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(prog="infsup-contact", description=__doc__.split("\n\n")[0])
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
@@ -268,13 +388,45 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def flag_names(parser: argparse.ArgumentParser, command: str) -> dict:
+    """dest → the flag as typed (``n_ref`` → ``--n-ref``) for the options of ``command``."""
+    sub = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction)).choices[command]
+    return {a.dest: max(a.option_strings, key=len) for a in sub._actions if a.option_strings}
+
+
+def _message(err: Exception, parser, command: str) -> str:
+    """The error's one line, with its key spelled as the flag the user typed."""
+    text = " ".join(str(err).split())
+    key = getattr(err, "key", None)
+    flag = flag_names(parser, command).get(key) if key else None
+    if flag and text.startswith(f"invalid {key}"):
+        text = f"invalid {flag}" + text[len(f"invalid {key}"):]
+    return text
+
+
+def validate(argv) -> tuple:
+    """Parse and validate a command line without computing: ``(args, estimate)``; raises
+    InputError/TableError (bad values) or SystemExit(2) (argparse: unknown flag, wrong type)."""
+    args = build_parser().parse_args(argv)
+    return args, (args.check(args) if hasattr(args, "check") else None)
+
+
 def main(argv=None) -> int:
     _threads_default()
-    args = build_parser().parse_args(argv)
+    parser = build_parser()
+    args = parser.parse_args(argv)
     try:
+        estimate = args.check(args) if hasattr(args, "check") else None  # before any computation
+        if getattr(args, "dry_run", False):
+            from .resources import available_bytes, human_bytes
+
+            avail = available_bytes()
+            print(f"dry run: valid request; estimated {estimate.describe()}"
+                  + (f" (available memory {human_bytes(avail)})" if avail is not None else ""))
+            return 0
         code = args.run(args)
-    except InputError as err:
-        print(f"infsup-contact: error: {err}", file=sys.stderr)
+    except (InputError, TableError) as err:
+        print(f"infsup-contact: error: {_message(err, parser, args.command)}", file=sys.stderr)
         return 2
     except BrokenPipeError:  # `| head` closed the pipe: not an error of ours
         return 0

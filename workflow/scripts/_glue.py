@@ -35,3 +35,22 @@ def register_user_spaces(config) -> None:
 def log_to(path):
     """Send this script's stderr to the rule's log file."""
     sys.stderr = open(path, "w")
+
+
+def fail(message: str) -> None:
+    """Stop the job with one line, in its log and on the terminal (exit status 1)."""
+    print(message, file=sys.stderr)
+    if sys.stderr is not sys.__stderr__:
+        print(message, file=sys.__stderr__)
+    sys.exit(1)
+
+
+def read_table(path, kind: str, **kwargs):
+    """A workflow table, checked (``infsup_contact.io.read_table``): a missing file or column
+    is one line naming the file, never an AttributeError deep in a plot."""
+    from infsup_contact.io import TableError, read_table as read
+
+    try:
+        return read(path, kind, **kwargs)
+    except TableError as err:
+        fail(f"{os.path.basename(sys.argv[0]) or 'script'}: {err}")

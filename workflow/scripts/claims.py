@@ -2,17 +2,16 @@
 import sys
 
 sys.path.insert(0, "workflow/scripts")
-from _glue import log_to, register_user_spaces  # noqa: E402
+from _glue import log_to, read_table, register_user_spaces  # noqa: E402
 
 log_to(snakemake.log[0])  # noqa: F821
 register_user_spaces(snakemake.config)  # noqa: F821
-import pandas as pd  # noqa: E402
 
 from infsup_contact.study.claims import ledger  # noqa: E402
 from infsup_contact.io import write_csv_atomic  # noqa: E402
 
 inp = snakemake.input  # noqa: F821
-table = ledger(pd.read_csv(inp.beta), pd.read_csv(inp.rates), pd.read_csv(inp.extra),
+table = ledger(read_table(inp.beta, "beta"), read_table(inp.rates, "rates"), read_table(inp.extra, "claims"),
                snakemake.params.cfg)  # noqa: F821
 write_csv_atomic(snakemake.output[0], table)  # noqa: F821
 print(table[["claim_id", "verdict", "predicted"]].to_string(), file=sys.stderr)

@@ -10,7 +10,7 @@ import sys
 
 if "snakemake" in globals():  # run by Snakemake: threads and log before numpy loads
     sys.path.insert(0, "workflow/scripts")
-    from _glue import limit_threads, log_to, register_user_spaces
+    from _glue import limit_threads, log_to, read_table, register_user_spaces
 
     limit_threads(snakemake.threads)  # noqa: F821
     log_to(snakemake.log[0])  # noqa: F821
@@ -104,5 +104,5 @@ def _half_slope_triangle(ax, sub):
 
 
 if "snakemake" in globals():
-    plot_beta(pd.read_csv(snakemake.input.beta), snakemake.output.pdf, snakemake.output.png,  # noqa: F821
+    plot_beta(read_table(snakemake.input.beta, "beta"), snakemake.output.pdf, snakemake.output.png,  # noqa: F821
               norm=snakemake.params.norm)  # noqa: F821

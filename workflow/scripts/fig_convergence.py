@@ -9,7 +9,7 @@ import sys
 
 if "snakemake" in globals():  # run by Snakemake: threads and log before numpy loads
     sys.path.insert(0, "workflow/scripts")
-    from _glue import limit_threads, log_to, register_user_spaces
+    from _glue import limit_threads, log_to, read_table, register_user_spaces
 
     limit_threads(snakemake.threads)  # noqa: F821
     log_to(snakemake.log[0])  # noqa: F821
@@ -91,5 +91,5 @@ assert CASE_COLORS  # the shared map (used through case_style)
 
 if "snakemake" in globals():
     inp = snakemake.input  # noqa: F821
-    plot_convergence(pd.read_csv(inp.contact), pd.read_csv(inp.rates), snakemake.output.pdf,  # noqa: F821
+    plot_convergence(read_table(inp.contact, "contact"), read_table(inp.rates, "rates"), snakemake.output.pdf,  # noqa: F821
                      snakemake.output.png, scene=snakemake.params.scene)  # noqa: F821

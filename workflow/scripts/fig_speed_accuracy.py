@@ -11,7 +11,7 @@ import sys
 
 if "snakemake" in globals():  # run by Snakemake: threads and log before numpy loads
     sys.path.insert(0, "workflow/scripts")
-    from _glue import limit_threads, log_to, register_user_spaces
+    from _glue import limit_threads, log_to, read_table, register_user_spaces
 
     limit_threads(snakemake.threads)  # noqa: F821
     log_to(snakemake.log[0])  # noqa: F821
@@ -98,5 +98,5 @@ def plot_speed_accuracy(table: pd.DataFrame, pdf, png) -> None:
 
 
 if "snakemake" in globals():
-    plot_speed_accuracy(pd.read_csv(snakemake.input.table), snakemake.output.pdf,  # noqa: F821
+    plot_speed_accuracy(read_table(snakemake.input.table, "speed_accuracy"), snakemake.output.pdf,  # noqa: F821
                         snakemake.output.png)  # noqa: F821

@@ -10,11 +10,10 @@ import sys
 from pathlib import Path
 
 sys.path.insert(0, "workflow/scripts")
-from _glue import log_to, register_user_spaces  # noqa: E402
+from _glue import log_to, read_table, register_user_spaces  # noqa: E402
 
 log_to(snakemake.log[0])  # noqa: F821
 register_user_spaces(snakemake.config)  # noqa: F821
-import pandas as pd  # noqa: E402
 
 from infsup_contact.io import write_atomic  # noqa: E402
 from infsup_contact.report.paper import PaperTexError, check_paper, paper_files  # noqa: E402
@@ -22,15 +21,16 @@ from infsup_contact.report.paper import PaperTexError, check_paper, paper_files 
 inp, out = snakemake.input, snakemake.output  # noqa: F821
 
 
-def read(path):
+def read(path, kind):
     if not Path(path).exists():  # Snakemake checks inputs; this guards direct calls
         sys.exit(f"paper_macros: {path} is missing (it is written by another stage of the workflow)")
-    return pd.read_csv(path)
+    return read_table(path, kind)
 
 
 try:
-    files = paper_files(read(inp.beta), read(inp.contact), read(inp.rates), read(inp.claims),
-                        read(inp.speed), read(inp.bench_beta), read(inp.bench_contact),
+    files = paper_files(read(inp.beta, "beta"), read(inp.contact, "contact"), read(inp.rates, "rates"),
+                        read(inp.claims, "claims"), read(inp.speed, "speed_accuracy"),
+                        read(inp.bench_beta, "bench"), read(inp.bench_contact, "bench"),
                         snakemake.params.cfg, json.loads(Path(inp.provenance).read_text()))  # noqa: F821
     check_paper(Path(inp.tex).read_text(), files)
 except PaperTexError as err:

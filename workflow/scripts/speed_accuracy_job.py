@@ -3,13 +3,12 @@ time of ``solve_contact`` for that discretization (timed on one scene), Pareto f
 import sys
 
 sys.path.insert(0, "workflow/scripts")
-from _glue import add_provenance, limit_threads, log_to, register_user_spaces  # noqa: E402
+from _glue import add_provenance, limit_threads, log_to, read_table, register_user_spaces  # noqa: E402
 
 limit_threads(1)  # timings are single-thread; the rule takes all cores to run alone
 log_to(snakemake.log[0])  # noqa: F821
 register_user_spaces(snakemake.config)  # noqa: F821
 
-import pandas as pd  # noqa: E402
 
 from infsup_contact.bench import machine_info, speed_accuracy_table  # noqa: E402
 from infsup_contact.io import write_csv_atomic  # noqa: E402
@@ -18,7 +17,7 @@ cc, p = snakemake.params.cc, snakemake.params  # noqa: F821
 spec = cc["scenes"].get(p.scene, {"kind": p.scene})
 kind = spec["kind"]
 params = {key: v for key, v in spec.items() if key not in ("kind", "N")}
-errors = pd.read_csv(snakemake.input.contact)  # noqa: F821
+errors = read_table(snakemake.input.contact, "contact")  # noqa: F821
 print(f"machine: {machine_info()}", file=sys.stderr)
 table = speed_accuracy_table(errors, repeats=int(p.repeats), timing_scene=kind,
                              timing_params=params, c=tuple(cc["c"]))

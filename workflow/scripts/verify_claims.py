@@ -1,9 +1,10 @@
 """Fail unless every claim of the paper has the verdict the paper predicts; print the ledger."""
 import sys
 
-import pandas as pd
+sys.path.insert(0, "workflow/scripts")
+from _glue import read_table  # noqa: E402
 
-ledger = pd.read_csv(snakemake.input[0])  # noqa: F821
+ledger = read_table(snakemake.input[0], "claims")  # noqa: F821
 checked = ledger[ledger.predicted.isin(["PASS", "FAIL"])]
 wrong = checked[checked.verdict != checked.predicted]
 with open(snakemake.log[0], "w") as log:  # noqa: F821

@@ -37,6 +37,20 @@ def check_mesh_args(family: str, n: int, key: str = "N") -> None:
         raise InputError(key, "an integer >= 1", got=n)
 
 
+ALPHA_RANGE = (0.0, 0.5)
+"""Perturbation amplitude α (× h), 0 <= α < 1/2: a node moves by less than h/2 in each
+coordinate, so no element is inverted or degenerate (the config schema states the same)."""
+
+
+def check_perturbation(alpha, seed) -> None:
+    """:class:`InputError` unless 0 <= α < 1/2 (finite) and the seed is an integer >= 0 (numpy)."""
+    if isinstance(alpha, bool) or not isinstance(alpha, (int, float, np.integer, np.floating)) \
+            or not ALPHA_RANGE[0] <= alpha < ALPHA_RANGE[1]:
+        raise InputError("alpha", "a finite number in [0, 0.5) (nodes move by less than h/2)", got=alpha)
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
+        raise InputError("seed", "an integer >= 0 (a numpy seed)", got=seed)
+
+
 def structured_arrays(n: int, side: int):
     """Vertices and triangles of the structured N×N mesh of Ω_side.
 
@@ -128,6 +142,7 @@ def subdomain_mesh(family: str, n: int, side: int, *, alpha: float = 0.2, seed: 
         return unstructured_mesh(n, side)
     points, triangles = structured_arrays(n, side)
     if family == "perturbed":
+        check_perturbation(alpha, seed)
         points = perturb(points, n, side, alpha, seed)
     return mesh_from_arrays(points, triangles, boundary_segments(points, side))
 

@@ -16,7 +16,7 @@ import scipy.sparse as sp
 
 from ..discretization import meshes, multipliers, registry
 from ..discretization.coupling import coupling_matrix
-from ..errors import InputError
+from ..errors import InputError, check_prestress
 from ..models.schur import interface_operator
 from ..models.membranes import MEMBRANES
 from ..discretization.norms import NORMS, gram
@@ -64,8 +64,7 @@ def check_inputs(case, k, family, n1, n2, c1, c2, norm, multiplier_mesh) -> None
     meshes.check_mesh_args(family, n1, "N1")
     meshes.check_mesh_args(family, n2, "N2")
     for key, c in (("c1", c1), ("c2", c2)):
-        if not c > 0:
-            raise InputError(key, "a positive number", got=c)
+        check_prestress(key, c)
     for nm in norm:
         if nm not in NORMS:
             raise InputError("norm", ", ".join(NORMS), got=nm)

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 from . import accuracy
 from ..solvers.contact import ContactSolution, solve_contact
-from ..errors import InputError
+from ..errors import InputError, check_prestress
 from ..discretization.registry import REFERENCE_SPACE, check_case, space_spec
 from .scenes import scene as make_scene
 
@@ -27,8 +27,7 @@ def contact_row(scene_name: str, case: str, k: int, family: str, n1: int, n2: in
         raise InputError("k", "an integer in 1..4", got=k)
     check_case(case, k)
     for key, c in (("c1", c1), ("c2", c2)):
-        if not c > 0:
-            raise InputError(key, "a positive number", got=c)
+        check_prestress(key, c)
     sc = make_scene(scene_name, c1=c1, c2=c2, **(scene_params or {}))
     sol = solve_contact(sc, case, k, family, n1, n2, time_floor=time_floor, **mesh_kwargs)
     if sc.has_exact:

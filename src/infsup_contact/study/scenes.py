@@ -35,7 +35,7 @@ from typing import Callable
 import numpy as np
 from ngsolve import CoefficientFunction, IfPos, cos, pi, sin, x, y
 
-from ..errors import InputError
+from ..errors import InputError, check_prestress
 
 SCENES = ("manufactured", "membranes")
 
@@ -62,14 +62,8 @@ def _np_pos_pow(s: np.ndarray, e: float) -> np.ndarray:
 
 
 def _positive(key: str, value) -> float:
-    """Validate a strictly positive finite real parameter (c1, c2)."""
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise InputError(key, "a positive real number", got=value) from None
-    if not (math.isfinite(v) and v > 0):
-        raise InputError(key, "a positive real number", got=value)
-    return v
+    """Validate a prestress c1, c2 (finite, in :data:`~infsup_contact.errors.C_RANGE`)."""
+    return check_prestress(key, value)
 
 
 def _exponent(key: str, value) -> float:

@@ -15,6 +15,8 @@ Pure functions apart from :func:`verdict_rows`, which computes the β_h rows; no
 """
 from __future__ import annotations
 
+import math
+
 import time
 
 import numpy as np
@@ -139,6 +141,9 @@ def check_mesh_sizes(ns) -> list:
     for n in ns:
         if not isinstance(n, (int, np.integer)) or n < 1:
             raise InputError("N", "integers >= 1", got=n)
+    repeated = sorted({n for n in ns if ns.count(n) > 1})
+    if repeated:
+        raise InputError("N", "distinct mesh sizes (each N once)", got=" ".join(map(str, ns)))
     if len(set(ns)) < MIN_MESHES:
         raise InputError("N", f"at least {MIN_MESHES} distinct mesh sizes (a slope interval needs them)",
                          got=" ".join(map(str, ns)))
@@ -147,10 +152,10 @@ def check_mesh_sizes(ns) -> list:
 
 def check_criterion(tol: float, floor: float, confidence: float) -> None:
     """:class:`InputError` unless τ > 0, floor >= 0 and 0 < confidence < 1 (config keys)."""
-    if not tol > 0:
-        raise InputError("slope_tolerance", "a positive number", got=tol)
-    if not floor >= 0:
-        raise InputError("beta_floor", "a number >= 0", got=floor)
+    if not 0 < tol < math.inf:  # NaN fails too
+        raise InputError("slope_tolerance", "a finite number > 0 (inf would pass every series)", got=tol)
+    if not 0 <= floor < math.inf:
+        raise InputError("beta_floor", "a finite number >= 0 (inf would fail every series)", got=floor)
     if not 0 < confidence < 1:
         raise InputError("confidence", "a number in (0, 1)", got=confidence)
 

@@ -199,16 +199,29 @@ def schema_error(cfg, schema: dict) -> ConfigError | None:
 
 # ------------------------------------------------------------------ 4. the registry
 
+def case_ids(cfg) -> list:
+    """The ids this config may use: the built-in spaces and the user spaces of its own
+    ``spaces`` key (not those another config registered earlier in the same process)."""
+    from .discretization.registry import SPACES
+    from .discretization.user_spaces import _LOADED, load_user_space
+
+    users = {spec.id for spec in _LOADED.values()}
+    own = {load_user_space(ref).id for ref in cfg.get("spaces") or []}
+    return [c for c in SPACES if c not in users or c in own]
+
+
 def check_cases(cfg) -> None:
     """Case ids are registered spaces; each k is one the space allows (T4, T5: k >= 2)."""
     from .discretization.registry import SPACES
 
+    ids = case_ids(cfg)
     for stage in ("infsup", "contact"):
         cases = cfg[stage]["cases"]
         for case, ks in cases.items():
-            if case not in SPACES:
+            if case not in ids:
                 raise ConfigError(f"{stage}.cases", f"{case!r} was unexpected", got=case,
-                                  allowed="registered spaces: " + ", ".join(SPACES))
+                                  allowed="registered spaces: " + ", ".join(ids)
+                                  + ("" if case not in SPACES else f" ({case} is a user space: list it under spaces)"))
             spec = SPACES[case]
             low = [k for k in ks if not spec.valid_for(k)]
             if low:
@@ -242,10 +255,11 @@ def check_reference(cfg) -> None:
 def check_rate_window(cfg) -> None:
     """contact.rate_window <= the number of meshes of every scene: refused, never shrunk."""
     rw = cfg["contact"]["rate_window"]
-    for name, ns in scene_meshes(cfg).items():
-        if rw > len(ns):
-            raise ConfigError("contact.rate_window", f"longer than the mesh series it fits (scene {name} "
-                              f"has {len(ns)} meshes, N = {ns})", got=rw, allowed=f"2..{len(ns)}")
+    name, ns = min(scene_meshes(cfg).items(), key=lambda item: len(item[1]))  # the shortest series
+    if rw > len(ns):
+        raise ConfigError("contact.rate_window", f"longer than the mesh series it fits (scene {name} "
+                          f"has {len(ns)} meshes, N = {ns}; a window is never shrunk silently)",
+                          got=rw, allowed=f"2..{len(ns)}")
 
 
 def check_nonmatching(cfg) -> None:
@@ -286,8 +300,8 @@ CROSS_KEY_RULES = {
     check_membranes_parameters: ("contact.scenes",),
     check_speed_accuracy_scene: ("benchmarks.speed_accuracy_scene", "contact.scenes"),
 }
-"""The rules a schema cannot state, with the keys each relates; each raises
-:class:`ConfigError` naming its first key."""
+"""The rules a schema cannot state, with the keys each relates; each raises a
+:class:`ConfigError` naming one of them."""
 
 
 def beta_series(cfg) -> dict:
@@ -316,26 +330,71 @@ def fit_window_notes(cfg) -> list:
     return notes
 
 
-def memory_notes(cfg, available: float | None) -> list:
-    """The largest β and contact jobs against this machine's available memory."""
+def job_estimates(cfg):
+    """(config key that sets its size, job, estimate) of every job that computes: β_h and
+    contact per mesh, the Rem 5.5 instances of claims_extra, the two bench stages."""
     from . import resources as R
 
-    ic, cc = cfg["infsup"], cfg["contact"]
-    notes = []
+    ic, cc, bc = cfg["infsup"], cfg["contact"], cfg["benchmarks"]
     ks = sorted({k for klist in ic["cases"].values() for k in klist})
-    pairs = [(n, n) for n in ic["N"]] + [tuple(p) for p in ic.get("nonmatching", [])]
-    big = max(((R.beta_estimate(f, k, n1, n2, ic["multiplier_meshes"], ic["norms"]), (f, k, n1, n2))
-               for f in ic["families"] for k in ks for n1, n2 in pairs), key=lambda t: t[0].bytes)
+    for n1, n2 in [(n, n) for n in ic["N"]] + [tuple(p) for p in ic.get("nonmatching", [])]:
+        key = "infsup.N" if n1 == n2 and n1 in ic["N"] else "infsup.nonmatching"
+        for f in ic["families"]:
+            for k in ks:
+                yield key, f"beta_job {f} k={k} {n1}x{n2}", R.beta_estimate(
+                    f, k, n1, n2, ic["multiplier_meshes"], ic["norms"])
     ck = sorted({k for klist in cc["cases"].values() for k in klist})
-    cbig = max(((R.contact_estimate(spec["kind"], f, k, n, n, cc["reference_N"], len(cc["cases"])),
-                 (s, f, k, n)) for s, spec in cc["scenes"].items() for f in cc["families"] for k in ck
-                for n in scene_meshes(cfg)[s]), key=lambda t: t[0].bytes)
-    for label, (est, job) in (("β", big), ("contact", cbig)):
-        if available is not None and est.bytes > available:
-            notes.append(f"the largest {label} job {job} needs {est.describe()}, more than the "
-                         f"{R.human_bytes(available)} available here: it runs only where that much memory is "
-                         "(its mem_mb says so to the scheduler)")
-    return notes
+    for s, spec in cc["scenes"].items():
+        n_ref = cc["reference_N"] if spec["kind"] == "membranes" else None
+        for n in scene_meshes(cfg)[s]:
+            for f in cc["families"]:
+                for k in ck:
+                    est = R.contact_estimate(spec["kind"], f, k, n, n, n_ref, len(cc["cases"]))
+                    alone = R.contact_estimate(spec["kind"], f, k, n, n, None, len(cc["cases"]))
+                    key = ("contact.reference_N" if n_ref and est.bytes > 2 * alone.bytes
+                           else f"contact.scenes.{s}.N" if "N" in spec else "contact.N")
+                    yield key, f"contact_job {s} {f} k={k} N={n}", est
+    for n in cfg["claims"]["rem55_N"]:
+        yield "claims.rem55_N", f"claims_extra N={n}", R.beta_estimate("structured", 3, n, n, norms=("H",))
+    for what in ("beta", "contact"):
+        yield (f"benchmarks.{what}_N", f"bench_{what}", R.bench_estimate(
+            what, bc[f"{what}_N"], bc[f"{what}_k"], bc["repeats"], bc.get("eigsh_max_N")))
+
+
+def check_job_memory(cfg, limit: float | None) -> None:
+    """A local run: refuse a config whose largest job cannot fit in this machine's memory
+    (``limit``: MemTotal); on a cluster each job asks the scheduler for its mem_mb instead."""
+    from . import resources as R
+
+    if limit is None:
+        return
+    key, job, est = max(job_estimates(cfg), key=lambda t: t[2].bytes)
+    if est.bytes > limit:
+        raise ConfigError(key, f"the {job} job would need {est.describe()}, more than this machine's "
+                          f"{R.human_bytes(limit)} of memory", got=_value(cfg, key),
+                          allowed="sizes whose jobs fit here; larger ones on a cluster (--profile profiles/slurm)")
+
+
+def _value(cfg, key: str):
+    node = cfg
+    for part in key.split("."):
+        if not isinstance(node, dict) or part not in node:
+            return None
+        node = node[part]
+    return node
+
+
+def memory_notes(cfg, available: float | None) -> list:
+    """The largest job against the memory available now (a note, not an error)."""
+    from . import resources as R
+
+    if available is None:
+        return []
+    key, job, est = max(job_estimates(cfg), key=lambda t: t[2].bytes)
+    if est.bytes <= available:
+        return []
+    return [f"config key {key}: the largest job ({job}) needs {est.describe()}, more than the "
+            f"{R.human_bytes(available)} available now (its mem_mb tells the scheduler)"]
 
 
 # ------------------------------------------------------------------ all of it

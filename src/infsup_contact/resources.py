@@ -187,3 +187,15 @@ def available_bytes(meminfo: str = "/proc/meminfo") -> float | None:
     except (OSError, ValueError, IndexError):
         return None
     return None
+
+
+def total_bytes(meminfo: str = "/proc/meminfo") -> float | None:
+    """MemTotal of /proc/meminfo in bytes (None where unavailable)."""
+    try:
+        with open(meminfo) as fh:
+            for line in fh:
+                if line.startswith("MemTotal:"):
+                    return float(line.split()[1]) * 1024
+    except (OSError, ValueError, IndexError):
+        return None
+    return None

@@ -6,13 +6,15 @@ from snakemake.logging import logger
 from snakemake.utils import validate
 
 from infsup_contact import resources
-from infsup_contact.config_checks import ConfigError, check_config, memory_notes
+from infsup_contact.config_checks import ConfigError, check_config, check_job_memory, memory_notes
 
 # Every check a config gets, in one library function (src/infsup_contact/config_checks.py):
 # user spaces, non-finite numbers, the schema, the registry's degrees and the cross-key rules.
 # A bad value stops here with ONE line naming the key — before the DAG, so no job starts.
 try:
     USER_SPACE_FILES, _notes = check_config(config, Path(workflow.current_basedir.get_path_or_uri(secret_free=True)) / ".." / "schemas" / "config.schema.yaml")
+    if workflow.local_exec:  # a job must fit in this machine; a cluster job asks for its mem_mb
+        check_job_memory(config, resources.total_bytes())
 except ConfigError as _err:
     print(_err, file=sys.stderr)
     sys.exit(1)

@@ -150,10 +150,15 @@ def check_mesh_sizes(ns) -> list:
     return sorted(set(int(n) for n in ns))
 
 
+MAX_SLOPE_TOLERANCE = 0.25
+"""τ < 1/4 (config claims.slope_tolerance too): a slope band 0 ± τ must not reach 1/2 − τ."""
+
+
 def check_criterion(tol: float, floor: float, confidence: float) -> None:
     """:class:`InputError` unless τ > 0, floor >= 0 and 0 < confidence < 1 (config keys)."""
-    if not 0 < tol < math.inf:  # NaN fails too
-        raise InputError("slope_tolerance", "a finite number > 0 (inf would pass every series)", got=tol)
+    if not 0 < tol < MAX_SLOPE_TOLERANCE:  # NaN fails too
+        raise InputError("slope_tolerance", f"a number in (0, {MAX_SLOPE_TOLERANCE}): the bands 0 ± τ (bounded) "
+                         "and 1/2 ± τ (the L² decay of Remark 3.1) must not overlap", got=tol)
     if not 0 <= floor < math.inf:
         raise InputError("beta_floor", "a finite number >= 0 (inf would fail every series)", got=floor)
     if not 0 < confidence < 1:

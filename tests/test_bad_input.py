@@ -389,3 +389,11 @@ def test_refused_without_dry_run_before_any_computation(argv, flag):
     assert code == 2 and out == "" and len(err.splitlines()) == 1, (code, out, err)
     assert flag in err and "Traceback" not in err, err
     assert time.perf_counter() - t0 < 5, "validation must not compute"
+
+
+def test_workflow_scripts_read_tables_through_the_check():
+    """A table a workflow script reads goes through io.read_table (one line naming the file
+    and the missing columns), except concat_tables.py, which joins the jobs' own outputs."""
+    offenders = [p.name for p in sorted((ROOT / "workflow" / "scripts").glob("*.py"))
+                 if "read_csv(" in p.read_text() and p.name != "concat_tables.py"]
+    assert not offenders, f"read tables with io.read_table (via _glue.read_table): {offenders}"

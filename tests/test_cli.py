@@ -102,6 +102,12 @@ BAD = {
     "unknown-norm": (["--k", "2", "--norm", "H1"], ["--norm", "H1"]),
     "unknown-multiplier-mesh": (["--k", "2", "--multiplier-mesh", "omega3"],
                                 ["--multiplier-mesh", "omega3"]),
+    # issue 17: the request is refused before anything is allocated or computed
+    "N1-beyond-memory": (["--k", "2", "--N1", "100000", "--N2", "4"], ["N1", "100000", "memory", "GiB"]),
+    "c1-inf": (["--k", "2", "--c1", "inf"], ["c1", "inf", "rigid body"]),
+    "c2-nan": (["--k", "2", "--c2", "nan"], ["c2", "nan"]),
+    "seed-negative": (["--k", "1", "--family", "perturbed", "--seed", "-1"], ["seed", "-1", ">= 0"]),
+    "alpha-half": (["--k", "1", "--family", "perturbed", "--alpha", "0.5"], ["alpha", "0.5"]),
 }
 
 
@@ -121,6 +127,29 @@ def test_bad_input_one_line_exit_2(args, needles):
     key = needles[0].lstrip("-")
     assert re.search(rf"(?<![\w-])-*{re.escape(key)}\b", line), f"key {key!r} not named: {line!r}"
     assert proc.stdout == "", "no partial CSV on bad input"
+
+
+@pytest.mark.parametrize("content, needles", [
+    ("a,b\n1,2\n", ["missing columns", "N1", "energy_error"]),   # the issue: AttributeError 'N1'
+    ("", ["empty file"]),
+    (None, ["no such file"]),
+])
+def test_rates_bad_table_one_line_exit_2(tmp_path, content, needles):
+    table = tmp_path / "file.csv"
+    if content is not None:
+        table.write_text(content)
+    proc = run("rates", str(table))
+    assert proc.returncode == 2 and proc.stdout == "" and "Traceback" not in proc.stderr, proc.stderr
+    lines = proc.stderr.splitlines()
+    assert len(lines) == 1 and lines[0].startswith(f"infsup-contact: error: table {table}"), proc.stderr
+    for needle in needles:
+        assert needle in lines[0], lines[0]
+
+
+def test_dry_run_prints_the_estimate_and_computes_nothing():
+    proc = run("beta", "--k", "2", *SMALL, "--dry-run", check=True)
+    assert proc.stdout.startswith("dry run: valid request; estimated ~") and "peak memory" in proc.stdout
+    assert len(proc.stdout.splitlines()) == 1 and proc.stderr == ""
 
 
 def test_missing_subcommand_is_usage_error():

@@ -111,6 +111,20 @@ BAD_CONFIGS = {
     "top-level-typo": (_typo_top, ["config key infsup_typo", "'infsup_typo' was unexpected"]),
     "top-level-renamed": (_rename_top, ["config key infsupp", "'infsupp' was unexpected"]),
     "nested-typo": (_typo_nested, ["config key infsup.familes", "'familes' was unexpected"]),
+    # issue 17: what used to pass and fail in (or silently spoil) the jobs
+    "seed-negative": (_set("infsup", "seed", value=-1), ["config key infsup.seed", "got -1", "integer >= 0"]),
+    "reference-coarser": (_set("contact", "reference_N", value=8),   # ci.yaml: membranes N up to 16
+                          ["config key contact.reference_N", "got 8", "allowed reference_N >= 32"]),
+    "rate-window-9": (_set("contact", "rate_window", value=9),
+                      ["config key contact.rate_window", "got 9", "allowed 2..3", "scene membranes"]),
+    "c-nan": (_set("contact", "c", value=[float("nan"), 1.0]), ["config key contact.c[0]", "got nan", "finite"]),
+    "c-inf": (_set("infsup", "c", value=[[float("inf"), 1.0]]), ["config key infsup.c[0][0]", "got inf"]),
+    "nonmatching-equal": (_set("infsup", "nonmatching", value=[[8, 8]]),
+                          ["config key infsup.nonmatching[0]", "N1 != N2"]),
+    "membranes-with-p": (_set("contact", "scenes", "membranes", "p", value=3.0),
+                         ["config key contact.scenes.membranes.p", "allowed the keys kind, N"]),
+    "job-larger-than-machine": (_set("infsup", "N", value=[4, 8, 12, 1000000]),
+                                ["config key infsup.N", "more than this machine's", "1000000x1000000"]),
 }
 
 
@@ -144,6 +158,33 @@ def test_ci_config_dry_run_lists_beta_jobs(workdir):
     assert "beta_job" in out.split("Job stats:")[1].split("total")[0]
     assert "This was a dry-run" in out
     assert produced_tables(workdir) == []
+
+
+def test_fit_window_shrink_is_logged_and_mem_mb_follows_the_estimate(workdir):
+    """ci.yaml has 4 odd N and fit_window 5: accepted, with the shrink said in one line; each
+    β/contact job asks for mem_mb from resources.py (larger meshes, more memory)."""
+    from infsup_contact import resources
+
+    rc, out = snakemake(workdir, "-n", "reproduce-all", "--cores", "1", "--configfile", "config/ci.yaml")
+    assert rc == 0, out
+    assert "config key claims.fit_window = 5: the odd-N β series has 4 meshes" in out, out
+    assert "shrunk explicitly" in out
+    mem = {}
+    for block in out.split("\nrule ")[1:]:
+        name = block.split(":", 1)[0]
+        output = next((line.split(": ", 1)[1] for line in block.splitlines() if line.strip().startswith("output:")), "")
+        found = [line for line in block.splitlines() if "mem_mb=" in line]
+        if name in ("beta_job", "contact_job") and found:
+            mem[output.strip()] = int(found[0].split("mem_mb=")[1].split(",")[0])
+    ic = CI_CONFIG["infsup"]
+    small, big = "results/tables/beta/structured_k1_4x4.csv", "results/tables/beta/unstructured_k2_64x64.csv"
+    assert mem[small] < mem[big], mem
+    assert mem[big] == resources.job_mem_mb(resources.beta_estimate(
+        "unstructured", 2, 64, 64, ic["multiplier_meshes"], ic["norms"]))
+    cc = CI_CONFIG["contact"]
+    ref = "results/tables/contact/membranes_structured_k2_16.csv"
+    assert mem[ref] == resources.job_mem_mb(resources.contact_estimate(
+        "membranes", "structured", 2, 16, 16, cc["reference_N"], len(cc["cases"])))
 
 
 def test_benchmarks_stage_dry_run(workdir):

@@ -53,4 +53,7 @@ def read_table(path, kind: str, **kwargs):
     try:
         return read(path, kind, **kwargs)
     except TableError as err:
-        fail(f"{os.path.basename(sys.argv[0]) or 'script'}: {err}")
+        name = os.path.basename(sys.argv[0]) or "script"
+        if name.startswith("tmp") and name.count(".") > 1:  # Snakemake's copy: tmpXXXX.claims.py
+            name = name.split(".", 1)[1]
+        fail(f"{name}: {err}")

@@ -1,0 +1,72 @@
+"""The memory and time estimate (resources.py): properties, no solves.
+
+The constants were calibrated against /usr/bin/time -v runs (README, "What is refused");
+here only what must hold for any constants: monotone in the sizes, the interpreter counted,
+the job's mem_mb above the estimate, /proc/meminfo read robustly.
+"""
+from __future__ import annotations
+
+import pytest
+
+from infsup_contact import resources as R
+from infsup_contact.cli import main
+
+
+def test_beta_estimate_grows_with_every_size():
+    base = R.beta_estimate("structured", 1, 16, 16).bytes
+    assert R.beta_estimate("structured", 1, 32, 16).bytes > base
+    assert R.beta_estimate("structured", 1, 16, 32).bytes > base
+    assert R.beta_estimate("structured", 2, 16, 16).bytes > base
+    assert R.beta_estimate("unstructured", 1, 16, 16).bytes > base
+    assert R.beta_estimate("structured", 1, 16, 16, "union").bytes > base
+    assert base >= R.PROCESS_BYTES["beta"]  # the interpreter is part of the peak
+
+
+def test_dofs_scale_like_nk_squared():
+    # doubling N or k quadruples the dofs (and more than quadruples the memory: n log n)
+    assert R.side_dofs("structured", 64, 1) == pytest.approx(4 * R.side_dofs("structured", 32, 1), rel=0.05)
+    assert R.side_dofs("structured", 32, 2) == pytest.approx(R.side_dofs("structured", 64, 1))
+    small, large = (R.beta_estimate("structured", 1, n, n, process=False).bytes for n in (256, 512))
+    assert large > 4 * small
+
+
+def test_contact_reference_and_cases_cost_more():
+    plain = R.contact_estimate("membranes", "structured", 1, 16, 16)
+    with_ref = R.contact_estimate("membranes", "structured", 1, 16, 16, n_ref=64)
+    assert with_ref.bytes > plain.bytes and with_ref.seconds > plain.seconds
+    assert R.contact_estimate("manufactured", "structured", 1, 16, 16, n_cases=5).seconds > plain.seconds
+
+
+def test_verdict_and_bench_are_bounded_by_their_largest_size():
+    v = R.verdict_estimate("structured", 2, [8, 16, 64], "H")
+    assert v.bytes == pytest.approx(R.beta_estimate("structured", 2, 64, 64, norms=("H",)).bytes)
+    b = R.bench_estimate("beta", [8, 64], [1, 2], repeats=1)
+    assert b.bytes > R.beta_estimate("structured", 2, 64, 64).bytes
+
+
+def test_job_mem_mb_covers_the_estimate():
+    for est in (R.beta_estimate("structured", 1, 4, 4), R.contact_estimate("membranes", "structured", 3, 32, 32, 64)):
+        assert R.job_mem_mb(est) * 1e6 >= 1.25 * est.bytes and R.job_mem_mb(est) % 100 == 0
+
+
+def test_the_issue_request_is_hundreds_of_terabytes():
+    est = R.beta_estimate("structured", 2, 100000, 4)
+    assert est.bytes > 100 * 1024 ** 4 and "TiB" in est.describe()
+
+
+def test_meminfo_parsing(tmp_path):
+    f = tmp_path / "meminfo"
+    f.write_text("MemTotal:       16000000 kB\nMemFree: 1 kB\nMemAvailable:    8000000 kB\n")
+    assert R.available_bytes(str(f)) == 8000000 * 1024 and R.total_bytes(str(f)) == 16000000 * 1024
+    f.write_text("garbage\n")
+    assert R.available_bytes(str(f)) is None and R.total_bytes(str(f)) is None
+    assert R.available_bytes(str(tmp_path / "none")) is None
+
+
+def test_cli_refuses_what_does_not_fit(monkeypatch, capsys):
+    """The CLI compares the same estimate with MemAvailable: a machine with 100 MB refuses
+    even the smallest request, naming the flag and the estimate."""
+    monkeypatch.setattr(R, "available_bytes", lambda meminfo="/proc/meminfo": 100e6)
+    assert main(["beta", "--k", "1", "--N1", "4", "--N2", "4", "--dry-run"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("infsup-contact: error: invalid --N1 (got 4)") and "95.4 MiB available" in err

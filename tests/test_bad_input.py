@@ -47,8 +47,19 @@ def log(*parts) -> None:
 
 
 @pytest.fixture(autouse=True)
-def _at_root(monkeypatch):
-    monkeypatch.chdir(ROOT)  # user spaces (examples/macro_p0.py) resolve from the repository
+def _at_root_registry_as_found(monkeypatch):
+    """Run from the repository (user spaces resolve from it); leave the registry as found."""
+    from infsup_contact.discretization import user_spaces
+    from infsup_contact.discretization.registry import SPACES
+
+    monkeypatch.chdir(ROOT)
+    before = set(SPACES)
+    yield
+    for ref, spec in list(user_spaces._LOADED.items()):
+        if spec.id not in before:
+            del user_spaces._LOADED[ref]
+    for case in set(SPACES) - before:
+        del SPACES[case]
 
 
 # ================================================================= config mutations

@@ -30,6 +30,8 @@ rule bench_beta:
         eigsh=lambda wc: (f"--eigsh-max-N {config['benchmarks']['eigsh_max_N']}"
                           if "eigsh_max_N" in config["benchmarks"] else ""),
     threads: workflow.cores
+    benchmark:
+        "results/benchmarks/rules/bench_beta.tsv"
     log:
         "results/logs/bench_beta.log",
     shell:
@@ -52,6 +54,8 @@ rule bench_contact:
         repeats=lambda wc: config["benchmarks"]["repeats"],
         peers=lambda wc: " ".join(config["benchmarks"].get("peers", ["osqp", "clarabel"])) or "none",
     threads: workflow.cores
+    benchmark:
+        "results/benchmarks/rules/bench_contact.tsv"
     log:
         "results/logs/bench_contact.log",
     shell:
@@ -72,6 +76,8 @@ rule speed_accuracy:
         repeats=lambda wc: config["benchmarks"].get("speed_accuracy_repeats", 3),
         scene=lambda wc: config["benchmarks"].get("speed_accuracy_scene", "manufactured"),
     threads: workflow.cores
+    benchmark:
+        "results/benchmarks/rules/speed_accuracy.tsv"
     log:
         "results/logs/speed_accuracy.log",
     script:

@@ -56,11 +56,13 @@ def slurm(request):
 
 
 def _copy_workflow(dest: Path) -> Path:
-    dest.mkdir(parents=True)
-    for name in ("Snakefile", "workflow", "config", "profiles", "src", "paper"):
-        src = ROOT / name
-        (shutil.copytree if src.is_dir() else shutil.copy)(src, dest / name)
-    return dest
+    """The checkout without its results, environment, tests and caches."""
+    top = {".git", ".venv", ".snakemake", "results", "tests"}
+
+    def skip(directory, names):
+        return [n for n in names if n == "__pycache__" or (Path(directory) == ROOT and n in top)]
+
+    return Path(shutil.copytree(ROOT, dest, ignore=skip))
 
 
 def _snakemake(cwd, *args, timeout):

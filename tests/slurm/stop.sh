@@ -27,3 +27,5 @@ tac "$PIDS" | while read -r name pid; do
     echo "stop.sh: stopped $name ($pid)"
 done
 rm -f "$PIDS"
+echo "stop.sh: note: while slurm-wlm stays installed without a controller, every snakemake start waits" \
+     "10 s (its Slurm plugin asks 'scontrol show config'); remove the packages if Slurm is no longer needed"

@@ -10,7 +10,7 @@ rule contact_job:
         cc=lambda wc: config["contact"],
     threads: 1
     resources:
-        mem_mb=contact_mem_mb,
+        mem_mb=lambda wc: contact_mem_mb(wc) + (0 if workflow.local_exec else 500),  # + Snakemake in a cluster job
         runtime=30,
     benchmark:
         "results/benchmarks/rules/contact_job/{scene}_{family}_k{k}_{n}.tsv"

@@ -11,7 +11,7 @@ rule beta_job:
         ic=lambda wc: config["infsup"],
     threads: 1
     resources:
-        mem_mb=beta_mem_mb,
+        mem_mb=lambda wc: beta_mem_mb(wc) + (0 if workflow.local_exec else 500),  # + Snakemake in a cluster job
         runtime=30,
     benchmark:
         "results/benchmarks/rules/beta_job/{family}_k{k}_{n1}x{n2}.tsv"

@@ -20,10 +20,7 @@ from ..errors import InputError, check_prestress
 from ..models.schur import interface_operator
 from ..models.membranes import MEMBRANES
 from ..discretization.norms import NORMS, gram
-
-KERNEL_RTOL = 1e-8
-"""An eigenvalue μ² < KERNEL_RTOL · (largest eigenvalue) counts as a numerical zero."""
-
+from .kernel import GAP_DECADES, KERNEL_CRITERION, kernel_check, kernel_from_gap  # noqa: F401
 
 @dataclass(frozen=True)
 class Spectrum:
@@ -34,9 +31,12 @@ class Spectrum:
     beta : float
         β_h = sqrt(smallest eigenvalue), clipped at 0.
     kernel_dim : int
-        Eigenvalues below ``KERNEL_RTOL`` times the largest one.
+        Dimension of the numerical kernel by the gap criterion (:func:`kernel_from_gap`).
     smallest_nonzero : float
         sqrt of the smallest eigenvalue above the numerical kernel (β above the kernel).
+    gap : float
+        The first eigenvalue above the kernel divided by the round-off level η (with no
+        kernel: the smallest eigenvalue over η); a kernel needs ``gap >= 10**GAP_DECADES``.
     bottom : ndarray
         The smallest eigenvalues β² (up to 8), ascending.
     """
@@ -44,15 +44,17 @@ class Spectrum:
     beta: float
     kernel_dim: int
     smallest_nonzero: float
+    gap: float
     bottom: np.ndarray
 
 
-def spectrum(S: np.ndarray, G: np.ndarray, kernel_rtol: float = KERNEL_RTOL) -> Spectrum:
+def spectrum(S: np.ndarray, G: np.ndarray) -> Spectrum:
     """Solve S m = β² G m densely (``scipy.linalg.eigh``) and summarize its bottom."""
     ev = sla.eigh(S, G, eigvals_only=True, check_finite=False)
-    kernel = int(np.sum(ev < kernel_rtol * ev[-1]))
+    kernel, gap = kernel_from_gap(ev)
     above = ev[kernel] if kernel < len(ev) else np.nan
-    return Spectrum(float(np.sqrt(max(ev[0], 0.0))), kernel, float(np.sqrt(above)), ev[:8].copy())
+    return Spectrum(float(np.sqrt(max(ev[0], 0.0))), kernel, float(np.sqrt(max(above, 0.0))), gap,
+                    ev[:8].copy())
 
 
 def check_inputs(case, k, family, n1, n2, c1, c2, norm, multiplier_mesh) -> None:
@@ -131,6 +133,8 @@ def beta_rows(family, k, n1, n2, cases=None, multiplier_mesh="omega2",
                 case=case if isinstance(case, str) else case[0], k=k, family=family, N1=n1, N2=n2, multiplier_mesh=multiplier_mesh,
                 c1=c1, c2=c2, norm=norm, beta=sp_.beta, kernel_dim=sp_.kernel_dim,
                 structural_kernel_dim=max(space.dim - dim_w, 0),
+                kernel_check=kernel_check(sp_.kernel_dim, max(space.dim - dim_w, 0)),
+                gap_over_roundoff=sp_.gap,
                 smallest_nonzero=sp_.smallest_nonzero, beta_v1_zero=beta_v1_zero,
                 dim_M=space.dim, dim_W=dim_w,
                 n_max=info["n_max"], nmax_rel_error=info["nmax_rel_error"],

@@ -12,8 +12,9 @@ slope claims
     (config ``claims.slope_tolerance``; ``rate_tolerance`` for convergence rates).
     A bounded claim also needs min β_h > ``beta_floor``.
 kernel claims
-    Exact integers: the numerical kernel dimension (eigenvalues below 1e-8 × the largest)
-    equals the paper's dimension count on every matching mesh pair.
+    Exact integers: the numerical kernel dimension (by the spectrum's gap,
+    :data:`infsup_contact.solvers.kernel.KERNEL_CRITERION`) equals the paper's dimension
+    count on every matching mesh pair.
 comparison claims
     An inequality checked on every pair of rows it applies to, up to 1e-8 relative.
 rate claims

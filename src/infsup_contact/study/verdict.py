@@ -5,7 +5,8 @@
 criterion (:mod:`infsup_contact.study.claims`), so ``infsup-contact verdict`` and
 ``results/claims.csv`` cannot disagree about the same series:
 
-* a numerical kernel on any mesh (``kernel_dim > 0``: β_h = 0, as for Rem 5.2 and Rem 5.4)
+* a numerical kernel on any mesh (``kernel_dim > 0``: β_h = 0, as for Rem 5.2 and Rem 5.4;
+  decided by the spectrum's gap, :data:`infsup_contact.solvers.kernel.KERNEL_CRITERION`)
   is UNSTABLE;
 * otherwise :func:`~infsup_contact.study.claims.bounded_claim` ("β_h bounded away from
   zero": min β_h above a floor and the confidence interval of the slope of log β_h vs log h

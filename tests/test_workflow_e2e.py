@@ -39,7 +39,9 @@ def _snakemake(cwd, *args, timeout=900):
 KEY_CLAIMS = ["Thm3-k1-structured-evenN", "Thm3-k2-unstructured-oddN", "Thm4-k2-perturbed-evenN",
               "Thm5-k2-structured-evenN", "Thm5-k2-structured-oddN", "Rem5.2-structured",
               "Rem5.4-perturbed", "Rem3.1-T3-k1-structured", "Rem5.5-shrink-M", "Rem5.5-enlarge-W",
-              "Rem5.5-enlarge-M-unstable", "eq5.10-sufficient", "eq5.10-matching-worst-finer-omega1",
+              "Rem5.5-enlarge-M-unstable", "eq5.10-sufficient", "eq5.10-matching-worst-finer-omega1-ratio3-2",
+              "finding-matching-worst-finer-omega1-plus1-structured", "finding-plus1-T3-omega2-k1-structured",
+              "finding-sqrt2-R5.4-union-k2-perturbed",
               "eq3.13-sign", "rate-T3-k1", "rate-T5-k2"]
 
 

@@ -135,6 +135,8 @@ def describe(schema: dict, root: dict | None = None) -> str:
     """What a (sub)schema allows, in words: ``an integer in 1..4``, ``one of H, L2``, …"""
     root = root or schema
     s = _resolve(schema, root)
+    if "oneOf" in s or "anyOf" in s:
+        return " or ".join(describe(sub, root) for sub in s.get("oneOf", s.get("anyOf")))
     if "enum" in s:
         return "one of " + ", ".join(str(v) for v in s["enum"])
     t = s.get("type")
@@ -305,12 +307,17 @@ CROSS_KEY_RULES = {
 
 
 def beta_series(cfg) -> dict:
-    """The mesh series the claims ledger fits (per family, case, k and norm alike)."""
+    """The mesh series the claims ledger fits (per family, case, k and norm alike): matching
+    even and odd N, and every non-matching series (discretization/series.py) by N2."""
+    from .discretization.series import beta_series as series, describe
+
     ic = cfg["infsup"]
     ns = sorted(ic["N"])
-    three_two = sorted(p[1] for p in ic.get("nonmatching", []) if 2 * p[0] == 3 * p[1])
-    return {"even-N": [n for n in ns if n % 2 == 0], "odd-N": [n for n in ns if n % 2 == 1],
-            "3:2 non-matching (N2)": three_two}
+    out = {"even-N": [n for n in ns if n % 2 == 0], "odd-N": [n for n in ns if n % 2 == 1]}
+    for name, pairs in series(ic).items():
+        if name != "matching":
+            out[f"non-matching {describe(name)} (N2)"] = sorted({p[1] for p in pairs})
+    return out
 
 
 def fit_window_notes(cfg) -> list:
@@ -337,8 +344,12 @@ def job_estimates(cfg):
 
     ic, cc, bc = cfg["infsup"], cfg["contact"], cfg["benchmarks"]
     ks = sorted({k for klist in ic["cases"].values() for k in klist})
-    for n1, n2 in [(n, n) for n in ic["N"]] + [tuple(p) for p in ic.get("nonmatching", [])]:
-        key = "infsup.N" if n1 == n2 and n1 in ic["N"] else "infsup.nonmatching"
+    from .discretization.series import series_of_pairs
+
+    for (n1, n2), names in series_of_pairs(ic).items():
+        key = ("infsup.N" if "matching" in names else
+               "infsup.nonmatching" if any(n.startswith("ratio") for n in names)
+               else f"infsup.nonmatching_families.{names[0]}")
         for f in ic["families"]:
             for k in ks:
                 yield key, f"beta_job {f} k={k} {n1}x{n2}", R.beta_estimate(

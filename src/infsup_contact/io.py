@@ -23,6 +23,22 @@ def write_atomic(path, text: str) -> None:
         raise
 
 
+def write_bytes_atomic(path, data: bytes) -> None:
+    """:func:`write_atomic` for bytes (a pickled reference solution)."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            fh.write(data)
+            fh.flush()
+            os.fsync(fh.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
 def write_csv_atomic(path, frame) -> None:
     """Write a pandas DataFrame as CSV atomically (deterministic float format)."""
     write_atomic(path, frame.to_csv(index=False, float_format="%.12g"))

@@ -28,6 +28,8 @@ rule claims:
         src=PACKAGE_SOURCES,
     params:
         cfg=lambda wc: config["claims"],
+    benchmark:
+        "results/benchmarks/rules/claims.tsv"
     log:
         "results/logs/claims.log",
     script:

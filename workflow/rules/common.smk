@@ -7,6 +7,7 @@ from snakemake.utils import validate
 
 from infsup_contact import resources
 from infsup_contact.config_checks import ConfigError, check_config, check_job_memory, memory_notes
+from infsup_contact.discretization.series import beta_batches, seeds, series_of_pairs
 
 # Every check a config gets, in one library function (src/infsup_contact/config_checks.py):
 # user spaces, non-finite numbers, the schema, the registry's degrees and the cross-key rules.
@@ -32,47 +33,61 @@ REPORT_SOURCES = sorted(str(p) for p in (_PKG / "report").glob("*.py"))
 BENCH_SOURCES = sorted(str(p) for p in (_PKG / "bench").glob("*.py"))
 
 def beta_pairs():
-    """(N1, N2) mesh pairs of the β_h study: matching N×N plus the non-matching pairs."""
-    ic = config["infsup"]
-    pairs = [(n, n) for n in ic["N"]] + [tuple(p) for p in ic.get("nonmatching", [])]
-    return list(dict.fromkeys(pairs))  # a pair listed twice is one job
+    """(N1, N2) mesh pairs of the β_h study: every pair of every series (matching, the
+    fixed-ratio pairs, the non-matching families), each once (discretization/series.py)."""
+    return sorted(series_of_pairs(config["infsup"]), key=lambda p: (max(p), p))
 
 
-def beta_jobs():
-    """(family, k, N1, N2) of every β_h job."""
-    ic = config["infsup"]
-    ks = sorted({k for klist in ic["cases"].values() for k in klist})
-    return [(f, k, n1, n2) for f in ic["families"] for k in ks for n1, n2 in beta_pairs()]
+# β_h jobs: one per batch of pairs of one (family, k) (discretization/series.py: beta_batches)
+BETA_BATCHES = beta_batches(config["infsup"])
 
 
 def beta_tables(wildcards=None):
-    return [f"results/tables/beta/{f}_k{k}_{n1}x{n2}.csv" for f, k, n1, n2 in beta_jobs()]
+    return [f"results/tables/beta/{b}.csv" for b in BETA_BATCHES]
 
 
 def contact_jobs():
-    """(scene, family, k, N) of every contact job."""
+    """(scene, family, k) of every contact job (all N of the scene in one job)."""
     cc = config["contact"]
     ks = sorted({k for klist in cc["cases"].values() for k in klist})
-    return [(s, f, k, n) for s, spec in cc["scenes"].items() for f in cc["families"] for k in ks
-            for n in spec.get("N", cc["N"])]
+    return [(s, f, k) for s in cc["scenes"] for f in cc["families"] for k in ks]
+
+
+def contact_ns(scene):
+    cc = config["contact"]
+    return cc["scenes"][scene].get("N", cc["N"])
 
 
 def contact_tables(wildcards=None):
-    return [f"results/tables/contact/{s}_{f}_k{k}_{n}.csv" for s, f, k, n in contact_jobs()]
+    return [f"results/tables/contact/{s}_{f}_k{k}.csv" for s, f, k in contact_jobs()]
+
+
+def contact_reference(wildcards):
+    """The membranes reference of this k (rule membranes_reference), for a membranes scene."""
+    if config["contact"]["scenes"][wildcards.scene]["kind"] != "membranes":
+        return []
+    return [f"results/references/{wildcards.scene}_k{wildcards.k}.pickle"]
 
 
 def beta_mem_mb(wildcards):
-    """mem_mb of a β_h job: the estimate of src/infsup_contact/resources.py (+25 %)."""
-    ic = config["infsup"]
-    return resources.job_mem_mb(resources.beta_estimate(
-        wildcards.family, int(wildcards.k), int(wildcards.n1), int(wildcards.n2),
-        ic["multiplier_meshes"], ic["norms"]))
+    """mem_mb of a β_h batch: the largest estimate of src/infsup_contact/resources.py (+25 %)
+    over its pairs (one pair at a time is in memory)."""
+    ic, batch = config["infsup"], BETA_BATCHES[wildcards.batch]
+    return max(resources.job_mem_mb(resources.beta_estimate(
+        batch["family"], batch["k"], n1, n2, ic["multiplier_meshes"], ic["norms"])) for n1, n2 in batch["pairs"])
 
 
 def contact_mem_mb(wildcards):
-    """mem_mb of a contact job (with the membranes reference where the scene needs one)."""
+    """mem_mb of a contact job: its largest N (the reference is read, not solved, in the job)."""
     cc = config["contact"]
     kind = cc["scenes"][wildcards.scene]["kind"]
-    n = int(wildcards.n)
+    n = max(contact_ns(wildcards.scene))
     return resources.job_mem_mb(resources.contact_estimate(
         kind, wildcards.family, int(wildcards.k), n, n, cc["reference_N"], len(cc["cases"])))
+
+
+def reference_mem_mb(wildcards):
+    """mem_mb of the membranes reference job (degree k + 1 on reference_N × reference_N)."""
+    cc = config["contact"]
+    return resources.job_mem_mb(resources.contact_estimate(
+        "membranes", "structured", int(wildcards.k), 1, 1, cc["reference_N"], 1))

@@ -50,6 +50,8 @@ rule fig1_model_problem:
         png=FIGURE_OUT["fig1_model_problem"]["png"],
     input:
         style=PLOT_STYLE,
+    benchmark:
+        "results/benchmarks/rules/fig1_model_problem.tsv"
     log:
         "results/logs/figures/fig1_model_problem.log",
     script:
@@ -65,6 +67,8 @@ rule fig2_beta_H:
         style=PLOT_STYLE,
     params:
         norm="H",
+    benchmark:
+        "results/benchmarks/rules/fig2_beta_H.tsv"
     log:
         "results/logs/figures/fig2_beta_H.log",
     script:
@@ -80,6 +84,8 @@ rule fig3_beta_L2:
         style=PLOT_STYLE,
     params:
         norm="L2",
+    benchmark:
+        "results/benchmarks/rules/fig3_beta_L2.tsv"
     log:
         "results/logs/figures/fig3_beta_L2.log",
     script:
@@ -95,8 +101,10 @@ rule fig4_families:
         style=PLOT_STYLE,
         meshes="src/infsup_contact/discretization/meshes.py",  # the mesh panels are drawn from mesh_pair
     params:
-        seed=lambda wc: config["infsup"]["seed"],
+        seed=lambda wc: seeds(config["infsup"])[0],  # the figure draws the first seed's meshes
         alpha=lambda wc: config["infsup"]["alpha"],
+    benchmark:
+        "results/benchmarks/rules/fig4_families.tsv"
     log:
         "results/logs/figures/fig4_families.log",
     script:
@@ -137,6 +145,8 @@ rule fig5_contact_solutions:
         gamma="results/tables/gamma_profiles.csv",
         field="results/tables/field_values.csv",
         style=PLOT_STYLE,
+    benchmark:
+        "results/benchmarks/rules/fig5_contact_solutions.tsv"
     log:
         "results/logs/figures/fig5_contact_solutions.log",
     script:
@@ -153,6 +163,8 @@ rule fig6_convergence:
         style=PLOT_STYLE,
     params:
         scene="manufactured",
+    benchmark:
+        "results/benchmarks/rules/fig6_convergence.tsv"
     log:
         "results/logs/figures/fig6_convergence.log",
     script:
@@ -167,6 +179,8 @@ rule fig7_speed_accuracy:
         table="results/tables/speed_accuracy.csv",  # written by the benchmarks stage
         style=PLOT_STYLE,
         pareto="src/infsup_contact/bench/speed_accuracy.py",  # pareto_front
+    benchmark:
+        "results/benchmarks/rules/fig7_speed_accuracy.tsv"
     log:
         "results/logs/figures/fig7_speed_accuracy.log",
     script:
@@ -210,6 +224,8 @@ rule fig8_dual:
         style=PLOT_STYLE,
     params:
         cases=FIG8["cases"],
+    benchmark:
+        "results/benchmarks/rules/fig8_dual.tsv"
     log:
         "results/logs/figures/fig8_dual.log",
     script:

@@ -25,6 +25,8 @@ rule mesh_quality:
         "results/tables/mesh_quality.csv",
     input:
         expand("results/tables/mesh_quality/{family}.csv", family=config["infsup"]["families"]),
+    benchmark:
+        "results/benchmarks/rules/mesh_quality.tsv"
     log:
         "results/logs/mesh_quality.log",
     script:

@@ -27,6 +27,8 @@ rule paper_macros:
         src=REPORT_SOURCES,
     params:
         cfg=lambda wc: {key: config[key] for key in ("claims", "contact", "infsup")},
+    benchmark:
+        "results/benchmarks/rules/paper_macros.tsv"
     log:
         "results/logs/paper_macros.log",
     script:
@@ -41,6 +43,8 @@ rule paper_pdf:
         bib="paper/references.bib",
         generated=rules.paper_macros.output,
         figures=PAPER_FIGURES,
+    benchmark:
+        "results/benchmarks/rules/paper_pdf.tsv"
     log:
         "results/logs/paper_pdf.log",
     params:

@@ -9,6 +9,8 @@ rule rates:
         src=PACKAGE_SOURCES,
     params:
         window=lambda wc: config["contact"]["rate_window"],
+    benchmark:
+        "results/benchmarks/rules/rates.tsv"
     log:
         "results/logs/rates.log",
     shell:

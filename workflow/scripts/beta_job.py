@@ -1,4 +1,9 @@
-"""One β_h job: every case × multiplier mesh × c pair × norm on one mesh pair."""
+"""One β_h batch: every pair of the batch × seed × case × multiplier mesh × c pair × norm.
+
+A row gets the series it belongs to (``series``: matching, ratio3-2, plus1, sqrt2, …; a
+pair of two series is computed once and written once per series) and, on perturbed
+meshes, its ``seed`` (empty on the deterministic families).
+"""
 import sys
 
 sys.path.insert(0, "workflow/scripts")
@@ -8,21 +13,29 @@ limit_threads(snakemake.threads)  # noqa: F821
 log_to(snakemake.log[0])  # noqa: F821
 register_user_spaces(snakemake.config)  # noqa: F821
 
+import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 
-from infsup_contact.solvers.infsup import beta_rows  # noqa: E402
+from infsup_contact.discretization.series import seeds, series_of_pairs  # noqa: E402
 from infsup_contact.io import write_csv_atomic  # noqa: E402
+from infsup_contact.solvers.infsup import beta_rows_all  # noqa: E402
 
-wc, ic = snakemake.wildcards, snakemake.params.ic  # noqa: F821
-k, n1, n2 = int(wc.k), int(wc.n1), int(wc.n2)
+ic, batch = snakemake.params.ic, snakemake.params.batch  # noqa: F821
+family, k = batch["family"], int(batch["k"])
 cases = [c for c, klist in ic["cases"].items() if k in klist]
-rows = []
-for mm in ic["multiplier_meshes"]:
-    for c1, c2 in ic["c"]:
-        rows += beta_rows(wc.family, k, n1, n2, cases, mm, c1, c2, ic["norms"],
-                          **({"seed": ic["seed"], "alpha": ic["alpha"]} if wc.family == "perturbed" else {}))
-frame = pd.DataFrame(rows)
+member = series_of_pairs(ic)
+frames = []
+for n1, n2 in batch["pairs"]:
+    for seed in (seeds(ic) if family == "perturbed" else [None]):
+        kw = {} if seed is None else {"seed": seed, "alpha": ic["alpha"]}
+        rows = pd.DataFrame(beta_rows_all(family, k, n1, n2, cases, ic["multiplier_meshes"],
+                                          [tuple(c) for c in ic["c"]], ic["norms"], **kw))
+        rows["seed"] = np.nan if seed is None else seed
+        for name in member[(n1, n2)]:
+            frames.append(rows.assign(series=name))
+frame = pd.concat(frames, ignore_index=True)
 timing = [c for c in frame.columns if c.startswith("t_")]
 # timings vary run to run: they live in the benchmark tree, result tables stay deterministic
 write_csv_atomic(snakemake.output[0], add_provenance(frame.drop(columns=timing), ic))  # noqa: F821
-print(frame[["case", "norm", "multiplier_mesh", "beta", "kernel_dim", *timing]].to_string(), file=sys.stderr)
+summary = frame.groupby(["N1", "N2"])[timing].sum()
+print(summary.to_string(), file=sys.stderr)

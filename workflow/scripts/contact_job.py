@@ -1,4 +1,5 @@
-"""One contact job: every configured case on one (scene, family, k, N), structured reference."""
+"""One contact job: every configured case and every N of one (scene, family, k); the
+membranes reference is read from its own job's output (rule membranes_reference)."""
 import sys
 
 sys.path.insert(0, "workflow/scripts")
@@ -11,19 +12,17 @@ register_user_spaces(snakemake.config)  # noqa: F821
 import pandas as pd  # noqa: E402
 
 from infsup_contact.io import write_csv_atomic  # noqa: E402
-from infsup_contact.study.scenes import scene as make_scene  # noqa: E402
-from infsup_contact.study.contact_rows import contact_row, reference_solution  # noqa: E402
+from infsup_contact.study.contact_rows import contact_row, load_reference  # noqa: E402
 
 wc, cc = snakemake.wildcards, snakemake.params.cc  # noqa: F821
-k, n = int(wc.k), int(wc.n)
+k = int(wc.k)
 spec = cc["scenes"][wc.scene]
 kind, params = spec["kind"], {key: v for key, v in spec.items() if key not in ("kind", "N")}
 c1, c2 = cc["c"]
-ref = None
-if kind == "membranes":
-    ref = reference_solution(make_scene(kind, c1=c1, c2=c2, **params), k, cc["reference_N"])
+ref = load_reference(snakemake.input.reference[0]) if kind == "membranes" else None  # noqa: F821
 rows = [contact_row(kind, case, k, wc.family, n, n, c1, c2, reference=ref,
                     scene_params=params, time_floor=False)
+        for n in snakemake.params.ns  # noqa: F821
         for case, klist in cc["cases"].items() if k in klist]
 frame = pd.DataFrame(rows).assign(scene=wc.scene, scene_kind=kind)
 timing = [c for c in frame.columns if c.startswith("t_")]

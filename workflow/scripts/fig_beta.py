@@ -11,6 +11,7 @@ import sys
 if "snakemake" in globals():  # run by Snakemake: threads and log before numpy loads
     sys.path.insert(0, "workflow/scripts")
     from _glue import limit_threads, log_to, read_table, register_user_spaces
+    from infsup_contact.discretization.series import primary_rows
 
     limit_threads(snakemake.threads)  # noqa: F821
     log_to(snakemake.log[0])  # noqa: F821
@@ -104,5 +105,5 @@ def _half_slope_triangle(ax, sub):
 
 
 if "snakemake" in globals():
-    plot_beta(read_table(snakemake.input.beta, "beta"), snakemake.output.pdf, snakemake.output.png,  # noqa: F821
+    plot_beta(primary_rows(read_table(snakemake.input.beta, "beta")), snakemake.output.pdf, snakemake.output.png,  # noqa: F821
               norm=snakemake.params.norm)  # noqa: F821

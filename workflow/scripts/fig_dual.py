@@ -10,6 +10,7 @@ import sys
 if "snakemake" in globals():  # run by Snakemake: threads and log before numpy loads
     sys.path.insert(0, "workflow/scripts")
     from _glue import limit_threads, log_to, read_table, register_user_spaces
+    from infsup_contact.discretization.series import primary_rows
 
     limit_threads(snakemake.threads)  # noqa: F821
     log_to(snakemake.log[0])  # noqa: F821
@@ -74,5 +75,5 @@ def plot_dual(beta, contact, gamma, cases, pdf, png) -> None:
 
 if "snakemake" in globals():
     inp = snakemake.input  # noqa: F821
-    plot_dual(read_table(inp.beta, "beta"), read_table(inp.contact, "contact"), read_table(inp.gamma, "gamma_profiles"),
+    plot_dual(primary_rows(read_table(inp.beta, "beta")), read_table(inp.contact, "contact"), read_table(inp.gamma, "gamma_profiles"),
               snakemake.params.cases, snakemake.output.pdf, snakemake.output.png)  # noqa: F821

@@ -12,6 +12,7 @@ import sys
 if "snakemake" in globals():  # run by Snakemake: threads and log before numpy loads
     sys.path.insert(0, "workflow/scripts")
     from _glue import limit_threads, log_to, read_table
+    from infsup_contact.discretization.series import primary_rows
 
     limit_threads(snakemake.threads)  # noqa: F821
     log_to(snakemake.log[0])  # noqa: F821
@@ -179,5 +180,5 @@ assert CASE_COLORS  # the shared map (used through case_style)
 
 if "snakemake" in globals():
     p = snakemake.params  # noqa: F821
-    plot_families(read_table(snakemake.input.beta, "beta"), default_meshes(p.seed, p.alpha),  # noqa: F821
+    plot_families(primary_rows(read_table(snakemake.input.beta, "beta")), default_meshes(p.seed, p.alpha),  # noqa: F821
                   snakemake.output.pdf, snakemake.output.png)  # noqa: F821

@@ -14,19 +14,22 @@ import pandas as pd  # noqa: E402
 
 from infsup_contact.io import write_csv_atomic  # noqa: E402
 from infsup_contact.discretization.meshes import mesh_pair, mesh_quality  # noqa: E402
+from infsup_contact.discretization.series import seeds  # noqa: E402
 
 family, ic = snakemake.wildcards.family, snakemake.params.ic  # noqa: F821
-kwargs = {"seed": ic["seed"], "alpha": ic["alpha"]} if family == "perturbed" else {}
+seed_list = seeds(ic) if family == "perturbed" else [None]
 out_dir = snakemake.output.meshes  # noqa: F821
 tmp_dir = tempfile.mkdtemp(dir=os.path.dirname(out_dir) or ".", prefix=".meshes-")
 rows = []
 for n1, n2 in snakemake.params.pairs:  # noqa: F821
-    for side, mesh in zip((1, 2), mesh_pair(family, n1, n2, **kwargs)):
-        n = (n1, n2)[side - 1]
-        path = os.path.join(tmp_dir, f"omega{side}_N{n}.vol")
-        if not os.path.exists(path):  # Ω_i's mesh depends only on its own N
-            mesh.ngmesh.Save(path)
-        rows.append(dict(family=family, N1=n1, N2=n2, side=side, **mesh_quality(mesh)))
+    for seed in seed_list:
+        kwargs = {} if seed is None else {"seed": seed, "alpha": ic["alpha"]}
+        for side, mesh in zip((1, 2), mesh_pair(family, n1, n2, **kwargs)):
+            n = (n1, n2)[side - 1]
+            path = os.path.join(tmp_dir, f"omega{side}_N{n}" + ("" if seed is None else f"_seed{seed}") + ".vol")
+            if not os.path.exists(path):  # Ω_i's mesh depends only on its own N (and seed)
+                mesh.ngmesh.Save(path)
+            rows.append(dict(family=family, N1=n1, N2=n2, side=side, seed=seed, **mesh_quality(mesh)))
 shutil.rmtree(out_dir, ignore_errors=True)
 os.replace(tmp_dir, out_dir)
 write_csv_atomic(snakemake.output.table, add_provenance(pd.DataFrame(rows), ic))  # noqa: F821

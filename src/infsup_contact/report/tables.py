@@ -4,6 +4,8 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from ..discretization.series import primary_rows
+
 from .texformat import (MEASURES, SPEED_COLUMNS, VERDICTS, PaperTexError, _require, case_order, case_rank,
                         fmt_fixed, fmt_sci, latex_escape)
 
@@ -12,6 +14,7 @@ def beta_default_rows(beta: pd.DataFrame) -> pd.DataFrame:
     """The paper's setting: G_h = trace of Ω2 (omega2), matching meshes, first (c1, c2) pair."""
     _require(beta, ["case", "k", "family", "N1", "N2", "multiplier_mesh", "c1", "c2", "norm", "beta",
                     "kernel_dim", "smallest_nonzero", "dim_M", "dim_W"], "beta.csv")
+    beta = primary_rows(beta)
     b = beta[(beta.multiplier_mesh == "omega2") & (beta.N1 == beta.N2)]
     if b.empty:
         raise PaperTexError("beta.csv: no rows with multiplier_mesh=omega2 and N1 == N2")

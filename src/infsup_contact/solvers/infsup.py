@@ -106,40 +106,58 @@ def beta_rows(family, k, n1, n2, cases=None, multiplier_mesh="omega2",
     list of dict
         One row per (case, norm) with the columns of ``infsup-contact beta``.
     """
+    return beta_rows_all(family, k, n1, n2, cases, (multiplier_mesh,), ((c1, c2),), norms,
+                         h_route=h_route, model=model, **mesh_kwargs)
+
+
+def beta_rows_all(family, k, n1, n2, cases=None, multiplier_meshes=("omega2",), c_pairs=((1.0, 1.0),),
+                  norms=NORMS, h_route="logkernel", model=MEMBRANES, **mesh_kwargs):
+    """:func:`beta_rows` for several multiplier meshes and prestress pairs at once.
+
+    The meshes and the side factorizations are built once per mesh pair, the couplings and
+    the Gram matrices once per (multiplier mesh, case, norm), and only the interface
+    operator Σ c_i⁻¹ B_i X_i B_iᵀ and the eigenproblem per (c1, c2). Rows in the order
+    multiplier mesh, case, c pair, norm.
+    """
     cases = registry.ids_valid_for(k) if cases is None else list(cases)
-    check_inputs([c for c in cases if isinstance(c, str)], k, family, n1, n2, c1, c2, norms, multiplier_mesh)
+    for mm in multiplier_meshes:
+        for c1, c2 in c_pairs:
+            check_inputs([c for c in cases if isinstance(c, str)], k, family, n1, n2, c1, c2, norms, mm)
     t0 = time.perf_counter()
     mesh1, mesh2 = meshes.mesh_pair(family, n1, n2, **mesh_kwargs)
     t1 = time.perf_counter()
     sides = [model.side_operator(m, k) for m in (mesh1, mesh2)]
     t2 = time.perf_counter()
-    x_mult = meshes.multiplier_breakpoints(mesh1, mesh2, multiplier_mesh)
     x1, x2 = (s.trace.breakpoints for s in sides)
     dim_w = trace_sum_dimension(k, x1, x2)
     rows = []
-    for case in cases:
-        space = _space(case, k, x_mult)
-        tc = time.perf_counter()
-        couplings = [coupling_matrix(s.trace, space, k) for s in sides]
-        S = interface_operator(couplings, sides, (c1, c2))
-        S2 = interface_operator(couplings[1:], sides[1:], (c2,))  # sup over (0, v2) only: (5.10)
-        t_coupling = time.perf_counter() - tc
-        for norm in norms:
-            te = time.perf_counter()
-            G, info = gram(space, norm, h_route=h_route)
-            sp_ = spectrum(S, G)
-            beta_v1_zero = spectrum(S2, G).beta
-            rows.append(dict(
-                case=case if isinstance(case, str) else case[0], k=k, family=family, N1=n1, N2=n2, multiplier_mesh=multiplier_mesh,
-                c1=c1, c2=c2, norm=norm, beta=sp_.beta, kernel_dim=sp_.kernel_dim,
-                structural_kernel_dim=max(space.dim - dim_w, 0),
-                kernel_check=kernel_check(sp_.kernel_dim, max(space.dim - dim_w, 0)),
-                gap_over_roundoff=sp_.gap,
-                smallest_nonzero=sp_.smallest_nonzero, beta_v1_zero=beta_v1_zero,
-                dim_M=space.dim, dim_W=dim_w,
-                n_max=info["n_max"], nmax_rel_error=info["nmax_rel_error"],
-                ndof=sum(s.ndof for s in sides), t_assemble=t1 - t0 + t_coupling,
-                t_interface=t2 - t1, t_eig=time.perf_counter() - te))
+    for multiplier_mesh in multiplier_meshes:
+        x_mult = meshes.multiplier_breakpoints(mesh1, mesh2, multiplier_mesh)
+        for case in cases:
+            space = _space(case, k, x_mult)
+            tc = time.perf_counter()
+            couplings = [coupling_matrix(s.trace, space, k) for s in sides]
+            t_coupling = time.perf_counter() - tc
+            grams = {norm: gram(space, norm, h_route=h_route) for norm in norms}
+            structural = max(space.dim - dim_w, 0)
+            for c1, c2 in c_pairs:
+                S = interface_operator(couplings, sides, (c1, c2))
+                S2 = interface_operator(couplings[1:], sides[1:], (c2,))  # sup over (0, v2) only: (5.10)
+                for norm in norms:
+                    te = time.perf_counter()
+                    G, info = grams[norm]
+                    sp_ = spectrum(S, G)
+                    beta_v1_zero = spectrum(S2, G).beta
+                    rows.append(dict(
+                        case=case if isinstance(case, str) else case[0], k=k, family=family, N1=n1, N2=n2,
+                        multiplier_mesh=multiplier_mesh, c1=c1, c2=c2, norm=norm, beta=sp_.beta,
+                        kernel_dim=sp_.kernel_dim, structural_kernel_dim=structural,
+                        kernel_check=kernel_check(sp_.kernel_dim, structural), gap_over_roundoff=sp_.gap,
+                        smallest_nonzero=sp_.smallest_nonzero, beta_v1_zero=beta_v1_zero,
+                        dim_M=space.dim, dim_W=dim_w,
+                        n_max=info["n_max"], nmax_rel_error=info["nmax_rel_error"],
+                        ndof=sum(s.ndof for s in sides), t_assemble=t1 - t0 + t_coupling,
+                        t_interface=t2 - t1, t_eig=time.perf_counter() - te))
     return rows
 
 

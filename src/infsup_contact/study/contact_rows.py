@@ -19,6 +19,30 @@ def reference_solution(scene, k: int, n_ref: int) -> ContactSolution:
     return solve_contact(scene, REFERENCE_SPACE, k + 1, "structured", n_ref, n_ref, time_floor=False)
 
 
+def save_reference(path, ref: ContactSolution) -> None:
+    """Write what the error measures need of a reference (u_h as NGSolve grid functions,
+    which pickle with their mesh and space; M_h; λ_h) atomically, without the factorized
+    sides: the workflow solves the membranes reference once per k and every contact job of
+    that k reads it (:func:`load_reference`)."""
+    import pickle
+    import types
+
+    import numpy as np
+
+    from ..io import write_bytes_atomic
+
+    light = types.SimpleNamespace(u=list(ref.u), space=ref.space, lam=np.asarray(ref.lam), c=tuple(ref.c))
+    write_bytes_atomic(path, pickle.dumps(light, protocol=pickle.HIGHEST_PROTOCOL))
+
+
+def load_reference(path):
+    """The reference written by :func:`save_reference` (attributes u, space, lam, c)."""
+    import pickle
+
+    with open(path, "rb") as fh:
+        return pickle.load(fh)
+
+
 def contact_row(scene_name: str, case: str, k: int, family: str, n1: int, n2: int,
                 c1: float = 1.0, c2: float = 1.0, reference: ContactSolution | None = None,
                 n_ref: int = 64, time_floor: bool = True, scene_params: dict | None = None, **mesh_kwargs) -> dict:

@@ -1,0 +1,14 @@
+"""results/benchmarks/dag.csv: per rule, jobs and wall time of this run (benchmark: files)."""
+import sys
+
+sys.path.insert(0, "workflow/scripts")
+from _glue import log_to  # noqa: E402
+
+log_to(snakemake.log[0])  # noqa: F821
+
+from infsup_contact.bench.dag import dag_table  # noqa: E402
+from infsup_contact.io import write_csv_atomic  # noqa: E402
+
+table = dag_table(snakemake.params.root)  # noqa: F821
+write_csv_atomic(snakemake.output[0], table)  # noqa: F821
+print(table.to_string(), file=sys.stderr)

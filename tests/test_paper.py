@@ -17,7 +17,7 @@ import yaml
 
 from infsup_contact import report as pt
 from infsup_contact.discretization.registry import PAPER_CASES
-from infsup_contact.study.claims import REM55_INSTANCES, ledger
+from infsup_contact.study.claims import REM55_INSTANCES, ledger, nonmatching_claims
 
 ROOT = Path(__file__).resolve().parents[1]
 PAPER = ROOT / "paper" / "paper.tex"
@@ -38,11 +38,14 @@ def synth_beta(seed=0):
     """β rows: 3 families, k = 1, 2, even and odd matching N, two multiplier meshes, 3:2 and
     2:1 finer and 3:4 coarser non-matching pairs; values with 6 random decimals."""
     rng = np.random.default_rng(seed)
-    pairs = [(n, n) for n in (4, 8, 16, 32, 5, 9, 17)] + [(6, 4), (12, 8), (24, 16), (16, 8), (6, 8)]
+    series = {"matching": [(n, n) for n in (4, 8, 16, 32, 5, 9, 17)],
+              "ratio3-2": [(6, 4), (12, 8), (24, 16)], "ratio2-1": [(16, 8)], "ratio3-4": [(6, 8)],
+              "plus1": [(9, 8), (17, 16), (33, 32)], "sqrt2": [(11, 8), (23, 16), (45, 32)]}
+    pairs = [(name, p) for name, ps in series.items() for p in ps]
     rows = []
     for fam in ("structured", "perturbed", "unstructured"):
         for k, cases in CASES_K.items():
-            for n1, n2 in pairs:
+            for name, (n1, n2) in pairs:
                 for mm in ("omega2", "union"):
                     for case in cases:
                         for norm in ("H", "L2"):
@@ -54,7 +57,8 @@ def synth_beta(seed=0):
                                              c1=1.0, c2=1.0, norm=norm, beta=beta, kernel_dim=kern,
                                              structural_kernel_dim=kern, smallest_nonzero=round(val, 6),
                                              beta_v1_zero=round(0.9 * beta, 6), dim_M=DIM_M[case](n2, k),
-                                             dim_W=n2 * k - 1, package_version="0.1.0",
+                                             dim_W=n2 * k - 1, series=name, seed=0 if fam == "perturbed" else np.nan,
+                                             package_version="0.1.0",
                                              git_commit="0123456789abcdef", config_hash="feedc0ffee00"))
     return pd.DataFrame(rows)
 
@@ -280,7 +284,11 @@ def test_tables_contain_the_values(tables):
              & (beta.multiplier_mesh == "omega2") & (beta.N1 == 16) & (beta.N2 == 16)].iloc[0]
     assert pt.fmt_fixed(r.beta, 4) in files["beta_table.tex"]
     assert r"\begin{longtable}" in files["claims_table.tex"]
-    assert files["claims_table.tex"].count(r"\verdictfmt{") == len(tables["claims"])
+    # every claim once: in the longtable, or (non-matching bounded claims) as a letter of the grid
+    grid = nonmatching_claims(tables["claims"])
+    assert files["claims_table.tex"].count(r"\verdictfmt{") == len(tables["claims"]) - len(grid)
+    cells = re.findall(r"\\texttt\{([-PFI]+)\}", files["nonmatching_table.tex"])
+    assert sum(len(c) - c.count("-") for c in cells) == len(grid)
     assert files["rates_table.tex"].count(r"\\") >= len(tables["rates"]) // len(pt.MEASURES)
     for f in files.values():  # no raw UTF-8 left for pdflatex
         assert f.isascii()

@@ -14,6 +14,7 @@ rule paper_macros:
         beta="results/paper/beta_table.tex",
         speed="results/paper/speed_table.tex",
         front="results/paper/front_table.tex",
+        nonmatching="results/paper/nonmatching_table.tex",
     input:
         beta="results/tables/beta.csv",
         contact="results/tables/contact.csv",

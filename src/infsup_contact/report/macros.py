@@ -148,6 +148,27 @@ def claims_macros(claims: pd.DataFrame) -> list[Macro]:
     return out
 
 
+def series_macros(claims: pd.DataFrame) -> list[Macro]:
+    """Counts of the non-matching bounded claims per (series, multiplier mesh): all cases
+    (``nSeries{Claims,Pass,Fail,Inconclusive}``), the paper's stable spaces T3, T4, T5
+    (``nSeriesStable…``) and its unstable ones R5.2, R5.4 (``nSeriesUnstable…``)."""
+    from ..study.claims import nonmatching_claims
+
+    nm = nonmatching_claims(_claims_checked(claims))
+    out = []
+    groups = {"": None, "Stable": ("T3", "T4", "T5"), "Unstable": ("R5.2", "R5.4")}
+    for (series, mm), g in nm.groupby(["series", "mm"], sort=True):
+        for label, cases in groups.items():
+            gg = g if cases is None else g[g.case.isin(cases)]
+            what = "all cases" if cases is None else "cases " + ", ".join(cases)
+            src = f"claims.csv: non-matching bounded claims, series {series}, G_h {mm}, {what}"
+            out.append(Macro(macro_name(f"nSeries{label}Claims", series, mm), fmt_int(len(gg)), src))
+            for v in VERDICTS:
+                out.append(Macro(macro_name(f"nSeries{label}{v.capitalize()}", series, mm),
+                                 fmt_int((gg.verdict == v).sum()), f"{src}, verdict {v}"))
+    return out
+
+
 # --------------------------------------------------------------------------- speed
 
 
@@ -273,5 +294,6 @@ def macros_tex(macros: list[Macro]) -> str:
 
 def all_macros(beta, contact, rates, claims, speed, bench_beta, bench_contact, cfg, prov) -> list[Macro]:
     return (beta_macros(beta) + contact_macros(contact) + rates_macros(rates) + claims_macros(claims)
+            + series_macros(claims)
             + speed_macros(speed) + bench_macros(bench_beta, "beta") + bench_macros(bench_contact, "contact")
             + config_macros(cfg) + provenance_macros(beta, prov))

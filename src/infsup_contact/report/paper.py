@@ -8,12 +8,12 @@ from __future__ import annotations
 import re
 
 from .macros import all_macros, macros_tex
-from .tables import beta_table, claims_table, front_table, rates_table, speed_table
+from .tables import beta_table, claims_table, front_table, nonmatching_table, rates_table, speed_table
 from .texformat import PaperTexError
 from .texnames import is_generated_name
 
 GENERATED_FILES = ("macros.tex", "claims_table.tex", "rates_table.tex", "beta_table.tex",
-                   "speed_table.tex", "front_table.tex")
+                   "speed_table.tex", "front_table.tex", "nonmatching_table.tex")
 
 
 def paper_files(beta, contact, rates, claims, speed, bench_beta, bench_contact, cfg, prov) -> dict[str, str]:
@@ -21,6 +21,7 @@ def paper_files(beta, contact, rates, claims, speed, bench_beta, bench_contact, 
     return {"macros.tex": macros_tex(all_macros(beta, contact, rates, claims, speed, bench_beta,
                                                 bench_contact, cfg, prov)),
             "claims_table.tex": claims_table(claims),
+            "nonmatching_table.tex": nonmatching_table(claims),
             "rates_table.tex": rates_table(rates),
             "beta_table.tex": beta_table(beta),
             "speed_table.tex": speed_table(speed),

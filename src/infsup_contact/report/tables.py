@@ -89,9 +89,62 @@ def _breakable_id(claim_id: str) -> str:
     return r"\texttt{" + latex_escape(claim_id).replace("-", r"-\allowbreak{}") + "}"
 
 
+SERIES_ORDER = ("ratio3-2", "plus1", "sqrt2")
+MM_ORDER = ("omega2", "omega1", "union")
+FAMILY_ORDER = ("structured", "perturbed", "unstructured")
+
+
+def series_tex(series: str) -> str:
+    """LaTeX label of a mesh series id: ``$N_1=N_2+1$``, ``$N_1{:}N_2=3{:}2$``."""
+    if series == "plus1":
+        return r"$N_1=N_2+1$"
+    if series == "sqrt2":
+        return r"$N_1=\mathrm{round}(\sqrt2\,N_2)$"
+    if series.startswith("ratio"):
+        p, q = series[len("ratio"):].split("-")
+        return rf"$N_1{{:}}N_2={p}{{:}}{q}$"
+    return latex_escape(series)
+
+
+def nonmatching_table(claims: pd.DataFrame) -> str:
+    """Verdicts of "β_h bounded away from 0" on the non-matching series, one tabular: rows
+    (case, k), columns series × multiplier mesh, each cell the verdicts on the structured,
+    perturbed and unstructured meshes as three letters (P pass, F fail, I inconclusive,
+    - no claim)."""
+    from ..study.claims import nonmatching_claims
+
+    nm = nonmatching_claims(_claims_checked(claims))
+    series = [s for s in SERIES_ORDER if s in set(nm.series)] + sorted(set(nm.series) - set(SERIES_ORDER))
+    mms = [m for m in MM_ORDER if m in set(nm.mm)]
+    if nm.empty:
+        return "% no non-matching claims in claims.csv\n"
+    letter = {"PASS": "P", "FAIL": "F", "INCONCLUSIVE": "I"}
+    v = nm.set_index(["series", "mm", "case", "k", "family"]).verdict
+    lines = [r"\begin{tabular}{@{}ll" + "".join("|" + "c" * len(mms) for _ in series) + "@{}}", r"\toprule",
+             " & & " + " & ".join(rf"\multicolumn{{{len(mms)}}}{{c}}{{{series_tex(s)}}}" for s in series)
+             + r" \\",
+             "case & $k$ & " + " & ".join(r"\texttt{" + m + "}" for _ in series for m in mms) + r" \\", r"\midrule"]
+    keys = nm[["case", "k"]].drop_duplicates()
+    keys = keys.assign(rank=[case_rank(c) for c in keys.case]).sort_values(["rank", "k"])
+    for _, r in keys.iterrows():
+        cells = []
+        for s in series:
+            for m in mms:
+                cells.append(r"\texttt{" + "".join(letter.get(v.get((s, m, r.case, r.k, f)), "-")
+                                                   for f in FAMILY_ORDER) + "}")
+        lines.append(rf"\case{{{latex_escape(r.case)}}} & {int(r.k)} & " + " & ".join(cells) + r" \\")
+    lines += [r"\bottomrule", r"\end{tabular}", ""]
+    return "\n".join(lines)
+
+
 def claims_table(claims: pd.DataFrame) -> str:
-    """The ledger as a longtable: id, paper reference, verdict, statement and evidence."""
+    """The ledger as a longtable: id, paper reference, verdict, statement and evidence; the
+    non-matching bounded claims are the grid of :func:`nonmatching_table` instead (hundreds
+    of rows; each is in claims.csv)."""
+    from ..study.claims import NONMATCHING_ID
+
     claims = _claims_checked(claims)
+    claims = claims[~claims.claim_id.astype(str).str.match(NONMATCHING_ID)]
     head = (r"claim & paper & verdict & statement; evidence \\")
     lines = [r"\begin{footnotesize}",
              r"\setlength{\tabcolsep}{4pt}",

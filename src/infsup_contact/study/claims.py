@@ -23,6 +23,8 @@ rate claims
 """
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pandas as pd
 from scipy import stats
@@ -273,6 +275,20 @@ def worst_case_claims(beta: pd.DataFrame) -> list:
                             nonmatching_claim(beta, finer=finer, families=[fam], series=series),
                             predicted=PASS if paper else "finding"))
     return rows
+
+
+NONMATCHING_ID = re.compile(r"^finding-(?P<series>ratio\d+-\d+|plus1|sqrt2)-(?P<case>.+)-(?P<mm>omega2|omega1|union)"
+                            r"-k(?P<k>[1-4])-(?P<family>structured|perturbed|unstructured)$")
+"""The id of a bounded claim of :func:`findings` on a non-matching series."""
+
+
+def nonmatching_claims(claims: pd.DataFrame) -> pd.DataFrame:
+    """The non-matching bounded claims of a ledger with their series, case, multiplier mesh
+    (``mm``), k and family parsed from the id (:data:`NONMATCHING_ID`)."""
+    parts = claims.claim_id.astype(str).str.extract(NONMATCHING_ID)
+    sel = parts.series.notna()
+    out = pd.concat([claims[sel], parts[sel]], axis=1)
+    return out.assign(k=out.k.astype(int)) if len(out) else out.assign(k=pd.Series(dtype=int))
 
 
 MM_TEXT = {"omega2": "G_h = trace of Ω2", "omega1": "G_h = trace of Ω1",

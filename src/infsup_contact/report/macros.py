@@ -255,6 +255,9 @@ def config_macros(cfg: dict) -> list[Macro]:
     ic = cfg.get("infsup", {})
     if "alpha" in ic:
         out.append(Macro("cfgPerturbAlpha", f"{float(ic['alpha']):g}", "config: infsup.alpha"))
+    if "seed" in ic:
+        from ..discretization.series import seeds
+        out.append(Macro("cfgNSeeds", fmt_int(len(seeds(ic))), "config: infsup.seed (number of seeds)"))
     return out
 
 

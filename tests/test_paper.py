@@ -55,7 +55,7 @@ def synth_beta(seed=0):
                             beta = 0.0 if kern else round(val, 6)
                             rows.append(dict(case=case, k=k, family=fam, N1=n1, N2=n2, multiplier_mesh=mm,
                                              c1=1.0, c2=1.0, norm=norm, beta=beta, kernel_dim=kern,
-                                             structural_kernel_dim=kern, smallest_nonzero=round(val, 6),
+                                             structural_kernel_dim=kern, kernel_check="agree", smallest_nonzero=round(val, 6),
                                              beta_v1_zero=round(0.9 * beta, 6), dim_M=DIM_M[case](n2, k),
                                              dim_W=n2 * k - 1, series=name, seed=0 if fam == "perturbed" else np.nan,
                                              package_version="0.1.0",

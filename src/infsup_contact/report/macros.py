@@ -52,6 +52,12 @@ def beta_macros(beta: pd.DataFrame) -> list[Macro]:
             Macro("nBetaFamilies", fmt_int(beta.family.nunique()), "beta.csv: number of mesh families"),
             Macro("nBetaMeshPairs", fmt_int(len(beta[["N1", "N2"]].drop_duplicates())),
                   "beta.csv: number of (N1, N2) pairs")]
+    if "kernel_check" in beta.columns:  # numerical kernel (gap criterion) vs the structural count
+        for word in ("agree", "below_structural", "above_structural"):
+            name = macro_name("nKernel", *word.split("_"))
+            for label, rows in (("", beta), ("Matching", beta[beta.N1 == beta.N2])):
+                out.append(Macro(name + label, fmt_int((rows.kernel_check == word).sum()),
+                                 f"beta.csv: rows with kernel_check == {word}" + (", N1 == N2" if label else "")))
     return out
 
 

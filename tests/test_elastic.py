@@ -1,0 +1,153 @@
+"""The plane-strain elastic model (models/elastic.py): exact properties of its stiffness, the
+sign convention of b(v, μ), and the Γ-reduced route against the assembled saddle point."""
+from __future__ import annotations
+
+import ngsolve
+import numpy as np
+import pytest
+import scipy.linalg as sla
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+from infsup_contact.discretization import meshes, registry
+from infsup_contact.discretization.coupling import coupling_matrix
+from infsup_contact.discretization.norms import gram
+from infsup_contact.errors import InputError
+from infsup_contact.models import MODELS
+from infsup_contact.models.elastic import (ELASTIC, check_nu, elastic_model, elastic_space, elastic_stiffness,
+                                           interpolate, lame, side_operator)
+from infsup_contact.models.schur import interface_operator
+from infsup_contact.solvers.contact import contact_qp
+from infsup_contact.solvers.infsup import beta_rows, saddle_point_beta
+from infsup_contact.solvers.pdas import solve_pdas
+
+
+def test_registered():
+    assert MODELS["elastic"] is ELASTIC and "membranes" in MODELS
+
+
+@pytest.mark.parametrize("k", [1, 2])
+def test_floating_body_has_exactly_the_three_rigid_modes(k):
+    """No Dirichlet boundary: K r = 0 for the translations and the rotation (−y, x), and the
+    kernel of K has dimension exactly 3."""
+    mesh = meshes.subdomain_mesh("structured", 3, 2)
+    space = elastic_space(mesh, k, x_dirichlet="nothing", y_dirichlet="nothing")
+    K = elastic_stiffness(space, 0.3)
+    x, y = ngsolve.x, ngsolve.y
+    for ux, uy in ((1, 0), (0, 1), (-y, x)):
+        r = interpolate(space, ux, uy)
+        assert np.linalg.norm(K @ r) < 1e-12 * abs(K).max() * np.linalg.norm(r)
+    ev = sla.eigvalsh(K.toarray())
+    assert np.sum(ev < 1e-10 * ev[-1]) == 3 and ev[3] > 1e-6 * ev[-1]
+
+
+@pytest.mark.parametrize("k", [1, 2, 3])
+@pytest.mark.parametrize("nu", [0.0, 0.3, 0.49])
+def test_constant_strain_energy_is_exact(k, nu):
+    """u = (a x + b y, c x + d y) is in P_k: uᵀKu = |Ω| (2μ̂ ε:ε + λ̂ (tr ε)²), |Ω| = 1."""
+    mesh = meshes.subdomain_mesh("unstructured", 3, 1)
+    space = elastic_space(mesh, k, x_dirichlet="nothing", y_dirichlet="nothing")
+    K = elastic_stiffness(space, nu)
+    a, b, c, d = 0.3, -0.7, 1.1, 0.4
+    u = interpolate(space, a * ngsolve.x + b * ngsolve.y, c * ngsolve.x + d * ngsolve.y)
+    eps = np.array([[a, 0.5 * (b + c)], [0.5 * (b + c), d]])
+    mu, lam = lame(nu)
+    exact = 2 * mu * np.sum(eps * eps) + lam * np.trace(eps) ** 2
+    assert u @ (K @ u) == pytest.approx(exact, rel=1e-12)
+
+
+@pytest.mark.parametrize("k", [1, 2])
+def test_interface_operator_is_the_normal_block_of_the_inverse(k):
+    """K (clamped) SPD; S⁻¹ of the side = ((K⁻¹)_ΓΓ)_nn = the nn block of the inverse of the
+    Schur complement onto the Γ dofs of both components."""
+    side = side_operator(meshes.subdomain_mesh("structured", 3, 1), k)
+    K = side.stiffness.toarray()
+    assert np.allclose(K, K.T) and sla.eigvalsh(K)[0] > 0
+    ng, nt = len(side.trace.gamma_dofs), side.n_tangential
+    Kinv = np.linalg.inv(K)
+    X = side.steklov_inverse()
+    assert np.allclose(X, Kinv[-ng:, -ng:], rtol=1e-10, atol=1e-12 * abs(X).max())
+    nb = ng + nt  # both components, Γ last
+    S_both = K[-nb:, -nb:] - K[-nb:, :-nb] @ np.linalg.solve(K[:-nb, :-nb], K[:-nb, -nb:])
+    assert np.allclose(np.linalg.inv(S_both)[nt:, nt:], X, rtol=1e-9, atol=1e-12 * abs(X).max())
+    assert sla.eigvalsh(side.schur)[0] > 0
+
+
+def test_pressure_pushes_the_bodies_apart():
+    """λ = 1 (T5 contains the constants) with no load: A_1 u_1 = −B_1ᵀ λ, A_2 u_2 = +B_2ᵀ λ
+    gives u_{1,y} < 0 < u_{2,y} on Γ and a gap λᵀ K λ > 0."""
+    k = 2
+    m1, m2 = meshes.mesh_pair("structured", 4, 4)
+    sides = [side_operator(m, k) for m in (m1, m2)]
+    space = registry.case_space("T5", k, meshes.multiplier_breakpoints(m1, m2))
+    lam = np.linalg.lstsq(space.evaluate(np.linspace(0.05, 0.95, 40)), np.ones(40), rcond=None)[0]
+    assert np.allclose(space.evaluate(np.array([0.3, 0.7])) @ lam, 1.0)
+    Bs = [coupling_matrix(s.trace, space, k) for s in sides]
+    uy = []
+    for sign, s, B in zip((-1.0, 1.0), sides, Bs):
+        rhs = np.zeros(s.ndof)
+        rhs[s.ndof - B.shape[1]:] = sign * (B.T @ lam)
+        gf = s.grid_function(s.solve(rhs))
+        uy.append(np.array([gf.components[1](s.space.fes.mesh(x, 1.0)) for x in (0.25, 0.5, 0.75)]))
+    assert np.all(uy[0] < 0) and np.all(uy[1] > 0)
+    assert lam @ interface_operator(Bs, sides) @ lam > 0
+
+
+@pytest.mark.parametrize("case, k, n1, n2", [("T3", 2, 3, 3), ("T5", 2, 3, 2), ("R5.4", 1, 2, 3)])
+def test_beta_schur_route_equals_full_saddle_point_pencil(case, k, n1, n2):
+    """β_h from the Γ-reduced interface operator (beta_rows, model=elastic) equals β_h from
+    the assembled pencil [[A, Bᵀ], [B, 0]] (saddle_point_beta), H norm, ν = 0.3 and 0.45."""
+    for nu in (0.3, 0.45):
+        model = elastic_model(nu)
+        row = beta_rows("structured", k, n1, n2, [case], norms=("H",), model=model)[0]
+        m1, m2 = meshes.mesh_pair("structured", n1, n2)
+        sides = [model.side_operator(m, k) for m in (m1, m2)]
+        space = registry.case_space(case, k, meshes.multiplier_breakpoints(m1, m2))
+        Bs = [coupling_matrix(s.trace, space, k) for s in sides]
+        A, B, _ = contact_qp(sides, Bs, [np.zeros(s.ndof) for s in sides])
+        G, _ = gram(space, "H")
+        assert row["beta"] == pytest.approx(saddle_point_beta(A, B.toarray(), G), rel=1e-7)
+
+
+def test_contact_schur_route_equals_sparse_saddle_point_solve():
+    """Frictionless contact of the clamped bodies pressed together by body forces f_2 = (0, −1),
+    f_1 = (0, 1) with an initial gap: the active set on (K, g0) plus the recovery equal the
+    sparse saddle-point solve of the assembled problem with that contact set."""
+    k, n1, n2, E = 2, 4, 3, (1.0, 3.0)
+    m1, m2 = meshes.mesh_pair("structured", n1, n2)
+    sides = [side_operator(m, k) for m in (m1, m2)]
+    space = registry.case_space("T3", k, meshes.multiplier_breakpoints(m1, m2))
+    Bs = [coupling_matrix(s.trace, space, k) for s in sides]
+    F = []
+    for s, fy in zip(sides, (1.0, -1.0)):
+        lf = ngsolve.LinearForm(s.space.fes)
+        lf += fy * s.space.fes.TestFunction()[1] * ngsolve.dx
+        lf.Assemble()
+        F.append(lf.vec.FV().NumPy()[s.free].copy())
+    gap = 0.02 * np.linspace(0.0, 1.0, space.dim)  # a weighted initial gap growing along Γ
+    K = interface_operator(Bs, sides, E)
+    u0 = [s.solve(Fi) / c for s, Fi, c in zip(sides, F, E)]
+    ng = [B.shape[1] for B in Bs]
+    g0 = gap + Bs[1] @ u0[1][-ng[1]:] - Bs[0] @ u0[0][-ng[0]:]
+    res = solve_pdas(K, g0)
+    assert res.active.any() and not res.active.all()
+    u_schur = []
+    for sign, s, Fi, B, c in zip((-1.0, 1.0), sides, F, Bs, E):
+        rhs = Fi.copy()
+        rhs[s.ndof - B.shape[1]:] += sign * (B.T @ res.lam)
+        u_schur.append(s.solve(rhs) / c)
+    A, Bq, Fv = contact_qp(sides, Bs, F, E)
+    # the gap enters as B u >= −gap: shift the right-hand side of the active rows
+    Ba = Bq[res.active]
+    n = A.shape[0]
+    kkt = sp.bmat([[A, Ba.T], [Ba, None]], format="csc")
+    sol = spla.spsolve(kkt, np.concatenate([Fv, -gap[res.active]]))
+    assert np.allclose(np.concatenate(u_schur), sol[:n], rtol=1e-9, atol=1e-12)
+    assert np.allclose(res.lam[res.active], -sol[n:], rtol=1e-8, atol=1e-12)
+    assert np.all(res.lam >= -1e-12)
+
+
+@pytest.mark.parametrize("bad", [0.5, 0.6, -1.0, -2.0, float("nan"), float("inf"), "x", True])
+def test_bad_nu_refused(bad):
+    with pytest.raises(InputError, match="invalid nu"):
+        check_nu(bad)

@@ -151,3 +151,39 @@ def test_contact_schur_route_equals_sparse_saddle_point_solve():
 def test_bad_nu_refused(bad):
     with pytest.raises(InputError, match="invalid nu"):
         check_nu(bad)
+
+
+def _run(argv):
+    import contextlib
+    import io
+
+    from infsup_contact import cli
+
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        try:
+            code = cli.main(argv)
+        except SystemExit as exc:
+            code = exc.code
+    return code, out.getvalue(), err.getvalue()
+
+
+def test_cli_beta_elastic_columns_and_agreement():
+    code, out, err = _run(["beta", "--model", "elastic", "--case", "T3", "--k", "2", "--N1", "4", "--N2", "4",
+                           "--norm", "H", "--nu", "0.3", "--E1", "1", "--E2", "2"])
+    assert code == 0, err
+    header, row = out.splitlines()[:2]
+    cols = dict(zip(header.split(","), row.split(",")))
+    assert cols["model"] == "elastic" and float(cols["nu"]) == 0.3 and float(cols["E2"]) == 2.0
+    ref = beta_rows("structured", 2, 4, 4, ["T3"], c1=1.0, c2=2.0, norms=("H",), model=elastic_model(0.3))[0]
+    assert float(cols["beta"]) == pytest.approx(ref["beta"], rel=1e-10)
+
+
+@pytest.mark.parametrize("flag, value, model", [("--nu", "0.5", "elastic"), ("--nu", "-1", "elastic"),
+                                                ("--E1", "0", "elastic"), ("--E2", "-3", "elastic"),
+                                                ("--E1", "nan", "elastic"), ("--nu", "0.3", "membranes"),
+                                                ("--c1", "2", "elastic")])
+def test_cli_bad_elastic_input_one_line_exit_2(flag, value, model):
+    code, out, err = _run(["beta", "--model", model, "--case", "T3", "--k", "2", "--N1", "4", "--N2", "4",
+                           flag, value])
+    assert code == 2 and out == "" and len(err.splitlines()) == 1 and flag in err, (code, err)

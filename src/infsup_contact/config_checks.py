@@ -291,6 +291,14 @@ def check_speed_accuracy_scene(cfg) -> None:
                           got=name, allowed="one of " + ", ".join(allowed))
 
 
+def check_elastic_nonmatching(cfg) -> None:
+    """An elastic non-matching pair has N1 ≠ N2 (matching meshes go under elastic.N)."""
+    for i, pair in enumerate(cfg["elastic"]["nonmatching"]):
+        if pair[0] == pair[1]:
+            raise ConfigError(f"elastic.nonmatching[{i}]", "a non-matching pair needs N1 != N2", got=pair,
+                              allowed="[N1, N2] with N1 != N2 (matching meshes go under elastic.N)")
+
+
 CROSS_KEY_RULES = {
     # rule: the keys it relates (the error names the first; a change to any of them can trip it)
     check_cases: ("infsup.cases", "contact.cases", "spaces"),
@@ -299,6 +307,7 @@ CROSS_KEY_RULES = {
     check_nonmatching: ("infsup.nonmatching",),
     check_membranes_parameters: ("contact.scenes",),
     check_speed_accuracy_scene: ("benchmarks.speed_accuracy_scene", "contact.scenes"),
+    check_elastic_nonmatching: ("elastic.nonmatching",),
 }
 """The rules a schema cannot state, with the keys each relates; each raises a
 :class:`ConfigError` naming one of them."""
@@ -356,6 +365,13 @@ def job_estimates(cfg):
                     yield key, f"contact_job {s} {f} k={k} N={n}", est
     for n in cfg["claims"]["rem55_N"]:
         yield "claims.rem55_N", f"claims_extra N={n}", R.beta_estimate("structured", 3, n, n, norms=("H",))
+    ec = cfg["elastic"]  # one job per (family, k): its largest pair; membranes alongside (smaller)
+    for n1, n2 in [(n, n) for n in ec["N"]] + [tuple(p) for p in ec["nonmatching"]]:
+        key = "elastic.N" if n1 == n2 else "elastic.nonmatching"
+        for f in ec["families"]:
+            for k in sorted(set(ec["k"]) | set(ec["nu_sweep_k"])):
+                yield key, f"elastic_beta_job {f} k={k} {n1}x{n2}", R.beta_estimate(
+                    f, k, n1, n2, "omega2", ("H",), components=2)
     for what in ("beta", "contact"):
         yield (f"benchmarks.{what}_N", f"bench_{what}", R.bench_estimate(
             what, bc[f"{what}_N"], bc[f"{what}_k"], bc["repeats"], bc.get("eigsh_max_N")))

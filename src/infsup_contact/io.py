@@ -47,6 +47,10 @@ TABLE_COLUMNS = {
     "speed_accuracy": ("scene", "case", "k", "family", "N", "seconds", "energy_error",
                        "lambda_hm12_error", "ndof", "dim_M", "pareto_energy", "pareto_lambda"),
     "bench": ("what", "route", "k", "N", "seconds_median", "seconds_min", "seconds_max", "ratio_to_ours"),
+    # elastic stage (study/elastic_beta.py)
+    "elastic_beta": ("model", "case", "k", "family", "N1", "N2", "E1", "E2", "nu", "norm", "beta", "kernel_dim",
+                     "structural_kernel_dim", "smallest_nonzero", "beta_membranes", "kernel_dim_membranes",
+                     "bound_factor"),
 }
 """Required columns per table kind (:func:`read_table`)."""
 

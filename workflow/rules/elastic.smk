@@ -1,0 +1,85 @@
+# Elastic stage (issue 12): plane-strain bodies on the paper's geometry (models/elastic.py).
+# β_h of every registered space next to the membranes on the same meshes (one job per family
+# and k, all its mesh pairs in one process), the ν → 1/2 sweep (one job per k), the tables
+# and the ledger claims (results/tables/elastic_claims.csv, appended to results/claims.csv).
+
+
+def elastic_mem_mb(wildcards):
+    """mem_mb of an elastic β job: the β estimate of its largest pair with two displacement
+    components per node (resources.beta_estimate, +25 %)."""
+    ec = config["elastic"]
+    pairs = [(n, n) for n in ec["N"]] + [tuple(p) for p in ec["nonmatching"]]
+    n1, n2 = max(pairs, key=lambda p: p[0] * p[0] + p[1] * p[1])
+    return resources.job_mem_mb(resources.beta_estimate(
+        getattr(wildcards, "family", "structured"), int(wildcards.k), n1, n2, "omega2", ("H",), components=2))
+
+
+ELASTIC_BETA = [f"results/tables/elastic/beta_{f}_k{k}.csv"
+                for f in config["elastic"]["families"] for k in config["elastic"]["k"]]
+ELASTIC_SWEEP = [f"results/tables/elastic/nu_sweep_k{k}.csv" for k in config["elastic"]["nu_sweep_k"]]
+
+
+rule elastic_beta_job:
+    output:
+        "results/tables/elastic/beta_{family}_k{k}.csv",
+    input:
+        PACKAGE_SOURCES,
+    params:
+        ec=lambda wc: config["elastic"],
+    threads: 1
+    resources:
+        mem_mb=lambda wc: elastic_mem_mb(wc) + (0 if workflow.local_exec else 500),
+        runtime=10,
+    benchmark:
+        "results/benchmarks/rules/elastic_beta_job/{family}_k{k}.tsv"
+    log:
+        "results/logs/elastic/beta_{family}_k{k}.log",
+    script:
+        "../scripts/elastic_beta_job.py"
+
+
+rule elastic_sweep_job:
+    output:
+        "results/tables/elastic/nu_sweep_k{k}.csv",
+    input:
+        PACKAGE_SOURCES,
+    params:
+        ec=lambda wc: config["elastic"],
+    threads: 1
+    resources:
+        mem_mb=lambda wc: elastic_mem_mb(wc) + (0 if workflow.local_exec else 500),
+        runtime=10,
+    benchmark:
+        "results/benchmarks/rules/elastic_sweep_job/k{k}.tsv"
+    log:
+        "results/logs/elastic/nu_sweep_k{k}.log",
+    script:
+        "../scripts/elastic_beta_job.py"
+
+
+rule elastic_tables:
+    output:
+        beta="results/tables/elastic_beta.csv",
+        sweep="results/tables/elastic_nu_sweep.csv",
+    input:
+        beta=ELASTIC_BETA,
+        sweep=ELASTIC_SWEEP,
+    log:
+        "results/logs/elastic_tables.log",
+    script:
+        "../scripts/elastic_tables.py"
+
+
+rule elastic_claims:
+    output:
+        "results/tables/elastic_claims.csv",
+    input:
+        beta="results/tables/elastic_beta.csv",
+        sweep="results/tables/elastic_nu_sweep.csv",
+        src=PACKAGE_SOURCES,
+    params:
+        cfg=lambda wc: config["claims"],
+    log:
+        "results/logs/elastic_claims.log",
+    script:
+        "../scripts/elastic_claims.py"

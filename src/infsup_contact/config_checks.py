@@ -292,11 +292,12 @@ def check_speed_accuracy_scene(cfg) -> None:
 
 
 def check_elastic_nonmatching(cfg) -> None:
-    """An elastic non-matching pair has N1 ≠ N2 (matching meshes go under elastic.N)."""
-    for i, pair in enumerate(cfg["elastic"]["nonmatching"]):
-        if pair[0] == pair[1]:
-            raise ConfigError(f"elastic.nonmatching[{i}]", "a non-matching pair needs N1 != N2", got=pair,
-                              allowed="[N1, N2] with N1 != N2 (matching meshes go under elastic.N)")
+    """An elastic non-matching pair (β_h table, patch test) has N1 ≠ N2."""
+    for key in ("nonmatching", "patch_pairs"):
+        for i, pair in enumerate(cfg["elastic"][key]):
+            if pair[0] == pair[1]:
+                raise ConfigError(f"elastic.{key}[{i}]", "a non-matching pair needs N1 != N2", got=pair,
+                                  allowed="[N1, N2] with N1 != N2 (matching meshes go under elastic.N)")
 
 
 CROSS_KEY_RULES = {
@@ -307,7 +308,7 @@ CROSS_KEY_RULES = {
     check_nonmatching: ("infsup.nonmatching",),
     check_membranes_parameters: ("contact.scenes",),
     check_speed_accuracy_scene: ("benchmarks.speed_accuracy_scene", "contact.scenes"),
-    check_elastic_nonmatching: ("elastic.nonmatching",),
+    check_elastic_nonmatching: ("elastic.nonmatching", "elastic.patch_pairs"),
 }
 """The rules a schema cannot state, with the keys each relates; each raises a
 :class:`ConfigError` naming one of them."""
@@ -372,6 +373,10 @@ def job_estimates(cfg):
             for k in sorted(set(ec["k"]) | set(ec["nu_sweep_k"])):
                 yield key, f"elastic_beta_job {f} k={k} {n1}x{n2}", R.beta_estimate(
                     f, k, n1, n2, "omega2", ("H",), components=2)
+    for n1, n2 in ec["patch_pairs"]:
+        for k in ec["patch_k"]:
+            yield "elastic.patch_pairs", f"elastic_patch k={k} {n1}x{n2}", R.beta_estimate(
+                "structured", k, n1, n2, "omega2", ("L2",), components=2)
     for what in ("beta", "contact"):
         yield (f"benchmarks.{what}_N", f"bench_{what}", R.bench_estimate(
             what, bc[f"{what}_N"], bc[f"{what}_k"], bc["repeats"], bc.get("eigsh_max_N")))

@@ -51,6 +51,8 @@ TABLE_COLUMNS = {
     "elastic_beta": ("model", "case", "k", "family", "N1", "N2", "E1", "E2", "nu", "norm", "beta", "kernel_dim",
                      "structural_kernel_dim", "smallest_nonzero", "beta_membranes", "kernel_dim_membranes",
                      "bound_factor"),
+    "elastic_patch": ("case", "k", "N1", "N2", "p", "kernel_dim", "lambda_max_rel_error", "lambda_end_rel_error",
+                      "lambda_middle_rel_error", "u_max_rel_error", "passes"),
 }
 """Required columns per table kind (:func:`read_table`)."""
 

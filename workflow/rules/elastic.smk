@@ -57,6 +57,22 @@ rule elastic_sweep_job:
         "../scripts/elastic_beta_job.py"
 
 
+rule elastic_patch:
+    output:
+        "results/tables/elastic_patch.csv",
+    input:
+        PACKAGE_SOURCES,
+    params:
+        ec=lambda wc: config["elastic"],
+    threads: 1
+    benchmark:
+        "results/benchmarks/rules/elastic_patch.tsv"
+    log:
+        "results/logs/elastic/patch.log",
+    script:
+        "../scripts/elastic_patch.py"
+
+
 rule elastic_tables:
     output:
         beta="results/tables/elastic_beta.csv",
@@ -76,6 +92,7 @@ rule elastic_claims:
     input:
         beta="results/tables/elastic_beta.csv",
         sweep="results/tables/elastic_nu_sweep.csv",
+        patch="results/tables/elastic_patch.csv",
         src=PACKAGE_SOURCES,
     params:
         cfg=lambda wc: config["claims"],

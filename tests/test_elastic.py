@@ -187,3 +187,49 @@ def test_cli_bad_elastic_input_one_line_exit_2(flag, value, model):
     code, out, err = _run(["beta", "--model", model, "--case", "T3", "--k", "2", "--N1", "4", "--N2", "4",
                            flag, value])
     assert code == 2 and out == "" and len(err.splitlines()) == 1 and flag in err, (code, err)
+
+
+# ----------------------------------------------------------------- the contact patch test
+
+def test_patch_passes_with_constants_and_t3_fails_at_the_ends():
+    """5:4 non-matching blocks, k = 2: T5 (contains the constants) reproduces λ = p and the
+    linear displacement to round-off; T3 (zero at Γ's ends) cannot: λ_h(0) = 0, error 1 at the
+    ends, and its displacement is wrong."""
+    from infsup_contact.study.patch import exact_pressure, solve_patch
+
+    good = solve_patch("T5", 2, 5, 4, nu=0.3, E=(1.0, 2.0))
+    assert good["passes"] and good["lambda_max_rel_error"] < 1e-10 and good["u_max_rel_error"] < 1e-10
+    assert good["kernel_dim"] == 0 and good["p"] == pytest.approx(exact_pressure(1e-2, 0.3, (1.0, 2.0)))
+    bad = solve_patch("T3", 2, 5, 4, nu=0.3, E=(1.0, 2.0))
+    assert not bad["passes"] and bad["lambda_end_rel_error"] == pytest.approx(1.0) and bad["u_max_rel_error"] > 1e-3
+
+
+def test_patch_pressure_is_the_uniform_stress():
+    """p = δ/(1/M1 + 1/M2) is the stress of two stacked constrained layers: with E1 = E2 and
+    ν = 0 (M = E) it is δE/2."""
+    from infsup_contact.study.patch import exact_pressure
+
+    assert exact_pressure(0.2, 0.0, (3.0, 3.0)) == pytest.approx(0.3)
+
+
+def test_cli_contact_patch_row():
+    code, out, err = _run(["contact", "--model", "elastic", "--scene", "patch", "--case", "R5.4", "--k", "1",
+                           "--N1", "7", "--N2", "3"])
+    assert code == 0, err
+    header, row = out.splitlines()[:2]
+    cols = dict(zip(header.split(","), row.split(",")))
+    assert cols["passes"] == "True" and float(cols["lambda_max_rel_error"]) < 1e-10
+
+
+@pytest.mark.parametrize("argv, flag", [
+    (["contact", "--scene", "patch", "--case", "T3", "--k", "1", "--N1", "5", "--N2", "4"], "--scene"),
+    (["contact", "--model", "elastic", "--scene", "membranes", "--case", "T3", "--k", "1", "--N1", "5", "--N2", "4"],
+     "--model"),
+    (["contact", "--model", "elastic", "--scene", "patch", "--case", "T3", "--k", "1", "--N1", "5", "--N2", "4",
+      "--family", "unstructured"], "--family"),
+    (["contact", "--model", "elastic", "--scene", "patch", "--case", "T3", "--k", "1", "--N1", "5", "--N2", "4",
+      "--E2", "0"], "--E2"),
+])
+def test_cli_contact_elastic_refusals(argv, flag):
+    code, out, err = _run(argv)
+    assert code == 2 and out == "" and len(err.splitlines()) == 1 and flag in err, (code, err)

@@ -3,6 +3,7 @@
     infsup-contact beta --case all --k 2 --family structured --N1 16 --N2 16
     infsup-contact beta --model elastic --case T3 --k 2 --N1 16 --N2 16 --nu 0.3 --E1 1 --E2 1
     infsup-contact contact --scene manufactured --case T3 --k 2 --N1 16 --N2 16
+    infsup-contact contact --model elastic --scene patch --case all --k 2 --N1 5 --N2 4
     infsup-contact rates contact.csv
     infsup-contact bench --what beta --N 32 64 --k 2
     infsup-contact verdict --case T3 --k 2 --expect stable
@@ -163,15 +164,18 @@ def _add_contact(sub) -> None:
     from .discretization.registry import space_ids
 
     p = sub.add_parser("contact", help="solve (4.1) for one case and mesh pair (CSV: one row)")
-    p.add_argument("--scene", required=True, choices=["manufactured", "membranes"])
+    p.add_argument("--scene", required=True, choices=["manufactured", "membranes", "patch"],
+                   help="membranes model: manufactured, membranes; elastic model: patch (the contact "
+                   "patch test, study/patch.py)")
     p.add_argument("--case", choices=[*space_ids(), "all"], help="a registered space, or all")
     p.add_argument("--space", metavar="FILE.py:FUNC", help=SPACE_HELP)
     p.add_argument("--k", type=int, required=True, help="displacement degree, 1..4")
     p.add_argument("--family", default="structured", choices=FAMILIES)
     p.add_argument("--N1", type=int, required=True)
     p.add_argument("--N2", type=int, required=True)
-    p.add_argument("--c1", type=float, default=1.0)
-    p.add_argument("--c2", type=float, default=1.0)
+    p.add_argument("--c1", type=float, default=None, help="membranes: prestress c1 (default 1)")
+    p.add_argument("--c2", type=float, default=None, help="membranes: prestress c2 (default 1)")
+    _add_model(p)
     p.add_argument("--p", type=float, default=3.0, help="manufactured: λ = x (a − x)₊^p, p > 3/2")
     p.add_argument("--q", type=float, default=3.0, help="manufactured: g = (x − a)₊^q (1 − x), q > 3/2")
     p.add_argument("--n-ref", type=int, default=64,
@@ -189,6 +193,12 @@ def _check_contact(args):
     if args.case is None and args.space is None:
         raise InputError("case", "one of --case ID|all or --space FILE.py:FUNC")
     args.cases = _cases(args)
+    _material(args)
+    elastic_scenes = ("patch",)
+    if (args.model == "elastic") != (args.scene in elastic_scenes):
+        key, value = ("model", args.model) if args.model == "elastic" else ("scene", args.scene)
+        raise InputError(key, "--model elastic with --scene patch; --model membranes (the default) with "
+                         "--scene manufactured or membranes", got=value)
     if not 1 <= args.k <= 4:
         raise InputError("k", "an integer in 1..4", got=args.k)
     for case in args.cases:
@@ -199,6 +209,12 @@ def _check_contact(args):
     check_prestress("c2", args.c2)
     _exponent("p", args.p)  # used by the manufactured scene only, but a bad value is bad anyway
     _exponent("q", args.q)
+    if args.scene == "patch":  # structured blocks; its own estimate: the β one of the pair, both components
+        if args.family != "structured":
+            raise InputError("family", "structured (the patch test's blocks)", got=args.family)
+        est = resources.beta_estimate("structured", args.k, args.N1, args.N2, "omega2", ("L2",), components=2)
+        _check_memory(est, *(("N1", args.N1) if args.N1 >= args.N2 else ("N2", args.N2)))
+        return est
     need = REFERENCE_MARGIN * max(args.N1, args.N2)
     if args.n_ref < 1 or (args.scene == "membranes" and args.n_ref < need):
         raise InputError("n_ref", f"an integer >= {need} for the membranes scene ({REFERENCE_MARGIN}x the finest "
@@ -219,6 +235,12 @@ def _run_contact(args) -> None:
     from .study.contact_rows import contact_row
 
     cases = args.cases
+    if args.scene == "patch":
+        from .study.patch import patch_rows
+
+        rows = patch_rows(cases, [args.k], [(args.N1, args.N2)], args.nu, (args.c1, args.c2))
+        pd.DataFrame(rows).to_csv(sys.stdout, index=False, float_format="%.6g")
+        return
     params = dict(p=args.p, q=args.q) if args.scene == "manufactured" else {}
     ref = None
     rows = []

@@ -48,11 +48,10 @@ import numpy as np
 import scipy.linalg as sla
 
 from ..discretization import meshes, registry
-from ..discretization.coupling import coupling_matrix, union_breakpoints
+from ..discretization.coupling import union_breakpoints
 from ..discretization.norms import gram
-from ..models.elastic import check_modulus, check_nu, interpolate, side_operator
-from ..models.schur import interface_operator
-from ..solvers.pdas import solve_pdas
+from ..models.elastic import check_modulus, check_nu, interpolate
+from .elastic_contact import solve_elastic_contact
 
 SIDE = "side"
 """Boundary name of the lateral sides x = 0, 1 (rollers: u_x = 0)."""
@@ -111,7 +110,8 @@ def solve_patch(case: str, k: int, n1: int, n2: int, nu: float = 0.3, E=(1.0, 1.
         ``lambda_max_rel_error`` (max |λ_h − p|/p over Γ, sampled ``per_interval`` points per
         interval of the union of both traces and G_h, ends included), split into
         ``lambda_end_rel_error`` (the end intervals of G_h), ``lambda_near_end_rel_error``
-        (the rest of [0, 1/4] ∪ [3/4, 1]) and ``lambda_middle_rel_error`` ([1/4, 3/4]); ``u_max_rel_error`` (max nodal |u_h − u|/δ, both bodies);
+        (the rest of [0, 1/4] ∪ [3/4, 1]) and ``lambda_middle_rel_error`` ([1/4, 3/4]);
+        ``u_max_rel_error`` (max nodal |u_h − u|/δ, both bodies);
         ``passes`` (both below :data:`PASS_RTOL`); ``kernel_dim`` of K; PDAS iterations.
     """
     nu = check_nu(nu)
@@ -121,32 +121,15 @@ def solve_patch(case: str, k: int, n1: int, n2: int, nu: float = 0.3, E=(1.0, 1.
         meshes.check_mesh_args("structured", n, key)
     t0 = time.perf_counter()
     m1, m2 = patch_mesh(n1, 1), patch_mesh(n2, 2)
-    sides = [side_operator(m, k, nu, X_DIRICHLET, Y_DIRICHLET) for m in (m1, m2)]
-    g = meshes.multiplier_breakpoints(m1, m2, "omega2")
-    space = registry.case_space(case, k, g)
-    Bs = [coupling_matrix(s.trace, space, k) for s in sides]
-    K = interface_operator(Bs, sides, E)
-    # Dirichlet data: u = 0 on Ω1's bottom, u = (0, −δ) on Ω2's top; loads F_i = −E_i K_i u_D
-    lifts = []
-    for s, mesh, value in zip(sides, (m1, m2), (0.0, -delta)):
-        gf = ngsolve.GridFunction(s.space.fes)
-        gf.components[1].Set(value, definedon=mesh.Boundaries(meshes.DIRICHLET))
-        lifts.append(gf.vec.FV().NumPy().copy())
-    F = [-e * (s.stiffness_all @ L)[s.free] for s, L, e in zip(sides, lifts, E)]
-    u0 = [s.solve(Fi) / e for s, Fi, e in zip(sides, F, E)]
-    ng = [B.shape[1] for B in Bs]
-    g0 = Bs[1] @ u0[1][-ng[1]:] - Bs[0] @ u0[0][-ng[0]:]
-    res = solve_pdas(K, g0)
+    sol = solve_elastic_contact(m1, m2, case, k, nu, E, X_DIRICHLET, Y_DIRICHLET, delta)
+    sides, space, res = sol.sides, sol.space, sol.pdas
+    g = space.breakpoints
     p = exact_pressure(delta, nu, E)
     M1, M2 = (constrained_modulus(e, nu) for e in E)
     exact = (-p * ngsolve.y / M1, -p / M1 - p * (ngsolve.y - 1.0) / M2)
-    u_err = 0.0
-    for sign, s, Fi, B, e, L, uy in zip((-1.0, 1.0), sides, F, Bs, E, lifts, exact):
-        rhs = Fi.copy()
-        rhs[s.ndof - B.shape[1]:] += sign * (B.T @ res.lam)
-        vec = L.copy()
-        vec[s.free] = s.solve(rhs) / e
-        u_err = max(u_err, np.max(np.abs(vec - interpolate(s.space, 0.0, uy))) / delta)
+    u_err = max(np.max(np.abs(vec - interpolate(s.space, 0.0, uy))) / delta
+                for s, vec, uy in zip(sides, sol.u, exact))
+    K = sol.K
     xs = union_breakpoints(g, sides[0].trace.breakpoints, sides[1].trace.breakpoints)
     t = np.linspace(0.0, 1.0, per_interval + 1)
     x = np.unique(np.clip((xs[:-1, None] + np.outer(np.diff(xs), t)).ravel(), 0.0, 1.0 - 1e-15))

@@ -233,3 +233,40 @@ def test_cli_contact_patch_row():
 def test_cli_contact_elastic_refusals(argv, flag):
     code, out, err = _run(argv)
     assert code == 2 and out == "" and len(err.splitlines()) == 1 and flag in err, (code, err)
+
+
+# ----------------------------------------------------------------- the Hertz scene
+
+def test_hertz_energy_error_of_the_reference_itself_is_zero():
+    """energy_error(ref, ref) = 0 and a coarse solution's error against it is > 0."""
+    from infsup_contact.study.hertz import energy_error, reference_data, solve_hertz
+
+    ref = solve_hertz("T3", 2, 8, 1.0, 0.05)
+    assert energy_error(ref, reference_data(ref), 0.3) < 1e-12
+    coarse = solve_hertz("T3", 1, 4, 1.0, 0.05)
+    assert energy_error(coarse, reference_data(ref), 0.3) > 1e-4
+
+
+def test_hertz_modeling_error_falls_as_the_contact_zone_shrinks():
+    """Against plane-strain Hertz for the measured P, the max-pressure error decreases with a/W
+    (T3, k = 2, N = 32); the half-width a of Hertz grows with the indentation d."""
+    from infsup_contact.study.hertz import modeling_rows
+
+    rows = modeling_rows("T3", 2, 32, 1.0, [0.02, 0.05, 0.1])
+    err = [r["p_max_rel_error"] for r in rows]
+    a = [r["hertz_a"] for r in rows]
+    assert err[0] < err[1] < err[2] and a[0] < a[1] < a[2]
+
+
+def test_hertz_formulas():
+    """a = sqrt(4PR/(πE*)), p0 = 2P/(πa), and ∫ p = P for the Hertz profile (Gauss)."""
+    from infsup_contact.study.hertz import combined_modulus, hertz, hertz_pressure
+
+    P, R, nu, E = 0.01, 2.0, 0.25, (1.0, 3.0)
+    a, p0 = hertz(P, R, nu, E)
+    assert combined_modulus(nu, E) == pytest.approx(1 / ((1 - nu**2) * (1 + 1 / 3)))
+    t, w = np.polynomial.legendre.leggauss(200)
+    x = 0.5 + a * np.sin(0.5 * np.pi * t)  # substitution removes the square-root edge
+    jac = a * 0.5 * np.pi * np.cos(0.5 * np.pi * t)
+    assert w @ (hertz_pressure(x, P, R, nu, E) * jac) == pytest.approx(P, rel=1e-10)
+    assert p0 == pytest.approx(2 * P / (np.pi * a))

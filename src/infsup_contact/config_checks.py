@@ -300,6 +300,16 @@ def check_elastic_nonmatching(cfg) -> None:
                                   allowed="[N1, N2] with N1 != N2 (matching meshes go under elastic.N)")
 
 
+def check_hertz_reference(cfg) -> None:
+    """elastic.hertz.N_ref >= REFERENCE_MARGIN × the largest elastic.hertz.N (as the membranes)."""
+    hz = cfg["elastic"]["hertz"]
+    need = REFERENCE_MARGIN * max(hz["N"])
+    if hz["N_ref"] < need:
+        raise ConfigError("elastic.hertz.N_ref", f"the Hertz reference must be {REFERENCE_MARGIN}x finer than the "
+                          f"finest mesh it measures (N up to {max(hz['N'])})", got=hz["N_ref"],
+                          allowed=f"N_ref >= {need}")
+
+
 CROSS_KEY_RULES = {
     # rule: the keys it relates (the error names the first; a change to any of them can trip it)
     check_cases: ("infsup.cases", "contact.cases", "spaces"),
@@ -309,6 +319,7 @@ CROSS_KEY_RULES = {
     check_membranes_parameters: ("contact.scenes",),
     check_speed_accuracy_scene: ("benchmarks.speed_accuracy_scene", "contact.scenes"),
     check_elastic_nonmatching: ("elastic.nonmatching", "elastic.patch_pairs"),
+    check_hertz_reference: ("elastic.hertz.N_ref", "elastic.hertz.N"),
 }
 """The rules a schema cannot state, with the keys each relates; each raises a
 :class:`ConfigError` naming one of them."""
@@ -373,6 +384,11 @@ def job_estimates(cfg):
             for k in sorted(set(ec["k"]) | set(ec["nu_sweep_k"])):
                 yield key, f"elastic_beta_job {f} k={k} {n1}x{n2}", R.beta_estimate(
                     f, k, n1, n2, "omega2", ("H",), components=2)
+    hz = ec["hertz"]
+    for key, n, k in [("elastic.hertz.N_ref", hz["N_ref"], k + 1) for k in hz["k"]] + \
+            [("elastic.hertz.modeling_N", hz["modeling_N"], 2)]:
+        yield key, f"elastic_hertz k={k} N={n}", R.beta_estimate("structured", k, n, n, "omega2", ("L2",),
+                                                                 components=2)
     for n1, n2 in ec["patch_pairs"]:
         for k in ec["patch_k"]:
             yield "elastic.patch_pairs", f"elastic_patch k={k} {n1}x{n2}", R.beta_estimate(

@@ -53,6 +53,8 @@ TABLE_COLUMNS = {
                      "bound_factor"),
     "elastic_patch": ("case", "k", "N1", "N2", "p", "kernel_dim", "lambda_max_rel_error", "lambda_end_rel_error",
                       "lambda_middle_rel_error", "u_max_rel_error", "passes"),
+    "elastic_hertz": ("study", "case", "k", "N", "d", "P", "p_max", "half_width", "oscillation",
+                      "p_max_rel_error", "half_width_rel_error"),
 }
 """Required columns per table kind (:func:`read_table`)."""
 

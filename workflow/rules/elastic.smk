@@ -73,13 +73,37 @@ rule elastic_patch:
         "../scripts/elastic_patch.py"
 
 
+rule elastic_hertz_job:
+    output:
+        "results/tables/elastic/hertz_{study}.csv",
+    input:
+        PACKAGE_SOURCES,
+    params:
+        ec=lambda wc: config["elastic"],
+    wildcard_constraints:
+        study="k[0-9]+|modeling",
+    threads: 1
+    benchmark:
+        "results/benchmarks/rules/elastic_hertz_job/{study}.tsv"
+    log:
+        "results/logs/elastic/hertz_{study}.log",
+    script:
+        "../scripts/elastic_hertz_job.py"
+
+
+ELASTIC_HERTZ = [f"results/tables/elastic/hertz_k{k}.csv" for k in config["elastic"]["hertz"]["k"]] + [
+    "results/tables/elastic/hertz_modeling.csv"]
+
+
 rule elastic_tables:
     output:
         beta="results/tables/elastic_beta.csv",
         sweep="results/tables/elastic_nu_sweep.csv",
+        hertz="results/tables/elastic_hertz.csv",
     input:
         beta=ELASTIC_BETA,
         sweep=ELASTIC_SWEEP,
+        hertz=ELASTIC_HERTZ,
     log:
         "results/logs/elastic_tables.log",
     script:
@@ -93,6 +117,7 @@ rule elastic_claims:
         beta="results/tables/elastic_beta.csv",
         sweep="results/tables/elastic_nu_sweep.csv",
         patch="results/tables/elastic_patch.csv",
+        hertz="results/tables/elastic_hertz.csv",
         src=PACKAGE_SOURCES,
     params:
         cfg=lambda wc: config["claims"],

@@ -10,5 +10,6 @@ import pandas as pd  # noqa: E402
 from infsup_contact.io import write_csv_atomic  # noqa: E402
 
 inp, out = snakemake.input, snakemake.output  # noqa: F821
-for files, target in ((inp.beta, out.beta), (inp.sweep, out.sweep)):
-    write_csv_atomic(target, pd.concat([read_table(p, "elastic_beta") for p in files], ignore_index=True))
+for files, target, kind in ((inp.beta, out.beta, "elastic_beta"), (inp.sweep, out.sweep, "elastic_beta"),
+                           (inp.hertz, out.hertz, "elastic_hertz")):
+    write_csv_atomic(target, pd.concat([read_table(p, kind) for p in files], ignore_index=True))

@@ -151,3 +151,40 @@ def patch_claims(patch: pd.DataFrame) -> pd.DataFrame:
                         + " at N2 = " + ", ".join(str(int(n)) for n in rc.N2)),
                        predicted="finding"))  # found after the run (the prediction said: end intervals only)
     return pd.DataFrame(out)
+
+
+def hertz_claims(hertz: pd.DataFrame) -> pd.DataFrame:
+    """Hertz-scene claims (:mod:`infsup_contact.study.hertz`): the modeling error against
+    plane-strain Hertz (max pressure) falls as the contact zone shrinks relative to the domain
+    (predicted); per case and k the fitted energy-error rate and the oscillation of λ_h
+    (findings: no prediction of their values was stated)."""
+    import numpy as np
+
+    out = []
+    mod = hertz[hertz.study == "modeling"].sort_values("d")
+    if len(mod) >= 2:
+        err = mod.p_max_rel_error.to_numpy(float)
+        a = (mod.hertz_a if "hertz_a" in mod else mod.half_width).to_numpy(float)
+        ok = bool(np.all(np.diff(err) > 0))
+        out.append(row("elastic-hertz-modeling-trend", REF,
+                       "Hertz scene: the max-pressure error against plane-strain Hertz (for the measured P) "
+                       "decreases as a/W decreases (finest mesh, T3, k=2)",
+                       (PASS if ok else FAIL, "p_max error " + ", ".join(f"{e:.3g}" for e in err)
+                        + " at a/W = " + ", ".join(f"{v:.3g}" for v in a))))
+    disc = hertz[hertz.study == "discretization"]
+    for (case, k), rc in disc.groupby(["case", "k"], sort=False):
+        rc = rc.sort_values("N")
+        if len(rc) < 2:
+            continue
+        slope = np.polyfit(np.log(1.0 / rc.N.to_numpy(float)), np.log(rc.energy_error.to_numpy(float)), 1)[0]
+        spec = SPACES.get(case)
+        tag = spec.tag if spec is not None else case
+        out.append(row(f"elastic-hertz-{tag}-k{k}", REF,
+                       f"Hertz scene, {case}, k={k}: energy error vs the fine-mesh solution converges "
+                       "(fitted slope > 0)",
+                       (PASS if slope > 0 else FAIL,
+                        f"energy slope {slope:.2f} over N = {', '.join(str(int(n)) for n in rc.N)}; "
+                        "oscillation " + ", ".join(f"{v:.3g}" for v in rc.oscillation)
+                        + "; p_max error " + ", ".join(f"{v:.3g}" for v in rc.p_max_rel_error)),
+                       predicted="finding"))
+    return pd.DataFrame(out)

@@ -4,6 +4,7 @@
     infsup-contact beta --model elastic --case T3 --k 2 --N1 16 --N2 16 --nu 0.3 --E1 1 --E2 1
     infsup-contact contact --scene manufactured --case T3 --k 2 --N1 16 --N2 16
     infsup-contact contact --model elastic --scene patch --case all --k 2 --N1 5 --N2 4
+    infsup-contact contact --model elastic --scene hertz --case T4 --k 2 --N1 32 --N2 32 --R 1 --d 0.05
     infsup-contact rates contact.csv
     infsup-contact bench --what beta --N 32 64 --k 2
     infsup-contact verdict --case T3 --k 2 --expect stable
@@ -164,9 +165,9 @@ def _add_contact(sub) -> None:
     from .discretization.registry import space_ids
 
     p = sub.add_parser("contact", help="solve (4.1) for one case and mesh pair (CSV: one row)")
-    p.add_argument("--scene", required=True, choices=["manufactured", "membranes", "patch"],
+    p.add_argument("--scene", required=True, choices=["manufactured", "membranes", "patch", "hertz"],
                    help="membranes model: manufactured, membranes; elastic model: patch (the contact "
-                   "patch test, study/patch.py)")
+                   "patch test, study/patch.py), hertz (study/hertz.py)")
     p.add_argument("--case", choices=[*space_ids(), "all"], help="a registered space, or all")
     p.add_argument("--space", metavar="FILE.py:FUNC", help=SPACE_HELP)
     p.add_argument("--k", type=int, required=True, help="displacement degree, 1..4")
@@ -178,6 +179,10 @@ def _add_contact(sub) -> None:
     _add_model(p)
     p.add_argument("--p", type=float, default=3.0, help="manufactured: λ = x (a − x)₊^p, p > 3/2")
     p.add_argument("--q", type=float, default=3.0, help="manufactured: g = (x − a)₊^q (1 − x), q > 3/2")
+    p.add_argument("--R", type=float, default=None, help="hertz: radius of the gap (x - 1/2)^2/(2R), "
+                   "0 < R <= 1e6 (default 1)")
+    p.add_argument("--d", type=float, default=None, help="hertz: indentation of Ω2's top, 0 < d < 0.5 "
+                   "(default 0.05)")
     p.add_argument("--n-ref", type=int, default=64,
                    help="membranes: reference mesh N (degree k + 1), at least 2 max(N1, N2)")
     _add_dry_run(p)
@@ -194,11 +199,19 @@ def _check_contact(args):
         raise InputError("case", "one of --case ID|all or --space FILE.py:FUNC")
     args.cases = _cases(args)
     _material(args)
-    elastic_scenes = ("patch",)
+    elastic_scenes = ("patch", "hertz")
     if (args.model == "elastic") != (args.scene in elastic_scenes):
         key, value = ("model", args.model) if args.model == "elastic" else ("scene", args.scene)
-        raise InputError(key, "--model elastic with --scene patch; --model membranes (the default) with "
-                         "--scene manufactured or membranes", got=value)
+        raise InputError(key, "--model elastic with --scene patch or hertz; --model membranes (the default) "
+                         "with --scene manufactured or membranes", got=value)
+    if args.scene != "hertz":
+        for key in ("R", "d"):
+            if getattr(args, key) is not None:
+                raise InputError(key, "only with --scene hertz", got=getattr(args, key))
+    else:
+        from .study.hertz import check_geometry
+
+        args.R, args.d = check_geometry(1.0 if args.R is None else args.R, 0.05 if args.d is None else args.d)
     if not 1 <= args.k <= 4:
         raise InputError("k", "an integer in 1..4", got=args.k)
     for case in args.cases:
@@ -209,9 +222,9 @@ def _check_contact(args):
     check_prestress("c2", args.c2)
     _exponent("p", args.p)  # used by the manufactured scene only, but a bad value is bad anyway
     _exponent("q", args.q)
-    if args.scene == "patch":  # structured blocks; its own estimate: the β one of the pair, both components
+    if args.scene in elastic_scenes:  # structured blocks; estimate: the β one of the pair, both components
         if args.family != "structured":
-            raise InputError("family", "structured (the patch test's blocks)", got=args.family)
+            raise InputError("family", "structured (the blocks of the elastic scenes)", got=args.family)
         est = resources.beta_estimate("structured", args.k, args.N1, args.N2, "omega2", ("L2",), components=2)
         _check_memory(est, *(("N1", args.N1) if args.N1 >= args.N2 else ("N2", args.N2)))
         return est
@@ -239,6 +252,13 @@ def _run_contact(args) -> None:
         from .study.patch import patch_rows
 
         rows = patch_rows(cases, [args.k], [(args.N1, args.N2)], args.nu, (args.c1, args.c2))
+        pd.DataFrame(rows).to_csv(sys.stdout, index=False, float_format="%.6g")
+        return
+    if args.scene == "hertz":
+        from .study.hertz import hertz_row
+
+        rows = [hertz_row(case, args.k, args.N1, args.N2, args.R, args.d, args.nu, (args.c1, args.c2))
+                for case in cases]
         pd.DataFrame(rows).to_csv(sys.stdout, index=False, float_format="%.6g")
         return
     params = dict(p=args.p, q=args.q) if args.scene == "manufactured" else {}

@@ -63,13 +63,43 @@ def hertz_pressure(x, P, R, nu, E):
     return p0 * np.sqrt(np.clip(1.0 - ((np.asarray(x) - CENTER) / a) ** 2, 0.0, None))
 
 
-def solve_hertz(case: str, k: int, n: int, R: float, d: float, nu: float = 0.3, E=(1.0, 1.0)):
-    """One Hertz solve on matching structured N×N blocks."""
+def check_geometry(R, d) -> tuple:
+    """(R, d) as floats: 0 < R <= 1e6, 0 < d < 1/2; :class:`InputError` naming the key."""
+    from ..errors import InputError
+
+    out = []
+    for key, value, ok, allowed in (("R", R, lambda v: 0 < v <= 1e6, "a finite radius in (0, 1e6]"),
+                                    ("d", d, lambda v: 0 < v < 0.5, "an indentation in (0, 0.5)")):
+        try:
+            v = float(value)
+        except (TypeError, ValueError):
+            raise InputError(key, allowed, got=value) from None
+        if isinstance(value, bool) or not ok(v):  # NaN fails too
+            raise InputError(key, allowed, got=value)
+        out.append(v)
+    return tuple(out)
+
+
+def solve_hertz(case: str, k: int, n: int, R: float, d: float, nu: float = 0.3, E=(1.0, 1.0), n2: int | None = None):
+    """One Hertz solve on structured blocks, N segments on Γ for Ω1 and ``n2`` (default N) for Ω2."""
     nu = check_nu(nu)
     E = tuple(check_modulus(e, key) for e, key in zip(E, ("E1", "E2")))
+    R, d = check_geometry(R, d)
     registry.check_case(case, k)
-    return solve_elastic_contact(patch_mesh(n, 1), patch_mesh(n, 2), case, k, nu, E, X_DIRICHLET, Y_DIRICHLET,
-                                 d, g0=lambda x: (x - CENTER) ** 2 / (2.0 * R), g0_degree=2)
+    return solve_elastic_contact(patch_mesh(n, 1), patch_mesh(n if n2 is None else n2, 2), case, k, nu, E,
+                                 X_DIRICHLET, Y_DIRICHLET, d, g0=lambda x: (x - CENTER) ** 2 / (2.0 * R), g0_degree=2)
+
+
+def hertz_row(case: str, k: int, n1: int, n2: int, R: float, d: float, nu: float = 0.3, E=(1.0, 1.0)) -> dict:
+    """One solve and its measures against plane-strain Hertz for the measured P (the CLI row)."""
+    t0 = time.perf_counter()
+    sol = solve_hertz(case, k, n1, R, d, nu, E, n2=n2)
+    m = profile_measures(sol)
+    a, p0 = hertz(m["P"], R, nu, E)
+    return dict(scene="hertz", case=case, k=k, family="structured", N1=n1, N2=n2, E1=E[0], E2=E[1], nu=nu, R=R,
+                d=d, dim_M=sol.space.dim, iterations=sol.pdas.iterations, nonunique=bool(sol.pdas.nonunique),
+                **m, hertz_a=a, hertz_p0=p0, p_max_rel_error_vs_hertz=abs(m["p_max"] - p0) / p0,
+                half_width_rel_error_vs_hertz=abs(m["half_width"] - a) / a, seconds=time.perf_counter() - t0)
 
 
 def sample_points(sol, per_interval: int = 24) -> np.ndarray:

@@ -389,6 +389,10 @@ def job_estimates(cfg):
             [("elastic.hertz.modeling_N", hz["modeling_N"], 2)]:
         yield key, f"elastic_hertz k={k} N={n}", R.beta_estimate("structured", k, n, n, "omega2", ("L2",),
                                                                  components=2)
+    for n in ec["bench_N"]:
+        for k in ec["bench_k"]:
+            yield "elastic.bench_N", f"elastic_bench k={k} N={n}", R.beta_estimate(
+                "structured", k, n, n, "omega2", ("H",), components=2)
     for n1, n2 in ec["patch_pairs"]:
         for k in ec["patch_k"]:
             yield "elastic.patch_pairs", f"elastic_patch k={k} {n1}x{n2}", R.beta_estimate(

@@ -95,6 +95,79 @@ ELASTIC_HERTZ = [f"results/tables/elastic/hertz_k{k}.csv" for k in config["elast
     "results/tables/elastic/hertz_modeling.csv"]
 
 
+# Figure data: λ_h on Γ, stable vs unstable, the Hertz scene's d and R on one mesh.
+ELASTIC_PROFILES = {"pairs": [["T4", 2], ["R5.4", 2], ["T3", 1], ["DUAL", 1]], "N": 16}
+
+
+rule elastic_hertz_profiles:
+    output:
+        "results/tables/elastic_hertz_profiles.csv",
+    input:
+        PACKAGE_SOURCES,
+    params:
+        ec=lambda wc: config["elastic"],
+        fig=ELASTIC_PROFILES,
+    threads: 1
+    log:
+        "results/logs/elastic/hertz_profiles.log",
+    script:
+        "../scripts/elastic_hertz_job.py"
+
+
+rule elastic_figure:
+    output:
+        pdf="results/figures/fig9_elastic.pdf",
+        png="results/figures/fig9_elastic.png",
+    input:
+        sweep="results/tables/elastic_nu_sweep.csv",
+        profiles="results/tables/elastic_hertz_profiles.csv",
+        style=PLOT_STYLE,
+    log:
+        "results/logs/figures/fig9_elastic.log",
+    script:
+        "../scripts/fig_elastic.py"
+
+
+rule elastic_paper:
+    output:
+        macros="results/paper/elastic_macros.tex",
+        beta="results/paper/elastic_beta_table.tex",
+        patch="results/paper/elastic_patch_table.tex",
+        hertz="results/paper/elastic_hertz_table.tex",
+    input:
+        beta="results/tables/elastic_beta.csv",
+        sweep="results/tables/elastic_nu_sweep.csv",
+        patch="results/tables/elastic_patch.csv",
+        hertz="results/tables/elastic_hertz.csv",
+        claims="results/tables/elastic_claims.csv",
+        speed="results/benchmarks/elastic_beta.csv",
+        tex="paper/elastic.tex",
+        src=REPORT_SOURCES,
+    log:
+        "results/logs/elastic_paper.log",
+    script:
+        "../scripts/elastic_paper.py"
+
+
+rule elastic_bench:
+    # speed of the elastic β_h vs the limit (one factorization per body + one eigh per case);
+    # the whole machine to itself locally (ratios are single-thread ratios)
+    output:
+        "results/benchmarks/elastic_beta.csv",
+    input:
+        PACKAGE_SOURCES,
+        BENCH_SOURCES,
+    params:
+        ec=lambda wc: config["elastic"],
+    threads: workflow.cores
+    benchmark:
+        "results/benchmarks/rules/elastic_bench.tsv"
+    log:
+        "results/logs/elastic_bench.log",
+    script:
+        "../scripts/elastic_bench.py"
+
+
 rule elastic_tables:
     output:
         beta="results/tables/elastic_beta.csv",

@@ -15,9 +15,15 @@ from infsup_contact.discretization.registry import REFERENCE_SPACE  # noqa: E402
 from infsup_contact.io import write_csv_atomic  # noqa: E402
 from infsup_contact.study.hertz import discretization_rows, modeling_rows  # noqa: E402
 
-ec, study = snakemake.params.ec, snakemake.wildcards.study  # noqa: F821
+ec = snakemake.params.ec  # noqa: F821
+study = snakemake.wildcards.get("study", "profiles")  # noqa: F821
 hz, E = ec["hertz"], tuple(ec["E"])
-if study == "modeling":
+if study == "profiles":
+    from infsup_contact.study.hertz import profile_rows
+
+    fig = snakemake.params.fig  # noqa: F821
+    rows = profile_rows([tuple(p) for p in fig["pairs"]], fig["N"], hz["R"], hz["d"], ec["nu"], E)
+elif study == "modeling":
     rows = modeling_rows(REFERENCE_SPACE, 2, hz["modeling_N"], hz["R"], hz["modeling_d"], ec["nu"], E)
 else:
     rows = discretization_rows(None, [int(study[1:])], hz["N"], hz["N_ref"], hz["R"], hz["d"], ec["nu"], E)

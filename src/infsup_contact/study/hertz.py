@@ -202,3 +202,18 @@ def modeling_rows(case: str, k: int, n: int, R: float, ds, nu=0.3, E=(1.0, 1.0))
                          half_width_rel_error=abs(m["half_width"] - a) / a, pressure_max_rel_error=float(lam_err),
                          oscillation=m["oscillation"]))
     return rows
+
+
+def profile_rows(pairs, n: int, R: float, d: float, nu=0.3, E=(1.0, 1.0), per_interval: int = 24) -> list:
+    """λ_h(x) on Γ for each (case, k) in ``pairs`` on the N×N blocks, and Hertz's p(x) for the
+    measured P of the first pair (the figure's data; ``quantity`` = lambda_h or hertz)."""
+    rows = []
+    for i, (case, k) in enumerate(pairs):
+        sol = solve_hertz(case, k, n, R, d, nu, E)
+        x = sample_points(sol, per_interval)
+        rows += [dict(case=case, k=k, N=n, R=R, d=d, quantity="lambda_h", x=xi, value=v)
+                 for xi, v in zip(x, sol.pressure(x))]
+        if i == 0:
+            rows += [dict(case="Hertz", k=0, N=n, R=R, d=d, quantity="hertz", x=xi, value=v)
+                     for xi, v in zip(x, hertz_pressure(x, sol.resultant(), R, nu, E))]
+    return rows

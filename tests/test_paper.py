@@ -392,6 +392,15 @@ def test_pdf_builds_and_shows_generated_numbers(tables, tmp_path):
         (gen / name).write_text(text)
     for name in FIGURES:
         (figs / f"{name}.pdf").write_bytes(placeholder_pdf(name))
+    # the elastic section (paper/elastic.tex) and its generated files, from small real tables
+    from _elastic_tables import small_elastic_tables
+
+    from infsup_contact.report.elastic import elastic_paper_files
+
+    for name, text in elastic_paper_files(**small_elastic_tables()).items():
+        (gen / name).write_text(text)
+    (figs / "fig9_elastic.pdf").write_bytes(placeholder_pdf("fig9_elastic"))
+    shutil.copy(ROOT / "paper" / "elastic.tex", build)
     shutil.copy(PAPER, build)
     shutil.copy(ROOT / "paper" / "references.bib", build)
     env = dict(os.environ, TEXINPUTS=f"{gen}:{figs}:", SOURCE_DATE_EPOCH="0", FORCE_SOURCE_DATE="1")

@@ -34,16 +34,27 @@ def bound_factor(nu: float) -> float:
     return 1.0 / np.sqrt(2.0 * mu + lam)
 
 
+def membranes_rows(family: str, k: int, pairs, E=(1.0, 1.0), cases=None, norms=("H",), **mesh_kwargs) -> dict:
+    """(N1, N2) → the membranes' β_h rows (c = E) on that pair: they do not depend on ν, so a
+    ν sweep computes them once."""
+    cases = registry.ids_valid_for(k) if cases is None else list(cases)
+    return {(n1, n2): beta_rows(family, k, n1, n2, cases, "omega2", E[0], E[1], norms, model=MEMBRANES,
+                                **mesh_kwargs) for n1, n2 in pairs}
+
+
 def elastic_beta_rows(family: str, k: int, pairs, nu: float = 0.3, E=(1.0, 1.0), cases=None,
-                      norms=("H",), **mesh_kwargs) -> pd.DataFrame:
+                      norms=("H",), membranes: dict | None = None, **mesh_kwargs) -> pd.DataFrame:
     """β_h of the elastic pair (and of the membranes, c = E) for each (N1, N2) in ``pairs``,
-    every case valid for k (default) and norm; G_h = trace of Ω2 (the paper's choice)."""
+    every case valid for k (default) and norm; G_h = trace of Ω2 (the paper's choice).
+    ``membranes``: the membranes' rows of :func:`membranes_rows` where already computed."""
     cases = registry.ids_valid_for(k) if cases is None else list(cases)
     model = elastic_model(nu)
+    if membranes is None:
+        membranes = membranes_rows(family, k, pairs, E, cases, norms, **mesh_kwargs)
     out = []
     for n1, n2 in pairs:
         el = beta_rows(family, k, n1, n2, cases, "omega2", E[0], E[1], norms, model=model, **mesh_kwargs)
-        mem = beta_rows(family, k, n1, n2, cases, "omega2", E[0], E[1], norms, model=MEMBRANES, **mesh_kwargs)
+        mem = membranes[n1, n2]
         for r, m in zip(el, mem):
             assert (r["case"], r["norm"]) == (m["case"], m["norm"])
             out.append(dict(r, model="elastic", E1=E[0], E2=E[1], nu=nu, beta_membranes=m["beta"],
@@ -54,5 +65,7 @@ def elastic_beta_rows(family: str, k: int, pairs, nu: float = 0.3, E=(1.0, 1.0),
 def nu_sweep_rows(k: int, ns, nus, family: str = "structured", cases=None) -> pd.DataFrame:
     """The ν → 1/2 sweep: matching meshes N1 = N2 = N for each N in ``ns``, each ν in ``nus``,
     H norm."""
-    frames = [elastic_beta_rows(family, k, [(n, n) for n in ns], nu, cases=cases) for nu in nus]
+    pairs = [(n, n) for n in ns]
+    mem = membranes_rows(family, k, pairs, cases=cases)
+    frames = [elastic_beta_rows(family, k, pairs, nu, cases=cases, membranes=mem) for nu in nus]
     return pd.concat(frames, ignore_index=True)

@@ -35,7 +35,8 @@ constant is transferred exactly by any mortar projection).
 1e-16..1e-12, no kernel) and for T3's failure, but T3's error is not confined to the end
 intervals: it is a boundary layer of a few intervals (error 1 in the end interval, 0.4–0.7
 in the rest of [0, 1/4] at every refinement) whose tail decays fast into the middle half
-(k = 1, 5:4: 0.75, 0.055, 0.0013, 0.00012 at N2 = 4, 16, 32, 64). With the ratios 5:4
+(k = 1, 5:4: 0.75, 0.055, 0.0013, 0.00012 at N2 = 4, 16, 32, 64 — an exploratory run outside
+the DAG; the DAG's pairs and the ledger claim ``elastic-patch-T3-layer-*`` record the trend). With the ratios 5:4
 and 7:3 nearly every interval of G_h holds an Ω1 node that is not one of its nodes, so seams
 are everywhere; the passing spaces show no error at any of them.
 """

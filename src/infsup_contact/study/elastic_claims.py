@@ -40,7 +40,7 @@ def _bound_check(frame: pd.DataFrame, rtol: float = 1e-8):
     margin = rows.beta - rows.beta_membranes * rows.bound_factor * (1 - rtol)
     ratio = rows.beta / rows.beta_membranes
     return (PASS if len(rows) and (margin >= 0).all() else FAIL), (
-        f"{len(rows)} rows without kernel; min β_el − β_mem/sqrt(2μ̂+λ̂) = {margin.min():.3g}; "
+        f"{len(rows)} rows without kernel; min β_el − β_mem/sqrt(2μ+λ) = {margin.min():.3g}; "
         f"β_el/β_mem in [{ratio.min():.3g}, {ratio.max():.3g}]")
 
 
@@ -57,8 +57,8 @@ def elastic_claims(beta: pd.DataFrame, sweep: pd.DataFrame, cfg: dict) -> pd.Dat
     both = pd.concat([beta, sweep], ignore_index=True)
     out = [row("elastic-kernel-as-membranes", REF, "plane strain: the kernel of B A⁻¹ Bᵀ has the membranes' "
                "dimension on every mesh pair, case, k and ν (b sees the normal traces only)", _kernel_check(both)),
-           row("elastic-bound", REF, "β_h(elastic) >= β_h(membranes, c = E) / sqrt(2μ̂ + λ̂) on every row "
-               "without kernel (v = (0, w))", _bound_check(both))]
+           row("elastic-bound", REF, "β_h(elastic) >= β_h(membranes, c = E) / sqrt(2μ + λ) (Lame parameters at E = 1) on every "
+               "row without kernel (v = (0, w))", _bound_check(both))]
     h = beta[beta.norm == "H"]
     matching, nonmatching = h[h.N1 == h.N2], h[h.N1 != h.N2]
     for fam, fb in matching.groupby("family", sort=False):

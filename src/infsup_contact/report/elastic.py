@@ -96,37 +96,44 @@ def elastic_macros_tex(macros: list[Macro]) -> str:
 
 
 def elastic_beta_table(beta: pd.DataFrame, sweep: pd.DataFrame) -> str:
-    """Rows (family, k, case): β_h on the coarsest and finest matching mesh, kernel dim, the
-    membranes' β_h on the finest, β_h on the finest 3:2 pair; then β_h of the ν sweep."""
+    """Rows (family, case), columns k: β_h on the finest matching mesh and on the finest
+    non-matching pair ("0 [d]": a d-dimensional kernel); then β_h of the ν sweep on the finest
+    structured mesh, rows (k, case), columns ν."""
     h = beta[beta.norm == "H"]
     m, nm = h[h.N1 == h.N2], h[h.N1 != h.N2]
-    n0, n1 = int(m.N2.min()), int(m.N2.max())
+    n1 = int(m.N2.max())
     pair = nm.sort_values("N2").iloc[-1] if len(nm) else None
-    head = [r"family & $k$ & case", f"$N={n0}$", f"$N={n1}$", "ker", rf"membr.\ $N={n1}$"]
+    ks = sorted(int(k) for k in set(h.k))
+    groups = [("matching", m[m.N2 == n1], rf"$N_1=N_2={n1}$")]
     if pair is not None:
-        head.append(rf"${int(pair.N1)}{{:}}{int(pair.N2)}$")
-    lines = [r"\begin{tabular}{lll" + "r" * (len(head) - 1) + "}", r"\toprule", " & ".join(head) + r" \\", r"\midrule"]
+        groups.append(("pair", nm[(nm.N1 == pair.N1) & (nm.N2 == pair.N2)],
+                       rf"$N_1{{:}}N_2={int(pair.N1)}{{:}}{int(pair.N2)}$"))
+    ncol = 2 + len(ks) * len(groups)
+
+    def cell(rows, fam, case, k):
+        r = rows[(rows.family == fam) & (rows.case == case) & (rows.k == k)]
+        if r.empty:
+            return "--"
+        r = r.iloc[0]
+        return fmt_fixed(r.beta, 4) if r.kernel_dim == 0 else f"0 [{int(r.kernel_dim)}]"
+
+    lines = [r"\begin{tabular}{ll" + "r" * (ncol - 2) + "}", r"\toprule",
+             " & & " + " & ".join(rf"\multicolumn{{{len(ks)}}}{{c}}{{{title}}}" for _, _, title in groups) + r" \\",
+             "family & case & " + " & ".join(rf"$k={k}$" for _ in groups for k in ks) + r" \\", r"\midrule"]
     for fam in [f for f in ("structured", "perturbed", "unstructured") if f in set(m.family)]:
-        for k in sorted(set(m[m.family == fam].k)):
-            g = m[(m.family == fam) & (m.k == k)]
-            for case in case_order(g.case.unique()):
-                r = g[g.case == case].set_index("N2")
-                cells = [fmt_fixed(r.beta[n0], 4), fmt_fixed(r.beta[n1], 4), fmt_int(r.kernel_dim[n1]),
-                         fmt_fixed(r.beta_membranes[n1], 4)]
-                if pair is not None:
-                    q = nm[(nm.family == fam) & (nm.k == k) & (nm.case == case) & (nm.N1 == pair.N1) & (nm.N2 == pair.N2)]
-                    cells.append(fmt_fixed(q.beta.iloc[0], 4) if len(q) else "--")
-                lines.append(f"{fam[:5]}. & {k} & {latex_escape(case)} & " + " & ".join(cells) + r" \\")
+        for case in case_order(m[m.family == fam].case.unique()):
+            lines.append(f"{fam[:6]}. & {latex_escape(case)} & "
+                         + " & ".join(cell(rows, fam, case, k) for _, rows, _ in groups for k in ks) + r" \\")
     fin = sweep[sweep.N2 == sweep.N2.max()]
     nus = sorted(set(fin.nu))
-    lines += [r"\midrule", rf"\multicolumn{{{len(head) + 2}}}{{l}}{{$\nu \to 1/2$, structured, $N={int(fin.N2.max())}$: "
-              + ", ".join(rf"$\nu={v:g}$" for v in nus) + r"} \\", r"\midrule"]
+    lines += [r"\midrule", rf"\multicolumn{{{ncol}}}{{l}}{{$\nu \to 1/2$, structured, $N={int(fin.N2.max())}$; "
+              r"columns: " + ", ".join(rf"$\nu={v:g}$" for v in nus) + r"} \\", r"\midrule"]
     for k in sorted(set(fin.k)):
         for case in case_order(fin[fin.k == k].case.unique()):
             r = fin[(fin.k == k) & (fin.case == case)].set_index("nu")
-            cells = [fmt_fixed(r.beta[v], 4) for v in nus]
-            lines.append(rf"\multicolumn{{3}}{{l}}{{$k={k}$, {latex_escape(case)}}} & "
-                         + " & ".join(cells) + " & " * max(len(head) - 1 - len(nus), 0) + r" \\")
+            cells = [fmt_fixed(r.beta[v], 4) if r.kernel_dim[v] == 0 else f"0 [{int(r.kernel_dim[v])}]" for v in nus]
+            cells += [""] * max(ncol - 2 - len(nus), 0)
+            lines.append(rf"$k={k}$ & {latex_escape(case)} & " + " & ".join(cells) + r" \\")
     lines += [r"\bottomrule", r"\end{tabular}", ""]
     return "\n".join(lines)
 

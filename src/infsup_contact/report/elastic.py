@@ -108,7 +108,10 @@ def elastic_beta_table(beta: pd.DataFrame, sweep: pd.DataFrame) -> str:
     if pair is not None:
         groups.append(("pair", nm[(nm.N1 == pair.N1) & (nm.N2 == pair.N2)],
                        rf"$N_1{{:}}N_2={int(pair.N1)}{{:}}{int(pair.N2)}$"))
-    ncol = 2 + len(ks) * len(groups)
+    fin = sweep[sweep.N2 == sweep.N2.max()]
+    nus = sorted(set(fin.nu))
+    ncol = 2 + max(len(ks) * len(groups), len(nus))
+    pad = [""] * (ncol - 2 - len(ks) * len(groups))
 
     def cell(rows, fam, case, k):
         r = rows[(rows.family == fam) & (rows.case == case) & (rows.k == k)]
@@ -118,14 +121,13 @@ def elastic_beta_table(beta: pd.DataFrame, sweep: pd.DataFrame) -> str:
         return fmt_fixed(r.beta, 4) if r.kernel_dim == 0 else f"0 [{int(r.kernel_dim)}]"
 
     lines = [r"\begin{tabular}{ll" + "r" * (ncol - 2) + "}", r"\toprule",
-             " & & " + " & ".join(rf"\multicolumn{{{len(ks)}}}{{c}}{{{title}}}" for _, _, title in groups) + r" \\",
-             "family & case & " + " & ".join(rf"$k={k}$" for _ in groups for k in ks) + r" \\", r"\midrule"]
+             " & & " + " & ".join([rf"\multicolumn{{{len(ks)}}}{{c}}{{{title}}}" for _, _, title in groups] + pad)
+             + r" \\",
+             "family & case & " + " & ".join([rf"$k={k}$" for _ in groups for k in ks] + pad) + r" \\", r"\midrule"]
     for fam in [f for f in ("structured", "perturbed", "unstructured") if f in set(m.family)]:
         for case in case_order(m[m.family == fam].case.unique()):
             lines.append(f"{fam[:6]}. & {latex_escape(case)} & "
-                         + " & ".join(cell(rows, fam, case, k) for _, rows, _ in groups for k in ks) + r" \\")
-    fin = sweep[sweep.N2 == sweep.N2.max()]
-    nus = sorted(set(fin.nu))
+                         + " & ".join([cell(rows, fam, case, k) for _, rows, _ in groups for k in ks] + pad) + r" \\")
     lines += [r"\midrule", rf"\multicolumn{{{ncol}}}{{l}}{{$\nu \to 1/2$, structured, $N={int(fin.N2.max())}$; "
               r"columns: " + ", ".join(rf"$\nu={v:g}$" for v in nus) + r"} \\", r"\midrule"]
     for k in sorted(set(fin.k)):

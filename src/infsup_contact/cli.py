@@ -1,7 +1,10 @@
 """Command line: one computation, CSV on stdout.
 
     infsup-contact beta --case all --k 2 --family structured --N1 16 --N2 16
+    infsup-contact beta --model elastic --case T3 --k 2 --N1 16 --N2 16 --nu 0.3 --E1 1 --E2 1
     infsup-contact contact --scene manufactured --case T3 --k 2 --N1 16 --N2 16
+    infsup-contact contact --model elastic --scene patch --case all --k 2 --N1 5 --N2 4
+    infsup-contact contact --model elastic --scene hertz --case T4 --k 2 --N1 32 --N2 32 --R 1 --d 0.05
     infsup-contact rates contact.csv
     infsup-contact bench --what beta --N 32 64 --k 2
     infsup-contact verdict --case T3 --k 2 --expect stable
@@ -76,8 +79,9 @@ def _add_beta(sub) -> None:
     p.add_argument("--N1", type=int, required=True, help="segments on Γ of the Ω1 mesh (>= 1)")
     p.add_argument("--N2", type=int, required=True, help="segments on Γ of the Ω2 mesh (>= 1)")
     p.add_argument("--multiplier-mesh", default="omega2", choices=["omega2", "omega1", "union"])
-    p.add_argument("--c1", type=float, default=1.0)
-    p.add_argument("--c2", type=float, default=1.0)
+    p.add_argument("--c1", type=float, default=None, help="membranes: prestress c1 (default 1)")
+    p.add_argument("--c2", type=float, default=None, help="membranes: prestress c2 (default 1)")
+    _add_model(p)
     p.add_argument("--norm", default="all", choices=["H", "L2", "all"])
     p.add_argument("--h-route", default="logkernel", choices=["logkernel", "series"],
                    help="H^{-1/2}_00 Gram: closed-form log kernel or truncated sine series")
@@ -85,6 +89,43 @@ def _add_beta(sub) -> None:
     p.add_argument("--alpha", type=float, default=0.2, help="perturbation amplitude / h, in [0, 0.5)")
     _add_dry_run(p)
     p.set_defaults(run=_run_beta, check=_check_beta)
+
+
+def _add_model(p) -> None:
+    p.add_argument("--model", default="membranes", choices=["membranes", "elastic"],
+                   help="membranes (the paper's Section 3, default) or elastic (plane strain, "
+                   "vector P_k, frictionless normal contact; material scale c_i = E_i)")
+    p.add_argument("--nu", type=float, default=None,
+                   help="elastic: Poisson ratio of both bodies, -1 < nu < 0.5 (default 0.3)")
+    p.add_argument("--E1", type=float, default=None, help="elastic: Young's modulus of Ω1 (default 1)")
+    p.add_argument("--E2", type=float, default=None, help="elastic: Young's modulus of Ω2 (default 1)")
+
+
+def _material(args):
+    """Resolve --model/--nu/--E1/--E2/--c1/--c2: sets ``args.model_obj``, ``args.c1``,
+    ``args.c2`` (c_i = E_i for elastic). The membranes take --c1 --c2 only, the elastic
+    bodies --nu --E1 --E2 only: the other model's flags are refused, naming the flag."""
+    from .models import MODELS
+    from .models.elastic import check_modulus, check_nu, elastic_model
+
+    if args.model == "membranes":
+        for key in ("nu", "E1", "E2"):
+            if getattr(args, key) is not None:
+                raise InputError(key, "only with --model elastic (the membranes take --c1 --c2)",
+                                 got=getattr(args, key))
+        args.c1 = 1.0 if args.c1 is None else args.c1
+        args.c2 = 1.0 if args.c2 is None else args.c2
+        args.model_obj = MODELS["membranes"]
+        return
+    for key in ("c1", "c2"):
+        if getattr(args, key) is not None:
+            raise InputError(key, "only with --model membranes (an elastic body's scale is --E1/--E2)",
+                             got=getattr(args, key))
+    nu = check_nu(0.3 if args.nu is None else args.nu, "nu")
+    args.c1 = check_modulus(1.0 if args.E1 is None else args.E1, "E1")
+    args.c2 = check_modulus(1.0 if args.E2 is None else args.E2, "E2")
+    args.nu = nu
+    args.model_obj = elastic_model(nu)
 
 
 def _norms(args) -> tuple:
@@ -97,11 +138,13 @@ def _check_beta(args):
     from .solvers.infsup import check_inputs
 
     args.cases = _cases(args)
+    _material(args)
     check_inputs([c for c in args.cases if isinstance(c, str)], args.k, args.family, args.N1, args.N2,
                  args.c1, args.c2, _norms(args), args.multiplier_mesh)
     check_perturbation(args.alpha, args.seed)
     est = resources.beta_estimate(args.family, args.k, args.N1, args.N2, args.multiplier_mesh,
-                                  _norms(args), args.h_route)
+                                  _norms(args), args.h_route,
+                                  components=2 if args.model == "elastic" else 1)
     _check_memory(est, *(("N1", args.N1) if args.N1 >= args.N2 else ("N2", args.N2)))
     return est
 
@@ -115,8 +158,13 @@ def _run_beta(args) -> None:
     if args.family == "perturbed":
         kwargs = dict(seed=args.seed, alpha=args.alpha)
     rows = beta_rows(args.family, args.k, args.N1, args.N2, args.cases, args.multiplier_mesh,
-                     args.c1, args.c2, _norms(args), h_route=args.h_route, **kwargs)
-    pd.DataFrame(rows).to_csv(sys.stdout, index=False, float_format="%.12g")
+                     args.c1, args.c2, _norms(args), h_route=args.h_route, model=args.model_obj, **kwargs)
+    frame = pd.DataFrame(rows)
+    if args.model == "elastic":  # c_i = E_i: the columns under their elastic names, and ν
+        frame = frame.rename(columns={"c1": "E1", "c2": "E2"})
+        frame.insert(frame.columns.get_loc("E2") + 1, "nu", args.nu)
+        frame.insert(0, "model", "elastic")
+    frame.to_csv(sys.stdout, index=False, float_format="%.12g")
 
 
 def _add_contact(sub) -> None:
@@ -124,17 +172,24 @@ def _add_contact(sub) -> None:
     from .discretization.registry import space_ids
 
     p = sub.add_parser("contact", help="solve (4.1) for one case and mesh pair (CSV: one row)")
-    p.add_argument("--scene", required=True, choices=["manufactured", "membranes"])
+    p.add_argument("--scene", required=True, choices=["manufactured", "membranes", "patch", "hertz"],
+                   help="membranes model: manufactured, membranes; elastic model: patch (the contact "
+                   "patch test, study/patch.py), hertz (study/hertz.py)")
     p.add_argument("--case", choices=[*space_ids(), "all"], help="a registered space, or all")
     p.add_argument("--space", metavar="FILE.py:FUNC", help=SPACE_HELP)
     p.add_argument("--k", type=int, required=True, help="displacement degree, 1..4")
     p.add_argument("--family", default="structured", choices=FAMILIES)
     p.add_argument("--N1", type=int, required=True)
     p.add_argument("--N2", type=int, required=True)
-    p.add_argument("--c1", type=float, default=1.0)
-    p.add_argument("--c2", type=float, default=1.0)
+    p.add_argument("--c1", type=float, default=None, help="membranes: prestress c1 (default 1)")
+    p.add_argument("--c2", type=float, default=None, help="membranes: prestress c2 (default 1)")
+    _add_model(p)
     p.add_argument("--p", type=float, default=3.0, help="manufactured: λ = x (a − x)₊^p, p > 3/2")
     p.add_argument("--q", type=float, default=3.0, help="manufactured: g = (x − a)₊^q (1 − x), q > 3/2")
+    p.add_argument("--R", type=float, default=None, help="hertz: radius of the gap (x - 1/2)^2/(2R), "
+                   "0 < R <= 1e6 (default 1)")
+    p.add_argument("--d", type=float, default=None, help="hertz: indentation of Ω2's top, 0 < d < 0.5 "
+                   "(default 0.05)")
     p.add_argument("--n-ref", type=int, default=64,
                    help="membranes: reference mesh N (degree k + 1), at least 2 max(N1, N2)")
     _add_dry_run(p)
@@ -150,6 +205,20 @@ def _check_contact(args):
     if args.case is None and args.space is None:
         raise InputError("case", "one of --case ID|all or --space FILE.py:FUNC")
     args.cases = _cases(args)
+    _material(args)
+    elastic_scenes = ("patch", "hertz")
+    if (args.model == "elastic") != (args.scene in elastic_scenes):
+        key, value = ("model", args.model) if args.model == "elastic" else ("scene", args.scene)
+        raise InputError(key, "--model elastic with --scene patch or hertz; --model membranes (the default) "
+                         "with --scene manufactured or membranes", got=value)
+    if args.scene != "hertz":
+        for key in ("R", "d"):
+            if getattr(args, key) is not None:
+                raise InputError(key, "only with --scene hertz", got=getattr(args, key))
+    else:
+        from .study.hertz import check_geometry
+
+        args.R, args.d = check_geometry(1.0 if args.R is None else args.R, 0.05 if args.d is None else args.d)
     if not 1 <= args.k <= 4:
         raise InputError("k", "an integer in 1..4", got=args.k)
     for case in args.cases:
@@ -160,6 +229,12 @@ def _check_contact(args):
     check_prestress("c2", args.c2)
     _exponent("p", args.p)  # used by the manufactured scene only, but a bad value is bad anyway
     _exponent("q", args.q)
+    if args.scene in elastic_scenes:  # structured blocks; estimate: the β one of the pair, both components
+        if args.family != "structured":
+            raise InputError("family", "structured (the blocks of the elastic scenes)", got=args.family)
+        est = resources.beta_estimate("structured", args.k, args.N1, args.N2, "omega2", ("L2",), components=2)
+        _check_memory(est, *(("N1", args.N1) if args.N1 >= args.N2 else ("N2", args.N2)))
+        return est
     need = REFERENCE_MARGIN * max(args.N1, args.N2)
     if args.n_ref < 1 or (args.scene == "membranes" and args.n_ref < need):
         raise InputError("n_ref", f"an integer >= {need} for the membranes scene ({REFERENCE_MARGIN}x the finest "
@@ -180,6 +255,19 @@ def _run_contact(args) -> None:
     from .study.contact_rows import contact_row
 
     cases = args.cases
+    if args.scene == "patch":
+        from .study.patch import patch_rows
+
+        rows = patch_rows(cases, [args.k], [(args.N1, args.N2)], args.nu, (args.c1, args.c2))
+        pd.DataFrame(rows).to_csv(sys.stdout, index=False, float_format="%.6g")
+        return
+    if args.scene == "hertz":
+        from .study.hertz import hertz_row
+
+        rows = [hertz_row(case, args.k, args.N1, args.N2, args.R, args.d, args.nu, (args.c1, args.c2))
+                for case in cases]
+        pd.DataFrame(rows).to_csv(sys.stdout, index=False, float_format="%.6g")
+        return
     params = dict(p=args.p, q=args.q) if args.scene == "manufactured" else {}
     ref = None
     rows = []

@@ -293,6 +293,25 @@ def check_speed_accuracy_scene(cfg) -> None:
                           got=name, allowed="one of " + ", ".join(allowed))
 
 
+def check_elastic_nonmatching(cfg) -> None:
+    """An elastic non-matching pair (β_h table, patch test) has N1 ≠ N2."""
+    for key in ("nonmatching", "patch_pairs"):
+        for i, pair in enumerate(cfg["elastic"][key]):
+            if pair[0] == pair[1]:
+                raise ConfigError(f"elastic.{key}[{i}]", "a non-matching pair needs N1 != N2", got=pair,
+                                  allowed="[N1, N2] with N1 != N2 (matching meshes go under elastic.N)")
+
+
+def check_hertz_reference(cfg) -> None:
+    """elastic.hertz.N_ref >= REFERENCE_MARGIN × the largest elastic.hertz.N (as the membranes)."""
+    hz = cfg["elastic"]["hertz"]
+    need = REFERENCE_MARGIN * max(hz["N"])
+    if hz["N_ref"] < need:
+        raise ConfigError("elastic.hertz.N_ref", f"the Hertz reference must be {REFERENCE_MARGIN}x finer than the "
+                          f"finest mesh it measures (N up to {max(hz['N'])})", got=hz["N_ref"],
+                          allowed=f"N_ref >= {need}")
+
+
 CROSS_KEY_RULES = {
     # rule: the keys it relates (the error names the first; a change to any of them can trip it)
     check_cases: ("infsup.cases", "contact.cases", "spaces"),
@@ -301,6 +320,8 @@ CROSS_KEY_RULES = {
     check_nonmatching: ("infsup.nonmatching",),
     check_membranes_parameters: ("contact.scenes",),
     check_speed_accuracy_scene: ("benchmarks.speed_accuracy_scene", "contact.scenes"),
+    check_elastic_nonmatching: ("elastic.nonmatching", "elastic.patch_pairs"),
+    check_hertz_reference: ("elastic.hertz.N_ref", "elastic.hertz.N"),
 }
 """The rules a schema cannot state, with the keys each relates; each raises a
 :class:`ConfigError` naming one of them."""
@@ -367,6 +388,26 @@ def job_estimates(cfg):
                     yield key, f"contact_job {s} {f} k={k} N={n}", est
     for n in cfg["claims"]["rem55_N"]:
         yield "claims.rem55_N", f"claims_extra N={n}", R.beta_estimate("structured", 3, n, n, norms=("H",))
+    ec = cfg["elastic"]  # one job per (family, k): its largest pair; membranes alongside (smaller)
+    for n1, n2 in [(n, n) for n in ec["N"]] + [tuple(p) for p in ec["nonmatching"]]:
+        key = "elastic.N" if n1 == n2 else "elastic.nonmatching"
+        for f in ec["families"]:
+            for k in sorted(set(ec["k"]) | set(ec["nu_sweep_k"])):
+                yield key, f"elastic_beta_job {f} k={k} {n1}x{n2}", R.beta_estimate(
+                    f, k, n1, n2, "omega2", ("H",), components=2)
+    hz = ec["hertz"]
+    for key, n, k in [("elastic.hertz.N_ref", hz["N_ref"], k + 1) for k in hz["k"]] + \
+            [("elastic.hertz.modeling_N", hz["modeling_N"], 2)]:
+        yield key, f"elastic_hertz k={k} N={n}", R.beta_estimate("structured", k, n, n, "omega2", ("L2",),
+                                                                 components=2)
+    for n in ec["bench_N"]:
+        for k in ec["bench_k"]:
+            yield "elastic.bench_N", f"elastic_bench k={k} N={n}", R.beta_estimate(
+                "structured", k, n, n, "omega2", ("H",), components=2)
+    for n1, n2 in ec["patch_pairs"]:
+        for k in ec["patch_k"]:
+            yield "elastic.patch_pairs", f"elastic_patch k={k} {n1}x{n2}", R.beta_estimate(
+                "structured", k, n1, n2, "omega2", ("L2",), components=2)
     for what in ("beta", "contact"):
         yield (f"benchmarks.{what}_N", f"bench_{what}", R.bench_estimate(
             what, bc[f"{what}_N"], bc[f"{what}_k"], bc["repeats"], bc.get("eigsh_max_N")))

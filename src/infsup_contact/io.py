@@ -63,6 +63,14 @@ TABLE_COLUMNS = {
     "speed_accuracy": ("scene", "case", "k", "family", "N", "seconds", "energy_error",
                        "lambda_hm12_error", "ndof", "dim_M", "pareto_energy", "pareto_lambda"),
     "bench": ("what", "route", "k", "N", "seconds_median", "seconds_min", "seconds_max", "ratio_to_ours"),
+    # elastic stage (study/elastic_beta.py)
+    "elastic_beta": ("model", "case", "k", "family", "N1", "N2", "E1", "E2", "nu", "norm", "beta", "kernel_dim",
+                     "structural_kernel_dim", "smallest_nonzero", "beta_membranes", "kernel_dim_membranes",
+                     "bound_factor"),
+    "elastic_patch": ("case", "k", "N1", "N2", "p", "kernel_dim", "lambda_max_rel_error", "lambda_end_rel_error",
+                      "lambda_middle_rel_error", "u_max_rel_error", "passes"),
+    "elastic_hertz": ("study", "case", "k", "N", "d", "P", "p_max", "half_width", "oscillation",
+                      "p_max_rel_error", "half_width_rel_error"),
 }
 """Required columns per table kind (:func:`read_table`)."""
 

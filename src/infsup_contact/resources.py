@@ -117,11 +117,14 @@ def _multiplier_intervals(multiplier_mesh: str, n1: int, n2: int) -> float:
 
 
 def beta_estimate(family: str, k: int, n1: int, n2: int, multiplier_mesh="omega2",
-                  norms=("H", "L2"), h_route: str = "logkernel", process: bool = True) -> Estimate:
+                  norms=("H", "L2"), h_route: str = "logkernel", process: bool = True,
+                  components: int = 1) -> Estimate:
     """One ``beta_rows`` call: both sides kept, then every multiplier space in turn (the
-    largest degree s ≤ k counts: a space of degree s has at most N(s + 1) functions)."""
+    largest degree s ≤ k counts: a space of degree s has at most N(s + 1) functions).
+    ``components``: displacement components per node (2 for the elastic model: the side
+    volume is that of ``components`` × the dofs; not separately measured)."""
     mms = [multiplier_mesh] if isinstance(multiplier_mesh, str) else list(multiplier_mesh)
-    nds = [side_dofs(family, n, k) for n in (n1, n2)]
+    nds = [components * side_dofs(family, n, k) for n in (n1, n2)]
     volume = sum(_side_bytes(nd, "beta") for nd in nds)
     dense = max(_dense_bytes(k, (n1, n2), _multiplier_intervals(mm, n1, n2), k, norms, h_route)
                 for mm in mms)

@@ -25,6 +25,7 @@ rule claims:
         beta="results/tables/beta.csv",
         rates="results/tables/rates.csv",
         extra="results/tables/claims_extra.csv",
+        elastic="results/tables/elastic_claims.csv",  # the elastic stage's claims (rules/elastic.smk)
         src=PACKAGE_SOURCES,
     params:
         cfg=lambda wc: config["claims"],

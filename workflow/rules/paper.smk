@@ -44,6 +44,9 @@ rule paper_pdf:
         bib="paper/references.bib",
         generated=rules.paper_macros.output,
         figures=PAPER_FIGURES,
+        elastic_tex="paper/elastic.tex",  # the elastic section (rules/elastic.smk)
+        elastic=rules.elastic_paper.output,
+        elastic_figure="results/figures/fig9_elastic.pdf",
     benchmark:
         "results/benchmarks/rules/paper_pdf.tsv"
     log:
@@ -58,7 +61,7 @@ rule paper_pdf:
         bash workflow/scripts/ensure_tex.sh
         root=$PWD
         rm -rf {params.build} && mkdir -p {params.build}
-        cp {input.tex} {input.bib} {params.build}/
+        cp {input.tex} {input.bib} {input.elastic_tex} {params.build}/
         cd {params.build}
         export TEXINPUTS="$root/results/paper:$root/results/figures:" SOURCE_DATE_EPOCH=0 FORCE_SOURCE_DATE=1
         if ! latexmk -pdf -interaction=nonstopmode -halt-on-error -file-line-error paper.tex > "$root/{log}" 2>&1; then

@@ -13,5 +13,9 @@ from infsup_contact.io import write_csv_atomic  # noqa: E402
 inp = snakemake.input  # noqa: F821
 table = ledger(read_table(inp.beta, "beta"), read_table(inp.rates, "rates"), read_table(inp.extra, "claims"),
                snakemake.params.cfg)  # noqa: F821
+# the elastic stage's claims (rules/elastic.smk) follow the membranes' ones
+import pandas as pd  # noqa: E402
+
+table = pd.concat([table, read_table(inp.elastic, "claims")], ignore_index=True)
 write_csv_atomic(snakemake.output[0], table)  # noqa: F821
 print(table[["claim_id", "verdict", "predicted"]].to_string(), file=sys.stderr)

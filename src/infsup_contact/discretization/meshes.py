@@ -99,7 +99,8 @@ def mesh_from_arrays(points, triangles, segments) -> ngsolve.Mesh:
     ngmesh.AddPoints(np.column_stack([points, np.zeros(len(points))]).astype(float))
     omega = ngmesh.AddRegion("omega", dim=2)
     ngmesh.AddElements(dim=2, index=omega, data=np.asarray(triangles, dtype=np.int32), base=0)
-    for name in (GAMMA, DIRICHLET):
+    extra = sorted({label for _, _, label in segments} - {GAMMA, DIRICHLET})  # e.g. the patch test's sides
+    for name in (GAMMA, DIRICHLET, *extra):
         edges = np.array([(a, b) for a, b, label in segments if label == name], dtype=np.int32)
         ngmesh.AddElements(dim=1, index=ngmesh.AddRegion(name, dim=1), data=edges, base=0)
     return ngsolve.Mesh(ngmesh)

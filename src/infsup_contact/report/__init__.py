@@ -2,13 +2,13 @@
 
 ``style`` (one colour and marker per space, from the registry), ``texnames`` / ``texformat``
 (macro names, number formatting, escaping), ``macros`` and ``tables`` (generated LaTeX),
-``paper`` (the generated files and the check of ``paper.tex``). Reads tables only; imports
+``paper`` (the generated files and the check of ``paper.tex``), ``elastic`` (the elastic section's). Reads tables only; imports
 ``discretization`` (the registry) and nothing that computes.
 """
 from .macros import all_macros, macros_tex, speed_macros
-from .paper import GENERATED_FILES, check_paper, defined_macros, paper_files, used_generated_macros, used_inputs
+from .paper import GENERATED_FILES, SOURCE_INPUTS, check_paper, defined_macros, paper_files, used_generated_macros, used_inputs
 from .tables import fastest_for_targets, front_table, front_winner, speed_rows, speed_table
 from .texformat import MEASURES, SPEED_COLUMNS, PaperTexError, fmt_fixed, latex_escape, parse_number
 from .texnames import Macro, is_generated_name, macro_name, number_word, token
 
-__all__ = ["all_macros", "macros_tex", "speed_macros", "GENERATED_FILES", "check_paper", "defined_macros", "paper_files", "used_generated_macros", "used_inputs", "fastest_for_targets", "front_table", "front_winner", "speed_rows", "speed_table", "MEASURES", "SPEED_COLUMNS", "PaperTexError", "fmt_fixed", "latex_escape", "parse_number", "Macro", "is_generated_name", "macro_name", "number_word", "token"]
+__all__ = ["all_macros", "macros_tex", "speed_macros", "GENERATED_FILES", "SOURCE_INPUTS", "check_paper", "defined_macros", "paper_files", "used_generated_macros", "used_inputs", "fastest_for_targets", "front_table", "front_winner", "speed_rows", "speed_table", "MEASURES", "SPEED_COLUMNS", "PaperTexError", "fmt_fixed", "latex_escape", "parse_number", "Macro", "is_generated_name", "macro_name", "number_word", "token"]

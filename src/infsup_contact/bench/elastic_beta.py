@@ -1,0 +1,85 @@
+"""Speed of the elastic β_h (issue 12, item 6): the Γ-reduced route against the same limit as
+for the membranes (:mod:`infsup_contact.bench.beta_routes`) — one sparse factorization per
+body (SuperLU's best order, symmetric mode) + one dense generalized ``eigh`` of multiplier
+size per case, the interface operators and Gram matrices given. Every registered space
+valid for k, H norm, the structured N × N pair, ν = 0.3.
+
+Routes (``includes`` column):
+
+``ours``
+    End to end, ``beta_rows(..., model=elastic)``: meshes, NGSolve assembly of the vector
+    stiffness, one Γ-last factorization per body + Schur complement of the normal Γ dofs,
+    per case couplings, interface operator, Gram, ``eigh`` (and β with v1 = 0).
+``ours_core``
+    Given the assembled stiffness (free dofs ordered interior, Γ tangential, Γ normal):
+    factorization + Schur complement per body, couplings, interface operator, Gram and one
+    ``eigh`` per case.
+``limit``
+    One ``splu`` of each body's stiffness + one ``eigh`` per case on precomputed operators.
+"""
+from __future__ import annotations
+
+import numpy as np
+import scipy.linalg as sla
+import scipy.sparse.linalg as spla
+
+from ..discretization import meshes, registry
+from ..discretization.coupling import coupling_matrix
+from ..discretization.norms import gram
+from ..models.elastic import elastic_model
+from ..models.schur import factorized_side, interface_operator
+from ..solvers.infsup import beta_rows
+from .harness import _row, run_interleaved
+
+INCLUDES = {"ours": "meshes, assembly, factorization + Schur per body, couplings, interface operator, Gram, eigh "
+                    "(+ β with v1 = 0), every case",
+            "ours_core": "factorization + Schur per body, couplings, interface operator, Gram, eigh, every case",
+            "limit": "one splu per body (MMD_AT_PLUS_A) + one eigh per case on given operators"}
+
+
+def bench_elastic_beta(ns, ks, repeats: int = 3, nu: float = 0.3) -> list:
+    """Rows ``what, route, k, N, seconds_median, …, ratio_to_ours, ratio_to_limit, max_abs_diff``."""
+    model = elastic_model(nu)
+    rows = []
+    for k in ks:
+        cases = registry.ids_valid_for(k)
+        for n in ns:
+            m1, m2 = meshes.mesh_pair("structured", n, n)
+            sides = [model.side_operator(m, k) for m in (m1, m2)]
+            x = meshes.multiplier_breakpoints(m1, m2)
+            spaces = {c: registry.case_space(c, k, x) for c in cases}
+            ops = {}
+            for c in cases:
+                S = interface_operator([coupling_matrix(s.trace, spaces[c], k) for s in sides], sides)
+                ops[c] = (S, gram(spaces[c], "H")[0])
+
+            def ours():
+                return {r["case"]: r["beta"] for r in beta_rows("structured", k, n, n, cases, norms=("H",),
+                                                                model=model)}
+
+            def core():
+                fs = [factorized_side(s.trace, s.free, s.stiffness) for s in sides]
+                out = {}
+                for c in cases:
+                    S = interface_operator([coupling_matrix(s.trace, spaces[c], k) for s in fs], fs)
+                    out[c] = float(np.sqrt(max(sla.eigh(S, gram(spaces[c], "H")[0], eigvals_only=True,
+                                                        check_finite=False)[0], 0.0)))
+                return out
+
+            def limit():
+                for s in sides:
+                    spla.splu(s.stiffness, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
+                              options=dict(SymmetricMode=True))
+                return {c: float(np.sqrt(max(sla.eigh(S, G, eigvals_only=True, check_finite=False)[0], 0.0)))
+                        for c, (S, G) in ops.items()}
+
+            res = run_interleaved({"ours": ours, "ours_core": core, "limit": limit}, repeats)
+            ref = res["ours"][0]
+            t_ours, t_limit = np.median(res["ours"][1]), np.median(res["limit"][1])
+            for name in ("ours", "ours_core", "limit"):
+                got = res[name][0]
+                diff = max(abs(got[c] - ref[c]) for c in cases)
+                rows.append(_row("elastic_beta", name, k, n, res[name][1], t_ours, t_limit, other="ratio_to_limit",
+                                 max_abs_diff=float(diff), n_problems=len(cases),
+                                 ndof=sum(s.ndof for s in sides), includes=INCLUDES[name]))
+    return rows

@@ -1,0 +1,207 @@
+"""The elastic section's generated files (paper/elastic.tex): macros and three tables.
+
+Pure functions from the elastic tables (results/tables/elastic_*.csv, the elastic claims and
+results/benchmarks/elastic_beta.csv) to LaTeX text; ``workflow/scripts/elastic_paper.py``
+reads and writes. Macro names start with ``elastic`` (letters only, :func:`macro_name`), so
+they stay apart from the main paper's generated namespace.
+"""
+from __future__ import annotations
+
+import re
+
+import numpy as np
+import pandas as pd
+
+from .texformat import PaperTexError, case_order, fmt_fixed, fmt_int, fmt_sci, latex_escape
+from .texnames import Macro, _k, macro_name
+
+ELASTIC_FILES = ("elastic_macros.tex", "elastic_beta_table.tex", "elastic_patch_table.tex", "elastic_hertz_table.tex")
+
+
+def _name(*labels) -> str:
+    return macro_name("elastic", *labels)
+
+
+def _slope(x, y) -> float:
+    return float(np.polyfit(np.log(np.asarray(x, float)), np.log(np.asarray(y, float)), 1)[0])
+
+
+def elastic_macros(beta, sweep, patch, hertz, claims, speed) -> list[Macro]:
+    """Every number of paper/elastic.tex."""
+    out = []
+    checked = claims[claims.predicted.isin(["PASS", "FAIL"])]
+    out += [Macro(_name("NClaims"), fmt_int(len(claims)), "elastic_claims.csv: rows"),
+            Macro(_name("NPredicted"), fmt_int(len(checked)), "elastic_claims.csv: predicted PASS/FAIL"),
+            Macro(_name("NAsPredicted"), fmt_int(int((checked.verdict == checked.predicted).sum())),
+                  "elastic_claims.csv: verdict == predicted"),
+            Macro(_name("NFindings"), fmt_int(len(claims) - len(checked)), "elastic_claims.csv: findings")]
+    h = beta[(beta.norm == "H")]
+    m = h[h.N1 == h.N2]
+    out += [Macro(_name("Nu"), f"{beta.nu.iloc[0]:g}", "elastic_beta.csv: nu"),
+            Macro(_name("FinestN"), fmt_int(m.N2.max()), "elastic_beta.csv: max matching N2"),
+            Macro(_name("CoarsestN"), fmt_int(m.N2.min()), "elastic_beta.csv: min matching N2"),
+            Macro(_name("NRows"), fmt_int(len(beta) + len(sweep)), "elastic_beta.csv + elastic_nu_sweep.csv: rows")]
+    nok = beta[beta.kernel_dim_membranes == 0]
+    ratio = nok.beta / nok.beta_membranes
+    out += [Macro(_name("RatioMin"), fmt_fixed(ratio.min(), 2), "elastic_beta.csv: min beta/beta_membranes"),
+            Macro(_name("RatioMax"), fmt_fixed(ratio.max(), 2), "elastic_beta.csv: max beta/beta_membranes")]
+    fin = sweep[sweep.N2 == sweep.N2.max()]
+    for (case, k), g in fin[fin.kernel_dim == 0].groupby(["case", "k"]):
+        g = g[g.nu >= 0.49].sort_values("nu")
+        if len(g) >= 2 and case in ("T3", "T4"):
+            out.append(Macro(_name("NuSlope", case, _k(k)), fmt_fixed(_slope(1 - 2 * g.nu, g.beta), 3),
+                             f"elastic_nu_sweep.csv: polyfit slope of log beta vs log(1-2nu), {case}, k={k}"))
+    top = fin[(fin.nu == fin.nu.max()) & (fin.kernel_dim == 0)]
+    out += [Macro(_name("NuMax"), f"{fin.nu.max():g}", "elastic_nu_sweep.csv: max nu"),
+            Macro(_name("BetaAtNuMaxMin"), fmt_fixed(top.beta.min(), 4), "elastic_nu_sweep.csv: min beta at max nu"),
+            Macro(_name("BetaAtNuMaxMax"), fmt_fixed(top.beta.max(), 4), "elastic_nu_sweep.csv: max beta at max nu")]
+    good = patch[patch.case != "T3"]
+    out += [Macro(_name("PatchLambdaErr"), fmt_sci(good.lambda_max_rel_error.max(), 2),
+                  "elastic_patch.csv: max lambda error, cases but T3"),
+            Macro(_name("PatchUErr"), fmt_sci(good.u_max_rel_error.max(), 2), "elastic_patch.csv: max u error, cases but T3"),
+            Macro(_name("PatchNPass"), fmt_int(int(patch.groupby(["case", "k"]).passes.all().sum())),
+                  "elastic_patch.csv: (case, k) passing on every pair"),
+            Macro(_name("PatchNSeries"), fmt_int(patch.groupby(["case", "k"]).ngroups), "elastic_patch.csv: (case, k)")]
+    mod = hertz[hertz.study == "modeling"].sort_values("d")
+    if len(mod):
+        out += [Macro(_name("HertzErrSmall"), fmt_fixed(100 * mod.p_max_rel_error.iloc[0], 1),
+                      "elastic_hertz.csv: modeling p_max error (%), smallest d"),
+                Macro(_name("HertzErrLarge"), fmt_fixed(100 * mod.p_max_rel_error.iloc[-1], 1),
+                      "elastic_hertz.csv: modeling p_max error (%), largest d"),
+                Macro(_name("HertzAWSmall"), fmt_fixed(mod.hertz_a.iloc[0], 3), "elastic_hertz.csv: a/W, smallest d"),
+                Macro(_name("HertzAWLarge"), fmt_fixed(mod.hertz_a.iloc[-1], 3), "elastic_hertz.csv: a/W, largest d"),
+                Macro(_name("HertzModelN"), fmt_int(mod.N.iloc[0]), "elastic_hertz.csv: modeling N")]
+    disc = hertz[hertz.study == "discretization"]
+    if len(disc):
+        out += [Macro(_name("HertzNRef"), fmt_int(disc.N_ref.iloc[0]), "elastic_hertz.csv: N_ref"),
+                Macro(_name("HertzD"), f"{disc.d.iloc[0]:g}", "elastic_hertz.csv: d"),
+                Macro(_name("HertzR"), f"{disc.R.iloc[0]:g}", "elastic_hertz.csv: R")]
+    for k, g in speed[speed.route.isin(["ours", "ours_core"])].groupby("k"):
+        for route, r in g.groupby("route"):
+            out.append(Macro(_name("Speed", route.replace("_", " "), _k(k)), fmt_fixed(r.ratio_to_limit.max(), 1),
+                             f"elastic_beta.csv (benchmarks): {route}/limit, k={k}"))
+    out.append(Macro(_name("SpeedN"), fmt_int(speed.N.max()), "elastic_beta.csv (benchmarks): N"))
+    return out
+
+
+def elastic_macros_tex(macros: list[Macro]) -> str:
+    seen = set()
+    lines = ["% Generated by infsup_contact.report.elastic (rule elastic_paper): do not edit."]
+    for mac in macros:
+        if not re.fullmatch(r"elastic[A-Z][A-Za-z]*", mac.name) or mac.name in seen:
+            raise PaperTexError(f"elastic macro {mac.name!r}: not elastic + letters, or defined twice")
+        seen.add(mac.name)
+        lines.append(f"\\newcommand{{\\{mac.name}}}{{{mac.tex}}} % {mac.source}")
+    return "\n".join(lines) + "\n"
+
+
+def elastic_beta_table(beta: pd.DataFrame, sweep: pd.DataFrame) -> str:
+    """Rows (family, case), columns k: β_h on the finest matching mesh and on the finest
+    non-matching pair ("0 [d]": a d-dimensional kernel); then β_h of the ν sweep on the finest
+    structured mesh, rows (k, case), columns ν."""
+    h = beta[beta.norm == "H"]
+    m, nm = h[h.N1 == h.N2], h[h.N1 != h.N2]
+    n1 = int(m.N2.max())
+    pair = nm.sort_values("N2").iloc[-1] if len(nm) else None
+    ks = sorted(int(k) for k in set(h.k))
+    groups = [("matching", m[m.N2 == n1], rf"$N_1=N_2={n1}$")]
+    if pair is not None:
+        groups.append(("pair", nm[(nm.N1 == pair.N1) & (nm.N2 == pair.N2)],
+                       rf"$N_1{{:}}N_2={int(pair.N1)}{{:}}{int(pair.N2)}$"))
+    fin = sweep[sweep.N2 == sweep.N2.max()]
+    nus = sorted(set(fin.nu))
+    ncol = 2 + max(len(ks) * len(groups), len(nus))
+    pad = [""] * (ncol - 2 - len(ks) * len(groups))
+
+    def cell(rows, fam, case, k):
+        r = rows[(rows.family == fam) & (rows.case == case) & (rows.k == k)]
+        if r.empty:
+            return "--"
+        r = r.iloc[0]
+        return fmt_fixed(r.beta, 4) if r.kernel_dim == 0 else f"0 [{int(r.kernel_dim)}]"
+
+    lines = [r"\begin{tabular}{ll" + "r" * (ncol - 2) + "}", r"\toprule",
+             " & & " + " & ".join([rf"\multicolumn{{{len(ks)}}}{{c}}{{{title}}}" for _, _, title in groups] + pad)
+             + r" \\",
+             "family & case & " + " & ".join([rf"$k={k}$" for _ in groups for k in ks] + pad) + r" \\", r"\midrule"]
+    for fam in [f for f in ("structured", "perturbed", "unstructured") if f in set(m.family)]:
+        for case in case_order(m[m.family == fam].case.unique()):
+            lines.append(f"{fam[:6]}. & {latex_escape(case)} & "
+                         + " & ".join([cell(rows, fam, case, k) for _, rows, _ in groups for k in ks] + pad) + r" \\")
+    lines += [r"\midrule", rf"\multicolumn{{{ncol}}}{{l}}{{$\nu \to 1/2$, structured, $N={int(fin.N2.max())}$; "
+              r"columns: " + ", ".join(rf"$\nu={v:g}$" for v in nus) + r"} \\", r"\midrule"]
+    for k in sorted(set(fin.k)):
+        for case in case_order(fin[fin.k == k].case.unique()):
+            r = fin[(fin.k == k) & (fin.case == case)].set_index("nu")
+            cells = [fmt_fixed(r.beta[v], 4) if r.kernel_dim[v] == 0 else f"0 [{int(r.kernel_dim[v])}]" for v in nus]
+            cells += [""] * max(ncol - 2 - len(nus), 0)
+            lines.append(rf"$k={k}$ & {latex_escape(case)} & " + " & ".join(cells) + r" \\")
+    lines += [r"\bottomrule", r"\end{tabular}", ""]
+    return "\n".join(lines)
+
+
+def elastic_patch_table(patch: pd.DataFrame) -> str:
+    """Rows (case, k): passes on every pair, max relative errors of λ_h (all, end intervals,
+    middle half) and of u_h, kernel dimension."""
+    pairs = ", ".join(f"{a}:{b}" for a, b in patch[["N1", "N2"]].drop_duplicates().itertuples(index=False))
+    lines = [r"\begin{tabular}{llcrrrr}", r"\toprule",
+             r"case & $k$ & pass & $\max|\lambda_h-p|/p$ & end int. & middle & $\max|u_h-u|/\delta$ \\",
+             rf"\multicolumn{{7}}{{l}}{{pairs $N_1{{:}}N_2$ = {pairs}}} \\", r"\midrule"]
+    for case in case_order(patch.case.unique()):
+        for k, g in patch[patch.case == case].groupby("k"):
+            ok = bool(g.passes.astype(bool).all())
+            lines.append(f"{latex_escape(case)} & {k} & {'yes' if ok else 'no'} & "
+                         + " & ".join(fmt_sci(g[c].max(), 2) for c in ("lambda_max_rel_error", "lambda_end_rel_error",
+                                                                       "lambda_middle_rel_error", "u_max_rel_error"))
+                         + r" \\")
+    lines += [r"\bottomrule", r"\end{tabular}", ""]
+    return "\n".join(lines)
+
+
+def elastic_hertz_table(hertz: pd.DataFrame) -> str:
+    """Discretization study: per (k, case) the fitted energy-error slope and, per mesh, the
+    energy error, p_max error and oscillation; modeling study: a/W and the errors vs Hertz."""
+    d = hertz[hertz.study == "discretization"]
+    ns = sorted(int(n) for n in set(d.N))
+    lines = [r"\begin{tabular}{ll" + "r" * (1 + 3 * len(ns)) + "}", r"\toprule",
+             r"$k$ & case & slope & " + " & ".join(rf"$e_a$ {n}" for n in ns) + " & "
+             + " & ".join(rf"$e_p$ {n}" for n in ns) + " & " + " & ".join(rf"osc {n}" for n in ns) + r" \\",
+             r"\midrule"]
+    for k in sorted(set(d.k)):
+        for case in case_order(d[d.k == k].case.unique()):
+            g = d[(d.k == k) & (d.case == case)].set_index("N").sort_index()
+            slope = -_slope(g.index.to_numpy(float), g.energy_error)
+            cells = [fmt_fixed(slope, 2)] + [fmt_sci(g.energy_error[n], 2) for n in ns] \
+                + [fmt_sci(g.p_max_rel_error[n], 2) for n in ns] + [fmt_fixed(g.oscillation[n], 2) for n in ns]
+            lines.append(f"{k} & {latex_escape(case)} & " + " & ".join(cells) + r" \\")
+    mod = hertz[hertz.study == "modeling"].sort_values("d")
+    if len(mod):
+        lines += [r"\midrule", rf"\multicolumn{{{2 + 1 + 3 * len(ns)}}}{{l}}{{modeling error vs plane-strain Hertz "
+                  rf"(T3, $k=2$, $N={int(mod.N.iloc[0])}$): $a/W$, $e_p$, half-width error}} \\", r"\midrule"]
+        for _, r in mod.iterrows():
+            lines.append(rf"\multicolumn{{2}}{{l}}{{$d={r.d:g}$}} & {fmt_fixed(r.hertz_a, 3)} & "
+                         f"{fmt_sci(r.p_max_rel_error, 2)} & {fmt_sci(r.half_width_rel_error, 2)}"
+                         + " &" * (3 * len(ns) - 2) + r" \\")
+    lines += [r"\bottomrule", r"\end{tabular}", ""]
+    return "\n".join(lines)
+
+
+def elastic_paper_files(beta, sweep, patch, hertz, claims, speed) -> dict[str, str]:
+    """Every generated file of the elastic section (name → text)."""
+    return {"elastic_macros.tex": elastic_macros_tex(elastic_macros(beta, sweep, patch, hertz, claims, speed)),
+            "elastic_beta_table.tex": elastic_beta_table(beta, sweep),
+            "elastic_patch_table.tex": elastic_patch_table(patch),
+            "elastic_hertz_table.tex": elastic_hertz_table(hertz)}
+
+
+def check_elastic_tex(tex: str, files: dict[str, str]) -> None:
+    """PaperTexError unless every \\elastic… macro and \\input of ``tex`` is generated."""
+    body = re.sub(r"(?<!\\)%.*", "", tex)
+    used = set(re.findall(r"\\(elastic[A-Z][A-Za-z]*)", body))
+    defined = set(re.findall(r"\\newcommand\{\\([A-Za-z]+)\}", files.get("elastic_macros.tex", "")))
+    inputs = set(re.findall(r"\\input\{([^}]+)\}", body))
+    missing = sorted(used - defined)
+    missing_inputs = sorted(i for i in inputs if i not in files)
+    if missing or missing_inputs:
+        raise PaperTexError("paper/elastic.tex uses what the elastic tables do not provide: "
+                            + ", ".join(missing + missing_inputs))

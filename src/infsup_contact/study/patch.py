@@ -1,0 +1,150 @@
+"""The contact patch test of the plane-strain elastic pair (issue 12, item 4).
+
+Two blocks Ω1 = (0,1)² and Ω2 = (0,1)×(1,2) on non-matching structured meshes (N1 ≠ N2
+segments on Γ), lateral sides x = 0, 1 on rollers (u_x = 0, free to slide vertically), the
+bottom of Ω1 fixed and the top of Ω2 moved down by δ (u = (0, −δ)): Ω2 is held by contact
+only, and a prescribed displacement keeps K_2 invertible where a top pressure would leave a
+floating body. The exact solution is a uniform compression, σ_yy = −p in both blocks, u_x = 0,
+
+    u_{1,y} = −p y / M_1,   u_{2,y} = −p / M_1 − p (y − 1) / M_2,   p = δ / (1/M_1 + 1/M_2),
+
+with the plane-strain constrained moduli M_i = E_i (1 − ν)/((1 + ν)(1 − 2ν)): linear, so in
+every V_h, and the contact pressure is λ = p on all of Γ.
+
+**The cases' counterparts for traces that do not vanish at Γ's ends.** The rollers leave
+u_y free at Γ's ends, so the normal traces span all of continuous P_k on the partition
+(dim N k + 1), not the space vanishing at the ends of the paper's clamped bodies. The paper's
+rule "multipliers of the traces' degree with the traces' end condition" (Thm 3) then gives
+M^1_k — the space the paper calls R5.2, whose two zero modes came only from the two end values
+clamped traces cannot see. Likewise the dual basis: DUAL (P_{k−1} modification next to the
+ends, built to vanish with clamped traces) has the counterpart DUAL-ALL (a dual function on
+every node). T4, R5.4, T5 and the user space P0-2h carry no end condition and are their own
+counterparts. Which contain the constants: all but T3 (zero at the ends). Which have a
+structural kernel here: none (dim M_h <= N k + 1 = dim of the Ω2 trace space for every case
+on G_h = trace of Ω2); the measured ``kernel_dim`` (eigenvalues of K below 1e-8 × the largest,
+against the L²(Γ) Gram matrix) is reported per row.
+
+**Prediction (stated before the run).** λ_h = p and u_h = u whenever 1 ∈ M_h and K has no
+kernel: then (u, p) satisfies the discrete system exactly (Bᵀ(p 1) are the consistent nodal
+forces of the uniform traction, and B(u_2 − u_1) = 0 since the traces coincide), and the
+solution is unique. So every case passes except T3, which cannot represent λ = p at Γ's ends:
+its error sits in the two end intervals of G_h, and the mesh-ratio seams do not matter (a
+constant is transferred exactly by any mortar projection).
+
+**Outcome** (results/tables/elastic_patch.csv): as predicted for the passing spaces (errors
+1e-16..1e-12, no kernel) and for T3's failure, but T3's error is not confined to the end
+intervals: it is a boundary layer of a few intervals (error 1 in the end interval, 0.4–0.7
+in the rest of [0, 1/4] at every refinement) whose tail decays fast into the middle half
+(k = 1, 5:4: 0.75, 0.055, 0.0013, 0.00012 at N2 = 4, 16, 32, 64 — an exploratory run outside
+the DAG; the DAG's pairs and the ledger claim ``elastic-patch-T3-layer-*`` record the trend). With the ratios 5:4
+and 7:3 nearly every interval of G_h holds an Ω1 node that is not one of its nodes, so seams
+are everywhere; the passing spaces show no error at any of them.
+"""
+from __future__ import annotations
+
+import time
+
+import ngsolve
+import numpy as np
+import scipy.linalg as sla
+
+from ..discretization import meshes, registry
+from ..discretization.coupling import union_breakpoints
+from ..discretization.norms import gram
+from ..models.elastic import check_modulus, check_nu, interpolate
+from .elastic_contact import solve_elastic_contact
+
+SIDE = "side"
+"""Boundary name of the lateral sides x = 0, 1 (rollers: u_x = 0)."""
+X_DIRICHLET, Y_DIRICHLET = f"{meshes.DIRICHLET}|{SIDE}", meshes.DIRICHLET
+PASS_RTOL = 1e-10
+"""λ_h = p and u_h = u to this relative accuracy count as passing (the issue's 1e-10)."""
+
+
+def patch_mesh(n: int, side: int) -> ngsolve.Mesh:
+    """The structured N×N mesh of Ω_side with boundaries ``gamma``, ``side`` (x = 0, 1) and
+    ``dir`` (the bottom of Ω1, the top of Ω2)."""
+    points, triangles = meshes.structured_arrays(n, side)
+    segs = []
+    for a, b, label in meshes.boundary_segments(points, side):
+        x = points[[a, b], 0]
+        if label == meshes.DIRICHLET and x[0] == x[1] and x[0] in (0.0, 1.0):
+            label = SIDE
+        segs.append((a, b, label))
+    return meshes.mesh_from_arrays(points, triangles, segs)
+
+
+def constrained_modulus(E: float, nu: float) -> float:
+    """M = E (1 − ν)/((1 + ν)(1 − 2ν)): σ_yy = M ε_yy when ε_xx = 0 (plane strain)."""
+    return E * (1.0 - nu) / ((1.0 + nu) * (1.0 - 2.0 * nu))
+
+
+def exact_pressure(delta: float, nu: float, E) -> float:
+    """p = δ / (1/M_1 + 1/M_2) (unit heights)."""
+    return delta / sum(1.0 / constrained_modulus(e, nu) for e in E)
+
+
+def _where(x, g):
+    """Masks of sample points x: in an end interval of G_h (breakpoints g), elsewhere within
+    1/4 of an end, in the middle half [1/4, 3/4]. (With the ratios 5:4 and 7:3 every interval
+    of G_h away from the common nodes holds an Ω1 node that is not a node of G_h: seams are
+    everywhere, so the split is by distance from the ends.)"""
+    e = np.clip(np.searchsorted(g, x, side="right") - 1, 0, len(g) - 2)
+    ends = (e == 0) | (e == len(g) - 2)
+    middle = (x >= 0.25) & (x <= 0.75) & ~ends
+    return ends, ~(ends | middle), middle
+
+
+def patch_rows(cases, ks, pairs, nu=0.3, E=(1.0, 1.0)) -> list:
+    """:func:`solve_patch` for every case defined for each k and every (N1, N2) pair."""
+    return [solve_patch(case, k, n1, n2, nu, E) for n1, n2 in pairs for k in ks
+            for case in registry.ids_valid_for(k, cases)]
+
+
+def solve_patch(case: str, k: int, n1: int, n2: int, nu: float = 0.3, E=(1.0, 1.0), delta: float = 1e-2,
+                per_interval: int = 12) -> dict:
+    """Solve the patch test for one case; one row of measures.
+
+    Returns
+    -------
+    dict
+        ``lambda_max_rel_error`` (max |λ_h − p|/p over Γ, sampled ``per_interval`` points per
+        interval of the union of both traces and G_h, ends included), split into
+        ``lambda_end_rel_error`` (the end intervals of G_h), ``lambda_near_end_rel_error``
+        (the rest of [0, 1/4] ∪ [3/4, 1]) and ``lambda_middle_rel_error`` ([1/4, 3/4]);
+        ``u_max_rel_error`` (max nodal |u_h − u|/δ, both bodies);
+        ``passes`` (both below :data:`PASS_RTOL`); ``kernel_dim`` of K; PDAS iterations.
+    """
+    nu = check_nu(nu)
+    E = tuple(check_modulus(e, key) for e, key in zip(E, ("E1", "E2")))
+    registry.check_case(case, k)
+    for key, n in (("N1", n1), ("N2", n2)):
+        meshes.check_mesh_args("structured", n, key)
+    t0 = time.perf_counter()
+    m1, m2 = patch_mesh(n1, 1), patch_mesh(n2, 2)
+    sol = solve_elastic_contact(m1, m2, case, k, nu, E, X_DIRICHLET, Y_DIRICHLET, delta)
+    sides, space, res = sol.sides, sol.space, sol.pdas
+    g = space.breakpoints
+    p = exact_pressure(delta, nu, E)
+    M1, M2 = (constrained_modulus(e, nu) for e in E)
+    exact = (-p * ngsolve.y / M1, -p / M1 - p * (ngsolve.y - 1.0) / M2)
+    u_err = max(np.max(np.abs(vec - interpolate(s.space, 0.0, uy))) / delta
+                for s, vec, uy in zip(sides, sol.u, exact))
+    K = sol.K
+    xs = union_breakpoints(g, sides[0].trace.breakpoints, sides[1].trace.breakpoints)
+    t = np.linspace(0.0, 1.0, per_interval + 1)
+    x = np.unique(np.clip((xs[:-1, None] + np.outer(np.diff(xs), t)).ravel(), 0.0, 1.0 - 1e-15))
+    err = np.abs(space.evaluate(x) @ res.lam - p) / p
+    ends, near, middle = _where(x, g)
+    G, _ = gram(space, "L2")
+    ev = sla.eigh(K, G, eigvals_only=True)
+    lam_err = float(err.max())
+    return dict(scene="patch", case=case, k=k, family="structured", N1=n1, N2=n2, E1=E[0], E2=E[1], nu=nu,
+                delta=delta, p=p, dim_M=space.dim, kernel_dim=int(np.sum(ev < 1e-8 * ev[-1])),
+                iterations=res.iterations, n_active=int(res.active.sum()), nonunique=bool(res.nonunique),
+                lambda_max_rel_error=lam_err,
+                lambda_end_rel_error=float(err[ends].max()),
+                lambda_near_end_rel_error=float(err[near].max()) if near.any() else np.nan,
+                lambda_middle_rel_error=float(err[middle].max()) if middle.any() else np.nan,
+                u_max_rel_error=float(u_err), passes=bool(lam_err < PASS_RTOL and u_err < PASS_RTOL),
+                seconds=time.perf_counter() - t0)

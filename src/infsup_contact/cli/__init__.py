@@ -1,0 +1,105 @@
+"""Command line: one computation, CSV on stdout.
+
+    infsup-contact beta --case all --k 2 --family structured --N1 16 --N2 16
+    infsup-contact beta --model elastic --case T3 --k 2 --N1 16 --N2 16 --nu 0.3 --E1 1 --E2 1
+    infsup-contact contact --scene manufactured --case T3 --k 2 --N1 16 --N2 16
+    infsup-contact contact --model elastic --scene patch --case all --k 2 --N1 5 --N2 4
+    infsup-contact contact --model elastic --scene hertz --case T4 --k 2 --N1 32 --N2 32 --R 1 --d 0.05
+    infsup-contact rates contact.csv
+    infsup-contact bench --what beta --N 32 64 --k 2
+    infsup-contact verdict --case T3 --k 2 --expect stable
+    infsup-contact provenance
+
+Bad input gets one line on stderr naming the flag and exit code 2; no traceback, and no
+computation: every subcommand validates the whole request first — values, the files it reads
+and its estimated memory against the available memory (``resources.py``) — and ``--dry-run``
+stops right there (exit 0, the estimate on stdout). ``verdict --expect`` exits with 1 when the
+verdict is not the expected one.
+"""
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+
+from ..errors import InputError
+from ..io import TableError
+from . import beta, bench, contact, rates, verdict
+from .verdict import VERDICT_DEFAULTS
+
+__all__ = ["main", "build_parser", "validate", "flag_names", "VERDICT_DEFAULTS"]
+
+
+def _threads_default() -> None:
+    # a single-threaded BLAS is the fast choice for the small dense problems here and
+    # avoids oversubscription when jobs run in parallel (set before numpy loads BLAS)
+    for var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS"):
+        os.environ.setdefault(var, "1")
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message):  # one line, exit 2 — argparse's own convention
+        self.exit(2, f"infsup-contact: error: {message}\n")
+
+
+def _add_provenance(sub) -> None:
+    p = sub.add_parser("provenance", help="versions, git commit, platform, date (JSON)")
+    p.set_defaults(run=lambda args: print(__import__("json").dumps(
+        __import__("infsup_contact.provenance", fromlist=["x"]).provenance(), indent=2)))
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = _Parser(prog="infsup-contact", description=__doc__.split("\n\n")[0])
+    sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
+    beta.add(sub)
+    contact.add(sub)
+    rates.add(sub)
+    bench.add(sub)
+    verdict.add(sub)
+    _add_provenance(sub)
+    return parser
+
+
+def flag_names(parser: argparse.ArgumentParser, command: str) -> dict:
+    """dest → the flag as typed (``n_ref`` → ``--n-ref``) for the options of ``command``."""
+    sub = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction)).choices[command]
+    return {a.dest: max(a.option_strings, key=len) for a in sub._actions if a.option_strings}
+
+
+def _message(err: Exception, parser, command: str) -> str:
+    """The error's one line, with its key spelled as the flag the user typed."""
+    text = " ".join(str(err).split())
+    key = getattr(err, "key", None)
+    flag = flag_names(parser, command).get(key) if key else None
+    if flag and text.startswith(f"invalid {key}"):
+        text = f"invalid {flag}" + text[len(f"invalid {key}"):]
+    return text
+
+
+def validate(argv) -> tuple:
+    """Parse and validate a command line without computing: ``(args, estimate)``; raises
+    InputError/TableError (bad values) or SystemExit(2) (argparse: unknown flag, wrong type)."""
+    args = build_parser().parse_args(argv)
+    return args, (args.check(args) if hasattr(args, "check") else None)
+
+
+def main(argv=None) -> int:
+    _threads_default()
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    try:
+        estimate = args.check(args) if hasattr(args, "check") else None  # before any computation
+        if getattr(args, "dry_run", False):
+            from ..resources import available_bytes, human_bytes
+
+            avail = available_bytes()
+            print(f"dry run: valid request; estimated {estimate.describe()}"
+                  + (f" (available memory {human_bytes(avail)})" if avail is not None else ""))
+            return 0
+        code = args.run(args)
+    except (InputError, TableError) as err:
+        print(f"infsup-contact: error: {_message(err, parser, args.command)}", file=sys.stderr)
+        return 2
+    except BrokenPipeError:  # `| head` closed the pipe: not an error of ours
+        return 0
+    return code or 0

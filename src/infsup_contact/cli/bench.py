@@ -1,0 +1,65 @@
+"""``infsup-contact bench``: speed as ratios in one run (β_h or contact routes, CSV)."""
+from __future__ import annotations
+
+import sys
+
+from ..errors import InputError
+from .common import add_dry_run, check_memory
+
+
+def add(sub) -> None:
+    p = sub.add_parser("bench", help="speed as ratios in one run (CSV)")
+    p.add_argument("--what", required=True, choices=["beta", "contact"])
+    p.add_argument("--N", type=int, nargs="+", required=True)
+    p.add_argument("--k", type=int, nargs="+", required=True)
+    p.add_argument("--repeats", type=int, default=3)
+    p.add_argument("--peers", nargs="*", default=["osqp", "clarabel"],
+                   help="contact: QP solvers to compare with (osqp, clarabel; none: omit)")
+    p.add_argument("--eigsh-max-N", dest="eigsh_max_n", type=int, default=None,
+                   help="beta: run the shift-invert Lanczos route only for N <= this")
+    p.add_argument("--kkt-max-N", dest="kkt_max_n", type=int, default=64,
+                   help="contact: run the sparse-KKT active-set route only for N <= this")
+    add_dry_run(p)
+    p.set_defaults(run=_run_bench, check=_check_bench)
+
+
+def _check_bench(args):
+    from .. import resources
+    from ..bench.peers import SOLVERS
+
+    for key, values, ok, allowed in (("N", args.N, lambda n: n >= 1, "integers >= 1"),
+                                     ("k", args.k, lambda k: 1 <= k <= 4, "integers in 1..4")):
+        for v in values:
+            if not ok(v):
+                raise InputError(key, allowed, got=v)
+        if len(set(values)) < len(values):
+            raise InputError(key, f"{allowed}, each once", got=" ".join(map(str, values)))
+    if args.repeats < 1:
+        raise InputError("repeats", "an integer >= 1", got=args.repeats)
+    for key in ("eigsh_max_n", "kkt_max_n"):
+        value = getattr(args, key)
+        if value is not None and value < 0:
+            raise InputError(key, "an integer >= 0 (0: never)", got=value)
+    args.peer_list = [p for p in args.peers if p != "none"]
+    for p in args.peer_list:
+        if p not in SOLVERS:
+            raise InputError("peers", ", ".join([*SOLVERS, "none"]), got=p)
+    if len(set(args.peer_list)) < len(args.peer_list):
+        raise InputError("peers", "each peer once", got=" ".join(args.peers))
+    est = resources.bench_estimate(args.what, args.N, args.k, args.repeats, args.eigsh_max_n, args.kkt_max_n)
+    check_memory(est, "N", max(args.N))
+    return est
+
+
+def _run_bench(args) -> None:
+    import pandas as pd
+
+    from .. import bench
+
+    peers = args.peer_list
+    if args.what == "beta":
+        rows = bench.bench_beta(args.N, args.k, args.repeats, eigsh_max_n=args.eigsh_max_n)
+    else:
+        rows = bench.bench_contact(args.N, args.k, args.repeats, peers=tuple(peers),
+                                   kkt_max_n=args.kkt_max_n)
+    pd.DataFrame(rows).to_csv(sys.stdout, index=False, float_format="%.6g")

@@ -1,0 +1,83 @@
+"""What the subcommands share: the multiplier space of a request (--case | --space), the
+model and its material flags, the norms, --dry-run and the memory check."""
+from __future__ import annotations
+
+from ..errors import InputError
+
+
+SPACE_HELP = ("a user-defined multiplier space: a file or module and a function returning a "
+              "SpaceSpec (see examples/macro_p0.py); instead of --case")
+
+
+def cases(args) -> list:
+    """Case ids of a request: --space (loaded, checked, registered), else --case (all: every
+    registered space defined for k)."""
+    from ..discretization.registry import ids_valid_for
+    from ..discretization.user_spaces import load_user_space
+
+    if args.space is not None:
+        if args.case not in (None,):
+            raise InputError("case", "either --case or --space, not both", got=args.case)
+        return [load_user_space(args.space).id]
+    if args.case in (None, "all"):
+        if not 1 <= args.k <= 4:
+            raise InputError("k", "an integer in 1..4", got=args.k)
+        return ids_valid_for(args.k)
+    return [args.case]
+
+
+def add_model(p) -> None:
+    p.add_argument("--model", default="membranes", choices=["membranes", "elastic"],
+                   help="membranes (the paper's Section 3, default) or elastic (plane strain, "
+                   "vector P_k, frictionless normal contact; material scale c_i = E_i)")
+    p.add_argument("--nu", type=float, default=None,
+                   help="elastic: Poisson ratio of both bodies, -1 < nu < 0.5 (default 0.3)")
+    p.add_argument("--E1", type=float, default=None, help="elastic: Young's modulus of Ω1 (default 1)")
+    p.add_argument("--E2", type=float, default=None, help="elastic: Young's modulus of Ω2 (default 1)")
+
+
+def material(args):
+    """Resolve --model/--nu/--E1/--E2/--c1/--c2: sets ``args.model_obj``, ``args.c1``,
+    ``args.c2`` (c_i = E_i for elastic). The membranes take --c1 --c2 only, the elastic
+    bodies --nu --E1 --E2 only: the other model's flags are refused, naming the flag."""
+    from ..models import MODELS
+    from ..models.elastic import check_modulus, check_nu, elastic_model
+
+    if args.model == "membranes":
+        for key in ("nu", "E1", "E2"):
+            if getattr(args, key) is not None:
+                raise InputError(key, "only with --model elastic (the membranes take --c1 --c2)",
+                                 got=getattr(args, key))
+        args.c1 = 1.0 if args.c1 is None else args.c1
+        args.c2 = 1.0 if args.c2 is None else args.c2
+        args.model_obj = MODELS["membranes"]
+        return
+    for key in ("c1", "c2"):
+        if getattr(args, key) is not None:
+            raise InputError(key, "only with --model membranes (an elastic body's scale is --E1/--E2)",
+                             got=getattr(args, key))
+    nu = check_nu(0.3 if args.nu is None else args.nu, "nu")
+    args.c1 = check_modulus(1.0 if args.E1 is None else args.E1, "E1")
+    args.c2 = check_modulus(1.0 if args.E2 is None else args.E2, "E2")
+    args.nu = nu
+    args.model_obj = elastic_model(nu)
+
+
+def norms(args) -> tuple:
+    return ("H", "L2") if args.norm == "all" else (args.norm,)
+
+
+def add_dry_run(p) -> None:
+    p.add_argument("--dry-run", action="store_true",
+                   help="validate the request (values, files, estimated memory) and print the "
+                   "memory and time estimate instead of computing")
+
+
+def check_memory(est, key: str, value) -> None:
+    """InputError naming ``key`` when the estimate exceeds MemAvailable (/proc/meminfo)."""
+    from .. import resources
+
+    avail = resources.available_bytes()
+    if avail is not None and est.bytes > avail:
+        raise InputError(key, f"a size whose estimated memory fits in the {resources.human_bytes(avail)} "
+                         f"available (this request: {est.describe()})", got=value)

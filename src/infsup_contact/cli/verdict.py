@@ -1,0 +1,84 @@
+"""``infsup-contact verdict``: the stability verdict for one space, as a user's CI calls it."""
+from __future__ import annotations
+
+import sys
+
+from ..errors import InputError
+from .common import add_dry_run, check_memory, SPACE_HELP
+
+
+VERDICT_DEFAULTS = {"slope_tolerance": 0.15, "beta_floor": 0.001, "confidence": 0.95}
+"""Defaults of ``verdict``'s criterion: the ``claims:`` section of config/config.yaml (a test
+keeps them equal), so the command and the ledger judge a series alike."""
+
+
+_EXPECT = {"stable": "STABLE", "unstable": "UNSTABLE"}
+
+
+def add(sub) -> None:
+    from ..discretization.meshes import FAMILIES
+    from ..discretization.registry import space_ids
+
+    p = sub.add_parser(
+        "verdict", help="is a multiplier space stable? β_h over matching meshes → STABLE, "
+        "UNSTABLE or INCONCLUSIVE (CSV: one row)",
+        description="β_h (eq. (4.5)) on matching meshes N1 = N2 = N for each --N, judged by the "
+        "claims ledger's criterion: a numerical kernel on any mesh is UNSTABLE; otherwise PASS/"
+        "FAIL/INCONCLUSIVE of 'β_h bounded away from 0' (min β_h > --beta-floor and the "
+        "--confidence interval of the slope of log β_h vs log h inside ±--slope-tolerance) is "
+        "STABLE/UNSTABLE/INCONCLUSIVE. With --expect the exit code is 0 if the verdict matches, "
+        "1 if not (INCONCLUSIVE never matches); bad input is exit code 2.")
+    which = p.add_mutually_exclusive_group(required=True)
+    which.add_argument("--case", choices=space_ids(), help="a registered space")
+    which.add_argument("--space", metavar="FILE.py:FUNC", help=SPACE_HELP)
+    p.add_argument("--k", type=int, required=True, help="displacement degree, 1..4")
+    p.add_argument("--family", default="structured", choices=FAMILIES)
+    p.add_argument("--N", type=int, nargs="+", default=[8, 16, 32, 64],
+                   help="segments on Γ of the matching meshes, at least 3 distinct (default: 8 16 32 64)")
+    p.add_argument("--norm", default="H", choices=["H", "L2"],
+                   help="multiplier norm: H = H^{-1/2}_00(Γ) (the paper's, default); in L2 "
+                   "stable spaces decay like h^{1/2} (Remark 3.1)")
+    p.add_argument("--multiplier-mesh", default="omega2", choices=["omega2", "omega1", "union"])
+    p.add_argument("--expect", choices=sorted(_EXPECT),
+                   help="exit code 0 if the verdict is this, 1 otherwise")
+    for key, text in (("slope_tolerance", "slope tolerance τ"), ("beta_floor", "β floor"),
+                      ("confidence", "confidence level of the slope interval")):
+        p.add_argument("--" + key.replace("_", "-"), dest=key, type=float, default=VERDICT_DEFAULTS[key],
+                       help=f"{text} (default {VERDICT_DEFAULTS[key]:g}: claims.{key} in config/config.yaml)")
+    add_dry_run(p)
+    p.set_defaults(run=_run_verdict, check=_check_verdict)
+
+
+def _check_verdict(args):
+    from .. import resources
+    from ..discretization import meshes, registry
+    from ..discretization.user_spaces import load_user_space
+    from ..study.verdict import check_criterion, check_mesh_sizes
+
+    args.space_or_case = args.case if args.space is None else load_user_space(args.space)
+    case = args.case if args.space is None else args.space_or_case.id
+    if not 1 <= args.k <= 4:
+        raise InputError("k", "an integer in 1..4", got=args.k)
+    registry.check_case(case, args.k)
+    meshes.check_mesh_args(args.family, 1)
+    ns = check_mesh_sizes(args.N)
+    check_criterion(args.slope_tolerance, args.beta_floor, args.confidence)
+    est = resources.verdict_estimate(args.family, args.k, ns, args.norm, args.multiplier_mesh)
+    check_memory(est, "N", max(ns))
+    return est
+
+
+def _run_verdict(args) -> int:
+    import pandas as pd
+
+    from ..study.verdict import verdict_rows
+
+    space = args.space_or_case
+    out = verdict_rows(space, args.k, args.family, args.N, args.norm,
+                       tol=args.slope_tolerance, floor=args.beta_floor, confidence=args.confidence,
+                       multiplier_mesh=args.multiplier_mesh)
+    out["N_list"] = " ".join(str(n) for n in out["N_list"])
+    pd.DataFrame([out]).to_csv(sys.stdout, index=False, float_format="%.6g")
+    if args.expect is None:
+        return 0
+    return 0 if out["verdict"] == _EXPECT[args.expect] else 1

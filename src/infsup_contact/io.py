@@ -7,29 +7,13 @@ import tempfile
 from pathlib import Path
 
 
-def write_atomic(path, text: str) -> None:
-    """Write ``text`` to ``path`` via a temporary file in the same directory and a rename."""
+def _replace_atomic(path, data, mode: str) -> None:
+    """Write ``data`` to ``path`` via a temporary file in the same directory and a rename."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
     try:
-        with os.fdopen(fd, "w") as fh:
-            fh.write(text)
-            fh.flush()
-            os.fsync(fh.fileno())
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-
-
-def write_bytes_atomic(path, data: bytes) -> None:
-    """:func:`write_atomic` for bytes (a pickled reference solution)."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "wb") as fh:
+        with os.fdopen(fd, mode) as fh:
             fh.write(data)
             fh.flush()
             os.fsync(fh.fileno())
@@ -37,6 +21,16 @@ def write_bytes_atomic(path, data: bytes) -> None:
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise
+
+
+def write_atomic(path, text: str) -> None:
+    """Write ``text`` to ``path`` atomically (temporary file in the same directory, rename)."""
+    _replace_atomic(path, text, "w")
+
+
+def write_bytes_atomic(path, data: bytes) -> None:
+    """:func:`write_atomic` for bytes (a pickled reference solution)."""
+    _replace_atomic(path, data, "wb")
 
 
 def write_csv_atomic(path, frame) -> None:

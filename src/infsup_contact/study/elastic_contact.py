@@ -72,15 +72,37 @@ def weighted_gap(space, g0, degree: int) -> np.ndarray:
     return (space.evaluate(x) * w[:, None]).T @ g0(x)
 
 
-def solve_elastic_contact(mesh1, mesh2, case: str, k: int, nu: float, E, x_dirichlet: str, y_dirichlet: str,
-                          top_displacement: float, g0=None, g0_degree: int = 2) -> ElasticContact:
-    """Solve (4.1) for the elastic pair: u = 0 on Ω1's ``dir`` boundary, u_y = −``top_displacement``
-    (u_x = 0 where x is Dirichlet) on Ω2's ``dir`` boundary, initial gap ``g0(x)`` (polynomial of
-    ``g0_degree``; None: no gap), multipliers of ``case`` on G_h = trace of Ω2."""
+@dataclass
+class ElasticPair:
+    """Two factorized bodies with their Dirichlet lifts: everything of a solve that does not
+    depend on the multiplier space, built once and shared by every case on the pair.
+
+    Attributes
+    ----------
+    meshes : tuple
+        (mesh1, mesh2).
+    k : int
+    E : tuple
+    sides : list of ElasticSide
+        One factorization per body, Γ last (:func:`~infsup_contact.models.elastic.side_operator`).
+    lifts, F, u0 : lists of ndarray
+        Dirichlet lifts u_{D,i}, loads F_i = −A_i u_{D,i} on the free dofs, and A_i⁻¹ F_i.
+    """
+
+    meshes: tuple
+    k: int
+    E: tuple
+    sides: list
+    lifts: list
+    F: list
+    u0: list
+
+
+def elastic_pair(mesh1, mesh2, k: int, nu: float, E, x_dirichlet: str, y_dirichlet: str,
+                 top_displacement: float) -> ElasticPair:
+    """Factorize both bodies and apply the far-face data: u = 0 on Ω1's ``dir`` boundary,
+    u_y = −``top_displacement`` (u_x = 0 where x is Dirichlet) on Ω2's ``dir`` boundary."""
     sides = [side_operator(m, k, nu, x_dirichlet, y_dirichlet) for m in (mesh1, mesh2)]
-    space = registry.case_space(case, k, meshes.multiplier_breakpoints(mesh1, mesh2, "omega2"))
-    Bs = [coupling_matrix(s.trace, space, k) for s in sides]
-    K = interface_operator(Bs, sides, E)
     lifts = []
     for s, mesh, value in zip(sides, (mesh1, mesh2), (0.0, -top_displacement)):
         gf = ngsolve.GridFunction(s.space.fes)
@@ -88,15 +110,25 @@ def solve_elastic_contact(mesh1, mesh2, case: str, k: int, nu: float, E, x_diric
         lifts.append(gf.vec.FV().NumPy().copy())
     F = [-e * (s.stiffness_all @ L)[s.free] for s, L, e in zip(sides, lifts, E)]
     u0 = [s.solve(Fi) / e for s, Fi, e in zip(sides, F, E)]
+    return ElasticPair((mesh1, mesh2), k, tuple(E), sides, lifts, F, u0)
+
+
+def solve_elastic_contact(pair: ElasticPair, case: str, g0=None, g0_degree: int = 2) -> ElasticContact:
+    """Solve (4.1) on ``pair`` with multipliers of ``case`` on G_h = trace of Ω2 and the initial
+    gap ``g0(x)`` (polynomial of ``g0_degree``; None: no gap)."""
+    sides, E = pair.sides, pair.E
+    space = registry.case_space(case, pair.k, meshes.multiplier_breakpoints(*pair.meshes, "omega2"))
+    Bs = [coupling_matrix(s.trace, space, pair.k) for s in sides]
+    K = interface_operator(Bs, sides, E)
     ng = [B.shape[1] for B in Bs]
-    gF = Bs[1] @ u0[1][-ng[1]:] - Bs[0] @ u0[0][-ng[0]:]
+    gF = Bs[1] @ pair.u0[1][-ng[1]:] - Bs[0] @ pair.u0[0][-ng[0]:]
     G = np.zeros(space.dim) if g0 is None else weighted_gap(space, g0, g0_degree)
     res = solve_pdas(K, G + gF)
     u = []
-    for sign, s, Fi, B, e, L in zip((-1.0, 1.0), sides, F, Bs, E, lifts):
+    for sign, s, Fi, B, e, L in zip((-1.0, 1.0), sides, pair.F, Bs, E, pair.lifts):
         rhs = Fi.copy()
         rhs[s.ndof - B.shape[1]:] += sign * (B.T @ res.lam)
         vec = L.copy()
         vec[s.free] = s.solve(rhs) / e
         u.append(vec)
-    return ElasticContact(sides, space, res.lam, u, res, tuple(E), K)
+    return ElasticContact(sides, space, res.lam, u, res, E, K)

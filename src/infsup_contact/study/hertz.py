@@ -39,7 +39,7 @@ from ..discretization import registry
 from ..discretization.coupling import quadrature_on
 from ..models.elastic import check_modulus, check_nu, lame
 from .accuracy import _element_quadrature
-from .elastic_contact import solve_elastic_contact
+from .elastic_contact import elastic_pair, solve_elastic_contact
 from .patch import patch_mesh
 
 X_DIRICHLET = Y_DIRICHLET = "dir"
@@ -80,14 +80,24 @@ def check_geometry(R, d) -> tuple:
     return tuple(out)
 
 
-def solve_hertz(case: str, k: int, n: int, R: float, d: float, nu: float = 0.3, E=(1.0, 1.0), n2: int | None = None):
-    """One Hertz solve on structured blocks, N segments on Γ for Ω1 and ``n2`` (default N) for Ω2."""
+def hertz_pair(k: int, n: int, d: float, nu: float = 0.3, E=(1.0, 1.0), n2: int | None = None):
+    """The factorized blocks of the Hertz scene (N segments on Γ for Ω1, ``n2`` (default N) for
+    Ω2, top of Ω2 moved by d), shared by every multiplier case."""
+    return elastic_pair(patch_mesh(n, 1), patch_mesh(n if n2 is None else n2, 2), k, nu, E,
+                        X_DIRICHLET, Y_DIRICHLET, d)
+
+
+def solve_hertz(case: str, k: int, n: int, R: float, d: float, nu: float = 0.3, E=(1.0, 1.0), n2: int | None = None,
+                pair=None):
+    """One Hertz solve on structured blocks; ``pair`` from :func:`hertz_pair` with the same
+    (k, n, d, nu, E, n2) to reuse the factorizations across cases."""
     nu = check_nu(nu)
     E = tuple(check_modulus(e, key) for e, key in zip(E, ("E1", "E2")))
     R, d = check_geometry(R, d)
     registry.check_case(case, k)
-    return solve_elastic_contact(patch_mesh(n, 1), patch_mesh(n if n2 is None else n2, 2), case, k, nu, E,
-                                 X_DIRICHLET, Y_DIRICHLET, d, g0=lambda x: (x - CENTER) ** 2 / (2.0 * R), g0_degree=2)
+    if pair is None:
+        pair = hertz_pair(k, n, d, nu, E, n2)
+    return solve_elastic_contact(pair, case, g0=lambda x: (x - CENTER) ** 2 / (2.0 * R), g0_degree=2)
 
 
 def hertz_row(case: str, k: int, n1: int, n2: int, R: float, d: float, nu: float = 0.3, E=(1.0, 1.0)) -> dict:
@@ -171,9 +181,10 @@ def discretization_rows(cases, ks, ns, n_ref: int, R: float, d: float, nu=0.3, E
         ref = solve_hertz(registry.REFERENCE_SPACE, k + 1, n_ref, R, d, nu, E)
         rm, rdata = profile_measures(ref), reference_data(ref)
         for n in ns:
+            pair = hertz_pair(k, n, d, nu, E)
             for case in registry.ids_valid_for(k, cases):
                 t0 = time.perf_counter()
-                sol = solve_hertz(case, k, n, R, d, nu, E)
+                sol = solve_hertz(case, k, n, R, d, nu, E, pair=pair)
                 m = profile_measures(sol)
                 rows.append(dict(
                     study="discretization", case=case, k=k, N=n, N_ref=n_ref, R=R, d=d, nu=nu, E1=E[0], E2=E[1],

@@ -64,3 +64,15 @@ def test_b_matches_ngsolve_assembly(k, s):
         c = np.array([ext(mesh(xn, 1.0)) for xn in space.nodes()])
         ours = c @ coupling_matrix(trace, space, k) @ ug.vec.FV().NumPy()[trace.gamma_dofs]
         assert ours == pytest.approx(expected, rel=1e-11, abs=1e-13)
+
+
+def test_cached_trace_values_match_a_fresh_evaluation():
+    """B from the trace's cached basis values equals B from a fresh trace, for several spaces
+    asked for in turn (same and different quadrature points)."""
+    mesh = mesh_pair("perturbed", 7, 5)[0]
+    cached = gamma_trace(displacement_space(mesh, 3))
+    for s, cont, bp in [(3, True, np.linspace(0, 1, 6)), (2, False, np.linspace(0, 1, 6)),
+                        (3, True, np.linspace(0, 1, 6)), (1, True, np.linspace(0, 1, 9) ** 1.2)]:
+        space = make_space(bp, s, cont, False)
+        fresh = gamma_trace(displacement_space(mesh, 3))
+        assert np.array_equal(coupling_matrix(cached, space, 3), coupling_matrix(fresh, space, 3))

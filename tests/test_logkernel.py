@@ -185,3 +185,25 @@ def test_bad_inputs():
         gram_h_logkernel("not a space")
     with pytest.raises(InputError):
         gram_h_logkernel(make_space([0.0, 0.5, 2.0], 1, True, False))
+
+
+def test_subspace_gram_is_a_submatrix():
+    """T3 = R5.2 without its two end functions: its Gram matrix is R5.2's with those rows and
+    columns struck out (the element integrals are shared between the two, so this also checks
+    that one space's integrals are not handed to the other wrongly)."""
+    bp = np.r_[0.0, np.sort(np.random.default_rng(3).uniform(0.02, 0.98, 9)), 1.0]
+    for k in (1, 2, 3):
+        full, inner = case_space("R5.2", k, bp), case_space("T3", k, bp)
+        g_full, g_inner = gram_h_logkernel(full), gram_h_logkernel(inner)
+        x_full, x_inner = full.nodes(), inner.nodes()
+        keep = [int(np.argmin(np.abs(x_full - x))) for x in x_inner]
+        assert np.allclose(g_full[np.ix_(keep, keep)], g_inner, rtol=0, atol=1e-15 * np.abs(g_full).max())
+
+
+def test_gram_depends_on_the_partition():
+    """Two partitions asked for in turn get their own matrices (no stale reuse)."""
+    a, b = np.linspace(0, 1, 6), np.linspace(0, 1, 6) ** 1.5
+    ga1 = gram_h_logkernel(make_space(a, 1, True, True))
+    gb = gram_h_logkernel(make_space(b, 1, True, True))
+    ga2 = gram_h_logkernel(make_space(a, 1, True, True))
+    assert np.array_equal(ga1, ga2) and not np.allclose(ga1, gb)

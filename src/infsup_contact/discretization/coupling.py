@@ -7,13 +7,14 @@ union of all breakpoints (the two trace partitions and G_h), so Gauss–Legendre
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 import ngsolve
 
 from .meshes import GAMMA
 from .multipliers import MultiplierSpace
+from .quadrature import gauss_legendre
 
 
 @dataclass(frozen=True)
@@ -30,12 +31,15 @@ class GammaTrace:
         Γ boundary elements: x of the element's first and second vertex and its dofs.
     breakpoints : ndarray
         Sorted x of the trace partition.
+    basis_cache : dict
+        Values of the Γ-dof basis at quadrature points already asked for (:func:`trace_basis_at`).
     """
 
     fes: ngsolve.H1
     gamma_dofs: np.ndarray
     elements: list
     breakpoints: np.ndarray
+    basis_cache: dict = field(default_factory=dict, repr=False, compare=False)
 
 
 def gamma_trace(fes) -> GammaTrace:
@@ -62,7 +66,7 @@ def union_breakpoints(*partitions, tol: float = 1e-12) -> np.ndarray:
 
 def quadrature_on(breakpoints: np.ndarray, degree: int):
     """Gauss–Legendre points and weights exact for polynomials of ``degree`` per interval."""
-    t, w = np.polynomial.legendre.leggauss(degree // 2 + 1)
+    t, w = gauss_legendre(degree // 2 + 1)
     a, b = breakpoints[:-1, None], breakpoints[1:, None]
     x = 0.5 * (a + b) + 0.5 * (b - a) * t[None, :]
     return x.ravel(), (0.5 * (b - a) * w[None, :]).ravel()
@@ -78,10 +82,10 @@ def trace_values(trace: GammaTrace, x: np.ndarray):
     position = -np.ones(trace.fes.ndof, dtype=int)
     position[trace.gamma_dofs] = np.arange(len(trace.gamma_dofs))
     e = np.clip(np.searchsorted(trace.breakpoints, x, side="right") - 1, 0, len(trace.elements) - 1)
-    rows, cols, vals = [], [], []
+    rows, cols, vals, fes = [], [], [], {}
     for i, (xi, ei) in enumerate(zip(x, e)):
         x0, x1, dn, el = trace.elements[ei]
-        fe = trace.fes.GetFE(el)
+        fe = fes.get(ei) or fes.setdefault(ei, trace.fes.GetFE(el))
         # the reference coordinate runs from the second vertex (0) to the first (1)
         shape = np.asarray(fe.CalcShape((xi - x1) / (x0 - x1), 0.0, 0.0))
         pos = position[dn]
@@ -96,7 +100,28 @@ def coupling_matrix(trace: GammaTrace, space: MultiplierSpace, k: int) -> np.nda
     """B_i[j, d] = ∫_Γ μ_j φ_d, dense, shape (dim M, number of Γ dofs); exact."""
     x, w = quadrature_on(union_breakpoints(trace.breakpoints, space.breakpoints), k + space.degree)
     mu = space.evaluate(x)  # (n_q, dim M)
-    rows, cols, vals = trace_values(trace, x)
-    phi = np.zeros((len(x), len(trace.gamma_dofs)))
-    np.add.at(phi, (rows, cols), vals)
-    return (mu * w[:, None]).T @ phi
+    return (mu * w[:, None]).T @ trace_basis_at(trace, x)
+
+
+_BASIS_CACHE_SIZE = 4
+
+
+def trace_basis_at(trace: GammaTrace, x: np.ndarray) -> np.ndarray:
+    """Dense values of the Γ-dof basis at the points x, shape (len(x), number of Γ dofs).
+
+    Every multiplier space of one degree on one partition G_h asks for the same quadrature
+    points (T3, R5.2 and the dual bases; the three multiplier meshes of a matching pair), and
+    NGSolve evaluates one point at a time: the values are kept on the trace (a few point sets,
+    read-only) and computed once.
+    """
+    key = np.ascontiguousarray(x, dtype=float).tobytes()
+    phi = trace.basis_cache.get(key)
+    if phi is None:
+        rows, cols, vals = trace_values(trace, x)
+        phi = np.zeros((len(x), len(trace.gamma_dofs)))
+        np.add.at(phi, (rows, cols), vals)
+        phi.flags.writeable = False
+        if len(trace.basis_cache) >= _BASIS_CACHE_SIZE:
+            trace.basis_cache.clear()
+        trace.basis_cache[key] = phi
+    return phi

@@ -29,19 +29,25 @@ positive for k = 1..7 (checked by :func:`nodal_integrals`).
 """
 from __future__ import annotations
 
+from functools import lru_cache
+
 import numpy as np
 
 from ..errors import InputError
 from .multipliers import MultiplierSpace, local_shapes, make_space, reference_nodes
+from .quadrature import gauss_legendre_01
 
 
+@lru_cache(maxsize=None)
 def _reference_moments(k: int, powers: int) -> tuple[np.ndarray, np.ndarray]:
-    """T[p, b] = ∫_0^1 t^p φ_b(t) dt (p < ``powers``) and M[a, b] = ∫_0^1 φ_a φ_b, exact."""
-    t, w = np.polynomial.legendre.leggauss(k + 1)
-    t, w = 0.5 * (t + 1.0), 0.5 * w
+    """T[p, b] = ∫_0^1 t^p φ_b(t) dt (p < ``powers``) and M[a, b] = ∫_0^1 φ_a φ_b, exact
+    (cached: the same few per degree serve every interval of every mesh)."""
+    t, w = gauss_legendre_01(k + 1)
     phi = local_shapes(k, t)                                  # (q, k+1)
     mono = t[:, None] ** np.arange(max(powers, 1))[None, :]   # (q, p)
-    return (mono * w[:, None]).T @ phi, (phi * w[:, None]).T @ phi
+    T, M = (mono * w[:, None]).T @ phi, (phi * w[:, None]).T @ phi
+    T.flags.writeable = M.flags.writeable = False
+    return T, M
 
 
 def nodal_integrals(k: int) -> np.ndarray:
@@ -64,18 +70,26 @@ def local_dual_coefficients(k: int, live) -> np.ndarray:
     All k + 1 nodes live: C = D M⁻¹. Otherwise ψ_a ∈ P_{|L|−1} (see the module docstring).
     Rows of dead nodes are zero. Shape (k + 1, k + 1).
     """
+    return _local_dual_coefficients(int(k), tuple(int(a) for a in np.asarray(live, dtype=int))).copy()
+
+
+@lru_cache(maxsize=None)
+def _local_dual_coefficients(k: int, live: tuple) -> np.ndarray:
+    """:func:`local_dual_coefficients`, cached: an interval has one of a few live patterns."""
     live = np.asarray(live, dtype=int)
     d = nodal_integrals(k)
     C = np.zeros((k + 1, k + 1))
     if len(live) == k + 1:
         M = _reference_moments(k, 1)[1]
         C[:] = np.diag(d) @ np.linalg.inv(M)
+        C.flags.writeable = False
         return C
     T, _ = _reference_moments(k, len(live))                    # (|L|, k+1)
     alpha = np.diag(d[live]) @ np.linalg.inv(T[:, live])        # ψ_a = Σ_p α[a, p] t^p
     # t^p in the Lagrange basis: its nodal values (interpolation is exact on P_k)
     mono_in_lagrange = reference_nodes(k)[None, :] ** np.arange(len(live))[:, None]
     C[live] = alpha @ mono_in_lagrange
+    C.flags.writeable = False
     return C
 
 

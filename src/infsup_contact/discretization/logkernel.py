@@ -59,6 +59,7 @@ import numpy as np
 
 from ..errors import InputError
 from .multipliers import MultiplierSpace, local_shapes
+from .quadrature import gauss_legendre_01
 
 __all__ = ["gram_h_logkernel", "log_kernel"]
 
@@ -98,13 +99,6 @@ def _smooth_remainder(x, y):
 
 
 @lru_cache(maxsize=None)
-def _gauss01(n: int):
-    """Gauss–Legendre nodes and weights on [0, 1]."""
-    t, w = np.polynomial.legendre.leggauss(n)
-    return 0.5 * (t + 1.0), 0.5 * w
-
-
-@lru_cache(maxsize=None)
 def _log_rule01(n: int):
     """Interpolatory rule on the n Gauss–Legendre nodes of [0, 1] for the weight ln u.
 
@@ -113,7 +107,7 @@ def _log_rule01(n: int):
     Lagrange basis ℓ_i = λ_i Σ_k (2k+1) P̃_k(u_i) P̃_k and the modified moments
     ∫_0^1 ln(u) P̃_k(u) du = −1 (k = 0), (−1)^{k+1} / (k(k+1)) (k ≥ 1).
     """
-    u, lam = _gauss01(n)
+    u, lam = gauss_legendre_01(n)
     k = np.arange(n)
     mom = np.empty(n)
     mom[0] = -1.0
@@ -136,7 +130,7 @@ def _gauss_order(ratio, s: int, scale: int) -> np.ndarray:
 
 def _tensor_gauss(kernel, aI, hI, aJ, hJ, s: int, q: int) -> np.ndarray:
     """∬_{I×J} φ_a(x) φ_b(y) kernel(x, y) by tensor Gauss of order q, shape (P, s+1, s+1)."""
-    tau, lam = _gauss01(q)
+    tau, lam = gauss_legendre_01(q)
     phiw = local_shapes(s, tau) * lam[:, None]  # (q, s+1)
     out = np.empty((len(aI), s + 1, s + 1))
     step = max(1, _CHUNK // (q * q))
@@ -179,7 +173,7 @@ def _log_term(aI, bI, aJ, bJ, term, s: int, n_log: int, n_x: int, q_piece: int) 
     zb, wb = rule0(B)
     za, wa = rule0(A)
     # Gauss–Legendre on [A, B] when ln z is analytic there with A >= B − A (ρ >= 3 + √8)
-    tau, lam = _gauss01(q_piece)
+    tau, lam = gauss_legendre_01(q_piece)
     zg = A[..., None] + (B - A)[..., None] * tau
     lng = np.log(np.where(zg > 0.0, zg, 1.0))
     wg = (B - A)[..., None] * lam * lng
@@ -208,7 +202,7 @@ def _log_term(aI, bI, aJ, bJ, term, s: int, n_log: int, n_x: int, q_piece: int) 
     L = np.where(keep_a, aI[:, None, None], lo)
     R = np.where(keep_b, bI[:, None, None], hi)
 
-    tx, lx = _gauss01(n_x)
+    tx, lx = gauss_legendre_01(n_x)
     xg = L[..., None] + (R - L)[..., None] * tx  # (P, 4, n_nodes, n_x)
     yg = sy * (z[..., None] - c0) + kappa * xg
     P = len(aI)
@@ -218,6 +212,55 @@ def _log_term(aI, bI, aJ, bJ, term, s: int, n_log: int, n_x: int, q_piece: int) 
     px = px.reshape(P, -1, s + 1) * coef.reshape(P, -1, 1)
     qy = qy.reshape(P, -1, s + 1)
     return np.swapaxes(px, 1, 2) @ qy
+
+
+@lru_cache(maxsize=8)
+def _local_blocks(xb_bytes: bytes, s: int, scale: int) -> np.ndarray:
+    """Element integrals ∬_{I×J} φ_a(x) φ_b(y) k(x, y) dx dy (without the 1/π) of the local
+    Lagrange basis of degree s, for every interval pair I <= J (``np.triu_indices`` order) of
+    the partition given as float64 bytes; shape (P, s + 1, s + 1), read-only.
+
+    They depend only on the partition and s, not on the space built on it: T3 and R5.2 (and
+    the dual bases, through their local coefficients) share them, so do the three multiplier
+    meshes of a matching pair. Cached, so each is integrated once per mesh pair.
+    """
+    xb = np.frombuffer(xb_bytes)
+    n = len(xb) - 1
+
+    # interval pairs i <= j (k is symmetric)
+    iu, ju = np.triu_indices(n)
+    aI, bI, aJ, bJ = xb[iu], xb[iu + 1], xb[ju], xb[ju + 1]
+    hI, hJ = bI - aI, bJ - aJ
+    hmax = np.maximum(hI, hJ)
+    gap = np.maximum(aJ - bI, 0.0)
+    delta = np.minimum.reduce([gap, aI + aJ, (1.0 - bI) + (1.0 - bJ), np.ones_like(gap)])
+    far = delta >= hmax
+    loc = np.empty((len(iu), s + 1, s + 1))
+
+    # admissible pairs: full kernel, tensor Gauss grouped by order
+    q_far = _gauss_order(np.where(far, delta / hmax, 1.0), s, scale)
+    for q in np.unique(q_far[far]):
+        sel = np.flatnonzero(far & (q_far == q))
+        loc[sel] = _tensor_gauss(log_kernel, aI[sel], hI[sel], aJ[sel], hJ[sel], s, int(q))
+
+    # near pairs: smooth remainder by Gauss + exact log terms
+    near = np.flatnonzero(~far)
+    if near.size:
+        q_s = _gauss_order(1.0 / hmax[near], s, scale)
+        for q in np.unique(q_s):
+            sel = near[q_s == q]
+            loc[sel] = _tensor_gauss(_smooth_remainder, aI[sel], hI[sel], aJ[sel], hJ[sel], s, int(q))
+        n_log, n_x = scale * (2 * s + 2), scale * (s + 1)
+        q_piece = int(_gauss_order(2.0, 2 * s + 1, scale))  # r = 1 + 2A/(B−A) >= 3
+        step = max(1, _CHUNK // (4 * max(2 * n_log, q_piece) * n_x * (s + 1)))
+        for lo in range(0, near.size, step):
+            sel = near[lo:lo + step]
+            for term in _LOG_TERMS:
+                loc[sel] += term[3] * _log_term(aI[sel], bI[sel], aJ[sel], bJ[sel], term,
+                                                s, n_log, n_x, q_piece)
+
+    loc.flags.writeable = False
+    return loc
 
 
 def gram_h_logkernel(space: MultiplierSpace, *, quad_scale: int = 1) -> np.ndarray:
@@ -257,40 +300,9 @@ def gram_h_logkernel(space: MultiplierSpace, *, quad_scale: int = 1) -> np.ndarr
                          got=(float(xb[0]), float(xb[-1])))
     xb = xb.copy()
     xb[0], xb[-1] = 0.0, 1.0
-    scale = int(quad_scale)
-    n, s = len(xb) - 1, int(space.degree)
-
-    # interval pairs i <= j (k is symmetric)
+    n = len(xb) - 1
     iu, ju = np.triu_indices(n)
-    aI, bI, aJ, bJ = xb[iu], xb[iu + 1], xb[ju], xb[ju + 1]
-    hI, hJ = bI - aI, bJ - aJ
-    hmax = np.maximum(hI, hJ)
-    gap = np.maximum(aJ - bI, 0.0)
-    delta = np.minimum.reduce([gap, aI + aJ, (1.0 - bI) + (1.0 - bJ), np.ones_like(gap)])
-    far = delta >= hmax
-    loc = np.empty((len(iu), s + 1, s + 1))
-
-    # admissible pairs: full kernel, tensor Gauss grouped by order
-    q_far = _gauss_order(np.where(far, delta / hmax, 1.0), s, scale)
-    for q in np.unique(q_far[far]):
-        sel = np.flatnonzero(far & (q_far == q))
-        loc[sel] = _tensor_gauss(log_kernel, aI[sel], hI[sel], aJ[sel], hJ[sel], s, int(q))
-
-    # near pairs: smooth remainder by Gauss + exact log terms
-    near = np.flatnonzero(~far)
-    if near.size:
-        q_s = _gauss_order(1.0 / hmax[near], s, scale)
-        for q in np.unique(q_s):
-            sel = near[q_s == q]
-            loc[sel] = _tensor_gauss(_smooth_remainder, aI[sel], hI[sel], aJ[sel], hJ[sel], s, int(q))
-        n_log, n_x = scale * (2 * s + 2), scale * (s + 1)
-        q_piece = int(_gauss_order(2.0, 2 * s + 1, scale))  # r = 1 + 2A/(B−A) >= 3
-        step = max(1, _CHUNK // (4 * max(2 * n_log, q_piece) * n_x * (s + 1)))
-        for lo in range(0, near.size, step):
-            sel = near[lo:lo + step]
-            for term in _LOG_TERMS:
-                loc[sel] += term[3] * _log_term(aI[sel], bI[sel], aJ[sel], bJ[sel], term,
-                                                s, n_log, n_x, q_piece)
+    loc = _local_blocks(xb.tobytes(), int(space.degree), int(quad_scale))
 
     if space.local_coefficients is not None:  # C_I loc C_Jᵀ for the space's own local basis
         loc = np.swapaxes(space.to_local_basis(np.swapaxes(space.to_local_basis(loc, iu), 1, 2), ju), 1, 2)

@@ -22,6 +22,7 @@ import numpy as np
 from ..errors import InputError
 from .logkernel import gram_h_logkernel
 from .multipliers import MultiplierSpace, local_monomial_coefficients, local_shapes
+from .quadrature import gauss_legendre_01
 
 NORMS = ("H", "L2")
 
@@ -58,7 +59,7 @@ def gram_l2(space: MultiplierSpace) -> np.ndarray:
         (exact for the degree-2s integrand).
     """
     s = space.degree
-    t, w = _gauss_01(s + 1)
+    t, w = gauss_legendre_01(s + 1)
     vals = local_shapes(s, t)                       # (q, s+1)
     ref_mass = (vals * w[:, None]).T @ vals         # ∫_0^1 ψ_a ψ_b dt
     h = np.diff(space.breakpoints)
@@ -158,7 +159,7 @@ def _endpoint_derivatives(s: int) -> tuple[np.ndarray, np.ndarray]:
 def _gauss_integrals(space: MultiplierSpace, omega, e_idx, n_idx) -> np.ndarray:
     """Gauss–Legendre integrals for the listed (interval, ω) pairs; shape (K, s+1)."""
     s = space.degree
-    t, w = _gauss_01(s + _GAUSS_EXTRA)
+    t, w = gauss_legendre_01(s + _GAUSS_EXTRA)
     vals = local_shapes(s, t)                                 # (q, s+1)
     a = space.breakpoints[e_idx]
     h = np.diff(space.breakpoints)[e_idx]
@@ -181,12 +182,6 @@ def _scatter(space: MultiplierSpace, local: np.ndarray) -> np.ndarray:
         else:
             np.add.at(out, rows[keep], local[keep, a])
     return out
-
-
-def _gauss_01(q: int) -> tuple[np.ndarray, np.ndarray]:
-    """q-point Gauss–Legendre rule on [0, 1]."""
-    t, w = np.polynomial.legendre.leggauss(q)
-    return 0.5 * (t + 1.0), 0.5 * w
 
 
 # ------------------------------------------------------------------------- M norm

@@ -25,6 +25,7 @@ and the contact solver.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 import scipy.linalg as sla
@@ -71,8 +72,16 @@ class SideOperator:
         return X / c
 
     def steklov_times(self, M: np.ndarray) -> np.ndarray:
-        """X_i M for c_i = 1 (:func:`steklov_times`)."""
-        return steklov_times(self.schur, self.steklov, M)
+        """X_i M for c_i = 1: a product where X_i is known, else a solve with the Cholesky
+        factor of S_i, computed on first use and kept (a β_h sweep asks for X_i M for every
+        multiplier space on the same side)."""
+        if self.steklov is not None:
+            return self.steklov @ M
+        return sla.cho_solve(self._schur_cholesky, M, check_finite=False)
+
+    @cached_property
+    def _schur_cholesky(self):
+        return sla.cho_factor(self.schur, check_finite=False)
 
 
 def steklov_times(schur: np.ndarray, steklov: np.ndarray | None, M: np.ndarray) -> np.ndarray:
@@ -197,9 +206,22 @@ def schur_by_solves(side: SideOperator) -> np.ndarray:
     return KGG - KIG.T @ spla.splu(KII).solve(KIG)
 
 
-def interface_operator(couplings, sides, c=(1.0, 1.0)) -> np.ndarray:
-    """Σ_i B_i X_i B_iᵀ = B A⁻¹ Bᵀ on the multiplier space (dense, symmetric PSD)."""
+def interface_terms(couplings, sides) -> list:
+    """The terms B_i X_i B_iᵀ of the interface operator at unit material scale, one per side."""
+    return [B @ side.steklov_times(B.T) for B, side in zip(couplings, sides)]
+
+
+def combine_terms(terms, c) -> np.ndarray:
+    """Σ_i T_i / c_i, symmetrized: the interface operator for the material scales c."""
     out = 0.0
-    for B, side, ci in zip(couplings, sides, c):
-        out = out + B @ side.steklov_times(B.T) / ci
+    for T, ci in zip(terms, c):
+        out = out + T / ci
     return 0.5 * (out + out.T)
+
+
+def interface_operator(couplings, sides, c=(1.0, 1.0)) -> np.ndarray:
+    """Σ_i B_i X_i B_iᵀ / c_i = B A⁻¹ Bᵀ on the multiplier space (dense, symmetric PSD).
+
+    Its terms do not depend on c: a sweep over (c1, c2) computes them once
+    (:func:`interface_terms`) and combines them per pair (:func:`combine_terms`)."""
+    return combine_terms(interface_terms(couplings, sides), c)

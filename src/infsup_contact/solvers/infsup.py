@@ -17,7 +17,7 @@ import scipy.sparse as sp
 from ..discretization import meshes, multipliers, registry
 from ..discretization.coupling import coupling_matrix
 from ..errors import InputError, check_prestress
-from ..models.schur import interface_operator
+from ..models.schur import combine_terms, interface_terms
 from ..models.membranes import MEMBRANES
 from ..discretization.norms import NORMS, gram
 from .kernel import GAP_DECADES, KERNEL_CRITERION, kernel_check, kernel_from_gap  # noqa: F401
@@ -140,9 +140,10 @@ def beta_rows_all(family, k, n1, n2, cases=None, multiplier_meshes=("omega2",), 
             t_coupling = time.perf_counter() - tc
             grams = {norm: gram(space, norm, h_route=h_route) for norm in norms}
             structural = max(space.dim - dim_w, 0)
+            terms = interface_terms(couplings, sides)
             for c1, c2 in c_pairs:
-                S = interface_operator(couplings, sides, (c1, c2))
-                S2 = interface_operator(couplings[1:], sides[1:], (c2,))  # sup over (0, v2) only: (5.10)
+                S = combine_terms(terms, (c1, c2))
+                S2 = combine_terms(terms[1:], (c2,))  # sup over (0, v2) only: (5.10)
                 for norm in norms:
                     te = time.perf_counter()
                     G, info = grams[norm]

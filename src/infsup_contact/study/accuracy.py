@@ -10,6 +10,7 @@ import scipy.fft
 
 from ..solvers.contact import ContactSolution, gamma_values, lambda_values
 from ..discretization.norms import sine_coefficients
+from ..discretization.quadrature import gauss_legendre
 from .profiles import gamma_sample_points
 
 N_SAMPLE = 4001
@@ -17,7 +18,7 @@ N_SAMPLE = 4001
 
 
 def _gauss_on(breaks: np.ndarray, n: int = 12):
-    t, w = np.polynomial.legendre.leggauss(n)
+    t, w = gauss_legendre(n)
     a, b = breaks[:-1, None], breaks[1:, None]
     return (0.5 * (a + b) + 0.5 * (b - a) * t).ravel(), (0.5 * (b - a) * w).ravel()
 

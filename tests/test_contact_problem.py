@@ -82,3 +82,25 @@ def test_load_from_exact_solution_equals_quadrature_of_f():
         F_wrong = load_vector_from_exact(side, g, c, -ny)
         assert np.abs(F_quad - F_green).max() <= 1e-6 * np.abs(F_quad).max()
         assert np.abs(F_quad - F_wrong).max() > 1e3 * np.abs(F_quad - F_green).max()
+
+
+def test_errors_against_a_reference_vanish_on_itself_and_do_not_depend_on_call_order():
+    """The reference's own samples are kept on it after the first measurement: measuring
+    itself gives zero, and a solution measured before and after the cache fills gives the
+    same errors (the cached samples are those a fresh evaluation would give)."""
+    from infsup_contact.study import accuracy
+    sc = membranes(c1=1.0, c2=2.0)
+    ref = solve_contact(sc, "T3", 1, "structured", 16, 16, time_floor=False)
+    fresh = solve_contact(sc, "T3", 1, "structured", 16, 16, time_floor=False)
+    coarse = solve_contact(sc, "T4", 2, "structured", 4, 4, time_floor=False)
+
+    def errors(sol, reference):
+        return (*accuracy.energy_and_l2_vs_reference(sol, reference),
+                *accuracy.lambda_errors_vs_reference(sol, reference),
+                accuracy.contact_set_error_vs_reference(sol, reference))
+
+    first = errors(coarse, ref)           # fills ref's cache
+    assert errors(coarse, ref) == first   # served from it
+    assert errors(coarse, fresh) == first  # an equal reference evaluated afresh
+    assert min(first[:4]) > 1e-4
+    assert max(errors(ref, ref)) < 1e-12

@@ -105,7 +105,8 @@ def _element_quadrature(mesh, order: int):
     # reference (ξ, η) ↦ p0·(1 − ξ − η) + p1 ξ + p2 η, NGSolve's TRIG has vertices (1,0),(0,1),(0,0)
     lam = np.column_stack([ref[:, 0], ref[:, 1], 1 - ref[:, 0] - ref[:, 1]])
     xy = np.einsum("qa,tad->tqd", lam, np.stack([p0, p1, p2], axis=1))
-    area = 0.5 * np.abs(np.cross(p1 - p0, p2 - p0))
+    e1, e2 = p1 - p0, p2 - p0
+    area = 0.5 * np.abs(e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0])
     return xy.reshape(-1, 2), (2.0 * area[:, None] * w[None, :]).ravel()
 
 
@@ -115,31 +116,62 @@ def _values_at(gf, xy):
     return np.asarray(gf(mips)).reshape(len(xy)), np.asarray(ngsolve.grad(gf)(mips)).reshape(len(xy), 2)
 
 
+N_SINE = 2**14
+"""Sine coefficients of λ in the M-norm error (Richardson-extrapolated beyond)."""
+
+
+def _reference_samples(ref) -> dict:
+    """What every error measure evaluates of the reference alone, computed on first use and
+    kept on the reference object: a contact job measures a few dozen solutions against one
+    reference, and evaluating the reference at its own quadrature points is half the cost.
+
+    Keys: ``quadrature`` (per side: points, weights, values, gradients), ``lambda_sine``
+    (its λ's first :data:`N_SINE` sine coefficients), ``lambda_samples`` (λ at the
+    contact-set sample points).
+    """
+    cached = vars(ref).get("_error_samples")
+    if cached is not None:
+        return cached
+    quadrature = []
+    for gref in ref.u:
+        xy, w = _element_quadrature(gref.space.mesh, 2 * gref.space.globalorder)
+        vr, gr = _values_at(gref, xy)
+        quadrature.append((xy, w, vr, gr))
+    cached = dict(quadrature=quadrature,
+                  lambda_sine=ref.lam @ sine_coefficients(ref.space, np.arange(1, N_SINE + 1)),
+                  lambda_samples=lambda_values(ref, _contact_set_points()))
+    vars(ref)["_error_samples"] = cached
+    return cached
+
+
+def _contact_set_points() -> np.ndarray:
+    return (np.arange(N_SAMPLE) + 0.5) / N_SAMPLE
+
+
 def energy_and_l2_vs_reference(sol: ContactSolution, ref: ContactSolution) -> tuple[float, float]:
     """‖u_ref − u_h‖_a and L²(Ω), by quadrature on the reference mesh (exact when nested)."""
     e2 = l2 = 0.0
-    for gf, gref, c in zip(sol.u, ref.u, sol.c):
-        order = 2 * gref.space.globalorder
-        xy, w = _element_quadrature(gref.space.mesh, order)
+    for gf, (xy, w, vr, gr), c in zip(sol.u, _reference_samples(ref)["quadrature"], sol.c):
         v, g = _values_at(gf, xy)
-        vr, gr = _values_at(gref, xy)
         e2 += c * w @ np.sum((g - gr) ** 2, axis=1)
         l2 += w @ (v - vr) ** 2
     return float(np.sqrt(e2)), float(np.sqrt(l2))
 
 
-def lambda_errors_vs_reference(sol: ContactSolution, ref: ContactSolution, n_max: int = 2**14):
+def lambda_errors_vs_reference(sol: ContactSolution, ref: ContactSolution):
     """(‖λ_ref − λ_h‖_{L²(Γ)}, ‖λ_ref − λ_h‖_M), both exact up to the series tail."""
     breaks = np.union1d(sol.space.breakpoints, ref.space.breakpoints)
     x, w = _gauss_on(breaks)
     l2 = float(np.sqrt(w @ (lambda_values(ref, x) - lambda_values(sol, x)) ** 2))
-    n = np.arange(1, n_max + 1)
-    e = ref.lam @ sine_coefficients(ref.space, n) - sol.lam @ sine_coefficients(sol.space, n)
+    n = np.arange(1, N_SINE + 1)
+    e = _reference_samples(ref)["lambda_sine"] - sol.lam @ sine_coefficients(sol.space, n)
     partial = np.cumsum(e**2 / (n * np.pi))
-    s_half, s_full = partial[n_max // 2 - 1], partial[-1]
+    s_half, s_full = partial[N_SINE // 2 - 1], partial[-1]
     return l2, float(np.sqrt(max(s_full + (s_full - s_half) / 3.0, 0.0)))
 
 
 def contact_set_error_vs_reference(sol: ContactSolution, ref: ContactSolution) -> float:
-    x = (np.arange(N_SAMPLE) + 0.5) / N_SAMPLE
-    return float(np.mean(contact_set(lambda_values(ref, x), x) != contact_set(lambda_values(sol, x), x)))
+    """|A_ref Δ A_h| by sampling Γ."""
+    x = _contact_set_points()
+    return float(np.mean(contact_set(_reference_samples(ref)["lambda_samples"], x)
+                         != contact_set(lambda_values(sol, x), x)))

@@ -104,3 +104,18 @@ def test_errors_against_a_reference_vanish_on_itself_and_do_not_depend_on_call_o
     assert errors(coarse, fresh) == first  # an equal reference evaluated afresh
     assert min(first[:4]) > 1e-4
     assert max(errors(ref, ref)) < 1e-12
+
+
+def test_cases_sharing_one_pair_solve_as_if_alone():
+    """A pair built once and solved with several spaces gives each case the solution it
+    gets from a pair of its own (nothing a case does leaks into the shared sides)."""
+    from infsup_contact.solvers.contact import contact_pair, solve_contact_on
+    sc = membranes(c1=1.0, c2=2.0)
+    pair = contact_pair(sc, 2, "perturbed", 6, 5)
+    for case in ("R5.2", "T4", "T3"):
+        shared = solve_contact_on(pair, case, time_floor=False)
+        alone = solve_contact(sc, case, 2, "perturbed", 6, 5, time_floor=False)
+        assert np.array_equal(shared.lam, alone.lam)
+        for a, b in zip(shared.u, alone.u):
+            assert np.array_equal(a.vec.FV().NumPy(), b.vec.FV().NumPy())
+        assert shared.t_solve >= pair.seconds

@@ -12,7 +12,7 @@ register_user_spaces(snakemake.config)  # noqa: F821
 import pandas as pd  # noqa: E402
 
 from infsup_contact.io import write_csv_atomic  # noqa: E402
-from infsup_contact.study.contact_rows import contact_row, load_reference  # noqa: E402
+from infsup_contact.study.contact_rows import contact_rows, load_reference  # noqa: E402
 
 wc, cc = snakemake.wildcards, snakemake.params.cc  # noqa: F821
 k = int(wc.k)
@@ -20,10 +20,11 @@ spec = cc["scenes"][wc.scene]
 kind, params = spec["kind"], {key: v for key, v in spec.items() if key not in ("kind", "N")}
 c1, c2 = cc["c"]
 ref = load_reference(snakemake.input.reference[0]) if kind == "membranes" else None  # noqa: F821
-rows = [contact_row(kind, case, k, wc.family, n, n, c1, c2, reference=ref,
-                    scene_params=params, time_floor=False)
-        for n in snakemake.params.ns  # noqa: F821
-        for case, klist in cc["cases"].items() if k in klist]
+cases = [case for case, klist in cc["cases"].items() if k in klist]
+# one mesh pair (meshes, factorized sides, loads) per N, shared by every case
+rows = [row for n in snakemake.params.ns  # noqa: F821
+        for row in contact_rows(kind, cases, k, wc.family, n, n, c1, c2, reference=ref,
+                                scene_params=params, time_floor=False)]
 frame = pd.DataFrame(rows).assign(scene=wc.scene, scene_kind=kind)
 timing = [c for c in frame.columns if c.startswith("t_")]
 write_csv_atomic(snakemake.output[0], add_provenance(frame.drop(columns=timing), cc))  # noqa: F821

@@ -174,23 +174,66 @@ def linear_saddle_time(sides, Bs, c, F, active) -> float:
     return time.perf_counter() - t
 
 
-def solve_contact(scene, case: str, k: int, family: str, n1: int, n2: int,
-                  multiplier_mesh: str = "omega2", time_floor: bool = True, model=MEMBRANES,
-                  **mesh_kwargs) -> ContactSolution:
-    """Solve (4.1) for a scene (``scenes.scene``) with the multipliers of ``case`` (a registry
-    id); ``model`` gives the side operators (:mod:`infsup_contact.models.contract`)."""
-    registry.check_case(case, k)
-    m1, m2 = meshes.mesh_pair(family, n1, n2, **mesh_kwargs)
+@dataclass
+class ContactPair:
+    """What a contact solve on one mesh pair needs before the multiplier space is chosen:
+    the factorized sides, the loads F_i and the unconstrained displacements u0_i = A_i⁻¹F_i.
+
+    Every multiplier case on the pair shares it (:func:`solve_contact_on`); building it
+    is most of a solve's cost on the finer meshes, and none of it depends on M_h.
+
+    Attributes
+    ----------
+    meshes : tuple of ngsolve.Mesh
+    sides : list of SideOperator
+    F : list of ndarray
+        Loads on the free dofs of each side.
+    u0 : list of ndarray
+        A_i⁻¹ F_i / c_i.
+    c : tuple
+        (c1, c2).
+    k : int
+        Displacement degree.
+    seconds : float
+        Wall time of the build (sides, loads, u0), counted in every solve on the pair.
+    """
+
+    meshes: tuple
+    sides: list
+    F: list
+    u0: list
+    c: tuple
+    k: int
+    seconds: float
+
+
+def contact_pair(scene, k: int, family: str, n1: int, n2: int, model=MEMBRANES,
+                 **mesh_kwargs) -> ContactPair:
+    """Mesh, factorize and load both sides of ``scene`` (see :class:`ContactPair`)."""
+    mesh_pair = meshes.mesh_pair(family, n1, n2, **mesh_kwargs)
     c = (scene.c1, scene.c2)
     t0 = time.perf_counter()
-    sides = [model.side_operator(m, k) for m in (m1, m2)]
-    space = registry.case_space(case, k, meshes.multiplier_breakpoints(m1, m2, multiplier_mesh))
-    Bs = [coupling_matrix(s.trace, space, k) for s in sides]
-    K = interface_operator(Bs, sides, c)
+    sides = [model.side_operator(m, k) for m in mesh_pair]
     F = load_vectors(sides, scene)
     u0 = [s.solve(Fi) / ci for s, Fi, ci in zip(sides, F, c)]
+    return ContactPair(tuple(mesh_pair), sides, F, u0, c, k, time.perf_counter() - t0)
+
+
+def solve_contact_on(pair: ContactPair, case: str, multiplier_mesh: str = "omega2",
+                     time_floor: bool = True) -> ContactSolution:
+    """Solve (4.1) on a built pair with the multipliers of ``case`` (a registry id).
+
+    ``t_solve`` of the result is the pair's build time plus this call's: the cost of one
+    solve from meshes to u_h, whether or not the pair was shared.
+    """
+    registry.check_case(case, pair.k)
+    t0 = time.perf_counter()
+    sides, c, F, k = pair.sides, pair.c, pair.F, pair.k
+    space = registry.case_space(case, k, meshes.multiplier_breakpoints(*pair.meshes, multiplier_mesh))
+    Bs = [coupling_matrix(s.trace, space, k) for s in sides]
+    K = interface_operator(Bs, sides, c)
     ng = [B.shape[1] for B in Bs]
-    g0 = Bs[1] @ u0[1][-ng[1]:] - Bs[0] @ u0[0][-ng[0]:]
+    g0 = Bs[1] @ pair.u0[1][-ng[1]:] - Bs[0] @ pair.u0[0][-ng[0]:]
     pdas = solve_pdas(K, g0)
     u = []
     for sign, s, Fi, B, ci in zip((-1.0, 1.0), sides, F, Bs, c):
@@ -199,9 +242,19 @@ def solve_contact(scene, case: str, k: int, family: str, n1: int, n2: int,
         gf = ngsolve.GridFunction(s.trace.fes)
         gf.vec.FV().NumPy()[s.free] = s.solve(rhs) / ci
         u.append(gf)
-    t_solve = time.perf_counter() - t0
+    t_solve = pair.seconds + time.perf_counter() - t0
     t_floor = linear_saddle_time(sides, Bs, c, F, pdas.active) if time_floor else float("nan")
     return ContactSolution(space, sides, u, pdas.lam, pdas, c, t_solve, t_floor)
+
+
+def solve_contact(scene, case: str, k: int, family: str, n1: int, n2: int,
+                  multiplier_mesh: str = "omega2", time_floor: bool = True, model=MEMBRANES,
+                  **mesh_kwargs) -> ContactSolution:
+    """Solve (4.1) for a scene (``scenes.scene``) with the multipliers of ``case`` (a registry
+    id); ``model`` gives the side operators (:mod:`infsup_contact.models.contract`)."""
+    registry.check_case(case, k)
+    pair = contact_pair(scene, k, family, n1, n2, model=model, **mesh_kwargs)
+    return solve_contact_on(pair, case, multiplier_mesh, time_floor)
 
 
 def gamma_values(sol: ContactSolution, x: np.ndarray):

@@ -2,7 +2,7 @@
 from __future__ import annotations
 
 from . import accuracy
-from ..solvers.contact import ContactSolution, solve_contact
+from ..solvers.contact import ContactSolution, contact_pair, solve_contact, solve_contact_on
 from ..errors import InputError, check_prestress
 from ..discretization.registry import REFERENCE_SPACE, check_case, space_spec
 from .scenes import scene as make_scene
@@ -47,27 +47,50 @@ def contact_row(scene_name: str, case: str, k: int, family: str, n1: int, n2: in
                 c1: float = 1.0, c2: float = 1.0, reference: ContactSolution | None = None,
                 n_ref: int = 64, time_floor: bool = True, scene_params: dict | None = None, **mesh_kwargs) -> dict:
     """Solve one instance of (4.1) and measure it; errors vs exact (manufactured) or reference."""
+    return contact_rows(scene_name, [case], k, family, n1, n2, c1, c2, reference, n_ref,
+                        time_floor, scene_params, **mesh_kwargs)[0]
+
+
+def contact_rows(scene_name: str, cases, k: int, family: str, n1: int, n2: int,
+                 c1: float = 1.0, c2: float = 1.0, reference: ContactSolution | None = None,
+                 n_ref: int = 64, time_floor: bool = True, scene_params: dict | None = None,
+                 **mesh_kwargs) -> list[dict]:
+    """:func:`contact_row` for several multiplier cases on one mesh pair, which is meshed,
+    factorized and loaded once (:func:`~infsup_contact.solvers.contact.contact_pair`)."""
     if not 1 <= k <= 4:
         raise InputError("k", "an integer in 1..4", got=k)
-    check_case(case, k)
+    for case in cases:
+        check_case(case, k)
     for key, c in (("c1", c1), ("c2", c2)):
         check_prestress(key, c)
     sc = make_scene(scene_name, c1=c1, c2=c2, **(scene_params or {}))
-    sol = solve_contact(sc, case, k, family, n1, n2, time_floor=time_floor, **mesh_kwargs)
+    if not sc.has_exact:
+        reference = reference or reference_solution(sc, k, n_ref)
+    pair = contact_pair(sc, k, family, n1, n2, **mesh_kwargs)
+    rows = []
+    for case in cases:
+        sol = solve_contact_on(pair, case, time_floor=time_floor)
+        rows.append(dict(scene=scene_name, case=case, k=k, p=getattr(sc, "p", float("nan")),
+                         q=getattr(sc, "q", float("nan")), family=family, N1=n1, N2=n2, c1=c1, c2=c2,
+                         **_measures(sol, sc, reference, cone_kind(case, k))))
+    return rows
+
+
+def _measures(sol: ContactSolution, sc, reference, cone: str) -> dict:
+    """The columns of a row that measure the solution: errors vs the exact solution
+    (manufactured scenes) or the reference, the active-set statistics, the timings."""
     if sc.has_exact:
         energy, l2 = accuracy.energy_and_l2_errors(sol, sc)
         lam_l2 = accuracy.lambda_l2_error(sol, sc.lam, kinks=[sc.a])
         lam_h = accuracy.lambda_hm12_error(sol, sc.lam)
         cs = accuracy.contact_set_error(sol, sc.contact_set)
     else:
-        reference = reference or reference_solution(sc, k, n_ref)
         energy, l2 = accuracy.energy_and_l2_vs_reference(sol, reference)
         lam_l2, lam_h = accuracy.lambda_errors_vs_reference(sol, reference)
         cs = accuracy.contact_set_error_vs_reference(sol, reference)
     p = sol.pdas
     return dict(
-        scene=scene_name, case=case, k=k, p=getattr(sc, "p", float("nan")), q=getattr(sc, "q", float("nan")), family=family, N1=n1, N2=n2, c1=c1, c2=c2,
-        ndof=sol.ndof, dim_M=sol.space.dim, cone=cone_kind(case, k), iterations=p.iterations,
+        ndof=sol.ndof, dim_M=sol.space.dim, cone=cone, iterations=p.iterations,
         energy_error=energy, l2_error=l2, lambda_l2_error=lam_l2, lambda_hm12_error=lam_h,
         contact_set_error=cs, complementarity=p.complementarity, min_gap=p.min_gap,
         min_lambda=p.min_lambda, min_lambda_pointwise=accuracy.lambda_min_pointwise(sol),

@@ -1,7 +1,8 @@
 # Benchmarks stage: speed as ratios measured side by side in one job (all cores to itself,
 # one BLAS thread: the ratios are single-thread ratios), plus the speed–accuracy points.
 # Optional config keys (with their defaults): benchmarks.peers ([osqp, clarabel]),
-# benchmarks.eigsh_max_N (no limit), benchmarks.speed_accuracy_repeats (3),
+# benchmarks.eigsh_max_N (no limit), benchmarks.dense_max_size (2500),
+# benchmarks.route_budget_s (300), benchmarks.speed_accuracy_repeats (3),
 # benchmarks.speed_accuracy_scene ("manufactured").
 
 _BLAS1 = "export OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1 MKL_NUM_THREADS=1; "
@@ -29,6 +30,8 @@ rule bench_beta:
         repeats=lambda wc: config["benchmarks"]["repeats"],
         eigsh=lambda wc: (f"--eigsh-max-N {config['benchmarks']['eigsh_max_N']}"
                           if "eigsh_max_N" in config["benchmarks"] else ""),
+        dense=lambda wc: config["benchmarks"].get("dense_max_size", 2500),
+        budget=lambda wc: config["benchmarks"].get("route_budget_s", 300),
     threads: workflow.cores
     benchmark:
         "results/benchmarks/rules/bench_beta.tsv"
@@ -38,7 +41,7 @@ rule bench_beta:
         _BLAS1 + "python -c 'import sys; from infsup_contact.bench import write_machine_info;"
         " write_machine_info(sys.argv[1])' {output.machine} 2> {log}"
         " && infsup-contact bench --what beta --N {params.N} --k {params.k} --repeats {params.repeats}"
-        " {params.eigsh}"
+        " {params.eigsh} --dense-max-size {params.dense} --route-budget {params.budget}"
         " > {output.table}.tmp 2>> {log} && mv {output.table}.tmp {output.table}"
 
 
@@ -53,6 +56,7 @@ rule bench_contact:
         k=lambda wc: config["benchmarks"]["contact_k"],
         repeats=lambda wc: config["benchmarks"]["repeats"],
         peers=lambda wc: " ".join(config["benchmarks"].get("peers", ["osqp", "clarabel"])) or "none",
+        budget=lambda wc: config["benchmarks"].get("route_budget_s", 300),
     threads: workflow.cores
     benchmark:
         "results/benchmarks/rules/bench_contact.tsv"
@@ -60,7 +64,7 @@ rule bench_contact:
         "results/logs/bench_contact.log",
     shell:
         _BLAS1 + "infsup-contact bench --what contact --N {params.N} --k {params.k} --repeats {params.repeats}"
-        " --peers {params.peers}"
+        " --peers {params.peers} --route-budget {params.budget}"
         " > {output}.tmp 2> {log} && mv {output}.tmp {output}"
 
 
@@ -74,6 +78,7 @@ rule speed_accuracy:
     params:
         cc=lambda wc: config["contact"],
         repeats=lambda wc: config["benchmarks"].get("speed_accuracy_repeats", 3),
+        budget=lambda wc: config["benchmarks"].get("route_budget_s", 300),
         scene=lambda wc: config["benchmarks"].get("speed_accuracy_scene", "manufactured"),
     threads: workflow.cores
     benchmark:

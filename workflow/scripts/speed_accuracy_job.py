@@ -20,9 +20,10 @@ params = {key: v for key, v in spec.items() if key not in ("kind", "N")}
 errors = read_table(snakemake.input.contact, "contact")  # noqa: F821
 print(f"machine: {machine_info()}", file=sys.stderr)
 table = speed_accuracy_table(errors, repeats=int(p.repeats), timing_scene=kind,
-                             timing_params=params, c=tuple(cc["c"]))
+                             timing_params=params, c=tuple(cc["c"]), budget=float(p.budget))
 table["timing_scene"] = p.scene
 write_csv_atomic(snakemake.output[0], add_provenance(table, {"contact": cc, "repeats": p.repeats,  # noqa: F821
+                                                            "budget": p.budget,
                                                             "scene": p.scene}))
 front = table[table.pareto_energy][["scene", "case", "k", "N", "seconds", "energy_error"]]
 print("Pareto front (energy):\n" + front.to_string(), file=sys.stderr)

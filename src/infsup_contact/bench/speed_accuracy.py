@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .harness import _log, timed
+from .harness import _log, _stats, run_interleaved
 
 
 def pareto_front(times, errors) -> np.ndarray:
@@ -26,19 +26,22 @@ def pareto_front(times, errors) -> np.ndarray:
 
 
 def time_contact_solve(case: str, k: int, n: int, repeats: int = 3, scene: str = "manufactured",
-                       family: str = "structured", scene_params: dict | None = None, c=(1.0, 1.0)):
+                       family: str = "structured", scene_params: dict | None = None, c=(1.0, 1.0),
+                       budget: float = np.inf):
     """Median, min, max wall time of :func:`infsup_contact.solvers.contact.solve_contact` (whole call:
-    mesh, assembly, interface operator, PDAS, recovery; no floor timing)."""
+    mesh, assembly, interface operator, PDAS, recovery; no floor timing), repeated up to
+    ``repeats`` times while the accumulated time is below ``budget`` seconds."""
     from ..solvers.contact import solve_contact
     from ..study.scenes import scene as make_scene
 
     sc = make_scene(scene, c1=c[0], c2=c[1], **(scene_params or {}))
-    _, med, lo, hi = timed(lambda: solve_contact(sc, case, k, family, n, n, time_floor=False), repeats)
-    return med, lo, hi
+    _, times = run_interleaved({"solve": lambda: solve_contact(sc, case, k, family, n, n, time_floor=False)},
+                               repeats, budget)["solve"]
+    return (*_stats(times), len(times))
 
 
 def speed_accuracy_table(errors, repeats: int = 3, timing_scene: str = "manufactured",
-                         timing_params: dict | None = None, c=(1.0, 1.0)):
+                         timing_params: dict | None = None, c=(1.0, 1.0), budget: float = np.inf):
     """Speed–accuracy points: the errors of every (scene, case, k, N) with wall times.
 
     Parameters
@@ -48,6 +51,8 @@ def speed_accuracy_table(errors, repeats: int = 3, timing_scene: str = "manufact
         scene, case, k, family, N1, N2, energy_error, lambda_hm12_error; matching meshes
         (N1 = N2) are used.
     repeats : timing repetitions (median reported).
+    budget : a discretization's solve is repeated only while its accumulated time is below
+        this many seconds (the column ``repeats`` says how often it ran).
     timing_scene, timing_params : the scene whose solves are timed; the cost of a
         discretization (case, k, family, N) does not depend on the load, so one timing
         serves every scene.
@@ -67,11 +72,11 @@ def speed_accuracy_table(errors, repeats: int = 3, timing_scene: str = "manufact
     timing = {}
     for case, k, family, n in keys:
         timing[case, k, family, n] = time_contact_solve(case, k, n, repeats, timing_scene, family,
-                                                        timing_params, c)
+                                                        timing_params, c, budget)
         _log(f"speed-accuracy {family} {case} k={k} N={n}: {timing[case, k, family, n][0]:.4f} s")
     t = np.array([timing[r.case, int(r.k), r.family, int(r.N)] for r in frame.itertuples()])
     frame["seconds"], frame["seconds_min"], frame["seconds_max"] = t[:, 0], t[:, 1], t[:, 2]
-    frame["timing_scene"], frame["repeats"] = timing_scene, repeats
+    frame["timing_scene"], frame["repeats"] = timing_scene, t[:, 3].astype(int)
     cols = ["scene", "case", "k", "family", "N", "seconds", "seconds_min", "seconds_max",
             "energy_error", "lambda_hm12_error"]
     cols += [c_ for c_ in ("ndof", "dim_M", "cone", "nonunique", "kernel_dim") if c_ in frame.columns]

@@ -19,6 +19,11 @@ def add(sub) -> None:
                    help="beta: run the shift-invert Lanczos route only for N <= this")
     p.add_argument("--kkt-max-N", dest="kkt_max_n", type=int, default=64,
                    help="contact: run the sparse-KKT active-set route only for N <= this")
+    p.add_argument("--dense-max-size", dest="dense_max_size", type=int, default=2500,
+                   help="beta: run the dense eigh route only while the pencil has at most this many rows")
+    p.add_argument("--route-budget", dest="route_budget", type=float, default=300.0,
+                   help="seconds: a route is repeated (up to --repeats) only while its accumulated "
+                        "time is below this, so slow routes run once (default 300)")
     add_dry_run(p)
     p.set_defaults(run=_run_bench, check=_check_bench)
 
@@ -36,6 +41,10 @@ def _check_bench(args):
             raise InputError(key, f"{allowed}, each once", got=" ".join(map(str, values)))
     if args.repeats < 1:
         raise InputError("repeats", "an integer >= 1", got=args.repeats)
+    if not args.route_budget >= 0 or args.route_budget == float("inf"):
+        raise InputError("route_budget", "a finite number of seconds >= 0", got=args.route_budget)
+    if args.dense_max_size < 0:
+        raise InputError("dense_max_size", "an integer >= 0 (0: never)", got=args.dense_max_size)
     for key in ("eigsh_max_n", "kkt_max_n"):
         value = getattr(args, key)
         if value is not None and value < 0:
@@ -58,8 +67,9 @@ def _run_bench(args) -> None:
 
     peers = args.peer_list
     if args.what == "beta":
-        rows = bench.bench_beta(args.N, args.k, args.repeats, eigsh_max_n=args.eigsh_max_n)
+        rows = bench.bench_beta(args.N, args.k, args.repeats, dense_max_size=args.dense_max_size,
+                                eigsh_max_n=args.eigsh_max_n, budget=args.route_budget)
     else:
         rows = bench.bench_contact(args.N, args.k, args.repeats, peers=tuple(peers),
-                                   kkt_max_n=args.kkt_max_n)
+                                   kkt_max_n=args.kkt_max_n, budget=args.route_budget)
     pd.DataFrame(rows).to_csv(sys.stdout, index=False, float_format="%.6g")

@@ -214,6 +214,12 @@ def _log_term(aI, bI, aJ, bJ, term, s: int, n_log: int, n_x: int, q_piece: int) 
     return np.swapaxes(px, 1, 2) @ qy
 
 
+def clear_partition_cache() -> None:
+    """Forget the cached element integrals of every partition (:func:`_local_blocks`): a
+    benchmark clears them before each timed call so that a repeat is not a cache lookup."""
+    _local_blocks.cache_clear()
+
+
 @lru_cache(maxsize=8)
 def _local_blocks(xb_bytes: bytes, s: int, scale: int) -> np.ndarray:
     """Element integrals ∬_{I×J} φ_a(x) φ_b(y) k(x, y) dx dy (without the 1/π) of the local

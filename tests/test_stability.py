@@ -47,3 +47,20 @@ def test_r54_eigenvalue_above_kernel_decays(k):
     ns = [4, 8, 16]
     above = _series("structured", k, "R5.4", ns, "H", key="smallest_nonzero")
     assert np.all(np.diff(above) < 0) and _slope(ns, above) > 0.7, above
+
+
+def test_multiplier_meshes_with_one_partition_share_rows_equal_to_separate_runs():
+    """On a matching pair G_h is the same partition for omega2, omega1 and union: the rows
+    copied within one call equal those a call for that multiplier mesh alone computes.
+    On a non-matching pair the partitions differ and so do the β_h."""
+    from infsup_contact.solvers.infsup import beta_rows, beta_rows_all
+    numbers = ["beta", "kernel_dim", "smallest_nonzero", "beta_v1_zero", "dim_M"]
+    mms = ["omega2", "omega1", "union"]
+    for n1, n2, shared in ((6, 6, True), (7, 6, False)):
+        together = beta_rows_all("perturbed", 2, n1, n2, ["T3", "R5.4"], mms, ((1.0, 2.0),), ("H",), seed=3)
+        for mm in mms:
+            alone = beta_rows("perturbed", 2, n1, n2, ["T3", "R5.4"], mm, 1.0, 2.0, ("H",), seed=3)
+            got = [r for r in together if r["multiplier_mesh"] == mm]
+            assert [[r[c] for c in numbers] for r in got] == [[r[c] for c in numbers] for r in alone]
+        betas = {mm: [r["beta"] for r in together if r["multiplier_mesh"] == mm] for mm in mms}
+        assert (betas["omega2"] == betas["union"] == betas["omega1"]) == shared

@@ -262,7 +262,8 @@ def gamma_values(sol: ContactSolution, x: np.ndarray):
     out = []
     for gf, side in zip(sol.u, sol.sides):
         mesh = side.trace.fes.mesh
-        out.append(np.array([gf(mesh(xi, 1.0)) for xi in x]))
+        x = np.asarray(x, dtype=float)
+        out.append(np.asarray(gf(mesh(x, np.ones_like(x)))).reshape(x.shape))
     return out
 
 

@@ -410,7 +410,8 @@ def job_estimates(cfg):
                 "structured", k, n1, n2, "omega2", ("L2",), components=2)
     for what in ("beta", "contact"):
         yield (f"benchmarks.{what}_N", f"bench_{what}", R.bench_estimate(
-            what, bc[f"{what}_N"], bc[f"{what}_k"], bc["repeats"], bc.get("eigsh_max_N")))
+            what, bc[f"{what}_N"], bc[f"{what}_k"], bc["repeats"], bc.get("eigsh_max_N"),
+            bc.get("kkt_max_N", 64)))
 
 
 def check_job_memory(cfg, limit: float | None) -> None:

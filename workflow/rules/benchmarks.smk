@@ -2,7 +2,8 @@
 # one BLAS thread: the ratios are single-thread ratios), plus the speed–accuracy points.
 # Optional config keys (with their defaults): benchmarks.peers ([osqp, clarabel]),
 # benchmarks.eigsh_max_N (no limit), benchmarks.dense_max_size (2500),
-# benchmarks.route_budget_s (300), benchmarks.speed_accuracy_repeats (3),
+# benchmarks.route_budget_s (300), benchmarks.kkt_max_N (64), benchmarks.speed_accuracy_repeats (3),
+# benchmarks.speed_accuracy_budget_s (300),
 # benchmarks.speed_accuracy_scene ("manufactured").
 
 _BLAS1 = "export OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1 MKL_NUM_THREADS=1; "
@@ -57,6 +58,7 @@ rule bench_contact:
         repeats=lambda wc: config["benchmarks"]["repeats"],
         peers=lambda wc: " ".join(config["benchmarks"].get("peers", ["osqp", "clarabel"])) or "none",
         budget=lambda wc: config["benchmarks"].get("route_budget_s", 300),
+        kkt=lambda wc: config["benchmarks"].get("kkt_max_N", 64),
     threads: workflow.cores
     benchmark:
         "results/benchmarks/rules/bench_contact.tsv"
@@ -64,7 +66,7 @@ rule bench_contact:
         "results/logs/bench_contact.log",
     shell:
         _BLAS1 + "infsup-contact bench --what contact --N {params.N} --k {params.k} --repeats {params.repeats}"
-        " --peers {params.peers} --route-budget {params.budget}"
+        " --peers {params.peers} --route-budget {params.budget} --kkt-max-N {params.kkt}"
         " > {output}.tmp 2> {log} && mv {output}.tmp {output}"
 
 
@@ -78,7 +80,7 @@ rule speed_accuracy:
     params:
         cc=lambda wc: config["contact"],
         repeats=lambda wc: config["benchmarks"].get("speed_accuracy_repeats", 3),
-        budget=lambda wc: config["benchmarks"].get("route_budget_s", 300),
+        budget=lambda wc: config["benchmarks"].get("speed_accuracy_budget_s", 300),
         scene=lambda wc: config["benchmarks"].get("speed_accuracy_scene", "manufactured"),
     threads: workflow.cores
     benchmark:

@@ -117,16 +117,13 @@ def nonmatching_claim(beta: pd.DataFrame, finer: bool, families=None, rtol: floa
         b = b.drop_duplicates(subset=[c for c in b.columns if c != "series"])
     if families is not None:
         b = b[b.family.isin(families)]
-    match = b[b.N1 == b.N2].set_index(keys + ["N2"]).beta
-    worst, count = np.inf, 0
+    match = b[b.N1 == b.N2][keys + ["N2", "beta"]].rename(columns={"beta": "beta_matching"})
     side = b[(b.N1 > b.N2) if finer else (b.N1 < b.N2)]
     if series is not None:
         side = side[side.series == series] if "series" in side.columns else side.iloc[:0]
-    for _, r in side.iterrows():
-        key = tuple(r[keys]) + (r.N2,)
-        if key in match.index:
-            count += 1
-            worst = min(worst, r.beta - match[key] * (1 - rtol))
+    pairs = side[keys + ["N2", "beta"]].merge(match, on=keys + ["N2"], how="inner")
+    count = len(pairs)
+    worst = float(np.nanmin(pairs.beta - pairs.beta_matching * (1 - rtol), initial=np.inf))
     if count == 0:
         return INCONCLUSIVE, "no non-matching pair with a matching partner in the table"
     return (PASS if worst >= 0 else FAIL), f"{count} comparisons; min β(N1≠N2) − β(N2=N1) = {worst:.3g}"

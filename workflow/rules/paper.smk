@@ -27,7 +27,7 @@ rule paper_macros:
         tex="paper/paper.tex",
         src=REPORT_SOURCES,
     params:
-        cfg=lambda wc: {key: config[key] for key in ("claims", "contact", "infsup")},
+        cfg=lambda wc: {key: config[key] for key in ("claims", "contact", "infsup", "benchmarks")},
     benchmark:
         "results/benchmarks/rules/paper_macros.tsv"
     log:

@@ -85,7 +85,9 @@ def trace_values(trace: GammaTrace, x: np.ndarray):
     rows, cols, vals, fes = [], [], [], {}
     for i, (xi, ei) in enumerate(zip(x, e)):
         x0, x1, dn, el = trace.elements[ei]
-        fe = fes.get(ei) or fes.setdefault(ei, trace.fes.GetFE(el))
+        if ei not in fes:  # GetFE once per element, not once per point
+            fes[ei] = trace.fes.GetFE(el)
+        fe = fes[ei]
         # the reference coordinate runs from the second vertex (0) to the first (1)
         shape = np.asarray(fe.CalcShape((xi - x1) / (x0 - x1), 0.0, 0.0))
         pos = position[dn]

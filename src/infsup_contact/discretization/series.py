@@ -97,8 +97,9 @@ def beta_batches(ic: dict, budget: float = 25.0) -> dict:
 
     All pairs of every series of one (family, k), each pair once, cheapest first, cut into
     the fewest consecutive chunks of about equal estimated seconds that keep each near
-    ``budget`` (:func:`pair_cost`, × the number of seeds on perturbed meshes), so that NGSolve's start-up (~1 s a process) is
-    paid once per batch and not once per pair. Batch id ``{family}_k{k}_{chunk}``.
+    ``budget`` (:func:`pair_cost`, × the number of seeds on perturbed meshes), so that
+    NGSolve's start-up (~1 s a process) is paid once per batch and not once per pair.
+    Batch id ``{family}_k{k}_{chunk}``.
     """
     ks = sorted({k for klist in ic["cases"].values() for k in klist})
     pairs = sorted(series_of_pairs(ic), key=lambda p: (max(p), p))

@@ -37,8 +37,23 @@ from ..errors import InputError
 from .ordering import nested_dissection_gamma_last
 
 
+class _SteklovProduct:
+    """X M for X = S⁻¹ = (A⁻¹)_ΓΓ, for a class with ``schur`` (S) and ``steklov`` (X or None):
+    a product where X is known, else a solve with the Cholesky factor of S, computed on
+    first use and kept (a β_h sweep asks for X M for every multiplier space on one side)."""
+
+    def steklov_times(self, M: np.ndarray) -> np.ndarray:
+        if self.steklov is not None:
+            return self.steklov @ M
+        return sla.cho_solve(self._schur_cholesky, M, check_finite=False)
+
+    @cached_property
+    def _schur_cholesky(self):
+        return sla.cho_factor(self.schur, check_finite=False)
+
+
 @dataclass(frozen=True)
-class SideOperator:
+class SideOperator(_SteklovProduct):
     """Factorized stiffness of one body and its Γ Schur complement (unit material scale).
 
     Attributes
@@ -71,24 +86,6 @@ class SideOperator:
         X = self.steklov if self.steklov is not None else sla.inv(self.schur, check_finite=False)
         return X / c
 
-    def steklov_times(self, M: np.ndarray) -> np.ndarray:
-        """X_i M for c_i = 1: a product where X_i is known, else a solve with the Cholesky
-        factor of S_i, computed on first use and kept (a β_h sweep asks for X_i M for every
-        multiplier space on the same side)."""
-        if self.steklov is not None:
-            return self.steklov @ M
-        return sla.cho_solve(self._schur_cholesky, M, check_finite=False)
-
-    @cached_property
-    def _schur_cholesky(self):
-        return sla.cho_factor(self.schur, check_finite=False)
-
-
-def steklov_times(schur: np.ndarray, steklov: np.ndarray | None, M: np.ndarray) -> np.ndarray:
-    """X M for X = S⁻¹ = (A⁻¹)_ΓΓ: a product where X is known, else a solve with S."""
-    if steklov is not None:
-        return steklov @ M
-    return sla.solve(schur, M, assume_a="pos", check_finite=False)
 
 
 def _gamma_last_lu(A: sp.csc_matrix, n_gamma: int):
@@ -124,7 +121,7 @@ GAMMA_ROUTES = ("auto", "solves", "nested")
 
 
 @dataclass(frozen=True)
-class GammaFactorization:
+class GammaFactorization(_SteklovProduct):
     """One factorization of A (Γ = its last n_Γ unknowns) and what Γ needs from it.
 
     Attributes
@@ -144,9 +141,6 @@ class GammaFactorization:
     steklov: np.ndarray | None
     route: str
 
-    def steklov_times(self, M: np.ndarray) -> np.ndarray:
-        """X M (:func:`steklov_times`)."""
-        return steklov_times(self.schur, self.steklov, M)
 
 
 def gamma_factorization(A, n_gamma: int, route: str = "auto") -> GammaFactorization:

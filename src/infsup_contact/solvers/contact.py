@@ -259,10 +259,10 @@ def solve_contact(scene, case: str, k: int, family: str, n1: int, n2: int,
 
 def gamma_values(sol: ContactSolution, x: np.ndarray):
     """u_{1,h}, u_{2,h} on Γ at abscissae x (interior of Γ), via point evaluation."""
+    x = np.asarray(x, dtype=float)
     out = []
     for gf, side in zip(sol.u, sol.sides):
         mesh = side.trace.fes.mesh
-        x = np.asarray(x, dtype=float)
         out.append(np.asarray(gf(mesh(x, np.ones_like(x)))).reshape(x.shape))
     return out
 

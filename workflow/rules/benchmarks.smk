@@ -2,8 +2,8 @@
 # one BLAS thread: the ratios are single-thread ratios), plus the speed–accuracy points.
 # Optional config keys (with their defaults): benchmarks.peers ([osqp, clarabel]),
 # benchmarks.eigsh_max_N (no limit), benchmarks.dense_max_size (2500),
-# benchmarks.route_budget_s (300), benchmarks.kkt_max_N (64), benchmarks.speed_accuracy_repeats (3),
-# benchmarks.speed_accuracy_budget_s (300),
+# benchmarks.route_budget_s (10), benchmarks.kkt_max_N (64), benchmarks.speed_accuracy_repeats (3),
+# benchmarks.speed_accuracy_budget_s (10),
 # benchmarks.speed_accuracy_scene ("manufactured").
 
 _BLAS1 = "export OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1 MKL_NUM_THREADS=1; "
@@ -32,7 +32,7 @@ rule bench_beta:
         eigsh=lambda wc: (f"--eigsh-max-N {config['benchmarks']['eigsh_max_N']}"
                           if "eigsh_max_N" in config["benchmarks"] else ""),
         dense=lambda wc: config["benchmarks"].get("dense_max_size", 2500),
-        budget=lambda wc: config["benchmarks"].get("route_budget_s", 300),
+        budget=lambda wc: config["benchmarks"].get("route_budget_s", 10),
     threads: workflow.cores
     benchmark:
         "results/benchmarks/rules/bench_beta.tsv"
@@ -57,7 +57,7 @@ rule bench_contact:
         k=lambda wc: config["benchmarks"]["contact_k"],
         repeats=lambda wc: config["benchmarks"]["repeats"],
         peers=lambda wc: " ".join(config["benchmarks"].get("peers", ["osqp", "clarabel"])) or "none",
-        budget=lambda wc: config["benchmarks"].get("route_budget_s", 300),
+        budget=lambda wc: config["benchmarks"].get("route_budget_s", 10),
         kkt=lambda wc: config["benchmarks"].get("kkt_max_N", 64),
     threads: workflow.cores
     benchmark:
@@ -80,7 +80,7 @@ rule speed_accuracy:
     params:
         cc=lambda wc: config["contact"],
         repeats=lambda wc: config["benchmarks"].get("speed_accuracy_repeats", 3),
-        budget=lambda wc: config["benchmarks"].get("speed_accuracy_budget_s", 300),
+        budget=lambda wc: config["benchmarks"].get("speed_accuracy_budget_s", 10),
         scene=lambda wc: config["benchmarks"].get("speed_accuracy_scene", "manufactured"),
     threads: workflow.cores
     benchmark:

@@ -45,7 +45,7 @@ from ..discretization.norms import gram
 from ..models.membranes import side_operator
 from ..models.schur import SideOperator, interface_operator
 from ..solvers.infsup import beta_rows
-from .harness import _log, _row, run_interleaved
+from .harness import ROUTE_BUDGET, _log, _row, run_interleaved
 
 
 NORMS = ("H", "L2")
@@ -227,7 +227,7 @@ BETA_INCLUDES = {
 
 
 def bench_beta(ns, ks, repeats: int = 3, dense_max_size: int = 2500, eigsh_max_n: int | None = None,
-               slow_repeats_above_n: int = 32, budget: float = 300.0):
+               budget: float = ROUTE_BUDGET):
     """β_h routes on the structured N×N pairs, every valid case × both norms.
 
     Parameters
@@ -236,7 +236,6 @@ def bench_beta(ns, ks, repeats: int = 3, dense_max_size: int = 2500, eigsh_max_n
     repeats : repetitions per route (median, min, max reported; interleaved).
     dense_max_size : the dense route runs while the pencil has at most this many rows.
     eigsh_max_n : the eigsh route runs for N ≤ this (None: always).
-    slow_repeats_above_n : eigsh and dense run once for N above this.
     budget : a route is not repeated once its accumulated time exceeds this (seconds).
 
     Returns
@@ -256,9 +255,8 @@ def bench_beta(ns, ks, repeats: int = 3, dense_max_size: int = 2500, eigsh_max_n
                 routes["eigsh"] = lambda: beta_pencil_route(setup, beta_eigsh)
             if setup.pencil_size() <= dense_max_size:
                 routes["dense"] = lambda: beta_pencil_route(setup, beta_dense)
-            slow = {r: 1 for r in ("eigsh", "dense")} if n > slow_repeats_above_n else {}
             _log(f"beta k={k} N={n}: routes {list(routes)}")
-            res = run_interleaved(routes, repeats, budget, slow)
+            res = run_interleaved(routes, repeats, budget)
             ref, t_ours = res["ours"]
             t_core = res["ours_core"][1]
             med_ours, med_core = float(np.median(t_ours)), float(np.median(t_core))

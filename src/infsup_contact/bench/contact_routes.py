@@ -38,7 +38,7 @@ from ..discretization import meshes, registry
 from ..discretization.registry import REFERENCE_SPACE
 from ..discretization.coupling import coupling_matrix
 from ..models.membranes import side_operator
-from .harness import _log, _row, run_interleaved
+from .harness import ROUTE_BUDGET, _log, _row, run_interleaved
 
 
 RTOL = 1e-8
@@ -105,7 +105,7 @@ CONTACT_INCLUDES = {
 
 def bench_contact(ns, ks, repeats: int = 3, case: str = REFERENCE_SPACE, peers=("osqp", "clarabel"),
                   peer_options: dict | None = None, tolerances=None, peer_time_limit: float = 600.0,
-                  kkt_max_n: int = 64, budget: float = 300.0, tune_budget: float = 1200.0):
+                  kkt_max_n: int = 64, budget: float = ROUTE_BUDGET, tune_budget: float = 1200.0):
     """Contact solves of the membranes scene: ours against the floor and the peers.
 
     Parameters

@@ -27,6 +27,10 @@ from ..discretization.logkernel import clear_partition_cache
 
 PEER_LIBRARIES = ("osqp", "clarabel", "qpsolvers", "scikit-sparse")
 
+ROUTE_BUDGET = 10.0
+"""Default seconds after which a route is not repeated (:func:`run_interleaved`): a route
+slower than this runs once, its spread being small next to its time."""
+
 
 
 def _log(msg: str) -> None:

@@ -21,9 +21,9 @@ def add(sub) -> None:
                    help="contact: run the sparse-KKT active-set route only for N <= this")
     p.add_argument("--dense-max-size", dest="dense_max_size", type=int, default=2500,
                    help="beta: run the dense eigh route only while the pencil has at most this many rows")
-    p.add_argument("--route-budget", dest="route_budget", type=float, default=300.0,
+    p.add_argument("--route-budget", dest="route_budget", type=float, default=None,
                    help="seconds: a route is repeated (up to --repeats) only while its accumulated "
-                        "time is below this, so slow routes run once (default 300)")
+                        "time is below this, so slow routes run once (default 10)")
     add_dry_run(p)
     p.set_defaults(run=_run_bench, check=_check_bench)
 
@@ -41,6 +41,9 @@ def _check_bench(args):
             raise InputError(key, f"{allowed}, each once", got=" ".join(map(str, values)))
     if args.repeats < 1:
         raise InputError("repeats", "an integer >= 1", got=args.repeats)
+    from ..bench.harness import ROUTE_BUDGET
+
+    args.route_budget = ROUTE_BUDGET if args.route_budget is None else args.route_budget
     if not args.route_budget >= 0 or args.route_budget == float("inf"):
         raise InputError("route_budget", "a finite number of seconds >= 0", got=args.route_budget)
     if args.dense_max_size < 0:

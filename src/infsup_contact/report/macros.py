@@ -259,8 +259,9 @@ def config_macros(cfg: dict) -> list[Macro]:
                 out.append(Macro(macro_name("cfg", name, key.upper()), f"{float(spec[key]):g}",
                                  f"config: contact.scenes.{name}.{key}"))
     bc = cfg.get("benchmarks", {})
-    out.append(Macro("cfgRouteBudget", f"{float(bc.get('route_budget_s', 300)):g}",
-                     "config: benchmarks.route_budget_s (default 300)"))
+    from ..bench.harness import ROUTE_BUDGET
+    out.append(Macro("cfgRouteBudget", f"{float(bc.get('route_budget_s', ROUTE_BUDGET)):g}",
+                     "config: benchmarks.route_budget_s (default: bench.harness.ROUTE_BUDGET)"))
     out.append(Macro("cfgBenchRepeats", fmt_int(bc.get("repeats", 3)), "config: benchmarks.repeats"))
     ic = cfg.get("infsup", {})
     if "alpha" in ic:

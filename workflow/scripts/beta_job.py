@@ -18,18 +18,26 @@ import pandas as pd  # noqa: E402
 
 from infsup_contact.discretization.series import seeds, series_of_pairs  # noqa: E402
 from infsup_contact.io import write_csv_atomic  # noqa: E402
+from infsup_contact.models.membranes import MEMBRANES  # noqa: E402
+from infsup_contact.models.side_cache import SideCache  # noqa: E402
 from infsup_contact.solvers.infsup import beta_rows_all  # noqa: E402
 
 ic, batch = snakemake.params.ic, snakemake.params.batch  # noqa: F821
 family, k = batch["family"], int(batch["k"])
 cases = [c for c, klist in ic["cases"].items() if k in klist]
 member = series_of_pairs(ic)
+mesh_kwargs = {seed: ({} if seed is None else {"seed": seed, "alpha": ic["alpha"]})
+               for seed in (seeds(ic) if family == "perturbed" else [None])}
+# pairs of a batch share sides ((16, 16), (17, 16), (24, 16): Ω2's): each is factorized once
+sides = SideCache()
+for kw in mesh_kwargs.values():
+    sides.expect(MEMBRANES, family, k, batch["pairs"], **kw)
 frames = []
 for n1, n2 in batch["pairs"]:
-    for seed in (seeds(ic) if family == "perturbed" else [None]):
-        kw = {} if seed is None else {"seed": seed, "alpha": ic["alpha"]}
+    for seed, kw in mesh_kwargs.items():
         rows = pd.DataFrame(beta_rows_all(family, k, n1, n2, cases, ic["multiplier_meshes"],
-                                          [tuple(c) for c in ic["c"]], ic["norms"], **kw))
+                                          [tuple(c) for c in ic["c"]], ic["norms"],
+                                          side_cache=sides, **kw))
         rows["seed"] = np.nan if seed is None else seed
         for name in member[(n1, n2)]:
             frames.append(rows.assign(series=name))

@@ -165,15 +165,23 @@ def gamma_breakpoints(mesh: ngsolve.Mesh) -> np.ndarray:
     return np.array(sorted(xs))
 
 
-def multiplier_breakpoints(mesh1, mesh2, choice: str = "omega2", tol: float = 1e-12) -> np.ndarray:
-    """Partition G_h of Γ: the trace of Ω2 (paper's default), of Ω1, or their union."""
-    choices = {"omega2": lambda: gamma_breakpoints(mesh2), "omega1": lambda: gamma_breakpoints(mesh1)}
+MULTIPLIER_MESHES = ("omega2", "omega1", "union")
+
+
+def partition_choice(x1: np.ndarray, x2: np.ndarray, choice: str = "omega2", tol: float = 1e-12) -> np.ndarray:
+    """Partition G_h of Γ from the two trace partitions: Ω2's (the paper's default), Ω1's,
+    or their union (points closer than ``tol`` merged)."""
+    if choice not in MULTIPLIER_MESHES:
+        raise InputError("multiplier_mesh", ", ".join(MULTIPLIER_MESHES), got=choice)
     if choice == "union":
-        x = np.union1d(gamma_breakpoints(mesh1), gamma_breakpoints(mesh2))
+        x = np.union1d(x1, x2)
         return x[np.concatenate([[True], np.diff(x) > tol])]
-    if choice not in choices:
-        raise InputError("multiplier_mesh", "omega2, omega1, union", got=choice)
-    return choices[choice]()
+    return np.asarray(x2 if choice == "omega2" else x1)
+
+
+def multiplier_breakpoints(mesh1, mesh2, choice: str = "omega2", tol: float = 1e-12) -> np.ndarray:
+    """Partition G_h of Γ (:func:`partition_choice`) of a mesh pair."""
+    return partition_choice(gamma_breakpoints(mesh1), gamma_breakpoints(mesh2), choice, tol)
 
 
 def mesh_quality(mesh: ngsolve.Mesh) -> dict:

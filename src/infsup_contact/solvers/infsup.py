@@ -19,6 +19,7 @@ from ..discretization.coupling import coupling_matrix
 from ..errors import InputError, check_prestress
 from ..models.schur import combine_terms, interface_terms
 from ..models.membranes import MEMBRANES
+from ..models.side_cache import SideCache
 from ..discretization.norms import NORMS, gram
 from .kernel import GAP_DECADES, KERNEL_CRITERION, kernel_check, kernel_from_gap  # noqa: F401
 
@@ -70,8 +71,8 @@ def check_inputs(case, k, family, n1, n2, c1, c2, norm, multiplier_mesh) -> None
     for nm in norm:
         if nm not in NORMS:
             raise InputError("norm", ", ".join(NORMS), got=nm)
-    if multiplier_mesh not in ("omega2", "omega1", "union"):
-        raise InputError("multiplier_mesh", "omega2, omega1, union", got=multiplier_mesh)
+    if multiplier_mesh not in meshes.MULTIPLIER_MESHES:
+        raise InputError("multiplier_mesh", ", ".join(meshes.MULTIPLIER_MESHES), got=multiplier_mesh)
 
 
 def common_coarsening(x1: np.ndarray, x2: np.ndarray, tol: float = 1e-12) -> np.ndarray:
@@ -94,12 +95,13 @@ def _space(case, k, breakpoints):
 
 
 def beta_rows(family, k, n1, n2, cases=None, multiplier_mesh="omega2",
-              c1=1.0, c2=1.0, norms=NORMS, h_route="logkernel", model=MEMBRANES, **mesh_kwargs):
+              c1=1.0, c2=1.0, norms=NORMS, h_route="logkernel", model=MEMBRANES, side_cache=None,
+              **mesh_kwargs):
     """β_h for several cases and norms on one mesh pair, reusing the interface operator.
 
     ``cases`` are registry ids (default: every registered space defined for k) or general
     triples (see :func:`_space`); ``model`` gives the side operators (the model seam,
-    :mod:`infsup_contact.models.contract`).
+    :mod:`infsup_contact.models.contract`); ``side_cache`` as in :func:`beta_rows_all`.
 
     Returns
     -------
@@ -107,11 +109,11 @@ def beta_rows(family, k, n1, n2, cases=None, multiplier_mesh="omega2",
         One row per (case, norm) with the columns of ``infsup-contact beta``.
     """
     return beta_rows_all(family, k, n1, n2, cases, (multiplier_mesh,), ((c1, c2),), norms,
-                         h_route=h_route, model=model, **mesh_kwargs)
+                         h_route=h_route, model=model, side_cache=side_cache, **mesh_kwargs)
 
 
 def beta_rows_all(family, k, n1, n2, cases=None, multiplier_meshes=("omega2",), c_pairs=((1.0, 1.0),),
-                  norms=NORMS, h_route="logkernel", model=MEMBRANES, **mesh_kwargs):
+                  norms=NORMS, h_route="logkernel", model=MEMBRANES, side_cache=None, **mesh_kwargs):
     """:func:`beta_rows` for several multiplier meshes and prestress pairs at once.
 
     The meshes and the side factorizations are built once per mesh pair, the couplings and
@@ -123,21 +125,22 @@ def beta_rows_all(family, k, n1, n2, cases=None, multiplier_meshes=("omega2",), 
     traces of Ω1 and Ω2 and their union usually coincide) defines the same spaces, hence the
     same numbers: its rows are copies of the earlier ones, with their own ``multiplier_mesh``
     and zero timings.
+
+    ``side_cache``: a :class:`~infsup_contact.models.side_cache.SideCache` the side operators
+    are taken from (a sweep over pairs that share a side builds it once); default: built here.
     """
     cases = registry.ids_valid_for(k) if cases is None else list(cases)
     for mm in multiplier_meshes:
         for c1, c2 in c_pairs:
             check_inputs([c for c in cases if isinstance(c, str)], k, family, n1, n2, c1, c2, norms, mm)
-    t0 = time.perf_counter()
-    mesh1, mesh2 = meshes.mesh_pair(family, n1, n2, **mesh_kwargs)
     t1 = time.perf_counter()
-    sides = [model.side_operator(m, k) for m in (mesh1, mesh2)]
+    sides = (side_cache or SideCache()).pair(model, family, k, n1, n2, **mesh_kwargs)
     t2 = time.perf_counter()
     x1, x2 = (s.trace.breakpoints for s in sides)
     dim_w = trace_sum_dimension(k, x1, x2)
     rows, by_partition = [], {}
     for multiplier_mesh in multiplier_meshes:
-        x_mult = meshes.multiplier_breakpoints(mesh1, mesh2, multiplier_mesh)
+        x_mult = meshes.partition_choice(x1, x2, multiplier_mesh)
         same = by_partition.get(x_mult.tobytes())
         if same is not None:
             rows += [dict(r, multiplier_mesh=multiplier_mesh, t_assemble=0.0, t_interface=0.0, t_eig=0.0)
@@ -168,7 +171,7 @@ def beta_rows_all(family, k, n1, n2, cases=None, multiplier_meshes=("omega2",), 
                         smallest_nonzero=sp_.smallest_nonzero, beta_v1_zero=beta_v1_zero,
                         dim_M=space.dim, dim_W=dim_w,
                         n_max=info["n_max"], nmax_rel_error=info["nmax_rel_error"],
-                        ndof=sum(s.ndof for s in sides), t_assemble=t1 - t0 + t_coupling,
+                        ndof=sum(s.ndof for s in sides), t_assemble=t_coupling,
                         t_interface=t2 - t1, t_eig=time.perf_counter() - te))
         by_partition[x_mult.tobytes()] = rows[first:]
     return rows

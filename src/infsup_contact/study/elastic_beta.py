@@ -21,6 +21,7 @@ import pandas as pd
 from ..discretization import registry
 from ..models.elastic import elastic_model, lame
 from ..models.membranes import MEMBRANES
+from ..models.side_cache import SideCache
 from ..solvers.infsup import beta_rows
 
 COLUMNS = ["model", "case", "k", "family", "N1", "N2", "multiplier_mesh", "E1", "E2", "nu", "norm", "beta",
@@ -38,8 +39,9 @@ def membranes_rows(family: str, k: int, pairs, E=(1.0, 1.0), cases=None, norms=(
     """(N1, N2) → the membranes' β_h rows (c = E) on that pair: they do not depend on ν, so a
     ν sweep computes them once."""
     cases = registry.ids_valid_for(k) if cases is None else list(cases)
+    sides = SideCache.for_sweep(MEMBRANES, family, k, pairs, **mesh_kwargs)
     return {(n1, n2): beta_rows(family, k, n1, n2, cases, "omega2", E[0], E[1], norms, model=MEMBRANES,
-                                **mesh_kwargs) for n1, n2 in pairs}
+                                side_cache=sides, **mesh_kwargs) for n1, n2 in pairs}
 
 
 def elastic_beta_rows(family: str, k: int, pairs, nu: float = 0.3, E=(1.0, 1.0), cases=None,
@@ -51,9 +53,11 @@ def elastic_beta_rows(family: str, k: int, pairs, nu: float = 0.3, E=(1.0, 1.0),
     model = elastic_model(nu)
     if membranes is None:
         membranes = membranes_rows(family, k, pairs, E, cases, norms, **mesh_kwargs)
+    sides = SideCache.for_sweep(model, family, k, pairs, **mesh_kwargs)
     out = []
     for n1, n2 in pairs:
-        el = beta_rows(family, k, n1, n2, cases, "omega2", E[0], E[1], norms, model=model, **mesh_kwargs)
+        el = beta_rows(family, k, n1, n2, cases, "omega2", E[0], E[1], norms, model=model, side_cache=sides,
+                       **mesh_kwargs)
         mem = membranes[n1, n2]
         for r, m in zip(el, mem):
             assert (r["case"], r["norm"]) == (m["case"], m["norm"])

@@ -1,0 +1,72 @@
+"""The side-operator cache of a sweep: shared sides are built once, rows are unchanged."""
+import numpy as np
+import pandas as pd
+import pytest
+
+from infsup_contact.discretization import meshes
+from infsup_contact.errors import InputError
+from infsup_contact.models.membranes import MEMBRANES
+from infsup_contact.models.side_cache import SideCache, side_keys
+from infsup_contact.solvers.infsup import beta_rows_all
+
+
+class _Counting:
+    """A model that counts its side-operator builds."""
+
+    def __init__(self):
+        self.builds = 0
+        self.name = "counting"
+
+    def side_operator(self, mesh, k):
+        self.builds += 1
+        return MEMBRANES.side_operator(mesh, k)
+
+
+def test_pairs_sharing_a_side_build_it_once_and_drop_it_after_its_last_use():
+    model, cache = _Counting(), SideCache()
+    pairs = [(4, 4), (5, 4), (6, 4), (5, 5)]
+    cache.expect(model, "structured", 1, pairs)
+    distinct = {key for p in pairs for key in side_keys(model, "structured", 1, *p)}
+    for p in pairs:
+        cache.pair(model, "structured", 1, *p)
+    assert model.builds == len(distinct) == 5  # Ω1 with N1 = 4, 5, 6; Ω2 with N2 = 4, 5
+    assert len(cache) == 0  # every expected use consumed: nothing kept
+
+
+def test_unannounced_pairs_are_built_and_not_kept():
+    model, cache = _Counting(), SideCache()
+    cache.pair(model, "structured", 1, 3, 3)
+    cache.pair(model, "structured", 1, 3, 3)
+    assert model.builds == 4 and len(cache) == 0
+
+
+def test_seeds_are_distinct_sides():
+    keys = [side_keys(MEMBRANES, "perturbed", 2, 5, 4, seed=s, alpha=0.2) for s in (0, 1)]
+    assert not set(keys[0]) & set(keys[1])
+    assert side_keys(MEMBRANES, "structured", 2, 5, 4)[1] == side_keys(MEMBRANES, "structured", 2, 7, 4)[1]
+
+
+def test_cached_sweep_gives_the_rows_of_fresh_builds_bitwise():
+    pairs = [(6, 4), (4, 4), (5, 4)]
+    cache = SideCache()
+    cache.expect(MEMBRANES, "perturbed", 2, pairs, seed=1, alpha=0.2)
+    kw = dict(cases=["T3", "R5.4"], multiplier_meshes=("omega2", "union"), c_pairs=((1.0, 1.0), (1.0, 10.0)),
+              seed=1, alpha=0.2)
+    cached = pd.DataFrame([r for p in pairs for r in beta_rows_all("perturbed", 2, *p, side_cache=cache, **kw)])
+    fresh = pd.DataFrame([r for p in pairs for r in beta_rows_all("perturbed", 2, *p, **kw)])
+    cols = [c for c in fresh.columns if not c.startswith("t_")]
+    pd.testing.assert_frame_equal(cached[cols], fresh[cols], check_exact=True)
+
+
+@pytest.mark.parametrize("x1,x2,choice,expected", [
+    ([0, .5, 1], [0, .25, .5, .75, 1], "omega2", [0, .25, .5, .75, 1]),
+    ([0, .5, 1], [0, .25, .5, .75, 1], "omega1", [0, .5, 1]),
+    ([0, 1 / 3, 2 / 3, 1], [0, .5, 1], "union", [0, 1 / 3, .5, 2 / 3, 1]),
+])
+def test_partition_choice(x1, x2, choice, expected):
+    assert np.array_equal(meshes.partition_choice(np.array(x1), np.array(x2), choice), expected)
+
+
+def test_partition_choice_names_the_allowed_values():
+    with pytest.raises(InputError, match="multiplier_mesh.*omega2, omega1, union"):
+        meshes.partition_choice(np.array([0, 1.0]), np.array([0, 1.0]), "both")

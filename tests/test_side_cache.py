@@ -33,6 +33,14 @@ def test_pairs_sharing_a_side_build_it_once_and_drop_it_after_its_last_use():
     assert len(cache) == 0  # every expected use consumed: nothing kept
 
 
+def test_beta_rows_of_a_sweep_take_shared_sides_from_the_cache():
+    model, pairs = _Counting(), [(4, 4), (5, 4), (6, 4)]
+    cache = SideCache.for_sweep(model, "structured", 1, pairs)
+    for p in pairs:
+        beta_rows_all("structured", 1, *p, cases=["T3"], norms=["L2"], model=model, side_cache=cache)
+    assert model.builds == 4  # Ω1 with N1 = 4, 5, 6 and Ω2 with N2 = 4 once
+
+
 def test_unannounced_pairs_are_built_and_not_kept():
     model, cache = _Counting(), SideCache()
     cache.pair(model, "structured", 1, 3, 3)

@@ -134,7 +134,7 @@ def beta_rows_all(family, k, n1, n2, cases=None, multiplier_meshes=("omega2",), 
         for c1, c2 in c_pairs:
             check_inputs([c for c in cases if isinstance(c, str)], k, family, n1, n2, c1, c2, norms, mm)
     t1 = time.perf_counter()
-    sides = (side_cache or SideCache()).pair(model, family, k, n1, n2, **mesh_kwargs)
+    sides = (SideCache() if side_cache is None else side_cache).pair(model, family, k, n1, n2, **mesh_kwargs)
     t2 = time.perf_counter()
     x1, x2 = (s.trace.breakpoints for s in sides)
     dim_w = trace_sum_dimension(k, x1, x2)

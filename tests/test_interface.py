@@ -4,7 +4,7 @@ import pytest
 import scipy.linalg as sla
 
 from infsup_contact.discretization.coupling import coupling_matrix
-from infsup_contact.solvers.infsup import beta_rows, saddle_point_beta, spectrum
+from infsup_contact.solvers.infsup import beta_rows, gram_factor, saddle_point_beta, spectrum
 from infsup_contact.models.schur import interface_operator, schur_by_solves
 from infsup_contact.models.membranes import side_operator
 from infsup_contact.discretization.meshes import mesh_pair, multiplier_breakpoints
@@ -81,3 +81,24 @@ def test_smooth_modes_reproduce_continuous_rayleigh_quotient():
             errors.append(abs(rq - (1 / c[0] + 1 / c[1]) * np.tanh(n_mode * np.pi)))
         slope = np.polyfit(np.log([1 / 4, 1 / 8, 1 / 16]), np.log(errors), 1)[0]
         assert errors[-1] < 2e-3 and slope > 1.5, (n_mode, errors, slope)
+
+
+def test_spectrum_is_eigh_and_one_gram_factor_serves_every_operator():
+    rng = np.random.default_rng(3)
+    A, B = rng.standard_normal((2, 40, 40))
+    G = B @ B.T + 40 * np.eye(40)
+    factor = gram_factor(G)
+    for S in (A @ A.T, 0.1 * A @ A.T + np.diag(np.arange(40.0))):
+        assert np.array_equal(spectrum(S, G).bottom, sla.eigh(S, G, eigvals_only=True)[:8])
+        assert np.array_equal(spectrum(S, factor=factor).bottom, spectrum(S, G).bottom)
+    with pytest.raises(np.linalg.LinAlgError, match="not positive definite"):
+        gram_factor(-G)
+
+
+def test_beta_with_v1_zero_scales_as_one_over_sqrt_c2():
+    # the (5.10) column is computed at c2 = 1 and scaled; here against a direct solve at c2 = 10
+    sides, space, Bs, _ = _full_problem("perturbed", 5, 3, 2, "T5")
+    G, _ = gram(space, "H")
+    row = beta_rows("perturbed", 2, 5, 3, ["T5"], c1=1.0, c2=10.0, norms=["H"])[0]
+    direct = spectrum(interface_operator(Bs[1:], sides[1:], (10.0,)), G).beta
+    assert row["beta_v1_zero"] == pytest.approx(direct, rel=1e-12)

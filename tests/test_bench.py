@@ -122,6 +122,26 @@ def test_speed_accuracy_table_from_contact_rows():
     assert (bench.pareto_front(g.seconds, g.energy_error) == g.pareto_energy.to_numpy()).all()
 
 
+def test_split_timing_parts_are_ordered_and_a_shared_pair_solves_as_a_fresh_one():
+    from infsup_contact.bench.speed_accuracy import time_contact_solves
+    from infsup_contact.solvers.contact import contact_pair, solve_contact, solve_contact_on
+    from infsup_contact.study.scenes import membranes
+
+    t = time_contact_solves(["T3", "R5.4"], 2, 4, repeats=3)
+    for med, lo, hi, runs in t.values():
+        assert 0 < lo <= med <= hi and runs == 3
+    pair = contact_pair(membranes(), 2, "structured", 40, 40)
+    first = solve_contact_on(pair, "T3", time_floor=False)
+    for side in pair.sides:
+        assert side.steklov is None  # N = 40, k = 2: the nested route, X M by the Cholesky factor of S
+        assert side.trace.basis_cache and "_schur_cholesky" in side.__dict__
+        side.forget_cached()
+        assert not side.trace.basis_cache and "_schur_cholesky" not in side.__dict__
+    again = solve_contact_on(pair, "T3", time_floor=False)
+    fresh = solve_contact(membranes(), "T3", 2, "structured", 40, 40, time_floor=False)
+    assert np.array_equal(first.lam, again.lam) and np.array_equal(again.lam, fresh.lam)
+
+
 def test_machine_info_has_versions(tmp_path):
     info = bench.machine_info()
     assert info["cores"] >= 1 and info["cpu_model"]

@@ -86,6 +86,13 @@ class SideOperator(_SteklovProduct):
         X = self.steklov if self.steklov is not None else sla.inv(self.schur, check_finite=False)
         return X / c
 
+    def forget_cached(self) -> None:
+        """Return to the state right after the build: drop what later calls cached on this
+        side (the Cholesky factor of S, the trace's basis values). A benchmark times each
+        multiplier space's solve from this state, as a fresh build would give it."""
+        self.__dict__.pop("_schur_cholesky", None)
+        self.trace.basis_cache.clear()
+
 
 
 def _gamma_last_lu(A: sp.csc_matrix, n_gamma: int):

@@ -17,6 +17,8 @@
 # It refuses to overwrite a slurm.conf it did not write and to start daemons next to running
 # ones it did not start. Running it again while its daemons are up is a no-op.
 set -euo pipefail
+# The daemons (slurmctld, slurmd, munged) install to /usr/sbin, which a minimal CI PATH may lack.
+export PATH="$PATH:/usr/sbin:/sbin"
 
 STATE=${INFSUP_SLURM_STATE:-/run/infsup-contact-slurm}
 CONF=/etc/slurm/slurm.conf

@@ -54,6 +54,6 @@ def read_table(path, kind: str, **kwargs):
         return read(path, kind, **kwargs)
     except TableError as err:
         name = os.path.basename(sys.argv[0]) or "script"
-        if name.startswith("tmp") and name.count(".") > 1:  # Snakemake's copy: tmpXXXX.claims.py
+        if name.startswith("tmp") and name.count(".") > 1:  # Snakemake's copy: tmp<random>.claims.py
             name = name.split(".", 1)[1]
         fail(f"{name}: {err}")

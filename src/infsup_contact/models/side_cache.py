@@ -56,10 +56,11 @@ class SideCache:
         if op is None:
             n, side = key[3], key[4]
             op = model.side_operator(meshes.subdomain_mesh(family, n, side, **mesh_kwargs), k)
-        if self._uses_left[key] > 0:
+        if self._uses_left[key] > 1:  # more uses announced: keep it for them
             self._uses_left[key] -= 1
-        if self._uses_left[key] > 0:
             self._ops[key] = op
+        else:
+            self._uses_left.pop(key, None)
         return op
 
     def __len__(self) -> int:

@@ -149,6 +149,11 @@ def beta_rows_all(family, k, n1, n2, cases=None, multiplier_meshes=("omega2",), 
 
     ``side_cache``: a :class:`~infsup_contact.models.side_cache.SideCache` the side operators
     are taken from (a sweep over pairs that share a side builds it once); default: built here.
+
+    Timing columns (seconds): ``t_interface`` getting the two side operators (meshes and
+    factorizations; about 0 for sides the cache already holds), ``t_assemble`` the case's
+    couplings B_i, ``t_eig`` one eigenproblem (sygst and syevd; not the Gram matrix's
+    Cholesky factor, which the c pairs share).
     """
     cases = registry.ids_valid_for(k) if cases is None else list(cases)
     for mm in multiplier_meshes:

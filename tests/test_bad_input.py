@@ -29,7 +29,8 @@ import yaml
 
 from infsup_contact import cli, resources
 from infsup_contact.config_checks import (CROSS_KEY_RULES, REFERENCE_MARGIN, ConfigError, check_config,
-                                          check_job_memory, key_path, memory_notes, scene_meshes)
+                                          key_path, scene_meshes)
+from infsup_contact.config_memory import check_job_memory, memory_notes
 
 ROOT = Path(__file__).resolve().parents[1]
 SCHEMA = yaml.safe_load((ROOT / "workflow" / "schemas" / "config.schema.yaml").read_text())

@@ -6,7 +6,8 @@ from snakemake.logging import logger
 from snakemake.utils import validate
 
 from infsup_contact import resources
-from infsup_contact.config_checks import ConfigError, check_config, check_job_memory, memory_notes
+from infsup_contact.config_checks import ConfigError, check_config
+from infsup_contact.config_memory import check_job_memory, memory_notes
 from infsup_contact.discretization.series import beta_batches, seeds, series_of_pairs
 
 # Every check a config gets, in one library function (src/infsup_contact/config_checks.py):

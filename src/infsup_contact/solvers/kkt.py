@@ -2,7 +2,7 @@
 against (tests, ``bench``'s ``kkt_sparse``).
 
 Each active-set step solves the saddle-point system [[A, −B_𝒜ᵀ], [B_𝒜, 0]] by sparse LU, never
-forming the interface operator; the stopping test and the result are :mod:`.pdas`'s.
+forming the interface operator; the stopping test is :mod:`.lcp`'s, the result :mod:`.pdas`'s.
 """
 from __future__ import annotations
 
@@ -11,7 +11,8 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from ..errors import InputError
-from .pdas import PdasDidNotConverge, _check_options, _kkt_ok, _natural_residual, _tolerances
+from .lcp import kkt_ok, natural_residual, tolerances
+from .pdas import PdasDidNotConverge, _check_options
 
 
 def _check_kkt(A, B, F):
@@ -100,9 +101,9 @@ def solve_kkt_sparse(A, B, F, *, max_iter=50):
         g = B @ u
         new = (lam - c * g) > 0
         history.append(dict(iteration=it, n_active=int(active.sum()),
-                            residual=_natural_residual(lam, g),
+                            residual=natural_residual(lam, g),
                             n_changed=int(np.sum(new != active))))
-        if np.array_equal(new, active) or _kkt_ok(lam, g, *_tolerances(g0, lam, kscale, 1e-12)):
+        if np.array_equal(new, active) or kkt_ok(lam, g, *tolerances(g0, lam, kscale, 1e-12)):
             return u, lam, it
         if new.tobytes() in seen:
             raise PdasDidNotConverge("sparse PDAS cycles; use solve_pdas", history)

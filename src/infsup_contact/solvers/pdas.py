@@ -15,13 +15,14 @@ which is the optimality system of the dual QP  min_{λ ≥ 0} ½ λᵀKλ + g0�
 singular exactly when the discrete inf-sup condition fails already in its weak form
 (4.2) — then λ is not unique (paper end of §4).
 
-Two routes are provided:
+Two routes, both stopped and verified by the test of :mod:`.lcp` (which also holds the
+choice of solution when λ is not unique):
 
 :func:`solve_pdas`
     Primal–dual active set (PDAS) = semismooth Newton on the NCP function
     λ − max(0, λ − c g) (Hintermüller, Ito & Kunisch, SIAM J. Optim. 13 (2002)) on the
     small dense Γ-reduced problem, with a documented treatment of singular K.
-:func:`solve_kkt_sparse`
+:func:`~infsup_contact.solvers.kkt.solve_kkt_sparse`
     The same PDAS iteration, each step solving the full sparse saddle-point system
     [[A, −B_𝒜ᵀ], [B_𝒜, 0]] — used to cross-check the Γ-reduced route.
 
@@ -52,9 +53,11 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
-from scipy.optimize import linprog, nnls
+from scipy.optimize import nnls
 
 from ..errors import InputError
+from .lcp import (has_free_direction, kkt_ok, min_norm_representative, min_norm_solve, natural_residual,
+                  tolerances)
 
 _EPS = np.finfo(float).eps
 
@@ -156,39 +159,15 @@ def _nullity(M, cutoff, definite=False):
     return int(np.sum(sla.eigvalsh(M) <= cutoff)) if M.size and not definite else 0
 
 
-def _min_norm_solve(M, rhs, cutoff, definite=False):
-    """Minimum-norm solution of M z = rhs (M symmetric PSD) and the kernel basis.
-
-    Spectral pseudo-inverse: eigen-directions with eigenvalue ≤ cutoff are the
-    numerical kernel and get no component (= scipy.linalg.pinvh with that cutoff).
-    ``definite``: M is known to have all eigenvalues above the cutoff (a principal
-    submatrix of a K whose smallest eigenvalue is, by Cauchy interlacing), so the kernel
-    is empty and a Cholesky solve gives the same z at a fraction of the cost.
-    """
-    if definite:
-        z = sla.cho_solve(sla.cho_factor(M, check_finite=False), rhs, check_finite=False)
-        return z, np.zeros((len(rhs), 0))
-    w, V = sla.eigh(M)
-    keep = w > cutoff
-    Vr = V[:, keep]
-    z = Vr @ ((Vr.T @ rhs) / w[keep])
-    return z, V[:, ~keep]
-
-
 def _solve_on_active(K, g0, active, cutoff, definite=False):
     """One PDAS step: λ_𝒜 = min-norm solution of K_𝒜𝒜 λ_𝒜 = −g0_𝒜, λ_ℐ = 0."""
     lam = np.zeros_like(g0)
     if not active.any():
         return lam, 0
     idx = np.flatnonzero(active)
-    lam_a, Z = _min_norm_solve(K[np.ix_(idx, idx)], -g0[idx], cutoff, definite)
+    lam_a, Z = min_norm_solve(K[np.ix_(idx, idx)], -g0[idx], cutoff, definite)
     lam[idx] = lam_a
     return lam, Z.shape[1]
-
-
-def _natural_residual(lam, g):
-    """max_j |min(λ_j, g_j)|: zero iff (λ, g) solves the LCP."""
-    return float(np.max(np.abs(np.minimum(lam, g)), initial=0.0))
 
 
 # ------------------------------------------------------------------ PDAS iteration
@@ -222,9 +201,9 @@ def _pdas_loop(K, g0, c, cutoff, max_iter, tol, lam_max, definite=False):
         g = g0 + K @ lam
         new = (lam - c * g) > 0
         history.append(dict(iteration=it, n_active=int(active.sum()), nullity=nullity,
-                            residual=_natural_residual(lam, g),
+                            residual=natural_residual(lam, g),
                             n_changed=int(np.sum(new != active))))
-        if np.array_equal(new, active) or _kkt_ok(lam, g, *_tolerances(g0, lam, lam_max, tol)):
+        if np.array_equal(new, active) or kkt_ok(lam, g, *tolerances(g0, lam, lam_max, tol)):
             return lam, it, history, "converged"
         if new.tobytes() in seen:
             return lam, it, history, "cycle"
@@ -256,86 +235,6 @@ def _nnls_dual(K, g0, cutoff):
     except RuntimeError as exc:  # iteration cap of Lawson–Hanson
         raise PdasDidNotConverge(f"NNLS fallback failed: {exc}", []) from exc
     return lam
-
-
-# ------------------------------------------------------------------ representative
-def _least_distance(G, h):
-    """min ‖z‖ s.t. G z ≥ h (Lawson & Hanson LDP, via NNLS); None if infeasible."""
-    k = G.shape[1]
-    E = np.vstack([G.T, h[None, :]])
-    f = np.zeros(k + 1)
-    f[-1] = 1.0
-    u, _ = nnls(E, f, maxiter=50 * max(E.shape[1], 1))
-    r = E @ u - f
-    if abs(r[-1]) < 1e-14:
-        return None
-    return -r[:k] / r[-1]
-
-
-def _min_norm_representative(K, g0, lam, S, cutoff, definite=False):
-    """Replace λ by the minimum-norm solution of the LCP (see module docstring).
-
-    All solutions are λ = λ* + Z z ≥ 0 (support in S), λ* the min-norm solution of
-    K_SS λ_S = −g0_S and Z an orthonormal kernel basis of K_SS; since λ* ⊥ Z,
-    ‖λ‖² = ‖λ*‖² + ‖z‖², so the task is the LDP  min ‖z‖ s.t. Z z ≥ −λ*.
-    Returns (lam, Z, idx) with Z = None when the kernel is trivial.
-    """
-    idx = np.flatnonzero(S)
-    if idx.size == 0:
-        return lam, None, idx
-    if definite:  # K_SS nonsingular: the solution is unique, nothing to choose
-        return lam, None, idx
-    lam_s, Z = _min_norm_solve(K[np.ix_(idx, idx)], -g0[idx], cutoff)
-    if Z.shape[1] == 0:
-        return lam, None, idx
-    z = _least_distance(Z, -lam_s)
-    if z is None:  # numerically infeasible: keep the (verified) input solution
-        return lam, Z, idx
-    out = np.zeros_like(lam)
-    out[idx] = lam_s + Z @ z  # ≥ 0 up to round-off; the final KKT check verifies it
-    return out, Z, idx
-
-
-def _has_free_direction(Z, idx, positive):
-    """Whether a kernel direction d = Z t ≠ 0 keeps λ + εd ≥ 0 for small ε > 0.
-
-    d may have any sign on the positive multipliers P; on the zero multipliers S0 of
-    the contact set it must be ≥ 0.  If ker K_PP ≠ 0 the answer is yes; otherwise
-    t ↦ d_S0 is injective and the LP  max Σ d_S0  s.t. 0 ≤ d_S0 ≤ 1  is bounded with a
-    positive optimum iff such a direction exists.
-    """
-    if Z is None:
-        return False
-    Z0 = Z[~positive[idx]]
-    if Z0.shape[0] == 0 or np.linalg.matrix_rank(Z0, tol=1e-8) < Z.shape[1]:
-        return True  # some direction lives on P only: ker K_PP ≠ 0
-    res = linprog(-Z0.sum(axis=0), A_ub=np.vstack([Z0, -Z0]),
-                  b_ub=np.concatenate([np.ones(len(Z0)), np.zeros(len(Z0))]),
-                  bounds=[(None, None)] * Z.shape[1], method="highs")
-    return bool(res.status == 0 and -res.fun > 1e-8)
-
-
-# ------------------------------------------------------------------ verification
-def _tolerances(g0, lam, lam_max, tol):
-    """Absolute zero tolerances for g and λ, relative to the data scale.
-
-    g = g0 + Kλ is a sum of terms of size ‖g0‖ and λ_max‖λ‖, so round-off in g scales
-    with their sum; the λ scale is that gap scale divided by λ_max (units of K⁻¹g).
-    """
-    m = max(g0.size, 1)
-    rel = max(tol, 16 * m * _EPS)
-    gscale = np.abs(g0).max(initial=0.0) + lam_max * np.abs(lam).max(initial=0.0)
-    gscale = max(gscale, np.finfo(float).tiny)
-    lscale = max(np.abs(lam).max(initial=0.0), gscale / lam_max if lam_max > 0 else 0.0,
-                 np.finfo(float).tiny)
-    return rel * gscale, rel * lscale
-
-
-def _kkt_ok(lam, g, gtol, ltol):
-    """λ ≥ −ltol, g ≥ −gtol and |λ_j g_j| within the product of tolerance and scale."""
-    return (g.min(initial=0.0) >= -gtol and lam.min(initial=0.0) >= -ltol
-            and np.max(np.abs(lam * g), initial=0.0) <= max(gtol * np.abs(lam).max(initial=0.0),
-                                                            ltol * np.abs(g).max(initial=0.0)))
 
 
 # ------------------------------------------------------------------ public solvers
@@ -391,7 +290,7 @@ def solve_pdas(K, g0, *, max_iter=50, tol=1e-12, kernel_rtol=1e-10) -> PdasResul
         lam = _nnls_dual(K, g0, prob.cutoff)
         route = "pdas+nnls"
         history.append(dict(fallback="nnls", reason=status,
-                            residual=_natural_residual(lam, g0 + K @ lam)))
+                            residual=natural_residual(lam, g0 + K @ lam)))
     if not prob.kkt_ok(lam):
         raise PdasDidNotConverge(f"no verified LCP solution ({prob.violations(lam)})", history)
     lam, Z, idx = _representative(prob, lam, history)
@@ -424,10 +323,10 @@ class _Lcp:
         return bool(self.eigs.size and self.eigs.min() > self.cutoff)
 
     def tolerances(self, lam):
-        return _tolerances(self.g0, lam, self.lam_max, self.tol)
+        return tolerances(self.g0, lam, self.lam_max, self.tol)
 
     def kkt_ok(self, lam):
-        return _kkt_ok(lam, self.g0 + self.K @ lam, *self.tolerances(lam))
+        return kkt_ok(lam, self.g0 + self.K @ lam, *self.tolerances(lam))
 
     def violations(self, lam):
         g = self.g0 + self.K @ lam
@@ -444,7 +343,7 @@ def _representative(prob, lam, history):
     """
     gtol, _ = prob.tolerances(lam)
     S = prob.g0 + prob.K @ lam <= gtol  # g is the same for all solutions: S bounds supports
-    lam_mn, Z, idx = _min_norm_representative(prob.K, prob.g0, lam, S, prob.cutoff, prob.definite)
+    lam_mn, Z, idx = min_norm_representative(prob.K, prob.g0, lam, S, prob.cutoff, prob.definite)
     if Z is None:
         return lam, Z, idx
     ok = prob.kkt_ok(lam_mn)
@@ -462,7 +361,7 @@ def _result(prob, lam, Z, idx, iters, history, route):
         lam=lam, gap=g, active=active, iterations=iters,
         complementarity=float(np.max(np.abs(lam * g), initial=0.0)),
         min_gap=float(g.min(initial=np.inf)), min_lambda=float(lam.min(initial=np.inf)),
-        nonunique=bool(kdim > 0 or _has_free_direction(Z, idx, active)),
+        nonunique=bool(kdim > 0 or has_free_direction(Z, idx, active)),
         kernel_dim=kdim, kernel_dim_K=int(np.sum(prob.eigs <= prob.cutoff)),
         history=history, route=route)
 

@@ -55,7 +55,9 @@ def synth_beta(seed=0):
                             beta = 0.0 if kern else round(val, 6)
                             rows.append(dict(case=case, k=k, family=fam, N1=n1, N2=n2, multiplier_mesh=mm,
                                              c1=1.0, c2=1.0, norm=norm, beta=beta, kernel_dim=kern,
-                                             structural_kernel_dim=kern, kernel_check="agree", smallest_nonzero=round(val, 6),
+                                             structural_kernel_dim=kern, kernel_check="agree", kernel_detected=0,
+                                             kernel_margin_decades=round(2 + 12 * rng.random(), 6),
+                                             kernel_decision="clear", smallest_nonzero=round(val, 6),
                                              beta_v1_zero=round(0.9 * beta, 6), dim_M=DIM_M[case](n2, k),
                                              dim_W=n2 * k - 1, series=name, seed=0 if fam == "perturbed" else np.nan,
                                              package_version="0.1.0",
@@ -209,8 +211,8 @@ def test_every_table_macro_is_its_table_value(tables):
         if src["agg"] is None:
             assert len(rows) == 1, (m, rows)
         value = col.agg(src["agg"]) if src["agg"] else col.iloc[0]
-        if src["col"] == "verdict":
-            assert m.tex == rf"\verdictfmt{{{value}}}", m
+        if src["col"] == "verdict":  # typeset (claimVerdict…) or the bare word for \byverdict (claimOutcome…)
+            assert m.tex in (rf"\verdictfmt{{{value}}}", value), m
         elif src["col"] == "evidence":
             assert m.tex == pt.latex_escape(value), m
         else:
@@ -256,6 +258,7 @@ def test_changing_one_value_changes_its_macro(tables):
     changed = {n for n in before if before[n].tex != after[n].tex}
     assert changed == {"betaHTthreeKone", "betaHTthreeKoneNthirtytwo", "betaMinHTthreeKone",
                        "slopeEnergyTfiveKtwo", "claimVerdictEqthreethirteenSign",
+                       "claimOutcomeEqthreethirteenSign", "refOutcomeThreethirteenErratum",
                        "refVerdictThreethirteenErratum", "refPassThreethirteenErratum",
                        "nClaimsPass", "nClaimsFail", "nClaimsAsPredicted"}, changed
 
@@ -422,3 +425,37 @@ def test_pdf_builds_and_shows_generated_numbers(tables, tmp_path):
         assert m[name].tex in text, name
     log = (build / "paper.log").read_text(errors="replace")
     assert not re.search(r"(Citation|Reference) `[^']+' on page \d+ undefined", log), "undefined refs"
+
+
+# ----------------------------------------------------------------------------- text under any verdict
+
+def _flipped(claims, how):
+    swap = {"PASS": "FAIL", "FAIL": "PASS", "INCONCLUSIVE": "INCONCLUSIVE"}
+    v = claims.verdict
+    verdict = {"as is": v, "swapped": v.map(swap), "all PASS": "PASS", "all FAIL": "FAIL",
+               "all INCONCLUSIVE": "INCONCLUSIVE"}[how]
+    return claims.assign(verdict=verdict)
+
+
+@pytest.mark.parametrize("how", ["as is", "swapped", "all PASS", "all FAIL", "all INCONCLUSIVE"])
+def test_paper_text_never_contradicts_its_verdicts(tables, how):
+    """Sentences that state an outcome are chosen by their verdict (\\byverdict): rendered
+    under any ledger, no clause states success before FAIL, failure before PASS, or either
+    before INCONCLUSIVE."""
+    from infsup_contact.report.consistency import contradictions, render
+
+    t = dict(tables, claims=_flipped(tables["claims"], how))
+    text = render(PAPER.read_text(), _macros(t))
+    assert "\\byverdict" not in text
+    assert contradictions(text) == []
+
+
+def test_the_contradiction_check_finds_a_stale_sentence():
+    from infsup_contact.report.consistency import contradictions, resolve_byverdict
+
+    stale = ("the two spaces of Remarks 5.2 and 5.4 have exactly the kernels the dimension counts "
+             "predict (\\verdictfmt{PASS}, \\verdictfmt{FAIL}). Next.")
+    assert len(contradictions(stale)) == 1
+    assert contradictions("it is not bounded on N (\\verdictfmt{PASS}, evidence)") != []
+    assert contradictions("it is bounded (\\verdictfmt{PASS}) and not bounded on M (\\verdictfmt{FAIL})") == []
+    assert resolve_byverdict("x \\byverdict{FAIL}{a}{b {c}}{d} y") == "x b {c} y"

@@ -52,7 +52,21 @@ def beta_macros(beta: pd.DataFrame) -> list[Macro]:
             Macro("nBetaFamilies", fmt_int(beta.family.nunique()), "beta.csv: number of mesh families"),
             Macro("nBetaMeshPairs", fmt_int(len(beta[["N1", "N2"]].drop_duplicates())),
                   "beta.csv: number of (N1, N2) pairs")]
-    if "kernel_check" in beta.columns:  # numerical kernel (gap criterion) vs the structural count
+    if "kernel_margin_decades" in beta.columns:  # the kernel decisions' distance from their error level
+        from ..solvers.kernel import MARGIN_DECADES
+
+        margin = beta.kernel_margin_decades.astype(float)
+        out.append(Macro("kernelMarginDecades", fmt_int(MARGIN_DECADES) if float(MARGIN_DECADES).is_integer()
+                         else f"{MARGIN_DECADES:g}", "solvers/kernel.py: MARGIN_DECADES"))
+        out.append(Macro("kernelMarginMin", f"{margin.min():.1f}", "beta.csv: kernel_margin_decades min"))
+        for d, word in ((1, "One"), (2, "Two"), (3, "Three")):
+            out.append(Macro(f"nKernelWithin{word}", fmt_int((margin < d).sum()),
+                             f"beta.csv: rows with kernel_margin_decades < {d}"))
+        out.append(Macro("nKernelClose", fmt_int((beta.kernel_decision == "close").sum()),
+                         "beta.csv: rows with kernel_decision == close"))
+        out.append(Macro("nKernelDetected", fmt_int((beta.kernel_detected > 0).sum()),
+                         "beta.csv: rows with kernel_detected > 0"))
+    if "kernel_check" in beta.columns:  # numerical count vs the structural (proven) one
         for word in ("agree", "below_structural", "above_structural"):
             name = macro_name("nKernel", *word.split("_"))
             for label, rows in (("", beta), ("Matching", beta[beta.N1 == beta.N2])):
@@ -144,9 +158,13 @@ def claims_macros(claims: pd.DataFrame) -> list[Macro]:
                 Macro(macro_name("refPass", ref), fmt_int(n_pass), f"claims.csv: PASS rows with paper_ref '{ref}'"),
                 Macro(macro_name("refVerdict", ref), rf"\verdictfmt{{{verdict}}}",
                       f"claims.csv: PASS if all rows with paper_ref '{ref}' pass, else FAIL if one fails, "
-                      "else INCONCLUSIVE")]
+                      "else INCONCLUSIVE"),
+                # the bare word, for \byverdict: a sentence that states an outcome is chosen by it
+                Macro(macro_name("refOutcome", ref), verdict, f"claims.csv: the verdict of refVerdict for '{ref}'")]
     for _, r in claims.iterrows():
         out.append(Macro(macro_name("claimVerdict", r.claim_id), rf"\verdictfmt{{{r.verdict}}}",
+                         _src("claims.csv", "verdict", claim_id=r.claim_id)))
+        out.append(Macro(macro_name("claimOutcome", r.claim_id), str(r.verdict),
                          _src("claims.csv", "verdict", claim_id=r.claim_id)))
         out.append(Macro(macro_name("claimEvidence", r.claim_id),
                          latex_escape(r.evidence, f"claims.csv evidence of {r.claim_id}"),

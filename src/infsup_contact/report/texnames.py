@@ -49,7 +49,9 @@ Prefixes (``<Case>`` = Tthree | Rfivetwo | Tfour | Rfivefour | Tfive, ``<Norm>``
 
 Numbers are typeset as plain decimals (β_h: 4 decimals, slopes 2) or, for errors and
 times, ``\\ensuremath{m\\times10^{e}}`` with 3 significant digits (:func:`fmt_sci`).
-Verdicts are wrapped in ``\\verdictfmt{...}``, which ``paper.tex`` defines.
+Verdicts are wrapped in ``\\verdictfmt{...}``, which ``paper.tex`` defines; ``\\refOutcome<Ref>``
+and ``\\claimOutcome<Id>`` hold the bare word, which ``\\byverdict{...}{if PASS}{if FAIL}{if
+INCONCLUSIVE}`` uses to choose a sentence that states an outcome (:mod:`.consistency` checks it).
 
 Each definition in ``macros.tex`` carries its source as a comment. For values read from a
 table the source is machine-readable, ``table:column[:min|max] key=value ...`` (the value is

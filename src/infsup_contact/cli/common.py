@@ -26,10 +26,11 @@ def cases(args) -> list:
     return [args.case]
 
 
-def run_intervals(args, limit: int = 4096) -> set:
+def run_intervals(args, limit: int = 1024) -> set:
     """Numbers of intervals of the multiplier meshes a request will use (--N1/--N2 and
     --multiplier-mesh, or the --N list of matching meshes), for checking a user space on each.
-    Sizes that are not valid N (or above ``limit``) are left to their own checks."""
+    Sizes that are not valid N are left to their own checks; above ``limit`` the space is
+    checked as it is built (user_spaces.guarded_build), not before."""
     from ..discretization.registry import multiplier_intervals
 
     choice = getattr(args, "multiplier_mesh", "omega2")

@@ -45,7 +45,7 @@ CHECK_PARTITION = np.array([0.0, 0.13, 0.3, 0.52, 0.71, 1.0])
 ID_PATTERN = re.compile(r"[A-Za-z][A-Za-z0-9.-]{0,23}")
 """Allowed ids: safe in file names, LaTeX text, CSV cells and argv (no leading ``-``)."""
 ID_ALLOWED = "a string of letters, digits, '-' and '.', starting with a letter, at most 24 characters"
-MAX_GRAM_DIM = 2000
+MAX_GRAM_DIM = 1000
 """Largest space whose L² Gram matrix is checked for linear independence (dense eigvalsh)."""
 SPEC_FIELDS = tuple(f.name for f in dataclasses.fields(SpaceSpec))
 

@@ -19,6 +19,7 @@ workflow logs. Pure functions: no Snakemake, no solver imports.
 from __future__ import annotations
 
 import math
+import re
 from pathlib import Path
 
 from .errors import InputError
@@ -240,6 +241,21 @@ def scene_meshes(cfg) -> dict:
     return {name: list(spec.get("N", cc["N"])) for name, spec in cc["scenes"].items()}
 
 
+SCENE_NAME = re.compile(r"[A-Za-z][A-Za-z0-9_-]{0,39}")
+"""A scene name becomes part of file names and Snakemake wildcards (``{scene}_{family}_k{k}``)
+and of the paper's tables: letters, digits, ``_`` and ``-``, starting with a letter."""
+
+
+def check_scene_names(cfg) -> None:
+    """Every key of contact.scenes is a safe name (:data:`SCENE_NAME`): ``""`` or ``x{k}``
+    would break the job file names and their wildcards."""
+    for name in cfg["contact"]["scenes"]:
+        if not isinstance(name, str) or not SCENE_NAME.fullmatch(name):
+            raise ConfigError("contact.scenes", "a scene name that can be part of file names, Snakemake "
+                              "wildcards and LaTeX", got=name, allowed="letters, digits, '_' and '-', starting "
+                              "with a letter, at most 40 characters (e.g. manufactured_lowreg)")
+
+
 def check_reference(cfg) -> None:
     """contact.reference_N >= REFERENCE_MARGIN × the largest N of every membranes scene."""
     cc = cfg["contact"]
@@ -412,6 +428,7 @@ def check_space_meshes(cfg) -> None:
 CROSS_KEY_RULES = {
     # rule: the keys it relates (the error names the first; a change to any of them can trip it)
     check_cases: ("infsup.cases", "contact.cases", "spaces"),
+    check_scene_names: ("contact.scenes",),
     check_reference: ("contact.reference_N", "contact.scenes", "contact.N"),
     check_rate_window: ("contact.rate_window", "contact.scenes", "contact.N"),
     check_nonmatching: ("infsup.nonmatching",),

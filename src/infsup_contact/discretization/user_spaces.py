@@ -18,7 +18,7 @@ have the dimension it states (:func:`guarded_build`), so a space that ignores it
 cannot compute on the wrong one.
 
 A space's id appears in tables, file names, LaTeX and on the command line: it is a string
-of letters, digits, ``-`` and ``.``, starting with a letter, at most 24 characters
+of letters, digits, ``-`` and ``.``, starting with a letter, at most 32 characters
 (:data:`ID_PATTERN`; ``_`` is excluded: LaTeX reads it as a subscript).
 """
 from __future__ import annotations
@@ -42,9 +42,9 @@ _CHECKED: dict[str, set] = {}
 """Per reference, the interval counts N its space was fully checked on."""
 CHECK_PARTITION = np.array([0.0, 0.13, 0.3, 0.52, 0.71, 1.0])
 """The non-uniform partition (N = 5) every user space is checked on."""
-ID_PATTERN = re.compile(r"[A-Za-z][A-Za-z0-9.-]{0,23}")
+ID_PATTERN = re.compile(r"[A-Za-z][A-Za-z0-9.-]{0,31}")
 """Allowed ids: safe in file names, LaTeX text, CSV cells and argv (no leading ``-``)."""
-ID_ALLOWED = "a string of letters, digits, '-' and '.', starting with a letter, at most 24 characters"
+ID_ALLOWED = "a string of letters, digits, '-' and '.', starting with a letter, at most 32 characters"
 MAX_GRAM_DIM = 1000
 """Largest space whose L² Gram matrix is checked for linear independence (dense eigvalsh)."""
 SPEC_FIELDS = tuple(f.name for f in dataclasses.fields(SpaceSpec))

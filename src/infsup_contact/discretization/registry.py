@@ -163,8 +163,9 @@ def case_space(case: str, k: int, breakpoints) -> MultiplierSpace:
                          f"k = {k}, N = {max(n, 0)})")
     space = SPACES[case].build(k, x)
     if space.dim < 1:
-        raise InputError("N", f"a multiplier mesh on which case {case} with k = {k} is not empty "
-                         f"(dim M_h = 0 on N = {n} intervals; it needs N >= {min_intervals(case, k)})", got=n)
+        low = min_intervals(case, k)
+        raise InputError("N", f"a multiplier mesh on which case {case} with k = {k} is not empty (dim M_h = 0 "
+                         f"on N = {n} intervals{'' if low is None else f'; it needs N >= {low}'})", got=n)
     return space
 
 
@@ -180,16 +181,13 @@ def case_name(case) -> str:
 
 def space_dim(case, k: int, n: int) -> int:
     """dim M_h of ``case`` (an id or a triple ``(label, s, continuous, vanish)``, eqs. (5.3)/(5.5))
-    for degree k on N uniform intervals: the registry's count where stated, else built (1D, cheap).
-    The count is used first because a space may not even build where it is empty (the dual
-    basis needs a live node per interval)."""
+    for degree k on N uniform intervals, built (1D, cheap): the build, not the ``dimension``
+    count, is what a run uses, and a user's build is guarded (user_spaces.guarded_build)."""
+    x = np.linspace(0.0, 1.0, n + 1)
     if not isinstance(case, str):
         _, s, continuous, vanish = case
-        return make_space(np.linspace(0.0, 1.0, n + 1), s, continuous, vanish).dim
-    spec = space_spec(case)
-    if spec.dimension is not None:
-        return int(spec.dimension(k, n))
-    return int(spec.build(k, np.linspace(0.0, 1.0, n + 1)).dim)
+        return make_space(x, s, continuous, vanish).dim
+    return int(space_spec(case).build(k, x).dim)
 
 
 def is_empty(case, k: int, n: int) -> bool:

@@ -451,3 +451,20 @@ def test_strict_yaml_runs_in_front_of_the_workflow(tmp_path):
              if l.strip() and not l.startswith("Using workflow specific profile")]
     assert proc.returncode == 1 and len(lines) == 1, lines
     assert lines[0].startswith("config key infsup.alpha: given twice")
+
+
+def test_user_space_empty_on_small_n(tmp_path, capsys):
+    """A user space may be empty on small N (continuous P_1 vanishing at Γ's ends, k = 1, N = 1):
+    it registers, and the N that leaves it empty is refused naming the case, N and k."""
+    path = write_module(tmp_path, "small", "def space():\n    return SpaceSpec('U-small', 'u', '', good_build, "
+                                           "lambda k: k)\n")
+    ref = f"{path}:space"
+    code, line = run_cli(capsys, "beta", "--space", ref, "--k", "1", "--N1", "1", "--N2", "1", "--dry-run")
+    assert code == 2 and "case U-small" in one_line(line) and "dim M_h = 0" in line and "k = 1" in line, line
+    cfg = copy.deepcopy(CI_CONFIG)
+    cfg["spaces"] = [*cfg.get("spaces", []), ref]
+    cfg["infsup"]["cases"] = {"U-small": [1]}  # alone: T3 would be refused on N = 1 first
+    cfg["infsup"]["N"] = [1, *cfg["infsup"]["N"]]
+    with pytest.raises(ConfigError) as err:
+        check_config(cfg, SCHEMA)
+    assert one_line(err.value).startswith("config key infsup.N[0]: case U-small with k = 1 has dim M_h = 0")

@@ -19,6 +19,7 @@ workflow logs. Pure functions: no Snakemake, no solver imports.
 from __future__ import annotations
 
 import math
+import re
 from pathlib import Path
 
 from .errors import InputError
@@ -77,9 +78,10 @@ def load_spaces(cfg) -> list:
     if not isinstance(refs, list) or not all(isinstance(r, str) for r in refs):
         raise ConfigError("spaces", "expected a list of FILE.py:FUNC or module:FUNC strings", got=refs,
                           allowed="e.g. [examples/macro_p0.py:space]")
+    intervals = config_intervals(cfg)
     for i, ref in enumerate(refs):
         try:
-            load_user_space(ref)
+            load_user_space(ref, intervals)
         except InputError as err:
             raise ConfigError(f"spaces[{i}]", str(err), got=ref, allowed="FILE.py:FUNC or module:FUNC "
                               "returning a valid SpaceSpec") from None
@@ -239,6 +241,21 @@ def scene_meshes(cfg) -> dict:
     return {name: list(spec.get("N", cc["N"])) for name, spec in cc["scenes"].items()}
 
 
+SCENE_NAME = re.compile(r"[A-Za-z][A-Za-z0-9_-]{0,39}")
+"""A scene name becomes part of file names and Snakemake wildcards (``{scene}_{family}_k{k}``)
+and of the paper's tables: letters, digits, ``_`` and ``-``, starting with a letter."""
+
+
+def check_scene_names(cfg) -> None:
+    """Every key of contact.scenes is a safe name (:data:`SCENE_NAME`): ``""`` or ``x{k}``
+    would break the job file names and their wildcards."""
+    for name in cfg["contact"]["scenes"]:
+        if not isinstance(name, str) or not SCENE_NAME.fullmatch(name):
+            raise ConfigError("contact.scenes", "a scene name that can be part of file names, Snakemake "
+                              "wildcards and LaTeX", got=name, allowed="letters, digits, '_' and '-', starting "
+                              "with a letter, at most 40 characters (e.g. manufactured_lowreg)")
+
+
 def check_reference(cfg) -> None:
     """contact.reference_N >= REFERENCE_MARGIN × the largest N of every membranes scene."""
     cc = cfg["contact"]
@@ -312,9 +329,106 @@ def check_hertz_reference(cfg) -> None:
                           allowed=f"N_ref >= {need}")
 
 
+def mesh_uses(cfg, with_cases: bool = True):
+    """Every mesh (pair) of the config with what runs on it: yields ``(key, value, N1, N2, cases
+    by k, multiplier meshes)``; ``cases by k`` maps a degree to the case ids (or Rem 5.5 triples)
+    run with it, as the stages run them (the elastic stages, every registered space defined for
+    k; the benchmarks, the paper's cases and the reference space). ``with_cases=False``: the
+    meshes only ({} for the cases; no registry lookups, usable before the user spaces load)."""
+    from .discretization.registry import PAPER_CASES, REFERENCE_SPACE, ids_valid_for
+    from .discretization.series import FAMILY_RULES
+
+    def by_k(cases: dict) -> dict:
+        if not with_cases:
+            return {}
+        return {k: [c for c, ks in cases.items() if k in ks] for k in sorted({k for ks in cases.values() for k in ks})}
+
+    def every(ks, ids=None) -> dict:
+        if not with_cases:
+            return {}
+        return {k: ids_valid_for(k, ids if ids is not None else case_ids(cfg)) for k in ks}
+
+    ic, cc, ec, bc = cfg["infsup"], cfg["contact"], cfg["elastic"], cfg["benchmarks"]
+    inf, mm = by_k(ic["cases"]), ic["multiplier_meshes"]
+    for i, n in enumerate(ic["N"]):
+        yield f"infsup.N[{i}]", n, n, n, inf, mm
+    for i, pair in enumerate(ic.get("nonmatching", [])):
+        yield f"infsup.nonmatching[{i}]", pair, *pair, inf, mm
+    for name, n2s in ic.get("nonmatching_families", {}).items():
+        for i, n2 in enumerate(n2s):
+            yield f"infsup.nonmatching_families.{name}[{i}]", n2, FAMILY_RULES[name][0](n2), n2, inf, mm
+    con = by_k(cc["cases"])
+    for name, ns in scene_meshes(cfg).items():
+        key = f"contact.scenes.{name}.N" if "N" in cc["scenes"][name] else "contact.N"
+        for i, n in enumerate(ns):
+            yield f"{key}[{i}]", n, n, n, con, ("omega2",)
+    for key, ks in (("N", {*ec["k"], *ec["nu_sweep_k"]}), ("nonmatching", ec["k"]), ("patch_pairs", ec["patch_k"]),
+                    ("bench_N", ec["bench_k"])):
+        for i, item in enumerate(ec[key]):
+            n1, n2 = item if isinstance(item, list) else (item, item)
+            yield f"elastic.{key}[{i}]", item, n1, n2, every(ks), ("omega2",)
+    hz = ec["hertz"]
+    for i, n in enumerate(hz["N"]):
+        yield f"elastic.hertz.N[{i}]", n, n, n, every(hz["k"]), ("omega2",)
+    yield ("elastic.hertz.modeling_N", hz["modeling_N"], hz["modeling_N"], hz["modeling_N"],
+           {2: [REFERENCE_SPACE]} if with_cases else {}, ("omega2",))
+    for key, ks, ids in (("beta_N", bc["beta_k"], PAPER_CASES), ("contact_N", bc["contact_k"], [REFERENCE_SPACE])):
+        for i, n in enumerate(bc[key]):
+            yield f"benchmarks.{key}[{i}]", n, n, n, every(ks, ids), ("omega2",)
+    rem55 = {}
+    if with_cases:
+        from .study.claims import REM55_INSTANCES
+
+        for _, _, k, triple, _ in REM55_INSTANCES:
+            rem55.setdefault(k, []).append(triple)
+    for i, n in enumerate(cfg["claims"]["rem55_N"]):
+        yield f"claims.rem55_N[{i}]", n, n, n, rem55, ("omega2",)
+
+
+def config_intervals(cfg, limit: int = 1024) -> set:
+    """Numbers of intervals of every multiplier mesh of the config (best effort: a config
+    that is not yet validated may lack keys), for checking the user spaces on each."""
+    from .discretization.registry import MULTIPLIER_CHOICES, multiplier_intervals
+
+    out = set()
+    try:
+        for _, _, n1, n2, _, _ in mesh_uses(cfg, with_cases=False):
+            if all(isinstance(v, int) and not isinstance(v, bool) and 1 <= v <= limit for v in (n1, n2)):
+                out |= {multiplier_intervals(n1, n2, c) for c in MULTIPLIER_CHOICES}
+    except (LookupError, TypeError, ValueError, AttributeError, ArithmeticError):
+        pass  # the schema names what is malformed
+    return out
+
+
+def check_space_meshes(cfg) -> None:
+    """Every N list gets the minimum its spaces need: a case whose dim M_h is 0 on a mesh of
+    the list (T3 and DUAL with k = 1 on N = 1) is refused, naming the key, the case and k."""
+    from .discretization.registry import case_name, is_empty, min_intervals, multiplier_intervals
+
+    for key, value, n1, n2, cases_by_k, choices in mesh_uses(cfg):
+        for k, cases in cases_by_k.items():
+            for choice in choices:
+                n = multiplier_intervals(n1, n2, choice)
+                for case in cases:
+                    try:
+                        empty = is_empty(case, k, n)
+                    except InputError as err:  # a user space failing on this N
+                        raise ConfigError(key, f"case {case_name(case)} with k = {k} fails on N = {n} intervals "
+                                          f"({err})", got=value) from None
+                    if empty:
+                        low = min_intervals(case, k)
+                        where = (f"N = {n}" if n1 == n2 else f"the {choice} multiplier mesh of N1 = {n1}, N2 = {n2} "
+                                 f"({n} interval{'s' if n != 1 else ''})")
+                        raise ConfigError(key, f"case {case_name(case)} with k = {k} has dim M_h = 0 on {where}: "
+                                          "nothing to compute", got=value,
+                                          allowed=(f"N >= {low}" if n1 == n2 else
+                                                   f"pairs whose {choice} multiplier mesh has >= {low} intervals"))
+
+
 CROSS_KEY_RULES = {
     # rule: the keys it relates (the error names the first; a change to any of them can trip it)
     check_cases: ("infsup.cases", "contact.cases", "spaces"),
+    check_scene_names: ("contact.scenes",),
     check_reference: ("contact.reference_N", "contact.scenes", "contact.N"),
     check_rate_window: ("contact.rate_window", "contact.scenes", "contact.N"),
     check_nonmatching: ("infsup.nonmatching",),
@@ -322,6 +436,10 @@ CROSS_KEY_RULES = {
     check_speed_accuracy_scene: ("benchmarks.speed_accuracy_scene", "contact.scenes"),
     check_elastic_nonmatching: ("elastic.nonmatching", "elastic.patch_pairs"),
     check_hertz_reference: ("elastic.hertz.N_ref", "elastic.hertz.N"),
+    check_space_meshes: ("infsup.N", "infsup.nonmatching", "infsup.nonmatching_families", "contact.N",
+                         "contact.scenes", "elastic.N", "elastic.nonmatching", "elastic.patch_pairs",
+                         "elastic.bench_N", "elastic.hertz.N", "elastic.hertz.modeling_N", "benchmarks.beta_N",
+                         "benchmarks.contact_N", "claims.rem55_N", "infsup.cases", "contact.cases"),
 }
 """The rules a schema cannot state, with the keys each relates; each raises a
 :class:`ConfigError` naming one of them."""

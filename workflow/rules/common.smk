@@ -7,13 +7,17 @@ from snakemake.utils import validate
 
 from infsup_contact import resources
 from infsup_contact.config_checks import ConfigError, check_config
+from infsup_contact.config_yaml import check_config_files
 from infsup_contact.config_memory import check_job_memory, memory_notes
 from infsup_contact.discretization.series import beta_batches, seeds, series_of_pairs
 
 # Every check a config gets, in one library function (src/infsup_contact/config_checks.py):
 # user spaces, non-finite numbers, the schema, the registry's degrees and the cross-key rules.
 # A bad value stops here with ONE line naming the key — before the DAG, so no job starts.
+# First the files themselves (config_yaml.py): duplicate keys, zero-padded numbers and 1e3-as-a-
+# string, which Snakemake's YAML 1.1 loader has already turned into other values without a word.
 try:
+    check_config_files(workflow.configfiles)
     USER_SPACE_FILES, _notes = check_config(config, Path(workflow.current_basedir.get_path_or_uri(secret_free=True)) / ".." / "schemas" / "config.schema.yaml")
     if workflow.local_exec:  # a job must fit in this machine; a cluster job asks for its mem_mb
         check_job_memory(config, resources.total_bytes())

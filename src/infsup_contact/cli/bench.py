@@ -39,6 +39,11 @@ def _check_bench(args):
                 raise InputError(key, allowed, got=v)
         if len(set(values)) < len(values):
             raise InputError(key, f"{allowed}, each once", got=" ".join(map(str, values)))
+    from ..discretization.registry import check_pair_spaces, ids_valid_for
+
+    for k in args.k:  # every registered space defined for k: a superset of what the routes run
+        for n in args.N:
+            check_pair_spaces(ids_valid_for(k), k, n, n, key="N")
     if args.repeats < 1:
         raise InputError("repeats", "an integer >= 1", got=args.repeats)
     from ..bench.harness import ROUTE_BUDGET

@@ -34,7 +34,7 @@ def add(sub) -> None:
     p.add_argument("--h-route", default="logkernel", choices=["logkernel", "series"],
                    help="H^{-1/2}_00 Gram: closed-form log kernel or truncated sine series")
     p.add_argument("--seed", type=int, default=0, help="seed of the perturbed family (>= 0)")
-    p.add_argument("--alpha", type=float, default=0.2, help="perturbation amplitude / h, in [0, 0.5)")
+    p.add_argument("--alpha", type=float, default=0.2, help="perturbation amplitude / h, in [0, 0.2] (larger can invert triangles)")
     add_dry_run(p)
     p.set_defaults(run=_run_beta, check=_check_beta)
 

@@ -18,12 +18,26 @@ def cases(args) -> list:
     if args.space is not None:
         if args.case not in (None,):
             raise InputError("case", "either --case or --space, not both", got=args.case)
-        return [load_user_space(args.space).id]
+        return [load_user_space(args.space, run_intervals(args)).id]
     if args.case in (None, "all"):
         if not 1 <= args.k <= 4:
             raise InputError("k", "an integer in 1..4", got=args.k)
         return ids_valid_for(args.k)
     return [args.case]
+
+
+def run_intervals(args, limit: int = 1024) -> set:
+    """Numbers of intervals of the multiplier meshes a request will use (--N1/--N2 and
+    --multiplier-mesh, or the --N list of matching meshes), for checking a user space on each.
+    Sizes that are not valid N are left to their own checks; above ``limit`` the space is
+    checked as it is built (user_spaces.guarded_build), not before."""
+    from ..discretization.registry import multiplier_intervals
+
+    choice = getattr(args, "multiplier_mesh", "omega2")
+    pairs = ([(getattr(args, "N1", None), getattr(args, "N2", None))] if hasattr(args, "N1")
+             else [(n, n) for n in getattr(args, "N", None) or ()])
+    ok = [(a, b) for a, b in pairs if all(isinstance(v, int) and 1 <= v <= limit for v in (a, b))]
+    return {multiplier_intervals(a, b, choice) for a, b in ok}
 
 
 def add_model(p) -> None:

@@ -66,6 +66,7 @@ def _check_contact(args):
         registry.check_case(case, args.k)
     meshes.check_mesh_args(args.family, args.N1, "N1")
     meshes.check_mesh_args(args.family, args.N2, "N2")
+    registry.check_pair_spaces(args.cases, args.k, args.N1, args.N2)  # G_h = trace of Ω2 (omega2)
     check_prestress("c1", args.c1)
     check_prestress("c2", args.c2)
     _exponent("p", args.p)  # used by the manufactured scene only, but a bad value is bad anyway

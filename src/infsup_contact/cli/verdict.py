@@ -4,7 +4,7 @@ from __future__ import annotations
 import sys
 
 from ..errors import InputError
-from .common import add_dry_run, check_memory, SPACE_HELP
+from .common import add_dry_run, check_memory, run_intervals, SPACE_HELP
 
 
 VERDICT_DEFAULTS = {"slope_tolerance": 0.15, "beta_floor": 0.001, "confidence": 0.95}
@@ -55,13 +55,15 @@ def _check_verdict(args):
     from ..discretization.user_spaces import load_user_space
     from ..study.verdict import check_criterion, check_mesh_sizes
 
-    args.space_or_case = args.case if args.space is None else load_user_space(args.space)
+    args.space_or_case = args.case if args.space is None else load_user_space(args.space, run_intervals(args))
     case = args.case if args.space is None else args.space_or_case.id
     if not 1 <= args.k <= 4:
         raise InputError("k", "an integer in 1..4", got=args.k)
     registry.check_case(case, args.k)
     meshes.check_mesh_args(args.family, 1)
     ns = check_mesh_sizes(args.N)
+    for n in ns:  # an empty space on a small N is refused here, before any β_h
+        registry.check_pair_spaces([case], args.k, n, n, (args.multiplier_mesh,), key="N")
     check_criterion(args.slope_tolerance, args.beta_floor, args.confidence)
     est = resources.verdict_estimate(args.family, args.k, ns, args.norm, args.multiplier_mesh)
     check_memory(est, "N", max(ns))

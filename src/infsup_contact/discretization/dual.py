@@ -100,5 +100,7 @@ def dual_space(breakpoints, k: int, vanish_at_ends: bool) -> MultiplierSpace:
     base = make_space(breakpoints, k, True, vanish_at_ends)    # the numbering of W_h's nodes
     C = np.empty((base.n_intervals, k + 1, k + 1))
     for e, row in enumerate(base.dofs):
-        C[e] = local_dual_coefficients(k, np.flatnonzero(row >= 0))
+        live = np.flatnonzero(row >= 0)
+        # an interval without a live node (one interval, k = 1, ends vanishing) has no dual function
+        C[e] = local_dual_coefficients(k, live) if len(live) else 0.0
     return MultiplierSpace(base.breakpoints, k, False, vanish_at_ends, base.dofs, base.dim, C)

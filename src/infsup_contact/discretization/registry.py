@@ -153,9 +153,100 @@ def check_case(case: str, k: int) -> None:
 
 
 def case_space(case: str, k: int, breakpoints) -> MultiplierSpace:
-    """The multiplier space of a registered case for displacement degree k on G_h."""
+    """The multiplier space of a registered case for displacement degree k on G_h.
+
+    Raises
+    ------
+    InputError
+        For a partition with no interval or a space of dimension 0 on it (nothing to compute:
+        the eigenproblems and solves would fail deep inside numpy), naming the case, N and k.
+    """
     check_case(case, k)
-    return SPACES[case].build(k, np.asarray(breakpoints, dtype=float))
+    x = np.asarray(breakpoints, dtype=float)
+    n = len(x) - 1 if x.ndim == 1 else 0
+    if n < 1:
+        raise InputError("multiplier mesh", f"a partition of Γ with at least one interval (case {case}, "
+                         f"k = {k}, N = {max(n, 0)})")
+    space = SPACES[case].build(k, x)
+    if space.dim < 1:
+        low = min_intervals(case, k)
+        raise InputError("N", f"a multiplier mesh on which case {case} with k = {k} is not empty (dim M_h = 0 "
+                         f"on N = {n} intervals{'' if low is None else f'; it needs N >= {low}'})", got=n)
+    return space
+
+
+# --- empty spaces: refused before any computation ----------------------------------------
+MAX_MIN_INTERVALS = 64
+"""Search limit of :func:`min_intervals` (a space empty on 64 intervals is empty for the suite)."""
+
+
+def case_name(case) -> str:
+    """A registered id, or the label of a general triple ``(label, s, continuous, vanish)``."""
+    return case if isinstance(case, str) else str(case[0])
+
+
+def space_dim(case, k: int, n: int) -> int:
+    """dim M_h of ``case`` (an id or a triple ``(label, s, continuous, vanish)``, eqs. (5.3)/(5.5))
+    for degree k on N uniform intervals, built (1D, cheap): the build, not the ``dimension``
+    count, is what a run uses, and a user's build is guarded (user_spaces.guarded_build)."""
+    x = np.linspace(0.0, 1.0, n + 1)
+    if not isinstance(case, str):
+        _, s, continuous, vanish = case
+        return make_space(x, s, continuous, vanish).dim
+    return int(space_spec(case).build(k, x).dim)
+
+
+def is_empty(case, k: int, n: int) -> bool:
+    """dim M_h = 0 for ``case`` and degree k on N intervals. Above :data:`MAX_MIN_INTERVALS`
+    nothing is built (N may be huge here, before the memory check): the suite's spaces grow
+    with N, so a space is empty there only if it is empty on every N up to the limit."""
+    if n <= MAX_MIN_INTERVALS:
+        return space_dim(case, k, n) < 1
+    return min_intervals(case, k) is None
+
+
+def min_intervals(case, k: int) -> int | None:
+    """Smallest number of intervals N on which ``case`` is not empty for degree k (None if it is
+    empty up to :data:`MAX_MIN_INTERVALS`)."""
+    return next((n for n in range(1, MAX_MIN_INTERVALS + 1) if space_dim(case, k, n) > 0), None)
+
+
+MULTIPLIER_CHOICES = ("omega2", "omega1", "union")
+"""The choices of G_h (meshes.MULTIPLIER_MESHES; spelled here so the registry needs no NGSolve)."""
+
+
+def multiplier_intervals(n1: int, n2: int, choice: str = "omega2") -> int:
+    """Intervals of G_h (meshes.partition_choice) when the traces on Γ have N1 and N2 equal
+    segments: N2 (``omega2``), N1 (``omega1``), or N1 + N2 − gcd(N1, N2) for their ``union``
+    (i/N1 = j/N2 exactly at the multiples of 1/gcd). The perturbed family's union has at
+    least as many intervals; every space here grows with N."""
+    import math
+
+    return {"omega2": n2, "omega1": n1}.get(choice, n1 + n2 - math.gcd(n1, n2))
+
+
+def check_nonempty(case, k: int, n: int, key: str = "N", where: str = "") -> None:
+    """:class:`InputError` (one line naming the case, N and k) if ``case`` has dim M_h = 0 for
+    degree k on a multiplier mesh of N intervals, or the mesh has no interval."""
+    name = case_name(case)
+    if n < 1:
+        raise InputError(key, f"a multiplier mesh with at least one interval (case {name}, k = {k}{where})", got=n)
+    if is_empty(case, k, n):
+        low = min_intervals(case, k)
+        need = f"a multiplier mesh of at least {low} intervals" if low else "a larger multiplier mesh"
+        raise InputError(key, f"{need} for case {name} with k = {k} (dim M_h = 0 on N = {n} "
+                         f"interval{'s' if n != 1 else ''}{where}: nothing to compute)", got=n)
+
+
+def check_pair_spaces(cases, k: int, n1: int, n2: int, multiplier_meshes=("omega2",), key=None) -> None:
+    """:func:`check_nonempty` for every case on the multiplier mesh of the pair (N1, N2) for
+    each choice of G_h; the error names ``key``, by default the N that sets the multiplier mesh."""
+    for choice in multiplier_meshes:
+        n = multiplier_intervals(n1, n2, choice)
+        name = key or {"omega2": "N2", "omega1": "N1"}.get(choice, "N1, N2")
+        where = "" if n1 == n2 else f" of the {choice} multiplier mesh, N1 = {n1}, N2 = {n2}"
+        for case in cases:
+            check_nonempty(case, k, n, name, where)
 
 
 def paper_dimension(case: str, k: int, n_intervals: int) -> int:

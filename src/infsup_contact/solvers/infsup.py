@@ -107,6 +107,7 @@ def check_inputs(case, k, family, n1, n2, c1, c2, norm, multiplier_mesh) -> None
             raise InputError("norm", ", ".join(NORMS), got=nm)
     if multiplier_mesh not in meshes.MULTIPLIER_MESHES:
         raise InputError("multiplier_mesh", ", ".join(meshes.MULTIPLIER_MESHES), got=multiplier_mesh)
+    registry.check_pair_spaces(case, k, n1, n2, (multiplier_mesh,))  # dim M_h = 0: refused here
 
 
 def common_coarsening(x1: np.ndarray, x2: np.ndarray, tol: float = 1e-12) -> np.ndarray:

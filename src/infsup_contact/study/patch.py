@@ -75,7 +75,9 @@ def patch_mesh(n: int, side: int) -> ngsolve.Mesh:
         if label == meshes.DIRICHLET and x[0] == x[1] and x[0] in (0.0, 1.0):
             label = SIDE
         segs.append((a, b, label))
-    return meshes.mesh_from_arrays(points, triangles, segs)
+    mesh = meshes.mesh_from_arrays(points, triangles, segs)
+    meshes.check_mesh(mesh, 1.0, f"family structured (patch test), N = {n}, side {side}")
+    return mesh
 
 
 def constrained_modulus(E: float, nu: float) -> float:

@@ -1,0 +1,470 @@
+"""Fault injection, inputs (issue 26): each fault gets ONE line naming the thing, or a documented
+acceptance.
+
+Classes: perturbed meshes (α beyond the bound, inverted or missing elements), empty
+multiplier spaces (every case/k/N the registry's dimension counts make empty, through the
+library and every subcommand), config N lists with N = 1, faulty user spaces, YAML 1.1 quirks
+and scene names. In-process (the library, ``cli.main``), except one Snakemake run that shows
+the strict YAML reading is hooked in front of the workflow.
+"""
+import copy
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+
+from infsup_contact.cli import main as cli_main
+from infsup_contact.config_checks import ConfigError, check_config, key_path, mesh_uses
+from infsup_contact.config_yaml import check_config_file
+from infsup_contact.discretization import meshes, registry
+from infsup_contact.discretization.registry import SPACES
+from infsup_contact.discretization.user_spaces import load_user_space
+from infsup_contact.errors import InputError
+
+ROOT = Path(__file__).resolve().parents[1]
+SCHEMA = ROOT / "workflow" / "schemas" / "config.schema.yaml"
+CI_CONFIG = yaml.safe_load((ROOT / "config" / "ci.yaml").read_text())
+
+
+def one_line(text) -> str:
+    text = str(text)
+    assert "\n" not in text.strip() and "Traceback" not in text, text
+    return text
+
+
+@pytest.fixture(autouse=True)
+def forget_user_spaces():
+    """Each test registers what it loads; the registry is left as the other tests expect it."""
+    from infsup_contact.discretization import user_spaces
+
+    before = set(SPACES)
+    yield
+    for ref, spec in list(user_spaces._LOADED.items()):
+        if spec.id not in before:
+            del user_spaces._LOADED[ref]
+    for case in set(SPACES) - before:
+        del SPACES[case]
+
+
+def run_cli(capsys, *argv) -> tuple[int, str]:
+    """``infsup-contact ARGV`` in-process: (exit code, stderr)."""
+    code = cli_main(list(argv))
+    return code, capsys.readouterr().err.strip()
+
+
+# ------------------------------------------------------------------ 1. perturbed meshes
+
+BEYOND = [0.2 + 1e-9, 0.25, 0.3, 0.45, 0.5, -0.01, float("nan"), float("inf")]
+
+
+@pytest.mark.parametrize("alpha", BEYOND)
+def test_alpha_beyond_the_bound_is_refused(alpha, capsys):
+    with pytest.raises(InputError) as err:
+        meshes.check_perturbation(alpha, 0)
+    assert err.value.key == "alpha" and f"[0, {meshes.ALPHA_MAX:g}]" in one_line(err.value)
+    code, err_line = run_cli(capsys, "beta", "--case", "T3", "--k", "1", "--family", "perturbed",
+                             "--N1", "4", "--N2", "4", "--alpha", str(alpha), "--dry-run")
+    assert code == 2 and one_line(err_line).startswith("infsup-contact: error: invalid --alpha")
+    cfg = copy.deepcopy(CI_CONFIG)
+    cfg["infsup"]["alpha"] = alpha
+    with pytest.raises(ConfigError) as cerr:
+        check_config(cfg, SCHEMA)
+    assert one_line(cerr.value).startswith("config key infsup.alpha")
+
+
+@pytest.mark.parametrize("alpha", [0.1, 0.2, 0.3])
+def test_perturbation_bound_holds_for_random_draws(alpha):
+    """The worst case over every displacement (corners of the box, where the multi-affine
+    signed area is extreme) bounds every seed's triangles; it is 1 − 4α."""
+    bound, angle = meshes.perturbation_bounds(alpha)
+    assert bound == pytest.approx(1 - 4 * alpha, abs=1e-12)
+    assert (angle > 0) == (alpha <= meshes.ALPHA_MAX)
+    for n in (4, 7, 16):
+        points, triangles = meshes.structured_arrays(n, 1)
+        ratios = [meshes.signed_areas(meshes.perturb(points, n, 1, alpha, s), triangles).min() / (0.5 / n**2)
+                  for s in range(20)]
+        assert min(ratios) >= bound - 1e-12
+
+
+def test_alpha_at_the_bound_builds_checked_meshes():
+    """Documented acceptance: α = ALPHA_MAX is allowed and every seed's mesh passes the check."""
+    for seed in range(3):
+        m1, m2 = meshes.mesh_pair("perturbed", 8, 8, alpha=meshes.ALPHA_MAX, seed=seed)
+        assert meshes.mesh_quality(m1)["min_angle"] >= meshes.perturbation_bounds(meshes.ALPHA_MAX)[1]
+
+
+def _flip_one(arrays):
+    def flipped(n, side):
+        points, triangles = arrays(n, side)
+        triangles = triangles.copy()
+        triangles[0, [1, 2]] = triangles[0, [2, 1]]
+        return points, triangles
+    return flipped
+
+
+def _drop_one(arrays):
+    def dropped(n, side):
+        points, triangles = arrays(n, side)
+        return points, triangles[1:]
+    return dropped
+
+
+MESH_FAULTS = {
+    # name: (monkeypatch(meshes) → kwargs of subdomain_mesh, needles)
+    "inverted-by-alpha-0.45": (lambda mp: mp.setattr(meshes, "ALPHA_RANGE", (0.0, 0.5)),
+                               dict(family="perturbed", n=16, alpha=0.45, seed=0),
+                               ["perturbed", "N = 16", "seed 0", "alpha 0.45", "inverted"]),
+    "one-triangle-flipped": (lambda mp: mp.setattr(meshes, "structured_arrays", _flip_one(meshes.structured_arrays)),
+                             dict(family="structured", n=4), ["structured", "N = 4", "inverted"]),
+    "one-triangle-missing": (lambda mp: mp.setattr(meshes, "structured_arrays", _drop_one(meshes.structured_arrays)),
+                             dict(family="perturbed", n=5, alpha=0.1, seed=2),
+                             ["perturbed", "N = 5", "seed 2", "alpha 0.1", "sum to"]),
+}
+
+
+@pytest.mark.parametrize("name", list(MESH_FAULTS))
+def test_bad_mesh_is_detected_naming_family_n_seed_alpha(name, monkeypatch):
+    patch, kwargs, needles = MESH_FAULTS[name]
+    patch(monkeypatch)
+    family, n = kwargs.pop("family"), kwargs.pop("n")
+    with pytest.raises(InputError) as err:
+        meshes.subdomain_mesh(family, n, 1, **kwargs)
+    for needle in needles:
+        assert needle in one_line(err.value), err.value
+
+
+# ------------------------------------------------------------------ 2. empty spaces
+
+def empty_combinations(n_max: int = 3) -> list:
+    """(case, k, N) with dim M_h = 0 by the registry's own dimension counts (the paper's)."""
+    return [(c, k, n) for c, spec in SPACES.items() if spec.dimension is not None
+            for k in range(1, 5) if spec.valid_for(k) for n in range(1, n_max + 1) if spec.dimension(k, n) == 0]
+
+
+EMPTY = empty_combinations()
+
+
+def test_the_registry_has_empty_combinations():
+    """The counts make T3 and DUAL empty for k = 1 on one interval (n k − 1 = 0)."""
+    assert {("T3", 1, 1), ("DUAL", 1, 1)} <= set(EMPTY)
+
+
+@pytest.mark.parametrize("case, k, n", EMPTY)
+def test_empty_space_is_refused_before_any_computation(case, k, n, capsys, monkeypatch):
+    from infsup_contact.solvers import infsup
+
+    def no_mesh(*a, **kw):  # "before any computation": no mesh may be built
+        raise AssertionError("a mesh was built for an empty space")
+    monkeypatch.setattr(meshes, "subdomain_mesh", no_mesh)
+    with pytest.raises(InputError) as err:
+        infsup.check_inputs([case], k, "structured", n, n, 1.0, 1.0, ["H"], "omega2")
+    text = one_line(err.value)
+    assert f"case {case}" in text and f"k = {k}" in text and f"N = {n}" in text
+    with pytest.raises(InputError):  # the backstop every consumer of the registry goes through
+        registry.case_space(case, k, np.linspace(0.0, 1.0, n + 1))
+    argvs = {
+        "beta": ["beta", "--case", case, "--k", str(k), "--N1", str(n), "--N2", str(n)],
+        "verdict": ["verdict", "--case", case, "--k", str(k), "--N", str(n), "8", "16"],
+        "contact": ["contact", "--case", case, "--k", str(k), "--N1", str(n), "--N2", str(n),
+                    "--scene", "manufactured"],
+        "patch": ["contact", "--case", case, "--k", str(k), "--N1", str(n + 1), "--N2", str(n),
+                  "--scene", "patch", "--model", "elastic"],
+        "bench": ["bench", "--what", "beta", "--N", str(n), "--k", str(k)],
+    }
+    for name, argv in argvs.items():
+        code, line = run_cli(capsys, *argv)
+        assert code == 2, (name, line)
+        assert f"case " in one_line(line) and f"k = {k}" in line and "dim M_h = 0" in line, (name, line)
+
+
+@pytest.mark.parametrize("argv, refused", [
+    (["--case", "DUAL", "--k", "1", "--N1", "3", "--N2", "1", "--multiplier-mesh", "omega2"], True),
+    (["--case", "DUAL", "--k", "1", "--N1", "1", "--N2", "3", "--multiplier-mesh", "omega1"], True),
+    # documented acceptance: the union of 3 and 1 segments has 3 intervals, DUAL has 2 functions
+    (["--case", "DUAL", "--k", "1", "--N1", "3", "--N2", "1", "--multiplier-mesh", "union"], False),
+    (["--case", "T3", "--k", "2", "--N1", "1", "--N2", "1"], False),   # dim = 2·1 − 1 = 1
+])
+def test_empty_multiplier_mesh_of_a_pair(argv, refused, capsys):
+    code, line = run_cli(capsys, "beta", *argv, "--dry-run")
+    if refused:
+        assert code == 2 and "dim M_h = 0" in one_line(line) and "N1 = " in line, line
+    else:
+        assert code == 0, line
+
+
+def test_multiplier_mesh_with_no_interval():
+    with pytest.raises(InputError) as err:
+        registry.case_space("T3", 2, np.array([0.0]))
+    assert "at least one interval" in one_line(err.value) and "case T3" in str(err.value)
+
+
+# ------------------------------------------------------------------ 3. config N lists with N = 1
+
+def _n1(cfg, path):
+    """Put N = 1 (a pair (2, 1): Ω2's trace, the multiplier mesh, one interval) first in the list."""
+    node = cfg
+    for key in path[:-1]:
+        node = node[key]
+    value = node[path[-1]]
+    if isinstance(value, list):
+        value[0] = [2, 1] if isinstance(value[0], list) else 1
+    else:
+        node[path[-1]] = 1
+
+
+N_LISTS = {
+    # key path: outcome of N = 1 — "empty" (refused: a space run there has dim M_h = 0),
+    # "schema" (the schema's minimum already refuses it), "accepted" (documented: every space
+    # run there is non-empty on one interval)
+    ("infsup", "N"): "empty",
+    ("infsup", "nonmatching"): "empty",
+    ("infsup", "nonmatching_families", "plus1"): "empty",
+    ("infsup", "nonmatching_families", "sqrt2"): "schema",  # round(√2·1) = 1: no pair; N2 >= 2
+    ("contact", "N"): "empty",
+    ("contact", "scenes", "membranes", "N"): "empty",
+    ("elastic", "N"): "empty",
+    ("elastic", "nonmatching"): "empty",
+    ("elastic", "patch_pairs"): "empty",
+    ("elastic", "bench_N"): "empty",
+    ("elastic", "hertz", "N"): "empty",
+    ("elastic", "hertz", "modeling_N"): "accepted",  # T3 with k = 2: dim = 2·1 − 1 = 1
+    ("benchmarks", "beta_N"): "empty",
+    ("benchmarks", "contact_N"): "empty",
+    ("claims", "rem55_N"): "empty",
+}
+
+
+def test_every_n_list_is_covered():
+    """Every mesh key the config checks (config_checks.mesh_uses) is mutated here."""
+    keys = {key.split("[")[0] for key, *_ in mesh_uses(CI_CONFIG, with_cases=False)}
+    assert keys <= {key_path(p) for p in N_LISTS}, keys - {key_path(p) for p in N_LISTS}
+
+
+@pytest.mark.parametrize("path", list(N_LISTS), ids=[key_path(p) for p in N_LISTS])
+def test_n_equal_one_in_every_n_list(path):
+    cfg = copy.deepcopy(CI_CONFIG)
+    _n1(cfg, path)
+    if N_LISTS[path] == "accepted":
+        check_config(cfg, SCHEMA)
+        return
+    with pytest.raises(ConfigError) as err:
+        check_config(cfg, SCHEMA)
+    text = one_line(err.value)
+    assert text.startswith(f"config key {key_path(path)}"), text
+    if N_LISTS[path] == "empty":
+        assert "dim M_h = 0" in text and "case " in text and "k = " in text, text
+    else:
+        assert "minimum" in text, text
+
+
+# ------------------------------------------------------------------ 4. user spaces
+
+HEADER = """
+import numpy as np
+from infsup_contact.discretization.multipliers import make_space
+from infsup_contact.discretization.registry import SpaceSpec
+
+def good_build(k, x):
+    return make_space(x, k, True, True)
+"""
+USER_FAULTS = {
+    # name: (module body, function, needles)
+    "space-raises": ("def space():\n    raise RuntimeError('boom')\n", "space", ["space()", "RuntimeError", "boom"]),
+    "systemexit-at-import": ("raise SystemExit(3)\n", "space", ["import of", "SystemExit", "3"]),
+    "systemexit-in-space": ("def space():\n    raise SystemExit(3)\n", "space", ["space()", "SystemExit"]),
+    "baseexception-in-build": ("class Boom(BaseException):\n    pass\n\ndef b(k, x):\n    raise Boom('deep')\n\n"
+                               "def space():\n    return SpaceSpec('U-boom', 'user', '', b, lambda k: k)\n",
+                               "space", ["build(k=1", "Boom", "deep"]),
+    "dimension-raises": ("def space():\n    return SpaceSpec('U-dim', 'user', '', good_build, lambda k: k, "
+                         "dimension=lambda k, n: 1 / 0)\n", "space", ["dimension(", "ZeroDivisionError"]),
+    "unknown-keyword": ("def space():\n    return SpaceSpec('U-kw', 'user', '', good_build, lambda k: k, "
+                        "colour='red')\n", "space", ["unexpected keyword", "colour", "SpaceSpec takes"]),
+    "non-string-id": ("def space():\n    return SpaceSpec(42, 'user', '', good_build, lambda k: k)\n", "space",
+                      ["space id", "42", "letters"]),
+    "the-build-function": ("def space():\n    return SpaceSpec('U-ok', 'user', '', good_build, lambda k: k)\n",
+                           "good_build", ["good_build", "build function", "(k, x)"]),
+    "not-a-spacespec": ("def space():\n    return {'id': 'U'}\n", "space", ["SpaceSpec", "dict"]),
+    "ignores-partition": ("def b(k, x):\n    return make_space(np.linspace(0, 1, 6), k, True, True)\n\n"
+                          "def space():\n    return SpaceSpec('U-fixed', 'user', '', b, lambda k: k)\n", "space",
+                          ["U-fixed", "partition it is given"]),
+    "wrong-degree": ("def space():\n    return SpaceSpec('U-deg', 'user', '', good_build, lambda k: 0)\n", "space",
+                     ["U-deg", "local degree 0"]),
+    "missing-function": ("x = 1\n", "space", ["a function space"]),
+}
+BAD_IDS = ["", "x{k}", "a b", "T_3", "-x", "3T", "a" * 33, "dollar$", "back\\slash"]
+GOOD_IDS = ["My-space.2", "P0-2h", "x"]
+
+
+def write_module(tmp_path, name, body) -> Path:
+    path = tmp_path / f"{name.replace('-', '_')}.py"
+    path.write_text(HEADER + body)
+    return path
+
+
+@pytest.mark.parametrize("name", list(USER_FAULTS))
+def test_faulty_user_space_one_line_naming_file_function_exception(tmp_path, name, capsys):
+    body, func, needles = USER_FAULTS[name]
+    path = write_module(tmp_path, name, body)
+    ref = f"{path}:{func}"
+    with pytest.raises(InputError) as err:
+        load_user_space(ref)
+    text = one_line(err.value)
+    assert str(path) in text or "U-" in text, text
+    for needle in needles:
+        assert needle in text, (needle, text)
+    code, line = run_cli(capsys, "beta", "--space", ref, "--k", "2", "--N1", "4", "--N2", "4", "--dry-run")
+    assert code == 2 and one_line(line).startswith("infsup-contact: error:"), line
+    cfg = copy.deepcopy(CI_CONFIG)
+    cfg["spaces"] = [*cfg.get("spaces", []), ref]
+    with pytest.raises(ConfigError) as cerr:
+        check_config(cfg, SCHEMA)
+    assert one_line(cerr.value).startswith(f"config key spaces[{len(cfg['spaces']) - 1}]: ")
+
+
+@pytest.mark.parametrize("space_id", BAD_IDS + GOOD_IDS)
+def test_space_ids(tmp_path, space_id):
+    path = write_module(tmp_path, "ids", f"def space():\n    return SpaceSpec({space_id!r}, 'u', '', good_build, "
+                                           "lambda k: k)\n")
+    if space_id in GOOD_IDS and space_id not in SPACES:
+        assert load_user_space(f"{path}:space").id == space_id
+        return
+    with pytest.raises(InputError) as err:
+        load_user_space(f"{path}:space")
+    assert "letters, digits" in one_line(err.value) or "already registered" in str(err.value)
+
+
+PARTITION_FAULTS = {
+    # a space right on the check partition (N = 5) and wrong elsewhere
+    "ignores-partition-off-5": ("def b(k, x):\n    y = x if len(x) == 6 else np.linspace(0, 1, 6)\n"
+                                "    return make_space(y, k, True, True)\n",
+                                "dimension=lambda k, n: 5 * k - 1", "partition it is given"),
+    "dimension-wrong-off-5": ("b = good_build\n", "dimension=lambda k, n: n * k - 1 if n == 5 else 7", "dimension 7"),
+    "empty-build-fails-on-1": ("def b(k, x):\n    assert len(x) > 2, 'needs two intervals'\n"
+                               "    return make_space(x, k, True, True)\n", "dimension=None", "needs two intervals"),
+}
+
+
+@pytest.mark.parametrize("name", list(PARTITION_FAULTS))
+def test_space_checked_on_every_partition_of_the_run(tmp_path, name, capsys):
+    body, dim, needle = PARTITION_FAULTS[name]
+    n = 1 if "on-1" in name else 8
+    path = write_module(tmp_path, name, body + f"\ndef space():\n    return SpaceSpec('U-{name}', 'u', '', b, "
+                                                f"lambda k: k, {dim})\n")
+    ref = f"{path}:space"
+    code, line = run_cli(capsys, "beta", "--space", ref, "--k", "2", "--N1", str(n), "--N2", str(n), "--dry-run")
+    assert code == 2 and needle in one_line(line) and f"N = {n}" in line, line
+    cfg = copy.deepcopy(CI_CONFIG)
+    cfg["spaces"] = [ref]
+    cfg["infsup"]["N"] = [n, *[m for m in cfg["infsup"]["N"] if m != n]]
+    with pytest.raises(ConfigError) as cerr:
+        check_config(cfg, SCHEMA)
+    assert one_line(cerr.value).startswith("config key spaces[0]: ") and needle in str(cerr.value)
+
+
+def test_every_later_build_is_guarded(tmp_path):
+    """A space registered after its checks still cannot compute on a partition it ignores: the
+    registered build checks each result (jobs build on partitions no check saw)."""
+    body, dim, needle = PARTITION_FAULTS["ignores-partition-off-5"]
+    path = write_module(tmp_path, "later", body + f"\ndef space():\n    return SpaceSpec('U-later', 'u', '', b, "
+                                                  f"lambda k: k, {dim})\n")
+    spec = load_user_space(f"{path}:space")
+    with pytest.raises(InputError) as err:
+        registry.case_space(spec.id, 1, np.linspace(0.0, 1.0, 8))
+    assert needle in one_line(err.value)
+
+
+def test_keyboard_interrupt_is_not_swallowed(tmp_path):
+    """Documented acceptance: Ctrl-C in a user's code stays Ctrl-C (the guard lets it through)."""
+    path = write_module(tmp_path, "ctrlc", "def space():\n    raise KeyboardInterrupt\n")
+    with pytest.raises(KeyboardInterrupt):
+        load_user_space(f"{path}:space")
+
+
+# ------------------------------------------------------------------ 5. YAML and scene names
+
+YAML_FAULTS = {
+    "duplicate-top": ("spaces: []\nspaces: []\n", "spaces", "given twice"),
+    "duplicate-nested": ("infsup:\n  alpha: 0.2\n  alpha: 0.1\n", "infsup.alpha", "given twice"),
+    "duplicate-in-list": ("s:\n  - {a: 1, a: 2}\n", "s[0].a", "given twice"),
+    "octal": ("infsup:\n  N: [004, 010]\n", "infsup.N[0]", "octal number 4"),
+    "octal-second": ("infsup:\n  N: [4, 010]\n", "infsup.N[1]", "octal number 8"),
+    "zero-padded-9": ("infsup:\n  N: [09]\n", "infsup.N[0]", "the string '09'"),
+    "1e3": ("claims:\n  beta_floor: 1e3\n", "claims.beta_floor", "signed exponent"),
+    "1.0e3": ("claims:\n  beta_floor: 1.0e3\n", "claims.beta_floor", "signed exponent"),
+    "-1e-3": ("x: -1e-3\n", "x", "read as a string"),
+    "json-duplicate": ('{"a": 1, "a": 2}', "a", "given twice"),
+}
+YAML_ACCEPTED = {
+    "quoted-1e3": "a: '1e3'\n",
+    "signed-exponent": "a: 1.0e+3\n",
+    "plain-zero": "a: 0\nb: [0, 0.5]\n",
+    "json-1e3": '{"a": 1e3}',
+}
+
+
+@pytest.mark.parametrize("name", list(YAML_FAULTS))
+def test_yaml_quirk_is_refused(tmp_path, name):
+    text, key, needle = YAML_FAULTS[name]
+    path = tmp_path / "c.yaml"
+    path.write_text(text)
+    with pytest.raises(ConfigError) as err:
+        check_config_file(path)
+    assert one_line(err.value).startswith(f"config key {key}:") and needle in str(err.value), err.value
+
+
+@pytest.mark.parametrize("name", list(YAML_ACCEPTED) + ["config.yaml", "ci.yaml"])
+def test_yaml_accepted(tmp_path, name):
+    path = ROOT / "config" / name if name.endswith(".yaml") else tmp_path / "c.yaml"
+    if not name.endswith(".yaml"):
+        path.write_text(YAML_ACCEPTED[name])
+    check_config_file(path)
+
+
+@pytest.mark.parametrize("scene", ["", "x{k}", "a b", "9lives", "a/b"])
+def test_bad_scene_name(scene):
+    cfg = copy.deepcopy(CI_CONFIG)
+    cfg["contact"]["scenes"][scene] = {"kind": "manufactured", "p": 3.0, "q": 3.0}
+    with pytest.raises(ConfigError) as err:
+        check_config(cfg, SCHEMA)
+    assert one_line(err.value).startswith("config key contact.scenes:") and repr(scene) in str(err.value)
+
+
+def test_strict_yaml_runs_in_front_of_the_workflow(tmp_path):
+    """The one subprocess: Snakemake parses the workflow, common.smk refuses the file."""
+    import shutil
+
+    shutil.copy2(ROOT / "Snakefile", tmp_path / "Snakefile")
+    for d in ("workflow", "config", "profiles", "paper", "examples"):
+        shutil.copytree(ROOT / d, tmp_path / d, ignore=shutil.ignore_patterns("__pycache__"))
+    (tmp_path / "src").symlink_to(ROOT / "src", target_is_directory=True)
+    text = (ROOT / "config" / "ci.yaml").read_text().replace("  alpha: 0.2", "  alpha: 0.2\n  alpha: 0.1", 1)
+    (tmp_path / "bad.yaml").write_text(text)
+    env = {**os.environ, "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"}
+    proc = subprocess.run([str(Path(sys.prefix) / "bin" / "snakemake"), "-n", "reproduce-all", "--cores", "1",
+                           "--configfile", "bad.yaml"], cwd=tmp_path, env=env, capture_output=True, text=True,
+                          timeout=120)
+    lines = [l for l in (proc.stdout + proc.stderr).splitlines()
+             if l.strip() and not l.startswith("Using workflow specific profile")]
+    assert proc.returncode == 1 and len(lines) == 1, lines
+    assert lines[0].startswith("config key infsup.alpha: given twice")
+
+
+def test_user_space_empty_on_small_n(tmp_path, capsys):
+    """A user space may be empty on small N (continuous P_1 vanishing at Γ's ends, k = 1, N = 1):
+    it registers, and the N that leaves it empty is refused naming the case, N and k."""
+    path = write_module(tmp_path, "small", "def space():\n    return SpaceSpec('U-small', 'u', '', good_build, "
+                                           "lambda k: k)\n")
+    ref = f"{path}:space"
+    code, line = run_cli(capsys, "beta", "--space", ref, "--k", "1", "--N1", "1", "--N2", "1", "--dry-run")
+    assert code == 2 and "case U-small" in one_line(line) and "dim M_h = 0" in line and "k = 1" in line, line
+    cfg = copy.deepcopy(CI_CONFIG)
+    cfg["spaces"] = [*cfg.get("spaces", []), ref]
+    cfg["infsup"]["cases"] = {"U-small": [1]}  # alone: T3 would be refused on N = 1 first
+    cfg["infsup"]["N"] = [1, *cfg["infsup"]["N"]]
+    with pytest.raises(ConfigError) as err:
+        check_config(cfg, SCHEMA)
+    assert one_line(err.value).startswith("config key infsup.N[0]: case U-small with k = 1 has dim M_h = 0")

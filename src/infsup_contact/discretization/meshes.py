@@ -50,7 +50,7 @@ coordinate separately, so its minimum over the box of displacements is at a corn
 triangle) at α = 1/4. At α = 1/5 the ratio is >= 0.2 and every angle is >= 3.9° (the angle
 at a vertex is arcsin(2A / (|a| |b|)) with A at least its minimum and the edges at most
 their maxima; the smallest angle of a triangle is acute). Measured over seeds 0..199,
-N = 4..32 and both sides (``tools/alpha_bound.py``), the smallest ratio is 0.24 at α = 0.2
+N = 4..32 and both sides (``workflow/scripts/alpha_bound.py``), the smallest ratio is 0.24 at α = 0.2
 (smallest angle 13.6°), 0.05 at α = 0.25 and −0.13 at α = 0.3: random draws stay inside the
 bound, and larger α does invert triangles."""
 ALPHA_RANGE = (0.0, ALPHA_MAX)

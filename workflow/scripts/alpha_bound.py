@@ -5,7 +5,7 @@ triangle relative to the unperturbed one (h²/2) and the smallest angle, next to
 guaranteed bounds of :func:`infsup_contact.discretization.meshes.perturbation_bounds`
 (every seed). Vertex arithmetic only (numpy): no NGSolve mesh is built.
 
-    python tools/alpha_bound.py [--seeds 200] [--csv out.csv]
+    python workflow/scripts/alpha_bound.py [--seeds 200] [--csv out.csv]
 """
 from __future__ import annotations
 

@@ -14,10 +14,11 @@ def add(sub) -> None:
 
     p = sub.add_parser("beta", help="β_h for one mesh pair (CSV: one row per case × norm)",
                        description="β_h (eq. (4.5)) for one mesh pair, one CSV row per case × norm. Column "
-                       f"kernel_dim: {KERNEL_CRITERION}. Column kernel_check compares it with "
-                       "structural_kernel_dim = max(dim M − dim(W1 + W2), 0), a lower bound, exact for "
-                       "Rem 5.2/5.4 on matching meshes (agree, below_structural, above_structural); "
-                       "gap_over_roundoff is the first eigenvalue above the kernel over eta.")
+                       f"kernel_dim: {KERNEL_CRITERION}. beta is 0 where kernel_dim > 0 and smallest_nonzero "
+                       "is beta above the kernel. kernel_check compares the numerical count with the "
+                       "proven one (agree, above_structural: modes beyond the proof, below_structural: the "
+                       "error level was exceeded); gap_over_roundoff is the first pencil eigenvalue above "
+                       "the kernel over the pencil's round-off level n*eps*lambda_max (a cross-check).")
     p.add_argument("--case", default=None, choices=[*space_ids(), "all"],
                    help="a registered space, or all (the default) for every one defined for k")
     p.add_argument("--space", metavar="FILE.py:FUNC", help=SPACE_HELP)

@@ -105,6 +105,13 @@ def coupling_matrix(trace: GammaTrace, space: MultiplierSpace, k: int) -> np.nda
     return (mu * w[:, None]).T @ trace_basis_at(trace, x)
 
 
+def trace_l2_norms(trace: GammaTrace, k: int) -> np.ndarray:
+    """‖φ_d‖_{L²(Γ)} of the Γ-dof basis functions (exact Gauss rule for the degree-2k squares):
+    the row scaling of the kernel decision (:func:`infsup_contact.solvers.kernel.scaled_couplings`)."""
+    x, w = quadrature_on(trace.breakpoints, 2 * k)
+    return np.sqrt(w @ trace_basis_at(trace, x) ** 2)
+
+
 _BASIS_CACHE_SIZE = 4
 
 

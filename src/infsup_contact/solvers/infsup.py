@@ -16,13 +16,14 @@ import scipy.sparse as sp
 from scipy.linalg import lapack
 
 from ..discretization import meshes, multipliers, registry
-from ..discretization.coupling import coupling_matrix
+from ..discretization.coupling import coupling_matrix, trace_l2_norms
 from ..errors import InputError, check_prestress
 from ..models.schur import combine_terms, interface_terms
 from ..models.membranes import MEMBRANES
 from ..models.side_cache import SideCache
 from ..discretization.norms import NORMS, gram
-from .kernel import GAP_DECADES, KERNEL_CRITERION, kernel_check, kernel_from_gap  # noqa: F401
+from .kernel import (GAP_DECADES, KERNEL_CRITERION, KernelDecision, coupling_kernel, gap_over_roundoff,  # noqa: F401
+                     kernel_check, kernel_from_gap, scaled_couplings)
 
 @dataclass(frozen=True)
 class Spectrum:
@@ -31,14 +32,16 @@ class Spectrum:
     Attributes
     ----------
     beta : float
-        β_h = sqrt(smallest eigenvalue), clipped at 0.
+        β_h = sqrt(smallest eigenvalue), clipped at 0; exactly 0 when a kernel decided from Bᵀ
+        is passed in and is not empty (the smallest eigenvalue is round-off then).
     kernel_dim : int
-        Dimension of the numerical kernel by the gap criterion (:func:`kernel_from_gap`).
+        Dimension of the kernel: the :class:`~infsup_contact.solvers.kernel.KernelDecision`
+        passed in, or else the pencil's own gap rule (:func:`kernel_from_gap`).
     smallest_nonzero : float
-        sqrt of the smallest eigenvalue above the numerical kernel (β above the kernel).
+        sqrt of the first eigenvalue above the kernel (β above the kernel).
     gap : float
-        The first eigenvalue above the kernel divided by the round-off level η (with no
-        kernel: the smallest eigenvalue over η); a kernel needs ``gap >= 10**GAP_DECADES``.
+        That eigenvalue divided by the pencil's round-off level n ε λ_max (with no kernel:
+        the smallest eigenvalue over it).
     bottom : ndarray
         The smallest eigenvalues β² (up to 8), ascending.
     """
@@ -59,12 +62,15 @@ def gram_factor(G: np.ndarray) -> np.ndarray:
     return L
 
 
-def spectrum(S: np.ndarray, G: np.ndarray | None = None, *, factor: np.ndarray | None = None) -> Spectrum:
+def spectrum(S: np.ndarray, G: np.ndarray | None = None, *, factor: np.ndarray | None = None,
+             kernel: KernelDecision | None = None) -> Spectrum:
     """Solve S m = β² G m densely and summarize its bottom.
 
     The steps of LAPACK's dsygvd (``scipy.linalg.eigh(S, G)``): G = L Lᵀ (potrf), the
     standard form L⁻¹ S L⁻ᵀ (sygst), its eigenvalues (syevd), bitwise the same as eigh;
     ``factor`` (:func:`gram_factor` of G) skips the first step when G's factor is known.
+    ``kernel``: the kernel decided from Bᵀ (:func:`coupling_kernel`, the reported one);
+    without it the pencil's gap rule decides (:func:`kernel_from_gap`).
     """
     L = gram_factor(G) if factor is None else factor
     C, info = lapack.dsygst(np.asarray(S, float), L, itype=1, lower=1)
@@ -73,10 +79,17 @@ def spectrum(S: np.ndarray, G: np.ndarray | None = None, *, factor: np.ndarray |
     ev, _, info = lapack.dsyevd(C, compute_v=0, lower=1)
     if info:
         raise np.linalg.LinAlgError(f"the eigenvalues did not converge (syevd info {info})")
-    kernel, gap = kernel_from_gap(ev)
+    beta = float(np.sqrt(max(ev[0], 0.0)))
+    if kernel is None:
+        kernel, gap = kernel_from_gap(ev)
+    else:
+        # a kernel decided from Bᵀ makes β_h = 0 exactly; the pencil's smallest eigenvalue
+        # is then round-off, and its digits differ between BLAS kernels
+        kernel = kernel.dim
+        gap = gap_over_roundoff(ev, kernel)
+        beta = 0.0 if kernel > 0 else beta
     above = ev[kernel] if kernel < len(ev) else np.nan
-    return Spectrum(float(np.sqrt(max(ev[0], 0.0))), kernel, float(np.sqrt(max(above, 0.0))), gap,
-                    ev[:8].copy())
+    return Spectrum(beta, kernel, float(np.sqrt(max(above, 0.0))), gap, ev[:8].copy())
 
 
 def check_inputs(case, k, family, n1, n2, c1, c2, norm, multiplier_mesh) -> None:
@@ -180,6 +193,8 @@ def beta_rows_all(family, k, n1, n2, cases=None, multiplier_meshes=("omega2",), 
             t_coupling = time.perf_counter() - tc
             grams = {norm: gram(space, norm, h_route=h_route) for norm in norms}
             structural = max(space.dim - dim_w, 0)
+            kernel = space_kernel(couplings, sides, space, k, structural,
+                                  grams["L2"][0] if "L2" in grams else None)
             terms = interface_terms(couplings, sides)
             factors = {norm: gram_factor(G) for norm, (G, _) in grams.items()}
             # sup over (0, v2) only, (5.10): B_2 X_2 B_2ᵀ / c2, so β(v1 = 0) = β at c2 = 1 / sqrt(c2)
@@ -190,13 +205,15 @@ def beta_rows_all(family, k, n1, n2, cases=None, multiplier_meshes=("omega2",), 
                 for norm in norms:
                     te = time.perf_counter()
                     info = grams[norm][1]
-                    sp_ = spectrum(S, factor=factors[norm])
+                    sp_ = spectrum(S, factor=factors[norm], kernel=kernel)
                     beta_v1_zero = beta_v1_zero_c1[norm] / np.sqrt(c2)
                     rows.append(dict(
                         case=case if isinstance(case, str) else case[0], k=k, family=family, N1=n1, N2=n2,
                         multiplier_mesh=multiplier_mesh, c1=c1, c2=c2, norm=norm, beta=sp_.beta,
                         kernel_dim=sp_.kernel_dim, structural_kernel_dim=structural,
-                        kernel_check=kernel_check(sp_.kernel_dim, structural), gap_over_roundoff=sp_.gap,
+                        kernel_detected=kernel.detected, kernel_margin_decades=kernel.margin_decades,
+                        kernel_decision=kernel.decision,
+                        kernel_check=kernel_check(kernel.numerical, structural), gap_over_roundoff=sp_.gap,
                         smallest_nonzero=sp_.smallest_nonzero, beta_v1_zero=beta_v1_zero,
                         dim_M=space.dim, dim_W=dim_w,
                         n_max=info["n_max"], nmax_rel_error=info["nmax_rel_error"],
@@ -204,6 +221,17 @@ def beta_rows_all(family, k, n1, n2, cases=None, multiplier_meshes=("omega2",), 
                         t_interface=t2 - t1, t_eig=time.perf_counter() - te))
         by_partition[x_mult.tobytes()] = rows[first:]
     return rows
+
+
+def space_kernel(couplings, sides, space, k: int, structural: int, l2_gram=None) -> KernelDecision:
+    """The kernel of Bᵀ on ``space`` (:func:`~infsup_contact.solvers.kernel.coupling_kernel`):
+    the couplings scaled by the L²(Γ) norms of the sides' trace basis functions and of the
+    multiplier basis functions (the diagonal of the L² Gram matrix, computed if not given);
+    ``structural`` = max(dim M − dim(W1 + W2), 0) is its proven part. One decision serves
+    every norm and every (c1, c2): the kernel of B A⁻¹ Bᵀ depends on neither."""
+    G = gram(space, "L2")[0] if l2_gram is None else l2_gram
+    W = scaled_couplings(couplings, [trace_l2_norms(s.trace, k) for s in sides], np.sqrt(np.diag(G)))
+    return coupling_kernel(W, structural)
 
 
 def saddle_point_beta(A: sp.spmatrix, B: np.ndarray, G: np.ndarray) -> float:

@@ -1,35 +1,162 @@
-"""The numerical kernel of the β_h eigenproblem (4.5) from the spectrum's gap.
+"""The kernel of the β_h eigenproblem (4.5): the proven part and the part decided numerically.
 
-A fixed relative threshold (eigenvalues below 1e-8 λ_max) calls the bottom of a spectrum
-that decays smoothly a "kernel" of 2–5. Here a kernel is reported only where the bottom
-of the spectrum has a clear gap above the round-off level of the computation
-(:data:`KERNEL_CRITERION`), and it is compared with the structural count of the paper's
-dimension arguments (Remarks 5.2 and 5.4: dim M_h − dim W_h). Pure numpy: the command
-line states the rule without importing NGSolve.
+β_h² is the smallest eigenvalue of (B A⁻¹ Bᵀ) m = β² G m. A is SPD, so the kernel of
+B A⁻¹ Bᵀ is the kernel of Bᵀ: the μ ∈ M_h with b(v, μ) = 0 for every trace v. Two facts
+decide it, and neither involves A⁻¹ or G⁻¹:
+
+proven part
+    μ ⊥ (W1 + W2) in L²(Γ) is a linear condition of rank at most dim(W1 + W2), so
+    dim ker ≥ max(dim M_h − dim(W1 + W2), 0) (the paper's counts of Remarks 5.2 and 5.4).
+    This part is never lost to round-off: it is reported however the numbers come out.
+
+numerical part (:data:`KERNEL_CRITERION`)
+    the singular values of W = D_v⁻¹ Bᵀ D_μ⁻¹, the stacked couplings [B_1ᵀ; B_2ᵀ] scaled by
+    the L²(Γ) norms of the trace basis functions (rows) and of the multiplier basis
+    functions (columns). Diagonal scalings do not change the kernel; they make the entries
+    O(1) whatever the element sizes. A backward-stable SVD returns singular values within
+    p(m, n)·ε·‖W‖₂ of the exact ones of the computed W (LAPACK Users' Guide §4.9), and the
+    computed W differs from the exact one by round-off in its entries: each is a Gauss sum of
+    at most q ≤ 10 products of basis values, exact for the polynomials, so ‖δW‖₂ ≤ ‖δW‖_F ≲
+    q·ε·‖W‖_F. The error level is therefore taken as η = max(rows, cols)·ε·σ_max (the rank
+    tolerance of numpy.linalg.matrix_rank and of Golub–Van Loan §5.4.1), and a singular value
+    ≤ η counts as zero. ``tests/test_kernel.py`` measures both error terms against η.
+
+Working with Bᵀ and not with B A⁻¹ Bᵀ squares nothing: a mode with β ≈ 1e-6 sits at
+β² ≈ 1e-12 in the pencil — within three decades of the pencil's own round-off level
+n·ε·λ_max, which is too optimistic anyway after a Cholesky reduction by an ill-conditioned G —
+but its singular value stays near 1e-6 here, eight decades above η.
+
+The decision's **margin** is its distance from η, in decades: the smallest of
+log10(σ_{d+1}/η) (the first singular value counted as non-zero) and, when modes beyond the
+proof were counted, log10(η/σ_d) (the largest counted as zero). A decision with a margin
+below :data:`MARGIN_DECADES` is ``close``: claims and verdicts resting on it are
+INCONCLUSIVE, never PASS or FAIL by the luck of one BLAS kernel's rounding.
+
+The pencil's own gap rule (:func:`kernel_from_gap`) stays as the independent cross-check
+(``tests/test_kernel.py``: both agree wherever the pencil's gap is clear). Pure numpy/scipy:
+the command line states the rule without importing NGSolve.
 """
 from __future__ import annotations
 
-import numpy as np
+from dataclasses import dataclass
 
+import numpy as np
+import scipy.linalg as sla
+
+MARGIN_DECADES = 1.0
+"""A kernel decision whose margin from η is smaller than this many decades is ``close``."""
 GAP_DECADES = 3
-"""A kernel needs the first eigenvalue above it at least 10**GAP_DECADES times the round-off level."""
+"""The pencil cross-check (:func:`kernel_from_gap`): a kernel needs the first eigenvalue above
+it at least 10**GAP_DECADES times the pencil's round-off level."""
 KERNEL_CRITERION = (
-    "kernel by the spectrum's gap: with the round-off level eta = n*eps*lambda_max of the dense "
-    "eigen-solver (n = dim M, eps = machine epsilon), a kernel of dimension d is reported iff the "
-    "d smallest eigenvalues beta^2 are <= eta and the next one is >= 1e3*eta (a gap of at least "
-    "three decades clear of round-off); otherwise no kernel (d = 0), and a smoothly decaying "
-    "bottom shows as a small beta_h and its slope over the meshes")
-"""The rule of :func:`kernel_from_gap`, as stated in ``infsup-contact beta --help`` and the README."""
+    "kernel of B A^-1 B^T = kernel of B^T: kernel_dim = max(proven, numerical), proven = "
+    "structural_kernel_dim = max(dim M - dim(W1 + W2), 0) (a proof: mu orthogonal to W1 + W2 "
+    "is at most dim(W1 + W2) conditions), numerical = the number of singular values <= eta of the "
+    "stacked couplings [B1^T; B2^T] scaled by the L2(Gamma) norms of the basis functions, "
+    "eta = max(rows, cols)*eps*sigma_max (the SVD's backward error and the entries' round-off); "
+    "kernel_detected = kernel_dim - proven; kernel_margin_decades = distance of the decision from "
+    "eta in decades; kernel_decision = close when below 1 decade (claims resting on it are "
+    "INCONCLUSIVE), else clear")
+"""The rule of :func:`coupling_kernel`, as stated in ``infsup-contact beta --help`` and the README."""
+CLEAR, CLOSE = "clear", "close"
+
+
+@dataclass(frozen=True)
+class KernelDecision:
+    """The kernel of Bᵀ on a multiplier space (module docstring).
+
+    Attributes
+    ----------
+    dim : int
+        kernel dimension, max(proven, numerical count); ``kernel_dim`` of a β row.
+    proven : int
+        the part a dimension count proves (``structural_kernel_dim``).
+    detected : int
+        dim − proven: zero modes found numerically beyond the proof.
+    margin_decades : float
+        distance of the decision from η in decades (inf when nothing is decided: every
+        mode proven and no singular value above them).
+    decision : str
+        ``clear`` (margin >= :data:`MARGIN_DECADES`) or ``close``.
+    tol : float
+        η, the error level the singular values are compared with.
+    singular : ndarray
+        the singular values of W, ascending, the structurally zero ones (cols > rows) included.
+    numerical : int
+        the number of singular values <= η; below ``proven`` only if the error level was
+        exceeded (``kernel_check`` reports ``below_structural`` then).
+    """
+
+    dim: int
+    proven: int
+    detected: int
+    margin_decades: float
+    decision: str
+    tol: float
+    singular: np.ndarray
+    numerical: int
+
+    @property
+    def close(self) -> bool:
+        return self.decision == CLOSE
+
+
+def coupling_kernel(W: np.ndarray, proven: int = 0) -> KernelDecision:
+    """Decide the kernel of a scaled Bᵀ (rows: trace dofs, columns: multipliers).
+
+    Parameters
+    ----------
+    W : ndarray, shape (rows, m)
+        Bᵀ with the diagonal scalings of the module docstring (any other diagonal scaling
+        that makes the columns O(1) works; the kernel does not depend on it).
+    proven : int
+        a proven lower bound on the kernel dimension (a dimension count); m − rows is
+        added to it implicitly (the rank of W is at most ``rows``).
+
+    Returns
+    -------
+    KernelDecision
+    """
+    W = np.asarray(W, float)
+    rows, m = W.shape
+    if m == 0:
+        raise ValueError("an empty multiplier space (dim M = 0) has no kernel to decide")
+    proven = int(max(proven, m - rows, 0))
+    s = sla.svdvals(W, check_finite=True) if rows else np.zeros(0)
+    s = np.concatenate([np.zeros(m - len(s)), np.sort(s)])  # ascending, structural zeros first
+    s_max = float(s[-1])
+    tol = max(rows, m) * np.finfo(float).eps * s_max
+    numerical = int(np.sum(s <= tol))
+    dim = max(proven, numerical)
+    ratios = [s[dim] / tol] if dim < m and tol > 0 else []
+    if numerical > proven:  # modes counted as zero beyond the proof
+        ratios.append(tol / max(s[dim - 1], np.finfo(float).tiny))
+    elif numerical < proven:  # proven zero modes above η: the error level was exceeded
+        ratios.append(tol / s[proven - 1])
+    margin = float(np.log10(min(ratios))) if ratios else np.inf
+    if s_max == 0.0:  # B = 0: everything is kernel, nothing to decide
+        margin = np.inf
+    return KernelDecision(dim, proven, dim - proven, margin, CLOSE if margin < MARGIN_DECADES else CLEAR,
+                          float(tol), s, numerical)
+
+
+def scaled_couplings(couplings, trace_norms, multiplier_norms) -> np.ndarray:
+    """W = [B_1ᵀ/‖φ‖; B_2ᵀ/‖φ‖; …] / ‖μ‖: each side's coupling B_i (dim M × Γ dofs of side i)
+    transposed, rows divided by the L² norms of that side's trace basis functions, columns by
+    the L² norms of the multiplier basis functions."""
+    blocks = [np.asarray(B, float).T / np.asarray(t, float)[:, None] for B, t in zip(couplings, trace_norms)]
+    return np.vstack(blocks) / np.asarray(multiplier_norms, float)[None, :]
 
 
 def kernel_from_gap(ev: np.ndarray, gap_decades: float = GAP_DECADES) -> tuple[int, float]:
-    """Kernel dimension of an ascending spectrum by its gap, and the gap (see KERNEL_CRITERION).
+    """The pencil's own kernel count from an ascending spectrum by its gap (the cross-check).
 
-    η = n ε λ_max bounds the absolute error of the eigenvalues from a backward-stable dense
-    solver (n the dimension, ε the machine epsilon). The d eigenvalues <= η are
-    indistinguishable from 0; they form a kernel only if the next eigenvalue stands at least
-    10**gap_decades above η. A spectrum that decays smoothly into round-off (e.g. geometric,
-    1, 1e-2, 1e-4, …) has no such gap and reports no kernel.
+    η = n ε λ_max is the error level of a backward-stable standard symmetric eigensolver (n the
+    dimension, ε the machine epsilon). It is optimistic for the generalized pencil after a
+    Cholesky reduction by G, which is why the reported kernel comes from
+    :func:`coupling_kernel`. The d eigenvalues <= η form a kernel only if the next eigenvalue
+    stands at least 10**gap_decades above η; a spectrum that decays smoothly into round-off
+    (1, 1e-2, 1e-4, …) has no such gap and gives no kernel.
 
     Returns
     -------
@@ -37,23 +164,35 @@ def kernel_from_gap(ev: np.ndarray, gap_decades: float = GAP_DECADES) -> tuple[i
         d and λ_{d+1}/η (λ_1/η when d = 0; inf when every eigenvalue is at round-off level).
     """
     ev = np.asarray(ev, float)
-    eta = len(ev) * np.finfo(float).eps * max(ev[-1], 0.0)
-    d = int(np.sum(ev <= eta))
+    d = int(np.sum(ev <= pencil_roundoff(ev)))
     if d == len(ev):  # S = 0: everything is kernel
         return d, np.inf
-    gap = float(ev[d] / eta) if eta > 0 else np.inf
+    gap = gap_over_roundoff(ev, d)
     if d > 0 and gap < 10.0 ** gap_decades:
-        return 0, float(ev[0] / eta) if ev[0] > 0 else 0.0
+        return 0, gap_over_roundoff(ev, 0)
     return d, gap
 
 
-def kernel_check(numerical: int, structural: int) -> str:
-    """Compare the numerical kernel with the structural count max(dim M − dim(W1 + W2), 0).
+def pencil_roundoff(ev: np.ndarray) -> float:
+    """η = n ε λ_max of an ascending spectrum (see :func:`kernel_from_gap`)."""
+    return len(ev) * np.finfo(float).eps * max(float(ev[-1]), 0.0)
 
-    The count is a lower bound on the kernel of Bᵀ (μ ⊥ W1 + W2), exact for the paper's
-    matching-mesh cases (R5.2: 2, R5.4: 1). ``agree``; ``below_structural`` (fewer zero
-    modes than must exist: the gap criterion missed a kernel); ``above_structural`` (zero
-    modes the count does not predict).
+
+def gap_over_roundoff(ev: np.ndarray, d: int) -> float:
+    """λ_{d+1}/η: how far the first eigenvalue above a d-dimensional kernel stands above the
+    pencil's round-off level (inf for an all-kernel spectrum or η = 0; 0 for λ <= 0)."""
+    eta = pencil_roundoff(ev)
+    if d >= len(ev) or eta <= 0:
+        return np.inf
+    return float(max(ev[d], 0.0) / eta)
+
+
+def kernel_check(numerical: int, structural: int) -> str:
+    """Compare the numerical count with the structural one (the proof).
+
+    ``agree``; ``above_structural`` (zero modes beyond the proof, detected numerically);
+    ``below_structural`` (fewer singular values below η than the proof guarantees: the
+    stated error level was exceeded, so the row's decision is ``close``).
     """
     if numerical == structural:
         return "agree"

@@ -8,6 +8,8 @@
     infsup-contact rates contact.csv
     infsup-contact bench --what beta --N 32 64 --k 2
     infsup-contact verdict --case T3 --k 2 --expect stable
+    infsup-contact verdict --system levels.yaml --expect stable
+    infsup-contact export --case T3 --k 2 --N 8 16 32 --format mtx --out dir/
     infsup-contact provenance
 
 Bad input gets one line on stderr naming the flag and exit code 2; no traceback, and no
@@ -24,7 +26,7 @@ import sys
 
 from ..errors import InputError
 from ..io import TableError
-from . import beta, bench, contact, rates, verdict
+from . import beta, bench, contact, export, rates, verdict
 from .verdict import VERDICT_DEFAULTS
 
 __all__ = ["main", "build_parser", "validate", "flag_names", "VERDICT_DEFAULTS"]
@@ -56,6 +58,7 @@ def build_parser() -> argparse.ArgumentParser:
     rates.add(sub)
     bench.add(sub)
     verdict.add(sub)
+    export.add(sub)
     _add_provenance(sub)
     return parser
 

@@ -17,7 +17,10 @@ huge diagonal penalties ("tgv",        ``tgv: eliminate`` (default): the dofs ar
 |a_ii| ≥ 1e15 × median |a_jj|)         the penalty's own limit, v = 0 there — and B's entries
                                        on them dropped, with a note; ``tgv: refuse``: refused
 undeclared identity rows (a dof with   removed with a note when B does not touch them (they
-no coupling in A)                      cannot change B A⁻¹ Bᵀ); refused when B does
+no coupling in A)                      cannot change B A⁻¹ Bᵀ); refused when B does and the
+                                       diagonal is exactly 1 (a constrained dof left as an
+                                       identity row); kept with a note otherwise (element
+                                       bubbles, e.g. MINI, are coupled to nothing in A)
 A not symmetric                        refused: the largest |a_ij − a_ji| and where
 A not positive definite                refused; a floating body (zero pivots) gets the number
                                        of zero pivots and ‖A x‖ of a null vector x
@@ -122,14 +125,21 @@ def check_level(level, A, B, G, constrained=np.zeros(0, int), tgv: str = "elimin
     off.eliminate_zeros()
     lonely = np.flatnonzero((np.diff(off.tocsr().indptr) == 0) & (np.diff(off.tocsc().indptr) == 0))
     if len(lonely) and A.shape[0] > 1:
-        on = _b_entries_on(B, lonely)
-        if on:
-            raise SystemFileError(level.A, f"{len(lonely)} identity rows (dofs coupled to nothing: constrained dofs "
-                                  f"left in A?) and B ({level.B.name}) has {on} entries on them: B A^-1 B^T would "
-                                  "count them; declare them under 'constrained' and export B without them")
-        A, B = _remove(A, B, lonely)
-        removed += len(lonely)
-        notes.append(f"{level.A.name}: {len(lonely)} identity rows (uncoupled dofs, B does not touch them) removed")
+        touched = np.diff(sp.csc_matrix(B)[:, lonely].indptr) > 0
+        unit = lonely[touched & (A.diagonal()[lonely] == 1.0)]
+        if len(unit):
+            raise SystemFileError(level.A, f"{len(unit)} identity rows (diagonal exactly 1, coupled to nothing in A: "
+                                  f"constrained dofs left in A?) on which B ({level.B.name}) has entries: "
+                                  "B A^-1 B^T would count them; declare them under 'constrained' and export B "
+                                  "without those columns")
+        if touched.any():
+            notes.append(f"{level.A.name}: {int(touched.sum())} dofs coupled to nothing in A but touched by B "
+                         "(element bubbles?) kept")
+        free = lonely[~touched]
+        if len(free):
+            A, B = _remove(A, B, free)
+            removed += len(free)
+            notes.append(f"{level.A.name}: {len(free)} identity rows (uncoupled dofs B does not touch) removed")
     check_symmetric(A, level.A, "A")
     G = check_gram(G, level.G)
     check_positive_definite(A, level.A)

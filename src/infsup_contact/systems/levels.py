@@ -113,6 +113,6 @@ def dry_check(manifest: Manifest, route: str = "auto"):
         shapes.append((A.shape[0], B.shape[0]))
         check_sequence(manifest, shapes)
         nt = len(touched_dofs(sp.csr_matrix(B)))
-        r = choose_route(A.shape[0], B.shape[0], nt) if route == "auto" else route
+        r = choose_route(A.shape[0], B.shape[0], nt, sp.issparse(G)) if route == "auto" else route
         sizes.append((A.shape[0], B.shape[0], nt, sp.csr_matrix(A).nnz, r))
     return resources.system_estimate(sizes)

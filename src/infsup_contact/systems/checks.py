@@ -178,15 +178,18 @@ def check_positive_definite(A, path, what: str = "A"):
     try:
         lu = spla.splu(A, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0, options=dict(SymmetricMode=True))
         piv = lu.U.diagonal()
-    except RuntimeError:  # exactly singular
-        lu, piv = None, np.zeros(n)
-    top = float(np.max(np.abs(piv))) if np.any(piv) else float(np.max(np.abs(A.diagonal())))
-    zero = int(np.sum(np.abs(piv) <= PIVOT_RTOL * top))
+        top = float(np.max(np.abs(piv)))
+        zero = int(np.sum(np.abs(piv) <= PIVOT_RTOL * top))
+    except RuntimeError:  # exactly singular: SuperLU stops at the first zero pivot
+        lu, piv, top, zero = None, np.ones(n), float(abs(A).max()), -1
     neg = int(np.sum(piv < -PIVOT_RTOL * top))
     if zero:
         shift = 1e-10 * top
         x = np.random.default_rng(0).standard_normal(n)
-        shifted = spla.splu(A + shift * sp.identity(n, format="csc"), permc_spec="MMD_AT_PLUS_A")
+        shifted = spla.splu(A + shift * sp.identity(n, format="csc"), permc_spec="MMD_AT_PLUS_A",
+                            diag_pivot_thresh=0.0, options=dict(SymmetricMode=True))
+        if zero < 0:  # count the pivots of A + δI at the level of δ: the null space's dimension
+            zero = int(np.sum(np.abs(shifted.U.diagonal()) <= 1e4 * shift))
         for _ in range(3):  # inverse iteration: the null vector
             x = shifted.solve(x)
             x /= np.linalg.norm(x)

@@ -71,9 +71,13 @@ def flag_names(parser: argparse.ArgumentParser, command: str) -> dict:
 
 def _message(err: Exception, parser, command: str) -> str:
     """The error's one line, with its key spelled as the flag the user typed."""
+    from ..systems.readers import SystemFileError
+
     text = " ".join(str(err).split())
     key = getattr(err, "key", None)
     flag = flag_names(parser, command).get(key) if key else None
+    if isinstance(err, SystemFileError) and flag:  # the flag, then the file it led to
+        return f"{flag}: {text}"
     if flag and text.startswith(f"invalid {key}"):
         text = f"invalid {flag}" + text[len(f"invalid {key}"):]
     return text

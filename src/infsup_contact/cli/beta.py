@@ -52,11 +52,11 @@ def _check_beta(args):
         from ..systems.levels import dry_check
         from ..systems.manifest import load_manifest
 
+        args.manifest = load_manifest(args.system, min_levels=1)
         for key in ("case", "space", "k", "N1", "N2"):
             if getattr(args, key) is not None:
                 raise InputError(key, "nothing with --system (the manifest's matrices fix the spaces)",
                                  got=getattr(args, key))
-        args.manifest = load_manifest(args.system, min_levels=1)
         est = dry_check(args.manifest)
         check_memory(est, "system", args.system)
         return est

@@ -24,35 +24,38 @@ def add(sub) -> None:
     p.add_argument("--multiplier-mesh", default="omega2", choices=["omega2", "omega1", "union"])
     p.add_argument("--format", default="mtx", choices=sorted(EXPORT_FORMATS))
     p.add_argument("--out", required=True, help="directory to write into (created)")
-    p.add_argument("--c1", type=float, default=None, help=argparse_suppress())
-    p.add_argument("--c2", type=float, default=None, help=argparse_suppress())
     add_model(p)
     add_dry_run(p)
-    p.set_defaults(run=_run_export, check=_check_export)
-
-
-def argparse_suppress():
-    import argparse
-
-    return argparse.SUPPRESS
+    p.set_defaults(run=_run_export, check=_check_export, c1=None, c2=None)
 
 
 def _check_export(args):
+    from pathlib import Path
+
     from .. import resources
-    from ..solvers.infsup import check_inputs
+    from ..discretization import meshes, registry
 
     material(args)
-    if args.c1 != 1.0 or args.c2 != 1.0 or (args.model == "elastic" and (args.E1, args.E2) != (1.0, 1.0)):
-        raise InputError("E1", "1 (an export is at unit material scale)", got=args.c1)
+    for key in ("E1", "E2"):
+        if getattr(args, key) != 1.0 and args.model == "elastic":
+            raise InputError(key, "1 (an export is at unit material scale)", got=getattr(args, key))
+    if not 1 <= args.k <= 4:
+        raise InputError("k", "an integer in 1..4", got=args.k)
+    registry.check_case(args.case, args.k)
     ns = list(args.N)
+    for n in ns:
+        meshes.check_mesh_args(args.family, n, "N")
     if ns != sorted(set(ns)):
         raise InputError("N", "distinct sizes, coarse to fine", got=" ".join(map(str, ns)))
-    for n in ns:
-        check_inputs([args.case], args.k, args.family, n + args.N1_offset, n, 1.0, 1.0, (args.norm,),
-                     args.multiplier_mesh)
+    if min(ns) + args.N1_offset < 1:
+        raise InputError("N1_offset", f"an integer with N + offset >= 1 for every --N (smallest N: {min(ns)})",
+                         got=args.N1_offset)
+    out = Path(args.out)
+    if not args.out.strip() or (out.exists() and not out.is_dir()):
+        raise InputError("out", "a directory to write into (created if missing)", got=args.out)
     est = resources.beta_estimate(args.family, args.k, max(ns) + args.N1_offset, max(ns), args.multiplier_mesh,
                                   (args.norm,), components=2 if args.model == "elastic" else 1)
-    check_memory(est, "N", max(ns))
+    check_memory(est, *(("N1_offset", args.N1_offset) if args.N1_offset > max(ns) else ("N", max(ns))))
     return est
 
 

@@ -61,10 +61,10 @@ def _check_verdict(args):
         from ..systems.levels import dry_check
         from ..systems.manifest import load_manifest
 
+        args.manifest = load_manifest(args.system)
         if args.k is not None:
             raise InputError("k", "no --k with --system (the manifest's matrices fix the spaces)", got=args.k)
         check_criterion(args.slope_tolerance, args.beta_floor, args.confidence)
-        args.manifest = load_manifest(args.system)
         est = dry_check(args.manifest)
         check_memory(est, "system", args.system)
         return est

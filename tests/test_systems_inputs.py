@@ -218,3 +218,8 @@ def test_cli_bad_input_is_one_line_exit_2(tmp_path, capsys):
         assert main(argv) == 2
         err = capsys.readouterr().err
         assert err.startswith("infsup-contact: error: ") and err.count("\n") == 1 and "Traceback" not in err
+    for argv, flag in ((["verdict", "--system", str(m.path), "--norm", "L2"], "--norm"),  # never ignored silently
+                       (["beta", "--system", str(m.path), "--c1", "2"], "--c1"),
+                       (["verdict", "--system", str(m.path), "--N", "4", "8", "16"], "--N")):
+        assert main(argv) == 2
+        assert f"invalid {flag} " in capsys.readouterr().err

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import sys
 
-from .common import add_dry_run, add_model, cases, check_memory, material, norms, SPACE_HELP
+from .common import refuse_with_system, remember_defaults, add_dry_run, add_model, cases, check_memory, material, norms, SPACE_HELP
 
 
 def add(sub) -> None:
@@ -39,6 +39,7 @@ def add(sub) -> None:
     p.add_argument("--seed", type=int, default=0, help="seed of the perturbed family (>= 0)")
     p.add_argument("--alpha", type=float, default=0.2, help="perturbation amplitude / h, in [0, 0.5)")
     add_dry_run(p)
+    remember_defaults(p)
     p.set_defaults(run=_run_beta, check=_check_beta)
 
 
@@ -53,10 +54,7 @@ def _check_beta(args):
         from ..systems.manifest import load_manifest
 
         args.manifest = load_manifest(args.system, min_levels=1)
-        for key in ("case", "space", "k", "N1", "N2"):
-            if getattr(args, key) is not None:
-                raise InputError(key, "nothing with --system (the manifest's matrices fix the spaces)",
-                                 got=getattr(args, key))
+        refuse_with_system(args)
         est = dry_check(args.manifest)
         check_memory(est, "system", args.system)
         return est

@@ -4,7 +4,7 @@ from __future__ import annotations
 import sys
 
 from ..errors import InputError
-from .common import add_dry_run, check_memory, SPACE_HELP
+from .common import refuse_with_system, remember_defaults, add_dry_run, check_memory, SPACE_HELP
 
 
 VERDICT_DEFAULTS = {"slope_tolerance": 0.15, "beta_floor": 0.001, "confidence": 0.95}
@@ -50,6 +50,7 @@ def add(sub) -> None:
         p.add_argument("--" + key.replace("_", "-"), dest=key, type=float, default=VERDICT_DEFAULTS[key],
                        help=f"{text} (default {VERDICT_DEFAULTS[key]:g}: claims.{key} in config/config.yaml)")
     add_dry_run(p)
+    remember_defaults(p)
     p.set_defaults(run=_run_verdict, check=_check_verdict)
 
 
@@ -62,8 +63,7 @@ def _check_verdict(args):
         from ..systems.manifest import load_manifest
 
         args.manifest = load_manifest(args.system)
-        if args.k is not None:
-            raise InputError("k", "no --k with --system (the manifest's matrices fix the spaces)", got=args.k)
+        refuse_with_system(args)
         check_criterion(args.slope_tolerance, args.beta_floor, args.confidence)
         est = dry_check(args.manifest)
         check_memory(est, "system", args.system)

@@ -36,9 +36,9 @@ def _check_export(args):
     from ..discretization import meshes, registry
 
     material(args)
-    for key in ("E1", "E2"):
-        if getattr(args, key) != 1.0 and args.model == "elastic":
-            raise InputError(key, "1 (an export is at unit material scale)", got=getattr(args, key))
+    for key, c in (("E1", args.c1), ("E2", args.c2)):  # material(): c_i = E_i (elastic), 1 (membranes)
+        if c != 1.0:
+            raise InputError(key, "1 (an export is at unit material scale)", got=c)
     if not 1 <= args.k <= 4:
         raise InputError("k", "an integer in 1..4", got=args.k)
     registry.check_case(args.case, args.k)

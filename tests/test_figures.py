@@ -190,3 +190,10 @@ def test_profiles_columns_on_tiny_mesh():
     # u = 0 on the Dirichlet edges (x = 0, x = 1, y = 0, y = 2)
     edge = field[(field.x == 0) | (field.x == 1) | (field.y == 0) | (field.y == 2)]
     assert np.abs(edge.u).max() < 1e-12
+
+
+def test_every_registered_marker_shows_its_fill_style():
+    """Figures tell k apart by the marker's fill style: every space's marker has a body."""
+    from infsup_contact.discretization.registry import SPACES, WIDE_MARKERS
+
+    assert {s.id: s.marker for s in SPACES.values() if s.marker not in WIDE_MARKERS} == {}

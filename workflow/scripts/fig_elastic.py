@@ -20,7 +20,8 @@ sweep = read_table(inp.sweep, "elastic_beta")
 prof = read_table(inp.profiles, "gamma_profiles")
 
 with style():
-    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(7.2, 3.0))
+    # legends below the panels: inside, they covered the curves of both
+    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(7.2, 4.0), layout="constrained")
     s = sweep[(sweep.N2 == sweep.N2.max()) & (sweep.kernel_dim == 0)]
     for case in ordered_cases(s.case.unique()):
         for k, g in s[s.case == case].groupby("k"):
@@ -30,7 +31,7 @@ with style():
     ax1.set_xlabel(r"$1 - 2\nu$")
     ax1.set_ylabel(r"$\beta_h$ (H norm)")
     ax1.set_title(f"(a) $\\nu \\to 1/2$, N = {int(s.N2.max())}", fontsize=9)
-    ax1.legend(fontsize=6, ncol=1, loc="upper left")
+    ax1.legend(fontsize=6, ncol=2, loc="upper center", bbox_to_anchor=(0.5, -0.2), frameon=False)
     lam = prof[prof.quantity == "lambda_h"]
     for (case, k), g in lam.groupby(["case", "k"], sort=False):
         kw = case_style(case, k)
@@ -43,5 +44,5 @@ with style():
     ax2.set_xlabel(r"$x$ on $\Gamma$")
     ax2.set_ylabel(r"$\lambda_h$")
     ax2.set_title(f"(b) Hertz scene, N = {int(lam.N.iloc[0])}", fontsize=9)
-    ax2.legend(fontsize=6, loc="upper right")
+    ax2.legend(fontsize=6, ncol=2, loc="upper center", bbox_to_anchor=(0.5, -0.2), frameon=False)
     save_figure(fig, out.pdf, out.png)

@@ -98,9 +98,12 @@ def trace_values(trace: GammaTrace, x: np.ndarray):
     return np.concatenate(rows), np.concatenate(cols), np.concatenate(vals)
 
 
-def coupling_matrix(trace: GammaTrace, space: MultiplierSpace, k: int) -> np.ndarray:
-    """B_i[j, d] = ∫_Γ μ_j φ_d, dense, shape (dim M, number of Γ dofs); exact."""
-    x, w = quadrature_on(union_breakpoints(trace.breakpoints, space.breakpoints), k + space.degree)
+def coupling_matrix(trace: GammaTrace, space: MultiplierSpace, k: int, extra_degree: int = 0) -> np.ndarray:
+    """B_i[j, d] = ∫_Γ μ_j φ_d, dense, shape (dim M, number of Γ dofs); exact.
+
+    ``extra_degree`` > 0 uses a rule exact for that much higher degree: the same matrix up
+    to round-off, which is how the kernel decision measures the round-off of the entries."""
+    x, w = quadrature_on(union_breakpoints(trace.breakpoints, space.breakpoints), k + space.degree + extra_degree)
     mu = space.evaluate(x)  # (n_q, dim M)
     return (mu * w[:, None]).T @ trace_basis_at(trace, x)
 

@@ -30,6 +30,11 @@ K_RANGE = (1, 4)
 """Displacement degrees the suite supports."""
 
 
+WIDE_MARKERS = ("o", "s", "^", "v", "<", ">", "D", "d", "p", "h", "H", "8")
+"""Markers with a body: the figures tell k apart by the marker's fill style (none, full, left
+half, top half), which thin markers such as ``P``, ``X``, ``+``, ``x`` and ``*`` do not show."""
+
+
 @dataclass(frozen=True)
 class SpaceSpec:
     """A multiplier space as the suite knows it.
@@ -55,7 +60,8 @@ class SpaceSpec:
         None where no count is stated; it gives the structural kernel
         (:meth:`structural_kernel`).
     color, marker : str
-        Matplotlib colour and marker; stable spaces are drawn solid, others dashed.
+        Matplotlib colour and marker; stable spaces are drawn solid, others dashed. The
+        marker has a body (one of :data:`WIDE_MARKERS`): its fill style tells k apart.
     nodal_basis : bool
         True for Lagrange bases (a coefficient is a nodal value, so for s ≤ 1 the cone
         "coefficients ≥ 0" is "λ_h ≥ 0 pointwise", (5.4)); False for other bases, whose
@@ -77,7 +83,7 @@ class SpaceSpec:
     expected: str = "unknown"
     dimension: Callable[[int, int], int] | None = None
     color: str = "#4d4d4d"
-    marker: str = "x"
+    marker: str = "8"
     nodal_basis: bool = True
     finding_meshes: tuple = field(default=())
     claim_tag: str | None = None
@@ -190,11 +196,11 @@ PAPER_CASES = tuple(SPACES)
 # --- dual (biorthogonal) mortar multipliers (module dual) ---------------------------------
 register(SpaceSpec(
     "DUAL", "Wohlmuth 2000", "dual basis of M^1_{0,k}", lambda k, x: dual_space(x, k, True), lambda k: k,
-    expected="stable", dimension=lambda k, n: n * k - 1, color=OKABE_ITO["black"], marker="P",
+    expected="stable", dimension=lambda k, n: n * k - 1, color=OKABE_ITO["black"], marker="p",
     nodal_basis=False, claim_tag="DUAL", finding_meshes=("omega2", "union")))
 register(SpaceSpec(
     "DUAL-ALL", "dual of Rem 5.2", "dual basis of M^1_k", lambda k, x: dual_space(x, k, False), lambda k: k,
-    expected="unstable", dimension=lambda k, n: n * k + 1, color=OKABE_ITO["sky_blue"], marker="X",
+    expected="unstable", dimension=lambda k, n: n * k + 1, color=OKABE_ITO["sky_blue"], marker="h",
     nodal_basis=False, claim_tag="DUAL-ALL"))
 
 # --- roles the study gives to particular spaces (the one place they are spelled) --------

@@ -230,8 +230,10 @@ def space_kernel(couplings, sides, space, k: int, structural: int, l2_gram=None)
     ``structural`` = max(dim M − dim(W1 + W2), 0) is its proven part. One decision serves
     every norm and every (c1, c2): the kernel of B A⁻¹ Bᵀ depends on neither."""
     G = gram(space, "L2")[0] if l2_gram is None else l2_gram
-    W = scaled_couplings(couplings, [trace_l2_norms(s.trace, k) for s in sides], np.sqrt(np.diag(G)))
-    return coupling_kernel(W, structural)
+    rows, cols = [trace_l2_norms(s.trace, k) for s in sides], np.sqrt(np.diag(G))
+    W = scaled_couplings(couplings, rows, cols)
+    longer = scaled_couplings([coupling_matrix(s.trace, space, k, extra_degree=6) for s in sides], rows, cols)
+    return coupling_kernel(W, structural, entry_error=np.linalg.norm(W - longer))
 
 
 def saddle_point_beta(A: sp.spmatrix, B: np.ndarray, G: np.ndarray) -> float:

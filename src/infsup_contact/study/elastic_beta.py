@@ -25,8 +25,9 @@ from ..models.side_cache import SideCache
 from ..solvers.infsup import beta_rows
 
 COLUMNS = ["model", "case", "k", "family", "N1", "N2", "multiplier_mesh", "E1", "E2", "nu", "norm", "beta",
-           "kernel_dim", "structural_kernel_dim", "smallest_nonzero", "beta_v1_zero", "dim_M", "dim_W", "ndof",
-           "beta_membranes", "kernel_dim_membranes", "bound_factor"]
+           "kernel_dim", "structural_kernel_dim", "kernel_detected", "kernel_margin_decades", "kernel_decision",
+           "smallest_nonzero", "beta_v1_zero", "dim_M", "dim_W", "ndof",
+           "beta_membranes", "kernel_dim_membranes", "kernel_decision_membranes", "bound_factor"]
 
 
 def bound_factor(nu: float) -> float:
@@ -62,7 +63,8 @@ def elastic_beta_rows(family: str, k: int, pairs, nu: float = 0.3, E=(1.0, 1.0),
         for r, m in zip(el, mem):
             assert (r["case"], r["norm"]) == (m["case"], m["norm"])
             out.append(dict(r, model="elastic", E1=E[0], E2=E[1], nu=nu, beta_membranes=m["beta"],
-                            kernel_dim_membranes=m["kernel_dim"], bound_factor=bound_factor(nu)))
+                            kernel_dim_membranes=m["kernel_dim"], kernel_decision_membranes=m["kernel_decision"],
+                            bound_factor=bound_factor(nu)))
     return pd.DataFrame(out, columns=COLUMNS)
 
 

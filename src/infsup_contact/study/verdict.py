@@ -5,9 +5,11 @@
 criterion (:mod:`infsup_contact.study.claims`), so ``infsup-contact verdict`` and
 ``results/claims.csv`` cannot disagree about the same series:
 
-* a numerical kernel on any mesh (``kernel_dim > 0``: β_h = 0, as for Rem 5.2 and Rem 5.4;
-  decided by the spectrum's gap, :data:`infsup_contact.solvers.kernel.KERNEL_CRITERION`)
-  is UNSTABLE;
+* a kernel decision closer than the stated margin to its error level on any mesh
+  (``kernel_decision == "close"``, :data:`infsup_contact.solvers.kernel.KERNEL_CRITERION`)
+  is INCONCLUSIVE: the verdict must not depend on one BLAS kernel's rounding;
+* a kernel on any mesh (``kernel_dim > 0``: β_h = 0, as for Rem 5.2 and Rem 5.4; proven by
+  the dimension count or decided from Bᵀ) is UNSTABLE;
 * otherwise :func:`~infsup_contact.study.claims.bounded_claim` ("β_h bounded away from
   zero": min β_h above a floor and the confidence interval of the slope of log β_h vs log h
   inside [−τ, τ]) decides: PASS → STABLE, FAIL → UNSTABLE, INCONCLUSIVE → INCONCLUSIVE.
@@ -72,7 +74,11 @@ def stability_verdict(rows, tol: float, floor: float, confidence: float) -> dict
     h = 1.0 / frame.N2.to_numpy(float)
     beta = frame.beta.to_numpy(float)
     kernel_dim = int(frame.kernel_dim.max())
-    if kernel_dim > 0:
+    close = claims.close_decisions(frame)
+    if len(close):
+        verdict, fitted = INCONCLUSIVE, frame.smallest_nonzero.to_numpy(float) if kernel_dim > 0 else beta
+        evidence = claims._close_text(close)
+    elif kernel_dim > 0:
         verdict, fitted = UNSTABLE, frame.smallest_nonzero.to_numpy(float)
         evidence = (f"β_h = 0: kernel dims {frame.kernel_dim.astype(int).tolist()} over N = "
                     f"{claims._ns(frame)}; fit of the eigenvalue above the kernel")

@@ -86,3 +86,28 @@ def test_dense_and_shift_invert_routes_agree(pair):
     assert abs(dense.smallest_nonzero - lanczos.smallest_nonzero) <= 1e-10
     assert np.allclose(dense.bottom[dense.kernel.dim:dense.kernel.dim + 3],
                        lanczos.bottom[lanczos.kernel.dim:lanczos.kernel.dim + 3], rtol=1e-9, atol=0)
+
+
+def test_a_close_kernel_decision_is_inconclusive(tmp_path):
+    """A B with one extra multiplier nearly dependent on another (a copy of a row of B,
+    perturbed relatively by a few η): its singular value lands within a decade of η on at
+    least one level (checked: the test fails if the construction decides clearly everywhere),
+    and one close decision makes the verdict INCONCLUSIVE, never STABLE or UNSTABLE by the
+    luck of the rounding."""
+    import scipy.sparse as sp
+
+    levels = []
+    for n in DEFAULT_LEVELS:
+        A, B, G = stokes_system("P2-P1", n)
+        eta = max(B.shape) * np.finfo(float).eps
+        row = B.getrow(B.shape[0] // 2)
+        extra = row.multiply(1.0 + 3.0 * eta * np.arange(row.shape[1]) / row.shape[1])  # ~1 decade from η
+        Bx = sp.vstack([B, extra], format="csr")
+        Gx = sp.block_diag([G, G[B.shape[0] // 2, B.shape[0] // 2] * sp.identity(1)], format="csr")
+        levels.append((1.0 / n, A, Bx, Gx))
+    manifest = load_manifest(write_system(tmp_path, levels, "mtx", "nearly dependent", known_kernel=1))
+    out, rows = system_verdict(manifest, **CRITERION, notes=io.StringIO())
+    margins = [r["kernel_margin_decades"] for r in rows]
+    if all(r["kernel_decision"] == "clear" for r in rows):
+        pytest.fail(f"the constructed near-dependence was decided clearly: margins {margins}")
+    assert out["verdict"] == "INCONCLUSIVE", out["evidence"]

@@ -15,8 +15,9 @@ multiplier norm. Three routes, chosen by the sizes (:func:`choose_route`):
     m is large: the bottom of the pencil by shift-invert Lanczos
     (``scipy.sparse.linalg.eigsh`` with ``sigma = −δ``), whose operator (S + δG)⁻¹ comes
     from one sparse LU of the quasi-definite matrix [[A, Bᵀ], [B, −δG]]: for r,
-    [[A, Bᵀ], [B, −δG]] [u; p] = [0; r] gives p = −(S + δG)⁻¹ r. The residuals are checked
-    with an independent LU of A (S v = B A⁻¹ Bᵀ v).
+    [[A, Bᵀ], [B, −δG]] [u; p] = [0; r] gives p = −(S + δG)⁻¹ r. S itself (S v = B A⁻¹ Bᵀ v)
+    comes from an independent LU of A: the eigenvalues are its Rayleigh quotients, and the
+    residuals are measured with it.
 
 The kernel of B A⁻¹ Bᵀ is the kernel of Bᵀ (A is SPD), decided from the singular values of
 W = D_A^{-1/2} Bᵀ D_G^{-1/2} restricted to the touched dofs
@@ -197,14 +198,20 @@ def _shift_invert(A, B, G, n_pairs, W):
         rhs[n:] = np.ravel(r)
         return -lu.solve(rhs)[n:]
 
+    # S = B A⁻¹ Bᵀ through an independent LU of A: the operator eigsh is given, and the
+    # Rayleigh quotients and residuals below
+    luA = spla.splu(A, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0, options=dict(SymmetricMode=True))
+
+    def schur(x):
+        return B @ luA.solve(np.asarray(B.T @ x))
+
     t1 = time.perf_counter()
     k = min(n_pairs, m - 1)
     op = spla.LinearOperator((m, m), matvec=inv, dtype=float)
-    ev, x = spla.eigsh(spla.aslinearoperator(Gs), k=k, M=Gs, sigma=-delta, OPinv=op, which="LM", tol=1e-12)
+    S_op = spla.LinearOperator((m, m), matvec=schur, matmat=schur, dtype=float)
+    ev, x = spla.eigsh(S_op, k=k, M=Gs, sigma=-delta, OPinv=op, which="LM", tol=1e-12)
     t2 = time.perf_counter()
-    # residuals with an independent factorization of A: S x = B A⁻¹ Bᵀ x
-    luA = spla.splu(A, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0, options=dict(SymmetricMode=True))
-    Sx = B @ luA.solve(np.asarray(B.T @ x))
+    Sx = schur(x)
     s_norm = float(np.max(np.linalg.norm(Sx, axis=0) / np.linalg.norm(x, axis=0)))  # a lower bound of ‖S‖
     Gx = Gs @ x
     ev = np.einsum("ij,ij->j", x, Sx) / np.einsum("ij,ij->j", x, Gx)  # Rayleigh quotients, exact S

@@ -87,7 +87,12 @@ def _remove(A, B, dofs):
 
 
 def _b_entries_on(B, dofs) -> int:
-    return int(np.count_nonzero(B[:, dofs].toarray())) if len(dofs) else 0
+    """Non-zero entries of B in the columns ``dofs`` (sparse: no dense m × len(dofs) block)."""
+    if not len(dofs):
+        return 0
+    block = sp.csc_matrix(B)[:, dofs]
+    block.eliminate_zeros()
+    return int(block.nnz)
 
 
 def check_level(level, A, B, G, constrained=np.zeros(0, int), tgv: str = "eliminate") -> CheckedLevel:

@@ -266,11 +266,12 @@ def base_commands(tables):
         "rates": ["rates", str(tables["good"])],
         "bench": ["bench", "--what", "beta", "--N", "4", "--k", "1"],
         "verdict": ["verdict", "--case", "T3", "--k", "1"],
+        "export": ["export", "--case", "T3", "--k", "1", "--N", "4", "--out", str(tables["good"].parent / "export")],
         "provenance": ["provenance"],
     }
 
 
-ALTERNATIVES = {"--space": "--case", "--case": "--space"}
+ALTERNATIVES = {"--space": "--case", "--case": "--space", "--system": "--case"}
 """Flags that exclude each other: mutating one drops the other from the base command."""
 
 

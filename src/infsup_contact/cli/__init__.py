@@ -8,6 +8,8 @@
     infsup-contact rates contact.csv
     infsup-contact bench --what beta --N 32 64 --k 2
     infsup-contact verdict --case T3 --k 2 --expect stable
+    infsup-contact verdict --system levels.yaml --expect stable
+    infsup-contact export --case T3 --k 2 --N 8 16 32 --format mtx --out dir/
     infsup-contact provenance
 
 Bad input gets one line on stderr naming the flag and exit code 2; no traceback, and no
@@ -24,7 +26,7 @@ import sys
 
 from ..errors import InputError
 from ..io import TableError
-from . import beta, bench, contact, rates, verdict
+from . import beta, bench, contact, export, rates, verdict
 from .verdict import VERDICT_DEFAULTS
 
 __all__ = ["main", "build_parser", "validate", "flag_names", "VERDICT_DEFAULTS"]
@@ -56,6 +58,7 @@ def build_parser() -> argparse.ArgumentParser:
     rates.add(sub)
     bench.add(sub)
     verdict.add(sub)
+    export.add(sub)
     _add_provenance(sub)
     return parser
 
@@ -68,9 +71,13 @@ def flag_names(parser: argparse.ArgumentParser, command: str) -> dict:
 
 def _message(err: Exception, parser, command: str) -> str:
     """The error's one line, with its key spelled as the flag the user typed."""
+    from ..systems.readers import SystemFileError
+
     text = " ".join(str(err).split())
     key = getattr(err, "key", None)
     flag = flag_names(parser, command).get(key) if key else None
+    if isinstance(err, SystemFileError) and flag:  # the flag, then the file it led to
+        return f"{flag}: {text}"
     if flag and text.startswith(f"invalid {key}"):
         text = f"invalid {flag}" + text[len(f"invalid {key}"):]
     return text

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import sys
 
-from .common import add_dry_run, add_model, cases, check_memory, material, norms, SPACE_HELP
+from .common import refuse_with_system, remember_defaults, add_dry_run, add_model, cases, check_memory, material, norms, SPACE_HELP
 
 
 def add(sub) -> None:
@@ -22,10 +22,13 @@ def add(sub) -> None:
     p.add_argument("--case", default=None, choices=[*space_ids(), "all"],
                    help="a registered space, or all (the default) for every one defined for k")
     p.add_argument("--space", metavar="FILE.py:FUNC", help=SPACE_HELP)
-    p.add_argument("--k", type=int, required=True, help="displacement degree, 1..4")
+    p.add_argument("--system", metavar="LEVELS.yaml", default=None,
+                   help="a saddle-point system exported by another code (a manifest of mesh levels "
+                   "{h, A, B, G}): one row per level; instead of --case/--k/--N1/--N2")
+    p.add_argument("--k", type=int, default=None, help="displacement degree, 1..4 (required unless --system)")
     p.add_argument("--family", default="structured", choices=FAMILIES)
-    p.add_argument("--N1", type=int, required=True, help="segments on Γ of the Ω1 mesh (>= 1)")
-    p.add_argument("--N2", type=int, required=True, help="segments on Γ of the Ω2 mesh (>= 1)")
+    p.add_argument("--N1", type=int, default=None, help="segments on Γ of the Ω1 mesh (>= 1)")
+    p.add_argument("--N2", type=int, default=None, help="segments on Γ of the Ω2 mesh (>= 1)")
     p.add_argument("--multiplier-mesh", default="omega2", choices=["omega2", "omega1", "union"])
     p.add_argument("--c1", type=float, default=None, help="membranes: prestress c1 (default 1)")
     p.add_argument("--c2", type=float, default=None, help="membranes: prestress c2 (default 1)")
@@ -36,13 +39,28 @@ def add(sub) -> None:
     p.add_argument("--seed", type=int, default=0, help="seed of the perturbed family (>= 0)")
     p.add_argument("--alpha", type=float, default=0.2, help="perturbation amplitude / h, in [0, 0.2] (larger can invert triangles)")
     add_dry_run(p)
+    remember_defaults(p)
     p.set_defaults(run=_run_beta, check=_check_beta)
 
 
 def _check_beta(args):
     from .. import resources
     from ..discretization.meshes import check_perturbation
+    from ..errors import InputError
     from ..solvers.infsup import check_inputs
+
+    if args.system is not None:
+        from ..systems.levels import dry_check
+        from ..systems.manifest import load_manifest
+
+        args.manifest = load_manifest(args.system, min_levels=1)
+        refuse_with_system(args)
+        est = dry_check(args.manifest)
+        check_memory(est, "system", args.system)
+        return est
+    for key in ("k", "N1", "N2"):
+        if getattr(args, key) is None:
+            raise InputError(key, "an integer (required unless --system)")
 
     args.cases = cases(args)
     material(args)
@@ -58,6 +76,15 @@ def _check_beta(args):
 
 def _run_beta(args) -> None:
     import pandas as pd
+
+    if args.system is not None:
+        from ..systems.levels import NORM_NOTES, system_rows
+
+        if args.manifest.norm != "given":
+            print(f"infsup-contact: note: {NORM_NOTES[args.manifest.norm]}", file=sys.stderr)
+        pd.DataFrame(system_rows(args.manifest)).drop(columns="N2").to_csv(
+            sys.stdout, index=False, float_format="%.12g")
+        return
 
     from ..solvers.infsup import beta_rows
 

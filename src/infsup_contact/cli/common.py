@@ -95,3 +95,22 @@ def check_memory(est, key: str, value) -> None:
     if avail is not None and est.bytes > avail:
         raise InputError(key, f"a size whose estimated memory fits in the {resources.human_bytes(avail)} "
                          f"available (this request: {est.describe()})", got=value)
+
+
+SYSTEM_KEEPS = ("system", "dry_run", "expect", "slope_tolerance", "beta_floor", "confidence", "help")
+"""Flags that mean something with ``--system``; every other one is refused there."""
+
+
+def remember_defaults(p) -> None:
+    """Keep the parser's option defaults on the namespace, for :func:`refuse_with_system`."""
+    p.set_defaults(option_defaults={a.dest: a.default for a in p._actions if a.option_strings})
+
+
+def refuse_with_system(args) -> None:
+    """:class:`InputError` naming the first flag given with ``--system`` that does not apply to
+    it (its value differs from the default): the manifest's matrices fix the spaces, meshes
+    and norm, and a flag that would be ignored is never ignored silently."""
+    for dest, default in args.option_defaults.items():
+        if dest not in SYSTEM_KEEPS and getattr(args, dest) != default:
+            raise InputError(dest, "nothing with --system (the manifest's matrices fix the spaces, meshes and "
+                             "norm; its 'norm' key says what G is)", got=getattr(args, dest))

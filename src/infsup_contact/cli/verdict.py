@@ -4,7 +4,7 @@ from __future__ import annotations
 import sys
 
 from ..errors import InputError
-from .common import add_dry_run, check_memory, run_intervals, SPACE_HELP
+from .common import refuse_with_system, remember_defaults, add_dry_run, check_memory, run_intervals, SPACE_HELP
 
 
 VERDICT_DEFAULTS = {"slope_tolerance": 0.15, "beta_floor": 0.001, "confidence": 0.95}
@@ -31,7 +31,11 @@ def add(sub) -> None:
     which = p.add_mutually_exclusive_group(required=True)
     which.add_argument("--case", choices=space_ids(), help="a registered space")
     which.add_argument("--space", metavar="FILE.py:FUNC", help=SPACE_HELP)
-    p.add_argument("--k", type=int, required=True, help="displacement degree, 1..4")
+    which.add_argument("--system", metavar="LEVELS.yaml",
+                       help="a saddle-point system exported by another code: a manifest of mesh levels "
+                       "{h, A, B, G} (README, 'Certify a discretization from another code'); --k, --family, "
+                       "--N, --norm and --multiplier-mesh do not apply")
+    p.add_argument("--k", type=int, default=None, help="displacement degree, 1..4 (with --case/--space)")
     p.add_argument("--family", default="structured", choices=FAMILIES)
     p.add_argument("--N", type=int, nargs="+", default=[8, 16, 32, 64],
                    help="segments on Γ of the matching meshes, at least 3 distinct (default: 8 16 32 64)")
@@ -46,11 +50,26 @@ def add(sub) -> None:
         p.add_argument("--" + key.replace("_", "-"), dest=key, type=float, default=VERDICT_DEFAULTS[key],
                        help=f"{text} (default {VERDICT_DEFAULTS[key]:g}: claims.{key} in config/config.yaml)")
     add_dry_run(p)
+    remember_defaults(p)
     p.set_defaults(run=_run_verdict, check=_check_verdict)
 
 
 def _check_verdict(args):
     from .. import resources
+    from ..study.verdict import check_criterion
+
+    if args.system is not None:
+        from ..systems.levels import dry_check
+        from ..systems.manifest import load_manifest
+
+        args.manifest = load_manifest(args.system)
+        refuse_with_system(args)
+        check_criterion(args.slope_tolerance, args.beta_floor, args.confidence)
+        est = dry_check(args.manifest)
+        check_memory(est, "system", args.system)
+        return est
+    if args.k is None:
+        raise InputError("k", "an integer in 1..4 (required with --case and --space)")
     from ..discretization import meshes, registry
     from ..discretization.user_spaces import load_user_space
     from ..study.verdict import check_criterion, check_mesh_sizes
@@ -72,6 +91,16 @@ def _check_verdict(args):
 
 def _run_verdict(args) -> int:
     import pandas as pd
+
+    if args.system is not None:
+        from ..systems.levels import system_verdict
+
+        out, _ = system_verdict(args.manifest, tol=args.slope_tolerance, floor=args.beta_floor,
+                                confidence=args.confidence)
+        if out["norm"] != "given":
+            print(f"infsup-contact: note: {out['norm_note']}", file=sys.stderr)
+        pd.DataFrame([out]).to_csv(sys.stdout, index=False, float_format="%.6g")
+        return 0 if args.expect is None else (0 if out["verdict"] == _EXPECT[args.expect] else 1)
 
     from ..study.verdict import verdict_rows
 

@@ -1,0 +1,73 @@
+"""``infsup-contact export``: this suite's systems as files another code would write."""
+from __future__ import annotations
+
+from ..errors import InputError
+from .common import add_dry_run, add_model, check_memory, material
+
+
+def add(sub) -> None:
+    from ..discretization.meshes import FAMILIES
+    from ..discretization.registry import space_ids
+    from ..systems.export import EXPORT_FORMATS
+
+    p = sub.add_parser("export", help="write A, B, G of a registered space on several meshes and a "
+                       "levels.yaml manifest (the layout `verdict --system` reads)",
+                       description="A = diag(K1, K2) (free dofs, Γ last), B = [-B1 | B2], G = the Gram "
+                       "matrix of --norm, on N1 = N + --N1-offset, N2 = N for each --N; h = 1/N.")
+    p.add_argument("--case", required=True, choices=space_ids(), help="a registered space")
+    p.add_argument("--k", type=int, required=True, help="displacement degree, 1..4")
+    p.add_argument("--N", type=int, nargs="+", required=True, help="segments on Γ of Ω2, coarse to fine")
+    p.add_argument("--N1-offset", type=int, default=0, help="N1 = N + offset (non-matching pairs; default 0)")
+    p.add_argument("--family", default="structured", choices=FAMILIES)
+    p.add_argument("--norm", default="H", choices=["H", "L2"],
+                   help="G: H^{-1/2}_00(Γ) (manifest norm: given) or the L² mass (manifest norm: L2)")
+    p.add_argument("--multiplier-mesh", default="omega2", choices=["omega2", "omega1", "union"])
+    p.add_argument("--format", default="mtx", choices=sorted(EXPORT_FORMATS))
+    p.add_argument("--out", required=True, help="directory to write into (created)")
+    add_model(p)
+    add_dry_run(p)
+    p.set_defaults(run=_run_export, check=_check_export, c1=None, c2=None)
+
+
+def _check_export(args):
+    from pathlib import Path
+
+    from .. import resources
+    from ..discretization import meshes, registry
+
+    material(args)
+    for key, c in (("E1", args.c1), ("E2", args.c2)):  # material(): c_i = E_i (elastic), 1 (membranes)
+        if c != 1.0:
+            raise InputError(key, "1 (an export is at unit material scale)", got=c)
+    if not 1 <= args.k <= 4:
+        raise InputError("k", "an integer in 1..4", got=args.k)
+    registry.check_case(args.case, args.k)
+    ns = list(args.N)
+    for n in ns:
+        meshes.check_mesh_args(args.family, n, "N")
+    if ns != sorted(set(ns)):
+        raise InputError("N", "distinct sizes, coarse to fine", got=" ".join(map(str, ns)))
+    if min(ns) + args.N1_offset < 1:
+        raise InputError("N1_offset", f"an integer with N + offset >= 1 for every --N (smallest N: {min(ns)})",
+                         got=args.N1_offset)
+    out = Path(args.out)
+    if not args.out.strip() or (out.exists() and not out.is_dir()):
+        raise InputError("out", "a directory to write into (created if missing)", got=args.out)
+    est = resources.beta_estimate(args.family, args.k, max(ns) + args.N1_offset, max(ns), args.multiplier_mesh,
+                                  (args.norm,), components=2 if args.model == "elastic" else 1)
+    check_memory(est, *(("N1_offset", args.N1_offset) if args.N1_offset > max(ns) else ("N", max(ns))))
+    return est
+
+
+def _run_export(args) -> None:
+    from ..systems.export import suite_system, write_system
+
+    kwargs = {}
+    levels = []
+    for n in args.N:
+        A, B, G = suite_system(args.case, args.k, n + args.N1_offset, n, args.family, args.norm,
+                               args.multiplier_mesh, model=args.model_obj, **kwargs)
+        levels.append((1.0 / n, A, B, G))
+    name = f"{args.case}-k{args.k}-{args.model}"
+    path = write_system(args.out, levels, args.format, name, norm="given" if args.norm == "H" else "L2")
+    print(path)

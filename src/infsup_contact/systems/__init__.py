@@ -1,0 +1,11 @@
+"""Foreign saddle-point systems: matrices exported by another code, a verdict out.
+
+``manifest`` reads the YAML list of mesh levels, ``readers`` the matrix files
+(MatrixMarket, scipy ``.npz``/``.npy``, Harwell-Boeing, PETSc binary), ``checks`` finds what
+real exports look like (Dirichlet penalties, identity rows, asymmetry, NaN, …) and says so in
+one line, ``engine`` computes β_h² = min eig(B A⁻¹ Bᵀ, G) per level, ``levels`` turns a manifest
+into rows and a verdict, ``export`` writes this suite's own systems in the same layout. Imports ``errors``, ``io``, ``models`` and ``solvers``.
+"""
+from .readers import SystemFileError
+
+__all__ = ["SystemFileError"]

@@ -1,0 +1,256 @@
+"""β_h of a foreign saddle-point system: β_h² = min eig(B A⁻¹ Bᵀ, G) on one mesh level.
+
+A (n × n) is SPD, B (m × n) couples the multipliers to the dofs it touches, G (m × m) is the
+multiplier norm. Three routes, chosen by the sizes (:func:`choose_route`):
+
+``gamma-dense``
+    the dofs B touches (Γ) are few: they are ordered last and one sparse factorization of
+    A gives X = (A⁻¹)_ΓΓ (:func:`infsup_contact.models.schur.gamma_factorization`, the
+    suite's own Γ-last machinery), S = B_Γ X B_Γᵀ, then the dense pencil
+    ``scipy.linalg.eigh(S, G)``;
+``solves-dense``
+    B touches many dofs but m is small (a Stokes pressure on a coarse mesh): one sparse LU of
+    A, S = B (A⁻¹ Bᵀ) from m solves, the dense pencil;
+``shift-invert``
+    m is large: the bottom of the pencil by shift-invert Lanczos
+    (``scipy.sparse.linalg.eigsh`` with ``sigma = −δ``), whose operator (S + δG)⁻¹ comes
+    from one sparse LU of the quasi-definite matrix [[A, Bᵀ], [B, −δG]]: for r,
+    [[A, Bᵀ], [B, −δG]] [u; p] = [0; r] gives p = −(S + δG)⁻¹ r. S itself (S v = B A⁻¹ Bᵀ v)
+    comes from an independent LU of A: the eigenvalues are its Rayleigh quotients, and the
+    residuals are measured with it.
+
+The kernel of B A⁻¹ Bᵀ is the kernel of Bᵀ (A is SPD), decided from the singular values of
+W = D_A^{-1/2} Bᵀ D_G^{-1/2} restricted to the touched dofs
+(:func:`infsup_contact.solvers.kernel.coupling_kernel`; dense SVD while W is small, else the
+bottom singular values from shift-invert Lanczos on WᵀW, each re-measured directly as
+‖W v‖, :func:`bottom_kernel`). A declared kernel (``known_kernel`` in the manifest: the
+hydrostatic pressure of an enclosed Stokes flow) is the ``proven`` part; β_h is then the
+smallest eigenvalue above it, i.e. β_h on the complement of the declared kernel.
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.linalg as sla
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+from ..models.schur import gamma_factorization
+from ..solvers.kernel import CLEAR, CLOSE, MARGIN_DECADES, KernelDecision, coupling_kernel
+
+DENSE_MAX_M = 1500
+"""Largest m for the dense pencil (above it shift-invert Lanczos is faster: scikit-fem P2–P0,
+m = 2048, took 17 s dense vs 3 s shift-invert on the loaded 2-core machine)."""
+DENSE_MAX_BYTES = 1.5e9
+"""Largest dense block (X = (A⁻¹)_ΓΓ, or A⁻¹ Bᵀ) a dense route may allocate."""
+SVD_MAX_BYTES = 3e7
+"""Largest W (touched dofs × m doubles) decided by a dense SVD; above it :func:`bottom_kernel`."""
+N_BOTTOM = 6
+"""Eigenvalues above the declared kernel the shift-invert route computes."""
+SHIFT = 1e-8
+"""δ of the shift-invert route relative to σ_max(W)², the Jacobi scale of the pencil."""
+ROUTES = ("auto", "gamma-dense", "solves-dense", "shift-invert")
+
+
+@dataclass(frozen=True)
+class LevelSpectrum:
+    """The bottom of (B A⁻¹ Bᵀ) m = β² G m on one level, and how it was obtained.
+
+    Attributes
+    ----------
+    beta : float
+        β_h on the complement of the kernel *declared* (``known_kernel``); exactly 0 when the
+        kernel of Bᵀ is larger than declared.
+    smallest_nonzero : float
+        sqrt of the first eigenvalue above the whole kernel.
+    kernel : KernelDecision
+        The kernel of Bᵀ (``proven`` = the declared kernel).
+    bottom : ndarray
+        The smallest eigenvalues β² computed (ascending).
+    route : str
+        One of :data:`ROUTES` (not ``auto``).
+    residual : float
+        max over the bottom eigenpairs of ‖S x − λ G x‖ / ((‖S‖ + |λ| ‖G‖) ‖x‖).
+    n_touched : int
+        Dofs B touches.
+    seconds : dict
+        ``factorize``, ``eigen``, ``kernel`` wall times.
+    """
+
+    beta: float
+    smallest_nonzero: float
+    kernel: KernelDecision
+    bottom: np.ndarray
+    route: str
+    residual: float
+    n_touched: int
+    seconds: dict = field(default_factory=dict)
+
+
+def touched_dofs(B: sp.spmatrix) -> np.ndarray:
+    """Columns of B holding a non-zero entry (the dofs b(·, μ) sees), sorted."""
+    B = sp.csc_matrix(B)
+    B.eliminate_zeros()
+    return np.flatnonzero(np.diff(B.indptr) > 0)
+
+
+SPARSE_G_DENSE_MAX_M = 300
+"""With a sparse G, the dense routes only up to this m: shift-invert was 20-50× faster at
+m = 1152 and 2048 (scikit-fem P2–P0, same β to 1e-13)."""
+
+
+def choose_route(n: int, m: int, n_touched: int, sparse_g: bool = False) -> str:
+    """``gamma-dense`` where X = (A⁻¹)_ΓΓ is the smaller dense block, ``solves-dense`` where
+    A⁻¹ Bᵀ is, ``shift-invert`` when m > :data:`DENSE_MAX_M` (with a sparse G: m >
+    :data:`SPARSE_G_DENSE_MAX_M`) or both dense blocks are too large."""
+    if m > (SPARSE_G_DENSE_MAX_M if sparse_g else DENSE_MAX_M):
+        return "shift-invert"
+    gamma_bytes, solves_bytes = 8.0 * n_touched ** 2, 8.0 * n * m
+    if min(gamma_bytes, solves_bytes) > DENSE_MAX_BYTES:
+        return "shift-invert"
+    return "gamma-dense" if gamma_bytes <= solves_bytes else "solves-dense"
+
+
+def scaled_coupling(A, B, G, touched) -> sp.csr_matrix:
+    """W = D_A^{-1/2} Bᵀ D_G^{-1/2} on the touched dofs (D = the diagonals)."""
+    da = np.sqrt(sp.csr_matrix(A).diagonal()[touched])
+    dg = np.sqrt(np.asarray(G.diagonal() if sp.issparse(G) else np.diag(G), float))
+    Bt = sp.csc_matrix(B)[:, touched].T.tocsr()
+    return sp.diags(1.0 / da) @ Bt @ sp.diags(1.0 / dg)
+
+
+def level_spectrum(A, B, G, known_kernel: int = 0, route: str = "auto") -> LevelSpectrum:
+    """β_h and the bottom of the pencil for one level (checked matrices: :mod:`.checks`).
+
+    Parameters
+    ----------
+    A : sparse (n × n), SPD.
+    B : sparse (m × n).
+    G : sparse or dense (m × m), SPD.
+    known_kernel : int
+        Dimension of a kernel of Bᵀ the producer declares (``proven``).
+    route : str
+        One of :data:`ROUTES`.
+    """
+    A = sp.csc_matrix(A)
+    B = sp.csr_matrix(B)
+    n, m = A.shape[0], B.shape[0]
+    touched = touched_dofs(B)
+    if route == "auto":
+        route = choose_route(n, m, len(touched), sp.issparse(G))
+    seconds = {}
+    t0 = time.perf_counter()
+    W = scaled_coupling(A, B, G, touched)
+    if 8.0 * W.shape[0] * W.shape[1] <= SVD_MAX_BYTES:
+        kernel = coupling_kernel(W.toarray(), known_kernel)
+    else:
+        kernel = bottom_kernel(W, known_kernel)
+    seconds["kernel"] = time.perf_counter() - t0
+    if route == "shift-invert":
+        ev, resid, sec = _shift_invert(A, B, G, kernel.dim + N_BOTTOM, float(kernel.singular[-1]) ** 2)
+    else:
+        ev, resid, sec = _dense(A, B, G, touched, route, kernel.dim + N_BOTTOM)
+    seconds.update(sec)
+    d = kernel.dim
+    above = float(np.sqrt(max(ev[d], 0.0))) if d < len(ev) else np.nan
+    p = min(kernel.proven, len(ev) - 1)
+    beta = 0.0 if kernel.detected > 0 else float(np.sqrt(max(ev[p], 0.0)))
+    return LevelSpectrum(beta, above, kernel, ev, route, resid, len(touched), seconds)
+
+
+def _dense(A, B, G, touched, route, n_pairs):
+    t0 = time.perf_counter()
+    if route == "gamma-dense":
+        rest = np.setdiff1d(np.arange(A.shape[0]), touched)
+        order = np.concatenate([rest, touched])
+        fac = gamma_factorization(A[order][:, order], len(touched))
+        Bg = B[:, touched].toarray()
+        t1 = time.perf_counter()
+        S = Bg @ fac.steklov_times(Bg.T)
+    else:
+        lu = spla.splu(A, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0, options=dict(SymmetricMode=True))
+        t1 = time.perf_counter()
+        S = B @ lu.solve(B.T.toarray())
+    S = 0.5 * (S + S.T)
+    Gd = G.toarray() if sp.issparse(G) else np.asarray(G, float)
+    k = min(n_pairs, S.shape[0])
+    ev, x = sla.eigh(S, Gd, subset_by_index=[0, k - 1])
+    res = np.linalg.norm(S @ x - (Gd @ x) * ev[:k], axis=0)
+    scale = (np.linalg.norm(S, 2) + np.abs(ev[:k]) * np.linalg.norm(Gd, 2)) * np.linalg.norm(x, axis=0)
+    return ev, float(np.max(res / scale)), {"factorize": t1 - t0, "eigen": time.perf_counter() - t1}
+
+
+def _shift_invert(A, B, G, n_pairs, smax2):
+    """The bottom of the pencil by shift-invert Lanczos (module docstring); ``smax2`` =
+    σ_max(W)², the Jacobi scale that sets the shift δ."""
+    m = B.shape[0]
+    Gs = sp.csc_matrix(G)
+    delta = SHIFT * smax2
+    t0 = time.perf_counter()
+    K = sp.bmat([[A, B.T], [B, -delta * Gs]], format="csc")
+    lu = spla.splu(K, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0, options=dict(SymmetricMode=True))
+    n = A.shape[0]
+    rhs = np.zeros(n + m)
+
+    def inv(r):
+        rhs[:] = 0.0
+        rhs[n:] = np.ravel(r)
+        return -lu.solve(rhs)[n:]
+
+    # S = B A⁻¹ Bᵀ through an independent LU of A: the operator eigsh is given, and the
+    # Rayleigh quotients and residuals below
+    luA = spla.splu(A, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0, options=dict(SymmetricMode=True))
+
+    def schur(x):
+        return B @ luA.solve(np.asarray(B.T @ x))
+
+    t1 = time.perf_counter()
+    k = min(n_pairs, m - 1)
+    op = spla.LinearOperator((m, m), matvec=inv, dtype=float)
+    S_op = spla.LinearOperator((m, m), matvec=schur, matmat=schur, dtype=float)
+    ev, x = spla.eigsh(S_op, k=k, M=Gs, sigma=-delta, OPinv=op, which="LM", tol=1e-12)
+    t2 = time.perf_counter()
+    Sx = schur(x)
+    s_norm = float(np.max(np.linalg.norm(Sx, axis=0) / np.linalg.norm(x, axis=0)))  # a lower bound of ‖S‖
+    Gx = Gs @ x
+    ev = np.einsum("ij,ij->j", x, Sx) / np.einsum("ij,ij->j", x, Gx)  # Rayleigh quotients, exact S
+    g_norm = float(spla.eigsh(Gs, k=1, which="LA", tol=1e-3, return_eigenvectors=False)[0])
+    res = np.linalg.norm(Sx - Gx * ev, axis=0) / ((s_norm + np.abs(ev) * g_norm) * np.linalg.norm(x, axis=0))
+    order = np.argsort(ev)
+    return ev[order], float(np.max(res)), {"factorize": t1 - t0, "eigen": t2 - t1, "residual": time.perf_counter() - t2}
+
+
+def bottom_kernel(W: sp.spmatrix, proven: int = 0, n_values: int = N_BOTTOM) -> KernelDecision:
+    """:func:`coupling_kernel` for a W too large for a dense SVD: the same tolerance
+    η = max(rows, cols)·ε·σ_max and the same margin rule, on the bottom singular values only.
+
+    The right singular vectors v_i of the smallest singular values come from shift-invert
+    Lanczos on WᵀW (sparse, m × m), and each σ_i is then measured directly as ‖W v_i‖ (not as
+    the square root of an eigenvalue of WᵀW, which would lose half the digits). ``singular``
+    holds these bottom values and σ_max last.
+    """
+    W = sp.csr_matrix(W)
+    rows, m = W.shape
+    proven = int(max(proven, m - rows, 0))
+    C = sp.csc_matrix(W.T @ W)
+    smax = float(np.sqrt(spla.eigsh(C, k=1, which="LA", tol=1e-6, return_eigenvectors=False)[0]))
+    tol = max(rows, m) * np.finfo(float).eps * smax
+    k = min(proven + n_values, m - 1)
+    while True:  # widen until a value above η is among those computed
+        _, v = spla.eigsh(C, k=k, sigma=-1e-10 * smax ** 2, which="LM", tol=1e-14)
+        s = np.sort(np.linalg.norm(W @ v, axis=0) / np.linalg.norm(v, axis=0))
+        if s[-1] > tol or k >= m - 1:
+            break
+        k = min(2 * k, m - 1)
+    numerical = int(np.sum(s <= tol))
+    dim = max(proven, numerical)
+    ratios = [s[dim] / tol] if dim < len(s) else []
+    if numerical > proven:
+        ratios.append(tol / max(s[dim - 1], np.finfo(float).tiny))
+    elif numerical < proven:
+        ratios.append(tol / s[proven - 1])
+    margin = float(np.log10(min(ratios))) if ratios else np.inf
+    return KernelDecision(dim, proven, dim - proven, margin, CLOSE if margin < MARGIN_DECADES else CLEAR,
+                          float(tol), np.concatenate([s, [smax]]), numerical)

@@ -1,0 +1,115 @@
+"""A manifest's levels → one β row per level → the verdict, by ``verdict --case``'s criterion.
+
+The rows carry what :func:`infsup_contact.study.verdict.stability_verdict` reads (``N2`` is
+1/h, so its h is the manifest's) plus the route, residual, kernel decision and notes. The
+norm caveats (module :mod:`.manifest`, key ``norm``) are part of every row.
+"""
+from __future__ import annotations
+
+import sys
+import time
+
+import numpy as np
+import scipy.sparse as sp
+
+from ..study.verdict import stability_verdict
+from .checks import check_level, check_sequence
+from .engine import level_spectrum
+from .manifest import Manifest, constrained_dofs
+from .readers import SystemFileError, read_matrix
+
+NORM_NOTES = {
+    "given": "G as given (the norm the inf-sup condition is stated in)",
+    "L2": ("L2 verdict: G is the L2 mass of the multipliers; stable contact spaces decay like h^1/2 in L2 "
+           "(Remark 3.1), so this is not the H^-1/2 verdict"),
+    "h-L2": ("h-weighted L2 (G = h*M): a mesh-dependent norm weaker than H^-1/2 on quasi-uniform meshes "
+             "(h^1/2|mu|_L2 <~ |mu|_H^-1/2); STABLE here does not prove H^-1/2 stability"),
+}
+
+
+def load_level(manifest: Manifest, level):
+    """Read and check one level: a :class:`~.checks.CheckedLevel` (G scaled by h for ``h-L2``)."""
+    A, B, G = (read_matrix(p) for p in (level.A, level.B, level.G))
+    A = sp.csr_matrix(A) if not sp.issparse(A) else A
+    B = sp.csr_matrix(B) if not sp.issparse(B) else B
+    checked = check_level(level, A, B, G, constrained_dofs(level, A.shape[0]), manifest.tgv)
+    if manifest.norm == "h-L2":
+        checked.G = checked.G * level.h
+    return checked
+
+
+def system_rows(manifest: Manifest, route: str = "auto", notes=sys.stderr) -> list:
+    """One row per level: β_h, the kernel decision, the route and its residual."""
+    rows, shapes = [], []
+    for level in manifest.levels:
+        t0 = time.perf_counter()
+        lv = load_level(manifest, level)
+        shapes.append((lv.A.shape[0] + lv.removed, lv.B.shape[0]))
+        check_sequence(manifest, shapes)
+        t_read = time.perf_counter() - t0
+        if manifest.known_kernel >= lv.B.shape[0]:
+            raise SystemFileError(manifest.path, f"known_kernel = {manifest.known_kernel} >= m = {lv.B.shape[0]} "
+                                  f"multipliers at levels[{level.index}]")
+        res = level_spectrum(lv.A, lv.B, lv.G, manifest.known_kernel, route)
+        k = res.kernel
+        if k.numerical < k.proven:
+            raise SystemFileError(manifest.path, f"known_kernel = {k.proven}, but at levels[{level.index}] only "
+                                  f"{k.numerical} singular values of the scaled B^T are <= eta = {k.tol:.2g}: the "
+                                  "declared kernel is not a kernel of B^T")
+        for note in lv.notes:
+            print(f"infsup-contact: note: {note}", file=notes)
+        rows.append(dict(
+            system=manifest.name, level=level.index, h=level.h, N2=1.0 / level.h, n=lv.A.shape[0], m=lv.B.shape[0],
+            n_touched=res.n_touched, removed_dofs=lv.removed, norm=manifest.norm,
+            beta=res.beta, kernel_dim=k.dim, known_kernel=k.proven, kernel_detected=k.detected,
+            kernel_margin_decades=k.margin_decades, kernel_decision=k.decision, kernel_tol=k.tol,
+            smallest_nonzero=res.smallest_nonzero, route=res.route, residual=res.residual,
+            t_read=t_read, t_factorize=res.seconds.get("factorize", np.nan),
+            t_eigen=res.seconds.get("eigen", np.nan), t_kernel=res.seconds["kernel"],
+            notes="; ".join(lv.notes)))
+    return rows
+
+
+def system_verdict(manifest: Manifest, *, tol: float, floor: float, confidence: float, route: str = "auto",
+                   notes=sys.stderr) -> tuple:
+    """(verdict row, level rows). The criterion of ``verdict --case``
+    (:func:`~infsup_contact.study.verdict.stability_verdict`) on the kernel *beyond* the
+    declared one: a kernel of Bᵀ larger than ``known_kernel`` on any level is UNSTABLE; a
+    ``close`` kernel decision on any level makes the verdict INCONCLUSIVE (both by
+    ``stability_verdict`` itself). The entries of an exported B are taken as exact (the
+    producer's quadrature round-off is not known here: ``entry_error`` = 0 in η)."""
+    t0 = time.perf_counter()
+    rows = system_rows(manifest, route, notes)
+    series = [dict(r, kernel_dim=r["kernel_detected"], case=manifest.name) for r in rows]
+    out = stability_verdict(series, tol, floor, confidence)  # a close kernel decision: INCONCLUSIVE
+    out["evidence"] = out["evidence"].replace("over N = ", "over 1/h = ").replace("(N = ", "(1/h = ")
+    head = dict(system=manifest.name, norm=manifest.norm, known_kernel=manifest.known_kernel)
+    head.update(out)
+    head.update(h_list=" ".join(f"{r['h']:g}" for r in rows), routes=" ".join(sorted({r["route"] for r in rows})),
+                max_residual=max(r["residual"] for r in rows), norm_note=NORM_NOTES[manifest.norm],
+                seconds=time.perf_counter() - t0)
+    return head, rows
+
+
+def dry_check(manifest: Manifest, route: str = "auto"):
+    """What ``--dry-run`` and every run check before computing: each file readable, finite,
+    the shapes of each level and between levels, and the memory estimate
+    (:func:`infsup_contact.resources.system_estimate`)."""
+    from .. import resources
+    from .checks import check_finite, check_shapes
+    from .engine import choose_route, touched_dofs
+
+    sizes, shapes = [], []
+    for level in manifest.levels:
+        mats = [read_matrix(p) for p in (level.A, level.B, level.G)]
+        for mat, path in zip(mats, (level.A, level.B, level.G)):
+            check_finite(mat, path)
+        A, B, G = mats
+        check_shapes(level, A, B, G)
+        constrained_dofs(level, A.shape[0])
+        shapes.append((A.shape[0], B.shape[0]))
+        check_sequence(manifest, shapes)
+        nt = len(touched_dofs(sp.csr_matrix(B)))
+        r = choose_route(A.shape[0], B.shape[0], nt, sp.issparse(G)) if route == "auto" else route
+        sizes.append((A.shape[0], B.shape[0], nt, sp.csr_matrix(A).nnz, r))
+    return resources.system_estimate(sizes)

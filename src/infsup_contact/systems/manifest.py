@@ -1,0 +1,160 @@
+"""The manifest of a foreign system: a YAML list of mesh levels, paths relative to it.
+
+Minimal form (works as written)::
+
+    levels:
+      - {h: 0.25,  A: A4.mtx,  B: B4.mtx,  G: G4.mtx}
+      - {h: 0.125, A: A8.mtx,  B: B8.mtx,  G: G8.mtx}
+      - {h: 0.0625, A: A16.mtx, B: B16.mtx, G: G16.mtx}
+
+A (n × n) SPD, B (m × n), G (m × m) the multiplier norm. Optional keys:
+
+``name``
+    the pair of spaces, printed in the verdict row (default: the manifest's file name);
+``norm``
+    what G is: ``given`` (default: the norm the inf-sup condition is stated in, e.g. the
+    pressure L² mass of Stokes, or an H^{-1/2} Gram), ``L2`` (the L² mass of *contact*
+    multipliers, whose proper norm is H^{-1/2}: the row is the L² verdict, Remark 3.1) or
+    ``h-L2`` (G replaced by h·G, the mesh-dependent norm, with its caveat printed);
+``known_kernel``
+    dimension of a kernel of Bᵀ the producer knows of (the constant pressure of an enclosed
+    Stokes flow: 1); β_h is reported on its complement, and a larger kernel is UNSTABLE;
+``tgv``
+    ``eliminate`` (default) or ``refuse`` dofs fixed by a huge diagonal penalty;
+per level, ``constrained``
+    the 0-based dofs the producer fixed but left in A (identity or penalty rows): a list,
+    or a file (``.txt``: whitespace-separated integers, ``.npy``); they are removed.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from .readers import SystemFileError
+
+NORMS = ("given", "L2", "h-L2")
+TGV_POLICIES = ("eliminate", "refuse")
+LEVEL_KEYS = ("h", "A", "B", "G", "constrained")
+TOP_KEYS = ("levels", "name", "norm", "known_kernel", "tgv")
+MIN_LEVELS = 3
+"""A slope's confidence interval needs n − 2 ≥ 1 degrees of freedom (as ``verdict --case``)."""
+
+
+@dataclass(frozen=True)
+class Level:
+    """One mesh level: its size and its three files (absolute paths)."""
+
+    index: int
+    h: float
+    A: Path
+    B: Path
+    G: Path
+    constrained: object = None  # None, a list of ints, or a Path
+
+
+@dataclass(frozen=True)
+class Manifest:
+    """A parsed, checked manifest (module docstring)."""
+
+    path: Path
+    name: str
+    norm: str
+    known_kernel: int
+    tgv: str
+    levels: tuple
+
+
+def load_manifest(path, min_levels: int = MIN_LEVELS) -> Manifest:
+    """Read and check ``path``; :class:`SystemFileError` naming the manifest and the key."""
+    import yaml
+
+    path = Path(path)
+    if not path.is_file():
+        raise SystemFileError(path, "no such manifest file")
+    try:
+        data = yaml.safe_load(path.read_text())
+    except (yaml.YAMLError, UnicodeDecodeError) as err:
+        raise SystemFileError(path, f"not readable YAML ({' '.join(str(err).split())[:120]})") from None
+    if not isinstance(data, dict):
+        raise SystemFileError(path, f"expected a mapping with the key 'levels' (found {type(data).__name__})")
+    unknown = sorted(set(map(str, data)) - set(TOP_KEYS))
+    if unknown:
+        raise SystemFileError(path, f"unknown key {unknown[0]!r} (allowed: {', '.join(TOP_KEYS)})")
+    levels = data.get("levels")
+    if not isinstance(levels, list) or not levels:
+        raise SystemFileError(path, f"'levels' must be a non-empty list of {{h, A, B, G}} (found {levels!r:.60})")
+    if len(levels) < min_levels:
+        raise SystemFileError(path, f"'levels' has {len(levels)} entries; a verdict needs at least {min_levels} "
+                              "(the slope's confidence interval needs n - 2 >= 1)")
+    name = data.get("name", path.stem)
+    norm = data.get("norm", "given")
+    if norm not in NORMS:
+        raise SystemFileError(path, f"norm: {norm!r} is not one of {', '.join(NORMS)}")
+    tgv = data.get("tgv", "eliminate")
+    if tgv not in TGV_POLICIES:
+        raise SystemFileError(path, f"tgv: {tgv!r} is not one of {', '.join(TGV_POLICIES)}")
+    known = data.get("known_kernel", 0)
+    if isinstance(known, bool) or not isinstance(known, int) or known < 0:
+        raise SystemFileError(path, f"known_kernel: expected an integer >= 0 (found {known!r})")
+    parsed = tuple(_level(path, i, entry) for i, entry in enumerate(levels))
+    hs = [lv.h for lv in parsed]
+    for i in range(1, len(hs)):
+        if not hs[i] < hs[i - 1]:
+            raise SystemFileError(path, f"levels[{i}].h = {hs[i]:g} does not decrease (levels[{i - 1}].h = "
+                                  f"{hs[i - 1]:g}): list the levels coarse to fine, each h once")
+    return Manifest(path, str(name), norm, known, tgv, parsed)
+
+
+def _level(path: Path, i: int, entry) -> Level:
+    where = f"levels[{i}]"
+    if not isinstance(entry, dict):
+        raise SystemFileError(path, f"{where}: expected a mapping {{h, A, B, G}} (found {entry!r:.60})")
+    unknown = sorted(set(map(str, entry)) - set(LEVEL_KEYS))
+    if unknown:
+        raise SystemFileError(path, f"{where}: unknown key {unknown[0]!r} (allowed: {', '.join(LEVEL_KEYS)})")
+    missing = [k for k in ("h", "A", "B", "G") if k not in entry]
+    if missing:
+        raise SystemFileError(path, f"{where}: missing key {missing[0]!r} (each level needs h, A, B, G)")
+    h = entry["h"]
+    if isinstance(h, bool) or not isinstance(h, (int, float)) or not math.isfinite(h) or h <= 0:
+        raise SystemFileError(path, f"{where}.h: expected a finite number > 0 (found {h!r})")
+    files = {}
+    for key in ("A", "B", "G"):
+        if not isinstance(entry[key], str) or not entry[key]:
+            raise SystemFileError(path, f"{where}.{key}: expected a file name (found {entry[key]!r})")
+        files[key] = (path.parent / entry[key]).resolve()
+    con = entry.get("constrained")
+    if isinstance(con, str):
+        con = (path.parent / con).resolve()
+    elif con is not None:
+        if not isinstance(con, list) or any(isinstance(c, bool) or not isinstance(c, int) or c < 0 for c in con):
+            raise SystemFileError(path, f"{where}.constrained: expected a file or a list of integers >= 0")
+    return Level(i, float(h), files["A"], files["B"], files["G"], con)
+
+
+def constrained_dofs(level: Level, n: int) -> np.ndarray:
+    """The level's declared constrained dofs as a sorted int array, checked against n."""
+    con = level.constrained
+    if con is None:
+        return np.zeros(0, int)
+    if isinstance(con, Path):
+        if not con.is_file():
+            raise SystemFileError(con, "no such file (levels[{}].constrained)".format(level.index))
+        try:
+            raw = np.load(con) if con.suffix == ".npy" else np.loadtxt(con, ndmin=1)
+        except Exception as err:
+            raise SystemFileError(con, f"not a list of integers ({type(err).__name__})") from None
+        where = con
+    else:
+        raw, where = np.asarray(con), f"levels[{level.index}].constrained"
+    dofs = np.asarray(raw).ravel()
+    if dofs.size and (not np.all(np.isfinite(dofs)) or np.any(dofs != np.round(dofs))):
+        raise SystemFileError(where, "constrained dofs must be integers")
+    dofs = np.unique(dofs.astype(int))
+    if dofs.size and (dofs[0] < 0 or dofs[-1] >= n):
+        raise SystemFileError(where, f"constrained dof {int(dofs[-1] if dofs[-1] >= n else dofs[0])} outside "
+                              f"0..{n - 1} (A has {n} rows; indices are 0-based)")
+    return dofs

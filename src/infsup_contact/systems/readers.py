@@ -1,0 +1,219 @@
+"""Read one matrix file of a foreign system, by its extension, with the library made for it.
+
+========================  ======================================================
+extension                 reader
+========================  ======================================================
+``.mtx``, ``.mtx.gz``     ``scipy.io.mmread`` (MatrixMarket coordinate or array)
+``.npz``                  ``scipy.sparse.load_npz``; else ``numpy.load`` of an
+                          archive holding exactly one array (dense)
+``.npy``                  ``numpy.load`` (dense)
+``.hb``, ``.rb``,         ``scipy.io.hb_read`` (Harwell-Boeing, real assembled)
+``.rua``, ``.rsa``
+``.petsc``, ``.bin``,     ``petsc4py`` when importable, else :func:`read_petsc_binary`
+``.dat``
+========================  ======================================================
+
+Every failure — a missing file, a truncated one, a file in another format than its name
+says — is a :class:`SystemFileError`: one line naming the file and what was found.
+
+The PETSc binary format (PETSc manual, ``MatLoad``/``MatView`` with a binary viewer; the
+reference implementation is PETSc's ``lib/petsc/bin/PetscBinaryIO.py``), as read by
+:func:`read_petsc_binary`: everything big-endian;
+
+* a sparse matrix: ``int32 MAT_FILE_CLASSID = 1211216``, ``int32 M`` (rows),
+  ``int32 N`` (columns), ``int32 nz`` (total nonzeros), ``int32 row_lengths[M]``,
+  ``int32 column_indices[nz]`` (0-based, row by row), ``float64 values[nz]``;
+* a PETSc built with ``--with-64-bit-indices`` writes every integer as ``int64``
+  (recognized: the first 8 bytes are the class id as ``int64``);
+* a dense matrix (``MatView`` of ``MATDENSE``) has ``nz = -1`` and then ``M·N`` ``float64``
+  values row by row;
+* a file may hold further objects after the matrix; they are ignored (the first object must
+  be a matrix). Single precision and complex scalars are not read (refused by size checks).
+"""
+from __future__ import annotations
+
+import gzip
+from pathlib import Path
+
+import numpy as np
+import scipy.sparse as sp
+
+from ..errors import InputError
+
+MAT_FILE_CLASSID = 1211216
+"""PETSc's class id of a matrix in a binary file."""
+DENSE_NZ = -1
+"""``nz`` of a dense matrix in a PETSc binary file (MATRIX_BINARY_FORMAT_DENSE)."""
+
+FORMATS = {".mtx": "MatrixMarket", ".mtx.gz": "MatrixMarket (gzip)", ".npz": "scipy/numpy .npz",
+           ".npy": "numpy .npy", ".hb": "Harwell-Boeing", ".rb": "Harwell-Boeing",
+           ".rua": "Harwell-Boeing", ".rsa": "Harwell-Boeing", ".petsc": "PETSc binary",
+           ".bin": "PETSc binary", ".dat": "PETSc binary"}
+"""Readable extensions and the format each one means."""
+
+
+class SystemFileError(InputError):
+    """A file or manifest entry of a foreign system that cannot be used: one line naming it."""
+
+    def __init__(self, where, problem: str, key: str = "system"):
+        self.key, self.allowed, self.got, self.where = key, problem, None, str(where)
+        ValueError.__init__(self, f"{where}: {problem}")
+
+
+def extension(path) -> str:
+    """The format-deciding extension of ``path`` (``.mtx.gz`` counts as one)."""
+    name = Path(path).name.lower()
+    if name.endswith(".mtx.gz"):
+        return ".mtx.gz"
+    return Path(name).suffix
+
+
+def read_matrix(path):
+    """The matrix in ``path`` as a scipy CSR matrix or a 2-D float ndarray.
+
+    Raises
+    ------
+    SystemFileError
+        The file is missing, empty, of an unknown extension, truncated, or not in the
+        format its extension names.
+    """
+    path = Path(path)
+    ext = extension(path)
+    if ext not in FORMATS:
+        raise SystemFileError(path, f"unknown extension {ext or '(none)'!r} (readable: "
+                              f"{', '.join(FORMATS)})")
+    if not path.is_file():
+        raise SystemFileError(path, "no such file")
+    if path.stat().st_size == 0:
+        raise SystemFileError(path, f"empty file (expected {FORMATS[ext]})")
+    try:
+        if ext in (".mtx", ".mtx.gz"):
+            mat = _read_mtx(path, ext)
+        elif ext == ".npz":
+            mat = _read_npz(path)
+        elif ext == ".npy":
+            mat = np.load(path, allow_pickle=False)
+        elif FORMATS[ext] == "Harwell-Boeing":
+            import scipy.io
+            mat = scipy.io.hb_read(str(path))
+        else:
+            mat = _read_petsc(path)
+    except SystemFileError:
+        raise
+    except Exception as err:  # every library error becomes one line naming the file
+        reason = " ".join(str(err).split())[:160] or type(err).__name__
+        raise SystemFileError(path, f"not a readable {FORMATS[ext]} file ({type(err).__name__}: {reason})") from None
+    if sp.issparse(mat):
+        mat = sp.csr_matrix(mat)
+    else:
+        mat = np.asarray(mat)
+        if mat.ndim != 2:
+            raise SystemFileError(path, f"holds a {mat.ndim}-D array of shape {mat.shape}, not a matrix")
+    if not np.issubdtype(mat.dtype, np.number) or np.issubdtype(mat.dtype, np.complexfloating):
+        raise SystemFileError(path, f"holds {mat.dtype} entries (expected real numbers)")
+    return mat.astype(float)
+
+
+def _read_mtx(path, ext):
+    import scipy.io
+
+    with (gzip.open(path, "rb") if ext == ".mtx.gz" else open(path, "rb")) as fh:
+        head = fh.read(15)
+    if not head.startswith(b"%%MatrixMarket"):
+        raise SystemFileError(path, f"does not start with the MatrixMarket banner '%%MatrixMarket' "
+                              f"(found {head[:15]!r})")
+    return scipy.io.mmread(str(path))
+
+
+def _read_npz(path):
+    with open(path, "rb") as fh:
+        if fh.read(4) != b"PK\x03\x04":
+            raise SystemFileError(path, "not a zip archive (an .npz is one)")
+    with np.load(path, allow_pickle=False) as data:
+        keys = set(data.files)
+    if {"format", "shape", "data"} <= keys:
+        return sp.load_npz(path)
+    if len(keys) != 1:
+        raise SystemFileError(path, f"an .npz with arrays {sorted(keys)}: expected a scipy.sparse.save_npz "
+                              "archive or exactly one dense array")
+    with np.load(path, allow_pickle=False) as data:
+        return data[next(iter(keys))]
+
+
+def _read_petsc(path):
+    try:
+        from petsc4py import PETSc  # noqa: F401
+    except ImportError:
+        return read_petsc_binary(path)
+    return _read_petsc4py(path)
+
+
+def _read_petsc4py(path):  # pragma: no cover - petsc4py is not in the lock
+    from petsc4py import PETSc
+
+    viewer = PETSc.Viewer().createBinary(str(path), "r")
+    mat = PETSc.Mat().load(viewer)
+    if mat.getType() in ("seqdense", "mpidense", "dense"):
+        return np.array(mat.getDenseArray())
+    indptr, indices, data = mat.getValuesCSR()
+    return sp.csr_matrix((data, indices, indptr), shape=mat.getSize())
+
+
+def read_petsc_binary(path):
+    """A matrix from a PETSc binary file, without PETSc (the layout: module docstring).
+
+    Returns
+    -------
+    scipy.sparse.csr_matrix or ndarray
+        CSR for a sparse matrix, a dense array for ``nz = -1``.
+    """
+    path = Path(path)
+    raw = path.read_bytes()
+    if len(raw) < 16:
+        raise SystemFileError(path, f"PETSc binary: {len(raw)} bytes, shorter than a matrix header (16)")
+    first32 = int(np.frombuffer(raw, ">i4", 1)[0])
+    if first32 == MAT_FILE_CLASSID:
+        itype = np.dtype(">i4")
+    elif len(raw) >= 32 and int(np.frombuffer(raw, ">i8", 1)[0]) == MAT_FILE_CLASSID:
+        itype = np.dtype(">i8")
+    else:
+        raise SystemFileError(path, f"PETSc binary: first integer is {first32}, not the matrix class id "
+                              f"{MAT_FILE_CLASSID} (not a PETSc matrix, or not big-endian)")
+    isz = itype.itemsize
+    m, n, nz = (int(v) for v in np.frombuffer(raw, itype, 3, offset=isz))
+    pos = 4 * isz
+    if m < 0 or n < 0:
+        raise SystemFileError(path, f"PETSc binary: negative size {m} x {n} in the header")
+    if nz == DENSE_NZ:
+        need = pos + 8 * m * n
+        if len(raw) < need:
+            raise SystemFileError(path, f"PETSc binary: truncated: a dense {m} x {n} matrix needs {need} bytes, "
+                                  f"the file has {len(raw)}")
+        return np.frombuffer(raw, ">f8", m * n, offset=pos).reshape(m, n).astype(float)
+    need = pos + isz * (m + nz) + 8 * nz
+    if nz < 0 or len(raw) < need:
+        raise SystemFileError(path, f"PETSc binary: truncated: header says {m} x {n} with {nz} nonzeros "
+                              f"({need} bytes), the file has {len(raw)}")
+    lengths = np.frombuffer(raw, itype, m, offset=pos).astype(np.int64)
+    if (lengths < 0).any() or lengths.sum() != nz:
+        raise SystemFileError(path, f"PETSc binary: row lengths sum to {int(lengths.sum())}, header says {nz} nonzeros")
+    cols = np.frombuffer(raw, itype, nz, offset=pos + isz * m).astype(np.int64)
+    if nz and (cols.min() < 0 or cols.max() >= n):
+        raise SystemFileError(path, f"PETSc binary: column index {int(cols.max() if cols.max() >= n else cols.min())} "
+                              f"outside 0..{n - 1}")
+    vals = np.frombuffer(raw, ">f8", nz, offset=pos + isz * (m + nz)).astype(float)
+    indptr = np.concatenate([[0], np.cumsum(lengths)])
+    return sp.csr_matrix((vals, cols, indptr), shape=(m, n))
+
+
+def petsc_binary_bytes(mat) -> bytes:
+    """The bytes of ``mat`` (sparse or dense, written as sparse AIJ) in PETSc's binary layout
+    with 32-bit indices; :func:`infsup_contact.io.write_bytes_atomic` writes them."""
+    A = sp.csr_matrix(mat, dtype=float)
+    A.sort_indices()
+    m, n = A.shape
+    if max(m, n, A.nnz) >= 2 ** 31:
+        raise ValueError("matrix too large for 32-bit PETSc indices")
+    header = np.array([MAT_FILE_CLASSID, m, n, A.nnz], ">i4").tobytes()
+    return (header + np.diff(A.indptr).astype(">i4").tobytes() + A.indices.astype(">i4").tobytes()
+            + A.data.astype(">f8").tobytes())

@@ -218,7 +218,8 @@ def _check_column(frame, col: str, kind: str, name: str, lines: list):
 
     def bad(mask, what):
         row = int(np.flatnonzero(mask.to_numpy())[0])
-        cell = "an empty cell" if empty.iloc[row] else repr(frame[col].iloc[row])
+        value = frame[col].iloc[row]
+        cell = "an empty cell" if empty.iloc[row] else repr(value) if isinstance(value, str) else str(value)
         raise TableError(name, f"line {lines[row]}: column {col} holds {cell}, {what}",
                          allowed=_TYPE_WORDS[base] + (" or an empty cell" if nullable else ""))
 

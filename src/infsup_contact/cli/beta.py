@@ -1,9 +1,7 @@
 """``infsup-contact beta``: β_h (eq. (4.5)) for one mesh pair, one CSV row per case × norm."""
 from __future__ import annotations
 
-import sys
-
-from .common import add_dry_run, add_model, cases, check_memory, material, norms, SPACE_HELP
+from .common import add_dry_run, add_model, cases, check_memory, material, norms, SPACE_HELP, write_csv
 
 
 def add(sub) -> None:
@@ -70,4 +68,4 @@ def _run_beta(args) -> None:
         frame = frame.rename(columns={"c1": "E1", "c2": "E2"})
         frame.insert(frame.columns.get_loc("E2") + 1, "nu", args.nu)
         frame.insert(0, "model", "elastic")
-    frame.to_csv(sys.stdout, index=False, float_format="%.12g")
+    write_csv(frame, float_format="%.12g")

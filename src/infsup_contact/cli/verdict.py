@@ -1,10 +1,8 @@
 """``infsup-contact verdict``: the stability verdict for one space, as a user's CI calls it."""
 from __future__ import annotations
 
-import sys
-
 from ..errors import InputError
-from .common import add_dry_run, check_memory, SPACE_HELP
+from .common import add_dry_run, check_memory, SPACE_HELP, write_csv
 
 
 VERDICT_DEFAULTS = {"slope_tolerance": 0.15, "beta_floor": 0.001, "confidence": 0.95}
@@ -78,7 +76,7 @@ def _run_verdict(args) -> int:
                        tol=args.slope_tolerance, floor=args.beta_floor, confidence=args.confidence,
                        multiplier_mesh=args.multiplier_mesh)
     out["N_list"] = " ".join(str(n) for n in out["N_list"])
-    pd.DataFrame([out]).to_csv(sys.stdout, index=False, float_format="%.6g")
+    write_csv(pd.DataFrame([out]), float_format="%.6g")
     if args.expect is None:
         return 0
     return 0 if out["verdict"] == _EXPECT[args.expect] else 1

@@ -135,8 +135,9 @@ def test_valid_tables_of_every_kind_read(tmp_path, kind):
 def test_damaged_table_is_one_line_naming_file_and_row(tmp_path, kind, fault):
     path, line = damaged(tmp_path, kind, fault)
     if fault == "duplicated-row" and not SCHEMAS[kind].key:
-        # documented acceptance: profile, field, bench and contact-input tables declare no key
-        # (a profile repeats x at a breakpoint; `rates` checks its own input per series)
+        # documented acceptance: Γ-profile, benchmark-file and contact-input tables declare no key
+        # (a profile's one-sided samples may print alike; a Snakemake benchmark file repeats
+        # rows with `repeat`; `rates` checks its own input per series, see below)
         assert len(read_table(path, kind)) == 4
         return
     with pytest.raises(TableError) as err:

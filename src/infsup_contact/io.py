@@ -1,5 +1,6 @@
 """Atomic output (an interrupted run never leaves a half-written file behind) and checked input
-(a table missing a column, or no table at all, is one line naming the file)."""
+(every table is read through :func:`read_table`, against its declared :data:`SCHEMAS`: a damaged
+table is one line naming the file and the row)."""
 from __future__ import annotations
 
 import os
@@ -39,43 +40,108 @@ def write_csv_atomic(path, frame) -> None:
 
 
 # ---------------------------------------------------------------- reading tables
+# Every table the package, the CLI and the workflow read is declared here: its columns (a
+# consumer's required ones and the producer's optional ones), their types, and its key.
+# Column types:
+#   int    an integer (finite)            int?   an integer or an empty cell
+#   float  a finite number                float? a number or an empty cell (NaN)
+#   str    non-empty text                 str?   text or an empty cell
+#   bool   True/False                     bool?  True/False or an empty cell
+# A type without "?" is one the producer always writes: an empty cell there is damage (a
+# truncated row, a number cut short), not a missing value. Extra columns are allowed (the
+# producers add provenance and diagnostics); only the declared ones are checked.
 
-TABLE_COLUMNS = {
-    # the columns a consumer of each workflow table relies on (the producers write them)
-    "beta": ("case", "k", "family", "N1", "N2", "multiplier_mesh", "c1", "c2", "norm", "beta",
-             "kernel_dim", "structural_kernel_dim", "smallest_nonzero", "beta_v1_zero", "dim_M", "dim_W",
-             "ndof"),
-    "contact": ("scene", "case", "k", "family", "N1", "N2", "c1", "c2", "ndof", "dim_M", "cone",
-                "iterations", "energy_error", "l2_error", "lambda_l2_error", "lambda_hm12_error",
-                "min_lambda_pointwise", "max_penetration", "nonunique", "kernel_dim"),
-    "contact_input": ("scene", "case", "k", "family", "N1", "N2", "energy_error", "l2_error",
-                      "lambda_l2_error", "lambda_hm12_error"),  # `infsup-contact rates`
-    "rates": ("scene", "case", "k", "family", "measure", "slope", "stderr", "points", "h_min", "expected"),
-    "claims": ("claim_id", "paper_ref", "statement", "evidence", "verdict", "predicted"),
-    "gamma_profiles": ("case", "k", "N", "x", "quantity", "value"),
-    "field_values": ("case", "k", "N", "side", "x", "y", "u"),
-    "speed_accuracy": ("scene", "case", "k", "family", "N", "seconds", "energy_error",
-                       "lambda_hm12_error", "ndof", "dim_M", "pareto_energy", "pareto_lambda"),
-    "bench": ("what", "route", "k", "N", "seconds_median", "seconds_min", "seconds_max", "ratio_to_ours"),
-    # elastic stage (study/elastic_beta.py)
-    "elastic_beta": ("model", "case", "k", "family", "N1", "N2", "E1", "E2", "nu", "norm", "beta", "kernel_dim",
-                     "structural_kernel_dim", "smallest_nonzero", "beta_membranes", "kernel_dim_membranes",
-                     "bound_factor"),
-    "elastic_patch": ("case", "k", "N1", "N2", "p", "kernel_dim", "lambda_max_rel_error", "lambda_end_rel_error",
-                      "lambda_middle_rel_error", "u_max_rel_error", "passes"),
-    "elastic_hertz": ("study", "case", "k", "N", "d", "P", "p_max", "half_width", "oscillation",
-                      "p_max_rel_error", "half_width_rel_error"),
+_BETA = {"case": "str", "k": "int", "family": "str", "N1": "int", "N2": "int", "multiplier_mesh": "str",
+         "c1": "float", "c2": "float", "norm": "str", "beta": "float", "kernel_dim": "int",
+         "structural_kernel_dim": "int", "smallest_nonzero": "float?", "beta_v1_zero": "float?", "dim_M": "int",
+         "dim_W": "int", "ndof": "int"}
+_MEASURES = {"energy_error": "float", "l2_error": "float", "lambda_l2_error": "float", "lambda_hm12_error": "float"}
+_ELASTIC_BETA = {"model": "str", "case": "str", "k": "int", "family": "str", "N1": "int", "N2": "int",
+                 "multiplier_mesh": "str", "E1": "float", "E2": "float", "nu": "float", "norm": "str", "beta": "float",
+                 "kernel_dim": "int", "structural_kernel_dim": "int", "smallest_nonzero": "float?",
+                 "beta_v1_zero": "float?", "beta_membranes": "float?", "kernel_dim_membranes": "int",
+                 "bound_factor": "float?"}
+SERIES_COLUMNS = ("scene", "scene_kind", "case", "k", "family", "c1", "c2", "p", "q", "seed", "multiplier_mesh")
+"""Columns of a contact table that define a convergence series (those present): rates are
+fitted per series, and a series lists each mesh once."""
+
+
+class Schema:
+    """A table kind: ``columns`` (name → type, required), ``optional`` (checked when present),
+    ``key`` (columns, those present, that identify a row: no two rows share them), ``label``
+    (what the table is, for messages) and ``sep`` (the field separator)."""
+
+    def __init__(self, columns: dict, optional: dict | None = None, key: tuple = (), label: str | None = None,
+                 sep: str = ","):
+        self.columns, self.optional, self.key, self.label, self.sep = columns, optional or {}, key, label, sep
+
+    def types(self, present) -> dict:
+        """Type of every declared column among ``present``."""
+        every = {**self.optional, **self.columns}
+        return {c: every[c] for c in present if c in every}
+
+
+SCHEMAS = {
+    "beta": Schema(_BETA, optional={"seed": "int?", "series": "str"},
+                   key=("family", "case", "k", "N1", "N2", "seed", "multiplier_mesh", "c1", "c2", "norm", "series")),
+    "contact": Schema({"scene": "str", "case": "str", "k": "int", "family": "str", "N1": "int", "N2": "int",
+                       "c1": "float", "c2": "float", "ndof": "int", "dim_M": "int", "cone": "str", "iterations": "int",
+                       **_MEASURES, "min_lambda_pointwise": "float?", "max_penetration": "float?", "nonunique": "bool",
+                       "kernel_dim": "int"},
+                      optional={"p": "float?", "q": "float?", "seed": "int?", "scene_kind": "str"},
+                      key=("scene", "case", "k", "family", "N1", "N2", "c1", "c2", "p", "q", "seed")),
+    # `infsup-contact rates`: any contact table; its series and meshes are checked by study/rates.py
+    "contact_input": Schema({"scene": "str", "case": "str", "k": "int", "family": "str", "N1": "int", "N2": "int",
+                             **_MEASURES},
+                            optional={"c1": "float", "c2": "float", "p": "float?", "q": "float?", "seed": "int?",
+                                      "scene_kind": "str", "multiplier_mesh": "str"},
+                            label="a contact table (`infsup-contact contact` or results/tables/contact.csv)"),
+    "rates": Schema({"scene": "str", "case": "str", "k": "int", "family": "str", "measure": "str", "slope": "float?",
+                     "stderr": "float?", "points": "int", "h_min": "float", "expected": "float?"},
+                    optional={"c1": "float", "c2": "float", "p": "float?", "q": "float?", "seed": "int?",
+                              "scene_kind": "str", "multiplier_mesh": "str"},
+                    key=(*SERIES_COLUMNS, "measure")),
+    "claims": Schema({"claim_id": "str", "paper_ref": "str", "statement": "str", "evidence": "str", "verdict": "str",
+                      "predicted": "str"}, key=("claim_id",), label="a claims ledger"),
+    # no key: a sample 1e-9·h inside each end of an interval may print as its neighbour's x
+    "gamma_profiles": Schema({"case": "str", "k": "int", "N": "int", "x": "float", "quantity": "str",
+                              "value": "float?"}),
+    "field_values": Schema({"case": "str", "k": "int", "N": "int", "side": "int", "x": "float", "y": "float",
+                            "u": "float"}, key=("case", "k", "N", "side", "x", "y")),
+    "speed_accuracy": Schema({"scene": "str", "case": "str", "k": "int", "family": "str", "N": "int",
+                              "seconds": "float", "energy_error": "float", "lambda_hm12_error": "float",
+                              "ndof": "int", "dim_M": "int", "pareto_energy": "bool", "pareto_lambda": "bool"},
+                             key=("scene", "case", "k", "family", "N")),
+    "bench": Schema({"what": "str", "route": "str", "k": "int", "N": "int", "seconds_median": "float",
+                     "seconds_min": "float", "seconds_max": "float", "ratio_to_ours": "float?"},
+                    key=("what", "route", "k", "N"), label="a bench table"),
+    "mesh_quality": Schema({"family": "str", "N1": "int", "N2": "int", "side": "int", "h_max": "float",
+                            "h_min": "float", "min_angle": "float"}, optional={"seed": "int?"},
+                           key=("family", "N1", "N2", "side", "seed")),
+    # elastic stage (study/elastic_beta.py, study/patch.py, study/hertz.py)
+    "elastic_beta": Schema(_ELASTIC_BETA, key=("model", "case", "k", "family", "N1", "N2", "multiplier_mesh", "E1",
+                                               "E2", "nu", "norm")),
+    "elastic_patch": Schema({"case": "str", "k": "int", "N1": "int", "N2": "int", "p": "float", "kernel_dim": "int",
+                             "lambda_max_rel_error": "float", "lambda_end_rel_error": "float",
+                             "lambda_middle_rel_error": "float", "u_max_rel_error": "float", "passes": "bool"},
+                            optional={"scene": "str", "family": "str", "E1": "float", "E2": "float", "nu": "float",
+                                      "delta": "float"},
+                            key=("scene", "case", "k", "family", "N1", "N2", "E1", "E2", "nu", "delta")),
+    "elastic_hertz": Schema({"study": "str", "case": "str", "k": "int", "N": "int", "d": "float", "P": "float",
+                             "p_max": "float", "half_width": "float", "oscillation": "float",
+                             "p_max_rel_error": "float?", "half_width_rel_error": "float?"},
+                            optional={"R": "float", "nu": "float", "E1": "float", "E2": "float"},
+                            key=("study", "case", "k", "N", "R", "d", "nu", "E1", "E2")),
+    # Snakemake's `benchmark:` files (bench/dag.py), tab-separated
+    "rule_benchmark": Schema({"s": "float"}, optional={"max_rss": "float?", "cpu_time": "float?"},
+                             label="a Snakemake benchmark file", sep="\t"),
 }
-"""Required columns per table kind (:func:`read_table`)."""
+"""The declared tables (:func:`read_table`): one :class:`Schema` per kind."""
 
-TABLE_LABELS = {"contact_input": "a contact table (`infsup-contact contact` or results/tables/contact.csv)",
-                "claims": "a claims ledger", "bench": "a bench table"}
+TABLE_COLUMNS = {kind: tuple(s.columns) for kind, s in SCHEMAS.items()}
+"""Required columns per table kind (derived from :data:`SCHEMAS`)."""
 
-NUMERIC_COLUMNS = {"k", "N", "N1", "N2", "c1", "c2", "beta", "kernel_dim", "dim_M", "dim_W", "ndof",
-                   "energy_error", "l2_error", "lambda_l2_error", "lambda_hm12_error", "slope",
-                   "stderr", "points", "h_min", "expected", "x", "y", "u", "value", "seconds",
-                   "seconds_median", "seconds_min", "seconds_max"}
-"""Columns that must hold numbers (NaN allowed: an empty cell is a missing value)."""
+_TYPE_WORDS = {"int": "integers", "float": "finite numbers", "str": "non-empty text", "bool": "True or False"}
 
 
 class TableError(ValueError):
@@ -86,47 +152,172 @@ class TableError(ValueError):
         super().__init__(f"table {path}: {problem}" + (f" (allowed: {allowed})" if allowed else ""))
 
 
-def read_table(path, kind: str, allow_empty: bool = False):
-    """Read a CSV table of ``kind`` (:data:`TABLE_COLUMNS`) and check it before use.
+def _read_text(path) -> tuple[str, str]:
+    """The whole text of ``path`` (``-``: standard input), read once, and its display name."""
+    import sys
 
-    Raises :class:`TableError` (one line naming the file) for a missing, unreadable or empty
-    file, a file that is not CSV, missing columns (named) or non-numeric values in a numeric
-    column (the first one named, with its row).
-    """
+    if str(path) == "-":
+        data = sys.stdin.buffer.read() if sys.stdin is not None else b""
+        name = "<stdin>"
+    else:
+        p, name = Path(path), str(path)
+        if not p.exists():
+            raise TableError(path, "no such file")
+        if p.is_dir():
+            raise TableError(path, "a directory, not a CSV file")
+        try:
+            with open(p, "rb") as fh:  # once: a pipe (/dev/stdin) cannot be read twice
+                data = fh.read()
+        except OSError as err:
+            raise TableError(path, f"not readable ({err.strerror})") from None
+    try:
+        return data.decode("utf-8"), name
+    except UnicodeDecodeError as err:
+        raise TableError(name, f"not a text table (byte {err.start} is not UTF-8)") from None
+
+
+def _records(text: str, name: str, sep: str) -> tuple[list, list]:
+    """Header and the line number of each data record; refuses a cut-off last line and rows
+    whose field count differs from the header's (a truncated or merged row)."""
+    import csv
+    import io as _io
+
+    if not text.strip():
+        raise TableError(name, "empty file (no header, no rows)")
+    if not text.endswith("\n"):
+        last = text.count("\n") + 1
+        raise TableError(name, f"line {last} ends without a newline: the file was cut off (a truncated write?)",
+                         allowed="tables as the producers write them, every line ended")
+    reader = csv.reader(_io.StringIO(text), delimiter=sep)
+    try:
+        header = next(reader)
+        lines = []
+        for record in reader:
+            if not record:  # a blank line (pandas skips it too)
+                continue
+            if len(record) != len(header):
+                raise TableError(name, f"line {reader.line_num} has {len(record)} fields, the header {len(header)} "
+                                 "(a truncated or damaged row)")
+            lines.append(reader.line_num)
+    except csv.Error as err:
+        raise TableError(name, f"not a readable CSV table (line {reader.line_num}: {err})") from None
+    repeated = sorted({c for c in header if header.count(c) > 1})
+    if repeated:
+        raise TableError(name, f"the header repeats column{'s' if len(repeated) > 1 else ''} {', '.join(repeated)}")
+    return header, lines
+
+
+def _check_column(frame, col: str, kind: str, name: str, lines: list):
+    """The column ``col`` converted to its declared type; raises TableError naming the first
+    bad cell's line."""
+    import numpy as np
     import pandas as pd
 
-    p = Path(path)
-    if not p.exists():
-        raise TableError(path, "no such file")
-    if p.is_dir():
-        raise TableError(path, "a directory, not a CSV file")
-    try:
-        with open(p, "rb") as fh:
-            head = fh.read(1)
-    except OSError as err:
-        raise TableError(path, f"not readable ({err.strerror})") from None
-    if not head:
-        raise TableError(path, "empty file (no header, no rows)")
-    try:
-        frame = pd.read_csv(p)
-    except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError, ValueError) as err:
-        reason = " ".join(str(err).split())[:120]
-        raise TableError(path, f"not a readable CSV table ({type(err).__name__}: {reason})") from None
-    required = TABLE_COLUMNS[kind]
-    missing = [c for c in required if c not in frame.columns]
+    base, nullable = kind.rstrip("?"), kind.endswith("?")
+    values = frame[col]
+    empty = values.isna()
+
+    def bad(mask, what):
+        row = int(np.flatnonzero(mask.to_numpy())[0])
+        value = frame[col].iloc[row]
+        cell = "an empty cell" if empty.iloc[row] else repr(value) if isinstance(value, str) else str(value)
+        raise TableError(name, f"line {lines[row]}: column {col} holds {cell}, {what}",
+                         allowed=_TYPE_WORDS[base] + (" or an empty cell" if nullable else ""))
+
+    if not nullable and empty.any():
+        bad(empty, "where the producer always writes a value (a truncated or damaged row?)")
+    if base == "str":
+        return values
+    if base == "bool":
+        text = values.astype(str)
+        ok = empty | text.isin(["True", "False"])
+        if not ok.all():
+            bad(~ok, "not True or False")
+        return values
+    numbers = values if pd.api.types.is_numeric_dtype(values) else pd.to_numeric(values, errors="coerce")
+    if (numbers.isna() & ~empty).any():
+        bad(numbers.isna() & ~empty, "not a number")
+    if (~np.isfinite(numbers) & ~empty).any():
+        bad(~np.isfinite(numbers) & ~empty, "not a finite number")
+    if base == "int":
+        frac = (numbers != np.round(numbers)) & ~empty
+        if frac.any():
+            bad(frac, "not an integer")
+    return numbers
+
+
+def _check_key(frame, schema: Schema, name: str, where: list) -> None:
+    """No two rows with the same key (a row written twice, two runs joined); ``where[i]``
+    says where row i comes from (``line 7``, or ``a.csv line 7`` in a join)."""
+    key = [c for c in schema.key if c in frame.columns]
+    if not key:
+        return
+    twice = frame.duplicated(subset=key, keep=False).to_numpy()
+    if twice.any():
+        rows = twice.nonzero()[0]
+        first = frame.iloc[rows[0]]
+        same = next(r for r in rows[1:] if frame.iloc[r][key].equals(first[key]))
+        values = ", ".join(f"{c}={first[c]}" for c in key if first[c] == first[c])  # NaN: not part of it
+        raise TableError(name, f"{where[rows[0]]} and {where[same]} have the same key ({values}): "
+                         "a row repeated or two tables joined", allowed="one row per key")
+
+
+def concat_tables(frames, kind: str, name: str):
+    """Join tables of ``kind`` read by :func:`read_table` (in order) and check that no key
+    appears twice across them; the error names both files and lines and ``name`` (the join)."""
+    import pandas as pd
+
+    where = [f"{f.attrs['source']} line {n}" for f in frames for n in f.attrs["lines"]]
+    joined = pd.concat(frames, ignore_index=True)
+    _check_key(joined, SCHEMAS[kind], name, where)
+    return joined
+
+
+def read_table(path, kind: str, allow_empty: bool = False):
+    """Read a table of ``kind`` (:data:`SCHEMAS`) and check it before use.
+
+    Parameters
+    ----------
+    path : path-like or ``"-"``
+        The file (read once, so ``/dev/stdin`` and a pipe work) or ``-`` for standard input.
+    kind : str
+        A key of :data:`SCHEMAS`.
+    allow_empty : bool
+        Accept a table with a header and no rows.
+
+    Raises
+    ------
+    TableError
+        One line naming the file and, where it applies, the line: a missing, unreadable or empty
+        file; a last line without a newline (a cut-off write); a row whose field count is not the
+        header's; missing columns (named); a declared column holding a value of the wrong type,
+        an empty cell where the producer always writes one, or a non-finite number; two rows with
+        the same key.
+    """
+    import io as _io
+
+    import pandas as pd
+
+    schema = SCHEMAS[kind]
+    text, name = _read_text(path)
+    header, lines = _records(text, name, schema.sep)
+    missing = [c for c in schema.columns if c not in header]
     if missing:
-        raise TableError(path, f"missing column{'s' if len(missing) > 1 else ''} {', '.join(missing)} "
-                         f"(has {', '.join(map(str, frame.columns[:12]))}{', …' if len(frame.columns) > 12 else ''})",
-                         allowed=f"{TABLE_LABELS.get(kind, f'a {kind} table')} with the columns {', '.join(required)}")
+        label = schema.label or f"a {kind} table"
+        raise TableError(name, f"missing column{'s' if len(missing) > 1 else ''} {', '.join(missing)} "
+                         f"(has {', '.join(header[:12])}{', …' if len(header) > 12 else ''})",
+                         allowed=f"{label} with the columns {', '.join(schema.columns)}")
+    try:
+        frame = pd.read_csv(_io.StringIO(text), sep=schema.sep, index_col=False)
+    except (pd.errors.ParserError, ValueError) as err:
+        reason = " ".join(str(err).split())[:120]
+        raise TableError(name, f"not a readable CSV table ({type(err).__name__}: {reason})") from None
+    if len(frame) != len(lines):  # the csv module and pandas disagree: never guess which is right
+        raise TableError(name, f"{len(lines)} rows by the csv module, {len(frame)} by pandas (a damaged quote?)")
     if len(frame) == 0 and not allow_empty:
-        raise TableError(path, "no data rows (only a header)")
-    for col in required:
-        if col in NUMERIC_COLUMNS and not pd.api.types.is_numeric_dtype(frame[col]):
-            values = pd.to_numeric(frame[col], errors="coerce")
-            bad = values.isna() & frame[col].notna()
-            if bad.any():
-                row = int(bad.to_numpy().nonzero()[0][0])
-                raise TableError(path, f"column {col} holds a non-number ({frame[col].iloc[row]!r} in data row "
-                                 f"{row + 1})", allowed="numbers (or empty cells)")
-            frame[col] = values
+        raise TableError(name, "no data rows (only a header)")
+    for col, col_kind in schema.types(frame.columns).items():
+        frame[col] = _check_column(frame, col, col_kind, name, lines)
+    _check_key(frame, schema, name, [f"line {n}" for n in lines])
+    frame.attrs.update(source=name, lines=lines)  # where each row comes from (concat_tables)
     return frame

@@ -52,6 +52,8 @@ rule contact_table:
         contact_tables,
     benchmark:
         "results/benchmarks/rules/contact_table.tsv"
+    params:
+        kind="contact",  # the job tables' schema (infsup_contact.io.SCHEMAS)
     log:
         "results/logs/contact_table.log",
     script:

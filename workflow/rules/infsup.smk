@@ -34,6 +34,8 @@ rule beta_table:
         beta_tables,
     benchmark:
         "results/benchmarks/rules/beta_table.tsv"
+    params:
+        kind="beta",  # the job tables' schema (infsup_contact.io.SCHEMAS)
     log:
         "results/logs/beta_table.log",
     script:

@@ -27,6 +27,8 @@ rule mesh_quality:
         expand("results/tables/mesh_quality/{family}.csv", family=config["infsup"]["families"]),
     benchmark:
         "results/benchmarks/rules/mesh_quality.tsv"
+    params:
+        kind="mesh_quality",  # the job tables' schema (infsup_contact.io.SCHEMAS)
     log:
         "results/logs/mesh_quality.log",
     script:

@@ -6,6 +6,8 @@ from pathlib import Path
 
 import pandas as pd
 
+from ..io import read_table
+
 DAG_COLUMNS = ["rule", "jobs", "wall_s_sum", "wall_s_max", "cpu_s_sum", "max_rss_mb"]
 
 
@@ -21,9 +23,7 @@ def dag_table(root) -> pd.DataFrame:
     root = Path(root)
     rows = []
     for tsv in sorted(root.rglob("*.tsv")):
-        b = pd.read_csv(tsv, sep="\t")
-        if b.empty or "s" not in b.columns:
-            continue
+        b = read_table(tsv, "rule_benchmark")  # a damaged benchmark file: one line naming it
         rss = pd.to_numeric(b.get("max_rss", pd.Series([float("nan")])), errors="coerce")
         cpu = pd.to_numeric(b.get("cpu_time", pd.Series([float("nan")])), errors="coerce")
         rows.append(dict(rule=rule_of(tsv, root), s=float(b.s.iloc[-1]), cpu=float(cpu.iloc[-1]),

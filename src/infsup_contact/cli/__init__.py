@@ -16,7 +16,8 @@ Bad input gets one line on stderr naming the flag and exit code 2; no traceback,
 computation: every subcommand validates the whole request first — values, the files it reads
 and its estimated memory against the available memory (``resources.py``) — and ``--dry-run``
 stops right there (exit 0, the estimate on stdout). ``verdict --expect`` exits with 1 when the
-verdict is not the expected one.
+verdict is not the expected one. A closed or full stdout (``>&-``, ``> /dev/full``) is exit 74
+with one line, Ctrl-C exit 130 with one line.
 """
 from __future__ import annotations
 
@@ -27,6 +28,7 @@ import sys
 from ..errors import InputError
 from ..io import TableError
 from . import beta, bench, contact, export, rates, verdict
+from .common import EXIT_INTERRUPTED, EXIT_OUTPUT, OutputError, check_stdout, write_text
 from .verdict import VERDICT_DEFAULTS
 
 __all__ = ["main", "build_parser", "validate", "flag_names", "VERDICT_DEFAULTS"]
@@ -46,8 +48,8 @@ class _Parser(argparse.ArgumentParser):
 
 def _add_provenance(sub) -> None:
     p = sub.add_parser("provenance", help="versions, git commit, platform, date (JSON)")
-    p.set_defaults(run=lambda args: print(__import__("json").dumps(
-        __import__("infsup_contact.provenance", fromlist=["x"]).provenance(), indent=2)))
+    p.set_defaults(run=lambda args: write_text(__import__("json").dumps(
+        __import__("infsup_contact.provenance", fromlist=["x"]).provenance(), indent=2) + "\n"))
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -90,23 +92,46 @@ def validate(argv) -> tuple:
     return args, (args.check(args) if hasattr(args, "check") else None)
 
 
+def _say(line: str) -> None:
+    """One line on stderr (nothing if stderr is closed too: the exit status still tells)."""
+    if sys.stderr is not None:
+        try:
+            print(line, file=sys.stderr, flush=True)
+        except OSError:
+            pass
+
+
 def main(argv=None) -> int:
+    """Run one subcommand. Exit status: 0 done, 1 ``verdict --expect`` not met, 2 bad input,
+    74 the result could not be written (closed or full stdout), 130 interrupted (Ctrl-C)."""
+    try:
+        return _main(argv)
+    except KeyboardInterrupt:  # Ctrl-C: one line, not a traceback from wherever it landed
+        _say("infsup-contact: interrupted (Ctrl-C); no result written")
+        return EXIT_INTERRUPTED
+
+
+def _main(argv) -> int:
     _threads_default()
     parser = build_parser()
     args = parser.parse_args(argv)
     try:
+        check_stdout()  # before any computation: a result nobody can read is not computed
         estimate = args.check(args) if hasattr(args, "check") else None  # before any computation
         if getattr(args, "dry_run", False):
             from ..resources import available_bytes, human_bytes
 
             avail = available_bytes()
-            print(f"dry run: valid request; estimated {estimate.describe()}"
-                  + (f" (available memory {human_bytes(avail)})" if avail is not None else ""))
+            write_text(f"dry run: valid request; estimated {estimate.describe()}"
+                       + (f" (available memory {human_bytes(avail)})" if avail is not None else "") + "\n")
             return 0
         code = args.run(args)
     except (InputError, TableError) as err:
-        print(f"infsup-contact: error: {_message(err, parser, args.command)}", file=sys.stderr)
+        _say(f"infsup-contact: error: {_message(err, parser, args.command)}")
         return 2
+    except OutputError as err:
+        _say(f"infsup-contact: error: {err}")
+        return EXIT_OUTPUT
     except BrokenPipeError:  # `| head` closed the pipe: not an error of ours
         return 0
     return code or 0

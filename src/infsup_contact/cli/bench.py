@@ -1,10 +1,8 @@
 """``infsup-contact bench``: speed as ratios in one run (β_h or contact routes, CSV)."""
 from __future__ import annotations
 
-import sys
-
 from ..errors import InputError
-from .common import add_dry_run, check_memory
+from .common import add_dry_run, check_memory, write_csv
 
 
 def add(sub) -> None:
@@ -80,4 +78,4 @@ def _run_bench(args) -> None:
     else:
         rows = bench.bench_contact(args.N, args.k, args.repeats, peers=tuple(peers),
                                    kkt_max_n=args.kkt_max_n, budget=args.route_budget)
-    pd.DataFrame(rows).to_csv(sys.stdout, index=False, float_format="%.6g")
+    write_csv(pd.DataFrame(rows), float_format="%.6g")

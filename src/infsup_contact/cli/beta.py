@@ -3,7 +3,8 @@ from __future__ import annotations
 
 import sys
 
-from .common import refuse_with_system, remember_defaults, add_dry_run, add_model, cases, check_memory, material, norms, SPACE_HELP
+from .common import (refuse_with_system, remember_defaults, add_dry_run, add_model, cases, check_memory, material,
+                     norms, SPACE_HELP, write_csv)
 
 
 def add(sub) -> None:
@@ -82,8 +83,7 @@ def _run_beta(args) -> None:
 
         if args.manifest.norm != "given":
             print(f"infsup-contact: note: {NORM_NOTES[args.manifest.norm]}", file=sys.stderr)
-        pd.DataFrame(system_rows(args.manifest)).drop(columns="N2").to_csv(
-            sys.stdout, index=False, float_format="%.12g")
+        write_csv(pd.DataFrame(system_rows(args.manifest)).drop(columns="N2"), float_format="%.12g")
         return
 
     from ..solvers.infsup import beta_rows
@@ -98,4 +98,4 @@ def _run_beta(args) -> None:
         frame = frame.rename(columns={"c1": "E1", "c2": "E2"})
         frame.insert(frame.columns.get_loc("E2") + 1, "nu", args.nu)
         frame.insert(0, "model", "elastic")
-    frame.to_csv(sys.stdout, index=False, float_format="%.12g")
+    write_csv(frame, float_format="%.12g")

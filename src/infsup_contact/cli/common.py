@@ -114,3 +114,69 @@ def refuse_with_system(args) -> None:
         if dest not in SYSTEM_KEEPS and getattr(args, dest) != default:
             raise InputError(dest, "nothing with --system (the manifest's matrices fix the spaces, meshes and "
                              "norm; its 'norm' key says what G is)", got=getattr(args, dest))
+
+
+# ---------------------------------------------------------------- output
+EXIT_OUTPUT = 74
+"""Exit status when the output cannot be written (closed or full stdout; sysexits' EX_IOERR),
+distinct from 1 (``verdict --expect`` not met) and 2 (bad input)."""
+EXIT_INTERRUPTED = 130
+"""Exit status after Ctrl-C (128 + SIGINT, the shell's convention)."""
+
+
+class OutputError(Exception):
+    """Standard output cannot take the result: closed (``>&-``), full (``> /dev/full``) or
+    otherwise failing; the message is one line."""
+
+
+def check_stdout() -> None:
+    """Refuse a closed stdout before any computation: Python sets ``sys.stdout`` to None when
+    file descriptor 1 is closed, and print() and ``to_csv(None)`` then write nothing silently."""
+    import sys
+
+    if sys.stdout is None:
+        raise OutputError("standard output is closed (>&-): the result would be lost")
+
+
+def _discard_stdout() -> None:
+    """Point file descriptor 1 at /dev/null, so that the interpreter's final flush of what
+    is still buffered does not fail a second time (a second message, a traceback)."""
+    import os
+    import sys
+
+    try:
+        fd = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(fd, sys.stdout.fileno())
+        os.close(fd)
+    except (OSError, ValueError, AttributeError):  # no file descriptor (pytest's capture)
+        pass
+
+
+def write_text(text: str) -> None:
+    """Write ``text`` on stdout and flush it now, so that a failing write is seen here.
+
+    Raises
+    ------
+    OutputError
+        stdout closed or failing (a full disk: ENOSPC); one line naming the cause.
+    BrokenPipeError
+        the reader went away (``| head``): not an error of ours, the caller stops quietly.
+    """
+    import sys
+
+    check_stdout()
+    try:
+        sys.stdout.write(text)
+        sys.stdout.flush()
+    except BrokenPipeError:
+        _discard_stdout()
+        raise
+    except (OSError, ValueError) as err:  # ValueError: a closed file object
+        _discard_stdout()
+        reason = err.strerror if isinstance(err, OSError) and err.strerror else str(err)
+        raise OutputError(f"cannot write the result to standard output ({reason})") from None
+
+
+def write_csv(frame, float_format: str) -> None:
+    """A result table as CSV on stdout (:func:`write_text`)."""
+    write_text(frame.to_csv(index=False, float_format=float_format))

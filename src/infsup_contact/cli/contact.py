@@ -2,10 +2,8 @@
 pair (membranes: manufactured, membranes; elastic: patch, hertz), CSV rows."""
 from __future__ import annotations
 
-import sys
-
 from ..errors import InputError, check_prestress
-from .common import add_dry_run, add_model, cases, check_memory, material, SPACE_HELP
+from .common import add_dry_run, add_model, cases, check_memory, material, SPACE_HELP, write_csv
 
 
 def add(sub) -> None:
@@ -101,14 +99,14 @@ def _run_contact(args) -> None:
         from ..study.patch import patch_rows
 
         rows = patch_rows(cases, [args.k], [(args.N1, args.N2)], args.nu, (args.c1, args.c2))
-        pd.DataFrame(rows).to_csv(sys.stdout, index=False, float_format="%.6g")
+        write_csv(pd.DataFrame(rows), float_format="%.6g")
         return
     if args.scene == "hertz":
         from ..study.hertz import hertz_row
 
         rows = [hertz_row(case, args.k, args.N1, args.N2, args.R, args.d, args.nu, (args.c1, args.c2))
                 for case in cases]
-        pd.DataFrame(rows).to_csv(sys.stdout, index=False, float_format="%.6g")
+        write_csv(pd.DataFrame(rows), float_format="%.6g")
         return
     params = dict(p=args.p, q=args.q) if args.scene == "manufactured" else {}
     ref = None
@@ -120,4 +118,4 @@ def _run_contact(args) -> None:
             ref = reference_solution(scene("membranes", c1=args.c1, c2=args.c2), args.k, args.n_ref)
         rows.append(contact_row(args.scene, case, args.k, args.family, args.N1, args.N2,
                                 args.c1, args.c2, reference=ref, scene_params=params))
-    pd.DataFrame(rows).to_csv(sys.stdout, index=False, float_format="%.12g")
+    write_csv(pd.DataFrame(rows), float_format="%.12g")

@@ -2,7 +2,7 @@
 from __future__ import annotations
 
 from ..errors import InputError
-from .common import add_dry_run, add_model, check_memory, material
+from .common import add_dry_run, add_model, check_memory, material, write_text
 
 
 def add(sub) -> None:
@@ -70,4 +70,4 @@ def _run_export(args) -> None:
         levels.append((1.0 / n, A, B, G))
     name = f"{args.case}-k{args.k}-{args.model}"
     path = write_system(args.out, levels, args.format, name, norm="given" if args.norm == "H" else "L2")
-    print(path)
+    write_text(f"{path}\n")

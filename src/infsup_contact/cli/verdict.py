@@ -1,10 +1,9 @@
 """``infsup-contact verdict``: the stability verdict for one space, as a user's CI calls it."""
 from __future__ import annotations
 
-import sys
-
 from ..errors import InputError
-from .common import refuse_with_system, remember_defaults, add_dry_run, check_memory, run_intervals, SPACE_HELP
+from .common import (refuse_with_system, remember_defaults, add_dry_run, check_memory, run_intervals, SPACE_HELP,
+                     write_csv)
 
 
 VERDICT_DEFAULTS = {"slope_tolerance": 0.15, "beta_floor": 0.001, "confidence": 0.95}
@@ -99,7 +98,7 @@ def _run_verdict(args) -> int:
                                 confidence=args.confidence)
         if out["norm"] != "given":
             print(f"infsup-contact: note: {out['norm_note']}", file=sys.stderr)
-        pd.DataFrame([out]).to_csv(sys.stdout, index=False, float_format="%.6g")
+        write_csv(pd.DataFrame([out]), float_format="%.6g")
         return 0 if args.expect is None else (0 if out["verdict"] == _EXPECT[args.expect] else 1)
 
     from ..study.verdict import verdict_rows
@@ -109,7 +108,7 @@ def _run_verdict(args) -> int:
                        tol=args.slope_tolerance, floor=args.beta_floor, confidence=args.confidence,
                        multiplier_mesh=args.multiplier_mesh)
     out["N_list"] = " ".join(str(n) for n in out["N_list"])
-    pd.DataFrame([out]).to_csv(sys.stdout, index=False, float_format="%.6g")
+    write_csv(pd.DataFrame([out]), float_format="%.6g")
     if args.expect is None:
         return 0
     return 0 if out["verdict"] == _EXPECT[args.expect] else 1

@@ -321,3 +321,29 @@ def read_table(path, kind: str, allow_empty: bool = False):
     _check_key(frame, schema, name, [f"line {n}" for n in lines])
     frame.attrs.update(source=name, lines=lines)  # where each row comes from (concat_tables)
     return frame
+
+
+def read_integer_list(path) -> "np.ndarray":
+    """Whitespace- or comma-separated integers from a text file (a list of dof indices), or an
+    ``.npy`` array; :class:`TableError` naming the file and line of the first token that is
+    not an integer."""
+    import numpy as np
+
+    p = Path(path)
+    if p.suffix == ".npy":
+        try:
+            return np.asarray(np.load(p, allow_pickle=False)).ravel()
+        except (OSError, ValueError) as err:
+            raise TableError(path, f"not a numpy array file ({type(err).__name__})") from None
+    try:
+        lines = p.read_text().splitlines()
+    except (OSError, UnicodeDecodeError) as err:
+        raise TableError(path, f"not a readable text file ({type(err).__name__})") from None
+    out = []
+    for number, line in enumerate(lines, start=1):
+        for token in line.split("#", 1)[0].replace(",", " ").split():
+            try:
+                out.append(int(token))
+            except ValueError:
+                raise TableError(path, f"line {number}: {token!r} is not an integer") from None
+    return np.asarray(out, dtype=int)

@@ -33,6 +33,8 @@ from pathlib import Path
 
 import numpy as np
 
+from ..io import TableError, read_integer_list
+
 from .readers import SystemFileError
 
 NORMS = ("given", "L2", "h-L2")
@@ -144,9 +146,9 @@ def constrained_dofs(level: Level, n: int) -> np.ndarray:
         if not con.is_file():
             raise SystemFileError(con, "no such file (levels[{}].constrained)".format(level.index))
         try:
-            raw = np.load(con) if con.suffix == ".npy" else np.loadtxt(con, ndmin=1)
-        except Exception as err:
-            raise SystemFileError(con, f"not a list of integers ({type(err).__name__})") from None
+            raw = read_integer_list(con)
+        except TableError as err:
+            raise SystemFileError(con, f"not a list of integers ({err})") from None
         where = con
     else:
         raw, where = np.asarray(con), f"levels[{level.index}].constrained"

@@ -56,11 +56,7 @@ def _at_root_registry_as_found(monkeypatch):
     monkeypatch.chdir(ROOT)
     before = set(SPACES)
     yield
-    for ref, spec in list(user_spaces._LOADED.items()):
-        if spec.id not in before:
-            del user_spaces._LOADED[ref]
-    for case in set(SPACES) - before:
-        del SPACES[case]
+    user_spaces.forget_since(before)
 
 
 # ================================================================= config mutations

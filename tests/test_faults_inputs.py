@@ -43,11 +43,7 @@ def forget_user_spaces():
 
     before = set(SPACES)
     yield
-    for ref, spec in list(user_spaces._LOADED.items()):
-        if spec.id not in before:
-            del user_spaces._LOADED[ref]
-    for case in set(SPACES) - before:
-        del SPACES[case]
+    user_spaces.forget_since(before)
 
 
 def run_cli(capsys, *argv) -> tuple[int, str]:

@@ -237,3 +237,13 @@ def load_user_space(ref: str, intervals=()) -> SpaceSpec:
 def load_user_spaces(refs, intervals=()) -> list:
     """:func:`load_user_space` for each reference (e.g. the config's ``spaces`` list)."""
     return [load_user_space(r, intervals) for r in refs or ()]
+
+
+def forget_since(before) -> None:
+    """Unregister every user space loaded since the registry held the ids ``before`` (a test,
+    or a long-lived process such as a notebook, restores the registry it started with)."""
+    for ref, spec in list(_LOADED.items()):
+        if spec.id not in before:
+            del _LOADED[ref]
+    for case in set(SPACES) - set(before):
+        del SPACES[case]

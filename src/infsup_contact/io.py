@@ -273,6 +273,18 @@ def concat_tables(frames, kind: str, name: str):
     return joined
 
 
+class SourceLines(tuple):
+    """The file line of each row of a table (``frame.attrs["lines"]``). Immutable, so a copy is
+    the object itself: pandas deep-copies ``attrs`` on every derived frame, and a plain list of
+    50,000 line numbers made the full ledger 30x slower (4 s → 140 s)."""
+
+    def __deepcopy__(self, memo):
+        return self
+
+    def __copy__(self):
+        return self
+
+
 def read_table(path, kind: str, allow_empty: bool = False):
     """Read a table of ``kind`` (:data:`SCHEMAS`) and check it before use.
 
@@ -319,7 +331,7 @@ def read_table(path, kind: str, allow_empty: bool = False):
     for col, col_kind in schema.types(frame.columns).items():
         frame[col] = _check_column(frame, col, col_kind, name, lines)
     _check_key(frame, schema, name, [f"line {n}" for n in lines])
-    frame.attrs.update(source=name, lines=lines)  # where each row comes from (concat_tables)
+    frame.attrs.update(source=name, lines=SourceLines(lines))  # where each row comes from (concat_tables)
     return frame
 
 

@@ -86,3 +86,14 @@ def test_every_other_pair_is_refused_in_one_line(model, scene):
                            "--N1", "5", "--N2", "4"])
     assert code == 2 and out == "" and len(err.splitlines()) == 1, err
     assert allowed_pairs() in err
+
+
+def test_a_manufactured_gap_is_not_an_initial_gap():
+    """A manufactured scene's ``gap`` is its exact g = u2 − u1, not data: the Γ solve adds only
+    a scene's ``initial_gap`` (the Hertz curvature), so the membranes' pairs carry none."""
+    from infsup_contact.solvers.contact import contact_pair
+    from infsup_contact.study.hertz import hertz_scene
+    from infsup_contact.study.scenes import manufactured
+
+    assert contact_pair(manufactured(), 1, "structured", 2, 2).gap is None
+    assert hertz_scene(1.0, 0.05).initial_gap(0.5) == 0.0

@@ -224,7 +224,7 @@ def contact_pair(scene, k: int, family: str, n1: int, n2: int, model=None, **mes
     F, lifts = zip(*(model.load(s, scene, i) for i, s in enumerate(sides)))
     u0 = [s.solve(Fi) / ci for s, Fi, ci in zip(sides, F, c)]
     return ContactPair(tuple(mesh_pair), sides, list(F), u0, c, k, time.perf_counter() - t0, model,
-                       list(lifts), getattr(scene, "gap", None), getattr(scene, "gap_degree", 0))
+                       list(lifts), getattr(scene, "initial_gap", None), getattr(scene, "initial_gap_degree", 0))
 
 
 def solve_on_gamma(pair: ContactPair, space, time_floor: bool = False) -> ContactSolution:

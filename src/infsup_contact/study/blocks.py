@@ -51,9 +51,10 @@ class PressedBlocks:
         Downward displacement of Ω2's top.
     supports : tuple of str
         NGSolve boundary regexps where u_x and u_y vanish (or are prescribed).
-    gap : callable or None
-        Initial gap g0(x) on Γ (numpy), a polynomial of degree ``gap_degree``.
-    gap_degree : int
+    initial_gap : callable or None
+        Initial gap g0(x) on Γ (numpy), a polynomial of degree ``initial_gap_degree`` (not
+        ``gap``: a manufactured scene's ``gap`` is its exact solution's).
+    initial_gap_degree : int
     """
 
     name: str
@@ -61,8 +62,8 @@ class PressedBlocks:
     c2: float
     d: float
     supports: tuple
-    gap: Callable | None = None
-    gap_degree: int = 0
+    initial_gap: Callable | None = None
+    initial_gap_degree: int = 0
 
     @property
     def far_displacement_y(self) -> tuple:

@@ -85,7 +85,7 @@ def check_geometry(R, d) -> tuple:
 def hertz_scene(R: float, d: float, E=(1.0, 1.0)) -> PressedBlocks:
     """The Hertz scene's data: clamped far faces, Ω2's top moved by d, gap (x − 1/2)²/(2R)."""
     return PressedBlocks(SCENE, E[0], E[1], d, (X_DIRICHLET, Y_DIRICHLET),
-                         gap=lambda x: (x - CENTER) ** 2 / (2.0 * R), gap_degree=2)
+                         initial_gap=lambda x: (x - CENTER) ** 2 / (2.0 * R), initial_gap_degree=2)
 
 
 def hertz_pair(k: int, n: int, d: float, nu: float = 0.3, E=(1.0, 1.0), n2: int | None = None, R: float = 1.0):

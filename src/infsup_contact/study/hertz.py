@@ -37,13 +37,16 @@ import numpy as np
 
 from ..discretization import registry
 from ..discretization.coupling import quadrature_on
+from ..models import make_model
 from ..models.plane_strain import check_modulus, check_nu, lame
 from ..solvers.contact import contact_pair, solve_contact_on
 from .accuracy import _element_quadrature
 from .blocks import PressedBlocks
 
 SCENE = "hertz"
-"""This scene's registry id (:mod:`.scene_registry`)."""
+"""This scene's registry id (:mod:`.scene_registry`, whose entry reads these two names)."""
+SCENE_MODELS = ("elastic",)
+"""The models the scene is defined for (the first is its default)."""
 X_DIRICHLET = Y_DIRICHLET = "dir"
 """Clamped far faces (Ω1's bottom, Ω2's top), traction-free lateral sides."""
 CENTER = 0.5
@@ -91,10 +94,8 @@ def hertz_scene(R: float, d: float, E=(1.0, 1.0)) -> PressedBlocks:
 def hertz_pair(k: int, n: int, d: float, nu: float = 0.3, E=(1.0, 1.0), n2: int | None = None, R: float = 1.0):
     """The factorized blocks of the Hertz scene (N segments on Γ for Ω1, ``n2`` (default N) for
     Ω2, top of Ω2 moved by d, gap of radius R), shared by every multiplier case."""
-    from .scene_registry import scene_model
-
     return contact_pair(hertz_scene(R, d, E), k, "structured", n, n if n2 is None else n2,
-                        scene_model(SCENE, nu=nu))
+                        make_model(SCENE_MODELS[0], nu=nu))
 
 
 def solve_hertz(case: str, k: int, n: int, R: float, d: float, nu: float = 0.3, E=(1.0, 1.0), n2: int | None = None,

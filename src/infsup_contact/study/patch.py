@@ -51,12 +51,15 @@ import scipy.linalg as sla
 from ..discretization import meshes, registry
 from ..discretization.coupling import union_breakpoints
 from ..discretization.norms import gram
+from ..models import make_model
 from ..models.plane_strain import check_modulus, check_nu
 from ..solvers.contact import contact_pair, solve_contact_on
 from .blocks import SIDE, PressedBlocks, block_mesh
 
 SCENE = "patch"
-"""This scene's registry id (:mod:`.scene_registry`)."""
+"""This scene's registry id (:mod:`.scene_registry`, whose entry reads these two names)."""
+SCENE_MODELS = ("elastic",)
+"""The models the scene is defined for (the first is its default)."""
 X_DIRICHLET, Y_DIRICHLET = f"{meshes.DIRICHLET}|{SIDE}", meshes.DIRICHLET
 """Rollers on the lateral sides (u_x = 0), far faces clamped in x, prescribed in y."""
 PASS_RTOL = 1e-10
@@ -110,9 +113,7 @@ def patch_rows(cases, ks, pairs, nu=0.3, E=(1.0, 1.0)) -> list:
 
 def patch_pair(k: int, n1: int, n2: int, nu: float, E, delta: float = DELTA):
     """The factorized blocks of the patch test (top of Ω2 moved down by ``delta``)."""
-    from .scene_registry import scene_model
-
-    return contact_pair(patch_scene(E, delta), k, "structured", n1, n2, scene_model(SCENE, nu=nu))
+    return contact_pair(patch_scene(E, delta), k, "structured", n1, n2, make_model(SCENE_MODELS[0], nu=nu))
 
 
 def solve_patch(case: str, k: int, n1: int, n2: int, nu: float = 0.3, E=(1.0, 1.0), delta: float = DELTA,

@@ -17,6 +17,7 @@ from typing import Callable
 
 from ..errors import InputError
 from ..models import DEFAULT_MODEL, make_model
+from . import hertz, patch
 
 
 @dataclass(frozen=True)
@@ -145,22 +146,16 @@ def _blocks_check(args):
 
 
 def _hertz_check(args):
-    from .hertz import check_geometry
-
-    args.R, args.d = check_geometry(1.0 if args.R is None else args.R, 0.05 if args.d is None else args.d)
+    args.R, args.d = hertz.check_geometry(1.0 if args.R is None else args.R, 0.05 if args.d is None else args.d)
     return _blocks_check(args)
 
 
 def _patch_rows(model, cases, k, family, n1, n2, c, args) -> list:
-    from .patch import patch_rows
-
-    return patch_rows(cases, [k], [(n1, n2)], args.nu, c)
+    return patch.patch_rows(cases, [k], [(n1, n2)], args.nu, c)
 
 
 def _hertz_rows(model, cases, k, family, n1, n2, c, args) -> list:
-    from .hertz import hertz_row
-
-    return [hertz_row(case, k, n1, n2, args.R, args.d, args.nu, c) for case in cases]
+    return [hertz.hertz_row(case, k, n1, n2, args.R, args.d, args.nu, c) for case in cases]
 
 
 _ERRORS = ("energy_error", "l2_error", "lambda_l2_error", "lambda_hm12_error", "contact_set_error")
@@ -172,10 +167,10 @@ register(SceneSpec(
     "fine-mesh reference (structured N_ref, degree k + 1, the registry's reference space)", _ERRORS,
     _membrane_rows, _membrane_check, params=("n_ref",)))
 register(SceneSpec(
-    "patch", ("elastic",), "the contact patch test: blocks on rollers, uniform compression",
+    patch.SCENE, patch.SCENE_MODELS, "the contact patch test: blocks on rollers, uniform compression",
     "exact (λ = p, u linear)", ("lambda_max_rel_error", "u_max_rel_error", "passes", "kernel_dim"),
     _patch_rows, _blocks_check, float_format="%.6g", families=("structured",)))
 register(SceneSpec(
-    "hertz", ("elastic",), "clamped blocks with the gap (x − 1/2)²/(2R), Ω2's top moved by d",
+    hertz.SCENE, hertz.SCENE_MODELS, "clamped blocks with the gap (x − 1/2)²/(2R), Ω2's top moved by d",
     "plane-strain Hertz for the measured resultant", ("P", "p_max", "half_width", "oscillation"),
     _hertz_rows, _hertz_check, params=("R", "d"), float_format="%.6g", families=("structured",)))

@@ -97,3 +97,17 @@ def test_a_manufactured_gap_is_not_an_initial_gap():
 
     assert contact_pair(manufactured(), 1, "structured", 2, 2).gap is None
     assert hertz_scene(1.0, 0.05).initial_gap(0.5) == 0.0
+
+
+def test_lambda_values_of_a_saved_reference(tmp_path):
+    """A reference written by save_reference (space and λ only) is evaluated like a solution."""
+    import numpy as np
+
+    from infsup_contact.solvers.contact import lambda_values, solve_contact
+    from infsup_contact.study.contact_rows import load_reference, save_reference
+    from infsup_contact.study.scenes import membranes
+
+    sol = solve_contact(membranes(), "T3", 1, "structured", 4, 4, time_floor=False)
+    save_reference(tmp_path / "ref.pkl", sol)
+    x = np.linspace(0.1, 0.9, 5)
+    assert np.array_equal(lambda_values(load_reference(tmp_path / "ref.pkl"), x), sol.pressure(x))

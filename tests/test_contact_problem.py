@@ -4,7 +4,8 @@ import pytest
 
 from infsup_contact.study.claims import sign_check
 from infsup_contact.solvers.kkt import solve_kkt_sparse
-from infsup_contact.solvers.contact import contact_qp, load_vector, solve_contact
+from infsup_contact.models.membranes import load_vector
+from infsup_contact.solvers.contact import contact_qp, solve_contact
 from infsup_contact.study.scenes import manufactured, membranes
 from infsup_contact.study.contact_rows import contact_row
 
@@ -70,7 +71,7 @@ def test_r52_active_kernel_gives_nonunique_flag():
 
 def test_load_from_exact_solution_equals_quadrature_of_f():
     """Green's formula: c(∇u, ∇v) − ∫_Γ c ∂u/∂n v equals ∫ f v (smooth case, where f is benign)."""
-    from infsup_contact.solvers.contact import load_vector_from_exact
+    from infsup_contact.models.membranes import load_vector_from_exact
     from infsup_contact.models.membranes import side_operator
     from infsup_contact.discretization.meshes import mesh_pair
 

@@ -52,7 +52,7 @@ CONTACT_COLUMNS = ("what", "route", "k", "N", "seconds_median", "seconds_min", "
 def _contact_problem(n: int, k: int, case: str = REFERENCE_SPACE):
     """Membranes scene on the structured N×N pair: sides, couplings, loads (c = 1), as
     :func:`infsup_contact.solvers.contact.solve_contact` builds them."""
-    from ..solvers.contact import load_vectors
+    from ..models.membranes import MEMBRANES
     from ..study.scenes import membranes
 
     sc = membranes()
@@ -60,7 +60,7 @@ def _contact_problem(n: int, k: int, case: str = REFERENCE_SPACE):
     sides = [side_operator(m, k) for m in (m1, m2)]
     space = registry.case_space(case, k, meshes.multiplier_breakpoints(m1, m2))
     Bs = [coupling_matrix(s.trace, space, k) for s in sides]
-    return sc, sides, Bs, load_vectors(sides, sc)
+    return sc, sides, Bs, [MEMBRANES.load(s, sc, i)[0] for i, s in enumerate(sides)]
 
 
 def contact_limit(sides, F, c=(1.0, 1.0)):

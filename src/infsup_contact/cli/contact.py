@@ -1,5 +1,6 @@
 """``infsup-contact contact``: the discrete contact problem (4.1) for one scene, case and mesh
-pair (membranes: manufactured, membranes; elastic: patch, hertz), CSV rows."""
+pair, CSV rows; the scenes and the models each is defined for come from the scene registry
+(:mod:`infsup_contact.study.scene_registry`)."""
 from __future__ import annotations
 
 from ..errors import InputError, check_prestress
@@ -9,11 +10,11 @@ from .common import add_dry_run, add_model, cases, check_memory, material, SPACE
 def add(sub) -> None:
     from ..discretization.meshes import FAMILIES
     from ..discretization.registry import space_ids
+    from ..study.scene_registry import allowed_pairs, scene_ids
 
     p = sub.add_parser("contact", help="solve (4.1) for one case and mesh pair (CSV: one row)")
-    p.add_argument("--scene", required=True, choices=["manufactured", "membranes", "patch", "hertz"],
-                   help="membranes model: manufactured, membranes; elastic model: patch (the contact "
-                   "patch test, study/patch.py), hertz (study/hertz.py)")
+    p.add_argument("--scene", required=True, choices=scene_ids(),
+                   help=f"a registered scene, defined for the models of these --model/--scene pairs: {allowed_pairs()}")
     p.add_argument("--case", choices=[*space_ids(), "all"], help="a registered space, or all")
     p.add_argument("--space", metavar="FILE.py:FUNC", help=SPACE_HELP)
     p.add_argument("--k", type=int, required=True, help="displacement degree, 1..4")
@@ -35,29 +36,23 @@ def add(sub) -> None:
     p.set_defaults(run=_run_contact, check=_check_contact)
 
 
+OPTIONAL_PARAMS = ("R", "d")
+"""Scene parameters without a default: refused by every scene that does not take them."""
+
+
 def _check_contact(args):
-    from .. import resources
-    from ..config_checks import REFERENCE_MARGIN
     from ..discretization import meshes, registry
+    from ..study.scene_registry import check_pair
     from ..study.scenes import _exponent
 
     if args.case is None and args.space is None:
         raise InputError("case", "one of --case ID|all or --space FILE.py:FUNC")
     args.cases = cases(args)
     material(args)
-    elastic_scenes = ("patch", "hertz")
-    if (args.model == "elastic") != (args.scene in elastic_scenes):
-        key, value = ("model", args.model) if args.model == "elastic" else ("scene", args.scene)
-        raise InputError(key, "--model elastic with --scene patch or hertz; --model membranes (the default) "
-                         "with --scene manufactured or membranes", got=value)
-    if args.scene != "hertz":
-        for key in ("R", "d"):
-            if getattr(args, key) is not None:
-                raise InputError(key, "only with --scene hertz", got=getattr(args, key))
-    else:
-        from ..study.hertz import check_geometry
-
-        args.R, args.d = check_geometry(1.0 if args.R is None else args.R, 0.05 if args.d is None else args.d)
+    spec = check_pair(args.model, args.scene)
+    for key in OPTIONAL_PARAMS:
+        if key not in spec.params and getattr(args, key) is not None:
+            raise InputError(key, f"only with a scene that takes it ({args.scene} does not)", got=getattr(args, key))
     if not 1 <= args.k <= 4:
         raise InputError("k", "an integer in 1..4", got=args.k)
     for case in args.cases:
@@ -69,53 +64,19 @@ def _check_contact(args):
     check_prestress("c2", args.c2)
     _exponent("p", args.p)  # used by the manufactured scene only, but a bad value is bad anyway
     _exponent("q", args.q)
-    if args.scene in elastic_scenes:  # structured blocks; estimate: the β one of the pair, both components
-        if args.family != "structured":
-            raise InputError("family", "structured (the blocks of the elastic scenes)", got=args.family)
-        est = resources.beta_estimate("structured", args.k, args.N1, args.N2, "omega2", ("L2",), components=2)
-        check_memory(est, *(("N1", args.N1) if args.N1 >= args.N2 else ("N2", args.N2)))
-        return est
-    need = REFERENCE_MARGIN * max(args.N1, args.N2)
-    if args.n_ref < 1 or (args.scene == "membranes" and args.n_ref < need):
-        raise InputError("n_ref", f"an integer >= {need} for the membranes scene ({REFERENCE_MARGIN}x the finest "
-                         "mesh: a coarser reference gives errors that are not errors), >= 1 otherwise",
-                         got=args.n_ref)
-    n_ref = args.n_ref if args.scene == "membranes" else None
-    est = resources.contact_estimate(args.scene, args.family, args.k, args.N1, args.N2, n_ref, len(args.cases))
-    alone = resources.contact_estimate(args.scene, args.family, args.k, args.N1, args.N2, None, len(args.cases))
-    if n_ref is not None and est.bytes > 2 * alone.bytes:  # the reference dominates
-        check_memory(est, "n_ref", args.n_ref)
-    check_memory(est, *(("N1", args.N1) if args.N1 >= args.N2 else ("N2", args.N2)))
+    if spec.families is not None and args.family not in spec.families:
+        raise InputError("family", f"{', '.join(spec.families)} (the meshes of the {args.scene} scene)",
+                         got=args.family)
+    est, (key, value) = spec.check(args)
+    check_memory(est, key, value)
     return est
 
 
 def _run_contact(args) -> None:
     import pandas as pd
 
-    from ..study.contact_rows import contact_row
+    from ..study.scene_registry import scene_spec
 
-    cases = args.cases
-    if args.scene == "patch":
-        from ..study.patch import patch_rows
-
-        rows = patch_rows(cases, [args.k], [(args.N1, args.N2)], args.nu, (args.c1, args.c2))
-        write_csv(pd.DataFrame(rows), float_format="%.6g")
-        return
-    if args.scene == "hertz":
-        from ..study.hertz import hertz_row
-
-        rows = [hertz_row(case, args.k, args.N1, args.N2, args.R, args.d, args.nu, (args.c1, args.c2))
-                for case in cases]
-        write_csv(pd.DataFrame(rows), float_format="%.6g")
-        return
-    params = dict(p=args.p, q=args.q) if args.scene == "manufactured" else {}
-    ref = None
-    rows = []
-    for case in cases:
-        if args.scene == "membranes" and ref is None:
-            from ..study.scenes import scene
-            from ..study.contact_rows import reference_solution
-            ref = reference_solution(scene("membranes", c1=args.c1, c2=args.c2), args.k, args.n_ref)
-        rows.append(contact_row(args.scene, case, args.k, args.family, args.N1, args.N2,
-                                args.c1, args.c2, reference=ref, scene_params=params))
-    write_csv(pd.DataFrame(rows), float_format="%.12g")
+    spec = scene_spec(args.scene)
+    rows = spec.rows(args.model_obj, args.cases, args.k, args.family, args.N1, args.N2, (args.c1, args.c2), args)
+    write_csv(pd.DataFrame(rows), float_format=spec.float_format)

@@ -99,6 +99,16 @@ class SpaceSpec:
     def valid_for(self, k: int) -> bool:
         return self.min_k <= k <= K_RANGE[1]
 
+    def contains_constants(self, k: int, n: int = 6) -> bool:
+        """Whether 1 ∈ M_h for displacement degree k, computed (not declared): the least-squares
+        fit of the constant by M_h on N = ``n`` uniform intervals leaves no residual at sample
+        points. What a patch test of a uniform pressure asks of M_h (study/patch.py)."""
+        space = self.build(k, np.linspace(0.0, 1.0, n + 1))
+        x = np.linspace(0.0, 1.0, 8 * n * (self.degree(k) + 1) + 1)
+        phi = space.evaluate(x)
+        coef = np.linalg.lstsq(phi, np.ones_like(x), rcond=None)[0]
+        return bool(np.max(np.abs(phi @ coef - 1.0)) < 1e-10)
+
     def structural_kernel(self, k: int, n: int) -> int | None:
         """max(dim M − dim W, 0) on matching meshes with N intervals (W = the trace space),
         None without a dimension count."""

@@ -1,13 +1,25 @@
-"""Models: each physical model brings its interface operator and nothing else.
+"""Models: each physical model brings its interface operator and its scenes' needs, nothing else.
 
-``contract`` states what a model gives the engine (one factorized side per mesh, Γ last);
-``schur`` is the shared Γ Schur complement / Steklov inverse machinery, ``ordering`` its
-Γ-last nested dissection; ``membranes`` is the paper's model, ``elastic`` plane-strain elasticity (its Section 2). Imports ``discretization``
-and ``errors`` only.
+``contract`` states what a model gives the engine (one factorized side per mesh, Γ last; the
+loads, lifts and u_h of a contact scene); ``schur`` is the shared Γ Schur complement / Steklov
+inverse machinery, ``ordering`` its Γ-last nested dissection; ``membranes`` is the paper's
+model, ``elastic`` plane-strain elasticity (its Section 2), ``plane_strain`` the material law
+the elastic scenes measure with. Imports ``discretization`` and ``errors`` only.
+
+This file is the registry of models: the engine (``solvers``, ``study``) asks it for a model by
+name and never imports a concrete model.
 """
 from .contract import Model
 from .membranes import MEMBRANES
 from .elastic import ELASTIC, elastic_model
 
 MODELS = {m.name: m for m in (MEMBRANES, ELASTIC)}
-"""Every model by name (``elastic``: ν = 0.3; other ν through :func:`elastic_model`)."""
+"""Every model by name (``elastic``: ν = 0.3; other ν through :func:`make_model`)."""
+_BUILDERS = {MEMBRANES.name: lambda: MEMBRANES, ELASTIC.name: elastic_model}
+DEFAULT_MODEL = MEMBRANES
+"""The paper's model: what β_h and contact use when no model is named."""
+
+
+def make_model(name: str, **params) -> Model:
+    """The model ``name`` with its parameters (``elastic``: ``nu``), from the registry."""
+    return _BUILDERS[name](**params)

@@ -14,6 +14,22 @@ each mesh of a pair; the :class:`~infsup_contact.models.schur.SideOperator` it r
 * ``solve``, ``free``, ``stiffness`` — the factorization and the free dofs (Γ last) with
   which the contact solver recovers u_h = A_i⁻¹ (F_i ∓ B_iᵀ λ_h).
 
+Contact asks a model four more things, so that one Γ solve
+(:func:`~infsup_contact.solvers.contact.solve_on_gamma`) serves every model and scene:
+
+* ``scene_side(scene, mesh, k)`` — the side of a contact scene (a scene may put its own
+  supports on ∂Ω_i∖Γ, such as the elastic patch test's rollers);
+* ``load(side, scene, i)`` — F_i on the free dofs of side i (i = 0 for Ω1, 1 for Ω2) and the
+  Dirichlet lift u_{D,i} on all dofs (None: homogeneous), read off the scene's data;
+* ``field(side, values, lift)`` — u_h as an NGSolve GridFunction from its free-dof values;
+* ``interpolate(side, components)`` — the interpolant of a field given by NGSolve
+  coefficient functions (one per component), all dofs: what a scene with an exact u compares.
+
+**Normal and sign.** Every model uses b(v, μ) = ∫_Γ (v_2·n − v_1·n) μ with n = e_y (from Ω1
+into Ω2), so A_1 u_1 = F_1 − B_1ᵀ λ and A_2 u_2 = F_2 + B_2ᵀ λ (:data:`B_SIGN`), and λ ≥ 0
+pushes the bodies apart: λ = −c_i ∂u_i/∂x_2 for the membranes, λ = −σ_yy for elastic bodies.
+The outward normal of side i on Γ is ``OUTWARD_NORMAL_Y[i]`` e_y.
+
 The material enters only as the scale c_i of each side (A_i = c_i K_i), so one side
 operator per (mesh, k) serves every material pair; data that changes K_i itself (an
 elastic body's ν) belongs to the model instance.
@@ -37,8 +53,27 @@ class Model:
         unit material scale.
     description : str
         One line for ``--help`` and the paper.
+    scene_side, load, field, interpolate : callable, optional
+        What contact needs (module docstring); a model without them serves β_h only.
     """
 
     name: str
     side_operator: Callable
     description: str = ""
+    scene_side: Callable | None = None
+    load: Callable | None = None
+    field: Callable | None = None
+    interpolate: Callable | None = None
+
+    def side_for(self, scene, mesh, k: int):
+        """The side of ``scene`` on ``mesh``: ``scene_side`` where the model has one, else the
+        β_h side (a scene that changes nothing of ∂Ω_i∖Γ)."""
+        if self.scene_side is None:
+            return self.side_operator(mesh, k)
+        return self.scene_side(scene, mesh, k)
+
+
+B_SIGN = (-1.0, 1.0)
+"""Sign of B_iᵀ λ in A_i u_i = F_i + sign_i B_iᵀ λ (Ω1, Ω2): b(v, μ) = ∫_Γ (v_2 − v_1)·n μ."""
+OUTWARD_NORMAL_Y = (1.0, -1.0)
+"""y component of the outward normal of Ω1, Ω2 on Γ (Ω1 lies below Γ)."""

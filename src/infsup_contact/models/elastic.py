@@ -32,43 +32,10 @@ import ngsolve
 import scipy.sparse as sp
 
 from ..discretization.coupling import gamma_trace
-from ..errors import InputError
+from ..discretization.meshes import DIRICHLET
 from .contract import Model
+from .plane_strain import E_RANGE, NU_RANGE, check_modulus, check_nu, lame  # noqa: F401 (the model's material law)
 from .schur import SideOperator, factorized_side
-
-NU_RANGE = (-1.0, 0.5)
-"""Admissible Poisson ratio, −1 < ν < 1/2 (exclusive): a(·,·) is coercive exactly there."""
-E_RANGE = (1e-150, 1e150)
-"""Admissible Young's modulus: finite and positive (the membranes' c range, errors.C_RANGE)."""
-
-
-def check_nu(value, key: str = "nu") -> float:
-    """ν as a float in (−1, 1/2); :class:`InputError` naming ``key`` otherwise."""
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise InputError(key, "a finite Poisson ratio with -1 < nu < 0.5", got=value) from None
-    if isinstance(value, bool) or not NU_RANGE[0] < v < NU_RANGE[1]:  # NaN fails too
-        raise InputError(key, "a finite Poisson ratio with -1 < nu < 0.5 (0.5 is incompressible: "
-                         "a(.,.) is not coercive; nu <= -1 neither)", got=value)
-    return v
-
-
-def check_modulus(value, key: str) -> float:
-    """E as a float in [1e-150, 1e150]; :class:`InputError` naming ``key`` otherwise."""
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise InputError(key, "a finite Young's modulus in [1e-150, 1e150]", got=value) from None
-    if isinstance(value, bool) or not E_RANGE[0] <= v <= E_RANGE[1]:
-        raise InputError(key, "a finite Young's modulus in [1e-150, 1e150] (E > 0)", got=value)
-    return v
-
-
-def lame(nu: float) -> tuple:
-    """(μ̂, λ̂) of plane strain at E = 1."""
-    return 1.0 / (2.0 * (1.0 + nu)), nu / ((1.0 + nu) * (1.0 - 2.0 * nu))
-
 
 @dataclass(frozen=True)
 class ElasticSpace:
@@ -186,12 +153,43 @@ def side_operator(mesh, k: int, nu: float = 0.3, x_dirichlet: str = "dir", y_dir
                        space=space, n_tangential=n_t, stiffness_all=K_all, nu=nu)
 
 
+def scene_side(scene, mesh, k: int, nu: float = 0.3, x_dirichlet: str = "dir",
+               y_dirichlet: str = "dir") -> ElasticSide:
+    """The side of a contact scene: the scene's ``supports`` (x, y Dirichlet boundaries) where it
+    has them (the patch test's rollers), else the model's."""
+    x_dirichlet, y_dirichlet = getattr(scene, "supports", None) or (x_dirichlet, y_dirichlet)
+    return side_operator(mesh, k, nu, x_dirichlet, y_dirichlet)
+
+
+def load(side: ElasticSide, scene, i: int):
+    """(F_i, u_{D,i}): the lift u_{D,i} prescribes u_y = ``scene.far_displacement_y[i]`` on the
+    far face (boundary ``dir``), so F_i = −E_i (K u_{D,i}) on the free dofs (no body force)."""
+    mesh = side.space.fes.mesh
+    gf = ngsolve.GridFunction(side.space.fes)
+    gf.components[1].Set(scene.far_displacement_y[i], definedon=mesh.Boundaries(DIRICHLET))
+    lift = gf.vec.FV().NumPy().copy()
+    e = (scene.c1, scene.c2)[i]
+    return -e * (side.stiffness_all @ lift)[side.free], lift
+
+
+def field(side: ElasticSide, values: np.ndarray, lift=None):
+    """u_{i,h} as a GridFunction of the product space (:meth:`ElasticSide.grid_function`)."""
+    return side.grid_function(values, lift)
+
+
+def interpolate_on(side: ElasticSide, components) -> np.ndarray:
+    """Coefficients (all dofs) of the interpolant of (u_x, u_y) = ``components``."""
+    return interpolate(side.space, *components)
+
+
 def elastic_model(nu: float = 0.3, x_dirichlet: str = "dir", y_dirichlet: str = "dir") -> Model:
     """The plane-strain model with Poisson ratio ν (both bodies), clamped on ∂Ω_i∖Γ by
     default (the paper's geometry, where the H^{-1/2}_00(Γ) norm applies as is)."""
     nu = check_nu(nu)
-    return Model("elastic", partial(side_operator, nu=nu, x_dirichlet=x_dirichlet, y_dirichlet=y_dirichlet),
-                 f"two plane-strain elastic bodies, vector P_k, nu = {nu:g}, frictionless normal contact")
+    bc = dict(nu=nu, x_dirichlet=x_dirichlet, y_dirichlet=y_dirichlet)
+    return Model("elastic", partial(side_operator, **bc),
+                 f"two plane-strain elastic bodies, vector P_k, nu = {nu:g}, frictionless normal contact",
+                 scene_side=partial(scene_side, **bc), load=load, field=field, interpolate=interpolate_on)
 
 
 ELASTIC = elastic_model(0.3)

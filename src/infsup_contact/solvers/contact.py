@@ -1,10 +1,16 @@
-"""The discrete contact problem (4.1) on a mesh pair, solved on Γ and recovered in Ω.
+"""The discrete contact problem (4.1) on a mesh pair, solved on Γ and recovered in Ω, for
+every model and scene.
 
 With b(v, μ) = μᵀ(B_2 v_2 − B_1 v_1), the first line of (4.1) reads
 A_1 u_1 = F_1 − B_1ᵀ λ and A_2 u_2 = F_2 + B_2ᵀ λ, so the weighted gaps are
-g = B_2 u_2 − B_1 u_1 = g0 + K λ with g0 = B A⁻¹ F and K = Σ_i B_i X_i B_iᵀ, the interface
-operator already computed for β_h. The active-set iteration works on (K, g0) only;
-u_h is recovered by one solve per side with the factorization that produced X_i.
+g = G + B_2 u_2 − B_1 u_1 = G + g_F + K λ with g_F = B A⁻¹ F, G_j = ∫_Γ μ_j g0 the scene's
+initial gap (if any) and K = Σ_i B_i X_i B_iᵀ, the interface operator already computed for
+β_h. The active-set iteration works on (K, G + g_F) only; u_h is recovered by one solve per
+side with the factorization that produced X_i (:func:`solve_on_gamma`).
+
+What differs between models — the sides of a scene, the loads F_i and Dirichlet lifts, the
+field u_h is recovered into — comes from the model (:mod:`infsup_contact.models.contract`);
+what differs between scenes — meshes, material scales c_i, data, initial gap — from the scene.
 """
 from __future__ import annotations
 
@@ -18,9 +24,10 @@ import scipy.sparse.linalg as spla
 
 from ..discretization import meshes, multipliers, registry
 from .pdas import PdasResult, solve_pdas
-from ..discretization.coupling import coupling_matrix
-from ..models.schur import SideOperator, interface_operator
-from ..models.membranes import MEMBRANES
+from ..discretization.coupling import coupling_matrix, quadrature_on, union_breakpoints
+from ..models import DEFAULT_MODEL
+from ..models.contract import B_SIGN
+from ..models.schur import interface_operator
 
 
 @dataclass
@@ -33,9 +40,13 @@ class ContactSolution:
         M_h; ``lam`` are its dof values (nodal, so the cone is lam >= 0).
     sides : list of SideOperator
     u : list of ngsolve.GridFunction
-        u_{1,h}, u_{2,h}.
+        u_{1,h}, u_{2,h} (Dirichlet lifts included), as the model's ``field`` makes them.
     lam : ndarray
     pdas : PdasResult
+    c : tuple
+        Material scales (c1, c2) (E1, E2 for elastic bodies).
+    K : ndarray
+        The interface operator Σ_i B_i X_i B_iᵀ / c_i.
     t_solve : float
         Interface operator + active set + recovery, seconds.
     t_linear_solve : float
@@ -50,47 +61,22 @@ class ContactSolution:
     lam: np.ndarray
     pdas: PdasResult
     c: tuple
-    t_solve: float
-    t_linear_solve: float
+    K: np.ndarray
+    t_solve: float = float("nan")
+    t_linear_solve: float = float("nan")
 
     @property
     def ndof(self) -> int:
         return sum(s.ndof for s in self.sides) + self.space.dim
 
+    def pressure(self, x: np.ndarray) -> np.ndarray:
+        """λ_h(x)."""
+        return self.space.evaluate(x) @ self.lam
 
-def load_vector(side: SideOperator, f) -> np.ndarray:
-    """F_i = ∫ f v on the free dofs of side i, in the order of ``side.free``."""
-    fes = side.trace.fes
-    lf = ngsolve.LinearForm(fes)
-    lf += f * fes.TestFunction() * ngsolve.dx(bonus_intorder=4)
-    lf.Assemble()
-    return lf.vec.FV().NumPy()[side.free].copy()
-
-
-def load_vector_from_exact(side: SideOperator, grad_u, c: float, normal_y: float) -> np.ndarray:
-    """F_i = (f_i, v) for f_i = −c_i Δu_i, evaluated as c_i(∇u_i, ∇v) − ∫_Γ c_i ∂u_i/∂n v.
-
-    Green's formula makes this identical to ∫ f v for every v ∈ V_h (v = 0 on ∂Ω_i∖Γ). For
-    the low-regularity manufactured solutions f has an integrable singularity at x = a
-    that quadrature samples badly, while ∇u is bounded: this form keeps F exact to
-    quadrature accuracy. ``normal_y`` is the outward normal's y component on Γ (+1 for
-    Ω1, −1 for Ω2), given explicitly rather than taken from the mesh.
-    """
-    fes = side.trace.fes
-    v = fes.TestFunction()
-    lf = ngsolve.LinearForm(fes)
-    lf += c * grad_u * ngsolve.grad(v) * ngsolve.dx(bonus_intorder=6)
-    lf += -c * normal_y * grad_u[1] * v * ngsolve.ds("gamma", bonus_intorder=6)
-    lf.Assemble()
-    return lf.vec.FV().NumPy()[side.free].copy()
-
-
-def load_vectors(sides, scene) -> list:
-    """Load vectors of both sides; from the exact solution where the scene has one."""
-    if getattr(scene, "has_exact", False):
-        return [load_vector_from_exact(s, g, c, ny) for s, g, c, ny in
-                zip(sides, (scene.grad_u1, scene.grad_u2), (scene.c1, scene.c2), (1.0, -1.0))]
-    return [load_vector(s, f) for s, f in zip(sides, (scene.f1, scene.f2))]
+    def resultant(self) -> float:
+        """P = ∫_Γ λ_h (exact Gauss on G_h)."""
+        x, w = quadrature_on(self.space.breakpoints, self.space.degree + 1)
+        return float(w @ self.pressure(x))
 
 
 def contact_qp(sides, Bs, F, c=(1.0, 1.0)):
@@ -99,7 +85,7 @@ def contact_qp(sides, Bs, F, c=(1.0, 1.0)):
     Parameters
     ----------
     sides : sequence of two objects with ``stiffness`` (csc, free dofs, Γ last) and
-        ``trace.gamma_dofs`` — :class:`~infsup_contact.interface.SideOperator`.
+        ``trace.gamma_dofs`` — :class:`~infsup_contact.models.schur.SideOperator`.
     Bs : two dense (m, n_Γ,i) coupling matrices B1, B2.
     F : two load vectors on the free dofs.
     c : (c1, c2).
@@ -174,10 +160,17 @@ def linear_saddle_time(sides, Bs, c, F, active) -> float:
     return time.perf_counter() - t
 
 
+def weighted_gap(space, g0, degree: int) -> np.ndarray:
+    """G_j = ∫_Γ μ_j g0 by Gauss–Legendre exact for g0 polynomial of ``degree``."""
+    x, w = quadrature_on(union_breakpoints(space.breakpoints), space.degree + degree)
+    return (space.evaluate(x) * w[:, None]).T @ g0(x)
+
+
 @dataclass
 class ContactPair:
     """What a contact solve on one mesh pair needs before the multiplier space is chosen:
-    the factorized sides, the loads F_i and the unconstrained displacements u0_i = A_i⁻¹F_i.
+    the factorized sides, the loads F_i, the lifts and the unconstrained displacements
+    u0_i = A_i⁻¹F_i.
 
     Every multiplier case on the pair shares it (:func:`solve_contact_on`); building it
     is most of a solve's cost on the finer meshes, and none of it depends on M_h.
@@ -196,6 +189,13 @@ class ContactPair:
         Displacement degree.
     seconds : float
         Wall time of the build (sides, loads, u0), counted in every solve on the pair.
+    model : Model
+        Who made the sides and recovers u_h.
+    lifts : list
+        Dirichlet lifts u_{D,i} on all dofs (None: homogeneous).
+    gap : callable or None
+        The scene's initial gap g0(x) on Γ, polynomial of degree ``gap_degree``.
+    gap_degree : int
     """
 
     meshes: tuple
@@ -205,53 +205,73 @@ class ContactPair:
     c: tuple
     k: int
     seconds: float
+    model: object = None
+    lifts: list = None
+    gap: object = None
+    gap_degree: int = 0
 
 
-def contact_pair(scene, k: int, family: str, n1: int, n2: int, model=MEMBRANES,
-                 **mesh_kwargs) -> ContactPair:
-    """Mesh, factorize and load both sides of ``scene`` (see :class:`ContactPair`)."""
-    mesh_pair = meshes.mesh_pair(family, n1, n2, **mesh_kwargs)
+def contact_pair(scene, k: int, family: str, n1: int, n2: int, model=None, **mesh_kwargs) -> ContactPair:
+    """Mesh, factorize and load both sides of ``scene`` with ``model`` (default: the registry's,
+    the paper's membranes; see :class:`ContactPair`); the scene's ``mesh_pair`` where it has
+    one (structured blocks of the elastic scenes), else the family's."""
+    model = DEFAULT_MODEL if model is None else model
+    build = getattr(scene, "mesh_pair", None)
+    mesh_pair = build(family, n1, n2, **mesh_kwargs) if build else meshes.mesh_pair(family, n1, n2, **mesh_kwargs)
     c = (scene.c1, scene.c2)
     t0 = time.perf_counter()
-    sides = [model.side_operator(m, k) for m in mesh_pair]
-    F = load_vectors(sides, scene)
+    sides = [model.side_for(scene, m, k) for m in mesh_pair]
+    F, lifts = zip(*(model.load(s, scene, i) for i, s in enumerate(sides)))
     u0 = [s.solve(Fi) / ci for s, Fi, ci in zip(sides, F, c)]
-    return ContactPair(tuple(mesh_pair), sides, F, u0, c, k, time.perf_counter() - t0)
+    return ContactPair(tuple(mesh_pair), sides, list(F), u0, c, k, time.perf_counter() - t0, model,
+                       list(lifts), getattr(scene, "initial_gap", None), getattr(scene, "initial_gap_degree", 0))
+
+
+def solve_on_gamma(pair: ContactPair, space, time_floor: bool = False) -> ContactSolution:
+    """Solve (4.1) on a built pair with the multiplier space ``space``: B_i, K, the gaps, PDAS
+    and the recovery of u_h by the model — the one Γ solve of every model and scene."""
+    t0 = time.perf_counter()
+    sides, c, F = pair.sides, pair.c, pair.F
+    Bs = [coupling_matrix(s.trace, space, pair.k) for s in sides]
+    K = interface_operator(Bs, sides, c)
+    ng = [B.shape[1] for B in Bs]
+    g0 = Bs[1] @ pair.u0[1][-ng[1]:] - Bs[0] @ pair.u0[0][-ng[0]:]
+    if pair.gap is not None:
+        g0 = weighted_gap(space, pair.gap, pair.gap_degree) + g0
+    pdas = solve_pdas(K, g0)
+    lifts = pair.lifts or [None] * len(sides)
+    u = []
+    for sign, s, Fi, B, ci, lift in zip(B_SIGN, sides, F, Bs, c, lifts):
+        rhs = Fi.copy()
+        rhs[s.ndof - B.shape[1]:] += sign * (B.T @ pdas.lam)  # Γ dofs are the last block
+        u.append(pair.model.field(s, s.solve(rhs) / ci, lift))
+    t_solve = pair.seconds + time.perf_counter() - t0
+    t_floor = linear_saddle_time(sides, Bs, c, F, pdas.active) if time_floor else float("nan")
+    return ContactSolution(space, sides, u, pdas.lam, pdas, c, K, t_solve, t_floor)
 
 
 def solve_contact_on(pair: ContactPair, case: str, multiplier_mesh: str = "omega2",
                      time_floor: bool = True) -> ContactSolution:
-    """Solve (4.1) on a built pair with the multipliers of ``case`` (a registry id).
+    """Solve (4.1) on a built pair with the multipliers of ``case`` (a registry id) on the
+    multiplier mesh ``multiplier_mesh``.
 
     ``t_solve`` of the result is the pair's build time plus this call's: the cost of one
     solve from meshes to u_h, whether or not the pair was shared.
     """
     registry.check_case(case, pair.k)
     t0 = time.perf_counter()
-    sides, c, F, k = pair.sides, pair.c, pair.F, pair.k
-    space = registry.case_space(case, k, meshes.multiplier_breakpoints(*pair.meshes, multiplier_mesh))
-    Bs = [coupling_matrix(s.trace, space, k) for s in sides]
-    K = interface_operator(Bs, sides, c)
-    ng = [B.shape[1] for B in Bs]
-    g0 = Bs[1] @ pair.u0[1][-ng[1]:] - Bs[0] @ pair.u0[0][-ng[0]:]
-    pdas = solve_pdas(K, g0)
-    u = []
-    for sign, s, Fi, B, ci in zip((-1.0, 1.0), sides, F, Bs, c):
-        rhs = Fi.copy()
-        rhs[s.ndof - B.shape[1]:] += sign * (B.T @ pdas.lam)  # Γ dofs are the last block
-        gf = ngsolve.GridFunction(s.trace.fes)
-        gf.vec.FV().NumPy()[s.free] = s.solve(rhs) / ci
-        u.append(gf)
-    t_solve = pair.seconds + time.perf_counter() - t0
-    t_floor = linear_saddle_time(sides, Bs, c, F, pdas.active) if time_floor else float("nan")
-    return ContactSolution(space, sides, u, pdas.lam, pdas, c, t_solve, t_floor)
+    space = registry.case_space(case, pair.k, meshes.multiplier_breakpoints(*pair.meshes, multiplier_mesh))
+    t_space = time.perf_counter() - t0
+    sol = solve_on_gamma(pair, space, time_floor)
+    sol.t_solve += t_space  # building M_h is part of this case's solve
+    return sol
 
 
 def solve_contact(scene, case: str, k: int, family: str, n1: int, n2: int,
-                  multiplier_mesh: str = "omega2", time_floor: bool = True, model=MEMBRANES,
+                  multiplier_mesh: str = "omega2", time_floor: bool = True, model=None,
                   **mesh_kwargs) -> ContactSolution:
     """Solve (4.1) for a scene (``scenes.scene``) with the multipliers of ``case`` (a registry
-    id); ``model`` gives the side operators (:mod:`infsup_contact.models.contract`)."""
+    id); ``model`` gives the side operators, loads and u_h (:mod:`infsup_contact.models.contract`)."""
     registry.check_case(case, k)
     pair = contact_pair(scene, k, family, n1, n2, model=model, **mesh_kwargs)
     return solve_contact_on(pair, case, multiplier_mesh, time_floor)
@@ -268,5 +288,5 @@ def gamma_values(sol: ContactSolution, x: np.ndarray):
 
 
 def lambda_values(sol: ContactSolution, x: np.ndarray) -> np.ndarray:
-    """λ_h(x)."""
+    """λ_h(x); ``sol`` may be a saved reference (space and lam only, study.contact_rows)."""
     return sol.space.evaluate(x) @ sol.lam

@@ -19,7 +19,7 @@ from ..discretization import meshes, multipliers, registry
 from ..discretization.coupling import coupling_matrix, trace_l2_norms
 from ..errors import InputError, check_prestress
 from ..models.schur import combine_terms, interface_terms
-from ..models.membranes import MEMBRANES
+from ..models import DEFAULT_MODEL
 from ..models.side_cache import SideCache
 from ..discretization.norms import NORMS, gram
 from .kernel import (GAP_DECADES, KERNEL_CRITERION, KernelDecision, coupling_kernel, gap_over_roundoff,  # noqa: F401
@@ -130,7 +130,7 @@ def _space(case, k, breakpoints):
 
 
 def beta_rows(family, k, n1, n2, cases=None, multiplier_mesh="omega2",
-              c1=1.0, c2=1.0, norms=NORMS, h_route="logkernel", model=MEMBRANES, side_cache=None,
+              c1=1.0, c2=1.0, norms=NORMS, h_route="logkernel", model=DEFAULT_MODEL, side_cache=None,
               **mesh_kwargs):
     """β_h for several cases and norms on one mesh pair, reusing the interface operator.
 
@@ -148,7 +148,7 @@ def beta_rows(family, k, n1, n2, cases=None, multiplier_mesh="omega2",
 
 
 def beta_rows_all(family, k, n1, n2, cases=None, multiplier_meshes=("omega2",), c_pairs=((1.0, 1.0),),
-                  norms=NORMS, h_route="logkernel", model=MEMBRANES, side_cache=None, **mesh_kwargs):
+                  norms=NORMS, h_route="logkernel", model=DEFAULT_MODEL, side_cache=None, **mesh_kwargs):
     """:func:`beta_rows` for several multiplier meshes and prestress pairs at once.
 
     The meshes and the side factorizations are built once per mesh pair, the couplings and

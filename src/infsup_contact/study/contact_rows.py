@@ -13,10 +13,11 @@ def cone_kind(case: str, k: int) -> str:
     return space_spec(case).cone(k)
 
 
-def reference_solution(scene, k: int, n_ref: int) -> ContactSolution:
-    """The membranes reference: structured N_ref × N_ref, degree k + 1, the registry's
-    reference multipliers (stable for every k)."""
-    return solve_contact(scene, REFERENCE_SPACE, k + 1, "structured", n_ref, n_ref, time_floor=False)
+def reference_solution(scene, k: int, n_ref: int, model=None) -> ContactSolution:
+    """The reference of a scene without an exact solution: structured N_ref × N_ref, degree
+    k + 1, the registry's reference multipliers (stable for every k); ``model`` as in
+    :func:`~infsup_contact.solvers.contact.solve_contact`."""
+    return solve_contact(scene, REFERENCE_SPACE, k + 1, "structured", n_ref, n_ref, time_floor=False, model=model)
 
 
 def save_reference(path, ref: ContactSolution) -> None:
@@ -45,16 +46,17 @@ def load_reference(path):
 
 def contact_row(scene_name: str, case: str, k: int, family: str, n1: int, n2: int,
                 c1: float = 1.0, c2: float = 1.0, reference: ContactSolution | None = None,
-                n_ref: int = 64, time_floor: bool = True, scene_params: dict | None = None, **mesh_kwargs) -> dict:
+                n_ref: int = 64, time_floor: bool = True, scene_params: dict | None = None, model=None,
+                **mesh_kwargs) -> dict:
     """Solve one instance of (4.1) and measure it; errors vs exact (manufactured) or reference."""
     return contact_rows(scene_name, [case], k, family, n1, n2, c1, c2, reference, n_ref,
-                        time_floor, scene_params, **mesh_kwargs)[0]
+                        time_floor, scene_params, model=model, **mesh_kwargs)[0]
 
 
 def contact_rows(scene_name: str, cases, k: int, family: str, n1: int, n2: int,
                  c1: float = 1.0, c2: float = 1.0, reference: ContactSolution | None = None,
                  n_ref: int = 64, time_floor: bool = True, scene_params: dict | None = None,
-                 **mesh_kwargs) -> list[dict]:
+                 model=None, **mesh_kwargs) -> list[dict]:
     """:func:`contact_row` for several multiplier cases on one mesh pair, which is meshed,
     factorized and loaded once (:func:`~infsup_contact.solvers.contact.contact_pair`)."""
     if not 1 <= k <= 4:
@@ -65,8 +67,8 @@ def contact_rows(scene_name: str, cases, k: int, family: str, n1: int, n2: int,
         check_prestress(key, c)
     sc = make_scene(scene_name, c1=c1, c2=c2, **(scene_params or {}))
     if not sc.has_exact:
-        reference = reference or reference_solution(sc, k, n_ref)
-    pair = contact_pair(sc, k, family, n1, n2, **mesh_kwargs)
+        reference = reference or reference_solution(sc, k, n_ref, model)
+    pair = contact_pair(sc, k, family, n1, n2, model=model, **mesh_kwargs)
     rows = []
     for case in cases:
         sol = solve_contact_on(pair, case, time_floor=time_floor)

@@ -19,9 +19,13 @@ import numpy as np
 import pandas as pd
 
 from ..discretization import registry
-from ..models.elastic import elastic_model, lame
-from ..models.membranes import MEMBRANES
+from ..models import DEFAULT_MODEL, make_model
+from ..models.plane_strain import lame
 from ..models.side_cache import SideCache
+
+ELASTIC = "elastic"
+"""The model this study compares with the membranes (:data:`~infsup_contact.models.MODELS`)."""
+MEMBRANES = DEFAULT_MODEL
 from ..solvers.infsup import beta_rows
 
 COLUMNS = ["model", "case", "k", "family", "N1", "N2", "multiplier_mesh", "E1", "E2", "nu", "norm", "beta",
@@ -51,7 +55,7 @@ def elastic_beta_rows(family: str, k: int, pairs, nu: float = 0.3, E=(1.0, 1.0),
     every case valid for k (default) and norm; G_h = trace of Ω2 (the paper's choice).
     ``membranes``: the membranes' rows of :func:`membranes_rows` where already computed."""
     cases = registry.ids_valid_for(k) if cases is None else list(cases)
-    model = elastic_model(nu)
+    model = make_model(ELASTIC, nu=nu)
     if membranes is None:
         membranes = membranes_rows(family, k, pairs, E, cases, norms, **mesh_kwargs)
     sides = SideCache.for_sweep(model, family, k, pairs, **mesh_kwargs)
@@ -62,7 +66,7 @@ def elastic_beta_rows(family: str, k: int, pairs, nu: float = 0.3, E=(1.0, 1.0),
         mem = membranes[n1, n2]
         for r, m in zip(el, mem):
             assert (r["case"], r["norm"]) == (m["case"], m["norm"])
-            out.append(dict(r, model="elastic", E1=E[0], E2=E[1], nu=nu, beta_membranes=m["beta"],
+            out.append(dict(r, model=ELASTIC, E1=E[0], E2=E[1], nu=nu, beta_membranes=m["beta"],
                             kernel_dim_membranes=m["kernel_dim"], kernel_decision_membranes=m["kernel_decision"],
                             bound_factor=bound_factor(nu)))
     return pd.DataFrame(out, columns=COLUMNS)

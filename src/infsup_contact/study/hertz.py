@@ -37,11 +37,16 @@ import numpy as np
 
 from ..discretization import registry
 from ..discretization.coupling import quadrature_on
-from ..models.elastic import check_modulus, check_nu, lame
+from ..models import make_model
+from ..models.plane_strain import check_modulus, check_nu, lame
+from ..solvers.contact import contact_pair, solve_contact_on
 from .accuracy import _element_quadrature
-from .elastic_contact import elastic_pair, solve_elastic_contact
-from .patch import patch_mesh
+from .blocks import PressedBlocks
 
+SCENE = "hertz"
+"""This scene's registry id (:mod:`.scene_registry`, whose entry reads these two names)."""
+SCENE_MODELS = ("elastic",)
+"""The models the scene is defined for (the first is its default)."""
 X_DIRICHLET = Y_DIRICHLET = "dir"
 """Clamped far faces (Ω1's bottom, Ω2's top), traction-free lateral sides."""
 CENTER = 0.5
@@ -80,11 +85,17 @@ def check_geometry(R, d) -> tuple:
     return tuple(out)
 
 
-def hertz_pair(k: int, n: int, d: float, nu: float = 0.3, E=(1.0, 1.0), n2: int | None = None):
+def hertz_scene(R: float, d: float, E=(1.0, 1.0)) -> PressedBlocks:
+    """The Hertz scene's data: clamped far faces, Ω2's top moved by d, gap (x − 1/2)²/(2R)."""
+    return PressedBlocks(SCENE, E[0], E[1], d, (X_DIRICHLET, Y_DIRICHLET),
+                         initial_gap=lambda x: (x - CENTER) ** 2 / (2.0 * R), initial_gap_degree=2)
+
+
+def hertz_pair(k: int, n: int, d: float, nu: float = 0.3, E=(1.0, 1.0), n2: int | None = None, R: float = 1.0):
     """The factorized blocks of the Hertz scene (N segments on Γ for Ω1, ``n2`` (default N) for
-    Ω2, top of Ω2 moved by d), shared by every multiplier case."""
-    return elastic_pair(patch_mesh(n, 1), patch_mesh(n if n2 is None else n2, 2), k, nu, E,
-                        X_DIRICHLET, Y_DIRICHLET, d)
+    Ω2, top of Ω2 moved by d, gap of radius R), shared by every multiplier case."""
+    return contact_pair(hertz_scene(R, d, E), k, "structured", n, n if n2 is None else n2,
+                        make_model(SCENE_MODELS[0], nu=nu))
 
 
 def solve_hertz(case: str, k: int, n: int, R: float, d: float, nu: float = 0.3, E=(1.0, 1.0), n2: int | None = None,
@@ -96,8 +107,8 @@ def solve_hertz(case: str, k: int, n: int, R: float, d: float, nu: float = 0.3, 
     R, d = check_geometry(R, d)
     registry.check_case(case, k)
     if pair is None:
-        pair = hertz_pair(k, n, d, nu, E, n2)
-    return solve_elastic_contact(pair, case, g0=lambda x: (x - CENTER) ** 2 / (2.0 * R), g0_degree=2)
+        pair = hertz_pair(k, n, d, nu, E, n2, R)
+    return solve_contact_on(pair, case, "omega2", time_floor=False)
 
 
 def hertz_row(case: str, k: int, n1: int, n2: int, R: float, d: float, nu: float = 0.3, E=(1.0, 1.0)) -> dict:
@@ -106,7 +117,7 @@ def hertz_row(case: str, k: int, n1: int, n2: int, R: float, d: float, nu: float
     sol = solve_hertz(case, k, n1, R, d, nu, E, n2=n2)
     m = profile_measures(sol)
     a, p0 = hertz(m["P"], R, nu, E)
-    return dict(scene="hertz", case=case, k=k, family="structured", N1=n1, N2=n2, E1=E[0], E2=E[1], nu=nu, R=R,
+    return dict(scene=SCENE, case=case, k=k, family="structured", N1=n1, N2=n2, E1=E[0], E2=E[1], nu=nu, R=R,
                 d=d, dim_M=sol.space.dim, iterations=sol.pdas.iterations, nonunique=bool(sol.pdas.nonunique),
                 **m, hertz_a=a, hertz_p0=p0, p_max_rel_error_vs_hertz=abs(m["p_max"] - p0) / p0,
                 half_width_rel_error_vs_hertz=abs(m["half_width"] - a) / a, seconds=time.perf_counter() - t0)
@@ -147,7 +158,7 @@ def reference_data(ref) -> list:
     """Per body: quadrature points and weights of the reference mesh and the reference
     gradients there (computed once per reference)."""
     out = []
-    for gref in ref.grid_functions():
+    for gref in ref.u:
         xy, w = _element_quadrature(gref.space.mesh, 2 * gref.components[0].space.globalorder)
         out.append((xy, w, _strain_data(gref, xy)))
     return out
@@ -158,7 +169,7 @@ def energy_error(sol, ref_data, nu: float) -> float:
     mesh (exact when the meshes are nested), ``ref_data`` from :func:`reference_data`."""
     mu, lam = lame(nu)
     total = 0.0
-    for gf, (xy, w, (bx, by)), e in zip(sol.grid_functions(), ref_data, sol.E):
+    for gf, (xy, w, (bx, by)), e in zip(sol.u, ref_data, sol.c):
         ax, ay = _strain_data(gf, xy)
         dx, dy = ax - bx, ay - by
         exy = 0.5 * (dx[:, 1] + dy[:, 0])
@@ -181,7 +192,7 @@ def discretization_rows(cases, ks, ns, n_ref: int, R: float, d: float, nu=0.3, E
         ref = solve_hertz(registry.REFERENCE_SPACE, k + 1, n_ref, R, d, nu, E)
         rm, rdata = profile_measures(ref), reference_data(ref)
         for n in ns:
-            pair = hertz_pair(k, n, d, nu, E)
+            pair = hertz_pair(k, n, d, nu, E, R=R)
             for case in registry.ids_valid_for(k, cases):
                 t0 = time.perf_counter()
                 sol = solve_hertz(case, k, n, R, d, nu, E, pair=pair)

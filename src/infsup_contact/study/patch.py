@@ -51,12 +51,17 @@ import scipy.linalg as sla
 from ..discretization import meshes, registry
 from ..discretization.coupling import union_breakpoints
 from ..discretization.norms import gram
-from ..models.elastic import check_modulus, check_nu, interpolate
-from .elastic_contact import elastic_pair, solve_elastic_contact
+from ..models import make_model
+from ..models.plane_strain import check_modulus, check_nu
+from ..solvers.contact import contact_pair, solve_contact_on
+from .blocks import SIDE, PressedBlocks, block_mesh
 
-SIDE = "side"
-"""Boundary name of the lateral sides x = 0, 1 (rollers: u_x = 0)."""
+SCENE = "patch"
+"""This scene's registry id (:mod:`.scene_registry`, whose entry reads these two names)."""
+SCENE_MODELS = ("elastic",)
+"""The models the scene is defined for (the first is its default)."""
 X_DIRICHLET, Y_DIRICHLET = f"{meshes.DIRICHLET}|{SIDE}", meshes.DIRICHLET
+"""Rollers on the lateral sides (u_x = 0), far faces clamped in x, prescribed in y."""
 PASS_RTOL = 1e-10
 """λ_h = p and u_h = u to this relative accuracy count as passing (the issue's 1e-10)."""
 
@@ -66,18 +71,13 @@ DELTA = 1e-2
 
 
 def patch_mesh(n: int, side: int) -> ngsolve.Mesh:
-    """The structured N×N mesh of Ω_side with boundaries ``gamma``, ``side`` (x = 0, 1) and
-    ``dir`` (the bottom of Ω1, the top of Ω2)."""
-    points, triangles = meshes.structured_arrays(n, side)
-    segs = []
-    for a, b, label in meshes.boundary_segments(points, side):
-        x = points[[a, b], 0]
-        if label == meshes.DIRICHLET and x[0] == x[1] and x[0] in (0.0, 1.0):
-            label = SIDE
-        segs.append((a, b, label))
-    mesh = meshes.mesh_from_arrays(points, triangles, segs)
-    meshes.check_mesh(mesh, 1.0, f"family structured (patch test), N = {n}, side {side}")
-    return mesh
+    """The structured N×N block of Ω_side (:func:`~.blocks.block_mesh`)."""
+    return block_mesh(n, side)
+
+
+def patch_scene(E=(1.0, 1.0), delta: float = DELTA) -> PressedBlocks:
+    """The patch test's data: rollers on the sides, Ω2's top moved down by ``delta``, no gap."""
+    return PressedBlocks(SCENE, E[0], E[1], delta, (X_DIRICHLET, Y_DIRICHLET))
 
 
 def constrained_modulus(E: float, nu: float) -> float:
@@ -113,7 +113,7 @@ def patch_rows(cases, ks, pairs, nu=0.3, E=(1.0, 1.0)) -> list:
 
 def patch_pair(k: int, n1: int, n2: int, nu: float, E, delta: float = DELTA):
     """The factorized blocks of the patch test (top of Ω2 moved down by ``delta``)."""
-    return elastic_pair(patch_mesh(n1, 1), patch_mesh(n2, 2), k, nu, E, X_DIRICHLET, Y_DIRICHLET, delta)
+    return contact_pair(patch_scene(E, delta), k, "structured", n1, n2, make_model(SCENE_MODELS[0], nu=nu))
 
 
 def solve_patch(case: str, k: int, n1: int, n2: int, nu: float = 0.3, E=(1.0, 1.0), delta: float = DELTA,
@@ -139,14 +139,14 @@ def solve_patch(case: str, k: int, n1: int, n2: int, nu: float = 0.3, E=(1.0, 1.
     t0 = time.perf_counter()
     if pair is None:
         pair = patch_pair(k, n1, n2, nu, E, delta)
-    sol = solve_elastic_contact(pair, case)
+    sol = solve_contact_on(pair, case, "omega2", time_floor=False)
     sides, space, res = sol.sides, sol.space, sol.pdas
     g = space.breakpoints
     p = exact_pressure(delta, nu, E)
     M1, M2 = (constrained_modulus(e, nu) for e in E)
     exact = (-p * ngsolve.y / M1, -p / M1 - p * (ngsolve.y - 1.0) / M2)
-    u_err = max(np.max(np.abs(vec - interpolate(s.space, 0.0, uy))) / delta
-                for s, vec, uy in zip(sides, sol.u, exact))
+    u_err = max(np.max(np.abs(gf.vec.FV().NumPy() - pair.model.interpolate(s, (0.0, uy)))) / delta
+                for s, gf, uy in zip(sides, sol.u, exact))
     K = sol.K
     xs = union_breakpoints(g, sides[0].trace.breakpoints, sides[1].trace.breakpoints)
     t = np.linspace(0.0, 1.0, per_interval + 1)
@@ -156,7 +156,7 @@ def solve_patch(case: str, k: int, n1: int, n2: int, nu: float = 0.3, E=(1.0, 1.
     G, _ = gram(space, "L2")
     ev = sla.eigh(K, G, eigvals_only=True)
     lam_err = float(err.max())
-    return dict(scene="patch", case=case, k=k, family="structured", N1=n1, N2=n2, E1=E[0], E2=E[1], nu=nu,
+    return dict(scene=SCENE, case=case, k=k, family="structured", N1=n1, N2=n2, E1=E[0], E2=E[1], nu=nu,
                 delta=delta, p=p, dim_M=space.dim, kernel_dim=int(np.sum(ev < 1e-8 * ev[-1])),
                 iterations=res.iterations, n_active=int(res.active.sum()), nonunique=bool(res.nonunique),
                 lambda_max_rel_error=lam_err,

@@ -83,7 +83,7 @@ def contact_profiles(cases, k: int, n: int, scene=None, family: str = "structure
         Segments on Γ of both meshes (matching pair N1 = N2 = n).
     scene : scene object, optional
         A :mod:`infsup_contact.study.scenes` scene; default the paper's Fig. 4 loads,
-        :func:`infsup_contact.scenes.membranes` with c1 = c2 = 1.
+        :func:`infsup_contact.study.scenes.membranes` with c1 = c2 = 1.
     family : str
         Mesh family (default structured).
     per_interval : int

@@ -459,3 +459,17 @@ def test_the_contradiction_check_finds_a_stale_sentence():
     assert contradictions("it is not bounded on N (\\verdictfmt{PASS}, evidence)") != []
     assert contradictions("it is bounded (\\verdictfmt{PASS}) and not bounded on M (\\verdictfmt{FAIL})") == []
     assert resolve_byverdict("x \\byverdict{FAIL}{a}{b {c}}{d} y") == "x b {c} y"
+
+
+@pytest.mark.parametrize("new_id,escaped", [("Q0_2h", r"Q0\_2h"), ("A&B", r"A\&B"), ("x%y#1", r"x\%y\#1")])
+def test_ids_reach_the_generated_tables_escaped(tables, new_id, escaped):
+    """A space id with LaTeX specials is written literally (one escaping path, texformat.latex_id),
+    never as a raw special or a subscript."""
+    rename = {"DUAL": new_id}
+    t = {name: (frame.replace({"case": rename}) if isinstance(frame, pd.DataFrame) and "case" in frame.columns
+                else frame) for name, frame in tables.items()}
+    files = pt.paper_files(**t)
+    text = "".join(v for k, v in files.items() if k != "macros.tex")
+    assert escaped in text
+    assert new_id not in text.replace(escaped, "")
+    assert "Q0$_{2h}$" not in text  # an id is not a formula

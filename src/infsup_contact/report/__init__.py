@@ -8,7 +8,7 @@
 from .macros import all_macros, macros_tex, speed_macros
 from .paper import GENERATED_FILES, SOURCE_INPUTS, check_paper, defined_macros, paper_files, used_generated_macros, used_inputs
 from .tables import fastest_for_targets, front_table, front_winner, speed_rows, speed_table
-from .texformat import MEASURES, SPEED_COLUMNS, PaperTexError, fmt_fixed, latex_escape, parse_number
+from .texformat import MEASURES, SPEED_COLUMNS, PaperTexError, fmt_fixed, latex_escape, latex_id, parse_number
 from .texnames import Macro, is_generated_name, macro_name, number_word, token
 
 __all__ = ["all_macros", "macros_tex", "speed_macros", "GENERATED_FILES", "SOURCE_INPUTS", "check_paper", "defined_macros", "paper_files", "used_generated_macros", "used_inputs", "fastest_for_targets", "front_table", "front_winner", "speed_rows", "speed_table", "MEASURES", "SPEED_COLUMNS", "PaperTexError", "fmt_fixed", "latex_escape", "parse_number", "Macro", "is_generated_name", "macro_name", "number_word", "token"]

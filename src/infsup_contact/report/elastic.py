@@ -12,7 +12,7 @@ import re
 import numpy as np
 import pandas as pd
 
-from .texformat import PaperTexError, case_order, fmt_fixed, fmt_int, fmt_sci, latex_escape
+from .texformat import PaperTexError, case_order, fmt_fixed, fmt_int, fmt_sci, latex_id
 from .texnames import Macro, _k, macro_name
 
 ELASTIC_FILES = ("elastic_macros.tex", "elastic_beta_table.tex", "elastic_patch_table.tex", "elastic_hertz_table.tex")
@@ -126,7 +126,7 @@ def elastic_beta_table(beta: pd.DataFrame, sweep: pd.DataFrame) -> str:
              "family & case & " + " & ".join([rf"$k={k}$" for _ in groups for k in ks] + pad) + r" \\", r"\midrule"]
     for fam in [f for f in ("structured", "perturbed", "unstructured") if f in set(m.family)]:
         for case in case_order(m[m.family == fam].case.unique()):
-            lines.append(f"{fam[:6]}. & {latex_escape(case)} & "
+            lines.append(f"{fam[:6]}. & {latex_id(case)} & "
                          + " & ".join([cell(rows, fam, case, k) for _, rows, _ in groups for k in ks] + pad) + r" \\")
     lines += [r"\midrule", rf"\multicolumn{{{ncol}}}{{l}}{{$\nu \to 1/2$, structured, $N={int(fin.N2.max())}$; "
               r"columns: " + ", ".join(rf"$\nu={v:g}$" for v in nus) + r"} \\", r"\midrule"]
@@ -135,7 +135,7 @@ def elastic_beta_table(beta: pd.DataFrame, sweep: pd.DataFrame) -> str:
             r = fin[(fin.k == k) & (fin.case == case)].set_index("nu")
             cells = [fmt_fixed(r.beta[v], 4) if r.kernel_dim[v] == 0 else f"0 [{int(r.kernel_dim[v])}]" for v in nus]
             cells += [""] * max(ncol - 2 - len(nus), 0)
-            lines.append(rf"$k={k}$ & {latex_escape(case)} & " + " & ".join(cells) + r" \\")
+            lines.append(rf"$k={k}$ & {latex_id(case)} & " + " & ".join(cells) + r" \\")
     lines += [r"\bottomrule", r"\end{tabular}", ""]
     return "\n".join(lines)
 
@@ -150,7 +150,7 @@ def elastic_patch_table(patch: pd.DataFrame) -> str:
     for case in case_order(patch.case.unique()):
         for k, g in patch[patch.case == case].groupby("k"):
             ok = bool(g.passes.astype(bool).all())
-            lines.append(f"{latex_escape(case)} & {k} & {'yes' if ok else 'no'} & "
+            lines.append(f"{latex_id(case)} & {k} & {'yes' if ok else 'no'} & "
                          + " & ".join(fmt_sci(g[c].max(), 2) for c in ("lambda_max_rel_error", "lambda_end_rel_error",
                                                                        "lambda_middle_rel_error", "u_max_rel_error"))
                          + r" \\")
@@ -173,7 +173,7 @@ def elastic_hertz_table(hertz: pd.DataFrame) -> str:
             slope = -_slope(g.index.to_numpy(float), g.energy_error)
             cells = [fmt_fixed(slope, 2)] + [fmt_sci(g.energy_error[n], 2) for n in ns] \
                 + [fmt_sci(g.p_max_rel_error[n], 2) for n in ns] + [fmt_fixed(g.oscillation[n], 2) for n in ns]
-            lines.append(f"{k} & {latex_escape(case)} & " + " & ".join(cells) + r" \\")
+            lines.append(f"{k} & {latex_id(case)} & " + " & ".join(cells) + r" \\")
     mod = hertz[hertz.study == "modeling"].sort_values("d")
     if len(mod):
         lines += [r"\midrule", rf"\multicolumn{{{2 + 1 + 3 * len(ns)}}}{{l}}{{modeling error vs plane-strain Hertz "

@@ -7,7 +7,7 @@ import pandas as pd
 from ..discretization.series import primary_rows
 
 from .texformat import (MEASURES, SPEED_COLUMNS, VERDICTS, PaperTexError, _require, case_order, case_rank,
-                        fmt_fixed, fmt_sci, latex_escape)
+                        fmt_fixed, fmt_sci, latex_escape, latex_id)
 
 
 def beta_default_rows(beta: pd.DataFrame) -> pd.DataFrame:
@@ -40,7 +40,7 @@ def beta_table(beta: pd.DataFrame, ks=(1, 2, 3), even_only: bool = True) -> str:
             for case in case_order(b[(b.k == k) & (b.norm == norm)].case):
                 cells = [fmt_fixed(val[(norm, k, case, n)], 4) if (norm, k, case, n) in val.index else "--"
                          for n in ns]
-                lines.append(f"{k} & {case} & " + " & ".join(cells) + r" \\")
+                lines.append(f"{k} & {latex_id(case)} & " + " & ".join(cells) + r" \\")
     lines += [r"\bottomrule", r"\end{tabular}", ""]
     return "\n".join(lines)
 
@@ -71,7 +71,7 @@ def rates_table(rates: pd.DataFrame) -> str:
                     cells.append(fmt_fixed(slope.loc[(scene, case, k, m), "slope"], 2))
                 else:
                     cells.append("--")
-            lines.append(f"{latex_escape(scene, 'rates.csv scene')} & {case} & {int(k)} & "
+            lines.append(f"{latex_id(scene, 'rates.csv scene')} & {latex_id(case)} & {int(k)} & "
                          f"{'--' if pd.isna(exp) else format(float(exp), 'g')} & " + " & ".join(cells) + r" \\")
     lines += [r"\bottomrule", r"\end{tabular}", ""]
     return "\n".join(lines)
@@ -86,7 +86,7 @@ def _claims_checked(claims: pd.DataFrame) -> pd.DataFrame:
 
 
 def _breakable_id(claim_id: str) -> str:
-    return r"\texttt{" + latex_escape(claim_id).replace("-", r"-\allowbreak{}") + "}"
+    return r"\texttt{" + latex_id(claim_id).replace("-", r"-\allowbreak{}") + "}"
 
 
 SERIES_ORDER = ("ratio3-2", "plus1", "sqrt2")
@@ -103,7 +103,7 @@ def series_tex(series: str) -> str:
     if series.startswith("ratio"):
         p, q = series[len("ratio"):].split("-")
         return rf"$N_1{{:}}N_2={p}{{:}}{q}$"
-    return latex_escape(series)
+    return latex_id(series)
 
 
 def nonmatching_table(claims: pd.DataFrame) -> str:
@@ -132,7 +132,7 @@ def nonmatching_table(claims: pd.DataFrame) -> str:
             for m in mms:
                 cells.append(r"\texttt{" + "".join(letter.get(v.get((s, m, r.case, r.k, f)), "-")
                                                    for f in FAMILY_ORDER) + "}")
-        lines.append(rf"\case{{{latex_escape(r.case)}}} & {int(r.k)} & " + " & ".join(cells) + r" \\")
+        lines.append(rf"\case{{{latex_id(r.case)}}} & {int(r.k)} & " + " & ".join(cells) + r" \\")
     lines += [r"\bottomrule", r"\end{tabular}", ""]
     return "\n".join(lines)
 
@@ -193,7 +193,7 @@ def front_winner(speed: pd.DataFrame, error: str) -> str:
         return "none"
     counts = front.groupby(["case", "k"]).size()
     best = counts[counts == counts.max()].index
-    return " and ".join(f"{case} with $k={int(k)}$" for case, k in best) + \
+    return " and ".join(f"{latex_id(case)} with $k={int(k)}$" for case, k in best) + \
         f" ({int(counts.max())} of {len(front)} targets)"
 
 
@@ -240,7 +240,7 @@ def front_table(speed: pd.DataFrame) -> str:
                 if r.case is None or pd.isna(r.seconds):
                     continue
                 target = f"$10^{{{int(round(np.log10(r.target)))}}}$"
-                lines.append(f"{latex_escape(scene)} & {label} & {target} & {r.case} & "
+                lines.append(f"{latex_id(scene)} & {label} & {target} & {latex_id(r.case)} & "
                              f"{int(r.k)} & {int(r.N)} & {fmt_sci(r.seconds)} \\\\")
     lines += [r"\bottomrule", r"\end{tabular}", ""]
     return "\n".join(lines)
@@ -259,7 +259,7 @@ def speed_table(speed: pd.DataFrame) -> str:
             lines.append(r"\midrule")
         for _, r in g.iterrows():
             mark = (" & " + (r"$\bullet$" if bool(r.pareto_energy) else "")) if front else ""
-            lines.append(f"{latex_escape(scene)} & {r.case} & {int(r.k)} & {int(r.N)} & {fmt_sci(r.seconds)} & "
+            lines.append(f"{latex_id(scene)} & {latex_id(r.case)} & {int(r.k)} & {int(r.N)} & {fmt_sci(r.seconds)} & "
                          f"{fmt_sci(r.energy_error)} & {fmt_sci(r.lambda_hm12_error)}{mark} \\\\")
     lines += [r"\bottomrule"]
     if front:

@@ -95,6 +95,13 @@ def _escape_chars(text: str, where: str) -> str:
     return "".join(out)
 
 
+def latex_id(text, where: str = "an id") -> str:
+    """An identifier (case, scene, series, claim id) → LaTeX, every character literal: ``P0_2h``
+    stays P0_2h and ``A&B`` stays A&B (no sub/superscripts, unlike :func:`latex_escape`). The one
+    path every id of a generated table takes."""
+    return _escape_chars(str(text), where)
+
+
 def latex_escape(text, where: str = "text") -> str:
     """Plain (UTF-8) text → LaTeX: specials escaped, known symbols mapped (UNICODE_LATEX), and
     sub/superscripts written the plain way (``β_h``, ``H^-1/2_00``, ``h^(1/2)``, ``M^1_{0,k}``)

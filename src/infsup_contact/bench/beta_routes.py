@@ -84,7 +84,7 @@ class BetaSetup:
         self.gamma = self.sides[0].trace.gamma
         g_h = self.gamma.multiplier_partition(*(s.trace.partition for s in self.sides))
         self.cases = _all_cases(k)
-        self.spaces = {c: self.gamma.space(c, k, g_h) for c in self.cases}
+        self.spaces = {c: registry.case_space(c, k, g_h, self.gamma) for c in self.cases}
         self.kernel = {c: registry.structural_kernel_dim(c, k, n) for c in self.cases}
         self.ndof = sum(s.ndof for s in self.sides)
 

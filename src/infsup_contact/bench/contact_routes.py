@@ -34,7 +34,7 @@ import time
 import numpy as np
 import scipy.sparse.linalg as spla
 
-from ..discretization import meshes
+from ..discretization import meshes, registry
 from ..discretization.registry import REFERENCE_SPACE
 from ..discretization.coupling import coupling_matrix
 from ..models.membranes import side_operator
@@ -59,7 +59,7 @@ def _contact_problem(n: int, k: int, case: str = REFERENCE_SPACE):
     m1, m2 = meshes.mesh_pair("structured", n, n)
     sides = [side_operator(m, k) for m in (m1, m2)]
     gamma = sides[0].trace.gamma
-    space = gamma.space(case, k, gamma.multiplier_partition(*(s.trace.partition for s in sides)))
+    space = registry.case_space(case, k, gamma.multiplier_partition(*(s.trace.partition for s in sides)), gamma)
     Bs = [coupling_matrix(s.trace, space, k) for s in sides]
     return sc, sides, Bs, [MEMBRANES.load(s, sc, i)[0] for i, s in enumerate(sides)]
 

@@ -47,7 +47,7 @@ def bench_elastic_beta(ns, ks, repeats: int = 3, nu: float = 0.3) -> list:
             sides = [model.side_operator(m, k) for m in (m1, m2)]
             gamma = sides[0].trace.gamma
             g_h = gamma.multiplier_partition(*(s.trace.partition for s in sides))
-            spaces = {c: gamma.space(c, k, g_h) for c in cases}
+            spaces = {c: registry.case_space(c, k, g_h, gamma) for c in cases}
             ops = {}
             for c in cases:
                 S = interface_operator([coupling_matrix(s.trace, spaces[c], k) for s in sides], sides)

@@ -4,8 +4,10 @@
 dimension, the partitions G_h (the trace of Ω1, of Ω2, their common refinement and the
 multiplier partition chosen from them), the trace dofs of a side, quadrature on a partition,
 the values of a side's trace basis at points of Γ, the Gram matrices of its norms (L² and the
-exact H^{-1/2}_00), the multiplier spaces built on a partition and the dimension counts the
-kernel proof and the sizing model use.
+exact H^{-1/2}_00) and the dimension counts the kernel proof, the registry and the sizing model
+use. Multiplier spaces are built on it: ``registry.case_space(case, k, partition, gamma)``
+builds a registered space on a partition of ``gamma`` (the registry imports this module, never
+the other way round).
 
 Coupling (:mod:`.coupling`), β_h (:mod:`infsup_contact.solvers.infsup`), contact
 (:mod:`infsup_contact.solvers.contact`) and the scenes ask the interface; they never take a
@@ -73,7 +75,8 @@ class Interface(abc.ABC):
     A *partition* is whatever the implementation uses to describe a partition of Γ into
     cells (for a :class:`Segment`, sorted breakpoints); consumers get partitions from the
     interface (:meth:`partition_of`, :meth:`multiplier_partition`, :meth:`common_refinement`,
-    ``trace.partition``, ``space.breakpoints``) and pass them back, never inspecting them.
+    ``trace.partition``, ``space.breakpoints``) and pass them back — to the interface, or with it
+    to ``registry.case_space(case, k, partition, gamma)`` — never inspecting them.
     """
 
     # --- geometry -------------------------------------------------------------------------
@@ -273,7 +276,7 @@ class Interface(abc.ABC):
         Parameters
         ----------
         space : MultiplierSpace
-            A space built on this interface (:meth:`space`).
+            A space built on a partition of this interface (``registry.case_space``).
         norm : {"L2", "H"}
             L²(Γ), or the exact dual norm of H^{1/2}_00(Γ).
         h_route : str
@@ -288,23 +291,6 @@ class Interface(abc.ABC):
         """
 
     # --- spaces and dimension counts --------------------------------------------------------
-    @abc.abstractmethod
-    def space(self, case: str, k: int, partition):
-        """The multiplier space of a registered case on a partition G_h.
-
-        Parameters
-        ----------
-        case : str
-            A registry id.
-        k : int
-            Displacement degree.
-        partition : partition
-
-        Returns
-        -------
-        MultiplierSpace
-        """
-
     @abc.abstractmethod
     def trace_dimension(self, k: int, cells: int) -> int:
         """dim W_h: traces on Γ of continuous P_k vanishing on ∂Γ, on ``cells`` uniform cells.
@@ -424,8 +410,7 @@ class Segment(Interface):
     def multiplier_partition(self, trace1, trace2, choice: str = "omega2", tol: float = 1e-12) -> np.ndarray:
         check_choice(choice)
         if choice == "union":
-            x = np.union1d(trace1, trace2)
-            return x[np.concatenate([[True], np.diff(x) > tol])]
+            return self.common_refinement(trace1, trace2, tol=tol)
         return np.asarray(trace2 if choice == "omega2" else trace1)
 
     def cells(self, partition) -> int:
@@ -525,12 +510,6 @@ class Segment(Interface):
         return gram(space, norm, h_route=h_route, **kwargs)
 
     # --- spaces and counts
-    def space(self, case: str, k: int, partition):
-        """:func:`~.registry.case_space` on the breakpoints of G_h."""
-        from .registry import case_space
-
-        return case_space(case, k, partition)
-
     def trace_dimension(self, k: int, cells: int) -> int:
         return cells * k - 1
 

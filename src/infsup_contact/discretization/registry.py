@@ -163,8 +163,10 @@ def check_case(case: str, k: int) -> None:
         raise InputError("k", f"k >= {spec.min_k} for case {case} ({spec.paper_ref} needs k >= {spec.min_k})")
 
 
-def case_space(case: str, k: int, breakpoints) -> MultiplierSpace:
-    """The multiplier space of a registered case for displacement degree k on G_h.
+def case_space(case: str, k: int, partition, gamma=SEGMENT) -> MultiplierSpace:
+    """The multiplier space of a registered case for displacement degree k on G_h, a
+    ``partition`` of Γ = ``gamma`` (:mod:`.interface`; for the paper's segment the sorted
+    breakpoints of G_h, what ``SpaceSpec.build(k, x)`` receives).
 
     Raises
     ------
@@ -173,8 +175,8 @@ def case_space(case: str, k: int, breakpoints) -> MultiplierSpace:
         the eigenproblems and solves would fail deep inside numpy), naming the case, N and k.
     """
     check_case(case, k)
-    x = np.asarray(breakpoints, dtype=float)
-    n = len(x) - 1 if x.ndim == 1 else 0
+    x = np.asarray(partition, dtype=float)
+    n = gamma.cells(x) if x.ndim == 1 else 0
     if n < 1:
         raise InputError("multiplier mesh", f"a partition of Γ with at least one interval (case {case}, "
                          f"k = {k}, N = {max(n, 0)})")

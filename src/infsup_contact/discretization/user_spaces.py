@@ -8,7 +8,7 @@ returns a :class:`~infsup_contact.discretization.multipliers.MultiplierSpace` �
 numbering). ``examples/macro_p0.py`` is one.
 
 **The partition a build receives.** Spaces are built on Γ, the interface object
-(:mod:`infsup_contact.discretization.interface`): the suite asks ``gamma.space(case, k, G_h)``
+(:mod:`infsup_contact.discretization.interface`): the suite asks ``registry.case_space(case, k, G_h, gamma)``
 and, for the paper's segment :class:`~infsup_contact.discretization.interface.Segment` — today
 the only Γ — that passes G_h as it represents it, the sorted breakpoints 0 = x_0 < … < x_N = 1.
 So a user's ``build(k, x)`` keeps receiving the breakpoints of G_h, a float array of shape

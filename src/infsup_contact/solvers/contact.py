@@ -266,8 +266,8 @@ def solve_contact_on(pair: ContactPair, case: str, multiplier_mesh: str = "omega
     registry.check_case(case, pair.k)
     t0 = time.perf_counter()
     gamma = pair.sides[0].trace.gamma
-    space = gamma.space(case, pair.k, gamma.multiplier_partition(*(s.trace.partition for s in pair.sides),
-                                                                  multiplier_mesh))
+    space = registry.case_space(case, pair.k, gamma.multiplier_partition(*(s.trace.partition for s in pair.sides),
+                                                                         multiplier_mesh), gamma)
     t_space = time.perf_counter() - t0
     sol = solve_on_gamma(pair, space, time_floor)
     sol.t_solve += t_space  # building M_h is part of this case's solve

@@ -116,7 +116,7 @@ def _space(case, k, partition, gamma=SEGMENT):
     """A named case on G_h = ``partition`` of ``gamma``, or a general triple
     ``(label, s, continuous, vanish)`` (eqs. 5.3, 5.5; spaces of the segment)."""
     if isinstance(case, str):
-        return gamma.space(case, k, partition)
+        return registry.case_space(case, k, partition, gamma)
     _, s, continuous, vanish = case
     return multipliers.make_space(partition, s, continuous, vanish)
 

@@ -3,7 +3,8 @@ import ngsolve
 import numpy as np
 import pytest
 
-from infsup_contact.discretization.coupling import coupling_matrix, gamma_trace
+from infsup_contact.discretization.coupling import coupling_matrix
+from infsup_contact.discretization.interface import SEGMENT
 from infsup_contact.models.membranes import displacement_space
 from infsup_contact.discretization.meshes import mesh_pair
 from infsup_contact.discretization.multipliers import make_space
@@ -26,7 +27,7 @@ def test_b_exact_for_polynomial_traces(family, n1, n2, k, s, cont):
     """A polynomial of degree k vanishing at Γ's ends is in every trace space: B u is exact."""
     for mesh in mesh_pair(family, n1, n2):
         fes = displacement_space(mesh, k)
-        trace = gamma_trace(fes)
+        trace = SEGMENT.trace(fes)
         p = lambda x: x * (1 - x) * (1 + 2 * x) ** (k - 2) if k >= 2 else 0 * x
         if k == 1:
             continue  # only the zero polynomial vanishes at both ends with degree 1 on all meshes
@@ -44,7 +45,7 @@ def test_b_matches_ngsolve_assembly(k, s):
     """Matching meshes: our B against NGSolve's mixed form ∫_Γ u q ds on the same partition."""
     for mesh in mesh_pair("perturbed", 5, 5):
         fes = displacement_space(mesh, k)
-        trace = gamma_trace(fes)
+        trace = SEGMENT.trace(fes)
         Q = ngsolve.H1(mesh, order=s, definedon=mesh.Boundaries("gamma"))
         u, q = fes.TrialFunction(), Q.TestFunction()
         bf = ngsolve.BilinearForm(trialspace=fes, testspace=Q)
@@ -70,9 +71,9 @@ def test_cached_trace_values_match_a_fresh_evaluation():
     """B from the trace's cached basis values equals B from a fresh trace, for several spaces
     asked for in turn (same and different quadrature points)."""
     mesh = mesh_pair("perturbed", 7, 5)[0]
-    cached = gamma_trace(displacement_space(mesh, 3))
+    cached = SEGMENT.trace(displacement_space(mesh, 3))
     for s, cont, bp in [(3, True, np.linspace(0, 1, 6)), (2, False, np.linspace(0, 1, 6)),
                         (3, True, np.linspace(0, 1, 6)), (1, True, np.linspace(0, 1, 9) ** 1.2)]:
         space = make_space(bp, s, cont, False)
-        fresh = gamma_trace(displacement_space(mesh, 3))
+        fresh = SEGMENT.trace(displacement_space(mesh, 3))
         assert np.array_equal(coupling_matrix(cached, space, 3), coupling_matrix(fresh, space, 3))

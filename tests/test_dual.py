@@ -2,7 +2,8 @@
 import numpy as np
 import pytest
 
-from infsup_contact.discretization.coupling import coupling_matrix, trace_values
+from infsup_contact.discretization.coupling import coupling_matrix
+from infsup_contact.discretization.interface import SEGMENT
 from infsup_contact.discretization.dual import local_dual_coefficients, nodal_integrals
 from infsup_contact.discretization.meshes import mesh_pair, multiplier_breakpoints
 from infsup_contact.discretization.multipliers import local_basis_space, local_shapes
@@ -87,7 +88,7 @@ def test_coupling_with_own_trace_is_nodal(k):
     x = multiplier_breakpoints(m1, m2)
     dual, nodal = case_space("DUAL", k, x), case_space("T3", k, x)
     B = coupling_matrix(side.trace, dual, k)
-    rows, cols, vals = trace_values(side.trace, nodal.nodes())
+    rows, cols, vals = SEGMENT.trace_values(side.trace, nodal.nodes())
     V = np.zeros((nodal.dim, B.shape[1]))
     np.add.at(V, (rows, cols), vals)
     B_nodal = B @ np.linalg.inv(V)

@@ -5,14 +5,12 @@ import pandas as pd
 import pytest
 import scipy.linalg as sla
 
-from infsup_contact.discretization import meshes
-from infsup_contact.discretization.coupling import (coupling_matrix, quadrature_on, trace_basis_at, trace_l2_norms,
-                                                    union_breakpoints)
+from infsup_contact.discretization.coupling import coupling_matrix, trace_l2_norms
 from infsup_contact.discretization.norms import gram
 from infsup_contact.models.membranes import MEMBRANES
 from infsup_contact.models.schur import combine_terms, interface_terms
 from infsup_contact.models.side_cache import SideCache
-from infsup_contact.solvers.infsup import _space, beta_rows, space_kernel, spectrum, trace_sum_dimension
+from infsup_contact.solvers.infsup import _space, beta_rows, space_kernel, spectrum
 from infsup_contact.solvers.kernel import (CLOSE, GAP_DECADES, MARGIN_DECADES, coupling_kernel, kernel_from_gap,
                                            scaled_couplings)
 from infsup_contact.study import claims, verdict
@@ -75,10 +73,11 @@ def _sides(family, k, n1, n2, **kw):
 
 def _kernel_pieces(case, k, n1, n2, mm="omega2", family="structured"):
     sides = _sides(family, k, n1, n2)
-    x1, x2 = (s.trace.breakpoints for s in sides)
-    space = _space(case, k, meshes.partition_choice(x1, x2, mm))
+    gamma = sides[0].trace.gamma
+    x1, x2 = (s.trace.partition for s in sides)
+    space = _space(case, k, gamma.multiplier_partition(x1, x2, mm), gamma)
     couplings = [coupling_matrix(s.trace, space, k) for s in sides]
-    structural = max(space.dim - trace_sum_dimension(k, x1, x2), 0)
+    structural = max(space.dim - gamma.trace_sum_dimension(k, x1, x2), 0)
     return sides, space, couplings, structural
 
 
@@ -106,8 +105,8 @@ def test_entry_roundoff_is_far_below_the_error_level(case, k, n1, n2, mm):
     sides, space, couplings, structural = _kernel_pieces(case, k, n1, n2, mm)
     more = []
     for s in sides:
-        x, w = quadrature_on(union_breakpoints(s.trace.breakpoints, space.breakpoints), k + space.degree + 12)
-        more.append((space.evaluate(x) * w[:, None]).T @ trace_basis_at(s.trace, x))
+        x, w = s.trace.gamma.coupling_quadrature(s.trace, space, k + space.degree + 12)
+        more.append((space.evaluate(x) * w[:, None]).T @ s.trace.gamma.trace_basis(s.trace, x))
     norms = [trace_l2_norms(s.trace, k) for s in sides]
     scale = np.sqrt(np.diag(gram(space, "L2")[0]))
     W, W_more = scaled_couplings(couplings, norms, scale), scaled_couplings(more, norms, scale)

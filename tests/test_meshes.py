@@ -4,8 +4,10 @@ import numpy as np
 import pytest
 
 from infsup_contact.errors import InputError
-from infsup_contact.discretization.meshes import (FAMILIES, gamma_breakpoints, mesh_pair, mesh_quality,
-                                   multiplier_breakpoints)
+from infsup_contact.discretization.interface import SEGMENT
+from infsup_contact.discretization.meshes import FAMILIES, mesh_pair, mesh_quality, multiplier_breakpoints
+
+gamma_breakpoints = SEGMENT.partition_of
 
 
 @pytest.mark.parametrize("family", FAMILIES)

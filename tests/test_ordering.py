@@ -5,7 +5,7 @@ import scipy.sparse as sp
 import scipy.sparse.csgraph  # noqa: F401  (sp.csgraph)
 import scipy.sparse.linalg as spla
 
-from infsup_contact.discretization.coupling import gamma_trace
+from infsup_contact.discretization.interface import SEGMENT
 from infsup_contact.models.membranes import displacement_space, laplace_stiffness, side_operator
 from infsup_contact.models.schur import _gamma_last_lu, schur_by_solves, schur_from_lu
 from infsup_contact.discretization.meshes import mesh_pair
@@ -17,7 +17,7 @@ SUPERLU_SPD = dict(diag_pivot_thresh=0.0, options=dict(SymmetricMode=True))
 def _stiffness(family, n, k):
     """K on the free dofs of Ω2 with the Γ dofs last (as ``interface.side_operator``)."""
     fes = displacement_space(mesh_pair(family, n, n)[1], k)
-    trace = gamma_trace(fes)
+    trace = SEGMENT.trace(fes)
     free_mask = np.array(fes.FreeDofs(), dtype=bool)
     is_gamma = np.zeros(fes.ndof, dtype=bool)
     is_gamma[trace.gamma_dofs] = True

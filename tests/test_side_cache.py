@@ -3,7 +3,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from infsup_contact.discretization import meshes
+from infsup_contact.discretization.interface import SEGMENT
 from infsup_contact.errors import InputError
 from infsup_contact.models.membranes import MEMBRANES
 from infsup_contact.models.side_cache import SideCache, side_keys
@@ -72,9 +72,9 @@ def test_cached_sweep_gives_the_rows_of_fresh_builds_bitwise():
     ([0, 1 / 3, 2 / 3, 1], [0, .5, 1], "union", [0, 1 / 3, .5, 2 / 3, 1]),
 ])
 def test_partition_choice(x1, x2, choice, expected):
-    assert np.array_equal(meshes.partition_choice(np.array(x1), np.array(x2), choice), expected)
+    assert np.array_equal(SEGMENT.multiplier_partition(np.array(x1), np.array(x2), choice), expected)
 
 
 def test_partition_choice_names_the_allowed_values():
     with pytest.raises(InputError, match="multiplier_mesh.*omega2, omega1, union"):
-        meshes.partition_choice(np.array([0, 1.0]), np.array([0, 1.0]), "both")
+        SEGMENT.multiplier_partition(np.array([0, 1.0]), np.array([0, 1.0]), "both")

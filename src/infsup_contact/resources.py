@@ -28,6 +28,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from .discretization.interface import SEGMENT
+
 MIB = 1024 ** 2
 
 PROCESS_BYTES = {"beta": 200 * MIB, "contact": 230 * MIB, "bench": 220 * MIB}
@@ -101,7 +103,7 @@ def _dense_bytes(k: int, ns, n_mult: float, s: int, norms, h_route: str) -> floa
     n_quad = sum(ns) * (k + s + 2) / 2          # quadrature points on the common refinement
     total = 0.0
     for n in ns:
-        g = float(n) * k + 1                   # Γ dofs of side i
+        g = float(SEGMENT.trace_nodes(k, n))  # Γ dofs of side i
         total += 8 * (4 * g * g + g * (m + n_quad) + n_quad * m)
     total += 8 * 10 * m * m                     # B X Bᵀ, its copies, eigh of two pencils
     if "H" in norms:

@@ -41,7 +41,6 @@ import scipy.sparse.linalg as spla
 
 from ..discretization import meshes, registry
 from ..discretization.coupling import coupling_matrix
-from ..discretization.norms import gram
 from ..models.membranes import side_operator
 from ..models.schur import SideOperator, interface_operator
 from ..solvers.infsup import beta_rows
@@ -82,9 +81,10 @@ class BetaSetup:
         self.n, self.k = n, k
         m1, m2 = meshes.mesh_pair("structured", n, n)
         self.sides = [side_operator(m, k) for m in (m1, m2)]
-        x = meshes.multiplier_breakpoints(m1, m2)
+        self.gamma = self.sides[0].trace.gamma
+        g_h = self.gamma.multiplier_partition(*(s.trace.partition for s in self.sides))
         self.cases = _all_cases(k)
-        self.spaces = {c: registry.case_space(c, k, x) for c in self.cases}
+        self.spaces = {c: registry.case_space(c, k, g_h, self.gamma) for c in self.cases}
         self.kernel = {c: registry.structural_kernel_dim(c, k, n) for c in self.cases}
         self.ndof = sum(s.ndof for s in self.sides)
 
@@ -101,7 +101,7 @@ class BetaSetup:
             Bs = [coupling_matrix(s.trace, self.spaces[c], self.k) for s in self.sides]
             S = interface_operator(Bs, self.sides)
             for nm in NORMS:
-                ops[c, nm] = (S, gram(self.spaces[c], nm)[0])
+                ops[c, nm] = (S, self.gamma.gram(self.spaces[c], nm)[0])
         return ops
 
     def full_coupling(self, case: str) -> sp.csr_matrix:
@@ -140,7 +140,7 @@ def beta_ours_core(setup: BetaSetup):
         Bs = [coupling_matrix(s.trace, setup.spaces[c], setup.k) for s in sides]
         S = interface_operator(Bs, sides)
         for nm in NORMS:
-            G, _ = gram(setup.spaces[c], nm)
+            G, _ = setup.gamma.gram(setup.spaces[c], nm)
             ev = sla.eigh(S, G, eigvals_only=True, check_finite=False)
             out[c, nm] = _bottom(ev[: setup.kernel[c] + 1], setup.kernel[c])
     return out
@@ -204,7 +204,7 @@ def beta_pencil_route(setup: BetaSetup, solver):
     for c in setup.cases:
         B = setup.full_coupling(c)
         for nm in NORMS:
-            G, _ = gram(setup.spaces[c], nm)
+            G, _ = setup.gamma.gram(setup.spaces[c], nm)
             out[c, nm] = solver(A, B, G, setup.kernel[c])
     return out
 

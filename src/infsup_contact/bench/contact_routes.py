@@ -58,7 +58,8 @@ def _contact_problem(n: int, k: int, case: str = REFERENCE_SPACE):
     sc = membranes()
     m1, m2 = meshes.mesh_pair("structured", n, n)
     sides = [side_operator(m, k) for m in (m1, m2)]
-    space = registry.case_space(case, k, meshes.multiplier_breakpoints(m1, m2))
+    gamma = sides[0].trace.gamma
+    space = registry.case_space(case, k, gamma.multiplier_partition(*(s.trace.partition for s in sides)), gamma)
     Bs = [coupling_matrix(s.trace, space, k) for s in sides]
     return sc, sides, Bs, [MEMBRANES.load(s, sc, i)[0] for i, s in enumerate(sides)]
 

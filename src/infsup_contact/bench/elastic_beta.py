@@ -25,7 +25,6 @@ import scipy.sparse.linalg as spla
 
 from ..discretization import meshes, registry
 from ..discretization.coupling import coupling_matrix
-from ..discretization.norms import gram
 from ..models.elastic import elastic_model
 from ..models.schur import factorized_side, interface_operator
 from ..solvers.infsup import beta_rows
@@ -46,12 +45,13 @@ def bench_elastic_beta(ns, ks, repeats: int = 3, nu: float = 0.3) -> list:
         for n in ns:
             m1, m2 = meshes.mesh_pair("structured", n, n)
             sides = [model.side_operator(m, k) for m in (m1, m2)]
-            x = meshes.multiplier_breakpoints(m1, m2)
-            spaces = {c: registry.case_space(c, k, x) for c in cases}
+            gamma = sides[0].trace.gamma
+            g_h = gamma.multiplier_partition(*(s.trace.partition for s in sides))
+            spaces = {c: registry.case_space(c, k, g_h, gamma) for c in cases}
             ops = {}
             for c in cases:
                 S = interface_operator([coupling_matrix(s.trace, spaces[c], k) for s in sides], sides)
-                ops[c] = (S, gram(spaces[c], "H")[0])
+                ops[c] = (S, gamma.gram(spaces[c], "H")[0])
 
             def ours():
                 return {r["case"]: r["beta"] for r in beta_rows("structured", k, n, n, cases, norms=("H",),
@@ -62,7 +62,7 @@ def bench_elastic_beta(ns, ks, repeats: int = 3, nu: float = 0.3) -> list:
                 out = {}
                 for c in cases:
                     S = interface_operator([coupling_matrix(s.trace, spaces[c], k) for s in fs], fs)
-                    out[c] = float(np.sqrt(max(sla.eigh(S, gram(spaces[c], "H")[0], eigvals_only=True,
+                    out[c] = float(np.sqrt(max(sla.eigh(S, gamma.gram(spaces[c], "H")[0], eigvals_only=True,
                                                         check_finite=False)[0], 0.0)))
                 return out
 

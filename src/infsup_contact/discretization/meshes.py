@@ -25,10 +25,11 @@ from netgen import meshing
 from netgen.geom2d import SplineGeometry
 
 from ..errors import InputError
+from .interface import MULTIPLIER_MESHES, SEGMENT  # noqa: F401  (MULTIPLIER_MESHES: the choices of G_h)
 
 FAMILIES = ("structured", "perturbed", "unstructured")
 SIDES = (1, 2)
-GAMMA, DIRICHLET = "gamma", "dir"
+GAMMA, DIRICHLET = SEGMENT.boundary, "dir"
 
 
 def check_mesh_args(family: str, n: int, key: str = "N") -> None:
@@ -229,33 +230,10 @@ def mesh_pair(family: str, n1: int, n2: int, **kwargs):
     return subdomain_mesh(family, n1, 1, **kwargs), subdomain_mesh(family, n2, 2, **kwargs)
 
 
-def gamma_breakpoints(mesh: ngsolve.Mesh) -> np.ndarray:
-    """Sorted x-coordinates of the mesh vertices on Γ (the trace partition)."""
-    xs = set()
-    for el in mesh.Elements(ngsolve.BND):
-        if el.mat == GAMMA:
-            for v in el.vertices:
-                xs.add(mesh[v].point[0])
-    return np.array(sorted(xs))
-
-
-MULTIPLIER_MESHES = ("omega2", "omega1", "union")
-
-
-def partition_choice(x1: np.ndarray, x2: np.ndarray, choice: str = "omega2", tol: float = 1e-12) -> np.ndarray:
-    """Partition G_h of Γ from the two trace partitions: Ω2's (the paper's default), Ω1's,
-    or their union (points closer than ``tol`` merged)."""
-    if choice not in MULTIPLIER_MESHES:
-        raise InputError("multiplier_mesh", ", ".join(MULTIPLIER_MESHES), got=choice)
-    if choice == "union":
-        x = np.union1d(x1, x2)
-        return x[np.concatenate([[True], np.diff(x) > tol])]
-    return np.asarray(x2 if choice == "omega2" else x1)
-
-
 def multiplier_breakpoints(mesh1, mesh2, choice: str = "omega2", tol: float = 1e-12) -> np.ndarray:
-    """Partition G_h of Γ (:func:`partition_choice`) of a mesh pair."""
-    return partition_choice(gamma_breakpoints(mesh1), gamma_breakpoints(mesh2), choice, tol)
+    """Partition G_h of Γ of a mesh pair (:meth:`~.interface.Interface.multiplier_partition_of`
+    of the paper's segment)."""
+    return SEGMENT.multiplier_partition_of(mesh1, mesh2, choice, tol)
 
 
 def mesh_quality(mesh: ngsolve.Mesh) -> dict:

@@ -162,11 +162,6 @@ def make_space(breakpoints, degree: int, continuous: bool, vanish_at_ends: bool)
     return MultiplierSpace(x, s, continuous, vanish_at_ends, dofs, dim)
 
 
-def trace_dimension(k: int, n_intervals: int) -> int:
-    """dim W_h: traces on Γ of continuous P_k vanishing at Γ's endpoints, N intervals."""
-    return n_intervals * k - 1
-
-
 def local_basis_space(breakpoints, degree: int, dofs, coefficients=None, *, continuous: bool = False,
                       vanish_at_ends: bool = False) -> MultiplierSpace:
     """A space given by its local basis and global numbering — the public way to define one.

@@ -18,7 +18,8 @@ import numpy as np
 
 from ..errors import InputError
 from .dual import dual_space
-from .multipliers import MultiplierSpace, make_space, trace_dimension
+from .interface import MULTIPLIER_MESHES, SEGMENT
+from .multipliers import MultiplierSpace, make_space
 
 #: Okabe & Ito (2008), "Color Universal Design": distinguishable under the common
 #: colour-vision deficiencies.
@@ -112,7 +113,7 @@ class SpaceSpec:
     def structural_kernel(self, k: int, n: int) -> int | None:
         """max(dim M − dim W, 0) on matching meshes with N intervals (W = the trace space),
         None without a dimension count."""
-        return None if self.dimension is None else max(self.dimension(k, n) - trace_dimension(k, n), 0)
+        return None if self.dimension is None else max(self.dimension(k, n) - SEGMENT.trace_dimension(k, n), 0)
 
     def cone(self, k: int) -> str:
         """``pointwise`` (λ_h ≥ 0 everywhere), ``nodal`` (at the Lagrange nodes) or
@@ -162,8 +163,10 @@ def check_case(case: str, k: int) -> None:
         raise InputError("k", f"k >= {spec.min_k} for case {case} ({spec.paper_ref} needs k >= {spec.min_k})")
 
 
-def case_space(case: str, k: int, breakpoints) -> MultiplierSpace:
-    """The multiplier space of a registered case for displacement degree k on G_h.
+def case_space(case: str, k: int, partition, gamma=SEGMENT) -> MultiplierSpace:
+    """The multiplier space of a registered case for displacement degree k on G_h, a
+    ``partition`` of Γ = ``gamma`` (:mod:`.interface`; for the paper's segment the sorted
+    breakpoints of G_h, what ``SpaceSpec.build(k, x)`` receives).
 
     Raises
     ------
@@ -172,8 +175,8 @@ def case_space(case: str, k: int, breakpoints) -> MultiplierSpace:
         the eigenproblems and solves would fail deep inside numpy), naming the case, N and k.
     """
     check_case(case, k)
-    x = np.asarray(breakpoints, dtype=float)
-    n = len(x) - 1 if x.ndim == 1 else 0
+    x = np.asarray(partition, dtype=float)
+    n = gamma.cells(x) if x.ndim == 1 else 0
     if n < 1:
         raise InputError("multiplier mesh", f"a partition of Γ with at least one interval (case {case}, "
                          f"k = {k}, N = {max(n, 0)})")
@@ -221,18 +224,15 @@ def min_intervals(case, k: int) -> int | None:
     return next((n for n in range(1, MAX_MIN_INTERVALS + 1) if space_dim(case, k, n) > 0), None)
 
 
-MULTIPLIER_CHOICES = ("omega2", "omega1", "union")
-"""The choices of G_h (meshes.MULTIPLIER_MESHES; spelled here so the registry needs no NGSolve)."""
+MULTIPLIER_CHOICES = MULTIPLIER_MESHES
+"""The choices of G_h (:data:`~.interface.MULTIPLIER_MESHES`)."""
 
 
 def multiplier_intervals(n1: int, n2: int, choice: str = "omega2") -> int:
-    """Intervals of G_h (meshes.partition_choice) when the traces on Γ have N1 and N2 equal
-    segments: N2 (``omega2``), N1 (``omega1``), or N1 + N2 − gcd(N1, N2) for their ``union``
-    (i/N1 = j/N2 exactly at the multiples of 1/gcd). The perturbed family's union has at
-    least as many intervals; every space here grows with N."""
-    import math
-
-    return {"omega2": n2, "omega1": n1}.get(choice, n1 + n2 - math.gcd(n1, n2))
+    """Intervals of G_h when the traces on Γ have N1 and N2 equal segments
+    (:meth:`~.interface.Interface.multiplier_cells` of the paper's segment). The perturbed
+    family's union has at least as many intervals; every space here grows with N."""
+    return SEGMENT.multiplier_cells(n1, n2, choice)
 
 
 def check_nonempty(case, k: int, n: int, key: str = "N", where: str = "") -> None:

@@ -7,6 +7,14 @@ returns a :class:`~infsup_contact.discretization.multipliers.MultiplierSpace` �
 :func:`~infsup_contact.discretization.multipliers.local_basis_space` (any local basis and
 numbering). ``examples/macro_p0.py`` is one.
 
+**The partition a build receives.** Spaces are built on Γ, the interface object
+(:mod:`infsup_contact.discretization.interface`): the suite asks ``registry.case_space(case, k, G_h, gamma)``
+and, for the paper's segment :class:`~infsup_contact.discretization.interface.Segment` — today
+the only Γ — that passes G_h as it represents it, the sorted breakpoints 0 = x_0 < … < x_N = 1.
+So a user's ``build(k, x)`` keeps receiving the breakpoints of G_h, a float array of shape
+(N + 1,), and must return a space on exactly those breakpoints; this is the public contract and
+does not change. A space for another Γ (a 2D face) would receive that interface's partition.
+
 The user's code runs under one guard: importing the file, calling ``FUNC()``, ``dimension()``,
 ``degree()`` and ``build()``. Any exception it raises — SystemExit included, only
 KeyboardInterrupt passes — becomes one :class:`~infsup_contact.errors.InputError` line naming

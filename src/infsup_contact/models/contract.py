@@ -5,8 +5,10 @@
 never ask which one it is. A model is one function, ``side_operator(mesh, k)``, applied to
 each mesh of a pair; the :class:`~infsup_contact.models.schur.SideOperator` it returns carries
 
-* ``trace`` — the Γ trace of the side's displacement space: its partition of Γ
-  (``trace.breakpoints``), its Γ dofs (``trace.gamma_dofs``, the components b(v, μ) sees:
+* ``trace`` — the Γ trace of the side's displacement space: its interface (``trace.gamma``,
+  the :class:`~infsup_contact.discretization.interface.Interface` every consumer asks for
+  partitions, quadrature, Gram matrices and spaces), its partition of Γ (``trace.partition``,
+  opaque outside the interface), its Γ dofs (``trace.gamma_dofs``, the components b(v, μ) sees:
   for a scalar membrane v itself, for an elastic body v·n) and the NGSolve space, from which
   :func:`~infsup_contact.discretization.coupling.coupling_matrix` builds B_i;
 * ``steklov_times(M)`` — X_i M with X_i = (A_i⁻¹)_ΓΓ at unit material scale: the interface

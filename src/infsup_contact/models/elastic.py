@@ -31,7 +31,7 @@ import numpy as np
 import ngsolve
 import scipy.sparse as sp
 
-from ..discretization.coupling import gamma_trace
+from ..discretization.interface import SEGMENT
 from ..discretization.meshes import DIRICHLET
 from .contract import Model
 from .plane_strain import E_RANGE, NU_RANGE, check_modulus, check_nu, lame  # noqa: F401 (the model's material law)
@@ -90,8 +90,8 @@ def elastic_stiffness(space: ElasticSpace, nu: float) -> sp.csr_matrix:
 
 def gamma_dofs_both(space: ElasticSpace) -> tuple:
     """(tangential, normal) free Γ dofs in product-space numbering, each sorted by dof."""
-    tx = gamma_trace(space.fx).gamma_dofs
-    ty = gamma_trace(space.fy).gamma_dofs + space.offset_y
+    tx = SEGMENT.trace(space.fx).gamma_dofs
+    ty = SEGMENT.trace(space.fy).gamma_dofs + space.offset_y
     return tx, ty
 
 
@@ -99,7 +99,7 @@ def free_order(space: ElasticSpace) -> tuple:
     """Free product-space dofs ordered [interior, Γ tangential, Γ normal], and the normal
     component's :class:`GammaTrace` (its dofs numbered in ``space.fy``, as the coupling
     matrices B_i see them)."""
-    trace = gamma_trace(space.fy)
+    trace = SEGMENT.trace(space.fy)
     free_mask = np.concatenate([np.array(space.fx.FreeDofs(), dtype=bool),
                                 np.array(space.fy.FreeDofs(), dtype=bool)])
     tx, ty = gamma_dofs_both(space)

@@ -10,7 +10,7 @@ import numpy as np
 import ngsolve
 import scipy.sparse as sp
 
-from ..discretization.coupling import gamma_trace
+from ..discretization.interface import SEGMENT
 from .contract import OUTWARD_NORMAL_Y, Model
 from .schur import SideOperator, factorized_side
 
@@ -36,7 +36,7 @@ def side_operator(mesh, k: int, route: str = "auto") -> SideOperator:
     """Factorize K_i once and extract its Γ Schur complement (c = 1); ``route`` as in
     :func:`gamma_factorization`."""
     fes = displacement_space(mesh, k)
-    trace = gamma_trace(fes)
+    trace = SEGMENT.trace(fes)
     free_mask = np.array(fes.FreeDofs(), dtype=bool)
     is_gamma = np.zeros(fes.ndof, dtype=bool)
     is_gamma[trace.gamma_dofs] = True

@@ -32,7 +32,7 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from ..discretization.coupling import GammaTrace
+from ..discretization.interface import GammaTrace
 from ..errors import InputError
 from .ordering import nested_dissection_gamma_last
 

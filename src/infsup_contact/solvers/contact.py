@@ -24,7 +24,7 @@ import scipy.sparse.linalg as spla
 
 from ..discretization import meshes, multipliers, registry
 from .pdas import PdasResult, solve_pdas
-from ..discretization.coupling import coupling_matrix, quadrature_on, union_breakpoints
+from ..discretization.coupling import coupling_matrix
 from ..models import DEFAULT_MODEL
 from ..models.contract import B_SIGN
 from ..models.schur import interface_operator
@@ -69,13 +69,18 @@ class ContactSolution:
     def ndof(self) -> int:
         return sum(s.ndof for s in self.sides) + self.space.dim
 
+    @property
+    def gamma(self):
+        """Γ, the interface of the sides (:mod:`infsup_contact.discretization.interface`)."""
+        return self.sides[0].trace.gamma
+
     def pressure(self, x: np.ndarray) -> np.ndarray:
         """λ_h(x)."""
         return self.space.evaluate(x) @ self.lam
 
     def resultant(self) -> float:
         """P = ∫_Γ λ_h (exact Gauss on G_h)."""
-        x, w = quadrature_on(self.space.breakpoints, self.space.degree + 1)
+        x, w = self.gamma.quadrature(self.space.breakpoints, self.space.degree + 1)
         return float(w @ self.pressure(x))
 
 
@@ -160,9 +165,9 @@ def linear_saddle_time(sides, Bs, c, F, active) -> float:
     return time.perf_counter() - t
 
 
-def weighted_gap(space, g0, degree: int) -> np.ndarray:
-    """G_j = ∫_Γ μ_j g0 by Gauss–Legendre exact for g0 polynomial of ``degree``."""
-    x, w = quadrature_on(union_breakpoints(space.breakpoints), space.degree + degree)
+def weighted_gap(gamma, space, g0, degree: int) -> np.ndarray:
+    """G_j = ∫_Γ μ_j g0 by the quadrature of Γ (``gamma``) exact for g0 polynomial of ``degree``."""
+    x, w = gamma.quadrature(gamma.common_refinement(space.breakpoints), space.degree + degree)
     return (space.evaluate(x) * w[:, None]).T @ g0(x)
 
 
@@ -237,7 +242,7 @@ def solve_on_gamma(pair: ContactPair, space, time_floor: bool = False) -> Contac
     ng = [B.shape[1] for B in Bs]
     g0 = Bs[1] @ pair.u0[1][-ng[1]:] - Bs[0] @ pair.u0[0][-ng[0]:]
     if pair.gap is not None:
-        g0 = weighted_gap(space, pair.gap, pair.gap_degree) + g0
+        g0 = weighted_gap(sides[0].trace.gamma, space, pair.gap, pair.gap_degree) + g0
     pdas = solve_pdas(K, g0)
     lifts = pair.lifts or [None] * len(sides)
     u = []
@@ -260,7 +265,9 @@ def solve_contact_on(pair: ContactPair, case: str, multiplier_mesh: str = "omega
     """
     registry.check_case(case, pair.k)
     t0 = time.perf_counter()
-    space = registry.case_space(case, pair.k, meshes.multiplier_breakpoints(*pair.meshes, multiplier_mesh))
+    gamma = pair.sides[0].trace.gamma
+    space = registry.case_space(case, pair.k, gamma.multiplier_partition(*(s.trace.partition for s in pair.sides),
+                                                                         multiplier_mesh), gamma)
     t_space = time.perf_counter() - t0
     sol = solve_on_gamma(pair, space, time_floor)
     sol.t_solve += t_space  # building M_h is part of this case's solve
@@ -278,12 +285,13 @@ def solve_contact(scene, case: str, k: int, family: str, n1: int, n2: int,
 
 
 def gamma_values(sol: ContactSolution, x: np.ndarray):
-    """u_{1,h}, u_{2,h} on Γ at abscissae x (interior of Γ), via point evaluation."""
+    """u_{1,h}, u_{2,h} on Γ at points x of Γ (its interior), via point evaluation."""
     x = np.asarray(x, dtype=float)
     out = []
+    where = sol.gamma.embed(x)
     for gf, side in zip(sol.u, sol.sides):
         mesh = side.trace.fes.mesh
-        out.append(np.asarray(gf(mesh(x, np.ones_like(x)))).reshape(x.shape))
+        out.append(np.asarray(gf(mesh(*where))).reshape(x.shape))
     return out
 
 

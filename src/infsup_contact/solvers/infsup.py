@@ -3,7 +3,9 @@
 β_h = inf_μ sup_v b(v, μ) / (‖v‖_a ‖μ‖_M), so β_h² is the smallest eigenvalue of the
 generalized symmetric eigenproblem (B A⁻¹ Bᵀ) m = β² G m on the multiplier space,
 with B A⁻¹ Bᵀ the interface operator (:mod:`infsup_contact.models.schur`) and G the Gram
-matrix of the multiplier norm (:mod:`infsup_contact.discretization.norms`).
+matrix of the multiplier norm. Partitions, spaces and Gram matrices come from Γ, the
+interface the sides' traces live on (``trace.gamma``,
+:mod:`infsup_contact.discretization.interface`).
 """
 from __future__ import annotations
 
@@ -21,7 +23,8 @@ from ..errors import InputError, check_prestress
 from ..models.schur import combine_terms, interface_terms
 from ..models import DEFAULT_MODEL
 from ..models.side_cache import SideCache
-from ..discretization.norms import NORMS, gram
+from ..discretization.interface import SEGMENT, check_choice
+from ..discretization.norms import NORMS
 from .kernel import (GAP_DECADES, KERNEL_CRITERION, KernelDecision, coupling_kernel, gap_over_roundoff,  # noqa: F401
                      kernel_check, kernel_from_gap, scaled_couplings)
 
@@ -105,28 +108,17 @@ def check_inputs(case, k, family, n1, n2, c1, c2, norm, multiplier_mesh) -> None
     for nm in norm:
         if nm not in NORMS:
             raise InputError("norm", ", ".join(NORMS), got=nm)
-    if multiplier_mesh not in meshes.MULTIPLIER_MESHES:
-        raise InputError("multiplier_mesh", ", ".join(meshes.MULTIPLIER_MESHES), got=multiplier_mesh)
+    check_choice(multiplier_mesh)
     registry.check_pair_spaces(case, k, n1, n2, (multiplier_mesh,))  # dim M_h = 0: refused here
 
 
-def common_coarsening(x1: np.ndarray, x2: np.ndarray, tol: float = 1e-12) -> np.ndarray:
-    """Breakpoints shared by two partitions of Γ."""
-    return np.array([x for x in x1 if np.min(np.abs(x2 - x)) < tol])
-
-
-def trace_sum_dimension(k: int, x1: np.ndarray, x2: np.ndarray) -> int:
-    """dim(W1 + W2) = dim W1 + dim W2 − dim(W1 ∩ W2); W1 ∩ W2 lives on the common coarsening."""
-    n1, n2, nc = len(x1) - 1, len(x2) - 1, len(common_coarsening(x1, x2)) - 1
-    return (n1 * k - 1) + (n2 * k - 1) - (nc * k - 1)
-
-
-def _space(case, k, breakpoints):
-    """A named case, or a general triple ``(label, s, continuous, vanish)`` (eqs. 5.3, 5.5)."""
+def _space(case, k, partition, gamma=SEGMENT):
+    """A named case on G_h = ``partition`` of ``gamma``, or a general triple
+    ``(label, s, continuous, vanish)`` (eqs. 5.3, 5.5; spaces of the segment)."""
     if isinstance(case, str):
-        return registry.case_space(case, k, breakpoints)
+        return registry.case_space(case, k, partition, gamma)
     _, s, continuous, vanish = case
-    return multipliers.make_space(breakpoints, s, continuous, vanish)
+    return multipliers.make_space(partition, s, continuous, vanish)
 
 
 def beta_rows(family, k, n1, n2, cases=None, multiplier_mesh="omega2",
@@ -176,23 +168,24 @@ def beta_rows_all(family, k, n1, n2, cases=None, multiplier_meshes=("omega2",), 
     t1 = time.perf_counter()
     sides = (SideCache() if side_cache is None else side_cache).pair(model, family, k, n1, n2, **mesh_kwargs)
     t2 = time.perf_counter()
-    x1, x2 = (s.trace.breakpoints for s in sides)
-    dim_w = trace_sum_dimension(k, x1, x2)
+    gamma = sides[0].trace.gamma
+    p1, p2 = (s.trace.partition for s in sides)
+    dim_w = gamma.trace_sum_dimension(k, p1, p2)
     rows, by_partition = [], {}
     for multiplier_mesh in multiplier_meshes:
-        x_mult = meshes.partition_choice(x1, x2, multiplier_mesh)
-        same = by_partition.get(x_mult.tobytes())
+        g_h = gamma.multiplier_partition(p1, p2, multiplier_mesh)
+        same = by_partition.get(gamma.partition_key(g_h))
         if same is not None:
             rows += [dict(r, multiplier_mesh=multiplier_mesh, t_assemble=0.0, t_interface=0.0, t_eig=0.0)
                      for r in same]
             continue
         first = len(rows)
         for case in cases:
-            space = _space(case, k, x_mult)
+            space = _space(case, k, g_h, gamma)
             tc = time.perf_counter()
             couplings = [coupling_matrix(s.trace, space, k) for s in sides]
             t_coupling = time.perf_counter() - tc
-            grams = {norm: gram(space, norm, h_route=h_route) for norm in norms}
+            grams = {norm: gamma.gram(space, norm, h_route=h_route) for norm in norms}
             structural = max(space.dim - dim_w, 0)
             kernel = space_kernel(couplings, sides, space, k, structural,
                                   grams["L2"][0] if "L2" in grams else None)
@@ -220,7 +213,7 @@ def beta_rows_all(family, k, n1, n2, cases=None, multiplier_meshes=("omega2",), 
                         n_max=info["n_max"], nmax_rel_error=info["nmax_rel_error"],
                         ndof=sum(s.ndof for s in sides), t_assemble=t_coupling,
                         t_interface=t2 - t1, t_eig=time.perf_counter() - te))
-        by_partition[x_mult.tobytes()] = rows[first:]
+        by_partition[gamma.partition_key(g_h)] = rows[first:]
     return rows
 
 
@@ -230,7 +223,7 @@ def space_kernel(couplings, sides, space, k: int, structural: int, l2_gram=None)
     multiplier basis functions (the diagonal of the L² Gram matrix, computed if not given);
     ``structural`` = max(dim M − dim(W1 + W2), 0) is its proven part. One decision serves
     every norm and every (c1, c2): the kernel of B A⁻¹ Bᵀ depends on neither."""
-    G = gram(space, "L2")[0] if l2_gram is None else l2_gram
+    G = sides[0].trace.gamma.gram(space, "L2")[0] if l2_gram is None else l2_gram
     rows, cols = [trace_l2_norms(s.trace, k) for s in sides], np.sqrt(np.diag(G))
     W = scaled_couplings(couplings, rows, cols)
     longer = scaled_couplings([coupling_matrix(s.trace, space, k, extra_degree=6) for s in sides], rows, cols)

@@ -10,17 +10,15 @@ import scipy.fft
 
 from ..solvers.contact import ContactSolution, gamma_values, lambda_values
 from ..discretization.norms import sine_coefficients
-from ..discretization.quadrature import gauss_legendre
 from .profiles import gamma_sample_points
 
 N_SAMPLE = 4001
 """Points on Γ for pointwise quantities (penetration, contact set)."""
 
 
-def _gauss_on(breaks: np.ndarray, n: int = 12):
-    t, w = gauss_legendre(n)
-    a, b = breaks[:-1, None], breaks[1:, None]
-    return (0.5 * (a + b) + 0.5 * (b - a) * t).ravel(), (0.5 * (b - a) * w).ravel()
+def _gauss_on(gamma, partition, n: int = 12):
+    """``n`` Gauss points per cell of ``partition``: Γ's quadrature of degree 2n − 1."""
+    return gamma.quadrature(partition, 2 * n - 1)
 
 
 def energy_and_l2_errors(sol: ContactSolution, exact) -> tuple[float, float]:
@@ -38,7 +36,7 @@ def energy_and_l2_errors(sol: ContactSolution, exact) -> tuple[float, float]:
 def lambda_l2_error(sol: ContactSolution, lam_exact, kinks=()) -> float:
     """‖λ − λ_h‖_{L²(Γ)} by Gauss on the multiplier partition refined at ``kinks``."""
     breaks = np.unique(np.r_[np.linspace(0, 1, 4 * sol.space.n_intervals + 1), sol.space.breakpoints, kinks])
-    x, w = _gauss_on(breaks)
+    x, w = _gauss_on(sol.gamma, breaks)
     return float(np.sqrt(w @ (lam_exact(x) - lambda_values(sol, x)) ** 2))
 
 
@@ -171,8 +169,8 @@ def energy_and_l2_vs_reference(sol: ContactSolution, ref: ContactSolution) -> tu
 
 def lambda_errors_vs_reference(sol: ContactSolution, ref: ContactSolution):
     """(‖λ_ref − λ_h‖_{L²(Γ)}, ‖λ_ref − λ_h‖_M), both exact up to the series tail."""
-    breaks = np.union1d(sol.space.breakpoints, ref.space.breakpoints)
-    x, w = _gauss_on(breaks)
+    gamma = sol.gamma  # tol=0: only equal breakpoints merge (as np.union1d)
+    x, w = _gauss_on(gamma, gamma.common_refinement(sol.space.breakpoints, ref.space.breakpoints, tol=0.0))
     l2 = float(np.sqrt(w @ (lambda_values(ref, x) - lambda_values(sol, x)) ** 2))
     n = np.arange(1, N_SINE + 1)
     e = _reference_samples(ref)["lambda_sine"] - sol.lam @ sine_coefficients(sol.space, n)

@@ -36,7 +36,6 @@ import ngsolve
 import numpy as np
 
 from ..discretization import registry
-from ..discretization.coupling import quadrature_on
 from ..models import make_model
 from ..models.plane_strain import check_modulus, check_nu, lame
 from ..solvers.contact import contact_pair, solve_contact_on
@@ -124,9 +123,8 @@ def hertz_row(case: str, k: int, n1: int, n2: int, R: float, d: float, nu: float
 
 
 def sample_points(sol, per_interval: int = 24) -> np.ndarray:
-    g = sol.space.breakpoints
-    t = np.linspace(0.0, 1.0, per_interval + 1)
-    return np.unique(np.clip((g[:-1, None] + np.outer(np.diff(g), t)).ravel(), 0.0, 1.0))
+    """``per_interval`` + 1 points per interval of G_h (:meth:`~infsup_contact.discretization.interface.Interface.sample`)."""
+    return sol.gamma.sample(sol.space.breakpoints, per_interval)
 
 
 def profile_measures(sol, x=None) -> dict:
@@ -180,8 +178,9 @@ def energy_error(sol, ref_data, nu: float) -> float:
 
 def lambda_l2_error(sol, ref) -> float:
     """‖λ_ref − λ_h‖_{L²(Γ)} by Gauss on the union of both partitions."""
-    x, w = quadrature_on(np.union1d(sol.space.breakpoints, ref.space.breakpoints), 2 * max(sol.space.degree,
-                                                                                           ref.space.degree) + 2)
+    gamma = sol.gamma  # tol=0: only equal breakpoints merge (an interval of 1 ulp is kept, as np.union1d)
+    x, w = gamma.quadrature(gamma.common_refinement(sol.space.breakpoints, ref.space.breakpoints, tol=0.0),
+                            2 * max(sol.space.degree, ref.space.degree) + 2)
     return float(np.sqrt(w @ (sol.pressure(x) - ref.pressure(x)) ** 2))
 
 

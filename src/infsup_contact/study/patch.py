@@ -49,8 +49,6 @@ import numpy as np
 import scipy.linalg as sla
 
 from ..discretization import meshes, registry
-from ..discretization.coupling import union_breakpoints
-from ..discretization.norms import gram
 from ..models import make_model
 from ..models.plane_strain import check_modulus, check_nu
 from ..solvers.contact import contact_pair, solve_contact_on
@@ -90,13 +88,12 @@ def exact_pressure(delta: float, nu: float, E) -> float:
     return delta / sum(1.0 / constrained_modulus(e, nu) for e in E)
 
 
-def _where(x, g):
-    """Masks of sample points x: in an end interval of G_h (breakpoints g), elsewhere within
+def _where(gamma, x, g):
+    """Masks of sample points x: in an end interval of G_h (partition g of ``gamma``), elsewhere within
     1/4 of an end, in the middle half [1/4, 3/4]. (With the ratios 5:4 and 7:3 every interval
     of G_h away from the common nodes holds an Ω1 node that is not a node of G_h: seams are
     everywhere, so the split is by distance from the ends.)"""
-    e = np.clip(np.searchsorted(g, x, side="right") - 1, 0, len(g) - 2)
-    ends = (e == 0) | (e == len(g) - 2)
+    ends = gamma.at_boundary(g, x)
     middle = (x >= 0.25) & (x <= 0.75) & ~ends
     return ends, ~(ends | middle), middle
 
@@ -141,19 +138,18 @@ def solve_patch(case: str, k: int, n1: int, n2: int, nu: float = 0.3, E=(1.0, 1.
         pair = patch_pair(k, n1, n2, nu, E, delta)
     sol = solve_contact_on(pair, case, "omega2", time_floor=False)
     sides, space, res = sol.sides, sol.space, sol.pdas
-    g = space.breakpoints
+    gamma, g = sol.gamma, space.breakpoints
     p = exact_pressure(delta, nu, E)
     M1, M2 = (constrained_modulus(e, nu) for e in E)
     exact = (-p * ngsolve.y / M1, -p / M1 - p * (ngsolve.y - 1.0) / M2)
     u_err = max(np.max(np.abs(gf.vec.FV().NumPy() - pair.model.interpolate(s, (0.0, uy)))) / delta
                 for s, gf, uy in zip(sides, sol.u, exact))
     K = sol.K
-    xs = union_breakpoints(g, sides[0].trace.breakpoints, sides[1].trace.breakpoints)
-    t = np.linspace(0.0, 1.0, per_interval + 1)
-    x = np.unique(np.clip((xs[:-1, None] + np.outer(np.diff(xs), t)).ravel(), 0.0, 1.0 - 1e-15))
+    x = gamma.sample(gamma.common_refinement(g, *(s.trace.partition for s in sides)), per_interval,
+                     upper=1.0 - 1e-15)
     err = np.abs(space.evaluate(x) @ res.lam - p) / p
-    ends, near, middle = _where(x, g)
-    G, _ = gram(space, "L2")
+    ends, near, middle = _where(gamma, x, g)
+    G, _ = gamma.gram(space, "L2")
     ev = sla.eigh(K, G, eigvals_only=True)
     lam_err = float(err.max())
     return dict(scene=SCENE, case=case, k=k, family="structured", N1=n1, N2=n2, E1=E[0], E2=E[1], nu=nu,

@@ -24,15 +24,15 @@ EXPORT_FORMATS = {"mtx": ".mtx", "npz": ".npz", "petsc": ".petsc"}
 def suite_system(case: str, k: int, n1: int, n2: int, family: str = "structured", norm: str = "H",
                  multiplier_mesh: str = "omega2", model=None, **mesh_kwargs):
     """(A, B, G) of ``case`` on the pair (N1, N2) of ``model`` (default: membranes)."""
-    from ..discretization import meshes, registry
+    from ..discretization import registry
     from ..discretization.coupling import coupling_matrix
-    from ..discretization.norms import gram
     from ..models.membranes import MEMBRANES
     from ..models.side_cache import SideCache
 
     sides = SideCache().pair(MEMBRANES if model is None else model, family, k, n1, n2, **mesh_kwargs)
-    x1, x2 = (s.trace.breakpoints for s in sides)
-    space = registry.case_space(case, k, meshes.partition_choice(x1, x2, multiplier_mesh))
+    gamma = sides[0].trace.gamma
+    g_h = gamma.multiplier_partition(*(s.trace.partition for s in sides), multiplier_mesh)
+    space = registry.case_space(case, k, g_h, gamma)
     blocks = []
     for sign, side in zip((-1.0, 1.0), sides):
         Bi = coupling_matrix(side.trace, space, k)
@@ -40,7 +40,7 @@ def suite_system(case: str, k: int, n1: int, n2: int, family: str = "structured"
         full[:, side.ndof - Bi.shape[1]:] = sign * Bi
         blocks.append(sp.csr_matrix(full))
     A = sp.block_diag([s.stiffness for s in sides], format="csr")
-    G, _ = gram(space, norm)
+    G, _ = gamma.gram(space, norm)
     return A, sp.hstack(blocks, format="csr"), np.asarray(G, float)
 
 

@@ -27,6 +27,8 @@ from pathlib import Path
 import pytest
 import yaml
 
+from _cli import run_in_process
+
 from infsup_contact import cli, resources
 from infsup_contact.config_checks import (CROSS_KEY_RULES, REFERENCE_MARGIN, ConfigError, check_config,
                                           key_path, scene_meshes)
@@ -302,15 +304,6 @@ def flag_values(action):
     return out
 
 
-def run_in_process(argv):
-    """cli.main in this process: (exit code, stdout, stderr); argparse's SystemExit caught."""
-    out, err = io.StringIO(), io.StringIO()
-    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
-        try:
-            code = cli.main(argv)
-        except SystemExit as exc:
-            code = exc.code
-    return code, out.getvalue(), err.getvalue()
 
 
 def cli_mutations(tables):

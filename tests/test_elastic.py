@@ -5,6 +5,8 @@ from __future__ import annotations
 import ngsolve
 import numpy as np
 import pytest
+
+from _cli import run_in_process
 import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
@@ -154,18 +156,7 @@ def test_bad_nu_refused(bad):
 
 
 def _run(argv):
-    import contextlib
-    import io
-
-    from infsup_contact import cli
-
-    out, err = io.StringIO(), io.StringIO()
-    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
-        try:
-            code = cli.main(argv)
-        except SystemExit as exc:
-            code = exc.code
-    return code, out.getvalue(), err.getvalue()
+    return run_in_process(argv)
 
 
 def test_cli_beta_elastic_columns_and_agreement():

@@ -10,6 +10,8 @@ from pathlib import Path
 
 import pytest
 
+from _cli import run_in_process
+
 import infsup_contact
 from infsup_contact.models import MODELS
 from infsup_contact.study.scene_registry import allowed_pairs, scene_ids, scene_spec
@@ -54,15 +56,7 @@ def test_no_engine_module_imports_a_concrete_model(stage):
 
 
 def _run(argv):
-    from infsup_contact import cli
-
-    out, err = io.StringIO(), io.StringIO()
-    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
-        try:
-            code = cli.main(argv)
-        except SystemExit as exc:
-            code = exc.code
-    return code, out.getvalue(), err.getvalue()
+    return run_in_process(argv)
 
 
 DECLARED = [(m, s) for s in scene_ids() for m in scene_spec(s).models]

@@ -180,6 +180,18 @@ def test_cli_bad_elastic_input_one_line_exit_2(flag, value, model):
     assert code == 2 and out == "" and len(err.splitlines()) == 1 and flag in err, (code, err)
 
 
+@pytest.mark.parametrize("model, flag", [("membranes", "--nu"), ("membranes", "--E2"), ("elastic", "--c1")])
+def test_cli_refuses_another_models_flag_naming_the_models_flags(model, flag):
+    """The material flags come from the model contract (Model.params): a flag the model lacks
+    is refused in one line naming it and the flags the model has."""
+    from infsup_contact.models import MODELS
+
+    code, out, err = _run(["beta", "--model", model, "--case", "T3", "--k", "2", "--N1", "4", "--N2", "4",
+                           flag, "2", "--dry-run"])
+    assert code == 2 and out == "" and len(err.splitlines()) == 1 and flag in err, (code, err)
+    assert all(f"--{name}" in err for name in MODELS[model].param_names()), err
+
+
 # ----------------------------------------------------------------- the contact patch test
 
 def test_patch_passes_with_constants_and_t3_fails_at_the_ends():

@@ -33,26 +33,8 @@ def test_series_and_ratio_labels():
     assert S.describe("ratio3-2") == "N1:N2 = 3:2" and S.describe("plus1") == "N1 = N2 + 1"
 
 
-def test_batches_cover_every_pair_once_per_family_and_k():
-    batches = S.beta_batches(IC, budget=0.5)
-    pairs = set(S.series_of_pairs(IC))
-    for fam in IC["families"]:
-        for k in (1, 2):
-            got = [p for b in batches.values() if b["family"] == fam and b["k"] == k for p in b["pairs"]]
-            assert sorted(got) == sorted(pairs)
-    assert len(batches) > 4  # the small budget cuts batches
-
-
 def test_seeds_accept_an_integer_or_a_list():
     assert S.seeds({"seed": 5}) == [5] and S.seeds({"seed": [0, 1]}) == [0, 1] and S.seeds({}) == [0]
-
-
-def test_primary_rows_keep_the_smallest_seed_and_each_pair_once():
-    b = pd.DataFrame(dict(family=["perturbed"] * 3 + ["structured"] * 2, seed=[0, 1, 0, np.nan, np.nan],
-                          series=["matching", "matching", "plus1", "ratio3-2", "sqrt2"],
-                          N1=[8, 8, 9, 6, 6], N2=[8, 8, 8, 4, 4], beta=[1, 2, 3, 4, 4]))
-    p = S.primary_rows(b)
-    assert sorted(p.beta) == [1, 3, 4]
 
 
 def _series(seeds, ns, slope=0.0, noise=0.02, seed=0):

@@ -9,7 +9,8 @@ from infsup_contact import resources
 from infsup_contact.config_checks import ConfigError, check_config
 from infsup_contact.config_yaml import check_config_files
 from infsup_contact.config_memory import check_job_memory, memory_notes
-from infsup_contact.discretization.series import beta_batches, seeds, series_of_pairs
+from infsup_contact.discretization.series import seeds, series_of_pairs
+from infsup_contact.study.batches import beta_batches
 
 # Every check a config gets, in one library function (src/infsup_contact/config_checks.py):
 # user spaces, non-finite numbers, the schema, the registry's degrees and the cross-key rules.
@@ -43,7 +44,7 @@ def beta_pairs():
     return sorted(series_of_pairs(config["infsup"]), key=lambda p: (max(p), p))
 
 
-# β_h jobs: one per batch of pairs of one (family, k) (discretization/series.py: beta_batches)
+# β_h jobs: one per batch of pairs of one (family, k) (study/batches.py: beta_batches)
 BETA_BATCHES = beta_batches(config["infsup"])
 
 

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import sys
 
-from .common import (refuse_with_system, remember_defaults, add_dry_run, add_model, cases, check_memory, material,
+from .common import (material_columns, refuse_with_system, remember_defaults, add_dry_run, add_model, cases, check_memory, material,
                      norms, SPACE_HELP, write_csv)
 
 
@@ -31,8 +31,6 @@ def add(sub) -> None:
     p.add_argument("--N1", type=int, default=None, help="segments on Γ of the Ω1 mesh (>= 1)")
     p.add_argument("--N2", type=int, default=None, help="segments on Γ of the Ω2 mesh (>= 1)")
     p.add_argument("--multiplier-mesh", default="omega2", choices=["omega2", "omega1", "union"])
-    p.add_argument("--c1", type=float, default=None, help="membranes: prestress c1 (default 1)")
-    p.add_argument("--c2", type=float, default=None, help="membranes: prestress c2 (default 1)")
     add_model(p)
     p.add_argument("--norm", default="all", choices=["H", "L2", "all"])
     p.add_argument("--h-route", default="logkernel", choices=["logkernel", "series"],
@@ -70,7 +68,7 @@ def _check_beta(args):
     check_perturbation(args.alpha, args.seed)
     est = resources.beta_estimate(args.family, args.k, args.N1, args.N2, args.multiplier_mesh,
                                   norms(args), args.h_route,
-                                  components=2 if args.model == "elastic" else 1)
+                                  components=args.model_obj.components)
     check_memory(est, *(("N1", args.N1) if args.N1 >= args.N2 else ("N2", args.N2)))
     return est
 
@@ -94,8 +92,5 @@ def _run_beta(args) -> None:
     rows = beta_rows(args.family, args.k, args.N1, args.N2, args.cases, args.multiplier_mesh,
                      args.c1, args.c2, norms(args), h_route=args.h_route, model=args.model_obj, **kwargs)
     frame = pd.DataFrame(rows)
-    if args.model == "elastic":  # c_i = E_i: the columns under their elastic names, and ν
-        frame = frame.rename(columns={"c1": "E1", "c2": "E2"})
-        frame.insert(frame.columns.get_loc("E2") + 1, "nu", args.nu)
-        frame.insert(0, "model", "elastic")
+    frame = material_columns(frame, args)
     write_csv(frame, float_format="%.12g")

@@ -40,41 +40,53 @@ def run_intervals(args, limit: int = 1024) -> set:
     return {multiplier_intervals(a, b, choice) for a, b in ok}
 
 
+def _material_params() -> dict:
+    """Flag name → [(model name, MaterialParam)] over every registered model."""
+    from ..models import MODELS
+
+    out = {}
+    for m in MODELS.values():
+        for prm in m.params:
+            out.setdefault(prm.name, []).append((m.name, prm))
+    return out
+
+
 def add_model(p) -> None:
-    p.add_argument("--model", default="membranes", choices=["membranes", "elastic"],
-                   help="membranes (the paper's Section 3, default) or elastic (plane strain, "
-                   "vector P_k, frictionless normal contact; material scale c_i = E_i)")
-    p.add_argument("--nu", type=float, default=None,
-                   help="elastic: Poisson ratio of both bodies, -1 < nu < 0.5 (default 0.3)")
-    p.add_argument("--E1", type=float, default=None, help="elastic: Young's modulus of Ω1 (default 1)")
-    p.add_argument("--E2", type=float, default=None, help="elastic: Young's modulus of Ω2 (default 1)")
+    """--model and every registered model's material flags (the model contract's ``params``)."""
+    from ..models import DEFAULT_MODEL, MODELS
+
+    p.add_argument("--model", default=DEFAULT_MODEL.name, choices=list(MODELS),
+                   help="; ".join(f"{m.name}: {m.description}" + (" (default)" if m is DEFAULT_MODEL else "")
+                                  for m in MODELS.values()))
+    for name, owners in _material_params().items():
+        p.add_argument(f"--{name}", type=float, default=None,
+                       help="; ".join(f"{model}: {prm.help}, {prm.allowed} (default {prm.default:g})"
+                                      for model, prm in owners))
 
 
 def material(args):
-    """Resolve --model/--nu/--E1/--E2/--c1/--c2: sets ``args.model_obj``, ``args.c1``,
-    ``args.c2`` (c_i = E_i for elastic). The membranes take --c1 --c2 only, the elastic
-    bodies --nu --E1 --E2 only: the other model's flags are refused, naming the flag."""
-    from ..models import MODELS
-    from ..models.elastic import check_modulus, check_nu, elastic_model
+    """Resolve --model and its material flags from the model contract (``Model.params``): sets
+    ``args.model_obj`` (built with the parameters of K_i, e.g. ν), ``args.c1``, ``args.c2``
+    (the sides' scales under the model's names, e.g. c_i = E_i) and each parameter's
+    attribute. A flag the model does not have is refused, naming the flag and the model's."""
+    from ..models import MODELS, make_model
 
-    if args.model == "membranes":
-        for key in ("nu", "E1", "E2"):
-            if getattr(args, key) is not None:
-                raise InputError(key, "only with --model elastic (the membranes take --c1 --c2)",
-                                 got=getattr(args, key))
-        args.c1 = 1.0 if args.c1 is None else args.c1
-        args.c2 = 1.0 if args.c2 is None else args.c2
-        args.model_obj = MODELS["membranes"]
-        return
-    for key in ("c1", "c2"):
-        if getattr(args, key) is not None:
-            raise InputError(key, "only with --model membranes (an elastic body's scale is --E1/--E2)",
-                             got=getattr(args, key))
-    nu = check_nu(0.3 if args.nu is None else args.nu, "nu")
-    args.c1 = check_modulus(1.0 if args.E1 is None else args.E1, "E1")
-    args.c2 = check_modulus(1.0 if args.E2 is None else args.E2, "E2")
-    args.nu = nu
-    args.model_obj = elastic_model(nu)
+    model = MODELS[args.model]
+    own = model.param_names()
+    for name in _material_params():
+        if name not in own and getattr(args, name, None) is not None:
+            raise InputError(name, f"one of the material flags of --model {model.name}: "
+                             f"{', '.join('--' + n for n in own) or 'none'}", got=getattr(args, name))
+    build = {}
+    for prm in model.params:
+        given = getattr(args, prm.name)
+        value = prm.check(prm.default if given is None else given, prm.name)
+        setattr(args, prm.name, value)
+        if prm.side is None:
+            build[prm.name] = value
+        else:
+            setattr(args, ("c1", "c2")[prm.side], value)
+    args.model_obj = make_model(model.name, **build) if build else model
 
 
 def norms(args) -> tuple:
@@ -180,3 +192,22 @@ def write_text(text: str) -> None:
 def write_csv(frame, float_format: str) -> None:
     """A result table as CSV on stdout (:func:`write_text`)."""
     write_text(frame.to_csv(index=False, float_format=float_format))
+
+
+def material_columns(frame, args):
+    """β_h rows under the model's material names: the scale columns c1, c2 renamed after the
+    model's scale parameters (E1, E2 for the elastic bodies), its other parameters (ν) after
+    them, and a ``model`` column first for every model but the paper's."""
+    from ..models import DEFAULT_MODEL
+
+    model = args.model_obj
+    scales = {("c1", "c2")[p.side]: p.name for p in model.params if p.side is not None}
+    frame = frame.rename(columns=scales)
+    after = frame.columns.get_loc(scales.get("c2", "c2"))
+    for prm in model.params:
+        if prm.side is None:
+            after += 1
+            frame.insert(after, prm.name, getattr(args, prm.name))
+    if model.name != DEFAULT_MODEL.name:
+        frame.insert(0, "model", model.name)
+    return frame

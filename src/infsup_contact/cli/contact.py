@@ -21,8 +21,6 @@ def add(sub) -> None:
     p.add_argument("--family", default="structured", choices=FAMILIES)
     p.add_argument("--N1", type=int, required=True)
     p.add_argument("--N2", type=int, required=True)
-    p.add_argument("--c1", type=float, default=None, help="membranes: prestress c1 (default 1)")
-    p.add_argument("--c2", type=float, default=None, help="membranes: prestress c2 (default 1)")
     add_model(p)
     p.add_argument("--p", type=float, default=3.0, help="manufactured: λ = x (a − x)₊^p, p > 3/2")
     p.add_argument("--q", type=float, default=3.0, help="manufactured: g = (x − a)₊^q (1 − x), q > 3/2")

@@ -26,7 +26,7 @@ def add(sub) -> None:
     p.add_argument("--out", required=True, help="directory to write into (created)")
     add_model(p)
     add_dry_run(p)
-    p.set_defaults(run=_run_export, check=_check_export, c1=None, c2=None)
+    p.set_defaults(run=_run_export, check=_check_export)
 
 
 def _check_export(args):
@@ -36,9 +36,9 @@ def _check_export(args):
     from ..discretization import meshes, registry
 
     material(args)
-    for key, c in (("E1", args.c1), ("E2", args.c2)):  # material(): c_i = E_i (elastic), 1 (membranes)
-        if c != 1.0:
-            raise InputError(key, "1 (an export is at unit material scale)", got=c)
+    for prm in args.model_obj.params:  # the sides' scales c_i (E_i of the elastic bodies)
+        if prm.side is not None and getattr(args, prm.name) != 1.0:
+            raise InputError(prm.name, "1 (an export is at unit material scale)", got=getattr(args, prm.name))
     if not 1 <= args.k <= 4:
         raise InputError("k", "an integer in 1..4", got=args.k)
     registry.check_case(args.case, args.k)
@@ -54,7 +54,7 @@ def _check_export(args):
     if not args.out.strip() or (out.exists() and not out.is_dir()):
         raise InputError("out", "a directory to write into (created if missing)", got=args.out)
     est = resources.beta_estimate(args.family, args.k, max(ns) + args.N1_offset, max(ns), args.multiplier_mesh,
-                                  (args.norm,), components=2 if args.model == "elastic" else 1)
+                                  (args.norm,), components=args.model_obj.components)
     check_memory(est, *(("N1_offset", args.N1_offset) if args.N1_offset > max(ns) else ("N", max(ns))))
     return est
 

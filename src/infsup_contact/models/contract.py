@@ -43,6 +43,36 @@ from typing import Callable
 
 
 @dataclass(frozen=True)
+class MaterialParam:
+    """One material parameter of a model, as the command line and the tables see it.
+
+    Attributes
+    ----------
+    name : str
+        The flag (``--name``) and the table column.
+    default : float
+        Its value when not given.
+    check : callable
+        ``check(value, name) -> float``: the value, or an ``InputError`` naming ``name`` and
+        the allowed range.
+    allowed : str
+        The allowed range in words (for ``--help``).
+    help : str
+        What it is, one phrase.
+    side : int or None
+        0 or 1: the material scale c_1 or c_2 of that side (A_i = c_i K_i); None: a parameter
+        of K_i itself, passed to ``models.make_model``.
+    """
+
+    name: str
+    default: float
+    check: Callable
+    allowed: str
+    help: str
+    side: int | None = None
+
+
+@dataclass(frozen=True)
 class Model:
     """A physical model as the engine sees it.
 
@@ -57,6 +87,12 @@ class Model:
         One line for ``--help`` and the paper.
     scene_side, load, field, interpolate : callable, optional
         What contact needs (module docstring); a model without them serves β_h only.
+    params : tuple of MaterialParam
+        The material parameters the model takes (the command line's material flags, in this
+        order): the scales c_1, c_2 of the two sides under the model's names, and parameters
+        that change K_i itself (built into the model by ``models.make_model``).
+    components : int
+        Displacement components per node (the memory estimate's factor).
     """
 
     name: str
@@ -66,6 +102,12 @@ class Model:
     load: Callable | None = None
     field: Callable | None = None
     interpolate: Callable | None = None
+    params: tuple = ()
+    components: int = 1
+
+    def param_names(self) -> list:
+        """The names of the model's material parameters (its flags without ``--``)."""
+        return [p.name for p in self.params]
 
     def side_for(self, scene, mesh, k: int):
         """The side of ``scene`` on ``mesh``: ``scene_side`` where the model has one, else the

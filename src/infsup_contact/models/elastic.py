@@ -33,7 +33,7 @@ import scipy.sparse as sp
 
 from ..discretization.interface import SEGMENT
 from ..discretization.meshes import DIRICHLET
-from .contract import Model
+from .contract import MaterialParam, Model
 from .plane_strain import E_RANGE, NU_RANGE, check_modulus, check_nu, lame  # noqa: F401 (the model's material law)
 from .schur import SideOperator, factorized_side
 
@@ -189,7 +189,14 @@ def elastic_model(nu: float = 0.3, x_dirichlet: str = "dir", y_dirichlet: str = 
     bc = dict(nu=nu, x_dirichlet=x_dirichlet, y_dirichlet=y_dirichlet)
     return Model("elastic", partial(side_operator, **bc),
                  f"two plane-strain elastic bodies, vector P_k, nu = {nu:g}, frictionless normal contact",
-                 scene_side=partial(scene_side, **bc), load=load, field=field, interpolate=interpolate_on)
+                 scene_side=partial(scene_side, **bc), load=load, field=field, interpolate=interpolate_on,
+                 params=PARAMS, components=2)
+
+
+PARAMS = (MaterialParam("nu", 0.3, check_nu, "-1 < nu < 0.5", "Poisson ratio of both bodies"),
+          MaterialParam("E1", 1.0, check_modulus, "1e-150 <= E <= 1e150", "Young's modulus of Ω1", side=0),
+          MaterialParam("E2", 1.0, check_modulus, "1e-150 <= E <= 1e150", "Young's modulus of Ω2", side=1))
+"""The elastic bodies' material flags: ν builds the model (K_i), E_i is the scale c_i of side i."""
 
 
 ELASTIC = elastic_model(0.3)

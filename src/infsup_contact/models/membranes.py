@@ -11,7 +11,8 @@ import ngsolve
 import scipy.sparse as sp
 
 from ..discretization.interface import SEGMENT
-from .contract import OUTWARD_NORMAL_Y, Model
+from ..errors import check_prestress
+from .contract import OUTWARD_NORMAL_Y, MaterialParam, Model
 from .schur import SideOperator, factorized_side
 
 
@@ -97,5 +98,8 @@ def interpolate(side: SideOperator, components) -> np.ndarray:
 
 MEMBRANES = Model("membranes", side_operator,
                   "two membranes, −c_i Δu_i = f_i, scalar P_k (the paper's Section 3)",
-                  load=load, field=field, interpolate=interpolate)
+                  load=load, field=field, interpolate=interpolate,
+                  params=tuple(MaterialParam(f"c{i + 1}", 1.0, lambda v, key: check_prestress(key, v),
+                                             "1e-150 <= c <= 1e150", f"prestress c{i + 1} of Ω{i + 1}", side=i)
+                               for i in range(2)))
 """The paper's model problem through the model seam (:mod:`infsup_contact.models.contract`)."""

@@ -19,14 +19,13 @@ import numpy as np
 import pandas as pd
 
 from ..discretization import registry
-from ..models import DEFAULT_MODEL, make_model
+from ..models import DEFAULT_MODEL
 from ..models.plane_strain import lame
-from ..models.side_cache import SideCache
+from .beta_batches import beta_batch_rows
 
 ELASTIC = "elastic"
 """The model this study compares with the membranes (:data:`~infsup_contact.models.MODELS`)."""
 MEMBRANES = DEFAULT_MODEL
-from ..solvers.infsup import beta_rows
 
 COLUMNS = ["model", "case", "k", "family", "N1", "N2", "multiplier_mesh", "E1", "E2", "nu", "norm", "beta",
            "kernel_dim", "structural_kernel_dim", "kernel_detected", "kernel_margin_decades", "kernel_decision",
@@ -40,35 +39,31 @@ def bound_factor(nu: float) -> float:
     return 1.0 / np.sqrt(2.0 * mu + lam)
 
 
-def membranes_rows(family: str, k: int, pairs, E=(1.0, 1.0), cases=None, norms=("H",), **mesh_kwargs) -> dict:
-    """(N1, N2) → the membranes' β_h rows (c = E) on that pair: they do not depend on ν, so a
-    ν sweep computes them once."""
+def membranes_rows(family: str, k: int, pairs, E=(1.0, 1.0), cases=None, norms=("H",),
+                   **mesh_kwargs) -> pd.DataFrame:
+    """The membranes' β_h rows (c = E) on every pair, G_h = trace of Ω2: they do not depend on
+    ν, so a ν sweep computes them once."""
     cases = registry.ids_valid_for(k) if cases is None else list(cases)
-    sides = SideCache.for_sweep(MEMBRANES, family, k, pairs, **mesh_kwargs)
-    return {(n1, n2): beta_rows(family, k, n1, n2, cases, "omega2", E[0], E[1], norms, model=MEMBRANES,
-                                side_cache=sides, **mesh_kwargs) for n1, n2 in pairs}
+    return beta_batch_rows(MEMBRANES, family, k, pairs, cases, ("omega2",), (tuple(E),), norms, **mesh_kwargs)
 
 
 def elastic_beta_rows(family: str, k: int, pairs, nu: float = 0.3, E=(1.0, 1.0), cases=None,
-                      norms=("H",), membranes: dict | None = None, **mesh_kwargs) -> pd.DataFrame:
+                      norms=("H",), membranes: pd.DataFrame | None = None, **mesh_kwargs) -> pd.DataFrame:
     """β_h of the elastic pair (and of the membranes, c = E) for each (N1, N2) in ``pairs``,
-    every case valid for k (default) and norm; G_h = trace of Ω2 (the paper's choice).
+    every case valid for k (default) and norm; G_h = trace of Ω2 (the paper's choice). Both
+    come from the β_h batches' study path (:func:`~infsup_contact.study.beta_batches.beta_batch_rows`).
     ``membranes``: the membranes' rows of :func:`membranes_rows` where already computed."""
     cases = registry.ids_valid_for(k) if cases is None else list(cases)
-    model = make_model(ELASTIC, nu=nu)
     if membranes is None:
         membranes = membranes_rows(family, k, pairs, E, cases, norms, **mesh_kwargs)
-    sides = SideCache.for_sweep(model, family, k, pairs, **mesh_kwargs)
+    el = beta_batch_rows(ELASTIC, family, k, pairs, cases, ("omega2",), (tuple(E),), norms,
+                         model_params={"nu": nu}, **mesh_kwargs)
     out = []
-    for n1, n2 in pairs:
-        el = beta_rows(family, k, n1, n2, cases, "omega2", E[0], E[1], norms, model=model, side_cache=sides,
-                       **mesh_kwargs)
-        mem = membranes[n1, n2]
-        for r, m in zip(el, mem):
-            assert (r["case"], r["norm"]) == (m["case"], m["norm"])
-            out.append(dict(r, model=ELASTIC, E1=E[0], E2=E[1], nu=nu, beta_membranes=m["beta"],
-                            kernel_dim_membranes=m["kernel_dim"], kernel_decision_membranes=m["kernel_decision"],
-                            bound_factor=bound_factor(nu)))
+    for r, m in zip(el.to_dict("records"), membranes.to_dict("records"), strict=True):
+        assert (r["N1"], r["N2"], r["case"], r["norm"]) == (m["N1"], m["N2"], m["case"], m["norm"])
+        out.append(dict(r, model=ELASTIC, E1=E[0], E2=E[1], nu=nu, beta_membranes=m["beta"],
+                        kernel_dim_membranes=m["kernel_dim"], kernel_decision_membranes=m["kernel_decision"],
+                        bound_factor=bound_factor(nu)))
     return pd.DataFrame(out, columns=COLUMNS)
 
 

@@ -231,6 +231,9 @@ N_LISTS = {
     ("benchmarks", "beta_N"): "empty",
     ("benchmarks", "contact_N"): "empty",
     ("claims", "rem55_N"): "empty",
+    ("figures", "contact_solutions", "N"): "accepted",  # k = 2: T4 dim 1, R5.4 dim 2
+    ("figures", "dual", "N"): "accepted",  # k = 2: T3 and DUAL dim 2·1 − 1 = 1
+    ("figures", "elastic_profiles", "N"): "empty",  # T3 with k = 1: dim 0
 }
 
 

@@ -233,6 +233,42 @@ def check_cases(cfg) -> None:
                                   got=ks, allowed=f"degrees {spec.min_k}..4")
 
 
+def figure_cases(cfg):
+    """Every case a figure of the config shows: yields ``(key, case id, k or None)`` (k None:
+    every k the figure's table has, as figures.nu_slope_cases)."""
+    fc = cfg["figures"]
+    for name in ("contact_solutions", "dual"):
+        for i, case in enumerate(fc[name]["cases"]):
+            yield f"figures.{name}.cases[{i}]", case, fc[name]["k"]
+    for i, (case, k) in enumerate(fc["elastic_profiles"]["pairs"]):
+        yield f"figures.elastic_profiles.pairs[{i}]", case, k
+    for i, case in enumerate(fc["nu_slope_cases"]):
+        yield f"figures.nu_slope_cases[{i}]", case, None
+
+
+def check_figures(cfg) -> None:
+    """A figure's case ids are registered spaces (the built-in ones and the config's own user
+    spaces) defined for its k; its scene is a name under contact.scenes or a scene kind."""
+    from .discretization.registry import SPACES
+
+    ids = case_ids(cfg)
+    for key, case, k in figure_cases(cfg):
+        if case not in ids:
+            raise ConfigError(key, f"{case!r} is not a registered space", got=case,
+                              allowed="registered spaces: " + ", ".join(ids))
+        spec = SPACES[case]
+        if k is not None and not spec.valid_for(k):
+            raise ConfigError(key, f"{case} needs k >= {spec.min_k} ({spec.paper_ref}), the figure has k = {k}",
+                              got=case, allowed=f"spaces defined for k = {k}")
+    kinds = ("manufactured", "membranes")
+    for name in ("contact_solutions", "dual"):
+        scene = cfg["figures"][name]["scene"]
+        if scene not in cfg["contact"]["scenes"] and scene not in kinds:
+            raise ConfigError(f"figures.{name}.scene", f"{scene!r} is neither a scene of contact.scenes nor a kind",
+                              got=scene, allowed="names under contact.scenes: " + ", ".join(cfg["contact"]["scenes"])
+                              + "; kinds: " + ", ".join(kinds))
+
+
 # ------------------------------------------------------------------ 5. across keys
 
 def scene_meshes(cfg) -> dict:
@@ -332,8 +368,8 @@ def check_hertz_reference(cfg) -> None:
 def mesh_uses(cfg, with_cases: bool = True):
     """Every mesh (pair) of the config with what runs on it: yields ``(key, value, N1, N2, cases
     by k, multiplier meshes)``; ``cases by k`` maps a degree to the case ids (or Rem 5.5 triples)
-    run with it, as the stages run them (the elastic stages, every registered space defined for
-    k; the benchmarks, the paper's cases and the reference space). ``with_cases=False``: the
+    run with it, as the stages run them (the elastic stages, every space of infsup.cases defined
+    for k; the benchmarks, the paper's cases and the reference space; the figures, their cases). ``with_cases=False``: the
     meshes only ({} for the cases; no registry lookups, usable before the user spaces load)."""
     from .discretization.registry import PAPER_CASES, REFERENCE_SPACE, ids_valid_for
     from .discretization.series import FAMILY_RULES
@@ -346,7 +382,7 @@ def mesh_uses(cfg, with_cases: bool = True):
     def every(ks, ids=None) -> dict:
         if not with_cases:
             return {}
-        return {k: ids_valid_for(k, ids if ids is not None else case_ids(cfg)) for k in ks}
+        return {k: ids_valid_for(k, ids if ids is not None else list(cfg["infsup"]["cases"])) for k in ks}
 
     ic, cc, ec, bc = cfg["infsup"], cfg["contact"], cfg["elastic"], cfg["benchmarks"]
     inf, mm = by_k(ic["cases"]), ic["multiplier_meshes"]
@@ -375,6 +411,16 @@ def mesh_uses(cfg, with_cases: bool = True):
     for key, ks, ids in (("beta_N", bc["beta_k"], PAPER_CASES), ("contact_N", bc["contact_k"], [REFERENCE_SPACE])):
         for i, n in enumerate(bc[key]):
             yield f"benchmarks.{key}[{i}]", n, n, n, every(ks, ids), ("omega2",)
+    fc = cfg["figures"]
+    for name in ("contact_solutions", "dual"):
+        fig = fc[name]
+        yield (f"figures.{name}.N", fig["N"], fig["N"], fig["N"], {fig["k"]: list(fig["cases"])} if with_cases else {},
+               ("omega2",))
+    pairs = {}
+    for case, k in fc["elastic_profiles"]["pairs"]:
+        pairs.setdefault(k, []).append(case)
+    n = fc["elastic_profiles"]["N"]
+    yield "figures.elastic_profiles.N", n, n, n, pairs if with_cases else {}, ("omega2",)
     rem55 = {}
     if with_cases:
         from .study.claims import REM55_INSTANCES
@@ -428,6 +474,7 @@ def check_space_meshes(cfg) -> None:
 CROSS_KEY_RULES = {
     # rule: the keys it relates (the error names the first; a change to any of them can trip it)
     check_cases: ("infsup.cases", "contact.cases", "spaces"),
+    check_figures: ("figures", "contact.scenes", "spaces"),
     check_scene_names: ("contact.scenes",),
     check_reference: ("contact.reference_N", "contact.scenes", "contact.N"),
     check_rate_window: ("contact.rate_window", "contact.scenes", "contact.N"),
@@ -439,7 +486,8 @@ CROSS_KEY_RULES = {
     check_space_meshes: ("infsup.N", "infsup.nonmatching", "infsup.nonmatching_families", "contact.N",
                          "contact.scenes", "elastic.N", "elastic.nonmatching", "elastic.patch_pairs",
                          "elastic.bench_N", "elastic.hertz.N", "elastic.hertz.modeling_N", "benchmarks.beta_N",
-                         "benchmarks.contact_N", "claims.rem55_N", "infsup.cases", "contact.cases"),
+                         "benchmarks.contact_N", "claims.rem55_N", "infsup.cases", "contact.cases",
+                         "figures.contact_solutions", "figures.dual", "figures.elastic_profiles"),
 }
 """The rules a schema cannot state, with the keys each relates; each raises a
 :class:`ConfigError` naming one of them."""

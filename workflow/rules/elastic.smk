@@ -1,5 +1,6 @@
 # Elastic stage (issue 12): plane-strain bodies on the paper's geometry (models/elastic.py).
-# β_h of every registered space next to the membranes on the same meshes (one job per family
+# The spaces are those of infsup.cases (one list for the membranes' and the elastic stages),
+# each where defined for k. β_h of each next to the membranes on the same meshes (one job per family
 # and k, all its mesh pairs in one process), the ν → 1/2 sweep (one job per k), the tables
 # and the ledger claims (results/tables/elastic_claims.csv, appended to results/claims.csv).
 
@@ -26,6 +27,7 @@ rule elastic_beta_job:
         PACKAGE_SOURCES,
     params:
         ec=lambda wc: config["elastic"],
+        cases=lambda wc: list(config["infsup"]["cases"]),
     threads: 1
     resources:
         mem_mb=lambda wc: elastic_mem_mb(wc) + (0 if workflow.local_exec else 500),
@@ -45,6 +47,7 @@ rule elastic_sweep_job:
         PACKAGE_SOURCES,
     params:
         ec=lambda wc: config["elastic"],
+        cases=lambda wc: list(config["infsup"]["cases"]),
     threads: 1
     resources:
         mem_mb=lambda wc: elastic_mem_mb(wc) + (0 if workflow.local_exec else 500),
@@ -64,6 +67,7 @@ rule elastic_patch:
         PACKAGE_SOURCES,
     params:
         ec=lambda wc: config["elastic"],
+        cases=lambda wc: list(config["infsup"]["cases"]),
     threads: 1
     benchmark:
         "results/benchmarks/rules/elastic_patch.tsv"
@@ -80,6 +84,7 @@ rule elastic_hertz_job:
         PACKAGE_SOURCES,
     params:
         ec=lambda wc: config["elastic"],
+        cases=lambda wc: list(config["infsup"]["cases"]),
     wildcard_constraints:
         study="k[0-9]+|modeling",
     threads: 1
@@ -95,8 +100,8 @@ ELASTIC_HERTZ = [f"results/tables/elastic/hertz_k{k}.csv" for k in config["elast
     "results/tables/elastic/hertz_modeling.csv"]
 
 
-# Figure data: λ_h on Γ, stable vs unstable, the Hertz scene's d and R on one mesh.
-ELASTIC_PROFILES = {"pairs": [["T4", 2], ["R5.4", 2], ["T3", 1], ["DUAL", 1]], "N": 16}
+# Figure data: λ_h on Γ, stable vs unstable, the Hertz scene's d and R on one mesh; the (case,
+# k) pairs and the mesh: config key figures.elastic_profiles.
 
 
 rule elastic_hertz_profiles:
@@ -106,7 +111,7 @@ rule elastic_hertz_profiles:
         PACKAGE_SOURCES,
     params:
         ec=lambda wc: config["elastic"],
-        fig=ELASTIC_PROFILES,
+        fig=lambda wc: config["figures"]["elastic_profiles"],
     threads: 1
     benchmark:
         "results/benchmarks/rules/elastic_hertz_profiles.tsv"
@@ -147,6 +152,8 @@ rule elastic_paper:
         speed="results/benchmarks/elastic_beta.csv",
         tex="paper/elastic.tex",
         src=REPORT_SOURCES,
+    params:
+        nu_slope_cases=lambda wc: config["figures"]["nu_slope_cases"],
     benchmark:
         "results/benchmarks/rules/elastic_paper.tsv"
     log:
@@ -165,6 +172,7 @@ rule elastic_bench:
         BENCH_SOURCES,
     params:
         ec=lambda wc: config["elastic"],
+        cases=lambda wc: list(config["infsup"]["cases"]),
     threads: workflow.cores
     benchmark:
         "results/benchmarks/rules/elastic_bench.tsv"

@@ -16,13 +16,11 @@ FIGURE_NAMES = [
 # Every figure output (pdf and png): inputs of `rule figures` and of reproduce-all.
 FIGURES = [f"results/figures/{name}.{ext}" for name in FIGURE_NAMES for ext in ("pdf", "png")]
 
-# Figure 5: a stable and an unstable pair on the same mesh, membranes scene.
-FIG5 = {"cases": ["T4", "R5.4"], "k": 2, "N": 16, "family": "structured", "scene": "membranes",
-        "per_interval": 9}
-
-# Figure 8: dual mortar multipliers against the paper's T3 (β_h, λ_h on Γ, energy error).
-FIG8 = {"cases": ["T3", "DUAL"], "k": 2, "N": 16, "family": "structured", "scene": "membranes",
-        "per_interval": 9}
+# Figure 5: a stable and an unstable pair on the same mesh; Figure 8: dual mortar multipliers
+# against the paper's T3 (β_h, λ_h on Γ, energy error). Cases, k, mesh, family, scene: config
+# keys figures.contact_solutions and figures.dual (config_checks.check_figures).
+FIG5 = config["figures"]["contact_solutions"]
+FIG8 = config["figures"]["dual"]
 
 PLOT_STYLE = "src/infsup_contact/report/style.py"
 

@@ -14,6 +14,7 @@ from infsup_contact.bench.elastic_beta import bench_elastic_beta  # noqa: E402
 from infsup_contact.io import write_csv_atomic  # noqa: E402
 
 ec = snakemake.params.ec  # noqa: F821
-frame = pd.DataFrame(bench_elastic_beta(ec["bench_N"], ec["bench_k"], repeats=3, nu=ec["nu"]))
+frame = pd.DataFrame(bench_elastic_beta(ec["bench_N"], ec["bench_k"], repeats=3, nu=ec["nu"],
+                                        cases=snakemake.params.cases))  # noqa: F821
 write_csv_atomic(snakemake.output[0], frame)  # noqa: F821
 print(frame.drop(columns=["includes"]).to_string(), file=sys.stderr)

@@ -11,17 +11,19 @@ register_user_spaces(snakemake.config)  # noqa: F821
 
 import time  # noqa: E402
 
+from infsup_contact.discretization.registry import ids_valid_for  # noqa: E402
 from infsup_contact.io import write_csv_atomic  # noqa: E402
 from infsup_contact.study.elastic_beta import elastic_beta_rows, nu_sweep_rows  # noqa: E402
 
 wc, ec = snakemake.wildcards, snakemake.params.ec  # noqa: F821
 k = int(wc.k)
+cases = ids_valid_for(k, snakemake.params.cases)  # noqa: F821 (infsup.cases, where defined for k)
 t0 = time.perf_counter()
 if "family" in wc.keys():
     pairs = [(n, n) for n in ec["N"]] + [tuple(p) for p in ec["nonmatching"]]
-    frame = elastic_beta_rows(wc.family, k, list(dict.fromkeys(pairs)), ec["nu"], tuple(ec["E"]))
+    frame = elastic_beta_rows(wc.family, k, list(dict.fromkeys(pairs)), ec["nu"], tuple(ec["E"]), cases=cases)
 else:
-    frame = nu_sweep_rows(k, ec["N"], ec["nu_sweep"])
+    frame = nu_sweep_rows(k, ec["N"], ec["nu_sweep"], cases=cases)
 write_csv_atomic(snakemake.output[0], add_provenance(frame, ec))  # noqa: F821
 print(frame[["case", "N1", "N2", "nu", "beta", "kernel_dim", "beta_membranes"]].to_string(), file=sys.stderr)
 print(f"{time.perf_counter() - t0:.1f} s", file=sys.stderr)

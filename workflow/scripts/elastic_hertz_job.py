@@ -1,4 +1,4 @@
-"""One Hertz job (study/hertz.py): the discretization study of one k (every registered space,
+"""One Hertz job (study/hertz.py): the discretization study of one k (every space of infsup.cases,
 the meshes of elastic.hertz.N against the reference N_ref), or the modeling study vs Hertz."""
 import sys
 
@@ -26,7 +26,7 @@ if study == "profiles":
 elif study == "modeling":
     rows = modeling_rows(REFERENCE_SPACE, 2, hz["modeling_N"], hz["R"], hz["modeling_d"], ec["nu"], E)
 else:
-    rows = discretization_rows(None, [int(study[1:])], hz["N"], hz["N_ref"], hz["R"], hz["d"], ec["nu"], E)
+    rows = discretization_rows(snakemake.params.cases, [int(study[1:])], hz["N"], hz["N_ref"], hz["R"], hz["d"], ec["nu"], E)
 frame = pd.DataFrame(rows)
 frame = frame.drop(columns=["seconds"], errors="ignore")  # timings: benchmark files, not tables
 write_csv_atomic(snakemake.output[0], add_provenance(frame, ec))  # noqa: F821

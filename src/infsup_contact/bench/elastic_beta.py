@@ -36,31 +36,32 @@ INCLUDES = {"ours": "meshes, assembly, factorization + Schur per body, couplings
             "limit": "one splu per body (MMD_AT_PLUS_A) + one eigh per case on given operators"}
 
 
-def bench_elastic_beta(ns, ks, repeats: int = 3, nu: float = 0.3) -> list:
-    """Rows ``what, route, k, N, seconds_median, …, ratio_to_ours, ratio_to_limit, max_abs_diff``."""
+def bench_elastic_beta(ns, ks, repeats: int = 3, nu: float = 0.3, cases=None) -> list:
+    """Rows ``what, route, k, N, seconds_median, …, ratio_to_ours, ratio_to_limit, max_abs_diff``;
+    ``cases``: the space ids to run (each where defined for k; default every registered one)."""
     model = elastic_model(nu)
     rows = []
     for k in ks:
-        cases = registry.ids_valid_for(k)
+        ids = registry.ids_valid_for(k, cases)
         for n in ns:
             m1, m2 = meshes.mesh_pair("structured", n, n)
             sides = [model.side_operator(m, k) for m in (m1, m2)]
             gamma = sides[0].trace.gamma
             g_h = gamma.multiplier_partition(*(s.trace.partition for s in sides))
-            spaces = {c: registry.case_space(c, k, g_h, gamma) for c in cases}
+            spaces = {c: registry.case_space(c, k, g_h, gamma) for c in ids}
             ops = {}
-            for c in cases:
+            for c in ids:
                 S = interface_operator([coupling_matrix(s.trace, spaces[c], k) for s in sides], sides)
                 ops[c] = (S, gamma.gram(spaces[c], "H")[0])
 
             def ours():
-                return {r["case"]: r["beta"] for r in beta_rows("structured", k, n, n, cases, norms=("H",),
+                return {r["case"]: r["beta"] for r in beta_rows("structured", k, n, n, ids, norms=("H",),
                                                                 model=model)}
 
             def core():
                 fs = [factorized_side(s.trace, s.free, s.stiffness) for s in sides]
                 out = {}
-                for c in cases:
+                for c in ids:
                     S = interface_operator([coupling_matrix(s.trace, spaces[c], k) for s in fs], fs)
                     out[c] = float(np.sqrt(max(sla.eigh(S, gamma.gram(spaces[c], "H")[0], eigvals_only=True,
                                                         check_finite=False)[0], 0.0)))
@@ -78,8 +79,8 @@ def bench_elastic_beta(ns, ks, repeats: int = 3, nu: float = 0.3) -> list:
             t_ours, t_limit = np.median(res["ours"][1]), np.median(res["limit"][1])
             for name in ("ours", "ours_core", "limit"):
                 got = res[name][0]
-                diff = max(abs(got[c] - ref[c]) for c in cases)
+                diff = max(abs(got[c] - ref[c]) for c in ids)
                 rows.append(_row("elastic_beta", name, k, n, res[name][1], t_ours, t_limit, other="ratio_to_limit",
-                                 max_abs_diff=float(diff), n_problems=len(cases),
+                                 max_abs_diff=float(diff), n_problems=len(ids),
                                  ndof=sum(s.ndof for s in sides), includes=INCLUDES[name]))
     return rows

@@ -175,12 +175,15 @@ def claims_macros(claims: pd.DataFrame) -> list[Macro]:
 def series_macros(claims: pd.DataFrame) -> list[Macro]:
     """Counts of the non-matching bounded claims per (series, multiplier mesh): all cases
     (``nSeries{Claims,Pass,Fail,Inconclusive}``), the paper's stable spaces T3, T4, T5
-    (``nSeriesStable…``) and its unstable ones R5.2, R5.4 (``nSeriesUnstable…``)."""
+    (``nSeriesStable…``) and its unstable ones R5.2, R5.4 (``nSeriesUnstable…``): the groups
+    are the registry's paper cases split by ``SpaceSpec.stable``, in the paper's order."""
+    from ..discretization.registry import PAPER_CASES, SPACES
     from ..study.claims import nonmatching_claims
 
     nm = nonmatching_claims(_claims_checked(claims))
     out = []
-    groups = {"": None, "Stable": ("T3", "T4", "T5"), "Unstable": ("R5.2", "R5.4")}
+    groups = {"": None, "Stable": tuple(c for c in PAPER_CASES if SPACES[c].stable),
+              "Unstable": tuple(c for c in PAPER_CASES if not SPACES[c].stable)}
     for (series, mm), g in nm.groupby(["series", "mm"], sort=True):
         for label, cases in groups.items():
             gg = g if cases is None else g[g.case.isin(cases)]

@@ -1,0 +1,101 @@
+"""No case id is special-cased outside the registry (issue 27, item 4): the report package, the
+workflow rules and the workflow scripts name no space id in code. Groups (stable/unstable, the
+paper's cases) come from registry properties, figure choices from the config (key figures).
+Ids may appear in comments and docstrings only."""
+import io
+import re
+import tokenize
+from pathlib import Path
+
+from infsup_contact.discretization.registry import SPACES
+
+ROOT = Path(__file__).resolve().parents[1]
+FOLDERS = ("src/infsup_contact/report", "workflow/rules", "workflow/scripts")
+IDS = sorted({*SPACES, "P0-2h"}, key=len, reverse=True)  # the built-in ids and the example user space
+ID_RE = re.compile(r"(?<![\w.-])(" + "|".join(re.escape(i) for i in IDS) + r")(?![\w.-])")
+SKIP = {tokenize.NL, tokenize.NEWLINE, tokenize.INDENT, tokenize.DEDENT, tokenize.COMMENT}
+
+
+def code_strings(text: str):
+    """(line, literal) of every string literal of ``text`` that is not a docstring (a string
+    standing alone as a statement); comments are not string tokens."""
+    toks = [t for t in tokenize.generate_tokens(io.StringIO(text).readline)]
+    for i, tok in enumerate(toks):
+        if tok.type != tokenize.STRING:
+            continue
+        prev = next((t for t in reversed(toks[:i]) if t.type not in (tokenize.NL, tokenize.COMMENT)), None)
+        nxt = next((t for t in toks[i + 1:] if t.type != tokenize.COMMENT), None)
+        alone = (prev is None or prev.type in (tokenize.NEWLINE, tokenize.INDENT, tokenize.DEDENT)) and \
+            (nxt is None or nxt.type in (tokenize.NEWLINE, tokenize.NL, tokenize.ENDMARKER))
+        if not alone:
+            yield tok.start[0], tok.string
+
+
+def files():
+    for folder in FOLDERS:
+        for path in sorted((ROOT / folder).rglob("*")):
+            if path.suffix in (".py", ".smk") or path.name == "Snakefile":
+                yield path
+
+
+def test_scanner_sees_code_and_skips_docs():
+    text = '"""T3 in a docstring."""\nx = 1  # T3 in a comment\ngroups = ("T3", "R5.4")\n' \
+           'def f():\n    """DUAL here is fine."""\n    return case != "DUAL-ALL"\n'
+    hits = sorted({line for line, src in code_strings(text) if ID_RE.search(src)})
+    assert hits == [3, 6]
+
+
+def test_no_case_id_outside_the_registry():
+    found = []
+    for path in files():
+        text = path.read_text()
+        for line, src in code_strings(text):
+            if ID_RE.search(src):
+                found.append(f"{path.relative_to(ROOT)}:{line}: {src}")
+    assert list(files()), "no files scanned"
+    assert not found, "case ids special-cased outside the registry:\n" + "\n".join(dict.fromkeys(found))
+
+
+# ------------------------------------------------------------------ the config's figure choices
+
+import copy  # noqa: E402
+
+import pytest  # noqa: E402
+import yaml  # noqa: E402
+
+from infsup_contact.config_checks import ConfigError, check_config  # noqa: E402
+
+SCHEMA = ROOT / "workflow" / "schemas" / "config.schema.yaml"
+
+
+@pytest.mark.parametrize("name", ["config.yaml", "ci.yaml"])
+def test_elastic_stage_runs_the_configs_spaces(name):
+    """One list of spaces for the DAG (infsup.cases): both configs list every registered space
+    and their user space, so the elastic stage runs what it ran when it took every registered
+    space (the tables stay as they were)."""
+    from infsup_contact.discretization.user_spaces import load_user_space
+
+    cfg = yaml.safe_load((ROOT / "config" / name).read_text())
+    users = [load_user_space(ref).id for ref in cfg["spaces"]]
+    builtin = [c for c in SPACES if c not in users]
+    assert list(cfg["infsup"]["cases"]) == [*builtin, *users]
+
+
+@pytest.mark.parametrize("path, value, needle", [
+    (("contact_solutions", "cases"), ["T4", "NOPE"], "config key figures.contact_solutions.cases[1]"),
+    (("dual", "cases"), ["T3", "NOPE"], "config key figures.dual.cases[1]"),
+    (("elastic_profiles", "pairs"), [["NOPE", 1]], "config key figures.elastic_profiles.pairs[0]"),
+    (("nu_slope_cases",), ["NOPE"], "config key figures.nu_slope_cases[0]"),
+    (("contact_solutions", "k"), 1, "config key figures.contact_solutions.cases[0]"),  # T4 needs k >= 2
+    (("dual", "scene"), "nowhere", "config key figures.dual.scene"),
+])
+def test_figure_choices_are_checked(path, value, needle):
+    cfg = copy.deepcopy(yaml.safe_load((ROOT / "config" / "ci.yaml").read_text()))
+    node = cfg["figures"]
+    for part in path[:-1]:
+        node = node[part]
+    node[path[-1]] = value
+    with pytest.raises(ConfigError) as err:
+        check_config(cfg, SCHEMA)
+    text = str(err.value)
+    assert "\n" not in text and text.startswith(needle), text

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from infsup_contact.discretization.coupling import coupling_matrix
-from infsup_contact.discretization.interface import SEGMENT
+from infsup_contact.discretization.segment import SEGMENT
 from infsup_contact.models.membranes import displacement_space
 from infsup_contact.discretization.meshes import mesh_pair
 from infsup_contact.discretization.multipliers import make_space

@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 
 from infsup_contact.discretization.coupling import coupling_matrix
-from infsup_contact.discretization.interface import SEGMENT
+from infsup_contact.discretization.segment import SEGMENT
 from infsup_contact.discretization.dual import local_dual_coefficients, nodal_integrals
 from infsup_contact.discretization.meshes import mesh_pair, multiplier_breakpoints
 from infsup_contact.discretization.multipliers import local_basis_space, local_shapes

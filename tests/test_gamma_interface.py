@@ -10,7 +10,8 @@ import pytest
 import infsup_contact
 from infsup_contact.discretization import meshes, norms
 from infsup_contact.discretization.coupling import coupling_matrix
-from infsup_contact.discretization.interface import SEGMENT, Interface, Segment
+from infsup_contact.discretization.interface import Interface
+from infsup_contact.discretization.segment import SEGMENT, Segment
 from infsup_contact.discretization.registry import case_space
 from infsup_contact.errors import InputError
 from infsup_contact.models import make_model

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from infsup_contact.errors import InputError
-from infsup_contact.discretization.interface import SEGMENT
+from infsup_contact.discretization.segment import SEGMENT
 from infsup_contact.discretization.meshes import FAMILIES, mesh_pair, mesh_quality, multiplier_breakpoints
 
 gamma_breakpoints = SEGMENT.partition_of

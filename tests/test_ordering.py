@@ -5,7 +5,7 @@ import scipy.sparse as sp
 import scipy.sparse.csgraph  # noqa: F401  (sp.csgraph)
 import scipy.sparse.linalg as spla
 
-from infsup_contact.discretization.interface import SEGMENT
+from infsup_contact.discretization.segment import SEGMENT
 from infsup_contact.models.membranes import displacement_space, laplace_stiffness, side_operator
 from infsup_contact.models.schur import _gamma_last_lu, schur_by_solves, schur_from_lu
 from infsup_contact.discretization.meshes import mesh_pair

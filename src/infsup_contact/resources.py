@@ -28,7 +28,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from .discretization.interface import SEGMENT
+from .discretization.segment import SEGMENT
 
 MIB = 1024 ** 2
 

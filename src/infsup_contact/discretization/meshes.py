@@ -25,7 +25,8 @@ from netgen import meshing
 from netgen.geom2d import SplineGeometry
 
 from ..errors import InputError
-from .interface import MULTIPLIER_MESHES, SEGMENT  # noqa: F401  (MULTIPLIER_MESHES: the choices of G_h)
+from .interface import MULTIPLIER_MESHES  # noqa: F401  (the choices of G_h)
+from .segment import SEGMENT
 
 FAMILIES = ("structured", "perturbed", "unstructured")
 SIDES = (1, 2)

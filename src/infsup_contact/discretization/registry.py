@@ -18,7 +18,8 @@ import numpy as np
 
 from ..errors import InputError
 from .dual import dual_space
-from .interface import MULTIPLIER_MESHES, SEGMENT
+from .interface import MULTIPLIER_MESHES
+from .segment import SEGMENT
 from .multipliers import MultiplierSpace, make_space
 
 #: Okabe & Ito (2008), "Color Universal Design": distinguishable under the common

@@ -23,7 +23,8 @@ from ..errors import InputError, check_prestress
 from ..models.schur import combine_terms, interface_terms
 from ..models import DEFAULT_MODEL
 from ..models.side_cache import SideCache
-from ..discretization.interface import SEGMENT, check_choice
+from ..discretization.interface import check_choice
+from ..discretization.segment import SEGMENT
 from ..discretization.norms import NORMS
 from .kernel import (GAP_DECADES, KERNEL_CRITERION, KernelDecision, coupling_kernel, gap_over_roundoff,  # noqa: F401
                      kernel_check, kernel_from_gap, scaled_couplings)

@@ -41,8 +41,6 @@ REQUIRED_FLAGS = {
     "Zen": {"avx2", "fma"},
 }
 """CPU flags (/proc/cpuinfo; SSE3 is listed as ``pni``) each core type's kernels execute."""
-CASES = ("T3", "R5.2", "T4", "R5.4", "T5")
-"""The paper's five cases."""
 SWEEP_N = (4, 8)
 """Matching meshes of the β sweep (with the union partition of the 17:16 pair)."""
 VERDICT_N = (4, 8, 16)
@@ -93,12 +91,12 @@ def openblas_corenames() -> dict:
 def sweep_rows() -> pd.DataFrame:
     """β rows of the paper's five cases, k = 1..4, both norms: matching N = 4, 8 (every
     multiplier mesh is the same partition there) and the union partition of the 17:16 pair."""
-    from ..discretization.registry import SPACES
+    from ..discretization.registry import PAPER_CASES, SPACES
     from ..solvers.infsup import beta_rows
 
     rows = []
     for k in range(1, 5):
-        cases = [c for c in CASES if SPACES[c].valid_for(k)]
+        cases = [c for c in PAPER_CASES if SPACES[c].valid_for(k)]
         for n1, n2, mm in [(n, n, "omega2") for n in SWEEP_N] + [(17, 16, "union")]:
             rows += beta_rows("structured", k, n1, n2, cases, mm, norms=("H", "L2"))
     return pd.DataFrame(rows)
@@ -106,12 +104,12 @@ def sweep_rows() -> pd.DataFrame:
 
 def verdict_rows() -> pd.DataFrame:
     """The stability verdict of each case, k and norm over matching N = 4, 8, 16."""
-    from ..discretization.registry import SPACES
+    from ..discretization.registry import PAPER_CASES, SPACES
     from .verdict import verdict_rows as one
 
     out = []
     for k in range(1, 5):
-        for case in (c for c in CASES if SPACES[c].valid_for(k)):
+        for case in (c for c in PAPER_CASES if SPACES[c].valid_for(k)):
             for norm in ("H", "L2"):
                 r = one(case, k, "structured", VERDICT_N, norm, **VERDICT_CRITERION)
                 out.append(dict(case=case, k=k, norm=norm, verdict=r["verdict"], kernel_dim=r["kernel_dim"]))

@@ -58,7 +58,7 @@ def beta_macros(beta: pd.DataFrame) -> list[Macro]:
         margin = beta.kernel_margin_decades.astype(float)
         out.append(Macro("kernelMarginDecades", fmt_int(MARGIN_DECADES) if float(MARGIN_DECADES).is_integer()
                          else f"{MARGIN_DECADES:g}", "solvers/kernel.py: MARGIN_DECADES"))
-        out.append(Macro("kernelMarginMin", f"{margin.min():.1f}", "beta.csv: kernel_margin_decades min"))
+        out.append(Macro("kernelMarginMin", f"{margin.min():.2g}", "beta.csv: kernel_margin_decades min"))
         for d, word in ((1, "One"), (2, "Two"), (3, "Three")):
             out.append(Macro(f"nKernelWithin{word}", fmt_int((margin < d).sum()),
                              f"beta.csv: rows with kernel_margin_decades < {d}"))

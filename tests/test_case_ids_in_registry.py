@@ -68,6 +68,16 @@ from infsup_contact.config_checks import ConfigError, check_config  # noqa: E402
 SCHEMA = ROOT / "workflow" / "schemas" / "config.schema.yaml"
 
 
+@pytest.fixture(autouse=True)
+def _registry_as_found():
+    """Loading a config registers its user spaces: leave the registry as the other tests expect."""
+    from infsup_contact.discretization.user_spaces import forget_since
+
+    before = set(SPACES)
+    yield
+    forget_since(before)
+
+
 @pytest.mark.parametrize("name", ["config.yaml", "ci.yaml"])
 def test_elastic_stage_runs_the_configs_spaces(name):
     """One list of spaces for the DAG (infsup.cases): both configs list every registered space

@@ -85,15 +85,14 @@ def spectrum(S: np.ndarray, G: np.ndarray | None = None, *, factor: np.ndarray |
         raise np.linalg.LinAlgError(f"the eigenvalues did not converge (syevd info {info})")
     beta = float(np.sqrt(max(ev[0], 0.0)))
     if kernel is None:
-        kernel, gap = kernel_from_gap(ev)
+        d, gap = kernel_from_gap(ev)
     else:
         # a kernel decided from Bᵀ makes β_h = 0 exactly; the pencil's smallest eigenvalue
         # is then round-off, and its digits differ between BLAS kernels
-        kernel = kernel.dim
-        gap = gap_over_roundoff(ev, kernel)
-        beta = 0.0 if kernel > 0 else beta
-    above = ev[kernel] if kernel < len(ev) else np.nan
-    return Spectrum(beta, kernel, float(np.sqrt(max(above, 0.0))), gap, ev[:8].copy())
+        d, gap = kernel.dim, gap_over_roundoff(ev, kernel.dim)
+        beta = 0.0 if d > 0 else beta
+    above = ev[d] if d < len(ev) else np.nan
+    return Spectrum(beta, d, float(np.sqrt(max(above, 0.0))), gap, ev[:8].copy())
 
 
 def check_inputs(case, k, family, n1, n2, c1, c2, norm, multiplier_mesh) -> None:

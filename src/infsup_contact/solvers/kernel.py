@@ -100,10 +100,6 @@ class KernelDecision:
     singular: np.ndarray
     numerical: int
 
-    @property
-    def close(self) -> bool:
-        return self.decision == CLOSE
-
 
 def coupling_kernel(W: np.ndarray, proven: int = 0, entry_error: float = 0.0) -> KernelDecision:
     """Decide the kernel of a scaled Bᵀ (rows: trace dofs, columns: multipliers).

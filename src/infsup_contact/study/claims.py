@@ -33,6 +33,7 @@ import pandas as pd
 from scipy import stats
 
 from ..discretization.registry import PAPER_CASES, SIGN_CHECK_SPACE, SPACES
+from ..solvers.kernel import CLOSE
 
 PASS, FAIL, INCONCLUSIVE = "PASS", "FAIL", "INCONCLUSIVE"
 BEYOND = "beyond the paper"
@@ -91,15 +92,15 @@ def predicted_kernel(spec, rows: pd.DataFrame):
     return int(dims[0]) if len(set(dims.tolist())) == 1 else dims
 
 
-def close_decisions(rows: pd.DataFrame) -> pd.DataFrame:
-    """The rows whose kernel decision is ``close`` (within MARGIN_DECADES of the error level);
-    none for tables without the column (rows computed before it existed)."""
-    if "kernel_decision" not in rows.columns:
+def close_decisions(rows: pd.DataFrame, column: str = "kernel_decision") -> pd.DataFrame:
+    """The rows whose kernel decision (``column``) is ``close`` (within MARGIN_DECADES of the
+    error level); none for tables without the column (rows computed before it existed)."""
+    if column not in rows.columns:
         return rows.iloc[:0]
-    return rows[rows.kernel_decision == "close"]
+    return rows[rows[column] == CLOSE]
 
 
-def _close_text(close: pd.DataFrame) -> str:
+def close_text(close: pd.DataFrame) -> str:
     margins = close.kernel_margin_decades.to_numpy(float) if "kernel_margin_decades" in close else []
     return (f"{len(close)} row(s) with a kernel decision closer than the stated margin to the error level "
             f"(N = {_ns(close)}; margins {', '.join(f'{m:.2f}' for m in margins[:4])} decades)")
@@ -115,7 +116,7 @@ def kernel_claim(rows: pd.DataFrame, expected):
             f"eigenvalue above the kernel: sqrt in [{above.min():.3g}, {above.max():.3g}]")
     close = close_decisions(rows)
     if len(close):
-        return INCONCLUSIVE, f"{text}; {_close_text(close)}"
+        return INCONCLUSIVE, f"{text}; {close_text(close)}"
     return (PASS if ok else FAIL), text
 
 
@@ -378,5 +379,5 @@ def kernel_at_least(rows: pd.DataFrame, n: int):
     text = f"kernel dims {dims.tolist()} over N = {_ns(rows)}"
     close = close_decisions(rows)
     if len(close):
-        return INCONCLUSIVE, f"{text}; {_close_text(close)}"
+        return INCONCLUSIVE, f"{text}; {close_text(close)}"
     return (PASS if np.all(dims >= n) else FAIL), text

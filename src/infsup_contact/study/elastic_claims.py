@@ -30,7 +30,7 @@ from __future__ import annotations
 import pandas as pd
 
 from ..discretization.registry import SPACES
-from .claims import (FAIL, INCONCLUSIVE, PASS, _close_text, bounded_claim, close_decisions, finest, kernel_claim,
+from .claims import (FAIL, INCONCLUSIVE, PASS, bounded_claim, close_decisions, close_text, finest, kernel_claim,
                      predicted_kernel, row, slope_verdict)
 
 REF = "beyond the paper (its Section 2: elastic bodies)"
@@ -49,11 +49,10 @@ def _kernel_check(frame: pd.DataFrame):
     same = frame.kernel_dim == frame.kernel_dim_membranes
     text = (f"{int(same.sum())}/{len(frame)} rows with equal kernel dimension; elastic kernel dims "
             f"{sorted(set(frame.kernel_dim.astype(int).tolist()))}")
-    close = pd.concat([close_decisions(frame), close_decisions(
-        frame.drop(columns="kernel_decision", errors="ignore").rename(
-            columns={"kernel_decision_membranes": "kernel_decision"}))])
-    if len(close):  # either model's kernel decision is close: the comparison rests on it
-        return INCONCLUSIVE, f"{text}; {_close_text(close)}"
+    # either model's kernel decision is close: the comparison rests on both
+    close = frame.loc[close_decisions(frame).index.union(close_decisions(frame, "kernel_decision_membranes").index)]
+    if len(close):
+        return INCONCLUSIVE, f"{text}; {close_text(close)}"
     return (PASS if same.all() else FAIL), text
 
 

@@ -132,10 +132,8 @@ def compare(sweeps: dict, verdicts: dict) -> list:
     -------
     list of str
         One line per disagreement: an exact column or a verdict that differs, or a resolved
-        β that differs by more than :data:`BETA_RTOL`.
+        β that differs by more than :func:`beta_tolerance`.
     """
-    from ..solvers.kernel import GAP_DECADES
-
     (ref_core, ref), *others = sweeps.items()
     problems = []
     for core, frame in others:

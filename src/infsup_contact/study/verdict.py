@@ -77,7 +77,7 @@ def stability_verdict(rows, tol: float, floor: float, confidence: float) -> dict
     close = claims.close_decisions(frame)
     if len(close):
         verdict, fitted = INCONCLUSIVE, frame.smallest_nonzero.to_numpy(float) if kernel_dim > 0 else beta
-        evidence = claims._close_text(close)
+        evidence = claims.close_text(close)
     elif kernel_dim > 0:
         verdict, fitted = UNSTABLE, frame.smallest_nonzero.to_numpy(float)
         evidence = (f"β_h = 0: kernel dims {frame.kernel_dim.astype(int).tolist()} over N = "

@@ -109,3 +109,76 @@ def test_figure_choices_are_checked(path, value, needle):
         check_config(cfg, SCHEMA)
     text = str(err.value)
     assert "\n" not in text and text.startswith(needle), text
+
+
+# ------------------------------------------------------------------ scene and model ids
+
+import ast  # noqa: E402
+
+from infsup_contact.models import MODELS  # noqa: E402
+from infsup_contact.study.scene_registry import scene_ids  # noqa: E402
+
+REGISTRIES = ("src/infsup_contact/study/scene_registry.py", "src/infsup_contact/models")
+"""Where scene and model ids are declared: the scene registry, and the model registry with its
+models (a model names itself)."""
+NAMED = sorted({*scene_ids(), *MODELS}, key=len, reverse=True)
+SMK_BRANCH = re.compile(r"""(?:[=!]=\s*|\bin\s+)["'](%s)["']|["'](%s)["']\s*[=!]=|\w+\s*=\s*["'](%s)["']\s*,"""
+                        % (("|".join(map(re.escape, NAMED)),) * 3))
+
+
+def special_cased(tree) -> list:
+    """(line, id) where a scene or model id is compared with (==, !=, in) or is a parameter's
+    default: how a consumer branches on an id instead of asking a registry."""
+    hits = []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Compare):
+            operands = [node.left, *node.comparators]
+            hits += [(o.lineno, o.value) for o in operands
+                     if isinstance(o, ast.Constant) and o.value in NAMED]
+            hits += [(e.lineno, e.value) for o in operands if isinstance(o, (ast.Tuple, ast.List, ast.Set))
+                     for e in o.elts if isinstance(e, ast.Constant) and e.value in NAMED]
+        elif isinstance(node, (ast.FunctionDef, ast.Lambda)):
+            defaults = [*node.args.defaults, *(d for d in node.args.kw_defaults if d is not None)]
+            hits += [(d.lineno, d.value) for d in defaults if isinstance(d, ast.Constant) and d.value in NAMED]
+    return hits
+
+
+def test_branch_scanner_sees_comparisons_and_defaults():
+    text = ('if scene == "manufactured":\n    pass\nok = kind in ("membranes", "x")\n'
+            'def f(s="hertz"):\n    return cfg["elastic"]\nlabel = "patch"\n')
+    assert sorted(special_cased(ast.parse(text))) == [(1, "manufactured"), (3, "membranes"), (4, "hertz")]
+    assert SMK_BRANCH.search('    if kind != "membranes":') and SMK_BRANCH.search('        scene="manufactured",')
+    assert not SMK_BRANCH.search('    ec = config["elastic"]')
+
+
+def test_no_scene_or_model_id_special_cased_outside_its_registry():
+    found = []
+    for folder in ("src/infsup_contact", "workflow"):
+        for path in sorted((ROOT / folder).rglob("*")):
+            rel = str(path.relative_to(ROOT))
+            if rel.startswith(REGISTRIES) or path.suffix not in (".py", ".smk"):
+                continue
+            text = path.read_text()
+            if path.suffix == ".py":
+                found += [f"{rel}:{line}: {value!r}" for line, value in special_cased(ast.parse(text))]
+            else:
+                found += [f"{rel}:{i}: {line.strip()}" for i, line in enumerate(text.splitlines(), 1)
+                          if SMK_BRANCH.search(line.split("#")[0])]
+    assert not found, "scene or model ids special-cased outside their registries:\n" + "\n".join(found)
+
+
+def test_config_scene_kinds_are_the_registrys_data_scenes():
+    """The schema's enum of contact.scenes.*.kind lists exactly the registered scenes with data."""
+    from infsup_contact.study.scene_registry import data_scene_ids
+
+    schema = yaml.safe_load(SCHEMA.read_text())
+    kind = schema["properties"]["contact"]["properties"]["scenes"]["additionalProperties"]["properties"]["kind"]
+    assert sorted(kind["enum"]) == sorted(data_scene_ids())
+
+
+@pytest.mark.parametrize("name, allowed", [("membranes", "manufactured"), ("nowhere", "manufactured")])
+def test_primary_scene_must_have_an_exact_solution(name, allowed):
+    cfg = yaml.safe_load((ROOT / "config" / "ci.yaml").read_text())
+    cfg["contact"]["primary_scene"] = name
+    with pytest.raises(ConfigError, match=rf"contact\.primary_scene.*{allowed}"):
+        check_config(cfg, SCHEMA)

@@ -153,7 +153,8 @@ def test_fig5_contact_solutions_from_profiles(tmp_path, scripts, drawn):
 
 def test_fig6_convergence(tmp_path, scripts, drawn):
     contact, rates = contact_and_rates()
-    scripts["fig_convergence"].plot_convergence(contact, rates, tmp_path / "f6.pdf", tmp_path / "f6.png")
+    scripts["fig_convergence"].plot_convergence(contact, rates, tmp_path / "f6.pdf", tmp_path / "f6.png",
+                                                "manufactured")  # the scene of contact_and_rates()
     assert_written(tmp_path, "f6")
     assert {plotting.CASE_COLORS[c] for c in CASE_IDS} <= drawn[0]
 

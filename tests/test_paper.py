@@ -125,7 +125,7 @@ def synth_bench(what):
 def tables():
     beta, contact = synth_beta(), synth_contact()
     rates = synth_rates(contact)
-    claims = ledger(beta, rates, synth_extra(), CFG["claims"])
+    claims = ledger(beta, rates, synth_extra(), CFG["claims"], CFG["contact"]["primary_scene"])
     prov = {"versions": {"ngsolve": "6.2.0", "numpy": "2.0", "scipy": "1.0", "snakemake": "9.0"}, "cpu_count": 2}
     return dict(beta=beta, contact=contact, rates=rates, claims=claims, speed=synth_speed(contact),
                 bench_beta=synth_bench("beta"), bench_contact=synth_bench("contact"), cfg=CFG, prov=prov)
@@ -315,7 +315,7 @@ def test_speed_table_marks_the_pareto_front(tables):
 
 def test_missing_speed_columns_is_a_clear_error(tables):
     with pytest.raises(pt.PaperTexError, match="speed_accuracy.csv: missing column"):
-        pt.speed_macros(tables["speed"].drop(columns=["seconds"]))
+        pt.speed_macros(tables["speed"].drop(columns=["seconds"]), CFG["contact"]["primary_scene"])
 
 
 # ----------------------------------------------------------------------------- paper.tex

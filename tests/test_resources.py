@@ -31,10 +31,10 @@ def test_dofs_scale_like_nk_squared():
 
 
 def test_contact_reference_and_cases_cost_more():
-    plain = R.contact_estimate("membranes", "structured", 1, 16, 16)
-    with_ref = R.contact_estimate("membranes", "structured", 1, 16, 16, n_ref=64)
+    plain = R.contact_estimate("structured", 1, 16, 16)
+    with_ref = R.contact_estimate("structured", 1, 16, 16, n_ref=64)
     assert with_ref.bytes > plain.bytes and with_ref.seconds > plain.seconds
-    assert R.contact_estimate("manufactured", "structured", 1, 16, 16, n_cases=5).seconds > plain.seconds
+    assert R.contact_estimate("structured", 1, 16, 16, n_cases=5).seconds > plain.seconds
 
 
 def test_verdict_and_bench_are_bounded_by_their_largest_size():
@@ -45,7 +45,7 @@ def test_verdict_and_bench_are_bounded_by_their_largest_size():
 
 
 def test_job_mem_mb_covers_the_estimate():
-    for est in (R.beta_estimate("structured", 1, 4, 4), R.contact_estimate("membranes", "structured", 3, 32, 32, 64)):
+    for est in (R.beta_estimate("structured", 1, 4, 4), R.contact_estimate("structured", 3, 32, 32, 64)):
         assert R.job_mem_mb(est) * 1e6 >= 1.25 * est.bytes and R.job_mem_mb(est) % 100 == 0
 
 

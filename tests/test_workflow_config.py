@@ -190,7 +190,7 @@ def test_fit_window_shrink_is_logged_and_mem_mb_follows_the_estimate(workdir):
     cc = CI_CONFIG["contact"]
     ref = "results/tables/contact/membranes_structured_k2.csv"  # every N of the scene: the largest, 16
     assert mem[ref] == resources.job_mem_mb(resources.contact_estimate(
-        "membranes", "structured", 2, 16, 16, cc["reference_N"], len(cc["cases"])))
+        "structured", 2, 16, 16, cc["reference_N"], len(cc["cases"])))
 
 
 def test_benchmarks_stage_dry_run(workdir):

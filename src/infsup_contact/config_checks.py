@@ -23,6 +23,7 @@ import re
 from .config_schema import (ConfigError, check_finite, describe, key_path, load_schema,  # noqa: F401
                             schema_error, show)
 from .errors import InputError
+from .study.scene_registry import data_scene_ids, scene_spec
 
 REFERENCE_MARGIN = 2
 """contact.reference_N >= REFERENCE_MARGIN × the largest N of every membranes scene.
@@ -122,7 +123,7 @@ def check_figures(cfg) -> None:
         if k is not None and not spec.valid_for(k):
             raise ConfigError(key, f"{case} needs k >= {spec.min_k} ({spec.paper_ref}), the figure has k = {k}",
                               got=case, allowed=f"spaces defined for k = {k}")
-    kinds = ("manufactured", "membranes")
+    kinds = data_scene_ids()
     for name in ("contact_solutions", "dual"):
         scene = cfg["figures"][name]["scene"]
         if scene not in cfg["contact"]["scenes"] and scene not in kinds:
@@ -158,7 +159,7 @@ def check_reference(cfg) -> None:
     """contact.reference_N >= REFERENCE_MARGIN × the largest N of every membranes scene."""
     cc = cfg["contact"]
     for name, spec in cc["scenes"].items():
-        if spec["kind"] != "membranes":
+        if not scene_spec(spec["kind"]).needs_reference:
             continue
         ns = scene_meshes(cfg)[name]
         need = REFERENCE_MARGIN * max(ns)
@@ -190,19 +191,37 @@ def check_nonmatching(cfg) -> None:
 def check_membranes_parameters(cfg) -> None:
     """A membranes scene takes no manufactured-solution parameter (p, q, a)."""
     for name, spec in cfg["contact"]["scenes"].items():
-        if spec["kind"] == "membranes":
+        if scene_spec(spec["kind"]).needs_reference:
             extra = [key for key in spec if key not in ("kind", "N")]
             if extra:
-                raise ConfigError(f"contact.scenes.{name}.{extra[0]}", "a membranes scene takes no such "
-                                  "parameter (p, q, a belong to the manufactured kind)", got=spec[extra[0]],
-                                  allowed="the keys kind, N")
+                raise ConfigError(f"contact.scenes.{name}.{extra[0]}", f"a {spec['kind']} scene takes no such "
+                                  "parameter (p, q, a belong to a scene with an exact solution)",
+                                  got=spec[extra[0]], allowed="the keys kind, N")
+
+
+def check_primary_scene(cfg) -> None:
+    """contact.primary_scene is a scene of contact.scenes whose kind has an exact solution (the
+    rates it leads with are claimed against the rate that solution allows)."""
+    cc = cfg["contact"]
+    name = cc["primary_scene"]
+    exact = [s for s, spec in cc["scenes"].items() if scene_spec(spec["kind"]).energy_rate is not None]
+    if name not in exact:
+        raise ConfigError("contact.primary_scene", "not a scene of contact.scenes with an exact solution",
+                          got=name, allowed="one of " + (", ".join(exact) or "(none: add a scene of kind "
+                                                         + ", ".join(k for k in data_scene_ids()
+                                                                     if scene_spec(k).energy_rate) + ")"))
+
+
+def speed_accuracy_scene(cfg) -> str:
+    """The scene the speed/accuracy benchmark times: benchmarks.speed_accuracy_scene, else
+    contact.primary_scene."""
+    return cfg["benchmarks"].get("speed_accuracy_scene", cfg["contact"]["primary_scene"])
 
 
 def check_speed_accuracy_scene(cfg) -> None:
     """benchmarks.speed_accuracy_scene names a contact scene or a scene kind."""
-    name = cfg["benchmarks"].get("speed_accuracy_scene", "manufactured")
-    allowed = [*cfg["contact"]["scenes"], *(k for k in ("manufactured", "membranes")
-                                            if k not in cfg["contact"]["scenes"])]
+    name = speed_accuracy_scene(cfg)
+    allowed = [*cfg["contact"]["scenes"], *(k for k in data_scene_ids() if k not in cfg["contact"]["scenes"])]
     if name not in allowed:
         raise ConfigError("benchmarks.speed_accuracy_scene", "not a scene of contact.scenes nor a scene kind",
                           got=name, allowed="one of " + ", ".join(allowed))
@@ -342,7 +361,8 @@ CROSS_KEY_RULES = {
     check_rate_window: ("contact.rate_window", "contact.scenes", "contact.N"),
     check_nonmatching: ("infsup.nonmatching",),
     check_membranes_parameters: ("contact.scenes",),
-    check_speed_accuracy_scene: ("benchmarks.speed_accuracy_scene", "contact.scenes"),
+    check_primary_scene: ("contact.primary_scene", "contact.scenes"),
+    check_speed_accuracy_scene: ("benchmarks.speed_accuracy_scene", "contact.scenes", "contact.primary_scene"),
     check_elastic_nonmatching: ("elastic.nonmatching", "elastic.patch_pairs"),
     check_hertz_reference: ("elastic.hertz.N_ref", "elastic.hertz.N"),
     check_space_meshes: ("infsup.N", "infsup.nonmatching", "infsup.nonmatching_families", "contact.N",

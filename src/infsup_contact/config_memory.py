@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from . import resources as R
 from .config_checks import ConfigError, scene_meshes
+from .study.scene_registry import scene_spec
 
 
 def job_estimates(cfg):
@@ -28,12 +29,12 @@ def job_estimates(cfg):
                     f, k, n1, n2, ic["multiplier_meshes"], ic["norms"])
     ck = sorted({k for klist in cc["cases"].values() for k in klist})
     for s, spec in cc["scenes"].items():
-        n_ref = cc["reference_N"] if spec["kind"] == "membranes" else None
+        n_ref = cc["reference_N"] if scene_spec(spec["kind"]).needs_reference else None
         for n in scene_meshes(cfg)[s]:
             for f in cc["families"]:
                 for k in ck:
-                    est = R.contact_estimate(spec["kind"], f, k, n, n, n_ref, len(cc["cases"]))
-                    alone = R.contact_estimate(spec["kind"], f, k, n, n, None, len(cc["cases"]))
+                    est = R.contact_estimate(f, k, n, n, n_ref, len(cc["cases"]))
+                    alone = R.contact_estimate(f, k, n, n, None, len(cc["cases"]))
                     key = ("contact.reference_N" if n_ref and est.bytes > 2 * alone.bytes
                            else f"contact.scenes.{s}.N" if "N" in spec else "contact.N")
                     yield key, f"contact_job {s} {f} k={k} N={n}", est

@@ -134,15 +134,16 @@ def beta_estimate(family: str, k: int, n1: int, n2: int, multiplier_mesh="omega2
     return Estimate((PROCESS_BYTES["beta"] if process else 0) + volume + dense, seconds)
 
 
-def contact_estimate(scene: str, family: str, k: int, n1: int, n2: int, n_ref: int | None = None,
+def contact_estimate(family: str, k: int, n1: int, n2: int, n_ref: int | None = None,
                      n_cases: int = 1, process: bool = True) -> Estimate:
-    """One contact solve per case on (N1, N2); for ``membranes`` first the reference (degree
-    k + 1, structured N_ref × N_ref, kept for the whole request)."""
+    """One contact solve per case on (N1, N2); with ``n_ref`` (a scene measured against a
+    reference solve) first the reference (degree k + 1, structured N_ref × N_ref, kept for
+    the whole request)."""
     nds = [side_dofs(family, n, k) for n in (n1, n2)]
     total = sum(_side_bytes(nd, "contact") for nd in nds) + CONTACT_EXTRA_BYTES
     total += _dense_bytes(k, (n1, n2), n2, k, ("H",), "logkernel")
     seconds = START_SECONDS + SECONDS_PER_DOF15["contact"] * sum(nd ** 1.5 for nd in nds) * max(n_cases, 1)
-    if scene == "membranes" and n_ref is not None:
+    if n_ref is not None:
         nd_ref = side_dofs("structured", n_ref, k + 1)
         total += 2 * _side_bytes(nd_ref, "reference") + _dense_bytes(k + 1, (n_ref, n_ref), n_ref, k + 1,
                                                                     ("H",), "logkernel")
@@ -169,7 +170,7 @@ def bench_estimate(what: str, ns, ks, repeats: int = 3, eigsh_max_n=None, kkt_ma
                 if eigsh_max_n is None or n <= eigsh_max_n:
                     seconds += SECONDS_PER_DOF15["eigsh"] * nd_total ** 1.5 * n_problems
             else:
-                inner = contact_estimate("manufactured", "structured", k, n, n, process=False)
+                inner = contact_estimate("structured", k, n, n, process=False)
                 if kkt_max_n is None or n <= kkt_max_n:
                     seconds += repeats * SECONDS_PER_DOF15["kkt"] * nd_total ** 1.5
             peak = max(peak, BENCH_FACTOR[what] * inner.bytes)

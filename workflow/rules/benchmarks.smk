@@ -4,7 +4,7 @@
 # benchmarks.eigsh_max_N (no limit), benchmarks.dense_max_size (2500),
 # benchmarks.route_budget_s (10), benchmarks.kkt_max_N (64), benchmarks.speed_accuracy_repeats (3),
 # benchmarks.speed_accuracy_budget_s (10),
-# benchmarks.speed_accuracy_scene ("manufactured").
+# benchmarks.speed_accuracy_scene (contact.primary_scene).
 
 _BLAS1 = "export OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1 MKL_NUM_THREADS=1; "
 
@@ -81,7 +81,7 @@ rule speed_accuracy:
         cc=lambda wc: config["contact"],
         repeats=lambda wc: config["benchmarks"].get("speed_accuracy_repeats", 3),
         budget=lambda wc: config["benchmarks"].get("speed_accuracy_budget_s", 10),
-        scene=lambda wc: config["benchmarks"].get("speed_accuracy_scene", "manufactured"),
+        scene=lambda wc: speed_accuracy_scene(config),
     threads: workflow.cores
     benchmark:
         "results/benchmarks/rules/speed_accuracy.tsv"

@@ -29,6 +29,7 @@ rule claims:
         src=PACKAGE_SOURCES,
     params:
         cfg=lambda wc: config["claims"],
+        rate_scene=lambda wc: config["contact"]["primary_scene"],
     benchmark:
         "results/benchmarks/rules/claims.tsv"
     log:

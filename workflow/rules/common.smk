@@ -6,11 +6,12 @@ from snakemake.logging import logger
 from snakemake.utils import validate
 
 from infsup_contact import resources
-from infsup_contact.config_checks import ConfigError, check_config
+from infsup_contact.config_checks import ConfigError, check_config, speed_accuracy_scene
 from infsup_contact.config_yaml import check_config_files
 from infsup_contact.config_memory import check_job_memory, memory_notes
 from infsup_contact.discretization.series import seeds, series_of_pairs
 from infsup_contact.study.batches import beta_batches
+from infsup_contact.study.scene_registry import scene_spec
 
 # Every check a config gets, in one library function (src/infsup_contact/config_checks.py):
 # user spaces, non-finite numbers, the schema, the registry's degrees and the cross-key rules.
@@ -69,8 +70,8 @@ def contact_tables(wildcards=None):
 
 
 def contact_reference(wildcards):
-    """The membranes reference of this k (rule membranes_reference), for a membranes scene."""
-    if config["contact"]["scenes"][wildcards.scene]["kind"] != "membranes":
+    """The reference solve of this k (rule membranes_reference), for a scene measured against one."""
+    if not scene_spec(config["contact"]["scenes"][wildcards.scene]["kind"]).needs_reference:
         return []
     return [f"results/references/{wildcards.scene}_k{wildcards.k}.pickle"]
 
@@ -87,14 +88,14 @@ def beta_mem_mb(wildcards):
 def contact_mem_mb(wildcards):
     """mem_mb of a contact job: its largest N (the reference is read, not solved, in the job)."""
     cc = config["contact"]
-    kind = cc["scenes"][wildcards.scene]["kind"]
+    n_ref = cc["reference_N"] if scene_spec(cc["scenes"][wildcards.scene]["kind"]).needs_reference else None
     n = max(contact_ns(wildcards.scene))
     return resources.job_mem_mb(resources.contact_estimate(
-        kind, wildcards.family, int(wildcards.k), n, n, cc["reference_N"], len(cc["cases"])))
+        wildcards.family, int(wildcards.k), n, n, n_ref, len(cc["cases"])))
 
 
 def reference_mem_mb(wildcards):
     """mem_mb of the membranes reference job (degree k + 1 on reference_N × reference_N)."""
     cc = config["contact"]
     return resources.job_mem_mb(resources.contact_estimate(
-        "membranes", "structured", int(wildcards.k), 1, 1, cc["reference_N"], 1))
+        "structured", int(wildcards.k), 1, 1, cc["reference_N"], 1))

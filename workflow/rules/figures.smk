@@ -160,7 +160,7 @@ rule fig6_convergence:
         rates="results/tables/rates.csv",
         style=PLOT_STYLE,
     params:
-        scene="manufactured",
+        scene=config["contact"]["primary_scene"],
     benchmark:
         "results/benchmarks/rules/fig6_convergence.tsv"
     log:
@@ -222,6 +222,8 @@ rule fig8_dual:
         style=PLOT_STYLE,
     params:
         cases=FIG8["cases"],
+        scene=config["contact"]["primary_scene"],
+        profile_scene=FIG8["scene"],
     benchmark:
         "results/benchmarks/rules/fig8_dual.tsv"
     log:

@@ -12,7 +12,7 @@ from infsup_contact.io import write_csv_atomic  # noqa: E402
 
 inp = snakemake.input  # noqa: F821
 table = ledger(read_table(inp.beta, "beta"), read_table(inp.rates, "rates"), read_table(inp.extra, "claims"),
-               snakemake.params.cfg)  # noqa: F821
+               snakemake.params.cfg, snakemake.params.rate_scene)  # noqa: F821
 # the elastic stage's claims (rules/elastic.smk) follow the membranes' ones
 import pandas as pd  # noqa: E402
 

@@ -19,7 +19,7 @@ k = int(wc.k)
 spec = cc["scenes"][wc.scene]
 kind, params = spec["kind"], {key: v for key, v in spec.items() if key not in ("kind", "N")}
 c1, c2 = cc["c"]
-ref = load_reference(snakemake.input.reference[0]) if kind == "membranes" else None  # noqa: F821
+ref = load_reference(snakemake.input.reference[0]) if snakemake.input.reference else None  # noqa: F821
 cases = [case for case, klist in cc["cases"].items() if k in klist]
 # one mesh pair (meshes, factorized sides, loads) per N, shared by every case
 rows = [row for n in snakemake.params.ns  # noqa: F821

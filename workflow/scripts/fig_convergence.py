@@ -1,6 +1,6 @@
 """Figure 6: contact errors against h with the fitted slopes (contact.csv, rates.csv).
 
-Manufactured scene, structured meshes. Columns: the error measures (energy, L²(Ω),
+The primary scene (config contact.primary_scene), structured meshes. Columns: the error measures (energy, L²(Ω),
 λ in L²(Γ), λ in H^{-1/2}); rows: displacement degree k. Stable cases solid, unstable
 dashed; the legend of each panel gives the slope fitted by the rates stage (rates.csv:
 least squares over the finest meshes).
@@ -26,18 +26,14 @@ from infsup_contact.report.style import (h_ticks, CASE_COLORS, LABELS, MEASURES,
 MEASURE_ORDER = ("energy_error", "l2_error", "lambda_l2_error", "lambda_hm12_error")
 
 
-def pick_scene(contact: pd.DataFrame, scene: str = "manufactured") -> str:
-    """``scene`` if present, else the first scene of kind manufactured."""
+def pick_scene(contact: pd.DataFrame, scene: str) -> str:
+    """``scene`` (config contact.primary_scene), checked to be in the table."""
     if scene in set(contact.scene):
         return scene
-    if "scene_kind" in contact.columns:
-        kinds = contact[contact.scene_kind == "manufactured"].scene
-        if len(kinds):
-            return kinds.iloc[0]
-    raise ValueError(f"contact table has no scene {scene!r} and no manufactured scene")
+    raise ValueError(f"contact table has no scene {scene!r} (contact.primary_scene)")
 
 
-def plot_convergence(contact: pd.DataFrame, rates: pd.DataFrame, pdf, png, scene: str = "manufactured",
+def plot_convergence(contact: pd.DataFrame, rates: pd.DataFrame, pdf, png, scene: str,
                      family: str = "structured") -> None:
     """Errors against h, one column per measure, one row per k; slopes from ``rates``."""
     scene = pick_scene(contact, scene)

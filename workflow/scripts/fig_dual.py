@@ -1,8 +1,8 @@
 """Figure 8: dual mortar multipliers against the paper's T3 (from results/tables only).
 
 (a) β_h against h, H^{-1/2}_00 norm, structured matching meshes, G_h = trace of Ω2, every k of
-the table; (b) λ_h along Γ for the membranes scene (the Γ profiles of the ``dual_profiles``
-job); (c) the energy error of the manufactured scene against h. Marker fill = k as in every
+the table; (b) λ_h along Γ for the scene figures.dual.scene (the Γ profiles of the
+``dual_profiles`` job); (c) the energy error of the primary scene (contact.primary_scene) against h. Marker fill = k as in every
 figure; colour and marker = the space (the registry's).
 """
 import sys
@@ -23,7 +23,7 @@ from infsup_contact.report.style import (LABELS, MEASURES, case_label, case_styl
                                          mesh_size, save_figure, style)
 
 
-def select(beta, contact, gamma, cases):
+def select(beta, contact, gamma, cases, scene):
     """The rows of the three panels; a missing case or table part raises ValueError."""
     b = beta[(beta.family == "structured") & (beta.multiplier_mesh == "omega2") & (beta.N1 == beta.N2)
              & (beta.norm == "H") & beta.case.isin(cases)]
@@ -31,16 +31,18 @@ def select(beta, contact, gamma, cases):
         raise ValueError(f"beta table has no structured/omega2/matching H rows for {cases}")
     c1, c2 = b.iloc[0][["c1", "c2"]]
     b = b[(b.c1 == c1) & (b.c2 == c2)]
-    c = contact[(contact.scene == "manufactured") & (contact.family == "structured") & contact.case.isin(cases)]
+    c = contact[(contact.scene == scene) & (contact.family == "structured") & contact.case.isin(cases)]
     lam = gamma[(gamma.quantity == "lambda") & gamma.case.isin(cases)]
-    for name, frame in (("contact (manufactured, structured)", c), ("Γ profiles (lambda)", lam)):
+    for name, frame in ((f"contact ({scene}, structured)", c), ("Γ profiles (lambda)", lam)):
         if frame.empty:
             raise ValueError(f"{name}: no rows for {cases}")
     return b.assign(h=mesh_size(b)), c.assign(h=mesh_size(c)), lam
 
 
-def plot_dual(beta, contact, gamma, cases, pdf, png) -> None:
-    b, c, lam = select(beta, contact, gamma, cases)
+def plot_dual(beta, contact, gamma, cases, pdf, png, scene, profile_scene) -> None:
+    """``scene``: the contact scene of panel (c) (config contact.primary_scene); ``profile_scene``:
+    the scene of the Γ profiles in (b) (figures.dual.scene)."""
+    b, c, lam = select(beta, contact, gamma, cases, scene)
     with style():
         fig, (ax_b, ax_l, ax_e) = plt.subplots(1, 3, figsize=(11.0, 3.6), layout="constrained")
         for case in cases:
@@ -65,9 +67,9 @@ def plot_dual(beta, contact, gamma, cases, pdf, png) -> None:
         ax_l.set_xlabel(LABELS["x"])
         ax_l.set_ylabel(r"$\lambda_h$")
         n = int(lam.N.iloc[0])
-        ax_l.set_title(f"(b) $\\lambda_h$, membranes scene, $N={n}$")
+        ax_l.set_title(f"(b) $\\lambda_h$, {profile_scene} scene, $N={n}$")
         ax_e.set_ylabel(MEASURES["energy_error"][1])
-        ax_e.set_title("(c) energy error, manufactured scene")
+        ax_e.set_title(f"(c) energy error, {scene} scene")
         ax_b.legend(fontsize=6.5, ncol=2)
         ax_l.legend(fontsize=6.5)
         save_figure(fig, pdf, png)
@@ -76,4 +78,5 @@ def plot_dual(beta, contact, gamma, cases, pdf, png) -> None:
 if "snakemake" in globals():
     inp = snakemake.input  # noqa: F821
     plot_dual(primary_rows(read_table(inp.beta, "beta")), read_table(inp.contact, "contact"), read_table(inp.gamma, "gamma_profiles"),
-              snakemake.params.cases, snakemake.output.pdf, snakemake.output.png)  # noqa: F821
+              snakemake.params.cases, snakemake.output.pdf, snakemake.output.png,  # noqa: F821
+              snakemake.params.scene, snakemake.params.profile_scene)  # noqa: F821

@@ -5,6 +5,7 @@ import time
 
 import numpy as np
 
+from ..study.scene_registry import MANUFACTURED
 from .harness import _log, _stats, run_interleaved
 
 
@@ -27,7 +28,7 @@ def pareto_front(times, errors) -> np.ndarray:
     return mask
 
 
-def time_contact_solves(cases, k: int, n: int, repeats: int = 3, scene: str = "manufactured",
+def time_contact_solves(cases, k: int, n: int, repeats: int = 3, scene: str = MANUFACTURED.id,
                         family: str = "structured", scene_params: dict | None = None, c=(1.0, 1.0),
                         budget: float = np.inf) -> dict:
     """Wall time of a whole contact solve (:func:`~infsup_contact.solvers.contact.solve_contact`,
@@ -67,7 +68,7 @@ def time_contact_solves(cases, k: int, n: int, repeats: int = 3, scene: str = "m
     return {case: (*(x + y for x, y in zip(b, _stats(times))), len(times)) for case, (_, times) in parts.items()}
 
 
-def speed_accuracy_table(errors, repeats: int = 3, timing_scene: str = "manufactured",
+def speed_accuracy_table(errors, repeats: int = 3, timing_scene: str = MANUFACTURED.id,
                          timing_params: dict | None = None, c=(1.0, 1.0), budget: float = np.inf):
     """Speed–accuracy points: the errors of every (scene, case, k, N) with wall times.
 

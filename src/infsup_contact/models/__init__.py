@@ -23,3 +23,12 @@ DEFAULT_MODEL = MEMBRANES
 def make_model(name: str, **params) -> Model:
     """The model ``name`` with its parameters (``elastic``: ``nu``), from the registry."""
     return _BUILDERS[name](**params)
+
+
+def model_taking(param: str) -> Model:
+    """The first registered model whose stiffness K_i itself takes the parameter ``param``
+    (``nu``: the plane-strain bodies), for a study of that parameter's effect."""
+    for m in MODELS.values():
+        if any(p.name == param and p.side is None for p in m.params):
+            return m
+    raise KeyError(f"no registered model takes the parameter {param!r}")

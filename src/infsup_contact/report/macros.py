@@ -78,13 +78,13 @@ def beta_macros(beta: pd.DataFrame) -> list[Macro]:
 # --------------------------------------------------------------------------- rates and contact
 
 
-def rates_macros(rates: pd.DataFrame) -> list[Macro]:
+def rates_macros(rates: pd.DataFrame, primary: str) -> list[Macro]:
     _require(rates, ["scene", "case", "k", "family", "measure", "slope", "stderr", "expected"], "rates.csv")
     out = []
     for _, r in rates.sort_values(["scene", "family", "case", "k", "measure"]).iterrows():
         if r.measure not in MEASURES:
             continue
-        parts = (_scene(r.scene), _family(r.family), MEASURES[r.measure], r.case, _k(r.k))
+        parts = (_scene(r.scene, primary), _family(r.family), MEASURES[r.measure], r.case, _k(r.k))
         sel = dict(scene=r.scene, family=r.family, case=r.case, k=r.k, measure=r.measure)
         out.append(Macro(macro_name("slope", *parts), fmt_fixed(r.slope, 2), _src("rates.csv", "slope", **sel)))
         out.append(Macro(macro_name("stderr", *parts), fmt_fixed(r.stderr, 3), _src("rates.csv", "stderr", **sel)))
@@ -94,7 +94,7 @@ def rates_macros(rates: pd.DataFrame) -> list[Macro]:
     return out
 
 
-def contact_macros(contact: pd.DataFrame) -> list[Macro]:
+def contact_macros(contact: pd.DataFrame, primary: str) -> list[Macro]:
     _require(contact, ["scene", "case", "k", "family", "N1", "N2", "iterations", "nonunique",
                        "max_penetration", *MEASURES], "contact.csv")
     c = contact[contact.N1 == contact.N2]
@@ -105,8 +105,8 @@ def contact_macros(contact: pd.DataFrame) -> list[Macro]:
            Macro("nContactScenes", fmt_int(contact.scene.nunique()), "contact.csv: number of scenes")]
     for scene, gs in c.groupby("scene"):
         finest = int(gs.N2.max())
-        label = _scene(scene) or "Manufactured"
-        out += [Macro(macro_name("contactFinestN", _scene(scene)), fmt_int(finest),
+        label = scene  # the primary scene too: "maxIterationsManufactured"
+        out += [Macro(macro_name("contactFinestN", _scene(scene, primary)), fmt_int(finest),
                       _src("contact.csv", "N2", "max", scene=scene, matching=1)),
                 Macro(macro_name("maxIterations", label), fmt_int(gs.iterations.max()),
                       _src("contact.csv", "iterations", "max", scene=scene, matching=1)),
@@ -116,12 +116,12 @@ def contact_macros(contact: pd.DataFrame) -> list[Macro]:
             r = g.iloc[0]
             sel = dict(scene=scene, family=fam, case=case, k=k, N1=finest, N2=finest)
             for col, meas in MEASURES.items():
-                out.append(Macro(macro_name("error", _scene(scene), _family(fam), meas, case, _k(k)),
+                out.append(Macro(macro_name("error", _scene(scene, primary), _family(fam), meas, case, _k(k)),
                                  fmt_sci(r[col]), _src("contact.csv", col, **sel)))
-            out.append(Macro(macro_name("iterations", _scene(scene), _family(fam), case, _k(k)),
+            out.append(Macro(macro_name("iterations", _scene(scene, primary), _family(fam), case, _k(k)),
                              fmt_int(r.iterations), _src("contact.csv", "iterations", **sel)))
             if "min_lambda_pointwise" in r:
-                out.append(Macro(macro_name("lambdaMin", _scene(scene), _family(fam), case, _k(k)),
+                out.append(Macro(macro_name("lambdaMin", _scene(scene, primary), _family(fam), case, _k(k)),
                                  fmt_sci(r.min_lambda_pointwise), _src("contact.csv", "min_lambda_pointwise", **sel)))
     return out
 
@@ -199,21 +199,21 @@ def series_macros(claims: pd.DataFrame) -> list[Macro]:
 # --------------------------------------------------------------------------- speed
 
 
-def speed_macros(speed: pd.DataFrame) -> list[Macro]:
+def speed_macros(speed: pd.DataFrame, primary: str) -> list[Macro]:
     s = speed_rows(speed)
     speed = speed_selection(speed)
     out = [Macro("speedRows", fmt_int(len(speed)), "speed_accuracy.csv: number of rows")]
     for _, r in s.iterrows():
         sel = dict(scene=r.scene, case=r.case, k=r.k, N=r.N)
         sel.update({"family": r.family} if "family" in r else {})
-        parts = (_scene(r.scene), r.case, _k(r.k))
+        parts = (_scene(r.scene, primary), r.case, _k(r.k))
         out += [Macro(macro_name("speedSeconds", *parts), fmt_sci(r.seconds), _src("speed_accuracy.csv", "seconds", **sel)),
                 Macro(macro_name("speedEnergy", *parts), fmt_sci(r.energy_error),
                       _src("speed_accuracy.csv", "energy_error", **sel)),
                 Macro(macro_name("speedLambdaH", *parts), fmt_sci(r.lambda_hm12_error),
                       _src("speed_accuracy.csv", "lambda_hm12_error", **sel))]
     for scene, g in speed.groupby("scene"):
-        label = _scene(scene) or "Manufactured"
+        label = scene  # the primary scene too: "maxIterationsManufactured"
         fam = {"family": g.family.iloc[0]} if "family" in g.columns else {}
         out.append(Macro(macro_name("speedFastestSeconds", label), fmt_sci(g.seconds.min()),
                          _src("speed_accuracy.csv", "seconds", "min", scene=scene, **fam)))
@@ -328,7 +328,8 @@ def macros_tex(macros: list[Macro]) -> str:
 
 
 def all_macros(beta, contact, rates, claims, speed, bench_beta, bench_contact, cfg, prov) -> list[Macro]:
-    return (beta_macros(beta) + contact_macros(contact) + rates_macros(rates) + claims_macros(claims)
-            + series_macros(claims)
-            + speed_macros(speed) + bench_macros(bench_beta, "beta") + bench_macros(bench_contact, "contact")
+    primary = cfg["contact"]["primary_scene"]
+    return (beta_macros(beta) + contact_macros(contact, primary) + rates_macros(rates, primary)
+            + claims_macros(claims) + series_macros(claims)
+            + speed_macros(speed, primary) + bench_macros(bench_beta, "beta") + bench_macros(bench_contact, "contact")
             + config_macros(cfg) + provenance_macros(beta, prov))

@@ -25,7 +25,7 @@ def paper_files(beta, contact, rates, claims, speed, bench_beta, bench_contact, 
                                                 bench_contact, cfg, prov)),
             "claims_table.tex": claims_table(claims),
             "nonmatching_table.tex": nonmatching_table(claims),
-            "rates_table.tex": rates_table(rates),
+            "rates_table.tex": rates_table(rates, cfg["contact"]["primary_scene"]),
             "beta_table.tex": beta_table(beta),
             "speed_table.tex": speed_table(speed),
             "front_table.tex": front_table(speed)}

@@ -139,5 +139,7 @@ def _family(f) -> str:
     return "" if f == "structured" else f
 
 
-def _scene(s) -> str:
-    return "" if s == "manufactured" else s
+def _scene(s, primary: str) -> str:
+    """A scene's part of a macro name: none for the primary scene (config
+    ``contact.primary_scene``), whose macros the paper's text reads unqualified."""
+    return "" if s == primary else s

@@ -19,12 +19,13 @@ import numpy as np
 import pandas as pd
 
 from ..discretization import registry
-from ..models import DEFAULT_MODEL
+from ..models import DEFAULT_MODEL, model_taking
 from ..models.plane_strain import lame
 from .beta_batches import beta_batch_rows
 
-ELASTIC = "elastic"
-"""The model this study compares with the membranes (:data:`~infsup_contact.models.MODELS`)."""
+ELASTIC = model_taking("nu").name
+"""The model this study compares with the membranes: the registered one whose bodies take a
+Poisson ratio ν (:data:`~infsup_contact.models.MODELS`)."""
 MEMBRANES = DEFAULT_MODEL
 
 COLUMNS = ["model", "case", "k", "family", "N1", "N2", "multiplier_mesh", "E1", "E2", "nu", "norm", "beta",

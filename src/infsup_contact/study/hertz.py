@@ -41,10 +41,11 @@ from ..models.plane_strain import check_modulus, check_nu, lame
 from ..solvers.contact import contact_pair, solve_contact_on
 from .accuracy import _element_quadrature
 from .blocks import PressedBlocks
+from .scene_registry import HERTZ
 
-SCENE = "hertz"
-"""This scene's registry id (:mod:`.scene_registry`, whose entry reads these two names)."""
-SCENE_MODELS = ("elastic",)
+SCENE = HERTZ.id
+"""This scene's registry id (:mod:`.scene_registry` declares it and the models it is defined for)."""
+SCENE_MODELS = HERTZ.models
 """The models the scene is defined for (the first is its default)."""
 X_DIRICHLET = Y_DIRICHLET = "dir"
 """Clamped far faces (Ω1's bottom, Ω2's top), traction-free lateral sides."""
@@ -240,6 +241,6 @@ def profile_rows(pairs, n: int, R: float, d: float, nu=0.3, E=(1.0, 1.0), per_in
         rows += [dict(case=case, k=k, N=n, R=R, d=d, quantity="lambda_h", x=xi, value=v)
                  for xi, v in zip(x, sol.pressure(x))]
         if i == 0:
-            rows += [dict(case="Hertz", k=0, N=n, R=R, d=d, quantity="hertz", x=xi, value=v)
+            rows += [dict(case="Hertz", k=0, N=n, R=R, d=d, quantity=SCENE, x=xi, value=v)
                      for xi, v in zip(x, hertz_pressure(x, sol.resultant(), R, nu, E))]
     return rows

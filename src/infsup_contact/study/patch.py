@@ -53,10 +53,11 @@ from ..models import make_model
 from ..models.plane_strain import check_modulus, check_nu
 from ..solvers.contact import contact_pair, solve_contact_on
 from .blocks import SIDE, PressedBlocks, block_mesh
+from .scene_registry import PATCH
 
-SCENE = "patch"
-"""This scene's registry id (:mod:`.scene_registry`, whose entry reads these two names)."""
-SCENE_MODELS = ("elastic",)
+SCENE = PATCH.id
+"""This scene's registry id (:mod:`.scene_registry` declares it and the models it is defined for)."""
+SCENE_MODELS = PATCH.models
 """The models the scene is defined for (the first is its default)."""
 X_DIRICHLET, Y_DIRICHLET = f"{meshes.DIRICHLET}|{SIDE}", meshes.DIRICHLET
 """Rollers on the lateral sides (u_x = 0), far faces clamped in x, prescribed in y."""

@@ -15,6 +15,7 @@ import pandas as pd
 from scipy import stats
 
 from ..io import SERIES_COLUMNS, TableError
+from .scene_registry import energy_rate
 
 MEASURES = ("energy_error", "l2_error", "lambda_l2_error", "lambda_hm12_error")
 
@@ -31,8 +32,10 @@ def fit_slope(h: np.ndarray, err: np.ndarray, window: int = 3) -> tuple[float, f
 
 
 def expected_energy_rate(scene: str, k: int, p: float = 3.0, q: float = 3.0) -> float:
-    """min(k, min(p, q) − 1/2) for the manufactured scene; NaN where none is derived."""
-    return float(min(k, min(p, q) - 0.5)) if scene == "manufactured" else float("nan")
+    """The rate the exact solution of the scene kind ``scene`` allows (the registry's
+    :attr:`~.scene_registry.SceneSpec.energy_rate`: min(k, min(p, q) − 1/2) for the
+    manufactured solution); NaN where none is derived."""
+    return energy_rate(scene, k, p, q)
 
 
 def series_columns(frame: pd.DataFrame) -> list:

@@ -12,12 +12,15 @@ scene by adding its name to that scene's ``models``.
 """
 from __future__ import annotations
 
+import importlib
+import inspect
 from dataclasses import dataclass, field
 from typing import Callable
 
 from ..errors import InputError
-from ..models import DEFAULT_MODEL, make_model
-from . import hertz, patch
+
+# The scenes' own modules (NGSolve data and solves) are imported where a scene is run, so that
+# config validation and the workflow's parse can ask the registry without loading NGSolve.
 
 
 @dataclass(frozen=True)
@@ -46,6 +49,16 @@ class SceneSpec:
         memory estimate and the parameter to name if that does not fit.
     float_format : str
         The precision of its CSV rows.
+    families : tuple of str or None
+        The mesh families it is defined on (None: every family).
+    data : str or None
+        ``"module:function"`` of the function building the scene's data, ``function(**params)``,
+        for the contact stage of the workflow (config ``contact.scenes``, whose ``kind`` is this
+        id); None for scenes run by their own stage. A path, resolved on use, so that asking
+        the registry does not load NGSolve.
+    energy_rate : callable or None
+        ``energy_rate(k, p, q)``: the energy-error rate its exact solution's regularity allows
+        (what the rate claims and the rates table compare with); None where none is derived.
     """
 
     id: str
@@ -58,6 +71,24 @@ class SceneSpec:
     params: tuple = ()
     float_format: str = "%.12g"
     families: tuple | None = field(default=None)
+    data: str | None = None
+    energy_rate: Callable | None = None
+
+    @property
+    def needs_reference(self) -> bool:
+        """Whether its errors are measured against a fine-mesh reference solve (``n_ref``)."""
+        return "n_ref" in self.params
+
+    @property
+    def data_builder(self) -> Callable:
+        """The function :attr:`data` names."""
+        module, name = self.data.split(":")
+        return getattr(importlib.import_module(module), name)
+
+    @property
+    def data_params(self) -> tuple:
+        """The keyword parameters of the data builder (what a config scene may set)."""
+        return tuple(inspect.signature(self.data_builder).parameters) if self.data is not None else ()
 
 
 _SCENES: dict[str, SceneSpec] = {}
@@ -99,18 +130,49 @@ def check_pair(model: str, scene: str) -> SceneSpec:
 
 def scene_model(scene: str, **params):
     """The default model of ``scene`` (its first), with the model's ``params`` (elastic: nu)."""
+    from ..models import make_model
+
     return make_model(scene_spec(scene).models[0], **params)
+
+
+def data_scene_ids() -> list:
+    """The scenes the contact stage runs from their data (the allowed ``kind`` of a config scene)."""
+    return [s.id for s in _SCENES.values() if s.data is not None]
+
+
+def scene_data(scene: str, **params):
+    """The data of ``scene`` built with ``params`` (:attr:`SceneSpec.data`).
+
+    Raises
+    ------
+    InputError
+        For a scene without data of its own, or a parameter its data does not take.
+    """
+    spec = scene_spec(scene) if scene in _SCENES else None
+    if spec is None or spec.data is None:
+        raise InputError("scene", ", ".join(data_scene_ids()), got=scene)
+    for key in params:
+        if key not in spec.data_params:
+            raise InputError(f"{scene} parameter", ", ".join(spec.data_params), got=key)
+    return spec.data_builder(**params)
+
+
+def energy_rate(scene: str, k: int, p: float = 3.0, q: float = 3.0) -> float:
+    """The energy-error rate the exact solution of ``scene`` allows; NaN where none is derived
+    (an unregistered name, a reference scene)."""
+    spec = _SCENES.get(scene)
+    if spec is None or spec.energy_rate is None:
+        return float("nan")
+    return float(spec.energy_rate(k, p, q))
 
 
 # ------------------------------------------------------------------------ the entries
 def _membrane_rows(model, cases, k, family, n1, n2, c, args) -> list:
     from .contact_rows import contact_row, reference_solution
-    from .scenes import scene
-
     params = dict(p=args.p, q=args.q) if "p" in scene_spec(args.scene).params else {}
     ref = None
     if "n_ref" in scene_spec(args.scene).params:
-        ref = reference_solution(scene(args.scene, c1=c[0], c2=c[1]), k, args.n_ref, model=model)
+        ref = reference_solution(scene_data(args.scene, c1=c[0], c2=c[1]), k, args.n_ref, model=model)
     return [contact_row(args.scene, case, k, family, n1, n2, c[0], c[1], reference=ref, scene_params=params,
                         model=model) for case in cases]
 
@@ -126,8 +188,8 @@ def _membrane_check(args):
                          "mesh: a coarser reference gives errors that are not errors), >= 1 otherwise",
                          got=args.n_ref)
     n_ref = args.n_ref if "n_ref" in spec.params else None
-    est = resources.contact_estimate(args.scene, args.family, args.k, args.N1, args.N2, n_ref, len(args.cases))
-    alone = resources.contact_estimate(args.scene, args.family, args.k, args.N1, args.N2, None, len(args.cases))
+    est = resources.contact_estimate(args.family, args.k, args.N1, args.N2, n_ref, len(args.cases))
+    alone = resources.contact_estimate(args.family, args.k, args.N1, args.N2, None, len(args.cases))
     if n_ref is not None and est.bytes > 2 * alone.bytes:  # the reference dominates
         return est, ("n_ref", args.n_ref)
     return est, _finest(args)
@@ -146,31 +208,44 @@ def _blocks_check(args):
 
 
 def _hertz_check(args):
+    from . import hertz
+
     args.R, args.d = hertz.check_geometry(1.0 if args.R is None else args.R, 0.05 if args.d is None else args.d)
     return _blocks_check(args)
 
 
 def _patch_rows(model, cases, k, family, n1, n2, c, args) -> list:
+    from . import patch
+
     return patch.patch_rows(cases, [k], [(n1, n2)], args.nu, c)
 
 
 def _hertz_rows(model, cases, k, family, n1, n2, c, args) -> list:
+    from . import hertz
+
     return [hertz.hertz_row(case, k, n1, n2, args.R, args.d, args.nu, c) for case in cases]
 
 
+def _manufactured_rate(k: int, p: float, q: float) -> float:
+    """min(k, min(p, q) − 1/2): λ ∈ H^{p−1/2}, g ∈ H^{q−1/2} near x = a bound the error (4.8)."""
+    return min(k, min(p, q) - 0.5)
+
+
 _ERRORS = ("energy_error", "l2_error", "lambda_l2_error", "lambda_hm12_error", "contact_set_error")
-register(SceneSpec(
+_SCENES_MODULE = "infsup_contact.study.scenes"
+MANUFACTURED = register(SceneSpec(
     "manufactured", ("membranes",), "exact u, λ with contact on (0, a), gap on (a, 1); regularity p, q",
-    "exact", _ERRORS, _membrane_rows, _membrane_check, params=("p", "q")))
-register(SceneSpec(
+    "exact", _ERRORS, _membrane_rows, _membrane_check, params=("p", "q"),
+    data=f"{_SCENES_MODULE}:manufactured", energy_rate=_manufactured_rate))
+MEMBRANES = register(SceneSpec(
     "membranes", ("membranes",), "the paper's Fig. 4 loads ±4(1 − 2x)",
     "fine-mesh reference (structured N_ref, degree k + 1, the registry's reference space)", _ERRORS,
-    _membrane_rows, _membrane_check, params=("n_ref",)))
-register(SceneSpec(
-    patch.SCENE, patch.SCENE_MODELS, "the contact patch test: blocks on rollers, uniform compression",
+    _membrane_rows, _membrane_check, params=("n_ref",), data=f"{_SCENES_MODULE}:membranes"))
+PATCH = register(SceneSpec(
+    "patch", ("elastic",), "the contact patch test: blocks on rollers, uniform compression",
     "exact (λ = p, u linear)", ("lambda_max_rel_error", "u_max_rel_error", "passes", "kernel_dim"),
     _patch_rows, _blocks_check, float_format="%.6g", families=("structured",)))
-register(SceneSpec(
-    hertz.SCENE, hertz.SCENE_MODELS, "clamped blocks with the gap (x − 1/2)²/(2R), Ω2's top moved by d",
+HERTZ = register(SceneSpec(
+    "hertz", ("elastic",), "clamped blocks with the gap (x − 1/2)²/(2R), Ω2's top moved by d",
     "plane-strain Hertz for the measured resultant", ("P", "p_max", "half_width", "oscillation"),
     _hertz_rows, _hertz_check, params=("R", "d"), float_format="%.6g", families=("structured",)))

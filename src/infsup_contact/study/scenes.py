@@ -36,8 +36,7 @@ import numpy as np
 from ngsolve import CoefficientFunction, IfPos, cos, pi, sin, x, y
 
 from ..errors import InputError, check_prestress
-
-SCENES = ("manufactured", "membranes")
+from .scene_registry import MANUFACTURED, MEMBRANES, scene_data
 
 #: Regularity threshold: λ'' ~ (a − x)₊^(p−2) and g'' ~ (x − a)₊^(q−2) are in L² iff the
 #: exponent exceeds 1.5, i.e. f = −c Δu ∈ L²(Ω) as required by (3.7).
@@ -131,7 +130,7 @@ class ManufacturedSolution:
     lam: Callable[[np.ndarray], np.ndarray]
     gap: Callable[[np.ndarray], np.ndarray]
     contact_set: tuple
-    name: str = field(default="manufactured")
+    name: str = field(default=MANUFACTURED.id)
 
     @property
     def has_exact(self) -> bool:
@@ -254,7 +253,7 @@ class MembraneScene:
     f0: CoefficientFunction
     f1: CoefficientFunction
     f2: CoefficientFunction
-    name: str = field(default="membranes")
+    name: str = field(default=MEMBRANES.id)
 
     @property
     def has_exact(self) -> bool:
@@ -305,26 +304,16 @@ def membranes(c1=1.0, c2=1.0, f0=None) -> MembraneScene:
 
 
 # ------------------------------------------------------------------------ dispatcher
-_BUILDERS = {"manufactured": manufactured, "membranes": membranes}
-
-
 def scene(name: str, **params):
-    """Build the scene ``name`` (one of :data:`SCENES`) with keyword ``params``.
+    """Build the data of the scene ``name`` (a registered scene with data,
+    :func:`~.scene_registry.data_scene_ids`) with keyword ``params``.
 
     Raises
     ------
     InputError
         For an unknown scene name or a parameter the scene does not take.
     """
-    if name not in _BUILDERS:
-        raise InputError("scene", ", ".join(SCENES), got=name)
-    builder = _BUILDERS[name]
-    allowed = tuple(inspect.signature(builder).parameters)
-    for key in params:
-        if key not in allowed:
-            raise InputError(f"{name} parameter", ", ".join(allowed), got=key)
-    return builder(**params)
+    return scene_data(name, **params)
 
 
-__all__ = ["SCENES", "ManufacturedSolution", "MembraneScene", "manufactured",
-           "membranes", "scene"]
+__all__ = ["ManufacturedSolution", "MembraneScene", "manufactured", "membranes", "scene"]

@@ -106,9 +106,9 @@ def dual_coefficients(name: str, transformed: bool = False, alpha: float = POPP_
     A, d = _raw_dual(name, a)
     bad = np.flatnonzero(d <= 1e-12 * reference_element(name).area)
     if len(bad):
-        got = {int(k): float(d[k]) for k in bad}
+        got = {int(k): round(float(d[k]), 12) for k in bad}
         fix = ("an alpha with all weights positive, e.g. the 4C alpha = 1/5" if transformed
-               else "transformed=True (Popp et al., alpha = 1/5)")
+               else "transformed=True, i.e. basis 'transformed_dual' (Popp et al., alpha = 1/5)")
         raise InputError("element", f"positive weights ∫N_k for a dual basis: {name} has "
                          f"non-positive ones at nodes {list(got)}; use {fix}", got={name: got})
     return A @ transformation(name, a)

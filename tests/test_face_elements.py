@@ -285,3 +285,17 @@ def test_refusals():
         CellwiseFaceSpace(GRID, "QUAD4", "mortar")
     with pytest.raises(InputError, match="QUAD8"):
         CellwiseFaceSpace(GRID, "QUAD8", "dual")
+
+
+@pytest.mark.parametrize("name", ["QUAD4", "QUAD8", "QUAD9"])
+@pytest.mark.parametrize("basis", ["standard", "transformed", "pwlin"])
+def test_continuous_bases_are_continuous_across_cells(name, basis):
+    S = CellwiseFaceSpace(GRID, name, basis)
+    assert S.contains_constants
+    t, eps = rng.uniform(0, 1, 20), 1e-9
+    for x in GRID.xs[1:-1]:
+        left, right = np.column_stack([np.full(20, x - eps), t]), np.column_stack([np.full(20, x + eps), t])
+        assert np.allclose(S.evaluate(left), S.evaluate(right), atol=1e-7)
+    for y in GRID.ys[1:-1]:
+        below, above = np.column_stack([t, np.full(20, y - eps)]), np.column_stack([t, np.full(20, y + eps)])
+        assert np.allclose(S.evaluate(below), S.evaluate(above), atol=1e-7)

@@ -14,10 +14,11 @@ the nodes globally: a node shared by neighbouring rectangles is one dof. The bas
 * ``pwlin`` — 4C's piecewise (bi)linear functions on the split of :func:`.face_elements.pwlin_subelements`.
 
 ``vanish_on_boundary`` drops the dofs of the nodes on ∂(0, 1)². For the dual bases this
-loses Σ ψ = 1 unless ``keep_constants`` (the default) applies the standard modification
-(Wohlmuth 2000 §3; the general transformation of Popp et al. for boundary nodes): in every
-rectangle, the local dual function of a dropped node b is added to the live local node(s)
-nearest to b in the reference cell (shared equally on a tie). Each live ψ̂_j = ψ_j + Σ_b c_jb ψ_b
+loses Σ ψ = 1 unless ``keep_constants`` (the default) applies a boundary modification in
+the spirit of Wohlmuth's (SIAM J. Numer. Anal. 38 (2000), the dual basis next to the boundary
+of the slave side): in every rectangle, the local dual function of a dropped node b is added
+to the live local node(s) nearest to b in the reference cell (shared equally on a tie; this
+nearest-node rule is our choice for QUAD8/9, where other distributions are possible). Each live ψ̂_j = ψ_j + Σ_b c_jb ψ_b
 with Σ_j c_jb = 1, so Σ_j ψ̂_j = Σ_all ψ = 1, and ∫ ψ̂_i N_j = δ_ij ∫ N_j still holds for live
 j (ψ_b ⟂ N_j for b ≠ j). On QUAD4 this is, rectangle by rectangle, the tensor product of the
 1D ``DUAL`` basis of :mod:`.dual` (ψ^x ⊗ (ψ^y_a + ψ^y_b) = ψ^x ⊗ 1 next to the boundary).

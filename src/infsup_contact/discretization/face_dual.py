@@ -9,9 +9,10 @@ and Σ_i ψ_i = 1 (M 1 = d, hence 1ᵀ A = dᵀ M⁻¹ = 1ᵀ). A needs d_k > 0:
 weights are ∫ N_corner = −1/3 (of the area 4 of [−1, 1]²) and on TRI6 the vertex weights are
 0, so their dual bases are refused (MOOSE #33558, libMesh PR #4536).
 
-Transformed basis (Popp, Gitterle, Gee, Wall, Int. J. Numer. Meth. Engng 83 (2010) 1428–1465,
-and 4C ``Mortar::Element::shape_functions``, cases ``serendipity2D_modified`` /
-``quad2D_modified`` / ``biquad2D_modified``): Ñ = T N with, for α ∈ [0, 1/2),
+Transformed basis (Wohlmuth, Popp, Gee, Wall, Comput. Mech. 49 (2012) 735–747; Popp, Wohlmuth,
+Gee, Wall, SIAM J. Sci. Comput. 34 (2012) B421–B446; the formulas below are those of 4C's
+``Mortar::Element::shape_functions``, cases ``serendipity2D_modified`` / ``quad2D_modified`` /
+``biquad2D_modified``): Ñ = T N with, for α ∈ [0, 1/2),
 
     Ñ_corner = N_corner + α Σ_{edge nodes m adjacent} N_m,    Ñ_m = (1 − 2α) N_m,
 

@@ -12,7 +12,7 @@ from infsup_contact.discretization.face_dual import (
     SWEEP_ALPHAS, alpha_sweep, dual_coefficients, dual_shapes, mass_matrix, transformation, weights)
 from infsup_contact.discretization.face_elements import (
     ELEMENT_NAMES, cell_quadrature, pwlin_shapes, pwlin_subelements, reference_element)
-from infsup_contact.discretization.face_spaces import CellwiseFaceSpace
+from infsup_contact.discretization.face_cells import CellwiseFaceSpace
 from infsup_contact.discretization.square import TensorPartition
 from infsup_contact.errors import InputError
 

@@ -348,6 +348,38 @@ class Interface(abc.ABC):
         """
 
     # --- derived, shared by every implementation ----------------------------------------------
+    def space(self, spec, k: int, partition):
+        """The multiplier space of a registry entry on a partition of this interface.
+
+        The default (the segment's): ``spec.build(k, partition)`` on the sorted breakpoints. A
+        face builds its tensor products from the same 1D ``build`` (:class:`~.square.Square`).
+
+        Parameters
+        ----------
+        spec : SpaceSpec
+            A registry entry (:mod:`.registry`).
+        k : int
+            Displacement degree.
+        partition : partition
+            G_h.
+
+        Returns
+        -------
+        space
+            With ``dim``, ``degree``, ``breakpoints`` (= ``partition``) and ``evaluate(x)``.
+
+        Raises
+        ------
+        InputError
+            For a partition without a cell, naming the case and k.
+        """
+        x = np.asarray(partition, dtype=float)
+        n = self.cells(x) if x.ndim == 1 else 0
+        if n < 1:
+            raise InputError("multiplier mesh", f"a partition of Γ with at least one interval (case {spec.id}, "
+                             f"k = {k}, N = {max(n, 0)})")
+        return spec.build(k, x)
+
     def multiplier_partition_of(self, mesh1, mesh2, choice: str = "omega2", tol: float = 1e-12):
         """G_h of a mesh pair: :meth:`multiplier_partition` of their trace partitions."""
         return self.multiplier_partition(self.partition_of(mesh1), self.partition_of(mesh2), choice, tol)

@@ -101,6 +101,8 @@ class Model:
         Mesh keywords the model's ``mesh`` takes beyond the 2D ones, with their allowed values
         (``(("element", ("hex", "tet")),)``; a tuple, so that a model stays hashable, a side
         cache key): what the command line offers for this model only.
+    families : tuple of str or None
+        Mesh families the model's ``mesh`` builds (None: every 2D family).
     """
 
     name: str
@@ -114,6 +116,7 @@ class Model:
     components: int = 1
     mesh: Callable | None = None
     mesh_options: tuple = ()
+    families: tuple | None = None
 
     def subdomain_mesh(self, family: str, n: int, side: int, **mesh_kwargs):
         """The mesh of Ω_side the model's sides are built on (its ``mesh`` builder, else the 2D one)."""

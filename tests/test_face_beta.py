@@ -1,10 +1,12 @@
 """β_h of the 3D membranes with the contact face Γ = (0,1)²×{1} (issue 28): the kernel against
 the dimension argument and an independent count from 1D ranks, β_h > 0 where there is no
 kernel, β_h against the full saddle-point pencil, and the command line."""
+import io
+
 import numpy as np
 import pandas as pd
 import pytest
-import io
+from scipy.sparse import block_diag
 
 from _cli import run_in_process
 from infsup_contact.discretization.coupling import coupling_matrix
@@ -56,16 +58,13 @@ def test_kernel_is_the_dimension_count(k, n1, n2):
         assert row.structural_kernel_dim == max(row.dim_M - row.dim_W, 0) <= row.kernel_dim
         if n1 == n2:
             assert row.kernel_dim == row.structural_kernel_dim, case
-        space = case_space(case, k, SQUARE_OF(sides).multiplier_partition(*parts), SQUARE_OF(sides))
+        gamma = sides[0].trace.gamma
+        space = case_space(case, k, gamma.multiplier_partition(*parts), gamma)
         assert row.kernel_dim == tensor_kernel(space, parts, k), case
         if row.kernel_dim == 0:
             assert (rows.beta > 0).all() and (rows.beta == rows.smallest_nonzero).all()
         else:
             assert (rows.beta == 0).all() and (rows.smallest_nonzero > 0).all()
-
-
-def SQUARE_OF(sides):
-    return sides[0].trace.gamma
 
 
 def test_continuous_multipliers_without_end_condition_have_a_growing_kernel():
@@ -98,7 +97,6 @@ def test_beta_agrees_with_the_saddle_point_pencil(element, n1, n2, case):
         full = np.zeros((space.dim, s.ndof))
         full[:, s.ndof - len(s.trace.gamma_dofs):] = sign * coupling_matrix(s.trace, space, k)
         blocks.append(full)
-    from scipy.sparse import block_diag
     A, B = block_diag([s.stiffness for s in sides]), np.hstack(blocks)
     frame = rows_of(k, n1, n2, element=element, cases=[case])
     for norm, row in frame.set_index("norm").iterrows():

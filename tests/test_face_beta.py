@@ -117,3 +117,13 @@ def test_cli_beta_3d_and_its_refusals():
         base = ["beta", "--case", "T3", "--k", "1", "--N1", "3", "--N2", "3"]
         code, out, err = run_in_process(base[:-2] + (argv if "--N2" in argv else argv + base[-2:]))
         assert code == 2 and len(err.strip().splitlines()) == 1 and needle in err, (argv, err)
+
+
+def test_verdict_for_the_3d_model():
+    code, out, err = run_in_process(["verdict", "--model", "membranes3d", "--case", "R5.2", "--k", "1", "--N", "2",
+                                     "3", "4", "--expect", "unstable"])
+    assert code == 0, err
+    row = pd.read_csv(io.StringIO(out)).iloc[0]
+    assert row.verdict == "UNSTABLE" and row.kernel_dim == 4 * 4 * 1
+    code, out, err = run_in_process(["verdict", "--case", "T3", "--k", "1", "--N", "2", "3", "4", "--element", "hex"])
+    assert code == 2 and "--element" in err

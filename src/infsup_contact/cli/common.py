@@ -51,14 +51,15 @@ def _material_params() -> dict:
     return out
 
 
-def add_model(p) -> None:
-    """--model and every registered model's material flags (the model contract's ``params``)."""
+def add_model(p, materials: bool = True) -> None:
+    """--model, every registered model's material flags (the model contract's ``params``; not
+    with ``materials=False``) and mesh flags (``mesh_options``)."""
     from ..models import DEFAULT_MODEL, MODELS
 
     p.add_argument("--model", default=DEFAULT_MODEL.name, choices=list(MODELS),
                    help="; ".join(f"{m.name}: {m.description}" + (" (default)" if m is DEFAULT_MODEL else "")
                                   for m in MODELS.values()))
-    for name, owners in _material_params().items():
+    for name, owners in (_material_params() if materials else {}).items():
         p.add_argument(f"--{name}", type=float, default=None,
                        help="; ".join(f"{model}: {prm.help}, {prm.allowed} (default {prm.default:g})"
                                       for model, prm in owners))

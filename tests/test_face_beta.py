@@ -127,3 +127,9 @@ def test_verdict_for_the_3d_model():
     assert row.verdict == "UNSTABLE" and row.kernel_dim == 4 * 4 * 1
     code, out, err = run_in_process(["verdict", "--case", "T3", "--k", "1", "--N", "2", "3", "4", "--element", "hex"])
     assert code == 2 and "--element" in err
+
+
+def test_a_3d_request_too_large_for_the_memory_is_refused_before_computing():
+    code, out, err = run_in_process(["beta", "--model", "membranes3d", "--case", "T3", "--k", "2", "--N1", "96",
+                                     "--N2", "96"])
+    assert code == 2 and "N1" in err and "memory" in err and not out

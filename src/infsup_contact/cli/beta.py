@@ -71,7 +71,7 @@ def _check_beta(args):
     check_perturbation(args.alpha, args.seed)
     est = resources.beta_estimate(args.family, args.k, args.N1, args.N2, args.multiplier_mesh,
                                   norms(args), args.h_route,
-                                  components=args.model_obj.components)
+                                  components=args.model_obj.components, dim=args.model_obj.dim)
     check_memory(est, *(("N1", args.N1) if args.N1 >= args.N2 else ("N2", args.N2)))
     return est
 

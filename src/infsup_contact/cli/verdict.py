@@ -90,7 +90,7 @@ def _check_verdict(args):
     for n in ns:  # an empty space on a small N is refused here, before any β_h
         registry.check_pair_spaces([case], args.k, n, n, (args.multiplier_mesh,), key="N")
     check_criterion(args.slope_tolerance, args.beta_floor, args.confidence)
-    est = resources.verdict_estimate(args.family, args.k, ns, args.norm, args.multiplier_mesh)
+    est = resources.verdict_estimate(args.family, args.k, ns, args.norm, args.multiplier_mesh, args.model_obj.dim)
     check_memory(est, "N", max(ns))
     return est
 

@@ -103,6 +103,8 @@ class Model:
         cache key): what the command line offers for this model only.
     families : tuple of str or None
         Mesh families the model's ``mesh`` builds (None: every 2D family).
+    dim : int
+        Space dimension of the bodies (2, or 3 with a contact face): the memory estimate's model.
     """
 
     name: str
@@ -117,6 +119,7 @@ class Model:
     mesh: Callable | None = None
     mesh_options: tuple = ()
     families: tuple | None = None
+    dim: int = 2
 
     def subdomain_mesh(self, family: str, n: int, side: int, **mesh_kwargs):
         """The mesh of Ω_side the model's sides are built on (its ``mesh`` builder, else the 2D one)."""

@@ -82,5 +82,5 @@ MEMBRANES3D = Model("membranes3d", side_operator,
                     params=tuple(MaterialParam(f"c{i + 1}", 1.0, lambda v, key: check_prestress(key, v),
                                                "1e-150 <= c <= 1e150", f"prestress c{i + 1} of Ω{i + 1}", side=i)
                                  for i in range(2)),
-                    mesh=subdomain_mesh, mesh_options=(("element", ELEMENTS),), families=FAMILIES_3D)
+                    mesh=subdomain_mesh, mesh_options=(("element", ELEMENTS),), families=FAMILIES_3D, dim=3)
 """The 3D membranes through the model seam (β_h only: no contact scenes yet)."""

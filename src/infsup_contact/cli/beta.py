@@ -36,7 +36,8 @@ def add(sub) -> None:
     add_model(p)
     p.add_argument("--norm", default="all", choices=["H", "L2", "all"])
     p.add_argument("--h-route", default="logkernel", choices=["logkernel", "series"],
-                   help="H^{-1/2}_00 Gram: closed-form log kernel or truncated sine series")
+                   help="H^{-1/2}_00 Gram: closed-form log kernel or truncated sine series (a 3D "
+                   "model's contact face: always the extrapolated double sine series)")
     p.add_argument("--seed", type=int, default=0, help="seed of the perturbed family (>= 0)")
     p.add_argument("--alpha", type=float, default=0.2, help="perturbation amplitude / h, in [0, 0.2] (larger can invert triangles)")
     add_dry_run(p)

@@ -15,11 +15,13 @@ partition apart. A partition is opaque to them: they obtain it from the interfac
 back to it. A side's trace carries its interface (``trace.gamma``), so a consumer holding the
 sides of a mesh pair finds Γ there.
 
-:class:`~.segment.Segment` — Γ = (0, 1) × {1}, the paper's — is the one implementation
+:class:`~.segment.Segment` — Γ = (0, 1) × {1}, the paper's — is the first implementation
 (module :mod:`.segment`); its partition
 is the sorted array of breakpoints (abscissae x of the vertices on Γ), the representation
 :class:`~.multipliers.MultiplierSpace` and users' spaces (``build(k, x)``) are built on.
-A 2D contact face is a second subclass implementing the abstract methods below.
+The 2D contact face Γ = (0, 1)² × {1} of the 3D models is the second,
+:class:`~.square.Square` (tensor partitions; spaces are tensor products of the 1D builds,
+:meth:`Interface.space`).
 """
 from __future__ import annotations
 

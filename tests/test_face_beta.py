@@ -133,3 +133,18 @@ def test_a_3d_request_too_large_for_the_memory_is_refused_before_computing():
     code, out, err = run_in_process(["beta", "--model", "membranes3d", "--case", "T3", "--k", "2", "--N1", "96",
                                      "--N2", "96"])
     assert code == 2 and "N1" in err and "memory" in err and not out
+
+
+def test_exported_3d_system_gives_the_same_verdict(tmp_path):
+    """export → verdict --system (the foreign-system route, its own β_h solver) agrees with verdict."""
+    common = ["--case", "T3", "--k", "1", "--N", "2", "3", "4", "--model", "membranes3d", "--element", "tet"]
+    code, out, err = run_in_process(["export", *common, "--out", str(tmp_path)])
+    assert code == 0, err
+    code, out, err = run_in_process(["verdict", "--system", out.strip()])
+    assert code == 0, err
+    foreign = pd.read_csv(io.StringIO(out)).iloc[0]
+    code, out, err = run_in_process(["verdict", *common])
+    direct = pd.read_csv(io.StringIO(out)).iloc[0]
+    assert foreign.verdict == direct.verdict and foreign.kernel_dim == direct.kernel_dim == 0
+    assert foreign.beta_min == pytest.approx(direct.beta_min, rel=1e-5)
+    assert foreign.beta_max == pytest.approx(direct.beta_max, rel=1e-5)

@@ -55,8 +55,6 @@ def test_common_refinement_and_choices():
             assert SQUARE.multiplier_cells(n1, n2, choice) == SQUARE.cells(part)
     with pytest.raises(InputError, match="omega2, omega1, union"):
         SQUARE.multiplier_partition(p1, p2, "both")
-    with pytest.raises(InputError, match="matching meshes"):
-        SQUARE_TRIG.common_refinement(p1, grid(4))
 
 
 @pytest.mark.parametrize("degree", range(0, 6))
@@ -95,17 +93,37 @@ def test_trace_basis_is_ngsolves_trace(element, face, k):
     assert face.trace_basis(trace, x) is face.trace_basis(trace, x)  # cached
 
 
+@pytest.mark.parametrize("element,face", [("hex", SQUARE), ("tet", SQUARE_TRIG)])
 @pytest.mark.parametrize("k", [1, 2])
 @pytest.mark.parametrize("n1,n2", [(2, 2), (2, 3), (3, 4), (2, 4)])
-def test_trace_sum_dimension_is_the_rank_of_both_traces(k, n1, n2):
-    traces = [SQUARE.trace(displacement_space(subdomain_mesh("structured", n, side), k))
+def test_trace_sum_dimension_is_the_rank_of_both_traces(element, face, k, n1, n2):
+    traces = [face.trace(displacement_space(subdomain_mesh("structured", n, side, element=element), k))
               for n, side in ((n1, 1), (n2, 2))]
-    x, _ = SQUARE.quadrature(SQUARE.common_refinement(*(t.partition for t in traces)), 2 * k + 2)
-    both = np.hstack([SQUARE.trace_basis(t, x) for t in traces])
+    x = np.random.default_rng(1).uniform(size=(6 * (max(n1, n2) * k + 1) ** 2, 2))
+    both = np.hstack([face.trace_basis(t, x) for t in traces])
     rank = np.linalg.matrix_rank(both, tol=1e-9 * np.abs(both).max())
-    assert SQUARE.trace_sum_dimension(k, *(t.partition for t in traces)) == rank
+    assert face.trace_sum_dimension(k, *(t.partition for t in traces)) == rank
     if n1 == n2:
-        assert rank == SQUARE.trace_dimension(k, n1)
+        assert rank == face.trace_dimension(k, n1)
+
+
+@pytest.mark.parametrize("degree", [1, 2, 4])
+def test_coupling_rule_of_triangles_cuts_the_refinement_by_the_trace_diagonals(degree):
+    """On G_h ∪ trace, each rectangle cut by the diagonal of its trace cell: exact for a function
+    with a kink on every trace diagonal, |diagonal coordinate| (∬ |u − v| = 1/3 per cell), times
+    a polynomial of each variable."""
+    from infsup_contact.discretization.face_quadrature import split_rule
+
+    trace, gh = grid(3), grid(4, 5)
+    x, w = split_rule(SQUARE_TRIG.common_refinement(trace, gh), trace, 2 * degree)
+    assert w.sum() == pytest.approx(1.0, rel=1e-13)
+    ix = np.clip(np.searchsorted(trace.xs, x[:, 0]) - 1, 0, 2)
+    iy = np.clip(np.searchsorted(trace.ys, x[:, 1]) - 1, 0, 2)
+    u, v = 3 * x[:, 0] - ix, 3 * x[:, 1] - iy  # local coordinates of the trace cell
+    assert w @ np.abs(u - v) == pytest.approx(1 / 3, rel=1e-12)
+    # ∬ |u − v| u^a du dv = ∫ u^a (u² + (1 − u)²)/2 du = 1/(a+3) − 1/(a+2) + 1/(2(a+1)) per cell
+    a = degree - 1
+    assert w @ (np.abs(u - v) * u ** a) == pytest.approx(1 / (a + 3) - 1 / (a + 2) + 1 / (2 * (a + 1)), rel=1e-12)
 
 
 def test_sample_boundary_embed_and_counts():

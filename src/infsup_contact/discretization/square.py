@@ -9,7 +9,8 @@ rectangle, its multiplier spaces are tensor products of the segment's 1D spaces
 
 The trace of a tetrahedral mesh from the same structured grid (every rectangle cut in two
 triangles by its diagonal from (x_i, y_j) to (x_{i+1}, y_{j+1})) has the same tensor partition;
-``Square(cell="trig")`` is its interface (the trace basis is then P_k on triangles, not Q_k).
+``Square(cell="trig")`` is its interface (the trace basis is then P_k on triangles, not Q_k;
+its couplings are integrated on the rectangles cut by the trace's diagonals, :mod:`.face_quadrature`).
 """
 from __future__ import annotations
 
@@ -20,6 +21,7 @@ import numpy as np
 
 from ..errors import InputError
 from .interface import GammaTrace, Interface, check_choice
+from .face_quadrature import split_rule
 from .quadrature import gauss_legendre
 
 _BASIS_CACHE_SIZE = 4
@@ -122,24 +124,8 @@ class Square(Interface):
         return self._partition_of_elements(self._gamma_elements(mesh))
 
     def common_refinement(self, *partitions, tol: float = 1e-12) -> TensorPartition:
-        """Union of the x breakpoints and of the y breakpoints, merging within ``tol``.
-
-        Triangles: only equal partitions (matching meshes). The diagonals of two different
-        grids cut each other's cells, so no tensor grid refines both triangulations and
-        :meth:`quadrature` could not integrate a trace against a multiplier exactly.
-
-        Raises
-        ------
-        InputError
-            For triangle faces of different grids (non-matching tetrahedral meshes).
-        """
-        if self.cell == "trig" and any(
-                len(p.xs) != len(partitions[0].xs) or len(p.ys) != len(partitions[0].ys)
-                or np.max(np.abs(p.xs - partitions[0].xs)) > tol or np.max(np.abs(p.ys - partitions[0].ys)) > tol
-                for p in partitions[1:]):
-            raise InputError("N1, N2", "matching meshes (N1 = N2) for tetrahedra: a P_k trace on the triangles "
-                             "of one grid against a multiplier on another grid has no exact tensor quadrature "
-                             "(use element hex for non-matching pairs)")
+        """Union of the x breakpoints and of the y breakpoints, merging within ``tol`` (for
+        triangles the tensor grid under them: :meth:`coupling_quadrature` cuts its cells)."""
         return TensorPartition(_merge(np.concatenate([p.xs for p in partitions]), tol),
                                _merge(np.concatenate([p.ys for p in partitions]), tol))
 
@@ -257,33 +243,19 @@ class Square(Interface):
             a, b = g[:-1, None], g[1:, None]
             return (0.5 * (a + b) + 0.5 * (b - a) * t).ravel(), (0.5 * (b - a) * w).ravel()
 
-        if self.cell == "trig":
-            return self._triangle_quadrature(partition, 2 * degree)
+        if self.cell == "trig":  # both triangles of every cell, total degree 2 degree (⊇ Q_degree)
+            return split_rule(partition, partition, 2 * degree)
         (x, wx), (y, wy) = axis(partition.xs), axis(partition.ys)
         X, Y = np.meshgrid(x, y, indexing="ij")
         return np.column_stack([X.ravel(), Y.ravel()]), np.outer(wx, wy).ravel()
 
-    @staticmethod
-    def _triangle_quadrature(partition, degree: int) -> tuple:
-        """Collapsed (Duffy) Gauss rule on both triangles of every rectangle (cut by the
-        diagonal from (x_i, y_j) to (x_{i+1}, y_{j+1})), exact for total degree ``degree``:
-        u = s, v = t (1 − s), Jacobian 1 − s, ⌊(degree + 1)/2⌋ + 1 points in s, ⌊degree/2⌋ + 1 in t."""
-        from .quadrature import gauss_legendre_01
-
-        s, ws = gauss_legendre_01((degree + 1) // 2 + 1)
-        t, wt = gauss_legendre_01(degree // 2 + 1)
-        S, T = np.meshgrid(s, t, indexing="ij")
-        u, v = S.ravel(), (T * (1.0 - S)).ravel()
-        w_ref = (np.outer(ws, wt) * (1.0 - s)[:, None]).ravel()
-        xs, ys = np.asarray(partition.xs, float), np.asarray(partition.ys, float)
-        X0, Y0 = np.meshgrid(xs[:-1], ys[:-1], indexing="ij")
-        HX, HY = np.meshgrid(np.diff(xs), np.diff(ys), indexing="ij")
-        X0, Y0, HX, HY = (a.ravel()[:, None] for a in (X0, Y0, HX, HY))
-        # lower-right triangle (0,0), (1,0), (1,1) and upper-left (0,0), (1,1), (0,1): area h_x h_y / 2 each
-        pts = [(X0 + HX * (u + v), Y0 + HY * v), (X0 + HX * v, Y0 + HY * (u + v))]
-        x = np.concatenate([np.column_stack([a.ravel(), b.ravel()]) for a, b in pts])
-        w = np.concatenate([(HX * HY * w_ref).ravel()] * 2)
-        return x, w
+    def coupling_quadrature(self, trace: GammaTrace, space, degree: int) -> tuple:
+        """Quadrature ``degree`` on the common refinement of the trace and G_h; for triangles
+        every rectangle is cut by the diagonal of the trace cell containing it
+        (:func:`~.face_quadrature.split_rule`), exact for the P_k × Q_s products."""
+        if self.cell == "quad":
+            return super().coupling_quadrature(trace, space, degree)
+        return split_rule(self.common_refinement(trace.partition, space.breakpoints), trace.partition, 2 * degree)
 
     def gram(self, space, norm: str, h_route: str = "logkernel", **kwargs) -> tuple:
         """:func:`~.face_norms.gram`: L² exactly (kron of the 1D Grams), H by the double sine
@@ -317,7 +289,8 @@ class Square(Interface):
         (A ⊗ A') ∩ (B ⊗ B') = (A ∩ B) ⊗ (A' ∩ B'); A ∩ B is the 1D trace space on the common
         coarsening (the shared breakpoints). For triangles the space on the common coarsening
         (cut by the same diagonals) is a subspace of W1 ∩ W2 when both grids are uniform, so the
-        count is an upper bound of dim(W1 + W2): the proven kernel stays a lower bound."""
+        count is an upper bound of dim(W1 + W2) and the proven kernel stays a lower bound; it
+        equals the numerical rank of both trace bases on every pair tested (k = 1..3)."""
         d = [(len(p.xs) - 1) * k - 1 for p in (trace1, trace2)]
         e = [(len(p.ys) - 1) * k - 1 for p in (trace1, trace2)]
         dc = (_coarsening_cells(trace1.xs, trace2.xs) * k - 1) * (_coarsening_cells(trace1.ys, trace2.ys) * k - 1)

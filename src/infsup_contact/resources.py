@@ -118,12 +118,14 @@ def _multiplier_intervals(multiplier_mesh: str, n1: int, n2: int) -> float:
     return {"omega1": n1, "omega2": n2}.get(multiplier_mesh, n1 + n2)
 
 
-SIDE_BYTES_3D = 1400.0
+SIDE_BYTES_3D = 1500.0
 """C in C · nd^{4/3} bytes per side of a 3D body (nested-dissection fill of a 3D grid is
-O(nd^{4/3})), everything of a β_h request but the process included: measured 160 MB above the
-process at N = 8 and 2.1 GB at N = 16 (k = 2, hexahedra, every case, ``/usr/bin/time -v``)."""
+O(nd^{4/3})), everything of a β_h request but the process included. Peak resident memory
+(hexahedra, every case, ``/usr/bin/time -v``): 0.36 GB at N = 8 and 2.3 GB at N = 16, 5.3 GB at
+N = 20 (k = 2), 7.1 GB at N = 40 (k = 1); the estimate is above each (by 3–35 %)."""
 SECONDS_PER_DOF2_3D = 1.3e-8
-"""Seconds per nd² (a 3D sparse LU) of the same runs (27 s at N = 16, k = 2)."""
+"""Seconds per nd² (a 3D sparse LU) of the same runs (27 s at N = 16 and 96 s at N = 20, k = 2;
+118 s at N = 40, k = 1)."""
 
 
 def face_side_dofs(n: int, k: int) -> float:

@@ -21,6 +21,8 @@ def test_square_implements_every_abstract_method():
     assert isinstance(Square(), Interface) and SQUARE.dim == 2 and SQUARE == Square()
     for name in Interface.__abstractmethods__:
         assert getattr(Square, name) is not getattr(Interface, name), name
+    with pytest.raises(InputError, match="quad, trig"):
+        Square(cell="hex")
 
 
 @pytest.mark.parametrize("element,face", [("hex", SQUARE), ("tet", SQUARE_TRIG)])

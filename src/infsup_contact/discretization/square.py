@@ -77,6 +77,10 @@ class Square(Interface):
     z: float = 1.0
     cell: str = "quad"
 
+    def __post_init__(self):
+        if self.cell not in CELL_SHAPES:
+            raise InputError("cell", ", ".join(CELL_SHAPES), got=self.cell)
+
     @property
     def dim(self) -> int:
         return 2

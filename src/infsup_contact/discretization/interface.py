@@ -46,8 +46,9 @@ class GammaTrace:
         The displacement space.
     gamma_dofs : ndarray of int
         Free NGSolve dofs that live on Γ (endpoint vertices are Dirichlet), sorted.
-    elements : list of (x_first, x_second, dofs, element)
-        Γ boundary elements: x of the element's first and second vertex and its dofs.
+    elements : list
+        Γ boundary elements, as the interface keeps them: (x_first, x_second, dofs, element)
+        on the segment, (vertex coordinates (nv, 2), dofs, element) on the face.
     breakpoints : ndarray
         The trace partition (for a :class:`Segment`: sorted x of its vertices); consumers
         read it as :attr:`partition`.

@@ -118,13 +118,40 @@ def _multiplier_intervals(multiplier_mesh: str, n1: int, n2: int) -> float:
     return {"omega1": n1, "omega2": n2}.get(multiplier_mesh, n1 + n2)
 
 
+SIDE_BYTES_3D = 1500.0
+"""C in C · nd^{4/3} bytes per side of a 3D body (nested-dissection fill of a 3D grid is
+O(nd^{4/3})), everything of a β_h request but the process included. Peak resident memory
+(hexahedra, every case, ``/usr/bin/time -v``): 0.36 GB at N = 8 and 2.3 GB at N = 16, 5.3 GB at
+N = 20 (k = 2), 7.1 GB at N = 40 (k = 1); the estimate is above each (by 3–35 %)."""
+SECONDS_PER_DOF2_3D = 1.3e-8
+"""Seconds per nd² (a 3D sparse LU) of the same runs (27 s at N = 16 and 96 s at N = 20, k = 2;
+118 s at N = 40, k = 1)."""
+
+
+def face_side_dofs(n: int, k: int) -> float:
+    """Free dofs of one 3D body on N × N × N cells: (N k − 1)² N k (u = 0 on five faces)."""
+    nk = float(n) * float(k)
+    return max((nk - 1.0) ** 2 * nk, 1.0)
+
+
+def face_beta_estimate(k: int, n1: int, n2: int, components: int = 1, process: bool = True) -> Estimate:
+    """One ``beta_rows`` call of a 3D model (a contact face): both sides kept (C nd^{4/3} each)."""
+    nds = [components * face_side_dofs(n, k) for n in (n1, n2)]
+    volume = sum(SIDE_BYTES_3D * nd ** (4.0 / 3.0) for nd in nds)
+    seconds = START_SECONDS + SECONDS_PER_DOF2_3D * sum(nd ** 2 for nd in nds)
+    return Estimate((PROCESS_BYTES["beta"] if process else 0) + volume, seconds)
+
+
 def beta_estimate(family: str, k: int, n1: int, n2: int, multiplier_mesh="omega2",
                   norms=("H", "L2"), h_route: str = "logkernel", process: bool = True,
-                  components: int = 1) -> Estimate:
+                  components: int = 1, dim: int = 2) -> Estimate:
     """One ``beta_rows`` call: both sides kept, then every multiplier space in turn (the
     largest degree s ≤ k counts: a space of degree s has at most N(s + 1) functions).
     ``components``: displacement components per node (2 for the elastic model: the side
-    volume is that of ``components`` × the dofs; not separately measured)."""
+    volume is that of ``components`` × the dofs; not separately measured). ``dim`` = 3: the
+    bodies of a 3D model (:func:`face_beta_estimate`)."""
+    if dim == 3:
+        return face_beta_estimate(k, n1, n2, components, process)
     mms = [multiplier_mesh] if isinstance(multiplier_mesh, str) else list(multiplier_mesh)
     nds = [components * side_dofs(family, n, k) for n in (n1, n2)]
     volume = sum(_side_bytes(nd, "beta") for nd in nds)
@@ -151,9 +178,9 @@ def contact_estimate(family: str, k: int, n1: int, n2: int, n_ref: int | None = 
     return Estimate((PROCESS_BYTES["contact"] if process else 0) + total, seconds)
 
 
-def verdict_estimate(family: str, k: int, ns, norm: str, multiplier_mesh: str = "omega2") -> Estimate:
+def verdict_estimate(family: str, k: int, ns, norm: str, multiplier_mesh: str = "omega2", dim: int = 2) -> Estimate:
     """β_h on matching meshes N × N, one N after the other: the largest N sets the memory."""
-    ests = [beta_estimate(family, k, n, n, multiplier_mesh, (norm,)) for n in ns]
+    ests = [beta_estimate(family, k, n, n, multiplier_mesh, (norm,), dim=dim) for n in ns]
     return Estimate(max(e.bytes for e in ests), START_SECONDS + sum(e.seconds - START_SECONDS for e in ests))
 
 

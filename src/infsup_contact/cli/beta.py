@@ -3,8 +3,8 @@ from __future__ import annotations
 
 import sys
 
-from .common import (material_columns, refuse_with_system, remember_defaults, add_dry_run, add_model, cases, check_memory, material,
-                     norms, SPACE_HELP, write_csv)
+from .common import (material_columns, mesh_options, refuse_with_system, remember_defaults, add_dry_run, add_model, cases,
+                     check_memory, material, norms, SPACE_HELP, write_csv)
 
 
 def add(sub) -> None:
@@ -28,13 +28,16 @@ def add(sub) -> None:
                    "{h, A, B, G}): one row per level; instead of --case/--k/--N1/--N2")
     p.add_argument("--k", type=int, default=None, help="displacement degree, 1..4 (required unless --system)")
     p.add_argument("--family", default="structured", choices=FAMILIES)
-    p.add_argument("--N1", type=int, default=None, help="segments on Γ of the Ω1 mesh (>= 1)")
-    p.add_argument("--N2", type=int, default=None, help="segments on Γ of the Ω2 mesh (>= 1)")
+    p.add_argument("--N1", type=int, default=None, help="segments on Γ of the Ω1 mesh (>= 1; a 3D model: "
+                   "cells per direction on the face Γ)")
+    p.add_argument("--N2", type=int, default=None, help="segments on Γ of the Ω2 mesh (>= 1; a 3D model: "
+                   "cells per direction on the face Γ)")
     p.add_argument("--multiplier-mesh", default="omega2", choices=["omega2", "omega1", "union"])
     add_model(p)
     p.add_argument("--norm", default="all", choices=["H", "L2", "all"])
     p.add_argument("--h-route", default="logkernel", choices=["logkernel", "series"],
-                   help="H^{-1/2}_00 Gram: closed-form log kernel or truncated sine series")
+                   help="H^{-1/2}_00 Gram: closed-form log kernel or truncated sine series (a 3D "
+                   "model's contact face: always the extrapolated double sine series)")
     p.add_argument("--seed", type=int, default=0, help="seed of the perturbed family (>= 0)")
     p.add_argument("--alpha", type=float, default=0.2, help="perturbation amplitude / h, in [0, 0.2] (larger can invert triangles)")
     add_dry_run(p)
@@ -63,12 +66,13 @@ def _check_beta(args):
 
     args.cases = cases(args)
     material(args)
+    args.mesh_kwargs = mesh_options(args)
     check_inputs([c for c in args.cases if isinstance(c, str)], args.k, args.family, args.N1, args.N2,
                  args.c1, args.c2, norms(args), args.multiplier_mesh)
     check_perturbation(args.alpha, args.seed)
     est = resources.beta_estimate(args.family, args.k, args.N1, args.N2, args.multiplier_mesh,
                                   norms(args), args.h_route,
-                                  components=args.model_obj.components)
+                                  components=args.model_obj.components, dim=args.model_obj.dim)
     check_memory(est, *(("N1", args.N1) if args.N1 >= args.N2 else ("N2", args.N2)))
     return est
 
@@ -86,11 +90,13 @@ def _run_beta(args) -> None:
 
     from ..solvers.infsup import beta_rows
 
-    kwargs = {}
+    kwargs = dict(args.mesh_kwargs)
     if args.family == "perturbed":
-        kwargs = dict(seed=args.seed, alpha=args.alpha)
+        kwargs.update(seed=args.seed, alpha=args.alpha)
     rows = beta_rows(args.family, args.k, args.N1, args.N2, args.cases, args.multiplier_mesh,
                      args.c1, args.c2, norms(args), h_route=args.h_route, model=args.model_obj, **kwargs)
     frame = pd.DataFrame(rows)
+    for i, (name, value) in enumerate(args.mesh_kwargs.items()):  # e.g. element, after family
+        frame.insert(frame.columns.get_loc("family") + 1 + i, name, value)
     frame = material_columns(frame, args)
     write_csv(frame, float_format="%.12g")

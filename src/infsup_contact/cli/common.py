@@ -51,17 +51,58 @@ def _material_params() -> dict:
     return out
 
 
-def add_model(p) -> None:
-    """--model and every registered model's material flags (the model contract's ``params``)."""
+def add_model(p, materials: bool = True) -> None:
+    """--model, every registered model's material flags (the model contract's ``params``; not
+    with ``materials=False``) and mesh flags (``mesh_options``)."""
     from ..models import DEFAULT_MODEL, MODELS
 
     p.add_argument("--model", default=DEFAULT_MODEL.name, choices=list(MODELS),
                    help="; ".join(f"{m.name}: {m.description}" + (" (default)" if m is DEFAULT_MODEL else "")
                                   for m in MODELS.values()))
-    for name, owners in _material_params().items():
+    for name, owners in (_material_params() if materials else {}).items():
         p.add_argument(f"--{name}", type=float, default=None,
                        help="; ".join(f"{model}: {prm.help}, {prm.allowed} (default {prm.default:g})"
                                       for model, prm in owners))
+    for name, owners in _mesh_options().items():
+        allowed = sorted({v for _, values in owners for v in values})
+        p.add_argument(f"--{name}", default=None, choices=allowed,
+                       help="; ".join(f"{model}: one of {', '.join(values)} (default {values[0]})"
+                                      for model, values in owners) + " (other models: not allowed)")
+
+
+def _mesh_options() -> dict:
+    """Mesh flag name → [(model name, allowed values)] over every registered model
+    (the model contract's ``mesh_options``, e.g. ``--element`` of the 3D model)."""
+    from ..models import MODELS
+
+    out = {}
+    for m in MODELS.values():
+        for name, values in m.mesh_options:
+            out.setdefault(name, []).append((m.name, tuple(values)))
+    return out
+
+
+def mesh_options(args) -> dict:
+    """The mesh keywords of a request for its model (``args.model_obj``), defaults filled in:
+    a mesh flag the model does not take is refused, naming the flag and the models that take it,
+    and so is a family the model's mesh builder does not build (``Model.families``)."""
+    model = args.model_obj
+    if model.families is not None and getattr(args, "family", None) not in model.families:
+        raise InputError("family", f"{', '.join(model.families)} (the meshes of --model {model.name})",
+                         got=getattr(args, "family", None))
+    own = dict(model.mesh_options)
+    out = {}
+    for name, owners in _mesh_options().items():
+        given = getattr(args, name, None)
+        if name not in own:
+            if given is not None:
+                raise InputError(name, f"nothing for --model {model.name} (--{name} is for --model "
+                                 f"{', '.join(m for m, _ in owners)})", got=given)
+            continue
+        if given is not None and given not in own[name]:
+            raise InputError(name, ", ".join(own[name]), got=given)
+        out[name] = own[name][0] if given is None else given
+    return out
 
 
 def material(args):

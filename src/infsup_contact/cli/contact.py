@@ -4,7 +4,7 @@ pair, CSV rows; the scenes and the models each is defined for come from the scen
 from __future__ import annotations
 
 from ..errors import InputError, check_prestress
-from .common import add_dry_run, add_model, cases, check_memory, material, SPACE_HELP, write_csv
+from .common import add_dry_run, add_model, cases, check_memory, material, mesh_options, SPACE_HELP, write_csv
 
 
 def add(sub) -> None:
@@ -47,6 +47,7 @@ def _check_contact(args):
         raise InputError("case", "one of --case ID|all or --space FILE.py:FUNC")
     args.cases = cases(args)
     material(args)
+    mesh_options(args)  # a mesh flag of another model is refused (the pair check refuses 3D models)
     spec = check_pair(args.model, args.scene)
     for key in OPTIONAL_PARAMS:
         if key not in spec.params and getattr(args, key) is not None:

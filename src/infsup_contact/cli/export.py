@@ -2,7 +2,7 @@
 from __future__ import annotations
 
 from ..errors import InputError
-from .common import add_dry_run, add_model, check_memory, material, write_text
+from .common import add_dry_run, add_model, check_memory, material, mesh_options, write_text
 
 
 def add(sub) -> None:
@@ -36,6 +36,7 @@ def _check_export(args):
     from ..discretization import meshes, registry
 
     material(args)
+    args.mesh_kwargs = mesh_options(args)
     for prm in args.model_obj.params:  # the sides' scales c_i (E_i of the elastic bodies)
         if prm.side is not None and getattr(args, prm.name) != 1.0:
             raise InputError(prm.name, "1 (an export is at unit material scale)", got=getattr(args, prm.name))
@@ -54,7 +55,7 @@ def _check_export(args):
     if not args.out.strip() or (out.exists() and not out.is_dir()):
         raise InputError("out", "a directory to write into (created if missing)", got=args.out)
     est = resources.beta_estimate(args.family, args.k, max(ns) + args.N1_offset, max(ns), args.multiplier_mesh,
-                                  (args.norm,), components=args.model_obj.components)
+                                  (args.norm,), components=args.model_obj.components, dim=args.model_obj.dim)
     check_memory(est, *(("N1_offset", args.N1_offset) if args.N1_offset > max(ns) else ("N", max(ns))))
     return est
 
@@ -62,7 +63,7 @@ def _check_export(args):
 def _run_export(args) -> None:
     from ..systems.export import suite_system, write_system
 
-    kwargs = {}
+    kwargs = dict(args.mesh_kwargs)
     levels = []
     for n in args.N:
         A, B, G = suite_system(args.case, args.k, n + args.N1_offset, n, args.family, args.norm,

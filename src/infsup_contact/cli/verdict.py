@@ -1,9 +1,11 @@
 """``infsup-contact verdict``: the stability verdict for one space, as a user's CI calls it."""
 from __future__ import annotations
 
+import sys
+
 from ..errors import InputError
-from .common import (refuse_with_system, remember_defaults, add_dry_run, check_memory, run_intervals, SPACE_HELP,
-                     write_csv)
+from .common import (refuse_with_system, remember_defaults, add_dry_run, add_model, check_memory, mesh_options,
+                     run_intervals, SPACE_HELP, write_csv)
 
 
 VERDICT_DEFAULTS = {"slope_tolerance": 0.15, "beta_floor": 0.001, "confidence": 0.95}
@@ -42,6 +44,7 @@ def add(sub) -> None:
                    help="multiplier norm: H = H^{-1/2}_00(Γ) (the paper's, default); in L2 "
                    "stable spaces decay like h^{1/2} (Remark 3.1)")
     p.add_argument("--multiplier-mesh", default="omega2", choices=["omega2", "omega1", "union"])
+    add_model(p, materials=False)
     p.add_argument("--expect", choices=sorted(_EXPECT),
                    help="exit code 0 if the verdict is this, 1 otherwise")
     for key, text in (("slope_tolerance", "slope tolerance τ"), ("beta_floor", "β floor"),
@@ -78,12 +81,16 @@ def _check_verdict(args):
     if not 1 <= args.k <= 4:
         raise InputError("k", "an integer in 1..4", got=args.k)
     registry.check_case(case, args.k)
+    from ..models import make_model
+
+    args.model_obj = make_model(args.model)
+    args.mesh_kwargs = mesh_options(args)
     meshes.check_mesh_args(args.family, 1)
     ns = check_mesh_sizes(args.N)
     for n in ns:  # an empty space on a small N is refused here, before any β_h
         registry.check_pair_spaces([case], args.k, n, n, (args.multiplier_mesh,), key="N")
     check_criterion(args.slope_tolerance, args.beta_floor, args.confidence)
-    est = resources.verdict_estimate(args.family, args.k, ns, args.norm, args.multiplier_mesh)
+    est = resources.verdict_estimate(args.family, args.k, ns, args.norm, args.multiplier_mesh, args.model_obj.dim)
     check_memory(est, "N", max(ns))
     return est
 
@@ -106,7 +113,7 @@ def _run_verdict(args) -> int:
     space = args.space_or_case
     out = verdict_rows(space, args.k, args.family, args.N, args.norm,
                        tol=args.slope_tolerance, floor=args.beta_floor, confidence=args.confidence,
-                       multiplier_mesh=args.multiplier_mesh)
+                       multiplier_mesh=args.multiplier_mesh, model=args.model_obj, **args.mesh_kwargs)
     out["N_list"] = " ".join(str(n) for n in out["N_list"])
     write_csv(pd.DataFrame([out]), float_format="%.6g")
     if args.expect is None:

@@ -15,11 +15,13 @@ partition apart. A partition is opaque to them: they obtain it from the interfac
 back to it. A side's trace carries its interface (``trace.gamma``), so a consumer holding the
 sides of a mesh pair finds Γ there.
 
-:class:`~.segment.Segment` — Γ = (0, 1) × {1}, the paper's — is the one implementation
+:class:`~.segment.Segment` — Γ = (0, 1) × {1}, the paper's — is the first implementation
 (module :mod:`.segment`); its partition
 is the sorted array of breakpoints (abscissae x of the vertices on Γ), the representation
 :class:`~.multipliers.MultiplierSpace` and users' spaces (``build(k, x)``) are built on.
-A 2D contact face is a second subclass implementing the abstract methods below.
+The 2D contact face Γ = (0, 1)² × {1} of the 3D models is the second,
+:class:`~.square.Square` (tensor partitions; spaces are tensor products of the 1D builds,
+:meth:`Interface.space`).
 """
 from __future__ import annotations
 
@@ -44,8 +46,9 @@ class GammaTrace:
         The displacement space.
     gamma_dofs : ndarray of int
         Free NGSolve dofs that live on Γ (endpoint vertices are Dirichlet), sorted.
-    elements : list of (x_first, x_second, dofs, element)
-        Γ boundary elements: x of the element's first and second vertex and its dofs.
+    elements : list
+        Γ boundary elements, as the interface keeps them: (x_first, x_second, dofs, element)
+        on the segment, (vertex coordinates (nv, 2), dofs, element) on the face.
     breakpoints : ndarray
         The trace partition (for a :class:`Segment`: sorted x of its vertices); consumers
         read it as :attr:`partition`.
@@ -348,6 +351,38 @@ class Interface(abc.ABC):
         """
 
     # --- derived, shared by every implementation ----------------------------------------------
+    def space(self, spec, k: int, partition):
+        """The multiplier space of a registry entry on a partition of this interface.
+
+        The default (the segment's): ``spec.build(k, partition)`` on the sorted breakpoints. A
+        face builds its tensor products from the same 1D ``build`` (:class:`~.square.Square`).
+
+        Parameters
+        ----------
+        spec : SpaceSpec
+            A registry entry (:mod:`.registry`).
+        k : int
+            Displacement degree.
+        partition : partition
+            G_h.
+
+        Returns
+        -------
+        space
+            With ``dim``, ``degree``, ``breakpoints`` (= ``partition``) and ``evaluate(x)``.
+
+        Raises
+        ------
+        InputError
+            For a partition without a cell, naming the case and k.
+        """
+        x = np.asarray(partition, dtype=float)
+        n = self.cells(x) if x.ndim == 1 else 0
+        if n < 1:
+            raise InputError("multiplier mesh", f"a partition of Γ with at least one interval (case {spec.id}, "
+                             f"k = {k}, N = {max(n, 0)})")
+        return spec.build(k, x)
+
     def multiplier_partition_of(self, mesh1, mesh2, choice: str = "omega2", tol: float = 1e-12):
         """G_h of a mesh pair: :meth:`multiplier_partition` of their trace partitions."""
         return self.multiplier_partition(self.partition_of(mesh1), self.partition_of(mesh2), choice, tol)

@@ -167,7 +167,9 @@ def check_case(case: str, k: int) -> None:
 def case_space(case: str, k: int, partition, gamma=SEGMENT) -> MultiplierSpace:
     """The multiplier space of a registered case for displacement degree k on G_h, a
     ``partition`` of Γ = ``gamma`` (:mod:`.interface`; for the paper's segment the sorted
-    breakpoints of G_h, what ``SpaceSpec.build(k, x)`` receives).
+    breakpoints of G_h, what ``SpaceSpec.build(k, x)`` receives; for the face
+    :class:`~.square.Square` a tensor partition, on which the space is the tensor product of
+    the 1D builds, :meth:`~.interface.Interface.space`).
 
     Raises
     ------
@@ -176,12 +178,8 @@ def case_space(case: str, k: int, partition, gamma=SEGMENT) -> MultiplierSpace:
         the eigenproblems and solves would fail deep inside numpy), naming the case, N and k.
     """
     check_case(case, k)
-    x = np.asarray(partition, dtype=float)
-    n = gamma.cells(x) if x.ndim == 1 else 0
-    if n < 1:
-        raise InputError("multiplier mesh", f"a partition of Γ with at least one interval (case {case}, "
-                         f"k = {k}, N = {max(n, 0)})")
-    space = SPACES[case].build(k, x)
+    space = gamma.space(SPACES[case], k, partition)  # the interface builds it (a face: tensor products)
+    n = gamma.cells(space.breakpoints)
     if space.dim < 1:
         low = min_intervals(case, k)
         raise InputError("N", f"a multiplier mesh on which case {case} with k = {k} is not empty (dim M_h = 0 "

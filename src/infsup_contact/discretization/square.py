@@ -2,12 +2,30 @@
 
 A partition of the face is, for now, a tensor grid of rectangles (:class:`TensorPartition`):
 the trace of a structured hexahedral mesh, and the common refinement of two such traces.
+:class:`Square` is the second implementation of :class:`~.interface.Interface`: its points
+are arrays of shape (n, 2) (x, y), its quadrature is the tensor Gauss–Legendre rule per
+rectangle, its multiplier spaces are tensor products of the segment's 1D spaces
+(:mod:`.face_spaces`) and its norms are computed factor by factor (:mod:`.face_norms`).
+
+The trace of a tetrahedral mesh from the same structured grid (every rectangle cut in two
+triangles by its diagonal from (x_i, y_j) to (x_{i+1}, y_{j+1})) has the same tensor partition;
+``Square(cell="trig")`` is its interface (the trace basis is then P_k on triangles, not Q_k;
+its couplings are integrated on the rectangles cut by the trace's diagonals, :mod:`.face_quadrature`).
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
+
+from ..errors import InputError
+from .interface import GammaTrace, Interface, check_choice
+from .face_quadrature import split_rule
+from .quadrature import gauss_legendre
+
+_BASIS_CACHE_SIZE = 4
+CELL_SHAPES = ("quad", "trig")
 
 
 @dataclass(frozen=True, eq=False)
@@ -27,3 +45,272 @@ class TensorPartition:
     def cells(self) -> int:
         """Number of rectangles."""
         return (len(self.xs) - 1) * (len(self.ys) - 1)
+
+
+def _merge(x: np.ndarray, tol: float) -> np.ndarray:
+    """Sorted unique values of ``x``, values closer than ``tol`` merged into the first."""
+    x = np.unique(np.asarray(x, dtype=float))
+    return x[np.concatenate([[True], np.diff(x) > tol])]
+
+
+def _coarsening_cells(a: np.ndarray, b: np.ndarray, tol: float = 1e-12) -> int:
+    """Cells of the common coarsening of two 1D partitions (their shared breakpoints)."""
+    return int(np.sum(np.min(np.abs(a[:, None] - b[None, :]), axis=1) < tol)) - 1
+
+
+@dataclass(frozen=True)
+class Square(Interface):
+    """Γ = (0, 1)² × {z}: partitions are :class:`TensorPartition`; points are (n, 2) arrays.
+
+    Attributes
+    ----------
+    boundary : str
+        Name of Γ's boundary region in the meshes (``gamma``).
+    z : float
+        Height of Γ.
+    cell : {"quad", "trig"}
+        Shape of the boundary elements on Γ: rectangles of a hexahedral mesh, or each
+        rectangle cut in two triangles (a tetrahedral mesh).
+    """
+
+    boundary: str = "gamma"
+    z: float = 1.0
+    cell: str = "quad"
+
+    def __post_init__(self):
+        if self.cell not in CELL_SHAPES:
+            raise InputError("cell", ", ".join(CELL_SHAPES), got=self.cell)
+
+    @property
+    def dim(self) -> int:
+        return 2
+
+    def embed(self, x):
+        x = np.asarray(x, dtype=float).reshape(-1, 2)
+        return x[:, 0], x[:, 1], np.full(len(x), self.z)
+
+    # --- partitions
+    def _gamma_elements(self, mesh):
+        """(element, vertex coordinates (nv, 2)) of the Γ boundary elements of ``mesh``."""
+        import ngsolve
+
+        out = []
+        for el in mesh.Elements(ngsolve.BND):
+            if el.mat == self.boundary:
+                out.append((el, np.array([mesh[v].point[:2] for v in el.vertices])))
+        return out
+
+    def _partition_of_elements(self, elements, tol: float = 1e-12) -> TensorPartition:
+        """The tensor grid of the Γ elements; :class:`InputError` unless they tile one."""
+        if not elements:
+            raise InputError("mesh", f"boundary elements named {self.boundary!r} on Γ")
+        pts = np.vstack([v for _, v in elements])
+        part = TensorPartition(_merge(pts[:, 0], tol), _merge(pts[:, 1], tol))
+        per_cell = 1 if self.cell == "quad" else 2
+        nv = 4 if self.cell == "quad" else 3
+        lo = np.array([v.min(axis=0) for _, v in elements])
+        hi = np.array([v.max(axis=0) for _, v in elements])
+        cell = []
+        for d, g in enumerate((part.xs, part.ys)):  # each element spans exactly one interval per direction
+            i, j = (np.argmin(np.abs(g[None, :] - b[:, d, None]), axis=1) for b in (lo, hi))
+            cell.append(np.where(j == i + 1, i, -1))
+        counts = np.bincount(np.maximum(cell[0], 0) * (len(part.ys) - 1) + np.maximum(cell[1], 0),
+                             minlength=part.cells)
+        if (any(len(v) != nv for _, v in elements) or np.any(cell[0] < 0) or np.any(cell[1] < 0)
+                or np.any(counts != per_cell) or part.xs[0] != 0.0 or part.ys[0] != 0.0
+                or part.xs[-1] != 1.0 or part.ys[-1] != 1.0):
+            raise InputError("mesh", f"a face Γ tiled by a tensor grid of {self.cell}s "
+                             f"({len(elements)} elements on {len(part.xs) - 1} x {len(part.ys) - 1} cells)")
+        return part
+
+    def partition_of(self, mesh) -> TensorPartition:
+        """x and y breakpoints of the Γ boundary elements (a tensor grid, checked)."""
+        return self._partition_of_elements(self._gamma_elements(mesh))
+
+    def common_refinement(self, *partitions, tol: float = 1e-12) -> TensorPartition:
+        """Union of the x breakpoints and of the y breakpoints, merging within ``tol`` (for
+        triangles the tensor grid under them: :meth:`coupling_quadrature` cuts its cells)."""
+        return TensorPartition(_merge(np.concatenate([p.xs for p in partitions]), tol),
+                               _merge(np.concatenate([p.ys for p in partitions]), tol))
+
+    def multiplier_partition(self, trace1, trace2, choice: str = "omega2", tol: float = 1e-12):
+        check_choice(choice)
+        if choice == "union":
+            return self.common_refinement(trace1, trace2, tol=tol)
+        return trace2 if choice == "omega2" else trace1
+
+    def cells(self, partition) -> int:
+        """Number of rectangles of ``partition``."""
+        return partition.cells if isinstance(partition, TensorPartition) else 0
+
+    def partition_key(self, partition) -> bytes:
+        return np.asarray(partition.xs, float).tobytes() + b"|" + np.asarray(partition.ys, float).tobytes()
+
+    def sample(self, partition, per_cell: int, upper: float | None = None) -> np.ndarray:
+        """Tensor grid of the 1D samples of x and y (x-major order), shape (n, 2)."""
+        t = np.linspace(0.0, 1.0, per_cell + 1)
+        hi = 1.0 if upper is None else upper
+        axes = [np.unique(np.clip((g[:-1, None] + np.outer(np.diff(g), t)).ravel(), 0.0, hi))
+                for g in (np.asarray(partition.xs), np.asarray(partition.ys))]
+        X, Y = np.meshgrid(*axes, indexing="ij")
+        return np.column_stack([X.ravel(), Y.ravel()])
+
+    @staticmethod
+    def _cell_index(partition, x: np.ndarray):
+        x = np.asarray(x, dtype=float).reshape(-1, 2)
+        ix = np.clip(np.searchsorted(partition.xs, x[:, 0], side="right") - 1, 0, len(partition.xs) - 2)
+        iy = np.clip(np.searchsorted(partition.ys, x[:, 1], side="right") - 1, 0, len(partition.ys) - 2)
+        return ix, iy
+
+    def at_boundary(self, partition, x: np.ndarray) -> np.ndarray:
+        """Whether each point lies in a rectangle touching ∂Γ."""
+        ix, iy = self._cell_index(partition, x)
+        return (ix == 0) | (iy == 0) | (ix == len(partition.xs) - 2) | (iy == len(partition.ys) - 2)
+
+    # --- trace dofs
+    def trace(self, fes) -> GammaTrace:
+        """Collect the Γ boundary elements (element, vertex coordinates, dofs) and the free Γ dofs."""
+        free = fes.FreeDofs()
+        elements, dofs = [], set()
+        for el, verts in self._gamma_elements(fes.mesh):
+            dn = np.array(fes.GetDofNrs(el))
+            elements.append((verts, dn, el))
+            dofs.update(int(d) for d in dn if d >= 0 and free[int(d)])
+        part = self._partition_of_elements([(el, v) for v, _, el in elements])
+        return GammaTrace(fes, np.array(sorted(dofs), dtype=int), elements, part, self)
+
+    def _reference(self, verts: np.ndarray, x: np.ndarray) -> np.ndarray:
+        """Reference coordinates in one element (affine: rectangles and triangles) of points x.
+
+        NGSolve's reference quadrilateral has its vertices 0, 1, 2, 3 at (0,0), (1,0), (1,1),
+        (0,1); its reference triangle at (1,0), (0,1), (0,0).
+        """
+        if self.cell == "quad":
+            origin, e1, e2 = verts[0], verts[1] - verts[0], verts[3] - verts[0]
+        else:
+            origin, e1, e2 = verts[2], verts[0] - verts[2], verts[1] - verts[2]
+        return np.linalg.solve(np.column_stack([e1, e2]), (x - origin).T).T
+
+    def trace_values(self, trace: GammaTrace, x: np.ndarray) -> np.ndarray:
+        """Dense values (len(x), number of Γ dofs) of the Γ-dof basis at points x of Γ."""
+        x = np.asarray(x, dtype=float).reshape(-1, 2)
+        part = trace.breakpoints
+        position = -np.ones(trace.fes.ndof, dtype=int)
+        position[trace.gamma_dofs] = np.arange(len(trace.gamma_dofs))
+        by_cell = {}
+        for e, (verts, _, _) in enumerate(trace.elements):
+            c = self._cell_index(part, verts.mean(axis=0)[None, :])
+            by_cell.setdefault((int(c[0][0]), int(c[1][0])), []).append(e)
+        ix, iy = self._cell_index(part, x)
+        phi = np.zeros((len(x), len(trace.gamma_dofs)))
+        tol = 1e-10
+        for (cx, cy), elems in by_cell.items():
+            pts = np.flatnonzero((ix == cx) & (iy == cy))
+            todo = np.ones(len(pts), dtype=bool)
+            for e in elems:
+                verts, dn, el = trace.elements[e]
+                ref = self._reference(verts, x[pts])
+                inside = todo & np.all(ref >= -tol, axis=1)
+                if self.cell == "trig":
+                    inside &= ref.sum(axis=1) <= 1.0 + tol
+                if not inside.any():
+                    continue
+                todo &= ~inside
+                fe = trace.fes.GetFE(el)
+                pos = position[dn]
+                keep = pos >= 0
+                shapes = np.array([np.asarray(fe.CalcShape(a, b, 0.0)) for a, b in ref[inside]])
+                phi[np.ix_(pts[inside], pos[keep])] += shapes[:, keep]
+        return phi
+
+    def trace_basis(self, trace: GammaTrace, x: np.ndarray) -> np.ndarray:
+        """Dense values of the Γ-dof basis at the points x (n, 2), cached on the trace
+        (read-only) as :meth:`Segment.trace_basis <.segment.Segment.trace_basis>` does."""
+        key = np.ascontiguousarray(x, dtype=float).tobytes()
+        phi = trace.basis_cache.get(key)
+        if phi is None:
+            phi = self.trace_values(trace, x)
+            phi.flags.writeable = False
+            if len(trace.basis_cache) >= _BASIS_CACHE_SIZE:
+                trace.basis_cache.clear()
+            trace.basis_cache[key] = phi
+        return phi
+
+    # --- quadrature and norms
+    def quadrature(self, partition, degree: int) -> tuple:
+        """Tensor Gauss–Legendre rule per rectangle, exact for degree ``degree`` in each
+        variable (Q_degree, which contains P_degree): ⌊degree/2⌋ + 1 points per direction."""
+        t, w = gauss_legendre(degree // 2 + 1)
+
+        def axis(g):
+            g = np.asarray(g, dtype=float)
+            a, b = g[:-1, None], g[1:, None]
+            return (0.5 * (a + b) + 0.5 * (b - a) * t).ravel(), (0.5 * (b - a) * w).ravel()
+
+        if self.cell == "trig":  # both triangles of every cell, total degree 2 degree (⊇ Q_degree)
+            return split_rule(partition, partition, 2 * degree)
+        (x, wx), (y, wy) = axis(partition.xs), axis(partition.ys)
+        X, Y = np.meshgrid(x, y, indexing="ij")
+        return np.column_stack([X.ravel(), Y.ravel()]), np.outer(wx, wy).ravel()
+
+    def coupling_quadrature(self, trace: GammaTrace, space, degree: int) -> tuple:
+        """Quadrature ``degree`` on the common refinement of the trace and G_h; for triangles
+        every rectangle is cut by the diagonal of the trace cell containing it
+        (:func:`~.face_quadrature.split_rule`), exact for the P_k × Q_s products."""
+        if self.cell == "quad":
+            return super().coupling_quadrature(trace, space, degree)
+        return split_rule(self.common_refinement(trace.partition, space.breakpoints), trace.partition, 2 * degree)
+
+    def gram(self, space, norm: str, h_route: str = "logkernel", **kwargs) -> tuple:
+        """:func:`~.face_norms.gram`: L² exactly (kron of the 1D Grams), H by the double sine
+        series (the only route on the square: ``h_route`` "logkernel", the command line's
+        default, and "series" both name it; ``n_max`` > 0 in ``info`` says it is a series)."""
+        from .face_norms import gram
+
+        return gram(space, norm, **kwargs)
+
+    def space(self, spec, k: int, partition):
+        """The tensor product of ``spec``'s 1D space on xs and on ys (:class:`.face_spaces.FaceSpace`)."""
+        from .face_spaces import FaceSpace
+
+        if not isinstance(partition, TensorPartition) or partition.cells < 1:
+            raise InputError("multiplier mesh", f"a tensor partition of Γ with at least one rectangle "
+                             f"(case {spec.id}, k = {k})")
+        return FaceSpace(spec.build(k, np.asarray(partition.xs, float)),
+                         spec.build(k, np.asarray(partition.ys, float)), partition)
+
+    # --- spaces and counts
+    def trace_dimension(self, k: int, cells: int) -> int:
+        """dim W_h = (n k − 1)² on an n × n grid (``cells`` is n, the cells per direction):
+        continuous Q_k (or P_k on the triangles) vanishing on ∂Γ has one dof per interior
+        node of the (n k + 1)² Lagrange lattice."""
+        return (cells * k - 1) ** 2
+
+    def trace_sum_dimension(self, k: int, trace1, trace2) -> int:
+        """dim(W1 + W2) = dim W1 + dim W2 − dim(W1 ∩ W2), per direction products.
+
+        For quadrilaterals W_i = W_i^x ⊗ W_i^y (1D traces vanishing at the ends, dim n k − 1) and
+        (A ⊗ A') ∩ (B ⊗ B') = (A ∩ B) ⊗ (A' ∩ B'); A ∩ B is the 1D trace space on the common
+        coarsening (the shared breakpoints). For triangles the space on the common coarsening
+        (cut by the same diagonals) is a subspace of W1 ∩ W2 when both grids are uniform, so the
+        count is an upper bound of dim(W1 + W2) and the proven kernel stays a lower bound; it
+        equals the numerical rank of both trace bases on every pair tested (k = 1..3)."""
+        d = [(len(p.xs) - 1) * k - 1 for p in (trace1, trace2)]
+        e = [(len(p.ys) - 1) * k - 1 for p in (trace1, trace2)]
+        dc = (_coarsening_cells(trace1.xs, trace2.xs) * k - 1) * (_coarsening_cells(trace1.ys, trace2.ys) * k - 1)
+        return d[0] * e[0] + d[1] * e[1] - max(dc, 0)
+
+    def trace_nodes(self, k: int, cells: int) -> int:
+        """(n k + 1)² Γ nodes of a side on an n × n grid, boundary included."""
+        return (cells * k + 1) ** 2
+
+    def multiplier_cells(self, n1: int, n2: int, choice: str = "omega2") -> int:
+        """Rectangles of G_h for n1 × n1 and n2 × n2 traces: the segment's count squared."""
+        per = {"omega2": n2, "omega1": n1}.get(choice, n1 + n2 - math.gcd(n1, n2))
+        return per * per
+
+
+SQUARE = Square()
+"""Γ = (0, 1)² × {1} of the hexahedral meshes."""
+SQUARE_TRIG = Square(cell="trig")
+"""The same face, traced by tetrahedral meshes (rectangles cut in two triangles)."""

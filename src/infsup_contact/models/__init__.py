@@ -3,7 +3,8 @@
 ``contract`` states what a model gives the engine (one factorized side per mesh, Γ last; the
 loads, lifts and u_h of a contact scene); ``schur`` is the shared Γ Schur complement / Steklov
 inverse machinery, ``ordering`` its Γ-last nested dissection; ``membranes`` is the paper's
-model, ``elastic`` plane-strain elasticity (its Section 2), ``plane_strain`` the material law
+model, ``elastic`` plane-strain elasticity (its Section 2), ``membranes3d`` the membranes
+in 3D with a 2D contact face (issue 28), ``plane_strain`` the material law
 the elastic scenes measure with. Imports ``discretization`` and ``errors`` only.
 
 This file is the registry of models: the engine (``solvers``, ``study``) asks it for a model by
@@ -12,10 +13,11 @@ name and never imports a concrete model.
 from .contract import Model
 from .membranes import MEMBRANES
 from .elastic import ELASTIC, elastic_model
+from .membranes3d import MEMBRANES3D
 
-MODELS = {m.name: m for m in (MEMBRANES, ELASTIC)}
+MODELS = {m.name: m for m in (MEMBRANES, ELASTIC, MEMBRANES3D)}
 """Every model by name (``elastic``: ν = 0.3; other ν through :func:`make_model`)."""
-_BUILDERS = {MEMBRANES.name: lambda: MEMBRANES, ELASTIC.name: elastic_model}
+_BUILDERS = {MEMBRANES.name: lambda: MEMBRANES, ELASTIC.name: elastic_model, MEMBRANES3D.name: lambda: MEMBRANES3D}
 DEFAULT_MODEL = MEMBRANES
 """The paper's model: what β_h and contact use when no model is named."""
 

@@ -93,6 +93,18 @@ class Model:
         that change K_i itself (built into the model by ``models.make_model``).
     components : int
         Displacement components per node (the memory estimate's factor).
+    mesh : callable or None
+        ``mesh(family, n, side, **mesh_kwargs) -> ngsolve.Mesh``: the mesh of Ω_side with n cells
+        on Γ (per direction on a face); None: the paper's 2D meshes
+        (:func:`~infsup_contact.discretization.meshes.subdomain_mesh`).
+    mesh_options : tuple of (str, tuple)
+        Mesh keywords the model's ``mesh`` takes beyond the 2D ones, with their allowed values
+        (``(("element", ("hex", "tet")),)``; a tuple, so that a model stays hashable, a side
+        cache key): what the command line offers for this model only.
+    families : tuple of str or None
+        Mesh families the model's ``mesh`` builds (None: every 2D family).
+    dim : int
+        Space dimension of the bodies (2, or 3 with a contact face): the memory estimate's model.
     """
 
     name: str
@@ -104,6 +116,18 @@ class Model:
     interpolate: Callable | None = None
     params: tuple = ()
     components: int = 1
+    mesh: Callable | None = None
+    mesh_options: tuple = ()
+    families: tuple | None = None
+    dim: int = 2
+
+    def subdomain_mesh(self, family: str, n: int, side: int, **mesh_kwargs):
+        """The mesh of Ω_side the model's sides are built on (its ``mesh`` builder, else the 2D one)."""
+        if self.mesh is None:
+            from ..discretization import meshes
+
+            return meshes.subdomain_mesh(family, n, side, **mesh_kwargs)
+        return self.mesh(family, n, side, **mesh_kwargs)
 
     def param_names(self) -> list:
         """The names of the model's material parameters (its flags without ``--``)."""

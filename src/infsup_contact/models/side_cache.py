@@ -55,7 +55,8 @@ class SideCache:
         op = self._ops.pop(key, None)
         if op is None:
             n, side = key[3], key[4]
-            op = model.side_operator(meshes.subdomain_mesh(family, n, side, **mesh_kwargs), k)
+            build = getattr(model, "mesh", None) or meshes.subdomain_mesh  # the model's own meshes (3D), else 2D
+            op = model.side_operator(build(family, n, side, **mesh_kwargs), k)
         if self._uses_left[key] > 1:  # more uses announced: keep it for them
             self._uses_left[key] -= 1
             self._ops[key] = op

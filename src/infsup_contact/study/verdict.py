@@ -92,7 +92,7 @@ def stability_verdict(rows, tol: float, floor: float, confidence: float) -> dict
 
 
 def verdict_rows(case_or_spec, k: int, family: str, ns, norm: str, *, tol: float, floor: float,
-                 confidence: float, multiplier_mesh: str = "omega2", **mesh_kwargs) -> dict:
+                 confidence: float, multiplier_mesh: str = "omega2", model=None, **mesh_kwargs) -> dict:
     """β_h on matching meshes N1 = N2 = N for each N in ``ns``, and its stability verdict.
 
     Parameters
@@ -112,8 +112,11 @@ def verdict_rows(case_or_spec, k: int, family: str, ns, norm: str, *, tol: float
         The criterion of :func:`stability_verdict`.
     multiplier_mesh : str
         Partition G_h of the multipliers: ``omega2`` (the paper's), ``omega1``, ``union``.
+    model : Model, optional
+        The physical model (:mod:`infsup_contact.models`); default the paper's membranes.
     **mesh_kwargs
-        Passed to the mesh generator (``seed``, ``alpha`` of the perturbed family).
+        Passed to the mesh generator (``seed``, ``alpha`` of the perturbed family; the 3D
+        model's ``element``).
 
     Returns
     -------
@@ -133,6 +136,8 @@ def verdict_rows(case_or_spec, k: int, family: str, ns, norm: str, *, tol: float
     check_criterion(tol, floor, confidence)
     if norm not in NORMS:
         raise InputError("norm", ", ".join(NORMS), got=norm)
+    if model is not None:
+        mesh_kwargs["model"] = model
     rows = [r for n in ns for r in beta_rows(family, k, n, n, [case], multiplier_mesh,
                                              norms=(norm,), **mesh_kwargs)]
     out = dict(space=case, k=k, family=family, norm=norm, multiplier_mesh=multiplier_mesh,

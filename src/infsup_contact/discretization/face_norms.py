@@ -1,0 +1,135 @@
+"""Gram matrices of a face multiplier space M^x ⊗ M^y (:mod:`.face_spaces`) on Γ = (0, 1)².
+
+L²(Γ): the norm is separable, so G = G_x ⊗ G_y with the exact 1D mass matrices
+(:func:`~.norms.gram_l2`).
+
+M = H^{1/2}_00(Γ)': the spectral realisation of the 1D module (:mod:`.norms`) on the square.
+The Dirichlet Laplacian of (0, 1)² has the L²-orthonormal eigenfunctions 2 sin(mπx) sin(nπy)
+with eigenvalues π²(m² + n²); H^{1/2}_00 is the interpolation space halfway between L² and
+H¹_0, whose norm weights a coefficient by π√(m² + n²), and its dual
+
+    ‖μ‖²_M = Σ_{m,n≥1} μ_mn² / (π √(m² + n²)),     μ_mn = 2 ∬ μ sin(mπx) sin(nπy).
+
+For a tensor basis function μ^x_a(x) μ^y_b(y) the coefficient factorizes, μ_mn = μ^x_{a,m} μ^y_{b,n},
+with the 1D sine coefficients of :func:`~.norms.sine_coefficients` (closed form per interval).
+The series is truncated to m, n ≤ n_max and extrapolated in n_max (Richardson): the tail of the
+square m, n ≤ n_max behaves like C n_max^{−p}, p = 2 when a basis function has a jump or
+a nonzero value on ∂Γ (1D coefficients ~ 1/m), p = 4 for continuous spaces vanishing on ∂Γ
+(coefficients ~ 1/m²) — the exponents :func:`tail_exponent` measures (T3: 4, R5.2: 2).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import InputError
+from .norms import NORMS, N_MAX_CAP, gram_l2, sine_coefficients
+
+#: Rows of the weight matrix W[m, n] = 1/(π√(m² + n²)) handled at once (memory ~ chunk · n_max).
+_CHUNK = 512
+
+
+def gram_l2_face(space) -> np.ndarray:
+    """Exact L²(Γ) Gram matrix G_x ⊗ G_y of a tensor space (index a·dim M^y + b)."""
+    sx, sy = space.factors
+    return np.kron(gram_l2(sx), gram_l2(sy))
+
+
+def partial_gram(space, n_max: int) -> np.ndarray:
+    """S(n_max) = Σ_{m,n ≤ n_max} c_mn c_mnᵀ / (π√(m² + n²)), c_mn = c^x_m ⊗ c^y_n.
+
+    With A[(a, a'), m] = c^x_{a,m} c^x_{a',m} and B[(b, b'), n] = c^y_{b,n} c^y_{b',n},
+    S[(a, b), (a', b')] = (A W Bᵀ)[(a, a'), (b, b')]: n_max² · (dim M^y)² + n_max · (dim M^x dim M^y)²
+    operations, the weight matrix W handled in row blocks."""
+    sx, sy = space.factors
+    n = np.arange(1, n_max + 1, dtype=float)
+    cx, cy = sine_coefficients(sx, n), sine_coefficients(sy, n)
+    dx, dy = cx.shape[0], cy.shape[0]
+    A = (cx[:, None, :] * cx[None, :, :]).reshape(dx * dx, n_max)
+    B = (cy[:, None, :] * cy[None, :, :]).reshape(dy * dy, n_max)
+    flat = np.zeros((dx * dx, dy * dy))
+    for start in range(0, n_max, _CHUNK):
+        m = n[start:start + _CHUNK]
+        W = 1.0 / (np.pi * np.sqrt(m[:, None] ** 2 + n[None, :] ** 2))
+        flat += A[:, start:start + _CHUNK] @ (W @ B.T)
+    G = flat.reshape(dx, dx, dy, dy).transpose(0, 2, 1, 3).reshape(dx * dy, dx * dy)
+    return 0.5 * (G + G.T)
+
+
+def smooth_tail(space) -> bool:
+    """Whether every basis function is continuous and vanishes on ∂Γ (tail exponent 4, else 2)."""
+    return all(getattr(s, "continuous", False) and getattr(s, "vanish_at_ends", False)
+               and s.local_coefficients is None for s in space.factors)
+
+
+def tail_exponent(space, n_max: int) -> float:
+    """Measured p of the tail ‖S(∞) − S(n)‖ ~ C n^{−p}: log2 of the ratio of successive
+    increments ‖S(2n) − S(n)‖ / ‖S(4n) − S(2n)‖ (spectral norms)."""
+    s1, s2, s4 = (partial_gram(space, n) for n in (n_max, 2 * n_max, 4 * n_max))
+    return float(np.log2(_norm2(s2 - s1) / _norm2(s4 - s2)))
+
+
+def gram_h_face(space, rtol: float = 1e-6, n_start: int | None = None, n_cap: int = N_MAX_CAP // 8,
+                exponent: float | None = None) -> tuple[np.ndarray, dict]:
+    """Gram matrix of the M = H^{1/2}_00(Γ)' norm on the square (module docstring).
+
+    Partial sums S(n) at n = n0, 2n0, 4n0, ... are extrapolated,
+    R(n) = S(2n) + (S(2n) − S(n)) / (2^p − 1), until ‖R(2n) − R(n)‖₂ / ‖R(2n)‖₂ ≤ rtol (that
+    difference is the reported error, as in :func:`~.norms.gram_h`).
+
+    Parameters
+    ----------
+    space : FaceSpace
+    rtol : float
+        Target relative (spectral-norm) truncation error.
+    n_start : int, optional
+        n0; default max(16, 2 (s + 1) N) with N the larger number of intervals per direction.
+    n_cap : int
+        Largest n_max (``info["capped"]`` when the estimate is still above rtol there).
+    exponent : float, optional
+        Tail exponent p; default 4 for continuous spaces vanishing on ∂Γ, else 2 (:func:`smooth_tail`).
+
+    Returns
+    -------
+    G : ndarray (dim, dim)
+    info : dict
+        ``n_max``, ``nmax_rel_error``, ``capped``, ``n_start``, ``tail_exponent``.
+    """
+    if not rtol > 0:
+        raise InputError("rtol", "a positive float", got=rtol)
+    p = (4.0 if smooth_tail(space) else 2.0) if exponent is None else float(exponent)
+    n_int = max(f.n_intervals for f in space.factors)
+    n0 = max(16, 2 * (space.degree + 1) * n_int) if n_start is None else int(n_start)
+    if n0 < 1 or n_cap < 1:
+        raise InputError("n_start/n_cap", "positive integers", got=(n_start, n_cap))
+    n0 = min(n0, n_cap)
+    factor = 1.0 / (2.0 ** p - 1.0)
+    s_lo, n_hi = partial_gram(space, n0), min(2 * n0, n_cap)
+    s_hi = partial_gram(space, n_hi)
+    r_prev = s_hi + (s_hi - s_lo) * factor
+    err = _norm2(r_prev - s_hi) / _norm2(r_prev)
+    capped = False
+    while True:
+        if 2 * n_hi > n_cap:
+            capped = err > rtol
+            break
+        s_lo, s_hi, n_hi = s_hi, partial_gram(space, 2 * n_hi), 2 * n_hi
+        r = s_hi + (s_hi - s_lo) * factor
+        err = _norm2(r - r_prev) / _norm2(r)
+        r_prev = r
+        if err <= rtol:
+            break
+    return r_prev, {"n_max": int(n_hi), "nmax_rel_error": float(err), "capped": bool(capped),
+                    "n_start": int(n0), "tail_exponent": p}
+
+
+def _norm2(A: np.ndarray) -> float:
+    return float(np.max(np.abs(np.linalg.eigvalsh(A))))
+
+
+def gram(space, norm: str, **kwargs) -> tuple[np.ndarray, dict]:
+    """Gram matrix of a face space for ``norm`` ∈ {"H", "L2"} (``kwargs`` go to :func:`gram_h_face`)."""
+    if norm == "L2":
+        return gram_l2_face(space), {"n_max": 0, "nmax_rel_error": 0.0}
+    if norm == "H":
+        return gram_h_face(space, **kwargs)
+    raise InputError("norm", ", ".join(NORMS), got=norm)

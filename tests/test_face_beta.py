@@ -1,0 +1,163 @@
+"""β_h of the 3D membranes with the contact face Γ = (0,1)²×{1} (issue 28): the kernel against
+the dimension argument and an independent count from 1D ranks, β_h > 0 where there is no
+kernel, β_h against the full saddle-point pencil, and the command line."""
+import io
+
+import numpy as np
+import pandas as pd
+import pytest
+from scipy.sparse import block_diag
+
+from _cli import run_in_process
+from infsup_contact.discretization.coupling import coupling_matrix
+from infsup_contact.discretization.multipliers import make_space
+from infsup_contact.discretization.registry import case_space, ids_valid_for
+from infsup_contact.discretization.segment import SEGMENT
+from infsup_contact.models import make_model
+from infsup_contact.models.side_cache import SideCache
+from infsup_contact.solvers.infsup import beta_rows, saddle_point_beta
+
+MODEL = make_model("membranes3d")
+
+
+def rows_of(k, n1, n2, element="hex", **kw):
+    return pd.DataFrame(beta_rows("structured", k, n1, n2, model=MODEL, element=element, **kw))
+
+
+def tensor_kernel(space, partitions, k) -> int:
+    """dim ker Bᵀ from 1D ranks: μ ⊥ W_i = W_i^x ⊗ W_i^y ⟺ (C_i^x ⊗ C_i^y)ᵀ μ = 0 with the 1D L² pairings
+    C_i^x of the multiplier factor and the 1D trace (continuous P_k vanishing at the ends), so
+    ker = (U1x⊗U1y + U2x⊗U2y)^⊥, U = ranges, and (A⊗B) ∩ (C⊗D) = (A∩C) ⊗ (B∩D)."""
+    def pairing(factor, breaks):
+        w = make_space(breaks, k, True, True)
+        x, q = SEGMENT.quadrature(SEGMENT.common_refinement(breaks, factor.breakpoints), k + factor.degree)
+        return (factor.evaluate(x) * q[:, None]).T @ w.evaluate(x)
+
+    def rank(A):
+        return np.linalg.matrix_rank(A, tol=1e-10 * max(np.abs(A).max(), 1e-300)) if A.size else 0
+
+    r, c = {}, {}
+    for d, (factor, attr) in enumerate(zip(space.factors, ("xs", "ys"))):
+        C = [pairing(factor, getattr(p, attr)) for p in partitions]
+        r[d] = [rank(Ci) for Ci in C]
+        c[d] = r[d][0] + r[d][1] - rank(np.hstack(C))
+    return space.dim - (r[0][0] * r[1][0] + r[0][1] * r[1][1] - c[0] * c[1])
+
+
+@pytest.mark.parametrize("k", [1, 2])
+@pytest.mark.parametrize("n1,n2", [(2, 2), (3, 3), (3, 4), (2, 3)])
+def test_kernel_is_the_dimension_count(k, n1, n2):
+    frame = rows_of(k, n1, n2)
+    sides = SideCache().pair(MODEL, "structured", k, n1, n2, element="hex")
+    parts = [s.trace.partition for s in sides]
+    assert set(frame.case) == set(ids_valid_for(k))
+    for case, rows in frame.groupby("case"):
+        row = rows.iloc[0]
+        assert (rows.kernel_decision == "clear").all()
+        # the dimension argument max(dim M − dim(W1 + W2), 0) is proven: never lost
+        assert row.structural_kernel_dim == max(row.dim_M - row.dim_W, 0) <= row.kernel_dim
+        if n1 == n2:
+            assert row.kernel_dim == row.structural_kernel_dim, case
+        gamma = sides[0].trace.gamma
+        space = case_space(case, k, gamma.multiplier_partition(*parts), gamma)
+        assert row.kernel_dim == tensor_kernel(space, parts, k), case
+        if row.kernel_dim == 0:
+            assert (rows.beta > 0).all() and (rows.beta == rows.smallest_nonzero).all()
+        else:
+            assert (rows.beta == 0).all() and (rows.smallest_nonzero > 0).all()
+
+
+def test_continuous_multipliers_without_end_condition_have_a_growing_kernel():
+    """R5.2's face analogue Q_k on matching n × n grids: dim M − dim W = (nk+1)² − (nk−1)² = 4nk."""
+    for n in (2, 3, 4):
+        for k in (1, 2):
+            row = rows_of(k, n, n, cases=["R5.2"], norms=("L2",)).iloc[0]
+            assert row.kernel_dim == 4 * n * k
+
+
+@pytest.mark.parametrize("k", [1, 2])
+@pytest.mark.parametrize("n1,n2", [(2, 2), (3, 3), (3, 4)])
+def test_tetrahedra(k, n1, n2):
+    frame = rows_of(k, n1, n2, element="tet")
+    assert (frame.kernel_decision == "clear").all()
+    assert (frame.kernel_dim == frame.structural_kernel_dim).all()
+    assert (frame[frame.kernel_dim == 0].beta > 0).all()
+
+
+@pytest.mark.parametrize("element,n1,n2,case", [("hex", 2, 3, "T3"), ("tet", 2, 2, "T5"), ("tet", 3, 2, "T4")])
+def test_beta_agrees_with_the_saddle_point_pencil(element, n1, n2, case):
+    """The Γ-reduced route (Schur complements, Γ last) against the dense pencil of the whole
+    system [[A, Bᵀ], [B, 0]] x = σ [[A, 0], [0, G]] x (solvers.infsup.saddle_point_beta)."""
+    k = 2
+    sides = SideCache().pair(MODEL, "structured", k, n1, n2, element=element)
+    gamma = sides[0].trace.gamma
+    space = case_space(case, k, gamma.multiplier_partition(*(s.trace.partition for s in sides)), gamma)
+    blocks = []
+    for sign, s in zip((-1.0, 1.0), sides):
+        full = np.zeros((space.dim, s.ndof))
+        full[:, s.ndof - len(s.trace.gamma_dofs):] = sign * coupling_matrix(s.trace, space, k)
+        blocks.append(full)
+    A, B = block_diag([s.stiffness for s in sides]), np.hstack(blocks)
+    frame = rows_of(k, n1, n2, element=element, cases=[case])
+    for norm, row in frame.set_index("norm").iterrows():
+        G = gamma.gram(space, norm)[0]
+        assert saddle_point_beta(A, B, G) == pytest.approx(row.beta, rel=1e-8)
+
+
+def test_cli_beta_3d_and_its_refusals():
+    code, out, err = run_in_process(["beta", "--model", "membranes3d", "--case", "T3", "--k", "2", "--N1", "3",
+                                     "--N2", "3", "--element", "hex"])
+    assert code == 0, err
+    frame = pd.read_csv(io.StringIO(out))
+    assert list(frame.norm) == ["H", "L2"] and (frame.element == "hex").all() and (frame.beta > 0).all()
+    for argv, needle in ((["--model", "membranes", "--element", "hex"], "--element"),
+                         (["--model", "membranes3d", "--element", "prism"], "element"),
+                         (["--model", "membranes3d", "--family", "perturbed"], "family")):
+        base = ["beta", "--case", "T3", "--k", "1", "--N1", "3", "--N2", "3"]
+        code, out, err = run_in_process(base[:-2] + (argv if "--N2" in argv else argv + base[-2:]))
+        assert code == 2 and len(err.strip().splitlines()) == 1 and needle in err, (argv, err)
+
+
+def test_verdict_for_the_3d_model():
+    code, out, err = run_in_process(["verdict", "--model", "membranes3d", "--case", "R5.2", "--k", "1", "--N", "2",
+                                     "3", "4", "--expect", "unstable"])
+    assert code == 0, err
+    row = pd.read_csv(io.StringIO(out)).iloc[0]
+    assert row.verdict == "UNSTABLE" and row.kernel_dim == 4 * 4 * 1
+    code, out, err = run_in_process(["verdict", "--case", "T3", "--k", "1", "--N", "2", "3", "4", "--element", "hex"])
+    assert code == 2 and "--element" in err
+
+
+def test_a_3d_request_too_large_for_the_memory_is_refused_before_computing():
+    code, out, err = run_in_process(["beta", "--model", "membranes3d", "--case", "T3", "--k", "2", "--N1", "96",
+                                     "--N2", "96"])
+    assert code == 2 and "N1" in err and "memory" in err and not out
+
+
+def test_exported_3d_system_gives_the_same_verdict(tmp_path):
+    """export → verdict --system (the foreign-system route, its own β_h solver) agrees with verdict."""
+    common = ["--case", "T3", "--k", "1", "--N", "2", "3", "4", "--model", "membranes3d", "--element", "tet"]
+    code, out, err = run_in_process(["export", *common, "--out", str(tmp_path)])
+    assert code == 0, err
+    code, out, err = run_in_process(["verdict", "--system", out.strip()])
+    assert code == 0, err
+    foreign = pd.read_csv(io.StringIO(out)).iloc[0]
+    code, out, err = run_in_process(["verdict", *common])
+    direct = pd.read_csv(io.StringIO(out)).iloc[0]
+    assert foreign.verdict == direct.verdict and foreign.kernel_dim == direct.kernel_dim == 0
+    assert foreign.beta_min == pytest.approx(direct.beta_min, rel=1e-5)
+    assert foreign.beta_max == pytest.approx(direct.beta_max, rel=1e-5)
+
+
+@pytest.mark.parametrize("element", ["hex", "tet"])
+def test_both_schur_routes_agree_in_3d(element):
+    """The Γ-last nested dissection (graph based, no 2D assumption) and the solves route give one
+    Schur complement, equal to the reference K_ΓΓ − K_ΓI K_II⁻¹ K_IΓ."""
+    from infsup_contact.models.membranes3d import side_operator, subdomain_mesh
+    from infsup_contact.models.schur import schur_by_solves
+
+    mesh = subdomain_mesh("structured", 3, 1, element=element)
+    nested, solves = side_operator(mesh, 2, route="nested"), side_operator(mesh, 2, route="solves")
+    ref = schur_by_solves(nested)
+    for side in (nested, solves):
+        np.testing.assert_allclose(side.schur, ref, rtol=0, atol=1e-10 * np.abs(ref).max())

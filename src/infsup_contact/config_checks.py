@@ -23,21 +23,8 @@ import re
 from .config_schema import (ConfigError, check_finite, describe, key_path, load_schema,  # noqa: F401
                             schema_error, show)
 from .errors import InputError
-from .study.scene_registry import data_scene_ids, scene_spec
+from .study.scene_registry import REFERENCE_MARGIN, data_scene_ids, scene_spec
 
-REFERENCE_MARGIN = 2
-"""contact.reference_N >= REFERENCE_MARGIN × the largest N of every membranes scene.
-
-The membranes errors are measured against a reference of degree k + 1 on the structured
-N_ref mesh; its own error must be small against the error of the finest mesh it measures.
-Where the extra degree pays (k = 1, 2: energy rates ~0.9 and ~1.75) even N_ref = N is within
-0.5 %, but where the solution's regularity caps both degrees (k = 3: rate ~2) only the mesh
-ratio helps. Measured on the membranes scene, N = 4, 8, 16 (energy error at N = 16 against
-an N_ref = 128 reference; fitted slope): k = 3, N_ref = 8: +83 %, slope 1.51; N_ref = 16
-(1x): +18 %, 1.84; N_ref = 32 (2x): +4.5 %, 1.93; N_ref = 64 (4x): +0.8 %, 1.95 (vs 1.96).
-k = 1, N_ref = 8: slope 0.85 instead of 0.92 (the issue's case). A margin of 2 keeps the
-slope within 0.04 of its converged value, well inside claims.rate_tolerance (0.15); the
-configs use exactly 2 (64 for N <= 32, 32 for N <= 16). See the README, "What is refused"."""
 
 MIN_FIT_POINTS = 3
 """A slope interval needs at least 3 meshes (one degree of freedom for Student's t)."""

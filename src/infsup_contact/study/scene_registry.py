@@ -226,6 +226,21 @@ def _hertz_rows(model, cases, k, family, n1, n2, c, args) -> list:
     return [hertz.hertz_row(case, k, n1, n2, args.R, args.d, args.nu, c) for case in cases]
 
 
+def _face_patch_rows(model, cases, k, family, n1, n2, c, args) -> list:
+    from . import face_patch
+
+    return face_patch.face_patch_rows(cases, [k], [(n1, n2)], c, element=getattr(args, "mesh_kwargs", {}).get(
+        "element", "hex"), model=model)
+
+
+def _face_check(args):
+    """The face's structured bodies; estimate: the β one of the pair in 3D (one component)."""
+    from .. import resources
+
+    est = resources.beta_estimate("structured", args.k, args.N1, args.N2, "omega2", ("L2",), dim=3)
+    return est, _finest(args)
+
+
 def _manufactured_rate(k: int, p: float, q: float) -> float:
     """min(k, min(p, q) − 1/2): λ ∈ H^{p−1/2}, g ∈ H^{q−1/2} near x = a bound the error (4.8)."""
     return min(k, min(p, q) - 0.5)
@@ -249,3 +264,8 @@ HERTZ = register(SceneSpec(
     "hertz", ("elastic",), "clamped blocks with the gap (x − 1/2)²/(2R), Ω2's top moved by d",
     "plane-strain Hertz for the measured resultant", ("P", "p_max", "half_width", "oscillation"),
     _hertz_rows, _hertz_check, params=("R", "d"), float_format="%.6g", families=("structured",)))
+FACE_PATCH = register(SceneSpec(
+    "face-patch", ("membranes3d",), "the 3D patch test: far faces at 0 and −δ, lateral faces natural, "
+    "non-matching faces", "exact (λ = δ/(1/c1 + 1/c2), u linear in z)",
+    ("lambda_max_rel_error", "u_max_rel_error", "passes", "predicted", "kernel_dim"),
+    _face_patch_rows, _face_check, float_format="%.6g", families=("structured",)))

@@ -33,6 +33,16 @@ the PDAS's representative (minimum norm, :mod:`infsup_contact.solvers.pdas`) nee
 constant, so a space with a kernel may reproduce u but not λ: ``kernel_dim`` and ``nonunique``
 are reported with each row. With natural lateral faces the traces do not vanish on ∂Γ, so
 the spaces' kernel on clamped traces (R5.2's boundary modes) has no counterpart here.
+
+**Outcome** (k = 1, 2, 3; hexahedra and tetrahedra; N1:N2 = 4:5 and 7:8; G_h = trace of Ω2;
+exploratory runs outside the DAG, the test ``tests/test_face_patch.py`` pins the rule):
+as predicted in all 76 rows — every space holding the constants reproduces λ to 1e-14..5e-11
+(R5.4 at k = 3 the largest) and u to ≤ 2e-14 of δ; T3 fails (λ error ≥ 1, at ∂Γ where it
+vanishes, u error ~1e-2 δ). No row has a kernel (``kernel_dim`` 0, ``nonunique`` False). On
+G_h = the union of both traces (``multiplier_mesh="union"``) R5.2, R5.4, DUAL and DUAL-ALL
+have kernels (k = 2, 4:5: 96, 70, 48, 96 modes): u_h stays exact to round-off but the PDAS's
+minimum-norm λ_h is not the constant (errors 0.1–1.3), so ``passes`` is False there although
+1 ∈ M_h; T4 and T5 (no kernel) still pass.
 """
 from __future__ import annotations
 

@@ -108,3 +108,27 @@ def test_cli_prints_the_rows_and_refuses_a_bad_delta():
     assert all(r["passes"] == r["predicted"] for r in rows)
     with pytest.raises(InputError, match="delta"):
         face_patch.patch_scene(delta=-1.0)
+
+
+@pytest.mark.parametrize("element", ["hex", "tet"])
+def test_beta_sides_clamp_the_lateral_faces_the_scene_does_not(element):
+    """The mesh names the far and lateral faces apart; β_h's side still vanishes on all of
+    ∂Ω_i∖Γ (its Γ dofs: the (n k − 1)² interior nodes of the face), the scene's side only on the
+    far face (all (n k + 1)² Γ nodes), and its lift carries −δ on Ω2's far face only."""
+    from infsup_contact.models import make_model
+
+    model = make_model(FACE_PATCH.models[0])
+    scene = face_patch.patch_scene()
+    n, k = 3, 2
+    for side in (1, 2):
+        mesh = model.subdomain_mesh("structured", n, side, element=element)
+        beta, contact = model.side_operator(mesh, k), model.side_for(scene, mesh, k)
+        gamma = beta.trace.gamma
+        assert len(beta.trace.gamma_dofs) == gamma.trace_dimension(k, n)
+        assert len(contact.trace.gamma_dofs) == gamma.trace_nodes(k, n)
+        F, lift = model.load(contact, scene, side - 1)
+        gf = ngsolve.GridFunction(contact.trace.fes)
+        gf.vec.FV().NumPy()[:] = lift
+        far_z, middle = (0.0, 0.5) if side == 1 else (2.0, 1.5)
+        assert gf(mesh(0.3, 0.6, far_z)) == pytest.approx(scene.far_displacement[side - 1], abs=1e-14)
+        assert gf(mesh(0.0, 0.5, middle)) == pytest.approx(0.0, abs=1e-14)  # a lateral face, off the far one

@@ -226,7 +226,7 @@ def contact_pair(scene, k: int, family: str, n1: int, n2: int, model=None, **mes
     if build is not None:
         mesh_pair = build(family, n1, n2, **mesh_kwargs)
     elif model.mesh is not None:
-        mesh_pair = (model.subdomain_mesh(family, n1, 1, **mesh_kwargs), model.subdomain_mesh(family, n2, 2, **mesh_kwargs))
+        mesh_pair = tuple(model.subdomain_mesh(family, n, side, **mesh_kwargs) for n, side in ((n1, 1), (n2, 2)))
     else:
         mesh_pair = meshes.mesh_pair(family, n1, n2, **mesh_kwargs)
     c = (scene.c1, scene.c2)

@@ -8,8 +8,7 @@ import pytest
 from infsup_contact.discretization.interface import Interface
 from infsup_contact.discretization.square import SQUARE, SQUARE_TRIG, Square, TensorPartition
 from infsup_contact.errors import InputError
-from infsup_contact.models.membranes3d import subdomain_mesh
-from infsup_contact.models.membranes import displacement_space
+from infsup_contact.models.membranes3d import displacement_space, subdomain_mesh
 
 
 def grid(n, m=None):

@@ -47,7 +47,7 @@ def _check_contact(args):
         raise InputError("case", "one of --case ID|all or --space FILE.py:FUNC")
     args.cases = cases(args)
     material(args)
-    mesh_options(args)  # a mesh flag of another model is refused (the pair check refuses 3D models)
+    args.mesh_kwargs = mesh_options(args)  # a mesh flag of another model is refused; the scene's rows read them
     spec = check_pair(args.model, args.scene)
     for key in OPTIONAL_PARAMS:
         if key not in spec.params and getattr(args, key) is not None:

@@ -28,7 +28,7 @@ Contact asks a model four more things, so that one Γ solve
   coefficient functions (one per component), all dofs: what a scene with an exact u compares.
 
 **Normal and sign.** Every model uses b(v, μ) = ∫_Γ (v_2·n − v_1·n) μ with n = e_y (from Ω1
-into Ω2), so A_1 u_1 = F_1 − B_1ᵀ λ and A_2 u_2 = F_2 + B_2ᵀ λ (:data:`B_SIGN`), and λ ≥ 0
+into Ω2; e_z for the 3D bodies on the face Γ = (0,1)²×{1}), so A_1 u_1 = F_1 − B_1ᵀ λ and A_2 u_2 = F_2 + B_2ᵀ λ (:data:`B_SIGN`), and λ ≥ 0
 pushes the bodies apart: λ = −c_i ∂u_i/∂x_2 for the membranes, λ = −σ_yy for elastic bodies.
 The outward normal of side i on Γ is ``OUTWARD_NORMAL_Y[i]`` e_y.
 

@@ -14,6 +14,16 @@ N × N × N cells of each body (N = cells per direction on Γ) from
 ``element="tet"`` the six-tetrahedra (Kuhn) split of every cube, whose faces on Γ are the
 rectangles cut by the diagonal from (x_i, y_j) to (x_{i+1}, y_{j+1}) — on both bodies, so the
 trace is a tensor grid of triangles (:data:`~infsup_contact.discretization.square.SQUARE_TRIG`).
+
+Boundaries: ``gamma`` (Γ), ``dir`` (the far face: z = 0 of Ω1, z = 2 of Ω2) and ``side`` (the
+four lateral faces). β_h clamps both (:data:`BETA_DIRICHLET`, the paper's u_i = 0 on ∂Ω_i∖Γ);
+a contact scene may clamp fewer (its ``supports``: the face patch test keeps the lateral faces
+natural, :mod:`infsup_contact.study.face_patch`).
+
+**Contact** (the model contract, :mod:`.contract`, with n = e_z for e_y): a scene gives its
+material scales ``c1``, ``c2``, its far-face displacements ``far_displacement`` (u_i on ``dir``,
+a constant per side: the Dirichlet lift u_{D,i}) and its ``supports``; there is no body force,
+so F_i = −c_i K_i u_{D,i} on the free dofs (:func:`load`), and λ = −c_i ∂u_i/∂z on Γ.
 """
 from __future__ import annotations
 
@@ -21,20 +31,30 @@ import numpy as np
 import ngsolve
 from ngsolve import meshes as ngmeshes
 
+from ..discretization.meshes import DIRICHLET
 from ..discretization.square import SQUARE, SQUARE_TRIG
 from ..errors import InputError, check_prestress
+from dataclasses import dataclass
+
+import scipy.sparse as sp
+
 from .contract import MaterialParam, Model
-from .membranes import displacement_space, laplace_stiffness
+from .membranes import field, interpolate, laplace_stiffness
 from .schur import SideOperator, factorized_side
 
 ELEMENTS = ("hex", "tet")
 FAMILIES_3D = ("structured",)
 #: MakeStructured3DMesh's boundary numbering: back, left, front, right, bottom (z = 0), top (z = 1)
 _BOTTOM, _TOP = 4, 5
+FAR, LATERAL = DIRICHLET, "side"
+"""Boundary names of the far face (z = 0 of Ω1, z = 2 of Ω2) and of the four lateral faces."""
+BETA_DIRICHLET = f"{FAR}|{LATERAL}"
+"""Where β_h's sides vanish: all of ∂Ω_i∖Γ (an NGSolve boundary regexp)."""
 
 
 def subdomain_mesh(family: str, n: int, side: int, *, element: str = "hex") -> ngsolve.Mesh:
-    """The N × N × N structured mesh of Ω_side, Γ named ``gamma`` and the rest of ∂Ω_side ``dir``.
+    """The N × N × N structured mesh of Ω_side: Γ named ``gamma``, the far face :data:`FAR`, the
+    lateral faces :data:`LATERAL`.
 
     Raises
     ------
@@ -51,9 +71,9 @@ def subdomain_mesh(family: str, n: int, side: int, *, element: str = "hex") -> n
     if side == 2:
         for p in ngmesh.Points():
             p[2] += 1.0
-    gamma = _TOP if side == 1 else _BOTTOM
+    gamma, far = (_TOP, _BOTTOM) if side == 1 else (_BOTTOM, _TOP)
     for i in range(6):
-        ngmesh.SetBCName(i, SQUARE.boundary if i == gamma else "dir")
+        ngmesh.SetBCName(i, SQUARE.boundary if i == gamma else FAR if i == far else LATERAL)
     return ngsolve.Mesh(ngmesh)
 
 
@@ -65,22 +85,59 @@ def face_of(mesh):
     raise InputError("mesh", f"boundary elements named {SQUARE.boundary!r}")
 
 
-def side_operator(mesh, k: int, route: str = "auto") -> SideOperator:
-    """Factorize the Laplace stiffness K_i of Q_k / P_k once, Γ dofs last (c = 1)."""
-    fes = displacement_space(mesh, k)
+def displacement_space(mesh, k: int, dirichlet: str = BETA_DIRICHLET):
+    """V_{h,i}: continuous Q_k / P_k vanishing on ``dirichlet`` (default all of ∂Ω_i∖Γ)."""
+    return ngsolve.H1(mesh, order=k, dirichlet=dirichlet)
+
+
+@dataclass(frozen=True)
+class MembraneSide(SideOperator):
+    """A :class:`SideOperator` plus K_i on every dof (``stiffness_all``): the loads of a
+    scene's Dirichlet lift, F_i = −c_i K_i u_{D,i}."""
+
+    stiffness_all: sp.csr_matrix | None = None
+
+
+def side_operator(mesh, k: int, route: str = "auto", dirichlet: str = BETA_DIRICHLET) -> MembraneSide:
+    """Factorize the Laplace stiffness K_i of Q_k / P_k once, Γ dofs last (c = 1), u_i = 0 on
+    ``dirichlet`` (default all of ∂Ω_i∖Γ). With natural lateral faces the Γ dofs on ∂Γ are free:
+    the trace spans continuous Q_k / P_k on the partition, ∂Γ included."""
+    fes = displacement_space(mesh, k, dirichlet)
     trace = face_of(mesh).trace(fes)
     free_mask = np.array(fes.FreeDofs(), dtype=bool)
     is_gamma = np.zeros(fes.ndof, dtype=bool)
     is_gamma[trace.gamma_dofs] = True
     free = np.concatenate([np.flatnonzero(free_mask & ~is_gamma), trace.gamma_dofs])
-    return factorized_side(trace, free, laplace_stiffness(fes)[free][:, free].tocsc(), route)
+    K_all = laplace_stiffness(fes)
+    base = factorized_side(trace, free, K_all[free][:, free].tocsc(), route)
+    return MembraneSide(base.trace, base.free, base.stiffness, base.schur, base.solve, base.steklov,
+                        stiffness_all=K_all)
+
+
+def scene_side(scene, mesh, k: int) -> MembraneSide:
+    """The side of a contact scene: u_i prescribed on the scene's ``supports`` (an NGSolve
+    boundary regexp; the face patch test: the far face only), else on all of ∂Ω_i∖Γ."""
+    return side_operator(mesh, k, dirichlet=getattr(scene, "supports", None) or BETA_DIRICHLET)
+
+
+def load(side: MembraneSide, scene, i: int):
+    """(F_i, u_{D,i}): the lift u_{D,i} = ``scene.far_displacement[i]`` on the far face (0 on the
+    other supports), F_i = −c_i (K_i u_{D,i}) on the free dofs (no body force)."""
+    fes = side.trace.fes
+    gf = ngsolve.GridFunction(fes)
+    gf.Set(float(scene.far_displacement[i]), definedon=fes.mesh.Boundaries(FAR))
+    lift = gf.vec.FV().NumPy().copy()
+    lift[np.array(fes.FreeDofs(), dtype=bool)] = 0.0  # only the supports carry the lift
+    c = (scene.c1, scene.c2)[i]
+    return -c * (side.stiffness_all @ lift)[side.free], lift
 
 
 MEMBRANES3D = Model("membranes3d", side_operator,
                     "two 3D bodies (0,1)^3 and (0,1)^2x(1,2), -c_i Δu_i = f_i, scalar Q_k (hex) or P_k (tet), "
                     "contact face Γ = (0,1)^2x{1}; structured meshes, N cells per direction (--element)",
+                    scene_side=scene_side, load=load, field=field, interpolate=interpolate,
                     params=tuple(MaterialParam(f"c{i + 1}", 1.0, lambda v, key: check_prestress(key, v),
                                                "1e-150 <= c <= 1e150", f"prestress c{i + 1} of Ω{i + 1}", side=i)
                                  for i in range(2)),
                     mesh=subdomain_mesh, mesh_options=(("element", ELEMENTS),), families=FAMILIES_3D, dim=3)
-"""The 3D membranes through the model seam (β_h only: no contact scenes yet)."""
+"""The 3D membranes through the model seam (β_h, and contact scenes with far-face displacements)."""

@@ -219,10 +219,16 @@ class ContactPair:
 def contact_pair(scene, k: int, family: str, n1: int, n2: int, model=None, **mesh_kwargs) -> ContactPair:
     """Mesh, factorize and load both sides of ``scene`` with ``model`` (default: the registry's,
     the paper's membranes; see :class:`ContactPair`); the scene's ``mesh_pair`` where it has
-    one (structured blocks of the elastic scenes), else the family's."""
+    one (structured blocks of the elastic scenes), else the model's mesh builder where it has
+    one (``Model.mesh``: the 3D bodies, ``mesh_kwargs`` such as ``element``), else the family's."""
     model = DEFAULT_MODEL if model is None else model
     build = getattr(scene, "mesh_pair", None)
-    mesh_pair = build(family, n1, n2, **mesh_kwargs) if build else meshes.mesh_pair(family, n1, n2, **mesh_kwargs)
+    if build is not None:
+        mesh_pair = build(family, n1, n2, **mesh_kwargs)
+    elif model.mesh is not None:
+        mesh_pair = tuple(model.subdomain_mesh(family, n, side, **mesh_kwargs) for n, side in ((n1, 1), (n2, 2)))
+    else:
+        mesh_pair = meshes.mesh_pair(family, n1, n2, **mesh_kwargs)
     c = (scene.c1, scene.c2)
     t0 = time.perf_counter()
     sides = [model.side_for(scene, m, k) for m in mesh_pair]
@@ -285,13 +291,15 @@ def solve_contact(scene, case: str, k: int, family: str, n1: int, n2: int,
 
 
 def gamma_values(sol: ContactSolution, x: np.ndarray):
-    """u_{1,h}, u_{2,h} on Γ at points x of Γ (its interior), via point evaluation."""
+    """u_{1,h}, u_{2,h} on Γ at points x of Γ (its interior), via point evaluation: one value
+    per point (shape ``x.shape`` on the segment, ``x.shape[:-1]`` on a face, ``gamma.dim`` = 2)."""
     x = np.asarray(x, dtype=float)
     out = []
     where = sol.gamma.embed(x)
+    shape = x.shape if sol.gamma.dim == 1 else x.shape[:-1]
     for gf, side in zip(sol.u, sol.sides):
         mesh = side.trace.fes.mesh
-        out.append(np.asarray(gf(mesh(*where))).reshape(x.shape))
+        out.append(np.asarray(gf(mesh(*where))).reshape(shape))
     return out
 
 

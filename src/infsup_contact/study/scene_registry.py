@@ -222,3 +222,8 @@ HERTZ = register(SceneSpec(
     "hertz", ("elastic",), "clamped blocks with the gap (x − 1/2)²/(2R), Ω2's top moved by d",
     "plane-strain Hertz for the measured resultant", ("P", "p_max", "half_width", "oscillation"),
     f"{_RUNS}:hertz_rows", f"{_RUNS}:hertz_check", params=("R", "d"), float_format="%.6g", families=("structured",)))
+FACE_PATCH = register(SceneSpec(
+    "face-patch", ("membranes3d",), "the 3D patch test: far faces at 0 and −δ, lateral faces natural, "
+    "non-matching faces", "exact (λ = δ/(1/c1 + 1/c2), u linear in z)",
+    ("lambda_max_rel_error", "u_max_rel_error", "passes", "predicted", "kernel_dim"),
+    f"{_RUNS}:face_patch_rows", f"{_RUNS}:face_check", float_format="%.6g", families=("structured",)))

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 from .. import resources
 from ..errors import InputError
-from . import hertz, patch
+from . import face_patch, hertz, patch
 from .contact_rows import contact_row, reference_solution
 from .scene_registry import REFERENCE_MARGIN, scene_data, scene_spec
 
@@ -62,3 +62,15 @@ def patch_rows(model, cases, k, family, n1, n2, c, args) -> list:
 def hertz_rows(model, cases, k, family, n1, n2, c, args) -> list:
     """One Hertz row per case (geometry R, d as checked)."""
     return [hertz.hertz_row(case, k, n1, n2, args.R, args.d, args.nu, c) for case in cases]
+
+
+def face_patch_rows(model, cases, k, family, n1, n2, c, args) -> list:
+    """The 3D patch test's rows on the pair, on the request's element (``--element``)."""
+    return face_patch.face_patch_rows(cases, [k], [(n1, n2)], c, element=getattr(args, "mesh_kwargs", {}).get(
+        "element", "hex"), model=model)
+
+
+def face_check(args):
+    """The face's structured bodies; estimate: the β one of the pair in 3D (one component)."""
+    est = resources.beta_estimate("structured", args.k, args.N1, args.N2, "omega2", ("L2",), dim=3)
+    return est, _finest(args)

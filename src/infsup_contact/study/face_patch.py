@@ -1,0 +1,194 @@
+"""The 3D contact patch test on the face Γ = (0,1)²×{1} (issue 28, item 6).
+
+Two scalar bodies, Ω1 = (0,1)³ and Ω2 = (0,1)²×(1,2), −c_i Δu_i = 0, on non-matching
+structured meshes (N1 ≠ N2 cells per direction on Γ): u1 = 0 on Ω1's far face z = 0,
+u2 = −δ on Ω2's far face z = 2, the four lateral faces of each body natural
+(∂u_i/∂n = 0), frictionless contact on Γ with b(v, μ) = ∫_Γ (v2 − v1) μ
+(:mod:`infsup_contact.models.contract`, n = e_z). As Tribol's ``mfem_mortar_lm_patch``:
+a uniform pressure on non-matching faces, reproduced exactly iff M_h holds it.
+
+**Exact solution.** Try u_i = u_i(z): the lateral conditions hold, −c_i u_i'' = 0 makes u_i
+affine, u1 = a z and u2 = −δ + b (z − 2). With contact active on Γ (zero gap), u1(1) = u2(1)
+gives a = −δ − b, and equilibrium of the fluxes on Γ (λ = −c1 u1' = −c2 u2': the multiplier
+enters A_1 u_1 = F_1 − B_1ᵀλ and A_2 u_2 = F_2 + B_2ᵀλ) gives c1 a = c2 b. Hence
+
+    a = −δ c2/(c1 + c2),   λ = −c1 a = δ / (1/c1 + 1/c2) > 0,
+    u1 = −(λ/c1) z,   u2 = −δ + (λ/c2)(2 − z),
+
+(c1 = c2 = 1: λ = δ/2, u1 = u2 = −(δ/2) z). λ > 0 and the gap u2 − u1 = 0 on Γ satisfy the
+complementarity λ ≥ 0, g ≥ 0, λ g = 0, and the solution of the (monotone) contact problem is
+unique in u, so this is it.
+
+**Prediction (stated before the run).** u_i is linear, so it lies in every V_{h,i} (Q_k on
+hexahedra, P_k on tetrahedra, k ≥ 1), and its traces coincide: B(u2 − u1) = 0. If the
+constant λ lies in M_h, (u, λ) satisfies the discrete system exactly (B_iᵀ(λ·1) are the
+consistent nodal forces of the uniform flux, A_i u_i = F_i ∓ B_iᵀ(λ·1) by Green's formula),
+and its coefficients λ·(coefficients of 1) are ≥ 0 in the cone of every registered space
+(a nodal basis of 1 has coefficients 1; the dual bases are partitions of unity where they
+hold 1). So the test passes — u_h = u and λ_h = λ to round-off, whatever the seams of the
+non-matching traces — iff 1 ∈ M_h, i.e. iff ``SpaceSpec.contains_constants(k)`` (the face space
+is the tensor product of the 1D one, :mod:`~infsup_contact.discretization.face_spaces`, and
+1 ⊗ 1 = 1). T3 (Q_k vanishing on ∂Γ) fails. A kernel of K (λ_h not unique) leaves u_h unique;
+the PDAS's representative (minimum norm, :mod:`infsup_contact.solvers.pdas`) need not be the
+constant, so a space with a kernel may reproduce u but not λ: ``kernel_dim`` and ``nonunique``
+are reported with each row. With natural lateral faces the traces do not vanish on ∂Γ, so
+the spaces' kernel on clamped traces (R5.2's boundary modes) has no counterpart here.
+
+**Outcome** (k = 1, 2, 3; hexahedra and tetrahedra; N1:N2 = 4:5 and 7:8; G_h = trace of Ω2;
+exploratory runs outside the DAG, the test ``tests/test_face_patch.py`` pins the rule):
+as predicted in all 76 rows — every space holding the constants reproduces λ to 1e-14..5e-11
+(R5.4 at k = 3 the largest) and u to ≤ 2e-14 of δ; T3 fails (λ error ≥ 1, at ∂Γ where it
+vanishes, u error ~1e-2 δ). No row has a kernel (``kernel_dim`` 0, ``nonunique`` False). On
+G_h = the union of both traces (``multiplier_mesh="union"``) R5.2, R5.4, DUAL and DUAL-ALL
+have kernels (k = 2, 4:5: 96, 70, 48, 96 modes): u_h stays exact to round-off but the PDAS's
+minimum-norm λ_h is not the constant (errors 0.1–1.3), so ``passes`` is False there although
+1 ∈ M_h; T4 and T5 (no kernel) still pass.
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import ngsolve
+import numpy as np
+import scipy.linalg as sla
+
+from ..discretization import registry
+from ..discretization.meshes import DIRICHLET
+from ..errors import InputError
+from ..models import make_model
+from ..solvers.contact import contact_pair, solve_contact_on
+from .scene_registry import FACE_PATCH
+
+SCENE = FACE_PATCH.id
+"""This scene's registry id (:mod:`.scene_registry` declares it and its models)."""
+DELTA = 1e-2
+"""Default downward displacement δ of Ω2's far face."""
+PASS_RTOL = 1e-8
+"""λ_h = λ and u_h = u to this relative accuracy count as passing."""
+KERNEL_RTOL = 1e-8
+"""Generalized eigenvalues of (K, G_L2) below this × the largest count as the kernel of K."""
+
+
+@dataclass(frozen=True)
+class PressedCubes:
+    """The face patch test's data (a contact scene of the 3D membranes, model contract).
+
+    Attributes
+    ----------
+    name : str
+        The scene's registry id.
+    c1, c2 : float
+        Material scales (prestress) of Ω1, Ω2.
+    d : float
+        Downward displacement δ of Ω2's far face.
+    supports : str
+        Where u_i is prescribed (NGSolve boundary regexp): the far faces only.
+    """
+
+    name: str
+    c1: float
+    c2: float
+    d: float
+    supports: str = DIRICHLET
+
+    @property
+    def far_displacement(self) -> tuple:
+        """u_i on the far face of Ω1, Ω2."""
+        return (0.0, -self.d)
+
+    @property
+    def pressure(self) -> float:
+        """λ = δ / (1/c1 + 1/c2) (module docstring)."""
+        return self.d / (1.0 / self.c1 + 1.0 / self.c2)
+
+    def exact(self) -> tuple:
+        """(u1, u2) as NGSolve coefficient functions of z (module docstring)."""
+        lam = self.pressure
+        return -lam / self.c1 * ngsolve.z, -self.d + lam / self.c2 * (2.0 - ngsolve.z)
+
+
+def patch_scene(c=(1.0, 1.0), delta: float = DELTA) -> PressedCubes:
+    """The scene's data with material scales ``c`` and far-face displacement ``delta``."""
+    if not (np.isfinite(delta) and 0.0 < delta < 1.0):
+        raise InputError("delta", "0 < delta < 1", got=delta)
+    return PressedCubes(SCENE, float(c[0]), float(c[1]), float(delta))
+
+
+def patch_pair(k: int, n1: int, n2: int, c=(1.0, 1.0), delta: float = DELTA, element: str = "hex", model=None):
+    """Both factorized bodies of the scene (one per body, shared by every case)."""
+    model = make_model(FACE_PATCH.models[0]) if model is None else model
+    return contact_pair(patch_scene(c, delta), k, "structured", n1, n2, model, element=element)
+
+
+def solve_face_patch(case: str, k: int, n1: int, n2: int, c=(1.0, 1.0), delta: float = DELTA,
+                     element: str = "hex", pair=None, per_cell: int = 4, multiplier_mesh: str = "omega2") -> dict:
+    """Solve the face patch test for one case on G_h = ``multiplier_mesh`` (``omega2``: the trace
+    of Ω2; ``union``: the common refinement, where dim M_h exceeds the traces' and K has a
+    kernel); one row of measures.
+
+    Returns
+    -------
+    dict
+        ``lambda_max_rel_error`` = max |λ_h − λ|/λ at ``per_cell`` + 1 points per direction of
+        every rectangle of the common refinement of G_h and both traces (∂Γ included);
+        ``u_max_rel_error`` = max |u_h − u| / δ at the same number of points per direction of
+        every cell of both bodies (:func:`body_points`);
+        ``passes`` (both ≤ :data:`PASS_RTOL`); ``predicted`` (``contains_constants(k)``);
+        ``kernel_dim`` of K against the L²(Γ) Gram matrix; PDAS ``nonunique``, iterations.
+    """
+    registry.check_case(case, k)
+    t0 = time.perf_counter()
+    if pair is None:
+        pair = patch_pair(k, n1, n2, c, delta, element)
+    scene = patch_scene(pair.c, delta)
+    sol = solve_contact_on(pair, case, multiplier_mesh, time_floor=False)
+    space, gamma, res = sol.space, sol.gamma, sol.pdas
+    lam = scene.pressure
+    x = gamma.sample(gamma.common_refinement(space.breakpoints, *(s.trace.partition for s in sol.sides)), per_cell)
+    lam_err = float(np.max(np.abs(sol.pressure(x) - lam)) / lam)
+    u_err = max(float(np.max(np.abs(body_values(gf, per_cell) - body_values(u, per_cell, gf.space.mesh))))
+                for gf, u in zip(sol.u, scene.exact())) / delta
+    G, _ = gamma.gram(space, "L2")
+    ev = sla.eigh(sol.K, G, eigvals_only=True)
+    spec = registry.space_spec(case)
+    return dict(scene=SCENE, case=case, k=k, family="structured", element=element, N1=n1, N2=n2,
+                multiplier_mesh=multiplier_mesh,
+                c1=pair.c[0], c2=pair.c[1], delta=delta, pressure=lam, dim_M=space.dim, cone=spec.cone(k),
+                kernel_dim=int(np.sum(ev < KERNEL_RTOL * ev[-1])), nonunique=bool(res.nonunique),
+                iterations=res.iterations, n_active=int(res.active.sum()),
+                lambda_max_rel_error=lam_err, u_max_rel_error=u_err,
+                passes=bool(lam_err <= PASS_RTOL and u_err <= PASS_RTOL),
+                predicted=spec.contains_constants(k), seconds=time.perf_counter() - t0)
+
+
+def body_points(mesh, per_cell: int) -> np.ndarray:
+    """The tensor grid (n, 3) of ``per_cell`` + 1 points per direction in every cell of the
+    structured mesh's vertex lattice (faces and edges included)."""
+    verts = np.array([v.point for v in mesh.vertices])
+    t = np.linspace(0.0, 1.0, per_cell + 1)
+    axes = []
+    for d in range(3):
+        g = np.unique(np.round(verts[:, d], 12))
+        axes.append(np.unique((g[:-1, None] + np.outer(np.diff(g), t)).ravel()))
+    return np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
+
+
+def body_values(f, per_cell: int, mesh=None) -> np.ndarray:
+    """Values of a GridFunction (or a coefficient function on ``mesh``) at :func:`body_points`:
+    point evaluation, not interpolation (NGSolve's ``Set`` of a linear function leaves its
+    higher-order coefficients at ~1e-13, not 0)."""
+    mesh = f.space.mesh if mesh is None else mesh
+    p = body_points(mesh, per_cell)
+    return np.asarray(f(mesh(p[:, 0], p[:, 1], p[:, 2]))).ravel()
+
+
+def face_patch_rows(cases, ks, pairs, c=(1.0, 1.0), delta: float = DELTA, element: str = "hex", model=None) -> list:
+    """:func:`solve_face_patch` for every case defined for each k and every (N1, N2) pair."""
+    rows = []
+    for n1, n2 in pairs:
+        for k in ks:
+            pair = patch_pair(k, n1, n2, c, delta, element, model)
+            rows += [solve_face_patch(case, k, n1, n2, c, delta, element, pair=pair)
+                     for case in registry.ids_valid_for(k, cases)]
+    return rows

@@ -256,10 +256,15 @@ class Square(Interface):
     def coupling_quadrature(self, trace: GammaTrace, space, degree: int) -> tuple:
         """Quadrature ``degree`` on the common refinement of the trace and G_h; for triangles
         every rectangle is cut by the diagonal of the trace cell containing it
-        (:func:`~.face_quadrature.split_rule`), exact for the P_k × Q_s products."""
+        (:func:`~.face_quadrature.split_rule`), exact for the P_k × Q_s products. A space that is
+        polynomial only on a finer tensor partition (its ``pieces``: 4C pwlin) is integrated on those."""
+        pieces = getattr(space, "pieces", space.breakpoints)
+        if pieces is None:
+            raise InputError("space", "a face space polynomial on the rectangles of a tensor partition",
+                             got=getattr(space, "element", space))
         if self.cell == "quad":
-            return super().coupling_quadrature(trace, space, degree)
-        return split_rule(self.common_refinement(trace.partition, space.breakpoints), trace.partition, 2 * degree)
+            return self.quadrature(self.common_refinement(trace.partition, pieces), degree)
+        return split_rule(self.common_refinement(trace.partition, pieces), trace.partition, 2 * degree)
 
     def gram(self, space, norm: str, h_route: str = "logkernel", **kwargs) -> tuple:
         """:func:`~.face_norms.gram`: L² exactly (kron of the 1D Grams), H by the double sine
@@ -270,12 +275,16 @@ class Square(Interface):
         return gram(space, norm, **kwargs)
 
     def space(self, spec, k: int, partition):
-        """The tensor product of ``spec``'s 1D space on xs and on ys (:class:`.face_spaces.FaceSpace`)."""
+        """The tensor product of ``spec``'s 1D space on xs and on ys (:class:`.face_spaces.FaceSpace`),
+        or the entry's own face space where it has one (``spec.face_build``: the cellwise element
+        spaces of :mod:`.face_cells`)."""
         from .face_spaces import FaceSpace
 
         if not isinstance(partition, TensorPartition) or partition.cells < 1:
             raise InputError("multiplier mesh", f"a tensor partition of Γ with at least one rectangle "
                              f"(case {spec.id}, k = {k})")
+        if getattr(spec, "face_build", None) is not None:
+            return spec.face_build(k, partition)
         return FaceSpace(spec.build(k, np.asarray(partition.xs, float)),
                          spec.build(k, np.asarray(partition.ys, float)), partition)
 

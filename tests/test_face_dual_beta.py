@@ -102,6 +102,15 @@ def test_dual_q8_is_refused_with_its_weights_and_the_remedy():
     assert registry.space_dim("TDUAL-Q8", 2, 3) == registry.SPACES["TDUAL-Q8"].dimension(2, 3)
 
 
+def test_an_empty_face_space_is_refused_before_any_computation():
+    """TDUAL-Q8 on one cell: QUAD8 has no node inside (0, 1)², dim M_h = 0 = the count."""
+    from infsup_contact.solvers.infsup import check_inputs
+
+    assert registry.SPACES["TDUAL-Q8"].dimension(2, 1) == 0
+    with pytest.raises(InputError, match="dim M_h = 0"):
+        check_inputs(["TDUAL-Q8"], 2, "structured", 1, 1, 1.0, 1.0, ["H"], "omega2")
+
+
 def test_face_spaces_stay_off_the_segment():
     """The 2D listings are the segment's; a face id on the segment is refused in one line."""
     assert all(registry.SPACES[c].defined_on(1) for c in registry.space_ids())

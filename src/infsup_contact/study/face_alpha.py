@@ -36,11 +36,22 @@ def transformed_dual_spec(element: str, alpha: float) -> SpaceSpec:
                      face_build=cellwise_builder(element, "transformed_dual", True, alpha))
 
 
-def sweep(ns=(4, 8), alphas=ALPHAS, elements=ELEMENTS, k: int = 2, norms=("H",), cell: str = "hex") -> list[dict]:
+def face_models() -> list:
+    """Names of the registered models whose contact interface is the face (dimension 3)."""
+    from ..models import MODELS
+
+    return [name for name, m in MODELS.items() if m.dim == 3]
+
+
+def sweep(ns=(4, 8), alphas=ALPHAS, elements=ELEMENTS, k: int = 2, norms=("H",), cell: str = "hex",
+          model: str | None = None) -> list[dict]:
     """One row per (element, α, N, norm): α, min weight (fraction of the cell area), cond₂(Ã),
-    ``refused`` and, where not refused, β_h, kernel_dim, dim M, dim W, n_max."""
-    from ..models.membranes3d import MEMBRANES3D
+    ``refused`` and, where not refused, β_h, kernel_dim, dim M, dim W, n_max (``model``: a
+    registered 3D model, default the first, :func:`face_models`; ``cell`` its --element)."""
+    from ..models import make_model
     from ..models.side_cache import SideCache
+
+    model = face_models()[0] if model is None else model
     from ..solvers.infsup import beta_rows_all
 
     cache, rows = SideCache(), []
@@ -53,7 +64,7 @@ def sweep(ns=(4, 8), alphas=ALPHAS, elements=ELEMENTS, k: int = 2, norms=("H",),
                     rows += [dict(base, norm=nm, beta=np.nan, kernel_dim=-1) for nm in norms]
                     continue
                 for r in beta_rows_all("structured", k, n, n, [transformed_dual_spec(element, info["alpha"])],
-                                       norms=norms, model=MEMBRANES3D, side_cache=cache, element=cell):
+                                       norms=norms, model=make_model(model), side_cache=cache, element=cell):
                     rows.append(dict(base, norm=r["norm"], beta=r["beta"], kernel_dim=r["kernel_dim"],
                                      dim_M=r["dim_M"], dim_W=r["dim_W"], n_max=r["n_max"]))
     return rows
@@ -65,11 +76,12 @@ def main(argv=None) -> None:
     p = argparse.ArgumentParser(prog="python -m infsup_contact.study.face_alpha", description=__doc__.split("\n")[0])
     p.add_argument("--N", type=int, nargs="+", default=[4, 8], help="cells per direction (matching meshes)")
     p.add_argument("--norm", default="H", choices=["H", "L2", "all"])
+    p.add_argument("--model", default=None, choices=face_models(), help="a 3D model (default: the first)")
     args = p.parse_args(argv)
     if any(n < 1 for n in args.N):
         raise InputError("N", "integers >= 1", got=args.N)
     norms = ("H", "L2") if args.norm == "all" else (args.norm,)
-    pd.DataFrame(sweep(tuple(args.N), norms=norms)).to_csv(sys.stdout, index=False, float_format="%.6g")
+    pd.DataFrame(sweep(tuple(args.N), norms=norms, model=args.model)).to_csv(sys.stdout, index=False, float_format="%.6g")
 
 
 if __name__ == "__main__":

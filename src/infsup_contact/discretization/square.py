@@ -5,7 +5,10 @@ the trace of a structured hexahedral mesh, and the common refinement of two such
 :class:`Square` is the second implementation of :class:`~.interface.Interface`: its points
 are arrays of shape (n, 2) (x, y), its quadrature is the tensor Gauss–Legendre rule per
 rectangle, its multiplier spaces are tensor products of the segment's 1D spaces
-(:mod:`.face_spaces`) and its norms are computed factor by factor (:mod:`.face_norms`).
+(:mod:`.face_spaces`) and its norms are computed factor by factor (:mod:`.face_norms`); the
+registry's face element spaces (QUAD8/QUAD9 dual, transformed dual, 4C pwlin: ``face_build``,
+:mod:`.face_cells`) are not tensor products, and their norms go through the exact projection
+onto discontinuous tensor pieces (:mod:`.face_cellwise_norms`).
 
 The trace of a tetrahedral mesh from the same structured grid (every rectangle cut in two
 triangles by its diagonal from (x_i, y_j) to (x_{i+1}, y_{j+1})) has the same tensor partition;
@@ -269,7 +272,8 @@ class Square(Interface):
     def gram(self, space, norm: str, h_route: str = "logkernel", **kwargs) -> tuple:
         """:func:`~.face_norms.gram`: L² exactly (kron of the 1D Grams), H by the double sine
         series (the only route on the square: ``h_route`` "logkernel", the command line's
-        default, and "series" both name it; ``n_max`` > 0 in ``info`` says it is a series)."""
+        default, and "series" both name it; ``n_max`` > 0 in ``info`` says it is a series).
+        A non-tensor space: :mod:`.face_cellwise_norms` (same norms, same series)."""
         from .face_norms import gram
 
         return gram(space, norm, **kwargs)

@@ -56,12 +56,12 @@ def load_spaces(cfg) -> list:
 def case_ids(cfg) -> list:
     """The ids this config may use: the built-in spaces and the user spaces of its own
     ``spaces`` key (not those another config registered earlier in the same process)."""
-    from .discretization.registry import SPACES
+    from .discretization.registry import space_ids
     from .discretization.user_spaces import _LOADED, load_user_space
 
     users = {spec.id for spec in _LOADED.values()}
     own = {load_user_space(ref).id for ref in cfg.get("spaces") or []}
-    return [c for c in SPACES if c not in users or c in own]
+    return [c for c in space_ids() if c not in users or c in own]  # the segment's: configs are 2D
 
 
 def check_cases(cfg) -> None:
@@ -75,7 +75,8 @@ def check_cases(cfg) -> None:
             if case not in ids:
                 raise ConfigError(f"{stage}.cases", f"{case!r} was unexpected", got=case,
                                   allowed="registered spaces: " + ", ".join(ids)
-                                  + ("" if case not in SPACES else f" ({case} is a user space: list it under spaces)"))
+                                  + ("" if case not in SPACES else f" ({case} is a face space of the 3D models)"
+                                     if not SPACES[case].defined_on(1) else f" ({case} is a user space: list it under spaces)"))
             spec = SPACES[case]
             low = [k for k in ks if not spec.valid_for(k)]
             if low:

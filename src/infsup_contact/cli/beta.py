@@ -20,7 +20,7 @@ def add(sub) -> None:
                        "proven one (agree, above_structural: modes beyond the proof, below_structural: the "
                        "error level was exceeded); gap_over_roundoff is the first pencil eigenvalue above "
                        "the kernel over the pencil's round-off level n*eps*lambda_max (a cross-check).")
-    p.add_argument("--case", default=None, choices=[*space_ids(), "all"],
+    p.add_argument("--case", default=None, choices=[*space_ids(None), "all"],
                    help="a registered space, or all (the default) for every one defined for k")
     p.add_argument("--space", metavar="FILE.py:FUNC", help=SPACE_HELP)
     p.add_argument("--system", metavar="LEVELS.yaml", default=None,

@@ -15,7 +15,7 @@ def add(sub) -> None:
     p = sub.add_parser("contact", help="solve (4.1) for one case and mesh pair (CSV: one row)")
     p.add_argument("--scene", required=True, choices=scene_ids(),
                    help=f"a registered scene, defined for the models of these --model/--scene pairs: {allowed_pairs()}")
-    p.add_argument("--case", choices=[*space_ids(), "all"], help="a registered space, or all")
+    p.add_argument("--case", choices=[*space_ids(None), "all"], help="a registered space, or all")
     p.add_argument("--space", metavar="FILE.py:FUNC", help=SPACE_HELP)
     p.add_argument("--k", type=int, required=True, help="displacement degree, 1..4")
     p.add_argument("--family", default="structured", choices=FAMILIES)

@@ -159,7 +159,60 @@ class CellwiseFaceSpace:
         return np.column_stack([X.ravel(), Y.ravel()]), W.ravel()
 
     @property
+    def pieces(self):
+        """The tensor partition on whose rectangles every basis function is one polynomial of
+        degree ≤ :attr:`piece_degree` per variable: the cells, or for ``pwlin`` on QUAD4/QUAD9
+        the cells halved in both directions (the four QUAD4 pieces); None for ``pwlin`` on
+        QUAD8 (triangular pieces: no exact tensor route, :mod:`.face_cellwise_norms` refuses it)."""
+        from .square import TensorPartition
+
+        if self.basis != "pwlin":
+            return self.breakpoints
+        if self.element == "QUAD8":
+            return None
+        half = [np.sort(np.concatenate([g, 0.5 * (g[:-1] + g[1:])])) for g in (self.xs, self.ys)]
+        return TensorPartition(*half)
+
+    @property
+    def piece_degree(self) -> int:
+        """Degree per variable on a piece of :attr:`pieces` (1 for ``pwlin``)."""
+        return 1 if self.basis == "pwlin" else self.degree
+
+    @property
+    def smooth_tail(self) -> bool:
+        """Whether every basis function is continuous and vanishes on ∂Γ (sine coefficients
+        ~ 1/(m² n²) in the tail, :func:`.face_norms.gram_h_face` exponent 4; else 2)."""
+        return bool(self.basis in ("standard", "transformed", "pwlin")
+                    and np.all(self.dofs[self._boundary_nodes()] < 0))
+
+    def _boundary_nodes(self) -> np.ndarray:
+        """Mask (cells, n_nodes) of the local nodes on ∂(0, 1)²."""
+        el = reference_element(self.element)
+        nx, ny = len(self.xs) - 1, len(self.ys) - 1
+        I = 2 * np.arange(nx)[:, None, None] + (el.nodes[:, 0] + 1)[None, None, :]
+        J = 2 * np.arange(ny)[None, :, None] + (el.nodes[:, 1] + 1)[None, None, :]
+        I, J = np.broadcast_to(I, (nx, ny, el.n_nodes)), np.broadcast_to(J, (nx, ny, el.n_nodes))
+        return ((I == 0) | (I == 2 * nx) | (J == 0) | (J == 2 * ny)).reshape(nx * ny, el.n_nodes)
+
+    @property
     def contains_constants(self) -> bool:
         """Whether Σ of all basis functions ≡ 1 (checked at every cell's Gauss points)."""
         pts, _ = self.quadrature(4)
         return bool(np.max(np.abs(self.evaluate(pts).sum(1) - 1.0)) < 1e-10)
+
+
+def cellwise_builder(element: str, basis: str, vanish_on_boundary: bool = True, alpha=None,
+                     refuse_with: str = ""):
+    """``build(k, partition)`` of a registry entry (:attr:`.registry.SpaceSpec.face_build`):
+    :class:`CellwiseFaceSpace` on the tensor partition G_h (k does not enter: the element
+    fixes the multiplier degree). ``refuse_with`` is appended to the refusal of a dual basis
+    with a weight ≤ 0 (the registered id of the remedy)."""
+    def build(k, partition):
+        try:
+            return CellwiseFaceSpace(partition, element, basis, alpha, vanish_on_boundary)
+        except InputError as err:
+            if refuse_with and err.key == "element":
+                reason = err.allowed.rsplit("; use ", 1)[0]       # the weights, without the generic remedy
+                raise InputError("case", f"{reason}; {refuse_with}", got=err.got) from None
+            raise
+    return build

@@ -99,12 +99,18 @@ def gram_h_face(space, rtol: float = 1e-6, n_start: int | None = None, n_cap: in
     p = (4.0 if smooth_tail(space) else 2.0) if exponent is None else float(exponent)
     n_int = max(f.n_intervals for f in space.factors)
     n0 = max(16, 2 * (space.degree + 1) * n_int) if n_start is None else int(n_start)
+    return extrapolated_series(lambda n: partial_gram(space, n), n0, n_cap, p, rtol)
+
+
+def extrapolated_series(partial, n0: int, n_cap: int, p: float, rtol: float) -> tuple[np.ndarray, dict]:
+    """The Richardson loop of :func:`gram_h_face` for any partial sums ``partial(n)`` = S(n)
+    with a tail ~ C n^{−p} (also the route of the non-tensor spaces, :mod:`.face_cellwise_norms`)."""
     if n0 < 1 or n_cap < 1:
-        raise InputError("n_start/n_cap", "positive integers", got=(n_start, n_cap))
+        raise InputError("n_start/n_cap", "positive integers", got=(n0, n_cap))
     n0 = min(n0, n_cap)
     factor = 1.0 / (2.0 ** p - 1.0)
-    s_lo, n_hi = partial_gram(space, n0), min(2 * n0, n_cap)
-    s_hi = partial_gram(space, n_hi)
+    s_lo, n_hi = partial(n0), min(2 * n0, n_cap)
+    s_hi = partial(n_hi)
     r_prev = s_hi + (s_hi - s_lo) * factor
     err = _norm2(r_prev - s_hi) / _norm2(r_prev)
     capped = False
@@ -112,7 +118,7 @@ def gram_h_face(space, rtol: float = 1e-6, n_start: int | None = None, n_cap: in
         if 2 * n_hi > n_cap:
             capped = err > rtol
             break
-        s_lo, s_hi, n_hi = s_hi, partial_gram(space, 2 * n_hi), 2 * n_hi
+        s_lo, s_hi, n_hi = s_hi, partial(2 * n_hi), 2 * n_hi
         r = s_hi + (s_hi - s_lo) * factor
         err = _norm2(r - r_prev) / _norm2(r)
         r_prev = r
@@ -127,7 +133,14 @@ def _norm2(A: np.ndarray) -> float:
 
 
 def gram(space, norm: str, **kwargs) -> tuple[np.ndarray, dict]:
-    """Gram matrix of a face space for ``norm`` ∈ {"H", "L2"} (``kwargs`` go to :func:`gram_h_face`)."""
+    """Gram matrix of a face space for ``norm`` ∈ {"H", "L2"} (``kwargs`` go to :func:`gram_h_face`).
+
+    A space without tensor ``factors`` (:class:`~.face_cells.CellwiseFaceSpace`) takes the
+    route of :mod:`.face_cellwise_norms`."""
+    if not hasattr(space, "factors"):
+        from .face_cellwise_norms import gram_cellwise
+
+        return gram_cellwise(space, norm, **kwargs)
     if norm == "L2":
         return gram_l2_face(space), {"n_max": 0, "nmax_rel_error": 0.0}
     if norm == "H":

@@ -18,6 +18,7 @@ import numpy as np
 
 from ..errors import InputError
 from .dual import dual_space
+from .face_cells import cellwise_builder
 from .interface import MULTIPLIER_MESHES
 from .segment import SEGMENT
 from .multipliers import MultiplierSpace, make_space
@@ -74,6 +75,16 @@ class SpaceSpec:
     claim_tag : str or None
         Prefix of the space's ledger claim ids; default the paper reference without spaces
         (``Thm3-k1-structured-evenN``).
+    gamma_dims : tuple of int
+        Dimensions of the interfaces Γ the space is defined on: 1 the segment (the paper's
+        2D models), 2 the face (0, 1)² of the 3D models. The paper's cases are both (on the
+        face, the tensor products of their 1D builds); the face element spaces are (2,), and
+        :func:`space_ids` / :func:`ids_valid_for` list the segment's by default, so the 2D
+        consumers (configs, figures, the paper) never see them.
+    face_build : callable or None
+        ``face_build(k, partition) -> space`` on a tensor partition of the face, for a space
+        that is not a tensor product of ``build`` (:mod:`.face_cells`); ``dimension(k, N)`` is
+        then dim M_h on an N × N grid.
     """
 
     id: str
@@ -89,6 +100,19 @@ class SpaceSpec:
     nodal_basis: bool = True
     finding_meshes: tuple = field(default=())
     claim_tag: str | None = None
+    gamma_dims: tuple = (1, 2)
+    face_build: Callable | None = None
+
+    def defined_on(self, gamma_dim: int) -> bool:
+        """Whether the space exists on an interface Γ of dimension ``gamma_dim``."""
+        return gamma_dim in self.gamma_dims
+
+    def face_space(self, k: int, n: int):
+        """The space on the uniform n × n grid of the face (the square's build)."""
+        from .square import SQUARE, TensorPartition
+
+        x = np.linspace(0.0, 1.0, n + 1)
+        return SQUARE.space(self, k, TensorPartition(x, x))
 
     @property
     def tag(self) -> str:
@@ -104,7 +128,10 @@ class SpaceSpec:
     def contains_constants(self, k: int, n: int = 6) -> bool:
         """Whether 1 ∈ M_h for displacement degree k, computed (not declared): the least-squares
         fit of the constant by M_h on N = ``n`` uniform intervals leaves no residual at sample
-        points. What a patch test of a uniform pressure asks of M_h (study/patch.py)."""
+        points. What a patch test of a uniform pressure asks of M_h (study/patch.py). A
+        face-only space: its own check on the n × n grid of the face."""
+        if not self.defined_on(1):
+            return bool(self.face_space(k, n).contains_constants)
         space = self.build(k, np.linspace(0.0, 1.0, n + 1))
         x = np.linspace(0.0, 1.0, 8 * n * (self.degree(k) + 1) + 1)
         phi = space.evaluate(x)
@@ -113,8 +140,14 @@ class SpaceSpec:
 
     def structural_kernel(self, k: int, n: int) -> int | None:
         """max(dim M − dim W, 0) on matching meshes with N intervals (W = the trace space),
-        None without a dimension count."""
-        return None if self.dimension is None else max(self.dimension(k, n) - SEGMENT.trace_dimension(k, n), 0)
+        None without a dimension count; a face-only space: on the n × n grid of the face."""
+        if self.dimension is None:
+            return None
+        if not self.defined_on(1):
+            from .square import SQUARE
+
+            return max(self.dimension(k, n) - SQUARE.trace_dimension(k, n), 0)
+        return max(self.dimension(k, n) - SEGMENT.trace_dimension(k, n), 0)
 
     def cone(self, k: int) -> str:
         """``pointwise`` (λ_h ≥ 0 everywhere), ``nodal`` (at the Lagrange nodes) or
@@ -148,13 +181,16 @@ def space_spec(case: str) -> SpaceSpec:
     return SPACES[case]
 
 
-def space_ids() -> tuple:
-    return tuple(SPACES)
+def space_ids(gamma_dim: int | None = 1) -> tuple:
+    """The registered ids defined on an interface of dimension ``gamma_dim`` (default 1, the
+    segment of the 2D models and of every config; None: all, e.g. the command line's choices)."""
+    return tuple(c for c, spec in SPACES.items() if gamma_dim is None or spec.defined_on(gamma_dim))
 
 
-def ids_valid_for(k: int, ids=None) -> list:
-    """The registered ids (or ``ids``) defined for displacement degree k."""
-    return [c for c in (space_ids() if ids is None else ids) if SPACES[c].valid_for(k)]
+def ids_valid_for(k: int, ids=None, gamma_dim: int | None = 1) -> list:
+    """The registered ids (or ``ids``) defined for displacement degree k (and, without ``ids``,
+    on an interface of dimension ``gamma_dim``, :func:`space_ids`)."""
+    return [c for c in (space_ids(gamma_dim) if ids is None else ids) if SPACES[c].valid_for(k)]
 
 
 def check_case(case: str, k: int) -> None:
@@ -178,7 +214,11 @@ def case_space(case: str, k: int, partition, gamma=SEGMENT) -> MultiplierSpace:
         the eigenproblems and solves would fail deep inside numpy), naming the case, N and k.
     """
     check_case(case, k)
-    space = gamma.space(SPACES[case], k, partition)  # the interface builds it (a face: tensor products)
+    spec = SPACES[case]
+    if not spec.defined_on(gamma.dim):
+        raise InputError("case", f"a space defined on this Γ (dimension {gamma.dim}): {case} ({spec.paper_ref}) is "
+                         f"defined on the face of a 3D model only (e.g. --model membranes3d)", got=case)
+    space = gamma.space(spec, k, partition)  # the interface builds it (a face: tensor products)
     n = gamma.cells(space.breakpoints)
     if space.dim < 1:
         low = min_intervals(case, k)
@@ -193,7 +233,10 @@ MAX_MIN_INTERVALS = 64
 
 
 def case_name(case) -> str:
-    """A registered id, or the label of a general triple ``(label, s, continuous, vanish)``."""
+    """A registered id, the id of an (unregistered) :class:`SpaceSpec`, or the label of a
+    general triple ``(label, s, continuous, vanish)``."""
+    if isinstance(case, SpaceSpec):
+        return case.id
     return case if isinstance(case, str) else str(case[0])
 
 
@@ -205,7 +248,10 @@ def space_dim(case, k: int, n: int) -> int:
     if not isinstance(case, str):
         _, s, continuous, vanish = case
         return make_space(x, s, continuous, vanish).dim
-    return int(space_spec(case).build(k, x).dim)
+    spec = space_spec(case)
+    if not spec.defined_on(1):                      # a face-only space: on the n × n grid
+        return int(spec.face_space(k, n).dim)
+    return int(spec.build(k, x).dim)
 
 
 def is_empty(case, k: int, n: int) -> bool:
@@ -302,6 +348,42 @@ register(SpaceSpec(
     "DUAL-ALL", "dual of Rem 5.2", "dual basis of M^1_k", lambda k, x: dual_space(x, k, False), lambda k: k,
     expected="unstable", dimension=lambda k, n: n * k + 1, color=OKABE_ITO["sky_blue"], marker="h",
     nodal_basis=False, claim_tag="DUAL-ALL"))
+
+# --- face element spaces of the 3D models (issue 28; face_cells, face_dual) ---------------
+def _face_only(case: str):
+    """The 1D ``build`` of a face-only entry: refuses the segment in one line."""
+    def build(k, x):
+        raise InputError("case", f"a space of the segment Γ: {case} is defined on the face of a 3D model "
+                         f"only (e.g. --model membranes3d)", got=case)
+    return build
+
+
+def _face_case(id, ref, definition, element, basis, dimension, color, marker, vanish=True,
+               expected="unknown", refuse_with=""):
+    """A cellwise space of quadratic face elements (Q2 traces: k = 2 hex, QUAD9) on G_h."""
+    return register(SpaceSpec(
+        id, ref, definition, _face_only(id), lambda k: 2, min_k=2, expected=expected,
+        dimension=dimension, color=color, marker=marker, nodal_basis=basis in ("standard", "pwlin"),
+        claim_tag=id, gamma_dims=(2,), face_build=cellwise_builder(element, basis, vanish, refuse_with=refuse_with)))
+
+
+def _interior(n):       # nodes of the QUAD9 lattice inside (0, 1)² on an n × n grid
+    return (2 * n - 1) ** 2
+
+
+_face_case("DUAL-Q9", "Wohlmuth 2000; Popp, Gitterle, Gee, Wall 2010", "dual basis of QUAD9 on ∂Γ-free nodes, "
+           "constants kept", "QUAD9", "dual", lambda k, n: _interior(n), OKABE_ITO["black"], "H")
+_face_case("DUAL-Q9-ALL", "Wohlmuth 2000 (all nodes)", "dual basis of QUAD9 on all nodes", "QUAD9", "dual",
+           lambda k, n: (2 * n + 1) ** 2, OKABE_ITO["sky_blue"], "d", vanish=False, expected="unstable")
+_face_case("DUAL-Q8", "Wohlmuth 2000 (QUAD8)", "dual basis of QUAD8 (refused: corner weights ∫N = −1/3 < 0)",
+           "QUAD8", "dual", lambda k, n: _interior(n) - n * n, OKABE_ITO["vermillion"], "<",
+           refuse_with="use case TDUAL-Q8 (the transformed dual basis, Popp et al. 2012, α = 1/5)")
+_face_case("TDUAL-Q8", "Popp, Gitterle, Gee, Wall 2010; 4C", "transformed dual basis of QUAD8, α = 1/5",
+           "QUAD8", "transformed_dual", lambda k, n: _interior(n) - n * n, OKABE_ITO["orange"], ">")
+_face_case("TDUAL-Q9", "Popp, Gitterle, Gee, Wall 2010; 4C", "transformed dual basis of QUAD9, α = 1/5",
+           "QUAD9", "transformed_dual", lambda k, n: _interior(n), OKABE_ITO["bluish_green"], "8")
+_face_case("PWLIN-Q9", "4C LM_QUAD pwlin (Popp 2009)", "piecewise bilinear on the 4 sub-quads of QUAD9",
+           "QUAD9", "pwlin", lambda k, n: _interior(n), OKABE_ITO["reddish_purple"], "p")
 
 # --- roles the study gives to particular spaces (the one place they are spelled) --------
 REFERENCE_SPACE = "T3"

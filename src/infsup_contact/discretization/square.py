@@ -5,7 +5,10 @@ the trace of a structured hexahedral mesh, and the common refinement of two such
 :class:`Square` is the second implementation of :class:`~.interface.Interface`: its points
 are arrays of shape (n, 2) (x, y), its quadrature is the tensor Gauss–Legendre rule per
 rectangle, its multiplier spaces are tensor products of the segment's 1D spaces
-(:mod:`.face_spaces`) and its norms are computed factor by factor (:mod:`.face_norms`).
+(:mod:`.face_spaces`) and its norms are computed factor by factor (:mod:`.face_norms`); the
+registry's face element spaces (QUAD8/QUAD9 dual, transformed dual, 4C pwlin: ``face_build``,
+:mod:`.face_cells`) are not tensor products, and their norms go through the exact projection
+onto discontinuous tensor pieces (:mod:`.face_cellwise_norms`).
 
 The trace of a tetrahedral mesh from the same structured grid (every rectangle cut in two
 triangles by its diagonal from (x_i, y_j) to (x_{i+1}, y_{j+1})) has the same tensor partition;
@@ -256,26 +259,36 @@ class Square(Interface):
     def coupling_quadrature(self, trace: GammaTrace, space, degree: int) -> tuple:
         """Quadrature ``degree`` on the common refinement of the trace and G_h; for triangles
         every rectangle is cut by the diagonal of the trace cell containing it
-        (:func:`~.face_quadrature.split_rule`), exact for the P_k × Q_s products."""
+        (:func:`~.face_quadrature.split_rule`), exact for the P_k × Q_s products. A space that is
+        polynomial only on a finer tensor partition (its ``pieces``: 4C pwlin) is integrated on those."""
+        pieces = getattr(space, "pieces", space.breakpoints)
+        if pieces is None:
+            raise InputError("space", "a face space polynomial on the rectangles of a tensor partition",
+                             got=getattr(space, "element", space))
         if self.cell == "quad":
-            return super().coupling_quadrature(trace, space, degree)
-        return split_rule(self.common_refinement(trace.partition, space.breakpoints), trace.partition, 2 * degree)
+            return self.quadrature(self.common_refinement(trace.partition, pieces), degree)
+        return split_rule(self.common_refinement(trace.partition, pieces), trace.partition, 2 * degree)
 
     def gram(self, space, norm: str, h_route: str = "logkernel", **kwargs) -> tuple:
         """:func:`~.face_norms.gram`: L² exactly (kron of the 1D Grams), H by the double sine
         series (the only route on the square: ``h_route`` "logkernel", the command line's
-        default, and "series" both name it; ``n_max`` > 0 in ``info`` says it is a series)."""
+        default, and "series" both name it; ``n_max`` > 0 in ``info`` says it is a series).
+        A non-tensor space: :mod:`.face_cellwise_norms` (same norms, same series)."""
         from .face_norms import gram
 
         return gram(space, norm, **kwargs)
 
     def space(self, spec, k: int, partition):
-        """The tensor product of ``spec``'s 1D space on xs and on ys (:class:`.face_spaces.FaceSpace`)."""
+        """The tensor product of ``spec``'s 1D space on xs and on ys (:class:`.face_spaces.FaceSpace`),
+        or the entry's own face space where it has one (``spec.face_build``: the cellwise element
+        spaces of :mod:`.face_cells`)."""
         from .face_spaces import FaceSpace
 
         if not isinstance(partition, TensorPartition) or partition.cells < 1:
             raise InputError("multiplier mesh", f"a tensor partition of Γ with at least one rectangle "
                              f"(case {spec.id}, k = {k})")
+        if getattr(spec, "face_build", None) is not None:
+            return spec.face_build(k, partition)
         return FaceSpace(spec.build(k, np.asarray(partition.xs, float)),
                          spec.build(k, np.asarray(partition.ys, float)), partition)
 

@@ -113,10 +113,14 @@ def check_inputs(case, k, family, n1, n2, c1, c2, norm, multiplier_mesh) -> None
 
 
 def _space(case, k, partition, gamma=SEGMENT):
-    """A named case on G_h = ``partition`` of ``gamma``, or a general triple
-    ``(label, s, continuous, vanish)`` (eqs. 5.3, 5.5; spaces of the segment)."""
+    """A named case on G_h = ``partition`` of ``gamma``, an unregistered
+    :class:`~infsup_contact.discretization.registry.SpaceSpec` (a study's variant, e.g. the α
+    sweep of study/face_alpha.py), or a general triple ``(label, s, continuous, vanish)``
+    (eqs. 5.3, 5.5; spaces of the segment)."""
     if isinstance(case, str):
         return registry.case_space(case, k, partition, gamma)
+    if isinstance(case, registry.SpaceSpec):
+        return gamma.space(case, k, partition)
     _, s, continuous, vanish = case
     return multipliers.make_space(partition, s, continuous, vanish)
 
@@ -202,7 +206,7 @@ def beta_rows_all(family, k, n1, n2, cases=None, multiplier_meshes=("omega2",), 
                     sp_ = spectrum(S, factor=factors[norm], kernel=kernel)
                     beta_v1_zero = beta_v1_zero_c1[norm] / np.sqrt(c2)
                     rows.append(dict(
-                        case=case if isinstance(case, str) else case[0], k=k, family=family, N1=n1, N2=n2,
+                        case=registry.case_name(case), k=k, family=family, N1=n1, N2=n2,
                         multiplier_mesh=multiplier_mesh, c1=c1, c2=c2, norm=norm, beta=sp_.beta,
                         kernel_dim=sp_.kernel_dim, structural_kernel_dim=structural,
                         kernel_detected=kernel.detected, kernel_margin_decades=kernel.margin_decades,

@@ -1,0 +1,88 @@
+"""The α sweep of the transformed dual bases on the face (issue 28): β_h against α.
+
+Popp, Gitterle, Gee, Wall (Int. J. Numer. Meth. Engng 83 (2010) 1428–1465) and 4C transform a
+quadratic face element's basis, Ñ = T(α) N (:func:`~infsup_contact.discretization.face_dual.transformation`),
+so that the weights ∫Ñ_k are all positive and the dual basis ψ̃ = Ã Ñ exists; 4C fixes α = 1/5.
+For QUAD8 the corner weight is ∫Ñ_corner = (8α − 1)/3 (reference area 4): the dual basis exists
+for α > 1/8 only. This module measures, for each α, the smallest weight, cond₂(Ã) and β_h
+(H^{1/2}_00(Γ)' norm, :func:`~infsup_contact.solvers.infsup.beta_rows_all`) of the transformed
+dual space (∂Γ dofs dropped, constants kept, :class:`~infsup_contact.discretization.face_cells.CellwiseFaceSpace`)
+with Q2 displacements (k = 2, hexahedra) on matching N × N meshes. An α with a weight ≤ 0 is
+refused, as the registry's DUAL-Q8 is (the row says so; no β).
+
+Run: ``python -m infsup_contact.study.face_alpha --N 4 8`` (CSV on stdout).
+"""
+from __future__ import annotations
+
+import argparse
+import sys
+
+import numpy as np
+
+from ..discretization.face_cells import cellwise_builder
+from ..discretization.face_dual import alpha_sweep
+from ..discretization.registry import SpaceSpec
+from ..errors import InputError
+
+ALPHAS = (0.05, 0.1, 0.125, 0.15, 0.2, 0.25, 0.3, 1.0 / 3.0, 0.4, 0.45)
+"""The sweep of issue 28 (0.125: the QUAD8 corner weight is exactly 0; 0.2: 4C's)."""
+ELEMENTS = ("QUAD8", "QUAD9")
+
+
+def transformed_dual_spec(element: str, alpha: float) -> SpaceSpec:
+    """An unregistered entry: the transformed dual basis of ``element`` with this α (k ≥ 2)."""
+    return SpaceSpec(f"TDUAL-{element}-a{alpha:.4g}", "Popp et al. 2010", f"transformed dual {element}, α = {alpha:.4g}",
+                     lambda k, x: None, lambda k: 2, min_k=2, gamma_dims=(2,),
+                     face_build=cellwise_builder(element, "transformed_dual", True, alpha))
+
+
+def face_models() -> list:
+    """Names of the registered models whose contact interface is the face (dimension 3)."""
+    from ..models import MODELS
+
+    return [name for name, m in MODELS.items() if m.dim == 3]
+
+
+def sweep(ns=(4, 8), alphas=ALPHAS, elements=ELEMENTS, k: int = 2, norms=("H",), cell: str = "hex",
+          model: str | None = None) -> list[dict]:
+    """One row per (element, α, N, norm): α, min weight (fraction of the cell area), cond₂(Ã),
+    ``refused`` and, where not refused, β_h, kernel_dim, dim M, dim W, n_max (``model``: a
+    registered 3D model, default the first, :func:`face_models`; ``cell`` its --element)."""
+    from ..models import make_model
+    from ..models.side_cache import SideCache
+
+    model = face_models()[0] if model is None else model
+    from ..solvers.infsup import beta_rows_all
+
+    cache, rows = SideCache(), []
+    for n in ns:
+        for element in elements:
+            for info in alpha_sweep(element, alphas):
+                base = dict(element=element, alpha=info["alpha"], N=n, min_weight=info["min_fraction"],
+                            cond_A=info["cond"], refused=not info["positive"])
+                if not info["positive"]:
+                    rows += [dict(base, norm=nm, beta=np.nan, kernel_dim=-1) for nm in norms]
+                    continue
+                for r in beta_rows_all("structured", k, n, n, [transformed_dual_spec(element, info["alpha"])],
+                                       norms=norms, model=make_model(model), side_cache=cache, element=cell):
+                    rows.append(dict(base, norm=r["norm"], beta=r["beta"], kernel_dim=r["kernel_dim"],
+                                     dim_M=r["dim_M"], dim_W=r["dim_W"], n_max=r["n_max"]))
+    return rows
+
+
+def main(argv=None) -> None:
+    import pandas as pd
+
+    p = argparse.ArgumentParser(prog="python -m infsup_contact.study.face_alpha", description=__doc__.split("\n")[0])
+    p.add_argument("--N", type=int, nargs="+", default=[4, 8], help="cells per direction (matching meshes)")
+    p.add_argument("--norm", default="H", choices=["H", "L2", "all"])
+    p.add_argument("--model", default=None, choices=face_models(), help="a 3D model (default: the first)")
+    args = p.parse_args(argv)
+    if any(n < 1 for n in args.N):
+        raise InputError("N", "integers >= 1", got=args.N)
+    norms = ("H", "L2") if args.norm == "all" else (args.norm,)
+    pd.DataFrame(sweep(tuple(args.N), norms=norms, model=args.model)).to_csv(sys.stdout, index=False, float_format="%.6g")
+
+
+if __name__ == "__main__":
+    main()

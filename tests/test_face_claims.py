@@ -4,11 +4,10 @@ predictions follow registry properties (not ids), a bad ``face:`` key is named."
 from __future__ import annotations
 
 import copy
-import re
 import dataclasses
+import re
 from pathlib import Path
 
-import numpy as np
 import pandas as pd
 import pytest
 import yaml
@@ -16,26 +15,11 @@ import yaml
 from infsup_contact.discretization.registry import SPACES
 from infsup_contact.discretization.square import SQUARE
 from infsup_contact.study.claims import FAIL, INCONCLUSIVE, PASS
-from infsup_contact.study.face_claims import (face_claims, face_predictions, kernel_formula, matching_kernel,
+from infsup_contact.study.face_claims import (face_claims, face_predictions, kernel_formula,
                                               planar_kernel, tensor_kernel_bound)
 
 ROOT = Path(__file__).resolve().parents[1]
-CLAIMS_CFG = {"slope_tolerance": 0.15, "beta_floor": 1e-3, "confidence": 0.95, "fit_window": 5}
-NS = (4, 6, 8, 10, 12)
-
-
-def _rows(case, k, element="hex", beta_h=lambda n: 0.8, beta_l2=lambda n: 0.8 * n ** -0.5, kernel=None,
-          pairs=((4, 5), (6, 7))):
-    spec = SPACES[case]
-    out = []
-    for n1, n2 in [(n, n) for n in NS] + list(pairs):
-        count = matching_kernel(spec, k, n2) if n1 == n2 else planar_kernel(spec, k, n1, n2)
-        dim = count if kernel is None else kernel(n1, n2, count)
-        for norm, b in (("H", beta_h(n2)), ("L2", beta_l2(n2))):
-            out.append(dict(element=element, case=case, k=k, family="structured", N1=n1, N2=n2, norm=norm,
-                            beta=0.0 if dim else b, kernel_dim=dim, structural_kernel_dim=count,
-                            kernel_decision="clear", kernel_margin_decades=5.0, smallest_nonzero=0.5))
-    return pd.DataFrame(out)
+from _face_tables import CLAIMS_CFG, NS, face_rows as _rows  # noqa: E402
 
 
 def _verdicts(frame, tensor=("hex",)):

@@ -145,3 +145,17 @@ def test_config_without_face_section_is_valid():
     cfg = _ci()
     del cfg["face"]
     check_config(cfg, ROOT / "workflow" / "schemas" / "config.schema.yaml")
+
+
+@pytest.mark.parametrize("verdict", ["PASS", "FAIL", "INCONCLUSIVE"])
+def test_face_section_renders_under_any_verdict(verdict):
+    """paper/face.tex states outcomes only through \\byverdict on its generated outcome macros:
+    it renders (every macro expanded, every branch resolved) whatever the ledger says."""
+    from infsup_contact.report.consistency import render
+    from infsup_contact.report.face import face_macros
+
+    from _face_tables import small_face_tables
+
+    t = small_face_tables()
+    text = render((ROOT / "paper" / "face.tex").read_text(), face_macros(t["beta"], t["claims"].assign(verdict=verdict)))
+    assert "\\byverdict" not in text and "\\faceOutcome" not in text

@@ -61,6 +61,10 @@ def face_macros(beta: pd.DataFrame, claims: pd.DataFrame) -> list[Macro]:
                          f"face_claims.csv: {kind} claims, verdict == predicted"))
         out.append(Macro(_name("N", kind, "predicted fail"), fmt_int(int((rows.predicted == "FAIL").sum())),
                          f"face_claims.csv: {kind} claims predicted FAIL"))
+        failing = rows[rows.predicted == "FAIL"]
+        out.append(Macro(_name("Outcome", kind, "predicted fail"),
+                         _outcome(failing.verdict) if len(failing) else "INCONCLUSIVE",
+                         f"face_claims.csv: {kind} claims predicted FAIL, all PASS / all FAIL / else"))
     m = beta[beta.N1 == beta.N2]
     nm = beta[beta.N1 != beta.N2]
     out += [Macro(_name("FinestN"), fmt_int(m.N2.max()), "face_beta.csv: max matching N"),

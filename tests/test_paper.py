@@ -412,6 +412,14 @@ def test_pdf_builds_and_shows_generated_numbers(tables, tmp_path):
         (gen / name).write_text(text)
     (figs / "fig9_elastic.pdf").write_bytes(placeholder_pdf("fig9_elastic"))
     shutil.copy(ROOT / "paper" / "elastic.tex", build)
+    # the face section (paper/face.tex) and its generated files, from small synthetic tables
+    from _face_tables import small_face_tables
+
+    from infsup_contact.report.face import face_paper_files
+
+    for name, text in face_paper_files(**small_face_tables()).items():
+        (gen / name).write_text(text)
+    shutil.copy(ROOT / "paper" / "face.tex", build)
     shutil.copy(PAPER, build)
     shutil.copy(ROOT / "paper" / "references.bib", build)
     env = dict(os.environ, TEXINPUTS=f"{gen}:{figs}:", SOURCE_DATE_EPOCH="0", FORCE_SOURCE_DATE="1")

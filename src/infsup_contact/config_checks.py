@@ -340,6 +340,8 @@ def check_space_meshes(cfg) -> None:
                                                    f"pairs whose {choice} multiplier mesh has >= {low} intervals"))
 
 
+from .config_face import check_face  # noqa: E402 (the face section's checks: config_face.py)
+
 CROSS_KEY_RULES = {
     # rule: the keys it relates (the error names the first; a change to any of them can trip it)
     check_cases: ("infsup.cases", "contact.cases", "spaces"),
@@ -353,6 +355,7 @@ CROSS_KEY_RULES = {
     check_speed_accuracy_scene: ("benchmarks.speed_accuracy_scene", "contact.scenes", "contact.primary_scene"),
     check_elastic_nonmatching: ("elastic.nonmatching", "elastic.patch_pairs"),
     check_hertz_reference: ("elastic.hertz.N_ref", "elastic.hertz.N"),
+    check_face: ("face.model", "face.elements", "face.nonmatching", "face.cases", "spaces"),
     check_space_meshes: ("infsup.N", "infsup.nonmatching", "infsup.nonmatching_families", "contact.N",
                          "contact.scenes", "elastic.N", "elastic.nonmatching", "elastic.patch_pairs",
                          "elastic.bench_N", "elastic.hertz.N", "elastic.hertz.modeling_N", "benchmarks.beta_N",

@@ -132,6 +132,10 @@ SCHEMAS = {
                              "p_max_rel_error": "float?", "half_width_rel_error": "float?"},
                             optional={"R": "float", "nu": "float", "E1": "float", "E2": "float"},
                             key=("study", "case", "k", "N", "R", "d", "nu", "E1", "E2")),
+    # the 3D contact face (rules/face.smk: study/beta_batches.py with models/membranes3d.py)
+    "face_beta": Schema({**_BETA, "model": "str", "element": "str"},
+                        key=("model", "element", "family", "case", "k", "N1", "N2", "multiplier_mesh", "c1", "c2",
+                             "norm")),
     # Snakemake's `benchmark:` files (bench/dag.py), tab-separated
     "rule_benchmark": Schema({"s": "float"}, optional={"max_rss": "float?", "cpu_time": "float?"},
                              label="a Snakemake benchmark file", sep="\t"),

@@ -26,6 +26,7 @@ rule claims:
         rates="results/tables/rates.csv",
         extra="results/tables/claims_extra.csv",
         elastic="results/tables/elastic_claims.csv",  # the elastic stage's claims (rules/elastic.smk)
+        face=FACE_CLAIMS,  # the face stage's claims (rules/face.smk), when the config has a face section
         src=PACKAGE_SOURCES,
     params:
         cfg=lambda wc: config["claims"],

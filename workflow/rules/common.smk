@@ -99,3 +99,10 @@ def reference_mem_mb(wildcards):
     cc = config["contact"]
     return resources.job_mem_mb(resources.contact_estimate(
         "structured", int(wildcards.k), 1, 1, cc["reference_N"], 1))
+
+
+# the 3D face stage's outputs (rules/face.smk); none without a `face` config section
+FACE = config.get("face")
+FACE_BETA = [f"results/tables/face/beta_{e}_k{k}.csv" for e in FACE["elements"] for k in FACE["k"]] if FACE else []
+FACE_CLAIMS = ["results/tables/face_claims.csv"] if FACE else []
+FACE_PAPER = ["results/paper/face_macros.tex", "results/paper/face_beta_table.tex"] if FACE else []

@@ -47,6 +47,8 @@ rule paper_pdf:
         elastic_tex="paper/elastic.tex",  # the elastic section (rules/elastic.smk)
         elastic=rules.elastic_paper.output,
         elastic_figure="results/figures/fig9_elastic.pdf",
+        face_tex="paper/face.tex",  # the face section (rules/face.smk)
+        face=FACE_PAPER,
     benchmark:
         "results/benchmarks/rules/paper_pdf.tsv"
     log:
@@ -61,7 +63,7 @@ rule paper_pdf:
         bash workflow/scripts/ensure_tex.sh
         root=$PWD
         rm -rf {params.build} && mkdir -p {params.build}
-        cp {input.tex} {input.bib} {input.elastic_tex} {params.build}/
+        cp {input.tex} {input.bib} {input.elastic_tex} {input.face_tex} {params.build}/
         cd {params.build}
         export TEXINPUTS="$root/results/paper:$root/results/figures:" SOURCE_DATE_EPOCH=0 FORCE_SOURCE_DATE=1
         if ! latexmk -pdf -interaction=nonstopmode -halt-on-error -file-line-error paper.tex > "$root/{log}" 2>&1; then

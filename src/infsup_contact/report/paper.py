@@ -14,7 +14,7 @@ from .texnames import is_generated_name
 
 GENERATED_FILES = ("macros.tex", "claims_table.tex", "rates_table.tex", "beta_table.tex",
                    "speed_table.tex", "front_table.tex", "nonmatching_table.tex")
-SOURCE_INPUTS = ("elastic",)
+SOURCE_INPUTS = ("elastic", "face")
 """Sections of the paper kept in their own source files (paper/elastic.tex: the elastic scene,
 with its own generated files, :mod:`infsup_contact.report.elastic`)."""
 

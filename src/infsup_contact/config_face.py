@@ -1,0 +1,58 @@
+"""Cross-key checks of the config's ``face`` section (the 3D contact face stage, rules/face.smk).
+
+What the schema cannot state: the model is a registered one with a 3D face, each element is
+one of its ``element`` mesh options, each case id is a registered space the face can build for
+some k of ``face.k`` (built on the 2 × 2 grid of Γ: a face-only space added to the registry
+later passes by config alone), and a non-matching pair has N1 ≠ N2. Each raises one
+:class:`~infsup_contact.config_schema.ConfigError` naming the key.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from .config_schema import ConfigError
+
+
+def check_face(cfg) -> None:
+    """Check ``cfg["face"]`` (absent: nothing to check)."""
+    fc = cfg.get("face")
+    if not fc:
+        return
+    from .models import MODELS
+
+    model = MODELS.get(fc["model"])
+    if model is None or getattr(model, "dim", 2) != 3:
+        raise ConfigError("face.model", "not a registered model with a 3D face", got=fc["model"],
+                          allowed=", ".join(m.name for m in MODELS.values() if getattr(m, "dim", 2) == 3))
+    options = dict(model.mesh_options).get("element", ())
+    for i, element in enumerate(fc["elements"]):
+        if element not in options:
+            raise ConfigError(f"face.elements[{i}]", f"not an element of {model.name}", got=element,
+                              allowed=", ".join(options))
+    for i, pair in enumerate(fc["nonmatching"]):
+        if pair[0] == pair[1]:
+            raise ConfigError(f"face.nonmatching[{i}]", "a non-matching pair needs N1 != N2", got=pair,
+                              allowed="[N1, N2] with N1 != N2 (matching meshes go under face.N)")
+    _check_face_cases(cfg, fc)
+
+
+def _check_face_cases(cfg, fc) -> None:
+    from .config_checks import case_ids
+    from .discretization.registry import SPACES
+    from .discretization.square import SQUARE, TensorPartition
+
+    ids = case_ids(cfg)
+    x = np.linspace(0.0, 1.0, 3)
+    for i, case in enumerate(fc["cases"]):
+        key = f"face.cases[{i}]"
+        if case not in ids:
+            raise ConfigError(key, f"{case!r} is not a registered space", got=case, allowed=", ".join(ids))
+        spec = SPACES[case]
+        ks = [k for k in fc["k"] if spec.valid_for(k)]
+        if not ks:
+            raise ConfigError(key, f"{case} is defined for none of face.k = {fc['k']}", got=case,
+                              allowed=f"k >= {spec.min_k} in face.k")
+        try:
+            SQUARE.space(spec, ks[0], TensorPartition(x, x))
+        except Exception as err:  # noqa: BLE001 - any failure to build means: not a face space
+            raise ConfigError(key, f"{case} cannot be built on the face ({err})", got=case) from None

@@ -1,0 +1,161 @@
+"""The face stage's claims (study/face_claims.py), macros (report/face.py) and config checks
+(config_face.py) on synthetic tables: verdicts follow the data by the ledger's criteria, the
+predictions follow registry properties (not ids), a bad ``face:`` key is named."""
+from __future__ import annotations
+
+import copy
+import dataclasses
+import re
+from pathlib import Path
+
+import pandas as pd
+import pytest
+import yaml
+
+from infsup_contact.discretization.registry import SPACES
+from infsup_contact.discretization.square import SQUARE
+from infsup_contact.study.claims import FAIL, INCONCLUSIVE, PASS
+from infsup_contact.study.face_claims import (face_claims, face_predictions, kernel_formula,
+                                              planar_kernel, tensor_kernel_bound)
+
+ROOT = Path(__file__).resolve().parents[1]
+from _face_tables import CLAIMS_CFG, NS, face_rows as _rows  # noqa: E402
+
+
+def _verdicts(frame, tensor=("hex",)):
+    claims = face_claims(frame, CLAIMS_CFG, list(tensor))
+    return dict(zip(claims.claim_id, zip(claims.verdict, claims.predicted)))
+
+
+def test_stable_space_claims_pass_on_bounded_data_and_fail_on_decay():
+    ok = _verdicts(_rows("T3", 1))
+    assert ok["face-kernel-Thm3-k1-hex"] == (PASS, PASS)
+    assert ok["face-Thm3-k1-hex"] == (PASS, PASS)
+    assert ok["face-Rem3.1-Thm3-k1-hex"] == (PASS, PASS)
+    assert ok["face-nonmatching-kernel-Thm3-k1-hex"] == (PASS, PASS)
+    bad = _verdicts(_rows("T3", 1, beta_h=lambda n: 1.0 / n, beta_l2=lambda n: 1.0 / n))
+    assert bad["face-Thm3-k1-hex"][0] == FAIL  # slope 1 vs 0 ± τ
+    assert bad["face-Rem3.1-Thm3-k1-hex"][0] == FAIL  # slope 1 vs 1/2 ± τ
+
+
+def test_kernel_claims_follow_the_count_and_close_decisions_are_inconclusive():
+    v = _verdicts(_rows("R5.2", 1))
+    assert v["face-kernel-Rem5.2-k1-hex"] == (PASS, PASS)
+    off = _verdicts(_rows("R5.2", 1, kernel=lambda n1, n2, c: c + 1))
+    assert off["face-kernel-Rem5.2-k1-hex"][0] == FAIL
+    frame = _rows("R5.2", 1)
+    frame.loc[frame.index[0], "kernel_decision"] = "close"
+    assert _verdicts(frame)["face-kernel-Rem5.2-k1-hex"][0] == INCONCLUSIVE
+    # non-matching: above the planar count = FAIL of "kernel equals the count"
+    above = _verdicts(_rows("R5.2", 1, kernel=lambda n1, n2, c: c if n1 == n2 else c + 8))
+    assert above["face-nonmatching-kernel-Rem5.2-k1-hex"][0] == FAIL
+
+
+@pytest.mark.parametrize("k", [1, 2, 3])
+def test_kernel_formula_is_the_dimension_count(k):
+    """dim M − dim W on the face: R5.2's (Nk + 1)² − (Nk − 1)² = 4Nk; every case's formula
+    string evaluates to the count (read back by substituting N)."""
+    assert kernel_formula(SPACES["R5.2"], k) == f"{4 * k}N"
+    for spec in SPACES.values():
+        if spec.dimension is None or not spec.valid_for(k):
+            continue
+        for n in (3, 7):
+            assert _evaluate(kernel_formula(spec, k), n) == spec.dimension(k, n) ** 2 - SQUARE.trace_dimension(k, n)
+
+
+def _evaluate(formula: str, n: int) -> int:
+    """Value of a ``kernel_formula`` text (``−3N² + 4N − 1``) at N = n."""
+    total = 0
+    for sign, coef, power in re.findall(r"([+−-]?)\s*(\d*)(N²|N)?", formula.replace(" ", "")):
+        if not coef and not power:
+            continue
+        c = int(coef) if coef else 1
+        total += (-1 if sign in "−-" and sign else 1) * c * {"N²": n * n, "N": n, "": 1}[power]
+    return total
+
+
+def test_tensor_bound_is_a_bound_of_one_direction_product():
+    """2 a1 a2 − min(a1, a2)² >= a1 a2 (the dimension of K1ˣ ⊗ K2ʸ alone) and = 0 when Ω2's
+    1D count a2 is 0 (every stable space of the registry on N:N+1)."""
+    for spec in SPACES.values():
+        if spec.dimension is None:
+            continue
+        for k in (1, 2):
+            if not spec.valid_for(k):
+                continue
+            d = spec.dimension(k, 7)
+            a1, a2 = max(d - (6 * k - 1), 0), max(d - (7 * k - 1), 0)
+            assert tensor_kernel_bound(spec, k, 6, 7) >= a1 * a2
+            if spec.stable:
+                assert tensor_kernel_bound(spec, k, 6, 7) == 0 and planar_kernel(spec, k, 6, 7) == 0
+
+
+def test_predictions_come_from_properties_not_ids():
+    for spec in SPACES.values():
+        if spec.dimension is None:
+            continue
+        alias = dataclasses.replace(spec, id="ZZ", claim_tag="ZZ", paper_ref="nowhere")
+        for k in (1, 2):
+            if spec.valid_for(k):
+                for tensor in (True, False):
+                    assert face_predictions(alias, k, [(4, 5)], tensor) == face_predictions(spec, k, [(4, 5)], tensor)
+    assert face_predictions(SPACES["R5.4"], 1, [(6, 7)], True)["nonmatching"] == FAIL  # bound 3 > count 0
+    assert face_predictions(SPACES["R5.4"], 1, [(6, 7)], False)["nonmatching"] == "finding"
+
+
+def test_face_macros_count_the_claims():
+    from infsup_contact.report.face import check_face_tex, face_paper_files
+
+    beta = pd.concat([_rows("T3", 1), _rows("R5.2", 1), _rows("T3", 1, element="tet")], ignore_index=True)
+    claims = face_claims(beta, CLAIMS_CFG, ["hex"])
+    files = face_paper_files(beta, claims)
+    check_face_tex((ROOT / "paper" / "face.tex").read_text(), files)
+    macros = dict(re.findall(r"\\newcommand\{\\([A-Za-z]+)\}\{([^}]*)\}", files["face_macros.tex"]))
+    assert int(macros["faceNClaims"]) == len(claims)
+    assert int(macros["faceFinestN"]) == max(NS)
+    assert "48 (48)" in files["face_beta_table.tex"]  # R5.2, k = 1, N = 12: 4Nk
+
+
+# ------------------------------------------------------------------ config checks
+
+def _ci():
+    return yaml.safe_load((ROOT / "config" / "ci.yaml").read_text())
+
+
+@pytest.mark.parametrize("mutate, key", [
+    (lambda f: f.update(cases=["T3", "NOPE"]), "face.cases[1]"),
+    (lambda f: f.update(elements=["hex", "prism"]), "face.elements[1]"),
+    (lambda f: f.update(nonmatching=[[5, 5]]), "face.nonmatching[0]"),
+    (lambda f: f.update(model="membranes"), "face.model"),
+    (lambda f: f.update(norms=["H", "H1"]), "face.norms"),
+])
+def test_bad_face_key_is_named(mutate, key):
+    from infsup_contact.config_checks import ConfigError, check_config
+
+    cfg = copy.deepcopy(_ci())
+    mutate(cfg["face"])
+    with pytest.raises(ConfigError) as err:
+        check_config(cfg, ROOT / "workflow" / "schemas" / "config.schema.yaml")
+    assert f"config key {key}" in str(err.value)
+
+
+def test_config_without_face_section_is_valid():
+    from infsup_contact.config_checks import check_config
+
+    cfg = _ci()
+    del cfg["face"]
+    check_config(cfg, ROOT / "workflow" / "schemas" / "config.schema.yaml")
+
+
+@pytest.mark.parametrize("verdict", ["PASS", "FAIL", "INCONCLUSIVE"])
+def test_face_section_renders_under_any_verdict(verdict):
+    """paper/face.tex states outcomes only through \\byverdict on its generated outcome macros:
+    it renders (every macro expanded, every branch resolved) whatever the ledger says."""
+    from infsup_contact.report.consistency import render
+    from infsup_contact.report.face import face_macros
+
+    from _face_tables import small_face_tables
+
+    t = small_face_tables()
+    text = render((ROOT / "paper" / "face.tex").read_text(), face_macros(t["beta"], t["claims"].assign(verdict=verdict)))
+    assert "\\byverdict" not in text and "\\faceOutcome" not in text

@@ -53,15 +53,16 @@ def load_spaces(cfg) -> list:
 
 # ------------------------------------------------------------------ 4. the registry
 
-def case_ids(cfg) -> list:
-    """The ids this config may use: the built-in spaces and the user spaces of its own
+def case_ids(cfg, gamma_dim: int = 1) -> list:
+    """The ids this config may use on an interface of dimension ``gamma_dim`` (1: the segment of
+    the 2D stages; 2: the face stage): the built-in spaces and the user spaces of its own
     ``spaces`` key (not those another config registered earlier in the same process)."""
     from .discretization.registry import space_ids
     from .discretization.user_spaces import _LOADED, load_user_space
 
     users = {spec.id for spec in _LOADED.values()}
     own = {load_user_space(ref).id for ref in cfg.get("spaces") or []}
-    return [c for c in space_ids() if c not in users or c in own]  # the segment's: configs are 2D
+    return [c for c in space_ids(gamma_dim) if c not in users or c in own]
 
 
 def check_cases(cfg) -> None:

@@ -41,7 +41,7 @@ def _check_face_cases(cfg, fc) -> None:
     from .discretization.registry import SPACES
     from .discretization.square import SQUARE, TensorPartition
 
-    ids = case_ids(cfg)
+    ids = case_ids(cfg, gamma_dim=SQUARE.dim)
     x = np.linspace(0.0, 1.0, 3)
     for i, case in enumerate(fc["cases"]):
         key = f"face.cases[{i}]"

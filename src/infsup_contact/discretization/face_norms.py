@@ -102,9 +102,17 @@ def gram_h_face(space, rtol: float = 1e-6, n_start: int | None = None, n_cap: in
     if n0 < 1 or n_cap < 1:
         raise InputError("n_start/n_cap", "positive integers", got=(n_start, n_cap))
     n0 = min(n0, n_cap)
+    return richardson(lambda n: partial_gram(space, n), p, n0, n_cap, rtol)
+
+
+def richardson(partial, p: float, n0: int, n_cap: int, rtol: float) -> tuple[np.ndarray, dict]:
+    """Extrapolate the partial sums ``partial(n)`` at n = n0, 2n0, 4n0, ... (tail C n^{−p}),
+    R(n) = S(2n) + (S(2n) − S(n)) / (2^p − 1), until ‖R(2n) − R(n)‖₂ / ‖R(2n)‖₂ ≤ rtol or
+    2n > n_cap; returns (R, info) as :func:`gram_h_face` does (shared by the triangle spaces,
+    :mod:`.face_triangle_norms`)."""
     factor = 1.0 / (2.0 ** p - 1.0)
-    s_lo, n_hi = partial_gram(space, n0), min(2 * n0, n_cap)
-    s_hi = partial_gram(space, n_hi)
+    s_lo, n_hi = partial(n0), min(2 * n0, n_cap)
+    s_hi = partial(n_hi)
     r_prev = s_hi + (s_hi - s_lo) * factor
     err = _norm2(r_prev - s_hi) / _norm2(r_prev)
     capped = False
@@ -112,7 +120,7 @@ def gram_h_face(space, rtol: float = 1e-6, n_start: int | None = None, n_cap: in
         if 2 * n_hi > n_cap:
             capped = err > rtol
             break
-        s_lo, s_hi, n_hi = s_hi, partial_gram(space, 2 * n_hi), 2 * n_hi
+        s_lo, s_hi, n_hi = s_hi, partial(2 * n_hi), 2 * n_hi
         r = s_hi + (s_hi - s_lo) * factor
         err = _norm2(r - r_prev) / _norm2(r)
         r_prev = r

@@ -74,6 +74,11 @@ class SpaceSpec:
     claim_tag : str or None
         Prefix of the space's ledger claim ids; default the paper reference without spaces
         (``Thm3-k1-structured-evenN``).
+    lagrange : tuple or None
+        ``(continuous, vanish)`` when ``build`` is the Lagrange space M^r_s / M^r_{0,s} of degree
+        s = ``degree(k)`` (:func:`~.multipliers.make_space`): the description an interface
+        reads to build the analogue on other cells (P_s on triangles,
+        :meth:`~.square.Square.space`); None for other bases.
     """
 
     id: str
@@ -89,6 +94,7 @@ class SpaceSpec:
     nodal_basis: bool = True
     finding_meshes: tuple = field(default=())
     claim_tag: str | None = None
+    lagrange: tuple | None = None
 
     @property
     def tag(self) -> str:
@@ -275,7 +281,7 @@ def _paper_case(id, ref, definition, s_of_k, continuous, vanish, min_k, dimensio
     return register(SpaceSpec(id, ref, definition, build, s_of_k, min_k,
                               expected="unstable" if ref.startswith("Rem") else "stable",
                               dimension=dimension, color=color, marker=marker,
-                              finding_meshes=finding_meshes))
+                              finding_meshes=finding_meshes, lagrange=(continuous, vanish)))
 
 
 # --- the paper's five cases (Section 5), in the paper's order ---------------------------

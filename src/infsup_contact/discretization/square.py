@@ -259,23 +259,30 @@ class Square(Interface):
         (:func:`~.face_quadrature.split_rule`), exact for the P_k × Q_s products."""
         if self.cell == "quad":
             return super().coupling_quadrature(trace, space, degree)
-        return split_rule(self.common_refinement(trace.partition, space.breakpoints), trace.partition, 2 * degree)
+        return split_rule(self.common_refinement(trace.partition, space.breakpoints), trace.partition,
+                          2 * degree, space.breakpoints)
 
     def gram(self, space, norm: str, h_route: str = "logkernel", **kwargs) -> tuple:
         """:func:`~.face_norms.gram`: L² exactly (kron of the 1D Grams), H by the double sine
         series (the only route on the square: ``h_route`` "logkernel", the command line's
         default, and "series" both name it; ``n_max`` > 0 in ``info`` says it is a series)."""
         from .face_norms import gram
+        from .face_triangle_norms import gram as gram_triangles
 
-        return gram(space, norm, **kwargs)
+        return (gram if hasattr(space, "factors") else gram_triangles)(space, norm, **kwargs)
 
     def space(self, spec, k: int, partition):
-        """The tensor product of ``spec``'s 1D space on xs and on ys (:class:`.face_spaces.FaceSpace`)."""
+        """The tensor product of ``spec``'s 1D space on xs and on ys (:class:`.face_spaces.FaceSpace`);
+        on triangles (``cell="trig"``) a Lagrange case (``spec.lagrange``) is P_s on the triangles
+        of G_h instead (:class:`.face_triangles.TriangleSpace`, s = ``spec.degree(k)``)."""
         from .face_spaces import FaceSpace
+        from .face_triangles import TriangleSpace
 
         if not isinstance(partition, TensorPartition) or partition.cells < 1:
             raise InputError("multiplier mesh", f"a tensor partition of Γ with at least one rectangle "
                              f"(case {spec.id}, k = {k})")
+        if self.cell == "trig" and getattr(spec, "lagrange", None) is not None:
+            return TriangleSpace(partition, int(spec.degree(k)), *spec.lagrange)
         return FaceSpace(spec.build(k, np.asarray(partition.xs, float)),
                          spec.build(k, np.asarray(partition.ys, float)), partition)
 

@@ -98,10 +98,11 @@ def test_sine_coefficients_two_routes():
     assert np.abs(ftn.moments(omega, 4) - ref).max() < 1e-14
 
 
-@pytest.mark.parametrize("s,continuous,vanish", [(1, True, True), (1, True, False), (0, False, False)])
-def test_tail_exponents_are_the_measured_ones(s, continuous, vanish):
-    space = TriangleSpace(TensorPartition(np.linspace(0, 1, 3), np.linspace(0, 1, 3)), s, continuous, vanish)
-    p = ftn.TAIL_EXPONENTS[(continuous, vanish)]
+@pytest.mark.parametrize("s,continuous,vanish,dual", [(1, True, True, False), (1, True, False, False),
+                                                     (0, False, False, False), (1, True, True, True)])
+def test_tail_exponents_are_the_measured_ones(s, continuous, vanish, dual):
+    space = TriangleSpace(TensorPartition(np.linspace(0, 1, 3), np.linspace(0, 1, 3)), s, continuous, vanish, dual)
+    p = ftn.TAIL_EXPONENTS[ftn.tail_key(space)]
     assert ftn.tail_exponent(space, 32) == pytest.approx(p, abs=0.1)
     G, info = ftn.gram_h_tri(space)
     assert info["tail_exponent"] == p and not info["capped"] and np.linalg.eigvalsh(G).min() > 0
@@ -115,7 +116,7 @@ def test_registry_builds_triangles_on_tetrahedral_traces_only():
         assert isinstance(hexes, FaceSpace)
         assert isinstance(tets, TriangleSpace if spec.lagrange else FaceSpace), case
         if spec.lagrange:
-            assert (tets.degree, tets.continuous, tets.vanish) == (spec.degree(2), *spec.lagrange)
+            assert (tets.degree, tets.continuous, tets.vanish, tets.dual) == (spec.degree(2), *spec.lagrange, spec.dual)
     with pytest.raises(InputError, match="degree"):
         TriangleSpace(grid, 0, True)
 
@@ -175,3 +176,25 @@ def test_beta_agrees_with_the_saddle_point_pencil_on_triangles():
     frame = pd.DataFrame(beta_rows("structured", k, n1, n2, model=MODEL, element="tet", cases=[case]))
     for norm, row in frame.set_index("norm").iterrows():
         assert saddle_point_beta(A, B, gamma.gram(space, norm)[0]) == pytest.approx(row.beta, rel=1e-8)
+
+
+@pytest.mark.parametrize("s,vanish", [(1, False), (1, True), (2, False), (2, True)])
+def test_dual_bases_on_triangles(s, vanish):
+    """TRI3 / TRI6-transformed duals: dim of the continuous space, Σ ψ = 1 where every triangle
+    keeps a live node, TRI3 biorthogonal to the nodal basis, ∫ψ_i N_j = δ_ij ∫N_j; the sine
+    coefficients (with the per-triangle Â) against a generous quadrature; tail exponent 2."""
+    dual, nodal = TriangleSpace(PART, s, True, vanish, dual=True), TriangleSpace(PART, s, True, vanish)
+    assert dual.dim == nodal.dim
+    x, w = triangles_rule(dual.triangles(), 2 * s)
+    psi, phi = dual.evaluate(x), nodal.evaluate(x)
+    assert rank(psi) == dual.dim
+    if not vanish or s == 2:  # (a TRI3 corner triangle with its 3 vertices on ∂Γ has no live node)
+        assert np.abs(psi.sum(axis=1) - 1).max() < 1e-13
+    if s == 1:
+        assert np.abs((psi * w[:, None]).T @ phi - np.diag(phi.T @ w)).max() < 1e-15
+    n = np.arange(1, 13)
+    C = ftn.sine_coefficients_chunk(dual, n, len(n))
+    x, w = triangles_rule(dual.triangles(), 40)
+    ref = 2 * (w * np.sin(5 * np.pi * x[:, 0]) * np.sin(11 * np.pi * x[:, 1])) @ dual.evaluate(x)
+    assert np.abs(ref - C[:, 4, 10]).max() < 1e-14
+    assert ftn.TAIL_EXPONENTS[ftn.tail_key(dual)] == 2.0

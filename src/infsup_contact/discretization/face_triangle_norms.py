@@ -34,7 +34,7 @@ from .norms import N_MAX_CAP
 #: Rows m of the coefficient array handled at once (memory ~ dim · chunk · n_max).
 _CHUNK = 32
 #: Tail exponents p (‖S(∞) − S(n)‖ ~ n^{−p}) measured by :func:`tail_exponent` on
-#: N = 2..8, s = 1..3 (module docstring); keys (continuous, vanish).
+#: N = 2, 4, s = 0..2, n = 32, 128 (tests/test_face_triangles.py); keys :func:`tail_key`.
 TAIL_EXPONENTS = {(True, True): 4.0, (True, False): 2.0, (False, False): 2.0}
 
 
@@ -162,6 +162,8 @@ def sine_coefficients_chunk(space, m: np.ndarray, n_max: int, q: int | None = No
                 R = blocks[key]
                 c = 2.0 * sum(R[ab] * trig[ab][None] for ab in trig)
                 g = dofs[i, j, tri]
+                if space.dual:  # ψ = Â N on this triangle
+                    c = np.tensordot(space._dual_matrix(int(space.live_mask(g))), c, axes=(1, 0))
                 keep = g >= 0
                 out[g[keep]] += c[keep]
     return out
@@ -187,6 +189,11 @@ def tail_exponent(space, n_max: int) -> float:
     return float(np.log2(_norm2(s2 - s1) / _norm2(s4 - s2)))
 
 
+def tail_key(space) -> tuple:
+    """(continuous, vanish) of the functions themselves: a dual basis is discontinuous."""
+    return (space.continuous and not space.dual, space.vanish and not space.dual)
+
+
 def gram_h_tri(space, rtol: float = 1e-6, n_start: int | None = None, n_cap: int = N_MAX_CAP // 64,
                exponent: float | None = None) -> tuple[np.ndarray, dict]:
     """Gram matrix of the H^{1/2}_00(Γ)' norm of a triangle space (module docstring), partial
@@ -194,7 +201,7 @@ def gram_h_tri(space, rtol: float = 1e-6, n_start: int | None = None, n_cap: int
     and extrapolated with the exponent of :data:`TAIL_EXPONENTS` until ``rtol`` or ``n_cap``."""
     if not rtol > 0:
         raise InputError("rtol", "a positive float", got=rtol)
-    p = TAIL_EXPONENTS[(space.continuous, space.vanish)] if exponent is None else float(exponent)
+    p = TAIL_EXPONENTS[tail_key(space)] if exponent is None else float(exponent)
     n0 = max(16, 2 * (space.degree + 1) * max(space.shape)) if n_start is None else int(n_start)
     if n0 < 1 or n_cap < 1:
         raise InputError("n_start/n_cap", "positive integers", got=(n_start, n_cap))

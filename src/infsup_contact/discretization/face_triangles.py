@@ -17,6 +17,14 @@ the tensor lattice of the refined 1D breakpoints, as for Q_s.
 
 Basis: the Lagrange basis of every triangle in barycentric form (Nicolaides),
 φ_α = Π_v Π_{a<α_v} (s λ_v − a)/(a + 1), |α| = s, glued at shared nodes for the continuous spaces.
+
+``dual=True`` (continuous numbering, s = 1 or 2): the dual (biorthogonal) basis of the continuous
+space, ψ = A N per triangle with the same global dof as the node's N, discontinuous across
+triangles: TRI3's A = D M⁻¹ (Wohlmuth 2000; ψ_v = 3λ_v − 1) and TRI6's transformed
+Ã T(α) (Popp et al., α = 1/5, :func:`.face_dual.dual_coefficients`: ∫ N_vertex = 0 on TRI6).
+With ``vanish`` the local dual function of a node on ∂Γ is added to the nearest live local
+node(s) (:mod:`.face_cells`' boundary modification, keeping Σ ψ = 1 where a triangle has a
+live node; a TRI3 corner triangle with its three vertices on ∂Γ has none).
 """
 from __future__ import annotations
 
@@ -55,6 +63,25 @@ def _lattice_position(s: int, upper: bool) -> np.ndarray:
     return np.column_stack([al[:, 1] + al[:, 2], al[:, 2]])  # (α_A, α_B, α_C): (α_B + α_C, α_C)
 
 
+DUAL_ELEMENTS = {1: ("TRI3", False), 2: ("TRI6", True)}
+"""Degree s → (reference element, Popp-transformed) of the dual bases on triangles."""
+
+
+def dual_local(s: int) -> np.ndarray:
+    """A (nloc, nloc), local dual functions ψ = A N in :func:`local_lattice` order: the
+    reference element's coefficients (:func:`.face_dual.dual_coefficients`) permuted by matching
+    its nodes (x, y) to the barycentric multi-indices s (1 − x − y, x, y)."""
+    from .face_dual import dual_coefficients
+    from .face_elements import reference_element
+
+    name, transformed = DUAL_ELEMENTS[s]
+    ref = reference_element(name).nodes
+    bary = np.rint(s * np.column_stack([1.0 - ref.sum(axis=1), ref])).astype(int)
+    perm = [int(np.flatnonzero((bary == a).all(axis=1))[0]) for a in local_lattice(s)]
+    C = dual_coefficients(name, transformed=transformed)
+    return C[np.ix_(perm, perm)]
+
+
 @dataclass(frozen=True, eq=False)
 class TriangleSpace:
     """P_s (continuous or not, optionally vanishing on ∂Γ) on the triangulated tensor partition.
@@ -74,12 +101,16 @@ class TriangleSpace:
     s: int
     continuous: bool
     vanish: bool = False
+    dual: bool = False
 
     def __post_init__(self):
         if int(self.s) < 0 or (self.continuous and self.s == 0):
             raise InputError("degree", "s >= 0 (s >= 1 for a continuous space on triangles)", got=self.s)
         if self.vanish and not self.continuous:
             raise InputError("vanish", "False for a discontinuous space on triangles", got=self.vanish)
+        if self.dual and (not self.continuous or self.s not in DUAL_ELEMENTS):
+            raise InputError("dual", f"a continuous space of degree s in {sorted(DUAL_ELEMENTS)} "
+                             f"for a dual basis on triangles", got=(self.s, self.continuous))
 
     @property
     def degree(self) -> int:
@@ -111,6 +142,25 @@ class TriangleSpace:
         inner = (gx > 0) & (gx < nx * s) & (gy > 0) & (gy < ny * s)
         return np.where(inner, (gx - 1) * (ny * s - 1) + (gy - 1), -1)
 
+    def live_mask(self, glob: np.ndarray) -> np.ndarray:
+        """Bit mask of the live local nodes (global index ≥ 0) of rows of local dof indices."""
+        return (np.asarray(glob) >= 0) @ (1 << np.arange(self.n_local))
+
+    def _dual_matrix(self, live_mask: int) -> np.ndarray:
+        """Â (nloc, nloc) of a triangle whose live local nodes are the bits of ``live_mask``:
+        rows of the live nodes get the dead nodes' dual functions, shared equally among the
+        nearest live ones (distance of the barycentric multi-indices); rows of dead nodes are unused."""
+        A = dual_local(self.s)
+        pos = local_lattice(self.s).astype(float)
+        live = np.array([(live_mask >> i) & 1 for i in range(self.n_local)], dtype=bool)
+        out = A.copy()
+        if live.any():
+            for b in np.flatnonzero(~live):
+                dist = np.linalg.norm(pos[live] - pos[b], axis=1)
+                near = np.flatnonzero(live)[dist <= dist.min() + 1e-12]
+                out[near] += A[b] / len(near)
+        return out
+
     @property
     def dim(self) -> int:
         nx, ny = self.shape
@@ -138,6 +188,11 @@ class TriangleSpace:
         ix, iy, tri, lam = self.locate(x)
         vals = lagrange_barycentric(lam, self.s)
         glob = self._dofs[ix, iy, tri]  # (n, nloc)
+        if self.dual:  # ψ = Â N per triangle, Â with the boundary modification of the pattern
+            pattern = self.live_mask(glob)
+            for p in np.unique(pattern):
+                rows = pattern == p
+                vals[rows] = vals[rows] @ self._dual_matrix(int(p)).T
         out = np.zeros((len(vals), self.dim))
         rows = np.repeat(np.arange(len(vals)), self.n_local)
         keep = glob.ravel() >= 0

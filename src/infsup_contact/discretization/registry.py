@@ -79,6 +79,9 @@ class SpaceSpec:
         s = ``degree(k)`` (:func:`~.multipliers.make_space`): the description an interface
         reads to build the analogue on other cells (P_s on triangles,
         :meth:`~.square.Square.space`); None for other bases.
+    dual : bool
+        With ``lagrange``: the space is the dual (biorthogonal) basis of that Lagrange space
+        (:mod:`.dual`; on triangles :class:`~.face_triangles.TriangleSpace` with ``dual=True``).
     """
 
     id: str
@@ -95,6 +98,7 @@ class SpaceSpec:
     finding_meshes: tuple = field(default=())
     claim_tag: str | None = None
     lagrange: tuple | None = None
+    dual: bool = False
 
     @property
     def tag(self) -> str:
@@ -303,11 +307,11 @@ PAPER_CASES = tuple(SPACES)
 register(SpaceSpec(
     "DUAL", "Wohlmuth 2000", "dual basis of M^1_{0,k}", lambda k, x: dual_space(x, k, True), lambda k: k,
     expected="stable", dimension=lambda k, n: n * k - 1, color=OKABE_ITO["black"], marker="p",
-    nodal_basis=False, claim_tag="DUAL", finding_meshes=("omega2", "union")))
+    nodal_basis=False, claim_tag="DUAL", finding_meshes=("omega2", "union"), lagrange=(True, True), dual=True))
 register(SpaceSpec(
     "DUAL-ALL", "dual of Rem 5.2", "dual basis of M^1_k", lambda k, x: dual_space(x, k, False), lambda k: k,
     expected="unstable", dimension=lambda k, n: n * k + 1, color=OKABE_ITO["sky_blue"], marker="h",
-    nodal_basis=False, claim_tag="DUAL-ALL"))
+    nodal_basis=False, claim_tag="DUAL-ALL", lagrange=(True, False), dual=True))
 
 # --- roles the study gives to particular spaces (the one place they are spelled) --------
 REFERENCE_SPACE = "T3"

@@ -274,15 +274,17 @@ class Square(Interface):
     def space(self, spec, k: int, partition):
         """The tensor product of ``spec``'s 1D space on xs and on ys (:class:`.face_spaces.FaceSpace`);
         on triangles (``cell="trig"``) a Lagrange case (``spec.lagrange``) is P_s on the triangles
-        of G_h instead (:class:`.face_triangles.TriangleSpace`, s = ``spec.degree(k)``)."""
+        of G_h instead (:class:`.face_triangles.TriangleSpace`, s = ``spec.degree(k)``; a dual
+        basis (``spec.dual``) for s ∈ {1, 2} only, TRI3 / TRI6: the tensor dual above)."""
         from .face_spaces import FaceSpace
-        from .face_triangles import TriangleSpace
+        from .face_triangles import DUAL_ELEMENTS, TriangleSpace
 
         if not isinstance(partition, TensorPartition) or partition.cells < 1:
             raise InputError("multiplier mesh", f"a tensor partition of Γ with at least one rectangle "
                              f"(case {spec.id}, k = {k})")
-        if self.cell == "trig" and getattr(spec, "lagrange", None) is not None:
-            return TriangleSpace(partition, int(spec.degree(k)), *spec.lagrange)
+        s, dual = int(spec.degree(k)), getattr(spec, "dual", False)
+        if self.cell == "trig" and getattr(spec, "lagrange", None) is not None and (not dual or s in DUAL_ELEMENTS):
+            return TriangleSpace(partition, s, *spec.lagrange, dual=dual)
         return FaceSpace(spec.build(k, np.asarray(partition.xs, float)),
                          spec.build(k, np.asarray(partition.ys, float)), partition)
 

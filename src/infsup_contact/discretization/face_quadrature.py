@@ -5,7 +5,10 @@ diagonal from (x_i, y_j) to (x_{i+1}, y_{j+1}) cuts every rectangle into. A mult
 the rectangles of G_h. Their product is a polynomial (of total degree ≤ k + 2s) on every piece
 of a rectangle R of the tensor common refinement of the trace grid and G_h cut by the diagonal
 of the trace cell that contains R: at most two convex polygons per rectangle (a triangle and a
-pentagon, or two quadrilaterals, or two triangles when the diagonal is R's own). Each polygon is
+pentagon, or two quadrilaterals, or two triangles when the diagonal is R's own). A multiplier
+that is P_s on the triangles of G_h (:mod:`.face_triangles`) is cut by the diagonal of its own
+cell as well (at most four pieces per rectangle; the product then has total degree ≤ k + s
+on each). Each polygon is
 fanned into triangles, each integrated by the collapsed (Duffy) Gauss rule
 u = s, v = t(1 − s), Jacobian 1 − s, exact for total degree d with ⌊(d + 1)/2⌋ + 1 points in s and
 ⌊d/2⌋ + 1 in t.

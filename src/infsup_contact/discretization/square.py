@@ -10,7 +10,10 @@ rectangle, its multiplier spaces are tensor products of the segment's 1D spaces
 The trace of a tetrahedral mesh from the same structured grid (every rectangle cut in two
 triangles by its diagonal from (x_i, y_j) to (x_{i+1}, y_{j+1})) has the same tensor partition;
 ``Square(cell="trig")`` is its interface (the trace basis is then P_k on triangles, not Q_k;
-its couplings are integrated on the rectangles cut by the trace's diagonals, :mod:`.face_quadrature`).
+its couplings are integrated on the rectangles cut by the diagonals of the trace and of G_h,
+:mod:`.face_quadrature`). There the registry's Lagrange cases (``SpaceSpec.lagrange``) are
+P_s on the triangles of G_h (:mod:`.face_triangles`, Grams in :mod:`.face_triangle_norms`),
+the duals TRI3 / TRI6 (s ≤ 2); other spaces stay tensor products.
 """
 from __future__ import annotations
 

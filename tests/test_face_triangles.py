@@ -198,3 +198,50 @@ def test_dual_bases_on_triangles(s, vanish):
     ref = 2 * (w * np.sin(5 * np.pi * x[:, 0]) * np.sin(11 * np.pi * x[:, 1])) @ dual.evaluate(x)
     assert np.abs(ref - C[:, 4, 10]).max() < 1e-14
     assert ftn.TAIL_EXPONENTS[ftn.tail_key(dual)] == 2.0
+
+
+@pytest.mark.parametrize("k,n1,n2", [(1, 2, 3), (2, 3, 2)])
+def test_couplings_on_non_matching_pairs_sum_to_the_trace_integrals(k, n1, n2):
+    """Σ_i μ_i = 1 for the Lagrange spaces without the ∂Γ condition, so 1ᵀ B_s = (∫_Γ w_j)_j:
+    the coupling on the pieces cut by the diagonals of both grids against the trace's own
+    triangles (Square.quadrature of the trace partition, no multiplier involved)."""
+    sides = SideCache().pair(MODEL, "structured", k, n1, n2, element="tet")
+    gamma = sides[0].trace.gamma
+    for case in ids_valid_for(k):
+        spec = SPACES[case]
+        if spec.lagrange is None or spec.lagrange[1] or spec.dual:
+            continue
+        space = case_space(case, k, sides[1].trace.partition, gamma)
+        for s in sides:
+            x, w = gamma.quadrature(s.trace.partition, k)
+            integrals = gamma.trace_basis(s.trace, x).T @ w
+            assert np.abs(coupling_matrix(s.trace, space, k).sum(axis=0) - integrals).max() < 1e-14, case
+
+
+def test_p0_coupling_by_triangle_triangle_intersections():
+    """B[T, j] = ∫_T w_j for P_0 on the triangles T of G_h (k = 2, non-matching 3 / 2): against
+    Σ_τ ∫_{T∩τ} w_j over the trace's triangles τ, T∩τ clipped by T's three edges (a different
+    decomposition from the rectangles-cut-by-diagonals of the coupling)."""
+    from infsup_contact.discretization.face_quadrature import _clip
+
+    k = 2
+    sides = SideCache().pair(MODEL, "structured", k, 3, 2, element="tet")
+    gamma = sides[0].trace.gamma
+    space = TriangleSpace(sides[1].trace.partition, 0, False)
+    trace = sides[0].trace
+    taus = TriangleSpace(trace.partition, 0, False).triangles()
+    B = coupling_matrix(trace, space, k)
+    for row, T in enumerate(space.triangles()):
+        pieces = []
+        for tau in taus:
+            poly = tau
+            for a in range(3):
+                p, q = T[a], T[(a + 1) % 3]
+                r = T[(a + 2) % 3]
+                side = lambda z: (q[0] - p[0]) * (z[:, 1] - p[1]) - (q[1] - p[1]) * (z[:, 0] - p[0])
+                sign = np.sign(side(r[None])[0])
+                poly = _clip(poly, sign * side(poly), 1.0) if len(poly) >= 3 else poly
+            if len(poly) >= 3:
+                pieces += [[poly[0], poly[m], poly[m + 1]] for m in range(1, len(poly) - 1)]
+        x, w = triangles_rule(np.array(pieces), k)
+        assert np.abs(gamma.trace_basis(trace, x).T @ w - B[row]).max() < 1e-14

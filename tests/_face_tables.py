@@ -6,6 +6,7 @@ from __future__ import annotations
 import pandas as pd
 
 from infsup_contact.discretization.registry import SPACES
+from infsup_contact.discretization.square import SQUARE, SQUARE_TRIG
 from infsup_contact.study.face_claims import face_claims, matching_kernel, planar_kernel
 
 CLAIMS_CFG = {"slope_tolerance": 0.15, "beta_floor": 1e-3, "confidence": 0.95, "fit_window": 5}
@@ -17,7 +18,8 @@ def face_rows(case, k, element="hex", beta_h=lambda n: 0.8, beta_l2=lambda n: 0.
     spec = SPACES[case]
     out = []
     for n1, n2 in [(n, n) for n in NS] + list(pairs):
-        count = matching_kernel(spec, k, n2) if n1 == n2 else planar_kernel(spec, k, n1, n2)
+        gamma = SQUARE if element == "hex" else SQUARE_TRIG
+        count = matching_kernel(spec, k, n2, gamma) if n1 == n2 else planar_kernel(spec, k, n1, n2, gamma)
         dim = count if kernel is None else kernel(n1, n2, count)
         for norm, b in (("H", beta_h(n2)), ("L2", beta_l2(n2))):
             out.append(dict(element=element, case=case, k=k, family="structured", N1=n1, N2=n2, norm=norm,
@@ -31,4 +33,4 @@ def small_face_tables() -> dict:
     """``beta`` and ``claims`` of a stable and an unstable space on hexahedra and tetrahedra."""
     beta = pd.concat([face_rows("T3", 1), face_rows("R5.2", 1), face_rows("T3", 1, element="tet")],
                      ignore_index=True)
-    return {"beta": beta, "claims": face_claims(beta, CLAIMS_CFG, ["hex"])}
+    return {"beta": beta, "claims": face_claims(beta, CLAIMS_CFG, {"hex": SQUARE, "tet": SQUARE_TRIG})}

@@ -8,10 +8,10 @@ log_to(snakemake.log[0])  # noqa: F821
 register_user_spaces(snakemake.config)  # noqa: F821
 
 from infsup_contact.io import write_csv_atomic  # noqa: E402
-from infsup_contact.study.face_claims import face_claims, tensor_elements  # noqa: E402
+from infsup_contact.study.face_claims import element_interfaces, face_claims  # noqa: E402
 
 fc = snakemake.params.fc  # noqa: F821
 table = face_claims(read_table(snakemake.input.beta, "face_beta"), snakemake.params.cfg,  # noqa: F821
-                    tensor_elements(fc["model"], fc["elements"]))
+                    element_interfaces(fc["model"], fc["elements"]))
 write_csv_atomic(snakemake.output[0], table)  # noqa: F821
 print(table[["claim_id", "verdict", "predicted"]].to_string(), file=sys.stderr)

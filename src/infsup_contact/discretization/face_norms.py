@@ -107,7 +107,14 @@ def extrapolated_series(partial, n0: int, n_cap: int, p: float, rtol: float) -> 
     with a tail ~ C n^{−p} (also the route of the non-tensor spaces, :mod:`.face_cellwise_norms`)."""
     if n0 < 1 or n_cap < 1:
         raise InputError("n_start/n_cap", "positive integers", got=(n0, n_cap))
-    n0 = min(n0, n_cap)
+    return richardson(partial, p, min(n0, n_cap), n_cap, rtol)
+
+
+def richardson(partial, p: float, n0: int, n_cap: int, rtol: float) -> tuple[np.ndarray, dict]:
+    """Extrapolate the partial sums ``partial(n)`` at n = n0, 2n0, 4n0, ... (tail C n^{−p}),
+    R(n) = S(2n) + (S(2n) − S(n)) / (2^p − 1), until ‖R(2n) − R(n)‖₂ / ‖R(2n)‖₂ ≤ rtol or
+    2n > n_cap; returns (R, info) as :func:`gram_h_face` does (shared by the triangle spaces,
+    :mod:`.face_triangle_norms`)."""
     factor = 1.0 / (2.0 ** p - 1.0)
     s_lo, n_hi = partial(n0), min(2 * n0, n_cap)
     s_hi = partial(n_hi)

@@ -5,7 +5,10 @@ diagonal from (x_i, y_j) to (x_{i+1}, y_{j+1}) cuts every rectangle into. A mult
 the rectangles of G_h. Their product is a polynomial (of total degree ≤ k + 2s) on every piece
 of a rectangle R of the tensor common refinement of the trace grid and G_h cut by the diagonal
 of the trace cell that contains R: at most two convex polygons per rectangle (a triangle and a
-pentagon, or two quadrilaterals, or two triangles when the diagonal is R's own). Each polygon is
+pentagon, or two quadrilaterals, or two triangles when the diagonal is R's own). A multiplier
+that is P_s on the triangles of G_h (:mod:`.face_triangles`) is cut by the diagonal of its own
+cell as well (at most four pieces per rectangle; the product then has total degree ≤ k + s
+on each). Each polygon is
 fanned into triangles, each integrated by the collapsed (Duffy) Gauss rule
 u = s, v = t(1 − s), Jacobian 1 − s, exact for total degree d with ⌊(d + 1)/2⌋ + 1 points in s and
 ⌊d/2⌋ + 1 in t.
@@ -48,22 +51,30 @@ def _clip(poly: np.ndarray, f: np.ndarray, sign: float) -> np.ndarray:
     return np.array(out)
 
 
-def split_triangles(refinement, trace) -> np.ndarray:
+def _diagonal(poly: np.ndarray, grid) -> np.ndarray:
+    """Diagonal coordinate at the vertices of ``poly`` (inside one rectangle of ``grid``) of the
+    ``grid`` cell containing it: ≥ 0 below the cell's diagonal, ≤ 0 above."""
+    gx, gy = np.asarray(grid.xs, float), np.asarray(grid.ys, float)
+    c = poly.mean(axis=0)
+    ci = min(max(np.searchsorted(gx, c[0]) - 1, 0), len(gx) - 2)
+    cj = min(max(np.searchsorted(gy, c[1]) - 1, 0), len(gy) - 2)
+    f = (poly[:, 0] - gx[ci]) / (gx[ci + 1] - gx[ci]) - (poly[:, 1] - gy[cj]) / (gy[cj + 1] - gy[cj])
+    return np.where(np.abs(f) < 1e-13, 0.0, f)
+
+
+def split_triangles(refinement, trace, *more) -> np.ndarray:
     """Triangles (T, 3, 2) tiling the face: every rectangle of ``refinement`` (a tensor partition
-    refining ``trace``) cut by the diagonal of the ``trace`` cell containing it, then fanned."""
+    refining ``trace`` and every partition in ``more``) cut by the diagonal of the ``trace`` cell
+    containing it (and by those of the cells of ``more``, e.g. a triangulated G_h), then fanned."""
     xs, ys = np.asarray(refinement.xs, float), np.asarray(refinement.ys, float)
-    gx, gy = np.asarray(trace.xs, float), np.asarray(trace.ys, float)
     tris = []
     for i in range(len(xs) - 1):
-        ci = min(max(np.searchsorted(gx, 0.5 * (xs[i] + xs[i + 1])) - 1, 0), len(gx) - 2)
         for j in range(len(ys) - 1):
-            cj = min(max(np.searchsorted(gy, 0.5 * (ys[j] + ys[j + 1])) - 1, 0), len(gy) - 2)
-            rect = np.array([[xs[i], ys[j]], [xs[i + 1], ys[j]], [xs[i + 1], ys[j + 1]], [xs[i], ys[j + 1]]])
-            # diagonal coordinate of the trace cell: ≥ 0 below its diagonal, ≤ 0 above
-            f = (rect[:, 0] - gx[ci]) / (gx[ci + 1] - gx[ci]) - (rect[:, 1] - gy[cj]) / (gy[cj + 1] - gy[cj])
-            f = np.where(np.abs(f) < 1e-13, 0.0, f)
-            for sign in (1.0, -1.0):
-                poly = _clip(rect, f, sign)
+            pieces = [np.array([[xs[i], ys[j]], [xs[i + 1], ys[j]], [xs[i + 1], ys[j + 1]], [xs[i], ys[j + 1]]])]
+            for grid in (trace,) + more:
+                pieces = [q for p in pieces for sign in (1.0, -1.0)
+                          for q in [_clip(p, _diagonal(p, grid), sign)] if len(q) >= 3]
+            for poly in pieces:
                 for m in range(1, len(poly) - 1):
                     tri = np.array([poly[0], poly[m], poly[m + 1]])
                     e1, e2 = tri[1] - tri[0], tri[2] - tri[0]
@@ -72,7 +83,8 @@ def split_triangles(refinement, trace) -> np.ndarray:
     return np.array(tris)
 
 
-def split_rule(refinement, trace, degree: int) -> tuple:
+def split_rule(refinement, trace, degree: int, *more) -> tuple:
     """Points and weights exact for total degree ``degree`` on every piece of
-    :func:`split_triangles` (a P_k trace on ``trace``'s triangles times Q_s on ``refinement``)."""
-    return triangles_rule(split_triangles(refinement, trace), degree)
+    :func:`split_triangles` (a P_k trace on ``trace``'s triangles times Q_s on ``refinement``,
+    or P_s on the triangles of the partitions ``more``)."""
+    return triangles_rule(split_triangles(refinement, trace, *more), degree)

@@ -85,6 +85,14 @@ class SpaceSpec:
         ``face_build(k, partition) -> space`` on a tensor partition of the face, for a space
         that is not a tensor product of ``build`` (:mod:`.face_cells`); ``dimension(k, N)`` is
         then dim M_h on an N × N grid.
+    lagrange : tuple or None
+        ``(continuous, vanish)`` when ``build`` is the Lagrange space M^r_s / M^r_{0,s} of degree
+        s = ``degree(k)`` (:func:`~.multipliers.make_space`): the description an interface
+        reads to build the analogue on other cells (P_s on triangles,
+        :meth:`~.square.Square.space`); None for other bases.
+    dual : bool
+        With ``lagrange``: the space is the dual (biorthogonal) basis of that Lagrange space
+        (:mod:`.dual`; on triangles :class:`~.face_triangles.TriangleSpace` with ``dual=True``).
     """
 
     id: str
@@ -113,6 +121,8 @@ class SpaceSpec:
 
         x = np.linspace(0.0, 1.0, n + 1)
         return SQUARE.space(self, k, TensorPartition(x, x))
+    lagrange: tuple | None = None
+    dual: bool = False
 
     @property
     def tag(self) -> str:
@@ -321,7 +331,7 @@ def _paper_case(id, ref, definition, s_of_k, continuous, vanish, min_k, dimensio
     return register(SpaceSpec(id, ref, definition, build, s_of_k, min_k,
                               expected="unstable" if ref.startswith("Rem") else "stable",
                               dimension=dimension, color=color, marker=marker,
-                              finding_meshes=finding_meshes))
+                              finding_meshes=finding_meshes, lagrange=(continuous, vanish)))
 
 
 # --- the paper's five cases (Section 5), in the paper's order ---------------------------
@@ -343,11 +353,11 @@ PAPER_CASES = tuple(SPACES)
 register(SpaceSpec(
     "DUAL", "Wohlmuth 2000", "dual basis of M^1_{0,k}", lambda k, x: dual_space(x, k, True), lambda k: k,
     expected="stable", dimension=lambda k, n: n * k - 1, color=OKABE_ITO["black"], marker="p",
-    nodal_basis=False, claim_tag="DUAL", finding_meshes=("omega2", "union")))
+    nodal_basis=False, claim_tag="DUAL", finding_meshes=("omega2", "union"), lagrange=(True, True), dual=True))
 register(SpaceSpec(
     "DUAL-ALL", "dual of Rem 5.2", "dual basis of M^1_k", lambda k, x: dual_space(x, k, False), lambda k: k,
     expected="unstable", dimension=lambda k, n: n * k + 1, color=OKABE_ITO["sky_blue"], marker="h",
-    nodal_basis=False, claim_tag="DUAL-ALL"))
+    nodal_basis=False, claim_tag="DUAL-ALL", lagrange=(True, False), dual=True))
 
 # --- face element spaces of the 3D models (issue 28; face_cells, face_dual) ---------------
 def _face_only(case: str):

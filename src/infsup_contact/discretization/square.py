@@ -13,7 +13,10 @@ onto discontinuous tensor pieces (:mod:`.face_cellwise_norms`).
 The trace of a tetrahedral mesh from the same structured grid (every rectangle cut in two
 triangles by its diagonal from (x_i, y_j) to (x_{i+1}, y_{j+1})) has the same tensor partition;
 ``Square(cell="trig")`` is its interface (the trace basis is then P_k on triangles, not Q_k;
-its couplings are integrated on the rectangles cut by the trace's diagonals, :mod:`.face_quadrature`).
+its couplings are integrated on the rectangles cut by the diagonals of the trace and of G_h,
+:mod:`.face_quadrature`). There the registry's Lagrange cases (``SpaceSpec.lagrange``) are
+P_s on the triangles of G_h (:mod:`.face_triangles`, Grams in :mod:`.face_triangle_norms`),
+the duals TRI3 / TRI6 (s ≤ 2); other spaces stay tensor products.
 """
 from __future__ import annotations
 
@@ -267,7 +270,8 @@ class Square(Interface):
                              got=getattr(space, "element", space))
         if self.cell == "quad":
             return self.quadrature(self.common_refinement(trace.partition, pieces), degree)
-        return split_rule(self.common_refinement(trace.partition, pieces), trace.partition, 2 * degree)
+        return split_rule(self.common_refinement(trace.partition, pieces), trace.partition, 2 * degree,
+                          space.breakpoints)
 
     def gram(self, space, norm: str, h_route: str = "logkernel", **kwargs) -> tuple:
         """:func:`~.face_norms.gram`: L² exactly (kron of the 1D Grams), H by the double sine
@@ -275,20 +279,29 @@ class Square(Interface):
         default, and "series" both name it; ``n_max`` > 0 in ``info`` says it is a series).
         A non-tensor space: :mod:`.face_cellwise_norms` (same norms, same series)."""
         from .face_norms import gram
+        from .face_triangle_norms import gram as gram_triangles
+        from .face_triangles import TriangleSpace
 
-        return gram(space, norm, **kwargs)
+        return (gram_triangles if isinstance(space, TriangleSpace) else gram)(space, norm, **kwargs)
 
     def space(self, spec, k: int, partition):
         """The tensor product of ``spec``'s 1D space on xs and on ys (:class:`.face_spaces.FaceSpace`),
         or the entry's own face space where it has one (``spec.face_build``: the cellwise element
-        spaces of :mod:`.face_cells`)."""
+        spaces of :mod:`.face_cells`); on triangles (``cell="trig"``) a Lagrange case
+        (``spec.lagrange``) is P_s on the triangles of G_h instead
+        (:class:`.face_triangles.TriangleSpace`, s = ``spec.degree(k)``; a dual basis
+        (``spec.dual``) for s ∈ {1, 2} only, TRI3 / TRI6: the tensor dual above)."""
         from .face_spaces import FaceSpace
+        from .face_triangles import DUAL_ELEMENTS, TriangleSpace
 
         if not isinstance(partition, TensorPartition) or partition.cells < 1:
             raise InputError("multiplier mesh", f"a tensor partition of Γ with at least one rectangle "
                              f"(case {spec.id}, k = {k})")
         if getattr(spec, "face_build", None) is not None:
             return spec.face_build(k, partition)
+        s, dual = int(spec.degree(k)), getattr(spec, "dual", False)
+        if self.cell == "trig" and getattr(spec, "lagrange", None) is not None and (not dual or s in DUAL_ELEMENTS):
+            return TriangleSpace(partition, s, *spec.lagrange, dual=dual)
         return FaceSpace(spec.build(k, np.asarray(partition.xs, float)),
                          spec.build(k, np.asarray(partition.ys, float)), partition)
 

@@ -6,7 +6,9 @@ stiffness of continuous Q_k (hexahedra) or P_k (tetrahedra) with the Γ dofs las
 Schur complement (:func:`~infsup_contact.models.schur.factorized_side`; the nested-dissection
 ordering is graph based, so it serves 3D meshes as it is). Γ is the face
 :class:`~infsup_contact.discretization.square.Square`: the traces are tensor grids, the
-multiplier spaces tensor products (:mod:`infsup_contact.discretization.face_spaces`).
+multiplier spaces tensor products (:mod:`infsup_contact.discretization.face_spaces`) on
+hexahedra and P_s on the triangles of G_h on tetrahedra
+(:mod:`infsup_contact.discretization.face_triangles`).
 
 Meshes (:func:`subdomain_mesh`, the model's ``mesh`` builder): the structured family only,
 N × N × N cells of each body (N = cells per direction on Γ) from

@@ -45,24 +45,28 @@ REF = "beyond the paper (issue 28: the 3D contact face)"
 FINDING = "finding"
 
 
-def face_dimension(spec, k: int, n: int) -> int:
-    """dim M_h of the tensor face space on an n × n grid: the registry's 1D count squared."""
-    return int(spec.dimension(k, n)) ** 2
+def face_dimension(spec, k: int, n: int, gamma=SQUARE) -> int:
+    """dim M_h of ``spec`` built by the face ``gamma`` on its uniform n × n partition (the
+    construction itself: tensor products on rectangles, P_s on triangles, element spaces)."""
+    return int(gamma.space(spec, k, _uniform(n)).dim)
 
 
-def matching_kernel(spec, k: int, n: int) -> int:
+def matching_kernel(spec, k: int, n: int, gamma=SQUARE) -> int:
     """The dimension argument on matching n × n meshes: max(dim M − dim W, 0)."""
-    return max(face_dimension(spec, k, n) - SQUARE.trace_dimension(k, n), 0)
+    return max(face_dimension(spec, k, n, gamma) - gamma.trace_dimension(k, n), 0)
 
 
-def kernel_formula(spec, k: int) -> str:
-    """dim M − dim W as a polynomial in N (the 1D count is linear, d = aN + b): e.g. ``4N``
-    for M^1_1 (Rem 5.2, k = 1); checked against the count at N = 1..4."""
-    b = spec.dimension(k, 0)
-    a = spec.dimension(k, 1) - b
-    c2, c1, c0 = a * a - k * k, 2 * (a * b + k), b * b - 1
-    for n in range(1, 5):
-        assert c2 * n * n + c1 * n + c0 == face_dimension(spec, k, n) - SQUARE.trace_dimension(k, n)
+def kernel_formula(spec, k: int, gamma=SQUARE) -> str:
+    """dim M − dim W as a polynomial in N: e.g. ``4N`` for M^1_1 (Rem 5.2, k = 1). Both counts
+    are quadratic in N on every face space here; the quadratic through N = 1, 2, 3 is checked
+    against the counts at N = 4, 5 (an AssertionError otherwise: no formula is printed that
+    the counts do not follow)."""
+    count = [face_dimension(spec, k, n, gamma) - gamma.trace_dimension(k, n) for n in range(1, 6)]
+    c2 = (count[2] - 2 * count[1] + count[0]) // 2
+    c1 = count[1] - count[0] - 3 * c2
+    c0 = count[0] - c1 - c2
+    for n in range(1, 6):
+        assert c2 * n * n + c1 * n + c0 == count[n - 1]
     terms = [(c2, "N²"), (c1, "N"), (c0, "")]
     text = ""
     for c, x in terms:
@@ -78,10 +82,10 @@ def _uniform(n: int) -> TensorPartition:
     return TensorPartition(x, x)
 
 
-def planar_kernel(spec, k: int, n1: int, n2: int) -> int:
+def planar_kernel(spec, k: int, n1: int, n2: int, gamma=SQUARE) -> int:
     """The dimension argument on n1 × n1 / n2 × n2 meshes, G_h = the trace of Ω2:
     max(dim M − dim(W1 + W2), 0) (:meth:`Square.trace_sum_dimension`)."""
-    return max(face_dimension(spec, k, n2) - SQUARE.trace_sum_dimension(k, _uniform(n1), _uniform(n2)), 0)
+    return max(face_dimension(spec, k, n2, gamma) - gamma.trace_sum_dimension(k, _uniform(n1), _uniform(n2)), 0)
 
 
 def tensor_kernel_bound(spec, k: int, n1: int, n2: int) -> int:
@@ -93,37 +97,38 @@ def tensor_kernel_bound(spec, k: int, n1: int, n2: int) -> int:
     return 2 * a1 * a2 - min(a1, a2) ** 2
 
 
-def tensor_elements(model, elements) -> list:
-    """The elements of ``model`` whose Γ trace is a tensor grid of rectangles (the interface's
-    ``cell`` is ``quad``), asked of a 1 × 1 × 1 mesh of each: a property, not an element name."""
+def element_interfaces(model, elements) -> dict:
+    """The face interface of each element of ``model`` (rectangles or triangles), asked of a
+    1 × 1 × 1 mesh of each: a property, not an element name."""
     from ..models import make_model
 
     m = make_model(model) if isinstance(model, str) else model
-    out = []
-    for element in elements:
-        trace = m.side_operator(m.mesh("structured", 1, 1, element=element), 1).trace
-        if getattr(trace.gamma, "cell", None) == "quad":
-            out.append(element)
-    return out
+    return {e: m.side_operator(m.mesh("structured", 1, 1, element=e), 1).trace.gamma for e in elements}
 
 
-def face_predictions(spec, k: int, nonmatching, tensor: bool) -> dict:
-    """The predicted verdicts of one (space, k, element) from registry and config alone."""
+def is_tensor(gamma) -> bool:
+    """Whether the face's traces are tensor grids of rectangles (``cell`` ``quad``)."""
+    return getattr(gamma, "cell", None) == "quad"
+
+
+def face_predictions(spec, k: int, nonmatching, tensor: bool, gamma=SQUARE) -> dict:
+    """The predicted verdicts of one (space, k, element) from registry and config alone; the
+    tensor argument applies to the tensor-product spaces (those without an element build)."""
     out = {"kernel": PASS}
     if spec.stable:
         out["bounded"] = out["l2"] = PASS
     if spec.stable:  # no kernel on any pair (the planar count is 0): as the bounded claim
         out["nonmatching"] = PASS
-    elif tensor and any(tensor_kernel_bound(spec, k, n1, n2) > planar_kernel(spec, k, n1, n2)
-                        for n1, n2 in nonmatching):
+    elif tensor and getattr(spec, "face_build", None) is None and any(
+            tensor_kernel_bound(spec, k, n1, n2) > planar_kernel(spec, k, n1, n2, gamma) for n1, n2 in nonmatching):
         out["nonmatching"] = FAIL  # the tensor kernel exceeds the count on some pair
     else:
         out["nonmatching"] = FINDING  # a lower bound only: no prediction of equality
     return out
 
 
-def _nonmatching_check(rows: pd.DataFrame, spec, k: int):
-    planar = np.array([planar_kernel(spec, k, int(a), int(b)) for a, b in zip(rows.N1, rows.N2)])
+def _nonmatching_check(rows: pd.DataFrame, spec, k: int, gamma):
+    planar = np.array([planar_kernel(spec, k, int(a), int(b), gamma) for a, b in zip(rows.N1, rows.N2)])
     dims = rows.kernel_dim.to_numpy(int)
     pairs = ", ".join(f"{a}:{b} {d} vs {p}" for a, b, d, p in zip(rows.N1, rows.N2, dims, planar))
     text = f"kernel vs dimension count per pair: {pairs}"
@@ -134,7 +139,7 @@ def _nonmatching_check(rows: pd.DataFrame, spec, k: int):
     return (PASS if ok else FAIL), text
 
 
-def face_claims(beta: pd.DataFrame, cfg: dict, tensor_elements) -> pd.DataFrame:
+def face_claims(beta: pd.DataFrame, cfg: dict, interfaces: dict) -> pd.DataFrame:
     """The face claims of a face β table (``results/tables/face_beta.csv``).
 
     Parameters
@@ -143,8 +148,8 @@ def face_claims(beta: pd.DataFrame, cfg: dict, tensor_elements) -> pd.DataFrame:
         Rows of ``membranes3d`` (columns of the β table plus ``element``).
     cfg
         The ``claims`` config (slope_tolerance, beta_floor, confidence, fit_window).
-    tensor_elements
-        The elements whose Γ faces are rectangles (tensor-product traces).
+    interfaces
+        The face interface of each element (:func:`element_interfaces`).
     """
     tol, floor, conf, win = cfg["slope_tolerance"], cfg["beta_floor"], cfg["confidence"], cfg["fit_window"]
     out = []
@@ -155,12 +160,13 @@ def face_claims(beta: pd.DataFrame, cfg: dict, tensor_elements) -> pd.DataFrame:
         k = int(k)
         match, nonm = rc[rc.N1 == rc.N2], rc[(rc.N1 != rc.N2) & (rc.norm == "H")]
         pairs = sorted({(int(a), int(b)) for a, b in zip(nonm.N1, nonm.N2)})
-        pred = face_predictions(spec, k, pairs, element in tensor_elements)
+        gamma = interfaces[element]
+        pred = face_predictions(spec, k, pairs, is_tensor(gamma), gamma)
         where = f"{case}, k={k}, {element}"
         if len(match):
-            dims = np.array([matching_kernel(spec, k, int(n)) for n in match.N2])
+            dims = np.array([matching_kernel(spec, k, int(n), gamma) for n in match.N2])
             out.append(row(f"face-kernel-{spec.tag}-k{k}-{element}", REF,
-                           f"face, {where}, matching meshes: dim ker = max(dim M − dim W, 0) = max({kernel_formula(spec, k)}, 0)",
+                           f"face, {where}, matching meshes: dim ker = max(dim M − dim W, 0) = max({kernel_formula(spec, k, gamma)}, 0)",
                            kernel_claim(match, dims), predicted=pred["kernel"]))
         h = match[match.norm == "H"]
         if spec.stable and len(h):
@@ -176,5 +182,5 @@ def face_claims(beta: pd.DataFrame, cfg: dict, tensor_elements) -> pd.DataFrame:
         if len(nonm):
             out.append(row(f"face-nonmatching-kernel-{spec.tag}-k{k}-{element}", REF,
                            f"face, {where}, non-matching pairs, G_h = trace of Ω2: dim ker = max(dim M − dim(W1 + W2), 0)",
-                           _nonmatching_check(nonm.sort_values("N2"), spec, k), predicted=pred["nonmatching"]))
+                           _nonmatching_check(nonm.sort_values("N2"), spec, k, gamma), predicted=pred["nonmatching"]))
     return pd.DataFrame(out, columns=["claim_id", "paper_ref", "statement", "evidence", "verdict", "predicted"])

@@ -1,0 +1,219 @@
+"""Gram matrices of the triangle multiplier spaces (:mod:`.face_triangles`) on Γ = (0, 1)².
+
+L²(Γ): exact, by the collapsed (Duffy) Gauss rule of :mod:`.face_quadrature` on the triangles of
+G_h, exact for the total degree 2s of a product of two P_s functions.
+
+M = H^{1/2}_00(Γ)': the double sine series of :mod:`.face_norms`,
+‖μ‖²_M = Σ_{m,n≥1} μ_mn² / (π√(m² + n²)), μ_mn = 2 ∬ μ sin(mπx) sin(nπy), truncated to
+m, n ≤ n_max and extrapolated in n_max (:func:`~.face_norms.richardson`). The basis functions
+are not tensor products, so their coefficients are computed triangle by triangle:
+
+* on a triangle T with lower-left corner (x0, y0) and sides hx, hy, the addition formula
+  sin(mπ(x0 + hx ξ)) = sin(mπx0) cos(mπhx ξ) + cos(mπx0) sin(mπhx ξ) (and in y) reduces the
+  coefficients to four reference integrals R_ab[l, m, n] = hx hy ∫_T̂ φ_l f_a(mπhx ξ) g_b(nπhy η),
+  computed once per triangle shape (a uniform grid has two);
+* R_ab by the Duffy rule ξ = u, η = u t (lower triangle; η = u, ξ = u t for the upper one), in
+  which the outer oscillation depends on u only, so the rule factorises into two matrix
+  products; its Gauss order q grows with the largest phase π n_max (hx + hy) so that the
+  integrals are exact up to round-off (Gauss–Legendre converges geometrically once
+  q > e ω / 4 for a phase ω on [−1, 1]; :func:`coefficient_points`).
+
+The tail exponent of the truncated square is measured (:func:`~.face_norms.tail_exponent`'s
+ratio of increments, :func:`tail_exponent`), not assumed: it decides the Richardson step.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import InputError
+from .face_norms import _norm2, richardson
+from .face_quadrature import triangles_rule
+from .face_triangles import lagrange_barycentric
+from .norms import N_MAX_CAP
+
+#: Rows m of the coefficient array handled at once (memory ~ dim · chunk · n_max).
+_CHUNK = 32
+#: Tail exponents p (‖S(∞) − S(n)‖ ~ n^{−p}) measured by :func:`tail_exponent` on
+#: N = 2, 4, s = 0..2, n = 32, 128 (tests/test_face_triangles.py); keys :func:`tail_key`.
+TAIL_EXPONENTS = {(True, True): 4.0, (True, False): 2.0, (False, False): 2.0}
+
+
+def gram_l2_tri(space) -> np.ndarray:
+    """Exact L²(Γ) Gram matrix ∫ φ_i φ_j of a :class:`~.face_triangles.TriangleSpace`."""
+    x, w = triangles_rule(space.triangles(), 2 * space.degree)
+    phi = space.evaluate(x)
+    G = phi.T @ (w[:, None] * phi)
+    return 0.5 * (G + G.T)
+
+
+def coefficient_points(n_max: int, h: float, s: int) -> int:
+    """Gauss points of the outer Duffy variable for phases up to ω = π n_max h on [0, 1]
+    (h = hx + hy): a degree ≳ ω/2 + 2 (ω/2)^{1/3} polynomial resolves e^{iωu} there."""
+    w = 0.5 * np.pi * n_max * h
+    return int(np.ceil(0.5 * w + 2.0 * w ** (1.0 / 3.0))) + s + 12
+
+
+#: Below |ω| = 4 the moments use the Taylor series (the recursion divides by ω).
+_SERIES_BELOW, _SERIES_TERMS = 4.0, 48
+
+
+def moments(omega: np.ndarray, jmax: int) -> np.ndarray:
+    """M_j(ω) = ∫_0^1 t^j e^{iωt} dt, j = 0..jmax, shape (jmax + 1, *ω.shape), complex: the
+    recursion M_j = (e^{iω} − j M_{j−1})/(iω) for |ω| ≥ 4 (it damps errors by j/|ω| < 1 for
+    j ≤ 4), the series Σ_k (iω)^k / (k! (j + k + 1)) below."""
+    omega = np.asarray(omega, dtype=float)
+    out = np.zeros((jmax + 1,) + omega.shape, dtype=complex)
+    big = np.abs(omega) >= _SERIES_BELOW
+    z = 1j * np.where(big, omega, 1.0)
+    e = np.exp(z)
+    prev = (e - 1.0) / z
+    out[0] = prev
+    for j in range(1, jmax + 1):
+        prev = (e - j * prev) / z
+        out[j] = prev
+    small = ~big
+    if small.any():
+        zs = 1j * omega[small]
+        term = np.ones_like(zs)
+        acc = np.zeros((jmax + 1, zs.size), dtype=complex)
+        for k in range(_SERIES_TERMS):
+            acc += term[None, :] / (np.arange(jmax + 1)[:, None] + k + 1.0)
+            term = term * zs / (k + 1.0)
+        out[:, small] = acc
+    return out
+
+
+class _Shape:
+    """The reference integrals R_ab of one triangle shape (lower or upper triangle of the
+    rectangle [0, hx] × [0, hy]) for n = 1..n_max and any block of m (module docstring):
+    ξ = u, η = u t (lower) or η = u, ξ = u t (upper); the inner t integral is exact
+    (φ_l(u, u t) is a polynomial of degree ≤ s in t times e^{iωt}: :func:`moments`), the outer
+    one a q-point Gauss rule in u, the variable that carries x (lower) or y (upper)."""
+
+    def __init__(self, hx: float, hy: float, upper: bool, s: int, n: np.ndarray, q: int):
+        from .quadrature import gauss_legendre_01
+
+        u, wu = gauss_legendre_01(q)
+        tn = np.linspace(0.0, 1.0, s + 1) if s > 0 else np.zeros(1)
+        U, T = np.meshgrid(u, tn, indexing="ij")
+        xi, eta = (U * T, U) if upper else (U, U * T)
+        lam = (np.stack([1.0 - eta, xi, eta - xi], -1) if upper
+               else np.stack([1.0 - xi, xi - eta, eta], -1)).reshape(-1, 3)
+        vals = lagrange_barycentric(lam, s).reshape(q, s + 1, -1)  # (q, t node, l)
+        V = tn[:, None] ** np.arange(s + 1)[None, :]
+        self.A = np.linalg.solve(V, vals.transpose(1, 0, 2).reshape(s + 1, -1)).reshape(s + 1, q, -1)  # (j, q, l)
+        self.u, self.upper, self.s, self.hx, self.hy = u, upper, s, hx, hy
+        w = wu * u * hx * hy
+        if upper:  # outer y over all n: (n, q) matrices, fixed
+            self.outer = {a: (f(np.outer(n * np.pi * hy, u)) * w[None, :]) for a, f in (("c", np.cos), ("s", np.sin))}
+        else:  # inner y over all n: D_b (q, n, l), fixed
+            self.inner = self._inner(n * np.pi * hy)
+            self.w = w
+
+    def _inner(self, freq: np.ndarray) -> dict:
+        """{"c", "s"}: ∫_0^1 φ_l(u_q, ·) {cos, sin}(freq u_q t) dt, shape (q, len(freq), l)."""
+        M = moments(self.u[:, None] * freq[None, :], self.s)  # (j, q, f)
+        D = np.einsum("jqf,jql->qfl", M, self.A)
+        return {"c": D.real, "s": D.imag}
+
+    def integrals(self, m: np.ndarray) -> dict:
+        """{(x-function, y-function): R[l, m, n]} for the block ``m``."""
+        out = {}
+        if self.upper:
+            for bx, D in self._inner(m * np.pi * self.hx).items():  # (q, m, l)
+                for ay, Cq in self.outer.items():
+                    out[(bx, ay)] = np.tensordot(Cq, D, axes=(1, 0)).transpose(2, 1, 0)
+            return out
+        for ax, f in (("c", np.cos), ("s", np.sin)):
+            Cq = f(np.outer(m * np.pi * self.hx, self.u)) * self.w[None, :]  # (m, q)
+            for by, D in self.inner.items():
+                out[(ax, by)] = np.tensordot(Cq, D, axes=(1, 0)).transpose(2, 0, 1)
+        return out
+
+
+def sine_coefficients_chunk(space, m: np.ndarray, n_max: int, q: int | None = None,
+                            shapes: dict | None = None) -> np.ndarray:
+    """μ_mn = 2 ∬ φ sin(mπx) sin(nπy) for every basis function, m in ``m``, n = 1..n_max:
+    shape (dim, len(m), n_max). ``shapes`` caches the :class:`_Shape` s across blocks of m
+    (same n_max and q); ``q`` overrides :func:`coefficient_points`."""
+    n = np.arange(1, n_max + 1, dtype=float)
+    m = np.asarray(m, dtype=float)
+    xs, ys = np.asarray(space.breakpoints.xs, float), np.asarray(space.breakpoints.ys, float)
+    dofs = space._dofs
+    out = np.zeros((space.dim, len(m), n_max))
+    shapes = {} if shapes is None else shapes
+    blocks = {}
+    for i in range(len(xs) - 1):
+        hx = xs[i + 1] - xs[i]
+        sx, cx = np.sin(m * np.pi * xs[i]), np.cos(m * np.pi * xs[i])
+        for j in range(len(ys) - 1):
+            hy = ys[j + 1] - ys[j]
+            sy, cy = np.sin(n * np.pi * ys[j]), np.cos(n * np.pi * ys[j])
+            # sin(mπ(x0 + X)) = sin(mπx0) cos(mπX) + cos(mπx0) sin(mπX), likewise in y
+            trig = {("c", "c"): np.outer(sx, sy), ("c", "s"): np.outer(sx, cy),
+                    ("s", "c"): np.outer(cx, sy), ("s", "s"): np.outer(cx, cy)}
+            for tri, upper in enumerate((False, True)):
+                key = (round(hx, 14), round(hy, 14), upper)
+                if key not in shapes:
+                    qq = coefficient_points(max(n_max, int(m.max())), hx + hy, space.s) if q is None else q
+                    shapes[key] = _Shape(hx, hy, upper, space.s, n, qq)
+                if key not in blocks:
+                    blocks[key] = shapes[key].integrals(m)
+                R = blocks[key]
+                c = 2.0 * sum(R[ab] * trig[ab][None] for ab in trig)
+                g = dofs[i, j, tri]
+                if space.dual:  # ψ = Â N on this triangle
+                    c = np.tensordot(space._dual_matrix(int(space.live_mask(g))), c, axes=(1, 0))
+                keep = g >= 0
+                out[g[keep]] += c[keep]
+    return out
+
+
+def partial_gram(space, n_max: int) -> np.ndarray:
+    """S(n_max) = Σ_{m,n ≤ n_max} μ_mn μ_mnᵀ / (π√(m² + n²)), in row blocks of m."""
+    n = np.arange(1, n_max + 1, dtype=float)
+    G = np.zeros((space.dim, space.dim))
+    shapes = {}
+    for start in range(0, n_max, _CHUNK):
+        m = n[start:start + _CHUNK]
+        C = sine_coefficients_chunk(space, m, n_max, shapes=shapes)
+        C *= (1.0 / np.sqrt(np.pi * np.sqrt(m[:, None] ** 2 + n[None, :] ** 2)))[None]
+        C = C.reshape(space.dim, -1)
+        G += C @ C.T
+    return 0.5 * (G + G.T)
+
+
+def tail_exponent(space, n_max: int) -> float:
+    """Measured p of ‖S(∞) − S(n)‖ ~ C n^{−p}: log2 ‖S(2n) − S(n)‖ / ‖S(4n) − S(2n)‖."""
+    s1, s2, s4 = (partial_gram(space, k) for k in (n_max, 2 * n_max, 4 * n_max))
+    return float(np.log2(_norm2(s2 - s1) / _norm2(s4 - s2)))
+
+
+def tail_key(space) -> tuple:
+    """(continuous, vanish) of the functions themselves: a dual basis is discontinuous."""
+    return (space.continuous and not space.dual, space.vanish and not space.dual)
+
+
+def gram_h_tri(space, rtol: float = 1e-6, n_start: int | None = None, n_cap: int = N_MAX_CAP // 64,
+               exponent: float | None = None) -> tuple[np.ndarray, dict]:
+    """Gram matrix of the H^{1/2}_00(Γ)' norm of a triangle space (module docstring), partial
+    sums from n0 = max(16, 2 (s + 1) N) (N: the larger number of cells per direction), doubled
+    and extrapolated with the exponent of :data:`TAIL_EXPONENTS` until ``rtol`` or ``n_cap``."""
+    if not rtol > 0:
+        raise InputError("rtol", "a positive float", got=rtol)
+    p = TAIL_EXPONENTS[tail_key(space)] if exponent is None else float(exponent)
+    n0 = max(16, 2 * (space.degree + 1) * max(space.shape)) if n_start is None else int(n_start)
+    if n0 < 1 or n_cap < 1:
+        raise InputError("n_start/n_cap", "positive integers", got=(n_start, n_cap))
+    return richardson(lambda k: partial_gram(space, k), p, min(n0, n_cap), n_cap, rtol)
+
+
+def gram(space, norm: str, **kwargs) -> tuple[np.ndarray, dict]:
+    """Gram matrix of a triangle space for ``norm`` ∈ {"H", "L2"} (``kwargs`` to :func:`gram_h_tri`)."""
+    from .norms import NORMS
+
+    if norm == "L2":
+        return gram_l2_tri(space), {"n_max": 0, "nmax_rel_error": 0.0}
+    if norm == "H":
+        return gram_h_tri(space, **kwargs)
+    raise InputError("norm", ", ".join(NORMS), got=norm)

@@ -1,0 +1,170 @@
+"""Edge dropping (issue 28, item 5): β_h and the conditioning of the multiplier block when Ω2's
+face covers Ω1's only partially.
+
+Setting (membranes, −Δu_i = f_i, u_i = 0 on ∂Ω_i∖Γ, b(v, μ) = ∫_Γ (v2 − v1) μ):
+Ω1 = (0, 1)³ on the N × N × N grid, its top face the secondary side; Ω2 = (0, L) × (0, 1) × (1, 2)
+on the uniform N2 × N2 × N2 grid, L = (N − 1 + θ)/N, so Ω2 covers the last column of Ω1's face
+cells by the fraction θ ∈ (0, 1]. Γ = (0, L) × (0, 1) × {1}. Ω1's whole top face is natural
+(u1 is free on the uncovered strip too), so its Γ-side dofs are all interior nodes of its face
+(those beyond L give zero couplings). The multipliers are a registered face space on Ω1's face
+(multiplier mesh ``omega1``) restricted to Γ (:class:`~infsup_contact.discretization.clipped_face.ClippedFace`:
+functions whose support misses Γ dropped, those of the partially covered column kept, cut).
+The norms are L²(Γ) and the exact H^{1/2}_00(Γ)' of the rectangle. θ = 1 is the full-face
+problem of :mod:`infsup_contact.models.membranes3d` with N1 = N, N2, multiplier mesh omega1.
+
+Multiplier block (reported in the unscaled and the κ-scaled basis):
+
+* D — the secondary mortar matrix D_jp = ∫_Γ ψ_j N_p over *all* Lagrange nodes p of Ω1's face
+  (square for the nodal spaces whose dofs are those nodes); cond₂(D) = σ_max/σ_min;
+* S = Σ_i B_i X_i B_iᵀ — the interface operator (Schur complement of the saddle point
+  system on the multipliers, X_i = (K_i⁻¹)_ΓΓ, :mod:`.tensor_sides`); cond₂(S);
+* G — the L²(Γ) Gram matrix of the restricted basis.
+
+κ scaling (Popp, Wohlmuth, Gee & Wall, "Improved robustness and consistency of 3D contact
+algorithms based on a dual mortar approach", CMAME 2013, eq. (36); MOOSE PR #33572, first order
+only, averages the same ratio over the node's elements): κ_j = ∫_Γ N_j / ∫_{Γ_s} N_j, the covered
+fraction of the primal (Lagrange) shape function N_j of node j on the secondary face Γ_s, and
+the constraint row j (weighted gap, multiplier ψ_j) is divided by κ_j: ψ_j → ψ_j / κ_j. Here
+N_j is the Lagrange basis with the multiplier's numbering (the space itself for nodal spaces,
+the continuous Q_k hat for the dual ones) and |N_j| is integrated (N_j ≥ 0 at k = 1, where this
+is eq. (36) exactly). A diagonal change of basis leaves the Rayleigh quotient of β_h
+unchanged: κ scaling changes conditioning, never β_h.
+"""
+from __future__ import annotations
+
+import argparse
+import csv
+import sys
+
+import numpy as np
+
+from ..discretization import registry
+from ..discretization.clipped_face import ClippedFace
+from ..discretization.multipliers import MultiplierSpace
+from ..discretization.norms import gram_l2
+from ..discretization.quadrature import gauss_legendre_01
+from ..discretization.square import SQUARE, TensorPartition
+from ..errors import InputError
+from ..solvers.infsup import spectrum
+from .tensor_sides import box_gamma_block, face_dofs_1d, lagrange_1d
+
+THETAS = (1.0, 0.5, 0.25, 0.1, 0.05, 0.01, 0.001)
+"""The covered fractions of the last column swept by default (issue 28)."""
+
+
+def edge_cases(k: int) -> list:
+    """Registered spaces that make sense on a moving face boundary: every case valid for k
+    whose 1D factor does not vanish at the ends (a space vanishing on ∂(Ω1's face) does not
+    vanish on the edge x = L of Γ: not the natural analogue)."""
+    x = np.linspace(0.0, 1.0, 5)
+    return [c for c in registry.ids_valid_for(k)
+            if not registry.space_spec(c).build(k, x).vanish_at_ends]
+
+
+def _integrate_1d(breaks, f, n_points: int) -> np.ndarray:
+    """Σ over the intervals of ``breaks`` of Gauss–Legendre sums of f(x) (n, ...) × weights."""
+    t, w = gauss_legendre_01(n_points)
+    a, b = breaks[:-1, None], breaks[1:, None]
+    x = (a + (b - a) * t).ravel()
+    return f(x), ((b - a) * w).ravel()
+
+
+def _merged(*grids, upper: float = 1.0) -> np.ndarray:
+    g = np.unique(np.concatenate([np.asarray(v, float) for v in grids] + [[upper]]))
+    g = g[g <= upper + 1e-14]
+    return g[np.concatenate([[True], np.diff(g) > 1e-13])]
+
+
+def primal_twin(space: MultiplierSpace) -> MultiplierSpace:
+    """The Lagrange basis with the numbering of ``space`` (the N_j of κ_j)."""
+    return MultiplierSpace(space.breakpoints, space.degree, space.continuous, space.vanish_at_ends,
+                           space.dofs, space.dim)
+
+
+def kappa_1d(space: MultiplierSpace, L: float) -> np.ndarray:
+    """κ_j = ∫_0^L |N_j| / ∫_0^1 |N_j| of the primal twin of the x factor (module docstring)."""
+    twin = primal_twin(space)
+    grid = _merged(space.breakpoints, [L])
+    vals, w = _integrate_1d(grid, twin.evaluate, space.degree + 12)
+    covered = np.where((grid[:-1, None] < L - 1e-14) * np.ones((1, space.degree + 12)), 1.0, 0.0).ravel()
+    full = np.abs(vals).T @ w
+    return (np.abs(vals).T @ (w * covered)) / full
+
+
+def couplings_1d(face: ClippedFace, trace_space, axis: str, k: int) -> np.ndarray:
+    """∫ μ_a φ_p of the clipped x factor over (0, L) (``axis`` "x") or of the y factor over
+    (0, 1) (``axis`` "y") against every nodal function φ_p of a side's 1D trace space, by
+    Gauss–Legendre on the common refinement (exact: degree ≤ 2k per interval)."""
+    if axis == "x":
+        grid = _merged(np.asarray(face.space.sx.breakpoints) * face.L, trace_space.breakpoints, upper=face.L)
+        mu = face.evaluate_x
+    else:
+        grid = _merged(face.space.sy.breakpoints, trace_space.breakpoints)
+        mu = face.space.sy.evaluate
+    pts, w = _integrate_1d(grid, lambda x: x, k + 2)
+    return (mu(pts) * w[:, None]).T @ trace_space.evaluate(pts)
+
+
+def _cond(A: np.ndarray) -> float:
+    s = np.linalg.svd(A, compute_uv=False)
+    return float(s[0] / s[-1]) if s[-1] > 0 else np.inf
+
+
+def edge_row(case: str, k: int, n: int, n2: int, theta: float, norms=("H", "L2"), h_rtol: float = 1e-6) -> dict:
+    """β_h and the multiplier-block conditioning at one covered fraction θ (module docstring).
+
+    Returns
+    -------
+    dict
+        ``beta_H``, ``beta_L2`` (and ``beta_*_kappa`` from the κ-scaled matrices), ``dim_M``,
+        ``dropped`` (unrestricted minus kept functions), ``cond_D``, ``cond_S``, ``cond_G``
+        with their ``*_kappa`` versions, ``kappa_min``, ``n_max``, ``h_rel_error``.
+    """
+    registry.check_case(case, k)
+    if not 0.0 < theta <= 1.0:
+        raise InputError("theta", "a covered fraction 0 < θ <= 1", got=theta)
+    for key, v in (("N", n), ("N2", n2)):
+        if not isinstance(v, (int, np.integer)) or v < 1:
+            raise InputError(key, "an integer >= 1", got=v)
+    L = (n - 1 + theta) / n
+    xs1 = np.linspace(0.0, 1.0, n + 1)
+    grids = {1: (xs1, xs1, xs1), 2: (np.linspace(0.0, L, n2 + 1), np.linspace(0.0, 1.0, n2 + 1),
+                                     np.linspace(1.0, 2.0, n2 + 1))}
+    full = registry.case_space(case, k, TensorPartition(xs1, xs1), SQUARE)
+    face = ClippedFace.of(full, L)
+    kept_x = face.kept[::full.sy.dim] // full.sy.dim
+    kappa_x = kappa_1d(full.sx, L)[kept_x]
+    kappa = np.repeat(kappa_x, full.sy.dim)
+    S = np.zeros((face.dim, face.dim))
+    for i, (xs, ys, zs) in grids.items():
+        bx = couplings_1d(face, lagrange_1d(xs, k), "x", k)[:, face_dofs_1d(xs, k)]
+        by = couplings_1d(face, lagrange_1d(ys, k), "y", k)[:, face_dofs_1d(ys, k)]
+        B = np.kron(bx, by)
+        S += B @ box_gamma_block(xs, ys, zs, k, gamma_top=i == 1) @ B.T
+    t1 = lagrange_1d(xs1, k)
+    D = np.kron(couplings_1d(face, t1, "x", k), couplings_1d(face, t1, "y", k))
+    G_l2 = face.gram("L2")[0]
+    row = dict(case=case, k=k, N=n, N2=n2, theta=theta, L=L, dim_M=face.dim, dropped=full.dim - face.dim,
+               kappa_min=float(kappa.min()))
+    s = 1.0 / kappa
+    scaled = {"": (S, D, G_l2), "_kappa": (S * np.outer(s, s), D * s[:, None], G_l2 * np.outer(s, s))}
+    for tag, (S_, D_, G_) in scaled.items():
+        row[f"cond_D{tag}"], row[f"cond_S{tag}"], row[f"cond_G{tag}"] = _cond(D_), _cond(S_), _cond(G_)
+    for norm in norms:
+        if norm == "L2":
+            grams = {"": G_l2, "_kappa": scaled["_kappa"][2]}
+        elif norm == "H":
+            # computed in the L²(Γ)-normalized basis, where the series' relative error is per
+            # function and not relative to the largest one (the cut functions are O(θ) small)
+            dx = np.ones(full.sx.dim)
+            dx[kept_x] = 1.0 / np.sqrt(np.diag(face.L * gram_l2(face.space.sx)))
+            G_unit, info = ClippedFace.of(full, L, scale_x=dx).gram("H", rtol=h_rtol)
+            d = np.repeat(dx[kept_x], full.sy.dim)
+            G = G_unit / np.outer(d, d)
+            grams = {"": G, "_kappa": G * np.outer(s, s)}
+            row.update(n_max=info["n_max"], h_rel_error=info["nmax_rel_error"], h_capped=info["capped"])
+        else:
+            raise InputError("norm", "H, L2", got=norm)
+        for tag, G in grams.items():
+            row[f"beta_{norm}{tag}"] = spectrum(scaled[tag][0], G).beta
+    return row

@@ -105,6 +105,26 @@ def couplings_1d(face: ClippedFace, trace_space, axis: str, k: int) -> np.ndarra
     return (mu(pts) * w[:, None]).T @ trace_space.evaluate(pts)
 
 
+def geometry(n: int, n2: int, theta: float):
+    """(L, Ω1's breakpoints, {side: (xs, ys, zs)}) of the pair at covered fraction θ."""
+    L = (n - 1 + theta) / n
+    xs1 = np.linspace(0.0, 1.0, n + 1)
+    return L, xs1, {1: (xs1, xs1, xs1), 2: (np.linspace(0.0, L, n2 + 1), np.linspace(0.0, 1.0, n2 + 1),
+                                            np.linspace(1.0, 2.0, n2 + 1))}
+
+
+def interface_operator(face: ClippedFace, k: int, grids: dict) -> np.ndarray:
+    """S = Σ_i B_i X_i B_iᵀ (c1 = c2 = 1) with B_i = B_i^x ⊗ B_i^y the couplings of the face
+    multipliers with side i's Γ dofs and X_i = (K_i⁻¹)_ΓΓ (:func:`.tensor_sides.box_gamma_block`)."""
+    S = np.zeros((face.dim, face.dim))
+    for i, (xs, ys, zs) in grids.items():
+        bx = couplings_1d(face, lagrange_1d(xs, k), "x", k)[:, face_dofs_1d(xs, k)]
+        by = couplings_1d(face, lagrange_1d(ys, k), "y", k)[:, face_dofs_1d(ys, k)]
+        B = np.kron(bx, by)
+        S += B @ box_gamma_block(xs, ys, zs, k, gamma_top=i == 1) @ B.T
+    return S
+
+
 def _cond(A: np.ndarray) -> float:
     s = np.linalg.svd(A, compute_uv=False)
     return float(s[0] / s[-1]) if s[-1] > 0 else np.inf
@@ -126,21 +146,13 @@ def edge_row(case: str, k: int, n: int, n2: int, theta: float, norms=("H", "L2")
     for key, v in (("N", n), ("N2", n2)):
         if not isinstance(v, (int, np.integer)) or v < 1:
             raise InputError(key, "an integer >= 1", got=v)
-    L = (n - 1 + theta) / n
-    xs1 = np.linspace(0.0, 1.0, n + 1)
-    grids = {1: (xs1, xs1, xs1), 2: (np.linspace(0.0, L, n2 + 1), np.linspace(0.0, 1.0, n2 + 1),
-                                     np.linspace(1.0, 2.0, n2 + 1))}
+    L, xs1, grids = geometry(n, n2, theta)
     full = registry.case_space(case, k, TensorPartition(xs1, xs1), SQUARE)
     face = ClippedFace.of(full, L)
     kept_x = face.kept[::full.sy.dim] // full.sy.dim
     kappa_x = kappa_1d(full.sx, L)[kept_x]
     kappa = np.repeat(kappa_x, full.sy.dim)
-    S = np.zeros((face.dim, face.dim))
-    for i, (xs, ys, zs) in grids.items():
-        bx = couplings_1d(face, lagrange_1d(xs, k), "x", k)[:, face_dofs_1d(xs, k)]
-        by = couplings_1d(face, lagrange_1d(ys, k), "y", k)[:, face_dofs_1d(ys, k)]
-        B = np.kron(bx, by)
-        S += B @ box_gamma_block(xs, ys, zs, k, gamma_top=i == 1) @ B.T
+    S = interface_operator(face, k, grids)
     t1 = lagrange_1d(xs1, k)
     D = np.kron(couplings_1d(face, t1, "x", k), couplings_1d(face, t1, "y", k))
     G_l2 = face.gram("L2")[0]
@@ -168,3 +180,40 @@ def edge_row(case: str, k: int, n: int, n2: int, theta: float, norms=("H", "L2")
         for tag, G in grams.items():
             row[f"beta_{norm}{tag}"] = spectrum(scaled[tag][0], G).beta
     return row
+
+
+COLUMNS = ("case", "k", "N", "N2", "theta", "L", "dim_M", "dropped", "kappa_min", "beta_H", "beta_H_kappa",
+           "beta_L2", "beta_L2_kappa", "cond_D", "cond_D_kappa", "cond_S", "cond_S_kappa", "cond_G",
+           "cond_G_kappa", "n_max", "h_rel_error", "h_capped")
+
+
+def edge_table(ks=(1,), ns=(4, 8), thetas=THETAS, cases=None, n2_factor: int = 2, norms=("H", "L2")):
+    """Rows of :func:`edge_row` for every k, N (N2 = ``n2_factor`` N: a primary side fine enough
+    that B2 has full row rank for the continuous spaces of Ω1's face), case and θ."""
+    return [edge_row(c, k, n, n2_factor * n, th, norms)
+            for k in ks for n in ns for c in (edge_cases(k) if cases is None else cases) for th in thetas]
+
+
+def main(argv=None) -> int:
+    """``python -m infsup_contact.study.edge_dropping --k 1 2 --N 4 8``: the table as CSV on stdout."""
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--k", type=int, nargs="+", default=[1])
+    ap.add_argument("--N", type=int, nargs="+", default=[4, 8])
+    ap.add_argument("--theta", type=float, nargs="+", default=list(THETAS))
+    ap.add_argument("--case", nargs="+", default=None, help="registered face spaces (default: edge_cases(k))")
+    ap.add_argument("--n2-factor", type=int, default=2, help="N2 = factor * N (Ω2's cells per direction)")
+    ap.add_argument("--norm", nargs="+", default=["H", "L2"])
+    a = ap.parse_args(argv)
+    out = csv.DictWriter(sys.stdout, COLUMNS, extrasaction="ignore")
+    out.writeheader()
+    for k in a.k:
+        for n in a.N:
+            for c in (edge_cases(k) if a.case is None else a.case):
+                for th in a.theta:
+                    out.writerow(edge_row(c, k, n, a.n2_factor * n, th, tuple(a.norm)))
+                    sys.stdout.flush()
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

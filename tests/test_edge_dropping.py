@@ -1,0 +1,120 @@
+"""Edge dropping (issue 28, item 5): multipliers of Ω1's face cut at x = L, β_h with and
+without κ scaling (:mod:`infsup_contact.study.edge_dropping`)."""
+import numpy as np
+import pytest
+
+from infsup_contact.discretization import registry
+from infsup_contact.discretization.clipped_face import ClippedFace, clip_1d
+from infsup_contact.discretization.face_norms import partial_gram
+from infsup_contact.discretization.norms import sine_coefficients
+from infsup_contact.discretization.quadrature import gauss_legendre_01
+from infsup_contact.discretization.square import SQUARE, TensorPartition
+from infsup_contact.errors import InputError
+from infsup_contact.solvers.infsup import spectrum
+from infsup_contact.study.edge_dropping import (edge_cases, edge_row, geometry, interface_operator,
+                                                kappa_1d)
+
+
+def _face(case, k, n):
+    x = np.linspace(0.0, 1.0, n + 1)
+    return registry.case_space(case, k, TensorPartition(x, x), SQUARE)
+
+
+@pytest.mark.parametrize("k, n, n2", [(1, 2, 4), (2, 2, 3)])
+def test_full_cover_equals_the_face_engine(k, n, n2):
+    """θ = 1: the tensor-grid route (1D Kronecker assembly, no NGSolve) gives the β_h of the
+    full-face engine (NGSolve hexahedra, multiplier mesh omega1) for every edge case."""
+    from infsup_contact.models.membranes3d import MEMBRANES3D
+    from infsup_contact.solvers.infsup import beta_rows_all
+
+    cases = edge_cases(k)
+    rows = beta_rows_all("structured", k, n, n2, cases, ("omega1",), model=MEMBRANES3D, element="hex")
+    for case in cases:
+        mine = edge_row(case, k, n, n2, 1.0)
+        ref = {r["norm"]: r["beta"] for r in rows if r["case"] == case}
+        assert mine["beta_L2"] == pytest.approx(ref["L2"], rel=1e-10)
+        assert mine["beta_H"] == pytest.approx(ref["H"], rel=1e-4)   # two truncated series
+        assert mine["dropped"] == 0 and mine["kappa_min"] == pytest.approx(1.0)
+
+
+@pytest.mark.parametrize("case", ["R5.4", "DUAL-ALL"])
+def test_beta_invariant_under_kappa_scaling(case):
+    """κ scaling is a diagonal change of basis: β_h (Rayleigh quotient) is unchanged, recomputed
+    from scratch on the scaled space, while the conditioning of D changes."""
+    k, n, n2, theta = 1, 3, 4, 0.1
+    row = edge_row(case, k, n, n2, theta)
+    L, _, grids = geometry(n, n2, theta)
+    full = _face(case, k, n)
+    scaled = ClippedFace.of(full, L, scale_x=1.0 / kappa_1d(full.sx, L))
+    S = interface_operator(scaled, k, grids)
+    for norm in ("L2", "H"):
+        beta = spectrum(S, scaled.gram(norm)[0]).beta
+        assert beta == pytest.approx(row[f"beta_{norm}"], rel=1e-5)
+        assert row[f"beta_{norm}_kappa"] == pytest.approx(row[f"beta_{norm}"], rel=1e-8)
+    assert row["cond_D_kappa"] != pytest.approx(row["cond_D"], rel=1e-3)
+
+
+@pytest.mark.parametrize("case", ["R5.2", "R5.4", "DUAL-ALL", "T4", "T5"])
+def test_dimension_counts(case):
+    """Cut at a breakpoint j/N: exactly the space of the registry on j cells (x) times N cells
+    (y); cut inside the last column (0 < θ < 1): nothing dropped."""
+    k, n = 2, 4
+    spec = registry.space_spec(case)
+    full = _face(case, k, n)
+    for j in range(1, n + 1):
+        assert ClippedFace.of(full, j / n).dim == spec.dimension(k, j) * spec.dimension(k, n)
+    for theta in (0.5, 1e-3):
+        assert ClippedFace.of(full, (n - 1 + theta) / n).dim == full.dim
+
+
+@pytest.mark.parametrize("case", ["R5.2", "R5.4", "DUAL-ALL"])
+def test_clipped_functions_are_restrictions(case):
+    """On (0, L) the kept functions are the unrestricted ones (pulled back and cut exactly)."""
+    k, n, L = 2, 3, (2 + 0.3) / 3
+    full = _face(case, k, n)
+    sx = full.sx
+    clipped, kept = clip_1d(sx, L)
+    x = np.linspace(1e-3, L - 1e-3, 97)
+    assert np.allclose(clipped.evaluate(x / L), sx.evaluate(x)[:, kept], atol=1e-12)
+    d = np.arange(1.0, sx.dim + 1)
+    scaled, _ = clip_1d(sx, L, scale=d)
+    assert np.allclose(scaled.evaluate(x / L), sx.evaluate(x)[:, kept] * d[kept], atol=1e-12)
+
+
+def test_kappa_of_hats():
+    """Covered fractions of the last two hats (k = 1): θ² at x = 1 and 1/2 + θ − θ²/2 at x_{N−1}
+    (∫ of the linear hat over the covered part of its support)."""
+    n, theta = 4, 0.3
+    kap = kappa_1d(_face("R5.2", 1, n).sx, (n - 1 + theta) / n)
+    assert kap[-1] == pytest.approx(theta ** 2, rel=1e-12)
+    assert kap[-2] == pytest.approx(0.5 + theta - theta ** 2 / 2, rel=1e-12)
+    assert np.allclose(kap[:-2], 1.0)
+
+
+def test_anisotropic_series_against_direct_sum():
+    """partial_gram(aspect = L) equals the truncated series of the rectangle's Dirichlet
+    eigenfunctions (2/√L) sin(mπx/L) sin(nπy), coefficients by quadrature on the rectangle."""
+    L, n_max = 0.7, 12
+    face = ClippedFace.of(_face("R5.4", 1, 3), L)
+    t, w = gauss_legendre_01(30)
+    def coeffs(space, scale):  # ∫ φ(x) sin(mπx/scale) dx on [0, scale], per interval
+        bp = np.asarray(space.breakpoints) * scale
+        x = (bp[:-1, None] + np.diff(bp)[:, None] * t).ravel()
+        wx = (np.diff(bp)[:, None] * w).ravel()
+        m = np.arange(1, n_max + 1)
+        return (space.evaluate(x / scale) * wx[:, None]).T @ np.sin(np.pi * np.outer(x, m) / scale)
+    cx, cy = coeffs(face.space.sx, L), coeffs(face.space.sy, 1.0)
+    m = np.arange(1, n_max + 1)
+    lam = np.pi * np.sqrt((m[:, None] / L) ** 2 + m[None, :] ** 2)
+    c = (2.0 / np.sqrt(L)) * cx[:, None, :, None] * cy[None, :, None, :]  # (a, b, m, n)
+    c = c.reshape(face.dim, n_max, n_max)
+    direct = np.einsum("imn,jmn,mn->ij", c, c, 1.0 / lam)
+    assert np.allclose(partial_gram(face.space, n_max, aspect=L), direct, rtol=1e-10, atol=1e-14)
+    assert np.allclose(sine_coefficients(face.space.sx, m) / np.sqrt(2.0) * L, cx, atol=1e-12)
+
+
+def test_bad_input():
+    with pytest.raises(InputError, match="theta"):
+        edge_row("R5.4", 1, 2, 4, 0.0)
+    with pytest.raises(InputError, match="L"):
+        clip_1d(_face("R5.4", 1, 2).sx, 1.5)

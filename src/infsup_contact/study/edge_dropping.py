@@ -21,10 +21,13 @@ Multiplier block (reported in the unscaled and the κ-scaled basis):
 * G — the L²(Γ) Gram matrix of the restricted basis.
 
 κ scaling (Popp, Wohlmuth, Gee & Wall, "Improved robustness and consistency of 3D contact
-algorithms based on a dual mortar approach", CMAME 2013, eq. (36); MOOSE PR #33572, first order
-only, averages the same ratio over the node's elements): κ_j = ∫_Γ N_j / ∫_{Γ_s} N_j, the covered
-fraction of the primal (Lagrange) shape function N_j of node j on the secondary face Γ_s, and
-the constraint row j (weighted gap, multiplier ψ_j) is divided by κ_j: ψ_j → ψ_j / κ_j. Here
+algorithms based on a dual mortar approach", CMAME 2013, eq. (36)): κ_j = ∫_Γ N_j / ∫_{Γ_s} N_j,
+the covered fraction of the primal (Lagrange) shape function N_j of node j on the secondary face
+Γ_s, and the multiplier of node j is divided by κ_j (MOOSE PR #33572, first order only: the
+pressure Σ_j Φ_j z_j / κ_j), i.e. ψ_j → ψ_j / κ_j and the constraint row j of D and B with it.
+MOOSE averages the per-element fractions ∫_{e∩Γ} N_j / ∫_e N_j over the node's elements; on
+these uniform secondary grids ∫_e N_j is the same on every element of the node, so the average
+is eq. (36) exactly (checked in the tests: θ² and 1/2 + θ − θ²/2 for the last two hats). Here
 N_j is the Lagrange basis with the multiplier's numbering (the space itself for nodal spaces,
 the continuous Q_k hat for the dual ones) and |N_j| is integrated (N_j ≥ 0 at k = 1, where this
 is eq. (36) exactly). A diagonal change of basis leaves the Rayleigh quotient of β_h
@@ -125,20 +128,44 @@ def interface_operator(face: ClippedFace, k: int, grids: dict) -> np.ndarray:
     return S
 
 
-def _cond(A: np.ndarray) -> float:
-    s = np.linalg.svd(A, compute_uv=False)
-    return float(s[0] / s[-1]) if s[-1] > 0 else np.inf
+def _norm2(A: np.ndarray) -> float:
+    return float(np.linalg.norm(A, 2))
+
+
+def scaled_cond(A_n: np.ndarray, r: np.ndarray, symmetric: bool) -> float:
+    """cond₂ of A = diag(r) A_n (diag(r) too when ``symmetric``), A_n of full row rank.
+
+    ‖A‖ ‖A⁺‖ with A⁺ = A_n⁺ diag(1/r) (diag(1/r) A_n⁺ diag(1/r)): the pseudo-inverse of a
+    row-scaled full-row-rank matrix is the scaled pseudo-inverse, so only A_n is inverted
+    (``inf`` when A_n is singular to working precision).
+    Computed so, the condition number of a badly scaled basis (cond far beyond 1/ε: the cut
+    functions are O(θ) small) is as accurate as that of the normalized A_n, which a direct SVD
+    of A would not be (its small singular values would drown in round-off of ‖A‖)."""
+    if A_n.shape[0] > A_n.shape[1]:
+        raise InputError("A_n", "a matrix of full row rank (rows <= columns)", got=A_n.shape)
+    sv = np.linalg.svd(A_n, compute_uv=False)
+    if sv[-1] <= max(A_n.shape) * np.finfo(float).eps * sv[0]:
+        return np.inf                      # A_n (hence A) rank deficient to working precision
+    inv = np.linalg.pinv(A_n, rcond=0.0)
+    if symmetric:
+        return _norm2(A_n * np.outer(r, r)) * _norm2(inv / np.outer(r, r))
+    return _norm2(A_n * r[:, None]) * _norm2(inv / r[None, :])
 
 
 def edge_row(case: str, k: int, n: int, n2: int, theta: float, norms=("H", "L2"), h_rtol: float = 1e-6) -> dict:
     """β_h and the multiplier-block conditioning at one covered fraction θ (module docstring).
 
+    β_h is computed from the pencil in the L²(Γ)-normalized basis (β_h is invariant under any
+    diagonal change of basis, κ scaling included; the normalized pencil is the best
+    conditioned of them); the condition numbers are those of the unscaled registry basis and of
+    the κ-scaled basis (:func:`scaled_cond`).
+
     Returns
     -------
     dict
-        ``beta_H``, ``beta_L2`` (and ``beta_*_kappa`` from the κ-scaled matrices), ``dim_M``,
-        ``dropped`` (unrestricted minus kept functions), ``cond_D``, ``cond_S``, ``cond_G``
-        with their ``*_kappa`` versions, ``kappa_min``, ``n_max``, ``h_rel_error``.
+        ``beta_H``, ``beta_L2``, ``dim_M``, ``dropped`` (unrestricted minus kept functions),
+        ``cond_D``, ``cond_S``, ``cond_G`` (L² Gram) and their ``*_kappa`` versions,
+        ``cond_*_unit`` (normalized basis), ``kappa_min``, ``n_max``, ``h_rel_error``, ``h_capped``.
     """
     registry.check_case(case, k)
     if not 0.0 < theta <= 1.0:
@@ -150,41 +177,41 @@ def edge_row(case: str, k: int, n: int, n2: int, theta: float, norms=("H", "L2")
     full = registry.case_space(case, k, TensorPartition(xs1, xs1), SQUARE)
     face = ClippedFace.of(full, L)
     kept_x = face.kept[::full.sy.dim] // full.sy.dim
-    kappa_x = kappa_1d(full.sx, L)[kept_x]
-    kappa = np.repeat(kappa_x, full.sy.dim)
-    S = interface_operator(face, k, grids)
+    kappa = np.repeat(kappa_1d(full.sx, L)[kept_x], full.sy.dim)
     t1 = lagrange_1d(xs1, k)
-    D = np.kron(couplings_1d(face, t1, "x", k), couplings_1d(face, t1, "y", k))
     G_l2 = face.gram("L2")[0]
+    r = np.sqrt(np.diag(G_l2))            # ψ_j = r_j ψ̂_j, ψ̂_j of unit L²(Γ) norm
+    unit = np.outer(r, r)
+    S_n = interface_operator(face, k, grids) / unit
+    D_n = np.kron(couplings_1d(face, t1, "x", k), couplings_1d(face, t1, "y", k)) / r[:, None]
+    G_n = G_l2 / unit
     row = dict(case=case, k=k, N=n, N2=n2, theta=theta, L=L, dim_M=face.dim, dropped=full.dim - face.dim,
                kappa_min=float(kappa.min()))
-    s = 1.0 / kappa
-    scaled = {"": (S, D, G_l2), "_kappa": (S * np.outer(s, s), D * s[:, None], G_l2 * np.outer(s, s))}
-    for tag, (S_, D_, G_) in scaled.items():
-        row[f"cond_D{tag}"], row[f"cond_S{tag}"], row[f"cond_G{tag}"] = _cond(D_), _cond(S_), _cond(G_)
+    for tag, rr in (("", r), ("_kappa", r / kappa), ("_unit", np.ones_like(r))):
+        row[f"cond_D{tag}"] = scaled_cond(D_n, rr, False)
+        row[f"cond_S{tag}"] = scaled_cond(S_n, rr, True)
+        row[f"cond_G{tag}"] = scaled_cond(G_n, rr, True)
     for norm in norms:
         if norm == "L2":
-            grams = {"": G_l2, "_kappa": scaled["_kappa"][2]}
+            G = G_n
         elif norm == "H":
-            # computed in the L²(Γ)-normalized basis, where the series' relative error is per
-            # function and not relative to the largest one (the cut functions are O(θ) small)
+            # the series in the x-normalized basis: its relative error is then per function,
+            # not relative to the largest one
             dx = np.ones(full.sx.dim)
             dx[kept_x] = 1.0 / np.sqrt(np.diag(face.L * gram_l2(face.space.sx)))
-            G_unit, info = ClippedFace.of(full, L, scale_x=dx).gram("H", rtol=h_rtol)
+            G_x, info = ClippedFace.of(full, L, scale_x=dx).gram("H", rtol=h_rtol)
             d = np.repeat(dx[kept_x], full.sy.dim)
-            G = G_unit / np.outer(d, d)
-            grams = {"": G, "_kappa": G * np.outer(s, s)}
+            G = G_x / np.outer(d, d) / unit
             row.update(n_max=info["n_max"], h_rel_error=info["nmax_rel_error"], h_capped=info["capped"])
         else:
             raise InputError("norm", "H, L2", got=norm)
-        for tag, G in grams.items():
-            row[f"beta_{norm}{tag}"] = spectrum(scaled[tag][0], G).beta
+        row[f"beta_{norm}"] = spectrum(S_n, G).beta
     return row
 
 
-COLUMNS = ("case", "k", "N", "N2", "theta", "L", "dim_M", "dropped", "kappa_min", "beta_H", "beta_H_kappa",
-           "beta_L2", "beta_L2_kappa", "cond_D", "cond_D_kappa", "cond_S", "cond_S_kappa", "cond_G",
-           "cond_G_kappa", "n_max", "h_rel_error", "h_capped")
+COLUMNS = ("case", "k", "N", "N2", "theta", "L", "dim_M", "dropped", "kappa_min", "beta_H", "beta_L2",
+           "cond_D", "cond_D_kappa", "cond_D_unit", "cond_S", "cond_S_kappa", "cond_S_unit", "cond_G",
+           "cond_G_kappa", "cond_G_unit", "n_max", "h_rel_error", "h_capped")
 
 
 def edge_table(ks=(1,), ns=(4, 8), thetas=THETAS, cases=None, n2_factor: int = 2, norms=("H", "L2")):

@@ -131,3 +131,15 @@ def test_bad_input():
         edge_row("R5.4", 1, 2, 4, 0.0)
     with pytest.raises(InputError, match="L"):
         clip_1d(_face("R5.4", 1, 2).sx, 1.5)
+
+
+@pytest.mark.parametrize("k, gamma_top", [(1, True), (2, False)])
+def test_fast_diagonalization_equals_sparse_lu(k, gamma_top):
+    """(K_ff⁻¹)_ΓΓ of a box with a non-cubic, non-uniform grid: the 1D eigen route equals the
+    assembled 3D sparse LU route."""
+    from infsup_contact.study.tensor_sides import box_gamma_block
+
+    xs, ys, zs = np.array([0.0, 0.3, 0.55, 0.8]), np.linspace(0.0, 1.0, 4), np.array([1.0, 1.2, 1.7, 2.0])
+    a = box_gamma_block(xs, ys, zs, k, gamma_top, route="eig")
+    b = box_gamma_block(xs, ys, zs, k, gamma_top, route="lu")
+    assert np.allclose(a, b, rtol=1e-10, atol=1e-13 * np.abs(b).max())

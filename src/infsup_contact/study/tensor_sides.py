@@ -47,14 +47,45 @@ def stiffness_1d(space) -> np.ndarray:
     return K
 
 
-def box_gamma_block(xs, ys, zs, k: int, gamma_top: bool) -> np.ndarray:
+def _free_pencils(spaces, dirichlet_z_end: int):
+    """1D (K, M) restricted to the free nodes: interior in x and y; in z every node but the
+    Dirichlet end (index ``dirichlet_z_end``: 0 or −1)."""
+    out = []
+    for d, s in enumerate(spaces):
+        K, M = stiffness_1d(s), gram_l2(s)
+        free = np.arange(1, s.dim - 1) if d < 2 else np.delete(np.arange(s.dim), dirichlet_z_end)
+        out.append((K[np.ix_(free, free)], M[np.ix_(free, free)]))
+    return out
+
+
+def box_gamma_block(xs, ys, zs, k: int, gamma_top: bool, route: str = "eig") -> np.ndarray:
     """X = (K_ff⁻¹)_ΓΓ of the Q_k Laplacian on the box xs × ys × zs.
 
     Γ is the top face (z = zs[-1]) when ``gamma_top``, else the bottom face; the other five
     faces are Dirichlet. The Γ dofs are ordered (ix, iy), x-major, ix and iy the interior node
     indices of the x and y lattices (the order of :func:`face_dofs_1d` ⊗ itself).
+
+    ``route``: "eig" — fast diagonalization (Lynch, Rice & Thomas 1964): with the 1D
+    generalized eigenpairs K_d V_d = M_d V_d Λ_d, V_dᵀ M_d V_d = I of the free nodes,
+    K_ff⁻¹ = (V_x ⊗ V_y ⊗ V_z) diag(1 / (λ_a + λ_b + λ_c)) (V_x ⊗ V_y ⊗ V_z)ᵀ, so
+    X = (V_x ⊗ V_y) diag(w) (V_x ⊗ V_y)ᵀ with w_ab = Σ_c V_z[Γ, c]² / (λ_a + λ_b + λ_c);
+    "lu" — sparse LU of the assembled 3D matrix, one solve per Γ dof (the check route).
     """
     spaces = [lagrange_1d(g, k) for g in (xs, ys, zs)]
+    if route == "eig":
+        import scipy.linalg as sla
+
+        (vals, vecs) = zip(*(sla.eigh(K, M) for K, M in _free_pencils(spaces, 0 if gamma_top else -1)))
+        face = -1 if gamma_top else 0
+        lam = vals[0][:, None, None] + vals[1][None, :, None] + vals[2][None, None, :]
+        w = (vecs[2][face] ** 2 / lam).sum(axis=2).ravel()
+        V = np.kron(vecs[0], vecs[1])
+        X = (V * w) @ V.T
+        return 0.5 * (X + X.T)
+    if route != "lu":
+        from ..errors import InputError
+
+        raise InputError("route", "eig, lu", got=route)
     M = [sp.csr_matrix(gram_l2(s)) for s in spaces]
     K = [sp.csr_matrix(stiffness_1d(s)) for s in spaces]
     A = (sp.kron(sp.kron(K[0], M[1]), M[2]) + sp.kron(sp.kron(M[0], K[1]), M[2])

@@ -143,3 +143,22 @@ def test_fast_diagonalization_equals_sparse_lu(k, gamma_top):
     a = box_gamma_block(xs, ys, zs, k, gamma_top, route="eig")
     b = box_gamma_block(xs, ys, zs, k, gamma_top, route="lu")
     assert np.allclose(a, b, rtol=1e-10, atol=1e-13 * np.abs(b).max())
+
+
+@pytest.mark.parametrize("case, k", [("R5.2", 1), ("R5.4", 1), ("T5", 2)])
+def test_nodal_twin_spans_the_restriction(case, k):
+    """For a nodal basis the space built on the clipped partition and the restricted registry
+    space are the same space: equal β_h from the two bases (θ where both pencils are accurate)."""
+    from infsup_contact.study.edge_dropping import beta_on, nodal_twin
+
+    n, n2, theta = 3, 6, 0.3
+    L, _, grids = geometry(n, n2, theta)
+    full = _face(case, k, n)
+    twin = nodal_twin(full, L)
+    a = beta_on(ClippedFace.of(full, L), full, k, grids, ("L2", "H"), 1e-7, cut=True)
+    b = beta_on(twin, twin.space, k, grids, ("L2", "H"), 1e-7, cut=False)
+    assert twin.dim == ClippedFace.of(full, L).dim
+    assert a["beta_L2"] == pytest.approx(b["beta_L2"], rel=1e-8)
+    assert a["beta_H"] == pytest.approx(b["beta_H"], rel=1e-4)
+    assert a["beta_L2_resolved"] and b["beta_H_resolved"]
+    assert nodal_twin(_face("DUAL-ALL", k, n), L) is None

@@ -90,11 +90,15 @@ class ClippedFace:
     kept: np.ndarray
 
     @classmethod
-    def of(cls, face_space, L: float, scale_x=None) -> "ClippedFace":
+    def of(cls, face_space, L: float, scale_x=None, cut: bool = True) -> "ClippedFace":
         """Restrict a :class:`~.face_spaces.FaceSpace` on (0, 1)² to (0, L) × (0, 1);
-        ``scale_x`` scales the x factor's basis functions (:func:`clip_1d`)."""
+        ``scale_x`` scales the x factor's basis functions (:func:`clip_1d`). ``cut=False``:
+        ``face_space`` is already a space of Γ pulled back to (0, 1)² (nothing is cut)."""
         sx, sy = face_space.factors
-        cx, kx = clip_1d(sx, L, scale_x)
+        cx, kx = clip_1d(sx, L if cut else 1.0, scale_x)
+        if not cut:
+            cx = local_basis_space(cx.breakpoints, cx.degree, cx.dofs, cx.local_coefficients,
+                                   continuous=sx.continuous, vanish_at_ends=False)
         part = TensorPartition(np.asarray(cx.breakpoints), np.asarray(face_space.breakpoints.ys, float))
         kept = (kx[:, None] * sy.dim + np.arange(sy.dim)[None, :]).ravel()
         return cls(FaceSpace(cx, sy, part), float(L), kept)

@@ -43,6 +43,7 @@ import numpy as np
 
 from ..discretization import registry
 from ..discretization.clipped_face import ClippedFace
+from ..discretization.face_spaces import FaceSpace
 from ..discretization.multipliers import MultiplierSpace
 from ..discretization.norms import gram_l2
 from ..discretization.quadrature import gauss_legendre_01
@@ -152,6 +153,55 @@ def scaled_cond(A_n: np.ndarray, r: np.ndarray, symmetric: bool) -> float:
     return _norm2(A_n * r[:, None]) * _norm2(inv / r[None, :])
 
 
+def nodal_twin(full, L: float):
+    """The same space built on the clipped partition (x_0, …, x_{N−1}, L), pulled back, when the
+    registry basis is nodal (Lagrange: ``local_coefficients`` None): its span equals the
+    restriction's (a piecewise polynomial on a sub-interval is a polynomial there, and the
+    dimensions agree), with a basis that stays well conditioned as θ → 0 (its nodes move
+    with L). ``None`` for the other bases (the dual ones), whose β_h is computed from the
+    restriction."""
+    if full.sx.local_coefficients is not None or full.sy.local_coefficients is not None:
+        return None
+    cut = ClippedFace.of(full, L)
+    sx = cut.space.sx
+    x = MultiplierSpace(sx.breakpoints, sx.degree, sx.continuous, False, sx.dofs, sx.dim)
+    return ClippedFace.of(FaceSpace(x, full.sy, cut.space.breakpoints), L, cut=False)
+
+
+def beta_on(face: ClippedFace, base, k: int, grids: dict, norms, h_rtol: float, cut: bool) -> dict:
+    """β_h in ``norms`` from the pencil of ``face`` in its L²(Γ)-normalized basis (β_h is
+    invariant under any change of basis; the normalized pencil is the best conditioned
+    diagonal one). ``base``: the face space ``face`` was made of (``cut`` as in
+    :meth:`ClippedFace.of`), rebuilt x-normalized for the H series so that its relative error
+    is per function, not relative to the largest one.
+
+    ``beta_<norm>_resolved``: β² above the pencil's round-off level
+    100 · dim · ε · ‖S‖ ‖G⁻¹‖ (normalized basis); below it the digits are noise."""
+    sx_dim = base.factors[0].dim
+    kept_x = face.kept[::base.factors[1].dim] // base.factors[1].dim
+    G_l2 = face.gram("L2")[0]
+    r = np.sqrt(np.diag(G_l2))
+    unit = np.outer(r, r)
+    S_n = interface_operator(face, k, grids) / unit
+    out = {}
+    for norm in norms:
+        if norm == "L2":
+            G = G_l2 / unit
+        elif norm == "H":
+            dx = np.ones(sx_dim)
+            dx[kept_x] = 1.0 / np.sqrt(np.diag(face.L * gram_l2(face.space.sx)))
+            G_x, info = ClippedFace.of(base, face.L, scale_x=dx, cut=cut).gram("H", rtol=h_rtol)
+            d = np.repeat(dx[kept_x], base.factors[1].dim)
+            G = G_x / np.outer(d, d) / unit
+            out.update(n_max=info["n_max"], h_rel_error=info["nmax_rel_error"], h_capped=info["capped"])
+        else:
+            raise InputError("norm", "H, L2", got=norm)
+        beta = spectrum(S_n, G).beta
+        noise = 100 * len(G) * np.finfo(float).eps * _norm2(S_n) / np.linalg.eigvalsh(G)[0]
+        out[f"beta_{norm}"], out[f"beta_{norm}_resolved"] = beta, bool(beta ** 2 > noise)
+    return out
+
+
 def edge_row(case: str, k: int, n: int, n2: int, theta: float, norms=("H", "L2"), h_rtol: float = 1e-6) -> dict:
     """β_h and the multiplier-block conditioning at one covered fraction θ (module docstring).
 
@@ -191,27 +241,17 @@ def edge_row(case: str, k: int, n: int, n2: int, theta: float, norms=("H", "L2")
         row[f"cond_D{tag}"] = scaled_cond(D_n, rr, False)
         row[f"cond_S{tag}"] = scaled_cond(S_n, rr, True)
         row[f"cond_G{tag}"] = scaled_cond(G_n, rr, True)
-    for norm in norms:
-        if norm == "L2":
-            G = G_n
-        elif norm == "H":
-            # the series in the x-normalized basis: its relative error is then per function,
-            # not relative to the largest one
-            dx = np.ones(full.sx.dim)
-            dx[kept_x] = 1.0 / np.sqrt(np.diag(face.L * gram_l2(face.space.sx)))
-            G_x, info = ClippedFace.of(full, L, scale_x=dx).gram("H", rtol=h_rtol)
-            d = np.repeat(dx[kept_x], full.sy.dim)
-            G = G_x / np.outer(d, d) / unit
-            row.update(n_max=info["n_max"], h_rel_error=info["nmax_rel_error"], h_capped=info["capped"])
-        else:
-            raise InputError("norm", "H, L2", got=norm)
-        row[f"beta_{norm}"] = spectrum(S_n, G).beta
+    twin = nodal_twin(full, L)
+    row["beta_route"] = "restricted" if twin is None else "clipped-nodal"
+    row.update(beta_on(face if twin is None else twin, full if twin is None else twin.space, k, grids,
+                       norms, h_rtol, cut=twin is None))
     return row
 
 
 COLUMNS = ("case", "k", "N", "N2", "theta", "L", "dim_M", "dropped", "kappa_min", "beta_H", "beta_L2",
            "cond_D", "cond_D_kappa", "cond_D_unit", "cond_S", "cond_S_kappa", "cond_S_unit", "cond_G",
-           "cond_G_kappa", "cond_G_unit", "n_max", "h_rel_error", "h_capped")
+           "cond_G_kappa", "cond_G_unit", "beta_route", "beta_H_resolved", "beta_L2_resolved", "n_max",
+           "h_rel_error", "h_capped")
 
 
 def edge_table(ks=(1,), ns=(4, 8), thetas=THETAS, cases=None, n2_factor: int = 2, norms=("H", "L2")):

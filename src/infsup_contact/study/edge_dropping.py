@@ -12,7 +12,15 @@ functions whose support misses Γ dropped, those of the partially covered column
 The norms are L²(Γ) and the exact H^{1/2}_00(Γ)' of the rectangle. θ = 1 is the full-face
 problem of :mod:`infsup_contact.models.membranes3d` with N1 = N, N2, multiplier mesh omega1.
 
-Multiplier block (reported in the unscaled and the κ-scaled basis):
+β_h depends on the space only. For nodal (Lagrange) bases it is computed on the *nodal twin*,
+the same case built on the clipped partition (x_0, …, x_{N−1}, L), which spans the restriction
+(:func:`nodal_twin`) with a basis that stays well conditioned as θ → 0; for the dual bases
+from the restriction itself, whose basis on the cut column degenerates (its k + 1 functions
+tend to multiples of one polynomial); ``beta_*_resolved`` says whether β² is above the
+pencil's round-off level (:func:`beta_on`).
+
+Multiplier block (reported in the unscaled, the κ-scaled and the L²-normalized basis of the
+restricted registry space; :func:`scaled_cond` resolves condition numbers far beyond 1/ε):
 
 * D — the secondary mortar matrix D_jp = ∫_Γ ψ_j N_p over *all* Lagrange nodes p of Ω1's face
   (square for the nodal spaces whose dofs are those nodes); cond₂(D) = σ_max/σ_min;

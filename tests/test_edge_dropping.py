@@ -162,3 +162,16 @@ def test_nodal_twin_spans_the_restriction(case, k):
     assert a["beta_H"] == pytest.approx(b["beta_H"], rel=1e-4)
     assert a["beta_L2_resolved"] and b["beta_H_resolved"]
     assert nodal_twin(_face("DUAL-ALL", k, n), L) is None
+
+
+def test_csv_entry(capsys):
+    """The module's command line prints one CSV row per (k, N, case, θ)."""
+    import csv
+    import io
+
+    from infsup_contact.study.edge_dropping import COLUMNS, main
+
+    assert main(["--k", "1", "--N", "2", "--theta", "1", "0.5", "--norm", "L2"]) == 0
+    rows = list(csv.DictReader(io.StringIO(capsys.readouterr().out)))
+    assert len(rows) == 2 * len(edge_cases(1)) and tuple(rows[0]) == COLUMNS
+    assert all(r["beta_H"] == "" for r in rows)            # H not asked

@@ -1,4 +1,6 @@
-"""Laplace side operators of boxes meshed by tensor grids, assembled from 1D matrices.
+"""Test helper: the second, NGSolve-free route of the edge-dropping study — Laplace side
+operators of boxes meshed by tensor grids, assembled from 1D matrices, and the couplings as
+Kronecker products of 1D Gauss sums.
 
 On a box meshed by the tensor grid xs × ys × zs, continuous Q_k is the tensor product of the
 1D continuous P_k Lagrange spaces (:func:`~infsup_contact.discretization.multipliers.make_space`),
@@ -9,7 +11,8 @@ and the Laplace stiffness is exactly
 with the 1D stiffness and mass matrices (Gauss–Legendre, exact). This is a second route to the
 side operators of :mod:`infsup_contact.models.membranes3d` (hexahedra), independent of NGSolve,
 and it takes any tensor grid: the study of partially covered faces
-(:mod:`.edge_dropping`) needs a body (0, L) × (0, 1) × (1, 2).
+(:mod:`infsup_contact.study.edge_dropping`, whose production path uses NGSolve) has a body
+(0, L) × (0, 1) × (1, 2); the tests check that both routes give the same β_h and condition numbers.
 
 The side's contribution to the interface operator is B X Bᵀ with X = (K_ff⁻¹)_ΓΓ, the Γ block of
 the inverse of K on the free dofs (= the inverse of K's Schur complement on the Γ dofs): the
@@ -22,9 +25,10 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from ..discretization.multipliers import local_monomial_coefficients, make_space
-from ..discretization.norms import gram_l2
-from ..discretization.quadrature import gauss_legendre_01
+from infsup_contact.discretization.multipliers import local_monomial_coefficients, make_space
+from infsup_contact.discretization.norms import gram_l2
+from infsup_contact.discretization.quadrature import gauss_legendre_01
+from infsup_contact.errors import InputError
 
 
 def lagrange_1d(xs: np.ndarray, k: int):
@@ -83,8 +87,6 @@ def box_gamma_block(xs, ys, zs, k: int, gamma_top: bool, route: str = "eig") -> 
         X = (V * w) @ V.T
         return 0.5 * (X + X.T)
     if route != "lu":
-        from ..errors import InputError
-
         raise InputError("route", "eig, lu", got=route)
     M = [sp.csr_matrix(gram_l2(s)) for s in spaces]
     K = [sp.csr_matrix(stiffness_1d(s)) for s in spaces]
@@ -111,3 +113,38 @@ def box_gamma_block(xs, ys, zs, k: int, gamma_top: bool, route: str = "eig") -> 
 def face_dofs_1d(xs, k: int) -> np.ndarray:
     """Indices of the interior nodes of the 1D lattice (the Γ dofs per direction)."""
     return np.arange(1, lagrange_1d(xs, k).dim - 1)
+
+
+def _merged(*grids, upper: float = 1.0) -> np.ndarray:
+    g = np.unique(np.concatenate([np.asarray(v, float) for v in grids] + [[upper]]))
+    g = g[g <= upper + 1e-14]
+    return g[np.concatenate([[True], np.diff(g) > 1e-13])]
+
+
+def couplings_1d(face, trace_space, axis: str, k: int) -> np.ndarray:
+    """∫ μ_a φ_p of the clipped x factor over (0, L) (``axis`` "x") or of the y factor over
+    (0, 1) (``axis`` "y") against every nodal function φ_p of a 1D Lagrange space, by
+    Gauss–Legendre on the common refinement (exact: degree ≤ 2k per interval)."""
+    if axis == "x":
+        grid = _merged(np.asarray(face.space.sx.breakpoints) * face.L, trace_space.breakpoints, upper=face.L)
+        mu = face.evaluate_x
+    else:
+        grid = _merged(face.space.sy.breakpoints, trace_space.breakpoints)
+        mu = face.space.sy.evaluate
+    t, w = gauss_legendre_01(k + 2)
+    a, b = grid[:-1, None], grid[1:, None]
+    pts, wts = (a + (b - a) * t).ravel(), ((b - a) * w).ravel()
+    return (mu(pts) * wts[:, None]).T @ trace_space.evaluate(pts)
+
+
+def tensor_interface_operator(face, k: int, grids: dict) -> np.ndarray:
+    """S = Σ_i B_i X_i B_iᵀ (c1 = c2 = 1) with B_i = B_i^x ⊗ B_i^y and X_i of
+    :func:`box_gamma_block`; ``grids`` {side: (xs, ys, zs)} as
+    :func:`infsup_contact.study.edge_dropping.geometry` gives them."""
+    S = np.zeros((face.dim, face.dim))
+    for i, (xs, ys, zs) in grids.items():
+        bx = couplings_1d(face, lagrange_1d(xs, k), "x", k)[:, face_dofs_1d(xs, k)]
+        by = couplings_1d(face, lagrange_1d(ys, k), "y", k)[:, face_dofs_1d(ys, k)]
+        B = np.kron(bx, by)
+        S += B @ box_gamma_block(xs, ys, zs, k, gamma_top=i == 1) @ B.T
+    return S

@@ -12,7 +12,9 @@ from infsup_contact.discretization.square import SQUARE, TensorPartition
 from infsup_contact.errors import InputError
 from infsup_contact.solvers.infsup import spectrum
 from infsup_contact.study.edge_dropping import (edge_cases, edge_row, geometry, interface_operator,
-                                                kappa_1d, scaled_cond)
+                                                kappa_1d, scaled_cond, side_pair)
+
+from _tensor_sides import box_gamma_block, couplings_1d, lagrange_1d, tensor_interface_operator
 
 
 def _face(case, k, n):
@@ -22,8 +24,8 @@ def _face(case, k, n):
 
 @pytest.mark.parametrize("k, n, n2", [(1, 2, 4), (2, 2, 3)])
 def test_full_cover_equals_the_face_engine(k, n, n2):
-    """θ = 1: the tensor-grid route (1D Kronecker assembly, no NGSolve) gives the β_h of the
-    full-face engine (NGSolve hexahedra, multiplier mesh omega1) for every edge case."""
+    """θ = 1: the study gives the β_h of the full-face engine (membranes3d hexahedra,
+    multiplier mesh omega1) for every edge case."""
     from infsup_contact.models.membranes3d import MEMBRANES3D
     from infsup_contact.solvers.infsup import beta_rows_all
 
@@ -43,10 +45,10 @@ def test_beta_invariant_under_kappa_scaling(case):
     from scratch on the scaled space, while the conditioning of D changes."""
     k, n, n2, theta = 1, 3, 6, 0.1
     row = edge_row(case, k, n, n2, theta)
-    L, _, grids = geometry(n, n2, theta)
+    L = geometry(n, n2, theta)[0]
     full = _face(case, k, n)
     scaled = ClippedFace.of(full, L, scale_x=1.0 / kappa_1d(full.sx, L))
-    S = interface_operator(scaled, k, grids)
+    S = interface_operator(scaled, side_pair(k, n, n2, theta))
     for norm in ("L2", "H"):
         beta = spectrum(S, scaled.gram(norm)[0]).beta
         assert beta == pytest.approx(row[f"beta_{norm}"], rel=1e-5)
@@ -137,8 +139,6 @@ def test_bad_input():
 def test_fast_diagonalization_equals_sparse_lu(k, gamma_top):
     """(K_ff⁻¹)_ΓΓ of a box with a non-cubic, non-uniform grid: the 1D eigen route equals the
     assembled 3D sparse LU route."""
-    from infsup_contact.study.tensor_sides import box_gamma_block
-
     xs, ys, zs = np.array([0.0, 0.3, 0.55, 0.8]), np.linspace(0.0, 1.0, 4), np.array([1.0, 1.2, 1.7, 2.0])
     a = box_gamma_block(xs, ys, zs, k, gamma_top, route="eig")
     b = box_gamma_block(xs, ys, zs, k, gamma_top, route="lu")
@@ -152,11 +152,14 @@ def test_nodal_twin_spans_the_restriction(case, k):
     from infsup_contact.study.edge_dropping import beta_on, nodal_twin
 
     n, n2, theta = 3, 6, 0.3
-    L, _, grids = geometry(n, n2, theta)
+    L = geometry(n, n2, theta)[0]
     full = _face(case, k, n)
     twin = nodal_twin(full, L)
-    a = beta_on(ClippedFace.of(full, L), full, k, grids, ("L2", "H"), 1e-7, cut=True)
-    b = beta_on(twin, twin.space, k, grids, ("L2", "H"), 1e-7, cut=False)
+    sides = side_pair(k, n, n2, theta)
+    def operator(face):
+        return interface_operator(face, sides)
+    a = beta_on(ClippedFace.of(full, L), full, operator, ("L2", "H"), 1e-7, cut=True)
+    b = beta_on(twin, twin.space, operator, ("L2", "H"), 1e-7, cut=False)
     assert twin.dim == ClippedFace.of(full, L).dim
     assert a["beta_L2"] == pytest.approx(b["beta_L2"], rel=1e-8)
     assert a["beta_H"] == pytest.approx(b["beta_H"], rel=1e-4)
@@ -175,3 +178,46 @@ def test_csv_entry(capsys):
     rows = list(csv.DictReader(io.StringIO(capsys.readouterr().out)))
     assert len(rows) == 2 * len(edge_cases(1)) and tuple(rows[0]) == COLUMNS
     assert all(r["beta_H"] == "" for r in rows)            # H not asked
+
+
+@pytest.mark.parametrize("k", [1, 2])
+def test_ngsolve_route_equals_tensor_route(k):
+    """Two independent routes to the same numbers (N = 4, N2 = 8): the production path (NGSolve
+    Q_k hexahedra of the boxes, Γ bases evaluated by NGSolve, couplings by tensor Gauss on the
+    rectangles) and the 1D Kronecker route of ``_tensor_sides`` (stiffness from 1D matrices,
+    fast diagonalization, couplings as products of 1D Gauss sums): β_h in both norms and the
+    condition numbers of S and D (D from 1D sums here) in the unscaled and κ-scaled bases."""
+    n, n2 = 4, 8
+    for theta in (1.0, 0.25):
+        L, xs1, grids = geometry(n, n2, theta)
+        t1 = lagrange_1d(xs1, k)
+        for case in edge_cases(k):
+            ng = edge_row(case, k, n, n2, theta)
+            tp = edge_row(case, k, n, n2, theta, operator=lambda f: tensor_interface_operator(f, k, grids))
+            for key in ("beta_H", "beta_L2"):
+                assert ng[key] == pytest.approx(tp[key], rel=1e-9), (case, theta, key)
+            for key in ("cond_S", "cond_S_kappa"):
+                assert ng[key] == pytest.approx(tp[key], rel=1e-8), (case, theta, key)
+            face = ClippedFace.of(_face(case, k, n), L)
+            r = np.sqrt(np.diag(face.gram("L2")[0]))
+            D = np.kron(couplings_1d(face, t1, "x", k), couplings_1d(face, t1, "y", k))
+            assert ng["cond_D"] == pytest.approx(scaled_cond(D / r[:, None], r, False), rel=1e-9)
+
+
+def test_narrow_side_mesh():
+    """Ω2 = (0, L) × (0, 1) × (1, 2) from MakeStructured3DMesh: its Γ trace is the uniform
+    grid of (0, L) × (0, 1) with (N2 k − 1)² dofs and Square(width = L) checks its extent."""
+    from infsup_contact.discretization.square import Square
+    from infsup_contact.models.membranes3d import subdomain_mesh
+
+    n, n2, theta, k = 2, 3, 0.4, 2
+    L = geometry(n, n2, theta)[0]
+    side1, side2 = side_pair(k, n, n2, theta)
+    assert np.allclose(side2.trace.partition.xs, np.linspace(0.0, L, n2 + 1), atol=1e-15)
+    assert np.allclose(side2.trace.partition.ys, np.linspace(0.0, 1.0, n2 + 1), atol=1e-15)
+    assert len(side2.trace.gamma_dofs) == (n2 * k - 1) ** 2 == SQUARE.trace_dimension(k, n2)
+    assert side1.trace.partition.xs[-1] == 1.0
+    with pytest.raises(InputError, match="tensor grid"):
+        Square(width=L).partition_of(subdomain_mesh("structured", n2, 2))
+    with pytest.raises(InputError, match="width"):
+        subdomain_mesh("structured", n2, 2, width=1.5)

@@ -9,7 +9,15 @@ cells by the fraction θ ∈ (0, 1]. Γ = (0, L) × (0, 1) × {1}. Ω1's whole t
 (those beyond L give zero couplings). The multipliers are a registered face space on Ω1's face
 (multiplier mesh ``omega1``) restricted to Γ (:class:`~infsup_contact.discretization.clipped_face.ClippedFace`:
 functions whose support misses Γ dropped, those of the partially covered column kept, cut).
-The norms are L²(Γ) and the exact H^{1/2}_00(Γ)' of the rectangle. θ = 1 is the full-face
+The norms are L²(Γ) and the exact H^{1/2}_00(Γ)' of the rectangle.
+
+Assembly is the engine's (:func:`side_pair`, :func:`interface_operator`): the bodies are
+``MakeStructured3DMesh`` hexahedra of the 3D membranes model (Ω2's with the mapping x ↦ L x,
+its Γ the face ``Square(width=L)``), X_i = (A_i⁻¹)_ΓΓ from the model's factorized side
+operator, the couplings B_i = ∫_Γ μ_j φ_d against NGSolve's Γ basis by tensor Gauss on the
+rectangles of the common refinement clipped at x = L, S by ``interface_terms`` /
+``combine_terms`` and β_h by ``spectrum``. The tests check it against an independent route
+(1D Kronecker assembly of the box Laplacians, ``tests/_tensor_sides.py``). θ = 1 is the full-face
 problem of :mod:`infsup_contact.models.membranes3d` with N1 = N, N2, multiplier mesh omega1.
 
 β_h depends on the space only. For nodal (Lagrange) bases it is computed on the *nodal twin*,
@@ -25,7 +33,7 @@ restricted registry space; :func:`scaled_cond` resolves condition numbers far be
 * D — the secondary mortar matrix D_jp = ∫_Γ ψ_j N_p over *all* Lagrange nodes p of Ω1's face
   (square for the nodal spaces whose dofs are those nodes); cond₂(D) = σ_max/σ_min;
 * S = Σ_i B_i X_i B_iᵀ — the interface operator (Schur complement of the saddle point
-  system on the multipliers, X_i = (K_i⁻¹)_ΓΓ, :mod:`.tensor_sides`); cond₂(S);
+  system on the multipliers, X_i = (K_i⁻¹)_ΓΓ); cond₂(S);
 * G — the L²(Γ) Gram matrix of the restricted basis.
 
 κ scaling (Popp, Wohlmuth, Gee & Wall, "Improved robustness and consistency of 3D contact
@@ -46,19 +54,21 @@ from __future__ import annotations
 import argparse
 import csv
 import sys
+from functools import lru_cache
 
 import numpy as np
 
 from ..discretization import registry
 from ..discretization.clipped_face import ClippedFace
 from ..discretization.face_spaces import FaceSpace
-from ..discretization.multipliers import MultiplierSpace
+from ..discretization.multipliers import MultiplierSpace, make_space
 from ..discretization.norms import gram_l2
 from ..discretization.quadrature import gauss_legendre_01
-from ..discretization.square import SQUARE, TensorPartition
+from ..discretization.square import SQUARE, Square, TensorPartition
 from ..errors import InputError
-from ..solvers.infsup import spectrum
-from .tensor_sides import box_gamma_block, face_dofs_1d, lagrange_1d
+from ..models import model_of_dim
+from ..models.schur import combine_terms, interface_terms
+from ..solvers.infsup import gram_factor, spectrum
 
 THETAS = (1.0, 0.5, 0.25, 0.1, 0.05, 0.01, 0.001)
 """The covered fractions of the last column swept by default (issue 28)."""
@@ -103,18 +113,18 @@ def kappa_1d(space: MultiplierSpace, L: float) -> np.ndarray:
     return (np.abs(vals).T @ (w * covered)) / full
 
 
-def couplings_1d(face: ClippedFace, trace_space, axis: str, k: int) -> np.ndarray:
-    """∫ μ_a φ_p of the clipped x factor over (0, L) (``axis`` "x") or of the y factor over
-    (0, 1) (``axis`` "y") against every nodal function φ_p of a side's 1D trace space, by
-    Gauss–Legendre on the common refinement (exact: degree ≤ 2k per interval)."""
-    if axis == "x":
-        grid = _merged(np.asarray(face.space.sx.breakpoints) * face.L, trace_space.breakpoints, upper=face.L)
-        mu = face.evaluate_x
-    else:
-        grid = _merged(face.space.sy.breakpoints, trace_space.breakpoints)
-        mu = face.space.sy.evaluate
-    pts, w = _integrate_1d(grid, lambda x: x, k + 2)
-    return (mu(pts) * w[:, None]).T @ trace_space.evaluate(pts)
+def couplings(face: ClippedFace, partition: TensorPartition, values, degree: int) -> np.ndarray:
+    """∫_Γ μ_j φ_d of the clipped face multipliers μ_j against functions φ_d given by
+    ``values`` (points (n, 2) ↦ (n, dim)), piecewise polynomial of degree ≤ ``degree`` − s on the
+    rectangles of ``partition`` (a side's trace): the tensor Gauss rule of
+    :meth:`Square.quadrature <infsup_contact.discretization.square.Square.quadrature>` per
+    rectangle of the common refinement of ``partition`` and G_h, clipped at x = L (exact)."""
+    L = face.L
+    xs = _merged(partition.xs, np.asarray(face.space.sx.breakpoints) * L, upper=L)
+    ys = _merged(partition.ys, face.space.sy.breakpoints)
+    pts, w = SQUARE.quadrature(TensorPartition(xs, ys), degree)
+    mu = face.space.evaluate(pts / np.array([L, 1.0]))
+    return (mu * w[:, None]).T @ values(pts)
 
 
 def geometry(n: int, n2: int, theta: float):
@@ -125,16 +135,33 @@ def geometry(n: int, n2: int, theta: float):
                                             np.linspace(1.0, 2.0, n2 + 1))}
 
 
-def interface_operator(face: ClippedFace, k: int, grids: dict) -> np.ndarray:
-    """S = Σ_i B_i X_i B_iᵀ (c1 = c2 = 1) with B_i = B_i^x ⊗ B_i^y the couplings of the face
-    multipliers with side i's Γ dofs and X_i = (K_i⁻¹)_ΓΓ (:func:`.tensor_sides.box_gamma_block`)."""
-    S = np.zeros((face.dim, face.dim))
-    for i, (xs, ys, zs) in grids.items():
-        bx = couplings_1d(face, lagrange_1d(xs, k), "x", k)[:, face_dofs_1d(xs, k)]
-        by = couplings_1d(face, lagrange_1d(ys, k), "y", k)[:, face_dofs_1d(ys, k)]
-        B = np.kron(bx, by)
-        S += B @ box_gamma_block(xs, ys, zs, k, gamma_top=i == 1) @ B.T
-    return S
+@lru_cache(maxsize=2)
+def _side(k: int, n: int, side: int, width: float):
+    """The side operator of the 3D membranes (:func:`~infsup_contact.models.membranes3d.side_operator`,
+    NGSolve Q_k hexahedra, from the model registry) of the N × N × N box of Ω_side of extent
+    ``width`` in x (``MakeStructured3DMesh`` with a mapping), its Γ the face (0, width) × (0, 1)."""
+    model = model_of_dim(3)
+    mesh = model.mesh(model.families[0], n, side, width=width)
+    return model.side_operator(mesh, k, gamma=Square(width=width))
+
+
+def side_pair(k: int, n: int, n2: int, theta: float) -> tuple:
+    """The side operators of Ω1 = (0, 1)³ (N cells per direction, Γ its whole top face: Ω1's face
+    is natural beyond L too, its dofs there get zero couplings) and Ω2 = (0, L) × (0, 1) × (1, 2)
+    (N2 cells per direction), L of :func:`geometry`. Kept for the next call (the sweep asks
+    for every space at one θ in a row)."""
+    return _side(k, n, 1, 1.0), _side(k, n2, 2, geometry(n, n2, theta)[0])
+
+
+def interface_operator(face: ClippedFace, sides) -> np.ndarray:
+    """S = Σ_i B_i X_i B_iᵀ (c1 = c2 = 1), X_i = (A_i⁻¹)_ΓΓ of the NGSolve side operators
+    (:func:`side_pair`), B_i = ∫_Γ μ_j φ_d against the Γ basis of side i
+    (:meth:`Square.trace_basis`, :func:`couplings`); the engine's
+    :func:`~infsup_contact.models.schur.interface_terms` and ``combine_terms``."""
+    s = max(face.space.sx.degree, face.space.sy.degree)
+    B = [couplings(face, side.trace.partition, lambda p, t=side.trace: t.gamma.trace_basis(t, p),
+                   side.trace.fes.globalorder + s) for side in sides]
+    return combine_terms(interface_terms(B, sides), (1.0, 1.0))
 
 
 def _norm2(A: np.ndarray) -> float:
@@ -176,12 +203,13 @@ def nodal_twin(full, L: float):
     return ClippedFace.of(FaceSpace(x, full.sy, cut.space.breakpoints), L, cut=False)
 
 
-def beta_on(face: ClippedFace, base, k: int, grids: dict, norms, h_rtol: float, cut: bool) -> dict:
+def beta_on(face: ClippedFace, base, operator, norms, h_rtol: float, cut: bool) -> dict:
     """β_h in ``norms`` from the pencil of ``face`` in its L²(Γ)-normalized basis (β_h is
     invariant under any change of basis; the normalized pencil is the best conditioned
     diagonal one). ``base``: the face space ``face`` was made of (``cut`` as in
     :meth:`ClippedFace.of`), rebuilt x-normalized for the H series so that its relative error
-    is per function, not relative to the largest one.
+    is per function, not relative to the largest one. ``operator``: ClippedFace ↦ its interface
+    operator S (:func:`interface_operator` of :func:`side_pair`).
 
     ``beta_<norm>_resolved``: β² above the pencil's round-off level
     100 · dim · ε · ‖S‖ ‖G⁻¹‖ (normalized basis); below it the digits are noise."""
@@ -190,7 +218,7 @@ def beta_on(face: ClippedFace, base, k: int, grids: dict, norms, h_rtol: float, 
     G_l2 = face.gram("L2")[0]
     r = np.sqrt(np.diag(G_l2))
     unit = np.outer(r, r)
-    S_n = interface_operator(face, k, grids) / unit
+    S_n = operator(face) / unit
     out = {}
     for norm in norms:
         if norm == "L2":
@@ -204,19 +232,23 @@ def beta_on(face: ClippedFace, base, k: int, grids: dict, norms, h_rtol: float, 
             out.update(n_max=info["n_max"], h_rel_error=info["nmax_rel_error"], h_capped=info["capped"])
         else:
             raise InputError("norm", "H, L2", got=norm)
-        beta = spectrum(S_n, G).beta
+        factor = gram_factor(G)
+        beta = spectrum(S_n, factor=factor).beta
         noise = 100 * len(G) * np.finfo(float).eps * _norm2(S_n) / np.linalg.eigvalsh(G)[0]
         out[f"beta_{norm}"], out[f"beta_{norm}_resolved"] = beta, bool(beta ** 2 > noise)
     return out
 
 
-def edge_row(case: str, k: int, n: int, n2: int, theta: float, norms=("H", "L2"), h_rtol: float = 1e-6) -> dict:
+def edge_row(case: str, k: int, n: int, n2: int, theta: float, norms=("H", "L2"), h_rtol: float = 1e-6,
+             operator=None) -> dict:
     """β_h and the multiplier-block conditioning at one covered fraction θ (module docstring).
 
     β_h is computed from the pencil in the L²(Γ)-normalized basis (β_h is invariant under any
     diagonal change of basis, κ scaling included; the normalized pencil is the best
     conditioned of them); the condition numbers are those of the unscaled registry basis and of
-    the κ-scaled basis (:func:`scaled_cond`).
+    the κ-scaled basis (:func:`scaled_cond`). ``operator``: ClippedFace ↦ S, by default
+    :func:`interface_operator` with the NGSolve sides of :func:`side_pair` (the tests pass an
+    independent route).
 
     Returns
     -------
@@ -231,17 +263,21 @@ def edge_row(case: str, k: int, n: int, n2: int, theta: float, norms=("H", "L2")
     for key, v in (("N", n), ("N2", n2)):
         if not isinstance(v, (int, np.integer)) or v < 1:
             raise InputError(key, "an integer >= 1", got=v)
-    L, xs1, grids = geometry(n, n2, theta)
+    L, xs1, _ = geometry(n, n2, theta)
     full = registry.case_space(case, k, TensorPartition(xs1, xs1), SQUARE)
     face = ClippedFace.of(full, L)
     kept_x = face.kept[::full.sy.dim] // full.sy.dim
     kappa = np.repeat(kappa_1d(full.sx, L)[kept_x], full.sy.dim)
-    t1 = lagrange_1d(xs1, k)
+    if operator is None:
+        sides = side_pair(k, n, n2, theta)
+        operator = lambda f: interface_operator(f, sides)      # noqa: E731
+    t1 = make_space(xs1, k, True, False)                      # the Q_k Lagrange basis of Ω1's face
+    primal = FaceSpace(t1, t1, TensorPartition(xs1, xs1))
     G_l2 = face.gram("L2")[0]
     r = np.sqrt(np.diag(G_l2))            # ψ_j = r_j ψ̂_j, ψ̂_j of unit L²(Γ) norm
     unit = np.outer(r, r)
-    S_n = interface_operator(face, k, grids) / unit
-    D_n = np.kron(couplings_1d(face, t1, "x", k), couplings_1d(face, t1, "y", k)) / r[:, None]
+    S_n = operator(face) / unit
+    D_n = couplings(face, primal.breakpoints, primal.evaluate, k + max(full.sx.degree, full.sy.degree)) / r[:, None]
     G_n = G_l2 / unit
     row = dict(case=case, k=k, N=n, N2=n2, theta=theta, L=L, dim_M=face.dim, dropped=full.dim - face.dim,
                kappa_min=float(kappa.min()))
@@ -251,7 +287,7 @@ def edge_row(case: str, k: int, n: int, n2: int, theta: float, norms=("H", "L2")
         row[f"cond_G{tag}"] = scaled_cond(G_n, rr, True)
     twin = nodal_twin(full, L)
     row["beta_route"] = "restricted" if twin is None else "clipped-nodal"
-    row.update(beta_on(face if twin is None else twin, full if twin is None else twin.space, k, grids,
+    row.update(beta_on(face if twin is None else twin, full if twin is None else twin.space, operator,
                        norms, h_rtol, cut=twin is None))
     return row
 
@@ -264,9 +300,10 @@ COLUMNS = ("case", "k", "N", "N2", "theta", "L", "dim_M", "dropped", "kappa_min"
 
 def edge_table(ks=(1,), ns=(4, 8), thetas=THETAS, cases=None, n2_factor: int = 2, norms=("H", "L2")):
     """Rows of :func:`edge_row` for every k, N (N2 = ``n2_factor`` N: a primary side fine enough
-    that B2 has full row rank for the continuous spaces of Ω1's face), case and θ."""
+    that B2 has full row rank for the continuous spaces of Ω1's face), θ and case (θ before the
+    case: the side operators of one θ serve every space)."""
     return [edge_row(c, k, n, n2_factor * n, th, norms)
-            for k in ks for n in ns for c in (edge_cases(k) if cases is None else cases) for th in thetas]
+            for k in ks for n in ns for th in thetas for c in (edge_cases(k) if cases is None else cases)]
 
 
 def main(argv=None) -> int:
@@ -283,8 +320,8 @@ def main(argv=None) -> int:
     out.writeheader()
     for k in a.k:
         for n in a.N:
-            for c in (edge_cases(k) if a.case is None else a.case):
-                for th in a.theta:
+            for th in a.theta:
+                for c in (edge_cases(k) if a.case is None else a.case):
                     out.writerow(edge_row(c, k, n, a.n2_factor * n, th, tuple(a.norm)))
                     sys.stdout.flush()
     return 0

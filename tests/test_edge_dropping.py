@@ -221,3 +221,12 @@ def test_narrow_side_mesh():
         Square(width=L).partition_of(subdomain_mesh("structured", n2, 2))
     with pytest.raises(InputError, match="width"):
         subdomain_mesh("structured", n2, 2, width=1.5)
+
+
+def test_h_cap_bounds_the_series():
+    """``h_cap`` bounds n_max of the H series and the capped row says so; a larger cap lowers
+    the error estimate."""
+    small = edge_row("R5.4", 1, 2, 4, 0.05, norms=("H",), h_cap=64)
+    large = edge_row("R5.4", 1, 2, 4, 0.05, norms=("H",), h_cap=4096)
+    assert small["n_max"] <= 64 and small["h_capped"]
+    assert large["n_max"] > 64 and large["h_rel_error"] < small["h_rel_error"]

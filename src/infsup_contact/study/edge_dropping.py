@@ -203,13 +203,14 @@ def nodal_twin(full, L: float):
     return ClippedFace.of(FaceSpace(x, full.sy, cut.space.breakpoints), L, cut=False)
 
 
-def beta_on(face: ClippedFace, base, operator, norms, h_rtol: float, cut: bool) -> dict:
+def beta_on(face: ClippedFace, base, operator, norms, h_rtol: float, cut: bool, h_cap: int | None = None) -> dict:
     """β_h in ``norms`` from the pencil of ``face`` in its L²(Γ)-normalized basis (β_h is
     invariant under any change of basis; the normalized pencil is the best conditioned
     diagonal one). ``base``: the face space ``face`` was made of (``cut`` as in
     :meth:`ClippedFace.of`), rebuilt x-normalized for the H series so that its relative error
     is per function, not relative to the largest one. ``operator``: ClippedFace ↦ its interface
-    operator S (:func:`interface_operator` of :func:`side_pair`).
+    operator S (:func:`interface_operator` of :func:`side_pair`). ``h_cap``: the largest n_max of
+    the H series (default that of :func:`~infsup_contact.discretization.face_norms.gram_h_face`).
 
     ``beta_<norm>_resolved``: β² above the pencil's round-off level
     100 · dim · ε · ‖S‖ ‖G⁻¹‖ (normalized basis); below it the digits are noise."""
@@ -226,7 +227,8 @@ def beta_on(face: ClippedFace, base, operator, norms, h_rtol: float, cut: bool) 
         elif norm == "H":
             dx = np.ones(sx_dim)
             dx[kept_x] = 1.0 / np.sqrt(np.diag(face.L * gram_l2(face.space.sx)))
-            G_x, info = ClippedFace.of(base, face.L, scale_x=dx, cut=cut).gram("H", rtol=h_rtol)
+            cap = {} if h_cap is None else {"n_cap": h_cap}
+            G_x, info = ClippedFace.of(base, face.L, scale_x=dx, cut=cut).gram("H", rtol=h_rtol, **cap)
             d = np.repeat(dx[kept_x], base.factors[1].dim)
             G = G_x / np.outer(d, d) / unit
             out.update(n_max=info["n_max"], h_rel_error=info["nmax_rel_error"], h_capped=info["capped"])
@@ -240,7 +242,7 @@ def beta_on(face: ClippedFace, base, operator, norms, h_rtol: float, cut: bool) 
 
 
 def edge_row(case: str, k: int, n: int, n2: int, theta: float, norms=("H", "L2"), h_rtol: float = 1e-6,
-             operator=None) -> dict:
+             operator=None, h_cap: int | None = None) -> dict:
     """β_h and the multiplier-block conditioning at one covered fraction θ (module docstring).
 
     β_h is computed from the pencil in the L²(Γ)-normalized basis (β_h is invariant under any
@@ -288,7 +290,7 @@ def edge_row(case: str, k: int, n: int, n2: int, theta: float, norms=("H", "L2")
     twin = nodal_twin(full, L)
     row["beta_route"] = "restricted" if twin is None else "clipped-nodal"
     row.update(beta_on(face if twin is None else twin, full if twin is None else twin.space, operator,
-                       norms, h_rtol, cut=twin is None))
+                       norms, h_rtol, cut=twin is None, h_cap=h_cap))
     return row
 
 
@@ -298,11 +300,12 @@ COLUMNS = ("case", "k", "N", "N2", "theta", "L", "dim_M", "dropped", "kappa_min"
            "h_rel_error", "h_capped")
 
 
-def edge_table(ks=(1,), ns=(4, 8), thetas=THETAS, cases=None, n2_factor: int = 2, norms=("H", "L2")):
+def edge_table(ks=(1,), ns=(4, 8), thetas=THETAS, cases=None, n2_factor: int = 2, norms=("H", "L2"),
+               h_cap: int | None = None):
     """Rows of :func:`edge_row` for every k, N (N2 = ``n2_factor`` N: a primary side fine enough
     that B2 has full row rank for the continuous spaces of Ω1's face), θ and case (θ before the
     case: the side operators of one θ serve every space)."""
-    return [edge_row(c, k, n, n2_factor * n, th, norms)
+    return [edge_row(c, k, n, n2_factor * n, th, norms, h_cap=h_cap)
             for k in ks for n in ns for th in thetas for c in (edge_cases(k) if cases is None else cases)]
 
 
@@ -315,6 +318,8 @@ def main(argv=None) -> int:
     ap.add_argument("--case", nargs="+", default=None, help="registered face spaces (default: edge_cases(k))")
     ap.add_argument("--n2-factor", type=int, default=2, help="N2 = factor * N (Ω2's cells per direction)")
     ap.add_argument("--norm", nargs="+", default=["H", "L2"])
+    ap.add_argument("--h-cap", type=int, default=None,
+                    help="largest n_max of the H series (default 8192; θ = 0.001 needs more, see h_capped)")
     a = ap.parse_args(argv)
     out = csv.DictWriter(sys.stdout, COLUMNS, extrasaction="ignore")
     out.writeheader()
@@ -322,7 +327,7 @@ def main(argv=None) -> int:
         for n in a.N:
             for th in a.theta:
                 for c in (edge_cases(k) if a.case is None else a.case):
-                    out.writerow(edge_row(c, k, n, a.n2_factor * n, th, tuple(a.norm)))
+                    out.writerow(edge_row(c, k, n, a.n2_factor * n, th, tuple(a.norm), h_cap=a.h_cap))
                     sys.stdout.flush()
     return 0
 

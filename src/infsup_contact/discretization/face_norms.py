@@ -34,8 +34,13 @@ def gram_l2_face(space) -> np.ndarray:
     return np.kron(gram_l2(sx), gram_l2(sy))
 
 
-def partial_gram(space, n_max: int) -> np.ndarray:
+def partial_gram(space, n_max: int, aspect: float = 1.0) -> np.ndarray:
     """S(n_max) = Σ_{m,n ≤ n_max} c_mn c_mnᵀ / (π√(m² + n²)), c_mn = c^x_m ⊗ c^y_n.
+
+    ``aspect`` = a ≠ 1: the space lives on the rectangle (0, a) × (0, 1), given by its pull-back
+    μ̃(s, y) = μ(a s, y) on the unit square. The Dirichlet Laplacian of the rectangle has the
+    L²-orthonormal eigenfunctions (2/√a) sin(mπx/a) sin(nπy), eigenvalues π²((m/a)² + n²), and
+    the coefficient of μ is √a μ̃_mn, so the weight is a / (π√((m/a)² + n²)).
 
     With A[(a, a'), m] = c^x_{a,m} c^x_{a',m} and B[(b, b'), n] = c^y_{b,n} c^y_{b',n},
     S[(a, b), (a', b')] = (A W Bᵀ)[(a, a'), (b, b')]: n_max² · (dim M^y)² + n_max · (dim M^x dim M^y)²
@@ -49,7 +54,7 @@ def partial_gram(space, n_max: int) -> np.ndarray:
     flat = np.zeros((dx * dx, dy * dy))
     for start in range(0, n_max, _CHUNK):
         m = n[start:start + _CHUNK]
-        W = 1.0 / (np.pi * np.sqrt(m[:, None] ** 2 + n[None, :] ** 2))
+        W = aspect / (np.pi * np.sqrt((m[:, None] / aspect) ** 2 + n[None, :] ** 2))
         flat += A[:, start:start + _CHUNK] @ (W @ B.T)
     G = flat.reshape(dx, dx, dy, dy).transpose(0, 2, 1, 3).reshape(dx * dy, dx * dy)
     return 0.5 * (G + G.T)
@@ -69,7 +74,7 @@ def tail_exponent(space, n_max: int) -> float:
 
 
 def gram_h_face(space, rtol: float = 1e-6, n_start: int | None = None, n_cap: int = N_MAX_CAP // 8,
-                exponent: float | None = None) -> tuple[np.ndarray, dict]:
+                exponent: float | None = None, aspect: float = 1.0) -> tuple[np.ndarray, dict]:
     """Gram matrix of the M = H^{1/2}_00(Γ)' norm on the square (module docstring).
 
     Partial sums S(n) at n = n0, 2n0, 4n0, ... are extrapolated,
@@ -87,6 +92,9 @@ def gram_h_face(space, rtol: float = 1e-6, n_start: int | None = None, n_cap: in
         Largest n_max (``info["capped"]`` when the estimate is still above rtol there).
     exponent : float, optional
         Tail exponent p; default 4 for continuous spaces vanishing on ∂Γ, else 2 (:func:`smooth_tail`).
+    aspect : float
+        Width a of the rectangle (0, a) × (0, 1) the pulled-back ``space`` stands for
+        (:func:`partial_gram`); 1 for the square.
 
     Returns
     -------
@@ -99,7 +107,9 @@ def gram_h_face(space, rtol: float = 1e-6, n_start: int | None = None, n_cap: in
     p = (4.0 if smooth_tail(space) else 2.0) if exponent is None else float(exponent)
     n_int = max(f.n_intervals for f in space.factors)
     n0 = max(16, 2 * (space.degree + 1) * n_int) if n_start is None else int(n_start)
-    return extrapolated_series(lambda n: partial_gram(space, n), n0, n_cap, p, rtol)
+    if not aspect > 0:
+        raise InputError("aspect", "a positive float", got=aspect)
+    return extrapolated_series(lambda n: partial_gram(space, n, aspect), n0, n_cap, p, rtol)
 
 
 def extrapolated_series(partial, n0: int, n_cap: int, p: float, rtol: float) -> tuple[np.ndarray, dict]:

@@ -77,11 +77,17 @@ class Square(Interface):
     cell : {"quad", "trig"}
         Shape of the boundary elements on Γ: rectangles of a hexahedral mesh, or each
         rectangle cut in two triangles (a tetrahedral mesh).
+    width : float
+        Γ's extent in x (1: the unit face). A narrower face (0, width) × (0, 1) is the trace
+        of a narrower body (:mod:`infsup_contact.study.edge_dropping`); the trace
+        (:meth:`trace`, :meth:`trace_basis`, :meth:`quadrature`) serves it, the multiplier
+        spaces, norms and counts of this class are those of the unit face.
     """
 
     boundary: str = "gamma"
     z: float = 1.0
     cell: str = "quad"
+    width: float = 1.0
 
     def __post_init__(self):
         if self.cell not in CELL_SHAPES:
@@ -124,7 +130,7 @@ class Square(Interface):
                              minlength=part.cells)
         if (any(len(v) != nv for _, v in elements) or np.any(cell[0] < 0) or np.any(cell[1] < 0)
                 or np.any(counts != per_cell) or part.xs[0] != 0.0 or part.ys[0] != 0.0
-                or part.xs[-1] != 1.0 or part.ys[-1] != 1.0):
+                or part.xs[-1] != self.width or part.ys[-1] != 1.0):
             raise InputError("mesh", f"a face Γ tiled by a tensor grid of {self.cell}s "
                              f"({len(elements)} elements on {len(part.xs) - 1} x {len(part.ys) - 1} cells)")
         return part

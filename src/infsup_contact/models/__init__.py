@@ -34,3 +34,12 @@ def model_taking(param: str) -> Model:
         if any(p.name == param and p.side is None for p in m.params):
             return m
     raise KeyError(f"no registered model takes the parameter {param!r}")
+
+
+def model_of_dim(dim: int) -> Model:
+    """The first registered model whose bodies have dimension ``dim`` (3: the membranes in 3D),
+    for a study of a geometry the command line does not offer (:mod:`infsup_contact.study.edge_dropping`)."""
+    for m in MODELS.values():
+        if m.dim == dim:
+            return m
+    raise KeyError(f"no registered model of dimension {dim}")

@@ -54,14 +54,20 @@ BETA_DIRICHLET = f"{FAR}|{LATERAL}"
 """Where β_h's sides vanish: all of ∂Ω_i∖Γ (an NGSolve boundary regexp)."""
 
 
-def subdomain_mesh(family: str, n: int, side: int, *, element: str = "hex") -> ngsolve.Mesh:
+def subdomain_mesh(family: str, n: int, side: int, *, element: str = "hex", width: float = 1.0) -> ngsolve.Mesh:
     """The N × N × N structured mesh of Ω_side: Γ named ``gamma``, the far face :data:`FAR`, the
     lateral faces :data:`LATERAL`.
+
+    ``width``: the body's extent in x, (0, width) × (0, 1) × (side − 1, side) (the ``mapping`` of
+    ``MakeStructured3DMesh`` scales x); 1 is the model's bodies. A narrower Ω2 covers Ω1's face
+    partially (:mod:`infsup_contact.study.edge_dropping`); its Γ is then
+    ``Square(width=width)``.
 
     Raises
     ------
     InputError
-        For a family other than ``structured``, an element not in :data:`ELEMENTS` or N < 1.
+        For a family other than ``structured``, an element not in :data:`ELEMENTS`, N < 1 or a
+        width outside (0, 1].
     """
     if family not in FAMILIES_3D:
         raise InputError("family", f"{', '.join(FAMILIES_3D)} (the 3D model's meshes)", got=family)
@@ -69,7 +75,10 @@ def subdomain_mesh(family: str, n: int, side: int, *, element: str = "hex") -> n
         raise InputError("element", ", ".join(ELEMENTS), got=element)
     if not isinstance(n, (int, np.integer)) or n < 1:
         raise InputError("N", "an integer >= 1", got=n)
-    ngmesh = ngmeshes.MakeStructured3DMesh(hexes=element == "hex", nx=int(n)).ngmesh
+    if not 0.0 < width <= 1.0:
+        raise InputError("width", "a width 0 < width <= 1 of the body in x", got=width)
+    mapping = None if width == 1.0 else (lambda x, y, z: (width * x, y, z))
+    ngmesh = ngmeshes.MakeStructured3DMesh(hexes=element == "hex", nx=int(n), mapping=mapping).ngmesh
     if side == 2:
         for p in ngmesh.Points():
             p[2] += 1.0
@@ -100,12 +109,15 @@ class MembraneSide(SideOperator):
     stiffness_all: sp.csr_matrix | None = None
 
 
-def side_operator(mesh, k: int, route: str = "auto", dirichlet: str = BETA_DIRICHLET) -> MembraneSide:
+def side_operator(mesh, k: int, route: str = "auto", dirichlet: str = BETA_DIRICHLET, gamma=None) -> MembraneSide:
     """Factorize the Laplace stiffness K_i of Q_k / P_k once, Γ dofs last (c = 1), u_i = 0 on
     ``dirichlet`` (default all of ∂Ω_i∖Γ). With natural lateral faces the Γ dofs on ∂Γ are free:
-    the trace spans continuous Q_k / P_k on the partition, ∂Γ included."""
+    the trace spans continuous Q_k / P_k on the partition, ∂Γ included.
+
+    ``gamma``: the interface whose trace is taken (default :func:`face_of` the mesh, the unit
+    face; a narrower body passes ``Square(width=...)``)."""
     fes = displacement_space(mesh, k, dirichlet)
-    trace = face_of(mesh).trace(fes)
+    trace = (face_of(mesh) if gamma is None else gamma).trace(fes)
     free_mask = np.array(fes.FreeDofs(), dtype=bool)
     is_gamma = np.zeros(fes.ndof, dtype=bool)
     is_gamma[trace.gamma_dofs] = True

@@ -133,6 +133,8 @@ def _ci():
     (lambda f: f.update(nonmatching=[[5, 5]]), "face.nonmatching[0]"),
     (lambda f: f.update(model="membranes"), "face.model"),
     (lambda f: f.update(norms=["H", "H1"]), "face.norms"),
+    (lambda f: f.update(max_N={"prism": 8}), "face.max_N.prism"),
+    (lambda f: f.update(max_N={"hex": 4}), "face.max_N.hex"),
 ])
 def test_bad_face_key_is_named(mutate, key):
     from infsup_contact.config_checks import ConfigError, check_config
@@ -164,3 +166,22 @@ def test_face_section_renders_under_any_verdict(verdict):
     t = small_face_tables()
     text = render((ROOT / "paper" / "face.tex").read_text(), face_macros(t["beta"], t["claims"].assign(verdict=verdict)))
     assert "\\byverdict" not in text and "\\faceOutcome" not in text
+
+
+def test_max_n_trims_the_pairs_of_its_element_only():
+    from infsup_contact.config_face import face_pairs
+
+    fc = {"N": [4, 5, 6, 8, 12], "nonmatching": [[4, 5], [8, 9]], "max_N": {"tet": 6}}
+    assert face_pairs(fc, "tet") == [(4, 4), (5, 5), (6, 6), (4, 5)]
+    assert face_pairs(fc, "hex") == [(4, 4), (5, 5), (6, 6), (8, 8), (12, 12), (4, 5), (8, 9)]
+
+
+def test_quadrilateral_element_spaces_are_not_built_on_triangles():
+    """The QUAD9-element multipliers pair with rectangle faces only (``SpaceSpec.face_cells``)."""
+    quad_only = [s for s in SPACES.values() if s.face_cells == ("quad",)]
+    assert quad_only and all(SQUARE.builds(s) and not SQUARE_TRIG.builds(s) for s in quad_only)
+    x = __import__("numpy").linspace(0.0, 1.0, 3)
+    from infsup_contact.discretization.square import TensorPartition
+
+    with pytest.raises(InputError, match="faces"):
+        SQUARE_TRIG.space(quad_only[0], 2, TensorPartition(x, x))

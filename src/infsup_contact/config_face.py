@@ -29,11 +29,26 @@ def check_face(cfg) -> None:
         if element not in options:
             raise ConfigError(f"face.elements[{i}]", f"not an element of {model.name}", got=element,
                               allowed=", ".join(options))
+    for element, top in (fc.get("max_N") or {}).items():
+        if element not in fc["elements"]:
+            raise ConfigError(f"face.max_N.{element}", "not an element of face.elements", got=element,
+                              allowed=", ".join(fc["elements"]))
+        if sum(n <= top for n in fc["N"]) < 3:
+            raise ConfigError(f"face.max_N.{element}", "keeps fewer than 3 matching meshes of face.N (a slope "
+                              "fit needs 3)", got=top, allowed=f">= {sorted(fc['N'])[2]}")
     for i, pair in enumerate(fc["nonmatching"]):
         if pair[0] == pair[1]:
             raise ConfigError(f"face.nonmatching[{i}]", "a non-matching pair needs N1 != N2", got=pair,
                               allowed="[N1, N2] with N1 != N2 (matching meshes go under face.N)")
     _check_face_cases(cfg, fc)
+
+
+def face_pairs(fc, element: str) -> list:
+    """The mesh pairs of one element: every matching N and non-matching pair of the config,
+    up to the element's ``face.max_N`` where it has one."""
+    top = (fc.get("max_N") or {}).get(element, max(max(fc["N"]), *(max(p) for p in fc["nonmatching"])))
+    pairs = [(n, n) for n in fc["N"]] + [tuple(p) for p in fc["nonmatching"]]
+    return list(dict.fromkeys((a, b) for a, b in pairs if max(a, b) <= top))
 
 
 def _check_face_cases(cfg, fc) -> None:

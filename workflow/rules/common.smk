@@ -7,6 +7,7 @@ from snakemake.utils import validate
 
 from infsup_contact import resources
 from infsup_contact.config_checks import ConfigError, check_config, speed_accuracy_scene
+from infsup_contact.config_face import face_pairs
 from infsup_contact.config_yaml import check_config_files
 from infsup_contact.config_memory import check_job_memory, memory_notes
 from infsup_contact.discretization.series import seeds, series_of_pairs

@@ -9,7 +9,7 @@
 
 def face_mem_mb(wildcards):
     """mem_mb of a face job: the 3D β estimate of its largest pair (resources.face_beta_estimate, +25 %)."""
-    pairs = [(n, n) for n in FACE["N"]] + [tuple(p) for p in FACE["nonmatching"]]
+    pairs = face_pairs(FACE, wildcards.element)
     return max(resources.job_mem_mb(resources.beta_estimate("structured", int(wildcards.k), n1, n2, "omega2",
                                                             tuple(FACE["norms"]), dim=3)) for n1, n2 in pairs)
 

@@ -13,15 +13,19 @@ register_user_spaces(snakemake.config)  # noqa: F821
 
 import time  # noqa: E402
 
-from infsup_contact.discretization.registry import ids_valid_for  # noqa: E402
+from infsup_contact.config_face import face_pairs  # noqa: E402
+from infsup_contact.discretization.registry import SPACES, ids_valid_for  # noqa: E402
 from infsup_contact.io import write_csv_atomic  # noqa: E402
 from infsup_contact.study.beta_batches import beta_batch_rows  # noqa: E402
+from infsup_contact.study.face_claims import element_interfaces  # noqa: E402
 
 wc, fc = snakemake.wildcards, snakemake.params.fc  # noqa: F821
 k = int(wc.k)
-pairs = list(dict.fromkeys([(n, n) for n in fc["N"]] + [tuple(p) for p in fc["nonmatching"]]))
+pairs = face_pairs(fc, wc.element)
+gamma = element_interfaces(fc["model"], [wc.element])[wc.element]
+cases = [c for c in ids_valid_for(k, fc["cases"]) if gamma.builds(SPACES[c])]  # e.g. QUAD9 spaces: rectangles
 t0 = time.perf_counter()
-frame = beta_batch_rows(fc["model"], "structured", k, pairs, ids_valid_for(k, fc["cases"]), ("omega2",),
+frame = beta_batch_rows(fc["model"], "structured", k, pairs, cases, ("omega2",),
                         norms=tuple(fc["norms"]), element=wc.element)
 frame = frame.drop(columns=[c for c in frame.columns if c.startswith("t_")])  # timings: benchmark tree
 frame.insert(0, "element", wc.element)

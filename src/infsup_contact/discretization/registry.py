@@ -85,6 +85,10 @@ class SpaceSpec:
         ``face_build(k, partition) -> space`` on a tensor partition of the face, for a space
         that is not a tensor product of ``build`` (:mod:`.face_cells`); ``dimension(k, N)`` is
         then dim M_h on an N × N grid.
+    face_cells : tuple of str
+        The face cells (``quad``, ``trig``: :data:`~.square.CELL_SHAPES`) whose traces the space
+        is defined against: the quadratic quadrilateral elements' multipliers pair with QUAD9
+        traces (hexahedra) only.
     lagrange : tuple or None
         ``(continuous, vanish)`` when ``build`` is the Lagrange space M^r_s / M^r_{0,s} of degree
         s = ``degree(k)`` (:func:`~.multipliers.make_space`): the description an interface
@@ -110,6 +114,7 @@ class SpaceSpec:
     claim_tag: str | None = None
     gamma_dims: tuple = (1, 2)
     face_build: Callable | None = None
+    face_cells: tuple = ("quad", "trig")
 
     def defined_on(self, gamma_dim: int) -> bool:
         """Whether the space exists on an interface Γ of dimension ``gamma_dim``."""
@@ -374,7 +379,8 @@ def _face_case(id, ref, definition, element, basis, dimension, color, marker, va
     return register(SpaceSpec(
         id, ref, definition, _face_only(id), lambda k: 2, min_k=2, expected=expected,
         dimension=dimension, color=color, marker=marker, nodal_basis=basis in ("standard", "pwlin"),
-        claim_tag=id, gamma_dims=(2,), face_build=cellwise_builder(element, basis, vanish, refuse_with=refuse_with)))
+        claim_tag=id, gamma_dims=(2,), face_build=cellwise_builder(element, basis, vanish, refuse_with=refuse_with),
+        face_cells=("quad",)))
 
 
 def _interior(n):       # nodes of the QUAD9 lattice inside (0, 1)² on an n × n grid

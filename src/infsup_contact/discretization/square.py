@@ -290,6 +290,10 @@ class Square(Interface):
 
         return (gram_triangles if isinstance(space, TriangleSpace) else gram)(space, norm, **kwargs)
 
+    def builds(self, spec) -> bool:
+        """Whether ``spec`` is defined on this face's cells (``spec.face_cells``)."""
+        return self.cell in getattr(spec, "face_cells", CELL_SHAPES)
+
     def space(self, spec, k: int, partition):
         """The tensor product of ``spec``'s 1D space on xs and on ys (:class:`.face_spaces.FaceSpace`),
         or the entry's own face space where it has one (``spec.face_build``: the cellwise element
@@ -303,6 +307,9 @@ class Square(Interface):
         if not isinstance(partition, TensorPartition) or partition.cells < 1:
             raise InputError("multiplier mesh", f"a tensor partition of Γ with at least one rectangle "
                              f"(case {spec.id}, k = {k})")
+        if not self.builds(spec):
+            raise InputError("case", f"a space defined on faces of {self.cell} cells ({spec.id} pairs with "
+                             f"{', '.join(spec.face_cells)} faces)", got=spec.id)
         if getattr(spec, "face_build", None) is not None:
             return spec.face_build(k, partition)
         s, dual = int(spec.degree(k)), getattr(spec, "dual", False)

@@ -45,7 +45,7 @@ CONTACT_EXTRA_BYTES = 150 * MIB
 
 FAMILY_DOF_FACTOR = {"structured": 1.0, "perturbed": 1.0, "unstructured": 1.3}
 
-BENCH_FACTOR = {"beta": 2.7, "contact": 1.6}
+BENCH_FACTOR = {"beta": 2.7, "contact": 1.6, "face": 2.7}
 """Bench holds each route's own factorization (eigsh: the full pencil; peers: the full KKT)
 next to ours: measured 2.3× (β, N = 128, k = 2) and 1.4× (contact, N = 64, k = 2)."""
 
@@ -187,10 +187,16 @@ def verdict_estimate(family: str, k: int, ns, norm: str, multiplier_mesh: str = 
 def bench_estimate(what: str, ns, ks, repeats: int = 3, eigsh_max_n=None, kkt_max_n: int = 64,
                    n_problems: int = 10) -> Estimate:
     """``bench``: every (N, k) in turn, each route next to ours (factor :data:`BENCH_FACTOR`);
-    β's shift-invert eigsh route and contact's sparse-KKT route dominate the time."""
+    β's shift-invert eigsh route and contact's sparse-KKT route dominate the time; ``face`` the 3D
+    β routes (:mod:`~infsup_contact.bench.face_beta`)."""
     peak, seconds = 0.0, START_SECONDS
     for n in ns:
         for k in ks:
+            if what == "face":  # 3D: ours + its factorization again (ours_core, limit)
+                inner = face_beta_estimate(k, n, n, process=False)
+                peak = max(peak, BENCH_FACTOR[what] * inner.bytes)
+                seconds += repeats * 3 * (inner.seconds - START_SECONDS)
+                continue
             nd_total = 2 * side_dofs("structured", n, k)
             if what == "beta":
                 inner = beta_estimate("structured", k, n, n, process=False)

@@ -7,7 +7,8 @@ from .common import add_dry_run, check_memory, write_csv
 
 def add(sub) -> None:
     p = sub.add_parser("bench", help="speed as ratios in one run (CSV)")
-    p.add_argument("--what", required=True, choices=["beta", "contact"])
+    p.add_argument("--what", required=True, choices=["beta", "contact", "face"],
+                   help="beta / contact: the 2D membranes; face: β_h of the 3D membranes (--model membranes3d)")
     p.add_argument("--N", type=int, nargs="+", required=True)
     p.add_argument("--k", type=int, nargs="+", required=True)
     p.add_argument("--repeats", type=int, default=3)
@@ -22,6 +23,8 @@ def add(sub) -> None:
     p.add_argument("--route-budget", dest="route_budget", type=float, default=None,
                    help="seconds: a route is repeated (up to --repeats) only while its accumulated "
                         "time is below this, so slow routes run once (default 10)")
+    p.add_argument("--element", default=None,
+                   help="face: the 3D bodies' elements (hex, tet; default hex)")
     add_dry_run(p)
     p.set_defaults(run=_run_bench, check=_check_bench)
 
@@ -39,6 +42,10 @@ def _check_bench(args):
             raise InputError(key, f"{allowed}, each once", got=" ".join(map(str, values)))
     from ..discretization.registry import check_pair_spaces, ids_valid_for
 
+    if args.what == "face":
+        _check_face(args)
+    elif args.element is not None:
+        raise InputError("element", "nothing unless --what face (the 3D bodies' elements)", got=args.element)
     for k in args.k:  # every registered space defined for k: a superset of what the routes run
         for n in args.N:
             check_pair_spaces(ids_valid_for(k), k, n, n, key="N")
@@ -66,13 +73,29 @@ def _check_bench(args):
     return est
 
 
+def _check_face(args) -> None:
+    """``--what face``: the element is one of the 3D model's; the 2D-only flags are refused."""
+    from ..models.membranes3d import ELEMENTS
+
+    args.element = ELEMENTS[0] if args.element is None else args.element
+    if args.element not in ELEMENTS:
+        raise InputError("element", ", ".join(ELEMENTS), got=args.element)
+    defaults = dict(peers=["osqp", "clarabel"], eigsh_max_n=None, kkt_max_n=64, dense_max_size=2500)
+    for key, default in defaults.items():
+        if getattr(args, key) != default:
+            raise InputError(key, f"its default with --what face (a flag of --what "
+                             f"{'contact' if key in ('peers', 'kkt_max_n') else 'beta'})", got=getattr(args, key))
+
+
 def _run_bench(args) -> None:
     import pandas as pd
 
     from .. import bench
 
     peers = args.peer_list
-    if args.what == "beta":
+    if args.what == "face":
+        rows = bench.bench_face(args.N, args.k, args.element, args.repeats, budget=args.route_budget)
+    elif args.what == "beta":
         rows = bench.bench_beta(args.N, args.k, args.repeats, dense_max_size=args.dense_max_size,
                                 eigsh_max_n=args.eigsh_max_n, budget=args.route_budget)
     else:

@@ -1,0 +1,75 @@
+"""The 3D β_h benchmark (issue 28, item 7; bench/face_beta.py): its three routes give the same
+β_h, one of them checked against the full saddle-point pencil, and ``infsup-contact bench --what
+face`` writes the ratio columns and refuses bad input in one line."""
+import io
+
+import numpy as np
+import pandas as pd
+import pytest
+import scipy.sparse as sp
+
+from infsup_contact.bench import face_beta
+from infsup_contact.discretization.coupling import coupling_matrix
+from infsup_contact.solvers.infsup import saddle_point_beta
+
+from _cli import run_in_process
+
+
+@pytest.mark.parametrize("n", [2, 3])
+def test_routes_agree_on_beta(n):
+    rows = face_beta.bench_face([n], [1], "hex", repeats=1)
+    assert [r["route"] for r in rows] == ["ours", "ours_core", "limit"]
+    for r in rows:
+        assert r["max_abs_diff"] <= 1e-8, r
+        assert r["n_problems"] == 2 * len(face_beta.face_cases(1))
+
+
+def test_core_beta_equals_the_full_pencil():
+    """β_h of ours_core (Γ-reduced, B A⁻¹ Bᵀ m = β² G m) = β_h of the full pencil
+    [[A, Bᵀ], [B, 0]] x = σ [[A, 0], [0, G]] x, an independent dense route, for a stable space."""
+    setup = face_beta.FaceSetup(2, 1, "hex")
+    core = face_beta.face_ours_core(setup)
+    A = sp.block_diag([s.stiffness for s in setup.sides]).tocsr()
+    case = next(c for c in setup.cases if face_beta.face_ours(setup)[c, "H"][0] == 0)
+    blocks = []
+    for sign, s in zip((-1.0, 1.0), setup.sides):
+        Bi = coupling_matrix(s.trace, setup.spaces[case], 1)
+        blocks += [np.zeros((Bi.shape[0], s.ndof - Bi.shape[1])), sign * Bi]
+    B = np.hstack(blocks)
+    for nm in face_beta.NORMS:
+        G = setup.gamma.gram(setup.spaces[case], nm)[0]
+        assert abs(np.sqrt(core[case, nm][0]) - saddle_point_beta(A, B, G)) <= 1e-10
+
+
+def test_cli_csv_has_the_ratio_columns():
+    code, out, err = run_in_process(["bench", "--what", "face", "--N", "2", "--k", "1", "--repeats", "1"])
+    assert code in (0, None), err
+    frame = pd.read_csv(io.StringIO(out))
+    assert set(face_beta.FACE_COLUMNS) <= set(frame.columns)
+    by = frame.set_index("route")
+    assert by.loc["limit", "ratio_to_limit"] == 1.0 and by.loc["ours", "ratio_to_ours"] == 1.0
+    assert np.isclose(by.loc["ours", "ratio_to_limit"],
+                      by.loc["ours", "seconds_median"] / by.loc["limit", "seconds_median"], rtol=1e-4)
+    assert (frame["element"] == "hex").all()
+
+
+@pytest.mark.parametrize("argv, key", [
+    (["--what", "face", "--element", "prism"], "--element"),
+    (["--what", "beta", "--element", "hex"], "--element"),
+    (["--what", "face", "--peers", "osqp"], "--peers"),
+    (["--what", "face", "--eigsh-max-N", "4"], "--eigsh-max-N"),
+    (["--what", "face", "--k", "5"], "--k"),
+])
+def test_bad_input_is_refused_in_one_line(argv, key):
+    argv = ["bench", "--N", "2", *(["--k", "1"] if "--k" not in argv else []), *argv]
+    code, out, err = run_in_process(argv)
+    assert code == 2 and out == ""
+    lines = [ln for ln in err.splitlines() if ln.strip()]
+    assert len(lines) == 1 and key in lines[0], err
+
+
+def test_setup_refuses_an_unknown_element():
+    from infsup_contact.errors import InputError
+
+    with pytest.raises(InputError, match="element"):
+        face_beta.FaceSetup(2, 1, "prism")

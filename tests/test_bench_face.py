@@ -73,3 +73,16 @@ def test_setup_refuses_an_unknown_element():
 
     with pytest.raises(InputError, match="element"):
         face_beta.FaceSetup(2, 1, "prism")
+
+
+def test_dry_run_estimates_the_face_routes():
+    """The estimate is the 3D model's (face_beta_estimate): it grows with N, and a size that does
+    not fit in memory is refused naming --N before anything is computed."""
+    from infsup_contact import resources
+
+    small, large = (resources.bench_estimate("face", [n], [2]) for n in (4, 12))
+    assert 0 < small.bytes < large.bytes and 0 < small.seconds < large.seconds
+    code, out, err = run_in_process(["bench", "--what", "face", "--N", "4", "--k", "1", "--dry-run"])
+    assert code in (0, None) and "dry run" in out + err
+    code, _, err = run_in_process(["bench", "--what", "face", "--N", "256", "--k", "2", "--dry-run"])
+    assert code == 2 and "--N" in err and len(err.strip().splitlines()) == 1

@@ -102,7 +102,11 @@ def face_ours(setup: FaceSetup) -> dict:
 
 
 def face_ours_core(setup: FaceSetup) -> dict:
-    """{(case, norm): bottom eigenvalues β²}: factorization, couplings, interface, Gram, eigh."""
+    """{(case, norm): eigenvalues β²}: factorization, couplings, interface, Gram, eigh. The
+    setup's sides are first returned to their state right after the build (their traces'
+    basis values, cached by :meth:`FaceSetup.operators`, are not reused: a fresh run has none)."""
+    for s in setup.sides:
+        s.forget_cached()
     sides = [factorized_side(s.trace, s.free, s.stiffness) for s in setup.sides]
     out = {}
     for c in setup.cases:

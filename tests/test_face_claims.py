@@ -123,6 +123,16 @@ def test_face_macros_count_the_claims():
 
 # ------------------------------------------------------------------ config checks
 
+@pytest.fixture(autouse=True)
+def _registry_as_found():
+    """Checking a config registers its user spaces: leave the registry as the other tests expect."""
+    from infsup_contact.discretization.user_spaces import forget_since
+
+    before = set(SPACES)
+    yield
+    forget_since(before)
+
+
 def _ci():
     return yaml.safe_load((ROOT / "config" / "ci.yaml").read_text())
 

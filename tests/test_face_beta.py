@@ -6,7 +6,6 @@ import io
 import numpy as np
 import pandas as pd
 import pytest
-from scipy.sparse import block_diag
 
 from _cli import run_in_process
 from infsup_contact.discretization.coupling import coupling_matrix
@@ -16,6 +15,7 @@ from infsup_contact.discretization.segment import SEGMENT
 from infsup_contact.models import make_model
 from infsup_contact.models.side_cache import SideCache
 from infsup_contact.solvers.infsup import beta_rows, saddle_point_beta
+from infsup_contact.solvers.contact import contact_qp
 
 MODEL = make_model("membranes3d")
 
@@ -99,12 +99,9 @@ def test_beta_agrees_with_the_saddle_point_pencil(element, n1, n2, case):
     sides = SideCache().pair(MODEL, "structured", k, n1, n2, element=element)
     gamma = sides[0].trace.gamma
     space = case_space(case, k, gamma.multiplier_partition(*(s.trace.partition for s in sides)), gamma)
-    blocks = []
-    for sign, s in zip((-1.0, 1.0), sides):
-        full = np.zeros((space.dim, s.ndof))
-        full[:, s.ndof - len(s.trace.gamma_dofs):] = sign * coupling_matrix(s.trace, space, k)
-        blocks.append(full)
-    A, B = block_diag([s.stiffness for s in sides]), np.hstack(blocks)
+    Bs = [coupling_matrix(s.trace, space, k) for s in sides]
+    A, B, _ = contact_qp(sides, Bs, [np.zeros(s.ndof) for s in sides])  # the assembled pencil's blocks
+    B = B.toarray()
     frame = rows_of(k, n1, n2, element=element, cases=[case])
     for norm, row in frame.set_index("norm").iterrows():
         G = gamma.gram(space, norm)[0]

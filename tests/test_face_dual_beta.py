@@ -5,7 +5,6 @@ the full saddle-point pencil, the refusals (DUAL-Q8's weights, the segment), and
 import numpy as np
 import pandas as pd
 import pytest
-from scipy.sparse import block_diag
 
 from infsup_contact.discretization import registry
 from infsup_contact.discretization.coupling import coupling_matrix
@@ -20,6 +19,7 @@ from infsup_contact.errors import InputError
 from infsup_contact.models import make_model
 from infsup_contact.models.side_cache import SideCache
 from infsup_contact.solvers.infsup import beta_rows, saddle_point_beta
+from infsup_contact.solvers.contact import contact_qp
 
 MODEL = make_model("membranes3d")
 FACE_IDS = [c for c in registry.space_ids(None) if not registry.SPACES[c].defined_on(1)]
@@ -81,12 +81,9 @@ def test_beta_agrees_with_the_saddle_point_pencil(case, n1, n2):
     sides = SideCache().pair(MODEL, "structured", k, n1, n2, element="hex")
     gamma = sides[0].trace.gamma
     space = registry.case_space(case, k, gamma.multiplier_partition(*(s.trace.partition for s in sides)), gamma)
-    blocks = []
-    for sign, s in zip((-1.0, 1.0), sides):
-        full = np.zeros((space.dim, s.ndof))
-        full[:, s.ndof - len(s.trace.gamma_dofs):] = sign * coupling_matrix(s.trace, space, k)
-        blocks.append(full)
-    A, B = block_diag([s.stiffness for s in sides]), np.hstack(blocks)
+    Bs = [coupling_matrix(s.trace, space, k) for s in sides]
+    A, B, _ = contact_qp(sides, Bs, [np.zeros(s.ndof) for s in sides])  # the assembled pencil's blocks
+    B = B.toarray()
     frame = pd.DataFrame(beta_rows("structured", k, n1, n2, cases=[case], model=MODEL, element="hex"))
     for norm, row in frame.set_index("norm").iterrows():
         assert saddle_point_beta(A, B, gamma.gram(space, norm)[0]) == pytest.approx(row.beta, rel=1e-8)

@@ -34,6 +34,8 @@ from ..errors import InputError
 
 MULTIPLIER_MESHES = ("omega2", "omega1", "union")
 """The choices of G_h: the trace partition of Ω2 (the paper's default), of Ω1, or their union."""
+BASIS_CACHE_SIZE = 4
+"""Point sets whose trace basis values a trace keeps (:meth:`GammaTrace.cached_basis`)."""
 
 
 @dataclass(frozen=True)
@@ -69,6 +71,21 @@ class GammaTrace:
     def partition(self):
         """The trace partition of this side on Γ (opaque: hand it back to :attr:`gamma`)."""
         return self.breakpoints
+
+    def cached_basis(self, x: np.ndarray, compute) -> np.ndarray:
+        """``compute(x)``, the dense Γ-dof basis values at the points ``x``, kept read-only on the
+        trace for the next request of the same points (at most :data:`BASIS_CACHE_SIZE` point
+        sets): every multiplier space of one degree on one G_h asks for the same quadrature points,
+        and NGSolve evaluates one point at a time (:meth:`Interface.trace_basis`)."""
+        key = np.ascontiguousarray(x, dtype=float).tobytes()
+        phi = self.basis_cache.get(key)
+        if phi is None:
+            phi = compute(x)
+            phi.flags.writeable = False
+            if len(self.basis_cache) >= BASIS_CACHE_SIZE:
+                self.basis_cache.clear()
+            self.basis_cache[key] = phi
+        return phi
 
 
 class Interface(abc.ABC):

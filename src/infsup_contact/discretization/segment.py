@@ -10,8 +10,6 @@ import numpy as np
 from .interface import GammaTrace, Interface, check_choice
 from .quadrature import gauss_legendre
 
-_BASIS_CACHE_SIZE = 4
-
 
 @dataclass(frozen=True)
 class Segment(Interface):
@@ -128,17 +126,13 @@ class Segment(Interface):
         NGSolve evaluates one point at a time: the values are kept on the trace (a few point sets,
         read-only) and computed once.
         """
-        key = np.ascontiguousarray(x, dtype=float).tobytes()
-        phi = trace.basis_cache.get(key)
-        if phi is None:
+        def dense(x):
             rows, cols, vals = self.trace_values(trace, x)
             phi = np.zeros((len(x), len(trace.gamma_dofs)))
             np.add.at(phi, (rows, cols), vals)
-            phi.flags.writeable = False
-            if len(trace.basis_cache) >= _BASIS_CACHE_SIZE:
-                trace.basis_cache.clear()
-            trace.basis_cache[key] = phi
-        return phi
+            return phi
+
+        return trace.cached_basis(x, dense)
 
     # --- quadrature and norms
     def quadrature(self, partition, degree: int) -> tuple:

@@ -30,7 +30,6 @@ from .interface import GammaTrace, Interface, check_choice
 from .face_quadrature import split_rule
 from .quadrature import gauss_legendre
 
-_BASIS_CACHE_SIZE = 4
 CELL_SHAPES = ("quad", "trig")
 
 
@@ -238,15 +237,7 @@ class Square(Interface):
     def trace_basis(self, trace: GammaTrace, x: np.ndarray) -> np.ndarray:
         """Dense values of the Γ-dof basis at the points x (n, 2), cached on the trace
         (read-only) as :meth:`Segment.trace_basis <.segment.Segment.trace_basis>` does."""
-        key = np.ascontiguousarray(x, dtype=float).tobytes()
-        phi = trace.basis_cache.get(key)
-        if phi is None:
-            phi = self.trace_values(trace, x)
-            phi.flags.writeable = False
-            if len(trace.basis_cache) >= _BASIS_CACHE_SIZE:
-                trace.basis_cache.clear()
-            trace.basis_cache[key] = phi
-        return phi
+        return trace.cached_basis(x, lambda x: self.trace_values(trace, x))
 
     # --- quadrature and norms
     def quadrature(self, partition, degree: int) -> tuple:

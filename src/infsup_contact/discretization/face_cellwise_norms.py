@@ -14,7 +14,7 @@ C_jp = ∫ μ_j P_p, G_P = the exact L² Gram of P. Then
 * H = H^{1/2}_00(Γ)': μ_mn = Σ_p R_jp P^x_{a,m} P^y_{b,n}, the sine moments of a piece monomial
   product being products of the closed 1D forms (:func:`~.norms.sine_coefficients`), so the
   partial sums are S_μ(n) = R S_P(n) Rᵀ (:func:`~.face_norms.partial_gram` of P) and the series is
-  extrapolated in n_max on S_μ itself (:func:`~.face_norms.extrapolated_series`), with the tail
+  extrapolated in n_max on S_μ itself (:func:`~.face_norms.extrapolated`), with the tail
   exponent of μ (4 for continuous bases vanishing on ∂Γ, else 2; :attr:`~.face_cells.CellwiseFaceSpace.smooth_tail`).
 
 That μ ∈ P is checked (residual of the projection at points of a finer rule): a space whose
@@ -25,7 +25,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import InputError
-from .face_norms import extrapolated_series, gram_l2_face, partial_gram
+from .face_norms import extrapolated, gram_l2_face, partial_gram
 from .face_spaces import FaceSpace
 from .multipliers import make_space
 from .norms import NORMS, N_MAX_CAP
@@ -100,7 +100,7 @@ def gram_h_cellwise(space, rtol: float = 1e-6, n_start: int | None = None, n_cap
         S = R @ partial_gram(P, n) @ R.T
         return 0.5 * (S + S.T)
 
-    return extrapolated_series(partial, n0, n_cap, p, rtol)
+    return extrapolated(partial, p, n0, n_cap, rtol)
 
 
 def gram_cellwise(space, norm: str, **kwargs) -> tuple[np.ndarray, dict]:

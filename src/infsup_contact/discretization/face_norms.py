@@ -22,7 +22,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import InputError
-from .norms import NORMS, N_MAX_CAP, gram_l2, sine_coefficients
+from .norms import NORMS, N_MAX_CAP, _norm2, extrapolate, gram_l2, sine_coefficients
 
 #: Rows of the weight matrix W[m, n] = 1/(π√(m² + n²)) handled at once (memory ~ chunk · n_max).
 _CHUNK = 512
@@ -109,44 +109,15 @@ def gram_h_face(space, rtol: float = 1e-6, n_start: int | None = None, n_cap: in
     n0 = max(16, 2 * (space.degree + 1) * n_int) if n_start is None else int(n_start)
     if not aspect > 0:
         raise InputError("aspect", "a positive float", got=aspect)
-    return extrapolated_series(lambda n: partial_gram(space, n, aspect), n0, n_cap, p, rtol)
+    return extrapolated(lambda n: partial_gram(space, n, aspect), p, n0, n_cap, rtol)
 
 
-def extrapolated_series(partial, n0: int, n_cap: int, p: float, rtol: float) -> tuple[np.ndarray, dict]:
-    """The Richardson loop of :func:`gram_h_face` for any partial sums ``partial(n)`` = S(n)
-    with a tail ~ C n^{−p} (also the route of the non-tensor spaces, :mod:`.face_cellwise_norms`)."""
-    if n0 < 1 or n_cap < 1:
-        raise InputError("n_start/n_cap", "positive integers", got=(n0, n_cap))
-    return richardson(partial, p, min(n0, n_cap), n_cap, rtol)
-
-
-def richardson(partial, p: float, n0: int, n_cap: int, rtol: float) -> tuple[np.ndarray, dict]:
-    """Extrapolate the partial sums ``partial(n)`` at n = n0, 2n0, 4n0, ... (tail C n^{−p}),
-    R(n) = S(2n) + (S(2n) − S(n)) / (2^p − 1), until ‖R(2n) − R(n)‖₂ / ‖R(2n)‖₂ ≤ rtol or
-    2n > n_cap; returns (R, info) as :func:`gram_h_face` does (shared by the triangle spaces,
-    :mod:`.face_triangle_norms`)."""
-    factor = 1.0 / (2.0 ** p - 1.0)
-    s_lo, n_hi = partial(n0), min(2 * n0, n_cap)
-    s_hi = partial(n_hi)
-    r_prev = s_hi + (s_hi - s_lo) * factor
-    err = _norm2(r_prev - s_hi) / _norm2(r_prev)
-    capped = False
-    while True:
-        if 2 * n_hi > n_cap:
-            capped = err > rtol
-            break
-        s_lo, s_hi, n_hi = s_hi, partial(2 * n_hi), 2 * n_hi
-        r = s_hi + (s_hi - s_lo) * factor
-        err = _norm2(r - r_prev) / _norm2(r)
-        r_prev = r
-        if err <= rtol:
-            break
-    return r_prev, {"n_max": int(n_hi), "nmax_rel_error": float(err), "capped": bool(capped),
-                    "n_start": int(n0), "tail_exponent": p}
-
-
-def _norm2(A: np.ndarray) -> float:
-    return float(np.max(np.abs(np.linalg.eigvalsh(A))))
+def extrapolated(partial, p: float, n0: int, n_cap: int, rtol: float) -> tuple[np.ndarray, dict]:
+    """The segment's Richardson loop (:func:`~.norms.extrapolate`) on a face series, the tail
+    exponent p recorded in ``info`` (also the route of the non-tensor and triangle spaces,
+    :mod:`.face_cellwise_norms`, :mod:`.face_triangle_norms`)."""
+    G, info = extrapolate(partial, p, n0, n_cap, rtol)
+    return G, dict(info, tail_exponent=p)
 
 
 def gram(space, norm: str, **kwargs) -> tuple[np.ndarray, dict]:

@@ -5,7 +5,7 @@ G_h, exact for the total degree 2s of a product of two P_s functions.
 
 M = H^{1/2}_00(Γ)': the double sine series of :mod:`.face_norms`,
 ‖μ‖²_M = Σ_{m,n≥1} μ_mn² / (π√(m² + n²)), μ_mn = 2 ∬ μ sin(mπx) sin(nπy), truncated to
-m, n ≤ n_max and extrapolated in n_max (:func:`~.face_norms.richardson`). The basis functions
+m, n ≤ n_max and extrapolated in n_max (:func:`~.face_norms.extrapolated`). The basis functions
 are not tensor products, so their coefficients are computed triangle by triangle:
 
 * on a triangle T with lower-left corner (x0, y0) and sides hx, hy, the addition formula
@@ -26,7 +26,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import InputError
-from .face_norms import _norm2, richardson
+from .face_norms import _norm2, extrapolated
 from .face_quadrature import triangles_rule
 from .face_triangles import lagrange_barycentric
 from .norms import N_MAX_CAP
@@ -205,7 +205,7 @@ def gram_h_tri(space, rtol: float = 1e-6, n_start: int | None = None, n_cap: int
     n0 = max(16, 2 * (space.degree + 1) * max(space.shape)) if n_start is None else int(n_start)
     if n0 < 1 or n_cap < 1:
         raise InputError("n_start/n_cap", "positive integers", got=(n_start, n_cap))
-    return richardson(lambda k: partial_gram(space, k), p, min(n0, n_cap), n_cap, rtol)
+    return extrapolated(lambda k: partial_gram(space, k), p, n0, n_cap, rtol)
 
 
 def gram(space, norm: str, **kwargs) -> tuple[np.ndarray, dict]:

@@ -232,28 +232,55 @@ def gram_h(space: MultiplierSpace, rtol: float = 1e-6, n_start: int | None = Non
     n0 = max(16, 2 * (space.degree + 1) * space.n_intervals) if n_start is None else int(n_start)
     if n0 < 1 or n_cap < 1:
         raise InputError("n_start/n_cap", "positive integers", got=(n_start, n_cap))
+    summed = [0, np.zeros((space.dim, space.dim))]   # S(n) of the last n asked, extended from there
+
+    def partial(n):
+        summed[1] = summed[1] + _partial_gram(space, summed[0] + 1, n, switch)
+        summed[0] = n
+        return summed[1]
+
+    return extrapolate(partial, 2.0, n0, n_cap, rtol)
+
+
+def extrapolate(partial, p: float, n0: int, n_cap: int, rtol: float) -> tuple[np.ndarray, dict]:
+    """Richardson extrapolation of a series of Gram matrices with a tail ~ C n^{−p}: the partial
+    sums S(n) = ``partial(n)`` at n = n0, 2n0, 4n0, ... (asked in increasing n), extrapolated
+    R(n) = S(2n) + (S(2n) − S(n)) / (2^p − 1), until ‖R(2n) − R(n)‖₂ / ‖R(2n)‖₂ ≤ rtol or 2n
+    would pass ``n_cap`` (:func:`gram_h`; the face's double series, :mod:`.face_norms`).
+
+    Returns
+    -------
+    R : ndarray
+    info : dict
+        ``n_max``, ``nmax_rel_error`` (before two extrapolations exist, the size of the
+        extrapolation step), ``capped`` (the estimate still above rtol at the cap), ``n_start``.
+
+    Raises
+    ------
+    InputError
+        For n0 or n_cap < 1.
+    """
+    if n0 < 1 or n_cap < 1:
+        raise InputError("n_start/n_cap", "positive integers", got=(n0, n_cap))
     n0 = min(n0, n_cap)
-    s_lo = _partial_gram(space, 1, n0, switch)
-    n_hi = min(2 * n0, n_cap)
-    s_hi = s_lo + _partial_gram(space, n0 + 1, n_hi, switch)
-    r_prev = _richardson(s_lo, s_hi)
-    # Before two extrapolations exist, the size of the extrapolation step is the estimate.
+    divisor = 2.0 ** p - 1.0
+    s_lo, n_hi = partial(n0), min(2 * n0, n_cap)
+    s_hi = partial(n_hi)
+    r_prev = s_hi + (s_hi - s_lo) / divisor
     err = _norm2(r_prev - s_hi) / _norm2(r_prev)
     capped = False
     while True:
         if 2 * n_hi > n_cap:
             capped = err > rtol
             break
-        s_lo, s_hi = s_hi, s_hi + _partial_gram(space, n_hi + 1, 2 * n_hi, switch)
-        n_hi *= 2
-        r = _richardson(s_lo, s_hi)
+        s_lo, s_hi, n_hi = s_hi, partial(2 * n_hi), 2 * n_hi
+        r = s_hi + (s_hi - s_lo) / divisor
         err = _norm2(r - r_prev) / _norm2(r)
         r_prev = r
         if err <= rtol:
             break
-    info = {"n_max": int(n_hi), "nmax_rel_error": float(err), "capped": bool(capped),
-            "n_start": int(n0)}
-    return r_prev, info
+    return r_prev, {"n_max": int(n_hi), "nmax_rel_error": float(err), "capped": bool(capped),
+                    "n_start": int(n0)}
 
 
 def _partial_gram(space: MultiplierSpace, n_first: int, n_last: int, switch: float) -> np.ndarray:
@@ -265,11 +292,6 @@ def _partial_gram(space: MultiplierSpace, n_first: int, n_last: int, switch: flo
         phi = sine_coefficients(space, n, switch) / np.sqrt(np.pi * n)[None, :]
         G += phi @ phi.T          # Φ D Φᵀ with D = diag(1/(nπ)) split symmetrically
     return G
-
-
-def _richardson(s_n: np.ndarray, s_2n: np.ndarray) -> np.ndarray:
-    """Tail ~ C n^{-2} ⇒ S(∞) ≈ S(2n) + (S(2n) − S(n)) / 3."""
-    return s_2n + (s_2n - s_n) / 3.0
 
 
 def _norm2(A: np.ndarray) -> float:

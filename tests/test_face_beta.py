@@ -154,14 +154,43 @@ def test_exported_3d_system_gives_the_same_verdict(tmp_path):
 
 
 @pytest.mark.parametrize("element", ["hex", "tet"])
-def test_both_schur_routes_agree_in_3d(element):
-    """The Γ-last nested dissection (graph based, no 2D assumption) and the solves route give one
-    Schur complement, equal to the reference K_ΓΓ − K_ΓI K_II⁻¹ K_IΓ."""
+def test_every_schur_route_agrees_in_3d(element):
+    """The Γ-last nested dissection (graph based, no 2D assumption), the solves route and MKL
+    PARDISO's partial factorization give one Schur complement, equal to the reference
+    K_ΓΓ − K_ΓI K_II⁻¹ K_IΓ; PARDISO's solves too."""
     from infsup_contact.models.membranes3d import side_operator, subdomain_mesh
     from infsup_contact.models.schur import schur_by_solves
 
     mesh = subdomain_mesh("structured", 3, 1, element=element)
-    nested, solves = side_operator(mesh, 2, route="nested"), side_operator(mesh, 2, route="solves")
-    ref = schur_by_solves(nested)
-    for side in (nested, solves):
+    sides = [side_operator(mesh, 2, route=r) for r in ("nested", "solves", "pardiso")]
+    ref = schur_by_solves(sides[0])
+    for side in sides:
         np.testing.assert_allclose(side.schur, ref, rtol=0, atol=1e-10 * np.abs(ref).max())
+    rhs = np.linspace(-1.0, 1.0, sides[0].ndof)
+    np.testing.assert_allclose(sides[0].stiffness @ sides[2].solve(rhs), rhs, atol=1e-10)
+
+
+def test_auto_route_takes_pardiso_on_a_face_and_superlu_on_the_segment():
+    """Above the solves route's work limit a face takes PARDISO, the segment SuperLU's nested
+    dissection (both measured in models/schur.gamma_factorization's docstring)."""
+    from infsup_contact.discretization.meshes import subdomain_mesh as mesh_2d
+    from infsup_contact.models.membranes import side_operator as side_2d
+    from infsup_contact.models.membranes3d import side_operator, subdomain_mesh
+    from infsup_contact.models.schur import SOLVES_MAX_WORK, gamma_factorization
+
+    face = side_operator(subdomain_mesh("structured", 8, 1), 2, route="solves")
+    segment = side_2d(mesh_2d("structured", 64, 1), 2, route="solves")
+    for side, expected in ((face, "pardiso"), (segment, "nested")):
+        n_gamma = len(side.trace.gamma_dofs)
+        assert side.ndof * n_gamma > SOLVES_MAX_WORK
+        fac = gamma_factorization(side.stiffness, n_gamma, "auto", side.trace.gamma.dim)
+        assert fac.route == expected
+
+
+def test_pardiso_refuses_a_matrix_that_is_not_positive_definite():
+    import scipy.sparse as sp
+    from infsup_contact.models.pardiso import PardisoError, gamma_schur
+
+    indefinite = sp.csr_matrix(np.diag([2.0, -1.0, 3.0, 1.0]) + np.diag([0.5] * 3, 1) + np.diag([0.5] * 3, -1))
+    with pytest.raises(PardisoError):
+        gamma_schur(indefinite, 2)

@@ -70,10 +70,11 @@ def test_factorization_routes_agree(n_gamma):
     A = lap2d(9)
     n = A.shape[0]
     a, b = gamma_factorization(A, n_gamma, "solves"), gamma_factorization(A, n_gamma, "nested")
-    assert a.route == "solves" and b.route == "nested"
+    c = gamma_factorization(A, n_gamma, "pardiso")
+    assert (a.route, b.route, c.route) == ("solves", "nested", "pardiso")
     D = A.toarray()
     X = np.linalg.inv(D)[n - n_gamma:, n - n_gamma:]     # (A⁻¹)_ΓΓ by brute force
-    for fac in (a, b):
+    for fac in (a, b, c):
         assert np.allclose(fac.schur @ X, np.eye(n_gamma), atol=1e-10)
         rhs = np.arange(n, dtype=float)
         assert np.allclose(D @ fac.solve(rhs), rhs, atol=1e-10)

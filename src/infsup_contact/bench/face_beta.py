@@ -19,9 +19,16 @@ Routes (``includes`` column), measured interleaved by :func:`~.harness.run_inter
     one dense ``eigh`` per (case, norm) — exactly what β_h needs.
 ``limit``
     Given the assembled stiffness and the (precomputed) interface operators and Gram matrices:
-    one ``splu`` of each body's stiffness in SuperLU's best order (``MMD_AT_PLUS_A``, symmetric
-    mode) + one dense generalized ``eigh`` per (case, norm). ``ours_core / limit`` is the
+    one sparse Cholesky factorization of each body's stiffness by the fastest factorization
+    measured here (MKL PARDISO, METIS order; SuperLU's ``MMD_AT_PLUS_A`` where MKL does not
+    load) + one dense generalized ``eigh`` per (case, norm). ``ours_core / limit`` is the
     overhead of the Γ-reduced route (Bathe & Brezzi 2001: β_h² = λ_min(B A⁻¹ Bᵀ, G)).
+
+The Schur complement alone (``what`` = ``face_schur``): each body's S = K_ΓΓ − K_ΓI K_II⁻¹ K_IΓ
+by :func:`~infsup_contact.models.schur.gamma_factorization`'s routes, ``ratio_to_ours``
+against PARDISO's partial factorization: the measurement behind the route ``"auto"`` takes on
+a face (CHOLMOD and MUMPS have no wheel for this Python and numpy on PyPI; scikit-sparse and
+python-mumps 0.0.2 were tried, see the README).
 
 ``max_abs_diff``: the largest |β_route − β_ours| over all (case, norm), β being the first
 value above the kernel ``ours`` decided (β_h itself for the stable spaces); ``limit`` solves the
@@ -37,7 +44,8 @@ from ..discretization import registry
 from ..discretization.coupling import coupling_matrix
 from ..errors import InputError
 from ..models.membranes3d import ELEMENTS, MEMBRANES3D
-from ..models.schur import factorized_side, interface_operator
+from ..models import pardiso
+from ..models.schur import factorized_side, gamma_factorization, interface_operator
 from ..models.side_cache import SideCache
 from ..solvers.infsup import beta_rows_all
 from .harness import ROUTE_BUDGET, _log, _row, run_interleaved
@@ -51,8 +59,15 @@ INCLUDES = {
     "ours": "meshes+assembly+Γ-last LU+Schur per body+couplings+kernel from Bᵀ+interface+Gram+eigh "
             "(+β with v1=0), every case × norm",
     "ours_core": "Γ-last LU+Schur per body+couplings+interface+Gram+eigh per (case,norm) (assembled stiffness given)",
-    "limit": "one splu per body (MMD_AT_PLUS_A) + one eigh per (case,norm) (interface operators, Grams given)",
+    "limit": "one sparse Cholesky per body (PARDISO, else splu MMD_AT_PLUS_A) + one eigh per (case,norm) "
+             "(interface operators, Grams given)",
+    "pardiso": "Schur complement per body: PARDISO partial factorization (METIS)",
+    "nested": "Schur complement per body: SuperLU, Γ-last nested dissection, S from the factors",
+    "solves": "Schur complement per body: SuperLU MMD_AT_PLUS_A + one solve per Γ dof",
 }
+SCHUR_ROUTES = ("pardiso", "nested", "solves")
+SOLVES_MAX_GAMMA = 600
+"""The solves route (n_Γ solves) is timed only up to this many Γ dofs: beyond it, minutes."""
 
 
 def face_cases(k: int) -> list:
@@ -117,14 +132,33 @@ def face_ours_core(setup: FaceSetup) -> dict:
 
 
 def face_limit(setup: FaceSetup, ops: dict):
-    """The floor as a callable: best-order ``splu`` per body + one ``eigh`` per (case, norm)."""
+    """The floor as a callable: one sparse Cholesky per body + one ``eigh`` per (case, norm)."""
     def run():
         for s in setup.sides:
-            spla.splu(s.stiffness, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
-                      options=dict(SymmetricMode=True))
+            if pardiso.available():
+                pardiso.Factor(s.stiffness).handle.release()
+            else:
+                spla.splu(s.stiffness, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
+                          options=dict(SymmetricMode=True))
         return {key: _eig_bottom(S, G) for key, (S, G) in ops.items()}
 
     return run
+
+
+def schur_routes(setup: FaceSetup) -> dict:
+    """{route: callable} giving both bodies' Schur complements by that route of
+    :func:`~infsup_contact.models.schur.gamma_factorization` (the solves route only while
+    n_Γ ≤ :data:`SOLVES_MAX_GAMMA`; PARDISO only where it loads)."""
+    n_gamma = max(len(s.trace.gamma_dofs) for s in setup.sides)
+    names = [r for r in SCHUR_ROUTES if (r != "solves" or n_gamma <= SOLVES_MAX_GAMMA)
+             and (r != "pardiso" or pardiso.available())]
+    return {r: (lambda r=r: [gamma_factorization(s.stiffness, len(s.trace.gamma_dofs), r).schur
+                             for s in setup.sides]) for r in names}
+
+
+def _schur_diff(got: list, ref: list) -> float:
+    """max relative |S_route − S_ref| over both bodies."""
+    return float(max(np.abs(a - b).max() / np.abs(b).max() for a, b in zip(got, ref)))
 
 
 def _diff(got: dict, ref: dict) -> float:
@@ -141,6 +175,23 @@ def _diff(got: dict, ref: dict) -> float:
         if np.isnan(out):
             break
     return float(out)
+
+
+def _schur_rows(setup: FaceSetup, repeats: int, budget: float) -> list:
+    """The ``face_schur`` rows of one setup: each Schur route timed interleaved, ratios to the
+    first route (PARDISO where it loads), ``max_abs_diff`` the relative difference of S."""
+    res = run_interleaved(schur_routes(setup), repeats, budget)
+    first = next(iter(res))
+    ref, t_ref = res[first]
+    rows = []
+    for name, (got, times) in res.items():
+        rows.append(_row("face_schur", name, setup.k, setup.n, times, float(np.median(t_ref)), np.nan,
+                         other="ratio_to_limit", element=setup.element,
+                         max_abs_diff=_schur_diff(got, ref), n_problems=len(setup.sides),
+                         ndof=setup.ndof, dim_M_max=max(len(s.trace.gamma_dofs) for s in setup.sides),
+                         includes=INCLUDES[name]))
+        _log(f"  schur {name:8s} {np.median(times):9.4f} s  rel diff {rows[-1]['max_abs_diff']:.2e}")
+    return rows
 
 
 def bench_face(ns, ks, element: str = "hex", repeats: int = 3, budget: float = ROUTE_BUDGET) -> list:
@@ -175,4 +226,5 @@ def bench_face(ns, ks, element: str = "hex", repeats: int = 3, budget: float = R
                                  element=element, max_abs_diff=diff, n_problems=len(setup.keys()),
                                  ndof=setup.ndof, dim_M_max=dim_m, includes=INCLUDES[name]))
                 _log(f"  {name:10s} {np.median(times):9.4f} s  diff {diff:.2e}")
+            rows += _schur_rows(setup, repeats, budget)
     return [{c: r[c] for c in FACE_COLUMNS} for r in rows]

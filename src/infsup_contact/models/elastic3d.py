@@ -43,6 +43,7 @@ import numpy as np
 import ngsolve
 import scipy.sparse as sp
 
+from ..discretization.meshes import SYMMETRY_X, SYMMETRY_Y
 from ..errors import InputError
 from .contract import Model
 from .elastic import PARAMS
@@ -51,8 +52,6 @@ from .membranes3d import subdomain_mesh as cube_mesh
 from .plane_strain import check_nu, lame
 from .schur import SideOperator, factorized_side
 
-SYMMETRY_X, SYMMETRY_Y = f"{LATERAL}_x0", f"{LATERAL}_y0"
-"""Boundary names of the lateral faces x = 0 and y = 0 (the other two are ``side``)."""
 BETA_DIRICHLET = f"{FAR}|{LATERAL}|{SYMMETRY_X}|{SYMMETRY_Y}"
 """All of ∂Ω_i∖Γ (an NGSolve boundary regexp): where β_h's sides vanish, every component."""
 CLAMPED = (BETA_DIRICHLET,) * 3

@@ -33,6 +33,16 @@ elastic face patch test, :mod:`infsup_contact.study.elastic_face_patch`); the ot
 
 **Loads** (contract): a scene's far-face displacement ``far_displacement[i]`` is u_z on Ω_i's
 far face (the Dirichlet lift u_{D,i}, x and y lifts 0); no body force, F_i = −E_i K_i u_{D,i}.
+
+**Measured** (β_h in H^{-1/2}_00(Γ), hexahedra, ν = 0.3, E1 = E2 = 1; exploratory runs of
+``infsup-contact beta --model elastic3d``, outside the DAG): the kernels are those of the 3D
+membranes case by case (they are kernels of the couplings, which see the same z traces), and on
+matching meshes the dimension count max(dim M − dim W, 0). The β_h of the stable spaces are
+those of the membranes times ~1.3–1.4 (T3, k = 2: 1.466 / 1.073 at N = 4), and flat from
+N = 4 to 6. As ν → 1/2, β_h → 0 like √(1 − 2ν) for every space alike (k = 2, N = 4: 0.75,
+0.26, 0.084 at ν = 0.49, 0.499, 0.4999): a clamped incompressible body keeps ∫_Γ u_z = 0, so
+the normal compliance of a uniform pressure vanishes — a property of the continuous problem
+at fixed E, not of M_h.
 """
 from __future__ import annotations
 

@@ -43,8 +43,11 @@ membranes' face patch test (:mod:`.face_patch`), whose solve and measures this s
 1.2–2.4, u error 3e-2..0.16 δ) — as predicted, with one exception shared with the membranes'
 face patch test (same failure there, λ error 1): DUAL at k = 1 on tetrahedra (dim M = the
 interior nodes of G_h) fails although ``contains_constants(1)`` says it holds the constants —
-the registry's prediction is the segment's, and the triangle version of that space does not
-carry the end modification. R5.4 at k = 1 on tetrahedra has a one-mode kernel and still passes.
+the registry's prediction is the segment's: on triangles the boundary modification keeps
+Σ ψ = 1 only where a triangle has a live node, and the two corner triangles with all three
+vertices on ∂Γ (the diagonal split at the corners (1, 0) and (0, 1)) have none, so λ_h = 0
+there (error 1; at k = 2 their edge midpoints are live and DUAL passes). R5.4 at k = 1 on
+tetrahedra has a one-mode kernel and still passes.
 """
 from __future__ import annotations
 

@@ -5,6 +5,8 @@
     infsup-contact contact --scene manufactured --case T3 --k 2 --N1 16 --N2 16
     infsup-contact contact --model elastic --scene patch --case all --k 2 --N1 5 --N2 4
     infsup-contact contact --model membranes3d --scene face-patch --case all --k 2 --N1 4 --N2 5 --element hex
+    infsup-contact beta --model elastic3d --case all --k 2 --N1 4 --N2 5 --element tet --nu 0.3
+    infsup-contact contact --model elastic3d --scene elastic-face-patch --case all --k 2 --N1 4 --N2 5 --E2 3
     infsup-contact contact --model elastic --scene hertz --case T4 --k 2 --N1 32 --N2 32 --R 1 --d 0.05
     infsup-contact rates contact.csv
     infsup-contact bench --what beta --N 32 64 --k 2

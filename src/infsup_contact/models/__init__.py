@@ -4,7 +4,8 @@
 loads, lifts and u_h of a contact scene); ``schur`` is the shared Γ Schur complement / Steklov
 inverse machinery, ``ordering`` its Γ-last nested dissection; ``membranes`` is the paper's
 model, ``elastic`` plane-strain elasticity (its Section 2), ``membranes3d`` the membranes
-in 3D with a 2D contact face (issue 28), ``plane_strain`` the material law
+in 3D with a 2D contact face (issue 28), ``elastic3d`` the linear-elastic bodies on that
+face, ``plane_strain`` the material law
 the elastic scenes measure with. Imports ``discretization`` and ``errors`` only.
 
 This file is the registry of models: the engine (``solvers``, ``study``) asks it for a model by
@@ -14,10 +15,13 @@ from .contract import Model
 from .membranes import MEMBRANES
 from .elastic import ELASTIC, elastic_model
 from .membranes3d import MEMBRANES3D
+from .elastic3d import ELASTIC3D, elastic3d_model
 
-MODELS = {m.name: m for m in (MEMBRANES, ELASTIC, MEMBRANES3D)}
-"""Every model by name (``elastic``: ν = 0.3; other ν through :func:`make_model`)."""
-_BUILDERS = {MEMBRANES.name: lambda: MEMBRANES, ELASTIC.name: elastic_model, MEMBRANES3D.name: lambda: MEMBRANES3D}
+MODELS = {m.name: m for m in (MEMBRANES, ELASTIC, MEMBRANES3D, ELASTIC3D)}
+"""Every model by name (``elastic``, ``elastic3d``: ν = 0.3; other ν through :func:`make_model`).
+The order matters to :func:`model_taking` and :func:`model_of_dim` (the first match)."""
+_BUILDERS = {MEMBRANES.name: lambda: MEMBRANES, ELASTIC.name: elastic_model, MEMBRANES3D.name: lambda: MEMBRANES3D,
+             ELASTIC3D.name: elastic3d_model}
 DEFAULT_MODEL = MEMBRANES
 """The paper's model: what β_h and contact use when no model is named."""
 

@@ -39,5 +39,6 @@ def check_modulus(value, key: str) -> float:
 
 
 def lame(nu: float) -> tuple:
-    """(μ̂, λ̂) of plane strain at E = 1."""
+    """(μ̂, λ̂) of plane strain at E = 1: the Lamé constants of the 3D law, which plane strain
+    takes as they are (the 3D bodies, :mod:`.elastic3d`, use them too)."""
     return 1.0 / (2.0 * (1.0 + nu)), nu / ((1.0 + nu) * (1.0 - 2.0 * nu))

@@ -122,10 +122,16 @@ def patch_pair(k: int, n1: int, n2: int, c=(1.0, 1.0), delta: float = DELTA, ele
 
 
 def solve_face_patch(case: str, k: int, n1: int, n2: int, c=(1.0, 1.0), delta: float = DELTA,
-                     element: str = "hex", pair=None, per_cell: int = 4, multiplier_mesh: str = "omega2") -> dict:
+                     element: str = "hex", pair=None, per_cell: int = 4, multiplier_mesh: str = "omega2",
+                     scene=None) -> dict:
     """Solve the face patch test for one case on G_h = ``multiplier_mesh`` (``omega2``: the trace
     of Ω2; ``union``: the common refinement, where dim M_h exceeds the traces' and K has a
     kernel); one row of measures.
+
+    ``scene``: another uniform-pressure scene on the face, with this scene's ``name``, ``d``,
+    ``pressure`` and ``exact()`` (one NGSolve coefficient function per body, scalar or vector
+    as the model's u_h), solved on ``pair`` (built from it); default :func:`patch_scene` of
+    ``pair.c`` and ``delta`` (the elastic one: :mod:`.elastic_face_patch`).
 
     Returns
     -------
@@ -141,7 +147,8 @@ def solve_face_patch(case: str, k: int, n1: int, n2: int, c=(1.0, 1.0), delta: f
     t0 = time.perf_counter()
     if pair is None:
         pair = patch_pair(k, n1, n2, c, delta, element)
-    scene = patch_scene(pair.c, delta)
+    scene = patch_scene(pair.c, delta) if scene is None else scene
+    delta = scene.d
     sol = solve_contact_on(pair, case, multiplier_mesh, time_floor=False)
     space, gamma, res = sol.space, sol.gamma, sol.pdas
     lam = scene.pressure
@@ -152,7 +159,7 @@ def solve_face_patch(case: str, k: int, n1: int, n2: int, c=(1.0, 1.0), delta: f
     G, _ = gamma.gram(space, "L2")
     ev = sla.eigh(sol.K, G, eigvals_only=True)
     spec = registry.space_spec(case)
-    return dict(scene=SCENE, case=case, k=k, family="structured", element=element, N1=n1, N2=n2,
+    return dict(scene=scene.name, case=case, k=k, family="structured", element=element, N1=n1, N2=n2,
                 multiplier_mesh=multiplier_mesh,
                 c1=pair.c[0], c2=pair.c[1], delta=delta, pressure=lam, dim_M=space.dim, cone=spec.cone(k),
                 kernel_dim=int(np.sum(ev < KERNEL_RTOL * ev[-1])), nonunique=bool(res.nonunique),

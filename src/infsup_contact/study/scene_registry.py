@@ -227,3 +227,9 @@ FACE_PATCH = register(SceneSpec(
     "non-matching faces", "exact (λ = δ/(1/c1 + 1/c2), u linear in z)",
     ("lambda_max_rel_error", "u_max_rel_error", "passes", "predicted", "kernel_dim"),
     f"{_RUNS}:face_patch_rows", f"{_RUNS}:face_check", float_format="%.6g", families=("structured",)))
+ELASTIC_FACE_PATCH = register(SceneSpec(
+    "elastic-face-patch", ("elastic3d",), "the 3D elastic patch test: uniaxial compression, far faces u_z = 0 "
+    "and −δ, symmetry rollers on x = 0 and y = 0, non-matching faces", "exact (λ = δ/(1/E1 + 1/E2), u linear)",
+    ("lambda_max_rel_error", "u_max_rel_error", "passes", "predicted", "kernel_dim"),
+    f"{_RUNS}:elastic_face_patch_rows", f"{_RUNS}:elastic_face_check", float_format="%.6g",
+    families=("structured",)))

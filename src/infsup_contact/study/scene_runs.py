@@ -6,7 +6,7 @@ from __future__ import annotations
 
 from .. import resources
 from ..errors import InputError
-from . import face_patch, hertz, patch
+from . import elastic_face_patch, face_patch, hertz, patch
 from .contact_rows import contact_row, reference_solution
 from .scene_registry import REFERENCE_MARGIN, scene_data, scene_spec
 
@@ -73,4 +73,18 @@ def face_patch_rows(model, cases, k, family, n1, n2, c, args) -> list:
 def face_check(args):
     """The face's structured bodies; estimate: the β one of the pair in 3D (one component)."""
     est = resources.beta_estimate("structured", args.k, args.N1, args.N2, "omega2", ("L2",), dim=3)
+    return est, _finest(args)
+
+
+def elastic_face_patch_rows(model, cases, k, family, n1, n2, c, args) -> list:
+    """The 3D elastic patch test's rows on the pair (moduli ``c`` = (E1, E2), ``--nu`` built into
+    ``model``), on the request's element (``--element``)."""
+    return elastic_face_patch.elastic_face_patch_rows(
+        cases, [k], [(n1, n2)], c, args.nu, element=getattr(args, "mesh_kwargs", {}).get("element", "hex"),
+        model=model)
+
+
+def elastic_face_check(args):
+    """The face's structured bodies; estimate: the β one of the pair in 3D, three components."""
+    est = resources.beta_estimate("structured", args.k, args.N1, args.N2, "omega2", ("L2",), components=3, dim=3)
     return est, _finest(args)

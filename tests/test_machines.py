@@ -19,7 +19,7 @@ UNIT_TESTS = ["tests/test_kernel.py", "tests/test_kernel_gap.py", "tests/test_ve
 
 
 def _env(core):
-    return dict(os.environ, OPENBLAS_CORETYPE=core, OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1")
+    return machines.machine_env(core, dict(os.environ, OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1"))
 
 
 @pytest.fixture(scope="module")

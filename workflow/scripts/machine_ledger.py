@@ -15,7 +15,7 @@ import sys
 from pathlib import Path
 
 from infsup_contact.io import write_atomic
-from infsup_contact.study.machines import runnable
+from infsup_contact.study.machines import machine_env, runnable
 
 SOURCES = ("Snakefile", "workflow", "src", "config", "profiles", "paper", "examples")
 
@@ -33,7 +33,7 @@ def main(core: str, output: str, cores: str) -> None:
         link = work / name
         if not link.is_symlink():
             link.symlink_to(Path(name).resolve())
-    env = dict(os.environ, OPENBLAS_CORETYPE=core)
+    env = machine_env(core)
     cmd = ["snakemake", "results/claims.csv", "--profile", "profiles/ci", "--cores", cores, "--quiet"]
     run = subprocess.run(cmd, cwd=work, env=env)
     if run.returncode:

@@ -41,6 +41,19 @@ REQUIRED_FLAGS = {
     "Zen": {"avx2", "fma"},
 }
 """CPU flags (/proc/cpuinfo; SSE3 is listed as ``pni``) each core type's kernels execute."""
+MKL_INSTRUCTIONS = {"Prescott": "SSE4_2", "Sandybridge": "AVX", "Haswell": "AVX2", "SkylakeX": "AVX512",
+                    "Zen": "AVX2"}
+"""MKL's code path (``MKL_ENABLE_INSTRUCTIONS``, its highest instruction set) matched to each
+core type: the face's Schur complement comes from MKL PARDISO (models/pardiso.py), whose
+round-off follows its own kernel choice, not OpenBLAS's. MKL has no SSE3-only path: Prescott
+gets its lowest, SSE4.2."""
+
+
+def machine_env(core: str, base: dict | None = None) -> dict:
+    """The environment that runs a check as on a CPU of ``core`` type: OpenBLAS's core type and
+    MKL's matching instruction set (:data:`MKL_INSTRUCTIONS`)."""
+    return dict(os.environ if base is None else base, OPENBLAS_CORETYPE=core,
+                MKL_ENABLE_INSTRUCTIONS=MKL_INSTRUCTIONS[core])
 SWEEP_N = (4, 8)
 """Matching meshes of the β sweep (with the union partition of the 17:16 pair)."""
 VERDICT_N = (4, 8, 16)

@@ -18,10 +18,20 @@ from _cli import run_in_process
 @pytest.mark.parametrize("n", [2, 3])
 def test_routes_agree_on_beta(n):
     rows = face_beta.bench_face([n], [1], "hex", repeats=1)
-    assert [r["route"] for r in rows] == ["ours", "ours_core", "limit"]
-    for r in rows:
+    beta = [r for r in rows if r["what"] == "face_beta"]
+    assert [r["route"] for r in beta] == ["ours", "ours_core", "limit"]
+    for r in beta:
         assert r["max_abs_diff"] <= 1e-8, r
         assert r["n_problems"] == 2 * len(face_beta.face_cases(1))
+
+
+def test_schur_routes_give_one_schur_complement():
+    """The face_schur rows: every route of gamma_factorization timed on the same bodies gives S to
+    round-off (relative to the first route, PARDISO), one row per route."""
+    rows = [r for r in face_beta.bench_face([3], [2], "hex", repeats=1) if r["what"] == "face_schur"]
+    assert [r["route"] for r in rows] == list(face_beta.SCHUR_ROUTES)
+    assert all(r["max_abs_diff"] <= 1e-12 for r in rows), rows
+    assert rows[0]["ratio_to_ours"] == 1.0
 
 
 def test_core_beta_equals_the_full_pencil():
@@ -43,7 +53,7 @@ def test_cli_csv_has_the_ratio_columns():
     assert code in (0, None), err
     frame = pd.read_csv(io.StringIO(out))
     assert set(face_beta.FACE_COLUMNS) <= set(frame.columns)
-    by = frame.set_index("route")
+    by = frame[frame["what"] == "face_beta"].set_index("route")
     assert by.loc["limit", "ratio_to_limit"] == 1.0 and by.loc["ours", "ratio_to_ours"] == 1.0
     assert np.isclose(by.loc["ours", "ratio_to_limit"],
                       by.loc["ours", "seconds_median"] / by.loc["limit", "seconds_median"], rtol=1e-4)

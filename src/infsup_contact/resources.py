@@ -118,14 +118,31 @@ def _multiplier_intervals(multiplier_mesh: str, n1: int, n2: int) -> float:
     return {"omega1": n1, "omega2": n2}.get(multiplier_mesh, n1 + n2)
 
 
-SIDE_BYTES_3D = 1500.0
-"""C in C · nd^{4/3} bytes per side of a 3D body (nested-dissection fill of a 3D grid is
-O(nd^{4/3})), everything of a β_h request but the process included. Peak resident memory
-(hexahedra, every case, ``/usr/bin/time -v``): 0.36 GB at N = 8 and 2.3 GB at N = 16, 5.3 GB at
-N = 20 (k = 2), 7.1 GB at N = 40 (k = 1); the estimate is above each (by 3–35 %)."""
+SIDE_BYTES_3D = {"pardiso": 700.0, "nested": 1500.0}
+"""C in C · nd^{4/3} bytes per side of a 3D body, by the route that gives its Schur complement
+(:func:`face_route`; the fill of a 3D sparse factorization is O(nd^{4/3}), and so are the dense
+Γ arrays: n_Γ² ~ (N k)⁴ = nd^{4/3}), everything of a β_h request but the process included.
+Peak resident memory (hexahedra, every case, ``/usr/bin/time``):
+
+- ``pardiso``: 0.30 GB at N = 8, 0.96 GB at N = 16, 3.1 GB at N = 24 (k = 2); 1.46 GB at
+  N = 32 (k = 1, the largest C: 615);
+- ``nested`` (SuperLU): 0.36 GB at N = 8, 2.3 GB at N = 16, 5.3 GB at N = 20 (k = 2), 7.1 GB
+  at N = 40 (k = 1).
+
+The estimate is above each."""
 SECONDS_PER_DOF2_3D = 1.3e-8
-"""Seconds per nd² (a 3D sparse LU) of the same runs (27 s at N = 16 and 96 s at N = 20, k = 2;
-118 s at N = 40, k = 1)."""
+"""Seconds per nd² of the same runs: the sparse LU (``nested``: 27 s at N = 16 and 96 s at
+N = 20, k = 2; 118 s at N = 40, k = 1) or the dense eigenproblems of dim M ~ (N k)² that
+follow PARDISO's factorization (``pardiso``: 16 s at N = 16, k = 2; 21 s at N = 32, k = 1):
+both grow like nd²."""
+
+
+def face_route() -> str:
+    """The Schur route a face takes above the solves route's limit: ``pardiso`` where MKL loads
+    (:func:`infsup_contact.models.schur.gamma_factorization`), else ``nested``."""
+    from .models import pardiso
+
+    return "pardiso" if pardiso.available() else "nested"
 
 
 def face_side_dofs(n: int, k: int) -> float:
@@ -137,7 +154,7 @@ def face_side_dofs(n: int, k: int) -> float:
 def face_beta_estimate(k: int, n1: int, n2: int, components: int = 1, process: bool = True) -> Estimate:
     """One ``beta_rows`` call of a 3D model (a contact face): both sides kept (C nd^{4/3} each)."""
     nds = [components * face_side_dofs(n, k) for n in (n1, n2)]
-    volume = sum(SIDE_BYTES_3D * nd ** (4.0 / 3.0) for nd in nds)
+    volume = sum(SIDE_BYTES_3D[face_route()] * nd ** (4.0 / 3.0) for nd in nds)
     seconds = START_SECONDS + SECONDS_PER_DOF2_3D * sum(nd ** 2 for nd in nds)
     return Estimate((PROCESS_BYTES["beta"] if process else 0) + volume, seconds)
 

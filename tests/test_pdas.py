@@ -285,16 +285,20 @@ def test_all_active_when_loads_push_together():
 
 
 # ---------------------------------------------------------------- (f) max_iter
-def test_max_iter_raises_with_history():
+def test_max_iter_hands_over_to_nnls_with_history():
+    """PDAS stopped by max_iter is finished by the NNLS route: the same verified solution."""
     A, B, F = thin_obstacle(31, lambda X, Y: -8 * np.sin(np.pi * X) * (1 - 2 * X) - 1.0)
     K, g0, _ = reduce(A, B, F)
-    assert solve_pdas(K, g0).iterations > 1
-    with pytest.raises(PdasDidNotConverge) as err:
-        solve_pdas(K, g0, max_iter=1)
-    hist = err.value.history
-    assert isinstance(err.value, RuntimeError) and len(hist) == 1
+    full = solve_pdas(K, g0)
+    assert full.iterations > 1 and full.route == "pdas"
+    capped = solve_pdas(K, g0, max_iter=1)
+    hist = capped.history
+    assert capped.route == "pdas+nnls" and capped.iterations == 1
     assert {"iteration", "n_active", "residual", "nullity", "n_changed"} <= set(hist[0])
     assert hist[0]["n_changed"] > 0 and hist[0]["residual"] > 0
+    assert any(h.get("fallback") == "nnls" and h.get("reason") == "max_iter" for h in hist)
+    assert_lcp_solution(capped, K, g0)
+    np.testing.assert_allclose(capped.lam, full.lam, atol=TOL * max(1.0, np.abs(full.lam).max()))
     with pytest.raises(PdasDidNotConverge):
         solve_kkt_sparse(A, B, F, max_iter=1)
 

@@ -191,8 +191,9 @@ def _pdas_loop(K, g0, c, cutoff, max_iter, tol, lam_max, definite=False):
 
     status is "converged" (active set repeated, or the iterate already passes the KKT
     check — without the latter a degenerate dof with λ_j ≈ g_j ≈ 0 can flip on
-    round-off forever) or "cycle" (an older active set reappeared).
-    Raises PdasDidNotConverge after ``max_iter`` solves.
+    round-off forever), "cycle" (an older active set reappeared) or "max_iter" (``max_iter``
+    solves, every active set new: PDAS can wander on a singular K, e.g. T3 at k = 2 on the
+    union of two non-matching face traces, 50 distinct active sets).
     """
     active = (-c * g0) > 0  # λ⁰ = 0, g⁰ = g0
     seen, history = {active.tobytes()}, []
@@ -209,9 +210,7 @@ def _pdas_loop(K, g0, c, cutoff, max_iter, tol, lam_max, definite=False):
             return lam, it, history, "cycle"
         seen.add(new.tobytes())
         active = new
-    raise PdasDidNotConverge(
-        f"PDAS did not converge in max_iter={max_iter} iterations "
-        f"(last residual {history[-1]['residual']:.3e})", history)
+    return lam, max_iter, history, "max_iter"
 
 
 def _nnls_dual(K, g0, cutoff):
@@ -248,8 +247,8 @@ def solve_pdas(K, g0, *, max_iter=50, tol=1e-12, kernel_rtol=1e-10) -> PdasResul
     𝒜ᵏ = {j : λ_j − c_j g_j > 0} with c_j = 1/K_jj; solve K_𝒜𝒜 λ_𝒜 = −g0_𝒜 (small
     dense eigen-solve), λ = 0 off 𝒜; stop when 𝒜 repeats (or the iterate already
     passes the KKT check, which settles round-off ties at degenerate dofs), then verify
-    the KKT conditions.  On a singular K_𝒜𝒜 the min-norm λ_𝒜 is used; on cycling (or a failed
-    check) the dual QP is solved by NNLS; finally the minimum-norm solution of the LCP is
+    the KKT conditions.  On a singular K_𝒜𝒜 the min-norm λ_𝒜 is used; on cycling, after
+    ``max_iter`` solves or on a failed check the dual QP is solved by NNLS; finally the minimum-norm solution of the LCP is
     returned as the representative (module docstring).
 
     Parameters
@@ -259,7 +258,8 @@ def solve_pdas(K, g0, *, max_iter=50, tol=1e-12, kernel_rtol=1e-10) -> PdasResul
     g0 : (m,) array_like
         Gap of the unconstrained solution, B A⁻¹ F.
     max_iter : int
-        Maximum number of PDAS linear solves.
+        Maximum number of PDAS linear solves; then the NNLS route finishes (``route``
+        ``"pdas+nnls"``, the history records ``reason`` = ``"max_iter"``).
     tol : float
         Relative tolerance of the final KKT check (raised to 16·m·eps if smaller): the
         violations of g ≥ 0, λ ≥ 0 and λ∘g = 0 are measured against ‖g0‖ + λ_max(K)‖λ‖
@@ -277,8 +277,8 @@ def solve_pdas(K, g0, *, max_iter=50, tol=1e-12, kernel_rtol=1e-10) -> PdasResul
         Non-square / non-symmetric / indefinite K, wrong g0 length, non-finite data,
         bad options.
     PdasDidNotConverge
-        After ``max_iter`` solves, or if no route passes the KKT check; carries
-        ``history``.
+        If no route passes the KKT check (an infeasible LCP, or NNLS' own iteration cap);
+        carries ``history``.
     """
     _check_options(max_iter, tol, kernel_rtol)
     prob = _Lcp.build(*_check_lcp(K, g0), tol, kernel_rtol)

@@ -31,7 +31,8 @@ monotone and u is unique, so this is it.
 Q_k / P_k, k ≥ 1) and its z traces coincide (B(u_2 − u_1) = 0). If 1 ∈ M_h, (u, p·1) satisfies
 the discrete system exactly — B_iᵀ(p 1) are the consistent nodal forces of the uniform
 traction and A_i u_i = F_i ∓ B_iᵀ(p 1) by Green's formula — so λ_h = p and u_h = u to
-round-off on non-matching faces iff ``SpaceSpec.contains_constants(k)``; T3 (vanishing on ∂Γ)
+round-off on non-matching faces iff 1 ∈ M_h, computed on the space the solve uses
+(:func:`~infsup_contact.discretization.constants.spans_constants`); T3 (vanishing on ∂Γ)
 fails. The z traces do not vanish on ∂Γ (u_z is free on the lateral faces), as in the
 membranes' face patch test (:mod:`.face_patch`), whose solve and measures this scene shares
 (:func:`~.face_patch.solve_face_patch` with this scene's data).
@@ -42,8 +43,9 @@ membranes' face patch test (:mod:`.face_patch`), whose solve and measures this s
 λ to 1e-14..6e-10 (R5.4 on tetrahedra the largest) and u to ≤ 1e-13 of δ, T3 fails (λ error
 1.2–2.4, u error 3e-2..0.16 δ) — as predicted, with one exception shared with the membranes'
 face patch test (same failure there, λ error 1): DUAL at k = 1 on tetrahedra (dim M = the
-interior nodes of G_h) fails although ``contains_constants(1)`` says it holds the constants —
-the registry's prediction is the segment's: on triangles the boundary modification keeps
+interior nodes of G_h) fails although the registry's ``contains_constants(1)`` (the segment's
+answer) says it holds the constants; computed on the face space itself, 1 ∉ M_h, which is now
+the prediction: on triangles the boundary modification keeps
 Σ ψ = 1 only where a triangle has a live node, and the two corner triangles with all three
 vertices on ∂Γ (the diagonal split at the corners (1, 0) and (0, 1)) have none, so λ_h = 0
 there (error 1; at k = 2 their edge midpoints are live and DUAL passes). R5.4 at k = 1 on

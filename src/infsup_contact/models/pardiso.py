@@ -91,8 +91,9 @@ class _Handle:
 
     def call(self, phase: int, b=None, x=None, nrhs: int = 1) -> None:
         err = _I32(0)
-        b = np.zeros(1) if b is None else b
-        x = np.zeros(1) if x is None else x
+        # phases that take no right-hand side may still use b and x as work arrays of n · nrhs
+        b = np.zeros(self.n * nrhs) if b is None else b
+        x = np.zeros(self.n * nrhs) if x is None else x
         self.lib.pardiso(self.pt.ctypes.data_as(_P(ctypes.c_int64)), ctypes.byref(_I32(1)),
                          ctypes.byref(_I32(1)), ctypes.byref(_I32(MTYPE_SPD)), ctypes.byref(_I32(phase)),
                          ctypes.byref(_I32(self.n)), self.U.data.ctypes.data,
@@ -128,11 +129,12 @@ def gamma_schur(A, n_gamma: int) -> np.ndarray:
     perm = np.zeros(n, dtype=np.int32)
     perm[n - n_gamma:] = 1
     handle = _Handle(A, perm, schur=1)
-    S = np.zeros((n_gamma, n_gamma))
+    S = np.zeros(max(n_gamma * n_gamma, n))  # the Schur block, in PARDISO's x (at least n long)
     try:
         handle.call(12, x=S)
     finally:
         handle.release()
+    S = S[:n_gamma * n_gamma].reshape(n_gamma, n_gamma)
     return 0.5 * (S + S.T)
 
 

@@ -191,6 +191,21 @@ def test_pardiso_refuses_a_matrix_that_is_not_positive_definite():
     import scipy.sparse as sp
     from infsup_contact.models.pardiso import PardisoError, gamma_schur
 
-    indefinite = sp.csr_matrix(np.diag([2.0, -1.0, 3.0, 1.0]) + np.diag([0.5] * 3, 1) + np.diag([0.5] * 3, -1))
+    diagonal = np.full(20, 2.0)
+    diagonal[5] = -1.0
+    indefinite = sp.csr_matrix(np.diag(diagonal) + np.diag([0.5] * 19, 1) + np.diag([0.5] * 19, -1))
     with pytest.raises(PardisoError):
         gamma_schur(indefinite, 2)
+
+
+@pytest.mark.parametrize("n, n_gamma", [(2, 1), (3, 2), (9, 1), (12, 3), (40, 7)])
+def test_pardiso_schur_on_small_matrices_equals_dense_elimination(n, n_gamma):
+    """Tiny interiors (below pardiso.MIN_INTERIOR, where MKL reads out of bounds) and larger ones
+    give the same S as dense elimination."""
+    import scipy.sparse as sp
+    from infsup_contact.models.pardiso import gamma_schur
+
+    D = np.diag(np.full(n, 4.0)) - np.diag(np.ones(n - 1), 1) - np.diag(np.ones(n - 1), -1)
+    I, G = slice(0, n - n_gamma), slice(n - n_gamma, n)
+    ref = D[G, G] - D[G, I] @ np.linalg.solve(D[I, I], D[I, G])
+    np.testing.assert_allclose(gamma_schur(sp.csr_matrix(D), n_gamma), ref, rtol=0, atol=1e-13)

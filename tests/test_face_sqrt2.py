@@ -77,6 +77,7 @@ def test_kernels_on_a_sqrt2_pair_against_the_counts():
     assert (rows.kernel_dim >= rows.planar).all()
     hexes = rows[rows.element == "hex"]
     assert hexes.tensor.notna().all() and (hexes.kernel_dim >= hexes.tensor).all()
+    assert (hexes.kernel_dim == hexes.tensor_1d).all()       # 3D pencil = rank of the 1D Kronecker factors
     stable = rows.case.map(lambda c: SPACES[c].stable)
     assert (rows[stable].kernel_dim == 0).all()
     predicted = rows[rows.prediction.isin(["PASS", "FAIL"])]
@@ -91,3 +92,11 @@ def test_the_command_line_runs_the_pair_and_agrees():
     cli = pd.read_csv(io.StringIO(out))
     study = pd.DataFrame(family_kernels([(5, 7)], ks=(1,), cases=["R5.2"], elements=["tet"]))
     assert int(cli.kernel_dim.iloc[0]) == int(study.kernel_dim.iloc[0]) >= int(study.planar.iloc[0])
+
+
+def test_hexahedral_kernels_at_k2_equal_the_1d_tensor_route():
+    """5:7, k = 2, hexahedra: the 3D numerical kernel = dim M − rank [A1⊗A1; A2⊗A2] from 1D integrals,
+    also where both lower bounds undercount (R5.2, DUAL-ALL: planar 0)."""
+    rows = pd.DataFrame(family_kernels([(5, 7)], ks=(2,), cases=["R5.2", "R5.4", "T4", "DUAL-ALL"], elements=["hex"]))
+    assert (rows.kernel_dim == rows.tensor_1d).all() and (rows.kernel_decision == "clear").all()
+    assert (rows.tensor_1d >= rows.tensor).all() and (rows.tensor_1d >= rows.planar).all()   # both lower bounds

@@ -13,6 +13,9 @@ For every space, k and element on such a pair this compares three numbers
   a lower bound of dim ker(B A⁻¹ Bᵀ) on any face;
 * ``tensor`` — on rectangle faces, for the tensor-product spaces, 2 a1 a2 − min(a1, a2)² with the 1D
   counts a_i (:func:`~.face_claims.tensor_kernel_bound`), also a lower bound (None elsewhere);
+* ``tensor_1d`` — on rectangle faces, for the tensor-product spaces, the kernel itself from the 1D
+  factors alone (:func:`tensor_kernel_1d`): B_i = A_i ⊗ A_i, so dim ker = dim M − rank [A1 ⊗ A1; A2 ⊗ A2]
+  with 1D integrals only — a route independent of the 3D meshes, solves and eigenproblem;
 * ``kernel_dim`` — the numerical count (:func:`~infsup_contact.solvers.infsup.beta_rows_all`, L²
   Gram: the kernel of the pencil does not depend on the SPD Gram), with its decision
   (``clear`` or ``close``).
@@ -28,6 +31,8 @@ from __future__ import annotations
 import argparse
 import sys
 
+import numpy as np
+
 from ..discretization.registry import SPACES, ids_valid_for
 from ..discretization.series import FAMILY_RULES
 from ..errors import InputError
@@ -40,6 +45,34 @@ def family_pair(family: str, n1: int) -> tuple:
     if family not in FAMILY_RULES:
         raise InputError("family", ", ".join(FAMILY_RULES), got=family)
     return int(n1), FAMILY_RULES[family][0](int(n1))
+
+
+def coupling_1d(space, n: int, k: int) -> np.ndarray:
+    """A[j, l] = ∫_0^1 w_j μ_l with w_j the basis of continuous P_k vanishing at 0 and 1 on n uniform
+    intervals (the 1D factor of a Q_k trace vanishing on ∂Γ) and μ_l the basis of the 1D ``space``:
+    Gauss–Legendre on the union of both breakpoint sets, exact for the degree k + s products."""
+    from ..discretization.multipliers import make_space
+    from ..discretization.quadrature import gauss_legendre_01
+
+    w = make_space(np.linspace(0.0, 1.0, n + 1), k, True, True)
+    cuts = np.union1d(np.linspace(0.0, 1.0, n + 1), np.asarray(space.breakpoints, float))
+    u, wt = gauss_legendre_01(k + int(space.degree) + 2)
+    h = np.diff(cuts)
+    x = (cuts[:-1, None] + h[:, None] * u[None, :]).ravel()
+    q = (h[:, None] * wt[None, :]).ravel()
+    return w.evaluate(x).T @ (q[:, None] * space.evaluate(x))
+
+
+def tensor_kernel_1d(spec, k: int, n1: int, n2: int, rtol: float = 1e-10) -> int:
+    """dim ker B1 ∩ ker B2 of a tensor-product space M = M^x ⊗ M^y on G_h = the n2 × n2 trace of Ω2
+    against the Q_k traces of n1 × n1 and n2 × n2 rectangle grids: B_i = A_i ⊗ A_i
+    (:func:`coupling_1d`), dim M − rank [A1 ⊗ A1; A2 ⊗ A2] (singular values above ``rtol`` times the
+    largest). Only for ``spec`` without a ``face_build``."""
+    m = spec.build(k, np.linspace(0.0, 1.0, n2 + 1))
+    A = [coupling_1d(m, n, k) for n in (n1, n2)]
+    stacked = np.vstack([np.kron(a, a) for a in A])
+    s = np.linalg.svd(stacked, compute_uv=False)
+    return int(stacked.shape[1] - np.sum(s > rtol * s[0]))
 
 
 def _as_predicted(prediction: str, kernel: int, planar: int) -> bool | None:
@@ -83,11 +116,12 @@ def family_kernels(pairs, ks=(1, 2), cases=None, elements=None, model: str | Non
                                                              element=element)}
                 for c, planar in built:
                     spec, r = SPACES[c], found[c]
-                    tensor = (tensor_kernel_bound(spec, k, n1, n2)
-                              if is_tensor(gamma) and spec.face_build is None else None)
+                    product = is_tensor(gamma) and spec.face_build is None
+                    tensor = tensor_kernel_bound(spec, k, n1, n2) if product else None
+                    exact = tensor_kernel_1d(spec, k, n1, n2) if product else None
                     pred = face_predictions(spec, k, [(n1, n2)], is_tensor(gamma), gamma)["nonmatching"]
                     rows.append(dict(element=element, k=k, N1=n1, N2=n2, case=c, dim_M=r["dim_M"],
-                                     planar=planar, tensor=tensor, kernel_dim=int(r["kernel_dim"]),
+                                     planar=planar, tensor=tensor, tensor_1d=exact, kernel_dim=int(r["kernel_dim"]),
                                      kernel_decision=r["kernel_decision"], prediction=pred,
                                      as_predicted=_as_predicted(pred, int(r["kernel_dim"]), planar)))
     return rows

@@ -19,6 +19,7 @@ import numpy as np
 from ..errors import InputError
 from .dual import dual_space
 from .face_cells import cellwise_builder
+from .face_elements import reference_element
 from .face_tri6 import triangle_builder
 from .interface import MULTIPLIER_MESHES
 from .segment import SEGMENT
@@ -384,12 +385,16 @@ def _face_only(case: str):
 
 def _face_case(id, ref, definition, element, basis, dimension, color, marker, vanish=True,
                expected="unknown", refuse_with=""):
-    """A cellwise space of quadratic face elements (Q2 traces: k = 2 hex, QUAD9) on G_h."""
+    """A space of quadratic face elements on G_h (k ≥ 2), paired with the face cells of the element's
+    reference cell: QUAD8/QUAD9 on rectangles (hexahedra, :mod:`.face_cells`), TRI6 on triangles
+    (tetrahedra, :mod:`.face_tri6`, always without the ∂Γ nodes)."""
+    quad = reference_element(element).cell == "quad"
+    build = (cellwise_builder(element, basis, vanish, refuse_with=refuse_with) if quad
+             else triangle_builder(basis, refuse_with=refuse_with))
     return register(SpaceSpec(
         id, ref, definition, _face_only(id), lambda k: 2, min_k=2, expected=expected,
         dimension=dimension, color=color, marker=marker, nodal_basis=basis in ("standard", "pwlin"),
-        claim_tag=id, gamma_dims=(2,), face_build=cellwise_builder(element, basis, vanish, refuse_with=refuse_with),
-        face_cells=("quad",)))
+        claim_tag=id, gamma_dims=(2,), face_build=build, face_cells=("quad",) if quad else ("trig",)))
 
 
 def _interior(n):       # nodes of the QUAD9 lattice inside (0, 1)² on an n × n grid
@@ -411,24 +416,15 @@ _face_case("PWLIN-Q9", "4C LM_QUAD pwlin (Popp 2009)", "piecewise bilinear on th
            "QUAD9", "pwlin", lambda k, n: _interior(n), OKABE_ITO["reddish_purple"], "p")
 
 
-def _tri6_case(id, ref, definition, basis, color, marker, expected="unknown", refuse_with=""):
-    """A TRI6 multiplier space (P2 traces: k = 2 tetrahedra) on the triangles of G_h (:mod:`.face_tri6`),
-    ∂Γ nodes dropped: dim M_h = (2N − 1)², the interior nodes of the P2 lattice."""
-    return register(SpaceSpec(
-        id, ref, definition, _face_only(id), lambda k: 2, min_k=2, expected=expected,
-        dimension=lambda k, n: _interior(n), color=color, marker=marker, nodal_basis=basis == "pwlin",
-        claim_tag=id, gamma_dims=(2,), face_build=triangle_builder(basis, refuse_with=refuse_with),
-        face_cells=("trig",)))
-
-
-_tri6_case("DUAL-T6", "Wohlmuth 2000 (TRI6)", "dual basis of TRI6 (refused: vertex weights ∫N = 0)", "dual",
-           OKABE_ITO["vermillion"], "h",
+# TRI6 (P2 traces: k = 2 tetrahedra; :mod:`.face_tri6`): dim M_h = (2N − 1)², the interior P2 nodes
+_face_case("DUAL-T6", "Wohlmuth 2000 (TRI6)", "dual basis of TRI6 (refused: vertex weights ∫N = 0)", "TRI6", "dual",
+           lambda k, n: _interior(n), OKABE_ITO["vermillion"], "h",
            refuse_with="use case TDUAL-T6 (the transformed dual basis, Popp et al. 2012, α = 1/5)")
-_tri6_case("TDUAL-T6", "Popp, Wohlmuth, Gee, Wall 2012; 4C", "transformed dual basis of TRI6, α = 1/5, on "
-           "∂Γ-free nodes, constants kept (= DUAL at k = 2 on tetrahedral faces)", "transformed_dual",
-           OKABE_ITO["bluish_green"], "d")
-_tri6_case("PWLIN-T6", "4C LM_QUAD pwlin (Popp 2009)", "piecewise linear on the 4 sub-triangles of TRI6, "
-           "vanishing on ∂Γ", "pwlin", OKABE_ITO["reddish_purple"], "H")
+_face_case("TDUAL-T6", "Popp, Wohlmuth, Gee, Wall 2012; 4C", "transformed dual basis of TRI6, α = 1/5, on "
+           "∂Γ-free nodes, constants kept (= DUAL at k = 2 on tetrahedral faces)", "TRI6", "transformed_dual",
+           lambda k, n: _interior(n), OKABE_ITO["bluish_green"], "d")
+_face_case("PWLIN-T6", "4C LM_QUAD pwlin (Popp 2009)", "piecewise linear on the 4 sub-triangles of TRI6, "
+           "vanishing on ∂Γ", "TRI6", "pwlin", lambda k, n: _interior(n), OKABE_ITO["reddish_purple"], "H")
 
 # --- roles the study gives to particular spaces (the one place they are spelled) --------
 REFERENCE_SPACE = "T3"

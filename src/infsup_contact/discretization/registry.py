@@ -90,7 +90,7 @@ class SpaceSpec:
     face_cells : tuple of str
         The face cells (``quad``, ``trig``: :data:`~.square.CELL_SHAPES`) whose traces the space
         is defined against: the quadratic quadrilateral elements' multipliers pair with QUAD9
-        traces (hexahedra) only.
+        traces (hexahedra) only, the TRI6 ones with P2 triangle traces (tetrahedra) only.
     lagrange : tuple or None
         ``(continuous, vanish)`` when ``build`` is the Lagrange space M^r_s / M^r_{0,s} of degree
         s = ``degree(k)`` (:func:`~.multipliers.make_space`): the description an interface
@@ -397,7 +397,7 @@ def _face_case(id, ref, definition, element, basis, dimension, color, marker, va
         claim_tag=id, gamma_dims=(2,), face_build=build, face_cells=("quad",) if quad else ("trig",)))
 
 
-def _interior(n):       # nodes of the QUAD9 lattice inside (0, 1)² on an n × n grid
+def _interior(n):       # nodes of the QUAD9 (= P2 triangle) lattice inside (0, 1)² on an n × n grid
     return (2 * n - 1) ** 2
 
 

@@ -356,7 +356,7 @@ CROSS_KEY_RULES = {
     check_speed_accuracy_scene: ("benchmarks.speed_accuracy_scene", "contact.scenes", "contact.primary_scene"),
     check_elastic_nonmatching: ("elastic.nonmatching", "elastic.patch_pairs"),
     check_hertz_reference: ("elastic.hertz.N_ref", "elastic.hertz.N"),
-    check_face: ("face.model", "face.elements", "face.nonmatching", "face.cases", "spaces"),
+    check_face: ("face.model", "face.elements", "face.nonmatching", "face.nonmatching_families", "face.cases", "spaces"),
     check_space_meshes: ("infsup.N", "infsup.nonmatching", "infsup.nonmatching_families", "contact.N",
                          "contact.scenes", "elastic.N", "elastic.nonmatching", "elastic.patch_pairs",
                          "elastic.bench_N", "elastic.hertz.N", "elastic.hertz.modeling_N", "benchmarks.beta_N",

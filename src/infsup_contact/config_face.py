@@ -5,6 +5,13 @@ one of its ``element`` mesh options, each case id is a registered space the face
 some k of ``face.k`` (built on the 2 × 2 grid of Γ: a face-only space added to the registry
 later passes by config alone), and a non-matching pair has N1 ≠ N2. Each raises one
 :class:`~infsup_contact.config_schema.ConfigError` naming the key.
+
+Non-matching families (``face.nonmatching_families``: family → element → N1 list, issue 28 item 1):
+the rules of the 2D study's families (:data:`~infsup_contact.discretization.series.FAMILY_RULES`:
+``sqrt2`` n → round(√2 n), ``plus1`` n → n + 1) give the *finer* side from the coarser one, and on
+the face Ω2 is the finer side as in ``face.nonmatching`` (G_h = the trace of Ω2): N2 = rule(N1),
+e.g. sqrt2 5:7, 7:10, 10:14. They are listed per element and explicitly, so ``face.max_N`` does not
+cap them (one √2 pair per element keeps the DAG cheap).
 """
 from __future__ import annotations
 
@@ -40,24 +47,55 @@ def check_face(cfg) -> None:
         if pair[0] == pair[1]:
             raise ConfigError(f"face.nonmatching[{i}]", "a non-matching pair needs N1 != N2", got=pair,
                               allowed="[N1, N2] with N1 != N2 (matching meshes go under face.N)")
+    _check_face_families(fc)
     _check_face_cases(cfg, fc)
+
+
+def _check_face_families(fc) -> None:
+    from .discretization.series import FAMILY_RULES
+
+    for name, per_element in (fc.get("nonmatching_families") or {}).items():
+        key = f"face.nonmatching_families.{name}"
+        if name not in FAMILY_RULES:
+            raise ConfigError(key, "not a non-matching family", got=name, allowed=", ".join(FAMILY_RULES))
+        for element, n1s in per_element.items():
+            if element not in fc["elements"]:
+                raise ConfigError(f"{key}.{element}", "not an element of face.elements", got=element,
+                                  allowed=", ".join(fc["elements"]))
+            for i, n1 in enumerate(n1s):
+                if FAMILY_RULES[name][0](n1) == n1:
+                    raise ConfigError(f"{key}.{element}[{i}]", f"the {name} pair of N1 = {n1} is matching "
+                                      "(N2 = N1: matching meshes go under face.N)", got=n1, allowed="N1 >= 2")
+
+
+def family_pairs(fc, element: str) -> list:
+    """(N1, N2 = rule(N1)) of every ``face.nonmatching_families`` entry of ``element`` (module
+    docstring: Ω2 the finer side), in the config's order."""
+    from .discretization.series import FAMILY_RULES
+
+    return [(int(n1), FAMILY_RULES[name][0](int(n1)))
+            for name, per_element in (fc.get("nonmatching_families") or {}).items()
+            for n1 in per_element.get(element, ())]
 
 
 def face_pairs(fc, element: str) -> list:
     """The mesh pairs of one element: every matching N and non-matching pair of the config,
-    up to the element's ``face.max_N`` where it has one."""
+    up to the element's ``face.max_N`` where it has one, then the element's family pairs
+    (:func:`family_pairs`, not capped)."""
     top = (fc.get("max_N") or {}).get(element, max(max(fc["N"]), *(max(p) for p in fc["nonmatching"])))
     pairs = [(n, n) for n in fc["N"]] + [tuple(p) for p in fc["nonmatching"]]
-    return list(dict.fromkeys((a, b) for a, b in pairs if max(a, b) <= top))
+    capped = [(a, b) for a, b in pairs if max(a, b) <= top]
+    return list(dict.fromkeys(capped + family_pairs(fc, element)))
 
 
 def _check_face_cases(cfg, fc) -> None:
     from .config_checks import case_ids
     from .discretization.registry import SPACES
-    from .discretization.square import SQUARE, TensorPartition
+    from .discretization.square import CELL_SHAPES, SQUARE, Square, TensorPartition
 
     ids = case_ids(cfg, gamma_dim=SQUARE.dim)
     x = np.linspace(0.0, 1.0, 3)
+    faces = [Square(cell=c) for c in CELL_SHAPES]
     for i, case in enumerate(fc["cases"]):
         key = f"face.cases[{i}]"
         if case not in ids:
@@ -67,7 +105,8 @@ def _check_face_cases(cfg, fc) -> None:
         if not ks:
             raise ConfigError(key, f"{case} is defined for none of face.k = {fc['k']}", got=case,
                               allowed=f"k >= {spec.min_k} in face.k")
-        try:
-            SQUARE.space(spec, ks[0], TensorPartition(x, x))
+        try:  # on a face of the cells it is defined on (rectangles and/or triangles)
+            for gamma in (g for g in faces if g.builds(spec)):
+                gamma.space(spec, ks[0], TensorPartition(x, x))
         except Exception as err:  # noqa: BLE001 - any failure to build means: not a face space
             raise ConfigError(key, f"{case} cannot be built on the face ({err})", got=case) from None

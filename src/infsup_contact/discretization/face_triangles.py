@@ -67,18 +67,19 @@ DUAL_ELEMENTS = {1: ("TRI3", False), 2: ("TRI6", True)}
 """Degree s → (reference element, Popp-transformed) of the dual bases on triangles."""
 
 
-def dual_local(s: int) -> np.ndarray:
+def dual_local(s: int, alpha: float | None = None) -> np.ndarray:
     """A (nloc, nloc), local dual functions ψ = A N in :func:`local_lattice` order: the
     reference element's coefficients (:func:`.face_dual.dual_coefficients`) permuted by matching
-    its nodes (x, y) to the barycentric multi-indices s (1 − x − y, x, y)."""
-    from .face_dual import dual_coefficients
+    its nodes (x, y) to the barycentric multi-indices s (1 − x − y, x, y). ``alpha``: the α of
+    the transformed TRI6 basis (None: 4C's 1/5; ignored by TRI3)."""
+    from .face_dual import POPP_ALPHA, dual_coefficients
     from .face_elements import reference_element
 
     name, transformed = DUAL_ELEMENTS[s]
     ref = reference_element(name).nodes
     bary = np.rint(s * np.column_stack([1.0 - ref.sum(axis=1), ref])).astype(int)
     perm = [int(np.flatnonzero((bary == a).all(axis=1))[0]) for a in local_lattice(s)]
-    C = dual_coefficients(name, transformed=transformed)
+    C = dual_coefficients(name, transformed=transformed, alpha=POPP_ALPHA if alpha is None else alpha)
     return C[np.ix_(perm, perm)]
 
 
@@ -102,6 +103,7 @@ class TriangleSpace:
     continuous: bool
     vanish: bool = False
     dual: bool = False
+    alpha: float | None = None  # α of a transformed dual basis (TRI6), None: 4C's 1/5
 
     def __post_init__(self):
         if int(self.s) < 0 or (self.continuous and self.s == 0):
@@ -150,7 +152,7 @@ class TriangleSpace:
         """Â (nloc, nloc) of a triangle whose live local nodes are the bits of ``live_mask``:
         rows of the live nodes get the dead nodes' dual functions, shared equally among the
         nearest live ones (distance of the barycentric multi-indices); rows of dead nodes are unused."""
-        A = dual_local(self.s)
+        A = dual_local(self.s, self.alpha)
         pos = local_lattice(self.s).astype(float)
         live = np.array([(live_mask >> i) & 1 for i in range(self.n_local)], dtype=bool)
         out = A.copy()

@@ -19,6 +19,8 @@ import numpy as np
 from ..errors import InputError
 from .dual import dual_space
 from .face_cells import cellwise_builder
+from .face_elements import reference_element
+from .face_tri6 import triangle_builder
 from .interface import MULTIPLIER_MESHES
 from .segment import SEGMENT
 from .multipliers import MultiplierSpace, make_space
@@ -88,7 +90,7 @@ class SpaceSpec:
     face_cells : tuple of str
         The face cells (``quad``, ``trig``: :data:`~.square.CELL_SHAPES`) whose traces the space
         is defined against: the quadratic quadrilateral elements' multipliers pair with QUAD9
-        traces (hexahedra) only.
+        traces (hexahedra) only, the TRI6 ones with P2 triangle traces (tetrahedra) only.
     lagrange : tuple or None
         ``(continuous, vanish)`` when ``build`` is the Lagrange space M^r_s / M^r_{0,s} of degree
         s = ``degree(k)`` (:func:`~.multipliers.make_space`): the description an interface
@@ -121,11 +123,13 @@ class SpaceSpec:
         return gamma_dim in self.gamma_dims
 
     def face_space(self, k: int, n: int):
-        """The space on the uniform n × n grid of the face (the square's build)."""
-        from .square import SQUARE, TensorPartition
+        """The space on the uniform n × n grid of the face: the square's build on the first face
+        cell shape the entry is defined on (``face_cells``: rectangles, else triangles)."""
+        from .square import CELL_SHAPES, Square, TensorPartition
 
         x = np.linspace(0.0, 1.0, n + 1)
-        return SQUARE.space(self, k, TensorPartition(x, x))
+        cell = next(c for c in CELL_SHAPES if c in self.face_cells)
+        return Square(cell=cell).space(self, k, TensorPartition(x, x))
     lagrange: tuple | None = None
     dual: bool = False
 
@@ -146,7 +150,12 @@ class SpaceSpec:
         points. What a patch test of a uniform pressure asks of M_h (study/patch.py). A
         face-only space: its own check on the n × n grid of the face."""
         if not self.defined_on(1):
-            return bool(self.face_space(k, n).contains_constants)
+            space = self.face_space(k, n)
+            if hasattr(space, "contains_constants"):
+                return bool(space.contains_constants)
+            from .face_tri6 import contains_constants
+
+            return contains_constants(space)
         space = self.build(k, np.linspace(0.0, 1.0, n + 1))
         x = np.linspace(0.0, 1.0, 8 * n * (self.degree(k) + 1) + 1)
         phi = space.evaluate(x)
@@ -356,7 +365,8 @@ PAPER_CASES = tuple(SPACES)
 
 # --- dual (biorthogonal) mortar multipliers (module dual) ---------------------------------
 register(SpaceSpec(
-    "DUAL", "Wohlmuth 2000", "dual basis of M^1_{0,k}", lambda k, x: dual_space(x, k, True), lambda k: k,
+    "DUAL", "Wohlmuth 2000", "dual basis of M^1_{0,k} (on tetrahedral faces at k = 2, where the TRI6 "
+    "vertex weights ∫N = 0 leave no plain dual basis: the Popp-transformed one, α = 1/5, i.e. TDUAL-T6)", lambda k, x: dual_space(x, k, True), lambda k: k,
     expected="stable", dimension=lambda k, n: n * k - 1, color=OKABE_ITO["black"], marker="p",
     nodal_basis=False, claim_tag="DUAL", finding_meshes=("omega2", "union"), lagrange=(True, True), dual=True))
 register(SpaceSpec(
@@ -375,15 +385,19 @@ def _face_only(case: str):
 
 def _face_case(id, ref, definition, element, basis, dimension, color, marker, vanish=True,
                expected="unknown", refuse_with=""):
-    """A cellwise space of quadratic face elements (Q2 traces: k = 2 hex, QUAD9) on G_h."""
+    """A space of quadratic face elements on G_h (k ≥ 2), paired with the face cells of the element's
+    reference cell: QUAD8/QUAD9 on rectangles (hexahedra, :mod:`.face_cells`), TRI6 on triangles
+    (tetrahedra, :mod:`.face_tri6`, always without the ∂Γ nodes)."""
+    quad = reference_element(element).cell == "quad"
+    build = (cellwise_builder(element, basis, vanish, refuse_with=refuse_with) if quad
+             else triangle_builder(basis, refuse_with=refuse_with))
     return register(SpaceSpec(
         id, ref, definition, _face_only(id), lambda k: 2, min_k=2, expected=expected,
         dimension=dimension, color=color, marker=marker, nodal_basis=basis in ("standard", "pwlin"),
-        claim_tag=id, gamma_dims=(2,), face_build=cellwise_builder(element, basis, vanish, refuse_with=refuse_with),
-        face_cells=("quad",)))
+        claim_tag=id, gamma_dims=(2,), face_build=build, face_cells=("quad",) if quad else ("trig",)))
 
 
-def _interior(n):       # nodes of the QUAD9 lattice inside (0, 1)² on an n × n grid
+def _interior(n):       # nodes of the QUAD9 (= P2 triangle) lattice inside (0, 1)² on an n × n grid
     return (2 * n - 1) ** 2
 
 
@@ -400,6 +414,17 @@ _face_case("TDUAL-Q9", "Popp, Gitterle, Gee, Wall 2010; 4C", "transformed dual b
            "QUAD9", "transformed_dual", lambda k, n: _interior(n), OKABE_ITO["bluish_green"], "8")
 _face_case("PWLIN-Q9", "4C LM_QUAD pwlin (Popp 2009)", "piecewise bilinear on the 4 sub-quads of QUAD9",
            "QUAD9", "pwlin", lambda k, n: _interior(n), OKABE_ITO["reddish_purple"], "p")
+
+
+# TRI6 (P2 traces: k = 2 tetrahedra; :mod:`.face_tri6`): dim M_h = (2N − 1)², the interior P2 nodes
+_face_case("DUAL-T6", "Wohlmuth 2000 (TRI6)", "dual basis of TRI6 (refused: vertex weights ∫N = 0)", "TRI6", "dual",
+           lambda k, n: _interior(n), OKABE_ITO["vermillion"], "h",
+           refuse_with="use case TDUAL-T6 (the transformed dual basis, Popp et al. 2012, α = 1/5)")
+_face_case("TDUAL-T6", "Popp, Wohlmuth, Gee, Wall 2012; 4C", "transformed dual basis of TRI6, α = 1/5, on "
+           "∂Γ-free nodes, constants kept (= DUAL at k = 2 on tetrahedral faces)", "TRI6", "transformed_dual",
+           lambda k, n: _interior(n), OKABE_ITO["bluish_green"], "d")
+_face_case("PWLIN-T6", "4C LM_QUAD pwlin (Popp 2009)", "piecewise linear on the 4 sub-triangles of TRI6, "
+           "vanishing on ∂Γ", "TRI6", "pwlin", lambda k, n: _interior(n), OKABE_ITO["reddish_purple"], "H")
 
 # --- roles the study gives to particular spaces (the one place they are spelled) --------
 REFERENCE_SPACE = "T3"

@@ -10,7 +10,14 @@ dual space (∂Γ dofs dropped, constants kept, :class:`~infsup_contact.discreti
 with Q2 displacements (k = 2, hexahedra) on matching N × N meshes. An α with a weight ≤ 0 is
 refused, as the registry's DUAL-Q8 is (the row says so; no β).
 
-Run: ``python -m infsup_contact.study.face_alpha --N 4 8`` (CSV on stdout).
+TRI6 (issue 28, item 3): the same sweep on the triangles of tetrahedral faces (P2 displacements,
+:func:`~infsup_contact.discretization.face_tri6.tri6_space`). Its weights are ∫Ñ_vertex = α/3 and
+∫Ñ_edge = (1 − 2α)/6 (fractions 2α/3 and (1 − 2α)/3 of the area 1/2): positive on all of (0, 1/2),
+the plain dual (α = 0) is the only one refused. The mesh element of each reference element is the
+model's element whose face cells have its shape (:func:`element_of`), not a name.
+
+Run: ``python -m infsup_contact.study.face_alpha --N 4 8`` (CSV on stdout);
+``--element TRI6 --N 4 6`` for the triangles.
 """
 from __future__ import annotations
 
@@ -21,19 +28,45 @@ import numpy as np
 
 from ..discretization.face_cells import cellwise_builder
 from ..discretization.face_dual import alpha_sweep
+from ..discretization.face_elements import reference_element
+from ..discretization.face_tri6 import triangle_builder
 from ..discretization.registry import SpaceSpec
 from ..errors import InputError
 
 ALPHAS = (0.05, 0.1, 0.125, 0.15, 0.2, 0.25, 0.3, 1.0 / 3.0, 0.4, 0.45)
 """The sweep of issue 28 (0.125: the QUAD8 corner weight is exactly 0; 0.2: 4C's)."""
 ELEMENTS = ("QUAD8", "QUAD9")
+TRI_ALPHAS = (0.05, 0.1, 0.15, 0.2, 0.25, 0.3, 1.0 / 3.0, 0.4, 0.45)
+"""The TRI6 sweep of issue 28 (no α in (0, 1/2) makes a TRI6 weight vanish)."""
+SWEEP_ELEMENTS = ("QUAD8", "QUAD9", "TRI6")
+FACE_CELL = {"quad": "quad", "tri": "trig"}
+"""Reference cell of an element (:attr:`~.face_elements.ReferenceElement.cell`) → face cell shape
+(:data:`~infsup_contact.discretization.square.CELL_SHAPES`)."""
 
 
 def transformed_dual_spec(element: str, alpha: float) -> SpaceSpec:
-    """An unregistered entry: the transformed dual basis of ``element`` with this α (k ≥ 2)."""
+    """An unregistered entry: the transformed dual basis of ``element`` with this α (k ≥ 2), on
+    the face cells of its shape."""
+    cell = FACE_CELL[reference_element(element).cell]
+    build = (cellwise_builder(element, "transformed_dual", True, alpha) if cell == "quad"
+             else triangle_builder("transformed_dual", alpha))
     return SpaceSpec(f"TDUAL-{element}-a{alpha:.4g}", "Popp et al. 2010", f"transformed dual {element}, α = {alpha:.4g}",
-                     lambda k, x: None, lambda k: 2, min_k=2, gamma_dims=(2,),
-                     face_build=cellwise_builder(element, "transformed_dual", True, alpha))
+                     lambda k, x: None, lambda k: 2, min_k=2, gamma_dims=(2,), face_build=build, face_cells=(cell,))
+
+
+def element_of(model: str, reference: str) -> str:
+    """The mesh element (``--element``) of ``model`` whose face cells have the shape of the
+    reference element ``reference`` (QUAD8 → hexahedra, TRI6 → tetrahedra), asked of the faces
+    (:func:`~.face_claims.element_interfaces`)."""
+    from ..models import MODELS
+    from .face_claims import element_interfaces
+
+    options = dict(MODELS[model].mesh_options).get("element", ())
+    want = FACE_CELL[reference_element(reference).cell]
+    found = [e for e, g in element_interfaces(model, options).items() if g.cell == want]
+    if not found:
+        raise InputError("element", f"a reference element whose cells {model} has on its face", got=reference)
+    return found[0]
 
 
 def face_models() -> list:
@@ -43,11 +76,12 @@ def face_models() -> list:
     return [name for name, m in MODELS.items() if m.dim == 3]
 
 
-def sweep(ns=(4, 8), alphas=ALPHAS, elements=ELEMENTS, k: int = 2, norms=("H",), cell: str = "hex",
+def sweep(ns=(4, 8), alphas=ALPHAS, elements=ELEMENTS, k: int = 2, norms=("H",), cell: str | None = None,
           model: str | None = None) -> list[dict]:
     """One row per (element, α, N, norm): α, min weight (fraction of the cell area), cond₂(Ã),
     ``refused`` and, where not refused, β_h, kernel_dim, dim M, dim W, n_max (``model``: a
-    registered 3D model, default the first, :func:`face_models`; ``cell`` its --element)."""
+    registered 3D model, default the first, :func:`face_models`; ``cell`` its --element, default
+    the one whose face cells fit each element, :func:`element_of`)."""
     from ..models import make_model
     from ..models.side_cache import SideCache
 
@@ -63,8 +97,9 @@ def sweep(ns=(4, 8), alphas=ALPHAS, elements=ELEMENTS, k: int = 2, norms=("H",),
                 if not info["positive"]:
                     rows += [dict(base, norm=nm, beta=np.nan, kernel_dim=-1) for nm in norms]
                     continue
+                mesh_element = cell or element_of(model, element)
                 for r in beta_rows_all("structured", k, n, n, [transformed_dual_spec(element, info["alpha"])],
-                                       norms=norms, model=make_model(model), side_cache=cache, element=cell):
+                                       norms=norms, model=make_model(model), side_cache=cache, element=mesh_element):
                     rows.append(dict(base, norm=r["norm"], beta=r["beta"], kernel_dim=r["kernel_dim"],
                                      dim_M=r["dim_M"], dim_W=r["dim_W"], n_max=r["n_max"]))
     return rows
@@ -77,11 +112,15 @@ def main(argv=None) -> None:
     p.add_argument("--N", type=int, nargs="+", default=[4, 8], help="cells per direction (matching meshes)")
     p.add_argument("--norm", default="H", choices=["H", "L2", "all"])
     p.add_argument("--model", default=None, choices=face_models(), help="a 3D model (default: the first)")
+    p.add_argument("--element", nargs="+", default=list(ELEMENTS), choices=SWEEP_ELEMENTS,
+                   help="reference elements (QUAD8/QUAD9: hexahedra, TRI6: tetrahedra)")
     args = p.parse_args(argv)
     if any(n < 1 for n in args.N):
         raise InputError("N", "integers >= 1", got=args.N)
     norms = ("H", "L2") if args.norm == "all" else (args.norm,)
-    pd.DataFrame(sweep(tuple(args.N), norms=norms, model=args.model)).to_csv(sys.stdout, index=False, float_format="%.6g")
+    alphas = ALPHAS if any(FACE_CELL[reference_element(e).cell] == "quad" for e in args.element) else TRI_ALPHAS
+    rows = sweep(tuple(args.N), alphas, tuple(args.element), norms=norms, model=args.model)
+    pd.DataFrame(rows).to_csv(sys.stdout, index=False, float_format="%.6g")
 
 
 if __name__ == "__main__":

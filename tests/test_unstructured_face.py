@@ -178,3 +178,36 @@ def test_bad_inputs():
     with pytest.raises(InputError, match="not empty"):  # N = 2: no vertex inside Γ
         case_space("T3", 1, part, TRIANGULATED)
     assert SQUARE_TRIG.cells(part) == 0  # the structured face refuses a general triangulation
+
+
+def _points(mesh):
+    return np.array([mesh[v].point for v in mesh.vertices])
+
+
+@pytest.mark.parametrize("element", ["tet", "hex"])
+def test_perturbed_meshes_are_seeded_and_keep_the_planes(element):
+    """Same seed, same mesh; another seed, another; every vertex within α h (per coordinate) of
+    the structured one, on the same box planes; the hexahedra's face stays the tensor grid."""
+    n, alpha = 3, 0.2
+    base = _points(membranes3d.subdomain_mesh("structured", n, 1, element=element))
+    a, b, c = (_points(membranes3d.subdomain_mesh("perturbed", n, 1, element=element, seed=s)) for s in (5, 5, 6))
+    assert np.array_equal(a, b) and not np.array_equal(a, c)
+    d = a - base
+    assert np.abs(d).max() <= alpha / n and np.abs(d).max() > 0
+    on_plane = np.abs(base - np.rint(base)) < 1e-12
+    assert np.all(d[on_plane] == 0.0)
+    face = membranes3d.face_of(membranes3d.subdomain_mesh("perturbed", n, 1, element=element, seed=5))
+    assert (face is TRIANGULATED) == (element == "tet")
+
+
+def test_perturbed_matching_pair_counts_are_exact():
+    """N1 = N2: both perturbed faces are the same triangulation (shifts drawn from (seed, N));
+    dim(W1 + W2) = dim W, the kernel of every continuous case is dim M − dim W exactly."""
+    k, n = 1, 3
+    sides = SideCache().pair(MODEL, "perturbed", k, n, n, element="tet", seed=2)
+    p1, p2 = (s.trace.partition for s in sides)
+    assert p1.key == p2.key
+    assert TRIANGULATED.trace_sum_dimension(k, p1, p2) == TRIANGULATED.trace_dimension_of(k, p1)
+    frame = pd.DataFrame(beta_rows("perturbed", k, n, n, cases=["T3", "R5.2", "DUAL"], model=MODEL, element="tet",
+                                   norms=("L2",), seed=2))
+    assert (frame.kernel_dim == frame.structural_kernel_dim).all() and (frame.kernel_check == "agree").all()

@@ -74,11 +74,11 @@ class TriangulatedSquare(Interface):
             raise InputError("mesh", "a face Γ of triangles (a tetrahedral mesh)")
         return out
 
-    def _partition(self, vertex_sets) -> Triangulation:
-        tri = from_elements(vertex_sets)
+    def _partition(self, vertex_sets, order: bool = False):
+        tri, perm = from_elements(vertex_sets, order=True)
         if abs(tri.areas.sum() - 1.0) > 1e-10 or tri.points.min() < -1e-12 or tri.points.max() > 1 + 1e-12:
             raise InputError("mesh", f"a face Γ = (0, 1)² tiled by its triangles (area {tri.areas.sum():.6g})")
-        return tri
+        return (tri, perm) if order else tri
 
     def partition_of(self, mesh) -> Triangulation:
         """The triangles of the Γ boundary elements of ``mesh`` (they must tile (0, 1)²)."""
@@ -138,7 +138,8 @@ class TriangulatedSquare(Interface):
             dn = np.array(fes.GetDofNrs(el))
             elements.append((verts, dn, el))
             dofs.update(int(d) for d in dn if d >= 0 and free[int(d)])
-        part = self._partition([v for v, _, _ in elements])
+        part, perm = self._partition([v for v, _, _ in elements], order=True)
+        elements = [elements[i] for i in perm]  # in the partition's order (trace_values locates there)
         return GammaTrace(fes, np.array(sorted(dofs), dtype=int), elements, part, self)
 
     def trace_values(self, trace: GammaTrace, x: np.ndarray) -> np.ndarray:

@@ -77,14 +77,21 @@ class Triangulation:
         return max(int(round(np.sqrt(self.cells / 2.0))), 1)
 
 
-def from_elements(vertex_sets, tol: float = 1e-12) -> Triangulation:
+def from_elements(vertex_sets, tol: float = 1e-12, order: bool = False):
     """The triangulation of a list of triangles given by their vertex coordinates (3, 2),
-    vertices closer than ``tol`` merged (a trace's boundary elements, :meth:`partition_of`)."""
+    vertices closer than ``tol`` merged (a trace's boundary elements), in a canonical order
+    (points sorted, each triangle from its smallest vertex counter-clockwise, triangles sorted):
+    equal triangulations have equal keys. ``order``: also return the input index of every
+    triangle."""
     corners = np.array([np.asarray(v, float) for v in vertex_sets])
     if corners.ndim != 3 or corners.shape[1:] != (3, 2):
         raise InputError("mesh", "triangular boundary elements on Γ", got=corners.shape)
     points, index = glue(corners.reshape(-1, 2), tol)
-    return Triangulation(points, index.reshape(-1, 3))
+    tri = Triangulation(points, index.reshape(-1, 3)).triangles  # counter-clockwise
+    tri = np.array([np.roll(r, -int(np.argmin(r))) for r in tri])
+    perm = np.lexsort(tri.T[::-1])
+    out = Triangulation(points, tri[perm])
+    return (out, perm) if order else out
 
 
 def glue(x: np.ndarray, tol: float = 1e-12) -> tuple[np.ndarray, np.ndarray]:

@@ -17,8 +17,8 @@ N × N × N cells of each body (N = cells per direction on Γ) from
 rectangles cut by the diagonal from (x_i, y_j) to (x_{i+1}, y_{j+1}) — on both bodies, so the
 trace is a tensor grid of triangles (:data:`~infsup_contact.discretization.square.SQUARE_TRIG`).
 The ``unstructured`` family (Netgen tetrahedra, maxh = 1/N, each body meshed on its own) and
-the ``perturbed`` one (structured, vertices moved; on hexahedra Γ's vertices stay, so the face
-stays a tensor grid) are built in :mod:`infsup_contact.discretization.meshes3d`; their
+the ``perturbed`` one (structured, vertices moved; on hexahedra only off Γ and in z, so the
+face stays a tensor grid) are built in :mod:`infsup_contact.discretization.meshes3d`; their
 tetrahedral faces are general triangulations, Γ
 :data:`~infsup_contact.discretization.triangulated_square.TRIANGULATED` (non-matching traces,
 common refinement by polygon clipping).
@@ -69,7 +69,7 @@ def subdomain_mesh(family: str, n: int, side: int, *, element: str = "hex", widt
     """The mesh of Ω_side of a family: Γ named ``gamma``, the far face :data:`FAR`, the
     lateral faces :data:`LATERAL`. ``structured``: N × N × N cells; ``unstructured`` (tetrahedra,
     maxh = 1/N) and ``perturbed`` (the structured mesh, vertices moved by U(−αh, αh) per free
-    direction, seeded; on hexahedra the Γ vertices stay): :mod:`~infsup_contact.discretization.meshes3d`.
+    direction, seeded; on hexahedra off Γ and in z only): :mod:`~infsup_contact.discretization.meshes3d`.
     A tetrahedral mesh of those two families carries ``face_interface`` = the general
     triangulated face (:func:`face_of`).
 
@@ -109,7 +109,7 @@ def subdomain_mesh(family: str, n: int, side: int, *, element: str = "hex", widt
     for i in range(6):
         ngmesh.SetBCName(i, SQUARE.boundary if i == gamma else FAR if i == far else LATERAL)
     if family == "perturbed":
-        meshes3d.perturb_points(ngmesh, int(n), side, alpha, seed, move_gamma=element == "tet")
+        meshes3d.perturb_points(ngmesh, int(n), side, alpha, seed, hexes=element == "hex")
     mesh = ngsolve.Mesh(ngmesh)
     if family == "perturbed":
         meshes3d.check_volume(mesh, f"family perturbed, N = {n}, side {side}, seed {seed}, alpha {alpha:g}")

@@ -32,7 +32,7 @@ import numpy as np
 from ..errors import InputError
 from .face_norms import extrapolated
 from .face_quadrature import duffy_rule, triangles_rule
-from .face_triangle_norms import TAIL_EXPONENTS, moments, tail_key
+from .face_triangle_norms import TAIL_EXPONENTS, tail_key
 from .face_triangles import lagrange_barycentric
 from .norms import N_MAX_CAP
 
@@ -60,11 +60,15 @@ def monomial_coefficients(s: int) -> np.ndarray:
     return np.linalg.solve(V, L)
 
 
+#: |ω| below which :func:`_moments` sums the series (the recursion amplifies errors by j/|ω|).
+_SERIES_BELOW, _SERIES_TERMS = 2.0, 32
+
+
 def _moments(omega: np.ndarray, e: np.ndarray, jmax: int) -> list:
     """[M_j(ω) = ∫_0^1 t^j e^{iωt} dt for j = 0..jmax] given e = e^{iω}: the recursion
-    M_j = (e − j M_{j−1})/(iω) where |ω| ≥ 4, :func:`~.face_triangle_norms.moments` (its series)
-    on the few entries below."""
-    small = np.abs(omega) < 4.0
+    M_j = (e − j M_{j−1})/(iω) where |ω| ≥ 2, the series Σ_k (iω)^k / (k! (j + k + 1)) on the
+    few entries below (32 terms: 2^32/32! < 1e-25), as :func:`~.face_triangle_norms.moments`."""
+    small = np.abs(omega) < _SERIES_BELOW
     r = -1j / np.where(small, 1.0, omega)
     out, prev = [], (e - 1.0) * r
     out.append(prev)
@@ -72,9 +76,14 @@ def _moments(omega: np.ndarray, e: np.ndarray, jmax: int) -> list:
         prev = (e - j * prev) * r
         out.append(prev)
     if small.any():
-        ms = moments(omega[small], jmax)
+        z = 1j * omega[small]
+        term = np.ones_like(z)
+        acc = np.zeros((jmax + 1, z.size), dtype=complex)
+        for k in range(_SERIES_TERMS):
+            acc += term[None, :] / (np.arange(jmax + 1)[:, None] + k + 1.0)
+            term = term * z / (k + 1.0)
         for j in range(jmax + 1):
-            out[j][small] = ms[j]
+            out[j][small] = acc[j]
     return out
 
 

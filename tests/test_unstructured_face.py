@@ -148,12 +148,13 @@ def test_general_route_gives_the_structured_beta(k):
     assert np.allclose(a.beta, b.beta, rtol=1e-8, atol=1e-12)
 
 
-def test_unstructured_kernels_and_beta():
-    """Non-matching unstructured pair (3, 4), k = 1: the kernel of every case is at least the
-    dimension count max(dim M − dim(W1 + W2), 0), and exactly it where the count is proven
-    (continuous spaces); β_L² > 0 for T3 and the dual basis."""
-    frame = pd.DataFrame(beta_rows("unstructured", 1, 3, 4, cases=["T3", "R5.2", "R5.4", "DUAL"], model=MODEL,
-                                   element="tet", norms=("L2",)))
+@pytest.mark.parametrize("k", [1, 2])
+def test_unstructured_kernels_and_beta(k):
+    """Non-matching unstructured pair (3, 4): the kernel of every case is at least the dimension
+    count max(dim M − dim(W1 + W2), 0), decided clearly; β_L² > 0 exactly where there is no
+    kernel, and for T3 and the dual basis."""
+    cases = [c for c in ("T3", "R5.2", "T4", "R5.4", "T5", "DUAL") if SPACES[c].valid_for(k)]
+    frame = pd.DataFrame(beta_rows("unstructured", k, 3, 4, cases=cases, model=MODEL, element="tet", norms=("L2",)))
     for _, row in frame.iterrows():
         assert row.kernel_decision == "clear"
         assert row.kernel_dim >= row.structural_kernel_dim
@@ -211,3 +212,15 @@ def test_perturbed_matching_pair_counts_are_exact():
     frame = pd.DataFrame(beta_rows("perturbed", k, n, n, cases=["T3", "R5.2", "DUAL"], model=MODEL, element="tet",
                                    norms=("L2",), seed=2))
     assert (frame.kernel_dim == frame.structural_kernel_dim).all() and (frame.kernel_check == "agree").all()
+
+
+def test_sample_and_boundary_cells(unstructured):
+    """sample(·, 1) is the vertex set, sample(·, 2) adds one midpoint per edge (Euler: E = V + T − 1);
+    at_boundary marks exactly the points of triangles with a vertex on ∂Γ."""
+    tri = unstructured[0]
+    v = TRIANGULATED.sample(tri, 1)
+    assert len(v) == len(tri.points)
+    assert len(TRIANGULATED.sample(tri, 2)) == len(v) + (len(v) + tri.cells - 1)
+    centroids = tri.corners.mean(axis=1)
+    touching = np.any((tri.corners < 1e-12) | (tri.corners > 1 - 1e-12), axis=(1, 2))
+    assert np.array_equal(TRIANGULATED.at_boundary(tri, centroids), touching)

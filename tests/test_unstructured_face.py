@@ -138,9 +138,12 @@ def test_general_route_gives_the_structured_beta(k):
     cases = [c for c in ("T3", "R5.2", "R5.4", "T5", "DUAL") if SPACES[c].valid_for(k)]
     rows = {}
     for name, model in (("structured", MODEL), ("general", GENERAL)):
-        norms = ("H", "L2") if k == 1 else ("L2",)
-        frame = pd.DataFrame(beta_rows("structured", k, 2, 3, cases=cases, model=model, element="tet", norms=norms))
-        rows[name] = frame.set_index(["case", "norm"])
+        # the H series of the continuous nodal cases only (the others' are long; their partial sums
+        # are compared in test_general_spaces_are_the_structured_ones)
+        split = [(cases, ("L2",)), (cases[:2], ("H",))]
+        frames = [r for c, norms in split
+                  for r in beta_rows("structured", k, 2, 3, cases=c, model=model, element="tet", norms=norms)]
+        rows[name] = pd.DataFrame(frames).set_index(["case", "norm"])
     a, b = rows["structured"], rows["general"]
     assert (a.kernel_dim == b.kernel_dim).all() and (a.dim_M == b.dim_M).all()
     # the general count bounds dim(W1 + W2) from above (W1 ∩ W2 from matched triangles only)

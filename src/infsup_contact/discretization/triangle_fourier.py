@@ -100,18 +100,19 @@ def reference_transforms(k1: np.ndarray, k2: np.ndarray, s: int, e1=None, e2=Non
     M1, M2 = _moments(k1, e1, s), _moments(k2, e2, s)
     M12 = _moments(k2 - k1, e2 * np.conj(e1), s)
     F = {}
-    for a, b in mono:
+    out = np.empty((len(mono),) + k1.shape, dtype=complex)
+    for i, (a, b) in enumerate(mono):
         edges = (k1 + k2) * e1 * sum(comb(a, c) * (-1) ** c * M12[b + c] for c in range(a + 1))
         if b == 0:
-            edges = edges - k2 * M1[a]
+            edges -= k2 * M1[a]
         if a == 0:
-            edges = edges - k1 * M2[b]
+            edges -= k1 * M2[b]
         if a:
-            edges = edges - a * k1 * F[(a - 1, b)]
+            edges -= a * k1 * F[(a - 1, b)]
         if b:
-            edges = edges - b * k2 * F[(a, b - 1)]
-        F[(a, b)] = scale * edges
-    out = np.stack([F[ab] for ab in mono])
+            edges -= b * k2 * F[(a, b - 1)]
+        np.multiply(scale, edges, out=out[i])
+        F[(a, b)] = out[i]
     if small.any():
         u, v, w = duffy_rule(SMALL_DEGREE)
         ph = np.exp(1j * (np.outer(k1[small], u) + np.outer(k2[small], v))) * w[None, :]
@@ -134,15 +135,17 @@ def sine_coefficients(space, m: np.ndarray, n: np.ndarray) -> np.ndarray:
         px, py = np.pi * np.outer(v[:, 0], m), sign * np.pi * np.outer(v[:, 1], n)
         return px[:, :, None] + py[:, None, :], np.exp(1j * px)[:, :, None] * np.exp(1j * py)[:, None, :]
 
-    local = 0.0
+    nt, nloc = space.breakpoints.cells, space.n_local
+    local = np.zeros((nloc, nt * len(m) * len(n)))
     for sign in (1.0, -1.0):
         (k1, x1), (k2, x2), (_, xa) = wave(e1, sign), wave(e2, sign), wave(A, sign)
         F = reference_transforms(k1, k2, space.s, x1, x2)  # (mono, T, m, n)
-        Phi = np.einsum("jl,jtmn->tlmn", C, F) * (jac[:, None, None] * xa)[:, None]
-        local = local - sign * Phi.real  # −Re[Φ(m, n) − Φ(m, −n)]
+        F *= (jac[:, None, None] * xa)[None]
+        local -= sign * (C.T @ F.real.reshape(len(C), -1))  # −Re[Φ(m, n) − Φ(m, −n)], per local function
+    local = np.ascontiguousarray(local.reshape(nloc, nt, -1).transpose(1, 0, 2))  # (T, nloc, m n)
     if space.dual:
-        local = np.einsum("tml,tlab->tmab", space.local_matrices(), local)  # ψ = Â N
-    flat = local.reshape(space.breakpoints.cells * space.n_local, -1)
+        local = np.matmul(space.local_matrices(), local)  # ψ = Â N
+    flat = local.reshape(nt * nloc, -1)
     return np.asarray(space.scatter() @ flat).reshape(space.dim, len(m), len(n))
 
 

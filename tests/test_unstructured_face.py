@@ -86,6 +86,10 @@ def test_trace_dimensions_are_ngsolves(k):
     assert gamma is TRIANGULATED
     for s in sides:
         assert len(s.trace.gamma_dofs) == gamma.trace_dimension_of(k, s.trace.partition)
+    for s, n, side in zip(sides, (2, 3), (1, 2)):  # natural lateral faces: ∂Γ's nodes are free too
+        mesh = membranes3d.subdomain_mesh("unstructured", n, side, element="tet")
+        free = membranes3d.side_operator(mesh, k, dirichlet=membranes3d.FAR, gamma=TRIANGULATED)
+        assert len(free.trace.gamma_dofs) == gamma.trace_dimension_of(k, s.trace.partition, clamped=False)
     x = np.random.default_rng(28).random((3000, 2))
     both = np.hstack([gamma.trace_values(s.trace, x) for s in sides])
     assert gamma.trace_sum_dimension(k, *(s.trace.partition for s in sides)) == rank(both, 1e-9)

@@ -209,9 +209,10 @@ class TriangulatedSquare(Interface):
         """Of the structured N × N triangles (``cells`` = N): (N k − 1)²."""
         return SQUARE_TRIG.trace_dimension(k, cells)
 
-    def trace_dimension_of(self, k: int, partition) -> int:
-        """dim W_h of a triangulation: P_k lattice nodes off ∂Γ (exact)."""
-        return interior_nodes(partition, k)
+    def trace_dimension_of(self, k: int, partition, clamped: bool = True) -> int:
+        """dim W_h of a triangulation: P_k lattice nodes off ∂Γ (exact; all nodes when the
+        lateral faces are not clamped, e.g. a contact scene's natural ones)."""
+        return interior_nodes(partition, k, clamped)
 
     def trace_sum_dimension(self, k: int, trace1, trace2) -> int:
         """dim W1 + dim W2 − (matched nodes, a lower bound of dim(W1 ∩ W2)): an upper bound of

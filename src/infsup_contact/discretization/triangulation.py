@@ -152,10 +152,11 @@ def on_boundary(x: np.ndarray, tol: float = 1e-10) -> np.ndarray:
     return np.any((np.abs(x) < tol) | (np.abs(x - 1.0) < tol), axis=1)
 
 
-def interior_nodes(tri: Triangulation, s: int) -> int:
-    """dim of continuous P_s on ``tri`` vanishing on ∂Γ: the lattice nodes off ∂Γ."""
+def interior_nodes(tri: Triangulation, s: int, clamped: bool = True) -> int:
+    """dim of continuous P_s on ``tri`` vanishing on ∂Γ: the lattice nodes off ∂Γ (all of them
+    when not ``clamped``)."""
     nodes, _ = lattice(tri, s)
-    return int(np.sum(~on_boundary(nodes)))
+    return int(np.sum(~on_boundary(nodes))) if clamped else len(nodes)
 
 
 def _polygons(tri: Triangulation):
@@ -198,10 +199,11 @@ def overlay(a: Triangulation, b: Triangulation, tol: float = 1e-12) -> Triangula
     return Triangulation(points, index.reshape(-1, 3), np.hstack([pa_old[par[:, 0]], pb_old[par[:, 1]]]))
 
 
-def matched_interior_nodes(a: Triangulation, b: Triangulation, k: int, tol: float = 1e-10) -> int:
-    """Nodes of the P_k lattice of ``a`` off ∂Γ whose every triangle of ``a`` is also a triangle
-    of ``b`` (same vertex set): the nodal functions there lie in both continuous P_k spaces, so
-    this is a lower bound of dim(W_a ∩ W_b), exact when a = b."""
+def matched_interior_nodes(a: Triangulation, b: Triangulation, k: int, tol: float = 1e-10,
+                           clamped: bool = True) -> int:
+    """Nodes of the P_k lattice of ``a`` (off ∂Γ if ``clamped``) whose every triangle of ``a`` is
+    also a triangle of ``b`` (same vertex set): the nodal functions there lie in both continuous
+    P_k spaces, so this is a lower bound of dim(W_a ∩ W_b), exact when a = b."""
     def keys(t):
         c = np.rint(t.corners / tol).astype(np.int64)
         c = np.sort(c.view([("x", np.int64), ("y", np.int64)]).reshape(t.cells, 3), axis=1)
@@ -214,4 +216,4 @@ def matched_interior_nodes(a: Triangulation, b: Triangulation, k: int, tol: floa
     nodes, glob = lattice(a, k)
     bad = np.zeros(len(nodes), dtype=bool)
     np.logical_or.at(bad, glob[~matched].ravel(), True)
-    return int(np.sum(~bad & ~on_boundary(nodes)))
+    return int(np.sum(~bad & (~on_boundary(nodes) if clamped else True)))

@@ -157,15 +157,18 @@ def test_general_route_gives_the_structured_beta(k):
 
 @pytest.mark.parametrize("k", [1, 2])
 def test_unstructured_kernels_and_beta(k):
-    """Non-matching unstructured pair (3, 4): the kernel of every case is at least the dimension
-    count max(dim M − dim(W1 + W2), 0), decided clearly; β_L² > 0 exactly where there is no
-    kernel, and for T3 and the dual basis."""
+    """Non-matching unstructured pairs: the kernel of every case, decided clearly from Bᵀ, is the
+    proven count max(global count, corner count) (TriangulatedSquare.proven_kernel); the corner
+    count is positive somewhere (the global one alone would miss those modes); β_L² > 0 exactly
+    where there is no kernel, and for T3 and the dual basis."""
     cases = [c for c in ("T3", "R5.2", "T4", "R5.4", "T5", "DUAL") if SPACES[c].valid_for(k)]
     frame = pd.DataFrame(beta_rows("unstructured", k, 3, 4, cases=cases, model=MODEL, element="tet", norms=("L2",)))
     for _, row in frame.iterrows():
         assert row.kernel_decision == "clear"
-        assert row.kernel_dim >= row.structural_kernel_dim
+        assert row.kernel_dim == row.structural_kernel_dim and row.kernel_check == "agree", row.case
         assert (row.beta > 0) == (row.kernel_dim == 0)
+    beyond = frame.structural_kernel_dim > np.maximum(frame.dim_M - frame.dim_W, 0)
+    assert beyond.any() or k == 1  # at k = 2 the corner modes of R5.2 / R5.4
     stable = frame.set_index("case").loc[["T3", "DUAL"]]
     assert (stable.kernel_dim == 0).all() and (stable.beta > 0).all()
 

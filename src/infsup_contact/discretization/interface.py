@@ -368,6 +368,26 @@ class Interface(abc.ABC):
         """
 
     # --- derived, shared by every implementation ----------------------------------------------
+    def proven_kernel(self, space, k: int, traces, dim_w: int) -> int:
+        """The part of dim ker Bᵀ on ``space`` that a count proves (the kernel rule never loses it
+        to round-off): max(dim M − dim(W1 + W2), 0), ``dim_w`` = :meth:`trace_sum_dimension`.
+        An interface may add local counts (:class:`~.triangulated_square.TriangulatedSquare`:
+        the corners of Γ).
+
+        Parameters
+        ----------
+        space : multiplier space on G_h
+        k : int
+        traces : sequence of GammaTrace
+            The two sides' traces.
+        dim_w : int
+
+        Returns
+        -------
+        int
+        """
+        return max(space.dim - dim_w, 0)
+
     def space(self, spec, k: int, partition):
         """The multiplier space of a registry entry on a partition of this interface.
 

@@ -30,8 +30,8 @@ import numpy as np
 from ..errors import InputError
 from .interface import GammaTrace, Interface, check_choice
 from .square import SQUARE_TRIG
-from .triangulation import (Triangulation, from_elements, interior_nodes, locate, matched_interior_nodes,
-                            on_boundary, overlay)
+from .triangulation import (Triangulation, contains, corner_triangles, from_elements, interior_nodes, locate,
+                            matched_interior_nodes, on_boundary, overlay)
 from .face_quadrature import triangles_rule
 
 #: Common refinements a face keeps (by the keys of their inputs).
@@ -219,6 +219,27 @@ class TriangulatedSquare(Interface):
         dim(W1 + W2), exact for equal traces (module docstring)."""
         return (self.trace_dimension_of(k, trace1) + self.trace_dimension_of(k, trace2)
                 - matched_interior_nodes(trace1, trace2, k))
+
+    def proven_kernel(self, space, k: int, traces, dim_w: int) -> int:
+        """max(global count, corner count): the global max(dim M − dim(W1 + W2), 0), or the sum
+        over the corners of Γ where a corner triangle T of G_h lies in a corner triangle of both
+        traces (:func:`~.triangulation.corner_triangles`) of dim M_T − k(k − 1)/2: the multiplier
+        functions supported in T (dim M_T) against the traces there, which all lie in
+        (x − c_x)(y − c_y) P_{k−2}(T) (they vanish on both sides through the corner). Each is a
+        lower bound of dim ker Bᵀ (the M_T of different corners are independent)."""
+        glob = max(space.dim - dim_w, 0)
+        dofs = getattr(space, "_dofs", None)
+        if not isinstance(getattr(space, "breakpoints", None), Triangulation) or dofs is None:
+            return glob
+        g_h = space.breakpoints
+        ref = [corner_triangles(t.partition) for t in traces]
+        count = np.bincount(dofs[dofs >= 0], minlength=space.dim)
+        local = 0
+        for c, cell in corner_triangles(g_h).items():
+            if all(c in r and contains(t.partition, r[c], g_h.corners[cell]) for r, t in zip(ref, traces)):
+                own = sum(1 for d in dofs[cell] if d >= 0 and count[d] == 1)
+                local += max(own - k * (k - 1) // 2, 0)
+        return max(glob, local)
 
     def trace_nodes(self, k: int, cells: int) -> int:
         return SQUARE_TRIG.trace_nodes(k, cells)

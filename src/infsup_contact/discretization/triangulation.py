@@ -217,3 +217,30 @@ def matched_interior_nodes(a: Triangulation, b: Triangulation, k: int, tol: floa
     bad = np.zeros(len(nodes), dtype=bool)
     np.logical_or.at(bad, glob[~matched].ravel(), True)
     return int(np.sum(~bad & (~on_boundary(nodes) if clamped else True)))
+
+
+CORNERS = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0], [1.0, 1.0]])
+"""The corners of Γ = (0, 1)²."""
+
+
+def corner_triangles(tri: Triangulation, tol: float = 1e-12) -> dict:
+    """{corner index: triangle} for the corners of Γ with exactly one triangle of ``tri``, whose
+    other two vertices lie on the two sides of ∂Γ through that corner (a corner triangle: a
+    continuous function vanishing on ∂Γ is (x − c_x)(y − c_y) times a polynomial of degree k − 2
+    there)."""
+    out = {}
+    for i, c in enumerate(CORNERS):
+        at = np.flatnonzero(np.any(np.all(np.abs(tri.corners - c) < tol, axis=2), axis=1))
+        if len(at) != 1:
+            continue
+        others = [v for v in tri.corners[at[0]] if np.abs(v - c).max() >= tol]
+        on_x = [abs(v[0] - c[0]) < tol for v in others]
+        on_y = [abs(v[1] - c[1]) < tol for v in others]
+        if sorted(on_x) == [False, True] and sorted(on_y) == [False, True]:
+            out[i] = int(at[0])
+    return out
+
+
+def contains(tri: Triangulation, t: int, points: np.ndarray, tol: float = 1e-12) -> bool:
+    """Whether the triangle ``t`` of ``tri`` contains every point (n, 2)."""
+    return bool(barycentric(tri.corners[t:t + 1], np.asarray(points, float)).min() >= -tol)

@@ -21,7 +21,9 @@ is the sorted array of breakpoints (abscissae x of the vertices on Γ), the repr
 :class:`~.multipliers.MultiplierSpace` and users' spaces (``build(k, x)``) are built on.
 The 2D contact face Γ = (0, 1)² × {1} of the 3D models is the second,
 :class:`~.square.Square` (tensor partitions; spaces are tensor products of the 1D builds,
-:meth:`Interface.space`).
+:meth:`Interface.space`); the same face traced by unstructured or perturbed tetrahedral meshes is
+the third, :class:`~.triangulated_square.TriangulatedSquare` (general triangulations, their
+common refinement by polygon clipping).
 """
 from __future__ import annotations
 

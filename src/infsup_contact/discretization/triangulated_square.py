@@ -30,8 +30,8 @@ import numpy as np
 from ..errors import InputError
 from .interface import GammaTrace, Interface, check_choice
 from .square import SQUARE_TRIG
-from .triangulation import (Triangulation, contains, corner_triangles, from_elements, interior_nodes, locate,
-                            matched_interior_nodes, on_boundary, overlay)
+from .triangulation import (CORNERS, Triangulation, contains, corner_triangles, from_elements, interior_nodes,
+                            locate, matched_interior_nodes, on_boundary, overlay)
 from .face_quadrature import triangles_rule
 
 #: Common refinements a face keeps (by the keys of their inputs).
@@ -221,24 +221,42 @@ class TriangulatedSquare(Interface):
                 - matched_interior_nodes(trace1, trace2, k))
 
     def proven_kernel(self, space, k: int, traces, dim_w: int) -> int:
-        """max(global count, corner count): the global max(dim M − dim(W1 + W2), 0), or the sum
-        over the corners of Γ where a corner triangle T of G_h lies in a corner triangle of both
-        traces (:func:`~.triangulation.corner_triangles`) of dim M_T − k(k − 1)/2: the multiplier
-        functions supported in T (dim M_T) against the traces there, which all lie in
-        (x − c_x)(y − c_y) P_{k−2}(T) (they vanish on both sides through the corner). Each is a
-        lower bound of dim ker Bᵀ (the M_T of different corners are independent)."""
+        """max(global count, corner count). Global: max(dim M − dim(W1 + W2), 0). Corners: for
+        the star S of each corner c of Γ in G_h (its cells at c; stars sharing a cell are skipped),
+        the multipliers supported in S (dim M_S) are orthogonal to both traces but for at most
+        U = dim(W1|_S + W2|_S) of them; U is bounded by the free trace dofs on the trace cells
+        meeting S, and where S lies in a corner triangle of a trace
+        (:func:`~.triangulation.corner_triangles`) by k(k − 1)/2, the dimension of
+        (x − c_x)(y − c_y) P_{k−2}, in which every trace function vanishing on both sides through
+        c lies (one space for both sides when both contain S). Σ_c max(dim M_S − U, 0) is a lower
+        bound of dim ker Bᵀ (the M_S of different corners are independent)."""
         glob = max(space.dim - dim_w, 0)
         dofs = getattr(space, "_dofs", None)
         if not isinstance(getattr(space, "breakpoints", None), Triangulation) or dofs is None:
             return glob
         g_h = space.breakpoints
-        ref = [corner_triangles(t.partition) for t in traces]
         count = np.bincount(dofs[dofs >= 0], minlength=space.dim)
-        local = 0
-        for c, cell in corner_triangles(g_h).items():
-            if all(c in r and contains(t.partition, r[c], g_h.corners[cell]) for r, t in zip(ref, traces)):
-                own = sum(1 for d in dofs[cell] if d >= 0 and count[d] == 1)
-                local += max(own - k * (k - 1) // 2, 0)
+        q = k * (k - 1) // 2
+        meets = [self.common_refinement(t.partition, g_h).parents for t in traces]  # (trace cell, G_h cell)
+        free = [set(int(d) for d in t.gamma_dofs) for t in traces]
+        corner = [corner_triangles(t.partition) for t in traces]
+        local, used = 0, set()
+        for c, point in enumerate(CORNERS):
+            star = set(np.flatnonzero(np.any(np.all(np.abs(g_h.corners - point) < 1e-12, axis=2), axis=1)).tolist())
+            if not star or star & used:
+                continue
+            used |= star
+            own = sum(1 for cell in star for d in dofs[cell] if d >= 0 and count[d] == 1
+                      and set(np.flatnonzero(np.any(dofs == d, axis=1)).tolist()) <= star)
+            bounds, inside = [], []
+            for t, m, f, cor in zip(traces, meets, free, corner):
+                cells = np.unique(m[np.isin(m[:, 1], list(star)), 0])
+                n_free = len({int(d) for e in cells for d in t.elements[e][1] if int(d) in f})
+                ok = c in cor and contains(t.partition, cor[c], g_h.corners[list(star)].reshape(-1, 2))
+                inside.append(ok)
+                bounds.append(min(n_free, q) if ok else n_free)
+            upper = min(sum(bounds), q) if all(inside) else sum(bounds)
+            local += max(own - upper, 0)
         return max(glob, local)
 
     def trace_nodes(self, k: int, cells: int) -> int:

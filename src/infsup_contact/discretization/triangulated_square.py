@@ -17,7 +17,8 @@ Dimension counts: dim W_i (continuous P_k on trace i vanishing on ∂Γ) is the 
 lattice nodes off ∂Γ (exact); dim(W1 ∩ W2) is bounded below by the nodes whose triangles are
 triangles of both traces (:func:`~.triangulation.matched_interior_nodes`; exact for equal
 traces, 0 for generic non-matching ones), so :meth:`trace_sum_dimension` is an upper bound of
-dim(W1 + W2) and the proven kernel max(dim M − dim(W1 + W2), 0) a lower bound. The counts that
+dim(W1 + W2) and the global count max(dim M − dim(W1 + W2), 0) a lower bound of the kernel;
+:meth:`proven_kernel` adds the modes at the corners of Γ that it misses. The counts that
 take a number of cells (:meth:`trace_dimension`, :meth:`trace_nodes`,
 :meth:`multiplier_cells`: sizing and emptiness checks) are those of the structured N × N grid.
 """

@@ -116,7 +116,7 @@ def test_cli_beta_3d_and_its_refusals():
     assert list(frame.norm) == ["H", "L2"] and (frame.element == "hex").all() and (frame.beta > 0).all()
     for argv, needle in ((["--model", "membranes", "--element", "hex"], "--element"),
                          (["--model", "membranes3d", "--element", "prism"], "element"),
-                         (["--model", "membranes3d", "--family", "perturbed"], "family")):
+                         (["--model", "membranes3d", "--family", "unstructured", "--element", "hex"], "element")):
         base = ["beta", "--case", "T3", "--k", "1", "--N1", "3", "--N2", "3"]
         code, out, err = run_in_process(base[:-2] + (argv if "--N2" in argv else argv + base[-2:]))
         assert code == 2 and len(err.strip().splitlines()) == 1 and needle in err, (argv, err)

@@ -21,7 +21,9 @@ is the sorted array of breakpoints (abscissae x of the vertices on Γ), the repr
 :class:`~.multipliers.MultiplierSpace` and users' spaces (``build(k, x)``) are built on.
 The 2D contact face Γ = (0, 1)² × {1} of the 3D models is the second,
 :class:`~.square.Square` (tensor partitions; spaces are tensor products of the 1D builds,
-:meth:`Interface.space`).
+:meth:`Interface.space`); the same face traced by unstructured or perturbed tetrahedral meshes is
+the third, :class:`~.triangulated_square.TriangulatedSquare` (general triangulations, their
+common refinement by polygon clipping).
 """
 from __future__ import annotations
 
@@ -368,6 +370,26 @@ class Interface(abc.ABC):
         """
 
     # --- derived, shared by every implementation ----------------------------------------------
+    def proven_kernel(self, space, k: int, traces, dim_w: int) -> int:
+        """The part of dim ker Bᵀ on ``space`` that a count proves (the kernel rule never loses it
+        to round-off): max(dim M − dim(W1 + W2), 0), ``dim_w`` = :meth:`trace_sum_dimension`.
+        An interface may add local counts (:class:`~.triangulated_square.TriangulatedSquare`:
+        the corners of Γ).
+
+        Parameters
+        ----------
+        space : multiplier space on G_h
+        k : int
+        traces : sequence of GammaTrace
+            The two sides' traces.
+        dim_w : int
+
+        Returns
+        -------
+        int
+        """
+        return max(space.dim - dim_w, 0)
+
     def space(self, spec, k: int, partition):
         """The multiplier space of a registry entry on a partition of this interface.
 

@@ -10,12 +10,18 @@ multiplier spaces tensor products (:mod:`infsup_contact.discretization.face_spac
 hexahedra and P_s on the triangles of G_h on tetrahedra
 (:mod:`infsup_contact.discretization.face_triangles`).
 
-Meshes (:func:`subdomain_mesh`, the model's ``mesh`` builder): the structured family only,
+Meshes (:func:`subdomain_mesh`, the model's ``mesh`` builder): the structured family,
 N × N × N cells of each body (N = cells per direction on Γ) from
 ``ngsolve.meshes.MakeStructured3DMesh``: ``element="hex"`` gives hexahedra,
 ``element="tet"`` the six-tetrahedra (Kuhn) split of every cube, whose faces on Γ are the
 rectangles cut by the diagonal from (x_i, y_j) to (x_{i+1}, y_{j+1}) — on both bodies, so the
 trace is a tensor grid of triangles (:data:`~infsup_contact.discretization.square.SQUARE_TRIG`).
+The ``unstructured`` family (Netgen tetrahedra, maxh = 1/N, each body meshed on its own) and
+the ``perturbed`` one (structured, vertices moved; on hexahedra only off Γ and in z, so the
+face stays a tensor grid) are built in :mod:`infsup_contact.discretization.meshes3d`; their
+tetrahedral faces are general triangulations, Γ
+:data:`~infsup_contact.discretization.triangulated_square.TRIANGULATED` (non-matching traces,
+common refinement by polygon clipping).
 
 Boundaries: ``gamma`` (Γ), ``dir`` (the far face: z = 0 of Ω1, z = 2 of Ω2) and ``side`` (the
 four lateral faces). β_h clamps both (:data:`BETA_DIRICHLET`, the paper's u_i = 0 on ∂Ω_i∖Γ);
@@ -34,7 +40,9 @@ import ngsolve
 from ngsolve import meshes as ngmeshes
 
 from ..discretization.meshes import DIRICHLET
+from ..discretization import meshes3d
 from ..discretization.square import SQUARE, SQUARE_TRIG
+from ..discretization.triangulated_square import TRIANGULATED
 from ..errors import InputError, check_prestress
 from dataclasses import dataclass
 
@@ -45,7 +53,9 @@ from .membranes import field, interpolate, laplace_stiffness
 from .schur import SideOperator, factorized_side
 
 ELEMENTS = ("hex", "tet")
-FAMILIES_3D = ("structured",)
+FAMILIES_3D = ("structured", "perturbed", "unstructured")
+UNSTRUCTURED_ELEMENTS = ("tet",)
+"""Elements of the unstructured family (Netgen meshes tetrahedra)."""
 #: MakeStructured3DMesh's boundary numbering: back, left, front, right, bottom (z = 0), top (z = 1)
 _BOTTOM, _TOP = 4, 5
 FAR, LATERAL = DIRICHLET, "side"
@@ -54,9 +64,14 @@ BETA_DIRICHLET = f"{FAR}|{LATERAL}"
 """Where β_h's sides vanish: all of ∂Ω_i∖Γ (an NGSolve boundary regexp)."""
 
 
-def subdomain_mesh(family: str, n: int, side: int, *, element: str = "hex", width: float = 1.0) -> ngsolve.Mesh:
-    """The N × N × N structured mesh of Ω_side: Γ named ``gamma``, the far face :data:`FAR`, the
-    lateral faces :data:`LATERAL`.
+def subdomain_mesh(family: str, n: int, side: int, *, element: str = "hex", width: float = 1.0,
+                   alpha: float = 0.2, seed: int = 0) -> ngsolve.Mesh:
+    """The mesh of Ω_side of a family: Γ named ``gamma``, the far face :data:`FAR`, the
+    lateral faces :data:`LATERAL`. ``structured``: N × N × N cells; ``unstructured`` (tetrahedra,
+    maxh = 1/N) and ``perturbed`` (the structured mesh, vertices moved by U(−αh, αh) per free
+    direction, seeded; on hexahedra off Γ and in z only): :mod:`~infsup_contact.discretization.meshes3d`.
+    A tetrahedral mesh of those two families carries ``face_interface`` = the general
+    triangulated face (:func:`face_of`).
 
     ``width``: the body's extent in x, (0, width) × (0, 1) × (side − 1, side) (the ``mapping`` of
     ``MakeStructured3DMesh`` scales x); 1 is the model's bodies. A narrower Ω2 covers Ω1's face
@@ -66,8 +81,9 @@ def subdomain_mesh(family: str, n: int, side: int, *, element: str = "hex", widt
     Raises
     ------
     InputError
-        For a family other than ``structured``, an element not in :data:`ELEMENTS`, N < 1 or a
-        width outside (0, 1].
+        For a family not in :data:`FAMILIES_3D`, an element not in :data:`ELEMENTS` (the
+        unstructured family: :data:`UNSTRUCTURED_ELEMENTS`), N < 1, a width outside (0, 1] (or
+        other than 1 for the unstructured and perturbed families), α or seed out of range.
     """
     if family not in FAMILIES_3D:
         raise InputError("family", f"{', '.join(FAMILIES_3D)} (the 3D model's meshes)", got=family)
@@ -75,8 +91,15 @@ def subdomain_mesh(family: str, n: int, side: int, *, element: str = "hex", widt
         raise InputError("element", ", ".join(ELEMENTS), got=element)
     if not isinstance(n, (int, np.integer)) or n < 1:
         raise InputError("N", "an integer >= 1", got=n)
-    if not 0.0 < width <= 1.0:
-        raise InputError("width", "a width 0 < width <= 1 of the body in x", got=width)
+    if not 0.0 < width <= 1.0 or (family != "structured" and width != 1.0):
+        raise InputError("width", "a width 0 < width <= 1 of the body in x (1 for the unstructured and "
+                         "perturbed families)", got=width)
+    if family == "unstructured":
+        if element not in UNSTRUCTURED_ELEMENTS:
+            raise InputError("element", f"{', '.join(UNSTRUCTURED_ELEMENTS)} (the unstructured family)", got=element)
+        mesh = meshes3d.unstructured_box(int(n), side)
+        mesh.face_interface = TRIANGULATED
+        return mesh
     mapping = None if width == 1.0 else (lambda x, y, z: (width * x, y, z))
     ngmesh = ngmeshes.MakeStructured3DMesh(hexes=element == "hex", nx=int(n), mapping=mapping).ngmesh
     if side == 2:
@@ -85,11 +108,22 @@ def subdomain_mesh(family: str, n: int, side: int, *, element: str = "hex", widt
     gamma, far = (_TOP, _BOTTOM) if side == 1 else (_BOTTOM, _TOP)
     for i in range(6):
         ngmesh.SetBCName(i, SQUARE.boundary if i == gamma else FAR if i == far else LATERAL)
-    return ngsolve.Mesh(ngmesh)
+    if family == "perturbed":
+        meshes3d.perturb_points(ngmesh, int(n), side, alpha, seed, hexes=element == "hex")
+    mesh = ngsolve.Mesh(ngmesh)
+    if family == "perturbed":
+        meshes3d.check_volume(mesh, f"family perturbed, N = {n}, side {side}, seed {seed}, alpha {alpha:g}")
+        if element == "tet":
+            mesh.face_interface = TRIANGULATED
+    return mesh
 
 
 def face_of(mesh):
-    """The interface of a mesh's Γ: quadrilateral faces (hexahedra) or triangles (tetrahedra)."""
+    """The interface of a mesh's Γ: the one its builder tagged (``face_interface``: a general
+    triangulation), else quadrilateral faces (hexahedra) or the structured triangles (tetrahedra)."""
+    tagged = getattr(mesh, "face_interface", None)
+    if tagged is not None:
+        return tagged
     for el in mesh.Elements(ngsolve.BND):
         if el.mat == SQUARE.boundary:
             return SQUARE if len(el.vertices) == 4 else SQUARE_TRIG
@@ -148,7 +182,8 @@ def load(side: MembraneSide, scene, i: int):
 
 MEMBRANES3D = Model("membranes3d", side_operator,
                     "two 3D bodies (0,1)^3 and (0,1)^2x(1,2), -c_i Δu_i = f_i, scalar Q_k (hex) or P_k (tet), "
-                    "contact face Γ = (0,1)^2x{1}; structured meshes, N cells per direction (--element)",
+                    "contact face Γ = (0,1)^2x{1}; structured, perturbed or unstructured (tet) meshes, "
+                    "N cells per direction or maxh = 1/N (--element)",
                     scene_side=scene_side, load=load, field=field, interpolate=interpolate,
                     params=tuple(MaterialParam(f"c{i + 1}", 1.0, lambda v, key: check_prestress(key, v),
                                                "1e-150 <= c <= 1e150", f"prestress c{i + 1} of Ω{i + 1}", side=i)

@@ -190,7 +190,7 @@ def beta_rows_all(family, k, n1, n2, cases=None, multiplier_meshes=("omega2",), 
             couplings = [coupling_matrix(s.trace, space, k) for s in sides]
             t_coupling = time.perf_counter() - tc
             grams = {norm: gamma.gram(space, norm, h_route=h_route) for norm in norms}
-            structural = max(space.dim - dim_w, 0)
+            structural = gamma.proven_kernel(space, k, [s.trace for s in sides], dim_w)
             kernel = space_kernel(couplings, sides, space, k, structural,
                                   grams["L2"][0] if "L2" in grams else None)
             terms = interface_terms(couplings, sides)

@@ -192,3 +192,19 @@ def face_patch_rows(cases, ks, pairs, c=(1.0, 1.0), delta: float = DELTA, elemen
             rows += [solve_face_patch(case, k, n1, n2, c, delta, element, pair=pair)
                      for case in registry.ids_valid_for(k, cases)]
     return rows
+
+
+def face_patch_table(cases, ks, pairs, elements, model: str | None = None) -> list:
+    """The DAG's patch table (rule face_patch, config ``face.patch``): :func:`face_patch_rows`
+    for every element of ``model`` (default the scene's first), restricted to the ``cases``
+    that element's face builds (``Interface.builds``: the QUAD9-element spaces pair with
+    rectangles only), every k and every non-matching pair."""
+    from .face_claims import element_interfaces
+
+    name = FACE_PATCH.models[0] if model is None else model
+    gammas = element_interfaces(name, elements)
+    rows = []
+    for element in elements:
+        own = [c for c in cases if gammas[element].builds(registry.space_spec(c))]
+        rows += face_patch_rows(own, ks, pairs, element=element, model=make_model(name))
+    return rows

@@ -43,6 +43,14 @@ G_h = the union of both traces (``multiplier_mesh="union"``) R5.2, R5.4, DUAL an
 have kernels (k = 2, 4:5: 96, 70, 48, 96 modes): u_h stays exact to round-off but the PDAS's
 minimum-norm λ_h is not the constant (errors 0.1–1.3), so ``passes`` is False there although
 1 ∈ M_h; T4 and T5 (no kernel) still pass.
+
+**In the DAG** (rule ``face_study_job``, :func:`face_patch_table`; ledger claims
+:mod:`.face_study_claims`): at k = 1 on tetrahedra DUAL fails (λ error 1, at the corner triangles):
+the boundary-modified TRI3 dual has no live node on a corner triangle whose three vertices lie
+on ∂Γ, so its face space lacks the constants although the 1D ``contains_constants`` (this
+module's ``predicted`` column) holds; the ledger's prediction checks 1 ∈ M_h on the space the
+face builds (``face_contains_constants``) and predicts that failure. R5.4 at k = 1 on
+tetrahedra has a kernel (1 and 2 modes on 4:5, 7:8) and still passes.
 """
 from __future__ import annotations
 

@@ -216,8 +216,10 @@ def test_bad_study_key_is_named(mutate, key):
     assert len(str(err.value).splitlines()) == 1
 
 
-def test_theta_grid_of_the_helper_matches_the_configs():
-    """The synthetic tables use the configs' θ grid and fit window (the claims' windows)."""
+def test_theta_window_of_the_helper_matches_the_configs():
+    """The synthetic tables use the configs' fit window and its θ (the claims' data), and full cover."""
+    window = sorted(t for t in THETAS if t <= FIT_THETA_MAX)
     for name in ("config.yaml", "ci.yaml"):
         ed = yaml.safe_load((ROOT / "config" / name).read_text())["face"]["edge_dropping"]
-        assert tuple(ed["theta"]) == THETAS and ed["fit_theta_max"] == FIT_THETA_MAX
+        assert ed["fit_theta_max"] == FIT_THETA_MAX and 1.0 in ed["theta"]
+        assert sorted(t for t in ed["theta"] if t <= FIT_THETA_MAX) == window

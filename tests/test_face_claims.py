@@ -113,7 +113,9 @@ def test_face_macros_count_the_claims():
 
     beta = pd.concat([_rows("T3", 1), _rows("R5.2", 1), _rows("T3", 1, element="tet")], ignore_index=True)
     claims = face_claims(beta, CLAIMS_CFG, {"hex": SQUARE, "tet": SQUARE_TRIG})
-    files = face_paper_files(beta, claims)
+    from _face_tables import small_study_tables
+
+    files = face_paper_files(beta, claims, **small_study_tables())  # paper/face.tex also shows the studies
     check_face_tex((ROOT / "paper" / "face.tex").read_text(), files)
     macros = dict(re.findall(r"\\newcommand\{\\([A-Za-z]+)\}\{([^}]*)\}", files["face_macros.tex"]))
     assert int(macros["faceNClaims"]) == len(claims)
@@ -170,11 +172,14 @@ def test_face_section_renders_under_any_verdict(verdict):
     it renders (every macro expanded, every branch resolved) whatever the ledger says."""
     from infsup_contact.report.consistency import render
     from infsup_contact.report.face import face_macros
+    from infsup_contact.report.face_studies import study_files
 
     from _face_tables import small_face_tables
 
     t = small_face_tables()
-    text = render((ROOT / "paper" / "face.tex").read_text(), face_macros(t["beta"], t["claims"].assign(verdict=verdict)))
+    macros = face_macros(t["beta"], t["claims"].assign(verdict=verdict))
+    macros += study_files(t["patch"], t["alpha"], t["edge"], t["study_claims"].assign(verdict=verdict))[0]
+    text = render((ROOT / "paper" / "face.tex").read_text(), macros)
     assert "\\byverdict" not in text and "\\faceOutcome" not in text
 
 

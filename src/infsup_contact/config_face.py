@@ -3,7 +3,8 @@
 What the schema cannot state: the model is a registered one with a 3D face, each element is
 one of its ``element`` mesh options, each case id is a registered space the face can build for
 some k of ``face.k`` (built on the 2 × 2 grid of Γ: a face-only space added to the registry
-later passes by config alone), and a non-matching pair has N1 ≠ N2. Each raises one
+later passes by config alone), a non-matching pair has N1 ≠ N2, and the face studies' keys
+(:func:`check_face_studies`). Each raises one
 :class:`~infsup_contact.config_schema.ConfigError` naming the key.
 
 Non-matching families (``face.nonmatching_families``: family → element → N1 list, issue 28 item 1):
@@ -49,6 +50,36 @@ def check_face(cfg) -> None:
                               allowed="[N1, N2] with N1 != N2 (matching meshes go under face.N)")
     _check_face_families(fc)
     _check_face_cases(cfg, fc)
+    check_face_studies(fc, model.name, options)
+
+
+def check_face_studies(fc, model_name: str, options) -> None:
+    """The face studies' keys (rules/face_studies.smk) the schema cannot state: the patch
+    test's elements are the model's, its pairs non-matching; the α sweep's elements are face
+    elements with a transformed (non-identity) basis; edge dropping keeps at least 3 θ at or
+    below ``fit_theta_max`` (a slope fit). Each raises one ConfigError naming the key."""
+    from .discretization.face_cells import QUAD_ELEMENTS
+    from .discretization.face_dual import transformation
+
+    for i, element in enumerate(fc["patch"]["elements"]):
+        if element not in options:
+            raise ConfigError(f"face.patch.elements[{i}]", f"not an element of {model_name}", got=element,
+                              allowed=", ".join(options))
+    for i, pair in enumerate(fc["patch"]["pairs"]):
+        if pair[0] == pair[1]:
+            raise ConfigError(f"face.patch.pairs[{i}]", "the patch test's pairs are non-matching: N1 != N2",
+                              got=pair, allowed="[N1, N2] with N1 != N2")
+    transformed = [e for e in QUAD_ELEMENTS if not np.allclose(transformation(e, 0.25), np.eye(len(transformation(e))))]
+    for i, element in enumerate(fc["alpha"]["elements"]):
+        if element not in transformed:
+            raise ConfigError(f"face.alpha.elements[{i}]", "not a face element with a transformed dual basis",
+                              got=element, allowed=", ".join(transformed))
+    ed = fc["edge_dropping"]
+    kept = sorted(t for t in ed["theta"] if t <= ed["fit_theta_max"])
+    if len(kept) < 3:
+        raise ConfigError("face.edge_dropping.fit_theta_max", "keeps fewer than 3 of face.edge_dropping.theta "
+                          "(a slope fit needs 3)", got=ed["fit_theta_max"],
+                          allowed=f">= {sorted(ed['theta'])[2]}" if len(ed["theta"]) >= 3 else "more θ")
 
 
 def _check_face_families(fc) -> None:

@@ -136,6 +136,18 @@ SCHEMAS = {
     "face_beta": Schema({**_BETA, "model": "str", "element": "str"},
                         key=("model", "element", "family", "case", "k", "N1", "N2", "multiplier_mesh", "c1", "c2",
                              "norm")),
+    # the face studies (rules/face_studies.smk: study/face_patch.py, face_alpha.py, edge_dropping.py);
+    # condition numbers may be inf (singular to working precision): extra columns, not declared
+    "face_patch": Schema({"element": "str", "case": "str", "k": "int", "N1": "int", "N2": "int",
+                          "lambda_max_rel_error": "float", "u_max_rel_error": "float", "kernel_dim": "int",
+                          "passes": "bool"}, key=("element", "case", "k", "N1", "N2")),
+    "face_alpha": Schema({"element": "str", "alpha": "float", "N": "int", "norm": "str", "min_weight": "float",
+                          "min_weight_gauss": "float", "accepted": "bool", "beta": "float?"},
+                         key=("element", "alpha", "N", "norm")),
+    "face_edge": Schema({"case": "str", "k": "int", "N": "int", "theta": "float", "beta_H": "float",
+                         "beta_L2": "float", "beta_H_resolved": "bool", "beta_L2_resolved": "bool",
+                         "beta_L2_kappa": "float?", "beta_L2_kappa_resolved": "bool", "fit_theta_max": "float"},
+                        key=("case", "k", "N", "theta")),
     # Snakemake's `benchmark:` files (bench/dag.py), tab-separated
     "rule_benchmark": Schema({"s": "float"}, optional={"max_rss": "float?", "cpu_time": "float?"},
                              label="a Snakemake benchmark file", sep="\t"),

@@ -105,5 +105,9 @@ def reference_mem_mb(wildcards):
 # the 3D face stage's outputs (rules/face.smk); none without a `face` config section
 FACE = config.get("face")
 FACE_BETA = [f"results/tables/face/beta_{e}_k{k}.csv" for e in FACE["elements"] for k in FACE["k"]] if FACE else []
-FACE_CLAIMS = ["results/tables/face_claims.csv"] if FACE else []
-FACE_PAPER = ["results/paper/face_macros.tex", "results/paper/face_beta_table.tex"] if FACE else []
+# the face studies (rules/face_studies.smk): their tables, claims and paper tables
+FACE_STUDIES = {s: f"results/face/{s}.csv" for s in ("patch", "alpha", "edge_dropping")} if FACE else {}
+FACE_CLAIMS = ["results/tables/face_claims.csv", "results/tables/face_study_claims.csv"] if FACE else []
+FACE_PAPER = ["results/paper/face_macros.tex", "results/paper/face_beta_table.tex",
+              "results/paper/face_patch_table.tex", "results/paper/face_alpha_table.tex",
+              "results/paper/face_edge_table.tex"] if FACE else []

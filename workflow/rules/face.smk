@@ -72,9 +72,16 @@ rule face_paper:
     output:
         macros="results/paper/face_macros.tex",
         beta="results/paper/face_beta_table.tex",
+        patch="results/paper/face_patch_table.tex",  # the face studies' tables (rules/face_studies.smk)
+        alpha="results/paper/face_alpha_table.tex",
+        edge="results/paper/face_edge_table.tex",
     input:
         beta="results/tables/face_beta.csv",
         claims="results/tables/face_claims.csv",
+        patch="results/face/patch.csv",
+        alpha="results/face/alpha.csv",
+        edge="results/face/edge_dropping.csv",
+        study_claims="results/tables/face_study_claims.csv",
         tex="paper/face.tex",
         src=REPORT_SOURCES,
     params:

@@ -19,9 +19,19 @@ RESIDUAL_TOL = 1e-10
 
 
 def interior_samples(partition, per: int = SAMPLES_PER_DIRECTION) -> np.ndarray:
-    """Points strictly inside every cell of a segment partition (1D array of breakpoints) or a
-    tensor face partition (``xs``, ``ys``), with different offsets in x and y so that none lies
-    on a cell's diagonal (the triangle faces' interior edges)."""
+    """Points strictly inside every cell of a segment partition (1D array of breakpoints), a
+    tensor face partition (``xs``, ``ys``; different offsets in x and y so that none lies on a
+    cell's diagonal, the triangle faces' interior edges) or a triangulation (``points``,
+    ``triangles``: a barycentric grid strictly inside every triangle)."""
+    if hasattr(partition, "triangles"):
+        i, j = np.meshgrid(np.arange(per), np.arange(per), indexing="ij")
+        keep = (i + j) < per
+        a, b = (i[keep] + 0.31) / (per + 1), (j[keep] + 0.29) / (per + 1)  # a, b > 0, a + b < 1
+        c = np.asarray(partition.points)[np.asarray(partition.triangles)]
+        pts = c[:, 0, None] + a[None, :, None] * (c[:, 1, None] - c[:, 0, None]) \
+            + b[None, :, None] * (c[:, 2, None] - c[:, 0, None])
+        return pts.reshape(-1, 2)
+
     def axis(g, offset):
         g = np.asarray(g, dtype=float)
         t = (np.arange(per) + offset) / per

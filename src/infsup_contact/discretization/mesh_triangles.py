@@ -39,6 +39,9 @@ class MeshTriangleSpace:
     s : int
     continuous, vanish, dual : bool
         As in :class:`~.face_triangles.TriangleSpace`.
+    alpha : float or None
+        As in :class:`~.face_triangles.TriangleSpace`: the α of a transformed dual basis (TRI6),
+        None for 4C's 1/5.
     """
 
     breakpoints: Triangulation
@@ -46,6 +49,7 @@ class MeshTriangleSpace:
     continuous: bool
     vanish: bool = False
     dual: bool = False
+    alpha: float | None = None
 
     def __post_init__(self):
         if not isinstance(self.breakpoints, Triangulation):

@@ -147,13 +147,21 @@ def face_beta_table(beta: pd.DataFrame) -> str:
     return "\n".join(lines) + "\n"
 
 
-def face_paper_files(beta: pd.DataFrame, claims: pd.DataFrame) -> dict[str, str]:
-    """Every generated file of the face section (name → text)."""
+def face_paper_files(beta: pd.DataFrame, claims: pd.DataFrame, patch: pd.DataFrame | None = None,
+                     alpha: pd.DataFrame | None = None, edge: pd.DataFrame | None = None,
+                     study_claims: pd.DataFrame | None = None) -> dict[str, str]:
+    """Every generated file of the face section (name → text); with the three study tables and
+    their claims also the study tables and macros (:mod:`.face_studies`)."""
     for col in ("element", "case", "k", "N1", "N2", "norm", "beta", "kernel_dim", "structural_kernel_dim"):
         if col not in beta.columns:
             raise PaperTexError(f"face_beta.csv lacks column {col!r}")
-    return {"face_macros.tex": face_macros_tex(face_macros(beta, claims)),
-            "face_beta_table.tex": face_beta_table(beta)}
+    macros, files = face_macros(beta, claims), {}
+    if patch is not None:
+        from .face_studies import study_files
+
+        more, files = study_files(patch, alpha, edge, study_claims)
+        macros += more
+    return {"face_macros.tex": face_macros_tex(macros), "face_beta_table.tex": face_beta_table(beta), **files}
 
 
 def check_face_tex(tex: str, files: dict[str, str]) -> None:

@@ -71,6 +71,7 @@ UNICODE_LATEX = {
     "ψ": r"$\psi$", "∇": r"$\nabla$", "Π": r"$\Pi$", "⁻": r"$^{-}$", "¹": r"\textsuperscript{1}",
     "ᵀ": r"$^{\mathsf T}$", "\u00a0": "~",
     "ν": r"$\nu$", "∝": r"$\propto$", "δ": r"$\delta$",  # the elastic claims (study/elastic_claims.py)
+    "α": r"$\alpha$", "θ": r"$\theta$", "κ": r"$\kappa$", "Ñ": r"$\tilde N$",  # the face studies' claims
 }
 _SPECIAL = {"\\": r"\textbackslash{}", "&": r"\&", "%": r"\%", "$": r"\$", "#": r"\#", "_": r"\_",
             "{": r"\{", "}": r"\}", "~": r"\textasciitilde{}", "^": r"\textasciicircum{}",

@@ -247,6 +247,23 @@ def beta_on(face: ClippedFace, base, operator, norms, h_rtol: float, cut: bool, 
     return out
 
 
+def beta_kappa(S_n: np.ndarray, G_n: np.ndarray, rk: np.ndarray) -> dict:
+    """β_h in the L²(Γ) norm from the pencil of the restricted registry basis in the κ-scaled
+    basis ψ̂_j r_j/κ_j, i.e. (diag(rk) S_n diag(rk), diag(rk) G_n diag(rk)) with ``rk`` = r/κ,
+    (S_n, G_n) the L²-normalized pencil: a second route to β_L2 (a diagonal change of basis
+    leaves the Rayleigh quotient unchanged, so it must agree with ``beta_L2`` wherever both are
+    resolved). ``beta_L2_kappa_resolved``: β² above the round-off level of the normalized
+    restricted pencil (:func:`beta_on`); ``nan`` where the scaled Gram matrix is not positive
+    definite to working precision."""
+    scale = np.outer(rk, rk)
+    noise = 100 * len(G_n) * np.finfo(float).eps * _norm2(S_n) / np.linalg.eigvalsh(G_n)[0]
+    try:
+        beta = spectrum(S_n * scale, factor=gram_factor(G_n * scale)).beta
+    except np.linalg.LinAlgError:
+        return {"beta_L2_kappa": np.nan, "beta_L2_kappa_resolved": False}
+    return {"beta_L2_kappa": beta, "beta_L2_kappa_resolved": bool(noise > 0 and beta ** 2 > noise)}
+
+
 def edge_row(case: str, k: int, n: int, n2: int, theta: float, norms=("H", "L2"), h_rtol: float = 1e-6,
              operator=None, h_cap: int | None = None) -> dict:
     """β_h and the multiplier-block conditioning at one covered fraction θ (module docstring).
@@ -263,7 +280,8 @@ def edge_row(case: str, k: int, n: int, n2: int, theta: float, norms=("H", "L2")
     dict
         ``beta_H``, ``beta_L2``, ``dim_M``, ``dropped`` (unrestricted minus kept functions),
         ``cond_D``, ``cond_S``, ``cond_G`` (L² Gram) and their ``*_kappa`` versions,
-        ``cond_*_unit`` (normalized basis), ``kappa_min``, ``n_max``, ``h_rel_error``, ``h_capped``.
+        ``cond_*_unit`` (normalized basis), ``kappa_min``, ``n_max``, ``h_rel_error``, ``h_capped``,
+        ``beta_L2_kappa`` (the κ-scaled restricted basis, :func:`beta_kappa`).
     """
     registry.check_case(case, k)
     if not 0.0 < theta <= 1.0:
@@ -293,6 +311,7 @@ def edge_row(case: str, k: int, n: int, n2: int, theta: float, norms=("H", "L2")
         row[f"cond_D{tag}"] = scaled_cond(D_n, rr, False)
         row[f"cond_S{tag}"] = scaled_cond(S_n, rr, True)
         row[f"cond_G{tag}"] = scaled_cond(G_n, rr, True)
+    row.update(beta_kappa(S_n, G_n, r / kappa))
     twin = nodal_twin(full, L)
     row["beta_route"] = "restricted" if twin is None else "clipped-nodal"
     row.update(beta_on(face if twin is None else twin, full if twin is None else twin.space, operator,
@@ -302,7 +321,7 @@ def edge_row(case: str, k: int, n: int, n2: int, theta: float, norms=("H", "L2")
 
 COLUMNS = ("case", "k", "N", "N2", "theta", "L", "dim_M", "dropped", "kappa_min", "beta_H", "beta_L2",
            "cond_D", "cond_D_kappa", "cond_D_unit", "cond_S", "cond_S_kappa", "cond_S_unit", "cond_G",
-           "cond_G_kappa", "cond_G_unit", "beta_route", "beta_H_resolved", "beta_L2_resolved", "n_max",
+           "cond_G_kappa", "cond_G_unit", "beta_route", "beta_H_resolved", "beta_L2_resolved", "beta_L2_kappa", "beta_L2_kappa_resolved", "n_max",
            "h_rel_error", "h_capped")
 
 
@@ -310,9 +329,10 @@ def edge_table(ks=(1,), ns=(4, 8), thetas=THETAS, cases=None, n2_factor: int = 2
                h_cap: int | None = None):
     """Rows of :func:`edge_row` for every k, N (N2 = ``n2_factor`` N: a primary side fine enough
     that B2 has full row rank for the continuous spaces of Ω1's face), θ and case (θ before the
-    case: the side operators of one θ serve every space)."""
+    case: the side operators of one θ serve every space); the cases are :func:`edge_cases` of
+    each k, those among ``cases`` when given (e.g. the config's ``face.cases``)."""
     return [edge_row(c, k, n, n2_factor * n, th, norms, h_cap=h_cap)
-            for k in ks for n in ns for th in thetas for c in (edge_cases(k) if cases is None else cases)]
+            for k in ks for n in ns for th in thetas for c in edge_cases(k) if cases is None or c in cases]
 
 
 def main(argv=None) -> int:

@@ -8,7 +8,10 @@ for α > 1/8 only. This module measures, for each α, the smallest weight, cond�
 (H^{1/2}_00(Γ)' norm, :func:`~infsup_contact.solvers.infsup.beta_rows_all`) of the transformed
 dual space (∂Γ dofs dropped, constants kept, :class:`~infsup_contact.discretization.face_cells.CellwiseFaceSpace`)
 with Q2 displacements (k = 2, hexahedra) on matching N × N meshes. An α with a weight ≤ 0 is
-refused, as the registry's DUAL-Q8 is (the row says so; no β).
+refused, as the registry's DUAL-Q8 is (the row says so; no β): ``accepted`` is the
+construction's own decision (:func:`accepted_by_construction`), ``weights_positive`` and
+``min_weight`` / ``min_weight_gauss`` the weights by two quadratures, so a table can show
+whether the two agree (the ledger's ``face-alpha-accept`` claims, :mod:`.face_study_claims`).
 
 TRI6 (issue 28, item 3): the same sweep on the triangles of tetrahedral faces (P2 displacements,
 :func:`~infsup_contact.discretization.face_tri6.tri6_space`). Its weights are ∫Ñ_vertex = α/3 and
@@ -27,9 +30,10 @@ import sys
 import numpy as np
 
 from ..discretization.face_cells import cellwise_builder
-from ..discretization.face_dual import alpha_sweep
+from ..discretization.face_dual import alpha_sweep, transformation
 from ..discretization.face_elements import reference_element
 from ..discretization.face_tri6 import triangle_builder
+from ..discretization.square import TensorPartition
 from ..discretization.registry import SpaceSpec
 from ..errors import InputError
 
@@ -69,6 +73,38 @@ def element_of(model: str, reference: str) -> str:
     return found[0]
 
 
+def gauss_min_weight(element: str, alpha: float) -> float:
+    """Second route to the smallest transformed weight min_k ∫Ñ_k / area: the shapes Ñ = T(α) N
+    summed against a Gauss–Legendre product rule (5 × 5 points) of the reference cell — the
+    square [−1, 1]², or the unit triangle collapsed from the unit square (Duffy: x = u,
+    y = (1 − u) v, Jacobian 1 − u) — exact for the (bi)quadratic N, not the moments of
+    :func:`~infsup_contact.discretization.face_dual.weights`."""
+    el = reference_element(element)
+    t, w = np.polynomial.legendre.leggauss(5)
+    if el.cell == "quad":
+        pts = np.stack(np.meshgrid(t, t, indexing="ij"), axis=-1).reshape(-1, 2)
+        ww = np.outer(w, w).ravel()
+    else:
+        u, wu = (t + 1.0) / 2.0, w / 2.0
+        U, V = np.meshgrid(u, u, indexing="ij")
+        pts = np.column_stack([U.ravel(), ((1.0 - U) * V).ravel()])
+        ww = (np.outer(wu, wu) * (1.0 - U)).ravel()
+    d = (el.shapes(pts) @ transformation(element, alpha).T).T @ ww
+    return float(d.min() / el.area)
+
+
+def accepted_by_construction(element: str, alpha: float, n: int, k: int = 2) -> bool:
+    """Whether the transformed dual space of ``element`` with this α is built on the uniform
+    n × n partition (its registry-style builder, :func:`transformed_dual_spec`), i.e. not refused
+    with an :class:`InputError`: the construction's own decision, next to the weights."""
+    x = np.linspace(0.0, 1.0, n + 1)
+    try:
+        transformed_dual_spec(element, alpha).face_build(k, TensorPartition(x, x))
+    except InputError:
+        return False
+    return True
+
+
 def face_models() -> list:
     """Names of the registered models whose contact interface is the face (dimension 3)."""
     from ..models import MODELS
@@ -78,10 +114,12 @@ def face_models() -> list:
 
 def sweep(ns=(4, 8), alphas=ALPHAS, elements=ELEMENTS, k: int = 2, norms=("H",), cell: str | None = None,
           model: str | None = None) -> list[dict]:
-    """One row per (element, α, N, norm): α, min weight (fraction of the cell area), cond₂(Ã),
-    ``refused`` and, where not refused, β_h, kernel_dim, dim M, dim W, n_max (``model``: a
-    registered 3D model, default the first, :func:`face_models`; ``cell`` its --element, default
-    the one whose face cells fit each element, :func:`element_of`)."""
+    """One row per (element, α, N, norm): α, min weight (fraction of the cell area; ``min_weight_gauss``
+    by a second quadrature), cond₂(Ã), ``weights_positive``, ``accepted`` (the construction
+    built the space, :func:`accepted_by_construction`; ``refused`` its negation) and, where
+    accepted, β_h, kernel_dim, dim M, dim W, n_max (``model``: a registered 3D model, default
+    the first, :func:`face_models`; ``cell`` its --element, default the one whose face cells
+    fit each element, :func:`element_of`)."""
     from ..models import make_model
     from ..models.side_cache import SideCache
 
@@ -92,9 +130,11 @@ def sweep(ns=(4, 8), alphas=ALPHAS, elements=ELEMENTS, k: int = 2, norms=("H",),
     for n in ns:
         for element in elements:
             for info in alpha_sweep(element, alphas):
+                accepted = accepted_by_construction(element, info["alpha"], n, k)
                 base = dict(element=element, alpha=info["alpha"], N=n, min_weight=info["min_fraction"],
-                            cond_A=info["cond"], refused=not info["positive"])
-                if not info["positive"]:
+                            min_weight_gauss=gauss_min_weight(element, info["alpha"]), cond_A=info["cond"],
+                            weights_positive=info["positive"], accepted=accepted, refused=not accepted)
+                if not accepted:
                     rows += [dict(base, norm=nm, beta=np.nan, kernel_dim=-1) for nm in norms]
                     continue
                 mesh_element = cell or element_of(model, element)

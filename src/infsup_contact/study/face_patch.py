@@ -46,6 +46,14 @@ G_h = the union of both traces (``multiplier_mesh="union"``) R5.2, R5.4, DUAL an
 have kernels (k = 2, 4:5: 96, 70, 48, 96 modes): u_h stays exact to round-off but the PDAS's
 minimum-norm λ_h is not the constant (errors 0.1–1.3), so ``passes`` is False there although
 1 ∈ M_h; T4 and T5 (no kernel) still pass.
+
+**In the DAG** (rule ``face_study_job``, :func:`face_patch_table`; ledger claims
+:mod:`.face_study_claims`): at k = 1 on tetrahedra DUAL fails (λ error 1, at the corner triangles):
+the boundary-modified TRI3 dual has no live node on a corner triangle whose three vertices lie
+on ∂Γ, so its face space lacks the constants although the 1D ``contains_constants`` (this
+module's ``predicted`` column) holds; the ledger's prediction checks 1 ∈ M_h on the space the
+face builds (``face_contains_constants``) and predicts that failure. R5.4 at k = 1 on
+tetrahedra has a kernel (1 and 2 modes on 4:5, 7:8) and still passes.
 """
 from __future__ import annotations
 
@@ -205,4 +213,20 @@ def face_patch_rows(cases, ks, pairs, c=(1.0, 1.0), delta: float = DELTA, elemen
             pair = patch_pair(k, n1, n2, c, delta, element, model)
             rows += [solve_face_patch(case, k, n1, n2, c, delta, element, pair=pair)
                      for case in registry.ids_valid_for(k, cases)]
+    return rows
+
+
+def face_patch_table(cases, ks, pairs, elements, model: str | None = None) -> list:
+    """The DAG's patch table (rule face_patch, config ``face.patch``): :func:`face_patch_rows`
+    for every element of ``model`` (default the scene's first), restricted to the ``cases``
+    that element's face builds (``Interface.builds``: the QUAD9-element spaces pair with
+    rectangles only), every k and every non-matching pair."""
+    from .face_claims import element_interfaces
+
+    name = FACE_PATCH.models[0] if model is None else model
+    gammas = element_interfaces(name, elements)
+    rows = []
+    for element in elements:
+        own = [c for c in cases if gammas[element].builds(registry.space_spec(c))]
+        rows += face_patch_rows(own, ks, pairs, element=element, model=make_model(name))
     return rows

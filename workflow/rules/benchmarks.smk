@@ -4,7 +4,8 @@
 # benchmarks.eigsh_max_N (no limit), benchmarks.dense_max_size (2500),
 # benchmarks.route_budget_s (10), benchmarks.kkt_max_N (64), benchmarks.speed_accuracy_repeats (3),
 # benchmarks.speed_accuracy_budget_s (10),
-# benchmarks.speed_accuracy_scene (contact.primary_scene).
+# benchmarks.speed_accuracy_scene (contact.primary_scene), benchmarks.face_N ([]: no face
+# benchmark), benchmarks.face_k ([2]).
 
 _BLAS1 = "export OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1 MKL_NUM_THREADS=1; "
 
@@ -16,6 +17,7 @@ rule benchmarks:
         "results/benchmarks/contact.csv",
         "results/tables/speed_accuracy.csv",
         "results/figures/fig7_speed_accuracy.pdf",
+        FACE_BENCH,
 
 
 rule bench_beta:
@@ -44,6 +46,28 @@ rule bench_beta:
         " && infsup-contact bench --what beta --N {params.N} --k {params.k} --repeats {params.repeats}"
         " {params.eigsh} --dense-max-size {params.dense} --route-budget {params.budget}"
         " > {output.table}.tmp 2>> {log} && mv {output.table}.tmp {output.table}"
+
+
+rule bench_face:
+    # the 3D face: β_h routes as ratios to the limit and the Schur-complement routes side by side
+    output:
+        "results/benchmarks/face.csv",
+    input:
+        PACKAGE_SOURCES,
+        BENCH_SOURCES,
+    params:
+        N=lambda wc: config["benchmarks"]["face_N"],
+        k=lambda wc: config["benchmarks"].get("face_k", [2]),
+        repeats=lambda wc: config["benchmarks"]["repeats"],
+        budget=lambda wc: config["benchmarks"].get("route_budget_s", 10),
+    threads: workflow.cores
+    benchmark:
+        "results/benchmarks/rules/bench_face.tsv"
+    log:
+        "results/logs/bench_face.log",
+    shell:
+        _BLAS1 + "infsup-contact bench --what face --N {params.N} --k {params.k} --repeats {params.repeats}"
+        " --route-budget {params.budget} > {output}.tmp 2> {log} && mv {output}.tmp {output}"
 
 
 rule bench_contact:

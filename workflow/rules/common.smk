@@ -104,6 +104,7 @@ def reference_mem_mb(wildcards):
 
 # the 3D face stage's outputs (rules/face.smk); none without a `face` config section
 FACE = config.get("face")
+FACE_BENCH = ["results/benchmarks/face.csv"] if config["benchmarks"].get("face_N") else []
 FACE_BETA = [f"results/tables/face/beta_{e}_k{k}.csv" for e in FACE["elements"] for k in FACE["k"]] if FACE else []
 # the face studies (rules/face_studies.smk): their tables, claims and paper tables
 FACE_STUDIES = {s: f"results/face/{s}.csv" for s in ("patch", "alpha", "edge_dropping")} if FACE else {}

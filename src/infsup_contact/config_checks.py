@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import re
 
+from .discretization.user_spaces import config_case_ids
 from .config_schema import (ConfigError, check_finite, describe, key_path, load_schema,  # noqa: F401
                             schema_error, show)
 from .errors import InputError
@@ -53,23 +54,11 @@ def load_spaces(cfg) -> list:
 
 # ------------------------------------------------------------------ 4. the registry
 
-def case_ids(cfg, gamma_dim: int = 1) -> list:
-    """The ids this config may use on an interface of dimension ``gamma_dim`` (1: the segment of
-    the 2D stages; 2: the face stage): the built-in spaces and the user spaces of its own
-    ``spaces`` key (not those another config registered earlier in the same process)."""
-    from .discretization.registry import space_ids
-    from .discretization.user_spaces import _LOADED, load_user_space
-
-    users = {spec.id for spec in _LOADED.values()}
-    own = {load_user_space(ref).id for ref in cfg.get("spaces") or []}
-    return [c for c in space_ids(gamma_dim) if c not in users or c in own]
-
-
 def check_cases(cfg) -> None:
     """Case ids are registered spaces; each k is one the space allows (T4, T5: k >= 2)."""
     from .discretization.registry import SPACES
 
-    ids = case_ids(cfg)
+    ids = config_case_ids(cfg)
     for stage in ("infsup", "contact"):
         cases = cfg[stage]["cases"]
         for case, ks in cases.items():
@@ -103,7 +92,7 @@ def check_figures(cfg) -> None:
     spaces) defined for its k; its scene is a name under contact.scenes or a scene kind."""
     from .discretization.registry import SPACES
 
-    ids = case_ids(cfg)
+    ids = config_case_ids(cfg)
     for key, case, k in figure_cases(cfg):
         if case not in ids:
             raise ConfigError(key, f"{case!r} is not a registered space", got=case,

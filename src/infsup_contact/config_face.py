@@ -120,11 +120,11 @@ def face_pairs(fc, element: str) -> list:
 
 
 def _check_face_cases(cfg, fc) -> None:
-    from .config_checks import case_ids
+    from .discretization.user_spaces import config_case_ids
     from .discretization.registry import SPACES
     from .discretization.square import CELL_SHAPES, SQUARE, Square, TensorPartition
 
-    ids = case_ids(cfg, gamma_dim=SQUARE.dim)
+    ids = config_case_ids(cfg, gamma_dim=SQUARE.dim)
     x = np.linspace(0.0, 1.0, 3)
     faces = [Square(cell=c) for c in CELL_SHAPES]
     for i, case in enumerate(fc["cases"]):

@@ -121,14 +121,8 @@ def extrapolated(partial, p: float, n0: int, n_cap: int, rtol: float) -> tuple[n
 
 
 def gram(space, norm: str, **kwargs) -> tuple[np.ndarray, dict]:
-    """Gram matrix of a face space for ``norm`` ∈ {"H", "L2"} (``kwargs`` go to :func:`gram_h_face`).
-
-    A space without tensor ``factors`` (:class:`~.face_cells.CellwiseFaceSpace`) takes the
-    route of :mod:`.face_cellwise_norms`."""
-    if not hasattr(space, "factors"):
-        from .face_cellwise_norms import gram_cellwise
-
-        return gram_cellwise(space, norm, **kwargs)
+    """Gram matrix of a tensor face space (its ``factors``) for ``norm`` ∈ {"H", "L2"} (``kwargs``
+    go to :func:`gram_h_face`); spaces without factors: :mod:`.face_cellwise_norms`."""
     if norm == "L2":
         return gram_l2_face(space), {"n_max": 0, "nmax_rel_error": 0.0}
     if norm == "H":

@@ -18,6 +18,7 @@ import numpy as np
 
 from ..errors import InputError
 from .dual import dual_space
+from .face_registry import register_face_cases
 from .interface import MULTIPLIER_MESHES
 from .segment import SEGMENT
 from .multipliers import MultiplierSpace, make_space
@@ -371,8 +372,8 @@ register(SpaceSpec(
     expected="unstable", dimension=lambda k, n: n * k + 1, color=OKABE_ITO["sky_blue"], marker="h",
     nodal_basis=False, claim_tag="DUAL-ALL", lagrange=(True, False), dual=True))
 
-# --- face element spaces of the 3D models (issue 28): registered by their own module ----
-from . import face_registry  # noqa: E402,F401  (after register and SpaceSpec exist; order kept)
+# --- face element spaces of the 3D models (issue 28): declared in their own module -----
+register_face_cases(register, SpaceSpec, OKABE_ITO)
 
 
 # --- roles the study gives to particular spaces (the one place they are spelled) --------

@@ -275,11 +275,14 @@ class Square(Interface):
         series (the only route on the square: ``h_route`` "logkernel", the command line's
         default, and "series" both name it; ``n_max`` > 0 in ``info`` says it is a series).
         A non-tensor space: :mod:`.face_cellwise_norms` (same norms, same series)."""
+        from .face_cellwise_norms import gram_cellwise
         from .face_norms import gram
         from .face_triangle_norms import gram as gram_triangles
         from .face_triangles import TriangleSpace
 
-        return (gram_triangles if isinstance(space, TriangleSpace) else gram)(space, norm, **kwargs)
+        if isinstance(space, TriangleSpace):
+            return gram_triangles(space, norm, **kwargs)
+        return (gram if hasattr(space, "factors") else gram_cellwise)(space, norm, **kwargs)
 
     def builds(self, spec) -> bool:
         """Whether ``spec`` is defined on this face's cells (``spec.face_cells``)."""

@@ -255,3 +255,14 @@ def forget_since(before) -> None:
             del _LOADED[ref]
     for case in set(SPACES) - set(before):
         del SPACES[case]
+
+
+def config_case_ids(cfg, gamma_dim: int = 1) -> list:
+    """The ids a config may use on an interface of dimension ``gamma_dim`` (1: the segment of
+    the 2D stages; 2: the face stage): the built-in spaces and the user spaces of its own
+    ``spaces`` key (not those another config registered earlier in the same process)."""
+    from .registry import space_ids
+
+    users = {spec.id for spec in _LOADED.values()}
+    own = {load_user_space(ref).id for ref in cfg.get("spaces") or []}
+    return [c for c in space_ids(gamma_dim) if c not in users or c in own]

@@ -211,12 +211,25 @@ def test_cli_beta_and_verdict():
 
 
 @pytest.mark.parametrize("argv, key", [
-    (["--nu", "0.5"], "nu"), (["--element", "prism"], "element"), (["--family", "perturbed"], "family"),
+    (["--nu", "0.5"], "nu"), (["--element", "prism"], "element"), (["--family", "unstructured"], "element"),
+    (["--family", "sqrt2"], "family"),
     (["--c1", "2"], "c1")])
 def test_cli_bad_input_one_line(argv, key):
     code, out, err = run_in_process(["beta", "--model", "elastic3d", "--case", "T3", "--k", "1", "--N1", "2",
                                      "--N2", "2", *argv])
     assert code == 2 and out == "" and len(err.strip().splitlines()) == 1 and key in err, err
+
+
+@pytest.mark.parametrize("family", ["perturbed", "unstructured"])
+def test_the_3d_families_give_the_proven_kernels(family):
+    """The membranes' perturbed and unstructured tetrahedral meshes serve the elastic bodies too (the
+    lateral faces renamed, the triangulated face kept): kernels equal the proof, T3 has none."""
+    code, out, err = run_in_process(["beta", "--model", "elastic3d", "--case", "all", "--k", "1", "--N1", "3",
+                                     "--N2", "4", "--element", "tet", "--family", family, "--norm", "H"])
+    assert code in (0, None), err
+    rows = {r["case"]: r for r in _csv(out)}
+    assert all(r["kernel_dim"] == r["structural_kernel_dim"] for r in rows.values()), rows
+    assert rows["T3"]["kernel_dim"] == "0" and float(rows["T3"]["beta"]) > 0.1
 
 
 def test_cli_contact_patch_rows():

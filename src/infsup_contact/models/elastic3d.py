@@ -68,11 +68,12 @@ CLAMPED = (BETA_DIRICHLET,) * 3
 """Supports (x, y, z) of β_h: u = 0 on ∂Ω_i∖Γ."""
 
 
-def subdomain_mesh(family: str, n: int, side: int, *, element: str = "hex", width: float = 1.0) -> ngsolve.Mesh:
+def subdomain_mesh(family: str, n: int, side: int, *, element: str = "hex", width: float = 1.0,
+                   alpha: float = 0.2, seed: int = 0) -> ngsolve.Mesh:
     """The mesh of the 3D membranes (:func:`~infsup_contact.models.membranes3d.subdomain_mesh`,
-    same arguments and checks) with the lateral faces x = 0 and y = 0 renamed
+    same arguments, families and checks) with the lateral faces x = 0 and y = 0 renamed
     :data:`SYMMETRY_X` and :data:`SYMMETRY_Y` (found by their vertices)."""
-    mesh = cube_mesh(family, n, side, element=element, width=width)
+    mesh = cube_mesh(family, n, side, element=element, width=width, alpha=alpha, seed=seed)
     names = {}
     for el in mesh.Elements(ngsolve.BND):
         if el.mat != LATERAL or el.index in names:
@@ -87,7 +88,10 @@ def subdomain_mesh(family: str, n: int, side: int, *, element: str = "hex", widt
     ngmesh = mesh.ngmesh
     for index, name in names.items():
         ngmesh.SetBCName(index, name)
-    return ngsolve.Mesh(ngmesh)
+    out = ngsolve.Mesh(ngmesh)
+    if hasattr(mesh, "face_interface"):  # a triangulated face (perturbed / unstructured tetrahedra)
+        out.face_interface = mesh.face_interface
+    return out
 
 
 def vector_space(mesh, k: int, supports=CLAMPED):

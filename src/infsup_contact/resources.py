@@ -118,18 +118,23 @@ def _multiplier_intervals(multiplier_mesh: str, n1: int, n2: int) -> float:
     return {"omega1": n1, "omega2": n2}.get(multiplier_mesh, n1 + n2)
 
 
-SIDE_BYTES_3D = {"pardiso": 700.0, "nested": 1500.0}
+SIDE_BYTES_3D = {("pardiso", 1): 700.0, ("pardiso", 2): 410.0, ("nested", 1): 1500.0, ("nested", 2): 1500.0}
 """C in C · nd^{4/3} bytes per side of a 3D body, by the route that gives its Schur complement
-(:func:`face_route`; the fill of a 3D sparse factorization is O(nd^{4/3}), and so are the dense
-Γ arrays: n_Γ² ~ (N k)⁴ = nd^{4/3}), everything of a β_h request but the process included.
-Peak resident memory (hexahedra, every case, ``/usr/bin/time``):
+(:func:`face_route`) and the degree (k ≥ 2 counts as 2): the fill of a 3D sparse factorization
+is O(nd^{4/3}), and so are the dense Γ arrays, n_Γ² ~ (N k)⁴ = nd^{4/3}; at equal nd, k = 1 has
+8× the cells and so more quadrature points per Γ basis function. Everything of a β_h request but
+the process included. Peak resident memory (hexahedra, every case, ``/usr/bin/time``), with
+the C each implies:
 
-- ``pardiso``: 0.30 GB at N = 8, 0.96 GB at N = 16, 3.1 GB at N = 24 (k = 2); 1.46 GB at
-  N = 32 (k = 1, the largest C: 615);
+- ``pardiso``, k = 1: 1.46 GB at N = 32 (677), 5.3 GB at N = 48 (521), 15.8 GB at N = 64 (499);
+- ``pardiso``, k = 2: 0.30 GB at N = 8, 0.96 GB at N = 16 (406), 3.1 GB at N = 24 (300), 8.9 GB
+  at N = 32 (278);
 - ``nested`` (SuperLU): 0.36 GB at N = 8, 2.3 GB at N = 16, 5.3 GB at N = 20 (k = 2), 7.1 GB
   at N = 40 (k = 1).
 
-The estimate is above each."""
+The estimate is above each; the ``pardiso`` route adds :data:`MKL_BYTES` for the loaded library."""
+MKL_BYTES = 64 * MIB
+"""Resident size of MKL once PARDISO is loaded (measured: 42 MB more than the package alone)."""
 SECONDS_PER_DOF2_3D = 1.3e-8
 """Seconds per nd² of the same runs: the sparse LU (``nested``: 27 s at N = 16 and 96 s at
 N = 20, k = 2; 118 s at N = 40, k = 1) or the dense eigenproblems of dim M ~ (N k)² that
@@ -154,7 +159,9 @@ def face_side_dofs(n: int, k: int) -> float:
 def face_beta_estimate(k: int, n1: int, n2: int, components: int = 1, process: bool = True) -> Estimate:
     """One ``beta_rows`` call of a 3D model (a contact face): both sides kept (C nd^{4/3} each)."""
     nds = [components * face_side_dofs(n, k) for n in (n1, n2)]
-    volume = sum(SIDE_BYTES_3D[face_route()] * nd ** (4.0 / 3.0) for nd in nds)
+    route = face_route()
+    volume = sum(SIDE_BYTES_3D[route, min(k, 2)] * nd ** (4.0 / 3.0) for nd in nds)
+    volume += MKL_BYTES if route == "pardiso" else 0.0
     seconds = START_SECONDS + SECONDS_PER_DOF2_3D * sum(nd ** 2 for nd in nds)
     return Estimate((PROCESS_BYTES["beta"] if process else 0) + volume, seconds)
 

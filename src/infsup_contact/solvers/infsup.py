@@ -10,7 +10,7 @@ interface the sides' traces live on (``trace.gamma``,
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 import scipy.linalg as sla
@@ -20,14 +20,15 @@ from scipy.linalg import lapack
 from ..discretization import meshes, multipliers, registry
 from ..discretization.coupling import coupling_matrix, trace_l2_norms
 from ..errors import InputError, check_prestress
+from . import bottom
 from ..models.schur import combine_terms, interface_terms
 from ..models import DEFAULT_MODEL
 from ..models.side_cache import SideCache
 from ..discretization.interface import check_choice
 from ..discretization.segment import SEGMENT
 from ..discretization.norms import NORMS
-from .kernel import (GAP_DECADES, KERNEL_CRITERION, KernelDecision, coupling_kernel, gap_over_roundoff,  # noqa: F401
-                     kernel_check, kernel_from_gap, scaled_couplings)
+from .kernel import (GAP_DECADES, KERNEL_CRITERION, KernelDecision, bottom_kernel, coupling_kernel,  # noqa: F401
+                     gap_over_roundoff, kernel_check, kernel_from_gap, scaled_couplings)
 
 @dataclass(frozen=True)
 class Spectrum:
@@ -93,6 +94,33 @@ def spectrum(S: np.ndarray, G: np.ndarray | None = None, *, factor: np.ndarray |
         beta = 0.0 if d > 0 else beta
     above = ev[d] if d < len(ev) else np.nan
     return Spectrum(beta, d, float(np.sqrt(max(above, 0.0))), gap, ev[:8].copy())
+
+
+N_BOTTOM = 8
+"""Eigenvalues above the kernel the iterative route computes (``Spectrum.bottom``)."""
+
+
+def bottom_spectrum(S: np.ndarray, factor: np.ndarray, kernel: KernelDecision | None = None,
+                    Z: np.ndarray | None = None) -> Spectrum:
+    """:func:`spectrum` without a dense eigensolver (dim M > :data:`.bottom.DENSE_MAX_M`).
+
+    The kernel (its dimension d from ``kernel``, its basis ``Z`` in multiplier coordinates) is
+    deflated and the :data:`N_BOTTOM` eigenvalues above it come from shift-invert Lanczos
+    (:func:`.bottom.bottom_pencil`); λ_max for the round-off level from Lanczos too. ``bottom``
+    holds the d kernel eigenvalues as exact zeros (a kernel of Bᵀ is one of S), then those.
+    Without ``kernel`` only the smallest eigenvalue is computed (β with v1 = 0).
+    """
+    d = 0 if kernel is None else kernel.dim
+    if d and (Z is None or Z.shape[1] != d):
+        raise ValueError(f"a kernel of dimension {d} needs its basis Z (m × {d}) to be deflated")
+    res = bottom.bottom_pencil(S, factor, N_BOTTOM if kernel is not None else 1, Z if d else None)
+    ev = np.concatenate([np.zeros(d), res.values])
+    lam = float(res.values[0])
+    eta = S.shape[0] * np.finfo(float).eps * res.lam_max  # the pencil's round-off level, as dense
+    gap = float(max(lam, 0.0) / eta) if eta > 0 else np.inf
+    lam = lam if lam > eta else 0.0  # an eigenvalue at round-off (a singular S, no kernel given) is 0
+    beta = 0.0 if d else float(np.sqrt(max(lam, 0.0)))
+    return Spectrum(beta, d, float(np.sqrt(max(lam, 0.0))), gap, ev[:8].copy())
 
 
 def check_inputs(case, k, family, n1, n2, c1, c2, norm, multiplier_mesh) -> None:
@@ -191,19 +219,21 @@ def beta_rows_all(family, k, n1, n2, cases=None, multiplier_meshes=("omega2",), 
             t_coupling = time.perf_counter() - tc
             grams = {norm: gamma.gram(space, norm, h_route=h_route) for norm in norms}
             structural = gamma.proven_kernel(space, k, [s.trace for s in sides], dim_w)
+            iterative = space.dim > bottom.DENSE_MAX_M
             kernel = space_kernel(couplings, sides, space, k, structural,
-                                  grams["L2"][0] if "L2" in grams else None)
+                                  grams["L2"][0] if "L2" in grams else None, iterative=iterative)
+            solve = _bottom_route(kernel) if iterative else spectrum
             terms = interface_terms(couplings, sides)
             factors = {norm: gram_factor(G) for norm, (G, _) in grams.items()}
             # sup over (0, v2) only, (5.10): B_2 X_2 B_2ᵀ / c2, so β(v1 = 0) = β at c2 = 1 / sqrt(c2)
             S2 = combine_terms(terms[1:], (1.0,))
-            beta_v1_zero_c1 = {norm: spectrum(S2, factor=factors[norm]).beta for norm in norms}
+            beta_v1_zero_c1 = {norm: solve(S2, factor=factors[norm]).beta for norm in norms}
             for c1, c2 in c_pairs:
                 S = combine_terms(terms, (c1, c2))
                 for norm in norms:
                     te = time.perf_counter()
                     info = grams[norm][1]
-                    sp_ = spectrum(S, factor=factors[norm], kernel=kernel)
+                    sp_ = solve(S, factor=factors[norm], kernel=kernel)
                     beta_v1_zero = beta_v1_zero_c1[norm] / np.sqrt(c2)
                     rows.append(dict(
                         case=registry.case_name(case), k=k, family=family, N1=n1, N2=n2,
@@ -221,17 +251,33 @@ def beta_rows_all(family, k, n1, n2, cases=None, multiplier_meshes=("omega2",), 
     return rows
 
 
-def space_kernel(couplings, sides, space, k: int, structural: int, l2_gram=None) -> KernelDecision:
+def space_kernel(couplings, sides, space, k: int, structural: int, l2_gram=None,
+                 iterative: bool = False) -> KernelDecision:
     """The kernel of Bᵀ on ``space`` (:func:`~infsup_contact.solvers.kernel.coupling_kernel`):
     the couplings scaled by the L²(Γ) norms of the sides' trace basis functions and of the
     multiplier basis functions (the diagonal of the L² Gram matrix, computed if not given);
     ``structural`` = max(dim M − dim(W1 + W2), 0) is its proven part. One decision serves
-    every norm and every (c1, c2): the kernel of B A⁻¹ Bᵀ depends on neither."""
+    every norm and every (c1, c2): the kernel of B A⁻¹ Bᵀ depends on neither.
+
+    ``iterative``: the bottom singular values only
+    (:func:`~infsup_contact.solvers.kernel.bottom_kernel`, for dim M > :data:`.bottom.DENSE_MAX_M`);
+    its ``vectors`` are returned in multiplier coordinates (a basis of the kernel of Bᵀ)."""
     G = sides[0].trace.gamma.gram(space, "L2")[0] if l2_gram is None else l2_gram
     rows, cols = [trace_l2_norms(s.trace, k) for s in sides], np.sqrt(np.diag(G))
     W = scaled_couplings(couplings, rows, cols)
     longer = scaled_couplings([coupling_matrix(s.trace, space, k, extra_degree=6) for s in sides], rows, cols)
-    return coupling_kernel(W, structural, entry_error=np.linalg.norm(W - longer))
+    if not iterative:
+        return coupling_kernel(W, structural, entry_error=np.linalg.norm(W - longer))
+    decision = bottom_kernel(sp.csr_matrix(W), structural, entry_error=np.linalg.norm(W - longer))
+    return replace(decision, vectors=decision.vectors / cols[:, None])  # W v = 0 ⇔ Bᵀ (v / cols) = 0
+
+
+def _bottom_route(kernel: KernelDecision):
+    """:func:`bottom_spectrum` with the call signature of :func:`spectrum`, deflating the
+    kernel basis of ``kernel`` (from :func:`space_kernel` with ``iterative``)."""
+    def solve(S, factor, kernel=None):
+        return bottom_spectrum(S, factor, kernel, None if kernel is None else kernel.vectors)
+    return solve
 
 
 def saddle_point_beta(A: sp.spmatrix, B: np.ndarray, G: np.ndarray) -> float:

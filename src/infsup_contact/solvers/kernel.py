@@ -41,10 +41,13 @@ the command line states the rule without importing NGSolve.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 import scipy.linalg as sla
+import scipy.sparse as sp
+
+from . import bottom
 
 MARGIN_DECADES = 1.0
 """A kernel decision whose margin from η is smaller than this many decades is ``close``."""
@@ -89,6 +92,9 @@ class KernelDecision:
     numerical : int
         the number of singular values <= η; below ``proven`` only if the error level was
         exceeded (``kernel_check`` reports ``below_structural`` then).
+    vectors : ndarray or None
+        an orthonormal basis (m × dim) of the kernel in W's column coordinates, where the route
+        computed one (:func:`bottom_kernel`; the deflation of :func:`.bottom.bottom_pencil`).
     """
 
     dim: int
@@ -99,9 +105,11 @@ class KernelDecision:
     tol: float
     singular: np.ndarray
     numerical: int
+    vectors: np.ndarray | None = field(default=None, repr=False, compare=False)
 
 
-def coupling_kernel(W: np.ndarray, proven: int = 0, entry_error: float = 0.0) -> KernelDecision:
+def coupling_kernel(W: np.ndarray, proven: int = 0, entry_error: float = 0.0,
+                    vectors: bool = False) -> KernelDecision:
     """Decide the kernel of a scaled Bᵀ (rows: trace dofs, columns: multipliers).
 
     Parameters
@@ -114,6 +122,8 @@ def coupling_kernel(W: np.ndarray, proven: int = 0, entry_error: float = 0.0) ->
         added to it implicitly (the rank of W is at most ``rows``).
     entry_error : float
         an estimate of ‖δW‖_F, the round-off of W's entries (module docstring); η gets twice it.
+    vectors : bool
+        also return the kernel's right singular vectors (a full SVD: costlier).
 
     Returns
     -------
@@ -124,11 +134,22 @@ def coupling_kernel(W: np.ndarray, proven: int = 0, entry_error: float = 0.0) ->
     if m == 0:
         raise ValueError("an empty multiplier space (dim M = 0) has no kernel to decide")
     proven = int(max(proven, m - rows, 0))
-    s = sla.svdvals(W, check_finite=True) if rows else np.zeros(0)
+    if vectors and rows:
+        _, s, vt = sla.svd(W, full_matrices=m > rows, check_finite=True)
+        V = vt[::-1].T  # right singular vectors, ascending singular values
+    else:
+        s, V = (sla.svdvals(W, check_finite=True) if rows else np.zeros(0)), None
     s = np.concatenate([np.zeros(m - len(s)), np.sort(s)])  # ascending, structural zeros first
     s_max = float(s[-1])
     tol = max(rows, m) * np.finfo(float).eps * s_max + 2.0 * float(entry_error)
     numerical = int(np.sum(s <= tol))
+    return _decision(s, proven, tol, numerical, s_max, None if V is None else V[:, :max(proven, numerical)])
+
+
+def _decision(s, proven, tol, numerical, s_max, vectors=None) -> KernelDecision:
+    """The decision and its margin (module docstring) from the ascending singular values s
+    (all of them, or the bottom ones with σ_max last)."""
+    m = len(s)
     dim = max(proven, numerical)
     ratios = [s[dim] / tol] if dim < m and tol > 0 else []
     if numerical > proven:  # modes counted as zero beyond the proof
@@ -139,7 +160,47 @@ def coupling_kernel(W: np.ndarray, proven: int = 0, entry_error: float = 0.0) ->
     if s_max == 0.0:  # B = 0: everything is kernel, nothing to decide
         margin = np.inf
     return KernelDecision(dim, proven, dim - proven, margin, CLOSE if margin < MARGIN_DECADES else CLEAR,
-                          float(tol), s, numerical)
+                          float(tol), s, numerical, vectors)
+
+
+BLOCK_EXTRA = 32
+"""Block size of :func:`bottom_kernel` beyond the proven kernel (doubled while too small)."""
+CERTIFY_FLOOR = 1e3
+"""The inertia count of :func:`bottom_kernel` is trusted where τ exceeds this many times the
+round-off of WᵀW, max(rows, m) ε σ_max²; below it the dense SVD decides."""
+
+
+def bottom_kernel(W, proven: int = 0, entry_error: float = 0.0) -> KernelDecision:
+    """:func:`coupling_kernel` for W too large for a dense SVD (dim M > :data:`.bottom.DENSE_MAX_M`):
+    the same η, the same count and the same margin, from the bottom singular values only.
+
+    1. The singular values <= η and their right vectors by block inverse subspace iteration,
+       then σ_{d+1} by Lanczos on the complement (:func:`.bottom.bottom_singular`; block
+       p = proven + :data:`BLOCK_EXTRA`, doubled while too small). Each counted value is ‖W v‖
+       for an orthonormal block, an upper bound of σ_i(W): the d modes counted are certainly
+       <= η.
+    2. Nothing was missed below σ_{d+1}: the inertia of WᵀW − τI at τ = σ_{d+1}²/2 must count
+       exactly d eigenvalues below τ (:func:`.bottom.count_below`).
+    Where either step fails (a count that differs, proven modes above η, τ within
+    :data:`CERTIFY_FLOOR` of WᵀW's round-off) the dense SVD decides, vectors included.
+    ``singular`` holds the d counted values, σ_{d+1} and σ_max; ``vectors`` the d kernel vectors.
+    """
+    W = sp.csr_matrix(W)
+    rows, m = W.shape
+    proven = int(max(proven, m - rows, 0))
+    smax = bottom.largest_singular(W)
+    tol = max(rows, m) * np.finfo(float).eps * smax + 2.0 * float(entry_error)
+    p = min(proven + BLOCK_EXTRA, m - 1)
+    while (res := bottom.bottom_singular(W, p, tol, smax)) is None and p < m - 1:
+        p = min(2 * p, m - 1)
+    tau = 0.0 if res is None else 0.5 * res.above ** 2
+    if res is None or res.count < proven or res.above <= tol or \
+            tau <= CERTIFY_FLOOR * max(rows, m) * np.finfo(float).eps * smax ** 2 or \
+            bottom.count_below((W.T @ W).toarray(), tau) != res.count:
+        return coupling_kernel(W.toarray(), proven, entry_error, vectors=True)
+    d = res.count
+    s = np.concatenate([res.values[:d], [res.above, smax]])
+    return _decision(s, proven, tol, d, smax, res.vectors[:, :d])
 
 
 def scaled_couplings(couplings, trace_norms, multiplier_norms) -> np.ndarray:

@@ -1,0 +1,246 @@
+"""The bottom of a spectrum without a dense eigensolver, for multiplier spaces too large for one.
+
+β_h needs two things from the bottom of a spectrum (:mod:`.infsup`, :mod:`.kernel`): the kernel of
+Bᵀ, from the smallest singular values of the scaled coupling W, and the smallest eigenvalues of
+the pencil (S, G) above that kernel. A dense SVD of W and a dense pencil cost O(m³) each with a
+large, partly BLAS-2 constant; on a 3D face (dim M ≈ 4,000 at k = 2, N = 32) they were 80 % of a
+β_h run. Above :data:`DENSE_MAX_M` both come from here instead, at the cost of a few Cholesky
+factorizations (BLAS-3, m³/3 each):
+
+:func:`bottom_singular`
+    block inverse subspace iteration on WᵀW with an *unsquared* Rayleigh–Ritz step: the Ritz
+    values are the singular values of W Q (Q orthonormal), so a zero mode is measured as ‖W v‖,
+    never as the square root of an eigenvalue of WᵀW (which would lose half the digits). A block
+    method, because the kernels are large (dimension 4(Nk) on a face) and single-vector Lanczos
+    finds one vector per multiple eigenvalue: ``scipy.sparse.linalg.eigsh`` counted 0 of R5.2's
+    96 proven zero modes at k = 2, N = 12.
+:func:`count_below`
+    Sylvester's law of inertia (an LDLᵀ factorization with Bunch–Kaufman pivoting, LAPACK
+    sytrf): the number of eigenvalues of a symmetric matrix below τ, which
+    certifies that the iteration missed no singular value below the first one above the kernel.
+:func:`bottom_pencil`
+    the smallest eigenvalues of (S, G) above a known kernel Z: Z is moved to the top of the
+    spectrum (S + γ G Z (ZᵀGZ)⁻¹ ZᵀG, γ = 2 λ_max), then Lanczos on the explicit inverse of
+    the standard form (shift-invert at 0: a Cholesky factorization, a triangular solve and a
+    rank-m product, all BLAS-3).
+
+Every start vector comes from a seeded generator (the same on every machine); what differs
+between BLAS kernels is round-off only.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.linalg as sla
+from scipy.linalg import blas, lapack
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+DENSE_MAX_M = 1500
+"""Largest dim M decided and solved densely (SVD of W, dense pencil); above it, this module.
+Every table of the default DAG stays below it (the segment, and the face up to N = 12 at k = 2)."""
+SHIFT = 1e-10
+"""δ of the subspace iteration on WᵀW + δ I, relative to σ_max²: zero modes converge at the
+rate δ/σ_{p+1}², i.e. in two or three steps."""
+MIN_ITER = 3
+"""Fewest steps of the subspace iteration of :func:`bottom_singular` (the count must also repeat)."""
+MAX_ITER = 30
+"""Most steps of that iteration."""
+LAM_MAX_RTOL = 1e-3
+"""Relative accuracy of λ_max in :func:`bottom_pencil` (``gap_over_roundoff`` to 3 digits)."""
+VALUE_RTOL = 1e-3
+"""Relative change at which the counted values of :func:`bottom_singular` have settled (the
+margin in decades to 4e-4)."""
+GUARD = 4
+"""Ritz values at the top of the block that may not be counted as zero (else the block grows)."""
+SEED = 20010601
+"""Seed of the start vectors (numpy's PCG64: the same stream on every machine)."""
+
+
+@dataclass(frozen=True)
+class BottomSingular:
+    """The kernel of W (its singular values <= η) and the first singular value above it.
+
+    Attributes
+    ----------
+    values : ndarray
+        Ritz values σ_1 <= … <= σ_p of the block (singular values of W Q, Q orthonormal): each
+        an upper bound of the corresponding singular value of W (Courant–Fischer).
+    vectors : ndarray, shape (m, p)
+        The orthonormal Ritz vectors, in the order of ``values``.
+    count : int
+        How many values are <= η.
+    above : float
+        σ_{count+1}(W), measured as ‖W v‖ for the Lanczos vector v of the complement of the
+        counted modes.
+    smax : float
+        σ_max(W) (Lanczos on WᵀW, relative accuracy ~1e-10).
+    iterations : int
+    """
+
+    values: np.ndarray
+    vectors: np.ndarray
+    count: int
+    above: float
+    smax: float
+    iterations: int
+
+
+def largest_singular(W: sp.spmatrix) -> float:
+    """σ_max(W) by Lanczos on WᵀW (a deterministic start vector)."""
+    C = sp.csr_matrix(W.T @ W)
+    v0 = np.ones(C.shape[0])
+    return float(np.sqrt(spla.eigsh(C, k=1, which="LA", tol=1e-10, v0=v0, return_eigenvectors=False)[0]))
+
+
+def bottom_singular(W, p: int, eta: float, smax: float | None = None) -> BottomSingular | None:
+    """The singular values of W (sparse, rows × m) below η, and the first above them.
+
+    1. Block inverse subspace iteration with (WᵀW + δI)⁻¹, δ = :data:`SHIFT` σ_max², block p,
+       and an unsquared Rayleigh–Ritz step (the SVD of W Q), until the count of Ritz values
+       <= η is the same in two consecutive steps and those values settled to
+       :data:`VALUE_RTOL` (at least :data:`MIN_ITER` steps): modes below η converge at the
+       rate δ/σ_{p+1}², i.e. at once.
+    2. σ_{count+1} by Lanczos on the same inverse restricted to the complement of the counted
+       modes (the extreme eigenvalue: one vector suffices, multiple or not).
+    Returns None when the count reaches p − :data:`GUARD` (the block is too small).
+    """
+    W = sp.csr_matrix(W)
+    m = W.shape[1]
+    smax = largest_singular(W) if smax is None else smax
+    C = (W.T @ W).toarray()
+    C[np.diag_indices(m)] += SHIFT * smax ** 2
+    F = sla.cho_factor(C, lower=True, check_finite=False)
+    del C
+    Q = sla.qr(np.random.default_rng(SEED).standard_normal((m, p)), mode="economic")[0]
+    counts, previous = [], None
+    for it in range(1, MAX_ITER + 1):
+        Q = sla.qr(sla.cho_solve(F, Q, check_finite=False), mode="economic")[0]
+        R = sla.qr(np.asarray(W @ Q), mode="r")[0][:p]
+        _, s, vt = sla.svd(R)  # the singular values of W Q without its left vectors
+        s, Q = s[::-1].copy(), Q @ vt[::-1].T  # ascending
+        counts.append(int(np.sum(s <= eta)))
+        if counts[-1] > p - GUARD:
+            return None
+        if it >= MIN_ITER and counts[-1] == counts[-2]:
+            d = counts[-1]  # the counted values settled to 3 digits (or below round-off) too
+            if np.all(np.abs(s[:d] - previous[:d]) <= VALUE_RTOL * s[:d] + np.finfo(float).eps * smax):
+                break
+        previous = s
+    d = counts[-1]
+    Z = Q[:, :d]
+    if d:  # refinement: (WᵀW + δI)⁻¹ amplifies the round-off of the solve by σ_max²/σ_{p+1}²
+        # along the range of Wᵀ; one corrected step Z − (WᵀW + δI)⁻¹ Wᵀ W Z removes it
+        Z = sla.qr(Z - sla.cho_solve(F, np.asarray(W.T @ (W @ Z)), check_finite=False), mode="economic")[0]
+        _, sz, vt = sla.svd(sla.qr(np.asarray(W @ Z), mode="r")[0][:d])
+        Z = Z @ vt[::-1].T
+        s = np.concatenate([sz[::-1], s[d:]])
+        Q = np.hstack([Z, Q[:, d:]])
+
+    def inv(x):  # (WᵀW + δI)⁻¹ on the complement of span Z
+        x = x - Z @ (Z.T @ x)
+        y = sla.cho_solve(F, x, check_finite=False)
+        return y - Z @ (Z.T @ y)
+
+    op = spla.LinearOperator((m, m), matvec=inv, matmat=inv, dtype=float)
+    v0 = inv(np.random.default_rng(SEED + 1).standard_normal(m))
+    _, v = spla.eigsh(op, k=1, which="LA", tol=1e-10, v0=v0)
+    above = float(np.linalg.norm(W @ v[:, 0]) / np.linalg.norm(v[:, 0]))
+    return BottomSingular(s, Q, d, above, smax, it)
+
+
+def count_below(C: np.ndarray, tau: float) -> int:
+    """Number of eigenvalues of the symmetric C below τ: the inertia of C − τI (Sylvester) from
+    its Bunch–Kaufman factorization P (C − τI) Pᵀ = L D Lᵀ (LAPACK sytrf), D of 1×1 and 2×2 blocks."""
+    M = np.array(C, float, order="F")
+    M[np.diag_indices_from(M)] -= tau
+    lwork = int(lapack.dsytrf_lwork(M.shape[0], lower=1)[0])  # the blocked algorithm needs room
+    lu, ipiv, info = lapack.dsytrf(M, lower=1, lwork=max(lwork, 1), overwrite_a=1)
+    if info < 0:
+        raise ValueError(f"sytrf: illegal argument {-info}")
+    diag, sub = np.diag(lu), np.append(np.diag(lu, -1), 0.0)
+    negative, i, m = 0, 0, len(diag)
+    while i < m:
+        if ipiv[i] < 0:  # a 2×2 block (rows i, i + 1)
+            det = diag[i] * diag[i + 1] - sub[i] ** 2
+            negative += 1 if det < 0 else (2 if diag[i] < 0 else 0)
+            i += 2
+        else:
+            negative += int(diag[i] < 0)
+            i += 1
+    return negative
+
+
+@dataclass(frozen=True)
+class BottomPencil:
+    """The smallest eigenvalues of (S, G) above a deflated kernel.
+
+    Attributes
+    ----------
+    values : ndarray
+        λ_{d+1} <= … (ascending; as many as Lanczos converged, up to the number asked).
+    lam_max : float
+        λ_max of the pencil (Lanczos, relative accuracy ~1e-6).
+    """
+
+    values: np.ndarray
+    lam_max: float
+
+
+def _standard_form(S: np.ndarray, L: np.ndarray) -> spla.LinearOperator:
+    """x ↦ L⁻¹ S L⁻ᵀ x, the standard form of (S, G = L Lᵀ)."""
+    m = S.shape[0]
+
+    def mv(x):
+        y = sla.solve_triangular(L, x, lower=True, trans="T", check_finite=False)
+        return sla.solve_triangular(L, S @ y, lower=True, check_finite=False)
+
+    return spla.LinearOperator((m, m), matvec=mv, matmat=mv, dtype=float)
+
+
+def lam_max(S: np.ndarray, L: np.ndarray) -> float:
+    """λ_max of (S, L Lᵀ) by Lanczos (a deterministic start vector; relative accuracy
+    :data:`LAM_MAX_RTOL`: the top of an H^{-1/2} pencil is clustered, and a round-off level and
+    the deflation's γ need no more)."""
+    v0 = np.ones(S.shape[0])
+    return float(spla.eigsh(_standard_form(S, L), k=1, which="LA", tol=LAM_MAX_RTOL, v0=v0,
+                            return_eigenvectors=False)[0])
+
+
+def bottom_pencil(S: np.ndarray, L: np.ndarray, n_values: int, Z: np.ndarray | None = None) -> BottomPencil:
+    """The n_values smallest eigenvalues of S x = λ G x, G = L Lᵀ (L lower: what lies above its
+    diagonal is ignored), above the kernel span Z.
+
+    ``Z`` (m × d, S Z ≈ 0) is moved to λ = γ = 2 λ_max: the G-orthogonal complement of Z is
+    invariant, so S' = S + γ G Z (ZᵀGZ)⁻¹ ZᵀG keeps the pencil's other eigenvalues, and it is
+    positive definite. With S' = R Rᵀ (Cholesky) and K = R⁻¹ L, the largest eigenvalues θ of
+    the explicit SPD matrix Kᵀ K = Lᵀ S'⁻¹ L are 1/λ (shift-invert at 0); Lanczos on it costs one
+    symmetric matrix-vector product per step. Without Z, S must be positive definite up to
+    round-off; a singular S gives λ ≈ 0 (its round-off), as the dense route does.
+    """
+    m = S.shape[0]
+    L = np.tril(L)  # a potrf factor may hold G's upper triangle above its diagonal (clean=0)
+    top = lam_max(S, L)
+    Sp = np.array(S, float)
+    if Z is not None and Z.shape[1]:
+        LtZ = L.T @ Z
+        GZ = L @ LtZ
+        Sp += 2.0 * top * GZ @ sla.solve(LtZ.T @ LtZ, GZ.T, assume_a="pos", check_finite=False)
+    # a floor keeps the factorization defined where S is singular (no Z given): λ ≈ 0 there anyway
+    Sp[np.diag_indices(m)] += 1e-14 * top * np.einsum("ij,ij->i", L, L)
+    R = sla.cholesky(Sp, lower=True, overwrite_a=True, check_finite=False)
+    K = sla.solve_triangular(R, L, lower=True, overwrite_b=False, check_finite=False)
+    del R
+    inverse = blas.dsyrk(1.0, K, trans=1, lower=1)  # Kᵀ K, lower triangle
+    del K
+
+    def mv(x):
+        return blas.dsymv(1.0, inverse, np.ravel(x), lower=1)
+
+    k = min(n_values, m - 1)
+    op = spla.LinearOperator((m, m), matvec=mv, dtype=float)
+    v0 = np.random.default_rng(SEED).standard_normal(m)
+    theta = spla.eigsh(op, k=k, which="LA", tol=1e-12, v0=v0, ncv=min(m, max(2 * k + 1, 40)),
+                       return_eigenvectors=False)
+    return BottomPencil(np.sort(1.0 / theta), top)

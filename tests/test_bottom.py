@@ -1,0 +1,96 @@
+"""The bottom of the spectrum without dense eigensolvers (solvers/bottom.py, kernel.bottom_kernel,
+infsup.bottom_spectrum): each against the dense route it replaces above DENSE_MAX_M."""
+import numpy as np
+import pytest
+import scipy.linalg as sla
+import scipy.sparse as sp
+
+from infsup_contact.solvers import bottom, infsup
+from infsup_contact.solvers.kernel import bottom_kernel, coupling_kernel
+
+
+@pytest.mark.parametrize("m", [1, 2, 7, 60, 300])
+def test_count_below_is_the_inertia(m):
+    """Sylvester: the negative part of the Bunch–Kaufman D of C − τI counts the eigenvalues below τ
+    (indefinite matrices, so 2×2 pivots occur)."""
+    rng = np.random.default_rng(m)
+    A = rng.standard_normal((m, m))
+    A = A + A.T
+    ev = np.linalg.eigvalsh(A)
+    for tau in (-1e3, ev[0] - 1e-3, 0.0, 0.37, float(np.median(ev)) + 1e-6, 1e3):
+        assert bottom.count_below(A, tau) == int(np.sum(ev < tau))
+
+
+def _kernel_matrix(rows, m, d, seed):
+    """A sparse W (rows × m) with an exact kernel of dimension d: d columns repeat others."""
+    rng = np.random.default_rng(seed)
+    W = sp.random(rows, m - d, density=0.05, random_state=rng, format="csc") + sp.eye(rows, m - d)
+    return sp.hstack([W, W[:, :d] * 2.0]).tocsr()
+
+
+@pytest.mark.parametrize("d", [0, 1, 40])
+def test_bottom_kernel_equals_the_dense_svd(d):
+    W = _kernel_matrix(400, 300, d, seed=d)
+    dense = coupling_kernel(W.toarray(), proven=d)
+    it = bottom_kernel(W, proven=d)
+    assert len(it.singular) == d + 2  # the iterative route answered (d values, σ_{d+1}, σ_max)
+    assert (it.dim, it.numerical, it.decision) == (dense.dim, dense.numerical, dense.decision) == (d, d, "clear")
+    assert it.margin_decades == pytest.approx(dense.margin_decades, abs=1e-6)
+    V = it.vectors
+    assert V.shape == (300, d)
+    np.testing.assert_allclose(V.T @ V, np.eye(d), atol=1e-12)
+    if d:
+        assert np.linalg.norm(W @ V, axis=0).max() <= it.tol
+
+
+def test_bottom_kernel_counts_modes_beyond_the_proof():
+    """Proven 0, kernel 40: the iteration finds all 40 (one Lanczos vector per multiple
+    eigenvalue would find one)."""
+    W = _kernel_matrix(400, 300, 40, seed=3)
+    it = bottom_kernel(W, proven=0)
+    assert (it.dim, it.detected, len(it.singular)) == (40, 40, 42)
+
+
+def _pencil(m, d, seed):
+    rng = np.random.default_rng(seed)
+    C = rng.standard_normal((m - d, m))
+    Q = np.linalg.qr(rng.standard_normal((m, m)))[0]
+    G = Q @ np.diag(rng.uniform(0.5, 2.0, m)) @ Q.T
+    return C.T @ C, G, sla.null_space(C)
+
+
+@pytest.mark.parametrize("d", [0, 5])
+def test_bottom_spectrum_equals_the_dense_pencil(d):
+    S, G, Z = _pencil(200, d, seed=d)
+    L = infsup.gram_factor(G)
+    W = np.vstack([S, np.zeros((10, 200))])  # a kernel decision with that kernel
+    kernel = coupling_kernel(W, proven=d)
+    dense = infsup.spectrum(S, factor=L, kernel=kernel)
+    it = infsup.bottom_spectrum(S, L, kernel, Z)
+    assert (it.kernel_dim, it.beta == 0.0) == (dense.kernel_dim, d > 0)
+    assert it.smallest_nonzero == pytest.approx(dense.smallest_nonzero, rel=1e-9)
+    assert it.beta == pytest.approx(dense.beta, rel=1e-9)
+    np.testing.assert_allclose(it.bottom[d:], dense.bottom[d:], rtol=1e-9)
+    assert it.gap == pytest.approx(dense.gap, rel=1e-2)
+    with pytest.raises(ValueError, match="needs its basis"):
+        infsup.bottom_spectrum(S, L, kernel, None) if d else (_ for _ in ()).throw(ValueError("needs its basis"))
+
+
+@pytest.mark.parametrize("case", ["T3", "R5.2", "R5.4", "DUAL-ALL"])
+def test_face_rows_agree_between_routes(case, monkeypatch):
+    """β rows of a real face (k = 2, hexahedra, 5:6: modes beyond the proof) by the dense and
+    the iterative route."""
+    rows = {}
+    for limit in (10 ** 9, 0):
+        monkeypatch.setattr(bottom, "DENSE_MAX_M", limit)
+        from infsup_contact.models import MODELS
+        rows[limit] = infsup.beta_rows("structured", 2, 5, 6, [case], model=MODELS["membranes3d"], element="hex")
+    for a, b in zip(rows[10 ** 9], rows[0]):
+        assert (a["kernel_dim"], a["kernel_decision"], a["kernel_check"]) == \
+            (b["kernel_dim"], b["kernel_decision"], b["kernel_check"])
+        if a["kernel_detected"] == 0:  # the margin is σ_{d+1}/η: the same number
+            assert b["kernel_margin_decades"] == pytest.approx(a["kernel_margin_decades"], abs=1e-6)
+        else:  # it also holds η/σ_d of a zero mode, i.e. each route's round-off: ‖W v‖ is not larger
+            assert b["kernel_margin_decades"] >= a["kernel_margin_decades"] - 0.05
+        assert b["beta"] == pytest.approx(a["beta"], rel=1e-9, abs=1e-12)
+        assert b["smallest_nonzero"] == pytest.approx(a["smallest_nonzero"], rel=1e-7)

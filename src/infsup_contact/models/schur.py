@@ -89,10 +89,10 @@ class SideOperator(_SteklovProduct):
 
     def forget_cached(self) -> None:
         """Return to the state right after the build: drop what later calls cached on this
-        side (the Cholesky factor of S, the trace's basis values). A benchmark times each
-        multiplier space's solve from this state, as a fresh build would give it."""
+        side (the Cholesky factor of S, the trace's basis values, dense and CSR). A benchmark
+        times each multiplier space's solve from this state, as a fresh build would give it."""
         self.__dict__.pop("_schur_cholesky", None)
-        self.trace.basis_cache.clear()
+        self.trace.forget_basis()
 
 
 

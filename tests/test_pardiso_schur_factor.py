@@ -97,12 +97,25 @@ def test_on_a_face_the_kept_factor_solves_as_a_second_factorization(face_sides):
     assert x.shape == F.shape and backward_error(A, x, F) < 1e-14 and rel(x, x_kept[:, 0]) < 1e-8
 
 
-def test_the_face_patch_contact_solution_is_unchanged(monkeypatch):
-    """The scene's sides keep their factor (scene_side); forcing route "pardiso" on this small
-    pair, the patch rows equal those with the factor freed (the former route) to round-off."""
+def _membrane_rows():
     from infsup_contact.discretization import registry
-    from infsup_contact.models import schur
     from infsup_contact.study import face_patch
+
+    return face_patch.face_patch_rows(registry.space_ids(), [2], [(3, 4)])
+
+
+def _elastic_rows():
+    from infsup_contact.discretization import registry
+    from infsup_contact.study import elastic_face_patch
+
+    return elastic_face_patch.elastic_face_patch_rows(registry.space_ids(), [1], [(2, 3)])
+
+
+@pytest.mark.parametrize("patch_rows", [_membrane_rows, _elastic_rows], ids=["membranes3d", "elastic3d"])
+def test_the_face_patch_contact_solution_is_unchanged(monkeypatch, patch_rows):
+    """The scenes' sides keep their factor (scene_side); forcing route "pardiso" on these small
+    pairs, the patch rows equal those with the factor freed (the former route) to round-off."""
+    from infsup_contact.models import schur
 
     real = schur.gamma_factorization
     kept = []
@@ -112,7 +125,7 @@ def test_the_face_patch_contact_solution_is_unchanged(monkeypatch):
             kept.append(keep_factor and keep)
             return real(A, n_gamma, "pardiso", gamma_dim, keep_factor and keep)
         monkeypatch.setattr(schur, "gamma_factorization", forced)
-        return face_patch.face_patch_rows(registry.space_ids(), [2], [(3, 4)])
+        return patch_rows()
 
     new = rows(True)
     assert kept and all(kept)  # every side of the scene asked to keep its factor

@@ -22,13 +22,13 @@ def coupling_matrix(trace: GammaTrace, space: MultiplierSpace, k: int, extra_deg
     ``extra_degree`` > 0 uses a rule exact for that much higher degree: the same matrix up
     to round-off, which is how the kernel decision measures the round-off of the entries."""
     x, w = trace.gamma.coupling_quadrature(trace, space, k + space.degree + extra_degree)
-    phi = trace.gamma.trace_basis(trace, x)
+    phi = trace.cached_sparse_basis(x)  # CSR, made once per point set for a sweep of spaces
     out = np.zeros((space.dim, phi.shape[1]))
     # each point sees (k + 1)^d trace and (s + 1)^d multiplier functions: a sparse product
     # costs O(n_q) where the dense one costs n_q · dim M · n_Γ (a face at N = 32: 1e11 flops)
     for rows in _chunks(len(w), space.dim):
         mu = sp.csr_matrix(space.evaluate(x[rows]) * w[rows, None])
-        out += (mu.T @ sp.csr_matrix(phi[rows])).toarray()
+        out += (mu.T @ phi[rows]).toarray()
     return out
 
 

@@ -28,7 +28,7 @@ from ..errors import InputError
 from .face_norms import extrapolated, gram_l2_face, partial_gram
 from .face_spaces import FaceSpace
 from .multipliers import make_space
-from .norms import NORMS, N_MAX_CAP
+from .norms import N_MAX_CAP, gram_by_norm
 from .quadrature import gauss_legendre
 
 #: Largest |μ − R P| / max|μ| accepted at the check points (round-off of the projection).
@@ -105,8 +105,4 @@ def gram_h_cellwise(space, rtol: float = 1e-6, n_start: int | None = None, n_cap
 
 def gram_cellwise(space, norm: str, **kwargs) -> tuple[np.ndarray, dict]:
     """Gram matrix for ``norm`` ∈ {"H", "L2"} of a non-tensor face space."""
-    if norm == "L2":
-        return gram_l2_cellwise(space), {"n_max": 0, "nmax_rel_error": 0.0}
-    if norm == "H":
-        return gram_h_cellwise(space, **kwargs)
-    raise InputError("norm", ", ".join(NORMS), got=norm)
+    return gram_by_norm(norm, lambda: gram_l2_cellwise(space), lambda **kw: gram_h_cellwise(space, **kw), **kwargs)

@@ -22,7 +22,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import InputError
-from .norms import NORMS, N_MAX_CAP, _norm2, extrapolate, gram_l2, sine_coefficients
+from .norms import N_MAX_CAP, _norm2, extrapolate, gram_by_norm, gram_l2, sine_coefficients
 
 #: Rows of the weight matrix W[m, n] = 1/(π√(m² + n²)) handled at once (memory ~ chunk · n_max).
 _CHUNK = 512
@@ -123,8 +123,4 @@ def extrapolated(partial, p: float, n0: int, n_cap: int, rtol: float) -> tuple[n
 def gram(space, norm: str, **kwargs) -> tuple[np.ndarray, dict]:
     """Gram matrix of a tensor face space (its ``factors``) for ``norm`` ∈ {"H", "L2"} (``kwargs``
     go to :func:`gram_h_face`); spaces without factors: :mod:`.face_cellwise_norms`."""
-    if norm == "L2":
-        return gram_l2_face(space), {"n_max": 0, "nmax_rel_error": 0.0}
-    if norm == "H":
-        return gram_h_face(space, **kwargs)
-    raise InputError("norm", ", ".join(NORMS), got=norm)
+    return gram_by_norm(norm, lambda: gram_l2_face(space), lambda **kw: gram_h_face(space, **kw), **kwargs)

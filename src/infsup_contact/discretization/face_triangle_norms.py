@@ -29,7 +29,7 @@ from ..errors import InputError
 from .face_norms import _norm2, extrapolated
 from .face_quadrature import triangles_rule
 from .face_triangles import lagrange_barycentric
-from .norms import N_MAX_CAP
+from .norms import N_MAX_CAP, gram_by_norm
 
 #: Rows m of the coefficient array handled at once (memory ~ dim · chunk · n_max).
 _CHUNK = 32
@@ -210,10 +210,4 @@ def gram_h_tri(space, rtol: float = 1e-6, n_start: int | None = None, n_cap: int
 
 def gram(space, norm: str, **kwargs) -> tuple[np.ndarray, dict]:
     """Gram matrix of a triangle space for ``norm`` ∈ {"H", "L2"} (``kwargs`` to :func:`gram_h_tri`)."""
-    from .norms import NORMS
-
-    if norm == "L2":
-        return gram_l2_tri(space), {"n_max": 0, "nmax_rel_error": 0.0}
-    if norm == "H":
-        return gram_h_tri(space, **kwargs)
-    raise InputError("norm", ", ".join(NORMS), got=norm)
+    return gram_by_norm(norm, lambda: gram_l2_tri(space), lambda **kw: gram_h_tri(space, **kw), **kwargs)

@@ -31,6 +31,7 @@ import abc
 from dataclasses import dataclass, field
 
 import numpy as np
+import scipy.sparse as sp
 
 from ..errors import InputError
 
@@ -60,6 +61,9 @@ class GammaTrace:
         The interface this trace lives on.
     basis_cache : dict
         Values of the Γ-dof basis at point sets already asked for (:meth:`Interface.trace_basis`).
+    sparse_cache : dict
+        The same values as CSR matrices (:meth:`cached_sparse_basis`), kept and dropped with
+        ``basis_cache`` (:meth:`forget_basis`).
     """
 
     fes: object
@@ -68,6 +72,7 @@ class GammaTrace:
     breakpoints: np.ndarray
     gamma: "Interface" = field(default=None, repr=False, compare=False)
     basis_cache: dict = field(default_factory=dict, repr=False, compare=False)
+    sparse_cache: dict = field(default_factory=dict, repr=False, compare=False)
 
     @property
     def partition(self):
@@ -79,15 +84,38 @@ class GammaTrace:
         trace for the next request of the same points (at most :data:`BASIS_CACHE_SIZE` point
         sets): every multiplier space of one degree on one G_h asks for the same quadrature points,
         and NGSolve evaluates one point at a time (:meth:`Interface.trace_basis`)."""
-        key = np.ascontiguousarray(x, dtype=float).tobytes()
+        key = _points_key(x)
         phi = self.basis_cache.get(key)
         if phi is None:
             phi = compute(x)
             phi.flags.writeable = False
             if len(self.basis_cache) >= BASIS_CACHE_SIZE:
-                self.basis_cache.clear()
+                self.forget_basis()
             self.basis_cache[key] = phi
         return phi
+
+    def cached_sparse_basis(self, x: np.ndarray):
+        """:meth:`Interface.trace_basis` at ``x`` as CSR, made once per point set for a sweep of
+        multiplier spaces (:func:`~.coupling.coupling_matrix`); its row slices are, bit for bit,
+        ``csr_matrix`` of the dense slices (sorted indices, no stored zeros)."""
+        key = _points_key(x)
+        phi = self.sparse_cache.get(key)
+        if phi is None:
+            phi = sp.csr_matrix(self.gamma.trace_basis(self, x))
+            if len(self.sparse_cache) >= BASIS_CACHE_SIZE:
+                self.sparse_cache.clear()
+            self.sparse_cache[key] = phi
+        return phi
+
+    def forget_basis(self) -> None:
+        """Drop the kept basis values, dense and sparse (a benchmark's fresh state)."""
+        self.basis_cache.clear()
+        self.sparse_cache.clear()
+
+
+def _points_key(x: np.ndarray) -> bytes:
+    """The cache key of a point set: its coordinates' bytes as float64, C order."""
+    return np.ascontiguousarray(x, dtype=float).tobytes()
 
 
 class Interface(abc.ABC):

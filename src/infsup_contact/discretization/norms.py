@@ -319,6 +319,51 @@ H_ROUTES = ("logkernel", "series")
 """Two independent routes to the H^{-1/2}_00 Gram matrix: the closed-form log kernel
 (:mod:`infsup_contact.discretization.logkernel`, no truncation, the default) and the sine series."""
 
+L2_INFO = {"n_max": 0, "nmax_rel_error": 0.0}
+"""What an exact (untruncated) Gram reports: no series, no truncation error."""
+
+
+def gram_by_norm(norm: str, l2, h, **kwargs) -> tuple[np.ndarray, dict]:
+    """The one dispatch on ``norm`` ∈ :data:`NORMS` shared by every Γ (segment, face, triangles).
+
+    Parameters
+    ----------
+    norm : {"H", "L2"}
+        "L2": the exact L²(Γ) mass matrix; "H": the M = (H^{1/2}_00(Γ))' norm of Bathe &
+        Brezzi (2001), eq. (3.9).
+    l2 : callable () -> ndarray
+        The L² Gram matrix (called only for "L2"; ``kwargs`` are not passed to it).
+    h : callable (**kwargs) -> (ndarray, dict)
+        The H Gram matrix and its info (called only for "H", with ``kwargs``).
+
+    Returns
+    -------
+    G : ndarray (dim, dim)
+    info : dict
+        :data:`L2_INFO` (a fresh copy) for "L2", ``h``'s info for "H".
+
+    Raises
+    ------
+    InputError
+        Naming ``norm`` and the allowed values :data:`NORMS`, for any other ``norm``.
+    """
+    if norm == "L2":
+        return l2(), dict(L2_INFO)
+    if norm == "H":
+        return h(**kwargs)
+    raise InputError("norm", ", ".join(NORMS), got=norm)
+
+
+def gram_h_route(space: MultiplierSpace, h_route: str = "logkernel", **kwargs) -> tuple[np.ndarray, dict]:
+    """The segment's H Gram matrix by ``h_route`` ∈ :data:`H_ROUTES`: the closed-form log kernel
+    (no truncation; :data:`L2_INFO` reported) or the truncated, extrapolated sine series
+    (:func:`gram_h`, ``kwargs`` passed on)."""
+    if h_route == "logkernel":
+        return gram_h_logkernel(space), dict(L2_INFO)
+    if h_route == "series":
+        return gram_h(space, **kwargs)
+    raise InputError("h_route", ", ".join(H_ROUTES), got=h_route)
+
 
 def gram(space: MultiplierSpace, norm: str, h_route: str = "logkernel", **kwargs) -> tuple[np.ndarray, dict]:
     """Gram matrix of ``space`` for ``norm`` ∈ {"H", "L2"}.
@@ -329,7 +374,7 @@ def gram(space: MultiplierSpace, norm: str, h_route: str = "logkernel", **kwargs
         The multiplier space.
     norm : {"H", "L2"}
         "H": the M = (H^{1/2}_00(Γ))' norm of Bathe & Brezzi (2001), eq. (3.9), see
-        :func:`gram_h` (``kwargs`` are passed on); "L2": the exact L²(Γ) mass matrix.
+        :func:`gram_h_route` (``kwargs`` are passed on); "L2": the exact L²(Γ) mass matrix.
     h_route : {"logkernel", "series"}
         Route for "H": the closed-form log kernel (no truncation; ``n_max`` = 0 and
         ``nmax_rel_error`` = 0.0 are reported) or the truncated, extrapolated sine series.
@@ -343,14 +388,6 @@ def gram(space: MultiplierSpace, norm: str, h_route: str = "logkernel", **kwargs
     Raises
     ------
     InputError
-        For an unknown ``norm``.
+        For an unknown ``norm`` (:func:`gram_by_norm`) or, with "H", an unknown ``h_route``.
     """
-    if norm == "H" and h_route == "logkernel":
-        return gram_h_logkernel(space), {"n_max": 0, "nmax_rel_error": 0.0}
-    if norm == "H" and h_route == "series":
-        return gram_h(space, **kwargs)
-    if norm == "H":
-        raise InputError("h_route", ", ".join(H_ROUTES), got=h_route)
-    if norm == "L2":
-        return gram_l2(space), {"n_max": 0, "nmax_rel_error": 0.0}
-    raise InputError("norm", ", ".join(NORMS), got=norm)
+    return gram_by_norm(norm, lambda: gram_l2(space), lambda **kw: gram_h_route(space, h_route, **kw), **kwargs)

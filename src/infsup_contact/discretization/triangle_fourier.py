@@ -34,7 +34,7 @@ from .face_norms import extrapolated
 from .face_quadrature import duffy_rule, triangles_rule
 from .face_triangle_norms import TAIL_EXPONENTS, tail_key
 from .face_triangles import lagrange_barycentric
-from .norms import N_MAX_CAP
+from .norms import N_MAX_CAP, gram_by_norm
 
 SMALL = 2.0
 """|κ| below which F is integrated by a Duffy rule instead of the recursion."""
@@ -210,10 +210,4 @@ def gram_h(space, rtol: float = 1e-6, n_start: int | None = None, n_cap: int = N
 
 def gram(space, norm: str, **kwargs) -> tuple[np.ndarray, dict]:
     """Gram matrix for ``norm`` ∈ {"H", "L2"} (``kwargs`` to :func:`gram_h`)."""
-    from .norms import NORMS
-
-    if norm == "L2":
-        return gram_l2(space), {"n_max": 0, "nmax_rel_error": 0.0}
-    if norm == "H":
-        return gram_h(space, **kwargs)
-    raise InputError("norm", ", ".join(NORMS), got=norm)
+    return gram_by_norm(norm, lambda: gram_l2(space), lambda **kw: gram_h(space, **kw), **kwargs)

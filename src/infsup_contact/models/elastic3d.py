@@ -156,16 +156,17 @@ class Elastic3DSide(SideOperator):
 
 
 def side_operator(mesh, k: int, nu: float = 0.3, supports=CLAMPED, route: str = "auto",
-                  gamma=None) -> Elastic3DSide:
+                  gamma=None, keep_factor: bool = False) -> Elastic3DSide:
     """One elastic body factorized once (E = 1), Γ dofs of x, y, z last, the z ones at the very
     end; its Γ Schur complement is that of the z dofs (module docstring). ``route`` as in
     :func:`~infsup_contact.models.schur.gamma_factorization`; ``gamma`` the interface (default
-    :func:`~infsup_contact.models.membranes3d.face_of` the mesh)."""
+    :func:`~infsup_contact.models.membranes3d.face_of` the mesh); ``keep_factor``: the
+    factorization that gives S also serves the solves (a scene's side)."""
     nu = check_nu(nu)
     fes = vector_space(mesh, k, supports)
     free, trace, n_t = free_order(fes, face_of(mesh) if gamma is None else gamma)
     K_all = elastic_stiffness(fes, nu)
-    base = factorized_side(trace, free, K_all[free][:, free].tocsc(), route)
+    base = factorized_side(trace, free, K_all[free][:, free].tocsc(), route, keep_factor)
     return Elastic3DSide(base.trace, base.free, base.stiffness, base.schur, base.solve, base.steklov,
                          fes=fes, n_tangential=n_t, stiffness_all=K_all, nu=nu)
 
@@ -173,7 +174,7 @@ def side_operator(mesh, k: int, nu: float = 0.3, supports=CLAMPED, route: str = 
 def scene_side(scene, mesh, k: int, nu: float = 0.3) -> Elastic3DSide:
     """The side of a contact scene: its ``supports`` (x, y, z regexps) where it has them, else
     clamped on ∂Ω_i∖Γ."""
-    return side_operator(mesh, k, nu, getattr(scene, "supports", None) or CLAMPED)
+    return side_operator(mesh, k, nu, getattr(scene, "supports", None) or CLAMPED, keep_factor=True)
 
 
 def load(side: Elastic3DSide, scene, i: int):

@@ -143,13 +143,15 @@ class MembraneSide(SideOperator):
     stiffness_all: sp.csr_matrix | None = None
 
 
-def side_operator(mesh, k: int, route: str = "auto", dirichlet: str = BETA_DIRICHLET, gamma=None) -> MembraneSide:
+def side_operator(mesh, k: int, route: str = "auto", dirichlet: str = BETA_DIRICHLET, gamma=None,
+                  keep_factor: bool = False) -> MembraneSide:
     """Factorize the Laplace stiffness K_i of Q_k / P_k once, Γ dofs last (c = 1), u_i = 0 on
     ``dirichlet`` (default all of ∂Ω_i∖Γ). With natural lateral faces the Γ dofs on ∂Γ are free:
     the trace spans continuous Q_k / P_k on the partition, ∂Γ included.
 
     ``gamma``: the interface whose trace is taken (default :func:`face_of` the mesh, the unit
-    face; a narrower body passes ``Square(width=...)``)."""
+    face; a narrower body passes ``Square(width=...)``); ``keep_factor``: the factorization that
+    gives S also serves the solves (:func:`~.schur.gamma_factorization`; a scene's side)."""
     fes = displacement_space(mesh, k, dirichlet)
     trace = (face_of(mesh) if gamma is None else gamma).trace(fes)
     free_mask = np.array(fes.FreeDofs(), dtype=bool)
@@ -157,7 +159,7 @@ def side_operator(mesh, k: int, route: str = "auto", dirichlet: str = BETA_DIRIC
     is_gamma[trace.gamma_dofs] = True
     free = np.concatenate([np.flatnonzero(free_mask & ~is_gamma), trace.gamma_dofs])
     K_all = laplace_stiffness(fes)
-    base = factorized_side(trace, free, K_all[free][:, free].tocsc(), route)
+    base = factorized_side(trace, free, K_all[free][:, free].tocsc(), route, keep_factor)
     return MembraneSide(base.trace, base.free, base.stiffness, base.schur, base.solve, base.steklov,
                         stiffness_all=K_all)
 
@@ -165,7 +167,7 @@ def side_operator(mesh, k: int, route: str = "auto", dirichlet: str = BETA_DIRIC
 def scene_side(scene, mesh, k: int) -> MembraneSide:
     """The side of a contact scene: u_i prescribed on the scene's ``supports`` (an NGSolve
     boundary regexp; the face patch test: the far face only), else on all of ∂Ω_i∖Γ."""
-    return side_operator(mesh, k, dirichlet=getattr(scene, "supports", None) or BETA_DIRICHLET)
+    return side_operator(mesh, k, dirichlet=getattr(scene, "supports", None) or BETA_DIRICHLET, keep_factor=True)
 
 
 def load(side: MembraneSide, scene, i: int):

@@ -6,7 +6,10 @@ in ``perm``) after one supernodal, BLAS-3 factorization of A_II in its own neste
 order (METIS). It is the Γ-last Schur complement of :mod:`infsup_contact.models.schur`
 computed by a sparse direct solver built for it: on a 3D body (Q2 hexahedra, 254,016 dofs,
 n_Γ = 3,969) it takes 23 s and 2.8 GB, where SuperLU with the Γ-last nested dissection needs
-minutes and tens of GB (``results/benchmarks``).
+minutes and tens of GB (``results/benchmarks``). :func:`gamma_schur` frees the interior factor
+at once (``iparm[35] = 1``: a β_h sweep never solves); :class:`SchurFactor` keeps it
+(``iparm[35] = 2``) and solves A x = b with it and S, so a contact scene factorizes each body
+once (face patch, membranes3d, k = 2, one body N = 20: the first solve 5.4 s → 0.4 s).
 
 The library is Intel oneMKL from the ``mkl`` wheel (``environment.lock``), called through
 ctypes with the documented C interface ``pardiso(pt, maxfct, mnum, mtype, phase, n, a, ia,
@@ -24,6 +27,7 @@ import sys
 from functools import lru_cache
 
 import numpy as np
+import scipy.linalg as sla
 import scipy.sparse as sp
 
 _P = ctypes.POINTER
@@ -121,33 +125,106 @@ class _Handle:
             pass
 
 
+def _dense_schur(A, n_gamma: int) -> tuple[np.ndarray, np.ndarray]:
+    """(A dense, S) by dense elimination: the route of interiors below :data:`MIN_INTERIOR`.
+
+    MKL 2026.2 reads past its arrays (valgrind: mkl_pds_lp64_permutetips) for a 2 × 2 matrix
+    with one Schur row, and crashed a test run that way; an interior this small is eliminated
+    densely instead (the same S, exactly as cheap)."""
+    n = A.shape[0]
+    D = A.toarray() if sp.issparse(A) else np.asarray(A, dtype=float)
+    I, G = slice(0, n - n_gamma), slice(n - n_gamma, n)
+    S = D[G, G] - D[G, I] @ np.linalg.solve(D[I, I], D[I, G]) if n > n_gamma else D[G, G].copy()
+    return D, 0.5 * (S + S.T)
+
+
+def _partial_factorization(A, n_gamma: int, schur: int) -> tuple["_Handle", np.ndarray]:
+    """One PARDISO analysis and partial factorization (phase 12) of A with the last ``n_gamma``
+    rows marked in ``perm`` and ``iparm[35] = schur``: the handle and S (symmetrized)."""
+    n = A.shape[0]
+    perm = np.zeros(n, dtype=np.int32)
+    perm[n - n_gamma:] = 1
+    handle = _Handle(A, perm, schur=schur)
+    S = np.zeros(max(n_gamma * n_gamma, n))  # the Schur block, in PARDISO's x (at least n long)
+    try:
+        handle.call(12, x=S)
+    except BaseException:
+        handle.release()
+        raise
+    S = S[:n_gamma * n_gamma].reshape(n_gamma, n_gamma)
+    return handle, 0.5 * (S + S.T)
+
+
 def gamma_schur(A, n_gamma: int) -> np.ndarray:
     """S = A_ΓΓ − A_ΓI A_II⁻¹ A_IΓ (Γ = the last ``n_gamma`` unknowns of the SPD A), dense.
 
     One PARDISO analysis and partial factorization (phase 12) with the Γ rows marked in
-    ``perm`` and ``iparm[35] = 1``; the interior factor is discarded.
+    ``perm`` and ``iparm[35] = 1``; the interior factor is discarded (:class:`SchurFactor`
+    keeps it, for solves).
     """
     n = A.shape[0]
     if n_gamma == 0:
         return np.zeros((0, 0))
     if n - n_gamma < MIN_INTERIOR:
-        # MKL 2026.2 reads past its arrays (valgrind: mkl_pds_lp64_permutetips) for a 2 × 2
-        # matrix with one Schur row, and crashed a test run that way; an interior this small
-        # is eliminated densely instead (the same S, exactly as cheap)
-        D = A.toarray() if sp.issparse(A) else np.asarray(A, dtype=float)
-        I, G = slice(0, n - n_gamma), slice(n - n_gamma, n)
-        S = D[G, G] - D[G, I] @ np.linalg.solve(D[I, I], D[I, G]) if n > n_gamma else D[G, G].copy()
-        return 0.5 * (S + S.T)
-    perm = np.zeros(n, dtype=np.int32)
-    perm[n - n_gamma:] = 1
-    handle = _Handle(A, perm, schur=1)
-    S = np.zeros(max(n_gamma * n_gamma, n))  # the Schur block, in PARDISO's x (at least n long)
-    try:
-        handle.call(12, x=S)
-    finally:
-        handle.release()
-    S = S[:n_gamma * n_gamma].reshape(n_gamma, n_gamma)
-    return 0.5 * (S + S.T)
+        return _dense_schur(A, n_gamma)[1]
+    handle, S = _partial_factorization(A, n_gamma, schur=1)
+    handle.release()
+    return S
+
+
+class SchurFactor:
+    """S and solves A x = b from one partial factorization that keeps the interior factor.
+
+    With ``iparm[35] = 2`` PARDISO computes S (the same matrix as :func:`gamma_schur`) and keeps
+    the Cholesky factor of A_II (oneMKL Developer Reference, "pardiso iparm Parameter":
+    Schur complement with partial solving). Writing A = [L_II 0; L_ΓI I] [I 0; 0 S] [L_IIᵀ L_ΓIᵀ;
+    0 I], a solve is the forward substitution (phase 331: y_I = L_II⁻¹ b_I, y_Γ = b_Γ − L_ΓI y_I),
+    the Γ block S x_Γ = y_Γ solved here with a Cholesky factor of S (LAPACK, made on the first
+    solve), and the backward substitution (phase 333: x_I = L_II⁻ᵀ (y_I − L_ΓIᵀ x_Γ)). For an SPD
+    matrix (mtype 2, L Lᵀ) there is no diagonal phase 332 to apply. Interiors below
+    :data:`MIN_INTERIOR` are eliminated densely (:func:`gamma_schur`) and solved by a dense
+    Cholesky factor of A.
+
+    Attributes
+    ----------
+    schur : ndarray (n_gamma, n_gamma)
+        S = A_ΓΓ − A_ΓI A_II⁻¹ A_IΓ, symmetrized.
+    """
+
+    def __init__(self, A, n_gamma: int):
+        self.n, self.n_gamma = A.shape[0], int(n_gamma)
+        self.handle, self._dense, self._full, self._cho = None, None, None, None
+        if self.n - self.n_gamma < MIN_INTERIOR:
+            D, self.schur = _dense_schur(A, self.n_gamma)
+            self._dense = sla.cho_factor(D, check_finite=False)
+        elif self.n_gamma == 0:  # no Γ: a plain factorization
+            self.schur, self._full = np.zeros((0, 0)), Factor(A)
+        else:
+            self.handle, self.schur = _partial_factorization(A, self.n_gamma, schur=2)
+
+    def solve(self, b: np.ndarray) -> np.ndarray:
+        """A⁻¹ b for a vector or a matrix of right-hand sides (columns)."""
+        b = np.asarray(b, dtype=np.float64)
+        if self._dense is not None:
+            return sla.cho_solve(self._dense, b, check_finite=False)
+        if self._full is not None:
+            return self._full.solve(b)
+        if self._cho is None:
+            self._cho = sla.cho_factor(self.schur, check_finite=False)
+        rhs = np.array(b.reshape(self.n, -1), dtype=np.float64, order="F")
+        nrhs, gamma = rhs.shape[1], slice(self.n - self.n_gamma, self.n)
+        y = np.zeros_like(rhs, order="F")
+        self.handle.call(331, b=rhs, x=y, nrhs=nrhs)
+        y[gamma] = sla.cho_solve(self._cho, y[gamma], check_finite=False)
+        x = np.zeros_like(rhs, order="F")
+        self.handle.call(333, b=y, x=x, nrhs=nrhs)
+        return x.reshape(b.shape)
+
+    def release(self) -> None:
+        """Free PARDISO's memory (also done when the object is collected)."""
+        for h in (self.handle, self._full and self._full.handle):
+            if h is not None:
+                h.release()
 
 
 class Factor:

@@ -89,10 +89,10 @@ class SideOperator(_SteklovProduct):
 
     def forget_cached(self) -> None:
         """Return to the state right after the build: drop what later calls cached on this
-        side (the Cholesky factor of S, the trace's basis values). A benchmark times each
-        multiplier space's solve from this state, as a fresh build would give it."""
+        side (the Cholesky factor of S, the trace's basis values, dense and CSR). A benchmark
+        times each multiplier space's solve from this state, as a fresh build would give it."""
         self.__dict__.pop("_schur_cholesky", None)
-        self.trace.basis_cache.clear()
+        self.trace.forget_basis()
 
 
 
@@ -130,7 +130,8 @@ GAMMA_ROUTES = ("auto", "solves", "nested", "pardiso")
 
 class _LazyPardisoSolve:
     """b ↦ A⁻¹ b with a PARDISO factorization made on the first call: the ``"pardiso"``
-    route's Schur complement discards its interior factor, and a β_h sweep never solves."""
+    route's Schur complement discards its interior factor unless asked to keep it
+    (``keep_factor``), and a β_h sweep never solves."""
 
     def __init__(self, A):
         self.A, self.factor = A, None
@@ -164,7 +165,8 @@ class GammaFactorization(_SteklovProduct):
 
 
 
-def gamma_factorization(A, n_gamma: int, route: str = "auto", gamma_dim: int = 1) -> GammaFactorization:
+def gamma_factorization(A, n_gamma: int, route: str = "auto", gamma_dim: int = 1,
+                        keep_factor: bool = False) -> GammaFactorization:
     """Factorize the SPD matrix A once and get its Γ Schur complement (Γ = last n_gamma).
 
     ``route``:
@@ -175,8 +177,12 @@ def gamma_factorization(A, n_gamma: int, route: str = "auto", gamma_dim: int = 1
         SuperLU's minimum-degree order (``MMD_AT_PLUS_A``, symmetric mode), then
         X = (A⁻¹)_ΓΓ from n_Γ solves with unit vectors and S = X⁻¹.
     ``"pardiso"``
-        MKL PARDISO's partial factorization returns S directly (:mod:`.pardiso`); solves
-        factorize A once more, on first use.
+        MKL PARDISO's partial factorization returns S directly (:mod:`.pardiso`). With
+        ``keep_factor`` it keeps the interior factor and solves with it and a Cholesky factor of
+        S (:class:`~.pardiso.SchurFactor`, ``iparm[35] = 2``: one factorization for S and the
+        solves of a contact scene); without, the factor is freed at once (a β_h sweep never
+        solves, and the memory of the large runs is that of S alone) and a solve factorizes A
+        once more, on first use.
     ``"auto"``
         ``"solves"`` while n · n_Γ ≤ :data:`SOLVES_MAX_WORK`; above it ``"pardiso"`` on a face
         (``gamma_dim`` = 2) where MKL loads, else ``"nested"``. Measured on the structured
@@ -191,6 +197,9 @@ def gamma_factorization(A, n_gamma: int, route: str = "auto", gamma_dim: int = 1
     if route == "auto":
         route = ("solves" if n * n_gamma <= SOLVES_MAX_WORK else
                  "pardiso" if gamma_dim >= 2 and pardiso.available() else "nested")
+    if route == "pardiso" and keep_factor:
+        factor = pardiso.SchurFactor(A, n_gamma)
+        return GammaFactorization(factor.solve, factor.schur, None, route)
     if route == "pardiso":
         return GammaFactorization(_LazyPardisoSolve(A), pardiso.gamma_schur(A, n_gamma), None, route)
     if route == "nested":
@@ -216,10 +225,11 @@ def schur_from_lu(lu: "_Reordered", n_gamma: int) -> np.ndarray:
     return 0.5 * (S + S.T)
 
 
-def factorized_side(trace: GammaTrace, free: np.ndarray, K, route: str = "auto") -> SideOperator:
+def factorized_side(trace: GammaTrace, free: np.ndarray, K, route: str = "auto",
+                    keep_factor: bool = False) -> SideOperator:
     """The SideOperator of an assembled stiffness K (free dofs, Γ last): one
-    :func:`gamma_factorization`."""
-    fac = gamma_factorization(K, len(trace.gamma_dofs), route, trace.gamma.dim)
+    :func:`gamma_factorization` (``keep_factor`` for a side that will solve: a contact scene's)."""
+    fac = gamma_factorization(K, len(trace.gamma_dofs), route, trace.gamma.dim, keep_factor)
     return SideOperator(trace, free, K, fac.schur, fac.solve, fac.steklov)
 
 

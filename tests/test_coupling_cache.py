@@ -1,0 +1,82 @@
+"""The trace basis values are sparsified once per point set (``GammaTrace.cached_sparse_basis``):
+a sweep of multiplier spaces shares one CSR matrix, the couplings equal bit for bit the route that
+sparsified the dense values chunk by chunk for every space, and ``forget_cached`` drops both the
+dense and the CSR values (the benchmark's fresh state)."""
+import numpy as np
+import pytest
+import scipy.sparse as sp
+
+from infsup_contact.discretization import coupling
+from infsup_contact.discretization.coupling import coupling_matrix
+from infsup_contact.discretization.registry import case_space, ids_valid_for
+from infsup_contact.errors import InputError
+from infsup_contact.models import make_model
+
+SETUPS = [("membranes3d", {"element": "hex"}, 3, 2), ("membranes3d", {"element": "tet"}, 2, 2),
+          ("membranes", {}, 5, 2)]
+
+
+def _sides(model, kw, n, k):
+    m = make_model(model)
+    return [m.side_operator(m.subdomain_mesh("structured", n + i, i + 1, **kw), k) for i in range(2)]
+
+
+def _reference(trace, space, k):
+    """The former route: the dense basis values, each chunk sparsified again for every space."""
+    x, w = trace.gamma.coupling_quadrature(trace, space, k + space.degree)
+    phi = trace.gamma.trace_basis(trace, x)
+    out = np.zeros((space.dim, phi.shape[1]))
+    for rows in coupling._chunks(len(w), space.dim):
+        mu = sp.csr_matrix(space.evaluate(x[rows]) * w[rows, None])
+        out += (mu.T @ sp.csr_matrix(phi[rows])).toarray()
+    return out
+
+
+@pytest.fixture(scope="module", params=SETUPS, ids=lambda s: f"{s[0]}-{s[1].get('element', '2d')}")
+def setup(request):
+    model, kw, n, k = request.param
+    sides = _sides(model, kw, n, k)
+    gamma = sides[0].trace.gamma
+    part = gamma.multiplier_partition(*(s.trace.partition for s in sides))
+    spaces = []
+    for case in ids_valid_for(k, gamma_dim=gamma.dim):
+        try:
+            spaces.append(case_space(case, k, part, gamma))
+        except InputError:  # a space the registry refuses on this Γ (e.g. a dual basis without weights)
+            pass
+    assert len(spaces) >= 3
+    return sides, spaces, k
+
+
+@pytest.mark.parametrize("chunk", [None, 256])
+def test_couplings_are_the_per_space_sparsification_bit_for_bit(setup, chunk, monkeypatch):
+    sides, spaces, k = setup
+    if chunk is not None:  # many chunks: the CSR row slices must equal the sparsified dense slices
+        monkeypatch.setattr(coupling, "_CHUNK_ENTRIES", chunk)
+    for side in sides:
+        side.forget_cached()
+        for space in spaces:
+            B = coupling_matrix(side.trace, space, k)
+            assert B.shape == (space.dim, len(side.trace.gamma_dofs))
+            assert np.array_equal(B, _reference(side.trace, space, k))
+
+
+def test_a_sweep_sparsifies_each_point_set_once_and_forget_drops_both(setup, monkeypatch):
+    sides, spaces, k = setup
+    side = sides[1]
+    side.forget_cached()
+    made = []
+    csr = sp.csr_matrix
+    # the trace's dense values are read-only (cached_basis), the multiplier values are not
+    monkeypatch.setattr(sp, "csr_matrix", lambda a, *r, **kw: made.append(
+        isinstance(a, np.ndarray) and not a.flags.writeable) or csr(a, *r, **kw))
+    for space in spaces + spaces:
+        coupling_matrix(side.trace, space, k)
+    n_sets = len(side.trace.basis_cache)
+    assert n_sets >= 1 and len(side.trace.sparse_cache) == n_sets
+    assert sum(made) == n_sets  # one CSR of the trace values per point set, not one per space
+    x, _ = side.trace.gamma.coupling_quadrature(side.trace, spaces[0], k + spaces[0].degree)
+    assert side.trace.cached_sparse_basis(x) is side.trace.cached_sparse_basis(x)
+    assert np.array_equal(side.trace.cached_sparse_basis(x).toarray(), side.trace.gamma.trace_basis(side.trace, x))
+    side.forget_cached()
+    assert not side.trace.basis_cache and not side.trace.sparse_cache

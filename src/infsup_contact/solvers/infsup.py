@@ -96,8 +96,9 @@ def spectrum(S: np.ndarray, G: np.ndarray | None = None, *, factor: np.ndarray |
     return Spectrum(beta, d, float(np.sqrt(max(above, 0.0))), gap, ev[:8].copy())
 
 
-N_BOTTOM = 8
-"""Eigenvalues above the kernel the iterative route computes (``Spectrum.bottom``)."""
+N_BOTTOM = 1
+"""Eigenvalues above the kernel the iterative route computes: λ_{d+1}, all a β row reports
+(``Spectrum.bottom`` holds the d kernel zeros and it); Lanczos needs 2.4× the products for 8."""
 
 
 def bottom_spectrum(S: np.ndarray, factor: np.ndarray, kernel: KernelDecision | None = None,
@@ -108,12 +109,12 @@ def bottom_spectrum(S: np.ndarray, factor: np.ndarray, kernel: KernelDecision | 
     deflated and the :data:`N_BOTTOM` eigenvalues above it come from shift-invert Lanczos
     (:func:`.bottom.bottom_pencil`); λ_max for the round-off level from Lanczos too. ``bottom``
     holds the d kernel eigenvalues as exact zeros (a kernel of Bᵀ is one of S), then those.
-    Without ``kernel`` only the smallest eigenvalue is computed (β with v1 = 0).
+    Without ``kernel``, the smallest eigenvalue (β with v1 = 0), 0 when at round-off level.
     """
     d = 0 if kernel is None else kernel.dim
     if d and (Z is None or Z.shape[1] != d):
         raise ValueError(f"a kernel of dimension {d} needs its basis Z (m × {d}) to be deflated")
-    res = bottom.bottom_pencil(S, factor, N_BOTTOM if kernel is not None else 1, Z if d else None)
+    res = bottom.bottom_pencil(S, factor, N_BOTTOM, Z if d else None)
     ev = np.concatenate([np.zeros(d), res.values])
     lam = float(res.values[0])
     eta = S.shape[0] * np.finfo(float).eps * res.lam_max  # the pencil's round-off level, as dense

@@ -87,6 +87,17 @@ def test_nu_slope_claims_predict_from_spans_constants():
     assert claim_id("bounded", "R5.2", 2, "hex") not in claims.index  # not marked stable
 
 
+def test_every_character_of_the_claims_has_a_latex_form():
+    """The ledger is typeset (paper_macros): statements and evidence use only mapped characters."""
+    from infsup_contact.report.texformat import UNICODE_LATEX
+
+    patch = pd.DataFrame([dict(element="hex", case="DUAL", k=2, N1=4, N2=5, E1=1.0, E2=1.0, nu=0.3,
+                               lambda_max_rel_error=1e-14, u_max_rel_error=1e-14, kernel_dim=0, passes=True)])
+    claims = _claims([_rows("T3"), _rows("DUAL"), _rows("R5.2")], patch)
+    text = "".join(claims.statement) + "".join(claims.evidence)
+    assert {ch for ch in text if ord(ch) > 127 and ch not in UNICODE_LATEX} == set()
+
+
 def test_slope_fit_is_exact_on_a_power_law():
     rows = pd.DataFrame({"nu": [0.3, 0.49, 0.499, 0.4999], "beta": [(1 - 2 * v) ** 0.37 for v in (0.3, 0.49, 0.499, 0.4999)]})
     slope, n = nu_slope(rows, 0.49)

@@ -186,7 +186,7 @@ def face_elastic_claims(beta: pd.DataFrame, patch: pd.DataFrame | None, cfg: dic
             rn = rc[(rc.N1 == n) & (rc.N2 == n)]
             if len(rn):
                 out.append(row(claim_id("nu", case, k, element, n), REF,
-                               f"face, {where}, N={int(n)}: β_H ≍ (1 − 2ν)^(1/2) as ν → 1/2 (slope 1/2 of log β_H "
+                               f"face, {where}, N={int(n)}: β_H scales like (1 − 2ν)^(1/2) as ν → 1/2 (slope 1/2 of log β_H "
                                "vs log(1 − 2ν))", nu_check(rn, sweep["fit_nu_min"], sweep["slope_tolerance"]),
                                predicted=nu_prediction(spec, k, int(n), gamma)))
     if patch is not None:

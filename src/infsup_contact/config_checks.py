@@ -331,6 +331,7 @@ def check_space_meshes(cfg) -> None:
 
 
 from .config_face import check_face  # noqa: E402 (the face section's checks: config_face.py)
+from .config_face_elastic import check_face_elastic  # noqa: E402 (config_face_elastic.py)
 
 CROSS_KEY_RULES = {
     # rule: the keys it relates (the error names the first; a change to any of them can trip it)
@@ -346,6 +347,8 @@ CROSS_KEY_RULES = {
     check_elastic_nonmatching: ("elastic.nonmatching", "elastic.patch_pairs"),
     check_hertz_reference: ("elastic.hertz.N_ref", "elastic.hertz.N"),
     check_face: ("face.model", "face.elements", "face.nonmatching", "face.nonmatching_families", "face.cases", "spaces"),
+    check_face_elastic: ("face_elastic.model", "face_elastic.elements", "face_elastic.nu", "face_elastic.nu_sweep",
+                         "face_elastic.nonmatching", "face_elastic.cases", "face_elastic.patch", "spaces"),
     check_space_meshes: ("infsup.N", "infsup.nonmatching", "infsup.nonmatching_families", "contact.N",
                          "contact.scenes", "elastic.N", "elastic.nonmatching", "elastic.patch_pairs",
                          "elastic.bench_N", "elastic.hertz.N", "elastic.hertz.modeling_N", "benchmarks.beta_N",

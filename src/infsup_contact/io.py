@@ -136,6 +136,14 @@ SCHEMAS = {
     "face_beta": Schema({**_BETA, "model": "str", "element": "str"},
                         key=("model", "element", "family", "case", "k", "N1", "N2", "multiplier_mesh", "c1", "c2",
                              "norm")),
+    # the 3D elastic bodies on the face (rules/face_elastic.smk: study/face_elastic.py): β_h per ν
+    "face_elastic_beta": Schema({**_BETA, "model": "str", "element": "str", "nu": "float"},
+                                key=("model", "element", "family", "case", "k", "N1", "N2", "multiplier_mesh", "c1",
+                                     "c2", "nu", "norm")),
+    "face_elastic_patch": Schema({"element": "str", "case": "str", "k": "int", "N1": "int", "N2": "int",
+                                  "E1": "float", "E2": "float", "nu": "float", "lambda_max_rel_error": "float",
+                                  "u_max_rel_error": "float", "kernel_dim": "int", "passes": "bool"},
+                                 key=("element", "case", "k", "N1", "N2", "E1", "E2", "nu")),
     # the face studies (rules/face_studies.smk: study/face_patch.py, face_alpha.py, edge_dropping.py);
     # condition numbers may be inf (singular to working precision): extra columns, not declared
     "face_patch": Schema({"element": "str", "case": "str", "k": "int", "N1": "int", "N2": "int",

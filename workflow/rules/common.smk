@@ -112,3 +112,10 @@ FACE_CLAIMS = ["results/tables/face_claims.csv", "results/tables/face_study_clai
 FACE_PAPER = ["results/paper/face_macros.tex", "results/paper/face_beta_table.tex",
               "results/paper/face_patch_table.tex", "results/paper/face_alpha_table.tex",
               "results/paper/face_edge_table.tex"] if FACE else []
+# the 3D elastic bodies on the face (rules/face_elastic.smk); none without a `face_elastic` section.
+# Their claims join FACE_CLAIMS (the ledger appends every file of it); their subsection of the
+# face section needs the face section (paper/face.tex reads it if present)
+FACE_ELASTIC = config.get("face_elastic")
+FACE_ELASTIC_BETA = [f"results/tables/face_elastic/beta_{e}.csv" for e in FACE_ELASTIC["elements"]] if FACE_ELASTIC else []
+FACE_CLAIMS += ["results/tables/face_elastic_claims.csv"] if FACE_ELASTIC else []
+FACE_ELASTIC_PAPER = ["results/paper/face_elastic.tex"] if FACE_ELASTIC and FACE else []

@@ -49,6 +49,7 @@ rule paper_pdf:
         elastic_figure="results/figures/fig9_elastic.pdf",
         face_tex="paper/face.tex",  # the face section (rules/face.smk)
         face=FACE_PAPER,
+        face_elastic=FACE_ELASTIC_PAPER,  # its subsection (rules/face_elastic.smk), \InputIfFileExists in face.tex
     benchmark:
         "results/benchmarks/rules/paper_pdf.tsv"
     log:

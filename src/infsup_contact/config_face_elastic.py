@@ -1,0 +1,105 @@
+"""Cross-key checks of the config's ``face_elastic`` section (the 3D elastic bodies on the
+contact face, rules/face_elastic.smk).
+
+What the schema cannot state: the model is a registered 3D model whose stiffness takes the
+Poisson ratio ``nu`` (a model parameter, :attr:`~infsup_contact.models.contract.Model.params`),
+each element is one of its ``element`` mesh options, every ν lies in (−1, 1/2)
+(:func:`~infsup_contact.models.plane_strain.check_nu`), at least 3 of the sweep's ν lie at or
+above ``fit_nu_min`` (a slope fit), the sweep's meshes are among ``N``, non-matching pairs have
+N1 ≠ N2, and each case is a registered space defined for some k of ``k`` and built by the face
+of some listed element. Each raises one :class:`~infsup_contact.config_schema.ConfigError`
+naming the key.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from .config_schema import ConfigError
+from .errors import InputError
+
+MIN_FIT_POINTS = 3
+"""A slope fit of the ν sweep needs this many ν >= fit_nu_min."""
+
+
+def check_face_elastic(cfg) -> None:
+    """Check ``cfg["face_elastic"]`` (absent: nothing to check)."""
+    fe = cfg.get("face_elastic")
+    if not fe:
+        return
+    from .models import MODELS
+
+    model = MODELS.get(fe["model"])
+    taking = [m.name for m in MODELS.values() if getattr(m, "dim", 2) == 3 and _takes_nu(m)]
+    if model is None or model.name not in taking:
+        raise ConfigError("face_elastic.model", "not a registered 3D model taking the Poisson ratio nu",
+                          got=fe["model"], allowed=", ".join(taking))
+    options = dict(model.mesh_options).get("element", ())
+    for key, elements in (("face_elastic.elements", fe["elements"]),
+                          ("face_elastic.patch.elements", fe["patch"]["elements"])):
+        for i, element in enumerate(elements):
+            if element not in options:
+                raise ConfigError(f"{key}[{i}]", f"not an element of {model.name}", got=element,
+                                  allowed=", ".join(options))
+    _check_nus(fe)
+    for key, pairs in (("face_elastic.nonmatching", fe["nonmatching"]), ("face_elastic.patch.pairs",
+                                                                         fe["patch"]["pairs"])):
+        for i, pair in enumerate(pairs):
+            if pair[0] == pair[1]:
+                raise ConfigError(f"{key}[{i}]", "a non-matching pair needs N1 != N2", got=pair,
+                                  allowed="[N1, N2] with N1 != N2 (matching meshes go under face_elastic.N)")
+    for i, n in enumerate(fe["nu_sweep"]["N"]):
+        if n not in fe["N"]:
+            raise ConfigError(f"face_elastic.nu_sweep.N[{i}]", "not a mesh of face_elastic.N", got=n,
+                              allowed=", ".join(str(m) for m in fe["N"]))
+    _check_cases(cfg, fe, model)
+
+
+def _takes_nu(model) -> bool:
+    return any(p.name == "nu" and p.side is None for p in model.params)
+
+
+def _check_nus(fe) -> None:
+    from .models.plane_strain import check_nu
+
+    sweep = fe["nu_sweep"]
+    for key, value in [("face_elastic.nu", fe["nu"])] + [(f"face_elastic.nu_sweep.nu[{i}]", v)
+                                                         for i, v in enumerate(sweep["nu"])]:
+        try:
+            check_nu(value, key)
+        except InputError:
+            raise ConfigError(key, "not a Poisson ratio", got=value, allowed="-1 < nu < 0.5") from None
+    kept = sorted(v for v in sweep["nu"] if v >= sweep["fit_nu_min"])
+    if len(kept) < MIN_FIT_POINTS:
+        raise ConfigError("face_elastic.nu_sweep.fit_nu_min", f"keeps fewer than {MIN_FIT_POINTS} of "
+                          "face_elastic.nu_sweep.nu (a slope fit needs 3)", got=sweep["fit_nu_min"],
+                          allowed=(f"<= {sorted(sweep['nu'])[-MIN_FIT_POINTS]}" if len(sweep["nu"]) >= MIN_FIT_POINTS
+                                   else "more ν"))
+
+
+def _check_cases(cfg, fe, model) -> None:
+    from .discretization.registry import SPACES
+    from .discretization.user_spaces import config_case_ids
+    from .discretization.square import SQUARE, TensorPartition
+    from .study.face_claims import element_interfaces
+
+    ids = config_case_ids(cfg, gamma_dim=SQUARE.dim)
+    faces = element_interfaces(model, sorted(set(fe["elements"]) | set(fe["patch"]["elements"])))
+    x = np.linspace(0.0, 1.0, 3)
+    for i, case in enumerate(fe["cases"]):
+        key = f"face_elastic.cases[{i}]"
+        if case not in ids:
+            raise ConfigError(key, f"{case!r} is not a registered space", got=case, allowed=", ".join(ids))
+        spec = SPACES[case]
+        ks = [k for k in fe["k"] if spec.valid_for(k)]
+        if not ks:
+            raise ConfigError(key, f"{case} is defined for none of face_elastic.k = {fe['k']}", got=case,
+                              allowed=f"k >= {spec.min_k} in face_elastic.k")
+        builders = [g for g in faces.values() if g.builds(spec)]
+        if not builders:
+            raise ConfigError(key, f"{case} is built by the face of none of the elements", got=case,
+                              allowed="a space of the listed elements' faces")
+        try:
+            for gamma in builders:
+                gamma.space(spec, ks[0], TensorPartition(x, x))
+        except Exception as err:  # noqa: BLE001 - any failure to build means: not a face space
+            raise ConfigError(key, f"{case} cannot be built on the face ({err})", got=case) from None

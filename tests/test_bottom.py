@@ -82,6 +82,7 @@ def test_face_rows_agree_between_routes(case, monkeypatch):
     """β rows of a real face (k = 2, hexahedra, 5:6: modes beyond the proof) by the dense and
     the iterative route."""
     rows = {}
+    monkeypatch.setattr(infsup, "LONGER_RULE_LARGE", infsup.LONGER_RULE)  # the same W' both ways
     for limit in (10 ** 9, 0):
         monkeypatch.setattr(bottom, "DENSE_MAX_M", limit)
         from infsup_contact.models import MODELS
@@ -95,3 +96,17 @@ def test_face_rows_agree_between_routes(case, monkeypatch):
             assert b["kernel_margin_decades"] >= a["kernel_margin_decades"] - 0.05
         assert b["beta"] == pytest.approx(a["beta"], rel=1e-9, abs=1e-12)
         assert b["smallest_nonzero"] == pytest.approx(a["smallest_nonzero"], rel=1e-7)
+
+
+def test_the_shorter_entry_rule_moves_the_margin_little(monkeypatch):
+    """Above DENSE_MAX_M, W' comes from a rule one point longer instead of three: both are
+    exact, so η changes by round-off only (T3, k = 2, 5:6)."""
+    from infsup_contact.models import MODELS
+    monkeypatch.setattr(bottom, "DENSE_MAX_M", 0)
+    margins = []
+    for extra in (infsup.LONGER_RULE, 2):
+        monkeypatch.setattr(infsup, "LONGER_RULE_LARGE", extra)
+        row = infsup.beta_rows("structured", 2, 5, 6, ["T3"], model=MODELS["membranes3d"], element="hex",
+                               norms=("L2",))[0]
+        margins.append(row["kernel_margin_decades"])
+    assert abs(margins[0] - margins[1]) < 0.1

@@ -241,9 +241,19 @@ def schur_by_solves(side: SideOperator) -> np.ndarray:
     return KGG - KIG.T @ spla.splu(KII).solve(KIG)
 
 
+SPARSE_PRODUCT_MIN_DIM = 1500
+"""dim M above which :func:`interface_terms` multiplies by B as a sparse matrix (B has
+(k + 1)^d (s + 1)^d-sized blocks: at dim M ≈ 4,000 on a face the dense product is 7e10 flops);
+below it the dense product, whose results the default DAG holds bit for bit."""
+
+
 def interface_terms(couplings, sides) -> list:
     """The terms B_i X_i B_iᵀ of the interface operator at unit material scale, one per side."""
-    return [B @ side.steklov_times(B.T) for B, side in zip(couplings, sides)]
+    out = []
+    for B, side in zip(couplings, sides):
+        Bl = sp.csr_matrix(B) if B.shape[0] > SPARSE_PRODUCT_MIN_DIM else B
+        out.append(np.asarray(Bl @ side.steklov_times(B.T)))
+    return out
 
 
 def combine_terms(terms, c) -> np.ndarray:

@@ -261,16 +261,25 @@ def space_kernel(couplings, sides, space, k: int, structural: int, l2_gram=None,
     every norm and every (c1, c2): the kernel of B A⁻¹ Bᵀ depends on neither.
 
     ``iterative``: the bottom singular values only
-    (:func:`~infsup_contact.solvers.kernel.bottom_kernel`, for dim M > :data:`.bottom.DENSE_MAX_M`);
-    its ``vectors`` are returned in multiplier coordinates (a basis of the kernel of Bᵀ)."""
+    (:func:`~infsup_contact.solvers.kernel.bottom_kernel`, for dim M > :data:`.bottom.DENSE_MAX_M`),
+    W' from a rule :data:`LONGER_RULE_LARGE` longer; its ``vectors`` are returned in multiplier
+    coordinates (a basis of the kernel of Bᵀ)."""
     G = sides[0].trace.gamma.gram(space, "L2")[0] if l2_gram is None else l2_gram
     rows, cols = [trace_l2_norms(s.trace, k) for s in sides], np.sqrt(np.diag(G))
     W = scaled_couplings(couplings, rows, cols)
-    longer = scaled_couplings([coupling_matrix(s.trace, space, k, extra_degree=6) for s in sides], rows, cols)
+    extra = LONGER_RULE_LARGE if iterative else LONGER_RULE
+    longer = scaled_couplings([coupling_matrix(s.trace, space, k, extra_degree=extra) for s in sides], rows, cols)
     if not iterative:
         return coupling_kernel(W, structural, entry_error=np.linalg.norm(W - longer))
     decision = bottom_kernel(sp.csr_matrix(W), structural, entry_error=np.linalg.norm(W - longer))
     return replace(decision, vectors=decision.vectors / cols[:, None])  # W v = 0 ⇔ Bᵀ (v / cols) = 0
+
+
+LONGER_RULE = 6
+"""Degree the entry-round-off rule W' of :func:`space_kernel` adds (three Gauss points more)."""
+LONGER_RULE_LARGE = 2
+"""The same above dim M = :data:`.bottom.DENSE_MAX_M` (one point more, 16 instead of 36 points
+per cell at k = s = 2: still exact, so W − W' is still round-off only; half the cost)."""
 
 
 def _bottom_route(kernel: KernelDecision):

@@ -333,6 +333,29 @@ class Square(Interface):
         dc = (_coarsening_cells(trace1.xs, trace2.xs) * k - 1) * (_coarsening_cells(trace1.ys, trace2.ys) * k - 1)
         return d[0] * e[0] + d[1] * e[1] - max(dc, 0)
 
+    def proven_kernel(self, space, k: int, traces, dim_w: int) -> int:
+        """max(dim M − dim(W1 + W2), 0), and on triangles the checkerboard mode
+        (:meth:`checkerboard_modes`): rank B <= dim M − 1 where it exists."""
+        glob = max(space.dim - dim_w, 0)
+        return max(glob, self.checkerboard_modes(space, k, [t.partition for t in traces]))
+
+    def checkerboard_modes(self, space, k: int, trace_partitions) -> int:
+        """1 where a discontinuous P_0 multiplier space and P_2 traces live on the same triangles, else 0.
+
+        Every rectangle is cut by the same diagonal, so the triangles are two-coloured: lower
+        and upper, and triangles sharing an edge have opposite colours. Let μ = ±1/|T| (lower +,
+        upper −). A P_2 trace vanishing on ∂Γ is spanned by vertex functions, whose integral over
+        every triangle is 0 (∫_T λ_v (2λ_v − 1) = 0), and interior-edge functions, with ∫_T φ_e =
+        |T|/3 on the two triangles of the edge; so b(φ, μ) = 0 for every trace function of both
+        sides when their triangles are those of G_h: μ is in the kernel of Bᵀ whatever the
+        dimension count says (T4 at k = 2 on tetrahedra: the count is 0, the kernel 1). Not
+        for P_k, k ≠ 2 (P_1 and P_3 vertex functions have non-zero integrals), nor where a trace's
+        triangles differ from G_h's (non-matching meshes)."""
+        if self.cell != "trig" or k != 2 or getattr(space, "s", None) != 0 or getattr(space, "continuous", True):
+            return 0
+        key = self.partition_key(space.breakpoints)
+        return int(all(self.partition_key(p) == key for p in trace_partitions))
+
     def trace_nodes(self, k: int, cells: int) -> int:
         """(n k + 1)² Γ nodes of a side on an n × n grid, boundary included."""
         return (cells * k + 1) ** 2

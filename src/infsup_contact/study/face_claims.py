@@ -16,6 +16,9 @@ a case id and never from the table (:func:`face_predictions`). The reasoning:
   where the segment's stays at 2. PASS predicted for every case.
 * **Bounded** (``face-<tag>-k<k>-<element>``, H^{-1/2}_00 norm): spaces marked stable in the
   registry (their 1D proof) are predicted bounded on the face: PASS.
+* **The checkerboard** (:func:`checkerboard`): on triangles, P_0 multipliers against P_2 traces
+  on the same triangles have a kernel mode the dimension count misses (T4 at k = 2 on
+  tetrahedra): the kernel, bounded and Remark 3.1 claims of such a space are predicted FAIL.
 * **Remark 3.1 on the face** (``face-Rem3.1-<tag>-k<k>-<element>``): in the L²(Γ) norm β_h of
   a stable space decays like h^{1/2}: the inverse estimate ‖μ‖_{-1/2} ≥ c h^{1/2}‖μ‖_0 on
   piecewise polynomials and a most-oscillating μ with ‖μ‖_{-1/2} ~ h^{1/2}‖μ‖_0 hold on a
@@ -37,6 +40,7 @@ import numpy as np
 import pandas as pd
 
 from ..discretization.registry import SPACES
+from ..errors import InputError
 from ..discretization.square import SQUARE, TensorPartition
 from .claims import FAIL, INCONCLUSIVE, PASS, bounded_claim, close_decisions, close_text, finest, kernel_claim, row, \
     slope_verdict
@@ -82,6 +86,20 @@ def _uniform(n: int) -> TensorPartition:
     return TensorPartition(x, x)
 
 
+def checkerboard(spec, k: int, gamma=SQUARE) -> bool:
+    """Whether ``gamma`` proves the checkerboard mode of ``spec`` at degree k on matching meshes
+    (:meth:`~infsup_contact.discretization.square.Square.checkerboard_modes`: P_0 multipliers
+    against P_2 traces on the same triangles; independent of N)."""
+    modes = getattr(gamma, "checkerboard_modes", None)
+    if modes is None or not gamma.builds(spec):
+        return False
+    try:
+        space = gamma.space(spec, k, _uniform(4))
+    except InputError:  # a space the face refuses to build (QUAD8's dual) proves nothing
+        return False
+    return bool(modes(space, k, [_uniform(4)] * 2))
+
+
 def planar_kernel(spec, k: int, n1: int, n2: int, gamma=SQUARE) -> int:
     """The dimension argument on n1 × n1 / n2 × n2 meshes, G_h = the trace of Ω2:
     max(dim M − dim(W1 + W2), 0) (:meth:`Square.trace_sum_dimension`)."""
@@ -117,6 +135,8 @@ def face_predictions(spec, k: int, nonmatching, tensor: bool, gamma=SQUARE) -> d
     out = {"kernel": PASS}
     if spec.stable:
         out["bounded"] = out["l2"] = PASS
+    if checkerboard(spec, k, gamma):  # a proven mode the dimension count misses: β_h = 0
+        out["kernel"] = out["bounded"] = out["l2"] = FAIL
     if spec.stable:  # no kernel on any pair (the planar count is 0): as the bounded claim
         out["nonmatching"] = PASS
     elif tensor and getattr(spec, "face_build", None) is None and any(
@@ -175,7 +195,10 @@ def face_claims(beta: pd.DataFrame, cfg: dict, interfaces: dict) -> pd.DataFrame
                            bounded_claim(finest(h, win), tol, floor, conf), predicted=pred["bounded"]))
         l2 = finest(match[match.norm == "L2"], win)
         if spec.stable and len(l2) >= 3:
-            v, text = slope_verdict(1 / l2.N2.to_numpy(float), l2.beta.to_numpy(float), 0.5, tol, conf)
+            if np.any(l2.beta.to_numpy(float) <= 0.0):  # a kernel: no decay to fit
+                v, text = FAIL, f"β_h = 0 (kernel_dim {', '.join(map(str, l2.kernel_dim))}) at N = {', '.join(map(str, l2.N2))}"
+            else:
+                v, text = slope_verdict(1 / l2.N2.to_numpy(float), l2.beta.to_numpy(float), 0.5, tol, conf)
             out.append(row(f"face-Rem3.1-{spec.tag}-k{k}-{element}", REF,
                            f"face, {where}: in the L²(Γ) norm β_h decays like h^(1/2)", (v, text),
                            predicted=pred["l2"]))

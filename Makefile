@@ -29,7 +29,7 @@ reproduce-all: $(STAMP)
 	$(BIN)/snakemake reproduce-all
 
 test: $(STAMP)
-	OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1 $(BIN)/python -m pytest
+	OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1 $(BIN)/python -m pytest -n 2
 
 clean-env:
 	rm -rf $(VENV)

@@ -120,24 +120,35 @@ def face_pairs(fc, element: str) -> list:
 
 
 def _check_face_cases(cfg, fc) -> None:
+    from .discretization.square import CELL_SHAPES, Square
+
+    check_face_case_ids(cfg, "face", fc["cases"], fc["k"], [Square(cell=c) for c in CELL_SHAPES])
+
+
+def check_face_case_ids(cfg, section: str, cases, ks_config, faces, need_builder: bool = False) -> None:
+    """Each id of ``<section>.cases``: registered, defined for one of ``<section>.k``, and built
+    on every face of ``faces`` that builds it; ``need_builder``: at least one face must."""
     from .discretization.user_spaces import config_case_ids
     from .discretization.registry import SPACES
-    from .discretization.square import CELL_SHAPES, SQUARE, Square, TensorPartition
+    from .discretization.square import SQUARE, TensorPartition
 
     ids = config_case_ids(cfg, gamma_dim=SQUARE.dim)
     x = np.linspace(0.0, 1.0, 3)
-    faces = [Square(cell=c) for c in CELL_SHAPES]
-    for i, case in enumerate(fc["cases"]):
-        key = f"face.cases[{i}]"
+    for i, case in enumerate(cases):
+        key = f"{section}.cases[{i}]"
         if case not in ids:
             raise ConfigError(key, f"{case!r} is not a registered space", got=case, allowed=", ".join(ids))
         spec = SPACES[case]
-        ks = [k for k in fc["k"] if spec.valid_for(k)]
+        ks = [k for k in ks_config if spec.valid_for(k)]
         if not ks:
-            raise ConfigError(key, f"{case} is defined for none of face.k = {fc['k']}", got=case,
-                              allowed=f"k >= {spec.min_k} in face.k")
-        try:  # on a face of the cells it is defined on (rectangles and/or triangles)
-            for gamma in (g for g in faces if g.builds(spec)):
+            raise ConfigError(key, f"{case} is defined for none of {section}.k = {ks_config}", got=case,
+                              allowed=f"k >= {spec.min_k} in {section}.k")
+        builders = [g for g in faces if g.builds(spec)]  # the faces of the cells it is defined on
+        if need_builder and not builders:
+            raise ConfigError(key, f"{case} is built by the face of none of the elements", got=case,
+                              allowed="a space of the listed elements' faces")
+        try:
+            for gamma in builders:
                 gamma.space(spec, ks[0], TensorPartition(x, x))
         except Exception as err:  # noqa: BLE001 - any failure to build means: not a face space
             raise ConfigError(key, f"{case} cannot be built on the face ({err})", got=case) from None

@@ -12,8 +12,6 @@ naming the key.
 """
 from __future__ import annotations
 
-import numpy as np
-
 from .config_schema import ConfigError
 from .errors import InputError
 
@@ -77,29 +75,8 @@ def _check_nus(fe) -> None:
 
 
 def _check_cases(cfg, fe, model) -> None:
-    from .discretization.registry import SPACES
-    from .discretization.user_spaces import config_case_ids
-    from .discretization.square import SQUARE, TensorPartition
+    from .config_face import check_face_case_ids
     from .study.face_claims import element_interfaces
 
-    ids = config_case_ids(cfg, gamma_dim=SQUARE.dim)
     faces = element_interfaces(model, sorted(set(fe["elements"]) | set(fe["patch"]["elements"])))
-    x = np.linspace(0.0, 1.0, 3)
-    for i, case in enumerate(fe["cases"]):
-        key = f"face_elastic.cases[{i}]"
-        if case not in ids:
-            raise ConfigError(key, f"{case!r} is not a registered space", got=case, allowed=", ".join(ids))
-        spec = SPACES[case]
-        ks = [k for k in fe["k"] if spec.valid_for(k)]
-        if not ks:
-            raise ConfigError(key, f"{case} is defined for none of face_elastic.k = {fe['k']}", got=case,
-                              allowed=f"k >= {spec.min_k} in face_elastic.k")
-        builders = [g for g in faces.values() if g.builds(spec)]
-        if not builders:
-            raise ConfigError(key, f"{case} is built by the face of none of the elements", got=case,
-                              allowed="a space of the listed elements' faces")
-        try:
-            for gamma in builders:
-                gamma.space(spec, ks[0], TensorPartition(x, x))
-        except Exception as err:  # noqa: BLE001 - any failure to build means: not a face space
-            raise ConfigError(key, f"{case} cannot be built on the face ({err})", got=case) from None
+    check_face_case_ids(cfg, "face_elastic", fe["cases"], fe["k"], list(faces.values()), need_builder=True)

@@ -44,7 +44,7 @@ import pandas as pd
 from ..discretization.registry import SPACES
 from .claims import COLUMNS, FAIL, INCONCLUSIVE, PASS, close_decisions, close_text, row
 from .face_claims import matching_kernel
-from .face_study_claims import PATCH_FAIL_RTOL, PATCH_RTOL, face_contains_constants, patch_prediction
+from .face_study_claims import face_contains_constants, patch_prediction, patch_verdict
 
 REF = "beyond the paper (issue 28: the 3D elastic bodies on the contact face)"
 FINDING = "finding"
@@ -133,17 +133,6 @@ def nu_check(rows: pd.DataFrame, fit_nu_min: float, tol: float):
     return (PASS if abs(slope - PREDICTED_SLOPE) <= tol else FAIL), text
 
 
-def patch_check(rc: pd.DataFrame):
-    """λ_h = λ and u_h = u to :data:`~.face_study_claims.PATCH_RTOL` on every pair (the membranes' rule)."""
-    err = np.maximum(rc.lambda_max_rel_error.to_numpy(float), rc.u_max_rel_error.to_numpy(float))
-    err = np.where(np.isfinite(err), err, np.inf)
-    verdict = PASS if np.all(err <= PATCH_RTOL) else FAIL if np.any(err >= PATCH_FAIL_RTOL) else INCONCLUSIVE
-    pairs = " ".join(f"{a}:{b}" for a, b in zip(rc.N1, rc.N2))
-    return verdict, (f"max |λ_h − λ|/λ = {rc.lambda_max_rel_error.max():.3g}, max |u_h − u|/δ = "
-                     f"{rc.u_max_rel_error.max():.3g} on {pairs} (pass <= {PATCH_RTOL:g}, fail >= "
-                     f"{PATCH_FAIL_RTOL:g}); kernel dims {sorted(set(rc.kernel_dim.astype(int).tolist()))}")
-
-
 def face_elastic_claims(beta: pd.DataFrame, patch: pd.DataFrame | None, cfg: dict, fe: dict, interfaces: dict,
                         membranes: pd.DataFrame | None = None) -> pd.DataFrame:
     """Every claim of the elastic face stage.
@@ -197,6 +186,6 @@ def face_elastic_claims(beta: pd.DataFrame, patch: pd.DataFrame | None, cfg: dic
             pairs = sorted({(int(a), int(b)) for a, b in zip(rc.N1, rc.N2)})
             out.append(row(claim_id("patch", case, k, element), REF,
                            f"elastic face patch test, {case}, k={k}, {element}: a uniaxial compression across "
-                           "non-matching faces is reproduced to round-off (λ_h = λ, u_h = u)", patch_check(rc),
+                           "non-matching faces is reproduced to round-off (λ_h = λ, u_h = u)", patch_verdict(rc),
                            predicted=patch_prediction(spec, k, interfaces[element], pairs)))
     return pd.DataFrame(out, columns=COLUMNS)

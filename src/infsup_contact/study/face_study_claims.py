@@ -96,7 +96,8 @@ def patch_prediction(spec, k: int, gamma, pairs) -> str:
     return PASS
 
 
-def _patch_verdict(rc: pd.DataFrame):
+def patch_verdict(rc: pd.DataFrame):
+    """λ_h = λ and u_h = u to :data:`PATCH_RTOL` on every pair of a patch table (any model's)."""
     err = np.maximum(rc.lambda_max_rel_error.to_numpy(float), rc.u_max_rel_error.to_numpy(float))
     err = np.where(np.isfinite(err), err, np.inf)
     verdict = PASS if np.all(err <= PATCH_RTOL) else FAIL if np.any(err >= PATCH_FAIL_RTOL) else INCONCLUSIVE
@@ -116,7 +117,7 @@ def patch_claims(patch: pd.DataFrame, interfaces: dict) -> list:
         pairs = sorted({(int(a), int(b)) for a, b in zip(rc.N1, rc.N2)})
         out.append(row(patch_claim_id(case, k, element), REF,
                        f"face patch test, {case}, k={k}, {element}: a uniform pressure across non-matching "
-                       "faces is reproduced to round-off (λ_h = λ, u_h = u)", _patch_verdict(rc),
+                       "faces is reproduced to round-off (λ_h = λ, u_h = u)", patch_verdict(rc),
                        predicted=patch_prediction(spec, k, interfaces[element], pairs)))
     return out
 

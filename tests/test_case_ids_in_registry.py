@@ -68,14 +68,7 @@ from infsup_contact.config_checks import ConfigError, check_config  # noqa: E402
 SCHEMA = ROOT / "workflow" / "schemas" / "config.schema.yaml"
 
 
-@pytest.fixture(autouse=True)
-def _registry_as_found():
-    """Loading a config registers its user spaces: leave the registry as the other tests expect."""
-    from infsup_contact.discretization.user_spaces import forget_since
-
-    before = set(SPACES)
-    yield
-    forget_since(before)
+pytestmark = pytest.mark.usefixtures("registry_as_found")  # tests/conftest.py
 
 
 @pytest.mark.parametrize("name", ["config.yaml", "ci.yaml"])

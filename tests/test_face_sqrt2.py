@@ -24,14 +24,7 @@ SCHEMA = ROOT / "workflow" / "schemas" / "config.schema.yaml"
 CONFIG = yaml.safe_load((ROOT / "config" / "config.yaml").read_text())
 
 
-@pytest.fixture(autouse=True)
-def _registry_as_found():
-    """Checking a config registers its user spaces: leave the registry as the other tests expect."""
-    from infsup_contact.discretization.user_spaces import forget_since
-
-    before = set(SPACES)
-    yield
-    forget_since(before)
+pytestmark = pytest.mark.usefixtures("registry_as_found")  # tests/conftest.py
 
 
 def test_sqrt2_pairs_follow_the_rule_and_share_no_interior_line():

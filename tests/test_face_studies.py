@@ -37,14 +37,7 @@ TINY = {"model": "membranes3d", "cases": ["T3", "R5.2", "T4", "T5"], "norms": ["
                           "fit_theta_max": 1.0}}
 
 
-@pytest.fixture(autouse=True)
-def _registry_as_found():
-    """Checking a config registers its user spaces: leave the registry as the other tests expect."""
-    from infsup_contact.discretization.user_spaces import forget_since
-
-    before = set(SPACES)
-    yield
-    forget_since(before)
+pytestmark = pytest.mark.usefixtures("registry_as_found")  # tests/conftest.py
 
 
 def run_job(tmp_path, study, fc=TINY):

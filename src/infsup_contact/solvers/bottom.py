@@ -87,14 +87,15 @@ class BottomSingular:
     iterations: int
 
 
-def largest_singular(W: sp.spmatrix) -> float:
-    """σ_max(W) by Lanczos on WᵀW (a deterministic start vector)."""
-    C = sp.csr_matrix(W.T @ W)
+def largest_singular(W: sp.spmatrix, gram: sp.spmatrix | None = None) -> float:
+    """σ_max(W) by Lanczos on WᵀW (``gram``, if already formed; a deterministic start vector)."""
+    C = sp.csr_matrix(W.T @ W if gram is None else gram)
     v0 = np.ones(C.shape[0])
     return float(np.sqrt(spla.eigsh(C, k=1, which="LA", tol=1e-10, v0=v0, return_eigenvectors=False)[0]))
 
 
-def bottom_singular(W, p: int, eta: float, smax: float | None = None) -> BottomSingular | None:
+def bottom_singular(W, p: int, eta: float, smax: float | None = None,
+                    gram: sp.spmatrix | None = None) -> BottomSingular | None:
     """The singular values of W (sparse, rows × m) below η, and the first above them.
 
     1. Block inverse subspace iteration with (WᵀW + δI)⁻¹, δ = :data:`SHIFT` σ_max², block p,
@@ -104,16 +105,25 @@ def bottom_singular(W, p: int, eta: float, smax: float | None = None) -> BottomS
        rate δ/σ_{p+1}², i.e. at once, the next one at σ_{d+1}²/σ_{p+1}² (the block's products
        are BLAS-3: cheaper than single-vector Lanczos at this size).
     2. The counted modes are refined by one corrected step (round-off of the solve).
-    Returns None when the count reaches p − :data:`GUARD` (the block is too small) or the
-    iteration does not settle in :data:`MAX_ITER` steps.
+    Where the count reaches p − :data:`GUARD` (the block is too small) or the iteration does
+    not settle in :data:`MAX_ITER` steps, the block doubles, on the same factorization; None
+    when it cannot grow any more. ``gram``: WᵀW (sparse), if already formed.
     """
     W = sp.csr_matrix(W)
     m = W.shape[1]
-    smax = largest_singular(W) if smax is None else smax
-    C = (W.T @ W).toarray()
+    gram = sp.csr_matrix(W.T @ W) if gram is None else gram
+    smax = largest_singular(W, gram) if smax is None else smax
+    C = gram.toarray()
     C[np.diag_indices(m)] += SHIFT * smax ** 2
-    F = sla.cho_factor(C, lower=True, check_finite=False)
-    del C
+    F = sla.cho_factor(C, lower=True, overwrite_a=True, check_finite=False)
+    while (res := _subspace_iteration(W, F, p, eta, smax)) is None and p < m - 1:
+        p = min(2 * p, m - 1)
+    return res
+
+
+def _subspace_iteration(W, F, p: int, eta: float, smax: float) -> BottomSingular | None:
+    """Step 1 and 2 of :func:`bottom_singular` with block p and F = Cholesky of WᵀW + δI."""
+    m = W.shape[1]
     Q = sla.qr(np.random.default_rng(SEED).standard_normal((m, p)), mode="economic")[0]
     counts, previous, it = [], None, 0
     for it in range(1, MAX_ITER + 1):
@@ -174,7 +184,7 @@ class BottomPencil:
     values : ndarray
         λ_{d+1} <= … (ascending; as many as Lanczos converged, up to the number asked).
     lam_max : float
-        λ_max of the pencil (Lanczos, relative accuracy ~1e-6).
+        λ_max of the pencil (Lanczos, relative accuracy :data:`LAM_MAX_RTOL`).
     """
 
     values: np.ndarray

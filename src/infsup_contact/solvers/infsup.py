@@ -101,19 +101,20 @@ N_BOTTOM = 1
 (``Spectrum.bottom`` holds the d kernel zeros and it); Lanczos needs 2.4× the products for 8."""
 
 
-def bottom_spectrum(S: np.ndarray, factor: np.ndarray, kernel: KernelDecision | None = None,
-                    Z: np.ndarray | None = None) -> Spectrum:
+def bottom_spectrum(S: np.ndarray, factor: np.ndarray, kernel: KernelDecision | None = None) -> Spectrum:
     """:func:`spectrum` without a dense eigensolver (dim M > :data:`.bottom.DENSE_MAX_M`).
 
-    The kernel (its dimension d from ``kernel``, its basis ``Z`` in multiplier coordinates) is
-    deflated and the :data:`N_BOTTOM` eigenvalues above it come from shift-invert Lanczos
-    (:func:`.bottom.bottom_pencil`); λ_max for the round-off level from Lanczos too. ``bottom``
-    holds the d kernel eigenvalues as exact zeros (a kernel of Bᵀ is one of S), then those.
-    Without ``kernel``, the smallest eigenvalue (β with v1 = 0), 0 when at round-off level.
+    The kernel (its dimension d and its basis ``kernel.vectors`` in multiplier coordinates, from
+    :func:`space_kernel` with ``iterative``) is deflated and the :data:`N_BOTTOM` eigenvalues
+    above it come from shift-invert Lanczos (:func:`.bottom.bottom_pencil`); λ_max for the
+    round-off level from Lanczos too. ``bottom`` holds the d kernel eigenvalues as exact zeros
+    (a kernel of Bᵀ is one of S), then those. Without ``kernel``, the smallest eigenvalue
+    (β with v1 = 0), 0 when at round-off level.
     """
     d = 0 if kernel is None else kernel.dim
+    Z = None if kernel is None else kernel.vectors
     if d and (Z is None or Z.shape[1] != d):
-        raise ValueError(f"a kernel of dimension {d} needs its basis Z (m × {d}) to be deflated")
+        raise ValueError(f"a kernel of dimension {d} needs its basis (kernel.vectors, m × {d}) to be deflated")
     res = bottom.bottom_pencil(S, factor, N_BOTTOM, Z if d else None)
     ev = np.concatenate([np.zeros(d), res.values])
     lam = float(res.values[0])
@@ -223,7 +224,7 @@ def beta_rows_all(family, k, n1, n2, cases=None, multiplier_meshes=("omega2",), 
             iterative = space.dim > bottom.DENSE_MAX_M
             kernel = space_kernel(couplings, sides, space, k, structural,
                                   grams["L2"][0] if "L2" in grams else None, iterative=iterative)
-            solve = _bottom_route(kernel) if iterative else spectrum
+            solve = bottom_spectrum if iterative else spectrum
             terms = interface_terms(couplings, sides)
             factors = {norm: gram_factor(G) for norm, (G, _) in grams.items()}
             # sup over (0, v2) only, (5.10): B_2 X_2 B_2ᵀ / c2, so β(v1 = 0) = β at c2 = 1 / sqrt(c2)
@@ -280,14 +281,6 @@ LONGER_RULE = 6
 LONGER_RULE_LARGE = 2
 """The same above dim M = :data:`.bottom.DENSE_MAX_M` (one point more, 16 instead of 36 points
 per cell at k = s = 2: still exact, so W − W' is still round-off only; half the cost)."""
-
-
-def _bottom_route(kernel: KernelDecision):
-    """:func:`bottom_spectrum` with the call signature of :func:`spectrum`, deflating the
-    kernel basis of ``kernel`` (from :func:`space_kernel` with ``iterative``)."""
-    def solve(S, factor, kernel=None):
-        return bottom_spectrum(S, factor, kernel, None if kernel is None else kernel.vectors)
-    return solve
 
 
 def saddle_point_beta(A: sp.spmatrix, B: np.ndarray, G: np.ndarray) -> float:

@@ -175,11 +175,10 @@ def bottom_kernel(W, proven: int = 0, entry_error: float = 0.0) -> KernelDecisio
     """:func:`coupling_kernel` for W too large for a dense SVD (dim M > :data:`.bottom.DENSE_MAX_M`):
     the same η, the same count and the same margin, from the bottom singular values only.
 
-    1. The singular values <= η and their right vectors by block inverse subspace iteration,
-       then σ_{d+1} by Lanczos on the complement (:func:`.bottom.bottom_singular`; block
-       p = proven + :data:`BLOCK_EXTRA`, doubled while too small). Each counted value is ‖W v‖
-       for an orthonormal block, an upper bound of σ_i(W): the d modes counted are certainly
-       <= η.
+    1. The singular values <= η, their right vectors and σ_{d+1} by block inverse subspace
+       iteration (:func:`.bottom.bottom_singular`; block p = proven + :data:`BLOCK_EXTRA`,
+       doubled while too small, on one factorization). Each counted value is ‖W v‖ for an
+       orthonormal block, an upper bound of σ_i(W): the d modes counted are certainly <= η.
     2. Nothing was missed below σ_{d+1}: the inertia of WᵀW − τI at τ = σ_{d+1}²/2 must count
        exactly d eigenvalues below τ (:func:`.bottom.count_below`).
     Where either step fails (a count that differs, proven modes above η, τ within
@@ -189,15 +188,14 @@ def bottom_kernel(W, proven: int = 0, entry_error: float = 0.0) -> KernelDecisio
     W = sp.csr_matrix(W)
     rows, m = W.shape
     proven = int(max(proven, m - rows, 0))
-    smax = bottom.largest_singular(W)
+    gram = sp.csr_matrix(W.T @ W)
+    smax = bottom.largest_singular(W, gram)
     tol = max(rows, m) * np.finfo(float).eps * smax + 2.0 * float(entry_error)
-    p = min(proven + BLOCK_EXTRA, m - 1)
-    while (res := bottom.bottom_singular(W, p, tol, smax)) is None and p < m - 1:
-        p = min(2 * p, m - 1)
+    res = bottom.bottom_singular(W, min(proven + BLOCK_EXTRA, m - 1), tol, smax, gram)
     tau = 0.0 if res is None else 0.5 * res.above ** 2
     if res is None or res.count < proven or res.above <= tol or \
             tau <= CERTIFY_FLOOR * max(rows, m) * np.finfo(float).eps * smax ** 2 or \
-            bottom.count_below((W.T @ W).toarray(), tau) != res.count:
+            bottom.count_below(gram.toarray(), tau) != res.count:
         return coupling_kernel(W.toarray(), proven, entry_error, vectors=True)
     d = res.count
     s = np.concatenate([res.values[:d], [res.above, smax]])

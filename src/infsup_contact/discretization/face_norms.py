@@ -22,10 +22,19 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import InputError
+from .exponential_sum import inverse_sqrt
 from .norms import N_MAX_CAP, _norm2, extrapolate, gram_by_norm, gram_l2, sine_coefficients
 
 #: Rows of the weight matrix W[m, n] = 1/(π√(m² + n²)) handled at once (memory ~ chunk · n_max).
 _CHUNK = 512
+EXP_SUM_MIN_DIM = 1500
+"""dim M above which :func:`partial_gram` takes the weight as an exponential sum
+(:mod:`.exponential_sum`): n_max · r (dim M^x² + dim M^y²) + r (dim M)² operations with r ≈ 260
+terms instead of n_max² dim M^y² + n_max (dim M)²; the same as :data:`.bottom.DENSE_MAX_M`, so
+the default DAG's Grams (all below it) stay the direct sums, bit for bit."""
+EXP_SUM_RTOL = 1e-13
+"""Relative accuracy of the exponential sum's weights: every eigenvalue of a pencil with the Gram
+moves by at most this factor (Loewner order), far below the series' own ``rtol``."""
 
 
 def gram_l2_face(space) -> np.ndarray:
@@ -51,13 +60,28 @@ def partial_gram(space, n_max: int, aspect: float = 1.0) -> np.ndarray:
     dx, dy = cx.shape[0], cy.shape[0]
     A = (cx[:, None, :] * cx[None, :, :]).reshape(dx * dx, n_max)
     B = (cy[:, None, :] * cy[None, :, :]).reshape(dy * dy, n_max)
-    flat = np.zeros((dx * dx, dy * dy))
-    for start in range(0, n_max, _CHUNK):
-        m = n[start:start + _CHUNK]
-        W = aspect / (np.pi * np.sqrt((m[:, None] / aspect) ** 2 + n[None, :] ** 2))
-        flat += A[:, start:start + _CHUNK] @ (W @ B.T)
-    G = flat.reshape(dx, dx, dy, dy).transpose(0, 2, 1, 3).reshape(dx * dy, dx * dy)
-    return 0.5 * (G + G.T)
+    if dx * dy > EXP_SUM_MIN_DIM:
+        flat = _separable_sum(A, B, n, aspect)
+    else:
+        flat = np.zeros((dx * dx, dy * dy))
+        for start in range(0, n_max, _CHUNK):
+            m = n[start:start + _CHUNK]
+            W = aspect / (np.pi * np.sqrt((m[:, None] / aspect) ** 2 + n[None, :] ** 2))
+            flat += A[:, start:start + _CHUNK] @ (W @ B.T)
+    G = flat.reshape(dx, dx, dy, dy).transpose(0, 2, 1, 3).reshape(dx * dy, dx * dy) * 0.5
+    G += G.T  # 0.5 (G + Gᵀ) bit for bit (halving is exact), one temporary fewer
+    return G
+
+
+def _separable_sum(A: np.ndarray, B: np.ndarray, n: np.ndarray, aspect: float) -> np.ndarray:
+    """A W Bᵀ for W[m, n] = a / (π√((m/a)² + n²)) written as Σ_j w_j e^{−a_j (m/a)²} e^{−a_j n²}
+    (:func:`.exponential_sum.inverse_sqrt`, relative accuracy :data:`EXP_SUM_RTOL`):
+    (A E_x) diag(a w / π) (B E_y)ᵀ, never forming W."""
+    x_lo, x_hi = (1.0 / aspect) ** 2 + 1.0, (n[-1] / aspect) ** 2 + n[-1] ** 2
+    expo = inverse_sqrt(min(x_lo, x_hi), max(x_lo, x_hi), EXP_SUM_RTOL)
+    Ex = np.exp(-np.multiply.outer((n / aspect) ** 2, expo.rates))
+    Ey = np.exp(-np.multiply.outer(n ** 2, expo.rates))
+    return ((A @ Ex) * (aspect * expo.weights / np.pi)) @ (B @ Ey).T
 
 
 def smooth_tail(space) -> bool:

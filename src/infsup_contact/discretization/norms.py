@@ -310,8 +310,17 @@ def _norm2(A: np.ndarray) -> float:
     if len(A) <= NORM2_DENSE_MAX:
         return float(np.max(np.abs(np.linalg.eigvalsh(A))))
     start = np.ones(len(A)) / np.sqrt(len(A))  # a fixed start: the estimate is reproducible
-    return float(abs(spla.eigsh(A, k=1, which="LM", tol=1e-8, v0=start,
+    ncv = NORM2_SHORT_KRYLOV if len(A) > NORM2_SHORT_KRYLOV_MIN else None
+    return float(abs(spla.eigsh(A, k=1, which="LM", tol=1e-8, v0=start, ncv=ncv,
                                 return_eigenvectors=False)[0]))
+
+
+NORM2_SHORT_KRYLOV_MIN = 1500
+"""Order above which :func:`_norm2` restarts Lanczos with :data:`NORM2_SHORT_KRYLOV` vectors
+instead of ARPACK's default 20: the top of a Gram matrix (or of a Richardson step) is well
+separated, 11 products reach the same 1e-8 where the default takes 21 (a dense product is 12 ms
+at order 4,225); the default DAG's Grams, all below, keep their digits."""
+NORM2_SHORT_KRYLOV = 10
 
 
 # ----------------------------------------------------------------------- dispatch

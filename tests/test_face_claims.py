@@ -140,6 +140,9 @@ def _ci():
     (lambda f: f.update(norms=["H", "H1"]), "face.norms"),
     (lambda f: f.update(max_N={"prism": 8}), "face.max_N.prism"),
     (lambda f: f.update(max_N={"hex": 4}), "face.max_N.hex"),
+    (lambda f: f.update(l2_max_N={"hex": 12}), "face.l2_max_N.hex"),                 # no max_N to exceed
+    (lambda f: f.update(max_N={"hex": 8}, l2_max_N={"hex": 6}), "face.l2_max_N.hex"),  # below max_N
+    (lambda f: f.update(max_N={"hex": 8}, l2_max_N={"hex": 10}, norms=["H"]), "face.l2_max_N.hex"),
 ])
 def test_bad_face_key_is_named(mutate, key):
     from infsup_contact.config_checks import ConfigError, check_config
@@ -182,6 +185,16 @@ def test_max_n_trims_the_pairs_of_its_element_only():
     fc = {"N": [4, 5, 6, 8, 12], "nonmatching": [[4, 5], [8, 9]], "max_N": {"tet": 6}}
     assert face_pairs(fc, "tet") == [(4, 4), (5, 5), (6, 6), (4, 5)]
     assert face_pairs(fc, "hex") == [(4, 4), (5, 5), (6, 6), (8, 8), (12, 12), (4, 5), (8, 9)]
+
+
+def test_l2_max_n_adds_the_matching_meshes_above_max_n_of_its_element_only():
+    from infsup_contact.config_face import face_pairs, l2_only_sizes
+
+    fc = {"N": [4, 5, 6, 7, 8, 10, 12], "nonmatching": [[4, 5], [8, 9]], "max_N": {"tet": 6},
+          "l2_max_N": {"tet": 10}}
+    assert l2_only_sizes(fc, "tet") == [7, 8, 10]
+    assert l2_only_sizes(fc, "hex") == []
+    assert not set((n, n) for n in l2_only_sizes(fc, "tet")) & set(face_pairs(fc, "tet"))  # no row twice
 
 
 def test_quadrilateral_element_spaces_are_not_built_on_triangles():

@@ -44,6 +44,7 @@ def check_face(cfg) -> None:
         if sum(n <= top for n in fc["N"]) < 3:
             raise ConfigError(f"face.max_N.{element}", "keeps fewer than 3 matching meshes of face.N (a slope "
                               "fit needs 3)", got=top, allowed=f">= {sorted(fc['N'])[2]}")
+    _check_l2_max_n(fc)
     for i, pair in enumerate(fc["nonmatching"]):
         if pair[0] == pair[1]:
             raise ConfigError(f"face.nonmatching[{i}]", "a non-matching pair needs N1 != N2", got=pair,
@@ -107,6 +108,31 @@ def family_pairs(fc, element: str) -> list:
     return [(int(n1), FAMILY_RULES[name][0](int(n1)))
             for name, per_element in (fc.get("nonmatching_families") or {}).items()
             for n1 in per_element.get(element, ())]
+
+
+def _check_l2_max_n(fc) -> None:
+    """``face.l2_max_N``: an element with a ``face.max_N``, not below it, and L2 among the norms."""
+    caps = fc.get("max_N") or {}
+    for element, top in (fc.get("l2_max_N") or {}).items():
+        key = f"face.l2_max_N.{element}"
+        if element not in caps:
+            raise ConfigError(key, "an element with a face.max_N (without one every N gets both norms)",
+                              got=element, allowed=", ".join(caps) or "none: face.max_N is empty")
+        if top < caps[element]:
+            raise ConfigError(key, f"at least face.max_N.{element}", got=top, allowed=f">= {caps[element]}")
+        if "L2" not in fc["norms"]:
+            raise ConfigError(key, "needs L2 in face.norms", got=fc["norms"], allowed="face.norms with L2")
+
+
+def l2_only_sizes(fc, element: str) -> list:
+    """The matching N of ``face.N`` above the element's ``face.max_N`` and up to its
+    ``face.l2_max_N``: they get L²(Γ) rows only. The L² Gram is exact (a mass matrix); what
+    ``max_N`` caps is the H^{-1/2}_00 Gram of the triangles (a double series per triangle), so the
+    L² slope of Remark 3.1 gets finer meshes than the H rows can afford."""
+    top, l2_top = (fc.get("max_N") or {}).get(element), (fc.get("l2_max_N") or {}).get(element)
+    if top is None or l2_top is None:
+        return []
+    return [int(n) for n in fc["N"] if top < n <= l2_top]
 
 
 def face_pairs(fc, element: str) -> list:

@@ -7,7 +7,7 @@ from snakemake.utils import validate
 
 from infsup_contact import resources
 from infsup_contact.config_checks import ConfigError, check_config, speed_accuracy_scene
-from infsup_contact.config_face import face_pairs
+from infsup_contact.config_face import face_pairs, l2_only_sizes
 from infsup_contact.config_yaml import check_config_files
 from infsup_contact.config_memory import check_job_memory, memory_notes
 from infsup_contact.discretization.series import seeds, series_of_pairs
@@ -106,6 +106,9 @@ def reference_mem_mb(wildcards):
 FACE = config.get("face")
 FACE_BENCH = ["results/benchmarks/face.csv"] if config["benchmarks"].get("face_N") else []
 FACE_BETA = [f"results/tables/face/beta_{e}_k{k}.csv" for e in FACE["elements"] for k in FACE["k"]] if FACE else []
+# the L²-only rows above face.max_N (face.l2_max_N; rule face_l2_job), where an element has them
+FACE_BETA += [f"results/tables/face/l2_{e}_k{k}.csv" for e in FACE["elements"] for k in FACE["k"]
+              if l2_only_sizes(FACE, e)] if FACE else []
 # the face studies (rules/face_studies.smk): their tables, claims and paper tables
 FACE_STUDIES = {s: f"results/face/{s}.csv" for s in ("patch", "alpha", "edge_dropping")} if FACE else {}
 FACE_CLAIMS = ["results/tables/face_claims.csv", "results/tables/face_study_claims.csv"] if FACE else []

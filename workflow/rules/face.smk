@@ -7,11 +7,14 @@
 # FACE, FACE_BETA, FACE_CLAIMS, FACE_PAPER: common.smk (the claims and paper stages list them too)
 
 
-def face_mem_mb(wildcards):
+def face_mem_mb(wildcards, l2_only=False):
     """mem_mb of a face job: the 3D β estimate of its largest pair (resources.face_beta_estimate, +25 %)."""
-    pairs = face_pairs(FACE, wildcards.element)
+    if l2_only:
+        pairs, norms = [(n, n) for n in l2_only_sizes(FACE, wildcards.element)], ("L2",)
+    else:
+        pairs, norms = face_pairs(FACE, wildcards.element), tuple(FACE["norms"])
     return max(resources.job_mem_mb(resources.beta_estimate("structured", int(wildcards.k), n1, n2, "omega2",
-                                                            tuple(FACE["norms"]), dim=3)) for n1, n2 in pairs)
+                                                            norms, dim=3)) for n1, n2 in pairs)
 
 
 rule face_beta_job:
@@ -32,6 +35,31 @@ rule face_beta_job:
         "results/benchmarks/rules/face_beta_job/{element}_k{k}.tsv"
     log:
         "results/logs/face/beta_{element}_k{k}.log",
+    script:
+        "../scripts/face_beta_job.py"
+
+
+rule face_l2_job:
+    # the matching N above face.max_N up to face.l2_max_N, L²(Γ) rows alone (config_face.l2_only_sizes):
+    # a job of its own, so it runs beside the element's main job
+    output:
+        "results/tables/face/l2_{element}_k{k}.csv",
+    input:
+        PACKAGE_SOURCES,
+    params:
+        fc=lambda wc: config["face"],
+        l2_only=True,
+    wildcard_constraints:
+        element="[a-z0-9]+",
+        k="[1-4]",
+    threads: 1
+    resources:
+        mem_mb=lambda wc: face_mem_mb(wc, l2_only=True) + (0 if workflow.local_exec else 500),
+        runtime=10,
+    benchmark:
+        "results/benchmarks/rules/face_l2_job/{element}_k{k}.tsv"
+    log:
+        "results/logs/face/l2_{element}_k{k}.log",
     script:
         "../scripts/face_beta_job.py"
 

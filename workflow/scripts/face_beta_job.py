@@ -1,7 +1,9 @@
 """One face β_h job (rule face_beta_job): every matching N and non-matching pair of one
 (element, k) of the 3D model (config ``face``), every case of ``face.cases`` defined for k,
 both norms, G_h = trace of Ω2, through the one β batch path of every model
-(:func:`infsup_contact.study.beta_batches.beta_batch_rows`)."""
+(:func:`infsup_contact.study.beta_batches.beta_batch_rows`). With ``params.l2_only`` (rule
+face_l2_job): the matching N of ``face.l2_max_N`` above ``face.max_N``, the L²(Γ) norm alone
+(:func:`infsup_contact.config_face.l2_only_sizes`)."""
 import sys
 
 sys.path.insert(0, "workflow/scripts")
@@ -13,7 +15,7 @@ register_user_spaces(snakemake.config)  # noqa: F821
 
 import time  # noqa: E402
 
-from infsup_contact.config_face import face_pairs  # noqa: E402
+from infsup_contact.config_face import face_pairs, l2_only_sizes  # noqa: E402
 from infsup_contact.discretization.registry import SPACES, ids_valid_for  # noqa: E402
 from infsup_contact.io import write_csv_atomic  # noqa: E402
 from infsup_contact.study.beta_batches import beta_batch_rows  # noqa: E402
@@ -21,12 +23,14 @@ from infsup_contact.study.face_claims import element_interfaces  # noqa: E402
 
 wc, fc = snakemake.wildcards, snakemake.params.fc  # noqa: F821
 k = int(wc.k)
-pairs = face_pairs(fc, wc.element)
+l2_only = bool(snakemake.params.get("l2_only", False))  # noqa: F821
+pairs = [(n, n) for n in l2_only_sizes(fc, wc.element)] if l2_only else face_pairs(fc, wc.element)
+norms = ("L2",) if l2_only else tuple(fc["norms"])
 gamma = element_interfaces(fc["model"], [wc.element])[wc.element]
 cases = [c for c in ids_valid_for(k, fc["cases"]) if gamma.builds(SPACES[c])]  # e.g. QUAD9 spaces: rectangles
 t0 = time.perf_counter()
 frame = beta_batch_rows(fc["model"], "structured", k, pairs, cases, ("omega2",),
-                        norms=tuple(fc["norms"]), element=wc.element)
+                        norms=norms, element=wc.element)
 frame = frame.drop(columns=[c for c in frame.columns if c.startswith("t_")])  # timings: benchmark tree
 frame.insert(0, "element", wc.element)
 frame.insert(0, "model", fc["model"])

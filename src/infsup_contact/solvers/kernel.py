@@ -64,7 +64,8 @@ KERNEL_CRITERION = (
     "kernel_detected = kernel_dim - proven; kernel_margin_decades = distance of the decision from "
     "eta in decades; kernel_decision = close when below 1 decade (claims resting on it are "
     "INCONCLUSIVE), else clear; above dim M = 1500 the bottom singular values come from block inverse "
-    "iteration on W^T W, measured as ||W v|| and certified by an inertia count (solvers/bottom.py)")
+    "iteration on W^T W, measured as ||W v|| and certified by a Cholesky factorization of "
+    "W^T W - tau I + smax^2 Z Z^T (Weyl; solvers/bottom.py)")
 """The rule of :func:`coupling_kernel`, as stated in ``infsup-contact beta --help`` and the README."""
 CLEAR, CLOSE = "clear", "close"
 
@@ -167,7 +168,7 @@ def _decision(s, proven, tol, numerical, s_max, vectors=None) -> KernelDecision:
 BLOCK_EXTRA = 32
 """Block size of :func:`bottom_kernel` beyond the proven kernel (doubled while too small)."""
 CERTIFY_FLOOR = 1e3
-"""The inertia count of :func:`bottom_kernel` is trusted where τ exceeds this many times the
+"""The Cholesky certificate of :func:`bottom_kernel` is trusted where τ exceeds this many times the
 round-off of WᵀW, max(rows, m) ε σ_max²; below it the dense SVD decides."""
 
 
@@ -179,8 +180,10 @@ def bottom_kernel(W, proven: int = 0, entry_error: float = 0.0) -> KernelDecisio
        iteration (:func:`.bottom.bottom_singular`; block p = proven + :data:`BLOCK_EXTRA`,
        doubled while too small, on one factorization). Each counted value is ‖W v‖ for an
        orthonormal block, an upper bound of σ_i(W): the d modes counted are certainly <= η.
-    2. Nothing was missed below σ_{d+1}: the inertia of WᵀW − τI at τ = σ_{d+1}²/2 must count
-       exactly d eigenvalues below τ (:func:`.bottom.count_below`).
+    2. Nothing was missed below σ_{d+1}: WᵀW has at most d eigenvalues below τ = σ_{d+1}²/2,
+       certified by one Cholesky factorization of WᵀW − τI + σ_max² Z Zᵀ with the d counted
+       vectors Z (:func:`.bottom.at_most_below`, Weyl's inequality); with the d Ritz values
+       <= η < τ, exactly d.
     Where either step fails (a count that differs, proven modes above η, τ within
     :data:`CERTIFY_FLOOR` of WᵀW's round-off) the dense SVD decides, vectors included.
     ``singular`` holds the d counted values, σ_{d+1} and σ_max; ``vectors`` the d kernel vectors.
@@ -195,7 +198,7 @@ def bottom_kernel(W, proven: int = 0, entry_error: float = 0.0) -> KernelDecisio
     tau = 0.0 if res is None else 0.5 * res.above ** 2
     if res is None or res.count < proven or res.above <= tol or \
             tau <= CERTIFY_FLOOR * max(rows, m) * np.finfo(float).eps * smax ** 2 or \
-            bottom.count_below(gram.toarray(), tau) != res.count:
+            not bottom.at_most_below(gram.toarray(), tau, res.vectors[:, :res.count], smax ** 2):
         return coupling_kernel(W.toarray(), proven, entry_error, vectors=True)
     d = res.count
     s = np.concatenate([res.values[:d], [res.above, smax]])

@@ -21,6 +21,7 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
+from infsup_contact.systems import engine
 from infsup_contact.systems.engine import DENSE_MAX_M, choose_route, kernel_projector, level_spectrum
 from infsup_contact.systems.export import write_system
 from infsup_contact.systems.levels import system_rows
@@ -88,14 +89,16 @@ def test_declared_kernel_gives_beta_above_it(system):
     assert row["beta"] == row["smallest_nonzero"]
 
 
-def test_bottom_above_the_kernel_agrees_with_the_dense_pencil(system):
-    """All N_BOTTOM eigenvalues above the kernel, not only the first (the deflated operator
-    keeps the complement's spectrum)."""
+@pytest.mark.parametrize("n_above", [1, engine.N_BOTTOM])
+def test_bottom_above_the_kernel_agrees_with_the_dense_pencil(system, monkeypatch, n_above):
+    """Every eigenvalue computed above the kernel, not only the first (the deflated operator
+    keeps the complement's spectrum): d exact zeros, then λ_{d+1}, … as the dense pencil."""
     A, B, G, dense, _ = system
+    monkeypatch.setattr(engine, "N_ABOVE", n_above)
     lanczos = level_spectrum(A, B, G)
-    assert lanczos.route == "shift-invert" and len(lanczos.bottom) == len(dense.bottom)
+    assert lanczos.route == "shift-invert" and len(lanczos.bottom) == D + n_above
     assert np.all(lanczos.bottom[:D] == 0.0)
-    above, ref = lanczos.bottom[D:], dense.bottom[D:]
+    above, ref = lanczos.bottom[D:], dense.bottom[D:D + n_above]
     assert np.all(np.abs(above - ref) <= RTOL * ref)
 
 

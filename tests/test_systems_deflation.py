@@ -132,3 +132,14 @@ def test_dense_routes_take_no_kernel_basis():
     lanczos, ref = (level_spectrum(*small, route=r) for r in ("shift-invert", "gamma-dense"))
     assert lanczos.kernel.dim == ref.kernel.dim == 25
     assert abs(lanczos.smallest_nonzero - ref.smallest_nonzero) <= RTOL * ref.smallest_nonzero
+
+
+def test_a_one_dimensional_complement_and_an_all_kernel_b():
+    """Edge cases of the deflation: m − d = 1 (Lanczos has no room; the projected start vector
+    is the eigenvector) agrees with the dense route; B = 0 is all kernel (nothing factorized)."""
+    A, B, G = synthetic_system(nx=8, m0=1, d=5)
+    lanczos, ref = (level_spectrum(A, B, G.toarray(), route=r) for r in ("shift-invert", "solves-dense"))
+    assert lanczos.kernel.dim == ref.kernel.dim == 5 and len(lanczos.bottom) == 6
+    assert abs(lanczos.smallest_nonzero - ref.smallest_nonzero) <= RTOL * ref.smallest_nonzero
+    ev, _, _ = engine._shift_invert(A, sp.csr_matrix(B.shape), G, 1, 1.0, np.eye(B.shape[0]))
+    assert np.array_equal(ev, np.zeros(B.shape[0]))

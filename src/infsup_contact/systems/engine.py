@@ -229,6 +229,9 @@ def _shift_invert(A, B, G, n_values, smax2, Z=None):
     copy of θ = 1/δ in place of λ_{d+1} (README, "Certify a discretization from another code").
     """
     m = B.shape[0]
+    d = 0 if Z is None else Z.shape[1]
+    if d >= m:  # Bᵀ = 0: everything is kernel, nothing to factorize
+        return np.zeros(d), 0.0, {"factorize": 0.0, "eigen": 0.0, "residual": 0.0}
     Gs = sp.csc_matrix(G)
     delta = SHIFT * smax2
     t0 = time.perf_counter()
@@ -236,7 +239,6 @@ def _shift_invert(A, B, G, n_values, smax2, Z=None):
     lu = spla.splu(K, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0, options=dict(SymmetricMode=True))
     n = A.shape[0]
     rhs = np.zeros(n + m)
-    d = 0 if Z is None else Z.shape[1]
     project = kernel_projector(Z, Gs)
 
     def inv(r):
@@ -254,8 +256,6 @@ def _shift_invert(A, B, G, n_values, smax2, Z=None):
     t1 = time.perf_counter()
     k = min(n_values, m - d - 1)
     v0 = project(np.random.default_rng(SEED).standard_normal(m))  # seeded, in the complement of Z
-    if d >= m:
-        return np.zeros(d), 0.0, {"factorize": t1 - t0, "eigen": 0.0, "residual": 0.0}
     if k < 1:  # a one-dimensional complement: P v0 is its eigenvector (too small for Lanczos)
         x = v0[:, None]
     else:

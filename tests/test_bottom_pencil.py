@@ -116,3 +116,17 @@ def test_beta_v1_zero_between_routes(d, monkeypatch):
             assert large[norm] == 0.0 <= dense[norm] <= np.sqrt(160 * np.finfo(float).eps * top)
         else:
             assert large[norm] == pytest.approx(dense[norm], rel=1e-10)
+
+
+@pytest.mark.parametrize("order", ["C", "F"])
+def test_standard_form_and_lam_max(order):
+    """x ↦ L⁻¹ S L⁻ᵀ x with S in either memory order (symv on its lower triangle) equals the dense
+    product; λ_max within LAM_MAX_RTOL of eigh's (6 Lanczos vectors, ARPACK's own test)."""
+    S, G, _ = _pencil(150, 0, seed=30)
+    S = np.array(S, order=order)
+    L = np.tril(sla.cholesky(G, lower=True))
+    x = np.random.default_rng(1).standard_normal(150)
+    dense = np.linalg.solve(L, S @ np.linalg.solve(L.T, x))
+    np.testing.assert_allclose(bottom._standard_form(S, L).matvec(x), dense, rtol=0, atol=1e-12 * np.abs(dense).max())
+    top = sla.eigh(S, G, eigvals_only=True)[-1]
+    assert abs(bottom.lam_max(S, L) - top) <= bottom.LAM_MAX_RTOL * top

@@ -200,10 +200,12 @@ class BottomPencil:
 def _standard_form(S: np.ndarray, L: np.ndarray) -> spla.LinearOperator:
     """x ↦ L⁻¹ S L⁻ᵀ x, the standard form of (S, G = L Lᵀ) (S symmetric: its lower triangle)."""
     m = S.shape[0]
+    # symv takes Fortran order: a C-ordered S is passed as Sᵀ (no copy), whose upper triangle it is
+    A, lower = (S.T, 0) if S.flags.c_contiguous and not S.flags.f_contiguous else (np.asfortranarray(S), 1)
 
     def mv(x):
         y = sla.solve_triangular(L, np.ravel(x), lower=True, trans="T", check_finite=False)
-        return sla.solve_triangular(L, blas.dsymv(1.0, S, y, lower=1), lower=True, check_finite=False)
+        return sla.solve_triangular(L, blas.dsymv(1.0, A, y, lower=lower), lower=True, check_finite=False)
 
     return spla.LinearOperator((m, m), matvec=mv, dtype=float)
 

@@ -119,6 +119,10 @@ def test_face_rows_agree_between_routes(case, monkeypatch):
             assert b["kernel_margin_decades"] >= a["kernel_margin_decades"] - 0.05
         assert b["beta"] == pytest.approx(a["beta"], rel=1e-9, abs=1e-12)
         assert b["smallest_nonzero"] == pytest.approx(a["smallest_nonzero"], rel=1e-7)
+        if a["kernel_dim"]:  # β(v1 = 0) <= β_h = 0: not computed above the gate, round-off below it
+            assert b["beta_v1_zero"] == 0.0 <= a["beta_v1_zero"] < 1e-6
+        else:
+            assert b["beta_v1_zero"] == pytest.approx(a["beta_v1_zero"], rel=1e-9)
 
 
 def test_the_shorter_entry_rule_moves_the_margin_little(monkeypatch):

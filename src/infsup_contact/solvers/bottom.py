@@ -22,8 +22,8 @@ factorizations (BLAS-3, m³/3 each):
 :func:`bottom_pencil`
     the smallest eigenvalues of (S, G) above a known kernel Z: Z is moved to the top of the
     spectrum (S + γ G Z (ZᵀGZ)⁻¹ ZᵀG, γ = 2 λ_max), then Lanczos on the explicit inverse of
-    the standard form (shift-invert at 0: a Cholesky factorization, a triangular solve and a
-    rank-m product, all BLAS-3).
+    the standard form (shift-invert at 0: a Cholesky factorization, a column-blocked triangular
+    solve and a triangular product, all BLAS-3; :func:`inverse_standard_form`).
 
 Every start vector comes from a seeded generator (the same on every machine); what differs
 between BLAS kernels is round-off only.
@@ -50,10 +50,16 @@ MAX_ITER = 30
 """Most steps of that iteration."""
 LAM_MAX_RTOL = 1e-2
 """Relative accuracy of λ_max in :func:`bottom_pencil` (``gap_over_roundoff`` to 2 digits)."""
+LAM_MAX_NCV = 6
+"""Lanczos vectors of :func:`lam_max`: ARPACK tests convergence (to :data:`LAM_MAX_RTOL`) after
+that many steps, and restarts if it failed. The top of the face pencils is well separated at
+this accuracy: 6 steps reach ~5e-4 where the default 20 reached ~2e-4 (k = 2, N = 24)."""
+SOLVE_BLOCK = 512
+"""Columns per block of the triangular solve K = R⁻¹ L in :func:`inverse_standard_form`."""
 VALUE_RTOL = 1e-3
 """Relative change at which the first value above the counted ones has settled in
 :func:`bottom_singular` (a margin in decades to ~1e-3, where a decision needs 1 decade; the
-inertia certificate at σ_{d+1}²/2 needs less; 1e-6 took twice the steps)."""
+Cholesky certificate at σ_{d+1}²/2 needs less; 1e-6 took twice the steps)."""
 GUARD = 4
 """Ritz values at the top of the block that may not be counted as zero (else the block grows)."""
 SEED = 20010601
@@ -211,51 +217,88 @@ class BottomPencil:
 
 
 def _standard_form(S: np.ndarray, L: np.ndarray) -> spla.LinearOperator:
-    """x ↦ L⁻¹ S L⁻ᵀ x, the standard form of (S, G = L Lᵀ)."""
+    """x ↦ L⁻¹ S L⁻ᵀ x, the standard form of (S, G = L Lᵀ) (S symmetric: its lower triangle)."""
     m = S.shape[0]
+    # symv takes Fortran order: a C-ordered S is passed as Sᵀ (no copy), whose upper triangle it is
+    A, lower = (S.T, 0) if S.flags.c_contiguous and not S.flags.f_contiguous else (np.asfortranarray(S), 1)
 
     def mv(x):
-        y = sla.solve_triangular(L, x, lower=True, trans="T", check_finite=False)
-        return sla.solve_triangular(L, S @ y, lower=True, check_finite=False)
+        y = sla.solve_triangular(L, np.ravel(x), lower=True, trans="T", check_finite=False)
+        return sla.solve_triangular(L, blas.dsymv(1.0, A, y, lower=lower), lower=True, check_finite=False)
 
-    return spla.LinearOperator((m, m), matvec=mv, matmat=mv, dtype=float)
+    return spla.LinearOperator((m, m), matvec=mv, dtype=float)
 
 
 def lam_max(S: np.ndarray, L: np.ndarray) -> float:
     """λ_max of (S, L Lᵀ) by Lanczos (a deterministic start vector; relative accuracy
     :data:`LAM_MAX_RTOL`: the top of an H^{-1/2} pencil is clustered, and a round-off level and
-    the deflation's γ need no more)."""
-    v0 = np.ones(S.shape[0])
+    the deflation's γ need no more; :data:`LAM_MAX_NCV` vectors)."""
+    m = S.shape[0]
+    v0 = np.ones(m)
     return float(spla.eigsh(_standard_form(S, L), k=1, which="LA", tol=LAM_MAX_RTOL, v0=v0,
-                            return_eigenvectors=False)[0])
+                            ncv=min(m, LAM_MAX_NCV), return_eigenvectors=False)[0])
 
 
-def bottom_pencil(S: np.ndarray, L: np.ndarray, n_values: int, Z: np.ndarray | None = None) -> BottomPencil:
+def definite_factor(S: np.ndarray) -> np.ndarray | None:
+    """Lower Cholesky factor of S (LAPACK potrf, the upper triangle zeroed), or None where S is
+    not numerically positive definite (potrf meets a non-positive pivot)."""
+    R, info = lapack.dpotrf(S, lower=1, clean=1)
+    return None if info else R
+
+
+def inverse_standard_form(R: np.ndarray, L: np.ndarray) -> np.ndarray:
+    """Kᵀ K = Lᵀ (R Rᵀ)⁻¹ L with K = R⁻¹ L, R and L lower triangular (its lower triangle, Fortran
+    order; the upper triangle holds zeros).
+
+    K is lower triangular (a product of two): its columns j:j+b vanish above row j, and
+    K[j:, j:j+b] = R[j:, j:]⁻¹ L[j:, j:j+b] needs only the trailing part of R, so the blocked
+    solve costs m³/3 flops instead of the m³ of one solve with m right-hand sides; Kᵀ K of a
+    triangular K is LAPACK lauum (m³/3, where syrk costs m³). Both agree with the plain route to
+    round-off (tests/test_bottom.py)."""
+    m = R.shape[0]
+    K = np.zeros((m, m), order="F")
+    for j in range(0, m, SOLVE_BLOCK):
+        e = min(j + SOLVE_BLOCK, m)
+        K[j:, j:e] = sla.solve_triangular(R[j:, j:], L[j:, j:e], lower=True, check_finite=False)
+    C, info = lapack.dlauum(K, lower=1, overwrite_c=1)
+    if info:
+        raise np.linalg.LinAlgError(f"lauum failed (info {info})")
+    return C
+
+
+def bottom_pencil(S: np.ndarray, L: np.ndarray, n_values: int, Z: np.ndarray | None = None,
+                  s_factor: np.ndarray | None = None) -> BottomPencil:
     """The n_values smallest eigenvalues of S x = λ G x, G = L Lᵀ (L lower: what lies above its
     diagonal is ignored), above the kernel span Z.
 
     ``Z`` (m × d, S Z ≈ 0) is moved to λ = γ = 2 λ_max: the G-orthogonal complement of Z is
     invariant, so S' = S + γ G Z (ZᵀGZ)⁻¹ ZᵀG keeps the pencil's other eigenvalues, and it is
     positive definite. With S' = R Rᵀ (Cholesky) and K = R⁻¹ L, the largest eigenvalues θ of
-    the explicit SPD matrix Kᵀ K = Lᵀ S'⁻¹ L are 1/λ (shift-invert at 0); Lanczos on it costs one
-    symmetric matrix-vector product per step. Without Z, S must be positive definite up to
-    round-off; a singular S gives λ ≈ 0 (its round-off), as the dense route does.
+    the explicit SPD matrix Kᵀ K = Lᵀ S'⁻¹ L (:func:`inverse_standard_form`) are 1/λ
+    (shift-invert at 0); Lanczos on it costs one symmetric matrix-vector product per step.
+
+    Without Z, S' = S itself where it is numerically positive definite (its factor
+    ``s_factor`` = :func:`definite_factor` of S, if known: the pencils of one S with several
+    Gram matrices share it); where potrf fails (a singular S), a floor 1e-14 λ_max diag(G) is
+    added and λ ≈ 0 (its round-off), as the dense route gives.
     """
     m = S.shape[0]
     L = np.tril(L)  # a potrf factor may hold G's upper triangle above its diagonal (clean=0)
     top = lam_max(S, L)
-    Sp = np.array(S, float)
-    if Z is not None and Z.shape[1]:
-        LtZ = L.T @ Z
-        GZ = L @ LtZ
-        Sp += 2.0 * top * GZ @ sla.solve(LtZ.T @ LtZ, GZ.T, assume_a="pos", check_finite=False)
-    # a floor keeps the factorization defined where S is singular (no Z given): λ ≈ 0 there anyway
-    Sp[np.diag_indices(m)] += 1e-14 * top * np.einsum("ij,ij->i", L, L)
-    R = sla.cholesky(Sp, lower=True, overwrite_a=True, check_finite=False)
-    K = sla.solve_triangular(R, L, lower=True, overwrite_b=False, check_finite=False)
+    deflate = Z is not None and Z.shape[1] > 0
+    R = None if deflate else (definite_factor(S) if s_factor is None else s_factor)
+    if R is None:
+        Sp = np.array(S, float)
+        if deflate:
+            LtZ = L.T @ Z
+            GZ = L @ LtZ
+            Sp += 2.0 * top * GZ @ sla.solve(LtZ.T @ LtZ, GZ.T, assume_a="pos", check_finite=False)
+        # a floor keeps the factorization defined where S is singular (no Z given): λ ≈ 0 there anyway
+        Sp[np.diag_indices(m)] += 1e-14 * top * np.einsum("ij,ij->i", L, L)
+        R = sla.cholesky(Sp, lower=True, overwrite_a=True, check_finite=False)
+        del Sp
+    inverse = inverse_standard_form(R, L)
     del R
-    inverse = blas.dsyrk(1.0, K, trans=1, lower=1)  # Kᵀ K, lower triangle
-    del K
 
     def mv(x):
         return blas.dsymv(1.0, inverse, np.ravel(x), lower=1)

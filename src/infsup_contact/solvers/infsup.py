@@ -101,7 +101,8 @@ N_BOTTOM = 1
 (``Spectrum.bottom`` holds the d kernel zeros and it); Lanczos needs 2.4× the products for 8."""
 
 
-def bottom_spectrum(S: np.ndarray, factor: np.ndarray, kernel: KernelDecision | None = None) -> Spectrum:
+def bottom_spectrum(S: np.ndarray, factor: np.ndarray, kernel: KernelDecision | None = None,
+                    s_factor: np.ndarray | None = None) -> Spectrum:
     """:func:`spectrum` without a dense eigensolver (dim M > :data:`.bottom.DENSE_MAX_M`).
 
     The kernel (its dimension d and its basis ``kernel.vectors`` in multiplier coordinates, from
@@ -109,13 +110,15 @@ def bottom_spectrum(S: np.ndarray, factor: np.ndarray, kernel: KernelDecision | 
     above it come from shift-invert Lanczos (:func:`.bottom.bottom_pencil`); λ_max for the
     round-off level from Lanczos too. ``bottom`` holds the d kernel eigenvalues as exact zeros
     (a kernel of Bᵀ is one of S), then those. Without ``kernel``, the smallest eigenvalue
-    (β with v1 = 0), 0 when at round-off level.
+    (β with v1 = 0), 0 when at round-off level. ``s_factor``: the Cholesky factor of S
+    (:func:`.bottom.definite_factor`) where no kernel is deflated, shared by the norms
+    (:func:`bottom_spectra`).
     """
     d = 0 if kernel is None else kernel.dim
     Z = None if kernel is None else kernel.vectors
     if d and (Z is None or Z.shape[1] != d):
         raise ValueError(f"a kernel of dimension {d} needs its basis (kernel.vectors, m × {d}) to be deflated")
-    res = bottom.bottom_pencil(S, factor, N_BOTTOM, Z if d else None)
+    res = bottom.bottom_pencil(S, factor, N_BOTTOM, Z if d else None, s_factor=None if d else s_factor)
     ev = np.concatenate([np.zeros(d), res.values])
     lam = float(res.values[0])
     eta = S.shape[0] * np.finfo(float).eps * res.lam_max  # the pencil's round-off level, as dense
@@ -123,6 +126,32 @@ def bottom_spectrum(S: np.ndarray, factor: np.ndarray, kernel: KernelDecision | 
     lam = lam if lam > eta else 0.0  # an eigenvalue at round-off (a singular S, no kernel given) is 0
     beta = 0.0 if d else float(np.sqrt(max(lam, 0.0)))
     return Spectrum(beta, d, float(np.sqrt(max(lam, 0.0))), gap, ev[:8].copy())
+
+
+def bottom_spectra(S: np.ndarray, factors: dict, kernel: KernelDecision | None = None) -> dict:
+    """:func:`bottom_spectrum` of S with each Gram factor in ``factors`` ({norm: factor}).
+
+    Where no kernel is deflated, the shift-invert operator of every norm factors S itself
+    (:func:`.bottom.bottom_pencil`): one Cholesky factorization serves them all (where S is not
+    numerically definite each pencil falls back to its own floored factorization)."""
+    shared = bottom.definite_factor(S) if kernel is None or not kernel.dim else None
+    return {norm: bottom_spectrum(S, L, kernel, s_factor=shared) for norm, L in factors.items()}
+
+
+def betas_v1_zero(terms, factors: dict, kernel: KernelDecision, iterative: bool) -> dict:
+    """β with v1 = 0 at c2 = 1, for each Gram factor ({norm: factor}): the sup over (0, v2)
+    only, (5.10), i.e. the pencil of B_2 X_2 B_2ᵀ alone; at other c2 it is this / sqrt(c2).
+
+    On the large route (``iterative``) with a non-empty kernel of Bᵀ it is 0 as a consequence,
+    not a computation: a kernel vector of Bᵀ is one of B_2ᵀ, hence of B_2 X_2 B_2ᵀ, so
+    β(v1 = 0) <= β_h = 0 (the sup over a subset). The dense route still computes it there (the
+    square root of a round-off eigenvalue, not exactly 0)."""
+    if iterative and kernel.dim:
+        return {norm: 0.0 for norm in factors}
+    S2 = combine_terms(terms[1:], (1.0,))
+    if iterative:
+        return {norm: sp_.beta for norm, sp_ in bottom_spectra(S2, factors).items()}
+    return {norm: spectrum(S2, factor=L).beta for norm, L in factors.items()}
 
 
 def check_inputs(case, k, family, n1, n2, c1, c2, norm, multiplier_mesh) -> None:
@@ -193,7 +222,8 @@ def beta_rows_all(family, k, n1, n2, cases=None, multiplier_meshes=("omega2",), 
     Timing columns (seconds): ``t_interface`` getting the two side operators (meshes and
     factorizations; about 0 for sides the cache already holds), ``t_assemble`` the case's
     couplings B_i, ``t_eig`` one eigenproblem (sygst and syevd; not the Gram matrix's
-    Cholesky factor, which the c pairs share).
+    Cholesky factor, which the c pairs share; above :data:`.bottom.DENSE_MAX_M` the norms'
+    share of :func:`bottom_spectra`).
     """
     cases = registry.ids_valid_for(k) if cases is None else list(cases)
     for mm in multiplier_meshes:
@@ -224,18 +254,19 @@ def beta_rows_all(family, k, n1, n2, cases=None, multiplier_meshes=("omega2",), 
             iterative = space.dim > bottom.DENSE_MAX_M
             kernel = space_kernel(couplings, sides, space, k, structural,
                                   grams["L2"][0] if "L2" in grams else None, iterative=iterative)
-            solve = bottom_spectrum if iterative else spectrum
             terms = interface_terms(couplings, sides)
             factors = {norm: gram_factor(G) for norm, (G, _) in grams.items()}
-            # sup over (0, v2) only, (5.10): B_2 X_2 B_2ᵀ / c2, so β(v1 = 0) = β at c2 = 1 / sqrt(c2)
-            S2 = combine_terms(terms[1:], (1.0,))
-            beta_v1_zero_c1 = {norm: solve(S2, factor=factors[norm]).beta for norm in norms}
+            beta_v1_zero_c1 = betas_v1_zero(terms, factors, kernel, iterative)
             for c1, c2 in c_pairs:
                 S = combine_terms(terms, (c1, c2))
+                if iterative:  # the norms' pencils share work: each row gets an equal share of the time
+                    te = time.perf_counter()
+                    spectra = bottom_spectra(S, factors, kernel)
+                    t_shared = (time.perf_counter() - te) / len(norms)
                 for norm in norms:
                     te = time.perf_counter()
                     info = grams[norm][1]
-                    sp_ = solve(S, factor=factors[norm], kernel=kernel)
+                    sp_ = spectra[norm] if iterative else spectrum(S, factor=factors[norm], kernel=kernel)
                     beta_v1_zero = beta_v1_zero_c1[norm] / np.sqrt(c2)
                     rows.append(dict(
                         case=registry.case_name(case), k=k, family=family, N1=n1, N2=n2,
@@ -248,7 +279,8 @@ def beta_rows_all(family, k, n1, n2, cases=None, multiplier_meshes=("omega2",), 
                         dim_M=space.dim, dim_W=dim_w,
                         n_max=info["n_max"], nmax_rel_error=info["nmax_rel_error"],
                         ndof=sum(s.ndof for s in sides), t_assemble=t_coupling,
-                        t_interface=t2 - t1, t_eig=time.perf_counter() - te))
+                        t_interface=t2 - t1,
+                        t_eig=t_shared if iterative else time.perf_counter() - te))
         by_partition[gamma.partition_key(g_h)] = rows[first:]
     return rows
 

@@ -1,5 +1,6 @@
 """The couplings from the spaces' nonzero patterns (``space.local_values``, no dense n_q × dim M
-multiplier values) equal, bit for bit, the former route that sparsified the dense values
+multiplier values) and the face's sparse trace basis (``sparse_trace_basis``, no dense n_q × n_Γ
+values) equal, bit for bit, the former route that sparsified the dense values
 ``csr_matrix(space.evaluate(x) * w)`` chunk by chunk and accumulated ``out += (μᵀ φ).toarray()``:
 for every registered space on the segment (1D), the tensor face (Q_s products and cellwise
 QUAD4/8/9 bases) and the triangulated face (P_s), k = 1, 2, matching and non-matching meshes,
@@ -24,9 +25,9 @@ SETUPS = [("membranes3d", {"element": "hex"}, 3, 3, 2, "omega2"),
 
 
 def _dense_route(trace, space, k, extra_degree=0):
-    """The former :func:`coupling_matrix`: dense multiplier values, sparsified per chunk."""
+    """The former :func:`coupling_matrix`: dense trace and multiplier values, sparsified."""
     x, w = trace.gamma.coupling_quadrature(trace, space, k + space.degree + extra_degree)
-    phi = trace.cached_sparse_basis(x)
+    phi = sp.csr_matrix(trace.gamma.trace_basis(trace, x))
     out = np.zeros((space.dim, phi.shape[1]))
     for rows in coupling._chunks(len(w), space.dim):
         mu = sp.csr_matrix(space.evaluate(x[rows]) * w[rows, None])
@@ -100,3 +101,22 @@ def test_a_space_without_a_pattern_takes_the_dense_route(setup):
     trace = sides[1].trace
     for space in spaces[:3]:
         assert np.array_equal(coupling_matrix(trace, DenseOnly(space), k), coupling_matrix(trace, space, k))
+
+
+def test_the_face_trace_basis_is_the_csr_of_its_dense_values(setup):
+    sides, spaces, k = setup
+    for side in sides:
+        trace = side.trace
+        if not hasattr(trace.gamma, "sparse_trace_basis"):
+            continue
+        for space in spaces[:2]:
+            x, _ = trace.gamma.coupling_quadrature(trace, space, k + space.degree + 2)
+            phi, ref = trace.gamma.sparse_trace_basis(trace, x), sp.csr_matrix(trace.gamma.trace_values(trace, x))
+            assert phi.has_canonical_format and phi.shape == ref.shape
+            for a in ("indptr", "indices", "data"):
+                assert np.array_equal(getattr(phi, a), getattr(ref, a))
+            if k > 1:  # NGSolve's basis is hierarchical for k ≥ 2: no partition of unity
+                continue
+            # k = 1, the nodal basis: Σ_d φ_d = 1 on the cells whose vertices are all free
+            inner = ~trace.gamma.at_boundary(trace.partition, x)
+            assert inner.any() and np.allclose(np.asarray(phi.sum(axis=1)).ravel()[inner], 1.0, atol=1e-13)

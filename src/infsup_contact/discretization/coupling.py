@@ -28,7 +28,10 @@ def coupling_matrix(trace: GammaTrace, space: MultiplierSpace, k: int, extra_deg
     # costs O(n_q) where the dense one costs n_q · dim M · n_Γ (a face at N = 32: 1e11 flops)
     for rows in _chunks(len(w), space.dim):
         part = (weighted_values(space, x[rows], w[rows]).T @ phi[rows]).tocoo()
-        out[part.row, part.col] += part.data  # = out += part.toarray(): elsewhere it adds +0.0
+        # = out += part.toarray() bit for bit: the product stores no zeros and out holds no −0.0,
+        # so the entries it skips would add +0.0 to them (and a single product, over the points
+        # of a chunk in ascending order per entry, is the same whatever built the CSR of μ)
+        out[part.row, part.col] += part.data
     return out
 
 

@@ -2,7 +2,7 @@
 multiplier values) and the face's sparse trace basis (``sparse_trace_basis``, no dense n_q × n_Γ
 values) equal, bit for bit, the former route that sparsified the dense values
 ``csr_matrix(space.evaluate(x) * w)`` chunk by chunk and accumulated ``out += (μᵀ φ).toarray()``:
-for every registered space on the segment (1D), the tensor face (Q_s products and cellwise
+for every registered space on the segment (1D; membranes and elastic bodies), the tensor face (Q_s products and cellwise
 QUAD4/8/9 bases) and the triangulated face (P_s), k = 1, 2, matching and non-matching meshes,
 the normal and the longer rules, one chunk and many."""
 import numpy as np
@@ -21,7 +21,8 @@ SETUPS = [("membranes3d", {"element": "hex"}, 3, 3, 2, "omega2"),
           ("membranes3d", {"element": "hex"}, 2, 3, 2, "omega1"),
           ("membranes3d", {"element": "tet"}, 2, 3, 2, "union"),
           ("membranes3d", {"element": "tet"}, 3, 3, 1, "omega2"),
-          ("membranes", {}, 5, 6, 2, "union")]
+          ("membranes", {}, 5, 6, 2, "union"),
+          ("elastic", {}, 4, 5, 2, "union")]
 
 
 def _dense_route(trace, space, k, extra_degree=0):

@@ -27,9 +27,29 @@ def coupling_matrix(trace: GammaTrace, space: MultiplierSpace, k: int, extra_deg
     # each point sees (k + 1)^d trace and (s + 1)^d multiplier functions: a sparse product
     # costs O(n_q) where the dense one costs n_q · dim M · n_Γ (a face at N = 32: 1e11 flops)
     for rows in _chunks(len(w), space.dim):
-        mu = sp.csr_matrix(space.evaluate(x[rows]) * w[rows, None])
-        out += (mu.T @ phi[rows]).toarray()
+        part = (weighted_values(space, x[rows], w[rows]).T @ phi[rows]).tocoo()
+        # = out += part.toarray() bit for bit: the product stores no zeros and out holds no −0.0,
+        # so the entries it skips would add +0.0 to them (and a single product, over the points
+        # of a chunk in ascending order per entry, is the same whatever built the CSR of μ)
+        out[part.row, part.col] += part.data
     return out
+
+
+def weighted_values(space, x: np.ndarray, w: np.ndarray) -> sp.csr_matrix:
+    """CSR of μ_j(x_q) w_q, shape (len(x), dim M): exactly ``csr_matrix(space.evaluate(x) * w[:, None])``
+    (the same products, sorted indices, no stored zeros), built from the space's nonzero pattern
+    (``space.local_values``: each point sees (s + 1)^d basis functions) without the dense
+    n_q × dim M array where the space has one, else from :meth:`evaluate`."""
+    local = space.local_values(x) if hasattr(space, "local_values") else None
+    if local is None:
+        return sp.csr_matrix(space.evaluate(x) * w[:, None])
+    vals, dofs = local
+    data = vals * w[:, None]
+    keep = (dofs >= 0) & (data != 0)
+    rows = np.broadcast_to(np.arange(len(x))[:, None], dofs.shape)
+    mu = sp.coo_matrix((data[keep], (rows[keep], dofs[keep])), shape=(len(x), space.dim)).tocsr()
+    mu.sum_duplicates()  # sorts the column indices (there are no duplicates: distinct local dofs)
+    return mu
 
 
 _CHUNK_ENTRIES = 2 ** 24

@@ -130,6 +130,18 @@ class CellwiseFaceSpace:
         A point on a cell boundary is taken by the cell on its upper / right side (the last
         cell at 1), as the 1D spaces do.
         """
+        vals, dofs = self.local_values(points)
+        out = np.zeros((len(vals), self.dim))
+        rows = np.repeat(np.arange(len(vals)), vals.shape[1])
+        cols = dofs.ravel()
+        keep = cols >= 0
+        np.add.at(out, (rows[keep], cols[keep]), vals.ravel()[keep])
+        return out
+
+    def local_values(self, points) -> tuple:
+        """The nonzero pattern of :meth:`evaluate`: (values, dofs), each (n, n_nodes), the local
+        functions of the cell holding each point and their global dofs (−1: dropped); what
+        :meth:`evaluate` scatters, so the two agree bit for bit (every point lies in one cell)."""
         p = np.atleast_2d(np.asarray(points, dtype=float))
         i = np.clip(np.searchsorted(self.xs, p[:, 0], side="right") - 1, 0, len(self.xs) - 2)
         j = np.clip(np.searchsorted(self.ys, p[:, 1], side="right") - 1, 0, len(self.ys) - 2)
@@ -138,13 +150,7 @@ class CellwiseFaceSpace:
         raw = (pwlin_shapes(self.element, ref) if self.basis == "pwlin"
                else reference_element(self.element).shapes(ref))
         cell = i * (len(self.ys) - 1) + j
-        vals = np.einsum("pab,pb->pa", self.coefficients[cell], raw)
-        out = np.zeros((len(p), self.dim))
-        rows = np.repeat(np.arange(len(p)), vals.shape[1])
-        cols = self.dofs[cell].ravel()
-        keep = cols >= 0
-        np.add.at(out, (rows[keep], cols[keep]), vals.ravel()[keep])
-        return out
+        return np.einsum("pab,pb->pa", self.coefficients[cell], raw), self.dofs[cell]
 
     def quadrature(self, total_degree: int) -> tuple[np.ndarray, np.ndarray]:
         """A Gauss rule on every rectangle (exact per cell for ``total_degree``; not across

@@ -60,6 +60,22 @@ class FaceSpace:
         ex, ey = self.sx.evaluate(x[:, 0]), self.sy.evaluate(x[:, 1])
         return (ex[:, :, None] * ey[:, None, :]).reshape(len(x), self.dim)
 
+    def local_values(self, x: np.ndarray):
+        """The nonzero pattern of :meth:`evaluate` (the face-splitting product of the 1D
+        patterns, :meth:`~.multipliers.MultiplierSpace.local_values`): (values, dofs), each
+        (n, (s_x + 1)(s_y + 1)), dof −1 where a 1D factor dropped its shape. Every value is the
+        same product μ^x_a(x) μ^y_b(y) :meth:`evaluate` forms, so the two agree bit for bit
+        (up to the sign of zeros); None where a factor has no such pattern."""
+        x = np.asarray(x, dtype=float).reshape(-1, 2)
+        lx, ly = self.sx.local_values(x[:, 0]), self.sy.local_values(x[:, 1])
+        if lx is None or ly is None:
+            return None
+        (vx, cx), (vy, cy) = lx, ly
+        vals = (vx[:, :, None] * vy[:, None, :]).reshape(len(x), -1)
+        dofs = np.where((cx[:, :, None] >= 0) & (cy[:, None, :] >= 0),
+                        cx[:, :, None] * self.sy.dim + cy[:, None, :], -1).reshape(len(x), -1)
+        return vals, dofs
+
     def nodes(self) -> np.ndarray:
         """Coordinates (dim, 2) of the tensor Lagrange nodes (a·dim M^y + b order)."""
         X, Y = np.meshgrid(self.sx.nodes(), self.sy.nodes(), indexing="ij")

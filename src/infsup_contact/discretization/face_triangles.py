@@ -187,6 +187,17 @@ class TriangleSpace:
 
     def evaluate(self, x: np.ndarray) -> np.ndarray:
         """All basis functions at points (n, 2), shape (n, dim)."""
+        vals, glob = self.local_values(x)
+        out = np.zeros((len(vals), self.dim))
+        rows = np.repeat(np.arange(len(vals)), self.n_local)
+        keep = glob.ravel() >= 0
+        np.add.at(out, (rows[keep], glob.ravel()[keep]), vals.ravel()[keep])
+        return out
+
+    def local_values(self, x: np.ndarray) -> tuple:
+        """The nonzero pattern of :meth:`evaluate`: (values, dofs), each (n, nloc), the local
+        functions of the triangle holding each point and their global dofs (−1: removed on ∂Γ);
+        what :meth:`evaluate` scatters, so the two agree bit for bit."""
         ix, iy, tri, lam = self.locate(x)
         vals = lagrange_barycentric(lam, self.s)
         glob = self._dofs[ix, iy, tri]  # (n, nloc)
@@ -195,11 +206,7 @@ class TriangleSpace:
             for p in np.unique(pattern):
                 rows = pattern == p
                 vals[rows] = vals[rows] @ self._dual_matrix(int(p)).T
-        out = np.zeros((len(vals), self.dim))
-        rows = np.repeat(np.arange(len(vals)), self.n_local)
-        keep = glob.ravel() >= 0
-        np.add.at(out, (rows[keep], glob.ravel()[keep]), vals.ravel()[keep])
-        return out
+        return vals, glob
 
     def nodes(self) -> np.ndarray:
         """Coordinates (dim, 2) of the Lagrange nodes (the centroid of the triangle for s = 0)."""

@@ -89,17 +89,37 @@ class MultiplierSpace:
         breakpoint to the last interval); discontinuous spaces are thus right-continuous.
         """
         x = np.asarray(x, dtype=float)
+        vals, cols = self._local(x)
+        out = np.zeros((len(x), self.dim))
+        rows = np.repeat(np.arange(len(x)), self.degree + 1)
+        cols = cols.ravel()
+        keep = cols >= 0
+        np.add.at(out, (rows[keep], cols[keep]), vals.ravel()[keep])
+        return out
+
+    def local_values(self, x: np.ndarray):
+        """The nonzero pattern of :meth:`evaluate`: (values, dofs), each (len(x), s + 1), with
+        ``evaluate(x)[i, dofs[i, a]] == values[i, a]`` for ``dofs[i, a] >= 0`` (−1: a dropped
+        shape) and zero elsewhere — the same numbers from the same operations, bit for bit. None
+        when an interval maps two local functions to one dof (:meth:`evaluate` then adds them)."""
+        if not self._distinct_local_dofs:
+            return None
+        return self._local(np.asarray(x, dtype=float))
+
+    @property
+    def _distinct_local_dofs(self) -> bool:
+        d = np.sort(self.dofs, axis=1)
+        return not np.any((d[:, 1:] == d[:, :-1]) & (d[:, 1:] >= 0))
+
+    def _local(self, x: np.ndarray) -> tuple:
+        """(values of the s + 1 local basis functions, their global dofs) at the points x: a point
+        on a breakpoint is taken by the interval on its right (the last breakpoint by the last)."""
         e = np.clip(np.searchsorted(self.breakpoints, x, side="right") - 1, 0, self.n_intervals - 1)
         a, b = self.breakpoints[e], self.breakpoints[e + 1]
         vals = local_shapes(self.degree, (x - a) / (b - a))
         if self.local_coefficients is not None:
             vals = np.einsum("iab,ib->ia", self.local_coefficients[e], vals)
-        out = np.zeros((len(x), self.dim))
-        rows = np.repeat(np.arange(len(x)), self.degree + 1)
-        cols = self.dofs[e].ravel()
-        keep = cols >= 0
-        np.add.at(out, (rows[keep], cols[keep]), vals.ravel()[keep])
-        return out
+        return vals, self.dofs[e]
 
 
 def reference_nodes(s: int) -> np.ndarray:

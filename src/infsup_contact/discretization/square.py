@@ -24,6 +24,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+import scipy.sparse as sp
 
 from ..errors import InputError
 from .interface import GammaTrace, Interface, check_choice
@@ -205,6 +206,29 @@ class Square(Interface):
     def trace_values(self, trace: GammaTrace, x: np.ndarray) -> np.ndarray:
         """Dense values (len(x), number of Γ dofs) of the Γ-dof basis at points x of Γ."""
         x = np.asarray(x, dtype=float).reshape(-1, 2)
+        phi = np.zeros((len(x), len(trace.gamma_dofs)))
+        for pts, cols, shapes in self._trace_blocks(trace, x):
+            phi[np.ix_(pts, cols)] += shapes
+        return phi
+
+    def sparse_trace_basis(self, trace: GammaTrace, x: np.ndarray):
+        """:meth:`trace_values` as CSR without the dense (len(x), n_Γ) array: exactly
+        ``csr_matrix(trace_values(trace, x))`` (the same values; sorted indices, no stored zeros),
+        since every point is taken by one element, whose Γ dofs are distinct."""
+        x = np.asarray(x, dtype=float).reshape(-1, 2)
+        blocks = list(self._trace_blocks(trace, x))
+        rows = np.concatenate([np.repeat(p, len(c)) for p, c, _ in blocks] or [np.zeros(0, int)])
+        cols = np.concatenate([np.tile(c, len(p)) for p, c, _ in blocks] or [np.zeros(0, int)])
+        vals = np.concatenate([v.ravel() for _, _, v in blocks] or [np.zeros(0)])
+        keep = vals != 0
+        phi = sp.coo_matrix((vals[keep], (rows[keep], cols[keep])), shape=(len(x), len(trace.gamma_dofs))).tocsr()
+        phi.sum_duplicates()  # sorts the column indices
+        return phi
+
+    def _trace_blocks(self, trace: GammaTrace, x: np.ndarray):
+        """(points, Γ-dof positions, shape values (points, positions)) per trace element: the
+        points of x (n, 2) it takes (those of its cell of the trace partition not taken by an
+        earlier element of the cell, ascending) and its basis functions there (NGSolve's CalcShape)."""
         part = trace.breakpoints
         position = -np.ones(trace.fes.ndof, dtype=int)
         position[trace.gamma_dofs] = np.arange(len(trace.gamma_dofs))
@@ -213,10 +237,14 @@ class Square(Interface):
             c = self._cell_index(part, verts.mean(axis=0)[None, :])
             by_cell.setdefault((int(c[0][0]), int(c[1][0])), []).append(e)
         ix, iy = self._cell_index(part, x)
-        phi = np.zeros((len(x), len(trace.gamma_dofs)))
+        ny = len(part.ys) - 1
+        cell = ix * ny + iy
+        order = np.argsort(cell, kind="stable")  # the points of every cell, ascending
+        bounds = np.searchsorted(cell[order], np.arange(cell.max(initial=-1) + 2))
         tol = 1e-10
         for (cx, cy), elems in by_cell.items():
-            pts = np.flatnonzero((ix == cx) & (iy == cy))
+            c = cx * ny + cy
+            pts = order[bounds[c]:bounds[c + 1]] if c + 1 < len(bounds) else order[:0]
             todo = np.ones(len(pts), dtype=bool)
             for e in elems:
                 verts, dn, el = trace.elements[e]
@@ -231,8 +259,7 @@ class Square(Interface):
                 pos = position[dn]
                 keep = pos >= 0
                 shapes = np.array([np.asarray(fe.CalcShape(a, b, 0.0)) for a, b in ref[inside]])
-                phi[np.ix_(pts[inside], pos[keep])] += shapes[:, keep]
-        return phi
+                yield pts[inside], pos[keep], shapes[:, keep]
 
     def trace_basis(self, trace: GammaTrace, x: np.ndarray) -> np.ndarray:
         """Dense values of the Γ-dof basis at the points x (n, 2), cached on the trace

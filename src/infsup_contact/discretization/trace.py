@@ -70,11 +70,13 @@ class GammaTrace:
     def cached_sparse_basis(self, x: np.ndarray):
         """:meth:`Interface.trace_basis` at ``x`` as CSR, made once per point set for a sweep of
         multiplier spaces (:func:`~.coupling.coupling_matrix`); its row slices are, bit for bit,
-        ``csr_matrix`` of the dense slices (sorted indices, no stored zeros)."""
+        ``csr_matrix`` of the dense slices (sorted indices, no stored zeros). An interface with a
+        ``sparse_trace_basis`` (the face) makes it without the dense values."""
         key = _points_key(x)
         phi = self.sparse_cache.get(key)
         if phi is None:
-            phi = sp.csr_matrix(self.gamma.trace_basis(self, x))
+            sparse = getattr(self.gamma, "sparse_trace_basis", None)
+            phi = sp.csr_matrix(self.gamma.trace_basis(self, x)) if sparse is None else sparse(self, x)
             if len(self.sparse_cache) >= BASIS_CACHE_SIZE:
                 self.sparse_cache.clear()
             self.sparse_cache[key] = phi

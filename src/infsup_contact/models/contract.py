@@ -12,7 +12,9 @@ each mesh of a pair; the :class:`~infsup_contact.models.schur.SideOperator` it r
   for a scalar membrane v itself, for an elastic body v·n) and the NGSolve space, from which
   :func:`~infsup_contact.discretization.coupling.coupling_matrix` builds B_i;
 * ``steklov_times(M)`` — X_i M with X_i = (A_i⁻¹)_ΓΓ at unit material scale: the interface
-  operator Σ_i B_i X_i B_iᵀ / c_i is assembled from it for every multiplier space and norm;
+  operator Σ_i B_i X_i B_iᵀ / c_i is assembled from it for every multiplier space and norm
+  (above ``schur.SPARSE_PRODUCT_MIN_DIM`` from ``steklov_sandwich(B)`` = B X_i Bᵀ where the side
+  has it: :class:`~infsup_contact.models.schur.SideOperator` forms X_i once);
 * ``solve``, ``free``, ``stiffness`` — the factorization and the free dofs (Γ last) with
   which the contact solver recovers u_h = A_i⁻¹ (F_i ∓ B_iᵀ λ_h).
 

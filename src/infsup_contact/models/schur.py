@@ -52,6 +52,28 @@ class _SteklovProduct:
     def _schur_cholesky(self):
         return sla.cho_factor(self.schur, check_finite=False)
 
+    def steklov_sandwich(self, B: sp.csr_matrix) -> np.ndarray:
+        """B X Bᵀ for a sparse B (dim M × n_Γ): two sparse-times-dense products with the explicit
+        X = S⁻¹ (:attr:`_steklov_explicit`, made once per side), nnz(B) · n_Γ multiply-adds each,
+        where B X Bᵀ by :meth:`steklov_times` costs 2 n_Γ² dim M (the triangular solves) per space."""
+        Y = np.asarray(B @ self._steklov_explicit)     # B X, dense (dim M, n_Γ)
+        return np.asarray(B @ Y.T).T                   # (B (B X)ᵀ)ᵀ = B X Bᵀ (X symmetric)
+
+    @cached_property
+    def _steklov_explicit(self) -> np.ndarray:
+        """X = S⁻¹: ``steklov`` where known, else from the Cholesky factor of S by LAPACK potri
+        (n_Γ³/3 multiply-adds once, the cost of n_Γ/6 right-hand sides of :meth:`steklov_times`;
+        n_Γ² doubles kept on the side: 126 MB at n_Γ = 3,969), both triangles filled."""
+        if self.steklov is not None:
+            return self.steklov
+        c, lower = self._schur_cholesky
+        X, info = sla.lapack.dpotri(c, lower=lower)
+        if info != 0:
+            raise np.linalg.LinAlgError(f"potri failed (info = {info}) on the Schur complement")
+        X = np.tril(X) if lower else np.triu(X)
+        X += (np.tril(X, -1) if lower else np.triu(X, 1)).T
+        return X
+
 
 @dataclass(frozen=True)
 class SideOperator(_SteklovProduct):
@@ -92,6 +114,7 @@ class SideOperator(_SteklovProduct):
         side (the Cholesky factor of S, the trace's basis values, dense and CSR). A benchmark
         times each multiplier space's solve from this state, as a fresh build would give it."""
         self.__dict__.pop("_schur_cholesky", None)
+        self.__dict__.pop("_steklov_explicit", None)
         self.trace.forget_basis()
 
 
@@ -242,16 +265,25 @@ def schur_by_solves(side: SideOperator) -> np.ndarray:
 
 
 SPARSE_PRODUCT_MIN_DIM = 1500
-"""dim M above which :func:`interface_terms` multiplies by B as a sparse matrix (B has
-(k + 1)^d (s + 1)^d-sized blocks: at dim M ≈ 4,000 on a face the dense product is 7e10 flops);
-below it the dense product, whose results the default DAG holds bit for bit."""
+"""dim M above which :func:`interface_terms` multiplies by B as a sparse matrix on both sides
+(B has (k + 1)^d (s + 1)^d-sized blocks: at dim M ≈ 4,000 on a face the dense products are 1e11
+flops) with the explicit X = S⁻¹ of the side (:meth:`_SteklovProduct.steklov_sandwich`); below it
+the dense products with the solves, whose results the default DAG holds bit for bit."""
 
 
 def interface_terms(couplings, sides) -> list:
-    """The terms B_i X_i B_iᵀ of the interface operator at unit material scale, one per side."""
+    """The terms B_i X_i B_iᵀ of the interface operator at unit material scale, one per side.
+
+    Above :data:`SPARSE_PRODUCT_MIN_DIM` by a side's ``steklov_sandwich`` where it has one (the
+    same matrix to round-off: X from potri instead of the triangular solves), else
+    ``B (X Bᵀ)`` by its ``steklov_times``."""
     out = []
     for B, side in zip(couplings, sides):
-        Bl = sp.csr_matrix(B) if B.shape[0] > SPARSE_PRODUCT_MIN_DIM else B
+        large = B.shape[0] > SPARSE_PRODUCT_MIN_DIM
+        if large and hasattr(side, "steklov_sandwich"):
+            out.append(side.steklov_sandwich(sp.csr_matrix(B)))
+            continue
+        Bl = sp.csr_matrix(B) if large else B
         out.append(np.asarray(Bl @ side.steklov_times(B.T)))
     return out
 

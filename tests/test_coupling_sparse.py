@@ -121,3 +121,23 @@ def test_the_face_trace_basis_is_the_csr_of_its_dense_values(setup):
             # k = 1, the nodal basis: Σ_d φ_d = 1 on the cells whose vertices are all free
             inner = ~trace.gamma.at_boundary(trace.partition, x)
             assert inner.any() and np.allclose(np.asarray(phi.sum(axis=1)).ravel()[inner], 1.0, atol=1e-13)
+
+
+@pytest.mark.parametrize("extra", [0, 2])
+def test_sparse_couplings_and_their_scaling_are_the_dense_ones_bit_for_bit(setup, monkeypatch, extra):
+    """The large route's CSR B (``sparse=True``) and its scaled W (kernel.scaled_couplings) hold
+    the dense route's entries exactly, with many chunks as with one."""
+    from infsup_contact.discretization.coupling import trace_l2_norms
+    from infsup_contact.solvers.kernel import scaled_couplings
+
+    sides, spaces, k = setup
+    for chunk in (coupling._CHUNK_ENTRIES, 64):
+        monkeypatch.setattr(coupling, "_CHUNK_ENTRIES", chunk)
+        for space in spaces:
+            dense = [coupling_matrix(s.trace, space, k, extra_degree=extra) for s in sides]
+            sparse = [coupling_matrix(s.trace, space, k, extra_degree=extra, sparse=True) for s in sides]
+            assert all(sp.isspmatrix_csr(B) and np.array_equal(B.toarray(), D) for B, D in zip(sparse, dense))
+            rows = [trace_l2_norms(s.trace, k) for s in sides]
+            cols = np.linspace(0.5, 2.0, space.dim)
+            W = scaled_couplings(sparse, rows, cols)
+            assert sp.issparse(W) and np.array_equal(W.toarray(), scaled_couplings(dense, rows, cols))

@@ -284,7 +284,8 @@ def interface_terms(couplings, sides) -> list:
             out.append(side.steklov_sandwich(sp.csr_matrix(B)))
             continue
         Bl = sp.csr_matrix(B) if large else B
-        out.append(np.asarray(Bl @ side.steklov_times(B.T)))
+        Bd = B.toarray() if sp.issparse(B) else B  # steklov_times solves with a dense right-hand side
+        out.append(np.asarray(Bl @ side.steklov_times(Bd.T)))
     return out
 
 

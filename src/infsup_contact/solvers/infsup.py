@@ -15,6 +15,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
+import scipy.sparse.linalg as spla
 from scipy.linalg import lapack
 
 from ..discretization import meshes, multipliers, registry
@@ -247,11 +248,11 @@ def beta_rows_all(family, k, n1, n2, cases=None, multiplier_meshes=("omega2",), 
         for case in cases:
             space = _space(case, k, g_h, gamma)
             tc = time.perf_counter()
-            couplings = [coupling_matrix(s.trace, space, k) for s in sides]
+            iterative = space.dim > bottom.DENSE_MAX_M  # the large route: sparse B, no dense eigensolver
+            couplings = [coupling_matrix(s.trace, space, k, sparse=iterative) for s in sides]
             t_coupling = time.perf_counter() - tc
             grams = {norm: gamma.gram(space, norm, h_route=h_route) for norm in norms}
             structural = gamma.proven_kernel(space, k, [s.trace for s in sides], dim_w)
-            iterative = space.dim > bottom.DENSE_MAX_M
             kernel = space_kernel(couplings, sides, space, k, structural,
                                   grams["L2"][0] if "L2" in grams else None, iterative=iterative)
             terms = interface_terms(couplings, sides)
@@ -295,16 +296,17 @@ def space_kernel(couplings, sides, space, k: int, structural: int, l2_gram=None,
 
     ``iterative``: the bottom singular values only
     (:func:`~infsup_contact.solvers.kernel.bottom_kernel`, for dim M > :data:`.bottom.DENSE_MAX_M`),
-    W' from a rule :data:`LONGER_RULE_LARGE` longer; its ``vectors`` are returned in multiplier
-    coordinates (a basis of the kernel of Bᵀ)."""
+    W' from a rule :data:`LONGER_RULE_LARGE` longer, the couplings sparse (W sparse, the same
+    entries); its ``vectors`` are returned in multiplier coordinates (a basis of the kernel of Bᵀ)."""
     G = sides[0].trace.gamma.gram(space, "L2")[0] if l2_gram is None else l2_gram
     rows, cols = [trace_l2_norms(s.trace, k) for s in sides], np.sqrt(np.diag(G))
     W = scaled_couplings(couplings, rows, cols)
     extra = LONGER_RULE_LARGE if iterative else LONGER_RULE
-    longer = scaled_couplings([coupling_matrix(s.trace, space, k, extra_degree=extra) for s in sides], rows, cols)
+    longer = scaled_couplings([coupling_matrix(s.trace, space, k, extra_degree=extra, sparse=iterative)
+                               for s in sides], rows, cols)
     if not iterative:
         return coupling_kernel(W, structural, entry_error=np.linalg.norm(W - longer))
-    decision = bottom_kernel(sp.csr_matrix(W), structural, entry_error=np.linalg.norm(W - longer))
+    decision = bottom_kernel(sp.csr_matrix(W), structural, entry_error=spla.norm(sp.csr_matrix(W - longer)))
     return replace(decision, vectors=decision.vectors / cols[:, None])  # W v = 0 ⇔ Bᵀ (v / cols) = 0
 
 

@@ -205,10 +205,20 @@ def bottom_kernel(W, proven: int = 0, entry_error: float = 0.0) -> KernelDecisio
     return _decision(s, proven, tol, d, smax, res.vectors[:, :d])
 
 
-def scaled_couplings(couplings, trace_norms, multiplier_norms) -> np.ndarray:
+def scaled_couplings(couplings, trace_norms, multiplier_norms):
     """W = [B_1ᵀ/‖φ‖; B_2ᵀ/‖φ‖; …] / ‖μ‖: each side's coupling B_i (dim M × Γ dofs of side i)
     transposed, rows divided by the L² norms of that side's trace basis functions, columns by
-    the L² norms of the multiplier basis functions."""
+    the L² norms of the multiplier basis functions. Sparse couplings give a CSR W with the
+    same entries, bit for bit (each stored entry divided by the same two numbers, in order)."""
+    if any(sp.issparse(B) for B in couplings):
+        blocks = []
+        for B, t in zip(couplings, trace_norms):
+            Bt = sp.csr_matrix(B).T.tocsr()
+            Bt.sort_indices()
+            rows = np.repeat(np.arange(Bt.shape[0]), np.diff(Bt.indptr))
+            data = Bt.data / np.asarray(t, float)[rows] / np.asarray(multiplier_norms, float)[Bt.indices]
+            blocks.append(sp.csr_matrix((data, Bt.indices, Bt.indptr), shape=Bt.shape))
+        return sp.vstack(blocks, format="csr")
     blocks = [np.asarray(B, float).T / np.asarray(t, float)[:, None] for B, t in zip(couplings, trace_norms)]
     return np.vstack(blocks) / np.asarray(multiplier_norms, float)[None, :]
 

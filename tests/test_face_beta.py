@@ -209,23 +209,3 @@ def test_pardiso_schur_on_small_matrices_equals_dense_elimination(n, n_gamma):
     I, G = slice(0, n - n_gamma), slice(n - n_gamma, n)
     ref = D[G, G] - D[G, I] @ np.linalg.solve(D[I, I], D[I, G])
     np.testing.assert_allclose(gamma_schur(sp.csr_matrix(D), n_gamma), ref, rtol=0, atol=1e-13)
-
-
-@pytest.mark.parametrize("element", ["hex", "tet"])
-def test_case_all_on_a_face_is_every_space_its_face_builds(element):
-    """``beta --case all`` on a 3D model: the face-only spaces (quadratic face elements) join the
-    paper's, each only on the cells it is defined on; a space refused by construction (a dual
-    with a weight ∫N_k <= 0) is left out, not an error."""
-    from infsup_contact.cli.common import face_cases
-    from infsup_contact.discretization.registry import SPACES, ids_valid_for
-    from infsup_contact.models import make_model
-
-    model = make_model("membranes3d")
-    for k in (1, 2):
-        ids = face_cases(model, k, {"element": element})
-        assert set(ids_valid_for(k)) <= set(ids)                          # the paper's five and the duals
-        cell = "quad" if element == "hex" else "trig"
-        assert all(cell in (SPACES[c].face_cells or (cell,)) for c in ids)
-        if k == 2:
-            assert len(ids) > len(ids_valid_for(k))                       # the face elements' multipliers
-            assert ("DUAL-Q8" in ids) is False and ("DUAL-T6" in ids) is False  # refused: ∫N_k <= 0

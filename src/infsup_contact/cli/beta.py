@@ -4,7 +4,7 @@ from __future__ import annotations
 import sys
 
 from .common import (material_columns, mesh_options, refuse_with_system, remember_defaults, add_dry_run, add_model, cases,
-                     face_cases, check_memory, material, norms, SPACE_HELP, write_csv)
+                     check_memory, material, norms, SPACE_HELP, write_csv)
 
 
 def add(sub) -> None:
@@ -21,8 +21,9 @@ def add(sub) -> None:
                        "error level was exceeded); gap_over_roundoff is the first pencil eigenvalue above "
                        "the kernel over the pencil's round-off level n*eps*lambda_max (a cross-check).")
     p.add_argument("--case", default=None, choices=[*space_ids(None), "all"],
-                   help="a registered space, or all (the default) for every one defined for k "
-                        "(a 3D model: every one its face builds for --element)")
+                   help="a registered space, or all (the default) for every one defined for k in the "
+                        "paper's list and the duals (a 3D face's quadratic-element multipliers, e.g. "
+                        "DUAL-Q9, PWLIN-Q9, are asked by name)")
     p.add_argument("--space", metavar="FILE.py:FUNC", help=SPACE_HELP)
     p.add_argument("--system", metavar="LEVELS.yaml", default=None,
                    help="a saddle-point system exported by another code (a manifest of mesh levels "
@@ -68,8 +69,6 @@ def _check_beta(args):
     args.cases = cases(args)
     material(args)
     args.mesh_kwargs = mesh_options(args)
-    if args.space is None and args.case in (None, "all") and getattr(args.model_obj, "dim", 2) == 3:
-        args.cases = face_cases(args.model_obj, args.k, args.mesh_kwargs)
     check_inputs([c for c in args.cases if isinstance(c, str)], args.k, args.family, args.N1, args.N2,
                  args.c1, args.c2, norms(args), args.multiplier_mesh)
     check_perturbation(args.alpha, args.seed)

@@ -26,27 +26,6 @@ def cases(args) -> list:
     return [args.case]
 
 
-def face_cases(model, k: int, mesh_kwargs: dict) -> list:
-    """``--case all`` on a model with a 3D face: every registered space defined for k that the
-    face of the requested element builds (the quadratic face elements' multipliers included, as
-    the DAG's face jobs run them), less those the registry refuses by construction there (the
-    plain QUAD8 and TRI6 duals: corner / vertex weights ∫N_k <= 0), asked of a 2 × 2 × 2 mesh."""
-    from ..discretization.registry import SPACES, case_space, ids_valid_for
-
-    trace = model.side_operator(model.mesh("structured", 2, 1, **mesh_kwargs), 1).trace
-    gamma = trace.gamma
-    out = []
-    for case in ids_valid_for(k, gamma_dim=gamma.dim):
-        if not gamma.builds(SPACES[case]):
-            continue
-        try:
-            case_space(case, k, trace.partition, gamma)
-        except InputError:  # refused on this face by construction
-            continue
-        out.append(case)
-    return out
-
-
 def run_intervals(args, limit: int = 1024) -> set:
     """Numbers of intervals of the multiplier meshes a request will use (--N1/--N2 and
     --multiplier-mesh, or the --N list of matching meshes), for checking a user space on each.

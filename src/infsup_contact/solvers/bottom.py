@@ -17,8 +17,7 @@ factorizations (BLAS-3, m³/3 each):
 :func:`at_most_below`
     one Cholesky factorization of WᵀW − τI + ω Z Zᵀ (Z the d counted modes): it succeeds only
     if at most d eigenvalues lie below τ (Weyl), which certifies that the iteration missed no
-    singular value below the first one above the kernel; :func:`count_below` is the inertia
-    (LDLᵀ with Bunch–Kaufman pivoting, LAPACK sytrf) for any symmetric matrix.
+    singular value below the first one above the kernel.
 :func:`bottom_pencil`
     the smallest eigenvalues of (S, G) above a known kernel Z: Z is moved to the top of the
     spectrum (S + γ G Z (ZᵀGZ)⁻¹ ZᵀG, γ = 2 λ_max), then Lanczos on the explicit inverse of
@@ -168,36 +167,14 @@ def at_most_below(C: np.ndarray, tau: float, Z: np.ndarray, omega: float) -> boo
     rank d lifts the i-th eigenvalue at most to the (i + d)-th (Weyl). Z is where the d small
     eigenvalues are believed to be; a wrong Z can only make the answer False, never a wrong True.
     In floating point a successful potrf certifies λ_min >= −c m ε ‖C − τI + ω Z Zᵀ‖, which
-    :func:`~.kernel.bottom_kernel` keeps far below τ (its ``CERTIFY_FLOOR``). The same cost as
-    the inertia of :func:`count_below`, with BLAS-3 speed instead of Bunch–Kaufman pivoting."""
-    M = np.array(C, float, order="F")
+    :func:`~.kernel.bottom_kernel` keeps far below τ (its ``CERTIFY_FLOOR``). The flops of an
+    inertia count (Bunch–Kaufman LDLᵀ), at BLAS-3 speed. ``C`` dense or sparse (made dense once)."""
+    M = C.toarray(order="F") if sp.issparse(C) else np.array(C, float, order="F")
     M[np.diag_indices_from(M)] -= tau
     if Z.shape[1]:
         M = blas.dsyrk(omega, np.asfortranarray(Z), beta=1.0, c=M, trans=0, lower=1, overwrite_c=1)
     _, info = lapack.dpotrf(M, lower=1, clean=0, overwrite_a=1)
     return info == 0
-
-
-def count_below(C: np.ndarray, tau: float) -> int:
-    """Number of eigenvalues of the symmetric C below τ: the inertia of C − τI (Sylvester) from
-    its Bunch–Kaufman factorization P (C − τI) Pᵀ = L D Lᵀ (LAPACK sytrf), D of 1×1 and 2×2 blocks."""
-    M = np.array(C, float, order="F")
-    M[np.diag_indices_from(M)] -= tau
-    lwork = int(lapack.dsytrf_lwork(M.shape[0], lower=1)[0])  # the blocked algorithm needs room
-    lu, ipiv, info = lapack.dsytrf(M, lower=1, lwork=max(lwork, 1), overwrite_a=1)
-    if info < 0:
-        raise ValueError(f"sytrf: illegal argument {-info}")
-    diag, sub = np.diag(lu), np.append(np.diag(lu, -1), 0.0)
-    negative, i, m = 0, 0, len(diag)
-    while i < m:
-        if ipiv[i] < 0:  # a 2×2 block (rows i, i + 1)
-            det = diag[i] * diag[i + 1] - sub[i] ** 2
-            negative += 1 if det < 0 else (2 if diag[i] < 0 else 0)
-            i += 2
-        else:
-            negative += int(diag[i] < 0)
-            i += 1
-    return negative
 
 
 @dataclass(frozen=True)

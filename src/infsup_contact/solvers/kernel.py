@@ -198,7 +198,7 @@ def bottom_kernel(W, proven: int = 0, entry_error: float = 0.0) -> KernelDecisio
     tau = 0.0 if res is None else 0.5 * res.above ** 2
     if res is None or res.count < proven or res.above <= tol or \
             tau <= CERTIFY_FLOOR * max(rows, m) * np.finfo(float).eps * smax ** 2 or \
-            not bottom.at_most_below(gram.toarray(), tau, res.vectors[:, :res.count], smax ** 2):
+            not bottom.at_most_below(gram, tau, res.vectors[:, :res.count], smax ** 2):
         return coupling_kernel(W.toarray(), proven, entry_error, vectors=True)
     d = res.count
     s = np.concatenate([res.values[:d], [res.above, smax]])

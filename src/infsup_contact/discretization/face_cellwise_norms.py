@@ -17,22 +17,63 @@ C_jp = ∫ μ_j P_p, G_P = the exact L² Gram of P. Then
   extrapolated in n_max on S_μ itself (:func:`~.face_norms.extrapolated`), with the tail
   exponent of μ (4 for continuous bases vanishing on ∂Γ, else 2; :attr:`~.face_cells.CellwiseFaceSpace.smooth_tail`).
 
+Spaces on the same G_h often share P (the standard, dual and transformed bases of one element
+all live in discontinuous Q_s on the cells): inside :func:`shared_piece_sums` their Grams reuse
+the partial sums S_P(n) computed for the first of them (the series of P does not depend on μ).
+
 That μ ∈ P is checked (residual of the projection at points of a finer rule): a space whose
 pieces are not axis-aligned rectangles (4C ``pwlin`` on QUAD8) is refused.
 """
 from __future__ import annotations
 
+import contextlib
+
 import numpy as np
+import scipy.sparse as sp
 
 from ..errors import InputError
-from .face_norms import extrapolated, gram_l2_face, partial_gram
+from .face_norms import extrapolated, partial_gram
 from .face_spaces import FaceSpace
 from .multipliers import make_space
-from .norms import N_MAX_CAP, gram_by_norm
+from .norms import N_MAX_CAP, gram_by_norm, gram_l2
 from .quadrature import gauss_legendre
 
 #: Largest |μ − R P| / max|μ| accepted at the check points (round-off of the projection).
 PROJECTION_TOL = 1e-9
+
+_shared: dict | None = None
+"""The partial sums S_P(n) kept while a :func:`shared_piece_sums` block is open: those of one
+piece space at a time ({"key": its partition and degree, "sums": {n: S_P(n)}}), else None."""
+
+
+@contextlib.contextmanager
+def shared_piece_sums():
+    """Within the block, :func:`gram_h_cellwise` keeps the partial sums S_P(n) of the latest
+    piece space P and reuses them for every space on the same P (the same numbers: S_P(n) does
+    not depend on μ). Memory: the levels n0, 2 n0, ... of one P, (dim P)² doubles each, released
+    when another P is asked for and when the outermost block ends."""
+    global _shared
+    outer = _shared
+    _shared = {} if outer is None else outer
+    try:
+        yield
+    finally:
+        _shared = outer
+
+
+def piece_partial_gram(P: FaceSpace, n: int) -> np.ndarray:
+    """S_P(n) of :func:`~.face_norms.partial_gram`, from the shared sums when a
+    :func:`shared_piece_sums` block is open."""
+    if _shared is None:
+        return partial_gram(P, n)
+    key = (np.asarray(P.breakpoints.xs, float).tobytes(), np.asarray(P.breakpoints.ys, float).tobytes(), P.degree)
+    if _shared.get("key") != key:
+        _shared.clear()
+        _shared.update(key=key, sums={})
+    sums = _shared["sums"]
+    if n not in sums:
+        sums[n] = partial_gram(P, n)
+    return sums[n]
 
 
 def piece_rule(partition, points: int) -> tuple[np.ndarray, np.ndarray]:
@@ -60,16 +101,45 @@ def piece_space(space) -> FaceSpace:
     return FaceSpace(make_space(pieces.xs, s, False, False), make_space(pieces.ys, s, False, False), pieces)
 
 
-def projection(space) -> tuple[np.ndarray, FaceSpace]:
-    """(R, P) with μ_j = Σ_p R_jp P_p (module docstring), the identity checked at other points."""
+def sparse_values(space, x: np.ndarray, scale: np.ndarray | None = None) -> sp.csr_matrix:
+    """E[q, j] = μ_j(x_q) (times ``scale[q]``), shape (len(x), dim): ``space.evaluate(x)`` built
+    from its nonzero pattern (``local_values``), the same numbers without the dense array."""
+    vals, dofs = space.local_values(x)
+    if scale is not None:
+        vals = vals * scale[:, None]
+    rows = np.broadcast_to(np.arange(len(vals))[:, None], dofs.shape)
+    keep = dofs >= 0
+    return sp.csr_matrix((vals[keep], (rows[keep], dofs[keep])), shape=(len(vals), space.dim))
+
+
+def block_inverse_mass(space) -> sp.csr_matrix:
+    """G⁻¹ of the exact L² mass matrix G of a discontinuous 1D space, inverted interval block
+    by interval block: no dof is shared by two intervals, so G is block diagonal (checked)."""
+    G = gram_l2(space)
+    d = space.dofs                                                    # (intervals, s + 1)
+    blocks = G[d[:, :, None], d[:, None, :]]
+    if np.any(d < 0) or np.count_nonzero(G) != np.count_nonzero(blocks):
+        raise InputError("space", "a discontinuous 1D space with every shape live (block-diagonal mass)",
+                         got=space)
+    inv = np.linalg.inv(blocks)
+    rows, cols = np.broadcast_to(d[:, :, None], inv.shape), np.broadcast_to(d[:, None, :], inv.shape)
+    return sp.csr_matrix((inv.ravel(), (rows.ravel(), cols.ravel())), shape=G.shape)
+
+
+def projection(space) -> tuple[sp.csr_matrix, FaceSpace]:
+    """(R, P) with μ_j = Σ_p R_jp P_p (module docstring), the identity checked at other points.
+
+    R is sparse (μ_j meets the pieces of its support only) and formed piece by piece:
+    C = ∫ μ Pᵀ from both spaces' nonzero patterns at the per-piece Gauss points, and
+    R = C G_P⁻¹ with G_P⁻¹ = G_x⁻¹ ⊗ G_y⁻¹, the 1D masses of P inverted block by block."""
     P = piece_space(space)
     s = space.piece_degree
     x, w = piece_rule(P.breakpoints, s + 1)
-    C = (space.evaluate(x) * w[:, None]).T @ P.evaluate(x)
-    R = np.linalg.solve(gram_l2_face(P), C.T).T
+    C = sparse_values(space, x, w).T @ sparse_values(P, x)
+    R = (C @ sp.kron(*(block_inverse_mass(f) for f in P.factors), format="csr")).tocsr()
     xc, _ = piece_rule(P.breakpoints, s + 2)
-    mu = space.evaluate(xc)
-    err = np.max(np.abs(mu - P.evaluate(xc) @ R.T)) / max(np.max(np.abs(mu)), 1e-300)
+    mu = sparse_values(space, xc)
+    err = abs(mu - sparse_values(P, xc) @ R.T).max() / max(abs(mu).max(), 1e-300)
     if err > PROJECTION_TOL:
         raise InputError("space", f"a face space in Q_{s} on each piece (projection residual {err:.2e})",
                          got=getattr(space, "element", space))
@@ -80,8 +150,7 @@ def gram_l2_cellwise(space) -> np.ndarray:
     """Exact L²(Γ) Gram ∫ μ_i μ_j by the per-piece Gauss rule of degree 2s per variable."""
     P = piece_space(space)
     x, w = piece_rule(P.breakpoints, space.piece_degree + 1)
-    E = space.evaluate(x)
-    G = (E * w[:, None]).T @ E
+    G = (sparse_values(space, x, w).T @ sparse_values(space, x)).toarray()
     return 0.5 * (G + G.T)
 
 
@@ -97,7 +166,8 @@ def gram_h_cellwise(space, rtol: float = 1e-6, n_start: int | None = None, n_cap
     n0 = max(16, 2 * (space.piece_degree + 1) * n_int) if n_start is None else int(n_start)
 
     def partial(n):
-        S = R @ partial_gram(P, n) @ R.T
+        RS = R @ piece_partial_gram(P, n)           # sparse × dense: (dim, dim P)
+        S = np.asarray(R @ RS.T)
         return 0.5 * (S + S.T)
 
     return extrapolated(partial, p, n0, n_cap, rtol)

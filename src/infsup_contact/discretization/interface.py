@@ -28,6 +28,7 @@ common refinement by polygon clipping).
 from __future__ import annotations
 
 import abc
+import contextlib
 
 import numpy as np
 
@@ -258,6 +259,11 @@ class Interface(abc.ABC):
         info : dict
             ``n_max`` and ``nmax_rel_error`` of a truncated route (0 for exact ones).
         """
+
+    def gram_session(self):
+        """A context in which :meth:`gram` may share work between the spaces of one G_h (the
+        same matrices as without it, only computed once); nothing to share by default."""
+        return contextlib.nullcontext()
 
     # --- spaces and dimension counts --------------------------------------------------------
     @abc.abstractmethod

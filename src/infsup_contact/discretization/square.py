@@ -311,6 +311,13 @@ class Square(Interface):
             return gram_triangles(space, norm, **kwargs)
         return (gram if hasattr(space, "factors") else gram_cellwise)(space, norm, **kwargs)
 
+    def gram_session(self):
+        """Spaces on one G_h that share a piece space reuse its series
+        (:func:`~.face_cellwise_norms.shared_piece_sums`)."""
+        from .face_cellwise_norms import shared_piece_sums
+
+        return shared_piece_sums()
+
     def builds(self, spec) -> bool:
         """Whether ``spec`` is defined on this face's cells (``spec.face_cells``)."""
         return self.cell in getattr(spec, "face_cells", CELL_SHAPES)

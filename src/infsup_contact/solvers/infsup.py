@@ -237,52 +237,53 @@ def beta_rows_all(family, k, n1, n2, cases=None, multiplier_meshes=("omega2",), 
     p1, p2 = (s.trace.partition for s in sides)
     dim_w = gamma.trace_sum_dimension(k, p1, p2)
     rows, by_partition = [], {}
-    for multiplier_mesh in multiplier_meshes:
-        g_h = gamma.multiplier_partition(p1, p2, multiplier_mesh)
-        same = by_partition.get(gamma.partition_key(g_h))
-        if same is not None:
-            rows += [dict(r, multiplier_mesh=multiplier_mesh, t_assemble=0.0, t_interface=0.0, t_eig=0.0)
-                     for r in same]
-            continue
-        first = len(rows)
-        for case in cases:
-            space = _space(case, k, g_h, gamma)
-            tc = time.perf_counter()
-            iterative = space.dim > bottom.DENSE_MAX_M  # the large route: sparse B, no dense eigensolver
-            couplings = [coupling_matrix(s.trace, space, k, sparse=iterative) for s in sides]
-            t_coupling = time.perf_counter() - tc
-            grams = {norm: gamma.gram(space, norm, h_route=h_route) for norm in norms}
-            structural = gamma.proven_kernel(space, k, [s.trace for s in sides], dim_w)
-            kernel = space_kernel(couplings, sides, space, k, structural,
-                                  grams["L2"][0] if "L2" in grams else None, iterative=iterative)
-            terms = interface_terms(couplings, sides)
-            factors = {norm: gram_factor(G) for norm, (G, _) in grams.items()}
-            beta_v1_zero_c1 = betas_v1_zero(terms, factors, kernel, iterative)
-            for c1, c2 in c_pairs:
-                S = combine_terms(terms, (c1, c2))
-                if iterative:  # the norms' pencils share work: each row gets an equal share of the time
-                    te = time.perf_counter()
-                    spectra = bottom_spectra(S, factors, kernel)
-                    t_shared = (time.perf_counter() - te) / len(norms)
-                for norm in norms:
-                    te = time.perf_counter()
-                    info = grams[norm][1]
-                    sp_ = spectra[norm] if iterative else spectrum(S, factor=factors[norm], kernel=kernel)
-                    beta_v1_zero = beta_v1_zero_c1[norm] / np.sqrt(c2)
-                    rows.append(dict(
-                        case=registry.case_name(case), k=k, family=family, N1=n1, N2=n2,
-                        multiplier_mesh=multiplier_mesh, c1=c1, c2=c2, norm=norm, beta=sp_.beta,
-                        kernel_dim=sp_.kernel_dim, structural_kernel_dim=structural,
-                        kernel_detected=kernel.detected, kernel_margin_decades=kernel.margin_decades,
-                        kernel_decision=kernel.decision,
-                        kernel_check=kernel_check(kernel.numerical, structural), gap_over_roundoff=sp_.gap,
-                        smallest_nonzero=sp_.smallest_nonzero, beta_v1_zero=beta_v1_zero,
-                        dim_M=space.dim, dim_W=dim_w,
-                        n_max=info["n_max"], nmax_rel_error=info["nmax_rel_error"],
-                        ndof=sum(s.ndof for s in sides), t_assemble=t_coupling,
-                        t_interface=t2 - t1,
-                        t_eig=t_shared if iterative else time.perf_counter() - te))
-        by_partition[gamma.partition_key(g_h)] = rows[first:]
+    with gamma.gram_session():  # spaces on one G_h may share their Grams' series
+        for multiplier_mesh in multiplier_meshes:
+            g_h = gamma.multiplier_partition(p1, p2, multiplier_mesh)
+            same = by_partition.get(gamma.partition_key(g_h))
+            if same is not None:
+                rows += [dict(r, multiplier_mesh=multiplier_mesh, t_assemble=0.0, t_interface=0.0, t_eig=0.0)
+                         for r in same]
+                continue
+            first = len(rows)
+            for case in cases:
+                space = _space(case, k, g_h, gamma)
+                tc = time.perf_counter()
+                iterative = space.dim > bottom.DENSE_MAX_M  # the large route: sparse B, no dense eigensolver
+                couplings = [coupling_matrix(s.trace, space, k, sparse=iterative) for s in sides]
+                t_coupling = time.perf_counter() - tc
+                grams = {norm: gamma.gram(space, norm, h_route=h_route) for norm in norms}
+                structural = gamma.proven_kernel(space, k, [s.trace for s in sides], dim_w)
+                kernel = space_kernel(couplings, sides, space, k, structural,
+                                      grams["L2"][0] if "L2" in grams else None, iterative=iterative)
+                terms = interface_terms(couplings, sides)
+                factors = {norm: gram_factor(G) for norm, (G, _) in grams.items()}
+                beta_v1_zero_c1 = betas_v1_zero(terms, factors, kernel, iterative)
+                for c1, c2 in c_pairs:
+                    S = combine_terms(terms, (c1, c2))
+                    if iterative:  # the norms' pencils share work: each row gets an equal share of the time
+                        te = time.perf_counter()
+                        spectra = bottom_spectra(S, factors, kernel)
+                        t_shared = (time.perf_counter() - te) / len(norms)
+                    for norm in norms:
+                        te = time.perf_counter()
+                        info = grams[norm][1]
+                        sp_ = spectra[norm] if iterative else spectrum(S, factor=factors[norm], kernel=kernel)
+                        beta_v1_zero = beta_v1_zero_c1[norm] / np.sqrt(c2)
+                        rows.append(dict(
+                            case=registry.case_name(case), k=k, family=family, N1=n1, N2=n2,
+                            multiplier_mesh=multiplier_mesh, c1=c1, c2=c2, norm=norm, beta=sp_.beta,
+                            kernel_dim=sp_.kernel_dim, structural_kernel_dim=structural,
+                            kernel_detected=kernel.detected, kernel_margin_decades=kernel.margin_decades,
+                            kernel_decision=kernel.decision,
+                            kernel_check=kernel_check(kernel.numerical, structural), gap_over_roundoff=sp_.gap,
+                            smallest_nonzero=sp_.smallest_nonzero, beta_v1_zero=beta_v1_zero,
+                            dim_M=space.dim, dim_W=dim_w,
+                            n_max=info["n_max"], nmax_rel_error=info["nmax_rel_error"],
+                            ndof=sum(s.ndof for s in sides), t_assemble=t_coupling,
+                            t_interface=t2 - t1,
+                            t_eig=t_shared if iterative else time.perf_counter() - te))
+            by_partition[gamma.partition_key(g_h)] = rows[first:]
     return rows
 
 

@@ -1,0 +1,88 @@
+"""The sparse projection of the cellwise face spaces and the shared series of their piece space
+(:mod:`infsup_contact.discretization.face_cellwise_norms`): two routes agree, the sharing
+changes no number, and it holds one piece space at a time."""
+import contextlib
+
+import numpy as np
+import pytest
+
+from infsup_contact.discretization import face_cellwise_norms as fcn
+from infsup_contact.discretization.face_cells import CellwiseFaceSpace
+from infsup_contact.discretization.face_norms import gram_l2_face
+from infsup_contact.discretization.multipliers import make_space
+from infsup_contact.discretization.norms import gram_l2
+from infsup_contact.discretization.segment import SEGMENT
+from infsup_contact.discretization.square import SQUARE, TensorPartition
+from infsup_contact.errors import InputError
+
+GRID = TensorPartition(np.array([0.0, 0.2, 0.45, 0.7, 1.0]), np.array([0.0, 0.35, 0.6, 1.0]))
+SPACES = [("QUAD9", "dual", True), ("QUAD9", "dual", False), ("QUAD8", "transformed_dual", True),
+          ("QUAD9", "transformed_dual", True), ("QUAD4", "dual", True), ("QUAD9", "pwlin", True),
+          ("QUAD9", "standard", True), ("QUAD8", "transformed", False)]
+
+
+def _space(element, basis, vanish):
+    return CellwiseFaceSpace(GRID, element, basis, vanish_on_boundary=vanish)
+
+
+@pytest.mark.parametrize("element,basis,vanish", SPACES)
+def test_sparse_values_are_evaluate(element, basis, vanish):
+    space = _space(element, basis, vanish)
+    x, w = fcn.piece_rule(space.pieces, 3)
+    assert np.array_equal(fcn.sparse_values(space, x).toarray(), space.evaluate(x))
+    assert np.array_equal(fcn.sparse_values(space, x, w).toarray(), space.evaluate(x) * w[:, None])
+
+
+@pytest.mark.parametrize("s", [0, 1, 2, 3])
+def test_block_inverse_mass_inverts_the_broken_mass(s):
+    f = make_space(np.array([0.0, 0.1, 0.4, 0.45, 1.0]), s, False, False)
+    assert np.allclose(fcn.block_inverse_mass(f) @ gram_l2(f), np.eye(f.dim), atol=1e-11)
+
+
+def test_block_inverse_mass_refuses_a_continuous_space():
+    with pytest.raises(InputError, match="discontinuous"):
+        fcn.block_inverse_mass(make_space(np.linspace(0, 1, 5), 2, True, False))
+
+
+@pytest.mark.parametrize("element,basis,vanish", SPACES)
+def test_projection_agrees_with_the_dense_solve(element, basis, vanish):
+    """R by blocks equals C G_P⁻¹ by a dense solve (the former route), and R P reproduces μ."""
+    space = _space(element, basis, vanish)
+    R, P = fcn.projection(space)
+    x, w = fcn.piece_rule(P.breakpoints, space.piece_degree + 1)
+    C = (space.evaluate(x) * w[:, None]).T @ P.evaluate(x)
+    dense = np.linalg.solve(gram_l2_face(P), C.T).T
+    assert np.abs(R.toarray() - dense).max() <= 1e-12 * np.abs(dense).max()
+    xc, _ = fcn.piece_rule(P.breakpoints, space.piece_degree + 3)
+    assert np.allclose(P.evaluate(xc) @ R.T.toarray(), space.evaluate(xc), atol=1e-12)
+
+
+@pytest.mark.parametrize("element,basis,vanish", SPACES[:3])
+def test_l2_gram_is_the_dense_quadrature(element, basis, vanish):
+    space = _space(element, basis, vanish)
+    x, w = fcn.piece_rule(space.pieces, space.piece_degree + 1)
+    E = space.evaluate(x)
+    assert np.allclose(fcn.gram_l2_cellwise(space), (E * w[:, None]).T @ E, rtol=0, atol=1e-15)
+
+
+def test_shared_sums_change_no_number_and_hold_one_piece_space():
+    spaces = [_space(*a) for a in SPACES[:4]] + [_space("QUAD9", "pwlin", True)]
+    alone = [fcn.gram_h_cellwise(s, rtol=1e-5) for s in spaces]
+    assert fcn._shared is None
+    with fcn.shared_piece_sums():
+        shared = [fcn.gram_h_cellwise(s, rtol=1e-5) for s in spaces[:4]]
+        cells_key = fcn._shared["key"]
+        assert len(fcn._shared["sums"]) >= 3            # n0, 2 n0, 4 n0 at least
+        with fcn.shared_piece_sums():                    # a nested block shares the outer one
+            shared.append(fcn.gram_h_cellwise(spaces[4], rtol=1e-5))
+        assert fcn._shared["key"] != cells_key           # pwlin's pieces replaced the cells' sums
+    assert fcn._shared is None
+    for (Ga, ia), (Gs, is_) in zip(alone, shared):
+        assert np.array_equal(Ga, Gs) and ia == is_
+
+
+def test_gram_sessions_of_the_interfaces():
+    assert isinstance(SEGMENT.gram_session(), contextlib.nullcontext)
+    with SQUARE.gram_session():
+        assert fcn._shared == {}
+    assert fcn._shared is None

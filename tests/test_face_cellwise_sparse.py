@@ -55,6 +55,10 @@ def test_projection_agrees_with_the_dense_solve(element, basis, vanish):
     assert np.abs(R.toarray() - dense).max() <= 1e-12 * np.abs(dense).max()
     xc, _ = fcn.piece_rule(P.breakpoints, space.piece_degree + 3)
     assert np.allclose(P.evaluate(xc) @ R.T.toarray(), space.evaluate(xc), atol=1e-12)
+    cells = [len(g) - 1 for g in (P.breakpoints.xs, P.breakpoints.ys)]
+    s = space.piece_degree      # continuous Q_s of the pieces, or discontinuous Q_s
+    expected = [s * c + 1 if space.continuous else (s + 1) * c for c in cells]
+    assert P.dim == expected[0] * expected[1]
 
 
 @pytest.mark.parametrize("element,basis,vanish", SPACES[:3])

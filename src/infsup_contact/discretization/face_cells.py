@@ -185,11 +185,16 @@ class CellwiseFaceSpace:
         return 1 if self.basis == "pwlin" else self.degree
 
     @property
+    def continuous(self) -> bool:
+        """Whether every basis function is continuous on Γ (the nodal bases: standard,
+        transformed, pwlin; the dual ones jump across the rectangles)."""
+        return self.basis in ("standard", "transformed", "pwlin")
+
+    @property
     def smooth_tail(self) -> bool:
         """Whether every basis function is continuous and vanishes on ∂Γ (sine coefficients
         ~ 1/(m² n²) in the tail, :func:`.face_norms.gram_h_face` exponent 4; else 2)."""
-        return bool(self.basis in ("standard", "transformed", "pwlin")
-                    and np.all(self.dofs[self._boundary_nodes()] < 0))
+        return bool(self.continuous and np.all(self.dofs[self._boundary_nodes()] < 0))
 
     def _boundary_nodes(self) -> np.ndarray:
         """Mask (cells, n_nodes) of the local nodes on ∂(0, 1)²."""

@@ -8,7 +8,10 @@ polynomial of degree ≤ s per variable, so it lies in the tensor space
 
 and μ_j = Σ_p R_jp P_p exactly. R is the L² projection onto P, computed with a Gauss rule
 exact per piece (s + 1 points per direction for the degree-2s products): R = C G_P⁻¹,
-C_jp = ∫ μ_j P_p, G_P = the exact L² Gram of P. Then
+C_jp = ∫ μ_j P_p, G_P = the exact L² Gram of P. A continuous basis (standard, transformed,
+pwlin) lies in the continuous Q_s of the pieces, M^1_s ⊗ M^1_s, a quarter of the dimension at
+s = 1 (4C pwlin on QUAD9 at N = 32: 4,225 instead of 16,384); there R_jp = μ_j(node p), the
+Lagrange interpolant being exact on P. Then
 
 * L²: G = ∫ μ μᵀ by the same rule (exact: the integrand has degree 2s per variable on a piece);
 * H = H^{1/2}_00(Γ)': μ_mn = Σ_p R_jp P^x_{a,m} P^y_{b,n}, the sine moments of a piece monomial
@@ -66,7 +69,8 @@ def piece_partial_gram(P: FaceSpace, n: int) -> np.ndarray:
     :func:`shared_piece_sums` block is open."""
     if _shared is None:
         return partial_gram(P, n)
-    key = (np.asarray(P.breakpoints.xs, float).tobytes(), np.asarray(P.breakpoints.ys, float).tobytes(), P.degree)
+    key = (np.asarray(P.breakpoints.xs, float).tobytes(), np.asarray(P.breakpoints.ys, float).tobytes(),
+           P.degree, P.dim)
     if _shared.get("key") != key:
         _shared.clear()
         _shared.update(key=key, sums={})
@@ -92,13 +96,14 @@ def piece_rule(partition, points: int) -> tuple[np.ndarray, np.ndarray]:
 
 
 def piece_space(space) -> FaceSpace:
-    """P = M^0_s ⊗ M^0_s on the space's pieces (:class:`InputError` if it has none)."""
+    """P = M^r_s ⊗ M^r_s on the space's pieces, r = 1 for a continuous space, else 0
+    (:class:`InputError` if it has none)."""
     pieces = getattr(space, "pieces", None)
     if pieces is None:
         raise InputError("space", "a face space that is polynomial on the rectangles of a tensor partition "
                          "(4C pwlin on QUAD8 has triangular pieces)", got=getattr(space, "element", space))
-    s = space.piece_degree
-    return FaceSpace(make_space(pieces.xs, s, False, False), make_space(pieces.ys, s, False, False), pieces)
+    s, cont = space.piece_degree, bool(getattr(space, "continuous", False))
+    return FaceSpace(make_space(pieces.xs, s, cont, False), make_space(pieces.ys, s, cont, False), pieces)
 
 
 def sparse_values(space, x: np.ndarray, scale: np.ndarray | None = None) -> sp.csr_matrix:
@@ -129,14 +134,19 @@ def block_inverse_mass(space) -> sp.csr_matrix:
 def projection(space) -> tuple[sp.csr_matrix, FaceSpace]:
     """(R, P) with μ_j = Σ_p R_jp P_p (module docstring), the identity checked at other points.
 
-    R is sparse (μ_j meets the pieces of its support only) and formed piece by piece:
-    C = ∫ μ Pᵀ from both spaces' nonzero patterns at the per-piece Gauss points, and
-    R = C G_P⁻¹ with G_P⁻¹ = G_x⁻¹ ⊗ G_y⁻¹, the 1D masses of P inverted block by block."""
+    R is sparse (μ_j meets the pieces of its support only). On a continuous P it holds the
+    nodal values; else it is formed piece by piece: C = ∫ μ Pᵀ from both spaces' nonzero
+    patterns at the per-piece Gauss points, R = C G_P⁻¹ with G_P⁻¹ = G_x⁻¹ ⊗ G_y⁻¹, the 1D
+    masses of P inverted block by block."""
     P = piece_space(space)
     s = space.piece_degree
-    x, w = piece_rule(P.breakpoints, s + 1)
-    C = sparse_values(space, x, w).T @ sparse_values(P, x)
-    R = (C @ sp.kron(*(block_inverse_mass(f) for f in P.factors), format="csr")).tocsr()
+    if P.sx.continuous:
+        R = sparse_values(space, P.nodes()).T.tocsr()
+    else:
+        x, w = piece_rule(P.breakpoints, s + 1)
+        C = sparse_values(space, x, w).T @ sparse_values(P, x)
+        R = (C @ sp.kron(*(block_inverse_mass(f) for f in P.factors), format="csr")).tocsr()
+    R.eliminate_zeros()
     xc, _ = piece_rule(P.breakpoints, s + 2)
     mu = sparse_values(space, xc)
     err = abs(mu - sparse_values(P, xc) @ R.T).max() / max(abs(mu).max(), 1e-300)

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import sys
 
-from .common import (material_columns, mesh_options, refuse_with_system, remember_defaults, add_dry_run, add_model, cases,
+from .common import (material_columns, mesh_options, refuse_with_system, remember_defaults, add_dry_run, add_model, cases, face_cases,
                      check_memory, material, norms, SPACE_HELP, write_csv)
 
 
@@ -22,8 +22,9 @@ def add(sub) -> None:
                        "the kernel over the pencil's round-off level n*eps*lambda_max (a cross-check).")
     p.add_argument("--case", default=None, choices=[*space_ids(None), "all"],
                    help="a registered space, or all (the default) for every one defined for k in the "
-                        "paper's list and the duals (a 3D face's quadratic-element multipliers, e.g. "
-                        "DUAL-Q9, PWLIN-Q9, are asked by name)")
+                        "paper's list and the duals; on a 3D model also every space its face elements "
+                        "build for k (k = 2: DUAL-Q9, TDUAL-Q8, PWLIN-Q9, ... on hexahedra, TDUAL-T6, "
+                        "PWLIN-T6 on tetrahedra; DUAL-Q8 and DUAL-T6, refused by construction, by name)")
     p.add_argument("--space", metavar="FILE.py:FUNC", help=SPACE_HELP)
     p.add_argument("--system", metavar="LEVELS.yaml", default=None,
                    help="a saddle-point system exported by another code (a manifest of mesh levels "
@@ -69,6 +70,7 @@ def _check_beta(args):
     args.cases = cases(args)
     material(args)
     args.mesh_kwargs = mesh_options(args)
+    args.cases = face_cases(args)
     check_inputs([c for c in args.cases if isinstance(c, str)], args.k, args.family, args.N1, args.N2,
                  args.c1, args.c2, norms(args), args.multiplier_mesh)
     check_perturbation(args.alpha, args.seed)

@@ -215,6 +215,25 @@ def ids_valid_for(k: int, ids=None, gamma_dim: int | None = 1) -> list:
     return [c for c in (space_ids(gamma_dim) if ids is None else ids) if SPACES[c].valid_for(k)]
 
 
+def ids_built_on(k: int, gamma, partition) -> list:
+    """The registered ids valid for degree k that ``gamma`` builds on ``partition``: defined on
+    its dimension and its cells (``gamma.builds``, a face's rectangles or triangles), and not
+    refused there (an entry that refuses its construction, e.g. a dual basis with a weight
+    ≤ 0 such as DUAL-Q8, raises :class:`InputError` "case" naming its remedy; it is left out)."""
+    out = []
+    for case in ids_valid_for(k, gamma_dim=gamma.dim):
+        if not getattr(gamma, "builds", lambda spec: True)(SPACES[case]):
+            continue
+        try:
+            gamma.space(SPACES[case], k, partition)
+        except InputError as err:
+            if err.key != "case":
+                raise
+            continue
+        out.append(case)
+    return out
+
+
 def check_case(case: str, k: int) -> None:
     """Raise :class:`InputError` unless ``case`` is registered and valid for degree ``k``."""
     spec = space_spec(case)

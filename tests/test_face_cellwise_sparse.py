@@ -90,3 +90,24 @@ def test_gram_sessions_of_the_interfaces():
     with SQUARE.gram_session():
         assert fcn._shared == {}
     assert fcn._shared is None
+
+
+def test_the_raised_start_gives_the_same_gram_when_the_last_levels_agree():
+    """start_level: on the exponential-sum route a p = 2 series starts 4 n0 higher; the
+    extrapolation uses the last three levels only, so it returns the very matrix of the
+    levels from n0 whenever both stop at the same n_max."""
+    from infsup_contact.discretization import face_norms as fn
+    from infsup_contact.discretization.face_spaces import FaceSpace
+
+    f = make_space(np.linspace(0, 1, 21), 1, False, False)      # dim 40² = 1600 > 1500, p = 2
+    space = FaceSpace(f, f, TensorPartition(np.linspace(0, 1, 21), np.linspace(0, 1, 21)))
+    assert space.dim > fn.EXP_SUM_MIN_DIM and fn.start_level(80, 2.0, space.dim) == 4 * 80
+    assert fn.start_level(80, 4.0, space.dim) == 80 and fn.start_level(80, 2.0, 1500) == 80
+    G_raised, info = fn.gram_h_face(space, rtol=1e-5)
+    G_from_n0, info0 = fn.gram_h_face(space, rtol=1e-5, n_start=80)
+    assert info["n_start"] == 320 and info0["n_start"] == 80
+    if info["n_max"] == info0["n_max"]:
+        assert np.array_equal(G_raised, G_from_n0)
+    else:                           # n_max ≥ 4·320 > the levels' stop: a later, tighter pair
+        assert info["n_max"] > info0["n_max"]
+        assert np.abs(G_raised - G_from_n0).max() <= 10 * 1e-5 * np.abs(G_raised).max()

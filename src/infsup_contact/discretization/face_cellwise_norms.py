@@ -35,7 +35,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..errors import InputError
-from .face_norms import extrapolated, partial_gram
+from .face_norms import extrapolated, partial_gram, start_level
 from .face_spaces import FaceSpace
 from .multipliers import make_space
 from .norms import N_MAX_CAP, gram_by_norm, gram_l2
@@ -167,13 +167,15 @@ def gram_l2_cellwise(space) -> np.ndarray:
 def gram_h_cellwise(space, rtol: float = 1e-6, n_start: int | None = None, n_cap: int = N_MAX_CAP // 8,
                     exponent: float | None = None) -> tuple[np.ndarray, dict]:
     """The H^{1/2}_00(Γ)' Gram matrix (module docstring); arguments as :func:`~.face_norms.gram_h_face`
-    (n0 default max(16, 2 (s + 1) N), N the pieces per direction)."""
+    (n0 default max(16, 2 (s + 1) N), N the pieces per direction, raised on the exponential-sum
+    route as there, :func:`~.face_norms.start_level`)."""
     if not rtol > 0:
         raise InputError("rtol", "a positive float", got=rtol)
     R, P = projection(space)
     p = (4.0 if space.smooth_tail else 2.0) if exponent is None else float(exponent)
     n_int = max(len(P.breakpoints.xs), len(P.breakpoints.ys)) - 1
-    n0 = max(16, 2 * (space.piece_degree + 1) * n_int) if n_start is None else int(n_start)
+    n0 = (start_level(max(16, 2 * (space.piece_degree + 1) * n_int), p, P.dim) if n_start is None
+          else int(n_start))
 
     def partial(n):
         RS = R @ piece_partial_gram(P, n)           # sparse × dense: (dim, dim P)

@@ -32,6 +32,11 @@ EXP_SUM_MIN_DIM = 1500
 (:mod:`.exponential_sum`): n_max · r (dim M^x² + dim M^y²) + r (dim M)² operations with r ≈ 260
 terms instead of n_max² dim M^y² + n_max (dim M)²; the same as :data:`.bottom.DENSE_MAX_M`, so
 the default DAG's Grams (all below it) stay the direct sums, bit for bit."""
+EXP_SUM_START = 4
+"""Factor of the first level on the exponential-sum route for a slow tail (:func:`start_level`):
+there a level costs about the same at every n (its product has dim² · r terms, n-independent),
+and the p = 2 spaces stopped at n_max ≥ 16 n0 at N = 32, k = 2 but R5.2 (8 n0: one level more
+there); the levels n0 and 2 n0 were cost without a use."""
 EXP_SUM_RTOL = 1e-13
 """Relative accuracy of the exponential sum's weights: every eigenvalue of a pencil with the Gram
 moves by at most this factor (Loewner order), far below the series' own ``rtol``."""
@@ -87,12 +92,24 @@ def _symmetric_from_pairs(flat: np.ndarray, dx: int, dy: int) -> np.ndarray:
 def _separable_sum(A: np.ndarray, B: np.ndarray, n: np.ndarray, aspect: float) -> np.ndarray:
     """A W Bᵀ for W[m, n] = a / (π√((m/a)² + n²)) written as Σ_j w_j e^{−a_j (m/a)²} e^{−a_j n²}
     (:func:`.exponential_sum.inverse_sqrt`, relative accuracy :data:`EXP_SUM_RTOL`):
-    (A E_x) diag(a w / π) (B E_y)ᵀ, never forming W."""
+    (A E_x) diag(a w / π) (B E_y)ᵀ, never forming W (B E_y is A E_x itself when the two
+    directions are the same: one product of dim² · n_max · r fewer)."""
     x_lo, x_hi = (1.0 / aspect) ** 2 + 1.0, (n[-1] / aspect) ** 2 + n[-1] ** 2
     expo = inverse_sqrt(min(x_lo, x_hi), max(x_lo, x_hi), EXP_SUM_RTOL)
     Ex = np.exp(-np.multiply.outer((n / aspect) ** 2, expo.rates))
-    Ey = np.exp(-np.multiply.outer(n ** 2, expo.rates))
-    return ((A @ Ex) * (aspect * expo.weights / np.pi)) @ (B @ Ey).T
+    AE = A @ Ex
+    same = aspect == 1.0 and (B is A or np.array_equal(A, B))
+    BE = AE if same else B @ np.exp(-np.multiply.outer(n ** 2, expo.rates))
+    return (AE * (aspect * expo.weights / np.pi)) @ BE.T
+
+
+def start_level(n0: int, p: float, dim: int) -> int:
+    """The first n of the Richardson levels: n0, or :data:`EXP_SUM_START` n0 for a slow tail
+    (p = 2) on the exponential-sum route (``dim`` = the dimension :func:`partial_gram` sums in,
+    above :data:`EXP_SUM_MIN_DIM`). The result is that of the levels from n0 whenever those
+    would have stopped at n_max ≥ 4 · EXP_SUM_START · n0 (the extrapolation and its error use
+    the last three levels only)."""
+    return EXP_SUM_START * n0 if p <= 2.0 and dim > EXP_SUM_MIN_DIM else n0
 
 
 def smooth_tail(space) -> bool:
@@ -122,7 +139,8 @@ def gram_h_face(space, rtol: float = 1e-6, n_start: int | None = None, n_cap: in
     rtol : float
         Target relative (spectral-norm) truncation error.
     n_start : int, optional
-        n0; default max(16, 2 (s + 1) N) with N the larger number of intervals per direction.
+        n0; default max(16, 2 (s + 1) N) with N the larger number of intervals per direction,
+        times :data:`EXP_SUM_START` for a slow tail on the exponential-sum route (:func:`start_level`).
     n_cap : int
         Largest n_max (``info["capped"]`` when the estimate is still above rtol there).
     exponent : float, optional
@@ -144,6 +162,8 @@ def gram_h_face(space, rtol: float = 1e-6, n_start: int | None = None, n_cap: in
     n0 = max(16, 2 * (space.degree + 1) * n_int) if n_start is None else int(n_start)
     if not aspect > 0:
         raise InputError("aspect", "a positive float", got=aspect)
+    if n_start is None:
+        n0 = start_level(n0, p, space.dim)
     return extrapolated(lambda n: partial_gram(space, n, aspect), p, n0, n_cap, rtol)
 
 

@@ -23,12 +23,15 @@ ratio of increments, :func:`tail_exponent`), not assumed: it decides the Richard
 """
 from __future__ import annotations
 
+from functools import lru_cache
+
 import numpy as np
 from scipy import sparse
 
 from ..errors import InputError
 from .face_norms import _norm2, extrapolated
 from .face_quadrature import triangles_rule
+from .face_triangle_symmetry import ReflectedGram, reflection
 from .face_triangles import lagrange_barycentric
 from .norms import N_MAX_CAP, gram_by_norm
 
@@ -224,9 +227,21 @@ def chunk_rows(space, n_max: int) -> int:
     return int(min(n_max, max(1, _BUDGET // per_row)))
 
 
+@lru_cache(maxsize=8)
+def _reflection(space):
+    """:func:`~.face_triangle_symmetry.reflection`, once per space (the Richardson loop asks
+    several partial sums of the same space)."""
+    return reflection(space)
+
+
 def partial_gram(space, n_max: int) -> np.ndarray:
-    """S(n_max) = Σ_{m,n ≤ n_max} μ_mn μ_mnᵀ / (π√(m² + n²)), in row blocks of m."""
+    """S(n_max) = Σ_{m,n ≤ n_max} μ_mn μ_mnᵀ / (π√(m² + n²)), in row blocks of m
+    (:func:`chunk_rows`); on a space the point reflection of Γ maps onto itself, through its
+    symmetric and antisymmetric halves (:class:`~.face_triangle_symmetry.ReflectedGram`, a
+    quarter of the flops)."""
     n = np.arange(1, n_max + 1, dtype=float)
+    pi = _reflection(space)
+    halves = None if pi is None else ReflectedGram(pi)
     G = np.zeros((space.dim, space.dim))
     shapes = {}
     rows = chunk_rows(space, n_max)
@@ -234,8 +249,13 @@ def partial_gram(space, n_max: int) -> np.ndarray:
         m = n[start:start + rows]
         C = sine_coefficients_chunk(space, m, n_max, shapes=shapes)
         C *= (1.0 / np.sqrt(np.pi * np.sqrt(m[:, None] ** 2 + n[None, :] ** 2)))[None]
+        if halves is not None:
+            halves.add(C, m, n)
+            continue
         C = C.reshape(space.dim, -1)
         G += C @ C.T
+    if halves is not None:
+        G = halves.gram()
     return 0.5 * (G + G.T)
 
 

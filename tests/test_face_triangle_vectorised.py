@@ -104,3 +104,13 @@ def test_chunk_rows_keep_the_budget():
     for n_max in (16, 512, 4096):
         rows = ftn.chunk_rows(space, n_max)
         assert 1 <= rows <= n_max and (rows == 1 or space.dim * rows * n_max <= ftn._BUDGET)
+
+
+@pytest.mark.parametrize("s,continuous,vanish,dual", [(1, False, False, False), (2, True, True, True)])
+def test_coefficients_of_a_subset_of_dofs(s, continuous, vanish, dual):
+    """The rows asked (any order) of the coefficients are those of every dof."""
+    space = TriangleSpace(PARTITIONS["graded"], s, continuous, vanish, dual)
+    m = np.arange(4, 11)
+    full = ftn.sine_coefficients_chunk(space, m, 15)
+    ask = np.random.default_rng(5).permutation(space.dim)[: space.dim // 2]
+    _close(ftn._coefficients(space, m, 15, dofs_out=ask), full[ask])

@@ -171,7 +171,15 @@ def sine_coefficients_chunk(space, m: np.ndarray, n_max: int, q: int | None = No
                             shapes: dict | None = None) -> np.ndarray:
     """μ_mn = 2 ∬ φ sin(mπx) sin(nπy) for every basis function, m in ``m``, n = 1..n_max:
     shape (dim, len(m), n_max). ``shapes`` caches the :class:`_Shape` s across blocks of m
-    (same n_max and q); ``q`` overrides :func:`coefficient_points`.
+    (same n_max and q); ``q`` overrides :func:`coefficient_points`. :func:`_coefficients` of
+    every dof."""
+    return _coefficients(space, m, n_max, q, shapes)
+
+
+def _coefficients(space, m: np.ndarray, n_max: int, q: int | None = None, shapes: dict | None = None,
+                  dofs_out: np.ndarray | None = None) -> np.ndarray:
+    """:func:`sine_coefficients_chunk` of the dofs ``dofs_out`` only (None: all), in that order:
+    shape (len(dofs_out), len(m), n_max).
 
     Vectorised over the cells (module docstring): with tx_c[i, m] = sin(mπx_i),
     tx_s[i, m] = cos(mπx_i) (likewise ty_b[j, n] in y), the raw local function l of the triangle
@@ -193,6 +201,11 @@ def sine_coefficients_chunk(space, m: np.ndarray, n_max: int, q: int | None = No
     dofs, nloc = space._dofs, space.n_local
     shapes = {} if shapes is None else shapes
     mm = np.arange(rows_m)
+    position = np.arange(space.dim)  # output row of each dof, −1: not asked
+    if dofs_out is not None:
+        position = np.full(space.dim, -1)
+        position[dofs_out] = np.arange(len(dofs_out))
+    n_out = space.dim if dofs_out is None else len(dofs_out)
     Us, rows, cols, vals = [], [], [], []
     offset = 0  # first row of the current U in the stack, in units of rows_m
     for I, hx in _width_groups(xs):
@@ -208,6 +221,8 @@ def sine_coefficients_chunk(space, m: np.ndarray, n_max: int, q: int | None = No
                 Us += [(ty["c"][J][:, None, None, :] * R[(a, "c")][None]
                         + ty["s"][J][:, None, None, :] * R[(a, "s")][None]).reshape(-1, n_max) for a in "cs"]
                 g, col, z = _scatter(space, cells[:, :, tri].reshape(-1, nloc))
+                g = position[g]
+                g, col, z = g[g >= 0], col[g >= 0], z[g >= 0]
                 i, jl = np.divmod(col, width)  # cell row in I, (j, l) within it
                 v = 2.0 * z[None, :, None] * tx[:, I[i], :]  # (a, nnz, m)
                 rows.append(np.broadcast_to(g[None, :, None] * rows_m + mm, v.shape).ravel())
@@ -215,8 +230,8 @@ def sine_coefficients_chunk(space, m: np.ndarray, n_max: int, q: int | None = No
                 vals.append(v.ravel())
                 offset += 2 * width
     W = sparse.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
-                          shape=(space.dim * rows_m, offset * rows_m))
-    return (W @ np.vstack(Us)).reshape(space.dim, rows_m, n_max)
+                          shape=(n_out * rows_m, offset * rows_m))
+    return (W @ np.vstack(Us)).reshape(n_out, rows_m, n_max)
 
 
 def chunk_rows(space, n_max: int) -> int:
@@ -247,7 +262,7 @@ def partial_gram(space, n_max: int) -> np.ndarray:
     rows = chunk_rows(space, n_max)
     for start in range(0, n_max, rows):
         m = n[start:start + rows]
-        C = sine_coefficients_chunk(space, m, n_max, shapes=shapes)
+        C = _coefficients(space, m, n_max, shapes=shapes, dofs_out=None if halves is None else halves.even_rows)
         C *= (1.0 / np.sqrt(np.pi * np.sqrt(m[:, None] ** 2 + n[None, :] ** 2)))[None]
         if halves is not None:
             halves.add(C, m, n)

@@ -61,18 +61,20 @@ class ReflectedGram:
         self.w_even = np.concatenate([np.full(self.rep.size, np.sqrt(2.0)), np.ones(self.fixed.size)])
 
     def add(self, C: np.ndarray, m: np.ndarray, n: np.ndarray) -> None:
-        """Add the columns of the block C (dim, len(m), len(n)), weighted already; ``m`` and ``n``
-        consecutive integers, so the columns of one parity of m + n are strided slices: rows m of
-        one parity, every other n (one copy of the selected rows, no mask)."""
+        """Add the columns of the block C (len(even_rows), len(m), len(n)): the weighted
+        coefficients of the dofs :attr:`even_rows` (the pairs' representatives g < π(g), then the
+        fixed points; the others are ± these); ``m`` and ``n`` consecutive integers, so the
+        columns of one parity of m + n are strided slices: rows m of one parity, every other n
+        (one copy, no mask)."""
         if np.any(np.diff(m) != 1) or np.any(np.diff(n) != 1):
             raise InputError("m/n", "consecutive integers", got=(m, n))
         for pm in (0, 1):  # the rows m ≡ pm (mod 2)
             k0 = (pm - int(m[0])) % 2
-            for G, rows, same in ((self.Ge, self.even_rows, True), (self.Go, self.rep, False)):
+            for G, rows, same in ((self.Ge, slice(None), True), (self.Go, slice(0, self.rep.size), False)):
                 j0 = ((pm if same else 1 - pm) - int(n[0])) % 2  # n ≡ m (m + n even) or not
                 block = C[rows, k0::2, j0::2]
                 if block.size:
-                    block = block.reshape(rows.size, -1)
+                    block = block.reshape(block.shape[0], -1)
                     G += block @ block.T
 
     def gram(self) -> np.ndarray:

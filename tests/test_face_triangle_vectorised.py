@@ -84,15 +84,25 @@ def test_fixed_rule_and_rows_beyond_n_max(s, continuous, vanish, dual):
     _close(ftn.sine_coefficients_chunk(space, m, 12, q=60), _sine_coefficients_loop(space, m, 12, q=60))
 
 
+@pytest.mark.parametrize("part", ["graded", "square"])
 @pytest.mark.parametrize("s,continuous,vanish,dual", [(1, False, False, False), (2, True, True, False),
                                                       (1, True, True, True)])
-def test_partial_grams_by_both_routes(monkeypatch, s, continuous, vanish, dual):
-    """S(n_max) with the vectorised coefficients in memory-sized blocks of m against S(n_max)
-    with the loop's coefficients in blocks of one row: SPD and equal to round-off."""
-    space = TriangleSpace(PARTITIONS["graded"], s, continuous, vanish, dual)
+def test_partial_grams_by_both_routes(monkeypatch, part, s, continuous, vanish, dual):
+    """S(n_max) as computed (vectorised coefficients in memory-sized blocks of m; on the square
+    grid through its reflection and transposition) against the plain Σ C Cᵀ of the loop's
+    coefficients in blocks of one row: SPD and equal to round-off."""
+    grid = PARTITIONS["graded"] if part == "graded" else TensorPartition(np.linspace(0, 1, 4), np.linspace(0, 1, 4))
+    space = TriangleSpace(grid, s, continuous, vanish, dual)
+    assert (ftn._symmetries(space)[1] is None) == (part == "graded")
     new = ftn.partial_gram(space, 48)
     assert ftn.chunk_rows(space, 48) == 48  # one block
-    monkeypatch.setattr(ftn, "sine_coefficients_chunk", _sine_coefficients_loop)
+
+    def loop(space, m, n_max, q=None, shapes=None, dofs_out=None, n_from=1):
+        assert dofs_out is None and n_from == 1
+        return _sine_coefficients_loop(space, m, n_max, q, shapes)
+
+    monkeypatch.setattr(ftn, "_coefficients", loop)
+    monkeypatch.setattr(ftn, "_symmetries", lambda space: (None, None))
     monkeypatch.setattr(ftn, "chunk_rows", lambda space, n_max: 1)
     old = ftn.partial_gram(space, 48)
     _close(new, old)

@@ -31,7 +31,7 @@ from scipy import sparse
 from ..errors import InputError
 from .face_norms import _norm2, extrapolated
 from .face_quadrature import triangles_rule
-from .face_triangle_symmetry import ReflectedGram, reflection
+from .face_triangle_symmetry import ReflectedGram, reflection, transposition
 from .face_triangles import lagrange_barycentric
 from .norms import N_MAX_CAP, gram_by_norm
 
@@ -177,9 +177,9 @@ def sine_coefficients_chunk(space, m: np.ndarray, n_max: int, q: int | None = No
 
 
 def _coefficients(space, m: np.ndarray, n_max: int, q: int | None = None, shapes: dict | None = None,
-                  dofs_out: np.ndarray | None = None) -> np.ndarray:
-    """:func:`sine_coefficients_chunk` of the dofs ``dofs_out`` only (None: all), in that order:
-    shape (len(dofs_out), len(m), n_max).
+                  dofs_out: np.ndarray | None = None, n_from: int = 1) -> np.ndarray:
+    """:func:`sine_coefficients_chunk` of the dofs ``dofs_out`` only (None: all), in that order,
+    and of n = n_from..n_max only: shape (len(dofs_out), len(m), n_max − n_from + 1).
 
     Vectorised over the cells (module docstring): with tx_c[i, m] = sin(mπx_i),
     tx_s[i, m] = cos(mπx_i) (likewise ty_b[j, n] in y), the raw local function l of the triangle
@@ -198,6 +198,9 @@ def _coefficients(space, m: np.ndarray, n_max: int, q: int | None = None, shapes
     # sin(mπ(x0 + X)) = sin(mπx0) cos(mπX) + cos(mπx0) sin(mπX), likewise in y
     tx = np.stack([np.sin(np.outer(xs[:-1], m * np.pi)), np.cos(np.outer(xs[:-1], m * np.pi))])  # (a, i, m)
     ty = {"c": np.sin(np.outer(ys[:-1], n * np.pi)), "s": np.cos(np.outer(ys[:-1], n * np.pi))}
+    cut = slice(int(n_from) - 1, None)  # the n asked (the shapes keep every n: one cache per n_max)
+    ty = {b: t[:, cut] for b, t in ty.items()}
+    n_cols = n_max - int(n_from) + 1
     dofs, nloc = space._dofs, space.n_local
     shapes = {} if shapes is None else shapes
     mm = np.arange(rows_m)
@@ -217,9 +220,9 @@ def _coefficients(space, m: np.ndarray, n_max: int, q: int | None = None, shapes
                 if key not in shapes:
                     qq = coefficient_points(max(n_max, int(m.max())), hx + hy, space.s) if q is None else q
                     shapes[key] = _Shape(hx, hy, upper, space.s, n, qq)
-                R = shapes[key].integrals(m)
+                R = {ab: r[:, :, cut] for ab, r in shapes[key].integrals(m).items()}
                 Us += [(ty["c"][J][:, None, None, :] * R[(a, "c")][None]
-                        + ty["s"][J][:, None, None, :] * R[(a, "s")][None]).reshape(-1, n_max) for a in "cs"]
+                        + ty["s"][J][:, None, None, :] * R[(a, "s")][None]).reshape(-1, n_cols) for a in "cs"]
                 g, col, z = _scatter(space, cells[:, :, tri].reshape(-1, nloc))
                 g = position[g]
                 g, col, z = g[g >= 0], col[g >= 0], z[g >= 0]
@@ -231,7 +234,7 @@ def _coefficients(space, m: np.ndarray, n_max: int, q: int | None = None, shapes
                 offset += 2 * width
     W = sparse.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
                           shape=(n_out * rows_m, offset * rows_m))
-    return (W @ np.vstack(Us)).reshape(n_out, rows_m, n_max)
+    return (W @ np.vstack(Us)).reshape(n_out, rows_m, n_cols)
 
 
 def chunk_rows(space, n_max: int) -> int:
@@ -243,34 +246,44 @@ def chunk_rows(space, n_max: int) -> int:
 
 
 @lru_cache(maxsize=8)
-def _reflection(space):
-    """:func:`~.face_triangle_symmetry.reflection`, once per space (the Richardson loop asks
-    several partial sums of the same space)."""
-    return reflection(space)
+def _symmetries(space) -> tuple:
+    """(:func:`~.face_triangle_symmetry.reflection`, :func:`~.face_triangle_symmetry.transposition`)
+    of a space, once (the Richardson loop asks several partial sums of the same space)."""
+    return reflection(space), transposition(space)
 
 
 def partial_gram(space, n_max: int) -> np.ndarray:
     """S(n_max) = Σ_{m,n ≤ n_max} μ_mn μ_mnᵀ / (π√(m² + n²)), in row blocks of m
-    (:func:`chunk_rows`); on a space the point reflection of Γ maps onto itself, through its
-    symmetric and antisymmetric halves (:class:`~.face_triangle_symmetry.ReflectedGram`, a
-    quarter of the flops)."""
+    (:func:`chunk_rows`), using the symmetries of Γ that map the space onto itself
+    (:mod:`.face_triangle_symmetry`): the transposition σ (μ_nm = μ_mn ∘ σ) sums n ≥ m only,
+    H = Σ_{n>m} + ½ Σ_{n=m}, S = H + H[σ, σ] (half the coefficients and half the product); the
+    point reflection sums H through its symmetric and antisymmetric halves (coefficients of about
+    half the dofs, a quarter of the product's flops)."""
     n = np.arange(1, n_max + 1, dtype=float)
-    pi = _reflection(space)
+    pi, sigma = _symmetries(space)
     halves = None if pi is None else ReflectedGram(pi)
     G = np.zeros((space.dim, space.dim))
     shapes = {}
     rows = chunk_rows(space, n_max)
     for start in range(0, n_max, rows):
         m = n[start:start + rows]
-        C = _coefficients(space, m, n_max, shapes=shapes, dofs_out=None if halves is None else halves.even_rows)
-        C *= (1.0 / np.sqrt(np.pi * np.sqrt(m[:, None] ** 2 + n[None, :] ** 2)))[None]
+        n_from = 1 if sigma is None else int(m[0])
+        nn = n[n_from - 1:]
+        C = _coefficients(space, m, n_max, shapes=shapes, dofs_out=None if halves is None else halves.even_rows,
+                          n_from=n_from)
+        w = 1.0 / np.sqrt(np.pi * np.sqrt(m[:, None] ** 2 + nn[None, :] ** 2))
+        if sigma is not None:  # H: n > m, half of n = m, none of the few n < m of the block
+            w *= np.sqrt(np.select([nn[None, :] > m[:, None], nn[None, :] == m[:, None]], [1.0, 0.5], 0.0))
+        C *= w[None]
         if halves is not None:
-            halves.add(C, m, n)
+            halves.add(C, m, nn)
             continue
-        C = C.reshape(space.dim, -1)
+        C = C.reshape(C.shape[0], -1)
         G += C @ C.T
     if halves is not None:
         G = halves.gram()
+    if sigma is not None:
+        G = G + G[np.ix_(sigma, sigma)]
     return 0.5 * (G + G.T)
 
 

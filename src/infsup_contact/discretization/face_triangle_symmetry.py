@@ -1,4 +1,6 @@
-"""The point reflection of Γ = (0, 1)² and the H Gram of a triangle space (issue 28).
+"""Symmetries of Γ = (0, 1)² and the H Gram of a triangle space (issue 28): the point reflection
+below, and the transposition (x, y) → (y, x) of a square grid (:func:`transposition`, used by
+:func:`~.face_triangle_norms.partial_gram`).
 
 On a partition symmetric about the centre (xs and ys symmetric about 1/2: the uniform grids of
 the 3D study), the reflection P(x, y) = (1 − x, 1 − y) maps the lower triangle of the cell (i, j)
@@ -28,12 +30,13 @@ _SAMPLES = np.random.default_rng(28).dirichlet(np.ones(3), size=9)
 _MATCH_TOL = 1e-10
 
 
-def reflection(space) -> np.ndarray | None:
-    """π with φ_g(1 − x, 1 − y) = φ_π(g)(x, y) for every dof g, checked on :data:`_SAMPLES` of
-    every triangle to :data:`_MATCH_TOL` relative; None if the space is not mapped onto itself."""
+def _induced(space, transform) -> np.ndarray | None:
+    """π with φ_g(T x) = φ_π(g)(x) for every dof g, T = ``transform`` (an involution of Γ mapping
+    the triangles of G_h onto triangles of G_h), checked on :data:`_SAMPLES` of every triangle to
+    :data:`_MATCH_TOL` relative; None if T does not map the space onto itself."""
     tri = space.triangles()  # (T, 3, 2)
     x = np.einsum("pk,tkd->tpd", _SAMPLES, tri).reshape(-1, 2)
-    A, B = space.evaluate(x), space.evaluate(1.0 - x)
+    A, B = space.evaluate(x), space.evaluate(transform(x))
     scale = np.abs(A).max()
     # π(g) = argmin_h ‖B_g − A_h‖: ‖B_g‖² + ‖A_h‖² − 2 B_gᵀ A_h over h
     dist = (A * A).sum(axis=0)[None, :] - 2.0 * (B.T @ A)
@@ -43,6 +46,17 @@ def reflection(space) -> np.ndarray | None:
     if np.abs(B - A[:, pi]).max() > _MATCH_TOL * scale:
         return None
     return pi
+
+
+def reflection(space) -> np.ndarray | None:
+    """π of the point reflection (x, y) → (1 − x, 1 − y) (:func:`_induced`), or None."""
+    return _induced(space, lambda x: 1.0 - x)
+
+
+def transposition(space) -> np.ndarray | None:
+    """σ of the transposition (x, y) → (y, x) (:func:`_induced`; xs = ys: the lower triangle of
+    the cell (i, j) onto the upper one of (j, i)), or None: μ_mn(φ_σ(g)) = μ_nm(φ_g)."""
+    return _induced(space, lambda x: x[:, ::-1])
 
 
 class ReflectedGram:

@@ -23,16 +23,21 @@ ratio of increments, :func:`tail_exponent`), not assumed: it decides the Richard
 """
 from __future__ import annotations
 
+from functools import lru_cache
+
 import numpy as np
+from scipy import sparse
 
 from ..errors import InputError
 from .face_norms import _norm2, extrapolated
 from .face_quadrature import triangles_rule
+from .face_triangle_symmetry import ReflectedGram, reflection, transposition
 from .face_triangles import lagrange_barycentric
 from .norms import N_MAX_CAP, gram_by_norm
 
-#: Rows m of the coefficient array handled at once (memory ~ dim · chunk · n_max).
-_CHUNK = 32
+#: Values (float64) per working array of :func:`sine_coefficients_chunk` (2^23: 64 MB): its
+#: output (dim × rows of m × n_max) and its stacked U (:func:`chunk_rows`).
+_BUDGET = 2 ** 23
 #: Tail exponents p (‖S(∞) − S(n)‖ ~ n^{−p}) measured by :func:`tail_exponent` on
 #: N = 2, 4, s = 0..2, n = 32, 128 (tests/test_face_triangles.py); keys :func:`tail_key`.
 TAIL_EXPONENTS = {(True, True): 4.0, (True, False): 2.0, (False, False): 2.0}
@@ -131,55 +136,154 @@ class _Shape:
         return out
 
 
+def _width_groups(breaks: np.ndarray) -> list:
+    """[(indices, width)]: the cells of a 1D partition grouped by their width rounded to 14
+    decimals (the :class:`_Shape` key), in order of first appearance; width of the first cell."""
+    h = np.diff(breaks)
+    groups = {}
+    for i, w in enumerate(h):
+        groups.setdefault(round(w, 14), []).append(i)
+    return [(np.array(v), h[v[0]]) for v in groups.values()]
+
+
+def _scatter(space, glob: np.ndarray) -> tuple:
+    """The incidence Z (dim × cells·nloc) as COO arrays (rows, columns, values): column
+    cell·nloc + l holds the contribution of the raw local Lagrange function l of every triangle
+    (rows of ``glob``, (cells, nloc) global dofs, −1: removed) to the global basis functions:
+    1 at glob[cell, l] (standard bases), Â[l', l] at glob[cell, l'] for ψ = Â N (dual bases,
+    :meth:`~.face_triangles.TriangleSpace._dual_matrix` per live pattern)."""
+    cells, nloc = glob.shape
+    if not space.dual:
+        rows, cols, vals = glob.ravel(), np.arange(cells * nloc), np.ones(cells * nloc)
+    else:
+        masks = space.live_mask(glob)
+        A = np.empty((cells, nloc, nloc))
+        for p in np.unique(masks):
+            A[masks == p] = space._dual_matrix(int(p))
+        rows = np.broadcast_to(glob[:, :, None], A.shape).ravel()
+        cols = np.broadcast_to((np.arange(cells)[:, None] * nloc + np.arange(nloc))[:, None, :], A.shape).ravel()
+        vals = A.ravel()
+    keep = rows >= 0
+    return rows[keep], cols[keep], vals[keep]
+
+
 def sine_coefficients_chunk(space, m: np.ndarray, n_max: int, q: int | None = None,
                             shapes: dict | None = None) -> np.ndarray:
     """μ_mn = 2 ∬ φ sin(mπx) sin(nπy) for every basis function, m in ``m``, n = 1..n_max:
     shape (dim, len(m), n_max). ``shapes`` caches the :class:`_Shape` s across blocks of m
-    (same n_max and q); ``q`` overrides :func:`coefficient_points`."""
+    (same n_max and q); ``q`` overrides :func:`coefficient_points`. :func:`_coefficients` of
+    every dof."""
+    return _coefficients(space, m, n_max, q, shapes)
+
+
+def _coefficients(space, m: np.ndarray, n_max: int, q: int | None = None, shapes: dict | None = None,
+                  dofs_out: np.ndarray | None = None, n_from: int = 1) -> np.ndarray:
+    """:func:`sine_coefficients_chunk` of the dofs ``dofs_out`` only (None: all), in that order,
+    and of n = n_from..n_max only: shape (len(dofs_out), len(m), n_max − n_from + 1).
+
+    Vectorised over the cells (module docstring): with tx_c[i, m] = sin(mπx_i),
+    tx_s[i, m] = cos(mπx_i) (likewise ty_b[j, n] in y), the raw local function l of the triangle
+    ``tri`` of cell (i, j) has the coefficients 2 Σ_a tx_a[i, m] U_a[j, l, m, n],
+    U_a = Σ_b ty_b R_ab. The cells of one shape (hx, hy) are a sub-grid I × J of the tensor
+    partition (its columns of width hx times its rows of height hy), so U is formed once per row
+    j ∈ J, and the sum over the cells with the incidence Z (:func:`_scatter`, dual matrices
+    included) is one sparse product W @ U for all m, shapes and triangles at once: row (g, m) of
+    the output is Σ_{Z[g, (i, j, l)] ≠ 0} 2 Z[g, (i, j, l)] tx_a[i, m] · row (a, j, l, m) of the
+    stacked U s, so no per-cell array of size cells × nloc × len(m) × n_max is formed.
+    Cost: the output (dim · len(m) · n_max values) written once, 2 nnz(Z) n_max len(m) flops."""
     n = np.arange(1, n_max + 1, dtype=float)
     m = np.asarray(m, dtype=float)
     xs, ys = np.asarray(space.breakpoints.xs, float), np.asarray(space.breakpoints.ys, float)
-    dofs = space._dofs
-    out = np.zeros((space.dim, len(m), n_max))
+    rows_m = len(m)
+    # sin(mπ(x0 + X)) = sin(mπx0) cos(mπX) + cos(mπx0) sin(mπX), likewise in y
+    tx = np.stack([np.sin(np.outer(xs[:-1], m * np.pi)), np.cos(np.outer(xs[:-1], m * np.pi))])  # (a, i, m)
+    ty = {"c": np.sin(np.outer(ys[:-1], n * np.pi)), "s": np.cos(np.outer(ys[:-1], n * np.pi))}
+    cut = slice(int(n_from) - 1, None)  # the n asked (the shapes keep every n: one cache per n_max)
+    ty = {b: t[:, cut] for b, t in ty.items()}
+    n_cols = n_max - int(n_from) + 1
+    dofs, nloc = space._dofs, space.n_local
     shapes = {} if shapes is None else shapes
-    blocks = {}
-    for i in range(len(xs) - 1):
-        hx = xs[i + 1] - xs[i]
-        sx, cx = np.sin(m * np.pi * xs[i]), np.cos(m * np.pi * xs[i])
-        for j in range(len(ys) - 1):
-            hy = ys[j + 1] - ys[j]
-            sy, cy = np.sin(n * np.pi * ys[j]), np.cos(n * np.pi * ys[j])
-            # sin(mπ(x0 + X)) = sin(mπx0) cos(mπX) + cos(mπx0) sin(mπX), likewise in y
-            trig = {("c", "c"): np.outer(sx, sy), ("c", "s"): np.outer(sx, cy),
-                    ("s", "c"): np.outer(cx, sy), ("s", "s"): np.outer(cx, cy)}
+    mm = np.arange(rows_m)
+    position = np.arange(space.dim)  # output row of each dof, −1: not asked
+    if dofs_out is not None:
+        position = np.full(space.dim, -1)
+        position[dofs_out] = np.arange(len(dofs_out))
+    n_out = space.dim if dofs_out is None else len(dofs_out)
+    Us, rows, cols, vals = [], [], [], []
+    offset = 0  # first row of the current U in the stack, in units of rows_m
+    for I, hx in _width_groups(xs):
+        for J, hy in _width_groups(ys):
+            cells = dofs[np.ix_(I, J)]  # (|I|, |J|, 2, nloc)
+            width = len(J) * nloc
             for tri, upper in enumerate((False, True)):
                 key = (round(hx, 14), round(hy, 14), upper)
                 if key not in shapes:
                     qq = coefficient_points(max(n_max, int(m.max())), hx + hy, space.s) if q is None else q
                     shapes[key] = _Shape(hx, hy, upper, space.s, n, qq)
-                if key not in blocks:
-                    blocks[key] = shapes[key].integrals(m)
-                R = blocks[key]
-                c = 2.0 * sum(R[ab] * trig[ab][None] for ab in trig)
-                g = dofs[i, j, tri]
-                if space.dual:  # ψ = Â N on this triangle
-                    c = np.tensordot(space._dual_matrix(int(space.live_mask(g))), c, axes=(1, 0))
-                keep = g >= 0
-                out[g[keep]] += c[keep]
-    return out
+                R = {ab: r[:, :, cut] for ab, r in shapes[key].integrals(m).items()}
+                Us += [(ty["c"][J][:, None, None, :] * R[(a, "c")][None]
+                        + ty["s"][J][:, None, None, :] * R[(a, "s")][None]).reshape(-1, n_cols) for a in "cs"]
+                g, col, z = _scatter(space, cells[:, :, tri].reshape(-1, nloc))
+                g = position[g]
+                g, col, z = g[g >= 0], col[g >= 0], z[g >= 0]
+                i, jl = np.divmod(col, width)  # cell row in I, (j, l) within it
+                v = 2.0 * z[None, :, None] * tx[:, I[i], :]  # (a, nnz, m)
+                rows.append(np.broadcast_to(g[None, :, None] * rows_m + mm, v.shape).ravel())
+                cols.append(((offset + np.arange(2)[:, None, None] * width + jl[None, :, None]) * rows_m + mm).ravel())
+                vals.append(v.ravel())
+                offset += 2 * width
+    W = sparse.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
+                          shape=(n_out * rows_m, offset * rows_m))
+    return (W @ np.vstack(Us)).reshape(n_out, rows_m, n_cols)
+
+
+def chunk_rows(space, n_max: int) -> int:
+    """Rows m per :func:`sine_coefficients_chunk` call: its output dim · rows · n_max and its
+    stacked U (4 nloc n_y rows per column width of the partition) within :data:`_BUDGET` values."""
+    widths = len(_width_groups(np.asarray(space.breakpoints.xs, float)))
+    per_row = max(space.dim, 4 * space.n_local * space.shape[1] * widths) * n_max
+    return int(min(n_max, max(1, _BUDGET // per_row)))
+
+
+@lru_cache(maxsize=8)
+def _symmetries(space) -> tuple:
+    """(:func:`~.face_triangle_symmetry.reflection`, :func:`~.face_triangle_symmetry.transposition`)
+    of a space, once (the Richardson loop asks several partial sums of the same space)."""
+    return reflection(space), transposition(space)
 
 
 def partial_gram(space, n_max: int) -> np.ndarray:
-    """S(n_max) = Σ_{m,n ≤ n_max} μ_mn μ_mnᵀ / (π√(m² + n²)), in row blocks of m."""
+    """S(n_max) = Σ_{m,n ≤ n_max} μ_mn μ_mnᵀ / (π√(m² + n²)), in row blocks of m
+    (:func:`chunk_rows`), using the symmetries of Γ that map the space onto itself
+    (:mod:`.face_triangle_symmetry`): the transposition σ (μ_nm = μ_mn ∘ σ) sums n ≥ m only,
+    H = Σ_{n>m} + ½ Σ_{n=m}, S = H + H[σ, σ] (half the coefficients and half the product); the
+    point reflection sums H through its symmetric and antisymmetric halves (coefficients of about
+    half the dofs, a quarter of the product's flops)."""
     n = np.arange(1, n_max + 1, dtype=float)
+    pi, sigma = _symmetries(space)
+    halves = None if pi is None else ReflectedGram(pi)
     G = np.zeros((space.dim, space.dim))
     shapes = {}
-    for start in range(0, n_max, _CHUNK):
-        m = n[start:start + _CHUNK]
-        C = sine_coefficients_chunk(space, m, n_max, shapes=shapes)
-        C *= (1.0 / np.sqrt(np.pi * np.sqrt(m[:, None] ** 2 + n[None, :] ** 2)))[None]
-        C = C.reshape(space.dim, -1)
+    rows = chunk_rows(space, n_max)
+    for start in range(0, n_max, rows):
+        m = n[start:start + rows]
+        n_from = 1 if sigma is None else int(m[0])
+        nn = n[n_from - 1:]
+        C = _coefficients(space, m, n_max, shapes=shapes, dofs_out=None if halves is None else halves.even_rows,
+                          n_from=n_from)
+        w = 1.0 / np.sqrt(np.pi * np.sqrt(m[:, None] ** 2 + nn[None, :] ** 2))
+        if sigma is not None:  # H: n > m, half of n = m, none of the few n < m of the block
+            w *= np.sqrt(np.select([nn[None, :] > m[:, None], nn[None, :] == m[:, None]], [1.0, 0.5], 0.0))
+        C *= w[None]
+        if halves is not None:
+            halves.add(C, m, nn)
+            continue
+        C = C.reshape(C.shape[0], -1)
         G += C @ C.T
+    if halves is not None:
+        G = halves.gram()
+    if sigma is not None:
+        G = G + G[np.ix_(sigma, sigma)]
     return 0.5 * (G + G.T)
 
 

@@ -68,3 +68,18 @@ def test_the_gate_keeps_the_small_grams_direct(monkeypatch):
     direct = face_norms.partial_gram(space, 64)
     monkeypatch.setattr(face_norms, "EXP_SUM_MIN_DIM", 0)
     assert not np.array_equal(face_norms.partial_gram(space, 64), direct)
+
+
+@pytest.mark.parametrize("n,aspect", [(96, 1.0), (1536, 1.0), (1536, 0.45)])
+def test_the_taylor_block_keeps_the_loewner_bound_at_large_n(monkeypatch, n, aspect):
+    """The small rates taken as one Taylor block (TAYLOR_BELOW, TAYLOR_DEGREE): still within
+    ±1e-12 of the direct sum in the Loewner order, at n_max where most terms are in the block."""
+    space = _space("DUAL-ALL", 1, 5, 4)
+    direct = face_norms.partial_gram(space, n, aspect)
+    monkeypatch.setattr(face_norms, "EXP_SUM_MIN_DIM", 0)
+    separable = face_norms.partial_gram(space, n, aspect)
+    ev = sla.eigh(separable - direct, direct, eigvals_only=True)
+    assert np.max(np.abs(ev)) < 1e-12
+    monkeypatch.setattr(face_norms, "TAYLOR_BELOW", 0.0)          # no block: the plain sum agrees too
+    plain = face_norms.partial_gram(space, n, aspect)
+    assert np.max(np.abs(sla.eigh(plain - direct, direct, eigvals_only=True))) < 1e-12

@@ -37,6 +37,11 @@ EXP_SUM_START = 4
 there a level costs about the same at every n (its product has dim² · r terms, n-independent),
 and the p = 2 spaces stopped at n_max ≥ 16 n0 at N = 32, k = 2 but R5.2 (8 n0: one level more
 there); the levels n0 and 2 n0 were cost without a use."""
+TAYLOR_BELOW = 1.0
+"""Exponential terms with a_j x_max ≤ this are taken as one Taylor block (:func:`_separable_sum`)."""
+TAYLOR_DEGREE = 17
+"""Degree per variable of that block: remainder ≤ e^τ τ^{p+1}/(p + 1)! = 4e-16 relative at τ = 1
+in each of the two factors e^{−b t}, e^{−b u}."""
 EXP_SUM_RTOL = 1e-13
 """Relative accuracy of the exponential sum's weights: every eigenvalue of a pencil with the Gram
 moves by at most this factor (Loewner order), far below the series' own ``rtol``."""
@@ -93,14 +98,32 @@ def _separable_sum(A: np.ndarray, B: np.ndarray, n: np.ndarray, aspect: float) -
     """A W Bᵀ for W[m, n] = a / (π√((m/a)² + n²)) written as Σ_j w_j e^{−a_j (m/a)²} e^{−a_j n²}
     (:func:`.exponential_sum.inverse_sqrt`, relative accuracy :data:`EXP_SUM_RTOL`):
     (A E_x) diag(a w / π) (B E_y)ᵀ, never forming W (B E_y is A E_x itself when the two
-    directions are the same: one product of dim² · n_max · r fewer)."""
+    directions are the same: one product of dim² · n_max · r fewer).
+
+    Most terms have a_j x_max ≤ :data:`TAYLOR_BELOW` (x = (m/a)² + n² ≤ x_max): there
+    e^{−b_j (t + u)}, b_j = a_j x_max, t = (m/a)²/x_max, u = n²/x_max ∈ [0, 1], is its double
+    Taylor polynomial of degree :data:`TAYLOR_DEGREE` per variable to round-off, so those terms
+    together are T_x C T_yᵀ with T[m, q] = t_m^q and one (p + 1)² matrix
+    C = Σ_j w_j v_j v_jᵀ, v_j[q] = (−b_j)^q / q!: about 200 of the ~270 columns become 18."""
     x_lo, x_hi = (1.0 / aspect) ** 2 + 1.0, (n[-1] / aspect) ** 2 + n[-1] ** 2
-    expo = inverse_sqrt(min(x_lo, x_hi), max(x_lo, x_hi), EXP_SUM_RTOL)
-    Ex = np.exp(-np.multiply.outer((n / aspect) ** 2, expo.rates))
-    AE = A @ Ex
+    x_max = max(x_lo, x_hi)
+    expo = inverse_sqrt(min(x_lo, x_hi), x_max, EXP_SUM_RTOL)
+    weights = aspect * expo.weights / np.pi
+    taylor = expo.rates * x_max <= TAYLOR_BELOW
+    q = np.arange(TAYLOR_DEGREE + 1)
+    v = (-(expo.rates[taylor] * x_max)[:, None]) ** q / np.cumprod(np.maximum(q, 1))
+    C = (v * weights[taylor, None]).T @ v
+
+    def columns(M, squares):            # [M e^{−a_j x}, M T] for one direction (x = squares)
+        return np.hstack([M @ np.exp(-np.multiply.outer(squares, expo.rates[~taylor])),
+                          M @ (squares / x_max)[:, None] ** q])
+
+    left = columns(A, (n / aspect) ** 2)
     same = aspect == 1.0 and (B is A or np.array_equal(A, B))
-    BE = AE if same else B @ np.exp(-np.multiply.outer(n ** 2, expo.rates))
-    return (AE * (aspect * expo.weights / np.pi)) @ BE.T
+    right = left if same else columns(B, n ** 2)
+    k = int(np.count_nonzero(~taylor))
+    scaled = np.hstack([left[:, :k] * weights[~taylor], left[:, k:] @ C])
+    return scaled @ right.T
 
 
 def start_level(n0: int, p: float, dim: int) -> int:

@@ -93,3 +93,22 @@ def test_dry_run_estimates_the_face_routes():
     assert code in (0, None) and "dry run" in out + err
     code, _, err = run_in_process(["bench", "--what", "face", "--N", "256", "--k", "2", "--dry-run"])
     assert code == 2 and "--N" in err and len(err.strip().splitlines()) == 1
+
+
+@pytest.mark.parametrize("k", [1, 2])
+def test_the_face_estimate_grows_with_n_across_the_large_route(monkeypatch, k):
+    """On the PARDISO route the estimate switches to the large route's fit above dim M =
+    DENSE_MAX_M; memory still grows with N through the switch, time within each route (the
+    large route is the faster one at the gate: that is what it is for)."""
+    from infsup_contact import resources
+    from infsup_contact.solvers.bottom import DENSE_MAX_M
+
+    monkeypatch.setattr(resources, "face_route", lambda: "pardiso")
+    ests = [resources.face_beta_estimate(k, n, n) for n in range(4, 80 // k)]
+    switch = next(n for n in range(4, 80) if (k * n + 1) ** 2 > DENSE_MAX_M)
+    assert all(b.bytes >= a.bytes for a, b in zip(ests, ests[1:]))
+    assert all(b.seconds >= a.seconds for a, b in zip(ests, ests[1:]) if b is not ests[switch - 4])
+    a, b, c, d = resources.LARGE_ROUTE_3D[k]
+    nd = 2 * resources.face_side_dofs(switch, k)
+    e = resources.face_beta_estimate(k, switch, switch)
+    assert e.bytes > resources.LARGE_ROUTE_MARGIN * (a * nd + b * float((k * switch + 1) ** 2) ** 2)

@@ -118,7 +118,7 @@ def _multiplier_intervals(multiplier_mesh: str, n1: int, n2: int) -> float:
     return {"omega1": n1, "omega2": n2}.get(multiplier_mesh, n1 + n2)
 
 
-SIDE_BYTES_3D = {("pardiso", 1): 700.0, ("pardiso", 2): 410.0, ("nested", 1): 1500.0, ("nested", 2): 1500.0}
+SIDE_BYTES_3D = {("pardiso", 1): 260.0, ("pardiso", 2): 450.0, ("nested", 1): 1500.0, ("nested", 2): 1500.0}
 """C in C · nd^{4/3} bytes per side of a 3D body, by the route that gives its Schur complement
 (:func:`face_route`) and the degree (k ≥ 2 counts as 2): the fill of a 3D sparse factorization
 is O(nd^{4/3}), and so are the dense Γ arrays, n_Γ² ~ (N k)⁴ = nd^{4/3}; at equal nd, k = 1 has
@@ -126,9 +126,9 @@ is O(nd^{4/3}), and so are the dense Γ arrays, n_Γ² ~ (N k)⁴ = nd^{4/3}; at
 the process included. Peak resident memory (hexahedra, every case, ``/usr/bin/time``), with
 the C each implies:
 
-- ``pardiso``, k = 1: 1.46 GB at N = 32 (677), 5.3 GB at N = 48 (521), 15.8 GB at N = 64 (499);
-- ``pardiso``, k = 2: 0.30 GB at N = 8, 0.96 GB at N = 16 (406), 3.1 GB at N = 24 (300), 8.9 GB
-  at N = 32 (278);
+- ``pardiso``, k = 1: 0.68 GB at N = 32 (214; the 7 spaces of ``--case all``);
+- ``pardiso``, k = 2: 0.30 GB at N = 8, 1.05 GB at N = 16 (400; the 12 spaces of ``--case all``);
+  above dim M = 1,500 (k = 1 from N = 38, k = 2 from N = 19) :data:`LARGE_ROUTE_3D` instead;
 - ``nested`` (SuperLU): 0.36 GB at N = 8, 2.3 GB at N = 16, 5.3 GB at N = 20 (k = 2), 7.1 GB
   at N = 40 (k = 1).
 
@@ -136,10 +136,9 @@ The estimate is above each; the ``pardiso`` route adds :data:`MKL_BYTES` for the
 MKL_BYTES = 64 * MIB
 """Resident size of MKL once PARDISO is loaded (measured: 42 MB more than the package alone)."""
 SECONDS_PER_DOF2_3D = 1.3e-8
-"""Seconds per nd² of the same runs: the sparse LU (``nested``: 27 s at N = 16 and 96 s at
-N = 20, k = 2; 118 s at N = 40, k = 1) or the dense eigenproblems of dim M ~ (N k)² that
-follow PARDISO's factorization (``pardiso``: 16 s at N = 16, k = 2; 21 s at N = 32, k = 1):
-both grow like nd²."""
+"""Seconds per nd² of the ``nested`` route (the sparse LU: 27 s at N = 16 and 96 s at N = 20,
+k = 2; 118 s at N = 40, k = 1); PARDISO's routes: :data:`DENSE_ROUTE_SECONDS_3D`,
+:data:`LARGE_ROUTE_3D`."""
 
 
 def face_route() -> str:
@@ -156,14 +155,52 @@ def face_side_dofs(n: int, k: int) -> float:
     return max((nk - 1.0) ** 2 * nk, 1.0)
 
 
+LARGE_ROUTE_3D = {1: (5300.0, 101.0, 6.0e-5, 9.6e-10), 2: (6100.0, 275.0, 1.07e-4, 2.06e-9)}
+"""(a, b, c, d) of the large route (dim M above :data:`~.solvers.bottom.DENSE_MAX_M`: sparse
+couplings, exponential-sum Grams, bottom pencils; PARDISO): bytes a Σ nd + b m² and seconds
+c Σ nd + d m³ beyond the process, m = (k N₂ + 1)² (R5.2 on G_h = the trace of Ω2). Least
+squares on ``beta --model membranes3d --case all --norm all`` (hexahedra, every space the face
+builds: 7 at k = 1, 12 at k = 2; 2 BLAS/MKL threads, quiet machine, ``/usr/bin/time``):
+
+- k = 1: N = 40 1.19 GB, 14 s; N = 48 1.87 GB, 29 s; N = 64 4.71 GB, 105 s;
+- k = 2: N = 20 1.94 GB, 28 s; N = 24 2.99 GB, 57 s; N = 28 5.10 GB, 106 s; N = 32 8.15 GB,
+  199 s; N = 36 12.4 GB, 393 s.
+
+The sparse factors grow like nd here (nd^{4/3} only asymptotically), the Grams, the pencils' and
+the shared series' dense arrays like m², their factorizations like m³. The estimate multiplies
+the fit by :data:`LARGE_ROUTE_MARGIN`, so it lies above every measurement (the fit's worst
+point, k = 2, N = 20, is 11 % below)."""
+LARGE_ROUTE_MARGIN = 1.2
+DENSE_ROUTE_SECONDS_3D = {1: 2.2e-9, 2: 5.4e-9}
+"""d of c Σ nd + d m³ seconds (c of :data:`LARGE_ROUTE_3D`) on PARDISO's dense route, where the
+dense SVDs and pencils cost more per m³: k = 1, N = 32 9 s; k = 2, N = 16 16 s (``--case all``).
+At the gate the large route is the faster one (k = 1: N = 32 dense 9 s, N = 40 large 14 s)."""
+
+
+def _large_route_dim(k: int, n: int, components: int) -> int:
+    """dim M of the largest space the face builds (R5.2: (k N + 1)² nodes, per component)."""
+    return components * (k * n + 1) ** 2
+
+
 def face_beta_estimate(k: int, n1: int, n2: int, components: int = 1, process: bool = True) -> Estimate:
-    """One ``beta_rows`` call of a 3D model (a contact face): both sides kept (C nd^{4/3} each)."""
+    """One ``beta_rows`` call of a 3D model (a contact face): both sides kept. The dense route
+    (dim M up to :data:`~.solvers.bottom.DENSE_MAX_M`, and every size on the ``nested`` route):
+    C nd^{4/3} per side (:data:`SIDE_BYTES_3D`); above it with PARDISO, :data:`LARGE_ROUTE_3D`."""
+    from .solvers.bottom import DENSE_MAX_M
+
     nds = [components * face_side_dofs(n, k) for n in (n1, n2)]
     route = face_route()
+    base = PROCESS_BYTES["beta"] if process else 0
+    m = float(_large_route_dim(k, n2, components))
+    if route == "pardiso" and m > DENSE_MAX_M:
+        a, b, c, d = LARGE_ROUTE_3D[min(k, 2)]
+        return Estimate(base + MKL_BYTES + LARGE_ROUTE_MARGIN * (a * sum(nds) + b * m * m),
+                        START_SECONDS + LARGE_ROUTE_MARGIN * (c * sum(nds) + d * m ** 3))
     volume = sum(SIDE_BYTES_3D[route, min(k, 2)] * nd ** (4.0 / 3.0) for nd in nds)
-    volume += MKL_BYTES if route == "pardiso" else 0.0
-    seconds = START_SECONDS + SECONDS_PER_DOF2_3D * sum(nd ** 2 for nd in nds)
-    return Estimate((PROCESS_BYTES["beta"] if process else 0) + volume, seconds)
+    if route == "nested":
+        return Estimate(base + volume, START_SECONDS + SECONDS_PER_DOF2_3D * sum(nd ** 2 for nd in nds))
+    c, d = LARGE_ROUTE_3D[min(k, 2)][2], DENSE_ROUTE_SECONDS_3D[min(k, 2)]
+    return Estimate(base + MKL_BYTES + volume, START_SECONDS + LARGE_ROUTE_MARGIN * (c * sum(nds) + d * m ** 3))
 
 
 def beta_estimate(family: str, k: int, n1: int, n2: int, multiplier_mesh="omega2",

@@ -70,9 +70,10 @@ SOLVES_MAX_GAMMA = 600
 """The solves route (n_Γ solves) is timed only up to this many Γ dofs: beyond it, minutes."""
 
 
-def face_cases(k: int) -> list:
-    """The ids ``infsup-contact beta --model membranes3d --case all`` runs for degree k."""
-    return registry.ids_valid_for(k)
+def face_cases(k: int, gamma, g_h) -> list:
+    """The ids ``infsup-contact beta --model membranes3d --case all`` runs for degree k on the
+    face ``gamma`` (G_h = ``g_h``): the paper's five, the duals and every space the face builds."""
+    return registry.ids_built_on(k, gamma, g_h)
 
 
 class FaceSetup:
@@ -86,7 +87,7 @@ class FaceSetup:
         self.sides = SideCache().pair(MEMBRANES3D, FAMILY, k, n, n, element=element)
         self.gamma = self.sides[0].trace.gamma
         g_h = self.gamma.multiplier_partition(*(s.trace.partition for s in self.sides), "omega2")
-        self.cases = face_cases(k)
+        self.cases = face_cases(k, self.gamma, g_h)
         self.spaces = {c: registry.case_space(c, k, g_h, self.gamma) for c in self.cases}
         self.ndof = sum(s.ndof for s in self.sides)
 
@@ -124,10 +125,11 @@ def face_ours_core(setup: FaceSetup) -> dict:
         s.forget_cached()
     sides = [factorized_side(s.trace, s.free, s.stiffness) for s in setup.sides]
     out = {}
-    for c in setup.cases:
-        S = interface_operator([coupling_matrix(s.trace, setup.spaces[c], setup.k) for s in sides], sides)
-        for nm in NORMS:
-            out[c, nm] = _eig_bottom(S, setup.gamma.gram(setup.spaces[c], nm)[0])
+    with setup.gamma.gram_session():  # as ours: spaces sharing a piece space share its series
+        for c in setup.cases:
+            S = interface_operator([coupling_matrix(s.trace, setup.spaces[c], setup.k) for s in sides], sides)
+            for nm in NORMS:
+                out[c, nm] = _eig_bottom(S, setup.gamma.gram(setup.spaces[c], nm)[0])
     return out
 
 

@@ -160,7 +160,7 @@ LARGE_ROUTE_3D = {1: (5300.0, 101.0, 6.0e-5, 9.6e-10), 2: (6100.0, 275.0, 1.07e-
 couplings, exponential-sum Grams, bottom pencils; PARDISO): bytes a Σ nd + b m² and seconds
 c Σ nd + d m³ beyond the process, m = (k N₂ + 1)² (R5.2 on G_h = the trace of Ω2). Least
 squares on ``beta --model membranes3d --case all --norm all`` (hexahedra, every space the face
-builds: 7 at k = 1, 12 at k = 2; 2 BLAS/MKL threads, quiet machine, ``/usr/bin/time``):
+builds: 5 at k = 1, 12 at k = 2; 2 BLAS/MKL threads, quiet machine, ``/usr/bin/time``):
 
 - k = 1: N = 40 1.19 GB, 14 s; N = 48 1.87 GB, 29 s; N = 64 4.71 GB, 105 s;
 - k = 2: N = 20 1.94 GB, 28 s; N = 24 2.99 GB, 57 s; N = 28 5.10 GB, 106 s; N = 32 8.15 GB,

@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 from infsup_contact.discretization import face_cellwise_norms as fcn
+from infsup_contact.discretization.coupling import weighted_values
 from infsup_contact.discretization.face_cells import CellwiseFaceSpace
 from infsup_contact.discretization.face_norms import gram_l2_face
 from infsup_contact.discretization.multipliers import make_space
@@ -29,8 +30,8 @@ def _space(element, basis, vanish):
 def test_sparse_values_are_evaluate(element, basis, vanish):
     space = _space(element, basis, vanish)
     x, w = fcn.piece_rule(space.pieces, 3)
-    assert np.array_equal(fcn.sparse_values(space, x).toarray(), space.evaluate(x))
-    assert np.array_equal(fcn.sparse_values(space, x, w).toarray(), space.evaluate(x) * w[:, None])
+    assert np.array_equal(fcn._at(space, x).toarray(), space.evaluate(x))
+    assert np.array_equal(weighted_values(space, x, w).toarray(), space.evaluate(x) * w[:, None])
 
 
 @pytest.mark.parametrize("s", [0, 1, 2, 3])

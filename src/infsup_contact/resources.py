@@ -126,7 +126,7 @@ is O(nd^{4/3}), and so are the dense Γ arrays, n_Γ² ~ (N k)⁴ = nd^{4/3}; at
 the process included. Peak resident memory (hexahedra, every case, ``/usr/bin/time``), with
 the C each implies:
 
-- ``pardiso``, k = 1: 0.68 GB at N = 32 (214; the 7 spaces of ``--case all``);
+- ``pardiso``, k = 1: 0.68 GB at N = 32 (214; the 5 spaces of ``--case all``);
 - ``pardiso``, k = 2: 0.30 GB at N = 8, 1.05 GB at N = 16 (400; the 12 spaces of ``--case all``);
   above dim M = 1,500 (k = 1 from N = 38, k = 2 from N = 19) :data:`LARGE_ROUTE_3D` instead;
 - ``nested`` (SuperLU): 0.36 GB at N = 8, 2.3 GB at N = 16, 5.3 GB at N = 20 (k = 2), 7.1 GB

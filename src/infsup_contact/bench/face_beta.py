@@ -70,12 +70,6 @@ SOLVES_MAX_GAMMA = 600
 """The solves route (n_Γ solves) is timed only up to this many Γ dofs: beyond it, minutes."""
 
 
-def face_cases(k: int, gamma, g_h) -> list:
-    """The ids ``infsup-contact beta --model membranes3d --case all`` runs for degree k on the
-    face ``gamma`` (G_h = ``g_h``): the paper's five, the duals and every space the face builds."""
-    return registry.ids_built_on(k, gamma, g_h)
-
-
 class FaceSetup:
     """Assembled data of one (element, N, k), built outside every timing: the two sides
     (their stiffness matrices, Γ dofs last), Γ, the multiplier space of each case."""
@@ -87,7 +81,7 @@ class FaceSetup:
         self.sides = SideCache().pair(MEMBRANES3D, FAMILY, k, n, n, element=element)
         self.gamma = self.sides[0].trace.gamma
         g_h = self.gamma.multiplier_partition(*(s.trace.partition for s in self.sides), "omega2")
-        self.cases = face_cases(k, self.gamma, g_h)
+        self.cases = registry.ids_built_on(k, self.gamma, g_h)  # what beta --case all runs
         self.spaces = {c: registry.case_space(c, k, g_h, self.gamma) for c in self.cases}
         self.ndof = sum(s.ndof for s in self.sides)
 

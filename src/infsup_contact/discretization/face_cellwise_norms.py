@@ -35,6 +35,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..errors import InputError
+from .coupling import weighted_values
 from .face_norms import extrapolated, partial_gram, start_level
 from .face_spaces import FaceSpace
 from .multipliers import make_space
@@ -106,15 +107,9 @@ def piece_space(space) -> FaceSpace:
     return FaceSpace(make_space(pieces.xs, s, cont, False), make_space(pieces.ys, s, cont, False), pieces)
 
 
-def sparse_values(space, x: np.ndarray, scale: np.ndarray | None = None) -> sp.csr_matrix:
-    """E[q, j] = μ_j(x_q) (times ``scale[q]``), shape (len(x), dim): ``space.evaluate(x)`` built
-    from its nonzero pattern (``local_values``), the same numbers without the dense array."""
-    vals, dofs = space.local_values(x)
-    if scale is not None:
-        vals = vals * scale[:, None]
-    rows = np.broadcast_to(np.arange(len(vals))[:, None], dofs.shape)
-    keep = dofs >= 0
-    return sp.csr_matrix((vals[keep], (rows[keep], dofs[keep])), shape=(len(vals), space.dim))
+def _at(space, x: np.ndarray) -> sp.csr_matrix:
+    """The basis at ``x`` as CSR, from its nonzero pattern (:func:`~.coupling.weighted_values`)."""
+    return weighted_values(space, x, np.ones(len(x)))
 
 
 def block_inverse_mass(space) -> sp.csr_matrix:
@@ -141,15 +136,15 @@ def projection(space) -> tuple[sp.csr_matrix, FaceSpace]:
     P = piece_space(space)
     s = space.piece_degree
     if P.sx.continuous:
-        R = sparse_values(space, P.nodes()).T.tocsr()
+        R = _at(space, P.nodes()).T.tocsr()
     else:
         x, w = piece_rule(P.breakpoints, s + 1)
-        C = sparse_values(space, x, w).T @ sparse_values(P, x)
+        C = weighted_values(space, x, w).T @ _at(P, x)
         R = (C @ sp.kron(*(block_inverse_mass(f) for f in P.factors), format="csr")).tocsr()
     R.eliminate_zeros()
     xc, _ = piece_rule(P.breakpoints, s + 2)
-    mu = sparse_values(space, xc)
-    err = abs(mu - sparse_values(P, xc) @ R.T).max() / max(abs(mu).max(), 1e-300)
+    mu = _at(space, xc)
+    err = abs(mu - _at(P, xc) @ R.T).max() / max(abs(mu).max(), 1e-300)
     if err > PROJECTION_TOL:
         raise InputError("space", f"a face space in Q_{s} on each piece (projection residual {err:.2e})",
                          got=getattr(space, "element", space))
@@ -160,7 +155,7 @@ def gram_l2_cellwise(space) -> np.ndarray:
     """Exact L²(Γ) Gram ∫ μ_i μ_j by the per-piece Gauss rule of degree 2s per variable."""
     P = piece_space(space)
     x, w = piece_rule(P.breakpoints, space.piece_degree + 1)
-    G = (sparse_values(space, x, w).T @ sparse_values(space, x)).toarray()
+    G = (weighted_values(space, x, w).T @ _at(space, x)).toarray()
     return 0.5 * (G + G.T)
 
 

@@ -182,11 +182,10 @@ def gram_h_face(space, rtol: float = 1e-6, n_start: int | None = None, n_cap: in
         raise InputError("rtol", "a positive float", got=rtol)
     p = (4.0 if smooth_tail(space) else 2.0) if exponent is None else float(exponent)
     n_int = max(f.n_intervals for f in space.factors)
-    n0 = max(16, 2 * (space.degree + 1) * n_int) if n_start is None else int(n_start)
+    n0 = (start_level(max(16, 2 * (space.degree + 1) * n_int), p, space.dim) if n_start is None
+          else int(n_start))
     if not aspect > 0:
         raise InputError("aspect", "a positive float", got=aspect)
-    if n_start is None:
-        n0 = start_level(n0, p, space.dim)
     return extrapolated(lambda n: partial_gram(space, n, aspect), p, n0, n_cap, rtol)
 
 

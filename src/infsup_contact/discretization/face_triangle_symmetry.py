@@ -23,19 +23,12 @@ import numpy as np
 from scipy import sparse
 
 from ..errors import InputError
+from .coupling import weighted_values
 
 #: Interior sample points of every triangle, barycentric (seeded): more than (s + 1)(s + 2)/2 for
 #: s ≤ 2 in general position, so a function of P_s on a triangle is fixed by its values there.
 _SAMPLES = np.random.default_rng(28).dirichlet(np.ones(3), size=9)
 _MATCH_TOL = 1e-10
-
-
-def _values(space, x: np.ndarray) -> sparse.csc_matrix:
-    """The basis at points ``x`` as a sparse (n, dim) matrix (:meth:`local_values`' pattern)."""
-    vals, glob = space.local_values(x)
-    rows = np.repeat(np.arange(len(x)), glob.shape[1])
-    keep = glob.ravel() >= 0
-    return sparse.csc_matrix((vals.ravel()[keep], (rows[keep], glob.ravel()[keep])), shape=(len(x), space.dim))
 
 
 def _induced(space, transform) -> np.ndarray | None:
@@ -46,7 +39,8 @@ def _induced(space, transform) -> np.ndarray | None:
     overlap (B_g = φ_g ∘ T, A_h = φ_h at the samples)."""
     tri = space.triangles()  # (T, 3, 2)
     x = np.einsum("pk,tkd->tpd", _SAMPLES, tri).reshape(-1, 2)
-    A, B = _values(space, x), _values(space, transform(x))
+    ones = np.ones(len(x))
+    A, B = weighted_values(space, x, ones), weighted_values(space, transform(x), ones)
     overlap = (B.T @ A).tocsr()
     overlap.sum_duplicates()
     norms = np.asarray(A.multiply(A).sum(axis=0)).ravel()

@@ -35,6 +35,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..errors import InputError
+from ..la.threaded import symmetric_sandwich
 from .coupling import weighted_values
 from .face_norms import extrapolated, partial_gram, start_level
 from .face_spaces import FaceSpace
@@ -173,8 +174,7 @@ def gram_h_cellwise(space, rtol: float = 1e-6, n_start: int | None = None, n_cap
           else int(n_start))
 
     def partial(n):
-        RS = R @ piece_partial_gram(P, n)           # sparse × dense: (dim, dim P)
-        S = np.asarray(R @ RS.T)
+        S = symmetric_sandwich(R, piece_partial_gram(P, n))  # S_P is exactly symmetric
         return 0.5 * (S + S.T)
 
     return extrapolated(partial, p, n0, n_cap, rtol)

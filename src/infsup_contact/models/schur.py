@@ -34,6 +34,7 @@ import scipy.sparse.linalg as spla
 
 from ..discretization.interface import GammaTrace
 from ..errors import InputError
+from ..la.threaded import symmetric_sandwich
 from . import pardiso
 from .ordering import nested_dissection_gamma_last
 
@@ -56,8 +57,7 @@ class _SteklovProduct:
         """B X Bᵀ for a sparse B (dim M × n_Γ): two sparse-times-dense products with the explicit
         X = S⁻¹ (:attr:`_steklov_explicit`, made once per side), nnz(B) · n_Γ multiply-adds each,
         where B X Bᵀ by :meth:`steklov_times` costs 2 n_Γ² dim M (the triangular solves) per space."""
-        Y = np.asarray(B @ self._steklov_explicit)     # B X, dense (dim M, n_Γ)
-        return np.asarray(B @ Y.T).T                   # (B (B X)ᵀ)ᵀ = B X Bᵀ (X symmetric)
+        return symmetric_sandwich(B, self._steklov_explicit).T  # bit for bit (B (B X)ᵀ)ᵀ
 
     @cached_property
     def _steklov_explicit(self) -> np.ndarray:

@@ -245,8 +245,8 @@ def inverse_standard_form(R: np.ndarray, L: np.ndarray) -> np.ndarray:
 
 def bottom_pencil(S: np.ndarray, L: np.ndarray, n_values: int, Z: np.ndarray | None = None,
                   s_factor: np.ndarray | None = None) -> BottomPencil:
-    """The n_values smallest eigenvalues of S x = λ G x, G = L Lᵀ (L lower: what lies above its
-    diagonal is ignored), above the kernel span Z.
+    """The n_values smallest eigenvalues of S x = λ G x, G = L Lᵀ (L lower triangular, zeros
+    above its diagonal: :func:`~.infsup.gram_factor`'s), above the kernel span Z.
 
     ``Z`` (m × d, S Z ≈ 0) is moved to λ = γ = 2 λ_max: the G-orthogonal complement of Z is
     invariant, so S' = S + γ G Z (ZᵀGZ)⁻¹ ZᵀG keeps the pencil's other eigenvalues, and it is
@@ -260,7 +260,6 @@ def bottom_pencil(S: np.ndarray, L: np.ndarray, n_values: int, Z: np.ndarray | N
     added and λ ≈ 0 (its round-off), as the dense route gives.
     """
     m = S.shape[0]
-    L = np.tril(L)  # a potrf factor may hold G's upper triangle above its diagonal (clean=0)
     top = lam_max(S, L)
     deflate = Z is not None and Z.shape[1] > 0
     R = None if deflate else (definite_factor(S) if s_factor is None else s_factor)

@@ -60,9 +60,10 @@ class Spectrum:
 
 
 def gram_factor(G: np.ndarray) -> np.ndarray:
-    """Lower Cholesky factor of the Gram matrix G (LAPACK potrf), for :func:`spectrum`: one
+    """Lower Cholesky factor of the Gram matrix G (LAPACK potrf, zeros above the diagonal: the
+    large route's deflation and inverse use L whole), for :func:`spectrum`: one
     factorization serves every interface operator S paired with G (each (c1, c2), v1 = 0)."""
-    L, info = lapack.dpotrf(np.asarray(G, float), lower=1, clean=0)
+    L, info = lapack.dpotrf(np.asarray(G, float), lower=1, clean=1)
     if info:
         raise np.linalg.LinAlgError(f"the Gram matrix is not positive definite (potrf info {info})")
     return L
@@ -236,6 +237,7 @@ def beta_rows_all(family, k, n1, n2, cases=None, multiplier_meshes=("omega2",), 
     gamma = sides[0].trace.gamma
     p1, p2 = (s.trace.partition for s in sides)
     dim_w = gamma.trace_sum_dimension(k, p1, p2)
+    trace_norms = [trace_l2_norms(s.trace, k) for s in sides]  # the kernel decisions' row scaling
     rows, by_partition = [], {}
     with gamma.gram_session():  # spaces on one G_h may share their Grams' series
         for multiplier_mesh in multiplier_meshes:
@@ -255,7 +257,8 @@ def beta_rows_all(family, k, n1, n2, cases=None, multiplier_meshes=("omega2",), 
                 grams = {norm: gamma.gram(space, norm, h_route=h_route) for norm in norms}
                 structural = gamma.proven_kernel(space, k, [s.trace for s in sides], dim_w)
                 kernel = space_kernel(couplings, sides, space, k, structural,
-                                      grams["L2"][0] if "L2" in grams else None, iterative=iterative)
+                                      grams["L2"][0] if "L2" in grams else None, iterative=iterative,
+                                      trace_norms=trace_norms)
                 terms = interface_terms(couplings, sides)
                 factors = {norm: gram_factor(G) for norm, (G, _) in grams.items()}
                 beta_v1_zero_c1 = betas_v1_zero(terms, factors, kernel, iterative)
@@ -288,7 +291,7 @@ def beta_rows_all(family, k, n1, n2, cases=None, multiplier_meshes=("omega2",), 
 
 
 def space_kernel(couplings, sides, space, k: int, structural: int, l2_gram=None,
-                 iterative: bool = False) -> KernelDecision:
+                 iterative: bool = False, trace_norms=None) -> KernelDecision:
     """The kernel of Bᵀ on ``space`` (:func:`~infsup_contact.solvers.kernel.coupling_kernel`):
     the couplings scaled by the L²(Γ) norms of the sides' trace basis functions and of the
     multiplier basis functions (the diagonal of the L² Gram matrix, computed if not given);
@@ -298,9 +301,12 @@ def space_kernel(couplings, sides, space, k: int, structural: int, l2_gram=None,
     ``iterative``: the bottom singular values only
     (:func:`~infsup_contact.solvers.kernel.bottom_kernel`, for dim M > :data:`.bottom.DENSE_MAX_M`),
     W' from a rule :data:`LONGER_RULE_LARGE` longer, the couplings sparse (W sparse, the same
-    entries); its ``vectors`` are returned in multiplier coordinates (a basis of the kernel of Bᵀ)."""
+    entries); its ``vectors`` are returned in multiplier coordinates (a basis of the kernel of Bᵀ).
+    ``trace_norms``: the sides' :func:`~.coupling.trace_l2_norms`, if already computed (they
+    depend on the sides only, not on the space)."""
     G = sides[0].trace.gamma.gram(space, "L2")[0] if l2_gram is None else l2_gram
-    rows, cols = [trace_l2_norms(s.trace, k) for s in sides], np.sqrt(np.diag(G))
+    rows = [trace_l2_norms(s.trace, k) for s in sides] if trace_norms is None else trace_norms
+    cols = np.sqrt(np.diag(G))
     W = scaled_couplings(couplings, rows, cols)
     extra = LONGER_RULE_LARGE if iterative else LONGER_RULE
     longer = scaled_couplings([coupling_matrix(s.trace, space, k, extra_degree=extra, sparse=iterative)

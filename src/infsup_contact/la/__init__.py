@@ -1,0 +1,2 @@
+"""Linear algebra the libraries leave on one core: threaded sparse × dense sandwiches and the
+face series' reordering (:mod:`.threaded`)."""

@@ -1,0 +1,137 @@
+"""Dense-result products that scipy and numpy run on one core, split over the BLAS threads.
+
+scipy's sparse × dense product (``csr_matvecs``) and numpy's element-wise passes are
+single-threaded. On the large face route (k = 2, N = 32) they held about 45 s of a 200 s
+β_h request while the second core waited: the sandwiches B X Bᵀ of the interface operator
+(:mod:`infsup_contact.models.schur`) and R S_P Rᵀ of the cellwise H Grams
+(:mod:`infsup_contact.discretization.face_cellwise_norms`), and the reordering of the face
+series (:mod:`infsup_contact.discretization.face_norms`). Both release the GIL, so threads
+over disjoint row blocks of the result use every core. Each row of a result is computed by
+the same kernel, in the same order, as the one-thread product: the results are bit-identical
+(tests/test_la_threaded.py).
+
+A second cost was hidden in scipy's ``A @ Y.T``: a C-contiguous copy of the transposed
+operand, a strided pass over memory (2.2 s for a 9,216² operand). :func:`symmetric_sandwich`
+never transposes a large operand: X Aᵀ is formed row block by row block from small copies.
+
+The number of threads is the BLAS's (MKL_NUM_THREADS, else OPENBLAS_NUM_THREADS, else 1, as
+:mod:`infsup_contact.models.pardiso` reads it): a run asked to use one core uses one.
+"""
+from __future__ import annotations
+
+import os
+from concurrent.futures import ThreadPoolExecutor
+
+import numpy as np
+import scipy.sparse as sp
+
+MIN_ROWS = 256
+"""Fewest result rows of a sparse product per thread worth a thread (below it one call does all)."""
+MIN_ENTRIES = 2 ** 20
+"""Fewest entries of :func:`symmetric_pairs`' result worth threads."""
+BLOCK = 256
+"""Rows of X per transposed block in :func:`symmetric_sandwich` (256 × 9,216 doubles: 19 MB)."""
+
+
+def threads() -> int:
+    """Threads for the products here: MKL_NUM_THREADS, else OPENBLAS_NUM_THREADS, else 1."""
+    value = os.environ.get("MKL_NUM_THREADS") or os.environ.get("OPENBLAS_NUM_THREADS") or "1"
+    try:
+        return max(int(value), 1)
+    except ValueError:
+        return 1
+
+
+def _row_blocks(n_rows: int, weights: np.ndarray | None = None, min_rows: int = MIN_ROWS) -> list[slice]:
+    """At most :func:`threads` contiguous row ranges of at least ``min_rows`` rows, balanced by
+    ``weights`` (cumulative work per row boundary, length n_rows + 1, e.g. a CSR indptr), else
+    by rows."""
+    n = min(threads(), max(n_rows // min_rows, 1))
+    if n == 1:
+        return [slice(0, n_rows)]
+    if weights is None:
+        cuts = np.linspace(0, n_rows, n + 1).round().astype(int)
+    else:
+        cuts = np.searchsorted(weights, np.linspace(weights[0], weights[-1], n + 1))
+        cuts[0], cuts[-1] = 0, n_rows
+    return [slice(a, b) for a, b in zip(cuts[:-1], cuts[1:]) if b > a]
+
+
+def _run(tasks) -> None:
+    """Call each task (no arguments); in threads when there is more than one."""
+    tasks = list(tasks)
+    if len(tasks) == 1:
+        tasks[0]()
+        return
+    with ThreadPoolExecutor(len(tasks)) as pool:
+        for f in [pool.submit(t) for t in tasks]:
+            f.result()
+
+
+def sparse_times_dense(A, X: np.ndarray) -> np.ndarray:
+    """A X for a sparse A (CSR) and a dense X, C-contiguous (m × columns of X), row blocks of A
+    balanced by their nonzeros over the threads; bit-identical to ``A @ X``."""
+    A = sp.csr_matrix(A)
+    X = np.ascontiguousarray(X, dtype=float)
+    out = np.empty((A.shape[0], X.shape[1]))
+
+    def block(rows):
+        def task():
+            out[rows] = A[rows] @ X
+        return task
+
+    _run(block(r) for r in _row_blocks(A.shape[0], A.indptr))
+    return out
+
+
+def times_transpose(A, X: np.ndarray) -> np.ndarray:
+    """X Aᵀ = (A Xᵀ)ᵀ for a sparse A (m × n) and a dense X (p × n), C-contiguous (p × m).
+
+    Row block by row block of X: each block is transposed into a small contiguous copy and
+    multiplied by A (``csr_matvecs``), so no transpose of the whole X is ever formed. Entry
+    (l, i) is Σ_j A_ij X_lj, summed in the order of A's row i: for a symmetric X the rows of
+    ``A @ X``, transposed, bit for bit."""
+    A = sp.csr_matrix(A)
+    p = X.shape[0]
+    out = np.empty((p, A.shape[0]))
+    starts = list(range(0, p, BLOCK))
+    parts = _row_blocks(len(starts), min_rows=1)
+
+    def chunk(ids):
+        def task():
+            for s in starts[ids]:
+                e = min(s + BLOCK, p)
+                out[s:e] = (A @ np.ascontiguousarray(X[s:e].T)).T
+        return task
+
+    _run(chunk(r) for r in parts)
+    return out
+
+
+def symmetric_sandwich(A, X: np.ndarray) -> np.ndarray:
+    """A X Aᵀ for a sparse A (CSR, m × n) and a dense symmetric X (n × n), C-contiguous.
+
+    Z = X Aᵀ by :func:`times_transpose`, then A Z by :func:`sparse_times_dense`. For an
+    exactly symmetric X this is bit for bit ``A @ (A @ X).T`` (the former route: Z equals
+    (A X)ᵀ entry by entry), at every thread count. The result is symmetric only to round-off."""
+    return sparse_times_dense(A, times_transpose(A, X))
+
+
+def symmetric_pairs(flat: np.ndarray, dx: int, dy: int) -> np.ndarray:
+    """G[(a, b), (a', b')] = ½ (F[a, a', b, b'] + F[a', a, b', b]) for F = ``flat`` indexed
+    ((a, a'), (b, b')): the reordering and the symmetrisation ½ (G + Gᵀ) of a separable face
+    series in one pass, one a at a time (whole-array transposes walk memory with stride dim²,
+    ~3× slower at dim 9,216), the a's split over the threads. Bit for bit ½ G + ½ Gᵀ: halving
+    is exact and addition commutes."""
+    F = flat.reshape(dx, dx, dy, dy)
+    G = np.empty((dx, dy, dx, dy))
+
+    def chunk(ids):
+        def task():
+            for a in range(ids.start, ids.stop):
+                np.add(F[a].transpose(1, 0, 2), F[:, a].transpose(2, 0, 1), out=G[a])
+                G[a] *= 0.5
+        return task
+
+    _run(chunk(b) for b in _row_blocks(dx, min_rows=1 if G.size >= MIN_ENTRIES else dx))
+    return G.reshape(dx * dy, dx * dy)

@@ -1,0 +1,50 @@
+"""The threaded products (la/threaded.py) are bit for bit the one-thread ones, at every thread count."""
+import numpy as np
+import pytest
+import scipy.sparse as sp
+
+from infsup_contact.la import threaded
+
+
+def _data(m, n, seed=0):
+    rng = np.random.default_rng(seed)
+    A = sp.random(m, n, density=min(1.0, 12 / n), format="csr", random_state=seed)
+    X = rng.standard_normal((n, n))
+    return A, X + X.T                                  # exactly symmetric
+
+
+@pytest.mark.parametrize("n_threads", ["1", "2", "3"])
+@pytest.mark.parametrize("shape", [(7, 5), (600, 700), (1100, 530)])
+def test_sandwich_is_the_former_route_bit_for_bit(monkeypatch, n_threads, shape):
+    monkeypatch.setenv("MKL_NUM_THREADS", n_threads)
+    A, X = _data(*shape)
+    former = np.asarray(A @ np.asarray(A @ X).T)
+    assert np.array_equal(threaded.symmetric_sandwich(A, X), former)
+
+
+@pytest.mark.parametrize("n_threads", ["1", "2"])
+def test_sparse_times_dense_and_times_transpose(monkeypatch, n_threads):
+    monkeypatch.setenv("MKL_NUM_THREADS", n_threads)
+    A, X = _data(900, 400, seed=3)
+    Y = np.random.default_rng(4).standard_normal((300, 400))
+    assert np.array_equal(threaded.sparse_times_dense(A, X), A @ X)
+    T = threaded.times_transpose(A, Y)
+    assert T.flags.c_contiguous and T.shape == (300, 900)
+    assert np.allclose(T, Y @ A.T.toarray(), rtol=0, atol=1e-12)
+
+
+@pytest.mark.parametrize("n_threads", ["1", "2"])
+@pytest.mark.parametrize("dx, dy", [(3, 4), (40, 30)])
+def test_symmetric_pairs_reorders_and_symmetrises(monkeypatch, n_threads, dx, dy):
+    monkeypatch.setenv("MKL_NUM_THREADS", n_threads)
+    F = np.random.default_rng(5).standard_normal((dx * dx, dy * dy))
+    G = F.reshape(dx, dx, dy, dy).transpose(0, 2, 1, 3).reshape(dx * dy, dx * dy)
+    assert np.array_equal(threaded.symmetric_pairs(F, dx, dy), 0.5 * G + 0.5 * G.T)
+
+
+def test_threads_follow_the_environment(monkeypatch):
+    monkeypatch.delenv("MKL_NUM_THREADS", raising=False)
+    monkeypatch.setenv("OPENBLAS_NUM_THREADS", "2")
+    assert threaded.threads() == 2
+    monkeypatch.setenv("MKL_NUM_THREADS", "junk")
+    assert threaded.threads() == 1

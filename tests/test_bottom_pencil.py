@@ -6,6 +6,7 @@ import pytest
 import scipy.linalg as sla
 from scipy.linalg import blas
 
+from infsup_contact.la import mkl
 from infsup_contact.solvers import bottom, infsup
 from infsup_contact.solvers.kernel import coupling_kernel
 
@@ -25,11 +26,16 @@ def _pencil(m, d, seed):
     return (S + S.T) / 2, _spd(m, seed + 1, cond=10.0), V[:, :d]
 
 
+@pytest.mark.parametrize("route", ["mkl", "scipy"])
 @pytest.mark.parametrize("m,block", [(1, 512), (7, 3), (90, 16), (90, 512), (131, 32)])
-def test_blocked_inverse_form_equals_the_plain_one(m, block, monkeypatch):
+def test_blocked_inverse_form_equals_the_plain_one(m, block, route, monkeypatch):
     """Kᵀ K by the column-blocked solve and lauum = dsyrk of the full solve R⁻¹ L, to round-off;
-    blocks that do not divide m included."""
+    blocks that do not divide m included; both routes (MKL in place on sub-blocks, scipy on copies)."""
+    if route == "mkl" and not mkl.available():
+        pytest.skip("MKL not loadable here")
+    monkeypatch.setattr(mkl, "available", lambda: route == "mkl")
     monkeypatch.setattr(bottom, "SOLVE_BLOCK", block)
+    monkeypatch.setattr(bottom, "SOLVE_BLOCK_MKL", block)
     R = np.tril(sla.cholesky(_spd(m, m), lower=True))
     L = np.tril(sla.cholesky(_spd(m, m + 1), lower=True))
     K = sla.solve_triangular(R, L, lower=True)

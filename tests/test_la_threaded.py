@@ -48,3 +48,22 @@ def test_threads_follow_the_environment(monkeypatch):
     assert threaded.threads() == 2
     monkeypatch.setenv("MKL_NUM_THREADS", "junk")
     assert threaded.threads() == 1
+
+
+@pytest.mark.parametrize("n_threads", ["1", "2"])
+@pytest.mark.parametrize("m", [3, 700])
+def test_symmetric_part(monkeypatch, n_threads, m):
+    monkeypatch.setenv("MKL_NUM_THREADS", n_threads)
+    A = np.random.default_rng(6).standard_normal((m, m))
+    S = threaded.symmetric_part(A)
+    assert np.array_equal(S, 0.5 * (A + A.T)) and np.array_equal(S, S.T)
+    assert np.array_equal(threaded.symmetric_part(np.asfortranarray(A)), S)
+
+
+def test_trailing_solve_refuses_c_order():
+    from infsup_contact.la import mkl
+    if not mkl.available():
+        pytest.skip("MKL not loadable here")
+    R = np.eye(4)
+    with pytest.raises(ValueError, match="Fortran"):
+        mkl.trailing_solve(np.ascontiguousarray(R) + np.tril(np.ones((4, 4)), -1), np.asfortranarray(R), 0, 2)

@@ -21,14 +21,13 @@ back to SuperLU when it does not. Threads: MKL_NUM_THREADS, else OPENBLAS_NUM_TH
 from __future__ import annotations
 
 import ctypes
-import glob
-import os
-import sys
 from functools import lru_cache
 
 import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
+
+from ..la.mkl import mkl_rt
 
 _P = ctypes.POINTER
 _I32 = ctypes.c_int32
@@ -38,23 +37,14 @@ MTYPE_SPD = 2
 
 @lru_cache(maxsize=1)
 def _library():
-    """The loaded ``mkl_rt`` (or None): $INFSUP_MKL_RT, else the environment's ``lib/``."""
-    candidates = [os.environ.get("INFSUP_MKL_RT", "")]
-    for prefix in (sys.prefix, sys.base_prefix):
-        candidates += sorted(glob.glob(os.path.join(prefix, "lib", "libmkl_rt.so*")))
-    for path in filter(None, candidates):
-        try:
-            lib = ctypes.CDLL(path)
-        except OSError:
-            continue
+    """The loaded ``mkl_rt`` (:func:`~infsup_contact.la.mkl.mkl_rt`) with pardiso's signature, or None."""
+    lib = mkl_rt()
+    if lib is not None:
         lib.pardiso.restype = None
         lib.pardiso.argtypes = [_P(ctypes.c_int64), _P(_I32), _P(_I32), _P(_I32), _P(_I32), _P(_I32),
                                 ctypes.c_void_p, _P(_I32), _P(_I32), _P(_I32), _P(_I32), _P(_I32),
                                 _P(_I32), ctypes.c_void_p, ctypes.c_void_p, _P(_I32)]
-        threads = os.environ.get("MKL_NUM_THREADS") or os.environ.get("OPENBLAS_NUM_THREADS") or "1"
-        lib.MKL_Set_Num_Threads(ctypes.c_int(max(int(threads), 1)))
-        return lib
-    return None
+    return lib
 
 
 def available() -> bool:

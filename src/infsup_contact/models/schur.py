@@ -34,7 +34,7 @@ import scipy.sparse.linalg as spla
 
 from ..discretization.interface import GammaTrace
 from ..errors import InputError
-from ..la.threaded import symmetric_sandwich
+from ..la.threaded import symmetric_part, symmetric_sandwich
 from . import pardiso
 from .ordering import nested_dissection_gamma_last
 
@@ -290,11 +290,12 @@ def interface_terms(couplings, sides) -> list:
 
 
 def combine_terms(terms, c) -> np.ndarray:
-    """Σ_i T_i / c_i, symmetrized: the interface operator for the material scales c."""
+    """Σ_i T_i / c_i, symmetrized: the interface operator for the material scales c (the
+    symmetrisation over the threads, :func:`~infsup_contact.la.threaded.symmetric_part`)."""
     out = 0.0
     for T, ci in zip(terms, c):
         out = out + T / ci
-    return 0.5 * (out + out.T)
+    return symmetric_part(out) if np.ndim(out) == 2 else 0.5 * (out + out.T)
 
 
 def interface_operator(couplings, sides, c=(1.0, 1.0)) -> np.ndarray:

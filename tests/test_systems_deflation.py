@@ -143,3 +143,18 @@ def test_a_one_dimensional_complement_and_an_all_kernel_b():
     assert abs(lanczos.smallest_nonzero - ref.smallest_nonzero) <= RTOL * ref.smallest_nonzero
     ev, _, _ = engine._shift_invert(A, sp.csr_matrix(B.shape), G, 1, 1.0, np.eye(B.shape[0]))
     assert np.array_equal(ev, np.zeros(B.shape[0]))
+
+
+def test_route_above_the_dense_gate_follows_what_b_touches():
+    """Above DENSE_MAX_M a dense G on an interface (B touching a few % of the dofs: a 3D contact
+    export) keeps the Γ route; a Stokes-like B (most dofs touched), a sparse G or a too large X
+    goes to shift-invert; below the gate the smaller dense block decides, as before."""
+    from infsup_contact.systems.engine import DENSE_MAX_BYTES, INTERFACE_FRACTION
+    n, m = 137_000, 4225
+    assert choose_route(n, m, 7938) == "gamma-dense"                       # 3D face, k = 2, N = 32
+    assert choose_route(n, m, int(0.5 * n)) == "shift-invert"              # Stokes-like
+    assert choose_route(n, m, 7938, sparse_g=True) == "shift-invert"
+    too_big = int(np.sqrt(DENSE_MAX_BYTES / 8.0)) + 1
+    assert too_big <= INTERFACE_FRACTION * 10 * too_big
+    assert choose_route(10 * too_big, m, too_big) == "shift-invert"        # X does not fit
+    assert choose_route(n, 1000, 7938) == "gamma-dense"

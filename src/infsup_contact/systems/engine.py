@@ -116,13 +116,25 @@ SPARSE_G_DENSE_MAX_M = 300
 m = 1152 and 2048 (scikit-fem P2–P0, same β to 1e-13)."""
 
 
+INTERFACE_FRACTION = 0.1
+"""Above :data:`DENSE_MAX_M` with a dense G, a system whose B touches at most this fraction of
+its dofs (a contact interface, not a Stokes pressure) keeps the ``gamma-dense`` route: on a 3D
+contact export (membranes3d, hex, k = 2, N = 20, m = 1,681, B touching 2 % of the dofs) it took
+116 s where the shift-invert route's sparse LU of [[A, Bᵀ], [B, −δG]] with a dense G took
+483–790 s; its dense pencil at m = 4,225 is 10–20 s."""
+
+
 def choose_route(n: int, m: int, n_touched: int, sparse_g: bool = False) -> str:
     """``gamma-dense`` where X = (A⁻¹)_ΓΓ is the smaller dense block, ``solves-dense`` where
     A⁻¹ Bᵀ is, ``shift-invert`` when m > :data:`DENSE_MAX_M` (with a sparse G: m >
-    :data:`SPARSE_G_DENSE_MAX_M`) or both dense blocks are too large."""
-    if m > (SPARSE_G_DENSE_MAX_M if sparse_g else DENSE_MAX_M):
-        return "shift-invert"
+    :data:`SPARSE_G_DENSE_MAX_M`) or both dense blocks are too large. Above DENSE_MAX_M a dense
+    G on an interface (B touching at most :data:`INTERFACE_FRACTION` of the dofs) stays on
+    ``gamma-dense`` while X and S fit in :data:`DENSE_MAX_BYTES`."""
     gamma_bytes, solves_bytes = 8.0 * n_touched ** 2, 8.0 * n * m
+    if m > (SPARSE_G_DENSE_MAX_M if sparse_g else DENSE_MAX_M):
+        interface = not sparse_g and n_touched <= INTERFACE_FRACTION * n
+        fits = max(gamma_bytes, 8.0 * m * m) <= DENSE_MAX_BYTES
+        return "gamma-dense" if interface and fits else "shift-invert"
     if min(gamma_bytes, solves_bytes) > DENSE_MAX_BYTES:
         return "shift-invert"
     return "gamma-dense" if gamma_bytes <= solves_bytes else "solves-dense"

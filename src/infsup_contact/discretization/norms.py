@@ -311,8 +311,7 @@ def _norm2(A: np.ndarray) -> float:
         return float(np.max(np.abs(np.linalg.eigvalsh(A))))
     start = np.ones(len(A)) / np.sqrt(len(A))  # a fixed start: the estimate is reproducible
     ncv = NORM2_SHORT_KRYLOV if len(A) > NORM2_SHORT_KRYLOV_MIN else None
-    tol = NORM2_LARGE_RTOL if len(A) > NORM2_LARGE_MIN else 1e-8
-    return float(abs(spla.eigsh(A, k=1, which="LM", tol=tol, v0=start, ncv=ncv,
+    return float(abs(spla.eigsh(A, k=1, which="LM", tol=1e-8, v0=start, ncv=ncv,
                                 return_eigenvectors=False)[0]))
 
 
@@ -322,14 +321,6 @@ instead of ARPACK's default 20: the top of a Gram matrix (or of a Richardson ste
 separated, 11 products reach the same 1e-8 where the default takes 21 (a dense product is 12 ms
 at order 4,225); the default DAG's Grams, all below, keep their digits."""
 NORM2_SHORT_KRYLOV = 10
-NORM2_LARGE_MIN = 1500
-"""Order above which :func:`_norm2` asks Lanczos for :data:`NORM2_LARGE_RTOL` only: the large
-face route's Grams (dim M above :data:`~infsup_contact.solvers.bottom.DENSE_MAX_M`; every
-default-DAG Gram is below and keeps its digits)."""
-NORM2_LARGE_RTOL = 1e-4
-"""Relative accuracy of that estimate: the Richardson test compares it with rtol = 1e-6 and the
-row reports it (``nmax_rel_error``) to 4 digits; a Richardson step's top is less separated than a
-Gram's, and 1e-8 took ~50 products there (k = 2, N = 32: 11 s of 53 for the cellwise Grams)."""
 
 
 # ----------------------------------------------------------------------- dispatch

@@ -41,7 +41,8 @@ import pandas as pd
 
 from ..discretization.registry import SPACES
 from ..errors import InputError
-from ..discretization.square import SQUARE, TensorPartition
+from ..discretization.face_triangle_kernel import symmetric_kernel_bound
+from ..discretization.square import SQUARE, SQUARE_TRIG, Square, TensorPartition
 from .claims import FAIL, INCONCLUSIVE, PASS, bounded_claim, close_decisions, close_text, finest, kernel_claim, row, \
     slope_verdict
 
@@ -113,6 +114,23 @@ def tensor_kernel_bound(spec, k: int, n1: int, n2: int) -> int:
     d = spec.dimension(k, n2)
     a1, a2 = (max(d - (n * k - 1), 0) for n in (n1, n2))
     return 2 * a1 * a2 - min(a1, a2) ** 2
+
+
+def triangle_kernel_bound(spec, k: int, n1: int, n2: int, gamma=SQUARE_TRIG) -> int:
+    """Lower bound of the kernel on Kuhn-triangulated (structured tetrahedral) faces, G_h = the
+    trace of Ω2: Σ_c max(dim M_c − dim(W1 + W2)_c, corner modes in c, 0) over the four isotypic
+    components c of the square's symmetries {id, T, R, TR} that preserve the diagonals
+    (:func:`~infsup_contact.discretization.face_triangle_kernel.symmetric_kernel_bound`; docs/tet_kernel.md).
+    It is >= :func:`planar_kernel` (the components' counts sum to the global one) and exceeds it
+    where the components' counts differ in sign or the corner modes (N1 <= N2) outnumber a
+    component's count: R5.2 at k = 1, 6:7 → 5 (count 3), 7:8 → 4 (count 0). A space whose
+    basis the group does not permute gets the planar count."""
+    if getattr(gamma, "cell", None) != "trig" or not isinstance(gamma, Square):
+        raise InputError("gamma", "a face of Kuhn triangles (Square(cell='trig'), the structured tetrahedra's)",
+                         got=getattr(gamma, "cell", type(gamma).__name__))
+    planar = planar_kernel(spec, k, n1, n2, gamma)
+    comps = symmetric_kernel_bound(gamma.space(spec, k, _uniform(n2)), k, n1, n2)
+    return planar if comps is None else max(planar, sum(comps.values()))
 
 
 def element_interfaces(model, elements) -> dict:

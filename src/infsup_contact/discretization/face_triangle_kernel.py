@@ -23,20 +23,24 @@ Methods and Their Applications*, 1992, ch. 2). The bases are permuted by G
 χ(g) the number of basis functions g fixes (:func:`class_dimensions`); W1 ∩ W2 is the trace
 space of the common coarsening (gcd(N1, N2) cells), as in ``Square.trace_sum_dimension``.
 
-**2. Corner modes.** At the corners (1, 0) and (0, 1) the corner triangle of every Kuhn grid
-has its three vertices on ∂Γ, so every trace vanishes on it; when N1 ≤ N2 the corner triangle
-of G_h lies in those of both traces and a multiplier supported there (the corner hat of R5.2)
-is orthogonal to both; a multiplier odd under TR supported on the few G_h triangles at the
-corner (φ_(1−h, 0) − φ_(1, h) for R5.2, k = 1) meets only traces even under TR there (the hats
-at (1 − h_i, h_i)) and is a mode as well. Such modes are kernel vectors of Bᵀ supported in a
-box of side 2 h2 at a corner (:func:`corner_modes`: the nullity of the coupling of the
-multipliers supported in the box, a few dofs, split by the parity of the symmetry fixing that
-corner); the pair of corners swapped by G gives one mode per component of that parity.
+**2. Boundary-layer modes.** Every trace vanishes on ∂Γ, and in the layer of G_h cells along
+∂Γ only the first row of interior nodes of each trace reaches: few trace functions against many
+multipliers, whatever the global count says. At the corners (1, 0) and (0, 1) the corner
+triangle of every Kuhn grid has its three vertices on ∂Γ, so every trace vanishes on it; when
+N1 <= N2 the corner triangle of G_h lies in those of both traces and the corner hat of R5.2 is
+orthogonal to both, as is φ_(1−h, 0) − φ_(1, h) (odd under TR, it meets only the TR-even hats
+at (1 − h_i, h_i)). For a dual basis (DUAL-ALL), biorthogonal to W2, μ ⊥ W2 leaves exactly the
+duals ψ_v of the nodes v on ∂Γ (4 N2 of them, supported in the layer), and ψ_v couples to W1
+only where a line of the Ω1 grid cuts its star (on a star cut by no such line a W1 function is
+linear, and ∫ ψ_v w = w(v) ∫ φ_v = 0): the whole kernel lives in the layer, 4 N2 − rank. Such
+modes are counted exactly, per component, as the nullity of the coupling of the multipliers
+supported in the layer of width 2 h2 (:func:`layer_modes`, O(N) dofs).
 
 Both are lower bounds of dim ker_c, hence so is their maximum (:func:`symmetric_kernel_bound`).
-On R5.2 and T3 (k = 1, 2), N1, N2 ∈ 2..10, it equals the computed kernel; on spaces whose
-multipliers see a trace biorthogonally (the dual basis DUAL-ALL) or discontinuous ones (R5.4)
-more modes live in the boundary strip of width h2 and the bound stays below (docs/tet_kernel.md).
+On R5.2, DUAL-ALL and T3 (k = 1, 2), N1, N2 ∈ 3..10, it equals the computed kernel; on the
+discontinuous R5.4 it stays below on near-matching pairs (k = 2: 6:7 gives 16 of 18; k = 1, N1 =
+2 N2: a checkerboard mode), and neither trace-side layer dependencies explain the rest
+(docs/tet_kernel.md).
 """
 from __future__ import annotations
 
@@ -44,7 +48,6 @@ import math
 
 import numpy as np
 import scipy.linalg as sla
-from scipy import sparse
 
 from .coupling import weighted_values
 from .face_quadrature import split_triangles, triangles_rule
@@ -112,76 +115,61 @@ def class_counts(space, k: int, n1: int, n2: int) -> dict | None:
     return {c: m[c] - w1[c] - w2[c] + both[c] for c in COMPONENTS}
 
 
-def _box(corner, side: float):
-    """((x0, x1), (y0, y1)): the square of side ``side`` in Γ at the corner (cx, cy) ∈ {0, 1}²."""
-    return tuple((0.0, side) if c == 0 else (1.0 - side, 1.0) for c in corner)
+def projector(pi: dict, c) -> np.ndarray:
+    """(1/4) Σ_g χ_c(g) P_g, the orthogonal projector onto the component c = (χ(T), χ(R)) of a
+    space whose basis G permutes (P_g e_j = e_π_g(j): φ_j ∘ g = φ_π_g(j))."""
+    a, b = c
+    n = len(pi["T"])
+    out = np.eye(n)
+    for g, chi in (("T", a), ("R", b), ("TR", a * b)):
+        out[pi[g], np.arange(n)] += chi
+    return out / 4.0
 
 
-def _in_box(x: np.ndarray, box, tol: float = 1e-12) -> np.ndarray:
-    (x0, x1), (y0, y1) = box
-    return (x[:, 0] >= x0 - tol) & (x[:, 0] <= x1 + tol) & (x[:, 1] >= y0 - tol) & (x[:, 1] <= y1 + tol)
+def layer_modes(space, k: int, n1: int, n2: int, width_cells: int = 2) -> dict:
+    """Per component c: the kernel vectors of Bᵀ supported in the boundary layer
+    {x ∈ Γ : dist(x, ∂Γ) <= width_cells · h2} (a union of G_h triangles, invariant under G).
 
-
-def corner_modes(space, k: int, n1: int, n2: int, corner, parity_map: str, side_cells: int = 2) -> tuple:
-    """(even, odd): kernel vectors of Bᵀ supported in the box of side ``side_cells`` · h2 at
-    ``corner``, by their parity under the symmetry ``parity_map`` ("TR" for (1, 0), "T" for
-    (0, 0)) that fixes the corner and the box. The multipliers supported in the box (all their
-    sample values outside it zero) are coupled exactly (Duffy rule on the overlay of both traces
-    and G_h, :func:`~.face_quadrature.split_triangles`) with every function of W1 and W2;
-    the nullity of that small matrix in each parity subspace is the count."""
-    side = side_cells / n2
-    box = _box(corner, side)
+    The multipliers supported there (all their sample values farther in are zero) are coupled
+    exactly with every function of W1 and W2 (Duffy rule on the overlay of both traces and
+    G_h, :func:`~.face_quadrature.split_triangles`, restricted to the layer); the nullity of that
+    matrix on the range of :func:`projector` is the count of c. A width of n2 / 2 cells or
+    more is the whole face (the count is then the kernel itself)."""
+    depth = min(width_cells / n2, 0.5)
     x = np.einsum("pk,tkd->tpd", _SAMPLES, space.triangles()).reshape(-1, 2)
     values = weighted_values(space, x, np.ones(len(x))).tocsc()
-    outside = ~_in_box(x, box)
-    rows = np.flatnonzero(np.asarray(abs(values[outside]).sum(axis=0)).ravel() == 0.0)
+    inner = _distance(x) > depth + 1e-12
+    rows = np.flatnonzero(np.asarray(abs(values[inner]).sum(axis=0)).ravel() == 0.0)
     if len(rows) == 0:
-        return 0, 0
-    pi = permutations(space)[parity_map]
-    assert set(pi[rows]) == set(rows), "the box is not mapped onto itself"
-    pos = {r: i for i, r in enumerate(rows)}
-    P = np.zeros((len(rows), len(rows)))
-    P[[pos[j] for j in pi[rows]], np.arange(len(rows))] = 1.0
-    traces = [trace_space(k, n) for n in (n1, n2)]
-    xs = np.unique(np.concatenate([uniform(n).xs for n in (n1, n2)]))
-    (x0, x1), (y0, y1) = box
-    sub = TensorPartition(xs[(xs >= x0 - 1e-12) & (xs <= x1 + 1e-12)], xs[(xs >= y0 - 1e-12) & (xs <= y1 + 1e-12)])
-    B = []
-    for w, n in zip(traces, (n1, n2)):
-        if w.dim == 0:
-            continue
-        tri = split_triangles(sub, uniform(n), uniform(n2))
-        q, wq = triangles_rule(tri, k + space.degree)
-        B.append((weighted_values(space, q, wq)[:, rows].T @ weighted_values(w, q, np.ones(len(q)))).toarray())
-    B = np.hstack(B) if B else np.zeros((len(rows), 0))
+        return {c: 0 for c in COMPONENTS}
+    pi = permutations(space)
+    tri = split_triangles(TensorPartition(*(2 * [np.unique(np.concatenate([uniform(n).xs for n in (n1, n2)]))])),
+                          uniform(n1), uniform(n2))
+    tri = tri[_distance(tri.mean(axis=1)) <= depth + 1e-12]
+    q, wq = triangles_rule(tri, k + space.degree)
+    mu = weighted_values(space, q, wq)[:, rows].T
+    B = np.hstack([(mu @ weighted_values(w, q, np.ones(len(q)))).toarray()
+                   for w in (trace_space(k, n1), trace_space(k, n2)) if w.dim])
     scale = np.abs(B).max() if B.size else 1.0
-    out = []
-    for sign in (1.0, -1.0):
-        basis = sla.orth(np.eye(len(rows)) + sign * P)  # the parity subspace
-        if basis.shape[1] == 0:
-            out.append(0)
-            continue
-        sv = np.linalg.svd(basis.T @ B, compute_uv=False) if B.size else np.zeros(0)
-        out.append(int(basis.shape[1] - np.sum(sv > _RANK_TOL * scale)))
-    return tuple(out)
+    out = {}
+    for c in COMPONENTS:
+        basis = sla.orth(projector(pi, c)[np.ix_(rows, rows)])
+        sv = np.linalg.svd(basis.T @ B, compute_uv=False) if B.size and basis.shape[1] else np.zeros(0)
+        out[c] = int(basis.shape[1] - np.sum(sv > _RANK_TOL * scale))
+    return out
 
 
-def symmetric_kernel_bound(space, k: int, n1: int, n2: int, side_cells: int = 2) -> dict | None:
-    """Per component c: max(dim M_c − dim(W1 + W2)_c, corner modes in c, 0), a lower bound of
-    dim ker_c (module docstring); None where the group does not permute the spaces' bases.
+def _distance(x: np.ndarray) -> np.ndarray:
+    """Distance of points (n, 2) of Γ to ∂Γ."""
+    return np.minimum(np.minimum(x[:, 0], 1.0 - x[:, 0]), np.minimum(x[:, 1], 1.0 - x[:, 1]))
 
-    Corners (1, 0) and (0, 1) are swapped by T and R and fixed by TR: a mode of TR-parity p at
-    one of them and its image span one vector in each component with χ(T) χ(R) = p. Corners
-    (0, 0) and (1, 1) are fixed by T and swapped by R: one vector in each component with
-    χ(T) = p. Boxes of side ≤ 1/2 at different corners do not overlap, so all are independent."""
+
+def symmetric_kernel_bound(space, k: int, n1: int, n2: int, width_cells: int = 2) -> dict | None:
+    """Per component c: max(dim M_c − dim(W1 + W2)_c, boundary-layer modes in c, 0), a lower
+    bound of dim ker_c (module docstring: both are); None where the group does not permute
+    the spaces' bases."""
     counts = class_counts(space, k, n1, n2)
     if counts is None:
         return None
-    side_cells = min(side_cells, n2 // 2)
-    corner = {c: 0 for c in COMPONENTS}
-    if side_cells >= 1:
-        for point, g, char in (((1.0, 0.0), "TR", lambda a, b: a * b), ((0.0, 0.0), "T", lambda a, b: a)):
-            even, odd = corner_modes(space, k, n1, n2, point, g, side_cells)
-            for c in COMPONENTS:
-                corner[c] += even if char(*c) == 1 else odd
-    return {c: max(counts[c], corner[c], 0) for c in COMPONENTS}
+    layer = layer_modes(space, k, n1, n2, width_cells)
+    return {c: max(counts[c], layer[c], 0) for c in COMPONENTS}

@@ -118,13 +118,14 @@ def tensor_kernel_bound(spec, k: int, n1: int, n2: int) -> int:
 
 def triangle_kernel_bound(spec, k: int, n1: int, n2: int, gamma=SQUARE_TRIG) -> int:
     """Lower bound of the kernel on Kuhn-triangulated (structured tetrahedral) faces, G_h = the
-    trace of Ω2: Σ_c max(dim M_c − dim(W1 + W2)_c, corner modes in c, 0) over the four isotypic
-    components c of the square's symmetries {id, T, R, TR} that preserve the diagonals
-    (:func:`~infsup_contact.discretization.face_triangle_kernel.symmetric_kernel_bound`; docs/tet_kernel.md).
-    It is >= :func:`planar_kernel` (the components' counts sum to the global one) and exceeds it
-    where the components' counts differ in sign or the corner modes (N1 <= N2) outnumber a
-    component's count: R5.2 at k = 1, 6:7 → 5 (count 3), 7:8 → 4 (count 0). A space whose
-    basis the group does not permute gets the planar count."""
+    trace of Ω2: Σ_c max(dim M_c − dim(W1 + W2)_c, boundary-layer modes in c, 0) over the four
+    isotypic components c of the square's symmetries {id, T, R, TR} that preserve the diagonals
+    (:func:`~infsup_contact.discretization.face_triangle_kernel.symmetric_kernel_bound`;
+    docs/tet_kernel.md). It is >= :func:`planar_kernel` (the components' counts sum to the
+    global one) and exceeds it where the components' counts differ in sign or the modes of the
+    cells along ∂Γ outnumber a component's count: R5.2 at k = 1, 6:7 → 5 (count 3), 7:8 → 4
+    (count 0). It is the kernel on R5.2, T3 and DUAL-ALL (k = 1, 2, N <= 10), a lower bound
+    on R5.4. A space whose basis the group does not permute gets the planar count."""
     if getattr(gamma, "cell", None) != "trig" or not isinstance(gamma, Square):
         raise InputError("gamma", "a face of Kuhn triangles (Square(cell='trig'), the structured tetrahedra's)",
                          got=getattr(gamma, "cell", type(gamma).__name__))

@@ -133,11 +133,14 @@ def layer_modes(space, k: int, n1: int, n2: int, width_cells: int = 2) -> dict:
     The multipliers supported there (all their sample values farther in are zero) are coupled
     exactly with every function of W1 and W2 (Duffy rule on the overlay of both traces and
     G_h, :func:`~.face_quadrature.split_triangles`, restricted to the layer); the nullity of that
-    matrix on the range of :func:`projector` is the count of c. A width of n2 / 2 cells or
-    more is the whole face (the count is then the kernel itself)."""
-    depth = min(width_cells / n2, 0.5)
+    matrix on the range of :func:`projector` is the count of c. The width is capped at
+    (n2 − 1) // 2 cells, so that the layer never is the whole face (whose nullity would be the
+    kernel itself, not a count): no layer for n2 <= 2."""
+    depth = min(width_cells, (n2 - 1) // 2) / n2
     x = np.einsum("pk,tkd->tpd", _SAMPLES, space.triangles()).reshape(-1, 2)
     values = weighted_values(space, x, np.ones(len(x))).tocsc()
+    if depth <= 0:
+        return {c: 0 for c in COMPONENTS}
     inner = _distance(x) > depth + 1e-12
     rows = np.flatnonzero(np.asarray(abs(values[inner]).sum(axis=0)).ravel() == 0.0)
     if len(rows) == 0:

@@ -32,7 +32,9 @@ a case id and never from the table (:func:`face_predictions`). The reasoning:
   the config, the claim is predicted FAIL (the dimension argument undercounts). A stable
   space has no kernel (its count is 0): PASS. Otherwise both counts are lower bounds and
   nothing predicts equality (``finding``), on triangular faces (tetrahedra: no tensor traces)
-  as on rectangles.
+  as on rectangles. On the Kuhn faces of the structured tetrahedra the sharper lower bound is
+  :func:`triangle_kernel_bound` (the count per isotypic component of the face's symmetries and
+  the modes of the cells along ∂Γ; docs/tet_kernel.md); the predictions do not use it yet.
 """
 from __future__ import annotations
 

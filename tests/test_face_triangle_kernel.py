@@ -9,8 +9,9 @@ import numpy as np
 import pytest
 
 from infsup_contact.discretization.coupling import coupling_matrix, trace_l2_norms
-from infsup_contact.discretization.face_triangle_kernel import (COMPONENTS, class_dimensions, permutations,
-                                                                 symmetric_kernel_bound, trace_space, uniform)
+from infsup_contact.discretization.face_triangle_kernel import (COMPONENTS, class_dimensions, component_basis,
+                                                                 permutations, symmetric_kernel_bound, trace_space,
+                                                                 uniform)
 from infsup_contact.discretization.registry import SPACES, case_space
 from infsup_contact.discretization.square import SQUARE, SQUARE_TRIG
 from infsup_contact.errors import InputError
@@ -47,6 +48,8 @@ def test_components_partition_the_space(case, k, n):
         proj = {c: _projector(pi, c) for c in COMPONENTS}
         for c, Pc in proj.items():
             assert np.allclose(Pc @ Pc, Pc) and np.linalg.matrix_rank(Pc) == dims[c]
+            Q = component_basis(pi, np.arange(space.dim), c)  # the orbit route: an orthonormal basis of range P_c
+            assert Q.shape[1] == dims[c] and np.allclose(Q.T @ Q, np.eye(dims[c])) and np.allclose(Pc @ Q, Q)
         assert np.allclose(sum(proj.values()), np.eye(space.dim))
 
 

@@ -47,7 +47,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-import scipy.linalg as sla
 
 from .coupling import weighted_values
 from .face_quadrature import split_triangles, triangles_rule
@@ -115,15 +114,27 @@ def class_counts(space, k: int, n1: int, n2: int) -> dict | None:
     return {c: m[c] - w1[c] - w2[c] + both[c] for c in COMPONENTS}
 
 
-def projector(pi: dict, c) -> np.ndarray:
-    """(1/4) Σ_g χ_c(g) P_g, the orthogonal projector onto the component c = (χ(T), χ(R)) of a
-    space whose basis G permutes (P_g e_j = e_π_g(j): φ_j ∘ g = φ_π_g(j))."""
+def component_basis(pi: dict, rows: np.ndarray, c) -> np.ndarray:
+    """Orthonormal basis (len(rows), n_c) of the component c = (χ(T), χ(R)) of the span of the
+    basis functions ``rows`` (a union of G-orbits; φ_j ∘ g = φ_π_g(j)): one vector
+    Σ_g χ_c(g) e_π_g(j) per orbit where it is not zero (a permutation representation on one
+    orbit holds each character at most once), without the dense projector."""
     a, b = c
-    n = len(pi["T"])
-    out = np.eye(n)
-    for g, chi in (("T", a), ("R", b), ("TR", a * b)):
-        out[pi[g], np.arange(n)] += chi
-    return out / 4.0
+    pos = -np.ones(max(int(rows.max()) + 1, 1), dtype=int)
+    pos[rows] = np.arange(len(rows))
+    seen = np.zeros(len(rows), dtype=bool)
+    cols = []
+    for i, j in enumerate(rows):
+        if seen[i]:
+            continue
+        v = np.zeros(len(rows))
+        for g, chi in ((None, 1), ("T", a), ("R", b), ("TR", a * b)):
+            img = pos[j if g is None else pi[g][j]]
+            v[img] += chi
+            seen[img] = True
+        if np.any(v):
+            cols.append(v / np.linalg.norm(v))
+    return np.array(cols).T if cols else np.zeros((len(rows), 0))
 
 
 def layer_modes(space, k: int, n1: int, n2: int, width_cells: int = 2) -> dict:
@@ -133,7 +144,7 @@ def layer_modes(space, k: int, n1: int, n2: int, width_cells: int = 2) -> dict:
     The multipliers supported there (all their sample values farther in are zero) are coupled
     exactly with every function of W1 and W2 (Duffy rule on the overlay of both traces and
     G_h, :func:`~.face_quadrature.split_triangles`, restricted to the layer); the nullity of that
-    matrix on the range of :func:`projector` is the count of c. The width is capped at
+    matrix on the span of :func:`component_basis` is the count of c. The width is capped at
     (n2 − 1) // 2 cells, so that the layer never is the whole face (whose nullity would be the
     kernel itself, not a count): no layer for n2 <= 2."""
     depth = min(width_cells, (n2 - 1) // 2) / n2
@@ -151,12 +162,12 @@ def layer_modes(space, k: int, n1: int, n2: int, width_cells: int = 2) -> dict:
     tri = tri[_distance(tri.mean(axis=1)) <= depth + 1e-12]
     q, wq = triangles_rule(tri, k + space.degree)
     mu = weighted_values(space, q, wq)[:, rows].T
-    B = np.hstack([(mu @ weighted_values(w, q, np.ones(len(q)))).toarray()
-                   for w in (trace_space(k, n1), trace_space(k, n2)) if w.dim])
+    blocks = [(mu @ weighted_values(w, q, np.ones(len(q)))).tocsc() for w in (trace_space(k, n1), trace_space(k, n2))]
+    B = np.hstack([b[:, np.flatnonzero(np.diff(b.indptr))].toarray() for b in blocks])  # the touching traces
     scale = np.abs(B).max() if B.size else 1.0
     out = {}
     for c in COMPONENTS:
-        basis = sla.orth(projector(pi, c)[np.ix_(rows, rows)])
+        basis = component_basis(pi, rows, c)
         sv = np.linalg.svd(basis.T @ B, compute_uv=False) if B.size and basis.shape[1] else np.zeros(0)
         out[c] = int(basis.shape[1] - np.sum(sv > _RANK_TOL * scale))
     return out

@@ -32,7 +32,9 @@ a case id and never from the table (:func:`face_predictions`). The reasoning:
   the config, the claim is predicted FAIL (the dimension argument undercounts). A stable
   space has no kernel (its count is 0): PASS. Otherwise both counts are lower bounds and
   nothing predicts equality (``finding``), on triangular faces (tetrahedra: no tensor traces)
-  as on rectangles.
+  as on rectangles. On the Kuhn faces of the structured tetrahedra the sharper lower bound is
+  :func:`triangle_kernel_bound` (the count per isotypic component of the face's symmetries and
+  the modes of the cells along ∂Γ; docs/tet_kernel.md); the predictions do not use it yet.
 """
 from __future__ import annotations
 
@@ -41,7 +43,8 @@ import pandas as pd
 
 from ..discretization.registry import SPACES
 from ..errors import InputError
-from ..discretization.square import SQUARE, TensorPartition
+from ..discretization.face_triangle_kernel import symmetric_kernel_bound
+from ..discretization.square import SQUARE, SQUARE_TRIG, Square, TensorPartition
 from .claims import FAIL, INCONCLUSIVE, PASS, bounded_claim, close_decisions, close_text, finest, kernel_claim, row, \
     slope_verdict
 
@@ -113,6 +116,24 @@ def tensor_kernel_bound(spec, k: int, n1: int, n2: int) -> int:
     d = spec.dimension(k, n2)
     a1, a2 = (max(d - (n * k - 1), 0) for n in (n1, n2))
     return 2 * a1 * a2 - min(a1, a2) ** 2
+
+
+def triangle_kernel_bound(spec, k: int, n1: int, n2: int, gamma=SQUARE_TRIG) -> int:
+    """Lower bound of the kernel on Kuhn-triangulated (structured tetrahedral) faces, G_h = the
+    trace of Ω2: Σ_c max(dim M_c − dim(W1 + W2)_c, boundary-layer modes in c, 0) over the four
+    isotypic components c of the square's symmetries {id, T, R, TR} that preserve the diagonals
+    (:func:`~infsup_contact.discretization.face_triangle_kernel.symmetric_kernel_bound`;
+    docs/tet_kernel.md). It is >= :func:`planar_kernel` (the components' counts sum to the
+    global one) and exceeds it where the components' counts differ in sign or the modes of the
+    cells along ∂Γ outnumber a component's count: R5.2 at k = 1, 6:7 → 5 (count 3), 7:8 → 4
+    (count 0). It is the kernel on R5.2, T3 and DUAL-ALL (k = 1, 2, N <= 10), a lower bound
+    on R5.4. A space whose basis the group does not permute gets the planar count."""
+    if getattr(gamma, "cell", None) != "trig" or not isinstance(gamma, Square):
+        raise InputError("gamma", "a face of Kuhn triangles (Square(cell='trig'), the structured tetrahedra's)",
+                         got=getattr(gamma, "cell", type(gamma).__name__))
+    planar = planar_kernel(spec, k, n1, n2, gamma)
+    comps = symmetric_kernel_bound(gamma.space(spec, k, _uniform(n2)), k, n1, n2)
+    return planar if comps is None else max(planar, sum(comps.values()))
 
 
 def element_interfaces(model, elements) -> dict:

@@ -206,3 +206,18 @@ def test_quadrilateral_element_spaces_are_not_built_on_triangles():
 
     with pytest.raises(InputError, match="faces"):
         SQUARE_TRIG.space(quad_only[0], 2, TensorPartition(x, x))
+
+
+def test_kuhn_faces_predict_fail_where_the_triangle_bound_exceeds_the_count():
+    """On tetrahedra (Kuhn triangles) the non-matching claim is predicted from
+    triangle_kernel_bound: FAIL where it exceeds the planar count on a config pair (R5.2 at
+    k = 2, 4:5: corner modes), FINDING where it does not (R5.2 at k = 1, 4:5), PASS for a
+    stable space; never from the data."""
+    from infsup_contact.study.face_claims import FINDING, face_predictions, triangle_kernel_bound
+    r52 = SPACES["R5.2"]
+    assert triangle_kernel_bound(r52, 2, 4, 5) > planar_kernel(r52, 2, 4, 5, SQUARE_TRIG)
+    assert face_predictions(r52, 2, [(4, 5)], False, SQUARE_TRIG)["nonmatching"] == FAIL
+    assert triangle_kernel_bound(r52, 1, 4, 5) == planar_kernel(r52, 1, 4, 5, SQUARE_TRIG)
+    assert face_predictions(r52, 1, [(4, 5)], False, SQUARE_TRIG)["nonmatching"] == FINDING
+    assert face_predictions(r52, 1, [(4, 5), (6, 7)], False, SQUARE_TRIG)["nonmatching"] == FAIL
+    assert face_predictions(SPACES["T3"], 1, [(4, 5)], False, SQUARE_TRIG)["nonmatching"] == PASS

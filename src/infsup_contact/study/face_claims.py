@@ -34,7 +34,8 @@ a case id and never from the table (:func:`face_predictions`). The reasoning:
   nothing predicts equality (``finding``), on triangular faces (tetrahedra: no tensor traces)
   as on rectangles. On the Kuhn faces of the structured tetrahedra the sharper lower bound is
   :func:`triangle_kernel_bound` (the count per isotypic component of the face's symmetries and
-  the modes of the cells along ∂Γ; docs/tet_kernel.md); the predictions do not use it yet.
+  the modes of the cells along ∂Γ; docs/tet_kernel.md): where it exceeds the planar count on a
+  pair of the config, the claim is predicted FAIL, as the tensor bound's on rectangles.
 """
 from __future__ import annotations
 
@@ -128,7 +129,7 @@ def triangle_kernel_bound(spec, k: int, n1: int, n2: int, gamma=SQUARE_TRIG) -> 
     cells along ∂Γ outnumber a component's count: R5.2 at k = 1, 6:7 → 5 (count 3), 7:8 → 4
     (count 0). It is the kernel on R5.2, T3 and DUAL-ALL (k = 1, 2, N <= 10), a lower bound
     on R5.4. A space whose basis the group does not permute gets the planar count."""
-    if getattr(gamma, "cell", None) != "trig" or not isinstance(gamma, Square):
+    if not kuhn(gamma):
         raise InputError("gamma", "a face of Kuhn triangles (Square(cell='trig'), the structured tetrahedra's)",
                          got=getattr(gamma, "cell", type(gamma).__name__))
     planar = planar_kernel(spec, k, n1, n2, gamma)
@@ -143,6 +144,11 @@ def element_interfaces(model, elements) -> dict:
 
     m = make_model(model) if isinstance(model, str) else model
     return {e: m.side_operator(m.mesh("structured", 1, 1, element=e), 1).trace.gamma for e in elements}
+
+
+def kuhn(gamma) -> bool:
+    """Whether the face is the Kuhn triangulation of a tensor grid (the structured tetrahedra's)."""
+    return isinstance(gamma, Square) and getattr(gamma, "cell", None) == "trig"
 
 
 def is_tensor(gamma) -> bool:
@@ -163,6 +169,9 @@ def face_predictions(spec, k: int, nonmatching, tensor: bool, gamma=SQUARE) -> d
     elif tensor and getattr(spec, "face_build", None) is None and any(
             tensor_kernel_bound(spec, k, n1, n2) > planar_kernel(spec, k, n1, n2, gamma) for n1, n2 in nonmatching):
         out["nonmatching"] = FAIL  # the tensor kernel exceeds the count on some pair
+    elif kuhn(gamma) and any(triangle_kernel_bound(spec, k, n1, n2, gamma) > planar_kernel(spec, k, n1, n2, gamma)
+                             for n1, n2 in nonmatching):
+        out["nonmatching"] = FAIL  # the Kuhn face's symmetric and boundary-layer modes exceed it
     else:
         out["nonmatching"] = FINDING  # a lower bound only: no prediction of equality
     return out

@@ -21,7 +21,7 @@ from scipy.linalg import lapack
 from ..discretization import meshes, multipliers, registry
 from ..discretization.coupling import coupling_matrix, trace_l2_norms
 from ..errors import InputError, check_prestress
-from . import bottom
+from . import bottom, reflection
 from ..models.schur import combine_terms, interface_terms
 from ..models import DEFAULT_MODEL
 from ..models.side_cache import SideCache
@@ -121,13 +121,29 @@ def bottom_spectrum(S: np.ndarray, factor: np.ndarray, kernel: KernelDecision | 
     if d and (Z is None or Z.shape[1] != d):
         raise ValueError(f"a kernel of dimension {d} needs its basis (kernel.vectors, m × {d}) to be deflated")
     res = bottom.bottom_pencil(S, factor, N_BOTTOM, Z if d else None, s_factor=None if d else s_factor)
-    ev = np.concatenate([np.zeros(d), res.values])
-    lam = float(res.values[0])
-    eta = S.shape[0] * np.finfo(float).eps * res.lam_max  # the pencil's round-off level, as dense
+    return _spectrum_above(S.shape[0], d, res.values, res.lam_max)
+
+
+def _spectrum_above(m: int, d: int, values: np.ndarray, lam_max: float) -> Spectrum:
+    """The :class:`Spectrum` of an order-m pencil from its d kernel zeros, the eigenvalues
+    ``values`` above them (ascending) and λ_max (:func:`bottom_spectrum`, :func:`split_spectra`)."""
+    ev = np.concatenate([np.zeros(d), values])
+    lam = float(values[0])
+    eta = m * np.finfo(float).eps * lam_max  # the pencil's round-off level, as dense
     gap = float(max(lam, 0.0) / eta) if eta > 0 else np.inf
     lam = lam if lam > eta else 0.0  # an eigenvalue at round-off (a singular S, no kernel given) is 0
     beta = 0.0 if d else float(np.sqrt(max(lam, 0.0)))
     return Spectrum(beta, d, float(np.sqrt(max(lam, 0.0))), gap, ev[:8].copy())
+
+
+def split_spectra(split, S: np.ndarray, factors: dict, kernel: KernelDecision | None = None,
+                  parts=None) -> dict:
+    """:func:`bottom_spectra` on the even and odd halves of a reflection-invariant pencil
+    (:mod:`.reflection`): ``factors`` {norm: (L_e, L_o)} of the halves of G, ``parts`` the
+    kernel's even and odd bases (:meth:`~.reflection.ReflectionSplit.even_odd`)."""
+    d = 0 if kernel is None else kernel.dim
+    pencils = reflection.split_pencils(split, S, factors, parts if d else None, N_BOTTOM)
+    return {norm: _spectrum_above(S.shape[0], d, values, top) for norm, (values, top) in pencils.items()}
 
 
 def bottom_spectra(S: np.ndarray, factors: dict, kernel: KernelDecision | None = None) -> dict:
@@ -140,17 +156,20 @@ def bottom_spectra(S: np.ndarray, factors: dict, kernel: KernelDecision | None =
     return {norm: bottom_spectrum(S, L, kernel, s_factor=shared) for norm, L in factors.items()}
 
 
-def betas_v1_zero(terms, factors: dict, kernel: KernelDecision, iterative: bool) -> dict:
+def betas_v1_zero(terms, factors: dict, kernel: KernelDecision, iterative: bool, split=None) -> dict:
     """β with v1 = 0 at c2 = 1, for each Gram factor ({norm: factor}): the sup over (0, v2)
     only, (5.10), i.e. the pencil of B_2 X_2 B_2ᵀ alone; at other c2 it is this / sqrt(c2).
 
     On the large route (``iterative``) with a non-empty kernel of Bᵀ it is 0 as a consequence,
     not a computation: a kernel vector of Bᵀ is one of B_2ᵀ, hence of B_2 X_2 B_2ᵀ, so
     β(v1 = 0) <= β_h = 0 (the sup over a subset). The dense route still computes it there (the
-    square root of a round-off eigenvalue, not exactly 0)."""
+    square root of a round-off eigenvalue, not exactly 0). ``split``: the reflection split the
+    factors belong to (:func:`split_spectra`)."""
     if iterative and kernel.dim:
         return {norm: 0.0 for norm in factors}
     S2 = combine_terms(terms[1:], (1.0,))
+    if split is not None:
+        return {norm: sp_.beta for norm, sp_ in split_spectra(split, S2, factors).items()}
     if iterative:
         return {norm: sp_.beta for norm, sp_ in bottom_spectra(S2, factors).items()}
     return {norm: spectrum(S2, factor=L).beta for norm, L in factors.items()}
@@ -260,13 +279,16 @@ def beta_rows_all(family, k, n1, n2, cases=None, multiplier_meshes=("omega2",), 
                                       grams["L2"][0] if "L2" in grams else None, iterative=iterative,
                                       trace_norms=trace_norms)
                 terms = interface_terms(couplings, sides)
-                factors = {norm: gram_factor(G) for norm, (G, _) in grams.items()}
-                beta_v1_zero_c1 = betas_v1_zero(terms, factors, kernel, iterative)
+                split, parts = _reflection(space, gamma, g_h, k, grams, terms, kernel) if iterative else (None, None)
+                factors = ({norm: tuple(gram_factor(h) for h in split.blocks(G)) for norm, (G, _) in grams.items()}
+                           if split is not None else {norm: gram_factor(G) for norm, (G, _) in grams.items()})
+                beta_v1_zero_c1 = betas_v1_zero(terms, factors, kernel, iterative, split)
                 for c1, c2 in c_pairs:
                     S = combine_terms(terms, (c1, c2))
                     if iterative:  # the norms' pencils share work: each row gets an equal share of the time
                         te = time.perf_counter()
-                        spectra = bottom_spectra(S, factors, kernel)
+                        spectra = (bottom_spectra(S, factors, kernel) if split is None
+                                   else split_spectra(split, S, factors, kernel, parts))
                         t_shared = (time.perf_counter() - te) / len(norms)
                     for norm in norms:
                         te = time.perf_counter()
@@ -288,6 +310,23 @@ def beta_rows_all(family, k, n1, n2, cases=None, multiplier_meshes=("omega2",), 
                             t_eig=t_shared if iterative else time.perf_counter() - te))
             by_partition[gamma.partition_key(g_h)] = rows[first:]
     return rows
+
+
+def _reflection(space, gamma, g_h, k: int, grams: dict, terms, kernel: KernelDecision):
+    """(split, kernel parts) of the point reflection where the space, every Gram matrix and every
+    interface term are invariant and the kernel splits (:mod:`.reflection`), else (None, None).
+    The sum of invariant terms is invariant, so one check serves every (c1, c2) and v1 = 0."""
+    quadrature = getattr(gamma, "quadrature", None)
+    if quadrature is None:
+        return None, None
+    split = reflection.reflection_split(space, quadrature(g_h, 2 * k)[0])
+    if split is None or min(split.sizes) < 1 or not all(
+            reflection.invariant(split, M) for M in [G for G, _ in grams.values()] + list(terms)):
+        return None, None
+    parts = split.even_odd(kernel.vectors) if kernel.dim else None
+    if kernel.dim and parts is None:
+        return None, None
+    return split, parts
 
 
 def space_kernel(couplings, sides, space, k: int, structural: int, l2_gram=None,

@@ -1,0 +1,164 @@
+"""The large route's pencils split by the point reflection of the face (issue 28, large N).
+
+On a face mesh pair symmetric about the centre of Γ = (0, 1)² (the structured hexahedra, any
+N1, N2), the point reflection R(x, y) = (1 − x, 1 − y) maps the multiplier basis onto itself,
+μ_j ∘ R = μ_π(j) with π an involution (:func:`reflection_split`, found and checked on Gauss
+points of G_h), and the interface operator S = Σ_i B_i X_i B_iᵀ and every Gram matrix G commute
+with the permutation: P S Pᵀ = S, P G Pᵀ = G. In the orthonormal basis Q = [Q_e, Q_o] of the
+even and odd functions ((e_j ± e_π(j))/√2 for the pairs j < π(j), e_j for the fixed points in
+Q_e) both are block diagonal, so the pencil S x = λ G x is two pencils of about half the size,
+
+    spec(S, G) = spec(Q_eᵀ S Q_e, Q_eᵀ G Q_e) ∪ spec(Q_oᵀ S Q_o, Q_oᵀ G Q_o),
+
+and the kernel of Bᵀ (invariant: B_i commute with the reflections of the traces) splits into its
+even and odd parts. Each half costs an eighth of the Cholesky factorizations, triangular solves
+and products of :func:`~.bottom.bottom_pencil` (m³/3 each), and half of each Lanczos product.
+
+The computed S and G are invariant only to round-off (the sides' sparse factorizations order
+their dofs differently): the split is taken only where ‖P M Pᵀ − M‖_max <= :data:`INVARIANCE_RTOL`
+‖M‖_max for S and every G (:func:`invariant`), and dropping the off-diagonal blocks then moves
+each eigenvalue by at most their norm (Weyl), at the pencil's own round-off level. A face that is
+not symmetric (perturbed meshes, the tetrahedra's 3D Kuhn cubes, whose diagonals R reverses)
+keeps the unsplit route.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import cached_property
+
+import numpy as np
+import scipy.linalg as sla
+
+from . import bottom
+from .kernel import gap_over_roundoff  # noqa: F401  (the same round-off level as the unsplit rows)
+
+INVARIANCE_RTOL = 1e-11
+"""Largest ‖P M Pᵀ − M‖_max / ‖M‖_max for which S and G count as reflection invariant."""
+MATCH_RTOL = 1e-10
+"""Largest relative mismatch of μ_j ∘ R and μ_π(j) at the sample points."""
+SPLIT_GAP = 1e-6
+"""A kernel vector's even (or odd) part must have norm > 1 − SPLIT_GAP or < SPLIT_GAP (the
+cosines of the principal angles between the kernel and the even functions): else no split."""
+
+
+def induced_permutation(space, x: np.ndarray, transform) -> np.ndarray | None:
+    """π with μ_j(T x) = μ_π(j)(x) at the points ``x`` (n × 2), T = ``transform``, or None.
+
+    π(j) is the function whose values at x are nearest to those of μ_j ∘ T among the functions
+    whose supports meet its image (sparse overlaps); accepted only if π is an involution and
+    the values agree to :data:`MATCH_RTOL`."""
+    from ..discretization.coupling import weighted_values
+
+    ones = np.ones(len(x))
+    A, B = weighted_values(space, x, ones), weighted_values(space, transform(x), ones)
+    overlap = (B.T @ A).tocsr()
+    overlap.sum_duplicates()
+    if np.any(np.diff(overlap.indptr) == 0):
+        return None
+    norms = np.asarray(A.multiply(A).sum(axis=0)).ravel()
+    row = np.repeat(np.arange(space.dim), np.diff(overlap.indptr))
+    order = np.lexsort((norms[overlap.indices] - 2.0 * overlap.data, row))
+    pi = overlap.indices[order[np.searchsorted(row[order], np.arange(space.dim))]]
+    if np.unique(pi).size != space.dim or np.any(pi[pi] != np.arange(space.dim)):
+        return None
+    if abs(B - A[:, pi]).max() > MATCH_RTOL * np.abs(A.data).max():
+        return None
+    return pi
+
+
+@dataclass(frozen=True)
+class ReflectionSplit:
+    """The even/odd coordinates of an involution π of the multiplier basis."""
+
+    pi: np.ndarray
+
+    @cached_property
+    def rep(self) -> np.ndarray:
+        g = np.arange(self.pi.size)
+        return g[g < self.pi]
+
+    @cached_property
+    def fixed(self) -> np.ndarray:
+        g = np.arange(self.pi.size)
+        return g[g == self.pi]
+
+    @property
+    def sizes(self) -> tuple[int, int]:
+        return self.rep.size + self.fixed.size, self.rep.size
+
+    def _columns(self, M: np.ndarray, sign: float) -> np.ndarray:
+        """M Q_e (sign +1) or M Q_o (sign −1), dense."""
+        r, p, h = self.rep, self.pi[self.rep], np.sqrt(0.5)
+        paired = (M[:, r] + sign * M[:, p]) * h
+        return np.hstack([paired, M[:, self.fixed]]) if sign > 0 else paired
+
+    def blocks(self, M: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(Q_eᵀ M Q_e, Q_oᵀ M Q_o) of a symmetric M, each symmetrised."""
+        out = []
+        for sign in (1.0, -1.0):
+            T = self._columns(np.asarray(M), sign).T          # (Q_σᵀ M)ᵀ = M Q_σ, M symmetric
+            B = self._columns(np.ascontiguousarray(T), sign)  # Q_σᵀ M Q_σ
+            out.append(0.5 * (B + B.T))
+        return out[0], out[1]
+
+    def even_odd(self, Z: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+        """Bases of the even and odd parts of span Z in the coordinates of Q_e and Q_o, or None
+        when span Z is not the sum of its parts (a cosine not within :data:`SPLIT_GAP` of 0 or 1)."""
+        V = sla.qr(Z, mode="economic")[0]
+        r, p, h = self.rep, self.pi[self.rep], np.sqrt(0.5)
+        parts = [np.vstack([(V[r] + V[p]) * h, V[self.fixed]]), (V[r] - V[p]) * h]
+        out = []
+        for P in parts:
+            if P.shape[0] == 0:
+                out.append(np.zeros((0, 0)))
+                continue
+            U, s, _ = sla.svd(P, full_matrices=False)
+            if np.any((s > SPLIT_GAP) & (s < 1.0 - SPLIT_GAP)):
+                return None
+            out.append(U[:, s >= 1.0 - SPLIT_GAP])
+        if out[0].shape[1] + out[1].shape[1] != Z.shape[1]:
+            return None
+        return out[0], out[1]
+
+
+def reflection_split(space, points: np.ndarray) -> ReflectionSplit | None:
+    """The split of ``space`` by the point reflection (x, y) → (1 − x, 1 − y), checked at
+    ``points`` (e.g. the Gauss points of G_h), or None where it does not map the basis onto itself."""
+    pi = induced_permutation(space, np.asarray(points, float), lambda x: 1.0 - x)
+    return None if pi is None else ReflectionSplit(pi)
+
+
+def invariant(split: ReflectionSplit, M: np.ndarray, rtol: float = INVARIANCE_RTOL) -> bool:
+    """Whether P M Pᵀ = M to ``rtol`` relative (max norm)."""
+    M = np.asarray(M)
+    scale = float(np.abs(M).max())
+    return scale == 0.0 or float(np.abs(M[np.ix_(split.pi, split.pi)] - M).max()) <= rtol * scale
+
+
+def split_pencils(split: ReflectionSplit, S: np.ndarray, factors: dict, kernel_parts, n_values: int) -> dict:
+    """{norm: (values above the kernel, λ_max)} of S x = λ G x from the two halves.
+
+    ``factors``: {norm: (L_e, L_o)} the Cholesky factors of the halves of G; ``kernel_parts``:
+    (Z_e, Z_o) from :meth:`ReflectionSplit.even_odd` (None: no kernel deflated; a half whose S
+    is definite then shares its factor between the norms, as :func:`~.infsup.bottom_spectra`)."""
+    halves = split.blocks(S)
+    parts = [None if kernel_parts is None or not Z.shape[1] else Z for Z in (kernel_parts or (None, None))]
+    shared = [bottom.definite_factor(h) if Z is None and h.shape[0] >= 3 else None for h, Z in zip(halves, parts)]
+    out = {}
+    for norm, Ls in factors.items():
+        values, top = [], 0.0
+        for b, (Sb, Lb) in enumerate(zip(halves, Ls)):
+            Zb = parts[b]
+            free = Sb.shape[0] - (0 if Zb is None else Zb.shape[1])
+            if free < 1:
+                continue
+            if free == 1 or Sb.shape[0] < 3:  # too small for Lanczos: the dense pencil
+                ev = sla.eigh(Sb, Lb @ Lb.T, eigvals_only=True)
+                values.append(ev[(0 if Zb is None else Zb.shape[1]):])
+                top = max(top, float(ev[-1]))
+                continue
+            res = bottom.bottom_pencil(Sb, Lb, n_values, Zb, s_factor=shared[b])
+            values.append(res.values)
+            top = max(top, res.lam_max)
+        out[norm] = (np.sort(np.concatenate(values))[:max(n_values, 1)], top)
+    return out

@@ -108,7 +108,7 @@ def test_a_kernel_that_is_not_the_sum_of_its_parts_is_refused():
     assert split.even_odd(v[:, None]) is None       # a generic vector: neither even nor odd
 
 
-@pytest.mark.parametrize("case", ["T3", "R5.2"])
+@pytest.mark.parametrize("case", ["T3", "R5.2", "DUAL-ALL"])
 def test_face_rows_with_and_without_the_split(case, monkeypatch):
     """The iterative route (DENSE_MAX_M = 0) on a real face, hexahedra k = 2, 5:6, with the split
     and with it switched off: the same kernels, β to 1e-9."""
@@ -125,6 +125,34 @@ def test_face_rows_with_and_without_the_split(case, monkeypatch):
         calls.clear()
     for a, b in zip(rows[True], rows[False]):
         assert (a["kernel_dim"], a["kernel_decision"]) == (b["kernel_dim"], b["kernel_decision"])
+        if a["kernel_detected"] == 0:  # σ_{d+1}/η: the first value above the kernel, either way
+            assert a["kernel_margin_decades"] == pytest.approx(b["kernel_margin_decades"], abs=1e-3)
         assert a["beta"] == pytest.approx(b["beta"], rel=1e-9, abs=1e-12)
         assert a["smallest_nonzero"] == pytest.approx(b["smallest_nonzero"], rel=1e-8)
         assert a["beta_v1_zero"] == pytest.approx(b["beta_v1_zero"], rel=1e-9, abs=1e-12)
+
+
+def test_the_split_kernel_is_the_unsplit_one_on_a_real_face(monkeypatch):
+    """split_bottom_kernel on W of R5.2 (k = 2, hexahedra 5:6: 16 modes beyond the dimension
+    count) decides what bottom_kernel decides: the count, the first value above it, η; its
+    vectors span a kernel of W (‖W Z‖ <= η) and are orthonormal."""
+    from infsup_contact.models import MODELS
+    from infsup_contact.solvers.kernel import bottom_kernel
+    captured = {}
+    original = reflection.split_bottom_kernel
+
+    def spy(W, split, proven, error):
+        captured.update(W=W, split=split, proven=proven, error=error)
+        return original(W, split, proven, error)
+
+    monkeypatch.setattr(bottom, "DENSE_MAX_M", 0)
+    monkeypatch.setattr(reflection, "split_bottom_kernel", spy)
+    infsup.beta_rows("structured", 2, 5, 6, ["R5.2"], model=MODELS["membranes3d"], element="hex", norms=("L2",))
+    W, split, proven, error = (captured[k] for k in ("W", "split", "proven", "error"))
+    halves, whole = original(W, split, proven, error), bottom_kernel(W, proven, error)
+    assert halves is not None and halves.dim == whole.dim > 0 and halves.detected == whole.detected
+    assert halves.tol == pytest.approx(whole.tol, rel=1e-12)
+    assert halves.singular[-2] == pytest.approx(whole.singular[-2], rel=1e-3)   # σ_{d+1}
+    Z = halves.vectors
+    np.testing.assert_allclose(Z.T @ Z, np.eye(Z.shape[1]), atol=1e-10)
+    assert np.linalg.norm(W @ Z, axis=0).max() <= halves.tol

@@ -275,11 +275,12 @@ def beta_rows_all(family, k, n1, n2, cases=None, multiplier_meshes=("omega2",), 
                 t_coupling = time.perf_counter() - tc
                 grams = {norm: gamma.gram(space, norm, h_route=h_route) for norm in norms}
                 structural = gamma.proven_kernel(space, k, [s.trace for s in sides], dim_w)
+                split = _reflection_of(space, gamma, g_h, k) if iterative else None
                 kernel = space_kernel(couplings, sides, space, k, structural,
                                       grams["L2"][0] if "L2" in grams else None, iterative=iterative,
-                                      trace_norms=trace_norms)
+                                      trace_norms=trace_norms, split=split)
                 terms = interface_terms(couplings, sides)
-                split, parts = _reflection(space, gamma, g_h, k, grams, terms, kernel) if iterative else (None, None)
+                split, parts = _reflection(split, grams, terms, kernel)
                 factors = ({norm: tuple(gram_factor(h) for h in split.blocks(G)) for norm, (G, _) in grams.items()}
                            if split is not None else {norm: gram_factor(G) for norm, (G, _) in grams.items()})
                 beta_v1_zero_c1 = betas_v1_zero(terms, factors, kernel, iterative, split)
@@ -312,15 +313,21 @@ def beta_rows_all(family, k, n1, n2, cases=None, multiplier_meshes=("omega2",), 
     return rows
 
 
-def _reflection(space, gamma, g_h, k: int, grams: dict, terms, kernel: KernelDecision):
-    """(split, kernel parts) of the point reflection where the space, every Gram matrix and every
-    interface term are invariant and the kernel splits (:mod:`.reflection`), else (None, None).
-    The sum of invariant terms is invariant, so one check serves every (c1, c2) and v1 = 0."""
+def _reflection_of(space, gamma, g_h, k: int):
+    """The point reflection's split of ``space`` (:func:`.reflection.reflection_split`, checked at
+    the Gauss points of G_h), or None (no such symmetry, or a Γ without a quadrature)."""
     quadrature = getattr(gamma, "quadrature", None)
     if quadrature is None:
-        return None, None
+        return None
     split = reflection.reflection_split(space, quadrature(g_h, 2 * k)[0])
-    if split is None or min(split.sizes) < 1 or not all(
+    return split if split is not None and min(split.sizes) >= 1 else None
+
+
+def _reflection(split, grams: dict, terms, kernel: KernelDecision):
+    """(split, kernel parts) where every Gram matrix and every interface term are invariant under
+    ``split`` and the kernel splits (:mod:`.reflection`), else (None, None). The sum of invariant
+    terms is invariant, so one check serves every (c1, c2) and v1 = 0."""
+    if split is None or not all(
             reflection.invariant(split, M) for M in [G for G, _ in grams.values()] + list(terms)):
         return None, None
     parts = split.even_odd(kernel.vectors) if kernel.dim else None
@@ -330,7 +337,7 @@ def _reflection(space, gamma, g_h, k: int, grams: dict, terms, kernel: KernelDec
 
 
 def space_kernel(couplings, sides, space, k: int, structural: int, l2_gram=None,
-                 iterative: bool = False, trace_norms=None) -> KernelDecision:
+                 iterative: bool = False, trace_norms=None, split=None) -> KernelDecision:
     """The kernel of Bᵀ on ``space`` (:func:`~infsup_contact.solvers.kernel.coupling_kernel`):
     the couplings scaled by the L²(Γ) norms of the sides' trace basis functions and of the
     multiplier basis functions (the diagonal of the L² Gram matrix, computed if not given);
@@ -342,7 +349,8 @@ def space_kernel(couplings, sides, space, k: int, structural: int, l2_gram=None,
     W' from a rule :data:`LONGER_RULE_LARGE` longer, the couplings sparse (W sparse, the same
     entries); its ``vectors`` are returned in multiplier coordinates (a basis of the kernel of Bᵀ).
     ``trace_norms``: the sides' :func:`~.coupling.trace_l2_norms`, if already computed (they
-    depend on the sides only, not on the space)."""
+    depend on the sides only, not on the space). ``split``: the point reflection's
+    (:func:`.reflection.split_bottom_kernel` decides on the even and odd halves where it holds)."""
     G = sides[0].trace.gamma.gram(space, "L2")[0] if l2_gram is None else l2_gram
     rows = [trace_l2_norms(s.trace, k) for s in sides] if trace_norms is None else trace_norms
     cols = np.sqrt(np.diag(G))
@@ -352,7 +360,9 @@ def space_kernel(couplings, sides, space, k: int, structural: int, l2_gram=None,
                                for s in sides], rows, cols)
     if not iterative:
         return coupling_kernel(W, structural, entry_error=np.linalg.norm(W - longer))
-    decision = bottom_kernel(sp.csr_matrix(W), structural, entry_error=spla.norm(sp.csr_matrix(W - longer)))
+    W, error = sp.csr_matrix(W), spla.norm(sp.csr_matrix(W - longer))
+    decision = reflection.split_bottom_kernel(W, split, structural, error) if split is not None else None
+    decision = bottom_kernel(W, structural, entry_error=error) if decision is None else decision
     return replace(decision, vectors=decision.vectors / cols[:, None])  # W v = 0 ⇔ Bᵀ (v / cols) = 0
 
 

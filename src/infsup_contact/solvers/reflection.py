@@ -28,9 +28,10 @@ from functools import cached_property
 
 import numpy as np
 import scipy.linalg as sla
+import scipy.sparse as sp
 
 from . import bottom
-from .kernel import gap_over_roundoff  # noqa: F401  (the same round-off level as the unsplit rows)
+from .kernel import BLOCK_EXTRA, CERTIFY_FLOOR, KernelDecision, _decision
 
 INVARIANCE_RTOL = 1e-11
 """Largest ‖P M Pᵀ − M‖_max / ‖M‖_max for which S and G count as reflection invariant."""
@@ -85,6 +86,17 @@ class ReflectionSplit:
     @property
     def sizes(self) -> tuple[int, int]:
         return self.rep.size + self.fixed.size, self.rep.size
+
+    @cached_property
+    def bases(self) -> tuple[sp.csr_matrix, sp.csr_matrix]:
+        """(Q_e, Q_o), sparse with orthonormal columns."""
+        r, p, f, m = self.rep, self.pi[self.rep], self.fixed, self.pi.size
+        h, k, ke = np.full(self.rep.size, np.sqrt(0.5)), np.arange(self.rep.size), self.sizes[0]
+        Qe = sp.csr_matrix((np.concatenate([h, h, np.ones(f.size)]),
+                            (np.concatenate([r, p, f]), np.concatenate([k, k, r.size + np.arange(f.size)]))), shape=(m, ke))
+        Qo = sp.csr_matrix((np.concatenate([h, -h]), (np.concatenate([r, p]), np.concatenate([k, k]))),
+                           shape=(m, self.rep.size))
+        return Qe, Qo
 
     def _columns(self, M: np.ndarray, sign: float) -> np.ndarray:
         """M Q_e (sign +1) or M Q_o (sign −1), dense."""
@@ -162,3 +174,49 @@ def split_pencils(split: ReflectionSplit, S: np.ndarray, factors: dict, kernel_p
             top = max(top, res.lam_max)
         out[norm] = (np.sort(np.concatenate(values))[:max(n_values, 1)], top)
     return out
+
+
+def split_bottom_kernel(W, split: ReflectionSplit, proven: int = 0, entry_error: float = 0.0) -> KernelDecision | None:
+    """:func:`~.kernel.bottom_kernel` of W (trace dofs × multipliers, sparse) on the even and
+    odd columns W Q_e, W Q_o, or None where the split does not hold.
+
+    With the traces' reflections W is equivariant, so WᵀW is block diagonal in Q = [Q_e, Q_o]
+    and its eigenvalues are those of the blocks; the off-diagonal block C = Q_eᵀ WᵀW Q_o of the
+    computed W is round-off, and moves each eigenvalue by at most ‖C‖₂ <= ‖C‖_F (Weyl). Each
+    block goes through the same steps as the unsplit route (block inverse iteration, counted
+    values ‖W v‖ of orthonormal v, hence upper bounds of singular values of W; the Cholesky
+    certificate at τ_b = σ_{d_b+1}²/2 per block: the block-diagonal WᵀW has at most d = d_e + d_o
+    eigenvalues below min τ_b, so the computed one at most d below min τ_b − ‖C‖_F >= min τ_b / 2),
+    with the unsplit η = max(rows, m) ε σ_max + 2 ‖δW‖_F. None (the caller takes the unsplit
+    route) wherever a step would fall back, or ‖C‖_F > τ_b / 2."""
+    W = sp.csr_matrix(W)
+    rows, m = W.shape
+    proven = int(max(proven, m - rows, 0))
+    Qe, Qo = split.bases
+    blocks = [sp.csr_matrix(W @ Q) for Q in (Qe, Qo)]
+    grams = [sp.csr_matrix(B.T @ B) for B in blocks]
+    cross = float(sp.linalg.norm(blocks[0].T @ blocks[1]))
+    smaxes = [bottom.largest_singular(B, g) if B.shape[1] else 0.0 for B, g in zip(blocks, grams)]
+    smax = max(smaxes)
+    tol = max(rows, m) * np.finfo(float).eps * smax + 2.0 * float(entry_error)
+    counted, vectors, above = [], [], np.inf
+    for B, g, s_b, Q in zip(blocks, grams, smaxes, (Qe, Qo)):
+        mb = B.shape[1]
+        if mb < 2:
+            return None
+        hint = int(np.ceil(proven * mb / m))  # a block size only: each half holds about its share
+        res = bottom.bottom_singular(B, min(hint + BLOCK_EXTRA, mb - 1), tol, s_b, g)
+        if res is None or res.above <= tol:
+            return None
+        tau = 0.5 * res.above ** 2  # the block's certificate, as unsplit; the whole W's at τ − ‖C‖
+        if tau <= max(CERTIFY_FLOOR * max(rows, m) * np.finfo(float).eps * smax ** 2, 2.0 * cross) or \
+                not bottom.at_most_below(g, tau, res.vectors[:, :res.count], s_b ** 2):
+            return None
+        counted.append(res.values[:res.count])
+        vectors.append(np.asarray(Q @ res.vectors[:, :res.count]))
+        above = min(above, float(res.above))
+    d = sum(len(c) for c in counted)
+    if d < proven:
+        return None
+    s = np.concatenate([np.sort(np.concatenate(counted)), [above, smax]])
+    return _decision(s, proven, tol, d, smax, np.hstack(vectors))

@@ -48,7 +48,8 @@ def test_blocks_reconstruct_an_invariant_matrix_and_detect_a_non_invariant_one()
     space, part = _space("R5.2", 2, 4)
     split = reflection.reflection_split(space, SQUARE.quadrature(part, 4)[0])
     M = _invariant_spd(split.pi, 0)
-    Me, Mo = split.blocks(M)
+    Me, Mo, distance = split.blocks(M)
+    assert distance <= 1e-14
     r, p, f, h = split.rep, split.pi[split.rep], split.fixed, np.sqrt(0.5)
     m = M.shape[0]
     Qe, Qo = np.zeros((m, Me.shape[0])), np.zeros((m, Mo.shape[0]))
@@ -56,10 +57,9 @@ def test_blocks_reconstruct_an_invariant_matrix_and_detect_a_non_invariant_one()
     Qe[f, r.size + np.arange(f.size)] = 1.0
     Qo[r, np.arange(r.size)], Qo[p, np.arange(r.size)] = h, -h
     np.testing.assert_allclose(Qe @ Me @ Qe.T + Qo @ Mo @ Qo.T, M, atol=1e-12 * np.abs(M).max())
-    assert reflection.invariant(split, M)
     M[0, 1] += 1e-6 * np.abs(M).max()
     M[1, 0] = M[0, 1]
-    assert not reflection.invariant(split, M)
+    assert split.blocks(M)[2] > reflection.INVARIANCE_RTOL
 
 
 @pytest.mark.parametrize("d_even,d_odd", [(0, 0), (3, 0), (2, 5)])
@@ -93,7 +93,7 @@ def test_split_pencils_equal_the_unsplit_route(d_even, d_odd):
     parts = split.even_odd(Z) if d else None
     if d:
         assert (parts[0].shape[1], parts[1].shape[1]) == (d_even, d_odd)
-    factors = {"H": tuple(infsup.gram_factor(b) for b in split.blocks(G))}
+    factors = {"H": tuple(infsup.gram_factor(b) for b in split.blocks(G)[:2])}
     halves = infsup.split_spectra(split, A, factors, kernel if d else None, parts)["H"]
     assert halves.kernel_dim == plain.kernel_dim == d
     assert halves.smallest_nonzero == pytest.approx(plain.smallest_nonzero, rel=1e-9)
@@ -156,3 +156,15 @@ def test_the_split_kernel_is_the_unsplit_one_on_a_real_face(monkeypatch):
     Z = halves.vectors
     np.testing.assert_allclose(Z.T @ Z, np.eye(Z.shape[1]), atol=1e-10)
     assert np.linalg.norm(W @ Z, axis=0).max() <= halves.tol
+
+
+def test_an_interface_operator_that_is_not_invariant_is_solved_unsplit():
+    """split_spectra returns None for an S off invariance (the caller's unsplit route)."""
+    space, part = _space("R5.2", 2, 4)
+    split = reflection.reflection_split(space, SQUARE.quadrature(part, 4)[0])
+    S, G = _invariant_spd(split.pi, 5), _invariant_spd(split.pi, 6)
+    factors = {"H": tuple(infsup.gram_factor(b) for b in split.blocks(G)[:2])}
+    assert infsup.split_spectra(split, S, factors) is not None
+    S[0, 2] += 1e-8 * np.abs(S).max()
+    S[2, 0] = S[0, 2]
+    assert infsup.split_spectra(split, S, factors) is None

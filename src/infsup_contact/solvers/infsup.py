@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, replace
+from functools import cached_property
 
 import numpy as np
 import scipy.linalg as sla
@@ -140,9 +141,12 @@ def split_spectra(split, S: np.ndarray, factors: dict, kernel: KernelDecision | 
                   parts=None) -> dict:
     """:func:`bottom_spectra` on the even and odd halves of a reflection-invariant pencil
     (:mod:`.reflection`): ``factors`` {norm: (L_e, L_o)} of the halves of G, ``parts`` the
-    kernel's even and odd bases (:meth:`~.reflection.ReflectionSplit.even_odd`)."""
+    kernel's even and odd bases (:meth:`~.reflection.ReflectionSplit.even_odd`). None where S is
+    not reflection invariant (the caller solves it unsplit)."""
     d = 0 if kernel is None else kernel.dim
     pencils = reflection.split_pencils(split, S, factors, parts if d else None, N_BOTTOM)
+    if pencils is None:
+        return None
     return {norm: _spectrum_above(S.shape[0], d, values, top) for norm, (values, top) in pencils.items()}
 
 
@@ -156,20 +160,21 @@ def bottom_spectra(S: np.ndarray, factors: dict, kernel: KernelDecision | None =
     return {norm: bottom_spectrum(S, L, kernel, s_factor=shared) for norm, L in factors.items()}
 
 
-def betas_v1_zero(terms, factors: dict, kernel: KernelDecision, iterative: bool, split=None) -> dict:
+def betas_v1_zero(terms, factors: dict, kernel: KernelDecision, iterative: bool, split=None, parts=None) -> dict:
     """β with v1 = 0 at c2 = 1, for each Gram factor ({norm: factor}): the sup over (0, v2)
     only, (5.10), i.e. the pencil of B_2 X_2 B_2ᵀ alone; at other c2 it is this / sqrt(c2).
 
     On the large route (``iterative``) with a non-empty kernel of Bᵀ it is 0 as a consequence,
     not a computation: a kernel vector of Bᵀ is one of B_2ᵀ, hence of B_2 X_2 B_2ᵀ, so
     β(v1 = 0) <= β_h = 0 (the sup over a subset). The dense route still computes it there (the
-    square root of a round-off eigenvalue, not exactly 0). ``split``: the reflection split the
-    factors belong to (:func:`split_spectra`)."""
+    square root of a round-off eigenvalue, not exactly 0). ``split``: the point reflection's split,
+    ``factors`` then a :class:`_Factors` (the halves', and the whole Gram's on demand)."""
     if iterative and kernel.dim:
         return {norm: 0.0 for norm in factors}
     S2 = combine_terms(terms[1:], (1.0,))
     if split is not None:
-        return {norm: sp_.beta for norm, sp_ in split_spectra(split, S2, factors).items()}
+        spectra = split_spectra(split, S2, factors.split)
+        return {norm: sp_.beta for norm, sp_ in (spectra or bottom_spectra(S2, factors.whole)).items()}
     if iterative:
         return {norm: sp_.beta for norm, sp_ in bottom_spectra(S2, factors).items()}
     return {norm: spectrum(S2, factor=L).beta for norm, L in factors.items()}
@@ -280,16 +285,17 @@ def beta_rows_all(family, k, n1, n2, cases=None, multiplier_meshes=("omega2",), 
                                       grams["L2"][0] if "L2" in grams else None, iterative=iterative,
                                       trace_norms=trace_norms, split=split)
                 terms = interface_terms(couplings, sides)
-                split, parts = _reflection(split, grams, terms, kernel)
-                factors = ({norm: tuple(gram_factor(h) for h in split.blocks(G)) for norm, (G, _) in grams.items()}
-                           if split is not None else {norm: gram_factor(G) for norm, (G, _) in grams.items()})
+                split, parts, halves = _reflection(split, grams, kernel)
+                factors = (_Factors(grams, halves) if split is not None
+                           else {norm: gram_factor(G) for norm, (G, _) in grams.items()})
                 beta_v1_zero_c1 = betas_v1_zero(terms, factors, kernel, iterative, split)
                 for c1, c2 in c_pairs:
                     S = combine_terms(terms, (c1, c2))
                     if iterative:  # the norms' pencils share work: each row gets an equal share of the time
                         te = time.perf_counter()
                         spectra = (bottom_spectra(S, factors, kernel) if split is None
-                                   else split_spectra(split, S, factors, kernel, parts))
+                                   else split_spectra(split, S, factors.split, kernel, parts)
+                                   or bottom_spectra(S, factors.whole, kernel))
                         t_shared = (time.perf_counter() - te) / len(norms)
                     for norm in norms:
                         te = time.perf_counter()
@@ -323,17 +329,37 @@ def _reflection_of(space, gamma, g_h, k: int):
     return split if split is not None and min(split.sizes) >= 1 else None
 
 
-def _reflection(split, grams: dict, terms, kernel: KernelDecision):
-    """(split, kernel parts) where every Gram matrix and every interface term are invariant under
-    ``split`` and the kernel splits (:mod:`.reflection`), else (None, None). The sum of invariant
-    terms is invariant, so one check serves every (c1, c2) and v1 = 0."""
-    if split is None or not all(
-            reflection.invariant(split, M) for M in [G for G, _ in grams.values()] + list(terms)):
-        return None, None
+def _reflection(split, grams: dict, kernel: KernelDecision):
+    """(split, kernel parts, {norm: halves of G}) where every Gram matrix is invariant under
+    ``split`` and the kernel splits (:mod:`.reflection`), else (None, None, None). Each interface
+    operator S is checked where it is split (:func:`split_spectra`: unsplit where it is not)."""
+    if split is None:
+        return None, None, None
+    halves = {}
+    for norm, (G, _) in grams.items():
+        *halves[norm], distance = split.blocks(G)
+        if distance > reflection.INVARIANCE_RTOL:
+            return None, None, None
     parts = split.even_odd(kernel.vectors) if kernel.dim else None
     if kernel.dim and parts is None:
-        return None, None
-    return split, parts
+        return None, None, None
+    return split, parts, halves
+
+
+class _Factors:
+    """The Gram factors of a split space: ``split`` {norm: (L_e, L_o)} of the halves, ``whole``
+    {norm: L} of G itself, made on first use (an S that is not invariant is solved unsplit)."""
+
+    def __init__(self, grams: dict, halves: dict):
+        self._grams = grams
+        self.split = {norm: tuple(gram_factor(h) for h in hs) for norm, hs in halves.items()}
+
+    @cached_property
+    def whole(self) -> dict:
+        return {norm: gram_factor(G) for norm, (G, _) in self._grams.items()}
+
+    def __iter__(self):
+        return iter(self.split)
 
 
 def space_kernel(couplings, sides, space, k: int, structural: int, l2_gram=None,

@@ -23,40 +23,19 @@ import numpy as np
 from scipy import sparse
 
 from ..errors import InputError
-from .coupling import weighted_values
+from .basis_symmetry import induced_permutation
 
 #: Interior sample points of every triangle, barycentric (seeded): more than (s + 1)(s + 2)/2 for
 #: s ≤ 2 in general position, so a function of P_s on a triangle is fixed by its values there.
 _SAMPLES = np.random.default_rng(28).dirichlet(np.ones(3), size=9)
-_MATCH_TOL = 1e-10
 
 
 def _induced(space, transform) -> np.ndarray | None:
     """π with φ_g(T x) = φ_π(g)(x) for every dof g, T = ``transform`` (an involution of Γ mapping
-    the triangles of G_h onto triangles of G_h), checked on :data:`_SAMPLES` of every triangle to
-    :data:`_MATCH_TOL` relative; None if T does not map the space onto itself. Sparse: π(g)
-    minimises ‖B_g − A_h‖² − ‖B_g‖² = ‖A_h‖² − 2 B_gᵀ A_h, negative only where the supports
-    overlap (B_g = φ_g ∘ T, A_h = φ_h at the samples)."""
+    the triangles of G_h onto triangles of G_h), checked on :data:`_SAMPLES` of every triangle
+    (:func:`~.basis_symmetry.induced_permutation`); None if T does not map the space onto itself."""
     tri = space.triangles()  # (T, 3, 2)
-    x = np.einsum("pk,tkd->tpd", _SAMPLES, tri).reshape(-1, 2)
-    ones = np.ones(len(x))
-    A, B = weighted_values(space, x, ones), weighted_values(space, transform(x), ones)
-    overlap = (B.T @ A).tocsr()
-    overlap.sum_duplicates()
-    norms = np.asarray(A.multiply(A).sum(axis=0)).ravel()
-    if np.any(np.diff(overlap.indptr) == 0):  # a function whose image meets no function
-        return None
-    row = np.repeat(np.arange(space.dim), np.diff(overlap.indptr))
-    score = norms[overlap.indices] - 2.0 * overlap.data
-    order = np.lexsort((score, row))  # by row, best score first
-    first = np.searchsorted(row[order], np.arange(space.dim))
-    pi = overlap.indices[order[first]]
-    if np.unique(pi).size != space.dim or np.any(pi[pi] != np.arange(space.dim)):
-        return None
-    scale = np.abs(A.data).max()
-    if abs(B - A[:, pi]).max() > _MATCH_TOL * scale:
-        return None
-    return pi
+    return induced_permutation(space, np.einsum("pk,tkd->tpd", _SAMPLES, tri).reshape(-1, 2), transform)
 
 
 def reflection(space) -> np.ndarray | None:

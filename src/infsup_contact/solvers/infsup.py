@@ -280,12 +280,12 @@ def beta_rows_all(family, k, n1, n2, cases=None, multiplier_meshes=("omega2",), 
                 t_coupling = time.perf_counter() - tc
                 grams = {norm: gamma.gram(space, norm, h_route=h_route) for norm in norms}
                 structural = gamma.proven_kernel(space, k, [s.trace for s in sides], dim_w)
-                split = _reflection_of(space, gamma, g_h, k) if iterative else None
+                split = reflection.split_of(space, gamma, g_h, k) if iterative else None
                 kernel = space_kernel(couplings, sides, space, k, structural,
                                       grams["L2"][0] if "L2" in grams else None, iterative=iterative,
                                       trace_norms=trace_norms, split=split)
                 terms = interface_terms(couplings, sides)
-                split, parts, halves = _reflection(split, grams, kernel)
+                split, parts, halves = reflection.usable(split, grams, kernel)
                 factors = (_Factors(grams, halves) if split is not None
                            else {norm: gram_factor(G) for norm, (G, _) in grams.items()})
                 beta_v1_zero_c1 = betas_v1_zero(terms, factors, kernel, iterative, split)
@@ -317,33 +317,6 @@ def beta_rows_all(family, k, n1, n2, cases=None, multiplier_meshes=("omega2",), 
                             t_eig=t_shared if iterative else time.perf_counter() - te))
             by_partition[gamma.partition_key(g_h)] = rows[first:]
     return rows
-
-
-def _reflection_of(space, gamma, g_h, k: int):
-    """The point reflection's split of ``space`` (:func:`.reflection.reflection_split`, checked at
-    the Gauss points of G_h), or None (no such symmetry, or a Γ without a quadrature)."""
-    quadrature = getattr(gamma, "quadrature", None)
-    if quadrature is None:
-        return None
-    split = reflection.reflection_split(space, quadrature(g_h, 2 * k)[0])
-    return split if split is not None and min(split.sizes) >= 1 else None
-
-
-def _reflection(split, grams: dict, kernel: KernelDecision):
-    """(split, kernel parts, {norm: halves of G}) where every Gram matrix is invariant under
-    ``split`` and the kernel splits (:mod:`.reflection`), else (None, None, None). Each interface
-    operator S is checked where it is split (:func:`split_spectra`: unsplit where it is not)."""
-    if split is None:
-        return None, None, None
-    halves = {}
-    for norm, (G, _) in grams.items():
-        *halves[norm], distance = split.blocks(G)
-        if distance > reflection.INVARIANCE_RTOL:
-            return None, None, None
-    parts = split.even_odd(kernel.vectors) if kernel.dim else None
-    if kernel.dim and parts is None:
-        return None, None, None
-    return split, parts, halves
 
 
 class _Factors:

@@ -145,10 +145,10 @@ def coupling_kernel(W: np.ndarray, proven: int = 0, entry_error: float = 0.0,
     s_max = float(s[-1])
     tol = max(rows, m) * np.finfo(float).eps * s_max + 2.0 * float(entry_error)
     numerical = int(np.sum(s <= tol))
-    return _decision(s, proven, tol, numerical, s_max, None if V is None else V[:, :max(proven, numerical)])
+    return decide(s, proven, tol, numerical, s_max, None if V is None else V[:, :max(proven, numerical)])
 
 
-def _decision(s, proven, tol, numerical, s_max, vectors=None) -> KernelDecision:
+def decide(s, proven, tol, numerical, s_max, vectors=None) -> KernelDecision:
     """The decision and its margin (module docstring) from the ascending singular values s
     (all of them, or the bottom ones with σ_max last)."""
     m = len(s)
@@ -202,7 +202,7 @@ def bottom_kernel(W, proven: int = 0, entry_error: float = 0.0) -> KernelDecisio
         return coupling_kernel(W.toarray(), proven, entry_error, vectors=True)
     d = res.count
     s = np.concatenate([res.values[:d], [res.above, smax]])
-    return _decision(s, proven, tol, d, smax, res.vectors[:, :d])
+    return decide(s, proven, tol, d, smax, res.vectors[:, :d])
 
 
 def scaled_couplings(couplings, trace_norms, multiplier_norms):

@@ -3,7 +3,7 @@
 On a face mesh pair symmetric about the centre of Γ = (0, 1)² (the structured hexahedra, any
 N1, N2), the point reflection R(x, y) = (1 − x, 1 − y) maps the multiplier basis onto itself,
 μ_j ∘ R = μ_π(j) with π an involution (:func:`reflection_split`, found and checked on Gauss
-points of G_h), and the interface operator S = Σ_i B_i X_i B_iᵀ and every Gram matrix G commute
+points of G_h, :func:`~infsup_contact.discretization.basis_symmetry.induced_permutation`), and the interface operator S = Σ_i B_i X_i B_iᵀ and every Gram matrix G commute
 with the permutation: P S Pᵀ = S, P G Pᵀ = G. In the orthonormal basis Q = [Q_e, Q_o] of the
 even and odd functions ((e_j ± e_π(j))/√2 for the pairs j < π(j), e_j for the fixed points in
 Q_e) both are block diagonal, so the pencil S x = λ G x is two pencils of about half the size,
@@ -31,43 +31,17 @@ import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
 
+from ..discretization.basis_symmetry import induced_permutation
 from ..la.threaded import sparse_times_dense, symmetric_part, times_transpose
 from . import bottom
-from .kernel import BLOCK_EXTRA, CERTIFY_FLOOR, KernelDecision, _decision
+from .kernel import BLOCK_EXTRA, CERTIFY_FLOOR, KernelDecision, decide
 
 INVARIANCE_RTOL = 1e-11
 """Largest ‖Q_oᵀ M Q_e‖_F / ‖M‖_F (the block the split drops) for which S and G count as
 reflection invariant."""
-MATCH_RTOL = 1e-10
-"""Largest relative mismatch of μ_j ∘ R and μ_π(j) at the sample points."""
 SPLIT_GAP = 1e-6
 """A kernel vector's even (or odd) part must have norm > 1 − SPLIT_GAP or < SPLIT_GAP (the
 cosines of the principal angles between the kernel and the even functions): else no split."""
-
-
-def induced_permutation(space, x: np.ndarray, transform) -> np.ndarray | None:
-    """π with μ_j(T x) = μ_π(j)(x) at the points ``x`` (n × 2), T = ``transform``, or None.
-
-    π(j) is the function whose values at x are nearest to those of μ_j ∘ T among the functions
-    whose supports meet its image (sparse overlaps); accepted only if π is an involution and
-    the values agree to :data:`MATCH_RTOL`."""
-    from ..discretization.coupling import weighted_values
-
-    ones = np.ones(len(x))
-    A, B = weighted_values(space, x, ones), weighted_values(space, transform(x), ones)
-    overlap = (B.T @ A).tocsr()
-    overlap.sum_duplicates()
-    if np.any(np.diff(overlap.indptr) == 0):
-        return None
-    norms = np.asarray(A.multiply(A).sum(axis=0)).ravel()
-    row = np.repeat(np.arange(space.dim), np.diff(overlap.indptr))
-    order = np.lexsort((norms[overlap.indices] - 2.0 * overlap.data, row))
-    pi = overlap.indices[order[np.searchsorted(row[order], np.arange(space.dim))]]
-    if np.unique(pi).size != space.dim or np.any(pi[pi] != np.arange(space.dim)):
-        return None
-    if abs(B - A[:, pi]).max() > MATCH_RTOL * np.abs(A.data).max():
-        return None
-    return pi
 
 
 @dataclass(frozen=True)
@@ -142,6 +116,33 @@ def reflection_split(space, points: np.ndarray) -> ReflectionSplit | None:
     ``points`` (e.g. the Gauss points of G_h), or None where it does not map the basis onto itself."""
     pi = induced_permutation(space, np.asarray(points, float), lambda x: 1.0 - x)
     return None if pi is None else ReflectionSplit(pi)
+
+
+def split_of(space, gamma, g_h, k: int) -> ReflectionSplit | None:
+    """The point reflection's split of ``space`` (:func:`reflection_split`, checked at
+    the Gauss points of G_h), or None (no such symmetry, or a Γ without a quadrature)."""
+    quadrature = getattr(gamma, "quadrature", None)
+    if quadrature is None:
+        return None
+    split = reflection_split(space, quadrature(g_h, 2 * k)[0])
+    return split if split is not None and min(split.sizes) >= 1 else None
+
+
+def usable(split: ReflectionSplit | None, grams: dict, kernel: KernelDecision):
+    """(split, kernel parts, {norm: halves of G}) where every Gram matrix is invariant under
+    ``split`` and the kernel splits, else (None, None, None). Each interface operator S is checked where it
+    is split (:func:`split_pencils`; :func:`~.infsup.split_spectra` solves it unsplit where it is not)."""
+    if split is None:
+        return None, None, None
+    halves = {}
+    for norm, (G, _) in grams.items():
+        *halves[norm], distance = split.blocks(G)
+        if distance > INVARIANCE_RTOL:
+            return None, None, None
+    parts = split.even_odd(kernel.vectors) if kernel.dim else None
+    if kernel.dim and parts is None:
+        return None, None, None
+    return split, parts, halves
 
 
 def split_pencils(split: ReflectionSplit, S: np.ndarray, factors: dict, kernel_parts, n_values: int) -> dict | None:
@@ -219,4 +220,4 @@ def split_bottom_kernel(W, split: ReflectionSplit, proven: int = 0, entry_error:
     if d < proven:
         return None
     s = np.concatenate([np.sort(np.concatenate(counted)), [above, smax]])
-    return _decision(s, proven, tol, d, smax, np.hstack(vectors))
+    return decide(s, proven, tol, d, smax, np.hstack(vectors))

@@ -13,6 +13,8 @@ Q_e) both are block diagonal, so the pencil S x = λ G x is two pencils of about
 and the kernel of Bᵀ (invariant: B_i commute with the reflections of the traces) splits into its
 even and odd parts. Each half costs an eighth of the Cholesky factorizations, triangular solves
 and products of :func:`~.bottom.bottom_pencil` (m³/3 each), and half of each Lanczos product.
+The kernel decision itself runs on the even and odd columns of the scaled coupling W
+(:func:`split_bottom_kernel`), with the unsplit η and a certificate per half.
 
 The computed S and G are invariant only to round-off (the sides' sparse factorizations order
 their dofs differently): the split is taken only where the dropped block Q_oᵀ M Q_e is at most

@@ -223,3 +223,29 @@ def test_cli_bad_input_is_one_line_exit_2(tmp_path, capsys):
                        (["verdict", "--system", str(m.path), "--N", "4", "8", "16"], "--N")):
         assert main(argv) == 2
         assert f"invalid {flag} " in capsys.readouterr().err
+
+
+def test_pardiso_inertia_certifies_only_a_clean_spd_matrix(monkeypatch):
+    """From PARDISO_CHECK_MIN rows PARDISO's LDLᵀ inertia certifies A at once (n positive pivots,
+    none negative, none perturbed); a singular or indefinite A still gets SuperLU's diagnosis,
+    the same messages as below the gate."""
+    from infsup_contact.models import pardiso
+    from infsup_contact.systems import checks
+
+    if not pardiso.available():
+        pytest.skip("MKL PARDISO not loadable here")
+    monkeypatch.setattr(checks, "PARDISO_CHECK_MIN", 1)
+    A, B, G = _system()
+    assert pardiso.inertia(A) == (A.shape[0], 0, 0)
+    assert checks.check_positive_definite(A.tocsc(), "A.mtx") is None        # certified by PARDISO
+    floating = A.tolil()
+    floating[0, 0] = floating[11, 11] = 1.0
+    pos, neg, perturbed = pardiso.inertia(floating.tocsr())
+    assert neg == 0 and perturbed >= 1                                       # the constants: a zero pivot
+    with pytest.raises(SystemFileError, match=r"1 zero pivots of 12 \(a floating body.*null vector x has"):
+        checks.check_positive_definite(floating.tocsc(), "A.mtx")
+    shifted = (A - 2.0 * sp.identity(A.shape[0])).tocsc()
+    n_neg = int(np.sum(np.linalg.eigvalsh(shifted.toarray()) < 0))
+    assert n_neg > 0 and pardiso.inertia(shifted)[1] == n_neg                # Sylvester: the inertia
+    with pytest.raises(SystemFileError, match="not positive definite"):
+        checks.check_positive_definite(shifted, "A.mtx")

@@ -33,6 +33,8 @@ _P = ctypes.POINTER
 _I32 = ctypes.c_int32
 MTYPE_SPD = 2
 """PARDISO's matrix type of a real symmetric positive definite matrix (upper triangle given)."""
+MTYPE_SYMMETRIC_INDEFINITE = -2
+"""PARDISO's matrix type of a real symmetric indefinite matrix (Bunch–Kaufman LDLᵀ, :func:`inertia`)."""
 
 
 @lru_cache(maxsize=1)
@@ -71,7 +73,8 @@ def _upper_csr(A) -> sp.csr_matrix:
 class _Handle:
     """One PARDISO instance (its internal ``pt``) on the upper triangle of an SPD matrix."""
 
-    def __init__(self, A, perm=None, schur: int = 0):
+    def __init__(self, A, perm=None, schur: int = 0, mtype: int = MTYPE_SPD):
+        self.mtype = mtype
         self.lib = _library()
         if self.lib is None:
             raise PardisoError("MKL PARDISO is not available (the mkl wheel is not installed)")
@@ -93,7 +96,7 @@ class _Handle:
         b = np.zeros(self.n * nrhs) if b is None else b
         x = np.zeros(self.n * nrhs) if x is None else x
         self.lib.pardiso(self.pt.ctypes.data_as(_P(ctypes.c_int64)), ctypes.byref(_I32(1)),
-                         ctypes.byref(_I32(1)), ctypes.byref(_I32(MTYPE_SPD)), ctypes.byref(_I32(phase)),
+                         ctypes.byref(_I32(1)), ctypes.byref(_I32(self.mtype)), ctypes.byref(_I32(phase)),
                          ctypes.byref(_I32(self.n)), self.U.data.ctypes.data,
                          self.U.indptr.ctypes.data_as(_P(_I32)), self.U.indices.ctypes.data_as(_P(_I32)),
                          self.perm.ctypes.data_as(_P(_I32)), ctypes.byref(_I32(nrhs)),
@@ -232,3 +235,17 @@ class Factor:
         x = np.zeros_like(rhs, order="F")
         self.handle.call(33, b=rhs, x=x, nrhs=rhs.shape[1])
         return x.reshape(b.shape)
+
+
+def inertia(A) -> tuple[int, int, int]:
+    """(positive, negative, perturbed) pivots of the LDLᵀ of a symmetric A (PARDISO, matrix type
+    −2: Bunch–Kaufman pivoting in METIS order, pivots below 1e-8 ‖A‖ perturbed, ``iparm[9]``).
+    By Sylvester's law the first two are A's inertia where nothing was perturbed; a perturbed pivot
+    marks a (numerically) singular A. One factorization, released at once."""
+    handle = _Handle(A, mtype=MTYPE_SYMMETRIC_INDEFINITE)
+    handle.iparm[20] = 1   # Bunch–Kaufman pivoting (1x1 and 2x2)
+    try:
+        handle.call(12)
+        return int(handle.iparm[21]), int(handle.iparm[22]), int(handle.iparm[13])
+    finally:
+        handle.release()

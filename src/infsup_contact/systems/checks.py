@@ -36,6 +36,7 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
+from ..models import pardiso
 from .readers import SystemFileError
 
 TGV_RATIO = 1e15
@@ -44,6 +45,8 @@ SYMMETRY_RTOL = 1e-10
 """A is symmetric when max |a_ij − a_ji| ≤ SYMMETRY_RTOL · max |a_ij|."""
 PIVOT_RTOL = 1e-12
 """A pivot below PIVOT_RTOL · max pivot is zero (a singular A: a floating body)."""
+PARDISO_CHECK_MIN = 2000
+"""Rows from which :func:`check_positive_definite` asks PARDISO's inertia first."""
 
 
 @dataclass
@@ -177,9 +180,19 @@ def check_gram(G, path):
 def check_positive_definite(A, path, what: str = "A"):
     """Refuse a singular or indefinite symmetric matrix. LDLᵀ without pivoting (SuperLU, symmetric
     mode): for a symmetric matrix the pivots' signs are its inertia (Sylvester), so all pivots
-    > PIVOT_RTOL · max is positive definite. Returns the factorization."""
+    > PIVOT_RTOL · max is positive definite. Returns the factorization (None where PARDISO
+    certified it: from :data:`PARDISO_CHECK_MIN` rows, its Bunch–Kaufman LDLᵀ with n positive
+    pivots, none negative and none perturbed below 1e-8 ‖A‖ is accepted at once; anything else
+    goes to SuperLU, whose diagnosis names the failure. On a 3D export, membranes3d k = 2, N = 20,
+    121,680 rows, SuperLU's LDLᵀ took 113 s)."""
     A = sp.csc_matrix(A)
     n = A.shape[0]
+    if n >= PARDISO_CHECK_MIN and pardiso.available():
+        try:  # a clean inertia certifies it at once; any doubt goes to the diagnosis below
+            if pardiso.inertia(A) == (n, 0, 0):
+                return None
+        except pardiso.PardisoError:
+            pass
     try:
         lu = spla.splu(A, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0, options=dict(SymmetricMode=True))
         piv = lu.U.diagonal()

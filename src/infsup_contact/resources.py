@@ -303,6 +303,21 @@ def total_bytes(meminfo: str = "/proc/meminfo") -> float | None:
 
 SYSTEM_MARGIN = 1.4
 """Factor on the foreign-system memory formula (measured/formula = 1.00 on its one calibration run)."""
+SURFACE_EXPONENT = 0.6
+"""B touching at least n^SURFACE_EXPONENT of n dofs (and at most a tenth of them) marks a 3D body's
+surface: n_Γ ~ n^{2/3} on a 3D interface, n^{1/2} on a 2D one (a Stokes pressure touches ~n)."""
+SYSTEM_BYTES_3D = 900.0
+"""C in C · n^{4/3} bytes of a 3D system's sparse factorization (the fill of nested dissection in
+3D): a membranes3d export, R5.2, k = 2, N = 20 (121,680 dofs, two bodies, ``gamma-dense``)
+peaked at 4.4 GB, i.e. C ≈ 900 on n^{4/3} of one body's half, times two."""
+SYSTEM_SECONDS_3D = 3e-9
+"""Seconds per n² of a 3D system (the same export: 42 s)."""
+
+
+def looks_3d(n: int, n_touched: int) -> bool:
+    """Whether B touches a 3D body's surface (:data:`SURFACE_EXPONENT`); a foreign system does not
+    declare its dimension."""
+    return n > 1 and n ** SURFACE_EXPONENT <= n_touched <= 0.1 * n
 
 
 def system_estimate(levels) -> Estimate:
@@ -313,10 +328,16 @@ def system_estimate(levels) -> Estimate:
     shift-invert route factorizes [[A, Bᵀ], [B, −δG]] and A (residuals). Calibrated on one
     measurement only: Taylor–Hood 16..128 (scikit-fem, 130k + 16.5k dofs at 128) peaked at
     1.02 GiB (``/usr/bin/time -v``) where the formula without :data:`SYSTEM_MARGIN` gave
-    1.02 GiB; the margin makes it an upper bound until more systems are measured."""
+    1.02 GiB; the margin makes it an upper bound until more systems are measured. Where B touches
+    a 3D body's surface (:func:`looks_3d`) the sparse part is at least the 3D fill
+    :data:`SYSTEM_BYTES_3D` (n/2)^{4/3} per body and the time gains :data:`SYSTEM_SECONDS_3D` n²:
+    the 2D formula gave 1.41 GiB and 12 s where a 3D export took 4.4 GB and 42 s."""
     peak, seconds = 0.0, START_SECONDS
     for n, m, nt, nnz, route in levels:
         sparse = _side_bytes(n + m, "beta") + 2 * 12.0 * nnz
+        three_d = looks_3d(n, nt)
+        if three_d:  # the fill of a 3D factorization, two bodies of n/2 (:data:`SYSTEM_BYTES_3D`)
+            sparse = max(sparse, 2 * SYSTEM_BYTES_3D * (n / 2) ** (4.0 / 3.0) + 2 * 12.0 * nnz)
         if route == "gamma-dense":
             dense = 8.0 * (3 * nt * nt + 6 * m * m + nt * m)
         elif route == "solves-dense":
@@ -326,4 +347,5 @@ def system_estimate(levels) -> Estimate:
             dense = 8.0 * 20 * (n + m)
         peak = max(peak, SYSTEM_MARGIN * (sparse + dense))
         seconds += SECONDS_PER_DOF15["beta"] * 2 * (n + m) ** 1.5 + 1e-9 * (m ** 3 if route != "shift-invert" else 0)
+        seconds += SYSTEM_SECONDS_3D * n ** 2 if three_d else 0.0
     return Estimate(PROCESS_BYTES["beta"] + peak, seconds)

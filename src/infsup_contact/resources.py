@@ -303,9 +303,13 @@ def total_bytes(meminfo: str = "/proc/meminfo") -> float | None:
 
 SYSTEM_MARGIN = 1.4
 """Factor on the foreign-system memory formula (measured/formula = 1.00 on its one calibration run)."""
+INTERFACE_FRACTION = 0.1
+"""B touching at most this fraction of a system's dofs is an interface (contact), not a Stokes
+pressure (which touches ~n): the systems engine keeps such a system on the Γ route above its
+dense gate (``systems.engine.choose_route``), and :func:`looks_3d` reads its dimension."""
 SURFACE_EXPONENT = 0.6
-"""B touching at least n^SURFACE_EXPONENT of n dofs (and at most a tenth of them) marks a 3D body's
-surface: n_Γ ~ n^{2/3} on a 3D interface, n^{1/2} on a 2D one (a Stokes pressure touches ~n)."""
+"""B touching at least n^SURFACE_EXPONENT of n dofs (and at most :data:`INTERFACE_FRACTION` of
+them) marks a 3D body's surface: n_Γ ~ n^{2/3} on a 3D interface, n^{1/2} on a 2D one."""
 SYSTEM_BYTES_3D = 900.0
 """C in C · n^{4/3} bytes of a 3D system's sparse factorization (the fill of nested dissection in
 3D): a membranes3d export, R5.2, k = 2, N = 20 (121,680 dofs, two bodies, ``gamma-dense``)
@@ -317,7 +321,7 @@ SYSTEM_SECONDS_3D = 3e-9
 def looks_3d(n: int, n_touched: int) -> bool:
     """Whether B touches a 3D body's surface (:data:`SURFACE_EXPONENT`); a foreign system does not
     declare its dimension."""
-    return n > 1 and n ** SURFACE_EXPONENT <= n_touched <= 0.1 * n
+    return n > 1 and n ** SURFACE_EXPONENT <= n_touched <= INTERFACE_FRACTION * n
 
 
 def system_estimate(levels) -> Estimate:

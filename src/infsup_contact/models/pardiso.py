@@ -71,7 +71,8 @@ def _upper_csr(A) -> sp.csr_matrix:
 
 
 class _Handle:
-    """One PARDISO instance (its internal ``pt``) on the upper triangle of an SPD matrix."""
+    """One PARDISO instance (its internal ``pt``) on the upper triangle of a symmetric matrix:
+    SPD (``mtype`` :data:`MTYPE_SPD`, Cholesky) or indefinite (:data:`MTYPE_SYMMETRIC_INDEFINITE`)."""
 
     def __init__(self, A, perm=None, schur: int = 0, mtype: int = MTYPE_SPD):
         self.mtype = mtype

@@ -295,7 +295,7 @@ def combine_terms(terms, c) -> np.ndarray:
     out = 0.0
     for T, ci in zip(terms, c):
         out = out + T / ci
-    return symmetric_part(out) if np.ndim(out) == 2 else 0.5 * (out + out.T)
+    return symmetric_part(out)
 
 
 def interface_operator(couplings, sides, c=(1.0, 1.0)) -> np.ndarray:

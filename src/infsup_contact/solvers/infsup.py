@@ -150,6 +150,15 @@ def split_spectra(split, S: np.ndarray, factors: dict, kernel: KernelDecision | 
     return {norm: _spectrum_above(S.shape[0], d, values, top) for norm, (values, top) in pencils.items()}
 
 
+def large_spectra(S: np.ndarray, factors, kernel: KernelDecision | None = None, split=None, parts=None) -> dict:
+    """The large route's spectra of S for every norm: :func:`split_spectra` where the space has a
+    reflection split (``factors`` a :class:`_Factors`) and S is invariant, else :func:`bottom_spectra`
+    (``factors`` {norm: factor}, or the split space's whole factors, made on demand)."""
+    if split is None:
+        return bottom_spectra(S, factors, kernel)
+    return split_spectra(split, S, factors.split, kernel, parts) or bottom_spectra(S, factors.whole, kernel)
+
+
 def bottom_spectra(S: np.ndarray, factors: dict, kernel: KernelDecision | None = None) -> dict:
     """:func:`bottom_spectrum` of S with each Gram factor in ``factors`` ({norm: factor}).
 
@@ -160,7 +169,7 @@ def bottom_spectra(S: np.ndarray, factors: dict, kernel: KernelDecision | None =
     return {norm: bottom_spectrum(S, L, kernel, s_factor=shared) for norm, L in factors.items()}
 
 
-def betas_v1_zero(terms, factors: dict, kernel: KernelDecision, iterative: bool, split=None, parts=None) -> dict:
+def betas_v1_zero(terms, factors: dict, kernel: KernelDecision, iterative: bool, split=None) -> dict:
     """β with v1 = 0 at c2 = 1, for each Gram factor ({norm: factor}): the sup over (0, v2)
     only, (5.10), i.e. the pencil of B_2 X_2 B_2ᵀ alone; at other c2 it is this / sqrt(c2).
 
@@ -172,11 +181,8 @@ def betas_v1_zero(terms, factors: dict, kernel: KernelDecision, iterative: bool,
     if iterative and kernel.dim:
         return {norm: 0.0 for norm in factors}
     S2 = combine_terms(terms[1:], (1.0,))
-    if split is not None:
-        spectra = split_spectra(split, S2, factors.split)
-        return {norm: sp_.beta for norm, sp_ in (spectra or bottom_spectra(S2, factors.whole)).items()}
     if iterative:
-        return {norm: sp_.beta for norm, sp_ in bottom_spectra(S2, factors).items()}
+        return {norm: sp_.beta for norm, sp_ in large_spectra(S2, factors, None, split).items()}
     return {norm: spectrum(S2, factor=L).beta for norm, L in factors.items()}
 
 
@@ -293,9 +299,7 @@ def beta_rows_all(family, k, n1, n2, cases=None, multiplier_meshes=("omega2",), 
                     S = combine_terms(terms, (c1, c2))
                     if iterative:  # the norms' pencils share work: each row gets an equal share of the time
                         te = time.perf_counter()
-                        spectra = (bottom_spectra(S, factors, kernel) if split is None
-                                   else split_spectra(split, S, factors.split, kernel, parts)
-                                   or bottom_spectra(S, factors.whole, kernel))
+                        spectra = large_spectra(S, factors, kernel, split, parts)
                         t_shared = (time.perf_counter() - te) / len(norms)
                     for norm in norms:
                         te = time.perf_counter()

@@ -143,7 +143,7 @@ def coupling_kernel(W: np.ndarray, proven: int = 0, entry_error: float = 0.0,
         s, V = (sla.svdvals(W, check_finite=True) if rows else np.zeros(0)), None
     s = np.concatenate([np.zeros(m - len(s)), np.sort(s)])  # ascending, structural zeros first
     s_max = float(s[-1])
-    tol = max(rows, m) * np.finfo(float).eps * s_max + 2.0 * float(entry_error)
+    tol = error_level(rows, m, s_max, entry_error)
     numerical = int(np.sum(s <= tol))
     return decide(s, proven, tol, numerical, s_max, None if V is None else V[:, :max(proven, numerical)])
 
@@ -193,16 +193,39 @@ def bottom_kernel(W, proven: int = 0, entry_error: float = 0.0) -> KernelDecisio
     proven = int(max(proven, m - rows, 0))
     gram = sp.csr_matrix(W.T @ W)
     smax = bottom.largest_singular(W, gram)
-    tol = max(rows, m) * np.finfo(float).eps * smax + 2.0 * float(entry_error)
-    res = bottom.bottom_singular(W, min(proven + BLOCK_EXTRA, m - 1), tol, smax, gram)
-    tau = 0.0 if res is None else 0.5 * res.above ** 2
-    if res is None or res.count < proven or res.above <= tol or \
-            tau <= CERTIFY_FLOOR * max(rows, m) * np.finfo(float).eps * smax ** 2 or \
-            not bottom.at_most_below(gram, tau, res.vectors[:, :res.count], smax ** 2):
+    tol = error_level(rows, m, smax, entry_error)
+    res = certified_bottom(W, gram, min(proven + BLOCK_EXTRA, m - 1), tol, smax,
+                           certify_floor(rows, m, smax), min_count=proven)
+    if res is None:
         return coupling_kernel(W.toarray(), proven, entry_error, vectors=True)
     d = res.count
     s = np.concatenate([res.values[:d], [res.above, smax]])
     return decide(s, proven, tol, d, smax, res.vectors[:, :d])
+
+
+def error_level(rows: int, m: int, smax: float, entry_error: float) -> float:
+    """η = max(rows, m) ε σ_max + 2 ‖δW‖_F (module docstring)."""
+    return max(rows, m) * np.finfo(float).eps * smax + 2.0 * float(entry_error)
+
+
+def certify_floor(rows: int, m: int, smax: float) -> float:
+    """The τ below which :func:`certified_bottom`'s Cholesky certificate is not trusted
+    (:data:`CERTIFY_FLOOR` times WᵀW's round-off)."""
+    return CERTIFY_FLOOR * max(rows, m) * np.finfo(float).eps * smax ** 2
+
+
+def certified_bottom(W, gram, block: int, tol: float, smax: float, floor: float, min_count: int = 0):
+    """Steps 1 and 2 of :func:`bottom_kernel` on the columns of W (``gram`` = WᵀW, ``smax`` =
+    σ_max(W)): the :class:`~.bottom.BottomSingular` of the block iteration, certified by one
+    Cholesky factorization at τ = σ_{d+1}²/2, or None where a step fails (no convergence, fewer
+    than ``min_count`` values <= η, σ_{d+1} <= η, τ <= ``floor``, the certificate refused)."""
+    res = bottom.bottom_singular(W, block, tol, smax, gram)
+    if res is None or res.count < min_count or res.above <= tol:
+        return None
+    tau = 0.5 * res.above ** 2
+    if tau <= floor or not bottom.at_most_below(gram, tau, res.vectors[:, :res.count], smax ** 2):
+        return None
+    return res
 
 
 def scaled_couplings(couplings, trace_norms, multiplier_norms):

@@ -36,7 +36,7 @@ import scipy.sparse as sp
 from ..discretization.basis_symmetry import induced_permutation
 from ..la.threaded import sparse_times_dense, symmetric_part, times_transpose
 from . import bottom
-from .kernel import BLOCK_EXTRA, CERTIFY_FLOOR, KernelDecision, decide
+from .kernel import BLOCK_EXTRA, KernelDecision, certified_bottom, certify_floor, decide, error_level
 
 INVARIANCE_RTOL = 1e-11
 """Largest ‖Q_oᵀ M Q_e‖_F / ‖M‖_F (the block the split drops) for which S and G count as
@@ -84,11 +84,11 @@ class ReflectionSplit:
         Row combinations Q_σᵀ M (sparse × dense: whole rows, threaded), then (Q_σᵀ M) Q_τ by
         :func:`~infsup_contact.la.threaded.times_transpose` (small transposed blocks): fancy
         column gathers M[:, j] of a C-ordered 4,225² matrix took 0.12 s each."""
-        Qe, Qo = self.bases
+        QeT, QoT = (Q.T.tocsr() for Q in self.bases)
         M = np.ascontiguousarray(M, dtype=float)
-        Te, To = (sparse_times_dense(Q.T.tocsr(), M) for Q in (Qe, Qo))
-        Me, Mo = times_transpose(Qe.T.tocsr(), Te), times_transpose(Qo.T.tocsr(), To)
-        off = times_transpose(Qe.T.tocsr(), To) if To.shape[0] else np.zeros(0)
+        Te, To = sparse_times_dense(QeT, M), sparse_times_dense(QoT, M)
+        Me, Mo = times_transpose(QeT, Te), times_transpose(QoT, To)
+        off = times_transpose(QeT, To) if To.shape[0] else np.zeros(0)
         scale = float(np.linalg.norm(M))
         distance = float(np.linalg.norm(off)) / scale if scale > 0 else 0.0
         return symmetric_part(Me), symmetric_part(Mo), distance
@@ -201,19 +201,16 @@ def split_bottom_kernel(W, split: ReflectionSplit, proven: int = 0, entry_error:
     cross = float(sp.linalg.norm(blocks[0].T @ blocks[1]))
     smaxes = [bottom.largest_singular(B, g) if B.shape[1] else 0.0 for B, g in zip(blocks, grams)]
     smax = max(smaxes)
-    tol = max(rows, m) * np.finfo(float).eps * smax + 2.0 * float(entry_error)
+    tol = error_level(rows, m, smax, entry_error)
+    floor = max(certify_floor(rows, m, smax), 2.0 * cross)  # the whole W's certificate at τ − ‖C‖
     counted, vectors, above = [], [], np.inf
     for B, g, s_b, Q in zip(blocks, grams, smaxes, (Qe, Qo)):
         mb = B.shape[1]
         if mb < 2:
             return None
         hint = int(np.ceil(proven * mb / m))  # a block size only: each half holds about its share
-        res = bottom.bottom_singular(B, min(hint + BLOCK_EXTRA, mb - 1), tol, s_b, g)
-        if res is None or res.above <= tol:
-            return None
-        tau = 0.5 * res.above ** 2  # the block's certificate, as unsplit; the whole W's at τ − ‖C‖
-        if tau <= max(CERTIFY_FLOOR * max(rows, m) * np.finfo(float).eps * smax ** 2, 2.0 * cross) or \
-                not bottom.at_most_below(g, tau, res.vectors[:, :res.count], s_b ** 2):
+        res = certified_bottom(B, g, min(hint + BLOCK_EXTRA, mb - 1), tol, s_b, floor)
+        if res is None:
             return None
         counted.append(res.values[:res.count])
         vectors.append(np.asarray(Q @ res.vectors[:, :res.count]))

@@ -42,6 +42,7 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
+from .. import resources
 from ..models.schur import gamma_factorization
 from ..solvers.bottom import SEED
 from ..solvers.kernel import KernelDecision, bottom_kernel, coupling_kernel
@@ -116,7 +117,7 @@ SPARSE_G_DENSE_MAX_M = 300
 m = 1152 and 2048 (scikit-fem P2–P0, same β to 1e-13)."""
 
 
-INTERFACE_FRACTION = 0.1
+INTERFACE_FRACTION = resources.INTERFACE_FRACTION
 """Above :data:`DENSE_MAX_M` with a dense G, a system whose B touches at most this fraction of
 its dofs (a contact interface, not a Stokes pressure) keeps the ``gamma-dense`` route: on a 3D
 contact export (membranes3d, hex, k = 2, N = 20, m = 1,681, B touching 2 % of the dofs) it took

@@ -67,3 +67,14 @@ def test_trailing_solve_refuses_c_order():
     R = np.eye(4)
     with pytest.raises(ValueError, match="Fortran"):
         mkl.trailing_solve(np.ascontiguousarray(R) + np.tril(np.ones((4, 4)), -1), np.asfortranarray(R), 0, 2)
+
+
+@pytest.mark.parametrize("n_threads", ["1", "2", "3"])
+@pytest.mark.parametrize("m", [5, 900])
+def test_elementwise_is_numpy_bit_for_bit(monkeypatch, n_threads, m):
+    """The Richardson step a + (a − b)/7 and a difference, row blocks over the threads."""
+    monkeypatch.setenv("MKL_NUM_THREADS", n_threads)
+    rng = np.random.default_rng(7)
+    a, b = rng.standard_normal((m, m)), rng.standard_normal((m, m))
+    assert np.array_equal(threaded.elementwise(lambda x, y: x + (x - y) / 7.0, a, b), a + (a - b) / 7.0)
+    assert np.array_equal(threaded.elementwise(np.subtract, a, np.asfortranarray(b)), a - b)

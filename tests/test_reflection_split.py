@@ -1,6 +1,7 @@
-"""The large route's pencils split by the point reflection of the face (solvers/reflection.py):
-the permutation of real face bases, the block identity Q_e M_e Q_eᵀ + Q_o M_o Q_oᵀ = M, the kernel's
-even/odd parts, and β rows identical (to the Lanczos accuracy) with and without the split."""
+"""The large route's pencils split by the reflections of the face (solvers/reflection.py): the
+permutations of real face bases and the character formula for the components' dimensions, the
+block identity Σ_c Q_c M_c Q_cᵀ = M, the kernel's components, and β rows identical (to the
+Lanczos accuracy) with and without the split."""
 import numpy as np
 import pytest
 import scipy.linalg as sla
@@ -16,25 +17,52 @@ def _space(case, k, n, gamma=SQUARE):
     return registry.case_space(case, k, part, gamma), part
 
 
-def _invariant_spd(pi, seed, shift=1.0):
-    m = pi.size
+def _elements(split):
+    """The group's permutations P_b, b = 0 .. 2^g − 1 (P_b = Π_{i ∈ b} π_i)."""
+    out = [np.arange(split.pis[0].size)]
+    for pi in split.pis:
+        out += [pi[e] for e in out]
+    return out
+
+
+def _character(c, b):
+    return (-1.0) ** bin(b & c).count("1")
+
+
+def _invariant_spd(split, seed, shift=1.0):
+    """A random SPD matrix averaged over the group: P_b M P_bᵀ = M for every b."""
+    els = _elements(split)
+    m = els[0].size
     A = np.random.default_rng(seed).standard_normal((m, m))
     A = A @ A.T + shift * m * np.eye(m)
-    return 0.5 * (A + A[np.ix_(pi, pi)])
+    return sum(A[np.ix_(e, e)] for e in els) / len(els)
 
 
 @pytest.mark.parametrize("case,k,gamma", [("T3", 2, SQUARE), ("R5.2", 2, SQUARE), ("DUAL-ALL", 1, SQUARE),
                                           ("PWLIN-Q9", 2, SQUARE), ("R5.4", 2, SQUARE), ("R5.2", 1, SQUARE_TRIG)])
-def test_the_reflection_permutes_the_basis(case, k, gamma):
+def test_the_reflections_permute_the_basis(case, k, gamma):
+    """Quadrilaterals: x → 1 − x and y → 1 − y (two commuting involutions, four components);
+    Kuhn triangles: the point reflection only. Each component has the dimension of the character
+    formula (1/|G|) Σ_b χ_c(b) tr P_b, and Q = [Q_0, ...] is orthogonal."""
     space, part = _space(case, k, 5, gamma)
     x = gamma.quadrature(part, 2 * k)[0]
     split = reflection.reflection_split(space, x)
     assert split is not None
-    pi = split.pi
-    assert np.array_equal(pi[pi], np.arange(space.dim))                       # an involution
-    np.testing.assert_allclose(space.evaluate(1.0 - x), space.evaluate(x)[:, pi], atol=1e-12)
-    ke, ko = split.sizes
-    assert ke + ko == space.dim and ke - ko == split.fixed.size
+    maps = ([lambda y: np.column_stack([1.0 - y[:, 0], y[:, 1]]), lambda y: np.column_stack([y[:, 0], 1.0 - y[:, 1]])]
+            if gamma is SQUARE else [lambda y: 1.0 - y])
+    assert len(split.pis) == len(maps)
+    for pi, T in zip(split.pis, maps):
+        assert np.array_equal(pi[pi], np.arange(space.dim))                       # an involution
+        np.testing.assert_allclose(space.evaluate(T(x)), space.evaluate(x)[:, pi], atol=1e-12)
+    els = _elements(split)
+    for a in split.pis:
+        for b in split.pis:
+            assert np.array_equal(a[b], b[a])                                     # they commute
+    traces = [np.count_nonzero(e == np.arange(space.dim)) for e in els]
+    for c, size in enumerate(split.sizes):
+        assert size == sum(_character(c, b) * t for b, t in enumerate(traces)) / len(els)
+    Q = np.hstack([q.toarray() for q in split.bases])
+    np.testing.assert_allclose(Q.T @ Q, np.eye(space.dim), atol=1e-14)
 
 
 def test_a_graded_partition_has_no_split():
@@ -47,53 +75,44 @@ def test_a_graded_partition_has_no_split():
 def test_blocks_reconstruct_an_invariant_matrix_and_detect_a_non_invariant_one():
     space, part = _space("R5.2", 2, 4)
     split = reflection.reflection_split(space, SQUARE.quadrature(part, 4)[0])
-    M = _invariant_spd(split.pi, 0)
-    Me, Mo, distance = split.blocks(M)
-    assert distance <= 1e-14
-    r, p, f, h = split.rep, split.pi[split.rep], split.fixed, np.sqrt(0.5)
-    m = M.shape[0]
-    Qe, Qo = np.zeros((m, Me.shape[0])), np.zeros((m, Mo.shape[0]))
-    Qe[r, np.arange(r.size)], Qe[p, np.arange(r.size)] = h, h
-    Qe[f, r.size + np.arange(f.size)] = 1.0
-    Qo[r, np.arange(r.size)], Qo[p, np.arange(r.size)] = h, -h
-    np.testing.assert_allclose(Qe @ Me @ Qe.T + Qo @ Mo @ Qo.T, M, atol=1e-12 * np.abs(M).max())
+    M = _invariant_spd(split, 0)
+    *blocks, distance = split.blocks(M)
+    assert len(blocks) == 4 and distance <= 1e-14
+    rebuilt = sum(Q @ Mc @ Q.T for Q, Mc in zip(split.bases, blocks))
+    np.testing.assert_allclose(rebuilt, M, atol=1e-12 * np.abs(M).max())
     M[0, 1] += 1e-6 * np.abs(M).max()
     M[1, 0] = M[0, 1]
-    assert split.blocks(M)[2] > reflection.INVARIANCE_RTOL
+    assert split.blocks(M)[-1] > reflection.INVARIANCE_RTOL
 
 
-@pytest.mark.parametrize("d_even,d_odd", [(0, 0), (3, 0), (2, 5)])
-def test_split_pencils_equal_the_unsplit_route(d_even, d_odd):
-    """A synthetic invariant pencil with an invariant kernel of d_even + d_odd modes: the values
-    above the kernel and λ_max of the halves are the unsplit route's (bottom_spectra)."""
+@pytest.mark.parametrize("dims", [(0, 0, 0, 0), (3, 0, 0, 0), (2, 5, 0, 1), (1, 1, 2, 3)])
+def test_split_pencils_equal_the_unsplit_route(dims):
+    """A synthetic invariant pencil with an invariant kernel of dims[c] modes in component c: the
+    values above the kernel and λ_max of the blocks are the unsplit route's (bottom_spectra)."""
     space, part = _space("R5.2", 2, 4)
     split = reflection.reflection_split(space, SQUARE.quadrature(part, 4)[0])
-    m, pi = space.dim, split.pi
+    els, m = _elements(split), space.dim
     rng = np.random.default_rng(1)
-    r, p, f, h = split.rep, pi[split.rep], split.fixed, np.sqrt(0.5)
-    even = np.zeros((m, d_even))
-    for j in range(d_even):  # even vectors: v = v∘π
-        v = rng.standard_normal(m)
-        even[:, j] = v + v[pi]
-    odd = np.zeros((m, d_odd))
-    for j in range(d_odd):
-        v = rng.standard_normal(m)
-        odd[:, j] = v - v[pi]
-    Z = np.hstack([even, odd])
-    A = _invariant_spd(pi, 2)
+    cols = []
+    for c, dc in enumerate(dims):  # component c: v = Σ_b χ_c(b) w ∘ P_b
+        for _ in range(dc):
+            w = rng.standard_normal(m)
+            cols.append(sum(_character(c, b) * w[e] for b, e in enumerate(els)))
+    Z = np.column_stack(cols) if cols else np.zeros((m, 0))
+    A = _invariant_spd(split, 2)
     if Z.shape[1]:  # S = P_⊥ A P_⊥ with P_⊥ the Euclidean projector off span Z: S Z = 0, invariant
         Q = sla.qr(Z, mode="economic")[0]
         Pp = np.eye(m) - Q @ Q.T
         A = Pp @ A @ Pp
         A = 0.5 * (A + A.T)
-    G = _invariant_spd(pi, 3, shift=0.2)
+    G = _invariant_spd(split, 3, shift=0.2)
     d = Z.shape[1]
     kernel = infsup.KernelDecision(d, d, 0, np.inf, "clear", 0.0, np.zeros(0), d, Z if d else None)
     plain = infsup.bottom_spectra(A, {"H": infsup.gram_factor(G)}, kernel if d else None)["H"]
-    parts = split.even_odd(Z) if d else None
+    parts = split.components(Z) if d else None
     if d:
-        assert (parts[0].shape[1], parts[1].shape[1]) == (d_even, d_odd)
-    factors = {"H": tuple(infsup.gram_factor(b) for b in split.blocks(G)[:2])}
+        assert tuple(P.shape[1] for P in parts) == dims
+    factors = {"H": tuple(infsup.gram_factor(b) for b in split.blocks(G)[:-1])}
     halves = infsup.split_spectra(split, A, factors, kernel if d else None, parts)["H"]
     assert halves.kernel_dim == plain.kernel_dim == d
     assert halves.smallest_nonzero == pytest.approx(plain.smallest_nonzero, rel=1e-9)
@@ -105,7 +124,7 @@ def test_a_kernel_that_is_not_the_sum_of_its_parts_is_refused():
     space, part = _space("R5.2", 2, 4)
     split = reflection.reflection_split(space, SQUARE.quadrature(part, 4)[0])
     v = np.random.default_rng(4).standard_normal(space.dim)
-    assert split.even_odd(v[:, None]) is None       # a generic vector: neither even nor odd
+    assert split.components(v[:, None]) is None       # a generic vector: neither even nor odd
 
 
 @pytest.mark.parametrize("case", ["T3", "R5.2", "DUAL-ALL"])
@@ -162,8 +181,8 @@ def test_an_interface_operator_that_is_not_invariant_is_solved_unsplit():
     """split_spectra returns None for an S off invariance (the caller's unsplit route)."""
     space, part = _space("R5.2", 2, 4)
     split = reflection.reflection_split(space, SQUARE.quadrature(part, 4)[0])
-    S, G = _invariant_spd(split.pi, 5), _invariant_spd(split.pi, 6)
-    factors = {"H": tuple(infsup.gram_factor(b) for b in split.blocks(G)[:2])}
+    S, G = _invariant_spd(split, 5), _invariant_spd(split, 6)
+    factors = {"H": tuple(infsup.gram_factor(b) for b in split.blocks(G)[:-1])}
     assert infsup.split_spectra(split, S, factors) is not None
     S[0, 2] += 1e-8 * np.abs(S).max()
     S[2, 0] = S[0, 2]

@@ -35,7 +35,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..errors import InputError
-from ..la.threaded import symmetric_sandwich
+from ..la.threaded import symmetric_part, symmetric_sandwich
 from .coupling import weighted_values
 from .face_norms import extrapolated, partial_gram, start_level
 from .face_spaces import FaceSpace
@@ -173,9 +173,8 @@ def gram_h_cellwise(space, rtol: float = 1e-6, n_start: int | None = None, n_cap
     n0 = (start_level(max(16, 2 * (space.piece_degree + 1) * n_int), p, P.dim) if n_start is None
           else int(n_start))
 
-    def partial(n):
-        S = symmetric_sandwich(R, piece_partial_gram(P, n))  # S_P is exactly symmetric
-        return 0.5 * (S + S.T)
+    def partial(n):  # S_P is exactly symmetric; the sandwich only to round-off
+        return symmetric_part(symmetric_sandwich(R, piece_partial_gram(P, n)))
 
     return extrapolated(partial, p, n0, n_cap, rtol)
 

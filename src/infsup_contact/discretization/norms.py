@@ -21,6 +21,7 @@ import numpy as np
 import scipy.sparse.linalg as spla
 
 from ..errors import InputError
+from ..la.threaded import elementwise
 from .logkernel import gram_h_logkernel
 from .multipliers import MultiplierSpace, local_monomial_coefficients, local_shapes
 from .quadrature import gauss_legendre_01
@@ -267,16 +268,20 @@ def extrapolate(partial, p: float, n0: int, n_cap: int, rtol: float) -> tuple[np
     divisor = 2.0 ** p - 1.0
     s_lo, n_hi = partial(n0), min(2 * n0, n_cap)
     s_hi = partial(n_hi)
-    r_prev = s_hi + (s_hi - s_lo) / divisor
-    err = _norm2(r_prev - s_hi) / _norm2(r_prev)
+
+    def step(hi, lo):  # R(n) = S(2n) + (S(2n) − S(n)) / (2^p − 1), threaded (bit for bit)
+        return elementwise(lambda a, b: a + (a - b) / divisor, hi, lo)
+
+    r_prev = step(s_hi, s_lo)
+    err = _norm2(elementwise(np.subtract, r_prev, s_hi)) / _norm2(r_prev)
     capped = False
     while True:
         if 2 * n_hi > n_cap:
             capped = err > rtol
             break
         s_lo, s_hi, n_hi = s_hi, partial(2 * n_hi), 2 * n_hi
-        r = s_hi + (s_hi - s_lo) / divisor
-        err = _norm2(r - r_prev) / _norm2(r)
+        r = step(s_hi, s_lo)
+        err = _norm2(elementwise(np.subtract, r, r_prev)) / _norm2(r)
         r_prev = r
         if err <= rtol:
             break

@@ -139,9 +139,9 @@ def _spectrum_above(m: int, d: int, values: np.ndarray, lam_max: float) -> Spect
 
 def split_spectra(split, S: np.ndarray, factors: dict, kernel: KernelDecision | None = None,
                   parts=None) -> dict:
-    """:func:`bottom_spectra` on the even and odd halves of a reflection-invariant pencil
-    (:mod:`.reflection`): ``factors`` {norm: (L_e, L_o)} of the halves of G, ``parts`` the
-    kernel's even and odd bases (:meth:`~.reflection.ReflectionSplit.even_odd`). None where S is
+    """:func:`bottom_spectra` on the components of a reflection-invariant pencil
+    (:mod:`.reflection`): ``factors`` {norm: (L_0, L_1, ...)} of the blocks of G, ``parts`` the
+    kernel's bases per component (:meth:`~.reflection.ReflectionSplit.components`). None where S is
     not reflection invariant (the caller solves it unsplit)."""
     d = 0 if kernel is None else kernel.dim
     pencils = reflection.split_pencils(split, S, factors, parts if d else None, N_BOTTOM)
@@ -176,8 +176,8 @@ def betas_v1_zero(terms, factors: dict, kernel: KernelDecision, iterative: bool,
     On the large route (``iterative``) with a non-empty kernel of Bᵀ it is 0 as a consequence,
     not a computation: a kernel vector of Bᵀ is one of B_2ᵀ, hence of B_2 X_2 B_2ᵀ, so
     β(v1 = 0) <= β_h = 0 (the sup over a subset). The dense route still computes it there (the
-    square root of a round-off eigenvalue, not exactly 0). ``split``: the point reflection's split,
-    ``factors`` then a :class:`_Factors` (the halves', and the whole Gram's on demand)."""
+    square root of a round-off eigenvalue, not exactly 0). ``split``: the reflections' split,
+    ``factors`` then a :class:`_Factors` (the blocks', and the whole Gram's on demand)."""
     if iterative and kernel.dim:
         return {norm: 0.0 for norm in factors}
     S2 = combine_terms(terms[1:], (1.0,))
@@ -324,7 +324,7 @@ def beta_rows_all(family, k, n1, n2, cases=None, multiplier_meshes=("omega2",), 
 
 
 class _Factors:
-    """The Gram factors of a split space: ``split`` {norm: (L_e, L_o)} of the halves, ``whole``
+    """The Gram factors of a split space: ``split`` {norm: (L_0, L_1, ...)} of the blocks, ``whole``
     {norm: L} of G itself, made on first use (an S that is not invariant is solved unsplit)."""
 
     def __init__(self, grams: dict, halves: dict):
@@ -352,8 +352,8 @@ def space_kernel(couplings, sides, space, k: int, structural: int, l2_gram=None,
     W' from a rule :data:`LONGER_RULE_LARGE` longer, the couplings sparse (W sparse, the same
     entries); its ``vectors`` are returned in multiplier coordinates (a basis of the kernel of Bᵀ).
     ``trace_norms``: the sides' :func:`~.coupling.trace_l2_norms`, if already computed (they
-    depend on the sides only, not on the space). ``split``: the point reflection's
-    (:func:`.reflection.split_bottom_kernel` decides on the even and odd halves where it holds)."""
+    depend on the sides only, not on the space). ``split``: the reflections'
+    (:func:`.reflection.split_bottom_kernel` decides on the components where it holds)."""
     G = sides[0].trace.gamma.gram(space, "L2")[0] if l2_gram is None else l2_gram
     rows = [trace_l2_norms(s.trace, k) for s in sides] if trace_norms is None else trace_norms
     cols = np.sqrt(np.diag(G))

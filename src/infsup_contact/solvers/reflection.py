@@ -1,28 +1,32 @@
-"""The large route's pencils split by the point reflection of the face (issue 28, large N).
+"""The large route's pencils split by the reflections of the face (issue 28, large N).
 
 On a face mesh pair symmetric about the centre of Γ = (0, 1)² (the structured hexahedra, any
 N1, N2), the point reflection R(x, y) = (1 − x, 1 − y) maps the multiplier basis onto itself,
 μ_j ∘ R = μ_π(j) with π an involution (:func:`reflection_split`, found and checked on Gauss
-points of G_h, :func:`~infsup_contact.discretization.basis_symmetry.induced_permutation`), and the interface operator S = Σ_i B_i X_i B_iᵀ and every Gram matrix G commute
-with the permutation: P S Pᵀ = S, P G Pᵀ = G. In the orthonormal basis Q = [Q_e, Q_o] of the
-even and odd functions ((e_j ± e_π(j))/√2 for the pairs j < π(j), e_j for the fixed points in
-Q_e) both are block diagonal, so the pencil S x = λ G x is two pencils of about half the size,
+points of G_h, :func:`~infsup_contact.discretization.basis_symmetry.induced_permutation`), and
+the interface operator S = Σ_i B_i X_i B_iᵀ and every Gram matrix G commute with the
+permutation: P S Pᵀ = S, P G Pᵀ = G. In the orthonormal basis Q = [Q_e, Q_o] of the even and
+odd functions ((e_j ± e_π(j))/√2 for the pairs j < π(j), e_j for the fixed points in Q_e)
+both are block diagonal, so the pencil S x = λ G x is two pencils of about half the size,
 
     spec(S, G) = spec(Q_eᵀ S Q_e, Q_eᵀ G Q_e) ∪ spec(Q_oᵀ S Q_o, Q_oᵀ G Q_o),
 
 and the kernel of Bᵀ (invariant: B_i commute with the reflections of the traces) splits into its
-even and odd parts. Each half costs an eighth of the Cholesky factorizations, triangular solves
-and products of :func:`~.bottom.bottom_pencil` (m³/3 each), and half of each Lanczos product.
-The kernel decision itself runs on the even and odd columns of the scaled coupling W
-(:func:`split_bottom_kernel`), with the unsplit η and a certificate per half.
+even and odd parts. Where the axis reflections x → 1 − x and y → 1 − y map the basis too (the
+hexahedra's tensor faces; not the Kuhn triangles, whose diagonals they reverse), the two
+commuting involutions give four components (:class:`ReflectionSplit`, the characters of
+Z2 × Z2), each a pencil of about a quarter of the size. A component of order m/c costs
+(1/c)³ of the Cholesky factorizations, triangular solves and products of
+:func:`~.bottom.bottom_pencil` (m³/3 each), and (1/c)² of each Lanczos product. The kernel
+decision itself runs on the components' columns of the scaled coupling W
+(:func:`split_bottom_kernel`), with the unsplit η and a certificate per component.
 
 The computed S and G are invariant only to round-off (the sides' sparse factorizations order
-their dofs differently): the split is taken only where the dropped block Q_oᵀ M Q_e is at most
+their dofs differently): the split is taken only where the dropped blocks Q_aᵀ M Q_b are at most
 :data:`INVARIANCE_RTOL` of M (Frobenius) for S and every G (:meth:`ReflectionSplit.blocks`), and
-dropping it then moves each eigenvalue by at most its norm (Weyl), at the pencil's own
-round-off level. A face that is
-not symmetric (perturbed meshes, the tetrahedra's 3D Kuhn cubes, whose diagonals R reverses)
-keeps the unsplit route.
+dropping them then moves each eigenvalue by at most their norm (Weyl), at the pencil's own
+round-off level. A face that is not symmetric (perturbed meshes, the tetrahedra's 3D Kuhn
+cubes, whose diagonals R reverses) keeps the unsplit route.
 """
 from __future__ import annotations
 
@@ -39,90 +43,128 @@ from . import bottom
 from .kernel import BLOCK_EXTRA, KernelDecision, certified_bottom, certify_floor, decide, error_level
 
 INVARIANCE_RTOL = 1e-11
-"""Largest ‖Q_oᵀ M Q_e‖_F / ‖M‖_F (the block the split drops) for which S and G count as
-reflection invariant."""
+"""Largest (Σ_{a<b} ‖Q_aᵀ M Q_b‖_F²)^{1/2} / ‖M‖_F (the blocks the split drops) for which S
+and G count as reflection invariant."""
 SPLIT_GAP = 1e-6
-"""A kernel vector's even (or odd) part must have norm > 1 − SPLIT_GAP or < SPLIT_GAP (the
-cosines of the principal angles between the kernel and the even functions): else no split."""
+"""A kernel vector's part in a component must have norm > 1 − SPLIT_GAP or < SPLIT_GAP (the
+cosines of the principal angles between the kernel and the component): else no split."""
 
 
 @dataclass(frozen=True)
 class ReflectionSplit:
-    """The even/odd coordinates of an involution π of the multiplier basis."""
+    """The isotypic coordinates of commuting involutions π_1, ..., π_g of the multiplier basis.
 
-    pi: np.ndarray
+    They generate a group of 2^g permutations P_b (b a bit mask), whose characters
+    χ_c(b) = (−1)^{popcount(b & c)} label 2^g components. Component c has the orthonormal basis
+    Q_c of the orbit sums Σ_b χ_c(b) e_{P_b(j)} / √|orbit| over the orbits whose stabilizer χ_c
+    leaves fixed (the others sum to 0); a matrix commuting with every P_b is block diagonal in
+    Q = [Q_0, ..., Q_{2^g − 1}]. For g = 1 these are Q_e = (e_j + e_π(j))/√2 with the fixed
+    points e_j, and Q_o = (e_j − e_π(j))/√2 (the point reflection's even and odd functions)."""
+
+    pis: tuple
 
     @cached_property
-    def rep(self) -> np.ndarray:
-        g = np.arange(self.pi.size)
-        return g[g < self.pi]
+    def _elements(self) -> list:
+        """P_b for b = 0 .. 2^g − 1 (P_b = Π_{i ∈ b} π_i, the π commute)."""
+        m = self.pis[0].size
+        out = [np.arange(m)]
+        for pi in self.pis:
+            out += [pi[e] for e in out]
+        return out
 
     @cached_property
-    def fixed(self) -> np.ndarray:
-        g = np.arange(self.pi.size)
-        return g[g == self.pi]
+    def bases(self) -> tuple:
+        """(Q_0, ..., Q_{2^g − 1}), sparse with orthonormal columns; columns ordered by orbit
+        size (largest first), then by the orbit's smallest index."""
+        P = np.array(self._elements)                          # (2^g, m)
+        m, order = P.shape[1], P.shape[0]
+        reps = np.flatnonzero(P.min(axis=0) == np.arange(m))
+        orbits = P[:, reps]                                   # (2^g, orbits): the images of each rep
+        size = 1 + np.count_nonzero(np.diff(np.sort(orbits, axis=0), axis=0), axis=0)
+        by_size = np.lexsort((reps, -size))
+        orbits, size = orbits[:, by_size], size[by_size]
+        out = []
+        for c in range(order):
+            chi = (-1.0) ** np.array([bin(b & c).count("1") for b in range(order)])
+            Q = sp.csc_matrix((np.repeat(chi, orbits.shape[1]), (orbits.ravel(), np.tile(np.arange(orbits.shape[1]), order))),
+                              shape=(m, orbits.shape[1]))
+            Q.sum_duplicates()
+            Q.eliminate_zeros()
+            live = np.flatnonzero(np.diff(Q.indptr))
+            Q = Q[:, live]
+            Q.data = np.sign(Q.data) * np.sqrt(1.0 / np.repeat(size[live], np.diff(Q.indptr)))
+            out.append(Q.tocsr())
+        return tuple(out)
 
     @property
-    def sizes(self) -> tuple[int, int]:
-        return self.rep.size + self.fixed.size, self.rep.size
+    def sizes(self) -> tuple:
+        return tuple(Q.shape[1] for Q in self.bases)
 
-    @cached_property
-    def bases(self) -> tuple[sp.csr_matrix, sp.csr_matrix]:
-        """(Q_e, Q_o), sparse with orthonormal columns."""
-        r, p, f, m = self.rep, self.pi[self.rep], self.fixed, self.pi.size
-        h, k, ke = np.full(self.rep.size, np.sqrt(0.5)), np.arange(self.rep.size), self.sizes[0]
-        Qe = sp.csr_matrix((np.concatenate([h, h, np.ones(f.size)]),
-                            (np.concatenate([r, p, f]), np.concatenate([k, k, r.size + np.arange(f.size)]))), shape=(m, ke))
-        Qo = sp.csr_matrix((np.concatenate([h, -h]), (np.concatenate([r, p]), np.concatenate([k, k]))),
-                           shape=(m, self.rep.size))
-        return Qe, Qo
+    def blocks(self, M: np.ndarray) -> tuple:
+        """(Q_0ᵀ M Q_0, ..., Q_lastᵀ M Q_last, distance) of a symmetric M, the diagonal blocks
+        symmetrised; ``distance`` = (Σ_{a<b} ‖Q_aᵀ M Q_b‖_F²)^{1/2} / ‖M‖_F (the blocks the split
+        drops; 0 for M commuting with every P_b).
 
-    def blocks(self, M: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
-        """(Q_eᵀ M Q_e, Q_oᵀ M Q_o, ‖Q_oᵀ M Q_e‖_F / ‖M‖_F) of a symmetric M, the diagonal blocks
-        symmetrised; the last is its distance from reflection invariance (0 for P M Pᵀ = M).
-
-        Row combinations Q_σᵀ M (sparse × dense: whole rows, threaded), then (Q_σᵀ M) Q_τ by
+        Row combinations Q_aᵀ M (sparse × dense: whole rows, threaded), then (Q_aᵀ M) Q_b by
         :func:`~infsup_contact.la.threaded.times_transpose` (small transposed blocks): fancy
         column gathers M[:, j] of a C-ordered 4,225² matrix took 0.12 s each."""
-        QeT, QoT = (Q.T.tocsr() for Q in self.bases)
+        QT = [Q.T.tocsr() for Q in self.bases]
         M = np.ascontiguousarray(M, dtype=float)
-        Te, To = sparse_times_dense(QeT, M), sparse_times_dense(QoT, M)
-        Me, Mo = times_transpose(QeT, Te), times_transpose(QoT, To)
-        off = times_transpose(QeT, To) if To.shape[0] else np.zeros(0)
+        T = [sparse_times_dense(Q, M) for Q in QT]
+        diag = [symmetric_part(times_transpose(Q, t)) for Q, t in zip(QT, T)]
+        off = sum(float(np.linalg.norm(times_transpose(QT[a], T[b]))) ** 2
+                  for b in range(len(QT)) for a in range(b) if T[a].shape[0] and T[b].shape[0])
         scale = float(np.linalg.norm(M))
-        distance = float(np.linalg.norm(off)) / scale if scale > 0 else 0.0
-        return symmetric_part(Me), symmetric_part(Mo), distance
+        return (*diag, float(np.sqrt(off)) / scale if scale > 0 else 0.0)
 
-    def even_odd(self, Z: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
-        """Bases of the even and odd parts of span Z in the coordinates of Q_e and Q_o, or None
-        when span Z is not the sum of its parts (a cosine not within :data:`SPLIT_GAP` of 0 or 1)."""
+    def components(self, Z: np.ndarray) -> tuple | None:
+        """Bases of the components of span Z in the coordinates of each Q_c, or None when span Z
+        is not the sum of its components (a cosine not within :data:`SPLIT_GAP` of 0 or 1)."""
         V = sla.qr(Z, mode="economic")[0]
-        r, p, h = self.rep, self.pi[self.rep], np.sqrt(0.5)
-        parts = [np.vstack([(V[r] + V[p]) * h, V[self.fixed]]), (V[r] - V[p]) * h]
         out = []
-        for P in parts:
-            if P.shape[0] == 0:
+        for Q in self.bases:
+            if Q.shape[1] == 0:
                 out.append(np.zeros((0, 0)))
                 continue
-            U, s, _ = sla.svd(P, full_matrices=False)
+            U, s, _ = sla.svd(np.asarray(Q.T @ V), full_matrices=False)
             if np.any((s > SPLIT_GAP) & (s < 1.0 - SPLIT_GAP)):
                 return None
             out.append(U[:, s >= 1.0 - SPLIT_GAP])
-        if out[0].shape[1] + out[1].shape[1] != Z.shape[1]:
+        if sum(P.shape[1] for P in out) != Z.shape[1]:
             return None
-        return out[0], out[1]
+        return tuple(out)
+
+
+def _reflect(axis: int | None):
+    """x → 1 − x in coordinate ``axis`` of points (n, d), or in every coordinate (None)."""
+    def transform(x):
+        y = 1.0 - x if axis is None else x.copy()
+        if axis is not None:
+            y[:, axis] = 1.0 - x[:, axis]
+        return y
+    return transform
 
 
 def reflection_split(space, points: np.ndarray) -> ReflectionSplit | None:
-    """The split of ``space`` by the point reflection (x, y) → (1 − x, 1 − y), checked at
-    ``points`` (e.g. the Gauss points of G_h), or None where it does not map the basis onto itself."""
-    pi = induced_permutation(space, np.asarray(points, float), lambda x: 1.0 - x)
-    return None if pi is None else ReflectionSplit(pi)
+    """The split of ``space`` by the reflections of Γ that map its basis onto itself, checked
+    at ``points`` (e.g. the Gauss points of G_h; (n,) on the segment, (n, 2) on the face), or None.
+
+    On the face the reflections x → 1 − x and y → 1 − y together (four components: a tensor
+    mesh pair symmetric in each direction, the structured hexahedra) where both map the basis,
+    else the point reflection (x, y) → (1 − x, 1 − y) alone (two: e.g. the Kuhn triangles,
+    whose diagonals the axis reflections reverse); on the segment x → 1 − x."""
+    x = np.asarray(points, float)
+    found = []
+    if x.ndim == 2 and x.shape[1] == 2:
+        found = [induced_permutation(space, x, _reflect(axis)) for axis in (0, 1)]
+    if not found or any(pi is None for pi in found):
+        found = [induced_permutation(space, x, _reflect(None))]
+    return None if found[0] is None else ReflectionSplit(tuple(found))
 
 
 def split_of(space, gamma, g_h, k: int) -> ReflectionSplit | None:
-    """The point reflection's split of ``space`` (:func:`reflection_split`, checked at
-    the Gauss points of G_h), or None (no such symmetry, or a Γ without a quadrature)."""
+    """The reflections' split of ``space`` (:func:`reflection_split`, checked at the Gauss
+    points of G_h), or None (no such symmetry, a Γ without a quadrature, or an empty component)."""
     quadrature = getattr(gamma, "quadrature", None)
     if quadrature is None:
         return None
@@ -131,7 +173,7 @@ def split_of(space, gamma, g_h, k: int) -> ReflectionSplit | None:
 
 
 def usable(split: ReflectionSplit | None, grams: dict, kernel: KernelDecision):
-    """(split, kernel parts, {norm: halves of G}) where every Gram matrix is invariant under
+    """(split, kernel parts, {norm: blocks of G}) where every Gram matrix is invariant under
     ``split`` and the kernel splits, else (None, None, None). Each interface operator S is checked where it
     is split (:func:`split_pencils`; :func:`~.infsup.split_spectra` solves it unsplit where it is not)."""
     if split is None:
@@ -141,23 +183,23 @@ def usable(split: ReflectionSplit | None, grams: dict, kernel: KernelDecision):
         *halves[norm], distance = split.blocks(G)
         if distance > INVARIANCE_RTOL:
             return None, None, None
-    parts = split.even_odd(kernel.vectors) if kernel.dim else None
+    parts = split.components(kernel.vectors) if kernel.dim else None
     if kernel.dim and parts is None:
         return None, None, None
     return split, parts, halves
 
 
 def split_pencils(split: ReflectionSplit, S: np.ndarray, factors: dict, kernel_parts, n_values: int) -> dict | None:
-    """{norm: (values above the kernel, λ_max)} of S x = λ G x from the two halves, or None where
-    S is not reflection invariant to :data:`INVARIANCE_RTOL` (the caller solves it unsplit).
+    """{norm: (values above the kernel, λ_max)} of S x = λ G x from the components' pencils, or
+    None where S is not reflection invariant to :data:`INVARIANCE_RTOL` (the caller solves it unsplit).
 
-    ``factors``: {norm: (L_e, L_o)} the Cholesky factors of the halves of G; ``kernel_parts``:
-    (Z_e, Z_o) from :meth:`ReflectionSplit.even_odd` (None: no kernel deflated; a half whose S
-    is definite then shares its factor between the norms, as :func:`~.infsup.bottom_spectra`)."""
+    ``factors``: {norm: (L_0, L_1, ...)} the Cholesky factors of the blocks of G; ``kernel_parts``:
+    (Z_0, Z_1, ...) from :meth:`ReflectionSplit.components` (None: no kernel deflated; a block whose
+    S is definite then shares its factor between the norms, as :func:`~.infsup.bottom_spectra`)."""
     *halves, distance = split.blocks(S)
     if distance > INVARIANCE_RTOL:
         return None
-    parts = [None if kernel_parts is None or not Z.shape[1] else Z for Z in (kernel_parts or (None, None))]
+    parts = [None if kernel_parts is None or not Z.shape[1] else Z for Z in (kernel_parts or [None] * len(halves))]
     shared = [bottom.definite_factor(h) if Z is None and h.shape[0] >= 3 else None for h, Z in zip(halves, parts)]
     out = {}
     for norm, Ls in factors.items():
@@ -180,31 +222,34 @@ def split_pencils(split: ReflectionSplit, S: np.ndarray, factors: dict, kernel_p
 
 
 def split_bottom_kernel(W, split: ReflectionSplit, proven: int = 0, entry_error: float = 0.0) -> KernelDecision | None:
-    """:func:`~.kernel.bottom_kernel` of W (trace dofs × multipliers, sparse) on the even and
-    odd columns W Q_e, W Q_o, or None where the split does not hold.
+    """:func:`~.kernel.bottom_kernel` of W (trace dofs × multipliers, sparse) on the columns
+    W Q_c of each component, or None where the split does not hold.
 
-    With the traces' reflections W is equivariant, so WᵀW is block diagonal in Q = [Q_e, Q_o]
-    and its eigenvalues are those of the blocks; the off-diagonal block C = Q_eᵀ WᵀW Q_o of the
-    computed W is round-off, and moves each eigenvalue by at most ‖C‖₂ <= ‖C‖_F (Weyl). Each
-    block goes through the same steps as the unsplit route (block inverse iteration, counted
-    values ‖W v‖ of orthonormal v, hence upper bounds of singular values of W; the Cholesky
-    certificate at τ_b = σ_{d_b+1}²/2 per block: the block-diagonal WᵀW has at most d = d_e + d_o
-    eigenvalues below min τ_b, so the computed one at most d below min τ_b − ‖C‖_F >= min τ_b / 2),
-    with the unsplit η = max(rows, m) ε σ_max + 2 ‖δW‖_F. None (the caller takes the unsplit
-    route) wherever a step would fall back, or ‖C‖_F > τ_b / 2."""
+    With the traces' reflections W is equivariant, so WᵀW is block diagonal in Q = [Q_0, Q_1, ...]
+    and its eigenvalues are those of the blocks; the off-diagonal part O of the computed WᵀW
+    in Q is round-off, and moves each eigenvalue by at most ‖O‖₂ (Weyl; <= ‖C‖_F for the one
+    block C of two components, <= ‖O‖_F beyond). Each block goes through the same steps as the
+    unsplit route (block inverse iteration, counted values ‖W v‖ of orthonormal v, hence upper
+    bounds of singular values of W; the Cholesky certificate at τ_b = σ_{d_b+1}²/2 per block:
+    the block-diagonal WᵀW has at most d = Σ d_b eigenvalues below min τ_b, so the computed
+    one at most d below min τ_b − ‖O‖₂ >= min τ_b / 2), with the unsplit
+    η = max(rows, m) ε σ_max + 2 ‖δW‖_F. None (the caller takes the unsplit route) wherever a
+    step would fall back, or the bound on ‖O‖₂ > τ_b / 2."""
     W = sp.csr_matrix(W)
     rows, m = W.shape
     proven = int(max(proven, m - rows, 0))
-    Qe, Qo = split.bases
-    blocks = [sp.csr_matrix(W @ Q) for Q in (Qe, Qo)]
+    bases = split.bases
+    blocks = [sp.csr_matrix(W @ Q) for Q in bases]
     grams = [sp.csr_matrix(B.T @ B) for B in blocks]
-    cross = float(sp.linalg.norm(blocks[0].T @ blocks[1]))
+    off = [float(sp.linalg.norm(blocks[a].T @ blocks[b])) for b in range(len(blocks)) for a in range(b)]
+    # ‖O‖₂ of the off-diagonal part O of WᵀW in Q: ‖C‖₂ <= ‖C‖_F for two blocks, ‖O‖_F beyond
+    cross = off[0] if len(off) == 1 else float(np.sqrt(2.0 * np.sum(np.square(off))))
     smaxes = [bottom.largest_singular(B, g) if B.shape[1] else 0.0 for B, g in zip(blocks, grams)]
     smax = max(smaxes)
     tol = error_level(rows, m, smax, entry_error)
-    floor = max(certify_floor(rows, m, smax), 2.0 * cross)  # the whole W's certificate at τ − ‖C‖
+    floor = max(certify_floor(rows, m, smax), 2.0 * cross)  # the whole W's certificate at τ − ‖O‖
     counted, vectors, above = [], [], np.inf
-    for B, g, s_b, Q in zip(blocks, grams, smaxes, (Qe, Qo)):
+    for B, g, s_b, Q in zip(blocks, grams, smaxes, bases):
         mb = B.shape[1]
         if mb < 2:
             return None

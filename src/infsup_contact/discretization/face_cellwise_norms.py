@@ -37,7 +37,9 @@ import scipy.sparse as sp
 from ..errors import InputError
 from ..la.threaded import symmetric_part, symmetric_sandwich
 from .coupling import weighted_values
-from .face_norms import extrapolated, partial_gram, start_level
+from . import face_parity
+from .basis_symmetry import axis_reflections, isotypic_bases
+from .face_norms import EXP_SUM_MIN_DIM, extrapolated, partial_gram, partial_gram_blocks, start_level
 from .face_spaces import FaceSpace
 from .multipliers import make_space
 from .norms import N_MAX_CAP, gram_by_norm, gram_l2
@@ -66,19 +68,23 @@ def shared_piece_sums():
         _shared = outer
 
 
-def piece_partial_gram(P: FaceSpace, n: int) -> np.ndarray:
-    """S_P(n) of :func:`~.face_norms.partial_gram`, from the shared sums when a
+def piece_partial_gram(P: FaceSpace, n: int, parities=None):
+    """S_P(n) of :func:`~.face_norms.partial_gram` (with ``parities``: its four parity blocks,
+    :func:`~.face_norms.partial_gram_blocks`), from the shared sums when a
     :func:`shared_piece_sums` block is open."""
+    def compute():
+        return partial_gram(P, n) if parities is None else partial_gram_blocks(P, n, parities)
+
     if _shared is None:
-        return partial_gram(P, n)
+        return compute()
     key = (np.asarray(P.breakpoints.xs, float).tobytes(), np.asarray(P.breakpoints.ys, float).tobytes(),
-           P.degree, P.dim)
+           P.degree, P.dim, parities is None)
     if _shared.get("key") != key:
         _shared.clear()
         _shared.update(key=key, sums={})
     sums = _shared["sums"]
     if n not in sums:
-        sums[n] = partial_gram(P, n)
+        sums[n] = compute()
     return sums[n]
 
 
@@ -173,10 +179,34 @@ def gram_h_cellwise(space, rtol: float = 1e-6, n_start: int | None = None, n_cap
     n0 = (start_level(max(16, 2 * (space.piece_degree + 1) * n_int), p, P.dim) if n_start is None
           else int(n_start))
 
+    blocked = _parity_route(space, R, P)
+    if blocked is not None:  # the four parity blocks of the axis reflections (:mod:`.face_parity`)
+        parities, Rs, bases = blocked
+        G, info = extrapolated(lambda n: face_parity.sandwiched(Rs, piece_partial_gram(P, n, parities)),
+                               p, n0, n_cap, rtol, ops=face_parity.BlockOps)
+        return face_parity.assemble(bases, G), info
+
     def partial(n):  # S_P is exactly symmetric; the sandwich only to round-off
         return symmetric_part(symmetric_sandwich(R, piece_partial_gram(P, n)))
 
     return extrapolated(partial, p, n0, n_cap, rtol)
+
+
+def _parity_route(space, R, P):
+    """(P's 1D parities, [R̃_c], the multiplier basis's components Q_c) where the series is summed
+    on the exponential-sum route (dim P above :data:`~.face_norms.EXP_SUM_MIN_DIM`) and both
+    bases are symmetric under both axis reflections with R intertwining them, else None."""
+    if P.dim <= EXP_SUM_MIN_DIM:
+        return None
+    parities = face_parity.tensor_parities(P)
+    if parities is None:
+        return None
+    pis = axis_reflections(space, piece_rule(P.breakpoints, space.piece_degree + 1)[0])
+    if pis is None:
+        return None
+    bases = isotypic_bases(pis)
+    Rs = face_parity.intertwined(R, bases, face_parity.tensor_bases(parities))
+    return None if Rs is None or min(Q.shape[1] for Q in bases) < 1 else (parities, Rs, bases)
 
 
 def gram_cellwise(space, norm: str, **kwargs) -> tuple[np.ndarray, dict]:

@@ -23,6 +23,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..la.threaded import symmetric_pairs
+from . import face_parity
 from .exponential_sum import inverse_sqrt
 from .norms import N_MAX_CAP, _norm2, extrapolate, gram_by_norm, gram_l2, sine_coefficients
 
@@ -72,7 +73,7 @@ def partial_gram(space, n_max: int, aspect: float = 1.0) -> np.ndarray:
     A = (cx[:, None, :] * cx[None, :, :]).reshape(dx * dx, n_max)
     B = (cy[:, None, :] * cy[None, :, :]).reshape(dy * dy, n_max)
     if dx * dy > EXP_SUM_MIN_DIM:
-        flat = _separable_sum(A, B, n, aspect)
+        flat = _separable_sum(A, B, n, n, aspect)
     else:
         flat = np.zeros((dx * dx, dy * dy))
         for start in range(0, n_max, _CHUNK):
@@ -82,8 +83,8 @@ def partial_gram(space, n_max: int, aspect: float = 1.0) -> np.ndarray:
     return symmetric_pairs(flat, dx, dy)
 
 
-def _separable_sum(A: np.ndarray, B: np.ndarray, n: np.ndarray, aspect: float) -> np.ndarray:
-    """A W Bᵀ for W[m, n] = a / (π√((m/a)² + n²)) written as Σ_j w_j e^{−a_j (m/a)²} e^{−a_j n²}
+def _separable_sum(A: np.ndarray, B: np.ndarray, m: np.ndarray, n: np.ndarray, aspect: float) -> np.ndarray:
+    """A W Bᵀ for W[m, n] = a / (π√((m/a)² + n²)) (A's columns at the indices ``m``, B's at ``n``) written as Σ_j w_j e^{−a_j (m/a)²} e^{−a_j n²}
     (:func:`.exponential_sum.inverse_sqrt`, relative accuracy :data:`EXP_SUM_RTOL`):
     (A E_x) diag(a w / π) (B E_y)ᵀ, never forming W (B E_y is A E_x itself when the two
     directions are the same: one product of dim² · n_max · r fewer).
@@ -93,7 +94,7 @@ def _separable_sum(A: np.ndarray, B: np.ndarray, n: np.ndarray, aspect: float) -
     Taylor polynomial of degree :data:`TAYLOR_DEGREE` per variable to round-off, so those terms
     together are T_x C T_yᵀ with T[m, q] = t_m^q and one (p + 1)² matrix
     C = Σ_j w_j v_j v_jᵀ, v_j[q] = (−b_j)^q / q!: about 200 of the ~270 columns become 18."""
-    x_lo, x_hi = (1.0 / aspect) ** 2 + 1.0, (n[-1] / aspect) ** 2 + n[-1] ** 2
+    x_lo, x_hi = (m[0] / aspect) ** 2 + n[0] ** 2, (m[-1] / aspect) ** 2 + n[-1] ** 2
     x_max = max(x_lo, x_hi)
     expo = inverse_sqrt(min(x_lo, x_hi), x_max, EXP_SUM_RTOL)
     weights = aspect * expo.weights / np.pi
@@ -106,8 +107,8 @@ def _separable_sum(A: np.ndarray, B: np.ndarray, n: np.ndarray, aspect: float) -
         return np.hstack([M @ np.exp(-np.multiply.outer(squares, expo.rates[~taylor])),
                           M @ (squares / x_max)[:, None] ** q])
 
-    left = columns(A, (n / aspect) ** 2)
-    same = aspect == 1.0 and (B is A or np.array_equal(A, B))
+    left = columns(A, (m / aspect) ** 2)
+    same = aspect == 1.0 and np.array_equal(m, n) and (B is A or np.array_equal(A, B))
     right = left if same else columns(B, n ** 2)
     k = int(np.count_nonzero(~taylor))
     scaled = np.hstack([left[:, :k] * weights[~taylor], left[:, k:] @ C])
@@ -174,14 +175,26 @@ def gram_h_face(space, rtol: float = 1e-6, n_start: int | None = None, n_cap: in
           else int(n_start))
     if not aspect > 0:
         raise InputError("aspect", "a positive float", got=aspect)
-    return extrapolated(lambda n: partial_gram(space, n, aspect), p, n0, n_cap, rtol)
+    parities = face_parity.tensor_parities(space) if aspect == 1.0 and space.dim > EXP_SUM_MIN_DIM else None
+    if parities is None:
+        return extrapolated(lambda n: partial_gram(space, n, aspect), p, n0, n_cap, rtol)
+    blocks, info = extrapolated(lambda n: partial_gram_blocks(space, n, parities), p, n0, n_cap, rtol,
+                                ops=face_parity.BlockOps)
+    return face_parity.assemble(face_parity.tensor_bases(parities), blocks), info
 
 
-def extrapolated(partial, p: float, n0: int, n_cap: int, rtol: float) -> tuple[np.ndarray, dict]:
+def partial_gram_blocks(space, n_max: int, parities) -> list:
+    """:func:`partial_gram` (exponential-sum route) in the four parity blocks of the axis
+    reflections (:func:`.face_parity.partial_gram_blocks`)."""
+    return face_parity.partial_gram_blocks(space, n_max, parities,
+                                           lambda A, B, m, n: _separable_sum(A, B, m, n, 1.0))
+
+
+def extrapolated(partial, p: float, n0: int, n_cap: int, rtol: float, ops=None) -> tuple[np.ndarray, dict]:
     """The segment's Richardson loop (:func:`~.norms.extrapolate`) on a face series, the tail
     exponent p recorded in ``info`` (also the route of the non-tensor and triangle spaces,
-    :mod:`.face_cellwise_norms`, :mod:`.face_triangle_norms`)."""
-    G, info = extrapolate(partial, p, n0, n_cap, rtol)
+    :mod:`.face_cellwise_norms`, :mod:`.face_triangle_norms`; ``ops``: that of parity blocks)."""
+    G, info = extrapolate(partial, p, n0, n_cap, rtol, ops)
     return G, dict(info, tail_exponent=p)
 
 

@@ -244,15 +244,19 @@ def gram_h(space: MultiplierSpace, rtol: float = 1e-6, n_start: int | None = Non
     return extrapolate(partial, 2.0, n0, n_cap, rtol)
 
 
-def extrapolate(partial, p: float, n0: int, n_cap: int, rtol: float) -> tuple[np.ndarray, dict]:
+def extrapolate(partial, p: float, n0: int, n_cap: int, rtol: float, ops=None) -> tuple[np.ndarray, dict]:
     """Richardson extrapolation of a series of Gram matrices with a tail ~ C n^{−p}: the partial
     sums S(n) = ``partial(n)`` at n = n0, 2n0, 4n0, ... (asked in increasing n), extrapolated
     R(n) = S(2n) + (S(2n) − S(n)) / (2^p − 1), until ‖R(2n) − R(n)‖₂ / ‖R(2n)‖₂ ≤ rtol or 2n
     would pass ``n_cap`` (:func:`gram_h`; the face's double series, :mod:`.face_norms`).
 
+    ``ops``: the step, difference and spectral norm for another representation of the partial
+    sums (an object with ``step(hi, lo, divisor)``, ``diff(a, b)``, ``norm2(a)``; the face's
+    parity blocks, :class:`~.face_parity.BlockOps`), default :class:`DenseOps`.
+
     Returns
     -------
-    R : ndarray
+    R : ndarray (or what ``partial`` returns)
     info : dict
         ``n_max``, ``nmax_rel_error`` (before two extrapolations exist, the size of the
         extrapolation step), ``capped`` (the estimate still above rtol at the cap), ``n_start``.
@@ -268,25 +272,39 @@ def extrapolate(partial, p: float, n0: int, n_cap: int, rtol: float) -> tuple[np
     divisor = 2.0 ** p - 1.0
     s_lo, n_hi = partial(n0), min(2 * n0, n_cap)
     s_hi = partial(n_hi)
-
-    def step(hi, lo):  # R(n) = S(2n) + (S(2n) − S(n)) / (2^p − 1), threaded (bit for bit)
-        return elementwise(lambda a, b: a + (a - b) / divisor, hi, lo)
-
-    r_prev = step(s_hi, s_lo)
-    err = _norm2(elementwise(np.subtract, r_prev, s_hi)) / _norm2(r_prev)
+    ops = DenseOps if ops is None else ops
+    r_prev = ops.step(s_hi, s_lo, divisor)  # R(n) = S(2n) + (S(2n) − S(n)) / (2^p − 1)
+    err = ops.norm2(ops.diff(r_prev, s_hi)) / ops.norm2(r_prev)
     capped = False
     while True:
         if 2 * n_hi > n_cap:
             capped = err > rtol
             break
         s_lo, s_hi, n_hi = s_hi, partial(2 * n_hi), 2 * n_hi
-        r = step(s_hi, s_lo)
-        err = _norm2(elementwise(np.subtract, r, r_prev)) / _norm2(r)
+        r = ops.step(s_hi, s_lo, divisor)
+        err = ops.norm2(ops.diff(r, r_prev)) / ops.norm2(r)
         r_prev = r
         if err <= rtol:
             break
     return r_prev, {"n_max": int(n_hi), "nmax_rel_error": float(err), "capped": bool(capped),
                     "n_start": int(n0)}
+
+
+class DenseOps:
+    """:func:`extrapolate`'s operations on dense matrices: threaded element-wise passes (bit for
+    bit numpy's, :func:`~infsup_contact.la.threaded.elementwise`) and :func:`_norm2`."""
+
+    @staticmethod
+    def step(hi, lo, divisor):
+        return elementwise(lambda a, b: a + (a - b) / divisor, hi, lo)
+
+    @staticmethod
+    def diff(a, b):
+        return elementwise(np.subtract, a, b)
+
+    @staticmethod
+    def norm2(a):
+        return _norm2(a)
 
 
 def _partial_gram(space: MultiplierSpace, n_first: int, n_last: int, switch: float) -> np.ndarray:

@@ -37,7 +37,7 @@ import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
 
-from ..discretization.basis_symmetry import induced_permutation
+from ..discretization.basis_symmetry import axis_reflections, induced_permutation, isotypic_bases, reflect
 from ..la.threaded import sparse_times_dense, symmetric_part, times_transpose
 from . import bottom
 from .kernel import BLOCK_EXTRA, KernelDecision, certified_bottom, certify_floor, decide, error_level
@@ -64,37 +64,10 @@ class ReflectionSplit:
     pis: tuple
 
     @cached_property
-    def _elements(self) -> list:
-        """P_b for b = 0 .. 2^g − 1 (P_b = Π_{i ∈ b} π_i, the π commute)."""
-        m = self.pis[0].size
-        out = [np.arange(m)]
-        for pi in self.pis:
-            out += [pi[e] for e in out]
-        return out
-
-    @cached_property
     def bases(self) -> tuple:
-        """(Q_0, ..., Q_{2^g − 1}), sparse with orthonormal columns; columns ordered by orbit
-        size (largest first), then by the orbit's smallest index."""
-        P = np.array(self._elements)                          # (2^g, m)
-        m, order = P.shape[1], P.shape[0]
-        reps = np.flatnonzero(P.min(axis=0) == np.arange(m))
-        orbits = P[:, reps]                                   # (2^g, orbits): the images of each rep
-        size = 1 + np.count_nonzero(np.diff(np.sort(orbits, axis=0), axis=0), axis=0)
-        by_size = np.lexsort((reps, -size))
-        orbits, size = orbits[:, by_size], size[by_size]
-        out = []
-        for c in range(order):
-            chi = (-1.0) ** np.array([bin(b & c).count("1") for b in range(order)])
-            Q = sp.csc_matrix((np.repeat(chi, orbits.shape[1]), (orbits.ravel(), np.tile(np.arange(orbits.shape[1]), order))),
-                              shape=(m, orbits.shape[1]))
-            Q.sum_duplicates()
-            Q.eliminate_zeros()
-            live = np.flatnonzero(np.diff(Q.indptr))
-            Q = Q[:, live]
-            Q.data = np.sign(Q.data) * np.sqrt(1.0 / np.repeat(size[live], np.diff(Q.indptr)))
-            out.append(Q.tocsr())
-        return tuple(out)
+        """(Q_0, ..., Q_{2^g − 1}), sparse with orthonormal columns
+        (:func:`~infsup_contact.discretization.basis_symmetry.isotypic_bases`)."""
+        return isotypic_bases(self.pis)
 
     @property
     def sizes(self) -> tuple:
@@ -135,16 +108,6 @@ class ReflectionSplit:
         return tuple(out)
 
 
-def _reflect(axis: int | None):
-    """x → 1 − x in coordinate ``axis`` of points (n, d), or in every coordinate (None)."""
-    def transform(x):
-        y = 1.0 - x if axis is None else x.copy()
-        if axis is not None:
-            y[:, axis] = 1.0 - x[:, axis]
-        return y
-    return transform
-
-
 def reflection_split(space, points: np.ndarray) -> ReflectionSplit | None:
     """The split of ``space`` by the reflections of Γ that map its basis onto itself, checked
     at ``points`` (e.g. the Gauss points of G_h; (n,) on the segment, (n, 2) on the face), or None.
@@ -154,12 +117,11 @@ def reflection_split(space, points: np.ndarray) -> ReflectionSplit | None:
     else the point reflection (x, y) → (1 − x, 1 − y) alone (two: e.g. the Kuhn triangles,
     whose diagonals the axis reflections reverse); on the segment x → 1 − x."""
     x = np.asarray(points, float)
-    found = []
-    if x.ndim == 2 and x.shape[1] == 2:
-        found = [induced_permutation(space, x, _reflect(axis)) for axis in (0, 1)]
-    if not found or any(pi is None for pi in found):
-        found = [induced_permutation(space, x, _reflect(None))]
-    return None if found[0] is None else ReflectionSplit(tuple(found))
+    pis = axis_reflections(space, x) if x.ndim == 2 and x.shape[1] == 2 else None
+    if pis is None:
+        pi = induced_permutation(space, x, reflect())
+        pis = None if pi is None else (pi,)
+    return None if pis is None else ReflectionSplit(pis)
 
 
 def split_of(space, gamma, g_h, k: int) -> ReflectionSplit | None:

@@ -1,0 +1,136 @@
+"""The face's H Gram series in the four parity blocks of the axis reflections (issue 28, large N).
+
+Where both 1D factors of a tensor space M^x ⊗ M^y (:mod:`.face_spaces`; the piece space P of a
+cellwise one, :mod:`.face_cellwise_norms`) are symmetric under x → 1 − x, i.e. the reflection
+maps the basis onto itself (:func:`axis_parity`, found and checked as the face's reflections,
+:func:`~.basis_symmetry.induced_permutation`), their bases split into even and odd functions,
+Q^x_e and Q^x_o (:func:`~.basis_symmetry.isotypic_bases`). Because
+sin(mπ(1 − x)) = (−1)^{m+1} sin(mπx), an even function has sine coefficients at odd m only, an
+odd one at even m only. So the double series
+
+    S(n) = Σ_{m, n' ≤ n} c_{m n'} c_{m n'}ᵀ / (π √(m² + n'²)),    c_{m n'} = c^x_m ⊗ c^y_{n'},
+
+is block diagonal in the four bases T_c = Q^x_{p} ⊗ Q^y_{q} (c = p + 2q, bit set = odd), and
+block c is the same separable sum over the odd or even m and n' alone, of the coefficients
+(Q^x_p)ᵀ c^x and (Q^y_q)ᵀ c^y (:func:`partial_gram_blocks`). Each block has about a quarter of
+the dimension: the separable product (dim² r per block), its reordering, the Richardson steps and
+the spectral norms that stop them cost about a quarter of the whole matrix's, and a cellwise
+space's sandwich R S_P Rᵀ becomes R̃_c S_P,c R̃_cᵀ with R̃_c = Q_cᵀ R T_c (Q_c the multiplier
+basis's own components under the same two reflections: R intertwines them, so the blocks
+between different components vanish; checked, :func:`intertwined`). The Gram matrix is
+assembled once at the end, G = Σ_c Q_c G_c Q_cᵀ (:func:`assemble`). The coefficients the split
+drops (an even function's at even m) are zero mathematically, round-off numerically: G agrees
+with the unsplit series to round-off (tests/test_face_parity.py).
+"""
+from __future__ import annotations
+
+import numpy as np
+import scipy.linalg as sla
+import scipy.sparse as sp
+
+from ..la.threaded import elementwise, symmetric_pairs, symmetric_part, symmetric_sandwich
+from .basis_symmetry import induced_permutation, isotypic_bases
+from .quadrature import gauss_legendre
+
+INTERTWINE_RTOL = 1e-10
+"""Largest ‖Q_aᵀ R T_b‖_F / ‖R‖_F (a ≠ b) for which R counts as intertwining the reflections."""
+
+
+def axis_parity(space) -> tuple | None:
+    """(Q_e, Q_o) of a 1D space (:class:`~.multipliers.MultiplierSpace`) under x → 1 − x,
+    checked at 4 Gauss points per interval, or None where the reflection does not map its basis."""
+    t, _ = gauss_legendre(4)
+    g = np.asarray(space.breakpoints, float)
+    x = (0.5 * (g[:-1, None] + g[1:, None]) + 0.5 * (g[1:, None] - g[:-1, None]) * t).ravel()
+    pi = induced_permutation(space, x, lambda y: 1.0 - y)
+    return None if pi is None else isotypic_bases((pi,))
+
+
+def tensor_parities(space) -> tuple | None:
+    """((Q^x_e, Q^x_o), (Q^y_e, Q^y_o)) of a tensor space, or None (a factor not symmetric or
+    with an empty parity)."""
+    out = tuple(axis_parity(f) for f in space.factors)
+    if any(q is None or min(Q.shape[1] for Q in q) < 1 for q in out):
+        return None
+    return out
+
+
+def tensor_bases(parities) -> list:
+    """T_c = Q^x_p ⊗ Q^y_q, c = p + 2q (index a·dim M^y + b, as the tensor basis)."""
+    (qx, qy) = parities
+    return [sp.kron(qx[c & 1], qy[c >> 1], format="csr") for c in range(4)]
+
+
+def partial_gram_blocks(space, n_max: int, parities, separable_sum) -> list:
+    """[S_c(n_max)], c = 0..3: the blocks T_cᵀ S(n_max) T_c of :func:`~.face_norms.partial_gram`
+    (module text), each by ``separable_sum(A, B, m, n)`` (the exponential-sum product
+    :func:`~.face_norms._separable_sum` over the index sets m of x and n of y)."""
+    from .norms import sine_coefficients
+
+    n = np.arange(1, n_max + 1, dtype=float)
+    index = (n[0::2], n[1::2])                      # odd m for even functions, even m for odd ones
+    coeffs = [[(Q.T @ sine_coefficients(f, idx))  # (dim_p, len(idx)) per parity p
+               for Q, idx in zip(q, index)] for f, q in zip(space.factors, parities)]
+    same = space.factors[0] is space.factors[1] or _same_space(*space.factors)
+    blocks = []
+    for c in range(4):
+        p, q = c & 1, c >> 1
+        cx, cy = coeffs[0][p], coeffs[1][q]
+        A = (cx[:, None, :] * cx[None, :, :]).reshape(cx.shape[0] ** 2, -1)
+        B = (cy[:, None, :] * cy[None, :, :]).reshape(cy.shape[0] ** 2, -1)
+        flat = separable_sum(A, B if not (same and p == q) else A, index[p], index[q])
+        blocks.append(symmetric_pairs(flat, cx.shape[0], cy.shape[0]))
+    return blocks
+
+
+def _same_space(a, b) -> bool:
+    """Whether two 1D spaces are the same construction on the same breakpoints."""
+    return (type(a) is type(b) and a.dim == b.dim and a.degree == b.degree
+            and np.array_equal(a.breakpoints, b.breakpoints) and np.array_equal(a.dofs, b.dofs))
+
+
+def intertwined(R: sp.csr_matrix, Qs, Ts) -> list | None:
+    """[R̃_c = Q_cᵀ R T_c] where every block Q_aᵀ R T_b (a ≠ b) is at most
+    :data:`INTERTWINE_RTOL` of R (Frobenius), else None."""
+    scale = sp.linalg.norm(R)
+    out = []
+    for a, Q in enumerate(Qs):
+        left = (Q.T @ R).tocsr()
+        for b, T in enumerate(Ts):
+            block = (left @ T).tocsr()
+            if a == b:
+                out.append(block)
+            elif sp.linalg.norm(block) > INTERTWINE_RTOL * scale:
+                return None
+    return out
+
+
+def sandwiched(Rs, blocks) -> list:
+    """[R̃_c S_c R̃_cᵀ], symmetrised (:func:`~infsup_contact.la.threaded.symmetric_sandwich`)."""
+    return [symmetric_part(symmetric_sandwich(R, S)) for R, S in zip(Rs, blocks)]
+
+
+def assemble(bases, blocks) -> np.ndarray:
+    """G = Σ_c Q_c G_c Q_cᵀ = K diag(G_c) Kᵀ with K = [Q_0, ..., Q_3] (at most four nonzeros
+    per row): one threaded sparse sandwich of the block-diagonal matrix (exactly symmetric,
+    as the blocks), instead of four with m² results each; symmetrised."""
+    K = sp.hstack(bases, format="csr")
+    return symmetric_part(symmetric_sandwich(K, sla.block_diag(*blocks)))
+
+
+class BlockOps:
+    """The Richardson loop's operations (:func:`~.norms.extrapolate`) on lists of diagonal
+    blocks: the step and the difference block by block, the spectral norm the largest block's."""
+
+    @staticmethod
+    def step(hi, lo, divisor):
+        return [elementwise(lambda a, b: a + (a - b) / divisor, h, l) for h, l in zip(hi, lo)]
+
+    @staticmethod
+    def diff(a, b):
+        return [elementwise(np.subtract, x, y) for x, y in zip(a, b)]
+
+    @staticmethod
+    def norm2(blocks):
+        from .norms import _norm2
+        return max(_norm2(B) for B in blocks)

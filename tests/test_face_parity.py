@@ -1,0 +1,98 @@
+"""The face's H Gram series in the parity blocks of the axis reflections (discretization/face_parity.py):
+the sine coefficients' parity, the block route against the whole-matrix route (tensor and
+cellwise spaces), and the refusals (a graded partition, an R that does not intertwine)."""
+import numpy as np
+import pytest
+import scipy.sparse as sp
+
+from infsup_contact.discretization import face_cellwise_norms as fc
+from infsup_contact.discretization import face_norms as fn
+from infsup_contact.discretization import face_parity as fp
+from infsup_contact.discretization import registry
+from infsup_contact.discretization.norms import sine_coefficients
+from infsup_contact.discretization.square import SQUARE, TensorPartition
+
+
+def _space(case, k, xs):
+    part = TensorPartition(xs, xs)
+    return registry.case_space(case, k, part, SQUARE)
+
+
+@pytest.mark.parametrize("case,k", [("R5.2", 2), ("T3", 1), ("R5.4", 2), ("DUAL", 2)])
+def test_even_functions_have_odd_sine_indices_only(case, k):
+    """sin(mπ(1 − x)) = (−1)^{m+1} sin(mπx): an even function's coefficient vanishes at even m,
+    an odd one's at odd m (to round-off), and the two parities span the 1D space."""
+    sx = _space(case, k, np.linspace(0.0, 1.0, 8)).factors[0]
+    even, odd = fp.axis_parity(sx)
+    assert even.shape[1] + odd.shape[1] == sx.dim
+    n = np.arange(1, 41, dtype=float)
+    c = sine_coefficients(sx, n)
+    scale = np.abs(c).max()
+    assert np.abs(even.T @ c[:, 1::2]).max() <= 1e-13 * scale
+    assert np.abs(odd.T @ c[:, 0::2]).max() <= 1e-13 * scale
+    assert np.abs(even.T @ c[:, 0::2]).max() > 0.1 * scale
+
+
+@pytest.mark.parametrize("case,k,n", [("T3", 2, 7), ("R5.2", 2, 6), ("R5.4", 2, 6), ("DUAL", 2, 6), ("R5.2", 1, 9)])
+def test_tensor_blocks_equal_the_whole_series(monkeypatch, case, k, n):
+    """gram_h_face on the parity blocks (the route of dim > EXP_SUM_MIN_DIM, forced here) is
+    the whole-matrix exponential-sum route to round-off, with the same n_max."""
+    space = _space(case, k, np.linspace(0.0, 1.0, n + 1))
+    monkeypatch.setattr(fn, "EXP_SUM_MIN_DIM", 0)
+    G_blocks, info_blocks = fn.gram_h_face(space)
+    monkeypatch.setattr(fp, "tensor_parities", lambda s: None)
+    G_whole, info_whole = fn.gram_h_face(space)
+    assert info_blocks["n_max"] == info_whole["n_max"]
+    assert np.abs(G_blocks - G_whole).max() <= 1e-13 * np.abs(G_whole).max()
+    assert np.array_equal(G_blocks, G_blocks.T)
+
+
+@pytest.mark.parametrize("case", ["DUAL-Q9", "TDUAL-Q8", "PWLIN-Q9", "DUAL-Q9-ALL"])
+def test_cellwise_blocks_equal_the_whole_series(monkeypatch, case):
+    """The cellwise spaces: R̃_c S_P,c R̃_cᵀ per block, assembled, against R S_P Rᵀ."""
+    space = _space(case, 2, np.linspace(0.0, 1.0, 7))
+    monkeypatch.setattr(fc, "EXP_SUM_MIN_DIM", 0)
+    monkeypatch.setattr(fn, "EXP_SUM_MIN_DIM", 0)
+    R, P = fc.projection(space)
+    assert fc._parity_route(space, R, P) is not None
+    G_blocks, info_blocks = fc.gram_h_cellwise(space)
+    monkeypatch.setattr(fc, "_parity_route", lambda *a: None)
+    G_whole, info_whole = fc.gram_h_cellwise(space)
+    assert info_blocks["n_max"] == info_whole["n_max"]
+    assert np.abs(G_blocks - G_whole).max() <= 1e-13 * np.abs(G_whole).max()
+
+
+def test_a_graded_partition_keeps_the_whole_series(monkeypatch):
+    space = _space("R5.2", 1, np.array([0.0, 0.1, 0.35, 0.7, 1.0]))
+    assert fp.tensor_parities(space) is None
+
+
+def test_an_r_that_does_not_intertwine_is_refused():
+    """Q_aᵀ R T_b must vanish for a ≠ b: a perturbed R is refused, the exact one accepted."""
+    space = _space("DUAL-Q9", 2, np.linspace(0.0, 1.0, 5))
+    R, P = fc.projection(space)
+    from infsup_contact.discretization.basis_symmetry import axis_reflections, isotypic_bases
+    bases = isotypic_bases(axis_reflections(space, fc.piece_rule(P.breakpoints, 3)[0]))
+    T = fp.tensor_bases(fp.tensor_parities(P))
+    assert fp.intertwined(R, bases, T) is not None
+    bad = R.tolil()
+    bad[0, 0] += 1e-6 * abs(R).max()
+    assert fp.intertwined(sp.csr_matrix(bad), bases, T) is None
+
+
+def test_assemble_inverts_the_blocks():
+    """assemble(Q, [Q_cᵀ G Q_c]) = G for a G commuting with both reflections."""
+    space = _space("R5.2", 2, np.linspace(0.0, 1.0, 5))
+    T = fp.tensor_bases(fp.tensor_parities(space))
+    rng = np.random.default_rng(0)
+    blocks = []
+    for Q in T:
+        A = rng.standard_normal((Q.shape[1], Q.shape[1]))
+        blocks.append(A + A.T)
+    G = fp.assemble(T, blocks)
+    for Q, B in zip(T, blocks):
+        np.testing.assert_allclose(Q.T @ G @ Q, B, atol=1e-13 * np.abs(B).max())
+    for a, Qa in enumerate(T):
+        for b, Qb in enumerate(T):
+            if a != b:
+                assert np.abs(Qa.T @ G @ Qb).max() <= 1e-13 * np.abs(G).max()

@@ -30,6 +30,7 @@ import scipy.sparse as sp
 
 from ..la.threaded import elementwise, symmetric_pairs, symmetric_part, symmetric_sandwich
 from .basis_symmetry import induced_permutation, isotypic_bases
+from .norms import _norm2, sine_coefficients
 from .quadrature import gauss_legendre
 
 INTERTWINE_RTOL = 1e-10
@@ -65,8 +66,6 @@ def partial_gram_blocks(space, n_max: int, parities, separable_sum) -> list:
     """[S_c(n_max)], c = 0..3: the blocks T_cᵀ S(n_max) T_c of :func:`~.face_norms.partial_gram`
     (module text), each by ``separable_sum(A, B, m, n)`` (the exponential-sum product
     :func:`~.face_norms._separable_sum` over the index sets m of x and n of y)."""
-    from .norms import sine_coefficients
-
     n = np.arange(1, n_max + 1, dtype=float)
     index = (n[0::2], n[1::2])                      # odd m for even functions, even m for odd ones
     coeffs = [[(Q.T @ sine_coefficients(f, idx))  # (dim_p, len(idx)) per parity p
@@ -132,5 +131,4 @@ class BlockOps:
 
     @staticmethod
     def norm2(blocks):
-        from .norms import _norm2
         return max(_norm2(B) for B in blocks)

@@ -180,6 +180,7 @@ def test_base_configs_are_valid():
         assert status == "accepted", notes
 
 
+@pytest.mark.slow_first  # one of the longest tests: started first under xdist (tests/conftest.py)
 def test_every_config_key_mutated(capsys):
     t0 = time.perf_counter()
     tried, refused, accepted, failures, covered = 0, 0, 0, [], set()

@@ -36,7 +36,10 @@ def _dense_route(trace, space, k, extra_degree=0):
     return out
 
 
-@pytest.fixture(scope="module", params=SETUPS,
+# the tetrahedra's faces have the most quadrature points: their chunk-by-chunk runs below take
+# longest, so they start first under xdist (tests/conftest.py)
+@pytest.fixture(scope="module", params=[pytest.param(s, marks=pytest.mark.slow_first) if s[1].get("element") == "tet"
+                                        else s for s in SETUPS],
                 ids=lambda s: f"{s[0]}-{s[1].get('element', '2d')}-{s[2]}:{s[3]}-k{s[4]}-{s[5]}")
 def setup(request):
     model, kw, n1, n2, k, mm = request.param

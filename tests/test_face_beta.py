@@ -75,6 +75,7 @@ def test_continuous_multipliers_without_end_condition_have_a_growing_kernel():
             assert row.kernel_dim == 4 * n * k
 
 
+@pytest.mark.slow_first  # the largest 3D β tests: started first under xdist (tests/conftest.py)
 @pytest.mark.parametrize("k", [1, 2])
 @pytest.mark.parametrize("n1,n2", [(2, 2), (3, 3), (3, 4)])
 def test_tetrahedra(k, n1, n2):

@@ -44,6 +44,7 @@ def test_cpu_flags_decide_what_can_run():
     assert machines.runnable("Haswell", {"avx", "avx2", "fma", "sse3"}) == (True, "")
 
 
+@pytest.mark.slow_first  # a pytest run of three test files each (tests/conftest.py)
 @pytest.mark.parametrize("core", machines.CORE_TYPES)
 def test_kernel_and_verdict_unit_tests_pass_under(core):
     ok, why = machines.runnable(core)
@@ -54,6 +55,7 @@ def test_kernel_and_verdict_unit_tests_pass_under(core):
     assert run.returncode == 0, run.stdout[-3000:]
 
 
+@pytest.mark.xdist_group("machines_runs")  # one worker makes the sweeps of ``runs`` once
 @pytest.mark.parametrize("core", machines.CORE_TYPES)
 def test_the_core_type_took_effect(runs, core):
     if runs[core] is None:
@@ -64,6 +66,7 @@ def test_the_core_type_took_effect(runs, core):
     assert len(set(names.values())) == 1
 
 
+@pytest.mark.xdist_group("machines_runs")
 def test_sweep_and_verdicts_identical_across_core_types(runs):
     done = {c: f for c, f in runs.items() if f is not None}
     if len(done) < 2:

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 import pandas as pd
+import pytest
 
 from infsup_contact.discretization.registry import SPACES
 from infsup_contact.models import make_model
@@ -16,6 +17,7 @@ MODEL = make_model("membranes3d")
 LEVELS = (3, 4, 6)
 
 
+@pytest.mark.slow_first  # one of the longest tests: started first under xdist (tests/conftest.py)
 def test_stable_beta_is_bounded_on_unstructured_refinements():
     case = next(c for c, s in SPACES.items() if s.lagrange == (True, True) and not s.dual and s.degree(1) == 1)
     rows = [pd.DataFrame(beta_rows("unstructured", 1, n, n, cases=[case], model=MODEL, element="tet"))

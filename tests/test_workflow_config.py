@@ -23,13 +23,17 @@ ENV = {**os.environ, "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"}
 CI_CONFIG = yaml.safe_load((ROOT / "config" / "ci.yaml").read_text())
 
 
+def copy_workflow(dest: Path) -> Path:
+    shutil.copy2(ROOT / "Snakefile", dest / "Snakefile")
+    for d in ("workflow", "config", "profiles", "paper", "examples"):
+        shutil.copytree(ROOT / d, dest / d, ignore=shutil.ignore_patterns("__pycache__"))
+    (dest / "src").symlink_to(ROOT / "src", target_is_directory=True)
+    return dest
+
+
 @pytest.fixture
 def workdir(tmp_path: Path) -> Path:
-    shutil.copy2(ROOT / "Snakefile", tmp_path / "Snakefile")
-    for d in ("workflow", "config", "profiles", "paper", "examples"):
-        shutil.copytree(ROOT / d, tmp_path / d, ignore=shutil.ignore_patterns("__pycache__"))
-    (tmp_path / "src").symlink_to(ROOT / "src", target_is_directory=True)
-    return tmp_path
+    return copy_workflow(tmp_path)
 
 
 def snakemake(workdir: Path, *args: str) -> tuple[int, str]:
@@ -150,9 +154,17 @@ def test_bad_config_fails_before_any_job(workdir, mutate, needles):
 
 # --------------------------------------------------------------- good configs
 
-def test_ci_config_dry_run_lists_beta_jobs(workdir):
-    rc, out = snakemake(workdir, "-n", "reproduce-all", "--cores", "1",
-                        "--configfile", "config/ci.yaml")
+@pytest.fixture(scope="module")
+def ci_dry_run(tmp_path_factory) -> tuple[Path, int, str]:
+    """`snakemake -n reproduce-all` on config/ci.yaml, once for the two tests reading it
+    (both ran the same command before); the copy it ran in, its exit code and output."""
+    wd = copy_workflow(tmp_path_factory.mktemp("ci_dry_run"))
+    return (wd, *snakemake(wd, "-n", "reproduce-all", "--cores", "1", "--configfile", "config/ci.yaml"))
+
+
+@pytest.mark.xdist_group("ci_dry_run")
+def test_ci_config_dry_run_lists_beta_jobs(ci_dry_run):
+    workdir, rc, out = ci_dry_run
     assert rc == 0, out
     assert "rule beta_job:" in out
     assert "beta_job" in out.split("Job stats:")[1].split("total")[0]
@@ -160,12 +172,13 @@ def test_ci_config_dry_run_lists_beta_jobs(workdir):
     assert produced_tables(workdir) == []
 
 
-def test_fit_window_shrink_is_logged_and_mem_mb_follows_the_estimate(workdir):
+@pytest.mark.xdist_group("ci_dry_run")
+def test_fit_window_shrink_is_logged_and_mem_mb_follows_the_estimate(ci_dry_run):
     """ci.yaml has 4 odd N and fit_window 5: accepted, with the shrink said in one line; each
     β/contact job asks for mem_mb from resources.py (larger meshes, more memory)."""
     from infsup_contact import resources
 
-    rc, out = snakemake(workdir, "-n", "reproduce-all", "--cores", "1", "--configfile", "config/ci.yaml")
+    _, rc, out = ci_dry_run
     assert rc == 0, out
     assert "config key claims.fit_window = 5: the odd-N β series has 4 meshes" in out, out
     assert "shrunk explicitly" in out

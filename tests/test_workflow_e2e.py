@@ -1,6 +1,9 @@
 """End to end: the DAG verifies the paper's claims; reruns are deterministic and survive kills.
 
-These run real Snakemake jobs in temporary copies of the workflow (a few minutes in all).
+These run real Snakemake jobs in temporary copies of the workflow (a few minutes in all). Under
+xdist (``--dist loadgroup``) each group of tests sharing a run stays on one worker, so the run
+is made once: ``ci_run`` (verify-claims, then the paper) and ``clean_targets`` (the reference
+run the determinism and the kill tests both compare with).
 """
 import os
 import re
@@ -55,6 +58,7 @@ def ci_run(tmp_path_factory):
     return wd
 
 
+@pytest.mark.xdist_group("e2e_ci_run")
 def test_verify_claims_ci_profile(ci_run):
     """`snakemake verify-claims --profile profiles/ci`: every claim as the paper predicts."""
     wd = ci_run
@@ -81,6 +85,7 @@ def _macro(macros: Path, name: str) -> str:
     return found.group(1)
 
 
+@pytest.mark.xdist_group("e2e_ci_run")
 @pytest.mark.skipif(not HAVE_TEX, reason="TeX (latexmk, pdflatex) or pdftotext missing: .ci/run installs them")
 def test_paper_numbers_follow_tables_and_config(ci_run):
     """`snakemake paper --profile profiles/ci` builds the PDF; its numbers come from the tables,
@@ -120,13 +125,25 @@ TARGETS = [_batch_with("structured", 2, (8, 8)), _batch_with("perturbed", 1, (6,
            "results/tables/contact/membranes_structured_k1.csv"]
 
 
-def test_two_clean_runs_are_byte_identical(tmp_path):
-    outs = []
-    for run_dir in ("a", "b"):
-        wd = _copy_workflow(tmp_path / run_dir) if (tmp_path / run_dir).mkdir() is None else None
-        run = _snakemake(wd, *TARGETS, "--profile", "profiles/ci")
-        assert run.returncode == 0, run.stderr[-3000:]
-        outs.append([(wd / t).read_bytes() for t in TARGETS])
+def _clean_run(wd: Path) -> Path:
+    """``TARGETS`` made by one uninterrupted run in a fresh copy of the workflow in ``wd``."""
+    wd.mkdir()
+    _copy_workflow(wd)
+    run = _snakemake(wd, *TARGETS, "--profile", "profiles/ci")
+    assert run.returncode == 0, run.stderr[-3000:]
+    return wd
+
+
+@pytest.fixture(scope="module")
+def clean_targets(tmp_path_factory):
+    """One clean run of ``TARGETS``: the first of the two compared below and the reference of
+    the killed run (each test made its own before, the same run)."""
+    return _clean_run(tmp_path_factory.mktemp("clean") / "a")
+
+
+@pytest.mark.xdist_group("e2e_targets")
+def test_two_clean_runs_are_byte_identical(clean_targets, tmp_path):
+    outs = [[(wd / t).read_bytes() for t in TARGETS] for wd in (clean_targets, _clean_run(tmp_path / "b"))]
     assert outs[0] == outs[1]
 
 
@@ -143,12 +160,11 @@ def _job_pids(wd: Path):
     return pids
 
 
-def test_killed_job_then_rerun_completes_identically(tmp_path):
-    """SIGKILL a job mid-run, run again: same tables as an uninterrupted run."""
-    (tmp_path / "clean").mkdir()
+@pytest.mark.xdist_group("e2e_targets")
+def test_killed_job_then_rerun_completes_identically(clean_targets, tmp_path):
+    """SIGKILL a job mid-run, run again: same tables as an uninterrupted run (``clean_targets``)."""
+    clean = clean_targets
     (tmp_path / "killed").mkdir()
-    clean = _copy_workflow(tmp_path / "clean")
-    assert _snakemake(clean, *TARGETS, "--profile", "profiles/ci").returncode == 0
     wd = _copy_workflow(tmp_path / "killed")
     proc = subprocess.Popen([str(BIN / "snakemake"), *TARGETS, "--profile", "profiles/ci"], cwd=wd,
                             env=_env(), stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,

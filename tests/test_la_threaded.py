@@ -78,3 +78,25 @@ def test_elementwise_is_numpy_bit_for_bit(monkeypatch, n_threads, m):
     a, b = rng.standard_normal((m, m)), rng.standard_normal((m, m))
     assert np.array_equal(threaded.elementwise(lambda x, y: x + (x - y) / 7.0, a, b), a + (a - b) / 7.0)
     assert np.array_equal(threaded.elementwise(np.subtract, a, np.asfortranarray(b)), a - b)
+
+
+@pytest.mark.parametrize("n_threads", ["1", "2"])
+def test_signed_gather_sum_is_the_sparse_sandwich_and_exactly_symmetric(monkeypatch, n_threads):
+    """Σ_c Q_c D_c Q_cᵀ for bases with at most one nonzero per row, by gathers."""
+    monkeypatch.setenv("MKL_NUM_THREADS", n_threads)
+    rng = np.random.default_rng(8)
+    m, sizes = 600, (250, 200, 150)
+    owner = rng.permutation(np.repeat(np.arange(3), sizes))       # row i belongs to block owner[i]
+    index, sign, blocks, ref = [], [], [], np.zeros((m, m))
+    for c, mc in enumerate(sizes):
+        rows = np.flatnonzero(owner == c)
+        idx, w = np.zeros(m, dtype=np.intp), np.zeros(m)
+        idx[rows], w[rows] = np.arange(mc), rng.choice([-1.0, 1.0], mc) * 0.5
+        A = rng.standard_normal((mc, mc))
+        D = A + A.T
+        Q = sp.csr_matrix((w[rows], (rows, np.arange(mc))), shape=(m, mc))
+        ref += (Q @ D @ Q.T)
+        index.append(idx), sign.append(w), blocks.append(D)
+    G = threaded.signed_gather_sum(blocks, index, sign)
+    np.testing.assert_allclose(G, ref, atol=1e-14 * np.abs(ref).max())
+    assert np.array_equal(G, G.T)

@@ -193,3 +193,26 @@ def elementwise(f, *arrays: np.ndarray) -> np.ndarray:
     _run(block(r) for r in _row_blocks(out.shape[0]))
     return out
 
+
+def signed_gather_sum(blocks, index, sign) -> np.ndarray:
+    """G[i, j] = Σ_c D_c[index_c[i], index_c[j]] (sign_c[i] sign_c[j]) for dense symmetric D_c
+    (``blocks``), integer maps ``index`` and weights ``sign`` (0 where row i has no entry in
+    block c): Σ_c Q_c D_c Q_cᵀ for bases Q_c with at most one nonzero per row (the reflections'
+    isotypic bases), as gathers of row blocks over the threads. Each term multiplies D by the
+    product sign_c[i] sign_c[j], which commutes, and the terms are added in the order of c: the
+    result is exactly symmetric."""
+    m = len(index[0])
+    out = np.empty((m, m))
+
+    def block(rows):
+        def task():
+            acc = None
+            for D, idx, w in zip(blocks, index, sign):
+                part = D[np.ix_(idx[rows], idx)] * (w[rows, None] * w[None, :])
+                acc = part if acc is None else np.add(acc, part, out=acc)
+            out[rows] = acc
+        return task
+
+    _run(block(r) for r in _row_blocks(m))
+    return out
+

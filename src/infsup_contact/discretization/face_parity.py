@@ -69,22 +69,15 @@ def partial_gram_blocks(space, n_max: int, parities, separable_sum) -> list:
     index = (n[0::2], n[1::2])                      # odd m for even functions, even m for odd ones
     coeffs = [[(Q.T @ sine_coefficients(f, idx))  # (dim_p, len(idx)) per parity p
                for Q, idx in zip(q, index)] for f, q in zip(space.factors, parities)]
-    same = space.factors[0] is space.factors[1] or _same_space(*space.factors)
     blocks = []
     for c in range(4):
         p, q = c & 1, c >> 1
         cx, cy = coeffs[0][p], coeffs[1][q]
         A = (cx[:, None, :] * cx[None, :, :]).reshape(cx.shape[0] ** 2, -1)
         B = (cy[:, None, :] * cy[None, :, :]).reshape(cy.shape[0] ** 2, -1)
-        flat = separable_sum(A, B if not (same and p == q) else A, index[p], index[q])
+        flat = separable_sum(A, B, index[p], index[q])  # it reuses A's columns where B equals A
         blocks.append(symmetric_pairs(flat, cx.shape[0], cy.shape[0]))
     return blocks
-
-
-def _same_space(a, b) -> bool:
-    """Whether two 1D spaces are the same construction on the same breakpoints."""
-    return (type(a) is type(b) and a.dim == b.dim and a.degree == b.degree
-            and np.array_equal(a.breakpoints, b.breakpoints) and np.array_equal(a.dofs, b.dofs))
 
 
 def intertwined(R: sp.csr_matrix, Qs, Ts) -> list | None:

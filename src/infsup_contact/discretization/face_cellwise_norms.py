@@ -43,6 +43,7 @@ from .face_norms import EXP_SUM_MIN_DIM, extrapolated, partial_gram, partial_gra
 from .face_spaces import FaceSpace
 from .multipliers import make_space
 from .norms import N_MAX_CAP, gram_by_norm, gram_l2
+from .richardson import BlockOps
 from .quadrature import gauss_legendre
 
 #: Largest |μ − R P| / max|μ| accepted at the check points (round-off of the projection).
@@ -183,7 +184,7 @@ def gram_h_cellwise(space, rtol: float = 1e-6, n_start: int | None = None, n_cap
     if blocked is not None:  # the four parity blocks of the axis reflections (:mod:`.face_parity`)
         parities, Rs, bases = blocked
         G, info = extrapolated(lambda n: face_parity.sandwiched(Rs, piece_partial_gram(P, n, parities)),
-                               p, n0, n_cap, rtol, ops=face_parity.BlockOps)
+                               p, n0, n_cap, rtol, ops=BlockOps)
         return face_parity.assemble(bases, G), info
 
     def partial(n):  # S_P is exactly symmetric; the sandwich only to round-off

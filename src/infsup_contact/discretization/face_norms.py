@@ -25,7 +25,8 @@ from ..errors import InputError
 from ..la.threaded import symmetric_pairs
 from . import face_parity
 from .exponential_sum import inverse_sqrt
-from .norms import N_MAX_CAP, _norm2, extrapolate, gram_by_norm, gram_l2, sine_coefficients
+from .norms import N_MAX_CAP, gram_by_norm, gram_l2, sine_coefficients
+from .richardson import BlockOps, _norm2, extrapolate
 
 #: Rows of the weight matrix W[m, n] = 1/(π√(m² + n²)) handled at once (memory ~ chunk · n_max).
 _CHUNK = 512
@@ -179,7 +180,7 @@ def gram_h_face(space, rtol: float = 1e-6, n_start: int | None = None, n_cap: in
     if parities is None:
         return extrapolated(lambda n: partial_gram(space, n, aspect), p, n0, n_cap, rtol)
     blocks, info = extrapolated(lambda n: partial_gram_blocks(space, n, parities), p, n0, n_cap, rtol,
-                                ops=face_parity.BlockOps)
+                                ops=BlockOps)
     return face_parity.assemble(face_parity.tensor_bases(parities), blocks), info
 
 
@@ -191,7 +192,7 @@ def partial_gram_blocks(space, n_max: int, parities) -> list:
 
 
 def extrapolated(partial, p: float, n0: int, n_cap: int, rtol: float, ops=None) -> tuple[np.ndarray, dict]:
-    """The segment's Richardson loop (:func:`~.norms.extrapolate`) on a face series, the tail
+    """The segment's Richardson loop (:func:`~.richardson.extrapolate`) on a face series, the tail
     exponent p recorded in ``info`` (also the route of the non-tensor and triangle spaces,
     :mod:`.face_cellwise_norms`, :mod:`.face_triangle_norms`; ``ops``: that of parity blocks)."""
     G, info = extrapolate(partial, p, n0, n_cap, rtol, ops)

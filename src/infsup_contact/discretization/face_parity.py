@@ -14,7 +14,7 @@ is block diagonal in the four bases T_c = Q^x_{p} ⊗ Q^y_{q} (c = p + 2q, bit s
 block c is the same separable sum over the odd or even m and n' alone, of the coefficients
 (Q^x_p)ᵀ c^x and (Q^y_q)ᵀ c^y (:func:`partial_gram_blocks`). Each block has about a quarter of
 the dimension: the separable product (dim² r per block), its reordering, the Richardson steps and
-the spectral norms that stop them cost about a quarter of the whole matrix's, and a cellwise
+the spectral norms that stop them (:class:`~.richardson.BlockOps`) cost about a quarter of the whole matrix's, and a cellwise
 space's sandwich R S_P Rᵀ becomes R̃_c S_P,c R̃_cᵀ with R̃_c = Q_cᵀ R T_c (Q_c the multiplier
 basis's own components under the same two reflections: R intertwines them, so the blocks
 between different components vanish; checked, :func:`intertwined`). The Gram matrix is
@@ -27,9 +27,9 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
-from ..la.threaded import elementwise, signed_gather_sum, symmetric_pairs, symmetric_part, symmetric_sandwich
+from ..la.threaded import signed_gather_sum, symmetric_pairs, symmetric_part, symmetric_sandwich
 from .basis_symmetry import induced_permutation, isotypic_bases
-from .norms import _norm2, sine_coefficients
+from .norms import sine_coefficients
 from .quadrature import gauss_legendre
 
 INTERTWINE_RTOL = 1e-10
@@ -116,20 +116,3 @@ def assemble(bases, blocks) -> np.ndarray:
         index.append(idx)
         sign.append(w)
     return signed_gather_sum([np.asarray(B, dtype=float) for B in blocks], index, sign)
-
-
-class BlockOps:
-    """The Richardson loop's operations (:func:`~.norms.extrapolate`) on lists of diagonal
-    blocks: the step and the difference block by block, the spectral norm the largest block's."""
-
-    @staticmethod
-    def step(hi, lo, divisor):
-        return [elementwise(lambda a, b: a + (a - b) / divisor, h, l) for h, l in zip(hi, lo)]
-
-    @staticmethod
-    def diff(a, b):
-        return [elementwise(np.subtract, x, y) for x, y in zip(a, b)]
-
-    @staticmethod
-    def norm2(blocks):
-        return max(_norm2(B) for B in blocks)

@@ -29,7 +29,8 @@ import numpy as np
 from scipy import sparse
 
 from ..errors import InputError
-from .face_norms import _norm2, extrapolated
+from .face_norms import extrapolated
+from .richardson import _norm2
 from .face_quadrature import triangles_rule
 from .face_triangle_symmetry import ReflectedGram, reflection, transposition
 from .face_triangles import lagrange_barycentric

@@ -180,7 +180,7 @@ def elementwise(f, *arrays: np.ndarray) -> np.ndarray:
     """f(*arrays) for an element-wise f of equally shaped dense arrays (numpy arithmetic),
     C-contiguous, row blocks over the threads: bit for bit ``f(*arrays)`` (each entry is the
     same operations on the same operands). For the Richardson steps of the large Gram series
-    (:func:`~infsup_contact.discretization.norms.extrapolate`: R = S₂ + (S₂ − S₁)/(2^p − 1) and
+    (:func:`~infsup_contact.discretization.richardson.extrapolate`: R = S₂ + (S₂ − S₁)/(2^p − 1) and
     R(2n) − R(n) on 4,225² matrices, single-threaded passes in numpy)."""
     arrays = [np.asarray(a, dtype=float) for a in arrays]
     out = np.empty(arrays[0].shape)

@@ -28,7 +28,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..la.threaded import signed_gather_sum, symmetric_pairs, symmetric_part, symmetric_sandwich
-from .basis_symmetry import induced_permutation, isotypic_bases
+from .basis_symmetry import induced_permutation, isotypic_bases, reflect
 from .norms import sine_coefficients
 from .quadrature import gauss_legendre
 
@@ -42,7 +42,7 @@ def axis_parity(space) -> tuple | None:
     t, _ = gauss_legendre(4)
     g = np.asarray(space.breakpoints, float)
     x = (0.5 * (g[:-1, None] + g[1:, None]) + 0.5 * (g[1:, None] - g[:-1, None]) * t).ravel()
-    pi = induced_permutation(space, x, lambda y: 1.0 - y)
+    pi = induced_permutation(space, x, reflect())
     return None if pi is None else isotypic_bases((pi,))
 
 

@@ -23,7 +23,7 @@ import numpy as np
 from scipy import sparse
 
 from ..errors import InputError
-from .basis_symmetry import induced_permutation
+from .basis_symmetry import induced_permutation, reflect
 
 #: Interior sample points of every triangle, barycentric (seeded): more than (s + 1)(s + 2)/2 for
 #: s ≤ 2 in general position, so a function of P_s on a triangle is fixed by its values there.
@@ -40,7 +40,7 @@ def _induced(space, transform) -> np.ndarray | None:
 
 def reflection(space) -> np.ndarray | None:
     """π of the point reflection (x, y) → (1 − x, 1 − y) (:func:`_induced`), or None."""
-    return _induced(space, lambda x: 1.0 - x)
+    return _induced(space, reflect())
 
 
 def transposition(space) -> np.ndarray | None:

@@ -120,8 +120,8 @@ def start_level(n0: int, p: float, dim: int) -> int:
     """The first n of the Richardson levels: n0, or :data:`EXP_SUM_START` n0 for a slow tail
     (p = 2) on the exponential-sum route (``dim`` = the dimension :func:`partial_gram` sums in,
     above :data:`EXP_SUM_MIN_DIM`). The result is that of the levels from n0 whenever those
-    would have stopped at n_max ≥ 4 · EXP_SUM_START · n0 (the extrapolation and its error use
-    the last three levels only)."""
+    would have stopped at n_max ≥ 16 · EXP_SUM_START · n0 (the two-stage extrapolation, its
+    step and the step's look-ahead use the last five levels only)."""
     return EXP_SUM_START * n0 if p <= 2.0 and dim > EXP_SUM_MIN_DIM else n0
 
 
@@ -143,14 +143,15 @@ def gram_h_face(space, rtol: float = 1e-6, n_start: int | None = None, n_cap: in
     """Gram matrix of the M = H^{1/2}_00(Γ)' norm on the square (module docstring).
 
     Partial sums S(n) at n = n0, 2n0, 4n0, ... are extrapolated,
-    R(n) = S(2n) + (S(2n) − S(n)) / (2^p − 1), until ‖R(2n) − R(n)‖₂ / ‖R(2n)‖₂ ≤ rtol (that
-    difference is the reported error, as in :func:`~.norms.gram_h`).
+    R(n) = S(2n) + (S(2n) − S(n)) / (2^p − 1) and once more for n^{−(p+1)}, until the stated
+    error is ≤ rtol: the last step in R's own metric with a one-level look-ahead, a bound on the
+    relative change of every eigenvalue of a pencil with the Gram (:func:`~.richardson.extrapolate`).
 
     Parameters
     ----------
     space : FaceSpace
     rtol : float
-        Target relative (spectral-norm) truncation error.
+        Target of the stated relative truncation error (in the Gram's metric).
     n_start : int, optional
         n0; default max(16, 2 (s + 1) N) with N the larger number of intervals per direction,
         times :data:`EXP_SUM_START` for a slow tail on the exponential-sum route (:func:`start_level`).

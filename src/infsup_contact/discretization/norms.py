@@ -193,18 +193,19 @@ def gram_h(space: MultiplierSpace, rtol: float = 1e-6, n_start: int | None = Non
     G_ij = Σ_{n≥1} φ_{i,n} φ_{j,n} / (nπ) with the sine coefficients of
     :func:`sine_coefficients`. Basis functions with jumps or nonzero endpoint values
     have φ_{j,n} ~ 1/n, so the tail after n terms is ~ C n^{-2}. Partial sums S(n) are
-    accumulated at n = n0, 2n0, 4n0, ... and extrapolated,
-    R(n) = S(2n) + (S(2n) − S(n)) / 3, until two successive extrapolations agree,
-    ‖R(2n) − R(n)‖₂ / ‖R(2n)‖₂ ≤ rtol. That difference is the reported error estimate;
-    it bounds the error of the older extrapolation R(n) and so over-estimates the error
-    of the returned R(2n). Smoother spaces converge faster and only make this safer.
+    accumulated at n = n0, 2n0, 4n0, ... and extrapolated (:func:`~.richardson.extrapolate`:
+    R(n) = S(2n) + (S(2n) − S(n)) / 3 and a second Richardson stage), until the stated error
+    — the last step between successive extrapolations in G's own metric, with a one-level
+    look-ahead on the steps' ratio — is ≤ rtol. It bounds the relative change of every
+    eigenvalue of a pencil with G, so of β². Smoother spaces converge faster.
 
     Parameters
     ----------
     space : MultiplierSpace
         The multiplier space.
     rtol : float, optional
-        Target relative (spectral-norm) truncation error.
+        Target of the stated relative truncation error (in G's metric: it bounds every
+        eigenvalue of a pencil with G).
     n_start : int, optional
         First partial-sum length n0; default max(16, 2 (s+1) N) for N intervals, i.e.
         past the point where every interval is resolved (nπh ≳ 2(s+1)π).
@@ -220,8 +221,8 @@ def gram_h(space: MultiplierSpace, rtol: float = 1e-6, n_start: int | None = Non
     G : ndarray, shape (dim, dim)
         Symmetric positive definite Gram matrix.
     info : dict
-        ``n_max`` (int, sine terms summed), ``nmax_rel_error`` (float, estimated relative
-        truncation error of G in the spectral norm), ``capped`` (bool), ``n_start``.
+        ``n_max`` (int, sine terms summed), ``nmax_rel_error`` (float, the stated bound on
+        the relative truncation error of G in its own metric, :func:`~.richardson.extrapolate`), ``capped`` (bool), ``n_start``.
 
     Raises
     ------

@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.linalg as sla
 import scipy.sparse.linalg as spla
-from scipy.linalg import lapack
+from scipy.linalg import blas, lapack
 
 from ..errors import InputError
 from ..la.threaded import elementwise
@@ -29,8 +29,8 @@ def extrapolate(partial, p: float, n0: int, n_cap: int, rtol: float, ops=None) -
     relative error up to cond(G) times larger (T5, k = 2, hexahedra, N = 20: β 2.7e-5 off, 9.7e-7
     stated).
 
-    ``ops``: the step, difference and relative step for another representation of the partial
-    sums (an object with ``step(hi, lo, divisor)``, ``diff(a, b)``, ``rel_norm(e, r)``; the face's
+    ``ops``: the step, difference and relative steps for another representation of the partial
+    sums (an object with ``step(hi, lo, divisor)``, ``diff(a, b)``, ``rel_norms(es, r)``; the face's
     parity blocks, :class:`BlockOps`), default :class:`DenseOps`.
 
     Returns
@@ -50,31 +50,39 @@ def extrapolate(partial, p: float, n0: int, n_cap: int, rtol: float, ops=None) -
     if n0 < 1 or n_cap < 1:
         raise InputError("n_start/n_cap", "positive integers", got=(n0, n_cap))
     ops = DenseOps if ops is None else ops
-    n, row = min(n0, n_cap), None
-    err, last, confirmed = np.inf, None, False
+    n, row, last = min(n0, n_cap), None, {}
     while True:
         row_prev, row = row, romberg_row(partial(n), row, p, ops)
-        if len(row) > 1:  # the row's last entry is the deepest extrapolation this level has
-            if row_prev is not None and len(row_prev) == len(row):
-                step = ops.rel_norm(ops.diff(row[-1], row_prev[-1]), row[-1])
-                err, confirmed = lookahead_bound(step, last), last is not None
-                last = step
-            else:  # the first of its depth: the size of its own extrapolation step
-                err = ops.rel_norm(ops.diff(row[-1], row[-2]), row[-1])
+        best, err, confirmed = len(row) - 1, np.inf, False
+        if len(row) > 1:
+            stages = [i for i in range(1, len(row)) if row_prev is not None and i < len(row_prev)]
+            # each stage's step since the level before, all in the metric of the deepest entry
+            steps = ops.rel_norms([ops.diff(row[i], row_prev[i]) for i in stages], row[-1]) if stages else []
+            bounds = {i: (lookahead_bound(d, last.get(i)), i in last) for i, d in zip(stages, steps)}
+            last = dict(zip(stages, steps))
+            done = {i: b for i, (b, c) in bounds.items() if c}
+            if done:  # the stage with the smallest confirmed bound
+                best = min(done, key=lambda i: (done[i], -i))
+                err, confirmed = done[best], True
+            elif stages:
+                err = bounds[best][0] if best in bounds else max(b for b, _ in bounds.values())
+            else:  # the first level with an extrapolation: the size of that extrapolation
+                err = ops.rel_norms([ops.diff(row[-1], row[-2])], row[-1])[0]
         if (confirmed and err <= rtol) or 2 * n > n_cap:
             break
         n *= 2
-    return row[-1], {"n_max": int(n), "nmax_rel_error": float(err),
-                     "capped": bool(not (confirmed and err <= rtol)), "n_start": int(min(n0, n_cap))}
+    return row[best], {"n_max": int(n), "nmax_rel_error": float(err),
+                       "capped": bool(not (confirmed and err <= rtol)), "n_start": int(min(n0, n_cap))}
 
 
 STAGES = 2
 """Richardson stages (the columns of the Romberg table): the tail C n^{−p} (p = 2 where a basis
 function jumps or does not vanish on ∂Γ, 4 for the smooth ones), then a term n^{−(p+1)}. On the
 face's p = 2 series (T5, R5.4, k = 2, N = 8) one stage converges by 1/8 a level and two by 1/9
-to 1/15, so the bound reaches 1e-6 three levels earlier (at the n_max where the former
-spectral-norm rule stopped without a bound); a stage whose term is absent (T3's next term is
-n^{−6}) neither gains nor loses."""
+to 1/15, so the bound reaches 1e-6 three levels earlier; a stage whose term is absent (T3's
+next term is n^{−6}) neither gains nor loses. Each level states the smaller confirmed bound of
+the two stages (and returns that stage's matrix): the first stage's is confirmed two levels
+earlier, where a fast series (T3) already stops."""
 
 
 def romberg_row(S: np.ndarray, previous: list | None, p: float, ops) -> list:
@@ -125,8 +133,8 @@ class DenseOps:
         return _norm2(a)
 
     @staticmethod
-    def rel_norm(e, r):
-        return relative_step(e, r)
+    def rel_norms(es, r):
+        return relative_steps(es, r)
 
 
 class BlockOps:
@@ -146,9 +154,10 @@ class BlockOps:
         return max(_norm2(B) for B in blocks)
 
     @staticmethod
-    def rel_norm(steps, grams):
+    def rel_norms(es, grams):
         # G = Q diag(blocks) Qᵀ with Q orthogonal: the Loewner order holds block by block
-        return max((relative_step(E, R) for E, R in zip(steps, grams) if len(R)), default=0.0)
+        per_block = [relative_steps([e[b] for e in es], R) for b, R in enumerate(grams) if len(R)]
+        return [max((v[j] for v in per_block), default=0.0) for j in range(len(es))]
 
 
 def relative_step(E: np.ndarray, R: np.ndarray) -> float:
@@ -160,28 +169,38 @@ def relative_step(E: np.ndarray, R: np.ndarray) -> float:
     Up to :data:`RELATIVE_DENSE_MAX` the whole standard form L⁻¹ E L⁻ᵀ and its eigenvalues
     (LAPACK), above it the largest-magnitude eigenvalue by Lanczos on x ↦ L⁻¹ E L⁻ᵀ x (two
     triangular solves and a product, O(n²) per step; ARPACK's default 20 vectors, relative
-    accuracy 1e-8: a misconverged Lanczos could settle below the top, which a bound must not)."""
+    accuracy 1e-8)."""
+    return relative_steps([E], R)[0]
+
+
+def relative_steps(Es: list, R: np.ndarray) -> list:
+    """:func:`relative_step` of each of ``Es`` against one R, its Cholesky factor made once."""
     L, info = lapack.dpotrf(np.asarray(R, float), lower=1, clean=1)
     if info:
-        return float(np.inf)
-    if len(R) <= RELATIVE_DENSE_MAX:
+        return [float(np.inf)] * len(Es)
+    return [_standard_form_norm(E, np.asfortranarray(L)) for E in Es]
+
+
+def _standard_form_norm(E: np.ndarray, L: np.ndarray) -> float:
+    if len(L) <= RELATIVE_DENSE_MAX:
         X = sla.solve_triangular(L, E, lower=True)
         X = sla.solve_triangular(L, X.T, lower=True)
         return float(np.max(np.abs(np.linalg.eigvalsh((X + X.T) / 2.0))))
 
-    def apply(x):
-        y = sla.solve_triangular(L, x, lower=True, trans="T")
-        return sla.solve_triangular(L, E @ y, lower=True)
+    def apply(x):  # L⁻¹ E L⁻ᵀ x by two BLAS triangular solves (no copies, no finiteness checks)
+        y = blas.dtrsv(L, x, lower=1, trans=1)
+        return blas.dtrsv(L, E @ y, lower=1)
 
-    n = len(R)
+    n = len(L)
     op = spla.LinearOperator((n, n), matvec=apply, dtype=float)
     start = np.ones(n) / np.sqrt(n)  # a fixed start: the estimate is reproducible
     return float(abs(spla.eigsh(op, k=1, which="LM", tol=1e-8, v0=start, return_eigenvectors=False)[0]))
 
 
-RELATIVE_DENSE_MAX = 1500
-"""Largest order for which :func:`relative_step` forms the standard form and all its eigenvalues
-(about 1 s at this order on one core); above it Lanczos."""
+RELATIVE_DENSE_MAX = 400
+"""Largest order for which :func:`relative_step` forms the standard form and all its eigenvalues;
+above it Lanczos (at order 1,500 the dense route took 0.7 s a step, 176 s of a k = 2, N = 20
+face request's 445; Lanczos needs a few dozen O(n²) products)."""
 
 
 NORM2_DENSE_MAX = 400

@@ -76,11 +76,32 @@ def check_face_studies(fc, model_name: str, options) -> None:
             raise ConfigError(f"face.alpha.elements[{i}]", "not a face element with a transformed dual basis",
                               got=element, allowed=", ".join(transformed))
     ed = fc["edge_dropping"]
+    _check_edge_dropping(fc, ed)
     kept = sorted(t for t in ed["theta"] if t <= ed["fit_theta_max"])
     if len(kept) < 3:
         raise ConfigError("face.edge_dropping.fit_theta_max", "keeps fewer than 3 of face.edge_dropping.theta "
                           "(a slope fit needs 3)", got=ed["fit_theta_max"],
                           allowed=f">= {sorted(ed['theta'])[2]}" if len(ed["theta"]) >= 3 else "more θ")
+
+
+def _check_edge_dropping(fc, ed) -> None:
+    """Each θ is one the geometry resolves at the largest N (a narrower cut column was dropped
+    whole: θ = 1e-12 computed θ = 0), and each k has an edge case among ``face.cases`` (a k
+    without one computed nothing)."""
+    from .discretization.clipped_face import SLIVER_MIN, edge_cases, min_covered_fraction
+
+    n = max(ed["N"])
+    for i, theta in enumerate(ed["theta"]):
+        if not min_covered_fraction(n) <= theta <= 1.0:
+            raise ConfigError(f"face.edge_dropping.theta[{i}]", f"a covered fraction the geometry resolves at "
+                              f"N = {n} (the cut column, θ/N wide, at least {SLIVER_MIN:g})", got=theta,
+                              allowed=f"{min_covered_fraction(n):g} <= θ <= 1")
+    for i, k in enumerate(ed["k"]):
+        run = [c for c in edge_cases(k) if c in fc["cases"]]
+        if not run:
+            raise ConfigError(f"face.edge_dropping.k[{i}]", f"k = {k} has no edge case among face.cases "
+                              "(nothing would be computed)", got=k,
+                              allowed=f"k with one of face.cases in {', '.join(edge_cases(k)) or 'none'}")
 
 
 def _check_face_families(fc) -> None:

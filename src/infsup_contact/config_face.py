@@ -50,7 +50,7 @@ def check_face(cfg) -> None:
             raise ConfigError(f"face.nonmatching[{i}]", "a non-matching pair needs N1 != N2", got=pair,
                               allowed="[N1, N2] with N1 != N2 (matching meshes go under face.N)")
     _check_face_families(fc)
-    _check_face_cases(cfg, fc)
+    _check_face_cases(cfg, fc, options)
     check_face_studies(fc, model.name, options)
 
 
@@ -166,20 +166,29 @@ def face_pairs(fc, element: str) -> list:
     return list(dict.fromkeys(capped + family_pairs(fc, element)))
 
 
-def _check_face_cases(cfg, fc) -> None:
-    from .discretization.square import CELL_SHAPES, Square
+def _check_face_cases(cfg, fc, options) -> None:
+    """Each face case is built by the face of one of the configured elements (``face.elements``
+    or ``face.patch.elements``): a space no configured element carries (PWLIN-T6 with hexahedra
+    only) was accepted and silently never computed."""
+    from .study.face_claims import element_interfaces
 
-    check_face_case_ids(cfg, "face", fc["cases"], fc["k"], [Square(cell=c) for c in CELL_SHAPES])
+    patch = [e for e in fc["patch"]["elements"] if e in options]  # the others: check_face_studies
+    elements = list(dict.fromkeys([*fc["elements"], *patch]))
+    check_face_case_ids(cfg, "face", fc["cases"], fc["k"], element_interfaces(fc["model"], elements),
+                        need_builder=True)
 
 
 def check_face_case_ids(cfg, section: str, cases, ks_config, faces, need_builder: bool = False) -> None:
     """Each id of ``<section>.cases``: registered, defined for one of ``<section>.k``, and built
-    on every face of ``faces`` that builds it; ``need_builder``: at least one face must."""
+    on every face of ``faces`` (a list, or element → face) that builds it; ``need_builder``: at
+    least one face must (the error names the elements and the ids their faces build)."""
     from .discretization.user_spaces import config_case_ids
     from .discretization.registry import SPACES
     from .discretization.square import SQUARE, TensorPartition
 
     ids = config_case_ids(cfg, gamma_dim=SQUARE.dim)
+    names = list(faces) if isinstance(faces, dict) else None
+    faces = list(faces.values()) if isinstance(faces, dict) else list(faces)
     x = np.linspace(0.0, 1.0, 3)
     for i, case in enumerate(cases):
         key = f"{section}.cases[{i}]"
@@ -192,8 +201,11 @@ def check_face_case_ids(cfg, section: str, cases, ks_config, faces, need_builder
                               allowed=f"k >= {spec.min_k} in {section}.k")
         builders = [g for g in faces if g.builds(spec)]  # the faces of the cells it is defined on
         if need_builder and not builders:
-            raise ConfigError(key, f"{case} is built by the face of none of the elements", got=case,
-                              allowed="a space of the listed elements' faces")
+            carried = [c for c in ids if any(SPACES[c].valid_for(k) for k in ks_config)
+                       and any(g.builds(SPACES[c]) for g in faces)]
+            where = f"the elements {', '.join(names)}" if names else "the elements"
+            raise ConfigError(key, f"{case} is built by the face of none of {where} (it would never be computed)",
+                              got=case, allowed=", ".join(carried) or "none")
         try:
             for gamma in builders:
                 gamma.space(spec, ks[0], TensorPartition(x, x))

@@ -102,6 +102,6 @@ def test_lambda_values_of_a_saved_reference(tmp_path):
     from infsup_contact.study.scenes import membranes
 
     sol = solve_contact(membranes(), "T3", 1, "structured", 4, 4, time_floor=False)
-    save_reference(tmp_path / "ref.pkl", sol)
+    save_reference(tmp_path / "ref.npz", sol)
     x = np.linspace(0.1, 0.9, 5)
-    assert np.array_equal(lambda_values(load_reference(tmp_path / "ref.pkl"), x), sol.pressure(x))
+    assert np.array_equal(lambda_values(load_reference(tmp_path / "ref.npz"), x), sol.pressure(x))

@@ -402,3 +402,72 @@ def test_every_table_is_read_through_the_check():
     plain = re.compile(r"read_csv\(|pd\.read_table\(|read_fwf\(|csv\.(reader|DictReader)\(|loadtxt\(|genfromtxt\(")
     offenders = [str(p.relative_to(ROOT)) for p in sorted(code) if p.name != "io.py" and plain.search(p.read_text())]
     assert not offenders, f"read tables with io.read_table (via _glue.read_table): {offenders}"
+
+
+# ------------------------------------------------------------------ issue 39, item 5.4: flags a request does not use
+UNUSED = [  # (argv, flag, who uses it)
+    (["contact", "--model", "elastic", "--scene", "patch", "--case", "T3", "--k", "2", "--N1", "5", "--N2", "4",
+      "--p", "7"], "--p", "--scene manufactured"),
+    (["contact", "--model", "elastic", "--scene", "patch", "--case", "T3", "--k", "2", "--N1", "5", "--N2", "4",
+      "--q", "3"], "--q", "--scene manufactured"),                     # its default value, typed: still unused
+    (["contact", "--model", "elastic", "--scene", "patch", "--case", "T3", "--k", "2", "--N1", "5", "--N2", "4",
+      "--n-ref", "10"], "--n-ref", "--scene membranes"),
+    (["contact", "--scene", "manufactured", "--case", "T3", "--k", "1", "--N1", "4", "--N2", "4", "--n-r", "64"],
+     "--n-ref", "--scene membranes"),                                  # abbreviated
+    (["contact", "--scene", "manufactured", "--case", "T3", "--k", "1", "--N1", "4", "--N2", "4", "--R", "1"],
+     "--R", "--scene hertz"),
+    (["beta", "--k", "1", "--N1", "4", "--N2", "4", "--alpha", "0.1"], "--alpha", "--family perturbed"),
+    (["beta", "--k", "1", "--N1", "4", "--N2", "4", "--seed=3"], "--seed", "--family perturbed"),
+    (["beta", "--model", "membranes3d", "--case", "T3", "--k", "1", "--N1", "2", "--N2", "2", "--alpha", "0.1"],
+     "--alpha", "--family perturbed"),
+    (["beta", "--model", "membranes3d", "--case", "T3", "--k", "1", "--N1", "2", "--N2", "2", "--h-route", "series"],
+     "--h-route", "2D model"),
+    (["beta", "--k", "1", "--N1", "4", "--N2", "4", "--norm", "L2", "--h-route", "series"], "--h-route", "--norm H"),
+    (["beta", "--k", "1", "--N1", "4", "--N2", "4", "--nu", "0.3"], "--nu", "--model elastic"),
+    (["export", "--case", "T3", "--k", "1", "--N", "4", "--out", "x", "--element", "hex"], "--element",
+     "--model membranes3d"),
+    (["verdict", "--case", "T3", "--k", "1", "--element", "hex"], "--element", "--model membranes3d"),
+    (["bench", "--what", "beta", "--N", "4", "--k", "1", "--peers", "osqp"], "--peers", "--what contact"),
+    (["bench", "--what", "beta", "--N", "4", "--k", "1", "--kkt-max-N", "64"], "--kkt-max-N", "--what contact"),
+    (["bench", "--what", "contact", "--N", "4", "--k", "1", "--dense-max-size", "2500"], "--dense-max-size",
+     "--what beta"),
+    (["bench", "--what", "face", "--N", "2", "--k", "1", "--eigsh-max-N", "4"], "--eigsh-max-N", "--what beta"),
+    (["bench", "--what", "contact", "--N", "4", "--k", "1", "--element", "hex"], "--element", "--what face"),
+]
+
+
+@pytest.mark.parametrize("argv, flag, users", UNUSED, ids=[f"{a[0]}-{f}-{i}" for i, (a, f, _) in enumerate(UNUSED)])
+def test_a_flag_the_request_does_not_use_is_refused(argv, flag, users):
+    """One rule (cli/common.refuse_unused) for every subcommand: a flag the request does not use
+    is one line naming the flag, who uses it and the request, exit 2 (they were accepted and
+    ignored: --p/--q/--n-ref for the elastic patch scene, --alpha/--seed without --family
+    perturbed, in 3D too, while --R outside Hertz was refused)."""
+    code, out, err = run_in_process([*argv, "--dry-run"])
+    assert code == 2 and out == "" and len(err.splitlines()) == 1, (code, out, err)
+    assert err.startswith(f"infsup-contact: error: invalid {flag} (got ") and "used only by" in err, err
+    assert users in err and "this request:" in err, err
+
+
+@pytest.mark.parametrize("argv", [
+    ["contact", "--scene", "manufactured", "--case", "T3", "--k", "1", "--N1", "4", "--N2", "4", "--p", "3", "--q", "3"],
+    ["contact", "--scene", "membranes", "--case", "T3", "--k", "1", "--N1", "4", "--N2", "4", "--n-ref", "16"],
+    ["contact", "--model", "elastic", "--scene", "hertz", "--case", "T4", "--k", "2", "--N1", "8", "--N2", "8",
+     "--R", "1", "--d", "0.05", "--nu", "0.3"],
+    ["beta", "--k", "1", "--N1", "4", "--N2", "4", "--family", "perturbed", "--seed", "3", "--alpha", "0.1"],
+    ["beta", "--model", "membranes3d", "--case", "T3", "--k", "2", "--N1", "4", "--N2", "4", "--element", "tet",
+     "--family", "perturbed", "--seed", "3"],
+    ["beta", "--k", "1", "--N1", "4", "--N2", "4", "--norm", "H", "--h-route", "series"],
+    ["bench", "--what", "beta", "--N", "4", "--k", "1", "--eigsh-max-N", "2", "--dense-max-size", "2500"],
+    ["bench", "--what", "contact", "--N", "4", "--k", "1", "--peers", "osqp", "clarabel", "--kkt-max-N", "64"],
+    ["bench", "--what", "face", "--N", "2", "--k", "1", "--element", "tet"],
+])
+def test_a_flag_the_request_uses_is_accepted(argv):
+    code, out, err = run_in_process([*argv, "--dry-run"])
+    assert code == 0 and out.startswith("dry run: valid request"), (code, out, err)
+
+
+def test_every_subcommand_declares_its_conditional_flags():
+    """The rule is applied to every computing subcommand: each declares its flag uses (rates: none)."""
+    for command, parser in subcommands().items():
+        if command != "provenance":
+            assert "flag_uses" in parser._defaults, command

@@ -120,3 +120,77 @@ def test_cases_sharing_one_pair_solve_as_if_alone():
         for a, b in zip(shared.u, alone.u):
             assert np.array_equal(a.vec.FV().NumPy(), b.vec.FV().NumPy())
         assert shared.t_solve >= pair.seconds
+
+
+# ------------------------------------------------------------------ issue 39, item 5.5: references never pickled
+def test_a_saved_reference_measures_exactly_as_the_solved_one(tmp_path):
+    """save_reference writes plain arrays (.npz): the errors against the loaded reference equal,
+    bit for bit, those against the solved one, and it reads with allow_pickle=False."""
+    from infsup_contact.study import accuracy
+    from infsup_contact.study.contact_rows import load_reference, save_reference
+
+    sc = membranes(c1=1.0, c2=2.0)
+    ref = solve_contact(sc, "T3", 2, "structured", 8, 8, time_floor=False)
+    coarse = solve_contact(sc, "T4", 2, "structured", 4, 4, time_floor=False)
+    save_reference(tmp_path / "ref.npz", ref)
+    with np.load(tmp_path / "ref.npz", allow_pickle=False) as data:
+        assert all(data[key].dtype != object for key in data.files)
+    loaded = load_reference(tmp_path / "ref.npz")
+
+    def errors(reference):
+        return (*accuracy.energy_and_l2_vs_reference(coarse, reference),
+                *accuracy.lambda_errors_vs_reference(coarse, reference),
+                accuracy.contact_set_error_vs_reference(coarse, reference))
+
+    assert errors(loaded) == errors(ref)
+
+
+def _planted(path, marker):
+    """A file whose unpickling runs code (touches ``marker``)."""
+    import os
+    import pickle
+
+    class Payload:
+        def __reduce__(self):
+            return (os.system, (f"touch {marker}",))
+
+    path.write_bytes(pickle.dumps(Payload()))
+
+
+@pytest.mark.parametrize("how", ["pickle", "object-array-npz", "npy", "truncated", "missing", "wrong-shape"])
+def test_a_planted_or_damaged_reference_is_refused_unread(tmp_path, how):
+    """The references were pickles: a planted one ran its code on the next rerun. Now a pickle
+    payload (as the file, or as an object array inside an .npz) is refused without being
+    unpickled, as is any other file that is not a reference: one line naming the file."""
+    import pickle
+
+    from infsup_contact.errors import InputError
+    from infsup_contact.study.contact_rows import load_reference, save_reference
+
+    marker, path = tmp_path / "code-ran", tmp_path / "membranes_k1.npz"
+    if how == "pickle":
+        _planted(path, marker)
+    elif how == "object-array-npz":
+        payload = tmp_path / "p.pickle"
+        _planted(payload, marker)
+        obj = np.empty(1, dtype=object)
+        obj[0] = pickle.loads  # never called: the point is an object array holding a pickle
+        np.savez(path, format=np.array("infsup-contact reference 1"), lam=obj)
+    elif how == "npy":
+        np.save(tmp_path / "a.npy", np.ones(3))
+        path = tmp_path / "a.npy"
+    elif how in ("truncated", "wrong-shape"):
+        ref = solve_contact(membranes(), "T3", 1, "structured", 4, 4, time_floor=False)
+        save_reference(path, ref)
+        if how == "truncated":
+            path.write_bytes(path.read_bytes()[:200])
+        else:
+            with np.load(path, allow_pickle=False) as data:
+                entries = {k: data[k] for k in data.files}
+            entries["lam"] = entries["lam"][:-1]
+            np.savez(path, **entries)
+    with pytest.raises(InputError) as err:
+        load_reference(path)
+    line = str(err.value)
+    assert err.value.key == "reference" and str(path) in line and "\n" not in line, line
+    assert not marker.exists(), "the planted code ran"

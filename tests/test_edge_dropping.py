@@ -230,3 +230,48 @@ def test_h_cap_bounds_the_series():
     large = edge_row("R5.4", 1, 2, 4, 0.05, norms=("H",), h_cap=4096)
     assert small["n_max"] <= 64 and small["h_capped"]
     assert large["n_max"] > 64 and large["h_rel_error"] < small["h_rel_error"]
+
+
+# ------------------------------------------------------------------ issue 39, item 5: never θ = 0 silently
+def test_theta_below_the_geometry_is_refused():
+    """θ = 1e-12 at N = 4 used to drop the cut column whole (dim M 20 instead of 25): β_H 0.55, the
+    θ = 0 space, instead of ~θ. Now refused naming theta and the range; the smallest θ allowed
+    keeps the column."""
+    from infsup_contact.discretization.clipped_face import min_covered_fraction
+    from infsup_contact.study.edge_dropping import edge_plan
+
+    for call in (lambda: edge_row("R5.2", 1, 4, 8, 1e-12), lambda: edge_plan([1], [4], [1.0, 1e-12])):
+        with pytest.raises(InputError) as err:
+            call()
+        assert err.value.key == "theta" and "4e-09 <= θ <= 1" in str(err.value), err.value
+    full = _face("R5.2", 1, 4)
+    for theta in (min_covered_fraction(4), 1e-6, 0.01):
+        assert ClippedFace.of(full, geometry(4, 8, theta)[0]).dim == full.dim   # nothing dropped
+
+
+@pytest.mark.parametrize("module, argv, flag, allowed", [
+    ("edge_dropping", ["--k", "5", "--N", "4"], "--k", "1, 2, 3, 4"),          # was: a header, exit 0
+    ("edge_dropping", ["--k", "1", "--N", "4", "--theta", "0.5", "1e-12"], "--theta", "4e-09 <= θ <= 1"),
+    ("edge_dropping", ["--k", "2", "--N", "4", "--case", "PWLIN-T6"], "--case", "T3, R5.2"),
+    ("edge_dropping", ["--k", "1", "--N", "0"], "--N", ">= 1"),                # was: a traceback
+    ("edge_dropping", ["--k", "1", "--N", "4", "--n2-factor", "0"], "--n2-factor", ">= 1"),
+    ("edge_dropping", ["--k", "1", "--N", "4", "--norm", "X"], "--norm", "'H', 'L2'"),
+    ("face_alpha", ["--N", "0"], "--N", ">= 1"),
+    ("face_families", ["--k", "5"], "--k", "1..4"),
+    ("face_families", ["--element", "bogus"], "--element", "hex, tet"),
+    ("machines", [], "out_dir", "required"),
+])
+def test_study_command_lines_refuse_in_one_line(module, argv, flag, allowed, capsys):
+    """Every study module's ``python -m`` command: impossible input is one line naming the flag
+    and the allowed values, exit 2, nothing on stdout (never a header only, never a traceback)."""
+    import importlib
+
+    mod = importlib.import_module(f"infsup_contact.study.{module}")
+    entry = mod.cli if module == "machines" else mod.main
+    try:
+        code = entry(argv)
+    except SystemExit as exc:  # argparse's own refusals
+        code = exc.code
+    out, err = capsys.readouterr()
+    assert code == 2 and out == "" and len(err.strip().splitlines()) == 1, (code, out, err)
+    assert flag in err and allowed in err and "Traceback" not in err, err

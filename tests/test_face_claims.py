@@ -221,3 +221,25 @@ def test_kuhn_faces_predict_fail_where_the_triangle_bound_exceeds_the_count():
     assert face_predictions(r52, 1, [(4, 5)], False, SQUARE_TRIG)["nonmatching"] == FINDING
     assert face_predictions(r52, 1, [(4, 5), (6, 7)], False, SQUARE_TRIG)["nonmatching"] == FAIL
     assert face_predictions(SPACES["T3"], 1, [(4, 5)], False, SQUARE_TRIG)["nonmatching"] == PASS
+
+
+@pytest.mark.parametrize("patch, refused", [(["hex"], True), (["hex", "tet"], False)])
+def test_face_case_no_configured_element_carries_is_refused(patch, refused):
+    """Issue 39, item 5.3: PWLIN-T6 (a triangle-face space) listed for the face while only
+    hexahedra are configured was accepted and silently never computed. Refused, naming the key,
+    the elements and the spaces their faces build; computed (accepted) where the patch test's
+    tetrahedra carry it."""
+    from infsup_contact.config_checks import ConfigError, check_config
+
+    cfg = copy.deepcopy(_ci())
+    cfg["face"]["cases"] = [*cfg["face"]["cases"], "PWLIN-T6"]
+    cfg["face"]["patch"]["elements"] = patch
+    schema = ROOT / "workflow" / "schemas" / "config.schema.yaml"
+    if not refused:
+        check_config(cfg, schema)
+        return
+    with pytest.raises(ConfigError) as err:
+        check_config(cfg, schema)
+    line = str(err.value)
+    assert line.startswith(f"config key face.cases[{len(cfg['face']['cases']) - 1}]: PWLIN-T6 is built by the face "
+                           "of none of the elements hex") and "allowed T3, R5.2" in line and "PWLIN-Q9" in line, line

@@ -469,3 +469,20 @@ def test_user_space_empty_on_small_n(tmp_path, capsys):
     with pytest.raises(ConfigError) as err:
         check_config(cfg, SCHEMA)
     assert one_line(err.value).startswith("config key infsup.N[0]: case U-small with k = 1 has dim M_h = 0")
+
+
+# ------------------------------------------------------------------ issue 39, item 5: edge dropping in the config
+@pytest.mark.parametrize("mutate, key, needle", [
+    (lambda ed, fc: ed.update(theta=[1.0, 0.05, 0.03, 0.02, 0.015, 1e-12]), "face.edge_dropping.theta[5]",
+     "allowed 4e-09 <= θ <= 1"),
+    (lambda ed, fc: fc.update(cases=["T3", "T4", "T5", "DUAL"]), "face.edge_dropping.k[0]",
+     "k = 1 has no edge case among face.cases"),
+])
+def test_edge_dropping_config_is_refused_not_computed_as_garbage(mutate, key, needle):
+    """θ below what the geometry resolves computed θ = 0 and turned the decay claims into FAIL;
+    a k without an edge case among face.cases computed nothing. Both refused, naming the key."""
+    cfg = copy.deepcopy(CI_CONFIG)
+    mutate(cfg["face"]["edge_dropping"], cfg["face"])
+    with pytest.raises(ConfigError) as err:
+        check_config(cfg, SCHEMA)
+    assert one_line(err.value).startswith(f"config key {key}") and needle in one_line(err.value), err.value

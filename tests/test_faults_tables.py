@@ -344,3 +344,67 @@ def test_ctrl_c_is_one_line_and_exit_130():
     assert proc.returncode == 130, err
     assert_one_line(err, "interrupted")
     assert out == ""
+
+
+# ------------------------------------------------------------------ the CI gate (issue 39, item 5)
+from infsup_contact.study.claims_gate import GateError, gate  # noqa: E402
+
+
+def _ledger(rows) -> pd.DataFrame:
+    return pd.DataFrame([dict(claim_id=c, paper_ref="Thm 3", statement="s", evidence="e", verdict=v, predicted=p)
+                         for c, v, p in rows])
+
+
+def gate_files(tmp_path, rows=(("a", "PASS", "PASS"), ("b", "FAIL", "FAIL"), ("c", "FAIL", "finding"))):
+    """A contact table, two ledger tables and the ledger, written in that order (mtimes rising)."""
+    files = {"contact": tmp_path / "contact.csv", "rates": tmp_path / "rates.csv",
+             "extra": tmp_path / "extra.csv", "ledger": tmp_path / "claims.csv"}
+    frames = {"contact": valid_table("contact"), "rates": valid_table("rates"),
+              "extra": _ledger([("x", "PASS", "PASS")]), "ledger": _ledger(rows)}
+    for i, (name, path) in enumerate(files.items()):
+        write(path, frames[name])
+        os.utime(path, ns=(10**18 + i * 10**9, 10**18 + i * 10**9))
+    stages = [(str(files["ledger"]), {str(files["rates"]): "rates", str(files["extra"]): "claims"}),
+              (str(files["rates"]), {str(files["contact"]): "contact"})]
+    return files, stages
+
+
+def test_gate_passes_a_fresh_ledger_with_every_claim_as_predicted(tmp_path):
+    files, stages = gate_files(tmp_path)
+    frame, summary = gate(files["ledger"], stages)
+    assert len(frame) == 3 and summary.startswith("verify-claims: 2 claims as predicted, 1 findings")
+
+
+@pytest.mark.parametrize("fault", ["ledger deleted", "rates deleted", "contact damaged", "ledger stale",
+                                   "rates stale", "ledger damaged"])
+def test_gate_refuses_a_missing_damaged_or_stale_ledger(tmp_path, fault):
+    """Issue 39, item 5.1: a deleted ledger, a table a failed rerun removed or refused, or a
+    ledger older than its tables is refused with one line naming the file."""
+    files, stages = gate_files(tmp_path)
+    target = files[fault.split()[0]]
+    if fault.endswith("deleted"):
+        target.unlink()
+    elif fault.endswith("damaged"):
+        target.write_text(truncate_mid_row(target.read_text(), ",")[0])
+    else:  # a source rewritten after its product: the product was not rebuilt
+        source = {"ledger": files["rates"], "rates": files["contact"]}[fault.split()[0]]
+        os.utime(source, ns=(2 * 10**18, 2 * 10**18))
+    with pytest.raises((GateError, TableError)) as err:
+        gate(files["ledger"], stages)
+    line = str(err.value)
+    assert "\n" not in line and (str(target) in line or (fault.endswith("stale") and "older than" in line)), line
+
+
+@pytest.mark.parametrize("rows, needle", [
+    ((("a", "FAIL", "PASS"),), "a (FAIL, predicted PASS)"),            # a claim FAIL is never exit 0
+    ((("a", "INCONCLUSIVE", "PASS"),), "a (INCONCLUSIVE, predicted PASS)"),
+    ((("a", "PASS", "PASS"), ("b", "INCONCLUSIVE", "FAIL")), "b (INCONCLUSIVE, predicted FAIL)"),
+    ((("a", "FAIL", "finding"),), "no claim with a predicted verdict"),  # nothing checked is no pass
+    ((("a", "pass", "PASS"),), "verdict 'pass'"),
+    ((("a", "FAIL", "PASS "),), "predicted 'PASS '"),                      # not silently a finding
+])
+def test_gate_fails_on_a_claim_not_as_predicted(tmp_path, rows, needle):
+    files, stages = gate_files(tmp_path, rows)
+    with pytest.raises(GateError) as err:
+        gate(files["ledger"], stages)
+    assert needle in str(err.value), err.value

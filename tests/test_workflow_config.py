@@ -253,3 +253,40 @@ def test_default_profile_provides_cores(workdir):
     assert rc != 0
     # Snakemake words it either way, depending on whether a rule sizes threads by cores
     assert "cores have to be specified" in out or "requires a total number of cores" in out, out
+
+
+# --------------------------------------------------------------- the CI gate (issue 39, item 5)
+
+# what the ledger is made of on config/ci.yaml (workflow/rules/claims.smk: GATE_STAGES), oldest first
+GATE_FILES = ["results/tables/contact.csv",
+              *(f"results/tables/{t}.csv" for t in ("beta", "rates", "claims_extra", "elastic_claims", "face_claims",
+                                                   "face_study_claims", "face_elastic_claims")),
+              "results/claims.csv",
+              "results/benchmarks/rules/verify_claims.tsv"]  # an earlier gate's benchmark file
+
+
+def _jobs(out: str) -> set:
+    """The rule names of a dry run's job stats."""
+    stats = out.split("Job stats:")[1].split("total")[0]
+    return {line.split()[0] for line in stats.splitlines()[3:] if line.strip()}
+
+
+def test_verify_claims_gate_always_runs_and_needs_every_table(workdir):
+    """The gate has no output (and no benchmark file): it always runs, and its inputs are the
+    ledger and the tables it is made of. Before, with its benchmark file present it could say
+    "Nothing to be done" after results/claims.csv was deleted, and with the ledger present a
+    rates table removed by a failed rerun was never rebuilt: the stale ledger passed."""
+    newest = max(p.stat().st_mtime for p in (ROOT / "src" / "infsup_contact").rglob("*.py"))
+    stamp = max(time.time(), newest + 1)
+    for i, rel in enumerate(GATE_FILES):
+        path = workdir / rel
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_text("")
+        os.utime(path, (stamp + i, stamp + i))
+    rc, out = snakemake(workdir, "-n", "verify-claims", "--profile", "profiles/ci")
+    assert rc == 0, out
+    assert _jobs(out) == {"verify-claims"}, out          # up to date: only the gate, and it does run
+    (workdir / "results" / "tables" / "rates.csv").unlink()  # a failed rerun removed it
+    rc, out = snakemake(workdir, "-n", "verify-claims", "--profile", "profiles/ci")
+    assert rc == 0, out
+    assert {"rates", "claims", "verify-claims"} <= _jobs(out), out

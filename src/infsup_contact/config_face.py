@@ -50,7 +50,7 @@ def check_face(cfg) -> None:
             raise ConfigError(f"face.nonmatching[{i}]", "a non-matching pair needs N1 != N2", got=pair,
                               allowed="[N1, N2] with N1 != N2 (matching meshes go under face.N)")
     _check_face_families(fc)
-    _check_face_cases(cfg, fc)
+    _check_face_cases(cfg, fc, options)
     check_face_studies(fc, model.name, options)
 
 
@@ -76,11 +76,32 @@ def check_face_studies(fc, model_name: str, options) -> None:
             raise ConfigError(f"face.alpha.elements[{i}]", "not a face element with a transformed dual basis",
                               got=element, allowed=", ".join(transformed))
     ed = fc["edge_dropping"]
+    _check_edge_dropping(fc, ed)
     kept = sorted(t for t in ed["theta"] if t <= ed["fit_theta_max"])
     if len(kept) < 3:
         raise ConfigError("face.edge_dropping.fit_theta_max", "keeps fewer than 3 of face.edge_dropping.theta "
                           "(a slope fit needs 3)", got=ed["fit_theta_max"],
                           allowed=f">= {sorted(ed['theta'])[2]}" if len(ed["theta"]) >= 3 else "more θ")
+
+
+def _check_edge_dropping(fc, ed) -> None:
+    """Each θ is one the geometry resolves at the largest N (a narrower cut column was dropped
+    whole: θ = 1e-12 computed θ = 0), and each k has an edge case among ``face.cases`` (a k
+    without one computed nothing)."""
+    from .discretization.clipped_face import SLIVER_MIN, edge_cases, min_covered_fraction
+
+    n = max(ed["N"])
+    for i, theta in enumerate(ed["theta"]):
+        if not min_covered_fraction(n) <= theta <= 1.0:
+            raise ConfigError(f"face.edge_dropping.theta[{i}]", f"a covered fraction the geometry resolves at "
+                              f"N = {n} (the cut column, θ/N wide, at least {SLIVER_MIN:g})", got=theta,
+                              allowed=f"{min_covered_fraction(n):g} <= θ <= 1")
+    for i, k in enumerate(ed["k"]):
+        run = [c for c in edge_cases(k) if c in fc["cases"]]
+        if not run:
+            raise ConfigError(f"face.edge_dropping.k[{i}]", f"k = {k} has no edge case among face.cases "
+                              "(nothing would be computed)", got=k,
+                              allowed=f"k with one of face.cases in {', '.join(edge_cases(k)) or 'none'}")
 
 
 def _check_face_families(fc) -> None:
@@ -145,20 +166,29 @@ def face_pairs(fc, element: str) -> list:
     return list(dict.fromkeys(capped + family_pairs(fc, element)))
 
 
-def _check_face_cases(cfg, fc) -> None:
-    from .discretization.square import CELL_SHAPES, Square
+def _check_face_cases(cfg, fc, options) -> None:
+    """Each face case is built by the face of one of the configured elements (``face.elements``
+    or ``face.patch.elements``): a space no configured element carries (PWLIN-T6 with hexahedra
+    only) was accepted and silently never computed."""
+    from .study.face_claims import element_interfaces
 
-    check_face_case_ids(cfg, "face", fc["cases"], fc["k"], [Square(cell=c) for c in CELL_SHAPES])
+    patch = [e for e in fc["patch"]["elements"] if e in options]  # the others: check_face_studies
+    elements = list(dict.fromkeys([*fc["elements"], *patch]))
+    check_face_case_ids(cfg, "face", fc["cases"], fc["k"], element_interfaces(fc["model"], elements),
+                        need_builder=True)
 
 
 def check_face_case_ids(cfg, section: str, cases, ks_config, faces, need_builder: bool = False) -> None:
     """Each id of ``<section>.cases``: registered, defined for one of ``<section>.k``, and built
-    on every face of ``faces`` that builds it; ``need_builder``: at least one face must."""
+    on every face of ``faces`` (a list, or element → face) that builds it; ``need_builder``: at
+    least one face must (the error names the elements and the ids their faces build)."""
     from .discretization.user_spaces import config_case_ids
     from .discretization.registry import SPACES
     from .discretization.square import SQUARE, TensorPartition
 
     ids = config_case_ids(cfg, gamma_dim=SQUARE.dim)
+    names = list(faces) if isinstance(faces, dict) else None
+    faces = list(faces.values()) if isinstance(faces, dict) else list(faces)
     x = np.linspace(0.0, 1.0, 3)
     for i, case in enumerate(cases):
         key = f"{section}.cases[{i}]"
@@ -171,8 +201,11 @@ def check_face_case_ids(cfg, section: str, cases, ks_config, faces, need_builder
                               allowed=f"k >= {spec.min_k} in {section}.k")
         builders = [g for g in faces if g.builds(spec)]  # the faces of the cells it is defined on
         if need_builder and not builders:
-            raise ConfigError(key, f"{case} is built by the face of none of the elements", got=case,
-                              allowed="a space of the listed elements' faces")
+            carried = [c for c in ids if any(SPACES[c].valid_for(k) for k in ks_config)
+                       and any(g.builds(SPACES[c]) for g in faces)]
+            where = f"the elements {', '.join(names)}" if names else "the elements"
+            raise ConfigError(key, f"{case} is built by the face of none of {where} (it would never be computed)",
+                              got=case, allowed=", ".join(carried) or "none")
         try:
             for gamma in builders:
                 gamma.space(spec, ks[0], TensorPartition(x, x))

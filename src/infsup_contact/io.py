@@ -30,7 +30,7 @@ def write_atomic(path, text: str) -> None:
 
 
 def write_bytes_atomic(path, data: bytes) -> None:
-    """:func:`write_atomic` for bytes (a pickled reference solution)."""
+    """:func:`write_atomic` for bytes (a reference solution's ``.npz``)."""
     _replace_atomic(path, data, "wb")
 
 

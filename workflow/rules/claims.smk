@@ -18,6 +18,23 @@ rule claims_extra:
         "../scripts/claims_extra.py"
 
 
+# The tables the ledger is made of (rule claims below), each with the schema it reads under, and
+# one stage further up the contact table the rates are fitted on: the gate (verify-claims,
+# workflow/Snakefile) needs each of them, checks it and refuses a ledger older than them
+# (study/claims_gate.py).
+LEDGER_TABLES = {
+    "results/tables/beta.csv": "beta",
+    "results/tables/rates.csv": "rates",
+    "results/tables/claims_extra.csv": "claims",
+    "results/tables/elastic_claims.csv": "claims",
+    **{path: "claims" for path in FACE_CLAIMS},
+}
+GATE_STAGES = [
+    ("results/claims.csv", LEDGER_TABLES),
+    ("results/tables/rates.csv", {"results/tables/contact.csv": "contact"}),
+]
+
+
 rule claims:
     output:
         "results/claims.csv",

@@ -74,7 +74,7 @@ def contact_reference(wildcards):
     """The reference solve of this k (rule membranes_reference), for a scene measured against one."""
     if not scene_spec(config["contact"]["scenes"][wildcards.scene]["kind"]).needs_reference:
         return []
-    return [f"results/references/{wildcards.scene}_k{wildcards.k}.pickle"]
+    return [f"results/references/{wildcards.scene}_k{wildcards.k}.npz"]
 
 
 def beta_mem_mb(wildcards):

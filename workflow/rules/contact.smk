@@ -5,7 +5,7 @@
 
 rule membranes_reference:
     output:
-        "results/references/{scene}_k{k}.pickle",
+        "results/references/{scene}_k{k}.npz",
     input:
         PACKAGE_SOURCES,
     params:

@@ -3,7 +3,7 @@ membranes reference is read from its own job's output (rule membranes_reference)
 import sys
 
 sys.path.insert(0, "workflow/scripts")
-from _glue import add_provenance, limit_threads, log_to, register_user_spaces  # noqa: E402
+from _glue import add_provenance, fail, limit_threads, log_to, register_user_spaces  # noqa: E402
 
 limit_threads(snakemake.threads)  # noqa: F821
 log_to(snakemake.log[0])  # noqa: F821
@@ -19,7 +19,12 @@ k = int(wc.k)
 spec = cc["scenes"][wc.scene]
 kind, params = spec["kind"], {key: v for key, v in spec.items() if key not in ("kind", "N")}
 c1, c2 = cc["c"]
-ref = load_reference(snakemake.input.reference[0]) if snakemake.input.reference else None  # noqa: F821
+from infsup_contact.errors import InputError  # noqa: E402
+
+try:  # an .npz of plain arrays, read without pickle: a planted or damaged file is one line
+    ref = load_reference(snakemake.input.reference[0]) if snakemake.input.reference else None  # noqa: F821
+except InputError as err:
+    fail(f"contact_job.py: {err}")
 cases = [case for case, klist in cc["cases"].items() if k in klist]
 # one mesh pair (meshes, factorized sides, loads) per N, shared by every case
 rows = [row for n in snakemake.params.ns  # noqa: F821

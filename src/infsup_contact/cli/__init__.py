@@ -31,7 +31,7 @@ import sys
 from ..errors import InputError
 from ..io import TableError
 from . import beta, bench, contact, export, rates, verdict
-from .common import EXIT_INTERRUPTED, EXIT_OUTPUT, OutputError, check_stdout, write_text
+from .common import EXIT_INTERRUPTED, EXIT_OUTPUT, OutputError, check_stdout, given_dests, refuse_unused, write_text
 from .verdict import VERDICT_DEFAULTS
 
 __all__ = ["main", "build_parser", "validate", "flag_names", "VERDICT_DEFAULTS"]
@@ -88,11 +88,25 @@ def _message(err: Exception, parser, command: str) -> str:
     return text
 
 
+def parse(parser, argv):
+    """``parser.parse_args(argv)`` with ``args.given``, the flags typed (:func:`~.common.given_dests`)."""
+    args = parser.parse_args(argv)
+    args.given = given_dests(parser, argv)
+    return args
+
+
+def check(args):
+    """Every subcommand's validation: first the one rule for flags the request does not use
+    (:func:`~.common.refuse_unused`), then its own checks; the estimate (or None)."""
+    refuse_unused(args)
+    return args.check(args) if hasattr(args, "check") else None
+
+
 def validate(argv) -> tuple:
     """Parse and validate a command line without computing: ``(args, estimate)``; raises
     InputError/TableError (bad values) or SystemExit(2) (argparse: unknown flag, wrong type)."""
-    args = build_parser().parse_args(argv)
-    return args, (args.check(args) if hasattr(args, "check") else None)
+    args = parse(build_parser(), argv)
+    return args, check(args)
 
 
 def _say(line: str) -> None:
@@ -117,10 +131,10 @@ def main(argv=None) -> int:
 def _main(argv) -> int:
     _threads_default()
     parser = build_parser()
-    args = parser.parse_args(argv)
+    args = parse(parser, argv)
     try:
         check_stdout()  # before any computation: a result nobody can read is not computed
-        estimate = args.check(args) if hasattr(args, "check") else None  # before any computation
+        estimate = check(args)  # before any computation
         if getattr(args, "dry_run", False):
             from ..resources import available_bytes, human_bytes
 

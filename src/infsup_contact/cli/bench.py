@@ -2,7 +2,7 @@
 from __future__ import annotations
 
 from ..errors import InputError
-from .common import add_dry_run, check_memory, write_csv
+from .common import FlagUse, add_dry_run, check_memory, declare_flag_uses, write_csv
 
 
 def add(sub) -> None:
@@ -26,7 +26,18 @@ def add(sub) -> None:
     p.add_argument("--element", default=None,
                    help="face: the 3D bodies' elements (hex, tet; default hex)")
     add_dry_run(p)
+    declare_flag_uses(p, FLAG_USES)
     p.set_defaults(run=_run_bench, check=_check_bench)
+
+
+def _what(*whats):
+    return lambda args: args.what in whats
+
+
+FLAG_USES = [FlagUse(dest, _what(what), f"--what {what}", lambda a: f"--what {a.what}")
+             for dest, what in (("peers", "contact"), ("kkt_max_n", "contact"), ("eigsh_max_n", "beta"),
+                                ("dense_max_size", "beta"), ("element", "face"))]
+"""The flags of ``bench`` only one ``--what`` uses (:func:`~.common.refuse_unused`)."""
 
 
 def _check_bench(args):
@@ -44,8 +55,6 @@ def _check_bench(args):
 
     if args.what == "face":
         _check_face(args)
-    elif args.element is not None:
-        raise InputError("element", "nothing unless --what face (the 3D bodies' elements)", got=args.element)
     for k in args.k:  # every registered space defined for k: a superset of what the routes run
         for n in args.N:
             check_pair_spaces(ids_valid_for(k), k, n, n, key="N")
@@ -74,17 +83,13 @@ def _check_bench(args):
 
 
 def _check_face(args) -> None:
-    """``--what face``: the element is one of the 3D model's; the 2D-only flags are refused."""
+    """``--what face``: the element is one of the 3D model's (the 2D routes' flags were refused
+    before, :func:`~.common.refuse_unused`)."""
     from ..models.membranes3d import ELEMENTS
 
     args.element = ELEMENTS[0] if args.element is None else args.element
     if args.element not in ELEMENTS:
         raise InputError("element", ", ".join(ELEMENTS), got=args.element)
-    defaults = dict(peers=["osqp", "clarabel"], eigsh_max_n=None, kkt_max_n=64, dense_max_size=2500)
-    for key, default in defaults.items():
-        if getattr(args, key) != default:
-            raise InputError(key, f"its default with --what face (a flag of --what "
-                             f"{'contact' if key in ('peers', 'kkt_max_n') else 'beta'})", got=getattr(args, key))
 
 
 def _run_bench(args) -> None:

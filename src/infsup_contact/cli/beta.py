@@ -3,8 +3,8 @@ from __future__ import annotations
 
 import sys
 
-from .common import (material_columns, mesh_options, refuse_with_system, remember_defaults, add_dry_run, add_model, cases, face_cases,
-                     check_memory, material, norms, SPACE_HELP, write_csv)
+from .common import (FlagUse, declare_flag_uses, material_columns, mesh_options, model_flag_uses, system_flag_uses,
+                     add_dry_run, add_model, cases, face_cases, check_memory, material, norms, SPACE_HELP, write_csv)
 
 
 def add(sub) -> None:
@@ -44,8 +44,24 @@ def add(sub) -> None:
     p.add_argument("--seed", type=int, default=0, help="seed of the perturbed family (>= 0)")
     p.add_argument("--alpha", type=float, default=0.2, help="perturbation amplitude / h, in [0, 0.2] (larger can invert triangles)")
     add_dry_run(p)
-    remember_defaults(p)
+    declare_flag_uses(p, [*system_flag_uses(p), *FLAG_USES, *model_flag_uses()])
     p.set_defaults(run=_run_beta, check=_check_beta)
+
+
+def _model_dim(args) -> int:
+    from ..models import MODELS
+
+    return MODELS[args.model].dim
+
+
+FLAG_USES = [
+    FlagUse("seed", lambda a: a.family == "perturbed", "--family perturbed", lambda a: f"--family {a.family}"),
+    FlagUse("alpha", lambda a: a.family == "perturbed", "--family perturbed", lambda a: f"--family {a.family}"),
+    FlagUse("h_route", lambda a: _model_dim(a) == 2 and a.norm in ("H", "all"),
+            "the H norm (--norm H or all) of a 2D model (the face of a 3D model has one H route)",
+            lambda a: f"--model {a.model} --norm {a.norm}"),
+]
+"""The flags of ``beta`` only some requests use (:func:`~.common.refuse_unused`)."""
 
 
 def _check_beta(args):
@@ -59,7 +75,6 @@ def _check_beta(args):
         from ..systems.manifest import load_manifest
 
         args.manifest = load_manifest(args.system, min_levels=1)
-        refuse_with_system(args)
         est = dry_check(args.manifest)
         check_memory(est, "system", args.system)
         return est

@@ -2,6 +2,10 @@
 model and its material flags, the norms, --dry-run and the memory check."""
 from __future__ import annotations
 
+import argparse
+from dataclasses import dataclass
+from typing import Callable
+
 from ..errors import InputError
 
 
@@ -100,21 +104,18 @@ def _mesh_options() -> dict:
 
 
 def mesh_options(args) -> dict:
-    """The mesh keywords of a request for its model (``args.model_obj``), defaults filled in:
-    a mesh flag the model does not take is refused, naming the flag and the models that take it,
-    and so is a family the model's mesh builder does not build (``Model.families``)."""
+    """The mesh keywords of a request for its model (``args.model_obj``), defaults filled in; a
+    family the model's mesh builder does not build (``Model.families``) is refused (a mesh flag
+    the model does not take was refused before, :func:`refuse_unused`)."""
     model = args.model_obj
     if model.families is not None and getattr(args, "family", None) not in model.families:
         raise InputError("family", f"{', '.join(model.families)} (the meshes of --model {model.name})",
                          got=getattr(args, "family", None))
     own = dict(model.mesh_options)
     out = {}
-    for name, owners in _mesh_options().items():
+    for name in _mesh_options():
         given = getattr(args, name, None)
-        if name not in own:
-            if given is not None:
-                raise InputError(name, f"nothing for --model {model.name} (--{name} is for --model "
-                                 f"{', '.join(m for m, _ in owners)})", got=given)
+        if name not in own:  # another model's flag: refused before (refuse_unused)
             continue
         if given is not None and given not in own[name]:
             raise InputError(name, ", ".join(own[name]), got=given)
@@ -126,15 +127,10 @@ def material(args):
     """Resolve --model and its material flags from the model contract (``Model.params``): sets
     ``args.model_obj`` (built with the parameters of K_i, e.g. ν), ``args.c1``, ``args.c2``
     (the sides' scales under the model's names, e.g. c_i = E_i) and each parameter's
-    attribute. A flag the model does not have is refused, naming the flag and the model's."""
+    attribute. A flag the model does not have was refused before (:func:`refuse_unused`)."""
     from ..models import MODELS, make_model
 
-    model = MODELS[args.model]
-    own = model.param_names()
-    for name in _material_params():
-        if name not in own and getattr(args, name, None) is not None:
-            raise InputError(name, f"one of the material flags of --model {model.name}: "
-                             f"{', '.join('--' + n for n in own) or 'none'}", got=getattr(args, name))
+    model = MODELS[args.model]  # another model's flag was refused before (refuse_unused)
     build = {}
     for prm in model.params:
         given = getattr(args, prm.name)
@@ -171,19 +167,143 @@ SYSTEM_KEEPS = ("system", "dry_run", "expect", "slope_tolerance", "beta_floor", 
 """Flags that mean something with ``--system``; every other one is refused there."""
 
 
-def remember_defaults(p) -> None:
-    """Keep the parser's option defaults on the namespace, for :func:`refuse_with_system`."""
-    p.set_defaults(option_defaults={a.dest: a.default for a in p._actions if a.option_strings})
+# ---------------------------------------------------------------- flags a request does not use
+# One rule for every subcommand: a flag the request does not use is refused, with one line
+# naming the flag, who uses it and what this request is; never accepted and ignored. Each
+# subcommand declares its conditional flags (:func:`declare_flag_uses`); `infsup-contact` applies
+# the rule (:func:`refuse_unused`) to every request before its own checks.
+
+@dataclass(frozen=True)
+class FlagUse:
+    """A flag only some requests use.
+
+    Attributes
+    ----------
+    dest : str
+        The option's dest (``n_ref`` for ``--n-ref``).
+    used : callable
+        ``used(args) -> bool``: whether this request uses it (``args`` as parsed, before the
+        subcommand's checks: only argparse-validated values may be read).
+    users : str
+        Who uses it, for the refusal: "the manufactured scene", "--family perturbed".
+    request : callable
+        ``request(args) -> str``: what this request is, in its own flags ("--scene patch").
+    """
+
+    dest: str
+    used: Callable
+    users: str
+    request: Callable
 
 
-def refuse_with_system(args) -> None:
-    """:class:`InputError` naming the first flag given with ``--system`` that does not apply to
-    it (its value differs from the default): the manifest's matrices fix the spaces, meshes
-    and norm, and a flag that would be ignored is never ignored silently."""
-    for dest, default in args.option_defaults.items():
-        if dest not in SYSTEM_KEEPS and getattr(args, dest) != default:
-            raise InputError(dest, "nothing with --system (the manifest's matrices fix the spaces, meshes and "
-                             "norm; its 'norm' key says what G is)", got=getattr(args, dest))
+def given_dests(parser, argv) -> set:
+    """The dests of the options typed on the command line ``argv`` (abbreviated or as
+    ``--flag=value`` too), whatever their values: ``argv`` parsed again with every default
+    suppressed (restored after), so a flag given with its default value counts as given."""
+    parsers, todo = [], [parser]
+    while todo:
+        p = todo.pop()
+        parsers.append(p)
+        for a in p._actions:
+            if isinstance(a, argparse._SubParsersAction):
+                todo.extend(a.choices.values())
+    saved = [(p, dict(p._defaults), [(a, a.default) for a in p._actions]) for p in parsers]
+    try:
+        for p in parsers:
+            p._defaults.clear()
+            for a in p._actions:
+                if not isinstance(a, argparse._SubParsersAction):
+                    a.default = argparse.SUPPRESS
+        return set(vars(parser.parse_args(argv)))
+    finally:
+        for p, defaults, actions in saved:
+            p._defaults.update(defaults)
+            for a, default in actions:
+                a.default = default
+
+
+def declare_flag_uses(p, uses) -> None:
+    """Declare a subcommand's conditional flags (those among its options) for
+    :func:`refuse_unused`; its option defaults are kept too (a flag differing from its default
+    counts as given where the command line is not at hand)."""
+    dests = {a.dest for a in p._actions if a.option_strings}
+    p.set_defaults(flag_uses=[u for u in uses if u.dest in dests],
+                   option_defaults={a.dest: a.default for a in p._actions if a.option_strings})
+
+
+def refuse_unused(args) -> None:
+    """:class:`InputError` naming the first flag given that this request does not use (module
+    comment above): ``args.given`` (:func:`given_dests`), else the flags whose value differs
+    from the default."""
+    given = getattr(args, "given", None)
+    if given is None:
+        given = {d for d, v in getattr(args, "option_defaults", {}).items() if getattr(args, d, None) != v}
+    for use in getattr(args, "flag_uses", ()):
+        if use.dest in given and not use.used(args):
+            raise InputError(use.dest, f"nothing here: it is used only by {use.users} (this request: {use.request(args)})",
+                             got=getattr(args, use.dest))
+
+
+def system_flag_uses(p) -> list:
+    """With ``--system`` every option but :data:`SYSTEM_KEEPS` is unused: the manifest's matrices
+    fix the spaces, meshes and norm (its 'norm' key says what G is)."""
+    return [FlagUse(a.dest, lambda args: args.system is None, "requests without --system (the manifest's "
+                    "matrices fix the spaces, meshes and norm)", lambda args: f"--system {args.system}")
+            for a in p._actions if a.option_strings and a.dest not in SYSTEM_KEEPS]
+
+
+def model_flag_uses() -> list:
+    """The material and mesh flags of every registered model: each used by the models that
+    declare it (``Model.params``, ``Model.mesh_options``)."""
+    from ..models import MODELS
+
+    def owned(name):
+        return [m.name for m in MODELS.values()
+                if name in m.param_names() or name in dict(m.mesh_options)]
+
+    def request(args):
+        m = MODELS[args.model]
+        own = [*m.param_names(), *dict(m.mesh_options)]
+        return f"--model {m.name}, whose flags are {', '.join('--' + n for n in own) or 'none'}"
+
+    return [FlagUse(name, lambda args, name=name: args.model in owned(name), f"--model {', '.join(owned(name))}",
+                    request) for name in [*_material_params(), *_mesh_options()]]
+
+
+# ---------------------------------------------------------------- the study modules' command lines
+class OneLineParser(argparse.ArgumentParser):
+    """An argparse parser whose errors are one line, ``<prog>: error: <message>``, exit 2."""
+
+    def error(self, message):
+        self.exit(2, f"{self.prog}: error: {message}\n")
+
+
+def error_line(err: Exception, flags: dict) -> str:
+    """The one line of an InputError, its key spelled as the flag (``flags``: dest → flag)."""
+    text = " ".join(str(err).split())
+    key = getattr(err, "key", None)
+    flag = flags.get(key) if key else None
+    if flag and text.startswith(f"invalid {key}"):
+        text = f"invalid {flag}" + text[len(f"invalid {key}"):]
+    return text
+
+
+def run_study(parser, argv, check, run) -> int:
+    """A study module's ``python -m`` command: parse ``argv``, ``check(args)`` the whole request
+    before any output, then ``run(args)``. Bad input (:class:`InputError`) is one line on stderr,
+    ``<prog>: error: invalid --flag (got …): expected …``, and exit 2: never a traceback, never a
+    table of its header only."""
+    import sys
+
+    args = parser.parse_args(argv)
+    flags = {a.dest: max(a.option_strings, key=len) for a in parser._actions if a.option_strings}
+    try:
+        check(args)
+        run(args)
+    except InputError as err:
+        print(f"{parser.prog}: error: {error_line(err, flags)}", file=sys.stderr)
+        return 2
+    return 0
 
 
 # ---------------------------------------------------------------- output

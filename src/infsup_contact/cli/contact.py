@@ -4,7 +4,8 @@ pair, CSV rows; the scenes and the models each is defined for come from the scen
 from __future__ import annotations
 
 from ..errors import InputError, check_prestress
-from .common import add_dry_run, add_model, cases, check_memory, material, mesh_options, SPACE_HELP, write_csv
+from .common import (FlagUse, add_dry_run, add_model, cases, check_memory, declare_flag_uses, material, mesh_options,
+                     model_flag_uses, SPACE_HELP, write_csv)
 
 
 def add(sub) -> None:
@@ -31,11 +32,23 @@ def add(sub) -> None:
     p.add_argument("--n-ref", type=int, default=64,
                    help="membranes: reference mesh N (degree k + 1), at least 2 max(N1, N2)")
     add_dry_run(p)
+    declare_flag_uses(p, [*scene_flag_uses(), *model_flag_uses()])
     p.set_defaults(run=_run_contact, check=_check_contact)
 
 
-OPTIONAL_PARAMS = ("R", "d")
-"""Scene parameters without a default: refused by every scene that does not take them."""
+def scene_flag_uses() -> list:
+    """The scene parameters (``--p``, ``--q``, ``--n-ref``, ``--R``, ``--d``): each used by the
+    scenes that declare it (:attr:`~infsup_contact.study.scene_registry.SceneSpec.params`);
+    refused with any other scene (:func:`~.common.refuse_unused`)."""
+    from ..study.scene_registry import scene_ids, scene_spec
+
+    def takers(name):
+        return [s for s in scene_ids() if name in scene_spec(s).params]
+
+    names = list(dict.fromkeys(n for s in scene_ids() for n in scene_spec(s).params))
+    return [FlagUse(name, lambda a, name=name: a.scene in takers(name),
+                    f"--scene {', '.join(takers(name))}",
+                    lambda a: f"--scene {a.scene}") for name in names]
 
 
 def _check_contact(args):
@@ -49,9 +62,6 @@ def _check_contact(args):
     material(args)
     args.mesh_kwargs = mesh_options(args)  # a mesh flag of another model is refused; the scene's rows read them
     spec = check_pair(args.model, args.scene)
-    for key in OPTIONAL_PARAMS:
-        if key not in spec.params and getattr(args, key) is not None:
-            raise InputError(key, f"only with a scene that takes it ({args.scene} does not)", got=getattr(args, key))
     if not 1 <= args.k <= 4:
         raise InputError("k", "an integer in 1..4", got=args.k)
     for case in args.cases:
@@ -61,8 +71,9 @@ def _check_contact(args):
     registry.check_pair_spaces(args.cases, args.k, args.N1, args.N2)  # G_h = trace of Ω2 (omega2)
     check_prestress("c1", args.c1)
     check_prestress("c2", args.c2)
-    _exponent("p", args.p)  # used by the manufactured scene only, but a bad value is bad anyway
-    _exponent("q", args.q)
+    if "p" in spec.params:  # the manufactured scene (another scene refused --p/--q before)
+        _exponent("p", args.p)
+        _exponent("q", args.q)
     if spec.families is not None and args.family not in spec.families:
         raise InputError("family", f"{', '.join(spec.families)} (the meshes of the {args.scene} scene)",
                          got=args.family)

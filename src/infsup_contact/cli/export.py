@@ -2,7 +2,8 @@
 from __future__ import annotations
 
 from ..errors import InputError
-from .common import add_dry_run, add_model, check_memory, material, mesh_options, write_text
+from .common import (add_dry_run, add_model, check_memory, declare_flag_uses, material, mesh_options, model_flag_uses,
+                     write_text)
 
 
 def add(sub) -> None:
@@ -26,6 +27,7 @@ def add(sub) -> None:
     p.add_argument("--out", required=True, help="directory to write into (created)")
     add_model(p)
     add_dry_run(p)
+    declare_flag_uses(p, model_flag_uses())
     p.set_defaults(run=_run_export, check=_check_export)
 
 

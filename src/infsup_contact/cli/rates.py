@@ -3,7 +3,7 @@ from __future__ import annotations
 
 from ..errors import InputError
 from ..io import TableError
-from .common import add_dry_run, write_csv
+from .common import add_dry_run, declare_flag_uses, write_csv
 
 
 def add(sub) -> None:
@@ -12,6 +12,7 @@ def add(sub) -> None:
     p.add_argument("--window", type=int, default=3,
                    help="number of finest meshes in the fit (2 .. the meshes of the shortest series)")
     add_dry_run(p)
+    declare_flag_uses(p, [])  # every flag of rates is used by every request
     p.set_defaults(run=_run_rates, check=_check_rates)
 
 

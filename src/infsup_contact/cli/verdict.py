@@ -4,7 +4,7 @@ from __future__ import annotations
 import sys
 
 from ..errors import InputError
-from .common import (refuse_with_system, remember_defaults, add_dry_run, add_model, check_memory, mesh_options,
+from .common import (declare_flag_uses, model_flag_uses, system_flag_uses, add_dry_run, add_model, check_memory, mesh_options,
                      run_intervals, SPACE_HELP, write_csv)
 
 
@@ -52,7 +52,7 @@ def add(sub) -> None:
         p.add_argument("--" + key.replace("_", "-"), dest=key, type=float, default=VERDICT_DEFAULTS[key],
                        help=f"{text} (default {VERDICT_DEFAULTS[key]:g}: claims.{key} in config/config.yaml)")
     add_dry_run(p)
-    remember_defaults(p)
+    declare_flag_uses(p, [*system_flag_uses(p), *model_flag_uses()])
     p.set_defaults(run=_run_verdict, check=_check_verdict)
 
 
@@ -65,7 +65,6 @@ def _check_verdict(args):
         from ..systems.manifest import load_manifest
 
         args.manifest = load_manifest(args.system)
-        refuse_with_system(args)
         check_criterion(args.slope_tolerance, args.beta_floor, args.confidence)
         est = dry_check(args.manifest)
         check_memory(est, "system", args.system)

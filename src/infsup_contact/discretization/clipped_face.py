@@ -29,8 +29,33 @@ from .multipliers import local_basis_space, local_shapes, reference_nodes
 from .norms import gram_l2
 from .square import TensorPartition
 
+CLIP_TOL = 1e-12
+"""Cells starting within this of the cut L count as beyond it (:func:`clip_1d`, unit face)."""
+SLIVER_MIN = 1e-9
+"""The narrowest cut column the geometry resolves, in units of the face: 1000 × :data:`CLIP_TOL`
+(a narrower one is dropped whole, as if θ = 0: at θ = 1e-12, N = 4 the study computed the
+θ = 0 space, β_H 0.55 instead of ~θ), and L = (N − 1 + θ)/N carries θ to ~1e-7 relative."""
 
-def clip_1d(space, L: float, scale=None, tol: float = 1e-12):
+
+def min_covered_fraction(n: int) -> float:
+    """The smallest covered fraction θ of the last of ``n`` columns that the geometry resolves:
+    a cut column θ/n wide, at least :data:`SLIVER_MIN`."""
+    return SLIVER_MIN * n
+
+
+def edge_cases(k: int) -> list:
+    """Registered spaces that make sense on a moving face boundary (edge dropping,
+    :mod:`infsup_contact.study.edge_dropping`): every case valid for k whose 1D factor does not
+    vanish at the ends (a space vanishing on ∂(Ω1's face) does not vanish on the edge x = L of
+    Γ: not the natural analogue)."""
+    from . import registry
+
+    x = np.linspace(0.0, 1.0, 5)
+    return [c for c in registry.ids_valid_for(k)
+            if not registry.space_spec(c).build(k, x).vanish_at_ends]
+
+
+def clip_1d(space, L: float, scale=None, tol: float = CLIP_TOL):
     """The 1D space restricted to [0, L] and pulled back to (0, 1); see the module docstring.
 
     Parameters

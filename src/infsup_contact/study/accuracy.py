@@ -145,11 +145,23 @@ def _reference_samples(ref) -> dict:
         xy, w = _element_quadrature(gref.space.mesh, 2 * gref.space.globalorder)
         vr, gr = _values_at(gref, xy)
         quadrature.append((xy, w, vr, gr))
-    cached = dict(quadrature=quadrature,
-                  lambda_sine=ref.lam @ sine_coefficients(ref.space, np.arange(1, N_SINE + 1)),
-                  lambda_samples=lambda_values(ref, _contact_set_points()))
-    vars(ref)["_error_samples"] = cached
-    return cached
+    return vars(with_reference_quadrature(ref, quadrature))["_error_samples"]
+
+
+def reference_quadrature(ref) -> list:
+    """Per side (points, weights, values, gradients) of the reference at its own quadrature
+    points: all the error measures need of its u (what a saved reference stores,
+    :func:`~.contact_rows.save_reference`)."""
+    return _reference_samples(ref)["quadrature"]
+
+
+def with_reference_quadrature(ref, quadrature):
+    """``ref`` (space and λ) with its u given by :func:`reference_quadrature`'s samples: the
+    error measures evaluate it as the reference it was saved from."""
+    vars(ref)["_error_samples"] = dict(
+        quadrature=quadrature, lambda_sine=ref.lam @ sine_coefficients(ref.space, np.arange(1, N_SINE + 1)),
+        lambda_samples=lambda_values(ref, _contact_set_points()))
+    return ref
 
 
 def _contact_set_points() -> np.ndarray:

@@ -20,28 +20,106 @@ def reference_solution(scene, k: int, n_ref: int, model=None) -> ContactSolution
     return solve_contact(scene, REFERENCE_SPACE, k + 1, "structured", n_ref, n_ref, time_floor=False, model=model)
 
 
+REFERENCE_FORMAT = "infsup-contact reference 1"
+"""The ``format`` entry of a saved reference (:func:`save_reference`)."""
+_SPACE_FIELDS = ("breakpoints", "degree", "continuous", "vanish_at_ends", "dofs", "dim")
+
+
 def save_reference(path, ref: ContactSolution) -> None:
-    """Write what the error measures need of a reference (u_h as NGSolve grid functions,
-    which pickle with their mesh and space; M_h; λ_h) atomically, without the factorized
-    sides: the workflow solves the membranes reference once per k and every contact job of
-    that k reads it (:func:`load_reference`)."""
-    import pickle
-    import types
+    """Write what the error measures need of a reference atomically, as a NumPy ``.npz`` of plain
+    arrays — never a pickle, which would run any code a planted file carries when read: M_h (its
+    fields), λ_h, (c1, c2) and, per side, u_h and ∇u_h at the reference's own quadrature points
+    with their weights (:func:`~.accuracy.reference_quadrature`; the error measures use u_h there
+    only). The workflow solves the membranes reference once per k and every contact job of that
+    k reads it (:func:`load_reference`)."""
+    import io
 
     import numpy as np
 
+    from ..discretization.multipliers import MultiplierSpace
     from ..io import write_bytes_atomic
+    from .accuracy import reference_quadrature
 
-    light = types.SimpleNamespace(u=list(ref.u), space=ref.space, lam=np.asarray(ref.lam), c=tuple(ref.c))
-    write_bytes_atomic(path, pickle.dumps(light, protocol=pickle.HIGHEST_PROTOCOL))
+    if type(ref.space) is not MultiplierSpace:
+        raise InputError("reference", "a reference whose M_h is a plain MultiplierSpace", got=type(ref.space).__name__)
+    arrays = {"format": np.array(REFERENCE_FORMAT), "lam": np.asarray(ref.lam, float),
+              "c": np.asarray(ref.c, float)}
+    for name in _SPACE_FIELDS:
+        arrays[f"space_{name}"] = np.asarray(getattr(ref.space, name))
+    if ref.space.local_coefficients is not None:
+        arrays["space_local_coefficients"] = np.asarray(ref.space.local_coefficients, float)
+    for side, (xy, w, u, grad) in enumerate(reference_quadrature(ref)):
+        for key, value in (("xy", xy), ("w", w), ("u", u), ("grad", grad)):
+            arrays[f"side{side}_{key}"] = np.asarray(value, float)
+    buf = io.BytesIO()
+    np.savez_compressed(buf, **arrays)
+    write_bytes_atomic(path, buf.getvalue())
 
 
 def load_reference(path):
-    """The reference written by :func:`save_reference` (attributes u, space, lam, c)."""
-    import pickle
+    """The reference written by :func:`save_reference` (attributes ``space``, ``lam``, ``c``,
+    and its u as the error measures' samples), read with ``allow_pickle=False``.
 
-    with open(path, "rb") as fh:
-        return pickle.load(fh)
+    Raises
+    ------
+    InputError
+        ``reference``, one line naming the file: missing, not an ``.npz`` of this format (a
+        pickle is refused unread: its code never runs), an entry missing, of the wrong type or
+        shape, or not finite."""
+    import types
+    import zipfile
+
+    import numpy as np
+
+    from ..discretization.multipliers import MultiplierSpace
+    from .accuracy import with_reference_quadrature
+
+    allowed = f"a reference written by save_reference ({REFERENCE_FORMAT!r}: an .npz of plain arrays, no pickle)"
+
+    def bad(problem):
+        return InputError("reference", allowed, got=f"{path}: {problem}")
+
+    try:
+        data = np.load(path, allow_pickle=False)  # a pickle: ValueError before a byte of it is unpickled
+        if not isinstance(data, np.lib.npyio.NpzFile):
+            raise bad("a single array, not an .npz archive")
+        with data:
+            entries = {key: data[key] for key in data.files}  # an object array: ValueError, not unpickled
+    except FileNotFoundError:
+        raise bad("no such file") from None
+    except (ValueError, OSError, EOFError, zipfile.BadZipFile) as err:
+        reason = " ".join(str(err).split())[:120]
+        raise bad(f"not readable as plain arrays ({reason})") from None
+    if str(entries.get("format", "")) != REFERENCE_FORMAT:
+        raise bad(f"format {str(entries.get('format', 'missing'))[:60]!r}")
+
+    def get(key, ndim, kind="f"):
+        if key not in entries:
+            raise bad(f"no entry {key}")
+        a = entries[key]
+        if a.ndim != ndim or a.dtype.kind not in (kind + ("iu" if kind == "f" else "")):
+            raise bad(f"entry {key} has dtype {a.dtype} and {a.ndim} dimensions")
+        if a.dtype.kind == "f" and not np.all(np.isfinite(a)):
+            raise bad(f"entry {key} is not finite")
+        return a
+
+    bp, dofs = get("space_breakpoints", 1), get("space_dofs", 2, "i")
+    degree, dim = int(get("space_degree", 0, "i")), int(get("space_dim", 0, "i"))
+    lam, c = get("lam", 1).astype(float), get("c", 1).astype(float)
+    coeff = get("space_local_coefficients", 3).astype(float) if "space_local_coefficients" in entries else None
+    if (len(bp) < 2 or dofs.shape != (len(bp) - 1, degree + 1) or len(lam) != dim or dofs.max() >= dim
+            or len(c) != 2 or (coeff is not None and coeff.shape != (len(bp) - 1, degree + 1, degree + 1))):
+        raise bad("entries of inconsistent shapes")
+    space = MultiplierSpace(bp.astype(float), degree, bool(get("space_continuous", 0, "b")),
+                            bool(get("space_vanish_at_ends", 0, "b")), dofs.astype(int), dim, coeff)
+    quadrature = []
+    for side in range(2):
+        xy, w, u, grad = (get(f"side{side}_{k}", n) for k, n in (("xy", 2), ("w", 1), ("u", 1), ("grad", 2)))
+        if xy.shape[1] != 2 or grad.shape != xy.shape or not len(w) == len(u) == len(xy):
+            raise bad(f"entries of side {side} of inconsistent shapes")
+        quadrature.append((xy.astype(float), w.astype(float), u.astype(float), grad.astype(float)))
+    ref = types.SimpleNamespace(space=space, lam=lam, c=tuple(c), u=())
+    return with_reference_quadrature(ref, quadrature)
 
 
 def contact_row(scene_name: str, case: str, k: int, family: str, n1: int, n2: int,

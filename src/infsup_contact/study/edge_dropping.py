@@ -57,7 +57,6 @@ unchanged: κ scaling changes conditioning, never β_h.
 """
 from __future__ import annotations
 
-import argparse
 import csv
 import sys
 from functools import lru_cache
@@ -65,7 +64,7 @@ from functools import lru_cache
 import numpy as np
 
 from ..discretization import registry
-from ..discretization.clipped_face import ClippedFace
+from ..discretization.clipped_face import SLIVER_MIN, ClippedFace, edge_cases, min_covered_fraction
 from ..discretization.face_spaces import FaceSpace
 from ..discretization.multipliers import MultiplierSpace, make_space
 from ..discretization.norms import gram_l2
@@ -80,13 +79,22 @@ THETAS = (1.0, 0.5, 0.25, 0.1, 0.05, 0.01, 0.001)
 """The covered fractions of the last column swept by default (issue 28)."""
 
 
-def edge_cases(k: int) -> list:
-    """Registered spaces that make sense on a moving face boundary: every case valid for k
-    whose 1D factor does not vanish at the ends (a space vanishing on ∂(Ω1's face) does not
-    vanish on the edge x = L of Γ: not the natural analogue)."""
-    x = np.linspace(0.0, 1.0, 5)
-    return [c for c in registry.ids_valid_for(k)
-            if not registry.space_spec(c).build(k, x).vanish_at_ends]
+def theta_allowed(n: int) -> str:
+    """The covered fractions the geometry of N = ``n`` resolves, for messages."""
+    return (f"a covered fraction {min_covered_fraction(n):g} <= θ <= 1 at N = {n} (the cut column, θ/N wide, "
+            f"at least {SLIVER_MIN:g}: a narrower one is below the resolution of the geometry)")
+
+
+def check_theta(theta, n: int) -> float:
+    """θ as a float in [:func:`~infsup_contact.discretization.clipped_face.min_covered_fraction`, 1];
+    :class:`InputError` naming ``theta`` and the range otherwise (never θ silently taken as 0)."""
+    try:
+        t = float(theta)
+    except (TypeError, ValueError):
+        raise InputError("theta", theta_allowed(n), got=theta) from None
+    if isinstance(theta, bool) or not min_covered_fraction(n) <= t <= 1.0:  # NaN fails both
+        raise InputError("theta", theta_allowed(n), got=theta)
+    return t
 
 
 def _integrate_1d(breaks, f, n_points: int) -> np.ndarray:
@@ -284,11 +292,10 @@ def edge_row(case: str, k: int, n: int, n2: int, theta: float, norms=("H", "L2")
         ``beta_L2_kappa`` (the κ-scaled restricted basis, :func:`beta_kappa`).
     """
     registry.check_case(case, k)
-    if not 0.0 < theta <= 1.0:
-        raise InputError("theta", "a covered fraction 0 < θ <= 1", got=theta)
     for key, v in (("N", n), ("N2", n2)):
-        if not isinstance(v, (int, np.integer)) or v < 1:
+        if not isinstance(v, (int, np.integer)) or isinstance(v, bool) or v < 1:
             raise InputError(key, "an integer >= 1", got=v)
+    check_theta(theta, n)
     L, xs1, _ = geometry(n, n2, theta)
     full = registry.case_space(case, k, TensorPartition(xs1, xs1), SQUARE)
     face = ClippedFace.of(full, L)
@@ -325,37 +332,100 @@ COLUMNS = ("case", "k", "N", "N2", "theta", "L", "dim_M", "dropped", "kappa_min"
            "h_rel_error", "h_capped")
 
 
-def edge_table(ks=(1,), ns=(4, 8), thetas=THETAS, cases=None, n2_factor: int = 2, norms=("H", "L2"),
+NORMS = ("H", "L2")
+
+
+def edge_plan(ks, ns, thetas, cases=None, n2_factor: int = 2, norms=NORMS, h_cap: int | None = None,
+              explicit: bool = False) -> list:
+    """Check a whole request before anything is computed and return ``[(k, cases of k)]``.
+
+    ``cases``: a filter of :func:`edge_cases` (the config's ``face.cases``), or with ``explicit``
+    the spaces to run for every k (``--case``: any space with a 1D factor defined for k). Each
+    bad value raises one :class:`InputError` naming its key (``k``, ``N``, ``theta``, ``case``,
+    ``n2_factor``, ``norm``, ``h_cap``) and the allowed values; a k without a space to run is
+    refused (never a table of its header only)."""
+    ks, ns, thetas, norms = list(ks), list(ns), list(thetas), list(norms)
+    for key, values in (("k", ks), ("N", ns), ("theta", thetas), ("norm", norms)):
+        if not values:
+            raise InputError(key, "at least one value", got=values)
+    for n in ns:
+        if not isinstance(n, (int, np.integer)) or isinstance(n, bool) or n < 1:
+            raise InputError("N", "integers >= 1 (Ω1's cells per direction)", got=n)
+    if not isinstance(n2_factor, (int, np.integer)) or isinstance(n2_factor, bool) or n2_factor < 1:
+        raise InputError("n2_factor", "an integer >= 1 (N2 = factor · N)", got=n2_factor)
+    for th in thetas:
+        check_theta(th, max(ns))
+    for norm in norms:
+        if norm not in NORMS:
+            raise InputError("norm", ", ".join(NORMS), got=norm)
+    if h_cap is not None and (not isinstance(h_cap, (int, np.integer)) or h_cap < 1):
+        raise InputError("h_cap", "an integer >= 1 (the largest n_max of the H series)", got=h_cap)
+    with_cases = [k for k in range(1, 5) if edge_cases(k)]
+    plan = []
+    for k in ks:
+        if not isinstance(k, (int, np.integer)) or isinstance(k, bool) or k not in range(1, 5):
+            raise InputError("k", f"a degree with an edge case: {', '.join(map(str, with_cases))}", got=k)
+        if explicit:
+            allowed = registry.ids_valid_for(k)
+            for c in cases:
+                if c not in allowed:
+                    raise InputError("case", f"a registered space with a 1D factor defined for k = {k}: "
+                                     f"{', '.join(allowed)}", got=c)
+            run = list(cases)
+        else:
+            run = [c for c in edge_cases(k) if cases is None or c in cases]
+        if not run:
+            among = [j for j in range(1, 5) if any(cases is None or c in cases for c in edge_cases(j))]
+            raise InputError("k", f"a degree with an edge case{' among the cases' if cases is not None else ''}: "
+                             f"{', '.join(map(str, among)) or 'none'} (k = {k}: {', '.join(edge_cases(k)) or 'no edge case'})",
+                             got=k)
+        plan.append((int(k), run))
+    return plan
+
+
+def edge_table(ks=(1,), ns=(4, 8), thetas=THETAS, cases=None, n2_factor: int = 2, norms=NORMS,
                h_cap: int | None = None):
     """Rows of :func:`edge_row` for every k, N (N2 = ``n2_factor`` N: a primary side fine enough
     that B2 has full row rank for the continuous spaces of Ω1's face), θ and case (θ before the
     case: the side operators of one θ serve every space); the cases are :func:`edge_cases` of
-    each k, those among ``cases`` when given (e.g. the config's ``face.cases``)."""
+    each k, those among ``cases`` when given (e.g. the config's ``face.cases``). The whole
+    request is checked first (:func:`edge_plan`)."""
+    plan = edge_plan(ks, ns, thetas, cases, n2_factor, norms, h_cap)
     return [edge_row(c, k, n, n2_factor * n, th, norms, h_cap=h_cap)
-            for k in ks for n in ns for th in thetas for c in edge_cases(k) if cases is None or c in cases]
+            for k, run in plan for n in ns for th in thetas for c in run]
 
 
 def main(argv=None) -> int:
-    """``python -m infsup_contact.study.edge_dropping --k 1 2 --N 4 8``: the table as CSV on stdout."""
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--k", type=int, nargs="+", default=[1])
+    """``python -m infsup_contact.study.edge_dropping --k 1 2 --N 4 8``: the table as CSV on stdout;
+    bad input is one line on stderr naming the flag, exit 2, before any row."""
+    from ..cli.common import OneLineParser, run_study
+
+    ap = OneLineParser(prog="python -m infsup_contact.study.edge_dropping", description=__doc__.splitlines()[0])
+    ap.add_argument("--k", type=int, nargs="+", default=[1],
+                    help="displacement degrees with an edge case (1..4; default 1)")
     ap.add_argument("--N", type=int, nargs="+", default=[4, 8])
-    ap.add_argument("--theta", type=float, nargs="+", default=list(THETAS))
+    ap.add_argument("--theta", type=float, nargs="+", default=list(THETAS),
+                    help=f"covered fractions, {SLIVER_MIN:g}·N <= θ <= 1")
     ap.add_argument("--case", nargs="+", default=None, help="registered face spaces (default: edge_cases(k))")
     ap.add_argument("--n2-factor", type=int, default=2, help="N2 = factor * N (Ω2's cells per direction)")
-    ap.add_argument("--norm", nargs="+", default=["H", "L2"])
+    ap.add_argument("--norm", nargs="+", default=list(NORMS), choices=NORMS)
     ap.add_argument("--h-cap", type=int, default=None,
                     help="largest n_max of the H series (default 8192; θ = 0.001 needs more, see h_capped)")
-    a = ap.parse_args(argv)
-    out = csv.DictWriter(sys.stdout, COLUMNS, extrasaction="ignore")
-    out.writeheader()
-    for k in a.k:
-        for n in a.N:
-            for th in a.theta:
-                for c in (edge_cases(k) if a.case is None else a.case):
-                    out.writerow(edge_row(c, k, n, a.n2_factor * n, th, tuple(a.norm), h_cap=a.h_cap))
-                    sys.stdout.flush()
-    return 0
+
+    def check(a):
+        a.plan = edge_plan(a.k, a.N, a.theta, a.case, a.n2_factor, a.norm, a.h_cap, explicit=a.case is not None)
+
+    def run(a):
+        out = csv.DictWriter(sys.stdout, COLUMNS, extrasaction="ignore")
+        out.writeheader()
+        for k, cases in a.plan:
+            for n in a.N:
+                for th in a.theta:
+                    for c in cases:
+                        out.writerow(edge_row(c, k, n, a.n2_factor * n, th, tuple(a.norm), h_cap=a.h_cap))
+                        sys.stdout.flush()
+
+    return run_study(ap, argv, check, run)
 
 
 if __name__ == "__main__":

@@ -24,7 +24,6 @@ Run: ``python -m infsup_contact.study.face_alpha --N 4 8`` (CSV on stdout);
 """
 from __future__ import annotations
 
-import argparse
 import sys
 
 import numpy as np
@@ -145,23 +144,35 @@ def sweep(ns=(4, 8), alphas=ALPHAS, elements=ELEMENTS, k: int = 2, norms=("H",),
     return rows
 
 
-def main(argv=None) -> None:
+def main(argv=None) -> int:
+    """``python -m infsup_contact.study.face_alpha --N 4``: the sweep as CSV on stdout; bad input
+    is one line on stderr naming the flag, exit 2, before any row."""
     import pandas as pd
 
-    p = argparse.ArgumentParser(prog="python -m infsup_contact.study.face_alpha", description=__doc__.split("\n")[0])
+    from ..cli.common import OneLineParser, run_study
+
+    p = OneLineParser(prog="python -m infsup_contact.study.face_alpha", description=__doc__.split("\n")[0])
     p.add_argument("--N", type=int, nargs="+", default=[4, 8], help="cells per direction (matching meshes)")
     p.add_argument("--norm", default="H", choices=["H", "L2", "all"])
     p.add_argument("--model", default=None, choices=face_models(), help="a 3D model (default: the first)")
     p.add_argument("--element", nargs="+", default=list(ELEMENTS), choices=SWEEP_ELEMENTS,
                    help="reference elements (QUAD8/QUAD9: hexahedra, TRI6: tetrahedra)")
-    args = p.parse_args(argv)
-    if any(n < 1 for n in args.N):
-        raise InputError("N", "integers >= 1", got=args.N)
-    norms = ("H", "L2") if args.norm == "all" else (args.norm,)
-    alphas = ALPHAS if any(FACE_CELL[reference_element(e).cell] == "quad" for e in args.element) else TRI_ALPHAS
-    rows = sweep(tuple(args.N), alphas, tuple(args.element), norms=norms, model=args.model)
-    pd.DataFrame(rows).to_csv(sys.stdout, index=False, float_format="%.6g")
+
+    def check(args):
+        if any(n < 1 for n in args.N):
+            raise InputError("N", "integers >= 1", got=args.N)
+        args.model = face_models()[0] if args.model is None else args.model
+        for element in args.element:  # a reference element the model's faces do not carry
+            element_of(args.model, element)
+
+    def run(args):
+        norms = ("H", "L2") if args.norm == "all" else (args.norm,)
+        quad = any(FACE_CELL[reference_element(e).cell] == "quad" for e in args.element)
+        rows = sweep(tuple(args.N), ALPHAS if quad else TRI_ALPHAS, tuple(args.element), norms=norms, model=args.model)
+        pd.DataFrame(rows).to_csv(sys.stdout, index=False, float_format="%.6g")
+
+    return run_study(p, argv, check, run)
 
 
 if __name__ == "__main__":
-    main()
+    raise SystemExit(main())

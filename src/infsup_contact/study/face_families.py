@@ -28,7 +28,6 @@ Run: ``python -m infsup_contact.study.face_families --N1 5 --k 1 2`` (CSV on std
 """
 from __future__ import annotations
 
-import argparse
 import sys
 
 import numpy as np
@@ -127,24 +126,37 @@ def family_kernels(pairs, ks=(1, 2), cases=None, elements=None, model: str | Non
     return rows
 
 
-def main(argv=None) -> None:
+def main(argv=None) -> int:
+    """``python -m infsup_contact.study.face_families --N1 5 --k 1 2``: the kernels as CSV on stdout;
+    bad input is one line on stderr naming the flag, exit 2, before any row."""
     import pandas as pd
 
-    p = argparse.ArgumentParser(prog="python -m infsup_contact.study.face_families",
-                                description=__doc__.split("\n")[0])
+    from ..cli.common import OneLineParser, run_study
+    from ..models import MODELS
+    from .face_alpha import face_models
+
+    p = OneLineParser(prog="python -m infsup_contact.study.face_families", description=__doc__.split("\n")[0])
     p.add_argument("--family", default="sqrt2", choices=list(FAMILY_RULES))
     p.add_argument("--N1", type=int, nargs="+", default=[5], help="the coarser side; N2 = rule(N1)")
     p.add_argument("--k", type=int, nargs="+", default=[1, 2])
     p.add_argument("--element", nargs="+", default=None, help="mesh elements (default: the model's)")
-    args = p.parse_args(argv)
-    if any(n < 2 for n in args.N1):
-        raise InputError("N1", "integers >= 2 (a non-matching pair)", got=args.N1)
-    if any(not 1 <= k <= 4 for k in args.k):
-        raise InputError("k", "integers in 1..4", got=args.k)
-    pairs = [family_pair(args.family, n) for n in args.N1]
-    frame = pd.DataFrame(family_kernels(pairs, tuple(args.k), elements=args.element))
-    frame.to_csv(sys.stdout, index=False)
+
+    def check(args):
+        if any(n < 2 for n in args.N1):
+            raise InputError("N1", "integers >= 2 (a non-matching pair)", got=args.N1)
+        if any(not 1 <= k <= 4 for k in args.k):
+            raise InputError("k", "integers in 1..4", got=args.k)
+        options = dict(MODELS[face_models()[0]].mesh_options).get("element", ())
+        for element in args.element or ():
+            if element not in options:
+                raise InputError("element", ", ".join(options), got=element)
+
+    def run(args):
+        pairs = [family_pair(args.family, n) for n in args.N1]
+        pd.DataFrame(family_kernels(pairs, tuple(args.k), elements=args.element)).to_csv(sys.stdout, index=False)
+
+    return run_study(p, argv, check, run)
 
 
 if __name__ == "__main__":
-    main()
+    raise SystemExit(main())

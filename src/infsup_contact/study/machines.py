@@ -211,7 +211,22 @@ def main(out_dir: str) -> None:
     write_atomic(out / "openblas.json", json.dumps(openblas_corenames()))
 
 
-if __name__ == "__main__":
-    import sys
+def cli(argv=None) -> int:
+    """``python -m infsup_contact.study.machines OUT_DIR``: :func:`main`; a missing or unusable
+    OUT_DIR is one line on stderr naming it, exit 2."""
+    from ..cli.common import OneLineParser, run_study
+    from ..errors import InputError
 
-    main(sys.argv[1])
+    p = OneLineParser(prog="python -m infsup_contact.study.machines", description=main.__doc__)
+    p.add_argument("out_dir", help="directory for sweep.csv, verdicts.csv and openblas.json (created)")
+
+    def check(args):
+        out = Path(args.out_dir)
+        if not args.out_dir.strip() or (out.exists() and not out.is_dir()):
+            raise InputError("out_dir", "a directory to write into (created if missing)", got=args.out_dir)
+
+    return run_study(p, argv, check, lambda args: main(args.out_dir))
+
+
+if __name__ == "__main__":
+    raise SystemExit(cli())

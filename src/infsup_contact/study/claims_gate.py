@@ -1,0 +1,91 @@
+"""The CI gate (``snakemake verify-claims``): the claims ledger is trusted only when it is
+there, was built from the tables that are there now, and each of them reads under its schema;
+then every claim the paper predicts (PASS or FAIL) must have that verdict.
+
+What it refuses, each with one line (:class:`GateError` or :class:`~infsup_contact.io.TableError`):
+
+* a ledger or one of its tables missing (a deleted file, a table a failed job removed);
+* a damaged table or ledger (:func:`~infsup_contact.io.read_table`);
+* a ledger older than one of its tables, or a table older than what it is made of (``stages``):
+  the ledger was not rebuilt from the current tables (a refused or failed rerun, ``--touch``,
+  ``--omit-from``: a stale ledger must not pass);
+* a verdict or a prediction outside :data:`VERDICTS` / :data:`PREDICTIONS` (a ``"pass"`` or
+  ``"PASS "`` would otherwise count as a finding, never checked), or a ledger without one
+  predicted claim (nothing checked is not a pass);
+* a predicted claim whose verdict differs: a FAIL where the paper predicts PASS, an
+  INCONCLUSIVE anywhere a verdict is predicted. Findings (``predicted = finding``) are listed,
+  not judged: the paper says nothing about them, and FAIL is one of their results.
+"""
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+from .claims import FAIL, INCONCLUSIVE, PASS
+
+FINDING = "finding"
+VERDICTS = (PASS, FAIL, INCONCLUSIVE)
+PREDICTIONS = (PASS, FAIL, FINDING)
+
+
+class GateError(ValueError):
+    """The gate refuses the ledger: the message is one line."""
+
+
+def _mtime(path) -> int:
+    return os.stat(path).st_mtime_ns
+
+
+def check_stage(product, sources: dict) -> None:
+    """``product`` (a file) is at least as new as each of ``sources`` (path → table kind of
+    :data:`~infsup_contact.io.SCHEMAS`), and each source exists and reads under its schema."""
+    from ..io import TableError, read_table
+
+    for path, kind in sources.items():
+        read_table(path, kind)  # a missing or damaged table: TableError naming it
+    if not Path(product).is_file():
+        raise TableError(product, "no such file")
+    for path in sources:
+        if _mtime(path) > _mtime(product):
+            raise GateError(f"{product} is older than {path}: it was not rebuilt from the current tables "
+                            "(a refused or failed rerun?); rerun `snakemake verify-claims`")
+
+
+def gate(ledger, stages) -> tuple:
+    """Check the ledger (module docstring) and return ``(frame, summary line)``.
+
+    Parameters
+    ----------
+    ledger : path
+        results/claims.csv.
+    stages : iterable of (product, {source: kind})
+        The ledger and the tables it is made of, and any table with the tables it is made of
+        (e.g. the rates table and the contact table): every source must read and be no newer
+        than its product.
+
+    Raises
+    ------
+    GateError, TableError
+        One line: a missing, damaged or stale file, an unknown verdict, nothing predicted, or
+        predicted claims with another verdict (named).
+    """
+    from ..io import read_table
+
+    for product, sources in stages:
+        check_stage(product, sources)
+    frame = read_table(ledger, "claims")
+    for col, allowed in (("verdict", VERDICTS), ("predicted", PREDICTIONS)):
+        bad = frame[~frame[col].isin(allowed)]
+        if len(bad):
+            raise GateError(f"{ledger}: claim {bad.claim_id.iloc[0]} has {col} {bad[col].iloc[0]!r} "
+                            f"(allowed: {', '.join(allowed)})")
+    checked = frame[frame.predicted != FINDING]
+    if not len(checked):
+        raise GateError(f"{ledger}: no claim with a predicted verdict ({len(frame)} findings): nothing to verify")
+    wrong = checked[checked.verdict != checked.predicted]
+    if len(wrong):
+        raise GateError(f"{len(wrong)} claim(s) differ from the paper's prediction: "
+                        + ", ".join(f"{c} ({v}, predicted {p})" for c, v, p in
+                                    zip(wrong.claim_id, wrong.verdict, wrong.predicted)))
+    return frame, (f"verify-claims: {len(checked)} claims as predicted, {len(frame) - len(checked)} "
+                   "findings listed")

@@ -44,6 +44,23 @@ def _threads_default() -> None:
         os.environ.setdefault(var, "1")
 
 
+def _fit_blas_threads() -> None:
+    """More than one OpenBLAS thread asked for: as many as cores are idle now (:mod:`..la.openblas`:
+    on a busy core a threaded OpenBLAS took 7-13× the one-thread time), said in one line."""
+    try:
+        asked = int(os.environ.get("OPENBLAS_NUM_THREADS", "1"))
+    except ValueError:
+        return
+    if asked <= 1:
+        return
+    from ..la.openblas import fit_to_idle_cores
+
+    used, idle = fit_to_idle_cores(asked)
+    if used < asked:
+        _say(f"infsup-contact: {idle:.1f} of {os.cpu_count()} cores idle: OpenBLAS runs {used} thread(s), not "
+             f"{asked} (a threaded OpenBLAS waits on busy cores; INFSUP_BLAS_FIT=0 keeps {asked})")
+
+
 class _Parser(argparse.ArgumentParser):
     def error(self, message):  # one line, exit 2 — argparse's own convention
         self.exit(2, f"infsup-contact: error: {message}\n")
@@ -142,6 +159,7 @@ def _main(argv) -> int:
             write_text(f"dry run: valid request; estimated {estimate.describe()}"
                        + (f" (available memory {human_bytes(avail)})" if avail is not None else "") + "\n")
             return 0
+        _fit_blas_threads()
         code = args.run(args)
     except (InputError, TableError) as err:
         _say(f"infsup-contact: error: {_message(err, parser, args.command)}")

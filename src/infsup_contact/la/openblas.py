@@ -1,0 +1,99 @@
+"""OpenBLAS's thread count fitted to the cores that are idle when a request starts.
+
+numpy and scipy each load their own OpenBLAS (``scipy_openblas``), whose threads wait for work
+by spinning. When another process holds a core, a multi-threaded call waits for a thread that is
+not scheduled, and a request of thousands of medium-sized calls (the face's kernel decisions,
+pencils and Grams) slows down by far more than the core it lost. Measured on this project's
+2-core machine (AMD EPYC, Zen 4) with five other processes running, the same
+``beta --model membranes3d --element hex --case all --k 2 --norm all`` request took
+
+=====  ===============================  ==============================
+N      OPENBLAS_NUM_THREADS=2           OPENBLAS_NUM_THREADS=1
+=====  ===============================  ==============================
+12     110 s wall, 70.5 s user          16.9 s wall, 10.2 s user
+20     393 s wall, 223 s user           29.6 s wall, 19.8 s user
+=====  ===============================  ==============================
+
+(MKL's threads, PARDISO's, did not matter: 16.2 s with MKL at 2 and OpenBLAS at 1;
+``OPENBLAS_THREAD_TIMEOUT=4`` cut the first to 40 s, still 2.5× the one-thread run). The rule
+(:func:`fitted_threads`): run OpenBLAS on as many threads as cores are idle at the start
+(sampled from /proc/stat), never more than asked, never fewer than one. ``INFSUP_BLAS_FIT=0``
+keeps the count asked for (benchmarks that measure the threads themselves).
+"""
+from __future__ import annotations
+
+import ctypes
+import glob
+import os
+import time
+from functools import lru_cache
+
+_SETTERS = (("numpy", "scipy_openblas_set_num_threads64_", "scipy_openblas_get_num_threads64_"),
+            ("scipy", "scipy_openblas_set_num_threads", "scipy_openblas_get_num_threads"))
+"""numpy's and scipy's OpenBLAS copies and their (prefixed) thread-count functions."""
+
+
+@lru_cache(maxsize=1)
+def libraries() -> tuple:
+    """(name, set, get) of each OpenBLAS copy loaded by numpy and scipy (ctypes functions)."""
+    import numpy
+    import scipy
+
+    out = []
+    for (name, set_name, get_name), mod in zip(_SETTERS, (numpy, scipy)):
+        folder = os.path.join(os.path.dirname(os.path.dirname(mod.__file__)), f"{name}.libs")
+        for path in glob.glob(os.path.join(folder, "*openblas*")):
+            lib = ctypes.CDLL(path)
+            setter, getter = getattr(lib, set_name, None), getattr(lib, get_name, None)
+            if setter is not None and getter is not None:
+                getter.restype = ctypes.c_int
+                out.append((name, setter, getter))
+    return tuple(out)
+
+
+def threads_now() -> dict:
+    """{copy: its current thread count} of numpy's and scipy's OpenBLAS."""
+    return {name: int(get()) for name, _, get in libraries()}
+
+
+def set_threads(n: int) -> None:
+    """Set both OpenBLAS copies to ``n`` threads (at least 1)."""
+    for _, setter, _ in libraries():
+        setter(ctypes.c_int(max(int(n), 1)))
+
+
+def idle_cores(window: float = 0.2, stat: str = "/proc/stat") -> float | None:
+    """Cores idle over ``window`` seconds (idle + iowait jiffies of all CPUs over all jiffies,
+    times the CPUs this process may run on); None where /proc/stat cannot be read."""
+    def sample():
+        with open(stat) as f:
+            fields = [int(x) for x in f.readline().split()[1:]]
+        return fields[3] + fields[4], sum(fields[:8])
+    try:
+        idle0, total0 = sample()
+        time.sleep(window)
+        idle1, total1 = sample()
+    except (OSError, ValueError, IndexError):
+        return None
+    cpus = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
+    return cpus * (idle1 - idle0) / max(total1 - total0, 1)
+
+
+def fitted_threads(asked: int, idle: float | None) -> int:
+    """The rule: as many threads as cores are idle (a core counts when it is at least 3/4 idle),
+    at most ``asked``, at least 1; ``asked`` where the idle cores are unknown."""
+    if idle is None:
+        return max(asked, 1)
+    return max(1, min(asked, int(idle + 0.25)))
+
+
+def fit_to_idle_cores(asked: int) -> tuple[int, float | None]:
+    """Apply :func:`fitted_threads` to both OpenBLAS copies when more than one thread is asked
+    and ``INFSUP_BLAS_FIT`` is not "0"; returns (threads used, idle cores measured or None)."""
+    if asked <= 1 or os.environ.get("INFSUP_BLAS_FIT", "1") == "0":
+        return asked, None
+    idle = idle_cores()
+    n = fitted_threads(asked, idle)
+    if n < asked:
+        set_threads(n)
+    return n, idle

@@ -114,8 +114,13 @@ def _elastic_rows():
 @pytest.mark.parametrize("patch_rows", [_membrane_rows, _elastic_rows], ids=["membranes3d", "elastic3d"])
 def test_the_face_patch_contact_solution_is_unchanged(monkeypatch, patch_rows):
     """The scenes' sides keep their factor (scene_side); forcing route "pardiso" on these small
-    pairs, the patch rows equal those with the factor freed (the former route) to round-off."""
+    pairs, both routes decide every row as predicted: where 1 ∈ M_h each reproduces (u, λ) within
+    the patch test's own tolerance (PASS_RTOL, 1e-8: a wrong S or solve misses it by decades),
+    not within the other route's round-off digits (1e-14..1e-12, which differ between CPUs);
+    where it fails (T3), the errors are the discretization's, O(1e-2..1), and agree as the
+    solutions do (cond ≈ 3e4: to ~1e-11, asked to 1e-6)."""
     from infsup_contact.models import schur
+    from infsup_contact.study.face_patch import PASS_RTOL
 
     real = schur.gamma_factorization
     kept = []
@@ -131,7 +136,10 @@ def test_the_face_patch_contact_solution_is_unchanged(monkeypatch, patch_rows):
     assert kept and all(kept)  # every side of the scene asked to keep its factor
     old = rows(False)
     assert [r["case"] for r in new] == [r["case"] for r in old] and new
+    errors = ("lambda_max_rel_error", "u_max_rel_error")
     for a, b in zip(new, old):
         assert a["passes"] == b["passes"] == a["predicted"], (a, b)
-        for key in ("lambda_max_rel_error", "u_max_rel_error"):
-            assert a[key] == pytest.approx(b[key], rel=1e-6, abs=1e-12), (key, a, b)
+        if a["predicted"]:
+            assert max(r[key] for r in (a, b) for key in errors) <= PASS_RTOL, (a, b)
+        else:
+            assert all(a[key] > 1e3 * PASS_RTOL and a[key] == pytest.approx(b[key], rel=1e-6) for key in errors), (a, b)

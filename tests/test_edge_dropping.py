@@ -186,7 +186,10 @@ def test_ngsolve_route_equals_tensor_route(k):
     Q_k hexahedra of the boxes, Γ bases evaluated by NGSolve, couplings by tensor Gauss on the
     rectangles) and the 1D Kronecker route of ``_tensor_sides`` (stiffness from 1D matrices,
     fast diagonalization, couplings as products of 1D Gauss sums): β_h in both norms and the
-    condition numbers of S and D (D from 1D sums here) in the unscaled and κ-scaled bases."""
+    condition numbers of S and D (D from 1D sums here) in the unscaled and κ-scaled bases. A
+    condition number is O(1) only while it is moderate: each route's round-off of S (dim M ε ‖S‖)
+    moves λ_min(S) by dim M ε cond relative (ε cond = 4e-6 at cond = 1.9e10: R5.2, k = 2, θ = 0.25);
+    so cond_S to the larger of 1e-8 and twice that, not to 1e-8 alone."""
     n, n2 = 4, 8
     for theta in (1.0, 0.25):
         L, xs1, grids = geometry(n, n2, theta)
@@ -197,7 +200,8 @@ def test_ngsolve_route_equals_tensor_route(k):
             for key in ("beta_H", "beta_L2"):
                 assert ng[key] == pytest.approx(tp[key], rel=1e-9), (case, theta, key)
             for key in ("cond_S", "cond_S_kappa"):
-                assert ng[key] == pytest.approx(tp[key], rel=1e-8), (case, theta, key)
+                roundoff = 2 * ng["dim_M"] * np.finfo(float).eps * tp[key]
+                assert ng[key] == pytest.approx(tp[key], rel=max(1e-8, roundoff)), (case, theta, key)
             face = ClippedFace.of(_face(case, k, n), L)
             r = np.sqrt(np.diag(face.gram("L2")[0]))
             D = np.kron(couplings_1d(face, t1, "x", k), couplings_1d(face, t1, "y", k))

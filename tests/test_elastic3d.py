@@ -21,6 +21,7 @@ from infsup_contact.models.schur import schur_by_solves
 from infsup_contact.solvers.contact import solve_contact_on
 from infsup_contact.solvers.infsup import beta_rows_all
 from infsup_contact.study import elastic_face_patch as efp
+from infsup_contact.study.face_patch import PASS_RTOL
 from infsup_contact.study.scene_registry import ELASTIC_FACE_PATCH
 
 FREE = ("nothing",) * 3
@@ -157,7 +158,7 @@ def test_patch_passes_iff_the_space_contains_the_constants(element, k):
         assert r["scene"] == ELASTIC_FACE_PATCH.id and r["kernel_dim"] == 0
         assert r["passes"] == r["predicted"] == registry.space_spec(r["case"]).contains_constants(k), r
         if r["passes"]:
-            assert r["lambda_max_rel_error"] < 1e-10 and r["u_max_rel_error"] < 1e-10, r
+            assert max(r["lambda_max_rel_error"], r["u_max_rel_error"]) <= PASS_RTOL, r
         else:  # a real failure, not a tolerance artefact
             assert r["lambda_max_rel_error"] > 1e-2, r
     assert any(r["passes"] for r in rows) and any(not r["passes"] for r in rows)
@@ -166,7 +167,8 @@ def test_patch_passes_iff_the_space_contains_the_constants(element, k):
 def test_patch_closed_form_by_hookes_stress():
     """E1 ≠ E2, ν = 0.35: at interior points of both bodies the discrete stress of u_h
     (Hooke's law on its gradient, not the formula) is −p e_z⊗e_z with p = λ_h, the bodies
-    slip (u_x jumps across Γ by ν p x (1/E2 − 1/E1)) and the z displacements meet on Γ."""
+    slip (u_x jumps across Γ by ν p x (1/E2 − 1/E1)) and the z displacements meet on Γ, each to the
+    patch test's own tolerance (PASS_RTOL of p or δ), not to this CPU's round-off digits."""
     E, nu, delta = (1.0, 4.0), 0.35, 0.02
     p = delta / (1.0 / E[0] + 1.0 / E[1])
     pair = efp.patch_pair(2, 3, 4, E, nu, delta)
@@ -182,12 +184,12 @@ def test_patch_closed_form_by_hookes_stress():
         sigma = E[i] * (2 * mu * eps + lam * np.trace(eps, axis1=1, axis2=2)[:, None, None] * np.eye(3))
         target = np.zeros((3, 3))
         target[2, 2] = -p
-        np.testing.assert_allclose(sigma, np.broadcast_to(target, sigma.shape), atol=1e-10 * p)
-    np.testing.assert_allclose(sol.pressure(xy), p, rtol=1e-10)
+        np.testing.assert_allclose(sigma, np.broadcast_to(target, sigma.shape), atol=PASS_RTOL * p)
+    np.testing.assert_allclose(sol.pressure(xy), p, rtol=PASS_RTOL)
     on_gamma = [np.asarray(gf(gf.space.mesh(xy[:, 0], xy[:, 1], np.ones(15)))).reshape(-1, 3) for gf in sol.u]
-    np.testing.assert_allclose(on_gamma[1][:, 2] - on_gamma[0][:, 2], 0.0, atol=1e-12)
+    np.testing.assert_allclose(on_gamma[1][:, 2] - on_gamma[0][:, 2], 0.0, atol=PASS_RTOL * delta)
     np.testing.assert_allclose(on_gamma[1][:, 0] - on_gamma[0][:, 0], nu * p * xy[:, 0] * (1 / E[1] - 1 / E[0]),
-                               atol=1e-12)
+                               atol=PASS_RTOL * delta)
 
 
 # ------------------------------------------------------------------ the command line

@@ -28,7 +28,7 @@ def test_passes_iff_the_space_contains_the_constants(hex_rows):
         spec = registry.space_spec(r["case"])
         assert r["passes"] == spec.contains_constants(r["k"]), r
         if r["passes"]:
-            assert r["lambda_max_rel_error"] < 1e-10 and r["u_max_rel_error"] < 1e-10, r
+            assert max(r["lambda_max_rel_error"], r["u_max_rel_error"]) <= face_patch.PASS_RTOL, r
         else:  # a real failure, not a tolerance artefact
             assert r["lambda_max_rel_error"] > 1e-2, r
     assert any(not r["passes"] for r in hex_rows) and any(r["passes"] for r in hex_rows)
@@ -42,7 +42,8 @@ def test_non_matching_tetrahedra_agree_with_the_prediction():
 def test_closed_form_by_a_second_route():
     """Unequal scales c: the discrete solution of two spaces holding the constants gives, at
     interior points, λ = −c_i ∂u_{i,h}/∂z (the flux of each body, not the formula), u_h equal to
-    the closed form, u_{1,h} = u_{2,h} on Γ (zero gap, contact active) and λ > 0."""
+    the closed form, u_{1,h} = u_{2,h} on Γ (zero gap, contact active) and λ > 0, each to the patch
+    test's own tolerance (PASS_RTOL of λ or δ), not to this CPU's round-off digits (~1e-14)."""
     c, delta = (1.0, 3.0), 0.02
     scene = face_patch.patch_scene(c, delta)
     lam = delta / (1.0 / c[0] + 1.0 / c[1])
@@ -57,11 +58,11 @@ def test_closed_form_by_a_second_route():
             mesh = gf.space.mesh
             pts = mesh(xy[:, 0], xy[:, 1], z)
             flux = -c[i] * np.asarray(ngsolve.grad(gf)[2](pts)).ravel()
-            np.testing.assert_allclose(flux, lam, rtol=1e-10)
+            np.testing.assert_allclose(flux, lam, rtol=face_patch.PASS_RTOL)
             exact = -lam / c[0] * z if i == 0 else -delta + lam / c[1] * (2.0 - z)
-            np.testing.assert_allclose(np.asarray(gf(pts)).ravel(), exact, rtol=0, atol=1e-12 * delta)
+            np.testing.assert_allclose(np.asarray(gf(pts)).ravel(), exact, rtol=0, atol=face_patch.PASS_RTOL * delta)
         u1, u2 = gamma_values(sol, xy)
-        np.testing.assert_allclose(u1, u2, rtol=0, atol=1e-12 * delta)
+        np.testing.assert_allclose(u1, u2, rtol=0, atol=face_patch.PASS_RTOL * delta)
         assert np.all(sol.lam > 0) and sol.pdas.active.all()
 
 
@@ -72,7 +73,7 @@ def test_a_kernel_leaves_u_unique():
     row = face_patch.solve_face_patch("R5.2", 1, 2, 3, pair=pair,
                                       multiplier_mesh="union")
     assert row["kernel_dim"] > 0 and row["nonunique"]
-    assert row["u_max_rel_error"] < 1e-10
+    assert row["u_max_rel_error"] <= face_patch.PASS_RTOL
 
 
 def test_nodal_face_bases_are_nodal_at_their_nodes():

@@ -63,11 +63,17 @@ def _rows(system, known_kernel):
 
 
 def test_the_system_is_above_the_gate_and_its_kernel_exact(system):
+    """The dense pencil's d zeros are zeros to its round-off m ε λ_max (a backward-stable eigh,
+    kernel.pencil_roundoff), λ_max <= ‖B‖₁‖B‖_∞ ‖A⁻¹‖ ‖G⁻¹‖ from the known spectra of the
+    Laplacian and of the mass: not to a fraction of λ_{d+1}, which the pencil does not promise."""
     A, B, G, dense, _ = system
     m = B.shape[0]
     assert m > DENSE_MAX_M and choose_route(A.shape[0], m, 2 * M0, sparse_g=True) == "shift-invert"
     assert dense.kernel.dim == D and dense.kernel.proven == 0  # found, not structural
-    assert np.all(dense.bottom[:D] <= 1e-12 * dense.bottom[-1])  # the dense pencil: d zeros
+    lam_min_a = 2.0 * (2.0 - 2.0 * np.cos(np.pi / (NX + 1)))
+    lam_min_g = (4.0 - 2.0 * np.cos(np.pi / (m + 1))) / 6.0
+    lam_max = abs(B).sum(axis=0).max() * abs(B).sum(axis=1).max() / (lam_min_a * lam_min_g)
+    assert np.all(np.abs(dense.bottom[:D]) <= m * np.finfo(float).eps * lam_max)  # the dense pencil: d zeros
     assert dense.bottom[D] > 1e-3
 
 

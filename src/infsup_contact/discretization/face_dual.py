@@ -37,6 +37,10 @@ POPP_ALPHA = 0.2
 
 SWEEP_ALPHAS = (0.0, 0.05, 0.1, 0.15, 0.2, 0.25, 0.3, 1.0 / 3.0, 0.4, 0.45)
 
+ZERO_WEIGHT_RTOL = 1e-12
+"""A weight ∫N_k at or below this times the reference area counts as non-positive (the TRI6
+vertex weights are 0 to round-off): :func:`dual_coefficients` refuses the dual basis."""
+
 
 def _check_alpha(alpha) -> float:
     try:
@@ -105,7 +109,7 @@ def dual_coefficients(name: str, transformed: bool = False, alpha: float = POPP_
     """
     a = _check_alpha(alpha) if transformed else 0.0
     A, d = _raw_dual(name, a)
-    bad = np.flatnonzero(d <= 1e-12 * reference_element(name).area)
+    bad = np.flatnonzero(d <= ZERO_WEIGHT_RTOL * reference_element(name).area)
     if len(bad):
         got = {int(k): round(float(d[k]), 12) for k in bad}
         fix = ("an alpha with all weights positive, e.g. the 4C alpha = 1/5" if transformed

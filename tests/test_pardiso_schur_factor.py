@@ -116,6 +116,7 @@ def test_the_face_patch_contact_solution_is_unchanged(monkeypatch, patch_rows):
     """The scenes' sides keep their factor (scene_side); forcing route "pardiso" on these small
     pairs, the patch rows equal those with the factor freed (the former route) to round-off."""
     from infsup_contact.models import schur
+    from infsup_contact.study.face_patch import PASS_RTOL
 
     real = schur.gamma_factorization
     kept = []
@@ -133,5 +134,9 @@ def test_the_face_patch_contact_solution_is_unchanged(monkeypatch, patch_rows):
     assert [r["case"] for r in new] == [r["case"] for r in old] and new
     for a, b in zip(new, old):
         assert a["passes"] == b["passes"] == a["predicted"], (a, b)
+        # A passing row's errors are round-off (~1e-12) and the two routes' round-off differs
+        # with the code path: R5.4, k = 2 gave λ errors 1.5e-12 / 2.7e-12 under OpenBLAS SkylakeX
+        # and MKL's default branch, equal to 1e-12 under Haswell or MKL_CBWR=COMPATIBLE
+        # (tests/test_machines.py). Two decades below PASS_RTOL they cannot flip ``passes``.
         for key in ("lambda_max_rel_error", "u_max_rel_error"):
-            assert a[key] == pytest.approx(b[key], rel=1e-6, abs=1e-12), (key, a, b)
+            assert a[key] == pytest.approx(b[key], rel=1e-6, abs=1e-2 * PASS_RTOL), (key, a, b)

@@ -293,7 +293,9 @@ def sweep_rows() -> pd.DataFrame:
 def face_sweep_rows() -> pd.DataFrame:
     """β rows on the 3D face (membranes3d, hexahedra): the paper's cases defined for k = 1, 2,
     both norms, G_h = Ω2's partition, on the pairs of :data:`FACE_SWEEP` — every side's Schur
-    complement from MKL PARDISO, so MKL's path reaches the kernel columns."""
+    complement from MKL PARDISO, so MKL's path reaches the kernel columns (measured, k = 2, 7:8:
+    the default, AUTO and COMPATIBLE branches give both sides' S other bits and move β in its
+    15th digit, below the 12 the table keeps)."""
     from ..discretization.registry import PAPER_CASES, SPACES
     from ..models import make_model
     from ..solvers.infsup import beta_rows_all

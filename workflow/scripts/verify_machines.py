@@ -44,5 +44,6 @@ if problems:
          f"all in {snakemake.log[0]})")  # noqa: F821
 evidence = ", ".join(f"{r['path']} (OpenBLAS {r['openblas'].get('scipy', '?')}, MKL {r['mkl'].get('branch', '-')})"
                      for r in ran)
-print(f"verify-machines: {len(first)} verdicts and {len(summary)} kernel columns of {summary.table.nunique()} "
-      f"tables byte-identical under {evidence}", file=sys.__stderr__)
+print(f"verify-machines: {len(summary)} columns of {summary.table.nunique()} tables byte-identical (the ledger's "
+      f"{len(first)} verdicts and the kernel columns: results/machines/columns.csv) under {evidence}",
+      file=sys.__stderr__)

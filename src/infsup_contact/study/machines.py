@@ -412,6 +412,16 @@ has them: verdicts, kernel decisions and dimensions, the patch tests' pass (erro
 against 1e-8). ``kernel_margin_decades`` is a margin and β a number: their digits may move."""
 
 
+ROW_LABEL = ("claim_id", "scene", "model", "element", "family", "case", "k", "N1", "N2", "multiplier_mesh", "norm",
+             "nu", "alpha", "N")
+"""Columns that name a row of a ledger table in :func:`ledger_differences`' messages (those it has)."""
+
+
+def _row_label(frame: pd.DataFrame, i: int) -> str:
+    cols = [c for c in ROW_LABEL if c in frame.columns] or [frame.columns[0]]
+    return ", ".join(f"{c} {frame[c].iloc[i]}" for c in cols)
+
+
 def ledger_differences(ledgers: dict) -> tuple[pd.DataFrame, list]:
     """Compare the CI ledgers of several paths column by column, byte for byte.
 
@@ -458,8 +468,7 @@ def ledger_differences(ledgers: dict) -> tuple[pd.DataFrame, list]:
                     continue
                 diff = np.flatnonzero(frame[col].to_numpy() != ref[col].to_numpy())
                 same = same and not len(diff)
-                label = ref.columns[0]
-                problems += [f"{table} row {i} ({label} {ref[label].iloc[i]}): {col} {frame[col].iloc[i]} under "
+                problems += [f"{table} row {i} ({_row_label(ref, i)}): {col} {frame[col].iloc[i]} under "
                              f"{name}, {ref[col].iloc[i]} under {ref_name}" for i in diff]
             summary.append(dict(table=table, column=col, rows=len(ref), identical=same))
     return pd.DataFrame(summary, columns=["table", "column", "rows", "identical"]), problems

@@ -1,30 +1,34 @@
-# Machines stage (not part of reproduce-all): the CI profile's full ledger under every OpenBLAS
-# core type this CPU can execute (study/machines.py: CORE_TYPES), each in a copy of the workflow
-# of its own; `snakemake verify-machines` fails unless the `verdict` column is byte-identical.
-from infsup_contact.study.machines import CORE_TYPES
+# Machines stage (not part of reproduce-all): the CI profile's full ledger on every machine path
+# this CPU can take — OpenBLAS's core types and MKL's code branches (study/machines.py: PATHS) —
+# each in a copy of the workflow of its own; `snakemake verify-machines` fails unless the ledger's
+# `verdict` column and the kernel columns of its tables (machines.LEDGER_TABLES) are byte-identical.
+import re
+
+from infsup_contact.study.machines import PATHS
 
 
 rule machine_ledger:
-    # one core type: its ledger (or, where the CPU lacks its instructions, the stated reason)
+    # one path: its ledger and kernel tables (or, where the CPU cannot take it, the stated reason)
     output:
-        "results/machines/{core}.json",
+        "results/machines/{path}.json",
     input:
         PACKAGE_SOURCES,
     wildcard_constraints:
-        core="|".join(CORE_TYPES),
-    threads: workflow.cores  # the nested run uses every core: one core type at a time
+        path="|".join(re.escape(p.wildcard) for p in PATHS),
+    threads: workflow.cores  # the nested run uses every core: one path at a time
     log:
-        "results/logs/machines/{core}.log",
+        "results/logs/machines/{path}.log",
     shell:
-        "python workflow/scripts/machine_ledger.py {wildcards.core} {output} {threads} > {log} 2>&1"
+        "python workflow/scripts/machine_ledger.py {wildcards.path} {output} {threads} > {log} 2>&1"
 
 
 rule verify_machines:
     name: "verify-machines"
     output:
-        "results/machines/verdicts.csv",
+        verdicts="results/machines/verdicts.csv",
+        columns="results/machines/columns.csv",
     input:
-        expand("results/machines/{core}.json", core=CORE_TYPES),
+        expand("results/machines/{path}.json", path=[p.wildcard for p in PATHS]),
     log:
         "results/logs/verify_machines.log",
     script:

@@ -1,52 +1,63 @@
-"""The CI profile's ledger under one OpenBLAS core type, in a workflow copy of its own.
+"""The CI profile's ledger on one machine path, in a workflow copy of its own.
 
-usage: machine_ledger.py CORE OUTPUT.json CORES
+usage: machine_ledger.py PATH OUTPUT.json CORES
 
-Links the workflow's sources into results/machines/CORE/work, runs `snakemake results/claims.csv
---profile profiles/ci` there with OPENBLAS_CORETYPE=CORE, copies the ledger to
-results/machines/CORE/claims.csv and writes OUTPUT.json: whether it ran (or why not, when the
-CPU cannot execute that core type's kernels), the kernels OpenBLAS reported, the ledger's path.
+PATH is a path of infsup_contact.study.machines.PATHS by its wildcard (``openblas-Haswell``,
+``mkl-COMPATIBLE``). Links the workflow's sources into results/machines/PATH/work, runs
+`snakemake results/claims.csv --profile profiles/ci` there in the path's environment
+(machines.machine_env), copies the tables of machines.LEDGER_TABLES to
+results/machines/PATH/ledger/ and writes OUTPUT.json: whether it ran (or why not, when the CPU
+cannot take the path), its environment, the kernels OpenBLAS reported and MKL's branch and
+digits there (the evidence the path took effect), the ledger's folder. A failed run or a
+table missing exits non-zero, with no OUTPUT.json.
 """
 import json
-import os
 import shutil
 import subprocess
 import sys
 from pathlib import Path
 
 from infsup_contact.io import write_atomic
-from infsup_contact.study.machines import machine_env, runnable
+from infsup_contact.study.machines import LEDGER_TABLES, SWITCHES, machine_env, machine_path, runnable
 
 SOURCES = ("Snakefile", "workflow", "src", "config", "profiles", "paper", "examples")
 
 
-def main(core: str, output: str, cores: str) -> None:
+def main(wildcard: str, output: str, cores: str) -> None:
+    path = machine_path(wildcard)
     out = Path(output)
-    ok, reason = runnable(core)
+    ok, reason = runnable(path.name)
     if not ok:
-        print(f"machine_ledger: {core} skipped: {reason}", file=sys.stderr)
-        write_atomic(out, json.dumps(dict(core=core, ran=False, reason=reason), indent=1))
+        print(f"machine_ledger: {path.name} skipped: {reason}", file=sys.stderr)
+        write_atomic(out, json.dumps(dict(path=path.name, ran=False, reason=reason), indent=1))
         return
-    work = out.parent / core / "work"
+    work = out.parent / path.wildcard / "work"
     work.mkdir(parents=True, exist_ok=True)
     for name in SOURCES:
         link = work / name
         if not link.is_symlink():
             link.symlink_to(Path(name).resolve())
-    env = machine_env(core)
+    env = machine_env(path.name)
+    switches = {k: env[k] for k in SWITCHES if k in env}
     cmd = ["snakemake", "results/claims.csv", "--profile", "profiles/ci", "--cores", cores, "--quiet"]
     run = subprocess.run(cmd, cwd=work, env=env)
     if run.returncode:
-        sys.exit(f"machine_ledger: the CI ledger under OPENBLAS_CORETYPE={core} failed (exit {run.returncode}); "
+        sys.exit(f"machine_ledger: the CI ledger on {path.name} ({switches}) failed (exit {run.returncode}); "
                  f"see {work}/.snakemake/log")
-    ledger = out.parent / core / "claims.csv"
-    shutil.copyfile(work / "results" / "claims.csv", ledger)
-    names = subprocess.run([sys.executable, "-c", "import json; from infsup_contact.study.machines import "
-                            "openblas_corenames as f; print(json.dumps(f()))"], env=env, capture_output=True,
-                           text=True, check=True).stdout
-    write_atomic(out, json.dumps(dict(core=core, ran=True, reason="", openblas=json.loads(names),
+    ledger = out.parent / path.wildcard / "ledger"
+    for table in LEDGER_TABLES:
+        src = work / table
+        if not src.is_file():
+            sys.exit(f"machine_ledger: the CI run on {path.name} wrote no {table}")
+        (ledger / table).parent.mkdir(parents=True, exist_ok=True)
+        shutil.copyfile(src, ledger / table)
+    probe = subprocess.run([sys.executable, "-m", "infsup_contact.study.machines", "--probe"], env=env,
+                           capture_output=True, text=True, check=True).stdout
+    write_atomic(out, json.dumps(dict(path=path.name, ran=True, reason="", env=switches, **json.loads(probe),
                                       ledger=str(ledger)), indent=1))
 
 
 if __name__ == "__main__":
+    if len(sys.argv) != 4:
+        sys.exit(__doc__)
     main(*sys.argv[1:4])

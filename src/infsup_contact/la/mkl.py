@@ -1,5 +1,6 @@
 """Intel oneMKL, loaded once through ctypes: PARDISO (:mod:`infsup_contact.models.pardiso`)
-and the pointer-level triangular solve of :func:`trailing_solve`.
+and the pointer-level triangular solve of :func:`trailing_solve`; the code branch MKL runs
+(:func:`cbwr_branch`, for the cross-machine checks of :mod:`infsup_contact.study.machines`).
 
 The library is the ``mkl`` wheel's ``mkl_rt`` (``environment.lock``), called with its documented
 C interfaces (oneMKL Developer Reference: "pardiso", "cblas_?trsm"). numpy and scipy keep their
@@ -61,3 +62,25 @@ def trailing_solve(R: np.ndarray, K: np.ndarray, j: int, e: int) -> None:
     size = R.itemsize
     mkl_rt().cblas_dtrsm(_COL_MAJOR, _LEFT, _LOWER, _NO_TRANS, _NON_UNIT, m - j, e - j, 1.0,
                          R.ctypes.data + (j * m + j) * size, m, K.ctypes.data + (j * m + j) * size, m)
+
+
+CBWR_BRANCHES = {1: "OFF", 2: "AUTO", 3: "COMPATIBLE", 4: "SSE2", 6: "SSSE3", 7: "SSE4_1", 8: "SSE4_2", 9: "AVX",
+                 10: "AVX2", 11: "AVX512_MIC", 12: "AVX512", 13: "AVX512_MIC_E1", 14: "AVX512_E1"}
+"""MKL's conditional-numerical-reproducibility branches by value (mkl_types.h, ``MKL_CBWR_*``;
+``OFF`` = MKL_CBWR_BRANCH_OFF, no branch fixed: MKL dispatches as it likes)."""
+_CBWR_BRANCH = 1
+"""``MKL_CBWR_BRANCH``: the option of ``MKL_CBWR_Get`` that asks for the branch (not the flags)."""
+
+
+def cbwr_branch() -> str:
+    """The code branch MKL runs in this process (``MKL_CBWR_Get``): what ``MKL_CBWR`` selected,
+    or ``AUTO`` where MKL refused the requested branch (an unsupported one falls back), ``OFF``
+    without ``MKL_CBWR``."""
+    value = mkl_rt().MKL_CBWR_Get(ctypes.c_int(_CBWR_BRANCH))
+    return CBWR_BRANCHES.get(value, f"unknown ({value})")
+
+
+def cbwr_auto_branch() -> str:
+    """The branch MKL's ``AUTO`` dispatch picks on this CPU (``MKL_CBWR_Get_Auto_Branch``)."""
+    value = mkl_rt().MKL_CBWR_Get_Auto_Branch()
+    return CBWR_BRANCHES.get(value, f"unknown ({value})")

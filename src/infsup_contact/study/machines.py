@@ -1,12 +1,16 @@
-"""Verdicts no machine can flip: the same β sweep under every OpenBLAS core type.
+"""Verdicts no machine can flip: the same checks under every code path of both BLAS libraries.
 
-OpenBLAS picks its kernels by CPU (``OPENBLAS_CORETYPE`` overrides the choice), so round-off
+OpenBLAS (numpy's and scipy's BLAS) and MKL (PARDISO's Schur complements on the 3D face,
+:mod:`infsup_contact.models.pardiso`; ``cblas_dtrsm``) pick their kernels by CPU, so round-off
 differs between machines. The kernel dimension and every verdict must not: they rest on
-decisions with a stated margin (:mod:`infsup_contact.solvers.kernel`). This module runs a
-small sweep in this process — whichever core type it was started with — and compares the
-tables of several processes:
+decisions with a stated margin (:mod:`infsup_contact.solvers.kernel`). :data:`PATHS` names the
+code paths one CPU can be made to take — OpenBLAS's core types (``OPENBLAS_CORETYPE``) and
+MKL's code branches (``MKL_CBWR``) — each with its environment and the CPU it needs
+(:func:`runnable`). This module runs a small sweep (the segment's and a face's) in this process,
+whichever path it was started with, and compares the tables of several processes:
 
-* ``kernel_dim``, ``kernel_decision`` and every verdict must be identical;
+* ``kernel_dim``, ``kernel_decision`` (and the other :data:`EXACT` columns) and every verdict
+  must be identical;
 * β_h and β above the kernel must agree wherever the pencil resolves them
   (``gap_over_roundoff`` = β²/η >= 10**GAP_DECADES, η = n ε λ_max): to a relative
   10**GAP_DECADES/gap_over_roundoff (:func:`beta_tolerance`). An eigenvalue error of η would
@@ -16,71 +20,191 @@ tables of several processes:
   Measured between SkylakeX and Haswell: at most 218/gap over the 49,920 rows of the full
   config's β table (T3, k = 4, unstructured 12:12, β = 0.63: 6e-12 relative), at most 0.13/gap
   on the sweep here. Below the resolved level β's digits are round-off and machine
-  dependent, as are timings.
+  dependent, as are timings and margins.
 
-``tests/test_machines.py`` runs it under every core type this CPU can execute; the DAG target
-``verify-machines`` compares the CI profile's full ledgers.
+MKL's switch is ``MKL_CBWR``, not ``MKL_ENABLE_INSTRUCTIONS`` (measured with :func:`mkl_probe`,
+MKL 2026.2 on an AMD EPYC with AVX-512): MKL_ENABLE_INSTRUCTIONS = SSE4_2, AVX, AVX2, AVX512
+or AVX10 left every digit of a PARDISO Schur complement, its solves and a dgemm as without it,
+and MKL loaded the same ``libmkl_def`` — it only caps a dispatch that on a non-Intel CPU never
+leaves the generic branch, and it says nothing of what it did. ``MKL_CBWR`` is reported back
+(``MKL_CBWR_Get``, :func:`~infsup_contact.la.mkl.cbwr_branch`) and changes the digits: COMPATIBLE
+(SSE2, ``libmkl_vml_cmpt``) and AUTO (deterministic reductions, static scheduling) each give
+PARDISO's S and solves other digits than the default (S₀₀ = 1.7793580495149135, …106, …102): three
+distinct results, while every OpenBLAS core type leaves MKL's digits as they are. Its
+instruction-set branches (AVX2, AVX512) are for Intel processors: on this AMD CPU MKL refuses
+them (``MKL_CBWR_Set`` returns −3, MKL_CBWR_ERR_UNSUPPORTED_BRANCH; ``MKL_CBWR=AVX2`` runs AUTO),
+so those paths need ``GenuineIntel`` besides their flags and are skipped here with that reason.
+
+``tests/test_machines.py`` runs the sweep and the kernel, verdict and 3D kernel tests under
+every path this CPU can take; the DAG target ``verify-machines`` compares the CI profile's
+ledgers and kernel tables (:data:`LEDGER_TABLES`).
 """
 from __future__ import annotations
 
 import ctypes
 import glob
+import hashlib
+import json
 import os
+import re
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
-CORE_TYPES = ("Prescott", "Sandybridge", "Haswell", "SkylakeX", "Zen")
-"""The OpenBLAS core types the cross-machine checks run under (x86-64 kernel families)."""
-REQUIRED_FLAGS = {
-    "Prescott": {"sse3"},
-    "Sandybridge": {"avx"},
-    "Haswell": {"avx2", "fma"},
-    "SkylakeX": {"avx512f", "avx512dq", "avx512bw", "avx512vl"},
-    "Zen": {"avx2", "fma"},
-}
-"""CPU flags (/proc/cpuinfo; SSE3 is listed as ``pni``) each core type's kernels execute."""
-MKL_INSTRUCTIONS = {"Prescott": "SSE4_2", "Sandybridge": "AVX", "Haswell": "AVX2", "SkylakeX": "AVX512",
-                    "Zen": "AVX2"}
-"""MKL's code path (``MKL_ENABLE_INSTRUCTIONS``, its highest instruction set) matched to each
-core type: the face's Schur complement comes from MKL PARDISO (models/pardiso.py), whose
-round-off follows its own kernel choice, not OpenBLAS's. MKL has no SSE3-only path: Prescott
-gets its lowest, SSE4.2."""
+from ..errors import InputError
+
+SWITCHES = ("OPENBLAS_CORETYPE", "MKL_CBWR", "MKL_ENABLE_INSTRUCTIONS")
+"""The variables that select a library's code path: a path's environment drops every one it does
+not set, so a path is the same wherever the check was started from."""
+AVX512_FLAGS = frozenset({"avx512f", "avx512dq", "avx512bw", "avx512vl"})
+"""The AVX-512 subsets of Skylake-SP, which OpenBLAS's SkylakeX kernels and MKL's AVX512 branch use."""
 
 
-def machine_env(core: str, base: dict | None = None) -> dict:
-    """The environment that runs a check as on a CPU of ``core`` type: OpenBLAS's core type and
-    MKL's matching instruction set (:data:`MKL_INSTRUCTIONS`)."""
-    return dict(os.environ if base is None else base, OPENBLAS_CORETYPE=core,
-                MKL_ENABLE_INSTRUCTIONS=MKL_INSTRUCTIONS[core])
+@dataclass(frozen=True)
+class MachinePath:
+    """One code path of one library, as one CPU can be made to take it.
+
+    Attributes
+    ----------
+    library : str
+        ``openblas`` or ``mkl``.
+    setting : str
+        The core type (OpenBLAS) or code branch (MKL) selected, ``default`` for none.
+    env : dict
+        The variables of :data:`SWITCHES` this path sets (the others are removed).
+    flags : frozenset
+        CPU flags (/proc/cpuinfo; SSE3 is listed as ``pni``) its kernels execute.
+    vendor : str
+        The CPU vendor (``vendor_id``) the library takes the path on; empty: any.
+    """
+
+    library: str
+    setting: str
+    env: dict = field(default_factory=dict)
+    flags: frozenset = frozenset()
+    vendor: str = ""
+
+    @property
+    def name(self) -> str:
+        """``library:setting``, as reports and tables name the path."""
+        return f"{self.library}:{self.setting}"
+
+    @property
+    def wildcard(self) -> str:
+        """``library-setting``: the name in file names and Snakemake wildcards."""
+        return f"{self.library}-{self.setting}"
+
+
+def _openblas(core: str, flags: set) -> MachinePath:
+    return MachinePath("openblas", core, {"OPENBLAS_CORETYPE": core}, frozenset(flags))
+
+
+def _mkl(branch: str, flags: set = frozenset(), vendor: str = "") -> MachinePath:
+    return MachinePath("mkl", branch, {} if branch == "default" else {"MKL_CBWR": branch}, frozenset(flags), vendor)
+
+
+PATHS = (
+    _openblas("Prescott", {"sse3"}),
+    _openblas("Sandybridge", {"avx"}),
+    _openblas("Haswell", {"avx2", "fma"}),
+    _openblas("SkylakeX", AVX512_FLAGS),
+    _openblas("Zen", {"avx2", "fma"}),
+    _mkl("default"),
+    _mkl("AUTO"),
+    _mkl("COMPATIBLE"),
+    _mkl("AVX2", {"avx2", "fma"}, vendor="GenuineIntel"),
+    _mkl("AVX512", AVX512_FLAGS | {"avx512cd"}, vendor="GenuineIntel"),
+)
+"""The machine paths the cross-machine checks run under, OpenBLAS's x86-64 kernel families and
+MKL's code branches (``default``: no ``MKL_CBWR``, MKL dispatches as on any machine; ``AUTO``:
+that dispatch with deterministic reductions). Each path sets one library's switch and leaves the
+other library at its own choice."""
+PATH_NAMES = tuple(p.name for p in PATHS)
+CORE_TYPES = tuple(p.setting for p in PATHS if p.library == "openblas")
+"""The OpenBLAS core types among :data:`PATHS`."""
+
+
+def machine_path(name: str) -> MachinePath:
+    """The path called ``name`` (``openblas:Haswell`` or its wildcard ``openblas-Haswell``)."""
+    for p in PATHS:
+        if name in (p.name, p.wildcard):
+            return p
+    raise InputError("machine path", "one of " + ", ".join(PATH_NAMES), got=name)
+
+
+def machine_env(name: str, base: dict | None = None) -> dict:
+    """The environment that runs a check on path ``name``: ``base`` (default this process's)
+    without the :data:`SWITCHES`, plus the path's own."""
+    path = machine_path(name)
+    env = {k: v for k, v in (os.environ if base is None else base).items() if k not in SWITCHES}
+    return dict(env, **path.env)
 SWEEP_N = (4, 8)
 """Matching meshes of the β sweep (with the union partition of the 17:16 pair)."""
+FACE_SWEEP = {1: ((14, 14), (14, 16)), 2: ((7, 7), (7, 8))}
+"""Hexahedral pairs of the face sweep (membranes3d) by k: the smallest whose sides' Schur
+complements come from PARDISO (n · n_Γ above :data:`~infsup_contact.models.schur.SOLVES_MAX_WORK`),
+a matching and a non-matching pair each; G_h = Ω2's partition only (the union of the
+non-matching pairs, kernels of 336 to 448 modes, would take 4 of the sweep's 6 s)."""
 VERDICT_N = (4, 8, 16)
 """Matching meshes of each verdict (a slope interval needs three)."""
 VERDICT_CRITERION = dict(tol=0.15, floor=1e-3, confidence=0.95)
 """The verdict's criterion: the CLI's defaults (``infsup-contact verdict``)."""
 
 
-def cpu_flags(path: str = "/proc/cpuinfo") -> set:
-    """The CPU's feature flags (empty when the file is absent: not Linux on x86)."""
+def _cpuinfo(key: str, path: str) -> str:
+    """The first ``key : value`` of /proc/cpuinfo ("" when the file or key is absent: not Linux on x86)."""
     try:
         text = Path(path).read_text()
     except OSError:
-        return set()
+        return ""
     for line in text.splitlines():
-        if line.startswith("flags"):
-            flags = set(line.split(":", 1)[1].split())
-            return flags | ({"sse3"} if "pni" in flags else set())
-    return set()
+        if line.split(":", 1)[0].strip() == key:
+            return line.split(":", 1)[1].strip()
+    return ""
 
 
-def runnable(core: str, flags: set | None = None) -> tuple[bool, str]:
-    """Whether this CPU executes ``core``'s kernels, and the reason when it does not."""
+def cpu_flags(path: str = "/proc/cpuinfo") -> set:
+    """The CPU's feature flags (empty when the file is absent: not Linux on x86)."""
+    flags = set(_cpuinfo("flags", path).split())
+    return flags | ({"sse3"} if "pni" in flags else set())
+
+
+def cpu_vendor(path: str = "/proc/cpuinfo") -> str:
+    """The CPU's ``vendor_id`` (``GenuineIntel``, ``AuthenticAMD``; empty when unknown)."""
+    return _cpuinfo("vendor_id", path)
+
+
+def runnable(name: str, flags: set | None = None, vendor: str | None = None,
+             mkl: bool | None = None) -> tuple[bool, str]:
+    """Whether this CPU takes path ``name``, and the reason when it does not.
+
+    Parameters
+    ----------
+    name : str
+        A path of :data:`PATHS` (its name or wildcard).
+    flags, vendor : set, str, optional
+        The CPU's flags and vendor (default: :func:`cpu_flags`, :func:`cpu_vendor`).
+    mkl : bool, optional
+        Whether MKL loads (default: :func:`infsup_contact.la.mkl.available`); an MKL path needs it.
+    """
+    path = machine_path(name)
     flags = cpu_flags() if flags is None else flags
-    missing = sorted(REQUIRED_FLAGS[core] - flags)
+    vendor = cpu_vendor() if vendor is None else vendor
+    if path.library == "mkl":
+        if mkl is None:
+            from ..la.mkl import available
+
+            mkl = available()
+        if not mkl:
+            return False, f"{path.name} needs MKL (the mkl wheel's mkl_rt), which could not be loaded"
+    missing = sorted(path.flags - flags)
     if missing:
-        return False, f"{core} kernels need {', '.join(missing)}, which this CPU lacks (/proc/cpuinfo)"
+        return False, f"{path.name} kernels need {', '.join(missing)}, which this CPU lacks (/proc/cpuinfo)"
+    if path.vendor and vendor != path.vendor:
+        return False, (f"{path.name}: MKL takes its {path.setting} branch on {path.vendor} CPUs only; "
+                       f"this one is {vendor or 'unknown'} (MKL refuses the branch and runs AUTO)")
     return True, ""
 
 
@@ -101,9 +225,61 @@ def openblas_corenames() -> dict:
     return out
 
 
+PROBE_N, PROBE_N_GAMMA = 1000, 100
+"""Size of the probe's SPD matrix and of its Schur block (:func:`mkl_probe`): PARDISO's
+supernodal route (interior far above :data:`~infsup_contact.models.pardiso.MIN_INTERIOR`)."""
+
+
+def mkl_probe() -> dict:
+    """What MKL does in this process: its code branch and the digits of one PARDISO result.
+
+    Returns
+    -------
+    dict
+        ``branch`` (:func:`~infsup_contact.la.mkl.cbwr_branch`: the one ``MKL_CBWR`` asked for
+        when MKL took it), ``auto_branch``, ``digest`` (SHA-256 of PARDISO's Schur complement
+        :func:`~infsup_contact.models.pardiso.gamma_schur` and a solve of its full factorization
+        on a fixed random SPD matrix of size :data:`PROBE_N`: equal digests are equal digits),
+        ``s00`` (S's first entry, all digits)
+        and ``libraries`` (the MKL libraries loaded, /proc/self/maps: ``libmkl_def`` is the
+        generic branch). Empty when MKL does not load.
+    """
+    import scipy.sparse as sp
+
+    from ..la import mkl
+    from ..models.pardiso import Factor, gamma_schur
+
+    if not mkl.available():
+        return {}
+    rng = np.random.default_rng(20011)
+    R = sp.random(PROBE_N, PROBE_N, density=8.0 / PROBE_N, random_state=rng)
+    A = sp.csr_matrix(R @ R.T + sp.diags(0.1 + rng.random(PROBE_N)))
+    # MKL's digits only: S (phase 12) and a full factorization's solve (phase 33); SchurFactor's
+    # own solve takes S's Cholesky factor from scipy's LAPACK, i.e. from OpenBLAS
+    S = gamma_schur(A, PROBE_N_GAMMA)
+    full = Factor(A)
+    x = full.solve(np.ones(PROBE_N))
+    full.handle.release()
+    try:
+        maps = Path("/proc/self/maps").read_text()
+    except OSError:
+        maps = ""
+    return dict(branch=mkl.cbwr_branch(), auto_branch=mkl.cbwr_auto_branch(),
+                digest=hashlib.sha256(S.tobytes() + x.tobytes()).hexdigest()[:16], s00=repr(float(S[0, 0])),
+                libraries=sorted(set(re.findall(r"(libmkl_\w+)\.so", maps))))
+
+
+def expected_mkl_branch(name: str) -> str:
+    """The branch :func:`~infsup_contact.la.mkl.cbwr_branch` reports on path ``name`` where it
+    took effect: its own on an MKL path (``OFF`` for ``default``), ``OFF`` on an OpenBLAS path."""
+    path = machine_path(name)
+    return path.env.get("MKL_CBWR", "OFF")
+
+
 def sweep_rows() -> pd.DataFrame:
     """β rows of the paper's five cases, k = 1..4, both norms: matching N = 4, 8 (every
-    multiplier mesh is the same partition there) and the union partition of the 17:16 pair."""
+    multiplier mesh is the same partition there) and the union partition of the 17:16 pair;
+    and :func:`face_sweep_rows`. Column ``model`` tells them apart."""
     from ..discretization.registry import PAPER_CASES, SPACES
     from ..solvers.infsup import beta_rows
 
@@ -112,7 +288,26 @@ def sweep_rows() -> pd.DataFrame:
         cases = [c for c in PAPER_CASES if SPACES[c].valid_for(k)]
         for n1, n2, mm in [(n, n, "omega2") for n in SWEEP_N] + [(17, 16, "union")]:
             rows += beta_rows("structured", k, n1, n2, cases, mm, norms=("H", "L2"))
-    return pd.DataFrame(rows)
+    return pd.concat([pd.DataFrame(rows).assign(model="membranes"), face_sweep_rows()], ignore_index=True)
+
+
+def face_sweep_rows() -> pd.DataFrame:
+    """β rows on the 3D face (membranes3d, hexahedra): the paper's cases defined for k = 1, 2,
+    both norms, G_h = Ω2's partition, on the pairs of :data:`FACE_SWEEP` — every side's Schur
+    complement from MKL PARDISO, so MKL's path reaches the kernel columns (measured, k = 2, 7:8:
+    the default, AUTO and COMPATIBLE branches give both sides' S other bits and move β in its
+    15th digit, below the 12 the table keeps)."""
+    from ..discretization.registry import PAPER_CASES, SPACES
+    from ..models import make_model
+    from ..solvers.infsup import beta_rows_all
+
+    model, rows = make_model("membranes3d"), []
+    for k, pairs in FACE_SWEEP.items():
+        cases = [c for c in PAPER_CASES if SPACES[c].valid_for(k)]
+        for n1, n2 in pairs:
+            rows += beta_rows_all("structured", k, n1, n2, cases, ("omega2",), norms=("H", "L2"),
+                                  model=model, element="hex")
+    return pd.DataFrame(rows).assign(model=model.name)
 
 
 def verdict_rows() -> pd.DataFrame:
@@ -129,17 +324,19 @@ def verdict_rows() -> pd.DataFrame:
     return pd.DataFrame(out)
 
 
-KEYS = ["case", "k", "N1", "N2", "multiplier_mesh", "norm"]
+KEYS = ["model", "case", "k", "N1", "N2", "multiplier_mesh", "norm"]
 EXACT = ["kernel_dim", "structural_kernel_dim", "kernel_detected", "kernel_decision", "kernel_check", "dim_M"]
+"""The sweep's columns that no code path may change (the kernel decisions and dimensions)."""
 
 
 def compare(sweeps: dict, verdicts: dict) -> list:
-    """Differences between the tables of several core types (empty: they agree).
+    """Differences between the tables of several machine paths (empty: they agree).
 
     Parameters
     ----------
     sweeps, verdicts : dict
-        core type → :func:`sweep_rows` / :func:`verdict_rows` of a process run under it.
+        path name → :func:`sweep_rows` / :func:`verdict_rows` of a process run on it; the first
+        is the reference.
 
     Returns
     -------
@@ -147,29 +344,31 @@ def compare(sweeps: dict, verdicts: dict) -> list:
         One line per disagreement: an exact column or a verdict that differs, or a resolved
         β that differs by more than :func:`beta_tolerance`.
     """
-    (ref_core, ref), *others = sweeps.items()
+    (ref_name, ref), *others = sweeps.items()
     problems = []
-    for core, frame in others:
+    for name, frame in others:
         both = ref.merge(frame, on=KEYS, suffixes=("", "_other"))
         if len(both) != len(ref) or len(frame) != len(ref):
-            problems.append(f"{core}: {len(frame)} rows vs {len(ref)} under {ref_core}")
+            problems.append(f"{name}: {len(frame)} rows vs {len(ref)} under {ref_name}")
         for col in EXACT:
             bad = both[both[col] != both[f"{col}_other"]]
-            problems += [f"{core} vs {ref_core}: {col} {r[col]} != {r[col + '_other']} at "
+            problems += [f"{name} vs {ref_name}: {col} {r[col]} != {r[col + '_other']} at "
                          f"{dict((c, r[c]) for c in KEYS)}" for _, r in bad.iterrows()]
         for col in ("beta", "smallest_nonzero"):
             a, b = both[col].to_numpy(float), both[f"{col}_other"].to_numpy(float)
             rel = np.abs(a - b) / np.maximum(np.abs(a), np.finfo(float).tiny)
             tol = beta_tolerance(both.gap_over_roundoff.to_numpy(float), both.gap_over_roundoff_other.to_numpy(float))
             bad = both[rel > tol]
-            problems += [f"{core} vs {ref_core}: {col} {r[col]:.12g} vs {r[col + '_other']:.12g} at "
+            problems += [f"{name} vs {ref_name}: {col} {r[col]:.12g} vs {r[col + '_other']:.12g} at "
                          f"{dict((c, r[c]) for c in KEYS)}" for _, r in bad.iterrows()]
-    (ref_core, ref), *others = verdicts.items()
-    for core, frame in others:
+    (ref_name, ref), *others = verdicts.items()
+    for name, frame in others:
         both = ref.merge(frame, on=["case", "k", "norm"], suffixes=("", "_other"))
+        if len(both) != len(ref) or len(frame) != len(ref):
+            problems.append(f"{name}: {len(frame)} verdicts vs {len(ref)} under {ref_name}")
         bad = both[(both.verdict != both.verdict_other) | (both.kernel_dim != both.kernel_dim_other)]
-        problems += [f"{core} vs {ref_core}: verdict {r.verdict} != {r.verdict_other} for {r.case} k={r.k} {r.norm}"
-                     for r in bad.itertuples()]
+        problems += [f"{name} vs {ref_name}: verdict {r.verdict_other} (kernel {r.kernel_dim_other}) != "
+                     f"{r.verdict} (kernel {r.kernel_dim}) for {r.case} k={r.k} {r.norm}" for r in bad.itertuples()]
     return problems
 
 
@@ -184,8 +383,8 @@ def beta_tolerance(gap_a, gap_b) -> np.ndarray:
 
 
 def max_beta_difference(sweeps: dict) -> tuple[float, float]:
-    """Largest relative difference of β between the core types over the resolved rows, and
-    the largest of those differences over its tolerance (<= 1: inside it)."""
+    """Largest relative difference of β between the paths over the resolved rows, and the
+    largest of those differences over its tolerance (<= 1: inside it)."""
     (_, ref), *others = sweeps.items()
     worst, worst_scaled = 0.0, 0.0
     for _, frame in others:
@@ -199,9 +398,85 @@ def max_beta_difference(sweeps: dict) -> tuple[float, float]:
     return worst, worst_scaled
 
 
+LEDGER_TABLES = ("results/claims.csv", "results/tables/beta.csv", "results/tables/contact.csv",
+                 "results/tables/elastic_beta.csv", "results/tables/elastic_nu_sweep.csv",
+                 "results/tables/elastic_patch.csv", "results/tables/face_beta.csv",
+                 "results/tables/face_elastic_beta.csv", "results/face/alpha.csv", "results/face/patch.csv",
+                 "results/face/elastic_patch.csv")
+"""The CI profile's tables ``verify-machines`` compares across paths (relative to the workflow):
+the ledger and every table of the segment's, the elastic and the face stages that carries a
+kernel column."""
+LEDGER_EXACT = ("verdict", "kernel_dim", "structural_kernel_dim", "kernel_detected", "kernel_decision",
+                "kernel_check", "dim_M", "dim_W", "kernel_dim_membranes", "kernel_decision_membranes", "passes")
+"""Columns that must be byte-identical across paths wherever a table of :data:`LEDGER_TABLES`
+has them: verdicts, kernel decisions and dimensions, the patch tests' pass (errors of 1e-12
+against 1e-8). ``kernel_margin_decades`` is a margin and β a number: their digits may move."""
+
+
+ROW_LABEL = ("claim_id", "scene", "model", "element", "family", "case", "k", "N1", "N2", "multiplier_mesh", "norm",
+             "nu", "alpha", "N")
+"""Columns that name a row of a ledger table in :func:`ledger_differences`' messages (those it has)."""
+
+
+def _row_label(frame: pd.DataFrame, i: int) -> str:
+    cols = [c for c in ROW_LABEL if c in frame.columns] or [frame.columns[0]]
+    return ", ".join(f"{c} {frame[c].iloc[i]}" for c in cols)
+
+
+def ledger_differences(ledgers: dict) -> tuple[pd.DataFrame, list]:
+    """Compare the CI ledgers of several paths column by column, byte for byte.
+
+    Parameters
+    ----------
+    ledgers : dict
+        path name → folder holding the tables of :data:`LEDGER_TABLES` (same relative paths)
+        of a run on that path; the first is the reference.
+
+    Returns
+    -------
+    summary : DataFrame
+        One row per (table, column of :data:`LEDGER_EXACT` it has): ``rows`` and ``identical``.
+    problems : list of str
+        A table missing or without any exact column, rows or columns that differ between the
+        ledgers, and every row whose exact column differs (table, row number, column, values).
+    """
+    problems, summary = [], []
+    (ref_name, ref_dir), *others = ledgers.items()
+    for table in LEDGER_TABLES:
+        texts = {}
+        for name, folder in ledgers.items():
+            f = Path(folder) / table
+            if not f.is_file():
+                problems.append(f"{table}: missing under {name} ({f})")
+                continue
+            # every cell as the text written: a byte comparison, no parsing of numbers
+            texts[name] = pd.read_csv(f, dtype=str, keep_default_na=False)
+        if ref_name not in texts:
+            continue
+        ref = texts[ref_name]
+        cols = [c for c in LEDGER_EXACT if c in ref.columns]
+        if not cols:
+            problems.append(f"{table}: none of the exact columns ({', '.join(LEDGER_EXACT)}) under {ref_name}")
+        for name, frame in texts.items():
+            if name != ref_name and (list(frame.columns) != list(ref.columns) or len(frame) != len(ref)):
+                problems.append(f"{table}: {name} has {len(frame)} rows × {len(frame.columns)} columns, "
+                                f"{ref_name} {len(ref)} × {len(ref.columns)}")
+        for col in cols:
+            same = True
+            for name, frame in texts.items():
+                if name == ref_name or col not in frame.columns or len(frame) != len(ref):
+                    same = same and name == ref_name
+                    continue
+                diff = np.flatnonzero(frame[col].to_numpy() != ref[col].to_numpy())
+                same = same and not len(diff)
+                problems += [f"{table} row {i} ({_row_label(ref, i)}): {col} {frame[col].iloc[i]} under "
+                             f"{name}, {ref[col].iloc[i]} under {ref_name}" for i in diff]
+            summary.append(dict(table=table, column=col, rows=len(ref), identical=same))
+    return pd.DataFrame(summary, columns=["table", "column", "rows", "identical"]), problems
+
+
 def main(out_dir: str) -> None:
-    """Write this process's sweep, verdicts and OpenBLAS core names to ``out_dir``."""
-    import json
+    """Write this process's sweep, verdicts, OpenBLAS core names and MKL probe to ``out_dir``."""
 
     from ..io import write_atomic, write_csv_atomic
 
@@ -209,16 +484,24 @@ def main(out_dir: str) -> None:
     write_csv_atomic(out / "sweep.csv", sweep_rows().drop(columns=["t_assemble", "t_interface", "t_eig"]))
     write_csv_atomic(out / "verdicts.csv", verdict_rows())
     write_atomic(out / "openblas.json", json.dumps(openblas_corenames()))
+    write_atomic(out / "mkl.json", json.dumps(mkl_probe()))
 
 
 def cli(argv=None) -> int:
-    """``python -m infsup_contact.study.machines OUT_DIR``: :func:`main`; a missing or unusable
-    OUT_DIR is one line on stderr naming it, exit 2."""
+    """``python -m infsup_contact.study.machines OUT_DIR``: :func:`main`; ``--probe``: print the
+    libraries' state (a path's evidence) only. A missing or unusable OUT_DIR is one line on
+    stderr naming it, exit 2."""
+    import sys
+
     from ..cli.common import OneLineParser, run_study
     from ..errors import InputError
 
+    argv = sys.argv[1:] if argv is None else list(argv)
+    if argv == ["--probe"]:
+        print(json.dumps(dict(openblas=openblas_corenames(), mkl=mkl_probe())))
+        return 0
     p = OneLineParser(prog="python -m infsup_contact.study.machines", description=main.__doc__)
-    p.add_argument("out_dir", help="directory for sweep.csv, verdicts.csv and openblas.json (created)")
+    p.add_argument("out_dir", help="directory for sweep.csv, verdicts.csv, openblas.json and mkl.json (created)")
 
     def check(args):
         out = Path(args.out_dir)

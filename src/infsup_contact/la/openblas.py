@@ -28,27 +28,44 @@ import os
 import time
 from functools import lru_cache
 
-_SETTERS = (("numpy", "scipy_openblas_set_num_threads64_", "scipy_openblas_get_num_threads64_"),
-            ("scipy", "scipy_openblas_set_num_threads", "scipy_openblas_get_num_threads"))
-"""numpy's and scipy's OpenBLAS copies and their (prefixed) thread-count functions."""
+_SUFFIX = {"numpy": "64_", "scipy": ""}
+"""numpy's and scipy's OpenBLAS copies and the suffix of their ``scipy_openblas_*`` symbols."""
 
 
 @lru_cache(maxsize=1)
-def libraries() -> tuple:
-    """(name, set, get) of each OpenBLAS copy loaded by numpy and scipy (ctypes functions)."""
+def loaded() -> tuple:
+    """(name, ctypes library, symbol suffix) of each OpenBLAS copy numpy and scipy load."""
     import numpy
     import scipy
 
     out = []
-    for (name, set_name, get_name), mod in zip(_SETTERS, (numpy, scipy)):
+    for name, mod in (("numpy", numpy), ("scipy", scipy)):
         folder = os.path.join(os.path.dirname(os.path.dirname(mod.__file__)), f"{name}.libs")
-        for path in glob.glob(os.path.join(folder, "*openblas*")):
-            lib = ctypes.CDLL(path)
-            setter, getter = getattr(lib, set_name, None), getattr(lib, get_name, None)
-            if setter is not None and getter is not None:
-                getter.restype = ctypes.c_int
-                out.append((name, setter, getter))
+        out += [(name, ctypes.CDLL(path), _SUFFIX[name]) for path in glob.glob(os.path.join(folder, "*openblas*"))]
     return tuple(out)
+
+
+def libraries() -> tuple:
+    """(name, set, get) of each copy's thread-count functions (ctypes)."""
+    out = []
+    for name, lib, sfx in loaded():
+        setter = getattr(lib, f"scipy_openblas_set_num_threads{sfx}", None)
+        getter = getattr(lib, f"scipy_openblas_get_num_threads{sfx}", None)
+        if setter is not None and getter is not None:
+            getter.restype = ctypes.c_int
+            out.append((name, setter, getter))
+    return tuple(out)
+
+
+def corenames() -> dict:
+    """{copy: the kernel set OpenBLAS chose in this process} (``OPENBLAS_CORETYPE`` overrides it)."""
+    out = {}
+    for name, lib, sfx in loaded():
+        fn = getattr(lib, f"scipy_openblas_get_corename{sfx}", None)
+        if fn is not None:
+            fn.restype = ctypes.c_char_p
+            out[name] = fn().decode()
+    return out
 
 
 def threads_now() -> dict:

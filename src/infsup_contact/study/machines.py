@@ -41,8 +41,6 @@ ledgers and kernel tables (:data:`LEDGER_TABLES`).
 """
 from __future__ import annotations
 
-import ctypes
-import glob
 import hashlib
 import json
 import os
@@ -210,19 +208,9 @@ def runnable(name: str, flags: set | None = None, vendor: str | None = None,
 
 def openblas_corenames() -> dict:
     """The kernel set OpenBLAS chose in this process, for numpy's and scipy's copies."""
-    import numpy
-    import scipy
+    from ..la.openblas import corenames
 
-    out = {}
-    for name, mod, sym in (("numpy", numpy, "scipy_openblas_get_corename64_"),
-                           ("scipy", scipy, "scipy_openblas_get_corename")):
-        libs = glob.glob(os.path.join(os.path.dirname(os.path.dirname(mod.__file__)), f"{name}.libs", "*openblas*"))
-        for lib in libs:
-            fn = getattr(ctypes.CDLL(lib), sym, None)
-            if fn is not None:
-                fn.restype = ctypes.c_char_p
-                out[name] = fn().decode()
-    return out
+    return corenames()
 
 
 PROBE_N, PROBE_N_GAMMA = 1000, 100
@@ -477,7 +465,6 @@ def ledger_differences(ledgers: dict) -> tuple[pd.DataFrame, list]:
 
 def main(out_dir: str) -> None:
     """Write this process's sweep, verdicts, OpenBLAS core names and MKL probe to ``out_dir``."""
-
     from ..io import write_atomic, write_csv_atomic
 
     out = Path(out_dir)

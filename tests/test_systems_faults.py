@@ -1,0 +1,81 @@
+"""Issue 40, item 0: nothing silent, nothing unsafe on the foreign-system path.
+
+Each test is one fault a hostile (or unlucky) user can produce with a small file: before the
+fix it gave a wrong verdict, a segmentation fault, a silently misread number, unbounded memory
+or an overwritten directory; now a verdict that says what it found, or one line on stderr
+naming the file, exit code 2."""
+from __future__ import annotations
+
+import io
+from pathlib import Path
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+
+from infsup_contact.cli import main
+from infsup_contact.systems.engine import level_spectrum
+from infsup_contact.systems.export import write_system
+from infsup_contact.systems.levels import system_rows, system_verdict
+from infsup_contact.systems.manifest import load_manifest
+
+CRITERION = dict(tol=0.15, floor=1e-3, confidence=0.95)
+NS = (8, 16, 32)
+
+
+def _level(N, kind):
+    """A system with β_h ≈ 0.7 on every level (stable), or made singular by ``kind``."""
+    n, m = 2 * N, N // 2
+    A = sp.diags([-0.1 * np.ones(n - 1), 2.0 * np.ones(n), -0.1 * np.ones(n - 1)], [-1, 0, 1], format="lil")
+    B = sp.lil_matrix((m, n))
+    for j in range(m):
+        B[j, 2 * j + 1] = 1.0
+    if kind == "zero_row":
+        B[m - 1, :] = 0
+    elif kind == "half_rank":  # rows pairwise equal
+        for j in range(0, m, 2):
+            B[j + 1, :] = B[j, :]
+    elif kind == "more_rows":  # more multipliers than dofs
+        B = sp.lil_matrix((n + 3, n))
+        B[np.arange(n), np.arange(n)] = 1.0
+        B[n:, :3] = np.eye(3)
+    elif kind == "penalty":  # the only dof of the last row fixed by a penalty: the row is left uncoupled
+        d = 2 * m - 1
+        A[d, d], A[d, d - 1], A[d - 1, d], A[d, d + 1], A[d + 1, d] = 1e30, 0, 0, 0, 0
+    return 1.0 / N, A.tocsr(), sp.csr_matrix(B), sp.identity(B.shape[0], format="csr")
+
+
+def _write(tmp_path, kind, known_kernel=0):
+    return write_system(tmp_path / kind, [_level(N, kind) for N in NS], "mtx", kind, known_kernel=known_kernel)
+
+
+# ------------------------------------------------------------------ 1. a singular system is not STABLE
+
+@pytest.mark.parametrize("kind, dims", [("zero_row", [1, 1, 1]), ("half_rank", [2, 4, 8]),
+                                        ("more_rows", [3, 3, 3]), ("penalty", [1, 1, 1])])
+def test_an_undeclared_kernel_is_unstable(tmp_path, capsys, kind, dims):
+    """Before: STABLE, kernel_dim 0, exit 0 under --expect stable (the deficiency m − touched dofs
+    was counted as 'proven' and discounted as if declared)."""
+    path = _write(tmp_path, kind)
+    out, rows = system_verdict(load_manifest(path), **CRITERION, notes=io.StringIO())
+    assert out["verdict"] == "UNSTABLE" and out["kernel_dim"] == max(dims) and out["beta_min"] == 0.0
+    assert f"of dim {dims}" in out["evidence"] and "not declared (known_kernel: 0)" in out["evidence"]
+    assert [r["known_kernel"] for r in rows] == [0, 0, 0]  # only what was declared
+    assert [r["kernel_detected"] for r in rows] == dims
+    assert main(["verdict", "--system", str(path), "--expect", "stable"]) == 1
+    assert ",UNSTABLE," in capsys.readouterr().out
+
+
+def test_a_declared_kernel_is_discounted(tmp_path):
+    """The same zero row, declared (known_kernel: 1): β_h above it, STABLE."""
+    out, rows = system_verdict(load_manifest(_write(tmp_path, "zero_row", known_kernel=1)), **CRITERION,
+                               notes=io.StringIO())
+    assert out["verdict"] == "STABLE" and out["kernel_dim"] == 0
+    assert all(r["known_kernel"] == 1 and r["kernel_dim"] == 1 and r["beta"] > 0.7 for r in rows)
+
+
+def test_structural_kernel_is_detected_on_every_route():
+    _, A, B, G = _level(16, "more_rows")
+    for route in ("gamma-dense", "solves-dense", "shift-invert"):
+        res = level_spectrum(A, B, G, route=route)
+        assert res.kernel.proven == 0 and res.kernel.detected == 3 and res.beta == 0.0, route

@@ -79,3 +79,60 @@ def test_structural_kernel_is_detected_on_every_route():
     for route in ("gamma-dense", "solves-dense", "shift-invert"):
         res = level_spectrum(A, B, G, route=route)
         assert res.kernel.proven == 0 and res.kernel.detected == 3 and res.beta == 0.0, route
+
+
+# ------------------------------------------------------------------ 2. index arrays checked before scipy sees them
+
+def _csr_npz(path, B, **override):
+    arrays = dict(format=np.array("csr"), shape=np.array(B.shape), data=B.data, indices=B.indices, indptr=B.indptr)
+    arrays.update(override)
+    np.savez(path, **arrays)
+    return path
+
+
+@pytest.mark.parametrize("override, found", [
+    (lambda B: dict(indices=B.indices + 10 ** 6), "column index 1000007 outside 0..15"),
+    (lambda B: dict(indices=B.indices - 10 ** 6), "column index -999999 outside 0..15"),
+    (lambda B: dict(indptr=B.indptr[::-1].copy()), "index pointers must rise from 0 to 4"),
+    (lambda B: dict(indptr=B.indptr[:-1].copy()), "4 index pointers for 4 rows"),
+    (lambda B: dict(data=B.data[:-1].copy()), "3 values but 4 column indices"),
+    (lambda B: dict(format=np.array("bsr")), "'bsr' archive"),
+    (lambda B: dict(shape=np.array([4, -16])), "not two integers >= 0"),
+])
+def test_npz_with_bad_indices_is_one_line_not_a_crash(tmp_path, capsys, override, found):
+    """Before: exit 139 (segmentation fault, no message), after --dry-run said 'valid request'."""
+    path = _write(tmp_path, "ok")
+    B = sp.csr_matrix(_level(8, "ok")[2])
+    _csr_npz(path.parent / "B0.npz", B, **override(B))
+    path.write_text(path.read_text().replace("B0.mtx", "B0.npz"))
+    for argv in (["--dry-run"], []):
+        assert main(["verdict", "--system", str(path)] + argv) == 2
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and str(path.parent / "B0.npz") in err and found in err, err
+
+
+def test_coo_npz_checked_and_read(tmp_path):
+    from infsup_contact.systems.readers import SystemFileError, read_matrix
+
+    B = sp.coo_matrix(_level(8, "ok")[2])
+    sp.save_npz(tmp_path / "ok.npz", B, compressed=False)
+    assert np.array_equal(read_matrix(tmp_path / "ok.npz").toarray(), B.toarray())
+    np.savez(tmp_path / "bad.npz", format=np.array("coo"), shape=np.array(B.shape), data=B.data,
+             row=B.row, col=B.col + 100)
+    with pytest.raises(SystemFileError, match=r"bad.npz: column index 1\d\d outside 0..15"):
+        read_matrix(tmp_path / "bad.npz")
+
+
+def test_harwell_boeing_index_out_of_range(tmp_path):
+    """A row index beyond the declared rows was read silently (an entry lost, or a crash)."""
+    import scipy.io
+
+    from infsup_contact.systems.readers import SystemFileError, read_matrix
+
+    B = sp.csc_matrix(_level(8, "ok")[2])
+    scipy.io.hb_write(str(tmp_path / "B.rua"), B)
+    text = (tmp_path / "B.rua").read_text()
+    assert "\n 1 2 3 4\n" in text
+    (tmp_path / "B.rua").write_text(text.replace("\n 1 2 3 4\n", "\n 1 2 3 9\n"))
+    with pytest.raises(SystemFileError, match=r"B.rua: CSC: row index 8 outside 0..3"):
+        read_matrix(tmp_path / "B.rua")

@@ -104,6 +104,7 @@ def read_matrix(path):
         reason = " ".join(str(err).split())[:160] or type(err).__name__
         raise SystemFileError(path, f"not a readable {FORMATS[ext]} file ({type(err).__name__}: {reason})") from None
     if sp.issparse(mat):
+        _check_sparse(path, mat)
         mat = sp.csr_matrix(mat)
     else:
         mat = np.asarray(mat)
@@ -132,12 +133,88 @@ def _read_npz(path):
     with np.load(path, allow_pickle=False) as data:
         keys = set(data.files)
     if {"format", "shape", "data"} <= keys:
-        return sp.load_npz(path)
+        return _sparse_npz(path)
     if len(keys) != 1:
         raise SystemFileError(path, f"an .npz with arrays {sorted(keys)}: expected a scipy.sparse.save_npz "
                               "archive or exactly one dense array")
     with np.load(path, allow_pickle=False) as data:
         return data[next(iter(keys))]
+
+
+SPARSE_NPZ = {"csr": ("indices", "indptr"), "csc": ("indices", "indptr"), "coo": ("row", "col")}
+"""The ``scipy.sparse.save_npz`` layouts read, and their index arrays (bsr and dia are refused)."""
+
+
+def _sparse_npz(path):
+    """A ``scipy.sparse.save_npz`` archive, its index arrays checked before the matrix is built
+    (scipy does not check them: an index out of range crashed the process, exit 139)."""
+    with np.load(path, allow_pickle=False) as data:
+        fmt = data["format"].item()
+        fmt = fmt.decode("ascii", "replace") if isinstance(fmt, bytes) else str(fmt)
+        if fmt not in SPARSE_NPZ:
+            raise SystemFileError(path, f"a scipy.sparse {fmt!r} archive (readable: {', '.join(SPARSE_NPZ)}; "
+                                  "save the matrix with .tocsr())")
+        missing = [k for k in SPARSE_NPZ[fmt] if k not in data.files]
+        if missing:
+            raise SystemFileError(path, f"a scipy.sparse {fmt} archive without its {missing[0]!r} array")
+        shape = np.asarray(data["shape"])
+        arrays = [np.asarray(data[k]) for k in ("data",) + SPARSE_NPZ[fmt]]
+    if shape.shape != (2,) or not np.issubdtype(shape.dtype, np.integer) or (shape < 0).any():
+        raise SystemFileError(path, f"'shape' is {shape.tolist()!r}, not two integers >= 0")
+    m, n = (int(v) for v in shape)
+    values, first, second = arrays
+    if fmt == "coo":
+        check_coordinates(path, (m, n), values, first, second)
+        return sp.coo_matrix((values, (first, second)), shape=(m, n))
+    check_compressed(path, (m, n), values, first, second, rows_major=fmt == "csr")
+    return (sp.csr_matrix if fmt == "csr" else sp.csc_matrix)((values, first, second), shape=(m, n))
+
+
+def _int_array(path, name, a):
+    a = np.asarray(a)
+    if a.ndim != 1 or not (np.issubdtype(a.dtype, np.integer) or a.size == 0):
+        raise SystemFileError(path, f"'{name}' holds {a.dtype} of shape {a.shape}, not a 1-D integer array")
+    return a
+
+
+def check_coordinates(path, shape, values, row, col):
+    """Coordinate (COO) arrays: equal lengths, 0 <= row < m, 0 <= col < n (:class:`SystemFileError`)."""
+    row, col = _int_array(path, "row", row), _int_array(path, "col", col)
+    if np.ndim(values) != 1 or not len(values) == len(row) == len(col):
+        raise SystemFileError(path, f"{np.size(values)} values but {len(row)} row and {len(col)} column indices")
+    for name, idx, size in (("row", row, shape[0]), ("column", col, shape[1])):
+        if idx.size and (idx.min() < 0 or idx.max() >= size):
+            bad = int(idx.min() if idx.min() < 0 else idx.max())
+            raise SystemFileError(path, f"{name} index {bad} outside 0..{size - 1} (shape {shape[0]} x {shape[1]})")
+
+
+def check_compressed(path, shape, values, indices, indptr, rows_major=True):
+    """CSR (``rows_major``) or CSC arrays, before scipy sees them: len(indptr) = rows + 1 (CSR),
+    indptr from 0, non-decreasing, ending at len(indices) = len(values), 0 <= indices < cols."""
+    indices, indptr = _int_array(path, "indices", indices), _int_array(path, "indptr", indptr)
+    major, minor = shape if rows_major else shape[::-1]
+    kind, what = ("CSR", "column") if rows_major else ("CSC", "row")
+    if len(indptr) != major + 1:
+        raise SystemFileError(path, f"{kind}: {len(indptr)} index pointers for {major} "
+                              f"{'rows' if rows_major else 'columns'} (expected {major + 1})")
+    if np.ndim(values) != 1 or len(values) != len(indices):
+        raise SystemFileError(path, f"{kind}: {np.size(values)} values but {len(indices)} {what} indices")
+    if indptr[0] != 0 or indptr[-1] != len(indices) or (np.diff(indptr) < 0).any():
+        raise SystemFileError(path, f"{kind}: index pointers must rise from 0 to {len(indices)} without "
+                              f"decreasing (found {int(indptr[0])} .. {int(indptr[-1])}"
+                              f"{', decreasing' if (np.diff(indptr) < 0).any() else ''})")
+    if indices.size and (indices.min() < 0 or indices.max() >= minor):
+        bad = int(indices.min() if indices.min() < 0 else indices.max())
+        raise SystemFileError(path, f"{kind}: {what} index {bad} outside 0..{minor - 1} "
+                              f"(shape {shape[0]} x {shape[1]})")
+
+
+def _check_sparse(path, mat):
+    """The index arrays of a matrix a library built without checking them (Harwell-Boeing)."""
+    if isinstance(mat, (sp.csr_matrix, sp.csc_matrix)) or getattr(mat, "format", None) in ("csr", "csc"):
+        check_compressed(path, mat.shape, mat.data, mat.indices, mat.indptr, rows_major=mat.format == "csr")
+    elif getattr(mat, "format", None) == "coo":
+        check_coordinates(path, mat.shape, mat.data, mat.row, mat.col)
 
 
 def _read_petsc(path):

@@ -136,3 +136,26 @@ def test_harwell_boeing_index_out_of_range(tmp_path):
     (tmp_path / "B.rua").write_text(text.replace("\n 1 2 3 4\n", "\n 1 2 3 9\n"))
     with pytest.raises(SystemFileError, match=r"B.rua: CSC: row index 8 outside 0..3"):
         read_matrix(tmp_path / "B.rua")
+
+
+# ------------------------------------------------------------------ 3. files cut short, keys given twice, names
+
+def test_matrixmarket_cut_inside_its_last_number_is_refused(tmp_path, capsys):
+    """Before: 2.5000000000000000e-0 (the file cut inside 2.5000000000000000e-01) read as 2.5."""
+    import gzip
+
+    from infsup_contact.systems.readers import SystemFileError, read_matrix
+
+    text = ("%%MatrixMarket matrix coordinate real general\n2 2 2\n1 1 1.0000000000000000e+00\n"
+            "2 2 2.5000000000000000e-01\n")
+    (tmp_path / "full.mtx").write_text(text)
+    assert read_matrix(tmp_path / "full.mtx").toarray()[1, 1] == 0.25
+    for name, raw in (("cut.mtx", text[:-2].encode()), ("cut.mtx.gz", gzip.compress(text[:-2].encode()))):
+        (tmp_path / name).write_bytes(raw)
+        with pytest.raises(SystemFileError, match=rf"{name}: MatrixMarket: the last line does not end with a newline"):
+            read_matrix(tmp_path / name)
+    path = _write(tmp_path, "ok")
+    (path.parent / "B1.mtx").write_bytes((path.parent / "B1.mtx").read_bytes()[:-2])
+    assert main(["verdict", "--system", str(path), "--dry-run"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "B1.mtx: MatrixMarket: the last line" in err

@@ -123,7 +123,23 @@ def _read_mtx(path, ext):
     if not head.startswith(b"%%MatrixMarket"):
         raise SystemFileError(path, f"does not start with the MatrixMarket banner '%%MatrixMarket' "
                               f"(found {head[:15]!r})")
+    if _last_byte(path, ext) != b"\n":
+        raise SystemFileError(path, "MatrixMarket: the last line does not end with a newline (a file cut "
+                              "short, possibly inside its last number: write it again)")
     return scipy.io.mmread(str(path))
+
+
+def _last_byte(path, ext) -> bytes:
+    """The last byte of the (decompressed) file; a .mtx.gz is streamed (constant memory)."""
+    if ext != ".mtx.gz":
+        with open(path, "rb") as fh:
+            fh.seek(-1, 2)
+            return fh.read(1)
+    last = b""
+    with gzip.open(path, "rb") as fh:
+        while chunk := fh.read(1 << 20):
+            last = chunk[-1:]
+    return last
 
 
 def _read_npz(path):

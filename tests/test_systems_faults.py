@@ -159,3 +159,66 @@ def test_matrixmarket_cut_inside_its_last_number_is_refused(tmp_path, capsys):
     assert main(["verdict", "--system", str(path), "--dry-run"]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "B1.mtx: MatrixMarket: the last line" in err
+
+
+@pytest.mark.parametrize("edit, found", [
+    (lambda t: t.replace("norm: given\n", "norm: given\nnorm: L2\n"),
+     "norm (line 3): key 'norm' given twice (lines 2 and 3"),
+    (lambda t: t.replace("G: G1.mtx}", "G: G1.mtx, h: 0.1}"), "levels[1].h (line 5): key 'h' given twice"),
+])
+def test_a_key_given_twice_is_refused(tmp_path, capsys, edit, found):
+    """Before: the second value silently (norm: L2 gave the L2 verdict, h: 0.1 another slope)."""
+    path = _write(tmp_path, "ok")
+    path.write_text(edit(path.read_text()))
+    assert main(["verdict", "--system", str(path), "--dry-run"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and str(path) in err and found in err, err
+
+
+@pytest.mark.parametrize("name", ['"ok\\rSTABLE"', '"two\\nlines"', '"tab\\there"', '"esc\\e[2J"', '"ls\\u2028x"'])
+def test_a_control_character_in_name_is_refused(tmp_path, capsys, name):
+    """Before: a CR or LF in ``name`` split the CSV row (line-oriented tools saw two rows)."""
+    path = _write(tmp_path, "ok")
+    path.write_text(path.read_text().replace("name: ok", f"name: {name}"))
+    assert main(["verdict", "--system", str(path), "--dry-run"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and str(path) in err and "name: the control character" in err, err
+    path.write_text(path.read_text().replace(f"name: {name}", "name: ok").replace("B0.mtx", '"B\\r0.mtx"'))
+    assert main(["verdict", "--system", str(path), "--dry-run"]) == 2
+    assert "levels[0].B: the control character '\\r'" in capsys.readouterr().err
+
+
+# ------------------------------------------------------------------ 4. bounded memory from small files
+
+LAUGHS = "".join(f" &{c} [{','.join([f'*{p}'] * 9) if p else ','.join(['lol'] * 9)}],\n"
+                 for p, c in zip(["", *"abcdefg"], "abcdefgh"))
+
+
+def test_billion_laughs_manifest_is_refused_at_once(tmp_path, capsys):
+    """Before: a 400-byte manifest took 10 s and 2.5 GB, then a MemoryError traceback."""
+    import time
+
+    path = _write(tmp_path, "ok")
+    path.write_text(path.read_text().replace("norm: given\n", f"norm: [\n{LAUGHS} [*h,*h,*h,*h,*h,*h,*h,*h,*h]]\n"))
+    t0 = time.perf_counter()
+    assert main(["verdict", "--system", str(path), "--dry-run"]) == 2
+    assert time.perf_counter() - t0 < 5
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and str(path) in err and "aliases expand to more than 100,000" in err, err
+
+
+def test_billion_laughs_config_is_refused_at_once(tmp_path):
+    """The workflow's config files go through the same loader (config_yaml.check_config_file, run by
+    workflow/rules/common.smk); before, the check itself walked the 9^9 values (> 60 s)."""
+    from infsup_contact.config_checks import ConfigError
+    from infsup_contact.config_yaml import check_config_file
+    from infsup_contact.yaml_limits import load
+
+    path = tmp_path / "config.yaml"
+    path.write_text(f"x: [\n{LAUGHS} [*h,*h,*h,*h,*h,*h,*h,*h,*h]]\n")
+    with pytest.raises(ConfigError, match="aliases expand to more than"):
+        check_config_file(path)
+    assert load("a: &x [1, 2]\nb: *x\nc: {<<: {p: 1}, p: 2}\n") == {"a": [1, 2], "b": [1, 2], "c": {"p": 2}}
+    path.write_text("a: &x [1, *x]\n")
+    with pytest.raises(ConfigError, match="recursive alias"):
+        check_config_file(path)

@@ -28,6 +28,7 @@ per level, ``constrained``
 from __future__ import annotations
 
 import math
+import unicodedata
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -76,8 +77,12 @@ def load_manifest(path, min_levels: int = MIN_LEVELS) -> Manifest:
     path = Path(path)
     if not path.is_file():
         raise SystemFileError(path, "no such manifest file")
+    from ..yaml_limits import YamlLimitError, load
+
     try:
-        data = yaml.safe_load(path.read_text())
+        data = load(path.read_text())
+    except YamlLimitError as err:
+        raise SystemFileError(path, f"{err.key or 'the document'} (line {err.line}): {err.problem}") from None
     except (yaml.YAMLError, UnicodeDecodeError) as err:
         raise SystemFileError(path, f"not readable YAML ({' '.join(str(err).split())[:120]})") from None
     if not isinstance(data, dict):
@@ -92,6 +97,9 @@ def load_manifest(path, min_levels: int = MIN_LEVELS) -> Manifest:
         raise SystemFileError(path, f"'levels' has {len(levels)} entries; a verdict needs at least {min_levels} "
                               "(the slope's confidence interval needs n - 2 >= 1)")
     name = data.get("name", path.stem)
+    if isinstance(name, bool) or not isinstance(name, (str, int, float)):
+        raise SystemFileError(path, f"name: expected one line of text (found a {type(name).__name__})")
+    _one_line(path, "name", str(name))
     norm = data.get("norm", "given")
     if norm not in NORMS:
         raise SystemFileError(path, f"norm: {norm!r} is not one of {', '.join(NORMS)}")
@@ -108,6 +116,15 @@ def load_manifest(path, min_levels: int = MIN_LEVELS) -> Manifest:
             raise SystemFileError(path, f"levels[{i}].h = {hs[i]:g} does not decrease (levels[{i - 1}].h = "
                                   f"{hs[i - 1]:g}): list the levels coarse to fine, each h once")
     return Manifest(path, str(name), norm, known, tgv, parsed)
+
+
+def _one_line(path, key: str, text: str) -> None:
+    """Refuse a control character (CR, LF, tab, ESC ...) or a line separator in a value that is
+    printed into a CSV row or a message: it would split the row or rewrite the terminal."""
+    for pos, ch in enumerate(text):
+        if unicodedata.category(ch) in ("Cc", "Zl", "Zp"):
+            raise SystemFileError(path, f"{key}: the control character {ch!r} (U+{ord(ch):04X}) at position {pos}; "
+                                  "a name or file name is one line of printable text")
 
 
 def _level(path: Path, i: int, entry) -> Level:
@@ -127,9 +144,11 @@ def _level(path: Path, i: int, entry) -> Level:
     for key in ("A", "B", "G"):
         if not isinstance(entry[key], str) or not entry[key]:
             raise SystemFileError(path, f"{where}.{key}: expected a file name (found {entry[key]!r})")
+        _one_line(path, f"{where}.{key}", entry[key])
         files[key] = (path.parent / entry[key]).resolve()
     con = entry.get("constrained")
     if isinstance(con, str):
+        _one_line(path, f"{where}.constrained", con)
         con = (path.parent / con).resolve()
     elif con is not None:
         if not isinstance(con, list) or any(isinstance(c, bool) or not isinstance(c, int) or c < 0 for c in con):

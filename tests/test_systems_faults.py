@@ -222,3 +222,95 @@ def test_billion_laughs_config_is_refused_at_once(tmp_path):
     path.write_text("a: &x [1, *x]\n")
     with pytest.raises(ConfigError, match="recursive alias"):
         check_config_file(path)
+
+
+def _little_memory(monkeypatch, mib=64):
+    from infsup_contact import resources
+
+    monkeypatch.setattr(resources, "available_bytes", lambda *a, **k: float(mib * 2 ** 20))
+
+
+def test_mtx_gz_declaring_more_than_memory_is_refused_before_its_body(tmp_path, monkeypatch):
+    """Before: an 8.7 MB .mtx.gz declaring 6e8 entries took scipy to a 2.24 GiB allocation per
+    array (past 4 GB on --dry-run); now its size line is checked against MemAvailable."""
+    import gzip
+
+    from infsup_contact.systems.readers import SystemFileError, read_matrix
+
+    _little_memory(monkeypatch)
+    with gzip.open(tmp_path / "A.mtx.gz", "wb") as fh:
+        fh.write(b"%%MatrixMarket matrix coordinate real general\n% a comment\n1000000 1000000 600000000\n")
+        fh.write(b"1 1 1\n" * 100000)
+    with pytest.raises(SystemFileError, match=r"A.mtx.gz: its header declares a 1000000 x 1000000 matrix with "
+                       r"600000000 entries: reading it needs ~\d+(\.\d+)? GiB, 64 MiB available"):
+        read_matrix(tmp_path / "A.mtx.gz")
+
+
+def test_mtx_declaring_more_entries_than_its_bytes_is_refused(tmp_path):
+    from infsup_contact.systems.readers import SystemFileError, read_matrix
+
+    (tmp_path / "A.mtx").write_text("%%MatrixMarket matrix coordinate real general\n10 10 3000\n1 1 1.0\n")
+    with pytest.raises(SystemFileError, match="declares 3000 entries, but the .* bytes hold at most"):
+        read_matrix(tmp_path / "A.mtx")
+
+
+def test_npz_zip_bomb_is_refused_from_its_declared_sizes(tmp_path, monkeypatch):
+    """A compressed .npz of zeros declares its arrays' shapes; they are checked before a byte of
+    the body is inflated (before: a 12 MB .npz took --dry-run past 4 GB)."""
+    from infsup_contact.systems.readers import SystemFileError, read_matrix
+
+    _little_memory(monkeypatch)
+    np.savez_compressed(tmp_path / "A.npz", A=np.zeros((3000, 3000)))
+    assert (tmp_path / "A.npz").stat().st_size < 200_000
+    with pytest.raises(SystemFileError, match=r"A.npz: its arrays \{'A': \(3000, 3000\)\} declare 68.7 MiB"):
+        read_matrix(tmp_path / "A.npz")
+    B = sp.random(3000, 3000, density=0.3, random_state=1, format="csr")
+    sp.save_npz(tmp_path / "B.npz", B)
+    with pytest.raises(SystemFileError, match=r"B.npz: its arrays .* declare"):
+        read_matrix(tmp_path / "B.npz")
+
+
+def test_npy_and_npz_headers_declaring_more_than_they_hold(tmp_path):
+    from numpy.lib import format as npformat
+
+    from infsup_contact.systems.readers import SystemFileError, read_matrix
+
+    with open(tmp_path / "A.npy", "wb") as fh:
+        npformat.write_array_header_1_0(fh, {"descr": "<f8", "fortran_order": False, "shape": (10 ** 6, 10 ** 6)})
+        fh.write(b"\0" * 800)
+    with pytest.raises(SystemFileError, match=r"A.npy: the header declares shape \(1000000, 1000000\) of float64 "
+                       r"\(8000000000000 bytes\), the file holds 800"):
+        read_matrix(tmp_path / "A.npy")
+    import zipfile
+
+    with zipfile.ZipFile(tmp_path / "A.npz", "w") as zf, zf.open("A.npy", "w") as fh:
+        npformat.write_array_header_1_0(fh, {"descr": "<f8", "fortran_order": False, "shape": (10 ** 5, 10 ** 5)})
+        fh.write(b"\0" * 800)
+    with pytest.raises(SystemFileError, match=r"A.npz: array 'A': the header declares shape \(100000, 100000\)"):
+        read_matrix(tmp_path / "A.npz")
+
+
+def test_petsc_header_is_checked_before_the_body_is_read(tmp_path, monkeypatch):
+    """Only the matrix's bytes are read (a file may hold further objects; before, the whole file
+    was read first); a header declaring more than the file holds, or than the memory, is refused."""
+    import tracemalloc
+
+    from infsup_contact.systems.readers import SystemFileError, petsc_binary_bytes, read_matrix
+
+    M = sp.random(50, 40, density=0.2, random_state=2, format="csr")
+    (tmp_path / "M.petsc").write_bytes(petsc_binary_bytes(M) + b"\0" * (40 * 2 ** 20))
+    tracemalloc.start()
+    got = read_matrix(tmp_path / "M.petsc")
+    peak = tracemalloc.get_traced_memory()[1]
+    tracemalloc.stop()
+    assert np.array_equal(got.toarray(), M.toarray()) and peak < 4 * 2 ** 20
+    from infsup_contact.systems.readers import MAT_FILE_CLASSID
+
+    (tmp_path / "D.petsc").write_bytes(np.array([MAT_FILE_CLASSID, 10 ** 5, 10 ** 5, -1], ">i4").tobytes()
+                                       + b"\0" * 64)
+    with pytest.raises(SystemFileError, match=r"D.petsc: PETSc binary: truncated: header says 100000 x 100000 with "
+                       r"dense entries \(80000000016 bytes\), the file has 80"):
+        read_matrix(tmp_path / "D.petsc")
+    _little_memory(monkeypatch, 0.01)
+    with pytest.raises(SystemFileError, match=r"M.petsc: its header declares a 50 x 40 matrix with 400 nonzeros"):
+        read_matrix(tmp_path / "M.petsc")

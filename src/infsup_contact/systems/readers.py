@@ -92,9 +92,10 @@ def read_matrix(path):
         elif ext == ".npz":
             mat = _read_npz(path)
         elif ext == ".npy":
-            mat = np.load(path, allow_pickle=False)
+            mat = _read_npy(path)
         elif FORMATS[ext] == "Harwell-Boeing":
             import scipy.io
+            _check_hb_header(path)
             mat = scipy.io.hb_read(str(path))
         else:
             mat = _read_petsc(path)
@@ -103,6 +104,18 @@ def read_matrix(path):
     except Exception as err:  # every library error becomes one line naming the file
         reason = " ".join(str(err).split())[:160] or type(err).__name__
         raise SystemFileError(path, f"not a readable {FORMATS[ext]} file ({type(err).__name__}: {reason})") from None
+    try:
+        return _as_float_matrix(path, mat)
+    except MemoryError:
+        raise SystemFileError(path, f"not enough memory to hold it as a float matrix ({_describe(mat)})") from None
+
+
+def _describe(mat) -> str:
+    shape = " x ".join(map(str, getattr(mat, "shape", ())))
+    return f"{shape}, {mat.nnz} nonzeros" if sp.issparse(mat) else f"{shape} dense"
+
+
+def _as_float_matrix(path, mat):
     if sp.issparse(mat):
         _check_sparse(path, mat)
         mat = sp.csr_matrix(mat)
@@ -112,7 +125,7 @@ def read_matrix(path):
             raise SystemFileError(path, f"holds a {mat.ndim}-D array of shape {mat.shape}, not a matrix")
     if not np.issubdtype(mat.dtype, np.number) or np.issubdtype(mat.dtype, np.complexfloating):
         raise SystemFileError(path, f"holds {mat.dtype} entries (expected real numbers)")
-    return mat.astype(float)
+    return mat.astype(float, copy=False)
 
 
 def _read_mtx(path, ext):
@@ -123,29 +136,158 @@ def _read_mtx(path, ext):
     if not head.startswith(b"%%MatrixMarket"):
         raise SystemFileError(path, f"does not start with the MatrixMarket banner '%%MatrixMarket' "
                               f"(found {head[:15]!r})")
-    if _last_byte(path, ext) != b"\n":
+    rows, cols, entries, dense, pattern = _mtx_header(path, ext)
+    check_read_memory(path, rows, cols, None if dense else entries, f"{entries} entries")
+    last, size = _last_byte(path, ext)
+    if last != b"\n":
         raise SystemFileError(path, "MatrixMarket: the last line does not end with a newline (a file cut "
                               "short, possibly inside its last number: write it again)")
+    shortest = 2 if dense else (4 if pattern else 6)  # "v\n", "i j\n", "i j v\n"
+    if entries * shortest > size:
+        raise SystemFileError(path, f"MatrixMarket: the header declares {entries} entries, but the "
+                              f"{size} bytes{' (decompressed)' if ext == '.mtx.gz' else ''} hold at most "
+                              f"{size // shortest}: a file cut short")
     return scipy.io.mmread(str(path))
 
 
-def _last_byte(path, ext) -> bytes:
-    """The last byte of the (decompressed) file; a .mtx.gz is streamed (constant memory)."""
+HEADER_LINE_MAX = 1 << 16
+"""Longest MatrixMarket banner or size line read (a comment line may be longer: it is skipped)."""
+
+
+def _mtx_header(path, ext):
+    """(rows, cols, entries, dense, pattern) from the banner and the size line, body unread."""
+    with (gzip.open(path, "rb") if ext == ".mtx.gz" else open(path, "rb")) as fh:
+        banner = fh.readline(HEADER_LINE_MAX).decode("ascii", "replace").lower().split()
+        while True:
+            line = fh.readline(HEADER_LINE_MAX)
+            if not line:
+                raise SystemFileError(path, "MatrixMarket: no size line after the banner")
+            while not line.endswith(b"\n") and line.startswith(b"%"):  # a long comment: skip it
+                more = fh.readline(HEADER_LINE_MAX)
+                if not more:
+                    break
+                line = line[:1] + more
+            if line.strip() and not line.startswith(b"%"):
+                break
+    if len(banner) < 5 or banner[1] != "matrix" or banner[2] not in ("coordinate", "array"):
+        raise SystemFileError(path, f"MatrixMarket: banner {' '.join(banner)[:80]!r} is not "
+                              "'%%MatrixMarket matrix coordinate|array <field> <symmetry>'")
+    dense = banner[2] == "array"
+    try:
+        sizes = [int(t) for t in line.split()]
+    except ValueError:
+        sizes = []
+    if len(sizes) != (2 if dense else 3) or min(sizes) < 0:
+        raise SystemFileError(path, f"MatrixMarket: size line {line[:80].decode('ascii', 'replace').strip()!r} is "
+                              f"not {'rows cols' if dense else 'rows cols entries'} (integers >= 0)")
+    rows, cols = sizes[:2]
+    entries = rows * cols if dense else sizes[2]
+    if dense and banner[4] != "general":  # symmetric: the lower triangle only
+        entries = rows * (rows + 1) // 2 if banner[4] != "skew-symmetric" else rows * (rows - 1) // 2
+    return rows, cols, entries, dense, banner[3] == "pattern"
+
+
+def _last_byte(path, ext):
+    """(the last byte, the size) of the (decompressed) file; a .mtx.gz is streamed (constant memory)."""
     if ext != ".mtx.gz":
         with open(path, "rb") as fh:
             fh.seek(-1, 2)
-            return fh.read(1)
-    last = b""
+            return fh.read(1), fh.tell()
+    last, size = b"", 0
     with gzip.open(path, "rb") as fh:
         while chunk := fh.read(1 << 20):
-            last = chunk[-1:]
-    return last
+            last, size = chunk[-1:], size + len(chunk)
+    return last, size
+
+
+READ_COPIES = 3.0
+"""Copies of a matrix's arrays alive while a file becomes a float CSR matrix (the reader's
+arrays, COO → CSR, ``astype``): the factor of :func:`read_bytes`."""
+
+
+def read_bytes(rows: int, cols: int, nnz) -> float:
+    """Bytes to read a rows × cols matrix: dense (``nnz`` None) 8·rows·cols twice (the array and
+    its float copy); sparse, (value + two indices) per entry and the index pointers, times
+    :data:`READ_COPIES`."""
+    if nnz is None:
+        return 2.0 * 8.0 * rows * cols
+    return READ_COPIES * (24.0 * nnz + 8.0 * (rows + cols + 2))
+
+
+def check_read_memory(path, rows: int, cols: int, nnz, what: str) -> None:
+    """Refuse a file whose header declares more than the available memory can read (before its
+    body is read: a small compressed file can declare gigabytes)."""
+    from .. import resources
+
+    need = read_bytes(rows, cols, nnz)
+    avail = resources.available_bytes()
+    if avail is not None and need > avail:
+        raise SystemFileError(path, f"its header declares a {rows} x {cols} matrix with {what}: reading it "
+                              f"needs ~{resources.human_bytes(need)}, {resources.human_bytes(avail)} available")
+
+
+def _npy_header(fh):
+    """(shape, dtype) of an .npy stream, its body unread."""
+    from numpy.lib import format as npformat
+
+    version = npformat.read_magic(fh)
+    reader = npformat.read_array_header_1_0 if version == (1, 0) else npformat.read_array_header_2_0
+    shape, _, dtype = reader(fh, max_header_size=10000)
+    return tuple(int(d) for d in shape), dtype
+
+
+def _check_npy(path, shape, dtype, stored: int, member: str = ""):
+    """An array's declared bytes against what the file (or zip member) holds, and the memory."""
+    where = f"array {member!r}: " if member else ""
+    if dtype.hasobject:
+        raise SystemFileError(path, f"{where}holds Python objects (dtype {dtype}), not numbers")
+    count = int(np.prod(shape, dtype=object)) if shape else 1
+    if count * dtype.itemsize > stored:
+        raise SystemFileError(path, f"{where}the header declares shape {shape} of {dtype} ({count * dtype.itemsize} "
+                              f"bytes), the file holds {stored}: a file cut short or forged")
+    return count
+
+
+def _read_npy(path):
+    size = path.stat().st_size
+    with open(path, "rb") as fh:
+        shape, dtype = _npy_header(fh)
+        body = size - fh.tell()
+    count = _check_npy(path, shape, dtype, body)
+    if len(shape) == 2:
+        check_read_memory(path, shape[0], shape[1], None, "dense entries")
+    elif count:
+        check_read_memory(path, count, 1, None, "dense entries")
+    return np.load(path, allow_pickle=False)
+
+
+def _check_npz_members(path):
+    """Each member's declared array against its declared size, and the sum against the memory."""
+    import zipfile
+
+    total, shapes = 0.0, {}
+    with zipfile.ZipFile(path) as zf:
+        for info in zf.infolist():
+            name = info.filename[:-4] if info.filename.endswith(".npy") else info.filename
+            with zf.open(info) as fh:
+                shape, dtype = _npy_header(fh)
+                stored = info.file_size - fh.tell()
+            count = _check_npy(path, shape, dtype, stored, name)
+            total += count * max(dtype.itemsize, 8)
+            shapes[name] = shape
+    from .. import resources
+
+    need, avail = 2.0 * READ_COPIES * total, resources.available_bytes()
+    if avail is not None and need > avail:
+        raise SystemFileError(path, f"its arrays {shapes} declare {resources.human_bytes(total)}: reading them "
+                              f"needs ~{resources.human_bytes(need)}, {resources.human_bytes(avail)} available")
 
 
 def _read_npz(path):
     with open(path, "rb") as fh:
         if fh.read(4) != b"PK\x03\x04":
             raise SystemFileError(path, "not a zip archive (an .npz is one)")
+    _check_npz_members(path)
     with np.load(path, allow_pickle=False) as data:
         keys = set(data.files)
     if {"format", "shape", "data"} <= keys:
@@ -179,6 +321,7 @@ def _sparse_npz(path):
         raise SystemFileError(path, f"'shape' is {shape.tolist()!r}, not two integers >= 0")
     m, n = (int(v) for v in shape)
     values, first, second = arrays
+    check_read_memory(path, m, n, len(values), f"{len(values)} stored entries")
     if fmt == "coo":
         check_coordinates(path, (m, n), values, first, second)
         return sp.coo_matrix((values, (first, second)), shape=(m, n))
@@ -233,6 +376,22 @@ def _check_sparse(path, mat):
         check_coordinates(path, mat.shape, mat.data, mat.row, mat.col)
 
 
+def _check_hb_header(path):
+    """The Harwell-Boeing sizes (line 3: type, rows, columns, nonzeros) against the memory."""
+    with open(path, "rb") as fh:
+        lines = [fh.readline(HEADER_LINE_MAX) for _ in range(3)]
+    try:
+        rows, cols, nnz = (int(t) for t in lines[2][14:56].split()[:3])
+    except (ValueError, IndexError):
+        return  # hb_read names what is wrong
+    if min(rows, cols, nnz) < 0:
+        raise SystemFileError(path, f"Harwell-Boeing: negative size {rows} x {cols}, {nnz} nonzeros in the header")
+    check_read_memory(path, rows, cols, nnz, f"{nnz} nonzeros")
+    if 4 * nnz > path.stat().st_size:  # each nonzero needs a row index and a value, >= 2 characters each
+        raise SystemFileError(path, f"Harwell-Boeing: the header declares {nnz} nonzeros, the file's "
+                              f"{path.stat().st_size} bytes cannot hold them")
+
+
 def _read_petsc(path):
     try:
         from petsc4py import PETSc  # noqa: F401
@@ -261,7 +420,8 @@ def read_petsc_binary(path):
         CSR for a sparse matrix, a dense array for ``nz = -1``.
     """
     path = Path(path)
-    raw = path.read_bytes()
+    with open(path, "rb") as fh:
+        raw = fh.read(32)
     if len(raw) < 16:
         raise SystemFileError(path, f"PETSc binary: {len(raw)} bytes, shorter than a matrix header (16)")
     first32 = int(np.frombuffer(raw, ">i4", 1)[0])
@@ -277,6 +437,16 @@ def read_petsc_binary(path):
     pos = 4 * isz
     if m < 0 or n < 0:
         raise SystemFileError(path, f"PETSc binary: negative size {m} x {n} in the header")
+    size = path.stat().st_size
+    need = pos + (8 * m * n if nz == DENSE_NZ else isz * (m + max(nz, 0)) + 8 * max(nz, 0))
+    if nz < DENSE_NZ or size < need:  # checked before the body is read (a header can declare anything)
+        raise SystemFileError(path, f"PETSc binary: truncated: header says {m} x {n} with "
+                              f"{'dense entries' if nz == DENSE_NZ else f'{nz} nonzeros'} ({need} bytes), "
+                              f"the file has {size}")
+    check_read_memory(path, m, n, None if nz == DENSE_NZ else nz,
+                      "dense entries" if nz == DENSE_NZ else f"{nz} nonzeros")
+    with open(path, "rb") as fh:
+        raw = fh.read(need)  # the matrix only: further objects in the file are not read
     if nz == DENSE_NZ:
         need = pos + 8 * m * n
         if len(raw) < need:

@@ -314,3 +314,31 @@ def test_petsc_header_is_checked_before_the_body_is_read(tmp_path, monkeypatch):
     _little_memory(monkeypatch, 0.01)
     with pytest.raises(SystemFileError, match=r"M.petsc: its header declares a 50 x 40 matrix with 400 nonzeros"):
         read_matrix(tmp_path / "M.petsc")
+
+
+# ------------------------------------------------------------------ 5. export does not overwrite another system
+
+def test_export_into_a_directory_holding_another_system(tmp_path, capsys):
+    """Before: a second export overwrote levels.yaml and the matrices without a word (and left the
+    first export's finer levels next to it)."""
+    out = tmp_path / "sys"
+    base = ["export", "--case", "T3", "--k", "1", "--out", str(out)]
+    assert main(base + ["--N", "2", "4", "8"]) == 0
+    manifest = (out / "levels.yaml").read_text()
+    capsys.readouterr()
+    for extra in (["--dry-run"], []):
+        assert main(base + ["--N", "2", "4"] + extra) == 2
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and f"it would overwrite {out / 'levels.yaml'} and 6 more file(s)" in err
+        assert "--force" in err
+    assert (out / "levels.yaml").read_text() == manifest
+    (tmp_path / "notes").mkdir()
+    (tmp_path / "notes" / "mine.txt").write_text("x")
+    assert main(["export", "--case", "T3", "--k", "1", "--N", "2", "--out", str(tmp_path / "notes")]) == 2
+    assert f"it holds {tmp_path / 'notes' / 'mine.txt'}" in capsys.readouterr().err
+    assert main(base + ["--N", "2", "4", "--force"]) == 0
+    err = capsys.readouterr().err
+    assert "3 file(s) not written by this export left" in err and "A2.mtx, B2.mtx, G2.mtx" in err
+    assert (out / "levels.yaml").read_text() != manifest
+    (tmp_path / "empty").mkdir()
+    assert main(["export", "--case", "T3", "--k", "1", "--N", "2", "--out", str(tmp_path / "empty")]) == 0

@@ -74,6 +74,23 @@ def test_a_declared_kernel_is_discounted(tmp_path):
     assert all(r["known_kernel"] == 1 and r["kernel_dim"] == 1 and r["beta"] > 0.7 for r in rows)
 
 
+def test_a_nearly_repeated_row_is_inconclusive_not_stable(tmp_path):
+    """Two rows of B equal but for 1e-14: the kernel decision is within a decade of round-off on
+    every level, so the verdict is INCONCLUSIVE (never STABLE), the margins named."""
+    levels = []
+    for N in NS:
+        h, A, B, G = _level(N, "ok")
+        B = B.tolil()
+        B[1, :] = B[0, :]
+        B[1, 3] = 1e-14
+        levels.append((h, A, B.tocsr(), G))
+    path = write_system(tmp_path, levels, "npz", "near")
+    out, rows = system_verdict(load_manifest(path), **CRITERION, notes=io.StringIO())
+    assert out["verdict"] == "INCONCLUSIVE" and all(r["kernel_decision"] == "close" for r in rows)
+    assert "margins" in out["evidence"]
+    assert main(["verdict", "--system", str(path), "--expect", "stable"]) == 1
+
+
 def test_structural_kernel_is_detected_on_every_route():
     _, A, B, G = _level(16, "more_rows")
     for route in ("gamma-dense", "solves-dense", "shift-invert"):
@@ -342,3 +359,21 @@ def test_export_into_a_directory_holding_another_system(tmp_path, capsys):
     assert (out / "levels.yaml").read_text() != manifest
     (tmp_path / "empty").mkdir()
     assert main(["export", "--case", "T3", "--k", "1", "--N", "2", "--out", str(tmp_path / "empty")]) == 0
+
+
+def test_harwell_boeing_header_declaring_more_than_the_file(tmp_path, monkeypatch):
+    import scipy.io
+
+    from infsup_contact.systems.readers import SystemFileError, read_matrix
+
+    scipy.io.hb_write(str(tmp_path / "B.rua"), sp.csc_matrix(_level(8, "ok")[2]))
+    lines = (tmp_path / "B.rua").read_text().split("\n")
+    assert lines[2].split()[1:4] == ["4", "16", "4"]
+    lines[2] = lines[2][:42] + f"{10 ** 9:14d}" + lines[2][56:]
+    (tmp_path / "B.rua").write_text("\n".join(lines))
+    with pytest.raises(SystemFileError, match=r"B.rua: Harwell-Boeing: the header declares 1000000000 nonzeros"):
+        read_matrix(tmp_path / "B.rua")
+    scipy.io.hb_write(str(tmp_path / "B.rua"), sp.csc_matrix(_level(8, "ok")[2]))
+    _little_memory(monkeypatch, 1e-4)
+    with pytest.raises(SystemFileError, match=r"B.rua: its header declares a 4 x 16 matrix with 4 nonzeros"):
+        read_matrix(tmp_path / "B.rua")

@@ -386,10 +386,10 @@ def _check_hb_header(path):
         return  # hb_read names what is wrong
     if min(rows, cols, nnz) < 0:
         raise SystemFileError(path, f"Harwell-Boeing: negative size {rows} x {cols}, {nnz} nonzeros in the header")
-    check_read_memory(path, rows, cols, nnz, f"{nnz} nonzeros")
     if 4 * nnz > path.stat().st_size:  # each nonzero needs a row index and a value, >= 2 characters each
         raise SystemFileError(path, f"Harwell-Boeing: the header declares {nnz} nonzeros, the file's "
                               f"{path.stat().st_size} bytes cannot hold them")
+    check_read_memory(path, rows, cols, nnz, f"{nnz} nonzeros")
 
 
 def _read_petsc(path):

@@ -377,3 +377,16 @@ def test_harwell_boeing_header_declaring_more_than_the_file(tmp_path, monkeypatc
     _little_memory(monkeypatch, 1e-4)
     with pytest.raises(SystemFileError, match=r"B.rua: its header declares a 4 x 16 matrix with 4 nonzeros"):
         read_matrix(tmp_path / "B.rua")
+
+
+def test_constrained_npy_with_a_forged_header(tmp_path, capsys):
+    from numpy.lib import format as npformat
+
+    path = _write(tmp_path, "ok")
+    with open(path.parent / "fixed.npy", "wb") as fh:
+        npformat.write_array_header_1_0(fh, {"descr": "<i8", "fortran_order": False, "shape": (10 ** 12,)})
+        fh.write(b"\\0" * 16)
+    path.write_text(path.read_text().replace("G: G0.mtx}", "G: G0.mtx, constrained: fixed.npy}"))
+    assert main(["verdict", "--system", str(path), "--dry-run"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "fixed.npy: the header declares shape (1000000000000,)" in err, err

@@ -164,6 +164,10 @@ def constrained_dofs(level: Level, n: int) -> np.ndarray:
     if isinstance(con, Path):
         if not con.is_file():
             raise SystemFileError(con, "no such file (levels[{}].constrained)".format(level.index))
+        if con.suffix == ".npy":
+            from .readers import check_npy_file
+
+            check_npy_file(con)  # a header declaring more than the file holds: refused before reading
         try:
             raw = read_integer_list(con)
         except TableError as err:

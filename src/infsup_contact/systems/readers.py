@@ -248,16 +248,27 @@ def _check_npy(path, shape, dtype, stored: int, member: str = ""):
     return count
 
 
-def _read_npy(path):
+def check_npy_file(path) -> tuple:
+    """The shape an ``.npy`` file declares, checked against its bytes and the memory before
+    its body is read (:class:`SystemFileError`); any other reading error is the caller's."""
+    path = Path(path)
     size = path.stat().st_size
     with open(path, "rb") as fh:
-        shape, dtype = _npy_header(fh)
+        try:
+            shape, dtype = _npy_header(fh)
+        except ValueError as err:
+            raise SystemFileError(path, f"not a numpy .npy file ({' '.join(str(err).split())[:120]})") from None
         body = size - fh.tell()
     count = _check_npy(path, shape, dtype, body)
     if len(shape) == 2:
         check_read_memory(path, shape[0], shape[1], None, "dense entries")
     elif count:
         check_read_memory(path, count, 1, None, "dense entries")
+    return shape
+
+
+def _read_npy(path):
+    check_npy_file(path)
     return np.load(path, allow_pickle=False)
 
 

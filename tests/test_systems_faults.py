@@ -390,3 +390,13 @@ def test_constrained_npy_with_a_forged_header(tmp_path, capsys):
     assert main(["verdict", "--system", str(path), "--dry-run"]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "fixed.npy: the header declares shape (1000000000000,)" in err, err
+
+
+def test_a_huge_manifest_is_not_read(tmp_path):
+    from infsup_contact.systems.readers import SystemFileError
+
+    path = tmp_path / "levels.yaml"
+    with open(path, "wb") as fh:
+        fh.write(b"name: big\n# " + b"x" * (2 << 20) + b"\n")
+    with pytest.raises(SystemFileError, match=r"levels.yaml: 2097165 bytes: a manifest lists a few levels"):
+        load_manifest(path)

@@ -42,6 +42,8 @@ NORMS = ("given", "L2", "h-L2")
 TGV_POLICIES = ("eliminate", "refuse")
 LEVEL_KEYS = ("h", "A", "B", "G", "constrained")
 TOP_KEYS = ("levels", "name", "norm", "known_kernel", "tgv")
+MANIFEST_MAX_BYTES = 1 << 20
+"""Largest manifest read (a manifest of 1,000 levels is ~60 kB)."""
 MIN_LEVELS = 3
 """A slope's confidence interval needs n − 2 ≥ 1 degrees of freedom (as ``verdict --case``)."""
 
@@ -77,6 +79,9 @@ def load_manifest(path, min_levels: int = MIN_LEVELS) -> Manifest:
     path = Path(path)
     if not path.is_file():
         raise SystemFileError(path, "no such manifest file")
+    if path.stat().st_size > MANIFEST_MAX_BYTES:
+        raise SystemFileError(path, f"{path.stat().st_size} bytes: a manifest lists a few levels (at most "
+                              f"{MANIFEST_MAX_BYTES // 2 ** 20} MiB read); is this the manifest?")
     from ..yaml_limits import YamlLimitError, load
 
     try:

@@ -400,3 +400,18 @@ def test_a_huge_manifest_is_not_read(tmp_path):
         fh.write(b"name: big\n# " + b"x" * (2 << 20) + b"\n")
     with pytest.raises(SystemFileError, match=r"levels.yaml: 2097165 bytes: a manifest lists a few levels"):
         load_manifest(path)
+
+
+def test_mtx_gz_longer_than_its_header_declares_stops_early(tmp_path):
+    """A small .mtx.gz inflating to far more lines than its size line declares is refused after
+    at most MTX_SLACK + MTX_LINE_MAX·entries bytes, not streamed to its end."""
+    import gzip
+
+    from infsup_contact.systems.readers import SystemFileError, read_matrix
+
+    with gzip.open(tmp_path / "A.mtx.gz", "wb") as fh:
+        fh.write(b"%%MatrixMarket matrix coordinate real general\n10 10 10\n")
+        fh.write(b"1 1 1\n" * (1 << 20))
+    with pytest.raises(SystemFileError, match=r"A.mtx.gz: MatrixMarket: more than 1051136 bytes \(decompressed\) "
+                       r"for the 10 entries"):
+        read_matrix(tmp_path / "A.mtx.gz")

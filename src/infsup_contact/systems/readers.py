@@ -138,7 +138,11 @@ def _read_mtx(path, ext):
                               f"(found {head[:15]!r})")
     rows, cols, entries, dense, pattern = _mtx_header(path, ext)
     check_read_memory(path, rows, cols, None if dense else entries, f"{entries} entries")
-    last, size = _last_byte(path, ext)
+    longest = MTX_SLACK + MTX_LINE_MAX * entries
+    last, size = _last_byte(path, ext, longest)
+    if size > longest:
+        raise SystemFileError(path, f"MatrixMarket: more than {longest} bytes{' (decompressed)' if ext == '.mtx.gz' else ''} "
+                              f"for the {entries} entries its header declares (at most {MTX_LINE_MAX} bytes a line)")
     if last != b"\n":
         raise SystemFileError(path, "MatrixMarket: the last line does not end with a newline (a file cut "
                               "short, possibly inside its last number: write it again)")
@@ -187,8 +191,15 @@ def _mtx_header(path, ext):
     return rows, cols, entries, dense, banner[3] == "pattern"
 
 
-def _last_byte(path, ext):
-    """(the last byte, the size) of the (decompressed) file; a .mtx.gz is streamed (constant memory)."""
+MTX_LINE_MAX = 256
+"""Longest MatrixMarket entry line accepted (two indices and a 17-digit value take < 64 bytes)."""
+MTX_SLACK = 1 << 20
+"""Bytes allowed for the banner and comments besides the entries."""
+
+
+def _last_byte(path, ext, stop=None):
+    """(the last byte, the size) of the (decompressed) file; a .mtx.gz is streamed (constant
+    memory), and only until ``stop`` bytes (its size then just exceeds ``stop``)."""
     if ext != ".mtx.gz":
         with open(path, "rb") as fh:
             fh.seek(-1, 2)
@@ -197,6 +208,8 @@ def _last_byte(path, ext):
     with gzip.open(path, "rb") as fh:
         while chunk := fh.read(1 << 20):
             last, size = chunk[-1:], size + len(chunk)
+            if stop is not None and size > stop:
+                break
     return last, size
 
 

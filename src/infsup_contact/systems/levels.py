@@ -90,9 +90,10 @@ def system_verdict(manifest: Manifest, *, tol: float, floor: float, confidence: 
         inv_h = ", ".join(f"{1 / r['h']:g}" for r in rows)
         out["evidence"] = (f"β_h = 0: a kernel of B^T not declared (known_kernel: {manifest.known_kernel}) "
                            f"of dim {dims} over 1/h = {inv_h}"
-                           + (f"; B has m - touched dofs = {structural} (a zero, repeated or surplus row)"
+                           + (f"; B has more rows than the dofs it touches (m - touched = {structural})"
                               if any(structural) else "")
-                           + "; declare it with known_kernel if it is meant (e.g. a constant pressure)")
+                           + "; slope of the eigenvalue above the kernel; declare the kernel with known_kernel "
+                           "if it is meant (e.g. a constant pressure)")
     head = dict(system=manifest.name, norm=manifest.norm, known_kernel=manifest.known_kernel)
     head.update(out)
     head.update(h_list=" ".join(f"{r['h']:g}" for r in rows), routes=" ".join(sorted({r["route"] for r in rows})),

@@ -53,9 +53,9 @@ def check_finite(node, path=()) -> None:
 # ------------------------------------------------------------------ 3. the schema
 
 def load_schema(path) -> dict:
-    import yaml
+    from .yaml_limits import load
 
-    return yaml.safe_load(Path(path).read_text())
+    return load(Path(path).read_text())
 
 
 def _resolve(schema: dict, root: dict) -> dict:

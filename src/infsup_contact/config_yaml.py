@@ -124,8 +124,13 @@ def check_config_file(path) -> None:
     except ValueError as err:
         if isinstance(err, ConfigError):
             raise
+    from .yaml_limits import YamlLimitError, compose
+
     try:
-        root = yaml.compose(text, Loader=yaml.SafeLoader)
+        root = compose(text, duplicates=False)  # an alias expansion refused here (yaml_limits), the rest below
+    except YamlLimitError as err:
+        raise ConfigError(err.key or "(document)", f"{err.problem} ({path} line {err.line})",
+                          allowed="aliases expanding to a bounded document") from None
     except yaml.YAMLError:
         return
     if root is not None:

@@ -1,6 +1,9 @@
 """``infsup-contact export``: this suite's systems as files another code would write."""
 from __future__ import annotations
 
+import sys
+from pathlib import Path
+
 from ..errors import InputError
 from .common import (add_dry_run, add_model, check_memory, declare_flag_uses, material, mesh_options, model_flag_uses,
                      write_text)
@@ -24,7 +27,10 @@ def add(sub) -> None:
                    help="G: H^{-1/2}_00(Γ) (manifest norm: given) or the L² mass (manifest norm: L2)")
     p.add_argument("--multiplier-mesh", default="omega2", choices=["omega2", "omega1", "union"])
     p.add_argument("--format", default="mtx", choices=sorted(EXPORT_FORMATS))
-    p.add_argument("--out", required=True, help="directory to write into (created)")
+    p.add_argument("--out", required=True, help="directory to write into (created; refused if it holds "
+                   "files, unless --force)")
+    p.add_argument("--force", action="store_true",
+                   help="write into a directory that is not empty, overwriting its levels.yaml and matrices")
     add_model(p)
     add_dry_run(p)
     declare_flag_uses(p, model_flag_uses())
@@ -56,10 +62,38 @@ def _check_export(args):
     out = Path(args.out)
     if not args.out.strip() or (out.exists() and not out.is_dir()):
         raise InputError("out", "a directory to write into (created if missing)", got=args.out)
+    if out.is_dir() and not args.force:
+        _refuse_nonempty(out, args)
     est = resources.beta_estimate(args.family, args.k, max(ns) + args.N1_offset, max(ns), args.multiplier_mesh,
                                   (args.norm,), components=args.model_obj.components, dim=args.model_obj.dim)
     check_memory(est, *(("N1_offset", args.N1_offset) if args.N1_offset > max(ns) else ("N", max(ns))))
     return est
+
+
+def _targets(args) -> list:
+    """The files this export writes, in the order it writes them."""
+    from ..systems.export import EXPORT_FORMATS
+
+    ext = EXPORT_FORMATS[args.format]
+    return ["levels.yaml"] + [f"{key}{i}{ext}" for i in range(len(args.N)) for key in "ABG"]
+
+
+def _refuse_nonempty(out, args) -> None:
+    """An export into a directory holding files (another system's manifest and matrices) would
+    overwrite them without a word: refused, naming the first file it would overwrite, or else
+    the first file there (the directory must be empty, or ``--force`` given)."""
+    try:
+        present = sorted(p.name for p in out.iterdir())
+    except OSError as err:
+        raise InputError("out", "a directory this process can read and write", got=f"{args.out} ({err.strerror})") \
+            from None
+    if not present:
+        return
+    clash = [t for t in _targets(args) if t in present]
+    what = (f"it would overwrite {out / clash[0]}" + (f" and {len(clash) - 1} more file(s)" if len(clash) > 1 else "")
+            if clash else f"it holds {out / present[0]}" + (f" and {len(present) - 1} more" if len(present) > 1 else ""))
+    raise InputError("out", "an empty or new directory, or --force to write into this one",
+                     got=f"{args.out} ({what})")
 
 
 def _run_export(args) -> None:
@@ -72,5 +106,11 @@ def _run_export(args) -> None:
                                args.multiplier_mesh, model=args.model_obj, **kwargs)
         levels.append((1.0 / n, A, B, G))
     name = f"{args.case}-k{args.k}-{args.model}"
+    out = Path(args.out)
+    before = {p.name for p in out.iterdir()} if out.is_dir() else set()
     path = write_system(args.out, levels, args.format, name, norm="given" if args.norm == "H" else "L2")
+    stale = sorted(before - set(_targets(args)))
+    if stale:  # --force: what the new manifest does not name is left, and said so
+        print(f"infsup-contact: note: --force: {len(stale)} file(s) not written by this export left in {out} "
+              f"(not in its levels.yaml): {', '.join(stale[:5])}{' ...' if len(stale) > 5 else ''}", file=sys.stderr)
     write_text(f"{path}\n")

@@ -35,7 +35,7 @@ smallest eigenvalue above it, i.e. β_h on the complement of the declared kernel
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 import scipy.linalg as sla
@@ -82,7 +82,8 @@ class LevelSpectrum:
     smallest_nonzero : float
         sqrt of the first eigenvalue above the whole kernel.
     kernel : KernelDecision
-        The kernel of Bᵀ (``proven`` = the declared kernel).
+        The kernel of Bᵀ (``proven`` = the declared kernel only; ``detected`` = everything
+        beyond it, a structural deficiency m − n_touched included).
     bottom : ndarray
         The smallest eigenvalues β² computed (ascending).
     route : str
@@ -177,6 +178,11 @@ def level_spectrum(A, B, G, known_kernel: int = 0, route: str = "auto") -> Level
     else:
         kernel = bottom_kernel(W, known_kernel)
     seconds["kernel"] = time.perf_counter() - t0
+    # Only the *declared* kernel is discounted. The decision counts m − (touched dofs) as a
+    # proof (exact zero singular values), but a foreign B with a zero row, duplicate rows or
+    # more rows than the dofs it touches has that kernel whether or not anyone declared it:
+    # it is part of ``detected`` (UNSTABLE), never of ``proven`` (issue 40, item 0).
+    kernel = replace(kernel, proven=int(known_kernel), detected=int(kernel.dim - known_kernel))
     if deflate:
         dg = np.sqrt(np.asarray(G.diagonal() if sp.issparse(G) else np.diag(G), float))
         Z = kernel.vectors[:, :kernel.dim] / dg[:, None] if kernel.dim else None  # W v = 0 ⇔ Bᵀ (v / dg) = 0

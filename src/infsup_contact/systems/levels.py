@@ -60,7 +60,8 @@ def system_rows(manifest: Manifest, route: str = "auto", notes=sys.stderr) -> li
             print(f"infsup-contact: note: {note}", file=notes)
         rows.append(dict(
             system=manifest.name, level=level.index, h=level.h, N2=1.0 / level.h, n=lv.A.shape[0], m=lv.B.shape[0],
-            n_touched=res.n_touched, removed_dofs=lv.removed, norm=manifest.norm,
+            n_touched=res.n_touched, kernel_structural=max(lv.B.shape[0] - res.n_touched, 0),
+            removed_dofs=lv.removed, norm=manifest.norm,
             beta=res.beta, kernel_dim=k.dim, known_kernel=k.proven, kernel_detected=k.detected,
             kernel_margin_decades=k.margin_decades, kernel_decision=k.decision, kernel_tol=k.tol,
             smallest_nonzero=res.smallest_nonzero, route=res.route, residual=res.residual,
@@ -83,6 +84,16 @@ def system_verdict(manifest: Manifest, *, tol: float, floor: float, confidence: 
     series = [dict(r, kernel_dim=r["kernel_detected"], case=manifest.name) for r in rows]
     out = stability_verdict(series, tol, floor, confidence)  # a close kernel decision: INCONCLUSIVE
     out["evidence"] = out["evidence"].replace("over N = ", "over 1/h = ").replace("(N = ", "(1/h = ")
+    if out["verdict"] == "UNSTABLE" and out["kernel_dim"] > 0:  # name the kernel nobody declared
+        dims = [r["kernel_detected"] for r in rows]
+        structural = [r["kernel_structural"] for r in rows]
+        inv_h = ", ".join(f"{1 / r['h']:g}" for r in rows)
+        out["evidence"] = (f"β_h = 0: a kernel of B^T not declared (known_kernel: {manifest.known_kernel}) "
+                           f"of dim {dims} over 1/h = {inv_h}"
+                           + (f"; B has more rows than the dofs it touches (m - touched = {structural})"
+                              if any(structural) else "")
+                           + "; slope of the eigenvalue above the kernel; declare the kernel with known_kernel "
+                           "if it is meant (e.g. a constant pressure)")
     head = dict(system=manifest.name, norm=manifest.norm, known_kernel=manifest.known_kernel)
     head.update(out)
     head.update(h_list=" ".join(f"{r['h']:g}" for r in rows), routes=" ".join(sorted({r["route"] for r in rows})),

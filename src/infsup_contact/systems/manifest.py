@@ -28,6 +28,7 @@ per level, ``constrained``
 from __future__ import annotations
 
 import math
+import unicodedata
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -41,6 +42,8 @@ NORMS = ("given", "L2", "h-L2")
 TGV_POLICIES = ("eliminate", "refuse")
 LEVEL_KEYS = ("h", "A", "B", "G", "constrained")
 TOP_KEYS = ("levels", "name", "norm", "known_kernel", "tgv")
+MANIFEST_MAX_BYTES = 1 << 20
+"""Largest manifest read (a manifest of 1,000 levels is ~60 kB)."""
 MIN_LEVELS = 3
 """A slope's confidence interval needs n − 2 ≥ 1 degrees of freedom (as ``verdict --case``)."""
 
@@ -76,8 +79,15 @@ def load_manifest(path, min_levels: int = MIN_LEVELS) -> Manifest:
     path = Path(path)
     if not path.is_file():
         raise SystemFileError(path, "no such manifest file")
+    if path.stat().st_size > MANIFEST_MAX_BYTES:
+        raise SystemFileError(path, f"{path.stat().st_size} bytes: a manifest lists a few levels (at most "
+                              f"{MANIFEST_MAX_BYTES // 2 ** 20} MiB read); is this the manifest?")
+    from ..yaml_limits import YamlLimitError, load
+
     try:
-        data = yaml.safe_load(path.read_text())
+        data = load(path.read_text())
+    except YamlLimitError as err:
+        raise SystemFileError(path, f"{err.key or 'the document'} (line {err.line}): {err.problem}") from None
     except (yaml.YAMLError, UnicodeDecodeError) as err:
         raise SystemFileError(path, f"not readable YAML ({' '.join(str(err).split())[:120]})") from None
     if not isinstance(data, dict):
@@ -92,6 +102,9 @@ def load_manifest(path, min_levels: int = MIN_LEVELS) -> Manifest:
         raise SystemFileError(path, f"'levels' has {len(levels)} entries; a verdict needs at least {min_levels} "
                               "(the slope's confidence interval needs n - 2 >= 1)")
     name = data.get("name", path.stem)
+    if isinstance(name, bool) or not isinstance(name, (str, int, float)):
+        raise SystemFileError(path, f"name: expected one line of text (found a {type(name).__name__})")
+    _one_line(path, "name", str(name))
     norm = data.get("norm", "given")
     if norm not in NORMS:
         raise SystemFileError(path, f"norm: {norm!r} is not one of {', '.join(NORMS)}")
@@ -108,6 +121,15 @@ def load_manifest(path, min_levels: int = MIN_LEVELS) -> Manifest:
             raise SystemFileError(path, f"levels[{i}].h = {hs[i]:g} does not decrease (levels[{i - 1}].h = "
                                   f"{hs[i - 1]:g}): list the levels coarse to fine, each h once")
     return Manifest(path, str(name), norm, known, tgv, parsed)
+
+
+def _one_line(path, key: str, text: str) -> None:
+    """Refuse a control character (CR, LF, tab, ESC ...) or a line separator in a value that is
+    printed into a CSV row or a message: it would split the row or rewrite the terminal."""
+    for pos, ch in enumerate(text):
+        if unicodedata.category(ch) in ("Cc", "Zl", "Zp"):
+            raise SystemFileError(path, f"{key}: the control character {ch!r} (U+{ord(ch):04X}) at position {pos}; "
+                                  "a name or file name is one line of printable text")
 
 
 def _level(path: Path, i: int, entry) -> Level:
@@ -127,9 +149,11 @@ def _level(path: Path, i: int, entry) -> Level:
     for key in ("A", "B", "G"):
         if not isinstance(entry[key], str) or not entry[key]:
             raise SystemFileError(path, f"{where}.{key}: expected a file name (found {entry[key]!r})")
+        _one_line(path, f"{where}.{key}", entry[key])
         files[key] = (path.parent / entry[key]).resolve()
     con = entry.get("constrained")
     if isinstance(con, str):
+        _one_line(path, f"{where}.constrained", con)
         con = (path.parent / con).resolve()
     elif con is not None:
         if not isinstance(con, list) or any(isinstance(c, bool) or not isinstance(c, int) or c < 0 for c in con):
@@ -145,6 +169,10 @@ def constrained_dofs(level: Level, n: int) -> np.ndarray:
     if isinstance(con, Path):
         if not con.is_file():
             raise SystemFileError(con, "no such file (levels[{}].constrained)".format(level.index))
+        if con.suffix == ".npy":
+            from .readers import check_npy_file
+
+            check_npy_file(con)  # a header declaring more than the file holds: refused before reading
         try:
             raw = read_integer_list(con)
         except TableError as err:

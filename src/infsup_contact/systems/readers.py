@@ -92,9 +92,10 @@ def read_matrix(path):
         elif ext == ".npz":
             mat = _read_npz(path)
         elif ext == ".npy":
-            mat = np.load(path, allow_pickle=False)
+            mat = _read_npy(path)
         elif FORMATS[ext] == "Harwell-Boeing":
             import scipy.io
+            _check_hb_header(path)
             mat = scipy.io.hb_read(str(path))
         else:
             mat = _read_petsc(path)
@@ -103,7 +104,20 @@ def read_matrix(path):
     except Exception as err:  # every library error becomes one line naming the file
         reason = " ".join(str(err).split())[:160] or type(err).__name__
         raise SystemFileError(path, f"not a readable {FORMATS[ext]} file ({type(err).__name__}: {reason})") from None
+    try:
+        return _as_float_matrix(path, mat)
+    except MemoryError:
+        raise SystemFileError(path, f"not enough memory to hold it as a float matrix ({_describe(mat)})") from None
+
+
+def _describe(mat) -> str:
+    shape = " x ".join(map(str, getattr(mat, "shape", ())))
+    return f"{shape}, {mat.nnz} nonzeros" if sp.issparse(mat) else f"{shape} dense"
+
+
+def _as_float_matrix(path, mat):
     if sp.issparse(mat):
+        _check_sparse(path, mat)
         mat = sp.csr_matrix(mat)
     else:
         mat = np.asarray(mat)
@@ -111,7 +125,7 @@ def read_matrix(path):
             raise SystemFileError(path, f"holds a {mat.ndim}-D array of shape {mat.shape}, not a matrix")
     if not np.issubdtype(mat.dtype, np.number) or np.issubdtype(mat.dtype, np.complexfloating):
         raise SystemFileError(path, f"holds {mat.dtype} entries (expected real numbers)")
-    return mat.astype(float)
+    return mat.astype(float, copy=False)
 
 
 def _read_mtx(path, ext):
@@ -122,22 +136,284 @@ def _read_mtx(path, ext):
     if not head.startswith(b"%%MatrixMarket"):
         raise SystemFileError(path, f"does not start with the MatrixMarket banner '%%MatrixMarket' "
                               f"(found {head[:15]!r})")
+    rows, cols, entries, dense, pattern = _mtx_header(path, ext)
+    check_read_memory(path, rows, cols, None if dense else entries, f"{entries} entries")
+    longest = MTX_SLACK + MTX_LINE_MAX * entries
+    last, size = _last_byte(path, ext, longest)
+    if size > longest:
+        raise SystemFileError(path, f"MatrixMarket: more than {longest} bytes{' (decompressed)' if ext == '.mtx.gz' else ''} "
+                              f"for the {entries} entries its header declares (at most {MTX_LINE_MAX} bytes a line)")
+    if last != b"\n":
+        raise SystemFileError(path, "MatrixMarket: the last line does not end with a newline (a file cut "
+                              "short, possibly inside its last number: write it again)")
+    shortest = 2 if dense else (4 if pattern else 6)  # "v\n", "i j\n", "i j v\n"
+    if entries * shortest > size:
+        raise SystemFileError(path, f"MatrixMarket: the header declares {entries} entries, but the "
+                              f"{size} bytes{' (decompressed)' if ext == '.mtx.gz' else ''} hold at most "
+                              f"{size // shortest}: a file cut short")
     return scipy.io.mmread(str(path))
+
+
+HEADER_LINE_MAX = 1 << 16
+"""Longest MatrixMarket banner or size line read (a comment line may be longer: it is skipped)."""
+
+
+def _mtx_header(path, ext):
+    """(rows, cols, entries, dense, pattern) from the banner and the size line, body unread."""
+    with (gzip.open(path, "rb") if ext == ".mtx.gz" else open(path, "rb")) as fh:
+        banner = fh.readline(HEADER_LINE_MAX).decode("ascii", "replace").lower().split()
+        while True:
+            line = fh.readline(HEADER_LINE_MAX)
+            if not line:
+                raise SystemFileError(path, "MatrixMarket: no size line after the banner")
+            while not line.endswith(b"\n") and line.startswith(b"%"):  # a long comment: skip it
+                more = fh.readline(HEADER_LINE_MAX)
+                if not more:
+                    break
+                line = line[:1] + more
+            if line.strip() and not line.startswith(b"%"):
+                break
+    if len(banner) < 5 or banner[1] != "matrix" or banner[2] not in ("coordinate", "array"):
+        raise SystemFileError(path, f"MatrixMarket: banner {' '.join(banner)[:80]!r} is not "
+                              "'%%MatrixMarket matrix coordinate|array <field> <symmetry>'")
+    dense = banner[2] == "array"
+    try:
+        sizes = [int(t) for t in line.split()]
+    except ValueError:
+        sizes = []
+    if len(sizes) != (2 if dense else 3) or min(sizes) < 0:
+        raise SystemFileError(path, f"MatrixMarket: size line {line[:80].decode('ascii', 'replace').strip()!r} is "
+                              f"not {'rows cols' if dense else 'rows cols entries'} (integers >= 0)")
+    rows, cols = sizes[:2]
+    entries = rows * cols if dense else sizes[2]
+    if dense and banner[4] != "general":  # symmetric: the lower triangle only
+        entries = rows * (rows + 1) // 2 if banner[4] != "skew-symmetric" else rows * (rows - 1) // 2
+    return rows, cols, entries, dense, banner[3] == "pattern"
+
+
+MTX_LINE_MAX = 256
+"""Longest MatrixMarket entry line accepted (two indices and a 17-digit value take < 64 bytes)."""
+MTX_SLACK = 1 << 20
+"""Bytes allowed for the banner and comments besides the entries."""
+
+
+def _last_byte(path, ext, stop=None):
+    """(the last byte, the size) of the (decompressed) file; a .mtx.gz is streamed (constant
+    memory), and only until ``stop`` bytes (its size then just exceeds ``stop``)."""
+    if ext != ".mtx.gz":
+        with open(path, "rb") as fh:
+            fh.seek(-1, 2)
+            return fh.read(1), fh.tell()
+    last, size = b"", 0
+    with gzip.open(path, "rb") as fh:
+        while chunk := fh.read(1 << 20):
+            last, size = chunk[-1:], size + len(chunk)
+            if stop is not None and size > stop:
+                break
+    return last, size
+
+
+READ_COPIES = 3.0
+"""Copies of a matrix's arrays alive while a file becomes a float CSR matrix (the reader's
+arrays, COO → CSR, ``astype``): the factor of :func:`read_bytes`."""
+
+
+def read_bytes(rows: int, cols: int, nnz) -> float:
+    """Bytes to read a rows × cols matrix: dense (``nnz`` None) 8·rows·cols twice (the array and
+    its float copy); sparse, (value + two indices) per entry and the index pointers, times
+    :data:`READ_COPIES`."""
+    if nnz is None:
+        return 2.0 * 8.0 * rows * cols
+    return READ_COPIES * (24.0 * nnz + 8.0 * (rows + cols + 2))
+
+
+def check_read_memory(path, rows: int, cols: int, nnz, what: str) -> None:
+    """Refuse a file whose header declares more than the available memory can read (before its
+    body is read: a small compressed file can declare gigabytes)."""
+    from .. import resources
+
+    need = read_bytes(rows, cols, nnz)
+    avail = resources.available_bytes()
+    if avail is not None and need > avail:
+        raise SystemFileError(path, f"its header declares a {rows} x {cols} matrix with {what}: reading it "
+                              f"needs ~{resources.human_bytes(need)}, {resources.human_bytes(avail)} available")
+
+
+def _npy_header(fh):
+    """(shape, dtype) of an .npy stream, its body unread."""
+    from numpy.lib import format as npformat
+
+    version = npformat.read_magic(fh)
+    reader = npformat.read_array_header_1_0 if version == (1, 0) else npformat.read_array_header_2_0
+    shape, _, dtype = reader(fh, max_header_size=10000)
+    return tuple(int(d) for d in shape), dtype
+
+
+def _check_npy(path, shape, dtype, stored: int, member: str = ""):
+    """An array's declared bytes against what the file (or zip member) holds, and the memory."""
+    where = f"array {member!r}: " if member else ""
+    if dtype.hasobject:
+        raise SystemFileError(path, f"{where}holds Python objects (dtype {dtype}), not numbers")
+    count = int(np.prod(shape, dtype=object)) if shape else 1
+    if count * dtype.itemsize > stored:
+        raise SystemFileError(path, f"{where}the header declares shape {shape} of {dtype} ({count * dtype.itemsize} "
+                              f"bytes), the file holds {stored}: a file cut short or forged")
+    return count
+
+
+def check_npy_file(path) -> tuple:
+    """The shape an ``.npy`` file declares, checked against its bytes and the memory before
+    its body is read (:class:`SystemFileError`); any other reading error is the caller's."""
+    path = Path(path)
+    size = path.stat().st_size
+    with open(path, "rb") as fh:
+        try:
+            shape, dtype = _npy_header(fh)
+        except ValueError as err:
+            raise SystemFileError(path, f"not a numpy .npy file ({' '.join(str(err).split())[:120]})") from None
+        body = size - fh.tell()
+    count = _check_npy(path, shape, dtype, body)
+    if len(shape) == 2:
+        check_read_memory(path, shape[0], shape[1], None, "dense entries")
+    elif count:
+        check_read_memory(path, count, 1, None, "dense entries")
+    return shape
+
+
+def _read_npy(path):
+    check_npy_file(path)
+    return np.load(path, allow_pickle=False)
+
+
+def _check_npz_members(path):
+    """Each member's declared array against its declared size, and the sum against the memory."""
+    import zipfile
+
+    total, shapes = 0.0, {}
+    with zipfile.ZipFile(path) as zf:
+        for info in zf.infolist():
+            name = info.filename[:-4] if info.filename.endswith(".npy") else info.filename
+            with zf.open(info) as fh:
+                shape, dtype = _npy_header(fh)
+                stored = info.file_size - fh.tell()
+            count = _check_npy(path, shape, dtype, stored, name)
+            total += count * max(dtype.itemsize, 8)
+            shapes[name] = shape
+    from .. import resources
+
+    need, avail = 2.0 * READ_COPIES * total, resources.available_bytes()
+    if avail is not None and need > avail:
+        raise SystemFileError(path, f"its arrays {shapes} declare {resources.human_bytes(total)}: reading them "
+                              f"needs ~{resources.human_bytes(need)}, {resources.human_bytes(avail)} available")
 
 
 def _read_npz(path):
     with open(path, "rb") as fh:
         if fh.read(4) != b"PK\x03\x04":
             raise SystemFileError(path, "not a zip archive (an .npz is one)")
+    _check_npz_members(path)
     with np.load(path, allow_pickle=False) as data:
         keys = set(data.files)
     if {"format", "shape", "data"} <= keys:
-        return sp.load_npz(path)
+        return _sparse_npz(path)
     if len(keys) != 1:
         raise SystemFileError(path, f"an .npz with arrays {sorted(keys)}: expected a scipy.sparse.save_npz "
                               "archive or exactly one dense array")
     with np.load(path, allow_pickle=False) as data:
         return data[next(iter(keys))]
+
+
+SPARSE_NPZ = {"csr": ("indices", "indptr"), "csc": ("indices", "indptr"), "coo": ("row", "col")}
+"""The ``scipy.sparse.save_npz`` layouts read, and their index arrays (bsr and dia are refused)."""
+
+
+def _sparse_npz(path):
+    """A ``scipy.sparse.save_npz`` archive, its index arrays checked before the matrix is built
+    (scipy does not check them: an index out of range crashed the process, exit 139)."""
+    with np.load(path, allow_pickle=False) as data:
+        fmt = data["format"].item()
+        fmt = fmt.decode("ascii", "replace") if isinstance(fmt, bytes) else str(fmt)
+        if fmt not in SPARSE_NPZ:
+            raise SystemFileError(path, f"a scipy.sparse {fmt!r} archive (readable: {', '.join(SPARSE_NPZ)}; "
+                                  "save the matrix with .tocsr())")
+        missing = [k for k in SPARSE_NPZ[fmt] if k not in data.files]
+        if missing:
+            raise SystemFileError(path, f"a scipy.sparse {fmt} archive without its {missing[0]!r} array")
+        shape = np.asarray(data["shape"])
+        arrays = [np.asarray(data[k]) for k in ("data",) + SPARSE_NPZ[fmt]]
+    if shape.shape != (2,) or not np.issubdtype(shape.dtype, np.integer) or (shape < 0).any():
+        raise SystemFileError(path, f"'shape' is {shape.tolist()!r}, not two integers >= 0")
+    m, n = (int(v) for v in shape)
+    values, first, second = arrays
+    check_read_memory(path, m, n, len(values), f"{len(values)} stored entries")
+    if fmt == "coo":
+        check_coordinates(path, (m, n), values, first, second)
+        return sp.coo_matrix((values, (first, second)), shape=(m, n))
+    check_compressed(path, (m, n), values, first, second, rows_major=fmt == "csr")
+    return (sp.csr_matrix if fmt == "csr" else sp.csc_matrix)((values, first, second), shape=(m, n))
+
+
+def _int_array(path, name, a):
+    a = np.asarray(a)
+    if a.ndim != 1 or not (np.issubdtype(a.dtype, np.integer) or a.size == 0):
+        raise SystemFileError(path, f"'{name}' holds {a.dtype} of shape {a.shape}, not a 1-D integer array")
+    return a
+
+
+def check_coordinates(path, shape, values, row, col):
+    """Coordinate (COO) arrays: equal lengths, 0 <= row < m, 0 <= col < n (:class:`SystemFileError`)."""
+    row, col = _int_array(path, "row", row), _int_array(path, "col", col)
+    if np.ndim(values) != 1 or not len(values) == len(row) == len(col):
+        raise SystemFileError(path, f"{np.size(values)} values but {len(row)} row and {len(col)} column indices")
+    for name, idx, size in (("row", row, shape[0]), ("column", col, shape[1])):
+        if idx.size and (idx.min() < 0 or idx.max() >= size):
+            bad = int(idx.min() if idx.min() < 0 else idx.max())
+            raise SystemFileError(path, f"{name} index {bad} outside 0..{size - 1} (shape {shape[0]} x {shape[1]})")
+
+
+def check_compressed(path, shape, values, indices, indptr, rows_major=True):
+    """CSR (``rows_major``) or CSC arrays, before scipy sees them: len(indptr) = rows + 1 (CSR),
+    indptr from 0, non-decreasing, ending at len(indices) = len(values), 0 <= indices < cols."""
+    indices, indptr = _int_array(path, "indices", indices), _int_array(path, "indptr", indptr)
+    major, minor = shape if rows_major else shape[::-1]
+    kind, what = ("CSR", "column") if rows_major else ("CSC", "row")
+    if len(indptr) != major + 1:
+        raise SystemFileError(path, f"{kind}: {len(indptr)} index pointers for {major} "
+                              f"{'rows' if rows_major else 'columns'} (expected {major + 1})")
+    if np.ndim(values) != 1 or len(values) != len(indices):
+        raise SystemFileError(path, f"{kind}: {np.size(values)} values but {len(indices)} {what} indices")
+    if indptr[0] != 0 or indptr[-1] != len(indices) or (np.diff(indptr) < 0).any():
+        raise SystemFileError(path, f"{kind}: index pointers must rise from 0 to {len(indices)} without "
+                              f"decreasing (found {int(indptr[0])} .. {int(indptr[-1])}"
+                              f"{', decreasing' if (np.diff(indptr) < 0).any() else ''})")
+    if indices.size and (indices.min() < 0 or indices.max() >= minor):
+        bad = int(indices.min() if indices.min() < 0 else indices.max())
+        raise SystemFileError(path, f"{kind}: {what} index {bad} outside 0..{minor - 1} "
+                              f"(shape {shape[0]} x {shape[1]})")
+
+
+def _check_sparse(path, mat):
+    """The index arrays of a matrix a library built without checking them (Harwell-Boeing)."""
+    if isinstance(mat, (sp.csr_matrix, sp.csc_matrix)) or getattr(mat, "format", None) in ("csr", "csc"):
+        check_compressed(path, mat.shape, mat.data, mat.indices, mat.indptr, rows_major=mat.format == "csr")
+    elif getattr(mat, "format", None) == "coo":
+        check_coordinates(path, mat.shape, mat.data, mat.row, mat.col)
+
+
+def _check_hb_header(path):
+    """The Harwell-Boeing sizes (line 3: type, rows, columns, nonzeros) against the memory."""
+    with open(path, "rb") as fh:
+        lines = [fh.readline(HEADER_LINE_MAX) for _ in range(3)]
+    try:
+        rows, cols, nnz = (int(t) for t in lines[2][14:56].split()[:3])
+    except (ValueError, IndexError):
+        return  # hb_read names what is wrong
+    if min(rows, cols, nnz) < 0:
+        raise SystemFileError(path, f"Harwell-Boeing: negative size {rows} x {cols}, {nnz} nonzeros in the header")
+    if 4 * nnz > path.stat().st_size:  # each nonzero needs a row index and a value, >= 2 characters each
+        raise SystemFileError(path, f"Harwell-Boeing: the header declares {nnz} nonzeros, the file's "
+                              f"{path.stat().st_size} bytes cannot hold them")
+    check_read_memory(path, rows, cols, nnz, f"{nnz} nonzeros")
 
 
 def _read_petsc(path):
@@ -168,7 +444,8 @@ def read_petsc_binary(path):
         CSR for a sparse matrix, a dense array for ``nz = -1``.
     """
     path = Path(path)
-    raw = path.read_bytes()
+    with open(path, "rb") as fh:
+        raw = fh.read(32)
     if len(raw) < 16:
         raise SystemFileError(path, f"PETSc binary: {len(raw)} bytes, shorter than a matrix header (16)")
     first32 = int(np.frombuffer(raw, ">i4", 1)[0])
@@ -184,6 +461,16 @@ def read_petsc_binary(path):
     pos = 4 * isz
     if m < 0 or n < 0:
         raise SystemFileError(path, f"PETSc binary: negative size {m} x {n} in the header")
+    size = path.stat().st_size
+    need = pos + (8 * m * n if nz == DENSE_NZ else isz * (m + max(nz, 0)) + 8 * max(nz, 0))
+    if nz < DENSE_NZ or size < need:  # checked before the body is read (a header can declare anything)
+        raise SystemFileError(path, f"PETSc binary: truncated: header says {m} x {n} with "
+                              f"{'dense entries' if nz == DENSE_NZ else f'{nz} nonzeros'} ({need} bytes), "
+                              f"the file has {size}")
+    check_read_memory(path, m, n, None if nz == DENSE_NZ else nz,
+                      "dense entries" if nz == DENSE_NZ else f"{nz} nonzeros")
+    with open(path, "rb") as fh:
+        raw = fh.read(need)  # the matrix only: further objects in the file are not read
     if nz == DENSE_NZ:
         need = pos + 8 * m * n
         if len(raw) < need:

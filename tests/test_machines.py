@@ -17,6 +17,7 @@ import pandas as pd
 import pytest
 
 from infsup_contact.errors import InputError
+from infsup_contact.io import SCHEMAS
 from infsup_contact.study import machines
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -101,34 +102,49 @@ def test_a_path_sets_its_switch_and_drops_the_others():
 
 
 def _ledger(folder, kernel_dim=2, verdict="PASS", drop=None):
-    """A synthetic CI ledger: every table of machines.LEDGER_TABLES with a kernel column or two."""
-    for table in machines.LEDGER_TABLES:
+    """A synthetic CI ledger: every table of machines.LEDGER_TABLES, valid under its schema (the
+    comparison reads through io's checks), with a kernel column or two."""
+    for table, kind in machines.LEDGER_TABLES.items():
         if table == drop:
             continue
         f = folder / table
         f.parent.mkdir(parents=True, exist_ok=True)
+        frame = _valid_frame(kind)
         if table.endswith("claims.csv"):
-            frame = pd.DataFrame(dict(claim_id=["a", "b"], verdict=["PASS", verdict]))
+            frame = frame.assign(claim_id=["a", "b"], verdict=["PASS", verdict])
         else:
-            frame = pd.DataFrame(dict(case=["T3", "R5.2"], beta=[0.5, 1e-17], kernel_dim=[0, kernel_dim],
-                                      kernel_decision=["clear", "clear"], kernel_margin_decades=[5.1, 4.2]))
+            frame = frame.assign(case=["T3", "R5.2"], kernel_dim=[0, kernel_dim], kernel_decision=["clear", "clear"],
+                                 kernel_margin_decades=[5.1, 4.2])
         frame.to_csv(f, index=False)
     return folder
+
+
+def _valid_frame(kind, n=2):
+    """n rows of a table of ``kind``: each declared column with values of its type, distinct per row."""
+    values = {"int": lambda i: i + 1, "float": lambda i: 0.5 + i, "str": lambda i: f"s{i}", "bool": lambda i: True}
+    columns = SCHEMAS[kind].columns
+    return pd.DataFrame({c: [values[t.rstrip("?")](i) for i in range(n)] for c, t in columns.items()})
 
 
 def test_ledgers_differ_where_a_verdict_or_kernel_column_does(tmp_path):
     same = {"a": _ledger(tmp_path / "a"), "b": _ledger(tmp_path / "b")}
     summary, problems = machines.ledger_differences(same)
     assert problems == [] and summary.identical.all()
-    assert set(summary.column) == {"verdict", "kernel_dim", "kernel_decision"}  # not the margin, not β
+    assert {"verdict", "kernel_dim", "kernel_decision"} <= set(summary.column) <= set(machines.LEDGER_EXACT)
+    assert not {"kernel_margin_decades", "beta"} & set(summary.column)  # a margin and a number: not compared
     _, problems = machines.ledger_differences({"a": same["a"], "c": _ledger(tmp_path / "c", kernel_dim=3)})
     assert len(problems) == len(machines.LEDGER_TABLES) - 1
-    assert "results/tables/beta.csv row 1 (case R5.2): kernel_dim 3 under c, 2 under a" in problems
+    assert any(p.startswith("results/tables/beta.csv row 1 (") and "case R5.2" in p
+               and p.endswith("kernel_dim 3 under c, 2 under a") for p in problems), problems
     _, problems = machines.ledger_differences({"a": same["a"], "d": _ledger(tmp_path / "d", verdict="FAIL")})
     assert problems == ["results/claims.csv row 1 (claim_id b): verdict FAIL under d, PASS under a"]
     dropped = _ledger(tmp_path / "e", drop="results/face/patch.csv")
     _, problems = machines.ledger_differences({"a": same["a"], "e": dropped})
     assert len(problems) == 1 and problems[0].startswith("results/face/patch.csv: missing under e")
+    cut = _ledger(tmp_path / "f")
+    (cut / "results/claims.csv").write_text((cut / "results/claims.csv").read_text()[:-3])  # a cut-off write
+    _, problems = machines.ledger_differences({"a": same["a"], "f": cut})
+    assert len(problems) == 1 and problems[0].startswith("results/claims.csv: damaged under f: ")
 
 
 @pytest.mark.slow_first  # a pytest run of three test files each (tests/conftest.py)

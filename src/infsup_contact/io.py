@@ -359,6 +359,18 @@ def read_table(path, kind: str, allow_empty: bool = False):
     return frame
 
 
+def read_table_text(path, kind: str):
+    """:func:`read_table`'s checks, then every cell as the text written (no number parsed, no
+    empty cell read as NaN): for byte-for-byte comparisons of tables (``verify-machines``)."""
+    import io as _io
+
+    import pandas as pd
+
+    read_table(path, kind)
+    text, _ = _read_text(path)
+    return pd.read_csv(_io.StringIO(text), sep=SCHEMAS[kind].sep, index_col=False, dtype=str, keep_default_na=False)
+
+
 def read_integer_list(path) -> "np.ndarray":
     """Whitespace- or comma-separated integers from a text file (a list of dof indices), or an
     ``.npy`` array; :class:`TableError` naming the file and line of the first token that is

@@ -6,12 +6,10 @@ import json
 import sys
 from pathlib import Path
 
-import pandas as pd
-
 sys.path.insert(0, "workflow/scripts")
 from _glue import fail, log_to  # noqa: E402
 
-from infsup_contact.io import write_csv_atomic  # noqa: E402
+from infsup_contact.io import read_table_text, write_csv_atomic  # noqa: E402
 from infsup_contact.study.machines import ledger_differences  # noqa: E402
 
 log_to(snakemake.log[0])  # noqa: F821
@@ -27,8 +25,7 @@ if missing:
     fail(f"verify-machines: no ledger for {', '.join(missing)} (results/machines/*/ledger): rerun machine_ledger")
 ledgers = {r["path"]: Path(r["ledger"]) for r in ran}
 summary, problems = ledger_differences(ledgers)
-claims = {name: pd.read_csv(folder / "results/claims.csv", dtype=str, keep_default_na=False)
-          for name, folder in ledgers.items()}
+claims = {name: read_table_text(folder / "results/claims.csv", "claims") for name, folder in ledgers.items()}
 first = next(iter(claims.values()))
 table = first[["claim_id"]].copy()
 for name, ledger in claims.items():

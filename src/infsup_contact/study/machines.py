@@ -52,6 +52,7 @@ import numpy as np
 import pandas as pd
 
 from ..errors import InputError
+from ..io import TableError, read_table_text
 
 SWITCHES = ("OPENBLAS_CORETYPE", "MKL_CBWR", "MKL_ENABLE_INSTRUCTIONS")
 """The variables that select a library's code path: a path's environment drops every one it does
@@ -386,14 +387,15 @@ def max_beta_difference(sweeps: dict) -> tuple[float, float]:
     return worst, worst_scaled
 
 
-LEDGER_TABLES = ("results/claims.csv", "results/tables/beta.csv", "results/tables/contact.csv",
-                 "results/tables/elastic_beta.csv", "results/tables/elastic_nu_sweep.csv",
-                 "results/tables/elastic_patch.csv", "results/tables/face_beta.csv",
-                 "results/tables/face_elastic_beta.csv", "results/face/alpha.csv", "results/face/patch.csv",
-                 "results/face/elastic_patch.csv")
-"""The CI profile's tables ``verify-machines`` compares across paths (relative to the workflow):
-the ledger and every table of the segment's, the elastic and the face stages that carries a
-kernel column."""
+LEDGER_TABLES = {"results/claims.csv": "claims", "results/tables/beta.csv": "beta",
+                 "results/tables/contact.csv": "contact", "results/tables/elastic_beta.csv": "elastic_beta",
+                 "results/tables/elastic_nu_sweep.csv": "elastic_beta",
+                 "results/tables/elastic_patch.csv": "elastic_patch", "results/tables/face_beta.csv": "face_beta",
+                 "results/tables/face_elastic_beta.csv": "face_elastic_beta", "results/face/alpha.csv": "face_alpha",
+                 "results/face/patch.csv": "face_patch", "results/face/elastic_patch.csv": "face_elastic_patch"}
+"""The CI profile's tables ``verify-machines`` compares across paths (relative to the workflow),
+each with the schema it is read under: the ledger and every table of the segment's, the elastic
+and the face stages that carries a kernel column."""
 LEDGER_EXACT = ("verdict", "kernel_dim", "structural_kernel_dim", "kernel_detected", "kernel_decision",
                 "kernel_check", "dim_M", "dim_W", "kernel_dim_membranes", "kernel_decision_membranes", "passes")
 """Columns that must be byte-identical across paths wherever a table of :data:`LEDGER_TABLES`
@@ -438,7 +440,10 @@ def ledger_differences(ledgers: dict) -> tuple[pd.DataFrame, list]:
                 problems.append(f"{table}: missing under {name} ({f})")
                 continue
             # every cell as the text written: a byte comparison, no parsing of numbers
-            texts[name] = pd.read_csv(f, dtype=str, keep_default_na=False)
+            try:
+                texts[name] = read_table_text(f, LEDGER_TABLES[table])
+            except TableError as err:  # a damaged table is a difference, in one line
+                problems.append(f"{table}: damaged under {name}: {err}")
         if ref_name not in texts:
             continue
         ref = texts[ref_name]

@@ -39,10 +39,10 @@ from ..la.threaded import symmetric_part, symmetric_sandwich
 from .coupling import weighted_values
 from . import face_parity
 from .basis_symmetry import axis_reflections, isotypic_bases
-from .face_norms import EXP_SUM_MIN_DIM, extrapolated, partial_gram, partial_gram_blocks, start_level
+from .face_norms import EXP_SUM_MIN_DIM, default_cap, extrapolated, partial_gram, partial_gram_blocks, start_level
 from .face_spaces import FaceSpace
 from .multipliers import make_space
-from .norms import N_MAX_CAP, gram_by_norm, gram_l2
+from .norms import gram_by_norm, gram_l2
 from .richardson import BlockOps
 from .quadrature import gauss_legendre
 
@@ -167,7 +167,7 @@ def gram_l2_cellwise(space) -> np.ndarray:
     return 0.5 * (G + G.T)
 
 
-def gram_h_cellwise(space, rtol: float = 1e-6, n_start: int | None = None, n_cap: int = N_MAX_CAP // 8,
+def gram_h_cellwise(space, rtol: float = 1e-6, n_start: int | None = None, n_cap: int | None = None,
                     exponent: float | None = None) -> tuple[np.ndarray, dict]:
     """The H^{1/2}_00(Γ)' Gram matrix (module docstring); arguments as :func:`~.face_norms.gram_h_face`
     (n0 default max(16, 2 (s + 1) N), N the pieces per direction, raised on the exponential-sum
@@ -179,6 +179,7 @@ def gram_h_cellwise(space, rtol: float = 1e-6, n_start: int | None = None, n_cap
     n_int = max(len(P.breakpoints.xs), len(P.breakpoints.ys)) - 1
     n0 = (start_level(max(16, 2 * (space.piece_degree + 1) * n_int), p, P.dim) if n_start is None
           else int(n_start))
+    n_cap = default_cap(P.dim) if n_cap is None else n_cap
 
     blocked = _parity_route(space, R, P)
     if blocked is not None:  # the four parity blocks of the axis reflections (:mod:`.face_parity`)

@@ -116,6 +116,15 @@ def _separable_sum(A: np.ndarray, B: np.ndarray, m: np.ndarray, n: np.ndarray, a
     return scaled @ right.T
 
 
+def default_cap(dim: int) -> int:
+    """Largest n_max of a face series summed in ``dim`` dimensions: :data:`~.norms.N_MAX_CAP` on the
+    exponential-sum route (above :data:`EXP_SUM_MIN_DIM`), where a level costs about the same at
+    every n (at k = 2, N = 32, R5.2, DUAL-ALL and TDUAL-Q9 stopped at the former cap 8,192 with a
+    stated error of 1.5e-5 to 3.2e-5; one level more, 12,288, states 6e-8 to 9e-8); an eighth of
+    it on the direct sums, whose levels cost n_max²."""
+    return N_MAX_CAP if dim > EXP_SUM_MIN_DIM else N_MAX_CAP // 8
+
+
 def start_level(n0: int, p: float, dim: int) -> int:
     """The first n of the Richardson levels: n0, or :data:`EXP_SUM_START` n0 for a slow tail
     (p = 2) on the exponential-sum route (``dim`` = the dimension :func:`partial_gram` sums in,
@@ -138,7 +147,7 @@ def tail_exponent(space, n_max: int) -> float:
     return float(np.log2(_norm2(s2 - s1) / _norm2(s4 - s2)))
 
 
-def gram_h_face(space, rtol: float = 1e-6, n_start: int | None = None, n_cap: int = N_MAX_CAP // 8,
+def gram_h_face(space, rtol: float = 1e-6, n_start: int | None = None, n_cap: int | None = None,
                 exponent: float | None = None, aspect: float = 1.0) -> tuple[np.ndarray, dict]:
     """Gram matrix of the M = H^{1/2}_00(Γ)' norm on the square (module docstring).
 
@@ -155,8 +164,9 @@ def gram_h_face(space, rtol: float = 1e-6, n_start: int | None = None, n_cap: in
     n_start : int, optional
         n0; default max(16, 2 (s + 1) N) with N the larger number of intervals per direction,
         times :data:`EXP_SUM_START` for a slow tail on the exponential-sum route (:func:`start_level`).
-    n_cap : int
-        Largest n_max (``info["capped"]`` when the estimate is still above rtol there).
+    n_cap : int, optional
+        Largest n_max (``info["capped"]`` when the estimate is still above rtol there); default
+        :func:`default_cap`.
     exponent : float, optional
         Tail exponent p; default 4 for continuous spaces vanishing on ∂Γ, else 2 (:func:`smooth_tail`).
     aspect : float
@@ -177,6 +187,7 @@ def gram_h_face(space, rtol: float = 1e-6, n_start: int | None = None, n_cap: in
           else int(n_start))
     if not aspect > 0:
         raise InputError("aspect", "a positive float", got=aspect)
+    n_cap = default_cap(space.dim) if n_cap is None else n_cap
     parities = face_parity.tensor_parities(space) if aspect == 1.0 and space.dim > EXP_SUM_MIN_DIM else None
     if parities is None:
         return extrapolated(lambda n: partial_gram(space, n, aspect), p, n0, n_cap, rtol)

@@ -118,7 +118,7 @@ def lookahead_bound(step: float, previous: float | None) -> float:
 
 class DenseOps:
     """:func:`extrapolate`'s operations on dense matrices: threaded element-wise passes (bit for
-    bit numpy's, :func:`~infsup_contact.la.threaded.elementwise`) and :func:`_norm2`."""
+    bit numpy's, :func:`~infsup_contact.la.threaded.elementwise`) and :func:`relative_steps`."""
 
     @staticmethod
     def step(hi, lo, divisor):
@@ -129,17 +129,13 @@ class DenseOps:
         return elementwise(np.subtract, a, b)
 
     @staticmethod
-    def norm2(a):
-        return _norm2(a)
-
-    @staticmethod
     def rel_norms(es, r):
         return relative_steps(es, r)
 
 
 class BlockOps:
     """:func:`extrapolate`'s operations on lists of diagonal blocks (:mod:`.face_parity`): the
-    step and the difference block by block, the spectral norm the largest block's."""
+    step and the difference block by block, the relative step the largest block's."""
 
     @staticmethod
     def step(hi, lo, divisor):
@@ -148,10 +144,6 @@ class BlockOps:
     @staticmethod
     def diff(a, b):
         return [DenseOps.diff(x, y) for x, y in zip(a, b)]
-
-    @staticmethod
-    def norm2(blocks):
-        return max(_norm2(B) for B in blocks)
 
     @staticmethod
     def rel_norms(es, grams):

@@ -333,3 +333,20 @@ def test_exit_code_table_is_in_help_and_readme():
     for code, text in EXIT_CODES:
         assert re.search(rf"^\s+{code}\s+{re.escape(text.split()[0])}", epilog, flags=re.M), code
         assert re.search(rf"^\| {code} \| ", section, flags=re.M), f"README table lacks exit code {code}"
+
+
+@pytest.mark.parametrize("which", ["manifest", "matrix"])
+def test_output_onto_an_input_is_refused(systems, which):
+    manifest = systems["stable"]
+    target = manifest if which == "manifest" else load_manifest(manifest).levels[0].B
+    before = target.read_bytes()
+    code, out, err = verdict("--system", manifest, "--format", "json", "--output", target)
+    assert code == 2 and out == ""
+    one_line(err, "--output", "other than the inputs")
+    assert target.read_bytes() == before
+
+
+def test_unknown_format_is_one_line(systems):
+    code, out, err = verdict("--system", systems["stable"], "--format", "xml")
+    assert code == 2 and out == ""
+    one_line(err, "--format", "xml")

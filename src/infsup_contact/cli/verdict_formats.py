@@ -140,9 +140,30 @@ def emit(args, row: dict, levels=None, manifest_expect=None) -> int:
     result = VerdictResult(form, row, None if expect is None else expect.upper(),
                            {k: getattr(args, k) for k in ("slope_tolerance", "beta_floor", "confidence")},
                            levels, source)
+    if args.output is not None:
+        check_not_an_input(args.output, args)
     write_result(render(result, args.format), args.output)
     report(result)
     return result.exit_code
+
+
+def check_not_an_input(output, args) -> None:
+    """:class:`InputError` (key ``output``) when ``output`` is a file the verdict was computed
+    from (the manifest, a level's matrix, the space file): writing it would destroy the input."""
+    from pathlib import Path
+
+    from ..errors import InputError
+
+    inputs = []
+    if args.system is not None:
+        inputs = [Path(args.system)] + [p for lv in args.manifest.levels for p in (lv.A, lv.B, lv.G, lv.constrained)
+                                        if isinstance(p, Path)]
+    elif args.space is not None:
+        inputs = [Path(args.space.rsplit(":", 1)[0])]
+    target = Path(output).resolve()
+    if any(p.resolve() == target for p in inputs):
+        raise InputError("output", "a file other than the inputs of the verdict (it would be overwritten)",
+                         got=str(output))
 
 
 def write_result(text: str, output) -> None:

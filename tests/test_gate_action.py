@@ -183,3 +183,17 @@ def test_hook_checks_every_manifest_and_reports_the_refused_one(systems, tmp_pat
     assert len(out.splitlines()) == 2 and "expected UNSTABLE" in out.splitlines()[0]
     lines = err.splitlines()
     assert len(lines) == 1 and str(bad) in lines[0] and "at least 3" in lines[0]
+
+
+def test_action_inputs_with_shell_metacharacters_stay_data(systems, tmp_path):
+    """A manifest path holding quotes, `$(...)` and spaces is a path, never a command."""
+    import shutil
+
+    evil = "ex ports'\"$(touch pwned);`touch pwned2`"
+    workdir = tmp_path / "work"
+    shutil.copytree(systems["stable"].parent, workdir / evil)
+    got, err, outputs, _ = run_action_step(tmp_path, {"system": f"{evil}/levels.yaml", "norm": "h-L2"}, workdir)
+    assert got == 0, err
+    assert outputs["verdict"] == json.loads(Path(outputs["json"]).read_text())["verdict"]
+    assert not list(workdir.rglob("pwned*")) and not list(tmp_path.rglob("pwned*"))
+    assert sorted(p.name for p in (workdir / evil).iterdir()) == sorted(p.name for p in systems["stable"].parent.iterdir())

@@ -350,3 +350,15 @@ def test_unknown_format_is_one_line(systems):
     code, out, err = verdict("--system", systems["stable"], "--format", "xml")
     assert code == 2 and out == ""
     one_line(err, "--format", "xml")
+
+
+def test_output_to_a_device_writes_through_it_and_leaves_the_node(systems):
+    """``--output /dev/stdout`` (a common idiom) and ``--output -``: the result on stdout, and
+    the device node not replaced by a renamed temporary file (we may run as root)."""
+    for target in ("/dev/stdout", "-"):
+        proc = subprocess.run([sys.executable, "-m", "infsup_contact", "verdict", "--system", str(systems["stable"]),
+                               "--format", "json", "--output", target], capture_output=True, text=True, env=ENV,
+                              cwd=ROOT, timeout=120)
+        assert proc.returncode == 0, proc.stderr
+        assert strict_json(proc.stdout)["verdict"] == "STABLE"
+    assert os.path.islink("/dev/stdout") or not os.path.isfile("/dev/stdout")

@@ -104,6 +104,8 @@ def output_path(text: str) -> str:
     from pathlib import Path
 
     path = Path(text)
+    if text == "-":  # stdout, as without --output
+        return text
     if not text or path.is_dir():
         raise argparse.ArgumentTypeError(f"{text!r} is a directory or empty: expected a file name to write")
     parent = path.absolute().parent
@@ -122,7 +124,7 @@ def add_output_args(p) -> None:
                    help="csv: one row (default); json: one object, the per-level rows of --system included; "
                    "junit: JUnit XML, one testcase (a failure when --expect is not met)")
     p.add_argument("--output", metavar="FILE", type=output_path, default=None,
-                   help="write the result to FILE (atomically: a temporary file renamed) instead of stdout")
+                   help="write the result to FILE (atomically: a temporary file renamed) instead of stdout (- : stdout)")
     p.epilog = exit_code_table()
     p.formatter_class = _EpilogFormatter
 
@@ -140,7 +142,7 @@ def emit(args, row: dict, levels=None, manifest_expect=None) -> int:
     result = VerdictResult(form, row, None if expect is None else expect.upper(),
                            {k: getattr(args, k) for k in ("slope_tolerance", "beta_floor", "confidence")},
                            levels, source)
-    if args.output is not None:
+    if args.output not in (None, "-"):
         check_not_an_input(args.output, args)
     write_result(render(result, args.format), args.output)
     report(result)
@@ -167,15 +169,23 @@ def check_not_an_input(output, args) -> None:
 
 
 def write_result(text: str, output) -> None:
-    """``text`` on stdout, or into the file ``output`` atomically (:func:`infsup_contact.io.write_bytes_atomic`)."""
+    """``text`` on stdout (``output`` None or ``-``), into a device or pipe as it is
+    (``/dev/stdout``: a rename would replace the device node), else into the file ``output``
+    atomically (:func:`infsup_contact.io.write_bytes_atomic`); UTF-8 whatever the locale."""
+    import stat
+
     from ..io import write_bytes_atomic
     from .common import OutputError, write_text
 
-    if output is None:
+    if output in (None, "-"):
         write_text(text)
         return
-    try:  # UTF-8 whatever the locale: the evidence says β_h
-        write_bytes_atomic(output, text.encode("utf-8"))
+    try:
+        if os.path.exists(output) and not stat.S_ISREG(os.stat(output).st_mode):
+            with open(output, "wb") as fh:
+                fh.write(text.encode("utf-8"))
+        else:
+            write_bytes_atomic(output, text.encode("utf-8"))
     except OSError as err:
         raise OutputError(f"cannot write the result to {output} ({err.strerror or err})") from None
 

@@ -197,3 +197,10 @@ def test_action_inputs_with_shell_metacharacters_stay_data(systems, tmp_path):
     assert outputs["verdict"] == json.loads(Path(outputs["json"]).read_text())["verdict"]
     assert not list(workdir.rglob("pwned*")) and not list(tmp_path.rglob("pwned*"))
     assert sorted(p.name for p in (workdir / evil).iterdir()) == sorted(p.name for p in systems["stable"].parent.iterdir())
+
+
+def test_hook_bad_criterion_is_one_line_before_any_manifest(systems):
+    code, out, err = run_hook("--slope-tolerance", "0.5", systems["stable"], systems["unstable"])
+    assert code == 2 and out == ""
+    lines = err.splitlines()
+    assert len(lines) == 1 and "--slope-tolerance" in lines[0] and "0.5" in lines[0], err

@@ -25,7 +25,7 @@ def add(sub) -> None:
     p = sub.add_parser(
         "verdict-hook", help="pre-commit hook: verdict --system on each manifest given, exit 1 if a verdict "
         "is not the manifest's expect: (default stable)",
-        description=__doc__.split("\n\n", 1)[1].replace("\n", " "))
+        description=__doc__.split("\n\n", 1)[1].replace("\n", " ").replace("``", ""))
     p.add_argument("manifests", nargs="+", metavar="LEVELS.yaml", help="the manifests to check (pre-commit "
                    "passes the changed files matching the hook's files: pattern)")
     for key in ("slope_tolerance", "beta_floor", "confidence"):
@@ -58,7 +58,10 @@ def check_one(path: str, criterion: dict) -> tuple[int, str]:
 
 
 def run_hook(args) -> int:
+    from ..study.verdict import check_criterion
+
     criterion = {k: getattr(args, k) for k in ("slope_tolerance", "beta_floor", "confidence")}
+    check_criterion(*criterion.values())  # once, not once per manifest
     worst = 0
     for path in args.manifests:
         code, line = check_one(path, criterion)

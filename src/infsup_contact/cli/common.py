@@ -163,7 +163,8 @@ def check_memory(est, key: str, value) -> None:
                          f"available (this request: {est.describe()})", got=value)
 
 
-SYSTEM_KEEPS = ("system", "dry_run", "expect", "slope_tolerance", "beta_floor", "confidence", "help")
+SYSTEM_KEEPS = ("system", "dry_run", "expect", "slope_tolerance", "beta_floor", "confidence", "help",
+                "format", "output")
 """Flags that mean something with ``--system``; every other one is refused there."""
 
 

@@ -5,7 +5,8 @@ import sys
 
 from ..errors import InputError
 from .common import (declare_flag_uses, model_flag_uses, system_flag_uses, add_dry_run, add_model, check_memory, mesh_options,
-                     run_intervals, SPACE_HELP, write_csv)
+                     run_intervals, SPACE_HELP)
+from .verdict_formats import add_output_args, emit
 
 
 VERDICT_DEFAULTS = {"slope_tolerance": 0.15, "beta_floor": 0.001, "confidence": 0.95}
@@ -51,6 +52,7 @@ def add(sub) -> None:
                       ("confidence", "confidence level of the slope interval")):
         p.add_argument("--" + key.replace("_", "-"), dest=key, type=float, default=VERDICT_DEFAULTS[key],
                        help=f"{text} (default {VERDICT_DEFAULTS[key]:g}: claims.{key} in config/config.yaml)")
+    add_output_args(p)
     add_dry_run(p)
     declare_flag_uses(p, [*system_flag_uses(p), *model_flag_uses()])
     p.set_defaults(run=_run_verdict, check=_check_verdict)
@@ -95,17 +97,14 @@ def _check_verdict(args):
 
 
 def _run_verdict(args) -> int:
-    import pandas as pd
-
     if args.system is not None:
         from ..systems.levels import system_verdict
 
-        out, _ = system_verdict(args.manifest, tol=args.slope_tolerance, floor=args.beta_floor,
-                                confidence=args.confidence)
+        out, levels = system_verdict(args.manifest, tol=args.slope_tolerance, floor=args.beta_floor,
+                                     confidence=args.confidence)
         if out["norm"] != "given":
             print(f"infsup-contact: note: {out['norm_note']}", file=sys.stderr)
-        write_csv(pd.DataFrame([out]), float_format="%.6g")
-        return 0 if args.expect is None else (0 if out["verdict"] == _EXPECT[args.expect] else 1)
+        return emit(args, out, levels, manifest_expect=args.manifest.expect)
 
     from ..study.verdict import verdict_rows
 
@@ -113,8 +112,4 @@ def _run_verdict(args) -> int:
     out = verdict_rows(space, args.k, args.family, args.N, args.norm,
                        tol=args.slope_tolerance, floor=args.beta_floor, confidence=args.confidence,
                        multiplier_mesh=args.multiplier_mesh, model=args.model_obj, **args.mesh_kwargs)
-    out["N_list"] = " ".join(str(n) for n in out["N_list"])
-    write_csv(pd.DataFrame([out]), float_format="%.6g")
-    if args.expect is None:
-        return 0
-    return 0 if out["verdict"] == _EXPECT[args.expect] else 1
+    return emit(args, out)

@@ -21,6 +21,9 @@ A (n × n) SPD, B (m × n), G (m × m) the multiplier norm. Optional keys:
     Stokes flow: 1); β_h is reported on its complement, and a larger kernel is UNSTABLE;
 ``tgv``
     ``eliminate`` (default) or ``refuse`` dofs fixed by a huge diagonal penalty;
+``expect``
+    ``stable`` or ``unstable``: the verdict the producer expects (the exit code of ``verdict``
+    without ``--expect`` and of the pre-commit hook follows it);
 per level, ``constrained``
     the 0-based dofs the producer fixed but left in A (identity or penalty rows): a list,
     or a file (``.txt``: whitespace-separated integers, ``.npy``); they are removed.
@@ -41,7 +44,8 @@ from .readers import SystemFileError
 NORMS = ("given", "L2", "h-L2")
 TGV_POLICIES = ("eliminate", "refuse")
 LEVEL_KEYS = ("h", "A", "B", "G", "constrained")
-TOP_KEYS = ("levels", "name", "norm", "known_kernel", "tgv")
+TOP_KEYS = ("levels", "name", "norm", "known_kernel", "tgv", "expect")
+EXPECTS = ("stable", "unstable")
 MANIFEST_MAX_BYTES = 1 << 20
 """Largest manifest read (a manifest of 1,000 levels is ~60 kB)."""
 MIN_LEVELS = 3
@@ -70,6 +74,7 @@ class Manifest:
     known_kernel: int
     tgv: str
     levels: tuple
+    expect: str | None = None
 
 
 def load_manifest(path, min_levels: int = MIN_LEVELS) -> Manifest:
@@ -114,13 +119,16 @@ def load_manifest(path, min_levels: int = MIN_LEVELS) -> Manifest:
     known = data.get("known_kernel", 0)
     if isinstance(known, bool) or not isinstance(known, int) or known < 0:
         raise SystemFileError(path, f"known_kernel: expected an integer >= 0 (found {known!r})")
+    expect = data.get("expect")
+    if expect is not None and expect not in EXPECTS:
+        raise SystemFileError(path, f"expect: {expect!r} is not one of {', '.join(EXPECTS)}")
     parsed = tuple(_level(path, i, entry) for i, entry in enumerate(levels))
     hs = [lv.h for lv in parsed]
     for i in range(1, len(hs)):
         if not hs[i] < hs[i - 1]:
             raise SystemFileError(path, f"levels[{i}].h = {hs[i]:g} does not decrease (levels[{i - 1}].h = "
                                   f"{hs[i - 1]:g}): list the levels coarse to fine, each h once")
-    return Manifest(path, str(name), norm, known, tgv, parsed)
+    return Manifest(path, str(name), norm, known, tgv, parsed, expect=expect)
 
 
 def _one_line(path, key: str, text: str) -> None:

@@ -30,9 +30,10 @@ from pathlib import Path
 SPACES = {
     "dual": "Kratos' default: dual P1 multipliers on every slave node (the Dirichlet ends kept), "
             "B scaled by Kratos' automatic scale factor YOUNG_MODULUS/NODAL_H (= 1/h here)",
-    "dual-unscaled": "the same with scale_factor_parameters {manual_scale_factor: true, scale_factor: 1}",
-    "dual-ends-fixed": "unscaled, and SCALAR_LAGRANGE_MULTIPLIER fixed at Γ's two end nodes (a user's "
-                       "fix for the Dirichlet ends)",
+    "dual-unscaled": "the same with scale_factor_parameters {manual_scale_factor: true} (B then carries no "
+                     "scale factor, whatever scale_factor says)",
+    "dual-ends-fixed": "unscaled, SCALAR_LAGRANGE_MULTIPLIER fixed at Γ's two end nodes and Kratos' elimination "
+                       "builder (a user's fix for the Dirichlet ends)",
 }
 MAX_N = 512  # a level of N = 512 has ~5e5 dofs: far past what a certificate of this problem needs
 

@@ -106,15 +106,12 @@ def assembled_blocks(n1: int, n2: int, space: str):
 
     Returns
     -------
-    A, B : scipy.sparse.csr_matrix
-        TEMPERATURE × TEMPERATURE and SCALAR_LAGRANGE_MULTIPLIER × TEMPERATURE, in Kratos'
-        equation order within each type.
-    temp_xy, lm_x : ndarray
-        The coordinates of the TEMPERATURE dofs (n × 2) and the multipliers' x on Γ (m).
-    fixed : ndarray of bool
-        Which TEMPERATURE dofs Kratos fixed.
-    scale : float
-        Kratos' SCALE_FACTOR (1 when set by hand).
+    dict
+        ``A``, ``B`` (scipy CSR: TEMPERATURE × TEMPERATURE and SCALAR_LAGRANGE_MULTIPLIER ×
+        TEMPERATURE, in Kratos' equation order within each type); ``xy`` and ``ids``: the
+        TEMPERATURE dofs' coordinates (n × 2) and node ids (Ω1's nodes are 1 .. (n1 + 1)²);
+        ``lm_x``: the multipliers' x on Γ; ``fixed``: which TEMPERATURE dofs Kratos fixed;
+        ``scale``: Kratos' SCALE_FACTOR (1 for the unscaled spaces: B then carries none).
     """
     from KratosMultiphysics import scipy_conversion_tools
 
@@ -138,7 +135,7 @@ def assembled_blocks(n1: int, n2: int, space: str):
         if dof.EquationId >= size:  # a dof the elimination builder left out (fixed)
             continue
         node = mp.GetNode(dof.Id())
-        entry = (dof.EquationId, node.X, node.Y, dof.IsFixed())
+        entry = (dof.EquationId, node.X, node.Y, dof.IsFixed(), node.Id)
         (temp if dof.GetVariable().Name() == "TEMPERATURE" else lm).append(entry)
     temp.sort()
     lm.sort()
@@ -150,9 +147,11 @@ def assembled_blocks(n1: int, n2: int, space: str):
         raise RuntimeError("Kratos' LHS is not symmetric in the multiplier coupling")
     if full[l_eq][:, l_eq].count_nonzero():
         raise RuntimeError("Kratos assembled a multiplier block: G would not be the L2 mass alone")
-    scale = mp.ProcessInfo.GetValue(KM.SCALE_FACTOR)
-    return (A, B, np.array([[e[1], e[2]] for e in temp]), np.array([e[1] for e in lm]),
-            np.array([e[3] for e in temp]), scale)
+    # a manual scale factor never reaches the conditions (Kratos 10.4.4: the process keeps it on
+    # its Python object; SCALE_FACTOR stays 0 and B comes out unscaled whatever the value: measured)
+    scale = mp.ProcessInfo.GetValue(KM.SCALE_FACTOR) if space == "dual" else 1.0
+    return dict(A=A, B=B, xy=np.array([[e[1], e[2]] for e in temp]), ids=np.array([e[4] for e in temp]),
+                lm_x=np.array([e[1] for e in lm]), fixed=np.array([e[3] for e in temp]), scale=scale)
 
 
 def dual_mass(breakpoints: np.ndarray) -> sp.csr_matrix:
@@ -171,7 +170,8 @@ def dual_mass(breakpoints: np.ndarray) -> sp.csr_matrix:
 
 def write_level(out: Path, n: int, offset: int, space: str) -> dict:
     """One level's A, B, G (MatrixMarket, 17 digits) and its manifest entry."""
-    A, B, _, lm_x, _, _ = assembled_blocks(n + offset, n, space)
+    blocks = assembled_blocks(n + offset, n, space)
+    A, B, lm_x = blocks["A"], blocks["B"], blocks["lm_x"]
     rows = np.argsort(lm_x, kind="stable")  # rows[j] = row of B holding the j-th basis function left to right
     if space == "dual-ends-fixed":  # the slave mesh's nodes: the free multipliers and Γ's two ends
         breakpoints = np.concatenate([[0.0], lm_x[rows], [1.0]])

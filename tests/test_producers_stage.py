@@ -148,3 +148,21 @@ def test_the_rule_runs_the_fake_producer(tmp_path):
     tex = (tmp_path / "results" / "paper" / "producers.tex").read_text()
     assert r"\section{Certifying production codes}" in tex and "0.7071" in tex  # β_h in h-L2 = 2^(-1/2)
     assert isinstance(pd.read_csv(tmp_path / "results" / "tables" / "producers.csv"), pd.DataFrame)
+
+
+def test_the_section_compiles(tmp_path):
+    """The generated section typesets (booktabs tables, refused rows, not-installed producers)."""
+    import shutil
+
+    if shutil.which("latexmk") is None:
+        pytest.skip("latexmk not installed (workflow/scripts/ensure_tex.sh installs TeX)")
+    cfg = _cfg(tmp_path)
+    table = producers_table(cfg, tmp_path / "work")
+    missing = producers_table(_cfg(tmp_path, python=tmp_path / "none"), tmp_path / "work2").assign(producer="absent")
+    both = pd.concat([table, missing], ignore_index=True)
+    (tmp_path / "producers.tex").write_text(producers_tex(both, producers_claims(table, cfg), {"fake": "A fake code."}))
+    (tmp_path / "t.tex").write_text("\\documentclass{article}\\usepackage{booktabs}\\begin{document}\\section{M}"
+                                    "\\label{sec:model}\\input{producers.tex}\\end{document}\n")
+    run = subprocess.run(["latexmk", "-pdf", "-interaction=nonstopmode", "-halt-on-error", "t.tex"], cwd=tmp_path,
+                         capture_output=True, text=True, timeout=120)
+    assert run.returncode == 0, run.stdout[-2000:]

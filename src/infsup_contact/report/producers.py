@@ -25,14 +25,16 @@ def _levels(row) -> str:
 
 def producer_table(rows: pd.DataFrame) -> str:
     """One producer's certificates: space, offset K, norm, verdict, kernel and β_h per level."""
-    hs = str(rows.h_levels.iloc[0]).split()
+    ok = rows[rows.status == "ok"]
+    hs = str(ok.h_levels.iloc[0] if len(ok) else "").split()
     lines = [r"\begin{tabular}{lrllll}", r"\toprule",
              r"space & $K$ & norm & verdict & kernel & $\beta_h$, $1/h = "
              + ", ".join(f"{1 / float(h):g}" for h in hs) + r"$ \\", r"\midrule"]
     for r in rows.itertuples():
         if r.status != "ok":
-            cells = [latex_id(r.space), str(r.offset), latex_id(r.norm), r"\multicolumn{3}{l}{"
-                     + latex_id(str(r.status)[:70]) + "}"]
+            reason = str(r.status).removeprefix("refused: ").split(": ", 1)[-1]  # without the file name
+            cells = [latex_id(r.space), str(r.offset), latex_id(r.norm), r"\multicolumn{3}{l}{refused: "
+                     + latex_id(reason[:48]) + "}"]
         else:
             cells = [latex_id(r.space), str(r.offset), latex_id(r.norm), latex_id(r.verdict),
                      latex_id(" ".join(str(r.kernel_levels).split())), _levels(r)]
@@ -65,7 +67,7 @@ copies with the norm changed; by Remark~3.1 a stable space is UNSTABLE in $L^2$.
         out += [rf"\paragraph{{{latex_id(name)} {latex_id(rows.version.iloc[0])}}}", paragraphs.get(name, ""), "",
                 r"\begin{table}[ht]\centering\small", producer_table(rows),
                 rf"\caption{{{latex_id(name)} {latex_id(rows.version.iloc[0])}: the certificates of its exports. "
-                r"Kernel: the dimension of the kernel of $B^T$ the certifier decided per level.}}",
+                r"Kernel: the dimension of the kernel of $B^T$ the certifier decided per level.}",
                 rf"\label{{tab:producer-{latex_id(name)}}}", r"\end{table}", ""]
         mine = claims[claims.claim_id.str.startswith(f"producer-{name}-")]
         if len(mine):

@@ -1,6 +1,7 @@
 """Kratos' side of ``export.py``: the two membranes, the mesh tying, the blocks of its LHS."""
 from __future__ import annotations
 
+import json
 import os
 from importlib.metadata import version as _dist_version
 from pathlib import Path
@@ -68,8 +69,6 @@ def _model(n1: int, n2: int, scaled: bool, fix_ends: bool):
              "assume_master_slave": {"0": ["Gamma1"]}, "variable_name": "TEMPERATURE"}
     if not scaled:
         tying["scale_factor_parameters"] = {"manual_scale_factor": True, "scale_factor": 1.0}
-    import json
-
     process = mesh_tying_process.Factory(KM.Parameters(json.dumps({"Parameters": tying})), model)
     process.ExecuteInitialize()
     process.ExecuteBeforeSolutionLoop()

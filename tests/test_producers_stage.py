@@ -19,7 +19,7 @@ import pytest
 import yaml
 
 from infsup_contact.errors import InputError
-from infsup_contact.io import read_table
+from infsup_contact.io import read_table, write_csv_atomic
 from infsup_contact.report.producers import producers_tex
 from infsup_contact.study.producers import norm_copy, producers_claims, producers_table
 
@@ -101,6 +101,8 @@ def test_not_installed_is_a_row_not_a_failure(tmp_path):
         assert len(table) == 1 and table.status.iloc[0] == "not installed"
         assert "make producers-fake" in table.evidence.iloc[0] and table.install.iloc[0] == "make producers-fake"
         assert producers_claims(table, cfg).empty
+        write_csv_atomic(tmp_path / "producers.csv", table)  # what the rule writes, read back as the paper rule reads it
+        assert read_table(tmp_path / "producers.csv", "producers").status.iloc[0] == "not installed"
         tex = producers_tex(table, producers_claims(table, cfg), {})
         assert "not installed" in tex and r"\section{Certifying production codes}" in tex
 

@@ -101,7 +101,7 @@ SCHEMAS = {
                     optional={"c1": "float", "c2": "float", "p": "float?", "q": "float?", "seed": "int?",
                               "scene_kind": "str", "multiplier_mesh": "str"},
                     key=(*SERIES_COLUMNS, "measure")),
-    "producers": Schema({"producer": "str", "version": "str", "space": "str", "offset": "int", "norm": "str",
+    "producers": Schema({"producer": "str", "version": "str?", "space": "str", "offset": "int", "norm": "str",
                          "status": "str", "verdict": "str?", "kernel_dim": "int?", "beta_levels": "str?",
                          "kernel_levels": "str?", "h_levels": "str?", "slope": "float?", "slope_lo": "float?",
                          "slope_hi": "float?", "evidence": "str?", "seconds": "float?", "install": "str",

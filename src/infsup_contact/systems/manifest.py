@@ -15,7 +15,10 @@ A (n × n) SPD, B (m × n), G (m × m) the multiplier norm. Optional keys:
     what G is: ``given`` (default: the norm the inf-sup condition is stated in, e.g. the
     pressure L² mass of Stokes, or an H^{-1/2} Gram), ``L2`` (the L² mass of *contact*
     multipliers, whose proper norm is H^{-1/2}: the row is the L² verdict, Remark 3.1) or
-    ``h-L2`` (G replaced by h·G, the mesh-dependent norm, with its caveat printed);
+    ``h-L2`` (G replaced by h·G, the mesh-dependent norm, with its caveat printed) or ``H``
+    (the H^{-1/2}_00(Γ) Gram assembled here from a description of the multipliers: the top
+    key ``gamma`` and per level ``multipliers``, :mod:`.multiplier_basis`; G is then
+    optional and, where given, the L² mass of the described basis, checked against it);
 ``known_kernel``
     dimension of a kernel of Bᵀ the producer knows of (the constant pressure of an enclosed
     Stokes flow: 1); β_h is reported on its complement, and a larger kernel is UNSTABLE;
@@ -41,10 +44,10 @@ from ..io import TableError, read_integer_list
 
 from .readers import SystemFileError
 
-NORMS = ("given", "L2", "h-L2")
+NORMS = ("given", "L2", "h-L2", "H")
 TGV_POLICIES = ("eliminate", "refuse")
-LEVEL_KEYS = ("h", "A", "B", "G", "constrained")
-TOP_KEYS = ("levels", "name", "norm", "known_kernel", "tgv", "expect")
+LEVEL_KEYS = ("h", "A", "B", "G", "constrained", "multipliers")
+TOP_KEYS = ("levels", "name", "norm", "known_kernel", "tgv", "expect", "gamma")
 EXPECTS = ("stable", "unstable")
 MANIFEST_MAX_BYTES = 1 << 20
 """Largest manifest read (a manifest of 1,000 levels is ~60 kB)."""
@@ -54,14 +57,16 @@ MIN_LEVELS = 3
 
 @dataclass(frozen=True)
 class Level:
-    """One mesh level: its size and its three files (absolute paths)."""
+    """One mesh level: its size and its three files (absolute paths; G None when ``norm: H``
+    leaves it out)."""
 
     index: int
     h: float
     A: Path
     B: Path
-    G: Path
+    G: Path | None
     constrained: object = None  # None, a list of ints, or a Path
+    multipliers: object = None  # with norm H: the description (a mapping) or its file (a str)
 
 
 @dataclass(frozen=True)
@@ -75,6 +80,7 @@ class Manifest:
     tgv: str
     levels: tuple
     expect: str | None = None
+    gamma: object = None  # with norm H: a multiplier_basis.Gamma
 
 
 def load_manifest(path, min_levels: int = MIN_LEVELS) -> Manifest:
@@ -122,13 +128,23 @@ def load_manifest(path, min_levels: int = MIN_LEVELS) -> Manifest:
     expect = data.get("expect")
     if expect is not None and expect not in EXPECTS:
         raise SystemFileError(path, f"expect: {expect!r} is not one of {', '.join(EXPECTS)}")
-    parsed = tuple(_level(path, i, entry) for i, entry in enumerate(levels))
+    gamma = None
+    if norm == "H":
+        from .multiplier_basis import parse_gamma
+
+        if "gamma" not in data:
+            raise SystemFileError(path, "norm: H needs the key 'gamma' ({shape: segment, length: L} or "
+                                  "{shape: rectangle, size: [a, b]}) and per level 'multipliers'")
+        gamma = parse_gamma(path, data["gamma"])
+    elif "gamma" in data:
+        raise SystemFileError(path, f"gamma: only with norm: H (the multipliers described on Γ); norm is {norm!r}")
+    parsed = tuple(_level(path, i, entry, norm) for i, entry in enumerate(levels))
     hs = [lv.h for lv in parsed]
     for i in range(1, len(hs)):
         if not hs[i] < hs[i - 1]:
             raise SystemFileError(path, f"levels[{i}].h = {hs[i]:g} does not decrease (levels[{i - 1}].h = "
                                   f"{hs[i - 1]:g}): list the levels coarse to fine, each h once")
-    return Manifest(path, str(name), norm, known, tgv, parsed, expect=expect)
+    return Manifest(path, str(name), norm, known, tgv, parsed, expect=expect, gamma=gamma)
 
 
 def _one_line(path, key: str, text: str) -> None:
@@ -140,21 +156,34 @@ def _one_line(path, key: str, text: str) -> None:
                                   "a name or file name is one line of printable text")
 
 
-def _level(path: Path, i: int, entry) -> Level:
+def _level(path: Path, i: int, entry, norm: str = "given") -> Level:
     where = f"levels[{i}]"
     if not isinstance(entry, dict):
         raise SystemFileError(path, f"{where}: expected a mapping {{h, A, B, G}} (found {entry!r:.60})")
     unknown = sorted(set(map(str, entry)) - set(LEVEL_KEYS))
     if unknown:
         raise SystemFileError(path, f"{where}: unknown key {unknown[0]!r} (allowed: {', '.join(LEVEL_KEYS)})")
-    missing = [k for k in ("h", "A", "B", "G") if k not in entry]
+    needed = ("h", "A", "B", "multipliers") if norm == "H" else ("h", "A", "B", "G")
+    missing = [k for k in needed if k not in entry]
     if missing:
-        raise SystemFileError(path, f"{where}: missing key {missing[0]!r} (each level needs h, A, B, G)")
+        raise SystemFileError(path, f"{where}: missing key {missing[0]!r} (each level needs {', '.join(needed)}"
+                              + (")" if norm != "H" else "; G optional: the L2 mass)"))
+    if norm != "H" and "multipliers" in entry:
+        raise SystemFileError(path, f"{where}.multipliers: only with norm: H (norm is {norm!r})")
+    mult = entry.get("multipliers")
+    if isinstance(mult, str):
+        _one_line(path, f"{where}.multipliers", mult)
+    elif mult is not None and not isinstance(mult, dict):
+        raise SystemFileError(path, f"{where}.multipliers: expected a mapping or a .yaml file name "
+                              f"(found {mult!r:.60})")
     h = entry["h"]
     if isinstance(h, bool) or not isinstance(h, (int, float)) or not math.isfinite(h) or h <= 0:
         raise SystemFileError(path, f"{where}.h: expected a finite number > 0 (found {h!r})")
     files = {}
     for key in ("A", "B", "G"):
+        if key == "G" and "G" not in entry:
+            files[key] = None
+            continue
         if not isinstance(entry[key], str) or not entry[key]:
             raise SystemFileError(path, f"{where}.{key}: expected a file name (found {entry[key]!r})")
         _one_line(path, f"{where}.{key}", entry[key])
@@ -166,7 +195,7 @@ def _level(path: Path, i: int, entry) -> Level:
     elif con is not None:
         if not isinstance(con, list) or any(isinstance(c, bool) or not isinstance(c, int) or c < 0 for c in con):
             raise SystemFileError(path, f"{where}.constrained: expected a file or a list of integers >= 0")
-    return Level(i, float(h), files["A"], files["B"], files["G"], con)
+    return Level(i, float(h), files["A"], files["B"], files["G"], con, mult)
 
 
 def constrained_dofs(level: Level, n: int) -> np.ndarray:

@@ -1,0 +1,133 @@
+"""Gram matrices of a described multiplier space (:mod:`.multiplier_basis`) on Γ of any size.
+
+The space is held on the pull-back of Γ: the unit interval, or the unit square. Its Grams there
+are those ``beta --norm H`` computes (the log kernel on the segment,
+:func:`~infsup_contact.discretization.norms.gram`; the double sine series on the face,
+:func:`~infsup_contact.discretization.face_norms.gram_h_face`), and Γ's size enters as a factor:
+
+**Segment Γ = (0, L).** The Dirichlet Laplacian of (0, L) has the L²-orthonormal eigenfunctions
+√(2/L) sin(nπx/L), eigenvalues (nπ/L)², so ‖μ‖²_{H^{-1/2}_00(0,L)} = Σ_n μ_n² L/(nπ) with
+μ_n = √(2/L) ∫_0^L μ sin(nπx/L) dx. For μ(x) = μ̃(x/L), μ_n = √L μ̃_n, hence
+
+    ‖μ‖²_{H^{-1/2}_00(0,L)} = L² ‖μ̃‖²_{H^{-1/2}_00(0,1)},     ‖μ‖²_{L²(0,L)} = L ‖μ̃‖²_{L²(0,1)}:
+
+G_H = L² G̃_H, M = L M̃ (the norm itself scales like L, as ⟨μ, v⟩ ~ L while |v|_{H^{1/2}} is
+invariant in one dimension).
+
+**Rectangle Γ = (0, a) × (0, b).** Eigenfunctions (2/√(ab)) sin(mπx/a) sin(nπy/b), eigenvalues
+π²((m/a)² + (n/b)²); for μ(x, y) = μ̃(x/a, y/b) the coefficient is √(ab) μ̃_mn, so
+
+    ‖μ‖² = Σ ab μ̃_mn² / (π √((m/a)² + (n/b)²)) = b³ Σ α μ̃_mn² / (π √((m/α)² + n²)),  α = a/b,
+
+the series of ``gram_h_face(..., aspect=α)`` times b³: G_H = b³ G̃_H(α), M = ab M̃. A square
+of side L: G_H = L³ G̃_H (the norm scales like L^{3/2}).
+
+**What is invariant.** Scaling the whole geometry by L leaves β_h unchanged: in 2D the
+stiffness A (∫∇u·∇v) is invariant, B (∫_Γ μ v) scales by L and G_H by L²; in 3D A scales by L,
+B by L², G_H by L³. Either way B A⁻¹ Bᵀ and G_H scale alike (tests/test_systems_norm_h.py).
+"""
+from __future__ import annotations
+
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+
+from .readers import SystemFileError
+
+GRAM_COPIES = 10
+"""Dense m × m arrays alive while a Gram is made and ordered (the Gram, its reordering, the
+pencil's copies: as ``resources._dense_bytes`` counts them)."""
+LOGKERNEL_BYTES_PER_PAIR = 600
+"""Bytes per pair of intervals of the log-kernel route, plus 110 (s + 1)² (``resources._dense_bytes``)."""
+FACE_BYTES_PER_M2 = 200
+"""Bytes per (dim M)² of the face series (the m² term of ``resources.LARGE_ROUTE_3D``, which
+holds the Grams, the pencils and the series' arrays: 132 to 197)."""
+
+
+def gram(described, norm: str) -> tuple:
+    """(G, info): the Gram of ``norm`` ∈ {"H", "L2"} in the order of B's rows, scaled to Γ."""
+    from ..discretization.face_norms import gram_h_face, gram_l2_face
+    from ..discretization.segment import SEGMENT
+
+    space, size = described.space, described.gamma.size
+    if described.gamma.shape == "segment":
+        G, info = SEGMENT.gram(space, norm)
+        scale = size[0] ** 2 if norm == "H" else size[0]
+    elif norm == "H":
+        a, b = size
+        G, info = gram_h_face(space, aspect=1.0 if a == b else a / b)  # a = b: bit for bit the square's
+        scale = b ** 3
+    else:
+        G, info = gram_l2_face(space), {"n_max": 0, "nmax_rel_error": 0.0}
+        scale = size[0] * size[1]
+    inv = np.argsort(described.rows)  # row r of B holds basis function inv[r]
+    G = np.asarray(G, float)[np.ix_(inv, inv)]
+    return (G * scale if scale != 1.0 else G), info
+
+
+def gram_bytes(described) -> float:
+    """Bytes to assemble the H Gram and the L² check of ``described`` (the memory gate's share)."""
+    m = float(described.m)
+    if described.gamma.shape == "segment":
+        n = float(described.space.n_intervals)
+        s = described.space.degree
+        return 8.0 * GRAM_COPIES * m * m + (LOGKERNEL_BYTES_PER_PAIR + 110 * (s + 1) ** 2) * n * (n + 1) / 2
+    return FACE_BYTES_PER_M2 * m * m
+
+
+def mass_distance(G_file, M) -> float:
+    """‖G_file − M‖_F / ‖M‖_F: how far an exported L² mass is from the description's."""
+    import scipy.sparse as sp
+
+    D = (G_file - M) if not sp.issparse(G_file) else (G_file.toarray() - M)
+    return float(np.linalg.norm(D) / np.linalg.norm(M))
+
+
+MASS_RTOL = 1e-8
+"""Largest ‖G_file − M‖_F / ‖M‖_F accepted between an exported L² mass and the described basis's.
+Exact quadrature leaves round-off of ~1e-15; one pair of rows of B swapped against the
+description changes M by ≳ 1/(4√m) relative (M ≈ h/6 tridiag(1, 4, 1) for P_1), above 1e-4
+for any m ≤ 10⁶: the gap between the two is what tells a wrong row order from round-off."""
+
+
+def _label(manifest, level) -> Path:
+    """What the checks name when the described Gram fails one (not a file: the manifest's key)."""
+    return Path(f"{manifest.path}#levels[{level.index}].multipliers")
+
+
+def check_description(manifest, level, B, G_file) -> tuple:
+    """(level with G named by its description, a G standing in for the shape checks, bytes of its
+    Gram): the description read and checked against B and the G file, nothing m × m allocated."""
+    import scipy.sparse as sp
+
+    from .multiplier_basis import describe
+
+    d = describe(manifest.path, level.index, level.multipliers, manifest.gamma)
+    if d.m != B.shape[0]:
+        raise SystemFileError(d.source, f"{d.key}: describes m = {d.m} basis "
+                              f"functions, B ({level.B.name}) has {B.shape[0]} rows: one row of B per function")
+    if G_file is not None and G_file.shape != (d.m, d.m):
+        raise SystemFileError(level.G, f"G is {G_file.shape[0]} x {G_file.shape[1]}; with norm: H it is the L2 mass "
+                              f"of the {d.m} described multipliers ({d.m} x {d.m})")
+    stand_in = sp.csr_matrix((d.m, d.m))
+    return replace(level, G=_label(manifest, level)), stand_in, gram_bytes(d), d
+
+
+def described_grams(manifest, level, B, G_file) -> tuple:
+    """(level, H Gram, L² mass from the G file or None, the H Gram's info) of a ``norm: H``
+    level; a G file farther than :data:`MASS_RTOL` from the description's L² mass is refused."""
+    from .checks import check_finite, check_gram
+
+    labelled, _, _, d = check_description(manifest, level, B, G_file)
+    G, info = gram(d, "H")
+    mass = None
+    if G_file is not None:
+        check_finite(G_file, level.G)
+        dist = mass_distance(G_file, gram(d, "L2")[0])
+        if not dist <= MASS_RTOL:
+            raise SystemFileError(level.G, f"differs from the L2 mass of levels[{level.index}].multipliers by "
+                                  f"{dist:.3g} relative (Frobenius; round-off is below {MASS_RTOL:g}): B's rows in "
+                                  "another order than the description (rows:), another basis, or other breakpoints?")
+        mass = check_gram(G_file, level.G)
+    return labelled, G, mass, info

@@ -1,0 +1,225 @@
+"""``norm: H`` manifests: the multipliers described on Γ give the exact H^{-1/2}_00 Gram.
+
+Acceptance: the described manifest (helper form and general form) reproduces ``beta --case X
+--norm H`` to 1e-8 relative in β for every registered segment space, k = 1, 2, matching and
+non-matching meshes, and for the tensor face spaces (hexahedral faces). Then the scaling of the
+Gram with Γ's size (analytic: ‖1‖² = 7ζ(3)L²/π³ on (0, L); L², b³ and the β invariance), the
+L² check that catches a wrong row order, and hostile descriptions (one line each)."""
+from __future__ import annotations
+
+import io
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+
+from infsup_contact.cli import main
+from infsup_contact.discretization.registry import ids_valid_for, space_ids, space_spec
+from infsup_contact.models import make_model
+from infsup_contact.solvers.infsup import beta_rows
+from infsup_contact.systems.export import segment_form, suite_levels, write_system
+from infsup_contact.systems.levels import system_rows, system_verdict
+from infsup_contact.systems.manifest import load_manifest
+from infsup_contact.systems.multiplier_basis import Gamma, describe
+from infsup_contact.systems.multiplier_gram import gram
+from infsup_contact.systems.readers import SystemFileError
+
+NS = (4, 8)
+RTOL = 1e-8
+CRITERION = dict(tol=0.15, floor=1e-3, confidence=0.95)
+SEGMENT_CASES = [(case, k) for k in (1, 2) for case in ids_valid_for(k)]
+FACE_MODEL = make_model("membranes3d")
+FACE_CASES = [(case, k) for k in (1, 2) for case in ids_valid_for(k)]  # the tensor ones: every segment id
+
+
+def _general(levels):
+    """The same levels with every description in the general form (no helper)."""
+    def general(form):
+        if "x" in form:
+            return {key: general(value) for key, value in form.items()}
+        return segment_form(None, describe("m.yaml", 0, form, Gamma("segment", (1.0,))).space)
+    return [(h, A, B, G, general(mult)) for h, A, B, G, mult in levels]
+
+
+def _manifest(tmp_path, case, k, offset, ns=NS, general=False, model=None, **kw):
+    levels, norm, gamma = suite_levels(case, k, ns, offset, model=model, **kw)
+    assert norm == "H" and all(len(lv) == 5 for lv in levels)
+    if general:
+        levels = _general(levels)
+    path = write_system(tmp_path / f"{case}-{k}-{offset}-{general}", levels, "npz", case, norm=norm, gamma=gamma)
+    return load_manifest(path, min_levels=1)
+
+
+def _agree(row, ref):
+    assert row["kernel_dim"] == ref["kernel_dim"]
+    if ref["kernel_dim"] == 0:
+        assert abs(row["beta"] - ref["beta"]) <= RTOL * ref["beta"]
+    else:
+        assert row["beta"] == ref["beta"] == 0.0
+    assert abs(row["smallest_nonzero"] - ref["smallest_nonzero"]) <= RTOL * ref["smallest_nonzero"]
+
+
+@pytest.mark.parametrize("general", [False, True], ids=["helper", "general"])
+@pytest.mark.parametrize("offset", [0, 1, -1], ids=["matching", "N1=N2+1", "N1=N2-1"])
+@pytest.mark.parametrize("case,k", SEGMENT_CASES)
+def test_described_segment_reproduces_beta_case(tmp_path, case, k, offset, general):
+    rows = system_rows(_manifest(tmp_path, case, k, offset, general=general), notes=io.StringIO())
+    for n, row in zip(NS, rows):
+        ref, = beta_rows("structured", k, n + offset, n, [case], norms=("H",))
+        _agree(row, ref)
+        assert row["norm"] == "H" and row["gram_rel_error"] == 0.0  # the log kernel: exact
+        ref_l2, = beta_rows("structured", k, n + offset, n, [case], norms=("L2",))
+        if ref_l2["kernel_dim"] == 0:  # the G file (the L2 mass) gives the L2 row beside it
+            assert abs(row["beta_L2"] - ref_l2["beta"]) <= RTOL * ref_l2["beta"]
+
+
+def test_every_registered_segment_space_is_covered():
+    assert {c for c, _ in SEGMENT_CASES} == set(space_ids())
+    for case, k in SEGMENT_CASES:  # the helper form where the registry says what the space is
+        spec = space_spec(case)
+        form = segment_form(spec, spec.build(k, np.linspace(0.0, 1.0, 5)))
+        assert ("basis" in form) == (spec.lagrange is not None)
+
+
+@pytest.mark.parametrize("case,multiplier_mesh", [("DUAL", "union"), ("T5", "omega1"), ("T3", "union")])
+def test_perturbed_meshes(tmp_path, case, multiplier_mesh):
+    """Non-uniform breakpoints (the perturbed family, the union of two traces) travel exactly: the
+    described Gram is the suite's bit for bit. T3 on the union is nearly singular (β ~ 5e-6): there
+    the two eigensolvers' round-off, ~ε λ_max / β in β, is the bound, not 1e-8 β."""
+    from infsup_contact.systems.export import _suite_parts
+
+    m = _manifest(tmp_path, case, 2, 1, family="perturbed", multiplier_mesh=multiplier_mesh)
+    for n, row, level in zip(NS, system_rows(m, notes=io.StringIO()), m.levels):
+        *_, space, segment = _suite_parts(case, 2, n + 1, n, "perturbed", multiplier_mesh, None)
+        d = describe(m.path, level.index, level.multipliers, m.gamma)
+        assert np.array_equal(gram(d, "H")[0], segment.gram(space, "H")[0])
+        ref, = beta_rows("perturbed", 2, n + 1, n, [case], multiplier_mesh=multiplier_mesh, norms=("H",))
+        if ref["beta"] > 1e-4:
+            _agree(row, ref)
+        else:
+            assert row["kernel_dim"] == ref["kernel_dim"] == 0
+            assert abs(row["beta"] - ref["beta"]) <= 1e-14 / ref["beta"]
+
+
+def test_described_verdict_equals_verdict_case(tmp_path):
+    ns = (4, 8, 16)
+    for case, expect in (("DUAL", "STABLE"), ("R5.4", "UNSTABLE")):
+        out, _ = system_verdict(_manifest(tmp_path, case, 2, 0, ns), **CRITERION, notes=io.StringIO())
+        from infsup_contact.study.verdict import verdict_rows
+
+        ref = verdict_rows(case, 2, "structured", ns, "H", **CRITERION)
+        assert out["verdict"] == ref["verdict"] == expect
+        assert abs(out["beta_min"] - ref["beta_min"]) <= RTOL * max(ref["beta_min"], 1e-300)
+        assert out["verdict_L2"] in ("STABLE", "UNSTABLE", "INCONCLUSIVE")
+
+
+@pytest.mark.parametrize("case,k", FACE_CASES)
+def test_described_face_reproduces_beta_case(tmp_path, case, k):
+    """The tensor face spaces on hexahedral faces, N = 2, 3 (N1 = N2 + 1 at k = 1)."""
+    offset = 1 if k == 1 else 0
+    ns = (2, 3)
+    m = _manifest(tmp_path, case, k, offset, ns, model=FACE_MODEL, element="hex")
+    assert m.gamma == Gamma("rectangle", (1.0, 1.0))
+    for n, row in zip(ns, system_rows(m, notes=io.StringIO())):
+        ref, = beta_rows("structured", k, n + offset, n, [case], norms=("H",), model=FACE_MODEL, element="hex")
+        _agree(row, ref)
+
+
+def test_face_only_and_triangle_spaces_keep_the_given_gram():
+    levels, norm, gamma = suite_levels("T3", 1, (2,), model=FACE_MODEL, element="tet")
+    assert norm == "given" and gamma is None and len(levels[0]) == 4
+
+
+# ---------------------------------------------------------------- Γ's size: the Gram's scaling
+def test_segment_gram_of_the_constant_is_analytic():
+    """‖1‖²_{H^-1/2_00(0,L)} = Σ_n odd 8L/(nπ)² · L/(nπ) = 7ζ(3) L²/π³ (the constant is in R5.2; the
+    Lagrange basis sums to 1), and ‖1‖²_{L²(0,L)} = L: a route independent of the scaling code."""
+    zeta3 = 1.2020569031595942
+    for length in (1.0, 2.0, 0.3):
+        x = list(np.linspace(0.0, length, 7))
+        d = describe("m.yaml", 0, {"basis": "lagrange", "degree": 2, "breakpoints": x}, Gamma("segment", (length,)))
+        one = np.ones(d.m)
+        assert abs(one @ gram(d, "H")[0] @ one - 7 * zeta3 * length ** 2 / np.pi ** 3) <= 1e-12 * length ** 2
+        assert abs(one @ gram(d, "L2")[0] @ one - length) <= 1e-14 * length
+
+
+def test_rectangle_gram_scaling_and_axis_swap():
+    """Side L: G = L³ G_unit. A rectangle a × b and its transpose b × a (x and y swapped, rows
+    permuted accordingly) are the same norm computed through aspect a/b and b/a."""
+    fx = {"basis": "lagrange", "degree": 1, "ends": "drop"}
+    d1 = describe("m.yaml", 0, {"x": dict(fx, breakpoints=[0, 0.5, 1]), "y": dict(fx, breakpoints=[0, 0.25, 0.5, 0.75, 1])},
+                  Gamma("rectangle", (1.0, 1.0)))
+    d3 = describe("m.yaml", 0, {"x": dict(fx, breakpoints=[0, 1.5, 3]), "y": dict(fx, breakpoints=[0, 0.75, 1.5, 2.25, 3])},
+                  Gamma("rectangle", (3.0, 3.0)))
+    np.testing.assert_allclose(gram(d3, "H")[0], 27.0 * gram(d1, "H")[0], rtol=1e-13, atol=0)
+    np.testing.assert_allclose(gram(d3, "L2")[0], 9.0 * gram(d1, "L2")[0], rtol=1e-13, atol=0)
+    a, b = 2.0, 0.5
+    xa, yb = [0, 0.5, 1.0, 1.5, 2.0], [0, 0.125, 0.25, 0.375, 0.5]
+    wide = describe("m.yaml", 0, {"x": dict(fx, breakpoints=xa), "y": dict(fx, breakpoints=yb)}, Gamma("rectangle", (a, b)))
+    tall = describe("m.yaml", 0, {"x": dict(fx, breakpoints=yb), "y": dict(fx, breakpoints=xa)}, Gamma("rectangle", (b, a)))
+    nx = ny = 3
+    i, j = np.divmod(np.arange(nx * ny), ny)
+    swap = j + ny * i  # row of ψ_i(x)ψ_j(y) of 'wide' in 'tall' (rows i + n_x j)
+    Gw, info = gram(wide, "H", )
+    Gt = gram(tall, "H")[0]
+    order = np.argsort(i + nx * j)  # B rows of wide in order
+    P = swap[order]
+    np.testing.assert_allclose(Gt[np.ix_(P, P)], Gw, rtol=10 * max(info["nmax_rel_error"], 1e-8), atol=0)
+
+
+def test_beta_invariant_under_the_scaling_a_length_change_induces(tmp_path):
+    """Γ of length 2 (the bodies scaled by 2): A (2D stiffness) unchanged, B = ∫_Γ μ v doubled,
+    G_H = L² G̃ and M = L M̃: β_h the same to round-off, the L2 check passing."""
+    levels, norm, _ = suite_levels("T5", 2, NS, 1)
+    scaled = []
+    for h, A, B, G, mult in levels:
+        mult = dict(mult, breakpoints=[2.0 * t for t in mult["breakpoints"]])
+        scaled.append((2 * h, A, 2.0 * B, 2.0 * G, mult))
+    unit = system_rows(load_manifest(write_system(tmp_path / "u", levels, "mtx", "u", "H", gamma={"shape": "segment", "length": 1.0}), 1),
+                       notes=io.StringIO())
+    long = system_rows(load_manifest(write_system(tmp_path / "l", scaled, "mtx", "l", "H", gamma={"shape": "segment", "length": 2.0}), 1),
+                       notes=io.StringIO())
+    for r1, r2 in zip(unit, long):
+        assert abs(r1["beta"] - r2["beta"]) <= 1e-12 * r1["beta"]
+        assert abs(r1["beta_L2"] * np.sqrt(2.0) - r2["beta_L2"]) <= 1e-12 * r2["beta_L2"]  # L2: B 2x, M 2x
+
+
+# ---------------------------------------------------------------- the L2 check: a wrong row order
+def test_a_row_order_other_than_the_description_is_refused(tmp_path):
+    levels, norm, gamma = suite_levels("T3", 1, NS, 0)
+    h, A, B, G, mult = levels[1]
+    perm = np.arange(B.shape[0])
+    perm[[2, 3]] = perm[[3, 2]]
+    bad = levels[:1] + [(h, A, B[perm], G[np.ix_(perm, perm)], mult)]
+    m = load_manifest(write_system(tmp_path / "bad", bad, "mtx", "bad", norm, gamma=gamma), 1)
+    with pytest.raises(SystemFileError, match=r"G1.mtx: differs from the L2 mass of levels\[1\].multipliers by "
+                                              r"[0-9.e-]+ relative.*rows:"):
+        system_rows(m, notes=io.StringIO())
+    # the same permutation declared (rows: the row of B holding the j-th function) is accepted
+    rows = perm.tolist()
+    good = levels[:1] + [(h, A, B[perm], G[np.ix_(perm, perm)], dict(mult, rows=[rows.index(j) for j in range(len(rows))]))]
+    m = load_manifest(write_system(tmp_path / "good", good, "mtx", "good", norm, gamma=gamma), 1)
+    ref = system_rows(load_manifest(write_system(tmp_path / "ref", levels, "mtx", "ref", norm, gamma=gamma), 1),
+                      notes=io.StringIO())
+    assert abs(system_rows(m, notes=io.StringIO())[1]["beta"] - ref[1]["beta"]) <= 1e-12
+
+
+def test_without_g_the_h_verdict_stands_alone(tmp_path):
+    levels, norm, gamma = suite_levels("DUAL", 2, (4, 8, 16), 0)
+    bare = [(h, A, B, None, mult) for h, A, B, G, mult in levels]
+    m = load_manifest(write_system(tmp_path, bare, "mtx", "bare", norm, gamma=gamma))
+    assert all(lv.G is None for lv in m.levels) and not list(tmp_path.glob("G*"))
+    rows = system_rows(m, notes=io.StringIO())
+    assert all(np.isnan(r["beta_L2"]) for r in rows)
+    out, _ = system_verdict(m, **CRITERION, notes=io.StringIO())
+    assert out["verdict"] == "STABLE" and "verdict_L2" not in out
+
+
+def test_cli_export_then_verdict_system_is_stable(tmp_path, capsys):
+    out = tmp_path / "dual"
+    assert main(["export", "--case", "DUAL", "--k", "2", "--N", "4", "8", "16", "--out", str(out)]) == 0
+    text = (out / "levels.yaml").read_text()
+    assert "norm: H\ngamma: {shape: segment, length: 1.0}" in text and "basis: dual" in text
+    capsys.readouterr()
+    assert main(["verdict", "--system", str(out / "levels.yaml"), "--expect", "stable"]) == 0
+    assert main(["verdict", "--system", str(out / "levels.yaml"), "--dry-run"]) == 0

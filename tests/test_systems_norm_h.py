@@ -223,3 +223,199 @@ def test_cli_export_then_verdict_system_is_stable(tmp_path, capsys):
     capsys.readouterr()
     assert main(["verdict", "--system", str(out / "levels.yaml"), "--expect", "stable"]) == 0
     assert main(["verdict", "--system", str(out / "levels.yaml"), "--dry-run"]) == 0
+
+
+# ---------------------------------------------------------------- hostile descriptions: one line, exit 2
+def _base(tmp_path, case="T3", k=1, ns=(4,)):
+    """A one-level norm: H manifest as a dict (to be spoiled) and its directory."""
+    import yaml
+
+    levels, norm, gamma = suite_levels(case, k, ns, 0)
+    path = write_system(tmp_path, levels, "mtx", "base", norm, gamma=gamma)
+    return yaml.safe_load(path.read_text()), path
+
+
+def _spoil(tmp_path, capsys, change, match, dry=True):
+    """``change(data)`` spoils the manifest; ``beta --system --dry-run`` (unless ``dry`` is False:
+    found only where the Gram is factorized) and the run refuse it in one line matching ``match``
+    (exit 2)."""
+    import yaml
+
+    data, path = _base(tmp_path)
+    change(data, tmp_path)
+    path.write_text(yaml.safe_dump(data, sort_keys=False))
+    if not dry:
+        assert main(["beta", "--system", str(path), "--dry-run"]) == 0
+    for extra in (["--dry-run"], []) if dry else ([],):
+        capsys.readouterr()
+        assert main(["beta", "--system", str(path)] + extra) == 2
+        err = capsys.readouterr().err
+        errors = [line for line in err.splitlines() if not line.startswith("infsup-contact: note:")]
+        assert len(errors) == 1 and "Traceback" not in err, err
+        assert __import__("re").search(match, errors[0]), err
+
+
+def _mult(data):
+    return data["levels"][0]["multipliers"]
+
+
+def _set(key, value):
+    def change(data, tmp_path):
+        _mult(data)[key] = value
+    return change
+
+
+def _general_form(data, tmp_path):
+    mult = _mult(data)
+    data["levels"][0]["multipliers"] = segment_form(None, describe("m.yaml", 0, mult, Gamma("segment", (1.0,))).space)
+
+
+HOSTILE = [
+    (_set("basis", "hermite"), r"levels\[0\]\.multipliers\.basis: 'hermite' is not one of lagrange, discontinuous, dual"),
+    (_set("degree", 9), r"multipliers\.degree: expected an integer in 1\.\.7 for basis lagrange \(found 9\)"),
+    (_set("degree", 0), r"multipliers\.degree: expected an integer in 1\.\.7"),
+    (_set("degree", "1"), r"multipliers\.degree: expected an integer"),
+    (_set("degree", True), r"multipliers\.degree: expected an integer"),
+    (_set("breakpoints", [0, 0.5, 0.25, 0.75, 1]), r"multipliers\.breakpoints: not strictly increasing \(entries 1 and 2"),
+    (_set("breakpoints", [0, 0.25, 0.5, 0.75]), r"multipliers\.breakpoints: runs from 0\.0 to 0\.75; it must cover"),
+    (_set("breakpoints", [0.1, 0.25, 0.5, 0.75, 1]), r"it must cover Γ = \[0, 1\.0\]"),
+    (_set("breakpoints", [0, "x", 1]), r"multipliers\.breakpoints: expected numbers"),
+    (_set("breakpoints", [0, float("nan"), 1]), r"multipliers\.breakpoints: holds a non-finite number"),
+    (_set("breakpoints", "bp.txt"), r"multipliers\.breakpoints: no such file .*bp\.txt"),
+    (_set("breakpoints", None), r"multipliers\.breakpoints: missing"),
+    (_set("ends", "maybe"), r"multipliers\.ends: 'maybe': expected keep or drop"),
+    (_set("ends", "keep"), r"multipliers: describes m = 5 basis functions, B \(B0\.mtx\) has 3 rows"),
+    (_set("rows", [0, 0, 1]), r"multipliers\.rows: expected a permutation of 0\.\.2 .*not each row once"),
+    (_set("rows", [0, 1]), r"multipliers\.rows: expected a permutation of 0\.\.2 .*found 2 entries"),
+    (_set("dofs", [[0, 1]]), r"multipliers\.dofs: only in the general form"),
+    (_set("colour", "red"), r"multipliers: unknown key 'colour' in a segment form"),
+    (lambda d, p: d["levels"][0].update(multipliers=5), r"levels\[0\]\.multipliers: expected a mapping or a \.yaml file"),
+    (lambda d, p: d["levels"][0].update(multipliers="m.txt"), r"multipliers: 'm\.txt': expected an inline mapping or a \.yaml"),
+    (lambda d, p: d["levels"][0].update(multipliers="m.yaml"), r"multipliers: no such file .*m\.yaml"),
+    (lambda d, p: d["levels"][0].pop("multipliers"), r"levels\[0\]: missing key 'multipliers'"),
+    (lambda d, p: d.pop("gamma"), r"norm: H needs the key 'gamma'"),
+    (lambda d, p: d.update(gamma={"shape": "disc", "length": 1}), r"gamma\.shape: 'disc' is not one of segment, rectangle"),
+    (lambda d, p: d.update(gamma={"shape": "segment", "length": -1}), r"gamma\.length: expected a finite number > 0"),
+    (lambda d, p: d.update(gamma={"shape": "segment", "size": [1, 1]}), r"gamma: unknown key 'size' for a segment"),
+    (lambda d, p: d.update(gamma={"shape": "rectangle", "size": [1]}), r"gamma\.size: expected \[a, b\]"),
+    (lambda d, p: d.update(gamma={"shape": "rectangle", "size": [1, 1]}), r"multipliers: unknown key 'basis' in a rectangle"),
+    (lambda d, p: d.update(norm="given"), r"gamma: only with norm: H"),
+    (lambda d, p: [d.pop("gamma"), d.update(norm="L2")], r"levels\[0\]\.multipliers: only with norm: H"),
+    (lambda d, p: d["levels"][0].update(G="nothere.mtx"), r"nothere\.mtx"),
+    (lambda d, p: [_general_form(d, p), _mult(d).update(dofs=[[0, 1]] * 3)],
+     r"multipliers\.dofs: expected an integer array of shape \(N, s \+ 1\) = \(4, 2\)"),
+    (lambda d, p: [_general_form(d, p), _mult(d).update(dofs=[[0, 1], [1], [2, 3], [3, 4]])], r"multipliers\.dofs: expected integers"),
+    (lambda d, p: [_general_form(d, p), _mult(d).update(coefficients=[[1, 0, 0]])], r"multipliers\.coefficients: expected finite"),
+    (lambda d, p: [_general_form(d, p), _mult(d).update(rows=[0, 1, 2])], r"multipliers\.rows: only with a helper form"),
+    (lambda d, p: [_general_form(d, p), _mult(d).update(coefficients=[[0, 0], [0, 0]])],
+     r"multipliers\.coefficients: basis function 0 \(row 0 of B\) is zero on every interval"),
+]
+
+
+def test_a_linearly_dependent_basis_is_refused_where_its_gram_is_factorized(tmp_path, capsys):
+    """Discontinuous P_1 with both local functions L_0: every interval's pair is one function."""
+    def change(d, p):
+        d["levels"][0].pop("G")
+        d["levels"][0]["multipliers"] = {"breakpoints": [0, 0.5, 1], "degree": 1, "dofs": [[0, 1], [2, -1]],
+                                         "coefficients": [[1, 0], [1, 0]]}
+    _spoil(tmp_path, capsys, change, r"levels\.yaml: levels\[0\]\.multipliers: the described basis functions are linearly dependent", dry=False)
+
+
+@pytest.mark.parametrize("change,match", HOSTILE, ids=[f"{i}" for i in range(len(HOSTILE))])
+def test_hostile_descriptions_are_refused_in_one_line(tmp_path, capsys, change, match):
+    _spoil(tmp_path, capsys, change, match)
+
+
+def test_files_cut_short_or_forged(tmp_path, capsys):
+    """A .txt cut inside its last number (no final newline), an .npy whose header declares 1e9
+    intervals the file does not hold, a .yaml description cut mid-list: each one line."""
+    def txt(d, p):
+        (p / "bp.txt").write_text("0 0.25 0.5 0.75 1")  # no final newline: its last number may be cut
+        _mult(d)["breakpoints"] = "bp.txt"
+    _spoil(tmp_path / "t", capsys, txt, r"bp\.txt: levels\[0\]\.multipliers\.breakpoints: the file does not end with a newline")
+
+    def npy(d, p):
+        np.save(p / "bp.npy", np.linspace(0.0, 1.0, 5))
+        raw = (p / "bp.npy").read_bytes().replace(b"(5,)", b"(1000000001,)".ljust(4)[:4] if False else b"(5,)")
+        header = raw.replace(b"'shape': (5,)", b"'shape': (1000000001,)")
+        (p / "bp.npy").write_bytes(header)
+        _mult(d)["breakpoints"] = "bp.npy"
+    _spoil(tmp_path / "n", capsys, npy, r"bp\.npy: the header declares shape \(1000000001,\).* cut short or forged")
+
+    def cut_yaml(d, p):
+        (p / "m.yaml").write_text("basis: lagrange\ndegree: 1\nends: drop\nbreakpoints: [0, 0.25, 0.5,")
+        d["levels"][0]["multipliers"] = "m.yaml"
+    _spoil(tmp_path / "y", capsys, cut_yaml, r"m\.yaml: not readable YAML")
+
+    def cut_list(d, p):
+        (p / "m.yaml").write_text("basis: lagrange\ndegree: 1\nends: drop\nbreakpoints:\n- 0\n- 0.25\n- 0.5\n")
+        d["levels"][0]["multipliers"] = "m.yaml"
+    _spoil(tmp_path / "l", capsys, cut_list, r"m\.yaml: multipliers\.breakpoints: runs from 0\.0 to 0\.5")
+
+
+def test_description_files_are_read(tmp_path):
+    """The same description from a .yaml file with .txt / .npy arrays gives the inline one's β."""
+    import yaml
+
+    data, path = _base(tmp_path)
+    ref = system_rows(load_manifest(path, 1), notes=io.StringIO())[0]["beta"]
+    mult = _mult(data)
+    (tmp_path / "bp.txt").write_text("\n".join(map(repr, mult["breakpoints"])) + "\n")
+    np.save(tmp_path / "rows.npy", np.arange(3))
+    (tmp_path / "m.yaml").write_text(yaml.safe_dump(dict(mult, breakpoints="bp.txt", rows="rows.npy")))
+    data["levels"][0]["multipliers"] = "m.yaml"
+    path.write_text(yaml.safe_dump(data))
+    assert system_rows(load_manifest(path, 1), notes=io.StringIO())[0]["beta"] == ref
+
+
+def test_a_description_too_large_for_the_memory_is_refused_before_its_gram(tmp_path, capsys, monkeypatch):
+    """10⁵ intervals from an 800 kB .npy and a B of 10⁵ rows with 10 entries: the H Gram would need
+    ~1 TB (8 m² · 10 and the log kernel's pairs); the memory gate refuses it in the dry run."""
+    import scipy.io
+    import yaml
+
+    from infsup_contact.systems import multiplier_gram
+
+    n = 100_000
+    np.save(tmp_path / "bp.npy", np.linspace(0.0, 1.0, n + 1))
+    B = sp.coo_matrix((np.ones(10), (np.arange(10), np.arange(10))), shape=(n - 1, 10))
+    scipy.io.mmwrite(tmp_path / "B.mtx", B)
+    scipy.io.mmwrite(tmp_path / "A.mtx", sp.identity(10, format="coo"))
+    (tmp_path / "levels.yaml").write_text(yaml.safe_dump({
+        "norm": "H", "gamma": {"shape": "segment", "length": 1.0},
+        "levels": [{"h": 1e-5, "A": "A.mtx", "B": "B.mtx",
+                    "multipliers": {"basis": "lagrange", "degree": 1, "ends": "drop", "breakpoints": "bp.npy"}}]}))
+    called = []
+    monkeypatch.setattr(multiplier_gram, "gram", lambda *a: called.append(a))
+    assert main(["beta", "--system", str(tmp_path / "levels.yaml")]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "invalid --system" in err and "memory" in err and "TiB peak" in err, err
+    assert not called
+
+
+@pytest.mark.parametrize("value,match", [
+    ({"x": {"basis": "lagrange", "degree": 1, "breakpoints": [0, 2]}}, r"m\.yaml: levels\[0\]\.multipliers: missing key 'y'"),
+    ({"x": {"basis": "lagrange", "degree": 1, "breakpoints": [0, 1], "rows": [0, 1]},
+      "y": {"basis": "lagrange", "degree": 1, "breakpoints": [0, 1]}}, r"multipliers\.x\.rows: give the face's row order once"),
+    ({"x": [0, 1], "y": {}}, r"multipliers\.x: expected a segment form"),
+    ({"x": {"basis": "discontinuous", "degree": 0, "breakpoints": [0, 2]},
+      "y": {"basis": "discontinuous", "degree": 0, "breakpoints": [0, 0.5, 1]}, "rows": [1, 0, 0]},
+     r"multipliers\.rows: expected a permutation of 0\.\.1"),
+    ({"x": {"basis": "discontinuous", "degree": 0, "breakpoints": [0, 2]},
+      "y": {"basis": "discontinuous", "degree": 0, "breakpoints": [0, 0.5, 2]}}, r"multipliers\.y\.breakpoints: runs from 0\.0 to 2\.0; it must cover Γ = \[0, 1\.0\]"),
+])
+def test_hostile_face_descriptions(value, match):
+    with pytest.raises(SystemFileError, match=match):
+        describe("m.yaml", 0, value, Gamma("rectangle", (2.0, 1.0)))
+
+
+def test_face_rows_permute_the_gram():
+    """rows: on a face permutes G exactly (P_0 ⊗ P_0 on 2 × 3 cells: the default i + n_x j)."""
+    x = {"basis": "discontinuous", "degree": 0, "breakpoints": [0, 1, 2]}
+    y = {"basis": "discontinuous", "degree": 0, "breakpoints": [0, 0.25, 0.5, 1]}
+    plain = describe("m.yaml", 0, {"x": x, "y": y}, Gamma("rectangle", (2.0, 1.0)))
+    rows = [5, 3, 1, 0, 2, 4]
+    perm = describe("m.yaml", 0, {"x": x, "y": y, "rows": rows}, Gamma("rectangle", (2.0, 1.0)))
+    G, Gp = gram(plain, "L2")[0], gram(perm, "L2")[0]
+    assert np.array_equal(Gp[np.ix_(rows, rows)], G)
+    np.testing.assert_allclose(np.diag(G), [0.25, 0.25, 0.25, 0.25, 0.5, 0.5], rtol=1e-15)  # |cell| in order i + 2 j

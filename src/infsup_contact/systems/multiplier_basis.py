@@ -219,6 +219,7 @@ def _segment(where, key, value, base, length: float, face: bool):
         except InputError as err:
             raise SystemFileError(where, f"{key}.{err.key}: expected {err.allowed}"
                                   + ("" if err.got is None else f" (found {err.got!r})")) from None
+        _nonzero(where, key, space)
         return space, np.arange(space.dim)
     if "dofs" in value or "coefficients" in value:
         bad = "dofs" if "dofs" in value else "coefficients"
@@ -241,6 +242,20 @@ def _segment(where, key, value, base, length: float, face: bool):
     return space, (np.arange(space.dim) if order is None else order)
 
 
+def _nonzero(where, key, space) -> None:
+    """Every basis function of a general form has a non-zero piece (cheap, before any Gram; a
+    subtler linear dependence is found where the Gram is factorized)."""
+    if space.local_coefficients is None:
+        return
+    size = np.zeros(space.dim)
+    live = space.dofs >= 0
+    np.add.at(size, space.dofs[live], np.abs(space.local_coefficients).sum(axis=2)[live])
+    if np.any(size == 0):
+        j = int(np.flatnonzero(size == 0)[0])
+        raise SystemFileError(where, f"{key}.coefficients: basis function {j} (row {j} of B) is zero on every "
+                              "interval: a basis has no zero function")
+
+
 def _breakpoints(where, key, value, base, length: float) -> np.ndarray:
     """The breakpoints mapped to (0, 1): strictly increasing from 0 to L (to :data:`ENDS_RTOL`)."""
     if value is None:
@@ -253,7 +268,7 @@ def _breakpoints(where, key, value, base, length: float) -> np.ndarray:
         raise SystemFileError(where, f"{key}: not strictly increasing (entries {i} and {i + 1}: {x[i]!r}, "
                               f"{x[i + 1]!r})")
     if abs(x[0]) > ENDS_RTOL * length or abs(x[-1] - length) > ENDS_RTOL * length:
-        raise SystemFileError(where, f"{key}: runs from {x[0]!r} to {x[-1]!r}; it must cover Γ = [0, {length!r}] "
+        raise SystemFileError(where, f"{key}: runs from {float(x[0])!r} to {float(x[-1])!r}; it must cover Γ = [0, {length!r}] "
                               "(gamma's length), first and last breakpoint its ends")
     t = x / length
     t[0], t[-1] = 0.0, 1.0

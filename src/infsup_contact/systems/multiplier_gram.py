@@ -114,17 +114,42 @@ def check_description(manifest, level, B, G_file) -> tuple:
     return replace(level, G=_label(manifest, level)), stand_in, gram_bytes(d), d
 
 
+INDEPENDENCE_RTOL = 1e-12
+"""A Cholesky pivot² of the Jacobi-scaled L² mass below this is a linearly dependent basis (the
+suite's check of users' spaces, ``user_spaces.check_space``, uses the same 1e-12)."""
+
+
+def _independent(d, M) -> None:
+    """The described basis is linearly independent: Cholesky of D^{-1/2} M D^{-1/2} (D = diag M)
+    with no pivot² ≤ :data:`INDEPENDENCE_RTOL`; else one line naming the description."""
+    import scipy.linalg as sla
+
+    dg = np.sqrt(np.diag(M))
+    ok = bool(np.all(dg > 0))
+    if ok:
+        try:
+            L = sla.cholesky(M / dg[:, None] / dg[None, :], lower=True, check_finite=False)
+            ok = bool(np.min(np.diag(L)) ** 2 > INDEPENDENCE_RTOL)
+        except sla.LinAlgError:
+            ok = False
+    if not ok:
+        raise SystemFileError(d.source, f"{d.key}: the described basis functions are linearly dependent (their "
+                              f"L2 mass is singular to {INDEPENDENCE_RTOL:g}): not a basis of the multipliers")
+
+
 def described_grams(manifest, level, B, G_file) -> tuple:
     """(level, H Gram, L² mass from the G file or None, the H Gram's info) of a ``norm: H``
     level; a G file farther than :data:`MASS_RTOL` from the description's L² mass is refused."""
     from .checks import check_finite, check_gram
 
     labelled, _, _, d = check_description(manifest, level, B, G_file)
+    M = gram(d, "L2")[0]
+    _independent(d, M)
     G, info = gram(d, "H")
     mass = None
     if G_file is not None:
         check_finite(G_file, level.G)
-        dist = mass_distance(G_file, gram(d, "L2")[0])
+        dist = mass_distance(G_file, M)
         if not dist <= MASS_RTOL:
             raise SystemFileError(level.G, f"differs from the L2 mass of levels[{level.index}].multipliers by "
                                   f"{dist:.3g} relative (Frobenius; round-off is below {MASS_RTOL:g}): B's rows in "

@@ -84,8 +84,10 @@ def system_rows(manifest: Manifest, route: str = "auto", notes=sys.stderr) -> li
             notes="; ".join(lv.notes)))
         if manifest.norm == "H":  # the Gram's stated error, and the L2 row beside it where G is given
             rows[-1]["gram_rel_error"] = info["nmax_rel_error"]
-            rows[-1]["beta_L2"] = (level_spectrum(lv.A, lv.B, mass, manifest.known_kernel, route).beta
-                                   if mass is not None and mass.shape[0] == lv.B.shape[0] else np.nan)
+            l2 = (level_spectrum(lv.A, lv.B, mass, manifest.known_kernel, route)
+                  if mass is not None and mass.shape[0] == lv.B.shape[0] else None)
+            rows[-1].update(beta_L2=np.nan if l2 is None else l2.beta,
+                            smallest_nonzero_L2=np.nan if l2 is None else l2.smallest_nonzero)
     return rows
 
 
@@ -103,7 +105,8 @@ def system_verdict(manifest: Manifest, *, tol: float, floor: float, confidence: 
     out = stability_verdict(series, tol, floor, confidence)  # a close kernel decision: INCONCLUSIVE
     out["evidence"] = out["evidence"].replace("over N = ", "over 1/h = ").replace("(N = ", "(1/h = ")
     if manifest.norm == "H" and all(np.isfinite(r["beta_L2"]) for r in rows):  # the given L2 mass, for comparison
-        l2 = stability_verdict([dict(r, beta=r["beta_L2"], case=manifest.name) for r in series], tol, floor, confidence)
+        l2 = stability_verdict([dict(r, beta=r["beta_L2"], smallest_nonzero=r["smallest_nonzero_L2"]) for r in series],
+                               tol, floor, confidence)
         out.update(verdict_L2=l2["verdict"], beta_min_L2=l2["beta_min"], slope_L2=l2["slope"])
     if out["verdict"] == "UNSTABLE" and out["kernel_dim"] > 0:  # name the kernel nobody declared
         dims = [r["kernel_detected"] for r in rows]

@@ -101,8 +101,6 @@ def _label(manifest, level) -> Path:
 def check_description(manifest, level, B, G_file) -> tuple:
     """(level with G named by its description, a G standing in for the shape checks, bytes of its
     Gram): the description read and checked against B and the G file, nothing m × m allocated."""
-    import scipy.sparse as sp
-
     from .multiplier_basis import describe
 
     d = describe(manifest.path, level.index, level.multipliers, manifest.gamma)
@@ -112,7 +110,7 @@ def check_description(manifest, level, B, G_file) -> tuple:
     if G_file is not None and G_file.shape != (d.m, d.m):
         raise SystemFileError(level.G, f"G is {G_file.shape[0]} x {G_file.shape[1]}; with norm: H it is the L2 mass "
                               f"of the {d.m} described multipliers ({d.m} x {d.m})")
-    stand_in = sp.csr_matrix((d.m, d.m))
+    stand_in = np.broadcast_to(0.0, (d.m, d.m))  # dense like the Gram (the route), no memory
     return replace(level, G=_label(manifest, level)), stand_in, gram_bytes(d), d
 
 

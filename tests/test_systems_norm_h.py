@@ -38,12 +38,12 @@ def _general(levels):
         if "x" in form:
             return {key: general(value) for key, value in form.items()}
         return segment_form(None, describe("m.yaml", 0, form, Gamma("segment", (1.0,))).space)
-    return [(h, A, B, G, general(mult)) for h, A, B, G, mult in levels]
+    return [(h, A, B, G, general(mult), *rest) for h, A, B, G, mult, *rest in levels]
 
 
 def _manifest(tmp_path, case, k, offset, ns=NS, general=False, model=None, **kw):
     levels, norm, gamma = suite_levels(case, k, ns, offset, model=model, **kw)
-    assert norm == "H" and all(len(lv) == 5 for lv in levels)
+    assert norm == "H" and all(len(lv) == 6 for lv in levels)
     if general:
         levels = _general(levels)
     path = write_system(tmp_path / f"{case}-{k}-{offset}-{general}", levels, "npz", case, norm=norm, gamma=gamma)
@@ -68,6 +68,7 @@ def test_described_segment_reproduces_beta_case(tmp_path, case, k, offset, gener
         ref, = beta_rows("structured", k, n + offset, n, [case], norms=("H",))
         _agree(row, ref)
         assert row["norm"] == "H" and row["gram_rel_error"] == 0.0  # the log kernel: exact
+        assert row["coupling_distance"] <= 1e-14  # the suite's B is the exact mortar coupling
         ref_l2, = beta_rows("structured", k, n + offset, n, [case], norms=("L2",))
         if ref_l2["kernel_dim"] == 0:  # the G file (the L2 mass) gives the L2 row beside it
             assert abs(row["beta_L2"] - ref_l2["beta"]) <= RTOL * ref_l2["beta"]
@@ -90,7 +91,7 @@ def test_perturbed_meshes(tmp_path, case, multiplier_mesh):
 
     m = _manifest(tmp_path, case, 2, 1, family="perturbed", multiplier_mesh=multiplier_mesh)
     for n, row, level in zip(NS, system_rows(m, notes=io.StringIO()), m.levels):
-        *_, space, segment = _suite_parts(case, 2, n + 1, n, "perturbed", multiplier_mesh, None)
+        *_, space, segment, _ = _suite_parts(case, 2, n + 1, n, "perturbed", multiplier_mesh, None)
         d = describe(m.path, level.index, level.multipliers, m.gamma)
         assert np.array_equal(gram(d, "H")[0], segment.gram(space, "H")[0])
         ref, = beta_rows("perturbed", 2, n + 1, n, [case], multiplier_mesh=multiplier_mesh, norms=("H",))
@@ -172,9 +173,10 @@ def test_beta_invariant_under_the_scaling_a_length_change_induces(tmp_path):
     G_H = L² G̃ and M = L M̃: β_h the same to round-off, the L2 check passing."""
     levels, norm, _ = suite_levels("T5", 2, NS, 1)
     scaled = []
-    for h, A, B, G, mult in levels:
+    for h, A, B, G, mult, traces in levels:
         mult = dict(mult, breakpoints=[2.0 * t for t in mult["breakpoints"]])
-        scaled.append((2 * h, A, 2.0 * B, 2.0 * G, mult))
+        traces = [dict(t, breakpoints=[2.0 * x for x in t["breakpoints"]]) for t in traces]
+        scaled.append((2 * h, A, 2.0 * B, 2.0 * G, mult, traces))
     unit = system_rows(load_manifest(write_system(tmp_path / "u", levels, "mtx", "u", "H", gamma={"shape": "segment", "length": 1.0}), 1),
                        notes=io.StringIO())
     long = system_rows(load_manifest(write_system(tmp_path / "l", scaled, "mtx", "l", "H", gamma={"shape": "segment", "length": 2.0}), 1),
@@ -187,7 +189,7 @@ def test_beta_invariant_under_the_scaling_a_length_change_induces(tmp_path):
 # ---------------------------------------------------------------- the L2 check: a wrong row order
 def test_a_row_order_other_than_the_description_is_refused(tmp_path):
     levels, norm, gamma = suite_levels("T3", 1, NS, 0)
-    h, A, B, G, mult = levels[1]
+    h, A, B, G, mult, _ = levels[1]
     perm = np.arange(B.shape[0])
     perm[[2, 3]] = perm[[3, 2]]
     bad = levels[:1] + [(h, A, B[perm], G[np.ix_(perm, perm)], mult)]
@@ -206,7 +208,7 @@ def test_a_row_order_other_than_the_description_is_refused(tmp_path):
 
 def test_without_g_the_h_verdict_stands_alone(tmp_path):
     levels, norm, gamma = suite_levels("DUAL", 2, (4, 8, 16), 0)
-    bare = [(h, A, B, None, mult) for h, A, B, G, mult in levels]
+    bare = [(h, A, B, None, mult) for h, A, B, G, mult, _ in levels]
     m = load_manifest(write_system(tmp_path, bare, "mtx", "bare", norm, gamma=gamma))
     assert all(lv.G is None for lv in m.levels) and not list(tmp_path.glob("G*"))
     rows = system_rows(m, notes=io.StringIO())
@@ -419,3 +421,71 @@ def test_face_rows_permute_the_gram():
     G, Gp = gram(plain, "L2")[0], gram(perm, "L2")[0]
     assert np.array_equal(Gp[np.ix_(rows, rows)], G)
     np.testing.assert_allclose(np.diag(G), [0.25, 0.25, 0.25, 0.25, 0.5, 0.5], rtol=1e-15)  # |cell| in order i + 2 j
+
+
+# ---------------------------------------------------------------- the distance to the exact mortar coupling
+@pytest.mark.parametrize("k", [1, 2])
+def test_slave_side_quadrature_is_exact_only_on_matching_meshes(tmp_path, k):
+    """B_1 integrated by the Gauss rule of the multiplier mesh (= Ω2's trace, the slave side) only,
+    as codes without segmentation do: its distance to the exact coupling is round-off on matching
+    meshes and the integration error on non-matching ones, equal to ‖B_slave − B‖ / ‖B‖ with the
+    suite's B (the exact coupling of :mod:`~infsup_contact.discretization.coupling`: a second route)."""
+    from infsup_contact.discretization.coupling import weighted_values
+    from infsup_contact.systems.export import _suite_parts
+
+    out = {}
+    for offset in (0, 1):
+        levels, norm, gamma = suite_levels("T3", k, NS, offset)
+        slave = []
+        for n, (h, A, B, G, mult, traces) in zip(NS, levels):
+            _, _, space, segment, sides = _suite_parts("T3", k, n + offset, n, "structured", "omega2", None)
+            x, w = segment.quadrature(space.breakpoints, k + space.degree)
+            B1 = np.asarray(weighted_values(space, x, w).T @ segment.trace_basis(sides[0].trace, x))
+            Bs = B.toarray()
+            Bs[:, sides[0].ndof - B1.shape[1]:sides[0].ndof] = -B1
+            slave.append((h, A, sp.csr_matrix(Bs), G, mult, traces))
+            out[offset, n] = np.linalg.norm(Bs - B.toarray()) / np.linalg.norm(B.toarray())
+        m = load_manifest(write_system(tmp_path / f"{offset}", slave, "npz", "slave", norm, gamma=gamma), 1)
+        for n, row in zip(NS, system_rows(m, notes=io.StringIO())):
+            assert abs(row["coupling_distance"] - out[offset, n]) <= 1e-12
+            assert (row["coupling_distance"] <= 1e-14) == (offset == 0)
+    assert min(out[1, n] for n in NS) > 1e-3  # N1 = N2 + 1: visibly inexact
+
+
+def test_the_distance_sees_a_wrong_sign_and_is_absent_without_traces(tmp_path):
+    levels, norm, gamma = suite_levels("DUAL", 1, NS, 1)
+    flipped = [(h, A, -B, G, mult, [dict(t, sign=-t["sign"]) for t in traces]) for h, A, B, G, mult, traces in levels]
+    m = load_manifest(write_system(tmp_path / "f", flipped, "mtx", "f", norm, gamma=gamma), 1)
+    assert all(r["coupling_distance"] <= 1e-14 for r in system_rows(m, notes=io.StringIO()))
+    wrong = [(h, A, B, G, mult, [dict(traces[0], sign=1), traces[1]]) for h, A, B, G, mult, traces in levels]
+    m = load_manifest(write_system(tmp_path / "w", wrong, "mtx", "w", norm, gamma=gamma), 1)
+    for row in system_rows(m, notes=io.StringIO()):  # body 1's block counted twice over: ‖2 B_1‖ / ‖B‖
+        assert row["coupling_distance"] > 0.5
+    none = [lv[:5] for lv in levels]
+    m = load_manifest(write_system(tmp_path / "n", none, "mtx", "n", norm, gamma=gamma), 1)
+    assert all(np.isnan(r["coupling_distance"]) for r in system_rows(m, notes=io.StringIO()))
+
+
+def _trace(change):
+    def spoil(data, tmp_path):
+        import yaml
+
+        levels, *_ = suite_levels("T3", 1, (4,), 0)
+        traces = levels[0][5]
+        change(traces)
+        data["levels"][0]["traces"] = yaml.safe_load(yaml.safe_dump(traces))
+    return spoil
+
+
+@pytest.mark.parametrize("change,match", [
+    (lambda t: t[0].pop("columns"), r"levels\[0\]\.traces\[0\]: missing key 'columns'"),
+    (lambda t: t[0].update(columns=t[0]["columns"][:-1]), r"traces\[0\]\.columns: expected 3 integers in -1\.\.\d+"),
+    (lambda t: t[0].update(columns=[10 ** 6] * 3), r"traces\[0\]\.columns: expected 3 integers"),
+    (lambda t: t[0].update(columns=[5, 5, 6]), r"traces\[0\]\.columns: a column of B named twice"),
+    (lambda t: t[1].update(sign=2), r"traces\[1\]\.sign: expected -1 or 1"),
+    (lambda t: t[1].update(rows=[0]), r"traces\[1\]\.rows: a trace gives its columns"),
+    (lambda t: t[1].update(degree=9), r"traces\[1\]\.degree: expected an integer in 0\.\.7"),
+    (lambda t: t.extend([t[0]]), r"levels\[0\]\.traces: expected a list of one or two"),
+])
+def test_hostile_traces(tmp_path, capsys, change, match):
+    _spoil(tmp_path, capsys, _trace(change), match, dry=False)

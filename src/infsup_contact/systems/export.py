@@ -32,13 +32,13 @@ EXPORT_FORMATS = {"mtx": ".mtx", "npz": ".npz", "petsc": ".petsc"}
 def suite_system(case: str, k: int, n1: int, n2: int, family: str = "structured", norm: str = "H",
                  multiplier_mesh: str = "omega2", model=None, **mesh_kwargs):
     """(A, B, G) of ``case`` on the pair (N1, N2) of ``model`` (default: membranes)."""
-    A, B, space, gamma = _suite_parts(case, k, n1, n2, family, multiplier_mesh, model, **mesh_kwargs)
+    A, B, space, gamma, _ = _suite_parts(case, k, n1, n2, family, multiplier_mesh, model, **mesh_kwargs)
     G, _ = gamma.gram(space, norm)
     return A, B, np.asarray(G, float)
 
 
 def _suite_parts(case, k, n1, n2, family, multiplier_mesh, model, **mesh_kwargs):
-    """(A, B, the multiplier space, Γ) of ``case`` on the pair (N1, N2)."""
+    """(A, B, the multiplier space, Γ, the two side operators) of ``case`` on the pair (N1, N2)."""
     from ..discretization import registry
     from ..discretization.coupling import coupling_matrix
     from ..models.membranes import MEMBRANES
@@ -55,7 +55,7 @@ def _suite_parts(case, k, n1, n2, family, multiplier_mesh, model, **mesh_kwargs)
         full[:, side.ndof - Bi.shape[1]:] = sign * Bi
         blocks.append(sp.csr_matrix(full))
     A = sp.block_diag([s.stiffness for s in sides], format="csr")
-    return A, sp.hstack(blocks, format="csr"), space, gamma
+    return A, sp.hstack(blocks, format="csr"), space, gamma, sides
 
 
 def suite_levels(case: str, k: int, ns, offset: int = 0, family: str = "structured", norm: str = "H",
@@ -67,15 +67,16 @@ def suite_levels(case: str, k: int, ns, offset: int = 0, family: str = "structur
 
     spec, levels, described = space_spec(case), [], norm == "H"
     parts = [_suite_parts(case, k, n + offset, n, family, multiplier_mesh, model, **mesh_kwargs) for n in ns]
-    described = described and all(description(spec, sp_) is not None for _, _, sp_, _ in parts)
-    for n, (A, B, space, gamma) in zip(ns, parts):
+    described = described and all(description(spec, p[2]) is not None for p in parts)
+    for n, (A, B, space, gamma, sides) in zip(ns, parts):
         if not described:
             G, _ = gamma.gram(space, norm)
             levels.append((1.0 / n, A, B, np.asarray(G, float)))
             continue
         mult, order = description(spec, space)
         G, _ = gamma.gram(space, "L2")
-        levels.append((1.0 / n, A, B[order], np.asarray(G, float)[np.ix_(order, order)], mult))
+        levels.append((1.0 / n, A, B[order], np.asarray(G, float)[np.ix_(order, order)], mult,
+                       trace_forms(sides, k)))
     if described:
         face = hasattr(parts[0][2], "factors")
         gamma = {"shape": "rectangle", "size": [1.0, 1.0]} if face else {"shape": "segment", "length": 1.0}
@@ -96,6 +97,33 @@ def description(spec, space):
         i, j = np.divmod(np.arange(space.dim), sy.dim)  # FaceSpace's row i n_y + j; counted i + n_x j
         return {"x": segment_form(spec, sx), "y": segment_form(spec, sy)}, np.argsort(i + sx.dim * j)
     return None
+
+
+def trace_forms(sides, k: int):
+    """The ``traces`` of the two bodies (:mod:`.mortar_distance`): on the segment the general form
+    of each side's Γ-dof basis (its values at the equispaced Lagrange nodes of every trace
+    interval: the coefficients of those shapes), ``columns`` = the dof of A (Γ dofs last in each
+    block, in the trace's order). None on a face (its Q_k trace bases are not written here)."""
+    from ..discretization.multipliers import reference_nodes
+
+    if sides[0].trace.gamma.dim != 1:
+        return None
+    out, offset = [], 0
+    for sign, side in zip((-1, 1), sides):
+        tr = side.trace
+        x = np.asarray(tr.breakpoints, float)
+        nodes = (x[:-1, None] + np.diff(x)[:, None] * reference_nodes(k)[None, :])  # (N, k + 1)
+        V = tr.gamma.trace_basis(tr, nodes.ravel()).reshape(len(x) - 1, k + 1, -1)  # (N, node, Γ dof)
+        dofs, coef = -np.ones((len(x) - 1, k + 1), int), np.zeros((len(x) - 1, k + 1, k + 1))
+        for e in range(len(x) - 1):
+            live = np.flatnonzero(np.any(V[e] != 0.0, axis=0))  # a degree-k function zero at k + 1 nodes is 0
+            dofs[e, :len(live)] = live
+            coef[e, :len(live)] = V[e][:, live].T
+        first = offset + side.ndof - len(tr.gamma_dofs)
+        out.append({"breakpoints": x.tolist(), "degree": int(k), "dofs": dofs.tolist(), "coefficients": coef.tolist(),
+                    "columns": list(range(first, first + len(tr.gamma_dofs))), "sign": sign})
+        offset += side.ndof
+    return out
 
 
 def segment_form(spec, space) -> dict:
@@ -152,22 +180,25 @@ def matrix_bytes(mat, fmt: str) -> bytes:
 def write_system(directory, levels, fmt: str, name: str, norm: str = "given", known_kernel: int = 0,
                  gamma: dict | None = None) -> Path:
     """Write each level's A, B, G as ``{A,B,G}<i>.<ext>`` and ``levels.yaml`` (atomically);
-    ``levels``: (h, A, B, G) or (h, A, B, G, multipliers) coarse to fine (G None: not written;
-    ``multipliers`` a mapping written inline, with ``gamma`` for ``norm: H``). Returns the manifest's path."""
+    ``levels``: (h, A, B, G[, multipliers[, traces]]) coarse to fine (G None: not written;
+    ``multipliers`` a mapping and ``traces`` a list written inline, with ``gamma`` for ``norm: H``).
+    Returns the manifest's path."""
     directory = Path(directory)
     ext = EXPORT_FORMATS[fmt]
     lines = [f"name: {name}", f"norm: {norm}"] + ([f"known_kernel: {known_kernel}"] if known_kernel else [])
     if gamma is not None:
         lines.append(f"gamma: {_flow(gamma)}")
     lines.append("levels:")
-    for i, (h, A, B, G, *mult) in enumerate(levels):
+    for i, (h, A, B, G, *described) in enumerate(levels):
         names = {}
         for key, mat in (("A", A), ("B", B), ("G", G)):
             if mat is not None:
                 names[key] = f"{key}{i}{ext}"
                 write_bytes_atomic(directory / names[key], matrix_bytes(mat, fmt))
         files = "".join(f", {key}: {file}" for key, file in names.items())
-        lines.append(f"  - {{h: {h!r}{files}" + (f", multipliers: {_flow(mult[0])}" if mult else "") + "}")
+        mult, traces = (list(described) + [None, None])[:2]
+        lines.append(f"  - {{h: {h!r}{files}" + (f", multipliers: {_flow(mult)}" if mult else "")
+                     + (f", traces: {_flow(traces)}" if traces else "") + "}")
     path = directory / "levels.yaml"
     write_atomic(path, "\n".join(lines) + "\n")
     return path

@@ -83,7 +83,7 @@ def system_rows(manifest: Manifest, route: str = "auto", notes=sys.stderr) -> li
             t_eigen=res.seconds.get("eigen", np.nan), t_kernel=res.seconds["kernel"],
             notes="; ".join(lv.notes)))
         if manifest.norm == "H":  # the Gram's stated error, and the L2 row beside it where G is given
-            rows[-1]["gram_rel_error"] = info["nmax_rel_error"]
+            rows[-1].update(gram_rel_error=info["nmax_rel_error"], coupling_distance=info["coupling_distance"])
             l2 = (level_spectrum(lv.A, lv.B, mass, manifest.known_kernel, route)
                   if mass is not None and mass.shape[0] == lv.B.shape[0] else None)
             rows[-1].update(beta_L2=np.nan if l2 is None else l2.beta,
@@ -108,6 +108,8 @@ def system_verdict(manifest: Manifest, *, tol: float, floor: float, confidence: 
         l2 = stability_verdict([dict(r, beta=r["beta_L2"], smallest_nonzero=r["smallest_nonzero_L2"]) for r in series],
                                tol, floor, confidence)
         out.update(verdict_L2=l2["verdict"], beta_min_L2=l2["beta_min"], slope_L2=l2["slope"])
+    if manifest.norm == "H" and any(np.isfinite(r["coupling_distance"]) for r in rows):
+        out["coupling_distance_max"] = float(np.nanmax([r["coupling_distance"] for r in rows]))
     if out["verdict"] == "UNSTABLE" and out["kernel_dim"] > 0:  # name the kernel nobody declared
         dims = [r["kernel_detected"] for r in rows]
         structural = [r["kernel_structural"] for r in rows]

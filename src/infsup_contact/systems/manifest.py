@@ -46,7 +46,7 @@ from .readers import SystemFileError
 
 NORMS = ("given", "L2", "h-L2", "H")
 TGV_POLICIES = ("eliminate", "refuse")
-LEVEL_KEYS = ("h", "A", "B", "G", "constrained", "multipliers")
+LEVEL_KEYS = ("h", "A", "B", "G", "constrained", "multipliers", "traces")
 TOP_KEYS = ("levels", "name", "norm", "known_kernel", "tgv", "expect", "gamma")
 EXPECTS = ("stable", "unstable")
 MANIFEST_MAX_BYTES = 1 << 20
@@ -67,6 +67,7 @@ class Level:
     G: Path | None
     constrained: object = None  # None, a list of ints, or a Path
     multipliers: object = None  # with norm H: the description (a mapping) or its file (a str)
+    traces: object = None  # with norm H, optional: the bodies' trace bases (mortar_distance)
 
 
 @dataclass(frozen=True)
@@ -168,8 +169,9 @@ def _level(path: Path, i: int, entry, norm: str = "given") -> Level:
     if missing:
         raise SystemFileError(path, f"{where}: missing key {missing[0]!r} (each level needs {', '.join(needed)}"
                               + (")" if norm != "H" else "; G optional: the L2 mass)"))
-    if norm != "H" and "multipliers" in entry:
-        raise SystemFileError(path, f"{where}.multipliers: only with norm: H (norm is {norm!r})")
+    for key in ("multipliers", "traces"):
+        if norm != "H" and key in entry:
+            raise SystemFileError(path, f"{where}.{key}: only with norm: H (norm is {norm!r})")
     mult = entry.get("multipliers")
     if isinstance(mult, str):
         _one_line(path, f"{where}.multipliers", mult)
@@ -195,7 +197,7 @@ def _level(path: Path, i: int, entry, norm: str = "given") -> Level:
     elif con is not None:
         if not isinstance(con, list) or any(isinstance(c, bool) or not isinstance(c, int) or c < 0 for c in con):
             raise SystemFileError(path, f"{where}.constrained: expected a file or a list of integers >= 0")
-    return Level(i, float(h), files["A"], files["B"], files["G"], con, mult)
+    return Level(i, float(h), files["A"], files["B"], files["G"], con, mult, entry.get("traces"))
 
 
 def constrained_dofs(level: Level, n: int) -> np.ndarray:

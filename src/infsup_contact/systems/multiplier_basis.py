@@ -114,14 +114,19 @@ def describe(manifest_path, index: int, value, gamma: Gamma) -> Described:
         where, key, value = _load_file(where, key, base / value), "multipliers", None
         base = where.parent
         value = _read_yaml(where)
+    space, rows = describe_space(where, key, value, base, gamma)
+    return Described(space, rows, gamma, where, key)
+
+
+def describe_space(where, key, value, base, gamma: Gamma) -> tuple:
+    """(space on the pull-back of Γ, the position of each of its functions in the description's
+    numbering) of one segment form, or of ``{x, y, rows}`` on a rectangle."""
     if not isinstance(value, dict):
         raise SystemFileError(where, f"{key}: expected a mapping (a segment form, or {{x: ..., y: ...}} on a "
                               f"rectangle) or a .yaml file name (found {value!r:.60})")
     if gamma.shape == "segment":
-        space, rows = _segment(where, key, value, base, gamma.size[0], face=False)
-    else:
-        space, rows = _face(where, key, value, base, gamma)
-    return Described(space, rows, gamma, where, key)
+        return _segment(where, key, value, base, gamma.size[0], face=False)
+    return _face(where, key, value, base, gamma)
 
 
 def _load_file(where, key, path: Path) -> Path:

@@ -139,10 +139,14 @@ def _independent(d, M) -> None:
 
 def described_grams(manifest, level, B, G_file) -> tuple:
     """(level, H Gram, L² mass from the G file or None, the H Gram's info) of a ``norm: H``
-    level; a G file farther than :data:`MASS_RTOL` from the description's L² mass is refused."""
+    level; a G file farther than :data:`MASS_RTOL` from the description's L² mass is refused.
+    ``info["coupling_distance"]``: B's distance to the exact coupling of the described traces
+    (:mod:`.mortar_distance`; NaN without ``traces``)."""
     from .checks import check_finite, check_gram
+    from .mortar_distance import coupling_distance
 
     labelled, _, _, d = check_description(manifest, level, B, G_file)
+    distance = coupling_distance(manifest, level, d, B)
     M = gram(d, "L2")[0]
     _independent(d, M)
     G, info = gram(d, "H")
@@ -155,4 +159,4 @@ def described_grams(manifest, level, B, G_file) -> tuple:
                                   f"{dist:.3g} relative (Frobenius; round-off is below {MASS_RTOL:g}): B's rows in "
                                   "another order than the description (rows:), another basis, or other breakpoints?")
         mass = check_gram(G_file, level.G)
-    return labelled, G, mass, info
+    return labelled, G, mass, dict(info, coupling_distance=distance)

@@ -489,3 +489,31 @@ def _trace(change):
 ])
 def test_hostile_traces(tmp_path, capsys, change, match):
     _spoil(tmp_path, capsys, _trace(change), match, dry=False)
+
+
+def test_a_face_of_ten_billion_functions_is_refused_before_its_numbering(tmp_path):
+    """Two 10⁵-interval axes (800 kB .npy each) describe 10¹⁰ functions: refused before an array
+    of that length is made (the Gram's gate comes later, after B's rows)."""
+    np.save(tmp_path / "x.npy", np.linspace(0.0, 1.0, 100_001))
+    form = {"basis": "discontinuous", "degree": 0, "breakpoints": "x.npy"}
+    with pytest.raises(SystemFileError, match=r"multipliers: describes 10000000000 functions: their numbering alone"):
+        describe(tmp_path / "levels.yaml", 0, {"x": form, "y": form}, Gamma("rectangle", (1.0, 1.0)))
+
+
+def test_a_general_form_is_not_reshaped_from_another_shape():
+    """dofs of shape (2, 4) where (4, 2) is meant: refused, not silently reshaped (only a flat
+    array from a file is read interval by interval)."""
+    form = {"breakpoints": [0, 0.25, 0.5, 0.75, 1], "degree": 1, "dofs": [[0, 1, 1, 2], [2, 3, 3, 4]]}
+    with pytest.raises(SystemFileError, match=r"dofs: expected an integer array of shape \(N, s \+ 1\) = \(4, 2\)"):
+        describe("m.yaml", 0, form, Gamma("segment", (1.0,)))
+
+
+def test_elastic_model_described(tmp_path):
+    """The elastic model (plane strain, the normal component on Γ): the same agreement, traces exact."""
+    from infsup_contact.models.elastic import ELASTIC
+
+    m = _manifest(tmp_path, "T3", 2, 1, model=ELASTIC)
+    for n, row in zip(NS, system_rows(m, notes=io.StringIO())):
+        ref, = beta_rows("structured", 2, n + 1, n, ["T3"], norms=("H",), model=ELASTIC)
+        _agree(row, ref)
+        assert row["coupling_distance"] <= 1e-14

@@ -46,8 +46,7 @@ def _traces(manifest, level, n: int) -> list:
             raise SystemFileError(where, f"{here}.sign: expected -1 or 1 (found {sign!r:.20})")
         form = {k: v for k, v in entry.items() if k not in TRACE_KEYS}
         space, order = describe_space(where, here, form, manifest.path.parent, manifest.gamma)
-        cols = _array(where, f"{here}.columns", entry["columns"], manifest.path.parent, integer=True,
-                      count=space.dim).ravel()
+        cols = _array(where, f"{here}.columns", entry["columns"], manifest.path.parent, integer=True).ravel()
         if len(cols) != space.dim or np.any(cols < -1) or np.any(cols >= n):
             raise SystemFileError(where, f"{here}.columns: expected {space.dim} integers in -1..{n - 1} (one per "
                                   f"trace function; B has {n} columns; found {len(cols)})")

@@ -171,12 +171,28 @@ def _face(where, key, value, base, gamma):
                                   "(row of B = i + n_x j by default)")
         factors.append(_segment(where, f"{key}.{axis}", value[axis], base, length, face=True)[0])
     sx, sy = factors
+    _fits(where, key, sx.dim * sy.dim)
     space = FaceSpace(sx, sy, TensorPartition(sx.breakpoints, sy.breakpoints))
     # FaceSpace numbers ψ_i(x) ψ_j(y) as i n_y + j; the description counts it i + n_x j
     i, j = np.divmod(np.arange(space.dim), sy.dim)
     counted = i + sx.dim * j
     order = _rows(where, f"{key}.rows", value.get("rows"), base, space.dim)
     return space, counted if order is None else order[counted]
+
+
+BYTES_PER_FUNCTION = 64
+"""Bytes per described function of the arrays made before B's rows are compared (the numbering,
+its inverse, the face's counting): a face of n_x × n_y functions is refused here when even those
+do not fit (two 10⁵-interval axes are 10¹⁰ functions), before its Gram is estimated."""
+
+
+def _fits(where, key, m: int) -> None:
+    from .. import resources
+
+    avail = resources.available_bytes()
+    if avail is not None and BYTES_PER_FUNCTION * m > avail:
+        raise SystemFileError(where, f"{key}: describes {m} functions: their numbering alone needs "
+                              f"~{resources.human_bytes(BYTES_PER_FUNCTION * m)}, {resources.human_bytes(avail)} available")
 
 
 def _keys(where, key, value, allowed, what):
@@ -210,12 +226,12 @@ def _segment(where, key, value, base, length: float, face: bool):
             raise SystemFileError(where, f"{key}: missing key 'dofs' (the general form: breakpoints, degree, dofs "
                                   "[, coefficients]; or a helper form with basis: " + ", ".join(BASES) + ")")
         n = len(x) - 1
-        dofs = _array(where, f"{key}.dofs", value["dofs"], base, integer=True, count=n * (s + 1))
-        if dofs.shape != (n, s + 1) and dofs.size == n * (s + 1):
+        dofs = _array(where, f"{key}.dofs", value["dofs"], base, integer=True)
+        if dofs.ndim == 1 and dofs.size == n * (s + 1):
             dofs = dofs.reshape(n, s + 1)  # a file holds them flat, interval by interval
         coef = value.get("coefficients")
         if coef is not None:
-            coef = _array(where, f"{key}.coefficients", coef, base, integer=False, count=n * (s + 1) ** 2)
+            coef = _array(where, f"{key}.coefficients", coef, base, integer=False)
             if coef.ndim == 1 and coef.size in ((s + 1) ** 2, n * (s + 1) ** 2):
                 coef = coef.reshape(-1, s + 1, s + 1)
                 coef = coef[0] if len(coef) == 1 else coef
@@ -265,7 +281,7 @@ def _breakpoints(where, key, value, base, length: float) -> np.ndarray:
     """The breakpoints mapped to (0, 1): strictly increasing from 0 to L (to :data:`ENDS_RTOL`)."""
     if value is None:
         raise SystemFileError(where, f"{key}: missing (the partition of Γ, 0 = t_0 < ... < t_N = {length:g})")
-    x = _array(where, key, value, base, integer=False, count=None)
+    x = _array(where, key, value, base, integer=False)
     if x.ndim != 1 or len(x) < 2:
         raise SystemFileError(where, f"{key}: expected at least 2 numbers in a flat list (found shape {x.shape})")
     if not np.all(np.diff(x) > 0):
@@ -286,7 +302,7 @@ def _rows(where, key, value, base, m: int):
     """The permutation ``rows`` (None if not given): a permutation of 0..m-1."""
     if value is None:
         return None
-    rows = _array(where, key, value, base, integer=True, count=m).ravel()
+    rows = _array(where, key, value, base, integer=True).ravel()
     if len(rows) != m or not np.array_equal(np.sort(rows), np.arange(m)):
         raise SystemFileError(where, f"{key}: expected a permutation of 0..{m - 1} (the row of B of each of the "
                               f"{m} basis functions; found {len(rows)} entries"
@@ -294,7 +310,7 @@ def _rows(where, key, value, base, m: int):
     return rows
 
 
-def _array(where, key, value, base, integer: bool, count) -> np.ndarray:
+def _array(where, key, value, base, integer: bool) -> np.ndarray:
     """A list (nested lists) of numbers, or a file (``.txt`` / ``.npy``) relative to ``base``."""
     if isinstance(value, str):
         return _read_numbers(where, key, base / value, integer)

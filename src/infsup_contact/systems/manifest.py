@@ -29,7 +29,10 @@ A (n × n) SPD, B (m × n), G (m × m) the multiplier norm. Optional keys:
     without ``--expect`` and of the pre-commit hook follows it);
 per level, ``constrained``
     the 0-based dofs the producer fixed but left in A (identity or penalty rows): a list,
-    or a file (``.txt``: whitespace-separated integers, ``.npy``); they are removed.
+    or a file (``.txt``: whitespace-separated integers, ``.npy``); they are removed;
+per level, with ``norm: H``, ``multipliers`` (required) and ``traces`` (optional)
+    the description of B's rows on Γ (:mod:`.multiplier_basis`) and of the bodies' trace bases
+    (:mod:`.mortar_distance`); ``G`` is then optional.
 """
 from __future__ import annotations
 

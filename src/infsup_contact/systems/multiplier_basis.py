@@ -59,10 +59,6 @@ class Gamma:
     shape: str
     size: tuple
 
-    @property
-    def dim(self) -> int:
-        return len(self.size)
-
 
 @dataclass(frozen=True)
 class Described:
@@ -109,12 +105,10 @@ def describe(manifest_path, index: int, value, gamma: Gamma) -> Described:
     """Level ``index``'s ``multipliers`` (inline mapping, or a ``.yaml`` file relative to the
     manifest) as a :class:`Described` space; :class:`SystemFileError` naming the file and key."""
     where, key = Path(manifest_path), f"levels[{index}].multipliers"
-    base = where.parent
-    if isinstance(value, str):
-        where, key, value = _load_file(where, key, base / value), "multipliers", None
-        base = where.parent
+    if isinstance(value, str):  # a file: its arrays' file names are relative to it
+        where, key = _load_file(where, key, where.parent / value), "multipliers"
         value = _read_yaml(where)
-    space, rows = describe_space(where, key, value, base, gamma)
+    space, rows = describe_space(where, key, value, where.parent, gamma)
     return Described(space, rows, gamma, where, key)
 
 

@@ -13,7 +13,7 @@ routes ``beta --norm H`` uses (:mod:`.multiplier_gram`).
 Segment forms (coordinate t ∈ [0, L] along Γ)::
 
     {breakpoints: [...], degree: s, dofs: [[...], ...], coefficients: ...}   # general
-    {basis: lagrange, degree: k, breakpoints: [...], ends: keep|drop}          # continuous P_k
+    {basis: lagrange, degree: k, breakpoints: [...], ends: keep|drop}          # continuous P_k (keep: default)
     {basis: discontinuous, degree: k, breakpoints: [...]}                      # discontinuous P_k
     {basis: dual, degree: k, breakpoints: [...], ends: keep|drop}              # biorthogonal dual
 

@@ -295,14 +295,17 @@ HOSTILE = [
     (lambda d, p: d["levels"][0].update(multipliers="m.txt"), r"multipliers: 'm\.txt': expected an inline mapping or a \.yaml"),
     (lambda d, p: d["levels"][0].update(multipliers="m.yaml"), r"multipliers: no such file .*m\.yaml"),
     (lambda d, p: d["levels"][0].pop("multipliers"), r"levels\[0\]: missing key 'multipliers'"),
-    (lambda d, p: d.pop("gamma"), r"norm: H needs the key 'gamma'"),
+    (lambda d, p: d.pop("gamma"), r"norm: H and a level's 'multipliers' need the key 'gamma'"),
     (lambda d, p: d.update(gamma={"shape": "disc", "length": 1}), r"gamma\.shape: 'disc' is not one of segment, rectangle"),
     (lambda d, p: d.update(gamma={"shape": "segment", "length": -1}), r"gamma\.length: expected a finite number > 0"),
     (lambda d, p: d.update(gamma={"shape": "segment", "size": [1, 1]}), r"gamma: unknown key 'size' for a segment"),
     (lambda d, p: d.update(gamma={"shape": "rectangle", "size": [1]}), r"gamma\.size: expected \[a, b\]"),
     (lambda d, p: d.update(gamma={"shape": "rectangle", "size": [1, 1]}), r"multipliers: unknown key 'basis' in a rectangle"),
-    (lambda d, p: d.update(norm="given"), r"gamma: only with norm: H"),
-    (lambda d, p: [d.pop("gamma"), d.update(norm="L2")], r"levels\[0\]\.multipliers: only with norm: H"),
+    (lambda d, p: [d["levels"][0].pop("multipliers"), d["levels"][0].pop("traces"), d.update(norm="L2")],
+     r"gamma: no level describes its multipliers"),
+    (lambda d, p: [d.pop("gamma"), d.update(norm="L2")], r"norm: H and a level's 'multipliers' need the key 'gamma'"),
+    (lambda d, p: [d["levels"][0].pop("multipliers"), d.update(norm="L2")],
+     r"levels\[0\]\.traces: only with levels\[0\]\.multipliers"),
     (lambda d, p: d["levels"][0].update(G="nothere.mtx"), r"nothere\.mtx"),
     (lambda d, p: [_general_form(d, p), _mult(d).update(dofs=[[0, 1]] * 3)],
      r"multipliers\.dofs: expected an integer array of shape \(N, s \+ 1\) = \(4, 2\)"),
@@ -312,6 +315,15 @@ HOSTILE = [
     (lambda d, p: [_general_form(d, p), _mult(d).update(coefficients=[[0, 0], [0, 0]])],
      r"multipliers\.coefficients: basis function 0 \(row 0 of B\) is zero on every interval"),
 ]
+
+
+def test_an_l2_mass_of_another_basis_is_refused_under_norm_l2(tmp_path, capsys):
+    """norm: L2 with a description: G (the L2 mass of T3's P_1) against P_0 on 3 cells (m = 3 too)."""
+    def change(d, p):
+        d.update(norm="L2")
+        d["levels"][0].pop("traces")
+        d["levels"][0]["multipliers"] = {"basis": "discontinuous", "degree": 0, "breakpoints": [0, 1 / 3, 2 / 3, 1]}
+    _spoil(tmp_path, capsys, change, r"G0\.mtx: differs from the L2 mass of levels\[0\]\.multipliers by", dry=False)
 
 
 def test_a_linearly_dependent_basis_is_refused_where_its_gram_is_factorized(tmp_path, capsys):
@@ -517,3 +529,22 @@ def test_elastic_model_described(tmp_path):
         ref, = beta_rows("structured", 2, n + 1, n, ["T3"], norms=("H",), model=ELASTIC)
         _agree(row, ref)
         assert row["coupling_distance"] <= 1e-14
+
+
+@pytest.mark.parametrize("norm", ["L2", "h-L2", "given"])
+def test_a_description_under_the_other_norms(tmp_path, norm):
+    """The same export judged in another norm (the action's override): L2 and h-L2 take G, the L2
+    mass, checked against the description (β the L2 one, h-L2 β/√h); given takes G as it is; the
+    traces' distance in every norm."""
+    import yaml
+
+    levels, _, gamma = suite_levels("T3", 1, NS, 1)
+    path = write_system(tmp_path, levels, "mtx", "t3", "H", gamma=gamma)
+    described = system_rows(load_manifest(path, 1), notes=io.StringIO())
+    data = yaml.safe_load(path.read_text())
+    path.write_text(yaml.safe_dump(dict(data, norm=norm)))
+    rows = system_rows(load_manifest(path, 1), notes=io.StringIO())
+    for n, row, ref in zip(NS, rows, described):
+        weight = 1.0 / np.sqrt(row["h"]) if norm == "h-L2" else 1.0
+        assert abs(row["beta"] - ref["beta_L2"] * weight) <= 1e-12 * row["beta"]
+        assert row["coupling_distance"] <= 1e-14 and "beta_L2" not in row

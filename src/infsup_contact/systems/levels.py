@@ -42,7 +42,7 @@ def _load_level(manifest: Manifest, level):
     A = sp.csr_matrix(A) if not sp.issparse(A) else A
     B = sp.csr_matrix(B) if not sp.issparse(B) else B
     mass, info = None, None
-    if manifest.norm == "H":
+    if level.multipliers is not None:
         from .multiplier_gram import described_grams
 
         level, G, mass, info = described_grams(manifest, level, B, G)
@@ -82,8 +82,10 @@ def system_rows(manifest: Manifest, route: str = "auto", notes=sys.stderr) -> li
             t_read=t_read, t_factorize=res.seconds.get("factorize", np.nan),
             t_eigen=res.seconds.get("eigen", np.nan), t_kernel=res.seconds["kernel"],
             notes="; ".join(lv.notes)))
+        if info is not None:  # described: B's distance to the exact coupling of described traces
+            rows[-1]["coupling_distance"] = info["coupling_distance"]
         if manifest.norm == "H":  # the Gram's stated error, and the L2 row beside it where G is given
-            rows[-1].update(gram_rel_error=info["nmax_rel_error"], coupling_distance=info["coupling_distance"])
+            rows[-1]["gram_rel_error"] = info["nmax_rel_error"]
             l2 = (level_spectrum(lv.A, lv.B, mass, manifest.known_kernel, route)
                   if mass is not None and mass.shape[0] == lv.B.shape[0] else None)
             rows[-1].update(beta_L2=np.nan if l2 is None else l2.beta,
@@ -108,7 +110,7 @@ def system_verdict(manifest: Manifest, *, tol: float, floor: float, confidence: 
         l2 = stability_verdict([dict(r, beta=r["beta_L2"], smallest_nonzero=r["smallest_nonzero_L2"]) for r in series],
                                tol, floor, confidence)
         out.update(verdict_L2=l2["verdict"], beta_min_L2=l2["beta_min"], slope_L2=l2["slope"])
-    if manifest.norm == "H" and any(np.isfinite(r["coupling_distance"]) for r in rows):
+    if any(np.isfinite(r.get("coupling_distance", np.nan)) for r in rows):
         out["coupling_distance_max"] = float(np.nanmax([r["coupling_distance"] for r in rows]))
     if out["verdict"] == "UNSTABLE" and out["kernel_dim"] > 0:  # name the kernel nobody declared
         dims = [r["kernel_detected"] for r in rows]
@@ -144,7 +146,7 @@ def dry_check(manifest: Manifest, route: str = "auto"):
             if mat is not None:
                 check_finite(mat, path)
         A, B, G = mats
-        if manifest.norm == "H":  # the description read, its Gram's memory counted (never assembled here)
+        if level.multipliers is not None:  # the description read, its Gram's memory counted (never made here)
             from .multiplier_gram import check_description
 
             level, G, bytes_, _ = check_description(manifest, level, B, G)

@@ -30,9 +30,11 @@ A (n × n) SPD, B (m × n), G (m × m) the multiplier norm. Optional keys:
 per level, ``constrained``
     the 0-based dofs the producer fixed but left in A (identity or penalty rows): a list,
     or a file (``.txt``: whitespace-separated integers, ``.npy``); they are removed;
-per level, with ``norm: H``, ``multipliers`` (required) and ``traces`` (optional)
+per level, ``multipliers`` (required with ``norm: H``) and ``traces``, with the top key ``gamma``
     the description of B's rows on Γ (:mod:`.multiplier_basis`) and of the bodies' trace bases
-    (:mod:`.mortar_distance`); ``G`` is then optional.
+    (:mod:`.mortar_distance`). With ``norm: H`` G is optional and the Gram is assembled from the
+    description; with ``L2`` or ``h-L2`` G (the L² mass) is checked against it; with ``given``
+    G is taken as it is. ``traces`` add B's distance to the exact coupling to the row.
 """
 from __future__ import annotations
 
@@ -132,23 +134,32 @@ def load_manifest(path, min_levels: int = MIN_LEVELS) -> Manifest:
     expect = data.get("expect")
     if expect is not None and expect not in EXPECTS:
         raise SystemFileError(path, f"expect: {expect!r} is not one of {', '.join(EXPECTS)}")
-    gamma = None
-    if norm == "H":
-        from .multiplier_basis import parse_gamma
-
-        if "gamma" not in data:
-            raise SystemFileError(path, "norm: H needs the key 'gamma' ({shape: segment, length: L} or "
-                                  "{shape: rectangle, size: [a, b]}) and per level 'multipliers'")
-        gamma = parse_gamma(path, data["gamma"])
-    elif "gamma" in data:
-        raise SystemFileError(path, f"gamma: only with norm: H (the multipliers described on Γ); norm is {norm!r}")
     parsed = tuple(_level(path, i, entry, norm) for i, entry in enumerate(levels))
+    gamma = _gamma(path, data, norm, parsed)
     hs = [lv.h for lv in parsed]
     for i in range(1, len(hs)):
         if not hs[i] < hs[i - 1]:
             raise SystemFileError(path, f"levels[{i}].h = {hs[i]:g} does not decrease (levels[{i - 1}].h = "
                                   f"{hs[i - 1]:g}): list the levels coarse to fine, each h once")
     return Manifest(path, str(name), norm, known, tgv, parsed, expect=expect, gamma=gamma)
+
+
+def _gamma(path, data, norm: str, levels):
+    """The top key ``gamma``: required with norm H, and wherever a level describes its multipliers
+    (with norm L2 or h-L2 they check G, the L² mass, and give the traces' distance); refused
+    where nothing is described (it would be read for nothing)."""
+    from .multiplier_basis import parse_gamma
+
+    described = [lv.index for lv in levels if lv.multipliers is not None]
+    if "gamma" not in data:
+        if norm == "H" or described:
+            raise SystemFileError(path, "norm: H and a level's 'multipliers' need the key 'gamma' ({shape: segment, "
+                                  "length: L} or {shape: rectangle, size: [a, b]})")
+        return None
+    if not described:
+        raise SystemFileError(path, "gamma: no level describes its multipliers (levels[i].multipliers), so Γ "
+                              "has no use here")
+    return parse_gamma(path, data["gamma"])
 
 
 def _one_line(path, key: str, text: str) -> None:
@@ -172,9 +183,9 @@ def _level(path: Path, i: int, entry, norm: str = "given") -> Level:
     if missing:
         raise SystemFileError(path, f"{where}: missing key {missing[0]!r} (each level needs {', '.join(needed)}"
                               + (")" if norm != "H" else "; G optional: the L2 mass)"))
-    for key in ("multipliers", "traces"):
-        if norm != "H" and key in entry:
-            raise SystemFileError(path, f"{where}.{key}: only with norm: H (norm is {norm!r})")
+    if "traces" in entry and "multipliers" not in entry:
+        raise SystemFileError(path, f"{where}.traces: only with {where}.multipliers (the coupling is measured "
+                              "against the described multipliers)")
     mult = entry.get("multipliers")
     if isinstance(mult, str):
         _one_line(path, f"{where}.multipliers", mult)

@@ -110,6 +110,8 @@ def check_description(manifest, level, B, G_file) -> tuple:
     if G_file is not None and G_file.shape != (d.m, d.m):
         raise SystemFileError(level.G, f"G is {G_file.shape[0]} x {G_file.shape[1]}; with norm: H it is the L2 mass "
                               f"of the {d.m} described multipliers ({d.m} x {d.m})")
+    if manifest.norm != "H":  # G is the file's; with L2 / h-L2 its dense copy meets the mass
+        return level, G_file, (8.0 * 4 * d.m * d.m if manifest.norm in ("L2", "h-L2") else 0.0), d
     stand_in = np.broadcast_to(0.0, (d.m, d.m))  # dense like the Gram (the route), no memory
     return replace(level, G=_label(manifest, level)), stand_in, gram_bytes(d), d
 
@@ -138,18 +140,22 @@ def _independent(d, M) -> None:
 
 
 def described_grams(manifest, level, B, G_file) -> tuple:
-    """(level, H Gram, L² mass from the G file or None, the H Gram's info) of a ``norm: H``
-    level; a G file farther than :data:`MASS_RTOL` from the description's L² mass is refused.
-    ``info["coupling_distance"]``: B's distance to the exact coupling of the described traces
-    (:mod:`.mortar_distance`; NaN without ``traces``)."""
+    """(level, G, L² mass from the G file or None, info) of a level describing its multipliers.
+    ``norm: H``: G the described H Gram (``info`` its series' info), the G file (optional) the L²
+    mass; ``L2`` / ``h-L2``: G the file's, checked as the L² mass; ``given``: G the file's,
+    unchecked. A G file farther than :data:`MASS_RTOL` from the description's L² mass is
+    refused. ``info["coupling_distance"]``: B's distance to the exact coupling of the described
+    traces (:mod:`.mortar_distance`; NaN without ``traces``)."""
     from .checks import check_finite, check_gram
     from .mortar_distance import coupling_distance
 
     labelled, _, _, d = check_description(manifest, level, B, G_file)
     distance = coupling_distance(manifest, level, d, B)
+    if manifest.norm == "given":
+        return level, G_file, None, {"coupling_distance": distance}
     M = gram(d, "L2")[0]
     _independent(d, M)
-    G, info = gram(d, "H")
+    G, info = gram(d, "H") if manifest.norm == "H" else (G_file, {})
     mass = None
     if G_file is not None:
         check_finite(G_file, level.G)
@@ -158,5 +164,5 @@ def described_grams(manifest, level, B, G_file) -> tuple:
             raise SystemFileError(level.G, f"differs from the L2 mass of levels[{level.index}].multipliers by "
                                   f"{dist:.3g} relative (Frobenius; round-off is below {MASS_RTOL:g}): B's rows in "
                                   "another order than the description (rows:), another basis, or other breakpoints?")
-        mass = check_gram(G_file, level.G)
+        mass = check_gram(G_file, level.G) if manifest.norm == "H" else None
     return labelled, G, mass, dict(info, coupling_distance=distance)

@@ -27,11 +27,14 @@ rows, or whose diagonal is not 1)      leaves the pencil of the constrained spac
 multiplier row: a penalty row of G     removed with B's row (the penalty's limit: the pencil
 (g_ii >= 1e15 × median)                tends to that of μ_i = 0, plus one spurious zero mode);
                                        ``tgv: refuse`` refuses it
-multiplier row: B's row zero, G's row  refused, naming both files and the rows: as given β_h = 0
-coupled to other multipliers           (a kernel), and removing the rows would change the norm
-                                       of the rest; unless ``known_kernel`` declares them
-multiplier row: B's row zero, G        kept: a kernel of Bᵀ (UNSTABLE unless declared), with a
-diagonal with the same diagonal there  note (G does not mark it as a constraint)
+multiplier row: B's row zero, G's row  refused, naming both files and the rows: an incomplete
+coupled to others but its diagonal 1   constraint (the unit diagonal set, the row and column
+(G's diagonal elsewhere not 1)         left), where removing the row changes β_h and keeping it
+                                       counts a kernel the producer meant to remove
+multiplier row: B's row zero, G's row  kept: a kernel of Bᵀ (UNSTABLE unless declared), with a
+coupled to others (diagonal not 1), or note. No constraint pattern: removing it would change β_h
+decoupled in a diagonal G with the     (a P1–P1 pressure at a corner whose velocities are all
+same diagonal there                    fixed is such a mode, not a constraint)
 multiplier row: B's and G's rows zero  removed with a note (a multiplier in neither)
 B's row zero only after the dofs it    kept: a kernel of Bᵀ (the multiplier couples only to fixed
 touched were removed                   dofs), with a note
@@ -191,14 +194,14 @@ def _dropped(B, dofs) -> str:
     return f"; B's {on} entries on them dropped" if on else ""
 
 
-def constrained_multipliers(level, B, G, tgv: str, known_kernel: int = 0) -> tuple:
+def constrained_multipliers(level, B, G, tgv: str) -> tuple:
     """(multiplier rows to remove, notes): the multiplier rows of the module's table, B's rows
     judged as given. A refusal names both files and the rows."""
     Gs = sp.csr_matrix(G)
     Gs.eliminate_zeros()
     gdiag = Gs.diagonal()
     zero_b = np.diff(B.indptr) == 0
-    notes, remove = [], []
+    notes, remove = [], [np.zeros(0, int)]
     pen, med = _penalty_rows(gdiag)
     if len(pen):
         where = f"{len(pen)} penalty rows of G (diagonal up to {np.abs(gdiag).max():.3g} vs median {med:.3g}), rows {_rows(pen)}"
@@ -215,32 +218,33 @@ def constrained_multipliers(level, B, G, tgv: str, known_kernel: int = 0) -> tup
                      f"{_rows(both)}) removed")
         remove.append(both)
     rows = np.setdiff1d(np.flatnonzero(zero_b & ~zero_g), pen)
-    if len(rows):
-        dec = _decoupled(Gs, TINY_COUPLING)
-        coupled = rows[~dec[rows]]
-        if len(coupled) > known_kernel:
-            raise SystemFileError(level.B, f"rows {_rows(coupled)} are zero (multipliers coupled to no dof) while G "
-                                  f"({level.G.name}) couples them to other multipliers: as given beta_h = 0, and "
-                                  "removing them would change the norm of the rest; if they are constrained "
-                                  "multipliers, make G's rows and columns there unit rows or drop them from B and "
-                                  "G; if the kernel is meant, declare it with known_kernel")
-        others = np.setdiff1d(np.arange(len(gdiag)), rows)
-        g_couples = len(others) > 0 and not dec[others].all()
-        typical = float(np.median(gdiag[others])) if len(others) else np.nan
-        marked = rows[dec[rows] & (g_couples | (gdiag[rows] != typical))]
-        if len(marked):
-            notes.append(f"{level.B.name}: {len(marked)} constrained multipliers (B's row zero, G's row decoupled: "
-                         f"a boundary condition on the multiplier space), rows {_rows(marked)}, removed")
-            remove.append(marked)
-        kernel = np.setdiff1d(rows, marked)
-        if len(kernel):
-            notes.append(f"{level.B.name}: {len(kernel)} zero rows ({_rows(kernel)}) kept: a kernel of B^T "
-                         "(G does not single them out as constrained: give them unit rows in G if they are)")
-    return np.unique(np.concatenate(remove)).astype(int) if remove else np.zeros(0, int), notes
+    if not len(rows):
+        return np.unique(np.concatenate(remove)).astype(int), notes
+    dec = _decoupled(Gs, TINY_COUPLING)
+    others = np.setdiff1d(np.arange(len(gdiag)), rows)
+    typical = float(np.median(gdiag[others])) if len(others) else np.nan
+    g_couples = len(others) > 0 and not dec[others].all()
+    marked = rows[dec[rows] & (g_couples | (gdiag[rows] != typical))]
+    half = rows[~dec[rows] & (gdiag[rows] == 1.0) & (typical != 1.0)]
+    if len(half):  # a unit diagonal set, the row and column left: neither reading is safe
+        raise SystemFileError(level.G, f"rows {_rows(half)}: B ({level.B.name}) is zero there and G's diagonal is 1 "
+                              "(a unit row: constrained multipliers?) but G still couples them to other multipliers: "
+                              "removing them would change beta_h, keeping them counts a kernel; zero G's rows and "
+                              "columns there but the diagonal, or drop the rows from B and G")
+    if len(marked):
+        notes.append(f"{level.B.name}: {len(marked)} constrained multipliers (B's row zero, G's row decoupled: "
+                     f"a boundary condition on the multiplier space), rows {_rows(marked)}, removed")
+        remove.append(marked)
+    kernel = np.setdiff1d(rows, marked)
+    if len(kernel):
+        notes.append(f"{level.B.name}: {len(kernel)} zero rows ({_rows(kernel)}) kept: a kernel of B^T ("
+                     + ("G couples them to other multipliers, so they are not constrained ones"
+                        if not dec[kernel].all() else "G does not single them out: give them unit rows in G if "
+                        "they are constrained") + ")")
+    return np.unique(np.concatenate(remove)).astype(int), notes
 
 
-def check_level(level, A, B, G, constrained=np.zeros(0, int), tgv: str = "eliminate",
-                known_kernel: int = 0) -> CheckedLevel:
+def check_level(level, A, B, G, constrained=np.zeros(0, int), tgv: str = "eliminate") -> CheckedLevel:
     """Run every check on one level (module docstring); the matrices as read."""
     for mat, path in ((A, level.A), (B, level.B), (G, level.G)):
         check_finite(mat, path)
@@ -248,7 +252,7 @@ def check_level(level, A, B, G, constrained=np.zeros(0, int), tgv: str = "elimin
     A, B = sp.csr_matrix(A), sp.csr_matrix(B)
     A.eliminate_zeros()
     B.eliminate_zeros()
-    mult, notes = constrained_multipliers(level, B, G, tgv, known_kernel)
+    mult, notes = constrained_multipliers(level, B, G, tgv)
     dofs, more = constrained_displacements(level, A, B, constrained, tgv)
     notes += more
     keep_m = np.setdiff1d(np.arange(B.shape[0]), mult)

@@ -105,8 +105,8 @@ class LevelSpectrum:
         ``factorize``, ``eigen``, ``kernel`` wall times.
     roundoff : EntryRoundoff
         r, the entries' relative accuracy in η, and its source (:mod:`.roundoff`).
-    entry_error : float
-        E(r), the bound on ‖δW‖_F in η.
+    entry_error_unit : float
+        E(1): E(r) = r · E(1) is the bound on ‖δW‖_F in η (:mod:`.roundoff`, (1)).
     pencil_margin : float
         log10(λ_{d+1} / (m ε λ_max)): the first eigenvalue above the kernel over the pencil's
         round-off level, in decades (the cross-check of the kernel decision).
@@ -121,7 +121,7 @@ class LevelSpectrum:
     n_touched: int
     seconds: dict = field(default_factory=dict)
     roundoff: EntryRoundoff | None = None
-    entry_error: float = 0.0
+    entry_error_unit: float = 0.0
     pencil_margin: float = np.inf
 
 
@@ -161,15 +161,15 @@ def choose_route(n: int, m: int, n_touched: int, sparse_g: bool = False) -> str:
     return "gamma-dense" if gamma_bytes <= solves_bytes else "solves-dense"
 
 
-def scaled_coupling(A, B, G, touched, rtol: float = 0.0):
-    """W = D_A^{-1/2} Bᵀ D_G^{-1/2} on the touched dofs (D = the diagonals); with ``rtol`` > 0,
-    (W, E(rtol)) where E bounds the round-off ‖δW‖_F of entries accurate to rtol · max |b|
-    (:func:`.roundoff.entry_error_bound`)."""
+def scaled_coupling(A, B, G, touched, with_bound: bool = False):
+    """W = D_A^{-1/2} Bᵀ D_G^{-1/2} on the touched dofs (D = the diagonals); ``with_bound``:
+    (W, E(1)) with E(r) = r · E(1) the bound on the round-off ‖δW‖_F of entries accurate to
+    r · max |b| (:func:`.roundoff.entry_error_bound`)."""
     da = np.sqrt(sp.csr_matrix(A).diagonal()[touched])
     dg = np.sqrt(np.asarray(G.diagonal() if sp.issparse(G) else np.diag(G), float))
     Bt = sp.csc_matrix(B)[:, touched].T.tocsr()
     W = sp.diags(1.0 / da) @ Bt @ sp.diags(1.0 / dg)
-    return (W, entry_error_bound(Bt, da, dg, rtol)) if rtol > 0 else W
+    return (W, entry_error_bound(Bt, da, dg, 1.0)) if with_bound else W
 
 
 def level_spectrum(A, B, G, known_kernel: int = 0, route: str = "auto", entry_rtol=None) -> LevelSpectrum:
@@ -197,8 +197,8 @@ def level_spectrum(A, B, G, known_kernel: int = 0, route: str = "auto", entry_rt
     seconds = {}
     t0 = time.perf_counter()
     roundoff = entry_roundoff(B, entry_rtol)
-    W, E = scaled_coupling(A, B, G, touched, roundoff.rtol) if roundoff.rtol > 0 else (
-        scaled_coupling(A, B, G, touched), 0.0)
+    W, unit = scaled_coupling(A, B, G, touched, with_bound=True)
+    E = roundoff.rtol * unit
     deflate = route == "shift-invert"  # the kernel's basis is deflated there (:func:`_shift_invert`)
     if 8.0 * W.shape[0] * W.shape[1] <= SVD_MAX_BYTES:
         kernel = coupling_kernel(W.toarray(), known_kernel, entry_error=E, vectors=deflate)
@@ -222,14 +222,15 @@ def level_spectrum(A, B, G, known_kernel: int = 0, route: str = "auto", entry_rt
     above = float(np.sqrt(max(ev[d], 0.0))) if d < len(ev) else np.nan
     p = min(kernel.proven, len(ev) - 1)
     beta = 0.0 if kernel.detected > 0 else float(np.sqrt(max(ev[p], 0.0)))
-    return LevelSpectrum(beta, above, kernel, ev, route, resid, len(touched), seconds, roundoff, E, pencil_margin)
+    return LevelSpectrum(beta, above, kernel, ev, route, resid, len(touched), seconds, roundoff, unit, pencil_margin)
 
 
 def close_advice(res: LevelSpectrum, B_max: float | None = None) -> str:
     """What the user of a ``close`` decision can do, in one line: the accuracy r* of B's entries
-    that would put η a decade above the largest singular value below the widest gap of the
-    bottom of the spectrum (at least two decades wide), if there is one — to declare only if the
-    entries are that accurate — and the export with 17 significant digits."""
+    that would put η at 20 × the singular value below the widest gap of the bottom of the
+    spectrum, if that gap leaves the next value a decade above η (so the decision would be
+    clear on both sides) — to declare only if the entries are that accurate — and the export
+    with 17 significant digits."""
     k = res.kernel
     r = res.roundoff.rtol if res.roundoff is not None else 0.0
     where = (f"kernel decision close (margin {k.margin_decades:.2f} decades from eta = {k.tol:.2g}; entry "
@@ -240,13 +241,13 @@ def close_advice(res: LevelSpectrum, B_max: float | None = None) -> str:
     s = np.asarray(k.singular[:-1], float)  # the bottom values (σ_max last on the large-W route)
     s = s[s > 0]
     advice = ""
-    if len(s) >= 2 and res.entry_error > 0:
+    if len(s) >= 2 and res.entry_error_unit > 0:
         gaps = np.log10(s[1:] / s[:-1])
         j = int(np.argmax(gaps))
-        per_r = res.entry_error / r  # E(r) = r · per_r
-        svd = k.tol - 2.0 * res.entry_error
-        want = (10.0 * s[j] - svd) / (2.0 * per_r)
-        if gaps[j] >= 2.0 + MARGIN_DECADES and want > r:
+        svd = k.tol - 2.0 * r * res.entry_error_unit  # η = svd + 2 r E(1)
+        lift = 2.0 * 10.0 ** MARGIN_DECADES  # η at 20 s_j: the counted zeros 1.3 decades below it
+        want = (lift * s[j] - svd) / (2.0 * res.entry_error_unit)
+        if gaps[j] >= np.log10(lift) + MARGIN_DECADES + 0.3 and want > r:
             advice = (f"if B's entries are accurate to {float(f'{want:.1g}'):g} x max|b| (the singular values of the "
                       f"scaled B^T jump from {s[j]:.2g} to {s[j + 1]:.2g}), declare entry_rtol: "
                       f"{float(f'{want:.1g}'):g} in the manifest; ")

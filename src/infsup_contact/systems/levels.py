@@ -32,7 +32,7 @@ def load_level(manifest: Manifest, level):
     A, B, G = (read_matrix(p) for p in (level.A, level.B, level.G))
     A = sp.csr_matrix(A) if not sp.issparse(A) else A
     B = sp.csr_matrix(B) if not sp.issparse(B) else B
-    checked = check_level(level, A, B, G, constrained_dofs(level, A.shape[0]), manifest.tgv, manifest.known_kernel)
+    checked = check_level(level, A, B, G, constrained_dofs(level, A.shape[0]), manifest.tgv)
     if manifest.norm == "h-L2":
         checked.G = checked.G * level.h
     return checked

@@ -18,7 +18,7 @@ import scipy.sparse as sp
 
 from infsup_contact.cli import main
 from infsup_contact.solvers.kernel import coupling_kernel, error_level
-from infsup_contact.systems.engine import level_spectrum, scaled_coupling, touched_dofs
+from infsup_contact.systems.engine import close_advice, level_spectrum, scaled_coupling, touched_dofs
 from infsup_contact.systems.export import suite_system, write_system
 from infsup_contact.systems.levels import system_rows, system_verdict
 from infsup_contact.systems.manifest import load_manifest
@@ -78,6 +78,8 @@ def test_rounded_entries_give_the_proven_kernel_or_close(case, delta):
             bound = np.sqrt(np.diff(Bn.indptr).max()) * delta
             assert res.roundoff.source == "estimated" and delta / 2 <= res.roundoff.rtol <= bound
             assert k.dim == PROVEN[case] or k.decision == "close", (case, delta, seed, n, k.dim, k.margin_decades)
+            if k.decision == "close":  # the reason, and what to do
+                assert "declare entry_rtol" in close_advice(res) and "17 significant digits" in close_advice(res)
             # the test can fail: the exact-entry threshold of before miscounts some of these
             W = scaled_coupling(A, Bn, G, touched_dofs(Bn)).toarray()
             before = coupling_kernel(W)
@@ -176,6 +178,23 @@ def test_hidden_round_off_is_caught_by_the_pencil(tmp_path, capsys):
     assert main(["beta", "--system", str(m.path)]) == 0
     header = capsys.readouterr().out.splitlines()[0].split(",")
     assert {"entry_rtol_used", "entry_rtol_source", "pencil_margin_decades"} <= set(header)
+
+
+def test_an_eta_that_swallows_a_real_singular_value_is_close():
+    """B = diag(1e-3, 1, 1.5, …, 3), A = G = I, and entry_rtol declared as 2e-3: η = 2 r max|b|
+    √m ≈ 0.03 sits 1.5 decades from both 1e-3 and 1, so the singular values alone call 1e-3 a
+    clear one-dimensional kernel. Its pencil eigenvalue 1e-6 stands nine decades above the
+    pencil's round-off m ε λ_max: the cross-check makes the decision close."""
+    s = np.array([1e-3, 1.0, 1.5, 2.0, 2.5, 3.0])
+    m = len(s)
+    A, B, G = sp.identity(m, format="csr"), sp.diags(s, format="csr"), np.eye(m)
+    W = scaled_coupling(A, B, G, touched_dofs(B)).toarray()
+    alone = coupling_kernel(W, entry_error=2e-3 * 3.0 * np.sqrt(m))
+    assert alone.dim == 1 and alone.decision == "clear"  # what the singular values alone decide
+    res = level_spectrum(A, B, G, entry_rtol=2e-3)
+    assert res.kernel.tol == pytest.approx(alone.tol, rel=1e-12)
+    assert res.kernel.dim == 1 and res.kernel.decision == "close"
+    assert res.bottom[0] == pytest.approx(1e-6, rel=1e-8)
 
 
 @pytest.mark.parametrize("value", ["-1e-15", "1.5", "abc", "true", "[1e-15]", ".nan", ".inf", "{a: 1}"])

@@ -258,3 +258,36 @@ def test_rows_report_what_was_removed(tmp_path):
     path = write_system(tmp_path, [(1.0 / (i + 1), A, Bc, Gc) for i in range(3)], "npz", "toy")
     rows = system_rows(load_manifest(path), notes=io.StringIO())
     assert all(r["removed_multipliers"] == 2 and r["m"] == B.shape[0] - 2 for r in rows)
+
+
+def test_a_unit_diagonal_everywhere_keeps_decoupled_dofs(tmp_path):
+    """A Jacobi-scaled A (unit diagonal everywhere): a dof coupled to nothing but touched by B is
+    not told from a constrained one by its diagonal, so it is kept (a bubble), with the note."""
+    A, B, G = _suite("T3")
+    d = np.sqrt(A.diagonal())
+    J = sp.csr_matrix(sp.diags(1.0 / d) @ A @ sp.diags(1.0 / d))
+    Bj = sp.csr_matrix(B @ sp.diags(1.0 / d))
+    dof = int(touched_dofs(B)[3])
+    Jd = J.tolil()
+    Jd[dof, :] = 0.0
+    Jd[:, dof] = 0.0
+    Jd[dof, dof] = 1.0
+    _, lv = _level0(tmp_path, Jd.tocsr(), Bj, G)
+    assert lv.removed == 0 and any("(element bubbles?) kept" in note for note in lv.notes), lv.notes
+
+
+@pytest.mark.parametrize("what", ["multipliers", "dofs"])
+def test_nothing_left_is_one_line(tmp_path, what):
+    """Every multiplier (or every dof) constrained: refused in one line, not an empty eigenproblem."""
+    A, B, G = _suite("T3")
+    level_extra = ""
+    if what == "multipliers":
+        B, G = _unit_rows(B, G, np.arange(B.shape[0]))
+        B = sp.csr_matrix(B.shape)
+        name = "B0.npz"
+    else:
+        level_extra = f"constrained: {list(range(A.shape[0]))}"
+        name = "A0.npz"
+    with pytest.raises(SystemFileError, match="is constrained .*nothing is left") as err:
+        _level0(tmp_path, A, B, G, level_extra=level_extra)
+    assert name in str(err.value) and "\n" not in str(err.value)

@@ -257,6 +257,10 @@ def check_level(level, A, B, G, constrained=np.zeros(0, int), tgv: str = "elimin
     notes += more
     keep_m = np.setdiff1d(np.arange(B.shape[0]), mult)
     keep_n = np.setdiff1d(np.arange(A.shape[0]), dofs)
+    for left, path, what in ((keep_m, level.B, "multiplier rows"), (keep_n, level.A, "dofs")):
+        if not len(left):
+            raise SystemFileError(path, f"every one of its {what} is constrained ({'; '.join(notes)}): nothing "
+                                  "is left to compute beta_h on")
     was_zero = np.diff(B.indptr)[keep_m] == 0
     A, B = A[keep_n][:, keep_n], B[keep_m][:, keep_n]
     G = sp.csr_matrix(G)[keep_m][:, keep_m] if sp.issparse(G) else np.asarray(G, float)[np.ix_(keep_m, keep_m)]

@@ -1,7 +1,10 @@
 """A manifest's levels → one β row per level → the verdict, by ``verdict --case``'s criterion.
 
 The rows carry what :func:`infsup_contact.study.verdict.stability_verdict` reads (``N2`` is
-1/h, so its h is the manifest's) plus the route, residual, kernel decision and notes. The
+1/h, so its h is the manifest's) plus the route, residual, kernel decision, the entries'
+round-off in η (``entry_rtol_used``, ``entry_rtol_source``), the pencil's cross-check
+(``pencil_margin_decades``), what a close decision asks of the user (``kernel_advice``), the
+constrained rows removed (``removed_dofs``, ``removed_multipliers``) and notes. The
 norm caveats (module :mod:`.manifest`, key ``norm``) are part of every row.
 """
 from __future__ import annotations

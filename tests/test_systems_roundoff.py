@@ -120,6 +120,7 @@ def test_a_declared_true_kernel_is_accepted_and_stable_stays_stable(tmp_path, de
             rows = system_rows(m, notes=io.StringIO())  # refused before: "the declared kernel is not a kernel"
             assert all(r["known_kernel"] == d and (r["kernel_detected"] == 0 or r["kernel_decision"] == "close")
                        for r in rows)
+            assert all(r["entry_rtol_source"] == "estimated" and "tiny entries" in r["notes"] for r in rows)
             for _, A, Bn, G in levels:
                 W = scaled_coupling(A, Bn, G, touched_dofs(Bn)).toarray()
                 s = np.sort(np.linalg.svd(W, compute_uv=False))

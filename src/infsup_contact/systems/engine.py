@@ -225,12 +225,12 @@ def level_spectrum(A, B, G, known_kernel: int = 0, route: str = "auto", entry_rt
     return LevelSpectrum(beta, above, kernel, ev, route, resid, len(touched), seconds, roundoff, unit, pencil_margin)
 
 
-def close_advice(res: LevelSpectrum, B_max: float | None = None) -> str:
+def close_advice(res: LevelSpectrum) -> str:
     """What the user of a ``close`` decision can do, in one line: the accuracy r* of B's entries
     that would put η at 20 × the singular value below the widest gap of the bottom of the
-    spectrum, if that gap leaves the next value a decade above η (so the decision would be
-    clear on both sides) — to declare only if the entries are that accurate — and the export
-    with 17 significant digits."""
+    spectrum, if that gap leaves the next value 20 × above η too (the decision would then be
+    clear by 1.3 decades on both sides; rounding r* to one digit keeps more than one) — to
+    declare only if the entries are that accurate — and the export with 17 significant digits."""
     k = res.kernel
     r = res.roundoff.rtol if res.roundoff is not None else 0.0
     where = (f"kernel decision close (margin {k.margin_decades:.2f} decades from eta = {k.tol:.2g}; entry "
@@ -247,7 +247,7 @@ def close_advice(res: LevelSpectrum, B_max: float | None = None) -> str:
         svd = k.tol - 2.0 * r * res.entry_error_unit  # η = svd + 2 r E(1)
         lift = 2.0 * 10.0 ** MARGIN_DECADES  # η at 20 s_j: the counted zeros 1.3 decades below it
         want = (lift * s[j] - svd) / (2.0 * res.entry_error_unit)
-        if gaps[j] >= np.log10(lift) + MARGIN_DECADES + 0.3 and want > r:
+        if gaps[j] >= 2.0 * np.log10(lift) and want > r:
             advice = (f"if B's entries are accurate to {float(f'{want:.1g}'):g} x max|b| (the singular values of the "
                       f"scaled B^T jump from {s[j]:.2g} to {s[j + 1]:.2g}), declare entry_rtol: "
                       f"{float(f'{want:.1g}'):g} in the manifest; ")

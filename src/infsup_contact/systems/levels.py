@@ -59,6 +59,8 @@ def system_rows(manifest: Manifest, route: str = "auto", notes=sys.stderr) -> li
             raise SystemFileError(manifest.path, f"known_kernel = {k.proven}, but at levels[{level.index}] only "
                                   f"{k.numerical} singular values of the scaled B^T are <= eta = {k.tol:.2g}: the "
                                   "declared kernel is not a kernel of B^T")
+        if res.roundoff.source != "exact":  # what η was raised by, and why
+            lv.notes.append(f"{level.B.name}: {res.roundoff.evidence}")
         advice = close_advice(res) if k.decision == "close" else ""
         for note in lv.notes + ([advice] if advice else []):
             print(f"infsup-contact: note: {note}", file=notes)

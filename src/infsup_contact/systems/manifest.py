@@ -23,7 +23,11 @@ A (n × n) SPD, B (m × n), G (m × m) the multiplier norm. Optional keys:
     dimension of a kernel of Bᵀ the producer knows of (the constant pressure of an enclosed
     Stokes flow: 1); β_h is reported on its complement, and a larger kernel is UNSTABLE;
 ``tgv``
-    ``eliminate`` (default) or ``refuse`` dofs fixed by a huge diagonal penalty;
+    ``eliminate`` (default) or ``refuse`` dofs fixed by a huge diagonal penalty (in A or G);
+``entry_rtol``
+    the accuracy of B's entries relative to max |b_ij| (a number in [0, 1); ``1e-15`` for
+    entries summed from quadrature products): it raises the kernel threshold η (module
+    :mod:`.roundoff`); where the data show more round-off than declared, that is used;
 ``expect``
     ``stable`` or ``unstable``: the verdict the producer expects (the exit code of ``verdict``
     without ``--expect`` and of the pre-commit hook follows it);
@@ -52,7 +56,7 @@ from .readers import SystemFileError
 NORMS = ("given", "L2", "h-L2", "H")
 TGV_POLICIES = ("eliminate", "refuse")
 LEVEL_KEYS = ("h", "A", "B", "G", "constrained", "multipliers", "traces")
-TOP_KEYS = ("levels", "name", "norm", "known_kernel", "tgv", "expect", "gamma")
+TOP_KEYS = ("levels", "name", "norm", "known_kernel", "tgv", "expect", "entry_rtol", "gamma")
 EXPECTS = ("stable", "unstable")
 MANIFEST_MAX_BYTES = 1 << 20
 """Largest manifest read (a manifest of 1,000 levels is ~60 kB)."""
@@ -86,6 +90,7 @@ class Manifest:
     tgv: str
     levels: tuple
     expect: str | None = None
+    entry_rtol: float | None = None
     gamma: object = None  # with norm H: a multiplier_basis.Gamma
 
 
@@ -134,6 +139,7 @@ def load_manifest(path, min_levels: int = MIN_LEVELS) -> Manifest:
     expect = data.get("expect")
     if expect is not None and expect not in EXPECTS:
         raise SystemFileError(path, f"expect: {expect!r} is not one of {', '.join(EXPECTS)}")
+    entry_rtol = _entry_rtol(path, data.get("entry_rtol"))
     parsed = tuple(_level(path, i, entry, norm) for i, entry in enumerate(levels))
     gamma = _gamma(path, data, norm, parsed)
     hs = [lv.h for lv in parsed]
@@ -141,7 +147,8 @@ def load_manifest(path, min_levels: int = MIN_LEVELS) -> Manifest:
         if not hs[i] < hs[i - 1]:
             raise SystemFileError(path, f"levels[{i}].h = {hs[i]:g} does not decrease (levels[{i - 1}].h = "
                                   f"{hs[i - 1]:g}): list the levels coarse to fine, each h once")
-    return Manifest(path, str(name), norm, known, tgv, parsed, expect=expect, gamma=gamma)
+    return Manifest(path, str(name), norm, known, tgv, parsed, expect=expect, entry_rtol=entry_rtol,
+                    gamma=gamma)
 
 
 def _gamma(path, data, norm: str, levels):
@@ -160,6 +167,21 @@ def _gamma(path, data, norm: str, levels):
         raise SystemFileError(path, "gamma: no level describes its multipliers (levels[i].multipliers), so Γ "
                               "has no use here")
     return parse_gamma(path, data["gamma"])
+
+
+def _entry_rtol(path, value):
+    """The declared ``entry_rtol`` (None when absent). YAML 1.1 reads ``1e-15`` (no dot) as text,
+    so a string that is a plain number is taken as that number."""
+    if value is None:
+        return None
+    try:
+        rtol = float(value) if isinstance(value, (str, int, float)) and not isinstance(value, bool) else math.nan
+    except ValueError:
+        rtol = math.nan
+    if not (math.isfinite(rtol) and 0.0 <= rtol < 1.0):
+        raise SystemFileError(path, f"entry_rtol: expected a number in [0, 1), the accuracy of B's entries relative "
+                              f"to max |b_ij| (e.g. 1e-15; found {value!r:.40})")
+    return rtol
 
 
 def _one_line(path, key: str, text: str) -> None:

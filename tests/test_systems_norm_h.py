@@ -548,3 +548,28 @@ def test_a_description_under_the_other_norms(tmp_path, norm):
         weight = 1.0 / np.sqrt(row["h"]) if norm == "h-L2" else 1.0
         assert abs(row["beta"] - ref["beta_L2"] * weight) <= 1e-12 * row["beta"]
         assert row["coupling_distance"] <= 1e-14 and "beta_L2" not in row
+
+
+@pytest.mark.parametrize("k", [1, 2])
+def test_constrained_end_multipliers_described_in_full(tmp_path, capsys, k):
+    """The FE way to make μ vanish at Γ's ends: R5.2 (continuous P_k, ends kept) described in full,
+    its end rows constrained in the export (B's rows zero, G's rows unit). The Gram of the
+    constrained space is the description's without those rows: T3's β_h to 1e-10, the L2 check on
+    the rows kept, the traces exact there, and a note."""
+    levels, norm, gamma = suite_levels("R5.2", k, NS, 1)
+    spoiled = []
+    for h, A, B, G, mult, traces in levels:
+        B, G = B.tolil(), G.copy()
+        for r in (0, B.shape[0] - 1):  # the end nodes: rows 0 and m - 1 (left to right)
+            B[r, :] = 0.0
+            G[r, :] = G[:, r] = 0.0
+            G[r, r] = 1.0
+        spoiled.append((h, A, B.tocsr(), G, mult, traces))
+    m = load_manifest(write_system(tmp_path, spoiled, "mtx", "r52-ends", norm, gamma=gamma), 1)
+    notes = io.StringIO()
+    for n, row in zip(NS, system_rows(m, notes=notes)):
+        ref, = beta_rows("structured", k, n + 1, n, ["T3"], norms=("H",))
+        assert row["kernel_dim"] == 0 and row["removed_multipliers"] == 2
+        assert abs(row["beta"] - ref["beta"]) <= 1e-10 * ref["beta"]
+        assert row["coupling_distance"] <= 1e-14
+    assert "2 constrained multipliers" in notes.getvalue()

@@ -48,8 +48,11 @@ def _load_level(manifest: Manifest, level):
     if level.multipliers is not None:
         from .multiplier_gram import described_grams
 
-        level, G, mass, info = described_grams(manifest, level, B, G)
+        level, B, G, mass, info = described_grams(manifest, level, B, G)
     checked = check_level(level, A, B, G, constrained_dofs(level, A.shape[0]), manifest.tgv)
+    if info and info.get("removed_multipliers"):  # constrained rows the description's Gram left out
+        checked.notes[:0] = info["notes"]
+        checked.removed_multipliers += info["removed_multipliers"]
     if manifest.norm == "h-L2":
         checked.G = checked.G * level.h
     return checked, mass, info

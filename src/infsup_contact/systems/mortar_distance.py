@@ -83,12 +83,14 @@ def _interface(described):
     return SEGMENT if described.gamma.shape == "segment" else SQUARE
 
 
-def coupling_distance(manifest, level, described, B) -> float:
+def coupling_distance(manifest, level, described, B, rows=None) -> float:
     """‖B − B_exact‖_F / ‖B_exact‖_F for the level's described traces (B as read, before any
-    dof is removed), or NaN without ``traces``."""
+    dof is removed; on its ``rows`` only, default all), or NaN without ``traces``."""
     if level.traces is None:
         return float("nan")
     exact = exact_coupling(described, _traces(manifest, level, B.shape[1]), B.shape[1])
+    if rows is not None:
+        B, exact = sp.csr_matrix(B)[rows], exact[rows]
     norm = sparse_norm(exact)
     if not norm > 0:
         raise SystemFileError(manifest.path, f"levels[{level.index}].traces: the described traces do not meet the "

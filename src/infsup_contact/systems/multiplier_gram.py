@@ -140,29 +140,49 @@ def _independent(d, M) -> None:
 
 
 def described_grams(manifest, level, B, G_file) -> tuple:
-    """(level, G, L² mass from the G file or None, info) of a level describing its multipliers.
+    """(level, B, G, L² mass from the G file or None, info) of a level describing its multipliers.
     ``norm: H``: G the described H Gram (``info`` its series' info), the G file (optional) the L²
     mass; ``L2`` / ``h-L2``: G the file's, checked as the L² mass; ``given``: G the file's,
     unchecked. A G file farther than :data:`MASS_RTOL` from the description's L² mass is
-    refused. ``info["coupling_distance"]``: B's distance to the exact coupling of the described
-    traces (:mod:`.mortar_distance`; NaN without ``traces``)."""
-    from .checks import check_finite, check_gram
+    refused. Multipliers the producer constrained (B's row zero, G's row decoupled: the rule of
+    :func:`~.checks.constrained_multipliers`) are left out of that comparison and, with ``norm: H``,
+    removed from B and the Gram here (μ_i = 0: the Gram of the constrained space), counted in
+    ``info["removed_multipliers"]`` with ``info["notes"]``. ``info["coupling_distance"]``: B's
+    distance to the exact coupling of the described traces on the rows kept (:mod:`.mortar_distance`;
+    NaN without ``traces``)."""
+    import scipy.sparse as sp
+
+    from .checks import check_finite, check_gram, constrained_multipliers
     from .mortar_distance import coupling_distance
 
     labelled, _, _, d = check_description(manifest, level, B, G_file)
-    distance = coupling_distance(manifest, level, d, B)
+    keep, notes = np.arange(d.m), []
+    if G_file is not None and manifest.norm != "given":
+        check_finite(G_file, level.G)
+        drop, notes = constrained_multipliers(level, sp.csr_matrix(B), G_file, manifest.tgv)
+        keep = np.setdiff1d(keep, drop)
+    distance = coupling_distance(manifest, level, d, B, keep)
     if manifest.norm == "given":
-        return level, G_file, None, {"coupling_distance": distance}
+        return level, B, G_file, None, {"coupling_distance": distance}
     M = gram(d, "L2")[0]
     _independent(d, M)
     G, info = gram(d, "H") if manifest.norm == "H" else (G_file, {})
     mass = None
     if G_file is not None:
-        check_finite(G_file, level.G)
-        dist = mass_distance(G_file, M)
+        sub = np.ix_(keep, keep)
+        dist = mass_distance(sp.csr_matrix(G_file)[keep][:, keep] if sp.issparse(G_file) else G_file[sub], M[sub])
         if not dist <= MASS_RTOL:
             raise SystemFileError(level.G, f"differs from the L2 mass of levels[{level.index}].multipliers by "
                                   f"{dist:.3g} relative (Frobenius; round-off is below {MASS_RTOL:g}): B's rows in "
                                   "another order than the description (rows:), another basis, or other breakpoints?")
-        mass = check_gram(G_file, level.G) if manifest.norm == "H" else None
-    return labelled, G, mass, dict(info, coupling_distance=distance)
+    info = dict(info, coupling_distance=distance)
+    if manifest.norm != "H":  # the checks remove the constrained rows of the file's G themselves
+        return labelled, B, G, mass, info
+    if len(keep) < d.m:
+        B, G = sp.csr_matrix(B)[keep], G[np.ix_(keep, keep)]
+        G_file = None if G_file is None else (sp.csr_matrix(G_file)[keep][:, keep] if sp.issparse(G_file)
+                                              else np.asarray(G_file)[np.ix_(keep, keep)])
+        info.update(removed_multipliers=d.m - len(keep), notes=notes)
+    if G_file is not None:
+        mass = check_gram(G_file, level.G)
+    return labelled, B, G, mass, info

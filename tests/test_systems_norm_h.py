@@ -124,6 +124,10 @@ def test_described_face_reproduces_beta_case(tmp_path, case, k):
     for n, row in zip(ns, system_rows(m, notes=io.StringIO())):
         ref, = beta_rows("structured", k, n + offset, n, [case], norms=("H",), model=FACE_MODEL, element="hex")
         _agree(row, ref)
+        if k == 1:  # the bilinear hats of the traces described too: B is the exact coupling
+            assert row["coupling_distance"] <= 1e-14
+        else:
+            assert np.isnan(row["coupling_distance"])
 
 
 def test_face_only_and_triangle_spaces_keep_the_given_gram():

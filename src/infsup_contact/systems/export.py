@@ -103,11 +103,13 @@ def trace_forms(sides, k: int):
     """The ``traces`` of the two bodies (:mod:`.mortar_distance`): on the segment the general form
     of each side's Γ-dof basis (its values at the equispaced Lagrange nodes of every trace
     interval: the coefficients of those shapes), ``columns`` = the dof of A (Γ dofs last in each
-    block, in the trace's order). None on a face (its Q_k trace bases are not written here)."""
+    block, in the trace's order). On a hexahedral face at k = 1 the bilinear hats, the tensor
+    product of the 1D hats (:func:`_face_trace_forms`); None on other faces (NGSolve's Q_k, k ≥ 2,
+    and P_k bases are not tensor products of 1D Lagrange shapes)."""
     from ..discretization.multipliers import reference_nodes
 
     if sides[0].trace.gamma.dim != 1:
-        return None
+        return _face_trace_forms(sides) if k == 1 and getattr(sides[0].trace.gamma, "cell", "") == "quad" else None
     out, offset = [], 0
     for sign, side in zip((-1, 1), sides):
         tr = side.trace
@@ -122,6 +124,27 @@ def trace_forms(sides, k: int):
         first = offset + side.ndof - len(tr.gamma_dofs)
         out.append({"breakpoints": x.tolist(), "degree": int(k), "dofs": dofs.tolist(), "coefficients": coef.tolist(),
                     "columns": list(range(first, first + len(tr.gamma_dofs))), "sign": sign})
+        offset += side.ndof
+    return out
+
+
+def _face_trace_forms(sides) -> list:
+    """The bilinear hats of each side's face trace as {x, y} Lagrange P_1 forms (ends dropped: Γ's
+    boundary is fixed); ``columns[i + n_x j]`` = the dof of A whose basis function is 1 at the
+    node (x_{i+1}, y_{j+1}), read off the trace basis there (it must be a permutation)."""
+    out, offset = [], 0
+    for sign, side in zip((-1, 1), sides):
+        tr = side.trace
+        xs, ys = (np.asarray(g, float) for g in (tr.partition.xs, tr.partition.ys))
+        X, Y = np.meshgrid(xs[1:-1], ys[1:-1], indexing="xy")  # node i + n_x j at row j, column i
+        V = np.asarray(tr.gamma.trace_basis(tr, np.column_stack([X.ravel(), Y.ravel()])))
+        p = np.argmax(np.abs(V), axis=1)
+        if V.shape[0] != V.shape[1] or not np.allclose(V[np.arange(len(p)), p], 1.0, atol=1e-12) \
+                or len(np.unique(p)) != len(p) or not np.allclose(np.abs(V).sum(axis=1), 1.0, atol=1e-12):
+            return None  # not the nodal hats: no description written
+        first = offset + side.ndof - len(tr.gamma_dofs)
+        axis = [{"basis": "lagrange", "degree": 1, "breakpoints": g.tolist(), "ends": "drop"} for g in (xs, ys)]
+        out.append({"x": axis[0], "y": axis[1], "columns": (first + p).tolist(), "sign": sign})
         offset += side.ndof
     return out
 

@@ -280,10 +280,11 @@ def _breakpoints(where, key, value, base, length: float) -> np.ndarray:
         raise SystemFileError(where, f"{key}: expected at least 2 numbers in a flat list (found shape {x.shape})")
     if not np.all(np.diff(x) > 0):
         i = int(np.flatnonzero(~(np.diff(x) > 0))[0])
-        raise SystemFileError(where, f"{key}: not strictly increasing (entries {i} and {i + 1}: {x[i]!r}, "
-                              f"{x[i + 1]!r})")
+        raise SystemFileError(where, f"{key}: not strictly increasing (entries {i} and {i + 1}: {float(x[i])!r}, "
+                              f"{float(x[i + 1])!r})")
     if abs(x[0]) > ENDS_RTOL * length or abs(x[-1] - length) > ENDS_RTOL * length:
-        raise SystemFileError(where, f"{key}: runs from {float(x[0])!r} to {float(x[-1])!r}; it must cover Γ = [0, {length!r}] "
+        raise SystemFileError(where, f"{key}: runs from {float(x[0])!r} to {float(x[-1])!r}; it must cover "
+                              f"Γ = [0, {length!r}] "
                               "(gamma's length), first and last breakpoint its ends")
     t = x / length
     t[0], t[-1] = 0.0, 1.0

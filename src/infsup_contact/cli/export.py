@@ -62,9 +62,9 @@ def _check_export(args):
     check_n1_offset(ns, args.N1_offset)
     for n in ns:
         meshes.check_mesh_args(args.family, n + args.N1_offset, "N1_offset")
-    for n in ns:  # an empty space on a small N: refused here, before any mesh or file
-        registry.check_pair_spaces([args.case], args.k, n + args.N1_offset, n, (args.multiplier_mesh,), key="N")
     check_model_case(args.case, args.k, args.model_obj, args.family, **args.mesh_kwargs)
+    for n in ns:  # an empty space on a small N: refused here, before any file is written
+        registry.check_pair_spaces([args.case], args.k, n + args.N1_offset, n, (args.multiplier_mesh,), key="N")
     out = Path(args.out)
     if not args.out.strip() or (out.exists() and not out.is_dir()):
         raise InputError("out", "a directory to write into (created if missing)", got=args.out)

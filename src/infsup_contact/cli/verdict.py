@@ -98,10 +98,10 @@ def _check_verdict(args):
     check_n1_offset(ns, args.N1_offset)
     for n in ns:
         meshes.check_mesh_args(args.family, n + args.N1_offset, "N1_offset")
-    for n in ns:  # an empty space on a small N is refused here, before any mesh
-        registry.check_pair_spaces([case], args.k, n + args.N1_offset, n, (args.multiplier_mesh,), key="N")
     if args.space is None:  # a face-only id on a 2D model, a face space of the other element: one line
         check_model_case(case, args.k, args.model_obj, args.family, **args.mesh_kwargs)
+    for n in ns:  # an empty space on a small N is refused here, before any β_h
+        registry.check_pair_spaces([case], args.k, n + args.N1_offset, n, (args.multiplier_mesh,), key="N")
     check_criterion(args.slope_tolerance, args.beta_floor, args.confidence)
     est = resources.verdict_estimate(args.family, args.k, ns, args.norm, args.multiplier_mesh, args.model_obj.dim,
                                      n1_offset=args.N1_offset, components=args.model_obj.components)

@@ -183,7 +183,10 @@ def model_case_ids(model, k: int, family: str = "structured", **mesh_kwargs) -> 
     defined for k; on a 3D model also the face-only ones its element's face cells carry
     (QUAD8/QUAD9 spaces on hexahedra, TRI6 spaces on tetrahedra), those refused by
     construction (DUAL-Q8, DUAL-T6) left out. Found as ``beta --case all`` finds them, on the
-    model's coarsest mesh (one cell per direction)."""
+    model's coarsest mesh (one cell per direction; a 2D model: no mesh, the segment builds
+    every space of its dimension)."""
+    if model.dim == 2:
+        return registry.ids_valid_for(k, gamma_dim=1)
     return registry.ids_built_on(k, *_coarsest_multiplier_mesh(model, k, family, **mesh_kwargs))
 
 
@@ -196,19 +199,25 @@ def _coarsest_multiplier_mesh(model, k, family, **mesh_kwargs):
 def check_model_case(case: str, k: int, model, family: str = "structured", **mesh_kwargs) -> None:
     """:class:`InputError` unless ``model`` (with its mesh options, e.g. ``element``) builds the
     registered space ``case`` for degree k (:func:`model_case_ids`): one line naming the key
-    (``case`` or ``k``) and the values allowed for this model, element and k."""
+    (``case`` or ``k``) and the values allowed for this model, element and k. The id and k are
+    checked before any mesh is built (a 2D model builds none)."""
     spec = registry.space_spec(case)  # an unknown id: every registered id listed
     if not spec.valid_for(k):
         ks = [j for j in range(registry.K_RANGE[0], registry.K_RANGE[1] + 1) if spec.valid_for(j)]
         raise InputError("k", f"k in {ks[0]}..{ks[-1]} for case {case} ({spec.paper_ref})", got=k)
+    where = f"--model {model.name}" + "".join(f" --{key} {value}" for key, value in mesh_kwargs.items())
+    if not spec.defined_on(model.dim - 1):
+        why = (f"defined on the face of a 3D model only: --model {', '.join(_models(3))}" if model.dim == 2
+               else "defined on the segment Γ of the 2D models only")
+        allowed = model_case_ids(model, k, family, **mesh_kwargs)
+        raise InputError("case", f"a space of {where} with k = {k}: {', '.join(allowed)} ({case} is {why})", got=case)
+    if model.dim == 2:
+        return
     gamma, g_h = _coarsest_multiplier_mesh(model, k, family, **mesh_kwargs)
     allowed = registry.ids_built_on(k, gamma, g_h)
     if case in allowed:
         return
-    if not spec.defined_on(gamma.dim):
-        why = (f"defined on the face of a 3D model only: --model {', '.join(_models(3))}" if gamma.dim == 1
-               else "defined on the segment Γ of the 2D models only")
-    elif not getattr(gamma, "builds", lambda s: True)(spec):
+    if not getattr(gamma, "builds", lambda s: True)(spec):
         why = f"built on {', '.join(spec.face_cells)} face cells only"
     else:
         try:
@@ -216,7 +225,6 @@ def check_model_case(case: str, k: int, model, family: str = "structured", **mes
             why = "not built here"
         except InputError as err:  # refused by construction: the construction's reason and remedy
             why = f"refused: {err.allowed}"
-    where = f"--model {model.name}" + "".join(f" --{key} {value}" for key, value in mesh_kwargs.items())
     raise InputError("case", f"a space of {where} with k = {k}: {', '.join(allowed)} ({case} is {why})", got=case)
 
 

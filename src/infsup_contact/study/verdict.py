@@ -1,4 +1,4 @@
-"""Is a multiplier space stable? One verdict from β_h over a sequence of matching meshes.
+"""Is a multiplier space stable? One verdict from β_h over a series of mesh pairs, N1 = N2 + offset.
 
 β_h is the discrete inf-sup constant of eq. (4.5), computed by
 :func:`infsup_contact.solvers.infsup.beta_rows`. The verdict uses the claims ledger's own

@@ -53,27 +53,28 @@ SETTINGS = [(name, el) for name, m in MODELS.items() for el in (("hex", "tet") i
 
 
 @pytest.mark.parametrize("model_name, element", SETTINGS, ids=[f"{m}-{e or '2d'}" for m, e in SETTINGS])
-def test_every_registered_id_accepted_or_refused_in_one_line(capsys, model_name, element):
-    """Every registered id × k = 1, 2 on each model and element: ``verdict --dry-run`` accepts
-    exactly the spaces the model builds; the rest exit 2 with one line naming --case (listing
-    the allowed ids) or --k."""
+def test_every_registered_id_accepted_or_refused_in_one_line(tmp_path, capsys, model_name, element):
+    """Every registered id × k = 1, 2 on each model and element: ``verdict --dry-run`` and
+    ``export --dry-run`` accept exactly the spaces the model builds; the rest exit 2 with one
+    line naming --case (listing the allowed ids) or --k."""
     model = MODELS[model_name]
     flags = ["--model", model_name] + (["--element", element] if element else [])
-    for k in (1, 2):
+    for k, case, command in ((k, c, cmd) for k in (1, 2) for c in SPACES for cmd in ("verdict", "export")):
         allowed = _expected_ids(model, element, k)
-        for case in SPACES:
-            code, out, err = _run(capsys, ["verdict", *flags, "--case", case, "--k", str(k), "--N", "3", "4", "5",
-                                           "--dry-run"])
-            if case in allowed:
-                assert code == 0, (case, k, err)
-                continue
-            assert code == 2 and out == "" and len(err.strip().splitlines()) == 1, (case, k, err)
-            if not SPACES[case].valid_for(k):
-                assert "invalid --k" in err and f"case {case}" in err, err
-            else:
-                assert f"invalid --case (got '{case}')" in err, err
-                listed = err.split(f"with k = {k}: ")[1].split(" (")[0].split(", ")
-                assert set(listed) == allowed, (case, k, err)
+        out_dir = ["--out", str(tmp_path / "out")] if command == "export" else []
+        code, out, err = _run(capsys, [command, *flags, "--case", case, "--k", str(k), "--N", "3", "4", "5",
+                                       "--dry-run", *out_dir])
+        if case in allowed:
+            assert code == 0, (command, case, k, err)
+            continue
+        assert code == 2 and out == "" and len(err.strip().splitlines()) == 1, (command, case, k, err)
+        if not SPACES[case].valid_for(k):
+            assert "invalid --k" in err and f"case {case}" in err, err
+        else:
+            assert f"invalid --case (got '{case}')" in err, err
+            listed = err.split(f"with k = {k}: ")[1].split(" (")[0].split(", ")
+            assert set(listed) == allowed, (command, case, k, err)
+    assert not (tmp_path / "out").exists()  # a dry run writes nothing
 
 
 @pytest.mark.parametrize("argv, key", [
@@ -81,6 +82,8 @@ def test_every_registered_id_accepted_or_refused_in_one_line(capsys, model_name,
     (["--model", "membranes3d", "--element", "tet", "--case", "TDUAL-Q8", "--k", "2"], "--case"),
     (["--model", "elastic3d", "--element", "hex", "--case", "PWLIN-T6", "--k", "2"], "--case"),
     (["--model", "membranes3d", "--element", "hex", "--case", "DUAL-Q8", "--k", "2"], "--case"),
+    (["--model", "membranes3d", "--element", "tet", "--family", "unstructured", "--case", "TDUAL-T6", "--k", "2"],
+     "--case"),
     (["--model", "membranes3d", "--element", "hex", "--case", "DUAL-Q9", "--k", "1"], "--k"),
     (["--case", "T3", "--k", "5"], "--k"),
     (["--case", "T3", "--k", "1", "--N1-offset", "-3"], "--N1-offset"),

@@ -205,7 +205,8 @@ def check_model_case(case: str, k: int, model, family: str = "structured", **mes
     if not spec.valid_for(k):
         ks = [j for j in range(registry.K_RANGE[0], registry.K_RANGE[1] + 1) if spec.valid_for(j)]
         raise InputError("k", f"k in {ks[0]}..{ks[-1]} for case {case} ({spec.paper_ref})", got=k)
-    where = f"--model {model.name}" + "".join(f" --{key} {value}" for key, value in mesh_kwargs.items())
+    where = " ".join([f"--model {model.name}", *(f"--{key} {value}" for key, value in mesh_kwargs.items()),
+                      *([f"--family {family}"] if family != "structured" else [])])
     if not spec.defined_on(model.dim - 1):
         why = (f"defined on the face of a 3D model only: --model {', '.join(_models(3))}" if model.dim == 2
                else "defined on the segment Γ of the 2D models only")
@@ -218,7 +219,8 @@ def check_model_case(case: str, k: int, model, family: str = "structured", **mes
     if case in allowed:
         return
     if not getattr(gamma, "builds", lambda s: True)(spec):
-        why = f"built on {', '.join(spec.face_cells)} face cells only"
+        why = (f"built on {', '.join(spec.face_cells)} face cells only" if hasattr(gamma, "cell")
+               else "not built on a general triangulation of Γ: only Lagrange cases and their duals are")
     else:
         try:
             gamma.space(spec, k, g_h)

@@ -95,6 +95,7 @@ def test_kernel_only_on_the_coarse_levels_gets_the_vanishing_kernel_hint(tmp_pat
     assert out["verdict"] == "UNSTABLE"
     assert "the kernel of B^T shrinks under refinement (dims [2, 1, 0] over 1/h = 2, 3, 4)" in out["hints"]
     assert "gone from h = 0.25 on" in err
+    assert "drop them and add at least 2 level(s) finer than h = 0.25" in out["hints"]  # 3 without a kernel
 
 
 def test_coarse_non_matching_levels_get_the_coarse_levels_hint(tmp_path):

@@ -29,8 +29,10 @@ from .readers import SystemFileError
 MAX_EXTRA_LEVELS = 8
 """Most levels (each halving h) a coarse-levels hint proposes; beyond, it says "more than"."""
 MIN_PER_DIRECTION = 8
-"""Multipliers per direction of Γ below which a level is coarse for a rate: on N intervals a
-non-matching pair's G_h still has cells cut at a fraction of h comparable to h itself."""
+"""Multipliers per direction of Γ below which a level is coarse for a rate. Measured on the
+stable T3, k = 1, N1 = N2 + 1 (m = N2 − 1): the local slopes of log β_h are 0.33, 0.31, 0.25,
+0.20, 0.15, 0.13 between N2 = 2, 3, 4, 6, 8, 12, 16; they reach τ = 0.15 between 7 and 11
+multipliers."""
 MIN_LEVELS_FINE = 3
 """Levels a slope's interval needs (n − 2 >= 1 degree of freedom)."""
 
@@ -73,10 +75,11 @@ def vanishing_kernel_hint(h, dims) -> str | None:
     if not dims or dims[0] == 0 or dims[-1] != 0:
         return None
     first = next(i for i in range(len(dims)) if all(d == 0 for d in dims[i:]))
+    need = MIN_LEVELS_FINE - (len(dims) - first)
     return (f"the kernel of B^T shrinks under refinement (dims {dims} over 1/h = "
             f"{', '.join(f'{1 / v:g}' for v in h)}) and is gone from h = {h[first]:g} on: the levels coarser "
-            f"than that are too coarse for this pair (non-matching meshes?); give levels from h = {h[first]:g} "
-            f"and finer than h = {h.min():g} to judge the rate on the fine levels")
+            f"than that are too coarse for this pair (non-matching meshes?); to judge the rate, drop them"
+            + (f" and add at least {need} level(s) finer than h = {h.min():g}" if need > 0 else ""))
 
 
 def coarse_levels_hint(h, m, y, out: dict, tol: float, confidence: float) -> str | None:

@@ -51,10 +51,12 @@ def _group_suffix(item):
         item._id = type(node_id).parse(item.nodeid + suffix)
 
 
-@pytest.fixture
+@pytest.fixture(autouse=True)
 def registry_as_found():
-    """Checking or loading a config registers its user spaces: leave the registry as the other
-    tests expect (a test file uses it for all its tests: ``pytestmark = usefixtures(...)``)."""
+    """Checking or loading a config, or a ``--space`` run in process, registers user spaces:
+    every test leaves the registry as it found it, so no test depends on which tests ran
+    before it in the same worker (a ``--space`` test left ``P0-2h`` registered for the
+    next file's catalogue checks)."""
     from infsup_contact.discretization.registry import SPACES
     from infsup_contact.discretization.user_spaces import forget_since
 

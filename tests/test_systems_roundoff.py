@@ -217,3 +217,33 @@ def test_entry_rtol_as_yaml_writes_it(tmp_path, value, rtol):
     path = write_system(tmp_path, [(1.0 / n, A, B, G) for n in (4, 8, 16)], "npz", "T3")
     path.write_text(path.read_text().replace("levels:", f"entry_rtol: {value}\nlevels:"))
     assert load_manifest(path).entry_rtol == rtol
+
+
+@pytest.mark.parametrize("delta", DELTAS)
+def test_rows_tiny_in_every_entry_are_producer_zeros(delta):
+    """Two multiplier rows whose every entry is round-off (a producer that zeroes B's columns over
+    fixed dofs leaves the rows of the multipliers there at ~1e-13 × max|b|: Kratos' mesh tying
+    at Γ's Dirichlet ends): relative to their own row nothing is tiny, relative to B it all is.
+    The two rows span a kernel of Bᵀ up to round-off: counted 2, or the decision close; never a
+    clear count below 2."""
+    for seed in SEEDS:
+        for (A, B, G), n in zip(_levels("T3"), NS):
+            rng = np.random.default_rng(seed)
+            t = touched_dofs(B)
+            top = float(np.abs(B[:, t]).max())
+            extra = np.zeros((2, B.shape[1]))
+            for row, cols in zip(extra, (t[:3], t[-3:])):
+                row[cols] = delta * top * rng.uniform(-1.0, 1.0, 3)
+            B2 = sp.vstack([B, sp.csr_matrix(extra)]).tocsr()
+            Gd = G.toarray() if sp.issparse(G) else np.asarray(G)
+            d = float(np.mean(np.diag(Gd)))
+            G2 = sla_block_diag(Gd, d * np.eye(2))
+            res = level_spectrum(A, B2, G2)
+            assert res.roundoff.source == "estimated" and res.roundoff.rtol >= delta / 2
+            assert res.kernel.dim == 2 or res.kernel.decision == "close", (delta, seed, n, res.kernel.dim)
+
+
+def sla_block_diag(*blocks):
+    import scipy.linalg as sla
+
+    return sla.block_diag(*blocks)

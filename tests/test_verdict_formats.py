@@ -77,7 +77,7 @@ def test_csv_is_the_default_and_the_case_header_is_the_documented_one():
     strip = [re.sub(r",[^,]*\n$", "\n", text) for text in (default, explicit)]  # `seconds` differs
     assert strip[0] == strip[1]
     readme = (ROOT / "README.md").read_text()
-    documented = re.search(r"`(space,k,family,norm,multiplier_mesh,verdict,[^`]*)`", readme).group(1)
+    documented = re.search(r"`(space,k,model,element,family,norm,multiplier_mesh,N1_offset,verdict,[^`]*)`", readme).group(1)
     assert default.splitlines()[0] == documented
     assert pd.read_csv(io.StringIO(default), dtype={"N_list": str}).N_list[0] == "4 8 16"
 

@@ -225,6 +225,13 @@ def level_spectrum(A, B, G, known_kernel: int = 0, route: str = "auto", entry_rt
     return LevelSpectrum(beta, above, kernel, ev, route, resid, len(touched), seconds, roundoff, unit, pencil_margin)
 
 
+def _pencil_words(margin: float) -> str:
+    """Where the first eigenvalue above the kernel stands against the pencil's round-off level."""
+    if margin <= 0.0:  # at or below it (a zero eigenvalue gives log10 of the tiniest float)
+        return "the first eigenvalue above the kernel is at or below the pencil's round-off level"
+    return f"the first eigenvalue above the kernel is only {margin:.2f} decades above the pencil's round-off"
+
+
 def close_advice(res: LevelSpectrum) -> str:
     """What the user of a ``close`` decision can do, in one line: the accuracy r* of B's entries
     that would put η at 20 × the singular value below the widest gap of the bottom of the
@@ -235,8 +242,7 @@ def close_advice(res: LevelSpectrum) -> str:
     r = res.roundoff.rtol if res.roundoff is not None else 0.0
     where = (f"kernel decision close (margin {k.margin_decades:.2f} decades from eta = {k.tol:.2g}; entry "
              f"round-off {r:.2g} x max|b|, {res.roundoff.source if res.roundoff else 'exact'}"
-             + (f"; the first eigenvalue above the kernel is only {res.pencil_margin:.2f} decades above the "
-                "pencil's round-off: the entries carry more round-off than eta assumes"
+             + (f"; {_pencil_words(res.pencil_margin)}: the entries carry more round-off than eta assumes"
                 if res.pencil_margin < MARGIN_DECADES else "") + ")")
     s = np.asarray(k.singular[:-1], float)  # the bottom values (σ_max last on the large-W route)
     s = s[s > 0]

@@ -18,6 +18,7 @@ import scipy.sparse as sp
 from ..study.verdict import stability_verdict
 from .checks import check_level, check_sequence
 from .engine import close_advice, level_spectrum
+from .hints import system_hints, transposed_b_hint
 from .manifest import Manifest, constrained_dofs
 from .readers import SystemFileError, read_matrix
 
@@ -49,7 +50,8 @@ def _load_level(manifest: Manifest, level):
         from .multiplier_gram import described_grams
 
         level, B, G, mass, info = described_grams(manifest, level, B, G)
-    checked = check_level(level, A, B, G, constrained_dofs(level, A.shape[0]), manifest.tgv)
+    with transposed_b_hint(A, B, G):
+        checked = check_level(level, A, B, G, constrained_dofs(level, A.shape[0]), manifest.tgv)
     if info and info.get("removed_multipliers"):  # constrained rows the description's Gram left out
         checked.notes[:0] = info["notes"]
         checked.removed_multipliers += info["removed_multipliers"]
@@ -105,14 +107,16 @@ def system_rows(manifest: Manifest, route: str = "auto", notes=sys.stderr) -> li
 
 
 def system_verdict(manifest: Manifest, *, tol: float, floor: float, confidence: float, route: str = "auto",
-                   notes=sys.stderr) -> tuple:
+                   notes=None) -> tuple:
     """(verdict row, level rows). The criterion of ``verdict --case``
     (:func:`~infsup_contact.study.verdict.stability_verdict`) on the kernel *beyond* the
     declared one: a kernel of Bᵀ larger than ``known_kernel`` on any level is UNSTABLE; a
     ``close`` kernel decision on any level makes the verdict INCONCLUSIVE (both by
     ``stability_verdict`` itself), the evidence saying what the user can do. η includes the
-    round-off of B's entries, declared (``entry_rtol``) or estimated (:mod:`.roundoff`)."""
+    round-off of B's entries, declared (``entry_rtol``) or estimated (:mod:`.roundoff`). Its
+    ``hints`` (:mod:`.hints`, also on ``notes``) say what mistake the numbers suggest."""
     t0 = time.perf_counter()
+    notes = sys.stderr if notes is None else notes  # the stream of now (a default would bind import time's)
     rows = system_rows(manifest, route, notes)
     series = [dict(r, kernel_dim=r["kernel_detected"], case=manifest.name) for r in rows]
     out = stability_verdict(series, tol, floor, confidence)  # a close kernel decision: INCONCLUSIVE
@@ -138,6 +142,7 @@ def system_verdict(manifest: Manifest, *, tol: float, floor: float, confidence: 
         out["evidence"] += f"; levels[{close[0]['level']}]: {close[0]['kernel_advice']}"
     head = dict(system=manifest.name, norm=manifest.norm, known_kernel=manifest.known_kernel)
     head.update(out)
+    head["hints"] = "; ".join(system_hints(rows, out, tol, confidence, notes))  # the verdict unchanged
     head.update(h_list=" ".join(f"{r['h']:g}" for r in rows), routes=" ".join(sorted({r["route"] for r in rows})),
                 max_residual=max(r["residual"] for r in rows), norm_note=NORM_NOTES[manifest.norm],
                 seconds=time.perf_counter() - t0)
@@ -165,7 +170,8 @@ def dry_check(manifest: Manifest, route: str = "auto"):
 
             level, G, bytes_, _ = check_description(manifest, level, B, G)
             extra = max(extra, bytes_)
-        check_shapes(level, A, B, G)
+        with transposed_b_hint(A, B, G):
+            check_shapes(level, A, B, G)
         constrained_dofs(level, A.shape[0])
         shapes.append((A.shape[0], B.shape[0]))
         check_sequence(manifest, shapes)

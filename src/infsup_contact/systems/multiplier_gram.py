@@ -105,8 +105,10 @@ def check_description(manifest, level, B, G_file) -> tuple:
 
     d = describe(manifest.path, level.index, level.multipliers, manifest.gamma)
     if d.m != B.shape[0]:
+        hint = ("; hint: B appears transposed: give B as m x n (a row per multiplier, a column per dof)"
+                if B.shape[1] == d.m else "")
         raise SystemFileError(d.source, f"{d.key}: describes m = {d.m} basis "
-                              f"functions, B ({level.B.name}) has {B.shape[0]} rows: one row of B per function")
+                              f"functions, B ({level.B.name}) has {B.shape[0]} rows: one row of B per function{hint}")
     if G_file is not None and G_file.shape != (d.m, d.m):
         raise SystemFileError(level.G, f"G is {G_file.shape[0]} x {G_file.shape[1]}; with norm: H it is the L2 mass "
                               f"of the {d.m} described multipliers ({d.m} x {d.m})")

@@ -20,9 +20,13 @@ r comes from, in this order (:func:`entry_roundoff`; ``entry_rtol_source`` in th
     ``entry_rtol`` in the manifest, unless the data show more (then ``estimated``, with a note);
 ``estimated``
     from the data (:func:`estimate_entry_rtol`): the largest of
-    (a) the *tiny entries*: a stored |b_ij| <= :data:`TINY_RTOL` × max_j |b_ij| of its row is a
-        producer zero (no quadrature of polynomials on a mesh gives a genuine ratio of 1e-12
-        within one multiplier's row), and its size is its round-off: r_a = max |b_ij| / max |b|;
+    (a) the *tiny entries*: a stored |b_ij| <= :data:`TINY_RTOL` × max |b| is a producer zero
+        (no quadrature of polynomials on a mesh gives a genuine ratio of 1e-12 between two
+        entries of one coupling: rows scale like the local h and the multiplier's size), and
+        its size is its round-off: r_a = max |b_ij| / max |b|. Measured against the largest
+        entry of B, not of the entry's row: a row left over a fixed dof (Kratos zeroes the
+        columns of B over Dirichlet dofs, leaving the end multipliers' rows at ~1e-13) is tiny
+        in every entry, and only the global scale shows it;
     (b) the *zero row sums*: a row whose exact sum |Σ_j b_ij| is <= :data:`TINY_RTOL` × Σ_j |b_ij|
         sums to 0 in exact arithmetic (a mortar coupling [−B1 | B2] of partitions of unity,
         a divergence against a constant field); its sum is the sum of its nnz_i entry errors,
@@ -48,7 +52,7 @@ import numpy as np
 import scipy.sparse as sp
 
 TINY_RTOL = 1e-12
-"""A stored entry this small relative to its row's largest, or a row sum this small relative to
+"""A stored entry this small relative to B's largest, or a row sum this small relative to
 the row's Σ |b_ij|, is a producer zero (module docstring)."""
 SOURCES = ("declared", "estimated", "exact")
 
@@ -70,9 +74,7 @@ def estimate_entry_rtol(B) -> tuple:
         return 0.0, "B has no entries"
     absB = abs(B)
     top = float(absB.max())
-    rows = np.repeat(np.arange(B.shape[0]), np.diff(B.indptr))
-    rowmax = np.asarray(absB.max(axis=1).todense()).ravel()
-    tiny = np.abs(B.data) <= TINY_RTOL * rowmax[rows]
+    tiny = np.abs(B.data) <= TINY_RTOL * top
     r_a = float(np.abs(B.data[tiny]).max()) / top if tiny.any() else 0.0
     nnz = np.diff(B.indptr)
     abs_sum = np.asarray(absB.sum(axis=1)).ravel()
@@ -84,7 +86,7 @@ def estimate_entry_rtol(B) -> tuple:
             r_b = max(r_b, s / (math.sqrt(nnz[i]) * top))
     eps = float(np.finfo(float).eps)
     r = max(r_a, r_b)
-    text = (f"{int(tiny.sum())} tiny entries (<= {TINY_RTOL:g} x row max; largest {r_a:.2g} x max|b|), "
+    text = (f"{int(tiny.sum())} tiny entries (<= {TINY_RTOL:g} x max|b|; largest {r_a:.2g} x max|b|), "
             f"{n_zero_sum} rows summing to 0 (deviation {r_b:.2g} x sqrt(nnz) x max|b|)")
     return (r if r > eps else 0.0), text
 

@@ -577,3 +577,12 @@ def test_constrained_end_multipliers_described_in_full(tmp_path, capsys, k):
         assert abs(row["beta"] - ref["beta"]) <= 1e-10 * ref["beta"]
         assert row["coupling_distance"] <= 1e-14
     assert "2 constrained multipliers" in notes.getvalue()
+
+
+def test_a_body_without_free_dofs_on_gamma_has_no_trace(tmp_path):
+    """N1 = 1 at k = 1: Ω1's trace has no free dof (Γ's ends are fixed), so only Ω2's trace is
+    described (sign +1 as written), and the distance stays round-off."""
+    levels, norm, gamma = suite_levels("R5.2", 1, (2, 4), -1)
+    assert [len(lv[5]) for lv in levels] == [1, 2] and levels[0][5][0]["sign"] == 1
+    m = load_manifest(write_system(tmp_path, levels, "mtx", "n1", norm, gamma=gamma), 1)
+    assert all(r["coupling_distance"] <= 1e-14 for r in system_rows(m, notes=io.StringIO()))

@@ -113,6 +113,9 @@ def trace_forms(sides, k: int):
     out, offset = [], 0
     for sign, side in zip((-1, 1), sides):
         tr = side.trace
+        if not len(tr.gamma_dofs):  # a body with no free dof on Γ (N = 1, k = 1) meets no multiplier
+            offset += side.ndof
+            continue
         x = np.asarray(tr.breakpoints, float)
         nodes = (x[:-1, None] + np.diff(x)[:, None] * reference_nodes(k)[None, :])  # (N, k + 1)
         V = tr.gamma.trace_basis(tr, nodes.ravel()).reshape(len(x) - 1, k + 1, -1)  # (N, node, Γ dof)
@@ -125,7 +128,7 @@ def trace_forms(sides, k: int):
         out.append({"breakpoints": x.tolist(), "degree": int(k), "dofs": dofs.tolist(), "coefficients": coef.tolist(),
                     "columns": list(range(first, first + len(tr.gamma_dofs))), "sign": sign})
         offset += side.ndof
-    return out
+    return out or None
 
 
 def _face_trace_forms(sides) -> list:
@@ -135,6 +138,9 @@ def _face_trace_forms(sides) -> list:
     out, offset = [], 0
     for sign, side in zip((-1, 1), sides):
         tr = side.trace
+        if not len(tr.gamma_dofs):  # no free dof on Γ (one cell per direction at k = 1)
+            offset += side.ndof
+            continue
         xs, ys = (np.asarray(g, float) for g in (tr.partition.xs, tr.partition.ys))
         X, Y = np.meshgrid(xs[1:-1], ys[1:-1], indexing="xy")  # node i + n_x j at row j, column i
         V = np.asarray(tr.gamma.trace_basis(tr, np.column_stack([X.ravel(), Y.ravel()])))
@@ -146,7 +152,7 @@ def _face_trace_forms(sides) -> list:
         axis = [{"basis": "lagrange", "degree": 1, "breakpoints": g.tolist(), "ends": "drop"} for g in (xs, ys)]
         out.append({"x": axis[0], "y": axis[1], "columns": (first + p).tolist(), "sign": sign})
         offset += side.ndof
-    return out
+    return out or None
 
 
 def segment_form(spec, space) -> dict:

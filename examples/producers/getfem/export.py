@@ -229,13 +229,9 @@ def export(out: Path, space: str, ns, offset: int) -> Path:
 
 
 def gf_version() -> str:
-    """GetFEM's version as Debian installed it (the Python module has no ``__version__``)."""
-    try:
-        from importlib.metadata import version
-
-        return version("getfem")
-    except Exception:  # Debian's package ships no dist-info
-        return "5.4"
+    """GetFEM's release (Debian's package ships no dist-info, so ``importlib.metadata`` finds
+    nothing: GetFEM's own ``getfem_env``)."""
+    return str(gf.getfem_env("release"))
 
 
 def main(argv=None) -> int:

@@ -138,28 +138,49 @@ def test_T3_without_its_constrained_rows_matches_beta_case(export, tmp_path):
         assert row["kernel_dim"] == "0"
 
 
+def _h_norm_read() -> bool:
+    from infsup_contact.systems.manifest import NORMS
+
+    return "H" in NORMS
+
+
 @pytest.mark.parametrize("space", SPACES)
 def test_manifest_dry_run(export, space):
     """The L² and h-L² copies validate; the ``norm: H`` manifest itself once the certifier
-    reads it (skipped until then)."""
+    reads it (skipped until then; T3 below)."""
     for norm in ("L2", "h-L2"):
         code, _, err = P.verdict_row(P.strip_manifest(export(space), norm), "--dry-run")
         assert code == 0, err
-    from infsup_contact.systems.manifest import NORMS
-
-    if "H" not in NORMS:
+    if not _h_norm_read():
         pytest.skip("norm: H is not read by this certifier yet (branch h-norm-h)")
+    if space.startswith("T3"):
+        pytest.skip("T3's constrained rows under norm: H: test_T3_norm_H")
     code, _, err = P.verdict_row(export(space), "--dry-run")
     assert code == 0, err
 
 
+@pytest.mark.xfail(strict=True, reason="norm: H compares the description (m - 2 functions, `rows` naming B's "
+                   "non-constrained rows) with B's m rows before the constrained rows (zero in B, unit in G) are "
+                   "removed: the certifier refuses DOLFINx's T3")
+def test_T3_norm_H(export):
+    """T3 with DOLFINx's dirichletbc on the multipliers is Thm 3's space: STABLE in H^{-1/2}_00
+    once the two constrained end rows are set aside (as the h-L² copy's are)."""
+    if not _h_norm_read():
+        pytest.skip("norm: H is not read by this certifier yet (branch h-norm-h)")
+    code, row, err = P.verdict_row(export("T3-k2"))
+    assert row is not None and row["verdict"] == "STABLE", err
+
+
+@pytest.mark.parametrize("norm", ["h-L2", "H"])
 @pytest.mark.parametrize("space, verdict", [("R5.2-k1", "UNSTABLE"), ("R5.2-k2", "UNSTABLE"),
                                             ("T4-k2", "STABLE"), ("T5-k2", "STABLE")])
-def test_h_L2_verdicts(tmp_path, space, verdict):
-    """h-L²: R5.2 has a kernel (dim M − dim of the Γ traces > 0: UNSTABLE in any norm); T4 and
-    T5 are H^{-1/2}-stable (Thms 4, 5), hence stable in the weaker h-L² norm. On N = 8, 16, 32:
+def test_verdicts(tmp_path, space, verdict, norm):
+    """R5.2 has a kernel (dim M − dim of the Γ traces > 0: UNSTABLE in any norm); T4 and T5 are
+    H^{-1/2}-stable (Thms 4, 5), hence stable in the weaker h-L² norm too. On N = 8, 16, 32:
     T5's h-L² β rises 0.412 → 0.433 from N = 4 to 8 (pre-asymptotic: INCONCLUSIVE on 4, 8, 16)."""
+    if norm == "H" and not _h_norm_read():
+        pytest.skip("norm: H is not read by this certifier yet (branch h-norm-h)")
     manifest = P.run_export(PYTHON, SCRIPT, tmp_path, space, (8, 16, 32))
-    code, row, err = P.verdict_row(P.strip_manifest(manifest, "h-L2"))
+    code, row, err = P.verdict_row(manifest if norm == "H" else P.strip_manifest(manifest, norm))
     assert row is not None, err
     assert row["verdict"] == verdict, row["evidence"]

@@ -141,6 +141,12 @@ def test_beta_against_beta_case(export, space, tmp_path):
         assert abs(float(mine["smallest_nonzero"]) / ref - 1) > 1e-6  # the quadrature shows in β
 
 
+def _h_norm_read() -> bool:
+    from infsup_contact.systems.manifest import NORMS
+
+    return "H" in NORMS
+
+
 @pytest.mark.parametrize("space", SPACES)
 @pytest.mark.parametrize("offset", [0, 1])
 def test_manifest_dry_run(export, space, offset):
@@ -148,20 +154,23 @@ def test_manifest_dry_run(export, space, offset):
     for norm in ("L2", "h-L2"):
         code, _, err = P.verdict_row(P.strip_manifest(export(space, offset), norm), "--dry-run")
         assert code == 0, err
-    from infsup_contact.systems.manifest import NORMS
-
-    if "H" not in NORMS:
+    if not _h_norm_read():
         pytest.skip("norm: H is not read by this certifier yet (branch h-norm-h)")
     code, _, err = P.verdict_row(export(space, offset), "--dry-run")
     assert code == 0, err
 
 
-@pytest.mark.parametrize("space, verdict", [("R5.2-k1", "UNSTABLE"), ("R5.2-k2", "UNSTABLE"),
-                                            ("T4-k2", "STABLE"), ("T5-k2", "STABLE")])
-def test_h_L2_verdicts_non_matching(tmp_path, space, verdict):
-    """h-L², N = 8, 16, 32, offset 1: R5.2 keeps a kernel (UNSTABLE in any norm); T4, T5 are
-    H^{-1/2}-stable (Thms 4, 5), so stable in the weaker h-L²."""
-    manifest = P.run_export(PYTHON, SCRIPT, tmp_path, space, (8, 16, 32), offset=1)
-    code, row, err = P.verdict_row(P.strip_manifest(manifest, "h-L2"))
+@pytest.mark.parametrize("norm", ["h-L2", "H"])
+@pytest.mark.parametrize("space, offset, verdict", [
+    ("R5.2-k1", 1, "UNSTABLE"), ("R5.2-k2", 1, "UNSTABLE"), ("T4-k2", 1, "STABLE"), ("T5-k2", 1, "STABLE"),
+    ("T3-k2", 0, "STABLE")])
+def test_verdicts(tmp_path, space, offset, verdict, norm):
+    """N = 8, 16, 32: R5.2 at offset 1 has no structural kernel but β_h decays (h-L² slope
+    0.85–1.06 measured); T3 (matching), T4 and T5 are H^{-1/2}-stable (Thms 3–5), so stable in
+    the weaker h-L² too."""
+    if norm == "H" and not _h_norm_read():
+        pytest.skip("norm: H is not read by this certifier yet (branch h-norm-h)")
+    manifest = P.run_export(PYTHON, SCRIPT, tmp_path, space, (8, 16, 32), offset=offset)
+    code, row, err = P.verdict_row(manifest if norm == "H" else P.strip_manifest(manifest, norm))
     assert row is not None, err
     assert row["verdict"] == verdict, row["evidence"]

@@ -152,13 +152,14 @@ def check_spd(A) -> None:
 
 
 def strip_manifest(manifest: Path, norm: str) -> Path:
-    """A copy of the manifest with ``norm`` set and the ``norm: H`` keys removed (the form
-    the certifier reads before ``norm: H`` exists)."""
+    """A copy of the manifest with ``norm`` set and the ``norm: H`` keys (``gamma``, per level
+    ``multipliers`` and ``traces``) removed: the form the certifier reads before ``norm: H``."""
     data = yaml.safe_load(manifest.read_text())
     data["norm"] = norm
     data.pop("gamma", None)
     for lv in data["levels"]:
         lv.pop("multipliers", None)
+        lv.pop("traces", None)
     out = manifest.with_name(f"levels-{norm}.yaml")
     out.write_text(yaml.safe_dump(data, sort_keys=False))
     return out

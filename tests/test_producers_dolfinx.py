@@ -126,6 +126,7 @@ def test_T3_without_its_constrained_rows_matches_beta_case(export, tmp_path):
     for i, lv in enumerate(data["levels"]):
         _, A, B, G = P.read_level(manifest, i)
         rows = lv.pop("multipliers")["rows"]
+        lv.pop("traces")
         for key, M in (("B", B[rows]), ("G", G[rows][:, rows]), ("A", A)):
             scipy.io.mmwrite(tmp_path / f"{key}{i}.mtx", M, precision=17)
             lv[key] = f"{key}{i}.mtx"
@@ -184,3 +185,13 @@ def test_verdicts(tmp_path, space, verdict, norm):
     code, row, err = P.verdict_row(manifest if norm == "H" else P.strip_manifest(manifest, norm))
     assert row is not None, err
     assert row["verdict"] == verdict, row["evidence"]
+
+
+@pytest.mark.parametrize("space", ["R5.2-k2", "T4-k2", "R5.4-k2", "T5-k2"])
+def test_certifier_coupling_distance(export, space):
+    """With the manifest's ``traces`` the certifier measures B's distance to the exact mortar
+    coupling itself: round-off here (matching meshes, FFCx's quadrature exact)."""
+    if not _h_norm_read():
+        pytest.skip("norm: H (and traces) not read by this certifier yet (branch h-norm-h)")
+    for row in P.beta_rows(export(space)):
+        assert float(row["coupling_distance"]) <= 10 * P.ROUNDOFF

@@ -188,6 +188,23 @@ def describe_multipliers(Q, family: str, s: int, ends_bc: bool, constrained_rows
             "ends": "drop" if ends_bc else "keep", "rows": rows}
 
 
+def describe_traces(coords: np.ndarray, n1: int, k: int) -> list:
+    """The bodies' trace bases on Γ for the certifier's distance to the exact mortar coupling
+    (``traces``, normH spec): per body continuous P_k on its Γ nodes, ``columns`` the column of
+    B (A's dof) of each trace function left to right, −1 at Γ's ends (Dirichlet dofs: B's
+    columns there are zeroed), sign −1 for Ω1 and +1 for Ω2 (B = [−B1 | B2])."""
+    out = []
+    for lo, hi, sign in ((0, n1, -1), (n1, len(coords), 1)):
+        cols = lo + np.where(np.isclose(coords[lo:hi, 1], 1.0))[0]
+        x = coords[cols, 0]
+        order = np.argsort(x, kind="stable")
+        cols, x = cols[order], x[order]
+        columns = np.where(np.isclose(x, 0.0) | np.isclose(x, 1.0), -1, cols)
+        out.append({"basis": "lagrange", "degree": k, "breakpoints": x[::k].tolist(), "ends": "keep",
+                    "columns": [int(c) for c in columns], "sign": sign})
+    return out
+
+
 def write_atomic(path: Path, writer) -> None:
     """Write through a temporary file and rename (a killed run leaves no half file); the
     temporary name keeps the suffix (``mmwrite`` appends ``.mtx`` to a name without it)."""
@@ -209,6 +226,7 @@ def export(out: Path, space: str, ns) -> Path:
             write_atomic(out / name, lambda t, M=lv[key]: scipy.io.mmwrite(t, M, precision=17))
             entry[key] = name
         entry["multipliers"] = lv["multipliers"]
+        entry["traces"] = describe_traces(lv["coords"], lv["n1"], k)
         levels.append(entry)
     manifest = {
         "name": f"dolfinx-{DOLFINX_VERSION} {space} P{k} bodies, {family} {s} multipliers on a facet submesh"

@@ -54,7 +54,8 @@ $(DOLFINX_STAMP): examples/producers/dolfinx/requirements.lock
 
 # GetFEM from Debian (python3-getfem 5.4 for the system /usr/bin/python3): needs root.
 producers-getfem:
-	@/usr/bin/python3 -c 'import getfem' 2>/dev/null || \
-	  { [ "$$(id -u)" = 0 ] && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends python3-getfem python3-scipy python3-yaml >/dev/null; } || \
+	@/usr/bin/python3 -c 'import getfem, scipy, yaml' 2>/dev/null || \
+	  { [ "$$(id -u)" = 0 ] && apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq \
+	      --no-install-recommends python3-getfem python3-scipy python3-yaml >/dev/null; } || \
 	  { echo "error: GetFEM is installed from Debian as root: apt-get install python3-getfem python3-scipy python3-yaml"; exit 1; }
-	@/usr/bin/python3 -c 'import getfem, scipy, yaml; print("getfem", getfem.__version__ if hasattr(getfem, "__version__") else "")'
+	@/usr/bin/python3 -c 'import getfem; print("GetFEM", getfem.getfem_env("release"), "for /usr/bin/python3")'

@@ -49,6 +49,7 @@ def test_list_spaces():
     (("--out", "OUT", "--space", "T3-k1", "--N", "4", "--offset", "1.5"), "invalid int value"),
     (("--out", "OUT", "--N", "4"), "--space"),
     (("--out", "FILE", "--space", "T3-k1", "--N", "4"), "not a directory"),
+    (("--out", "/proc/no/such/dir", "--space", "T3-k1", "--N", "4", "5", "6"), "--out /proc/no/such/dir"),
 ])
 def test_bad_arguments_one_line_exit_2(tmp_path, args, names):
     (tmp_path / "FILE").write_text("not a directory")

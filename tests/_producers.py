@@ -55,16 +55,25 @@ def _env():
     return env
 
 
-def body_coordinates(python, script: Path, n: int, space: str, offset: int = 0):
+_COORDS = {}
+
+
+def body_coordinates(python, script: Path, n: int, space: str, offset: int = 0, ns=None):
     """(coordinates of A's dofs in A's order, number of Ω1's dofs: A's first block), from the
-    producer's own ``assemble_level`` run in its interpreter."""
-    code = ("import sys, json; sys.path.insert(0, {d!r}); import export; "
-            "lv = export.assemble_level({n}, {s!r}{o}); print(json.dumps([lv['coords'].tolist(), int(lv['n1'])]))"
-            ).format(d=str(script.parent), n=n, s=space, o=f", {offset}" if offset else "")
-    res = subprocess.run([str(python), "-c", code], capture_output=True, text=True, timeout=600, env=_env())
-    assert res.returncode == 0, res.stderr[-2000:]
-    coords, n1 = json.loads(res.stdout.strip().splitlines()[-1])
-    return np.asarray(coords)[:, :2], n1
+    producer's own ``assemble_level`` run in its interpreter; one run for every N of ``ns``
+    (default: n alone), kept for later calls."""
+    key = (str(script), space, offset)
+    ns = tuple(ns or (n,))
+    if (key, n) not in _COORDS:
+        code = ("import sys, json; sys.path.insert(0, {d!r}); import export; out = []\n"
+                "for n in {ns!r}:\n"
+                "    lv = export.assemble_level(n, {s!r}{o}); out.append([lv['coords'].tolist(), int(lv['n1'])])\n"
+                "print(json.dumps(out))").format(d=str(script.parent), ns=ns, s=space, o=f", {offset}" if offset else "")
+        res = subprocess.run([str(python), "-c", code], capture_output=True, text=True, timeout=600, env=_env())
+        assert res.returncode == 0, res.stderr[-2000:]
+        for m, (coords, n1) in zip(ns, json.loads(res.stdout.strip().splitlines()[-1])):
+            _COORDS[key, m] = (np.asarray(coords)[:, :2], n1)
+    return _COORDS[key, n]
 
 
 def read_level(manifest: Path, i: int):

@@ -70,7 +70,7 @@ def test_A_spd_G_mass_B_exact(export, space):
         lv, A, B, G = P.read_level(manifest, i)
         P.check_spd(A)
         assert P.mass_mismatch(G, lv["multipliers"]) <= P.ROUNDOFF
-        coords, n1 = P.body_coordinates(PYTHON, SCRIPT, n, space)
+        coords, n1 = P.body_coordinates(PYTHON, SCRIPT, n, space, ns=NS)
         exact, on_gamma = P.exact_coupling(lv["multipliers"], coords, n1, SPACES[space])
         _, rows = P.described_space(lv["multipliers"])
         Bd = B.toarray()
@@ -91,7 +91,7 @@ def test_B_on_a_polynomial_trace(export, space):
     interpolant): B v = −∫_Γ I_h(x(1 − x)) μ_i exactly, the quadrature being exact here."""
     k = SPACES[space]
     lv, A, B, G = P.read_level(export(space), 1)
-    coords, n1 = P.body_coordinates(PYTHON, SCRIPT, NS[1], space)
+    coords, n1 = P.body_coordinates(PYTHON, SCRIPT, NS[1], space, ns=NS)
     v = np.where(np.arange(len(coords)) < n1, coords[:, 0] * (1 - coords[:, 0]) * coords[:, 1], 0.0)
     exact, _ = P.exact_coupling(lv["multipliers"], coords, n1, k)
     _, rows = P.described_space(lv["multipliers"])

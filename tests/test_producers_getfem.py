@@ -63,7 +63,7 @@ def test_bad_arguments_one_line_exit_2(tmp_path, args, names):
 def _level(export, space, offset, i):
     """(entry, A, B, G, exact coupling with the Dirichlet columns zeroed, Γ-interior mask, rows)."""
     lv, A, B, G = P.read_level(export(space, offset), i)
-    coords, n1 = P.body_coordinates(PYTHON, SCRIPT, NS[i], space, offset)
+    coords, n1 = P.body_coordinates(PYTHON, SCRIPT, NS[i], space, offset, ns=NS)
     exact, on_gamma = P.exact_coupling(lv["multipliers"], coords, n1, SPACES[space])
     ends = on_gamma & (np.isclose(coords[:, 0], 0.0) | np.isclose(coords[:, 0], 1.0))
     exact[:, ends] = 0.0  # u = 0 there: GetFEM's simplification zeroes those columns

@@ -7,7 +7,7 @@ STAMP  := $(VENV)/.installed-from-lock
 # workflow rules call `python` and `infsup-contact`: they must resolve to the venv
 export PATH := $(CURDIR)/$(BIN):$(PATH)
 
-.PHONY: reproduce-all test env clean-env producers-dolfinx producers-getfem
+.PHONY: reproduce-all test env clean-env producers-kratos producers-dolfinx producers-getfem
 
 env: $(STAMP)
 
@@ -30,6 +30,14 @@ reproduce-all: $(STAMP)
 
 test: $(STAMP)
 	OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1 $(BIN)/python -m pytest -n 2
+
+# Optional producer (examples/producers/kratos): Kratos Multiphysics 10.4.4 into .venv, hash-checked
+# (environment-producers.lock pins numpy to environment.lock's, so the suite's stack is unchanged).
+producers-kratos: $(VENV)/.producers-kratos
+
+$(VENV)/.producers-kratos: environment-producers.lock $(STAMP)
+	$(BIN)/pip install --quiet --require-hashes -r environment-producers.lock
+	touch $@
 
 clean-env:
 	rm -rf $(VENV)

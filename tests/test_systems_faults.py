@@ -76,7 +76,9 @@ def test_a_declared_kernel_is_discounted(tmp_path):
 
 def test_a_nearly_repeated_row_is_inconclusive_not_stable(tmp_path):
     """Two rows of B equal but for 1e-14: the kernel decision is within a decade of round-off on
-    every level, so the verdict is INCONCLUSIVE (never STABLE), the margins named."""
+    a level (1e-14 x the row's max is a producer zero, so η holds that round-off and the pair
+    is a kernel up to it: close on the coarse levels), so the verdict is INCONCLUSIVE (never
+    STABLE), the margins named."""
     levels = []
     for N in NS:
         h, A, B, G = _level(N, "ok")
@@ -86,8 +88,9 @@ def test_a_nearly_repeated_row_is_inconclusive_not_stable(tmp_path):
         levels.append((h, A, B.tocsr(), G))
     path = write_system(tmp_path, levels, "npz", "near")
     out, rows = system_verdict(load_manifest(path), **CRITERION, notes=io.StringIO())
-    assert out["verdict"] == "INCONCLUSIVE" and all(r["kernel_decision"] == "close" for r in rows)
-    assert "margins" in out["evidence"]
+    assert out["verdict"] == "INCONCLUSIVE" and any(r["kernel_decision"] == "close" for r in rows)
+    assert all(r["kernel_decision"] == "close" or r["kernel_dim"] == 1 for r in rows)
+    assert "margins" in out["evidence"] and "entry_rtol" in out["evidence"]
     assert main(["verdict", "--system", str(path), "--expect", "stable"]) == 1
 
 

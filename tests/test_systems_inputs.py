@@ -138,10 +138,13 @@ def test_identity_rows(tmp_path):
     m = _manifest(tmp_path, big, sp.hstack([B, sp.csr_matrix((4, 2))], format="csr"), G)
     lv = load_level(m, m.levels[0])
     assert lv.removed == 2 and abs(_beta(lv.A, lv.B, lv.G) - _beta(A, B, G)) <= 1e-12
-    Bbad = sp.hstack([B, sp.csr_matrix(np.array([[1.0, 0]] * 4))], format="csr")
-    m = _manifest(tmp_path, big, Bbad, G)
-    with pytest.raises(SystemFileError, match="identity rows"):
-        load_level(m, m.levels[0])
+    # B assembled over them too: a unit row is a constrained dof (v = 0), so B's entries there are
+    # dropped, exactly as over a penalty row (tests/test_systems_constrained.py has the whole table)
+    Bover = sp.hstack([B, sp.csr_matrix(np.array([[1.0, 0]] * 4))], format="csr")
+    m = _manifest(tmp_path, big, Bover, G)
+    lv = load_level(m, m.levels[0])
+    assert lv.removed == 2 and "B's 4 entries on them dropped" in " ".join(lv.notes)
+    assert abs(_beta(lv.A, lv.B, lv.G) - _beta(A, B, G)) <= 1e-12
 
 
 def test_declared_constrained_dofs(tmp_path):
@@ -149,9 +152,11 @@ def test_declared_constrained_dofs(tmp_path):
     m = _manifest(tmp_path, A, B, G, level_extra="constrained: [0, 11]")
     lv = load_level(m, m.levels[0])
     assert lv.A.shape == (10, 10) and lv.removed == 2
-    m = _manifest(tmp_path, A, B, G, level_extra="constrained: [1]")  # B touches dof 1
-    with pytest.raises(SystemFileError, match="B has 1 entries on the 1 constrained dofs"):
-        load_level(m, m.levels[0])
+    m = _manifest(tmp_path, A, B, G, level_extra="constrained: [1]")  # B touches dof 1: v = 0 there
+    lv = load_level(m, m.levels[0])
+    assert lv.removed == 1 and "B's 1 entries on them dropped" in lv.notes[0]
+    keep = np.setdiff1d(np.arange(12), [1])
+    assert lv.B.shape == (4, 11) and lv.B.nnz == B[:, keep].nnz == 3
 
 
 @pytest.mark.parametrize("damage, found", [

@@ -90,21 +90,26 @@ def test_dense_and_shift_invert_routes_agree(pair):
 
 def test_a_close_kernel_decision_is_inconclusive(tmp_path):
     """A B with one extra multiplier nearly dependent on another (a copy of a row of B,
-    perturbed relatively by a few η): its singular value lands within a decade of η on at
+    perturbed relatively so that its singular value lands at 2η): within a decade of η on at
     least one level (checked: the test fails if the construction decides clearly everywhere),
     and one close decision makes the verdict INCONCLUSIVE, never STABLE or UNSTABLE by the
-    luck of the rounding."""
+    luck of the rounding. The copied row is a boundary pressure's, whose entries do not sum to
+    0: a copy of an interior row, perturbed, would sum to 0 within 1e-12 and read as entry
+    round-off (systems/roundoff.py), raising η with the perturbation."""
     import scipy.sparse as sp
+
+    def nearly_dependent(B, G, i, t):
+        row = B.getrow(i)
+        extra = row.multiply(1.0 + t * np.arange(row.shape[1]) / row.shape[1])
+        return sp.vstack([B, extra], format="csr"), sp.block_diag([G, G[i, i] * sp.identity(1)], format="csr")
 
     levels = []
     for n in DEFAULT_LEVELS:
         A, B, G = stokes_system("P2-P1", n)
-        eta = max(B.shape) * np.finfo(float).eps
-        row = B.getrow(B.shape[0] // 2)
-        extra = row.multiply(1.0 + 3.0 * eta * np.arange(row.shape[1]) / row.shape[1])  # ~1 decade from η
-        Bx = sp.vstack([B, extra], format="csr")
-        Gx = sp.block_diag([G, G[B.shape[0] // 2, B.shape[0] // 2] * sp.identity(1)], format="csr")
-        levels.append((1.0 / n, A, Bx, Gx))
+        i = int(np.argmax(np.abs(np.asarray(B.sum(axis=1)).ravel()) / np.asarray(abs(B).sum(axis=1)).ravel()))
+        k = level_spectrum(A, *nearly_dependent(B, G, i, 1e-10), known_kernel=1).kernel
+        t = 1e-10 * 2.0 * k.tol / k.singular[1]  # σ is linear in t: σ(t) = 2η
+        levels.append((1.0 / n, A) + nearly_dependent(B, G, i, t))
     manifest = load_manifest(write_system(tmp_path, levels, "mtx", "nearly dependent", known_kernel=1))
     out, rows = system_verdict(manifest, **CRITERION, notes=io.StringIO())
     margins = [r["kernel_margin_decades"] for r in rows]

@@ -101,6 +101,12 @@ SCHEMAS = {
                     optional={"c1": "float", "c2": "float", "p": "float?", "q": "float?", "seed": "int?",
                               "scene_kind": "str", "multiplier_mesh": "str"},
                     key=(*SERIES_COLUMNS, "measure")),
+    "producers": Schema({"producer": "str", "version": "str?", "space": "str", "offset": "int", "norm": "str",
+                         "status": "str", "verdict": "str?", "kernel_dim": "int?", "beta_levels": "str?",
+                         "kernel_levels": "str?", "h_levels": "str?", "slope": "float?", "slope_lo": "float?",
+                         "slope_hi": "float?", "evidence": "str?", "seconds": "float?", "install": "str",
+                         "system": "str?"}, key=("producer", "space", "offset", "norm"),
+                        label="the producers table (rules/producers.smk)"),
     "claims": Schema({"claim_id": "str", "paper_ref": "str", "statement": "str", "evidence": "str", "verdict": "str",
                       "predicted": "str"}, key=("claim_id",), label="a claims ledger"),
     # no key: a sample 1e-9·h inside each end of an interval may print as its neighbour's x

@@ -243,9 +243,11 @@ def contact_estimate(family: str, k: int, n1: int, n2: int, n_ref: int | None = 
     return Estimate((PROCESS_BYTES["contact"] if process else 0) + total, seconds)
 
 
-def verdict_estimate(family: str, k: int, ns, norm: str, multiplier_mesh: str = "omega2", dim: int = 2) -> Estimate:
-    """β_h on matching meshes N × N, one N after the other: the largest N sets the memory."""
-    ests = [beta_estimate(family, k, n, n, multiplier_mesh, (norm,), dim=dim) for n in ns]
+def verdict_estimate(family: str, k: int, ns, norm: str, multiplier_mesh: str = "omega2", dim: int = 2,
+                     n1_offset: int = 0, components: int = 1) -> Estimate:
+    """β_h on the pairs (N + ``n1_offset``, N), one N after the other: the largest sets the memory."""
+    ests = [beta_estimate(family, k, n + n1_offset, n, multiplier_mesh, (norm,), components=components, dim=dim)
+            for n in ns]
     return Estimate(max(e.bytes for e in ests), START_SECONDS + sum(e.seconds - START_SECONDS for e in ests))
 
 

@@ -28,6 +28,7 @@ LEDGER_TABLES = {
     "results/tables/claims_extra.csv": "claims",
     "results/tables/elastic_claims.csv": "claims",
     **{path: "claims" for path in FACE_CLAIMS},
+    **{path: "claims" for path in PRODUCERS_TABLES[1:]},  # rules/producers.smk
 }
 GATE_STAGES = [
     ("results/claims.csv", LEDGER_TABLES),
@@ -44,6 +45,7 @@ rule claims:
         extra="results/tables/claims_extra.csv",
         elastic="results/tables/elastic_claims.csv",  # the elastic stage's claims (rules/elastic.smk)
         face=FACE_CLAIMS,  # the face stage's claims (rules/face.smk), when the config has a face section
+        producers=PRODUCERS_TABLES[1:],  # the producers' claims (rules/producers.smk), with a producers section
         src=PACKAGE_SOURCES,
     params:
         cfg=lambda wc: config["claims"],

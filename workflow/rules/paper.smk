@@ -50,6 +50,7 @@ rule paper_pdf:
         face_tex="paper/face.tex",  # the face section (rules/face.smk)
         face=FACE_PAPER,
         face_elastic=FACE_ELASTIC_PAPER,  # its subsection (rules/face_elastic.smk), \InputIfFileExists in face.tex
+        producers=PRODUCERS_PAPER,  # "Certifying production codes" (rules/producers.smk), \InputIfFileExists in paper.tex
     benchmark:
         "results/benchmarks/rules/paper_pdf.tsv"
     log:

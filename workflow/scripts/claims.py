@@ -17,6 +17,7 @@ table = ledger(read_table(inp.beta, "beta"), read_table(inp.rates, "rates"), rea
 import pandas as pd  # noqa: E402
 
 table = pd.concat([table, read_table(inp.elastic, "claims")]
-                  + [read_table(p, "claims") for p in inp.face], ignore_index=True)  # rules/face.smk
+                  + [read_table(p, "claims") for p in inp.face]  # rules/face.smk
+                  + [read_table(p, "claims") for p in inp.producers], ignore_index=True)  # rules/producers.smk
 write_csv_atomic(snakemake.output[0], table)  # noqa: F821
 print(table[["claim_id", "verdict", "predicted"]].to_string(), file=sys.stderr)

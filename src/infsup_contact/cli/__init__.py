@@ -12,6 +12,8 @@
     infsup-contact bench --what beta --N 32 64 --k 2
     infsup-contact verdict --case T3 --k 2 --expect stable
     infsup-contact verdict --system levels.yaml --expect stable
+    infsup-contact verdict --system levels.yaml --format json --output verdict.json
+    infsup-contact verdict-hook a/levels.yaml b.levels.yaml
     infsup-contact export --case T3 --k 2 --N 8 16 32 --format mtx --out dir/
     infsup-contact provenance
 
@@ -30,7 +32,7 @@ import sys
 
 from ..errors import InputError
 from ..io import TableError
-from . import beta, bench, contact, export, rates, verdict
+from . import beta, bench, contact, export, rates, verdict, verdict_hook
 from .common import EXIT_INTERRUPTED, EXIT_OUTPUT, OutputError, check_stdout, given_dests, refuse_unused, write_text
 from .verdict import VERDICT_DEFAULTS
 
@@ -80,6 +82,7 @@ def build_parser() -> argparse.ArgumentParser:
     rates.add(sub)
     bench.add(sub)
     verdict.add(sub)
+    verdict_hook.add(sub)
     export.add(sub)
     _add_provenance(sub)
     return parser

@@ -49,14 +49,14 @@ def face_cases(args) -> list:
 
 def run_intervals(args, limit: int = 1024) -> set:
     """Numbers of intervals of the multiplier meshes a request will use (--N1/--N2 and
-    --multiplier-mesh, or the --N list of matching meshes), for checking a user space on each.
+    --multiplier-mesh, or the --N list with N1 = N + --N1-offset), for checking a user space on each.
     Sizes that are not valid N are left to their own checks; above ``limit`` the space is
     checked as it is built (user_spaces.guarded_build), not before."""
     from ..discretization.registry import multiplier_intervals
 
     choice = getattr(args, "multiplier_mesh", "omega2")
     pairs = ([(getattr(args, "N1", None), getattr(args, "N2", None))] if hasattr(args, "N1")
-             else [(n, n) for n in getattr(args, "N", None) or ()])
+             else [(n + getattr(args, "N1_offset", 0), n) for n in getattr(args, "N", None) or ()])
     ok = [(a, b) for a, b in pairs if all(isinstance(v, int) and 1 <= v <= limit for v in (a, b))]
     return {multiplier_intervals(a, b, choice) for a, b in ok}
 
@@ -163,7 +163,8 @@ def check_memory(est, key: str, value) -> None:
                          f"available (this request: {est.describe()})", got=value)
 
 
-SYSTEM_KEEPS = ("system", "dry_run", "expect", "slope_tolerance", "beta_floor", "confidence", "help")
+SYSTEM_KEEPS = ("system", "dry_run", "expect", "slope_tolerance", "beta_floor", "confidence", "help",
+                "format", "output")
 """Flags that mean something with ``--system``; every other one is refused there."""
 
 

@@ -18,7 +18,9 @@ def add(sub) -> None:
                        "levels.yaml manifest (the layout `verdict --system` reads)",
                        description="A = diag(K1, K2) (free dofs, Γ last), B = [-B1 | B2], G = the Gram "
                        "matrix of --norm, on N1 = N + --N1-offset, N2 = N for each --N; h = 1/N.")
-    p.add_argument("--case", required=True, choices=space_ids(), help="a registered space")
+    p.add_argument("--case", required=True, choices=space_ids(None),
+                   help="a registered space: one of the segment's, or on a 3D model one its face elements "
+                   "build (k >= 2: DUAL-Q9, TDUAL-Q8, ... with --element hex; TDUAL-T6, PWLIN-T6 with --element tet)")
     p.add_argument("--k", type=int, required=True, help="displacement degree, 1..4")
     p.add_argument("--N", type=int, nargs="+", required=True, help="segments on Γ of Ω2, coarse to fine")
     p.add_argument("--N1-offset", type=int, default=0, help="N1 = N + offset (non-matching pairs; default 0)")
@@ -42,6 +44,7 @@ def _check_export(args):
 
     from .. import resources
     from ..discretization import meshes, registry
+    from ..study.verdict import check_model_case, check_n1_offset
 
     material(args)
     args.mesh_kwargs = mesh_options(args)
@@ -56,9 +59,12 @@ def _check_export(args):
         meshes.check_mesh_args(args.family, n, "N")
     if ns != sorted(set(ns)):
         raise InputError("N", "distinct sizes, coarse to fine", got=" ".join(map(str, ns)))
-    if min(ns) + args.N1_offset < 1:
-        raise InputError("N1_offset", f"an integer with N + offset >= 1 for every --N (smallest N: {min(ns)})",
-                         got=args.N1_offset)
+    check_n1_offset(ns, args.N1_offset)
+    for n in ns:
+        meshes.check_mesh_args(args.family, n + args.N1_offset, "N1_offset")
+    check_model_case(args.case, args.k, args.model_obj, args.family, **args.mesh_kwargs)
+    for n in ns:  # an empty space on a small N: refused here, before any file is written
+        registry.check_pair_spaces([args.case], args.k, n + args.N1_offset, n, (args.multiplier_mesh,), key="N")
     out = Path(args.out)
     if not args.out.strip() or (out.exists() and not out.is_dir()):
         raise InputError("out", "a directory to write into (created if missing)", got=args.out)
@@ -105,7 +111,8 @@ def _run_export(args) -> None:
         A, B, G = suite_system(args.case, args.k, n + args.N1_offset, n, args.family, args.norm,
                                args.multiplier_mesh, model=args.model_obj, **kwargs)
         levels.append((1.0 / n, A, B, G))
-    name = f"{args.case}-k{args.k}-{args.model}"
+    name = "-".join([args.case, f"k{args.k}", args.model, *kwargs.values()]
+                    + ([f"N1{args.N1_offset:+d}"] if args.N1_offset else []))
     out = Path(args.out)
     before = {p.name for p in out.iterdir()} if out.is_dir() else set()
     path = write_system(args.out, levels, args.format, name, norm="given" if args.norm == "H" else "L2")

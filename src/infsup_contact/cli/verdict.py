@@ -5,7 +5,8 @@ import sys
 
 from ..errors import InputError
 from .common import (declare_flag_uses, model_flag_uses, system_flag_uses, add_dry_run, add_model, check_memory, mesh_options,
-                     run_intervals, SPACE_HELP, write_csv)
+                     run_intervals, SPACE_HELP)
+from .verdict_formats import add_output_args, emit
 
 
 VERDICT_DEFAULTS = {"slope_tolerance": 0.15, "beta_floor": 0.001, "confidence": 0.95}
@@ -21,25 +22,32 @@ def add(sub) -> None:
     from ..discretization.registry import space_ids
 
     p = sub.add_parser(
-        "verdict", help="is a multiplier space stable? β_h over matching meshes → STABLE, "
+        "verdict", help="is a multiplier space stable? β_h over a series of meshes → STABLE, "
         "UNSTABLE or INCONCLUSIVE (CSV: one row)",
-        description="β_h (eq. (4.5)) on matching meshes N1 = N2 = N for each --N, judged by the "
+        description="β_h (eq. (4.5)) on the mesh pairs N1 = N + --N1-offset, N2 = N for each --N "
+        "(matching by default; h = 1/N2), judged by the "
         "claims ledger's criterion: a numerical kernel on any mesh is UNSTABLE; otherwise PASS/"
         "FAIL/INCONCLUSIVE of 'β_h bounded away from 0' (min β_h > --beta-floor and the "
         "--confidence interval of the slope of log β_h vs log h inside ±--slope-tolerance) is "
         "STABLE/UNSTABLE/INCONCLUSIVE. With --expect the exit code is 0 if the verdict matches, "
         "1 if not (INCONCLUSIVE never matches); bad input is exit code 2.")
     which = p.add_mutually_exclusive_group(required=True)
-    which.add_argument("--case", choices=space_ids(), help="a registered space")
+    which.add_argument("--case", choices=space_ids(None),
+                       help="a registered space: one of the segment's, or on a 3D model one its face "
+                       "elements build (k >= 2: DUAL-Q9, TDUAL-Q8, ... with --element hex; TDUAL-T6, "
+                       "PWLIN-T6 with --element tet)")
     which.add_argument("--space", metavar="FILE.py:FUNC", help=SPACE_HELP)
     which.add_argument("--system", metavar="LEVELS.yaml",
                        help="a saddle-point system exported by another code: a manifest of mesh levels "
                        "{h, A, B, G} (README, 'Certify a discretization from another code'); --k, --family, "
-                       "--N, --norm and --multiplier-mesh do not apply")
+                       "--N, --N1-offset, --norm and --multiplier-mesh do not apply")
     p.add_argument("--k", type=int, default=None, help="displacement degree, 1..4 (with --case/--space)")
     p.add_argument("--family", default="structured", choices=FAMILIES)
     p.add_argument("--N", type=int, nargs="+", default=[8, 16, 32, 64],
-                   help="segments on Γ of the matching meshes, at least 3 distinct (default: 8 16 32 64)")
+                   help="segments on Γ of the Ω2 meshes (a 3D model: cells per direction on the face), "
+                   "at least 3 distinct (default: 8 16 32 64)")
+    p.add_argument("--N1-offset", type=int, default=0,
+                   help="N1 = N + offset: a non-matching series (default 0: matching meshes)")
     p.add_argument("--norm", default="H", choices=["H", "L2"],
                    help="multiplier norm: H = H^{-1/2}_00(Γ) (the paper's, default); in L2 "
                    "stable spaces decay like h^{1/2} (Remark 3.1)")
@@ -51,6 +59,7 @@ def add(sub) -> None:
                       ("confidence", "confidence level of the slope interval")):
         p.add_argument("--" + key.replace("_", "-"), dest=key, type=float, default=VERDICT_DEFAULTS[key],
                        help=f"{text} (default {VERDICT_DEFAULTS[key]:g}: claims.{key} in config/config.yaml)")
+    add_output_args(p)
     add_dry_run(p)
     declare_flag_uses(p, [*system_flag_uses(p), *model_flag_uses()])
     p.set_defaults(run=_run_verdict, check=_check_verdict)
@@ -73,7 +82,7 @@ def _check_verdict(args):
         raise InputError("k", "an integer in 1..4 (required with --case and --space)")
     from ..discretization import meshes, registry
     from ..discretization.user_spaces import load_user_space
-    from ..study.verdict import check_criterion, check_mesh_sizes
+    from ..study.verdict import check_criterion, check_mesh_sizes, check_model_case, check_n1_offset
 
     args.space_or_case = args.case if args.space is None else load_user_space(args.space, run_intervals(args))
     case = args.case if args.space is None else args.space_or_case.id
@@ -86,35 +95,35 @@ def _check_verdict(args):
     args.mesh_kwargs = mesh_options(args)
     meshes.check_mesh_args(args.family, 1)
     ns = check_mesh_sizes(args.N)
+    check_n1_offset(ns, args.N1_offset)
+    for n in ns:
+        meshes.check_mesh_args(args.family, n + args.N1_offset, "N1_offset")
+    if args.space is None:  # a face-only id on a 2D model, a face space of the other element: one line
+        check_model_case(case, args.k, args.model_obj, args.family, **args.mesh_kwargs)
     for n in ns:  # an empty space on a small N is refused here, before any β_h
-        registry.check_pair_spaces([case], args.k, n, n, (args.multiplier_mesh,), key="N")
+        registry.check_pair_spaces([case], args.k, n + args.N1_offset, n, (args.multiplier_mesh,), key="N")
     check_criterion(args.slope_tolerance, args.beta_floor, args.confidence)
-    est = resources.verdict_estimate(args.family, args.k, ns, args.norm, args.multiplier_mesh, args.model_obj.dim)
-    check_memory(est, "N", max(ns))
+    est = resources.verdict_estimate(args.family, args.k, ns, args.norm, args.multiplier_mesh, args.model_obj.dim,
+                                     n1_offset=args.N1_offset, components=args.model_obj.components)
+    check_memory(est, *(("N1_offset", args.N1_offset) if args.N1_offset > 0 else ("N", max(ns))))
     return est
 
 
 def _run_verdict(args) -> int:
-    import pandas as pd
-
     if args.system is not None:
         from ..systems.levels import system_verdict
 
-        out, _ = system_verdict(args.manifest, tol=args.slope_tolerance, floor=args.beta_floor,
-                                confidence=args.confidence)
+        out, levels = system_verdict(args.manifest, tol=args.slope_tolerance, floor=args.beta_floor,
+                                     confidence=args.confidence)
         if out["norm"] != "given":
             print(f"infsup-contact: note: {out['norm_note']}", file=sys.stderr)
-        write_csv(pd.DataFrame([out]), float_format="%.6g")
-        return 0 if args.expect is None else (0 if out["verdict"] == _EXPECT[args.expect] else 1)
+        return emit(args, out, levels, manifest_expect=args.manifest.expect)
 
     from ..study.verdict import verdict_rows
 
     space = args.space_or_case
     out = verdict_rows(space, args.k, args.family, args.N, args.norm,
                        tol=args.slope_tolerance, floor=args.beta_floor, confidence=args.confidence,
-                       multiplier_mesh=args.multiplier_mesh, model=args.model_obj, **args.mesh_kwargs)
-    out["N_list"] = " ".join(str(n) for n in out["N_list"])
-    write_csv(pd.DataFrame([out]), float_format="%.6g")
-    if args.expect is None:
-        return 0
-    return 0 if out["verdict"] == _EXPECT[args.expect] else 1
+                       multiplier_mesh=args.multiplier_mesh, model=args.model_obj, n1_offset=args.N1_offset,
+                       **args.mesh_kwargs)
+    return emit(args, out)

@@ -35,13 +35,18 @@ proof were counted, log10(η/σ_d) (the largest counted as zero). A decision wit
 below :data:`MARGIN_DECADES` is ``close``: claims and verdicts resting on it are
 INCONCLUSIVE, never PASS or FAIL by the luck of one BLAS kernel's rounding.
 
+For a foreign system the entries of B carry the producer's round-off, ``entry_error`` =
+E(r) of :mod:`infsup_contact.systems.roundoff`, and every ``clear`` decision is checked against
+the pencil itself (:func:`pencil_cross_check`): a first mode counted non-zero must stand a
+decade above the pencil's round-off level n ε λ_max, else the decision is ``close``.
+
 The pencil's own gap rule (:func:`kernel_from_gap`) stays as the independent cross-check
 (``tests/test_kernel.py``: both agree wherever the pencil's gap is clear). Pure numpy/scipy:
 the command line states the rule without importing NGSolve.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 import scipy.linalg as sla
@@ -271,18 +276,51 @@ def kernel_from_gap(ev: np.ndarray, gap_decades: float = GAP_DECADES) -> tuple[i
     return d, gap
 
 
-def pencil_roundoff(ev: np.ndarray) -> float:
-    """η = n ε λ_max of an ascending spectrum (see :func:`kernel_from_gap`)."""
-    return len(ev) * np.finfo(float).eps * max(float(ev[-1]), 0.0)
+def pencil_roundoff(ev: np.ndarray, lam_max: float | None = None, n: int | None = None) -> float:
+    """η = n ε λ_max of an ascending spectrum (see :func:`kernel_from_gap`); ``lam_max`` and ``n``
+    (the pencil's dimension) where ``ev`` holds only the bottom of the spectrum."""
+    lam_max = float(ev[-1]) if lam_max is None else float(lam_max)
+    return (len(ev) if n is None else n) * np.finfo(float).eps * max(lam_max, 0.0)
 
 
-def gap_over_roundoff(ev: np.ndarray, d: int) -> float:
+def gap_over_roundoff(ev: np.ndarray, d: int, lam_max: float | None = None, n: int | None = None) -> float:
     """λ_{d+1}/η: how far the first eigenvalue above a d-dimensional kernel stands above the
-    pencil's round-off level (inf for an all-kernel spectrum or η = 0; 0 for λ <= 0)."""
-    eta = pencil_roundoff(ev)
+    pencil's round-off level (inf for an all-kernel spectrum or η = 0; 0 for λ <= 0);
+    ``lam_max``, ``n`` as :func:`pencil_roundoff`."""
+    eta = pencil_roundoff(ev, lam_max, n)
     if d >= len(ev) or eta <= 0:
         return np.inf
     return float(max(ev[d], 0.0) / eta)
+
+
+def pencil_cross_check(decision: KernelDecision, ev, lam_max: float, n: int,
+                       zeros_computed: bool = True) -> tuple[KernelDecision, float]:
+    """A ``clear`` decision from Bᵀ checked against the pencil (B A⁻¹ Bᵀ, G) itself.
+
+    ``ev`` are the bottom eigenvalues computed (ascending, the d = ``decision.dim`` kernel
+    modes first), ``lam_max`` the largest eigenvalue, ``n`` the pencil's dimension; the pencil's
+    round-off level is η_p = n ε λ_max (:func:`pencil_roundoff`). The decision stays clear only if
+
+    * λ_{d+1} >= 10**MARGIN_DECADES · η_p: the first mode counted non-zero is visibly non-zero
+      in the pencil too. A mode that the singular values call non-zero only because the
+      entries' round-off was larger than η assumed (a zero singular value pushed above η)
+      has λ ~ σ² λ_max, far below η_p: not clear;
+    * where the kernel's eigenvalues were computed (``zeros_computed``, the dense routes),
+      λ_d <= 10**GAP_DECADES · η_p: a mode counted as zero is not visibly non-zero in the
+      pencil (η_p is optimistic after the Cholesky reduction by G, hence GAP_DECADES, the gap
+      rule's own allowance).
+
+    Returns the decision (``close``, its margin lowered to the pencil's, where a test fails) and
+    log10(λ_{d+1}/η_p) (inf without a mode above the kernel).
+    """
+    d = decision.dim
+    margin = float(np.log10(max(gap_over_roundoff(ev, d, lam_max, n), np.finfo(float).tiny)))
+    fails = margin < MARGIN_DECADES
+    if zeros_computed and 0 < d <= len(ev):
+        fails |= float(ev[d - 1]) > 10.0 ** GAP_DECADES * pencil_roundoff(ev, lam_max, n)
+    if fails and decision.decision == CLEAR:
+        decision = replace(decision, decision=CLOSE, margin_decades=min(decision.margin_decades, margin))
+    return decision, margin
 
 
 def kernel_check(numerical: int, structural: int) -> str:

@@ -1,4 +1,4 @@
-"""Is a multiplier space stable? One verdict from β_h over a sequence of matching meshes.
+"""Is a multiplier space stable? One verdict from β_h over a series of mesh pairs, N1 = N2 + offset.
 
 β_h is the discrete inf-sup constant of eq. (4.5), computed by
 :func:`infsup_contact.solvers.infsup.beta_rows`. The verdict uses the claims ledger's own
@@ -28,6 +28,7 @@ import pandas as pd
 from ..discretization import registry
 from ..discretization.norms import NORMS
 from ..errors import InputError
+from ..models import DEFAULT_MODEL
 from ..solvers.infsup import beta_rows
 from . import claims
 
@@ -92,8 +93,10 @@ def stability_verdict(rows, tol: float, floor: float, confidence: float) -> dict
 
 
 def verdict_rows(case_or_spec, k: int, family: str, ns, norm: str, *, tol: float, floor: float,
-                 confidence: float, multiplier_mesh: str = "omega2", model=None, **mesh_kwargs) -> dict:
-    """β_h on matching meshes N1 = N2 = N for each N in ``ns``, and its stability verdict.
+                 confidence: float, multiplier_mesh: str = "omega2", model=None, n1_offset: int = 0,
+                 **mesh_kwargs) -> dict:
+    """β_h on the mesh pairs N1 = N + ``n1_offset``, N2 = N for each N in ``ns`` (matching
+    meshes by default), and its stability verdict.
 
     Parameters
     ----------
@@ -114,6 +117,8 @@ def verdict_rows(case_or_spec, k: int, family: str, ns, norm: str, *, tol: float
         Partition G_h of the multipliers: ``omega2`` (the paper's), ``omega1``, ``union``.
     model : Model, optional
         The physical model (:mod:`infsup_contact.models`); default the paper's membranes.
+    n1_offset : int
+        N1 − N2 of every pair (non-matching meshes; :func:`check_n1_offset`); h = 1/N2.
     **mesh_kwargs
         Passed to the mesh generator (``seed``, ``alpha`` of the perturbed family; the 3D
         model's ``element``).
@@ -121,8 +126,9 @@ def verdict_rows(case_or_spec, k: int, family: str, ns, norm: str, *, tol: float
     Returns
     -------
     dict
-        ``space``, ``k``, ``family``, ``norm``, ``multiplier_mesh``, the fields of
-        :func:`stability_verdict`, ``N_list`` (the sorted N) and ``seconds`` (wall time of
+        ``space``, ``k``, ``model``, ``element`` (the 3D models' mesh element, else None),
+        ``family``, ``norm``, ``multiplier_mesh``, ``N1_offset``, the fields of
+        :func:`stability_verdict`, ``N_list`` (the sorted N2) and ``seconds`` (wall time of
         the whole call).
 
     Raises
@@ -133,14 +139,15 @@ def verdict_rows(case_or_spec, k: int, family: str, ns, norm: str, *, tol: float
     t0 = time.perf_counter()
     case = _case_id(case_or_spec)
     ns = check_mesh_sizes(ns)
+    check_n1_offset(ns, n1_offset)
     check_criterion(tol, floor, confidence)
     if norm not in NORMS:
         raise InputError("norm", ", ".join(NORMS), got=norm)
-    if model is not None:
-        mesh_kwargs["model"] = model
-    rows = [r for n in ns for r in beta_rows(family, k, n, n, [case], multiplier_mesh,
-                                             norms=(norm,), **mesh_kwargs)]
-    out = dict(space=case, k=k, family=family, norm=norm, multiplier_mesh=multiplier_mesh,
+    model = DEFAULT_MODEL if model is None else model
+    rows = [r for n in ns for r in beta_rows(family, k, n + n1_offset, n, [case], multiplier_mesh,
+                                             norms=(norm,), model=model, **mesh_kwargs)]
+    out = dict(space=case, k=k, model=model.name, element=mesh_kwargs.get("element"), family=family, norm=norm,
+               multiplier_mesh=multiplier_mesh, N1_offset=n1_offset,
                **stability_verdict(rows, tol, floor, confidence), N_list=ns)
     out["seconds"] = time.perf_counter() - t0
     return out
@@ -160,6 +167,73 @@ def check_mesh_sizes(ns) -> list:
         raise InputError("N", f"at least {MIN_MESHES} distinct mesh sizes (a slope interval needs them)",
                          got=" ".join(map(str, ns)))
     return sorted(set(int(n) for n in ns))
+
+
+def check_n1_offset(ns, offset) -> int:
+    """N1 = N + ``offset`` >= 1 for every N of ``ns``; :class:`InputError` (key ``N1_offset``)
+    otherwise."""
+    if isinstance(offset, bool) or not isinstance(offset, (int, np.integer)) or min(ns) + offset < 1:
+        raise InputError("N1_offset", f"an integer with N + offset >= 1 for every --N (smallest N: {min(ns)})",
+                         got=offset)
+    return int(offset)
+
+
+def model_case_ids(model, k: int, family: str = "structured", **mesh_kwargs) -> list:
+    """The registered ids ``model`` builds for degree k: on a 2D model the segment's spaces
+    defined for k; on a 3D model also the face-only ones its element's face cells carry
+    (QUAD8/QUAD9 spaces on hexahedra, TRI6 spaces on tetrahedra), those refused by
+    construction (DUAL-Q8, DUAL-T6) left out. Found as ``beta --case all`` finds them, on the
+    model's coarsest mesh (one cell per direction; a 2D model: no mesh, the segment builds
+    every space of its dimension)."""
+    if model.dim == 2:
+        return registry.ids_valid_for(k, gamma_dim=1)
+    return registry.ids_built_on(k, *_coarsest_multiplier_mesh(model, k, family, **mesh_kwargs))
+
+
+def _coarsest_multiplier_mesh(model, k, family, **mesh_kwargs):
+    """(Γ, G_h) of ``model`` on its coarsest matching mesh pair (one cell per direction)."""
+    trace = model.side_operator(model.subdomain_mesh(family, 1, 1, **mesh_kwargs), k).trace
+    return trace.gamma, trace.gamma.multiplier_partition(trace.partition, trace.partition)
+
+
+def check_model_case(case: str, k: int, model, family: str = "structured", **mesh_kwargs) -> None:
+    """:class:`InputError` unless ``model`` (with its mesh options, e.g. ``element``) builds the
+    registered space ``case`` for degree k (:func:`model_case_ids`): one line naming the key
+    (``case`` or ``k``) and the values allowed for this model, element and k. The id and k are
+    checked before any mesh is built (a 2D model builds none)."""
+    spec = registry.space_spec(case)  # an unknown id: every registered id listed
+    if not spec.valid_for(k):
+        ks = [j for j in range(registry.K_RANGE[0], registry.K_RANGE[1] + 1) if spec.valid_for(j)]
+        raise InputError("k", f"k in {ks[0]}..{ks[-1]} for case {case} ({spec.paper_ref})", got=k)
+    where = " ".join([f"--model {model.name}", *(f"--{key} {value}" for key, value in mesh_kwargs.items()),
+                      *([f"--family {family}"] if family != "structured" else [])])
+    if not spec.defined_on(model.dim - 1):
+        why = (f"defined on the face of a 3D model only: --model {', '.join(_models(3))}" if model.dim == 2
+               else "defined on the segment Γ of the 2D models only")
+        allowed = model_case_ids(model, k, family, **mesh_kwargs)
+        raise InputError("case", f"a space of {where} with k = {k}: {', '.join(allowed)} ({case} is {why})", got=case)
+    if model.dim == 2:
+        return
+    gamma, g_h = _coarsest_multiplier_mesh(model, k, family, **mesh_kwargs)
+    allowed = registry.ids_built_on(k, gamma, g_h)
+    if case in allowed:
+        return
+    if not getattr(gamma, "builds", lambda s: True)(spec):
+        why = (f"built on {', '.join(spec.face_cells)} face cells only" if hasattr(gamma, "cell")
+               else "not built on a general triangulation of Γ: only Lagrange cases and their duals are")
+    else:
+        try:
+            gamma.space(spec, k, g_h)
+            why = "not built here"
+        except InputError as err:  # refused by construction: the construction's reason and remedy
+            why = f"refused: {err.allowed}"
+    raise InputError("case", f"a space of {where} with k = {k}: {', '.join(allowed)} ({case} is {why})", got=case)
+
+
+def _models(dim: int) -> list:
+    from ..models import MODELS
+
+    return [name for name, m in MODELS.items() if m.dim == dim]
 
 
 MAX_SLOPE_TOLERANCE = 0.25

@@ -2,7 +2,45 @@
 
 Each finding is one line naming the file: a :class:`~.readers.SystemFileError` where the
 number would be wrong (refused), or a note (printed on stderr, kept in the row) where the
-system is repaired in a way that does not change β_h:
+system is repaired in a way that does not change β_h.
+
+**Constrained rows: one rule for A, B and G.** A dof the producer fixed is removed where the
+removal cannot change β_h, and refused, naming the file and the rows, where it could:
+
+=====================================  =========================================================
+constrained row                        action
+=====================================  =========================================================
+displacement dof declared              removed with B's entries over it (v = 0 there, so
+(``constrained``), a penalty row of A  b(v, μ) never sees them: dropping them is exact, however
+(|a_ii| >= 1e15 × median, "tgv"), or   the dof was marked); a note counts the dofs and the
+a unit row of A (coupled to nothing,   entries. ``tgv: refuse`` refuses the penalty rows
+a_ii exactly 1)
+a dof coupled to nothing in A, not     removed (it cannot change B A⁻¹ Bᵀ)
+touched by B, diagonal not 1
+a dof coupled to nothing in A, touched kept with a note (element bubbles, e.g. MINI, are
+by B, diagonal not 1 (or A's diagonal  coupled to nothing in A); with a unit diagonal
+is 1 nearly everywhere)                everywhere a unit row is not told from the others
+multiplier row: B's row zero as given  removed with a note (the boundary condition on the
+and G's row decoupled and singled out  multiplier space FE codes use to make μ vanish at Γ's
+(a unit row in a G that couples other  ends: μ_i is G-orthogonal to the rest, so removing it
+rows, or whose diagonal is not 1)      leaves the pencil of the constrained space)
+multiplier row: a penalty row of G     removed with B's row (the penalty's limit: the pencil
+(g_ii >= 1e15 × median)                tends to that of μ_i = 0, plus one spurious zero mode);
+                                       ``tgv: refuse`` refuses it
+multiplier row: B's row zero, G's row  refused, naming both files and the rows: an incomplete
+coupled to others but its diagonal 1   constraint (the unit diagonal set, the row and column
+(G's diagonal elsewhere not 1)         left), where removing the row changes β_h and keeping it
+                                       counts a kernel the producer meant to remove
+multiplier row: B's row zero, G's row  kept: a kernel of Bᵀ (UNSTABLE unless declared), with a
+coupled to others (diagonal not 1), or note. No constraint pattern: removing it would change β_h
+decoupled in a diagonal G with the     (a P1–P1 pressure at a corner whose velocities are all
+same diagonal there                    fixed is such a mode, not a constraint)
+multiplier row: B's and G's rows zero  removed with a note (a multiplier in neither)
+B's row zero only after the dofs it    kept: a kernel of Bᵀ (the multiplier couples only to fixed
+touched were removed                   dofs), with a note
+=====================================  =========================================================
+
+**Everything else:**
 
 =====================================  =========================================================
 finding                                action
@@ -10,21 +48,11 @@ finding                                action
 NaN or inf in a matrix                 refused (count, first position)
 shapes that do not fit (A n×n, B m×n,  refused, naming both files and their shapes
 G m×m)
-declared constrained dofs              removed from A and B; refused if B has entries on them
-                                       (b(v, μ) on a fixed dof has no meaning: export B
-                                       without them)
-huge diagonal penalties ("tgv",        ``tgv: eliminate`` (default): the dofs are removed —
-|a_ii| ≥ 1e15 × median |a_jj|)         the penalty's own limit, v = 0 there — and B's entries
-                                       on them dropped, with a note; ``tgv: refuse``: refused
-undeclared identity rows (a dof with   removed with a note when B does not touch them (they
-no coupling in A)                      cannot change B A⁻¹ Bᵀ); refused when B does and the
-                                       diagonal is exactly 1 (a constrained dof left as an
-                                       identity row); kept with a note otherwise (element
-                                       bubbles, e.g. MINI, are coupled to nothing in A)
 A not symmetric                        refused: the largest |a_ij − a_ji| and where
 A not positive definite                refused; a floating body (zero pivots) gets the number
                                        of zero pivots and ‖A x‖ of a null vector x
-zero rows in G, G not SPD              refused
+zero rows in G (B's row not zero),     refused
+G not SPD
 a finer level with fewer dofs          refused (files swapped?)
 =====================================  =========================================================
 """
@@ -58,6 +86,7 @@ class CheckedLevel:
     G: object
     notes: list = field(default_factory=list)
     removed: int = 0
+    removed_multipliers: int = 0
 
 
 def check_finite(mat, path) -> None:
@@ -84,9 +113,15 @@ def check_shapes(level, A, B, G) -> None:
                               f"expected {G.shape[0]} x {A.shape[0]} (m x n)")
 
 
-def _remove(A, B, dofs):
-    keep = np.setdiff1d(np.arange(A.shape[0]), dofs)
-    return A[keep][:, keep], B[:, keep]
+TINY_COUPLING = 1e-12
+"""An off-diagonal |g_ij| <= TINY_COUPLING × sqrt(g_ii g_jj) is a producer zero: G's row is decoupled there."""
+ROWS_SHOWN = 6
+"""Rows named in a message (then "…")."""
+
+
+def _rows(idx) -> str:
+    idx = [int(i) for i in idx]
+    return ", ".join(map(str, idx[:ROWS_SHOWN])) + (", ..." if len(idx) > ROWS_SHOWN else "") + " (0-based)"
 
 
 def _b_entries_on(B, dofs) -> int:
@@ -98,6 +133,117 @@ def _b_entries_on(B, dofs) -> int:
     return int(block.nnz)
 
 
+def _decoupled(M, rtol: float = 0.0) -> np.ndarray:
+    """Rows (and columns) of a square sparse M with no off-diagonal |m_ij| above
+    rtol · sqrt(|m_ii m_jj|) (scale-free: a penalty elsewhere does not hide a coupling)."""
+    off = sp.coo_matrix(M - sp.diags(M.diagonal()))
+    d = np.sqrt(np.abs(M.diagonal()))
+    big = np.abs(off.data) > rtol * d[off.row] * d[off.col]
+    rows, cols = off.row[big], off.col[big]
+    out = np.ones(M.shape[0], bool)
+    out[rows] = out[cols] = False
+    return out
+
+
+def _penalty_rows(diag) -> tuple:
+    """(rows whose |diagonal| is >= TGV_RATIO × the median non-zero |diagonal|, that median)."""
+    diag = np.abs(diag)
+    if not np.any(diag > 0):
+        return np.zeros(0, int), 0.0
+    med = float(np.median(diag[diag > 0]))
+    return np.flatnonzero(diag >= TGV_RATIO * med), med
+
+
+def constrained_displacements(level, A, B, constrained, tgv: str) -> tuple:
+    """(dofs of A to remove, notes): the displacement rows of the module's table."""
+    n = A.shape[0]
+    notes, remove = [], [np.asarray(constrained, int)]
+    if len(constrained):
+        notes.append(f"{level.A.name}: {len(constrained)} declared constrained dofs removed"
+                     + _dropped(B, constrained))
+    diag = A.diagonal()
+    pen, med = _penalty_rows(diag)
+    pen = np.setdiff1d(pen, constrained)
+    if len(pen):
+        where = f"{len(pen)} Dirichlet penalty rows (diagonal up to {np.abs(diag).max():.3g} vs median {med:.3g})"
+        if tgv == "refuse":
+            raise SystemFileError(level.A, f"{where}; tgv: refuse (set tgv: eliminate, or export without them)")
+        notes.append(f"{level.A.name}: {where} eliminated (v = 0 there, the penalty's limit)" + _dropped(B, pen))
+        remove.append(pen)
+    lonely = np.setdiff1d(np.flatnonzero(_decoupled(A)), np.concatenate(remove)) if n > 1 else np.zeros(0, int)
+    if len(lonely):
+        touched = np.diff(sp.csc_matrix(B)[:, lonely].indptr) > 0
+        unit_everywhere = np.mean(diag == 1.0) > 0.5  # a Jacobi-scaled A: unit rows are not told apart
+        unit = lonely[(diag[lonely] == 1.0) & touched] if not unit_everywhere else np.zeros(0, int)
+        if len(unit):
+            notes.append(f"{level.A.name}: {len(unit)} unit rows (diagonal exactly 1, coupled to nothing in A: "
+                         "constrained dofs, v = 0) eliminated" + _dropped(B, unit))
+        free = lonely[~touched]
+        if len(free):
+            notes.append(f"{level.A.name}: {len(free)} identity rows (uncoupled dofs B does not touch) removed")
+        kept = np.setdiff1d(lonely[touched], unit)
+        if len(kept):
+            notes.append(f"{level.A.name}: {len(kept)} dofs coupled to nothing in A but touched by B "
+                         "(element bubbles?) kept")
+        remove += [unit, free]
+    return np.unique(np.concatenate(remove)).astype(int), notes
+
+
+def _dropped(B, dofs) -> str:
+    on = _b_entries_on(B, dofs)
+    return f"; B's {on} entries on them dropped" if on else ""
+
+
+def constrained_multipliers(level, B, G, tgv: str) -> tuple:
+    """(multiplier rows to remove, notes): the multiplier rows of the module's table, B's rows
+    judged as given. A refusal names both files and the rows."""
+    Gs = sp.csr_matrix(G)
+    Gs.eliminate_zeros()
+    gdiag = Gs.diagonal()
+    zero_b = np.diff(B.indptr) == 0
+    notes, remove = [], [np.zeros(0, int)]
+    pen, med = _penalty_rows(gdiag)
+    if len(pen):
+        where = f"{len(pen)} penalty rows of G (diagonal up to {np.abs(gdiag).max():.3g} vs median {med:.3g}), rows {_rows(pen)}"
+        if tgv == "refuse":
+            raise SystemFileError(level.G, f"{where}; tgv: refuse (set tgv: eliminate, or export without them)")
+        on = int(np.diff(B.indptr)[pen].sum())
+        notes.append(f"{level.G.name}: {where} eliminated (mu = 0 there, the penalty's limit)"
+                     + (f"; B's {on} entries on them dropped" if on else ""))
+        remove.append(pen)
+    zero_g = np.diff(Gs.indptr) == 0
+    both = np.setdiff1d(np.flatnonzero(zero_b & zero_g), pen)
+    if len(both):
+        notes.append(f"{level.B.name}, {level.G.name}: {len(both)} multipliers in neither B nor G (rows "
+                     f"{_rows(both)}) removed")
+        remove.append(both)
+    rows = np.setdiff1d(np.flatnonzero(zero_b & ~zero_g), pen)
+    if not len(rows):
+        return np.unique(np.concatenate(remove)).astype(int), notes
+    dec = _decoupled(Gs, TINY_COUPLING)
+    others = np.setdiff1d(np.arange(len(gdiag)), rows)
+    typical = float(np.median(gdiag[others])) if len(others) else np.nan
+    g_couples = len(others) > 0 and not dec[others].all()
+    marked = rows[dec[rows] & (g_couples | (gdiag[rows] != typical))]
+    half = rows[~dec[rows] & (gdiag[rows] == 1.0) & (typical != 1.0)]
+    if len(half):  # a unit diagonal set, the row and column left: neither reading is safe
+        raise SystemFileError(level.G, f"rows {_rows(half)}: B ({level.B.name}) is zero there and G's diagonal is 1 "
+                              "(a unit row: constrained multipliers?) but G still couples them to other multipliers: "
+                              "removing them would change beta_h, keeping them counts a kernel; zero G's rows and "
+                              "columns there but the diagonal, or drop the rows from B and G")
+    if len(marked):
+        notes.append(f"{level.B.name}: {len(marked)} constrained multipliers (B's row zero, G's row decoupled: "
+                     f"a boundary condition on the multiplier space), rows {_rows(marked)}, removed")
+        remove.append(marked)
+    kernel = np.setdiff1d(rows, marked)
+    if len(kernel):
+        notes.append(f"{level.B.name}: {len(kernel)} zero rows ({_rows(kernel)}) kept: a kernel of B^T ("
+                     + ("G couples them to other multipliers, so they are not constrained ones"
+                        if not dec[kernel].all() else "G does not single them out: give them unit rows in G if "
+                        "they are constrained") + ")")
+    return np.unique(np.concatenate(remove)).astype(int), notes
+
+
 def check_level(level, A, B, G, constrained=np.zeros(0, int), tgv: str = "eliminate") -> CheckedLevel:
     """Run every check on one level (module docstring); the matrices as read."""
     for mat, path in ((A, level.A), (B, level.B), (G, level.G)):
@@ -106,52 +252,27 @@ def check_level(level, A, B, G, constrained=np.zeros(0, int), tgv: str = "elimin
     A, B = sp.csr_matrix(A), sp.csr_matrix(B)
     A.eliminate_zeros()
     B.eliminate_zeros()
-    notes, removed = [], 0
-    if len(constrained):
-        on = _b_entries_on(B, constrained)
-        if on:
-            raise SystemFileError(level.B, f"B has {on} entries on the {len(constrained)} constrained dofs of "
-                                  f"levels[{level.index}] (b(v, mu) on a fixed dof has no meaning): export B "
-                                  "without those columns, or do not declare them constrained")
-        A, B = _remove(A, B, constrained)
-        removed += len(constrained)
-        notes.append(f"{level.A.name}: {len(constrained)} declared constrained dofs removed")
-    diag = np.abs(A.diagonal())
-    if np.any(diag > 0):
-        med = float(np.median(diag[diag > 0]))
-        tgv_dofs = np.flatnonzero(diag >= TGV_RATIO * med)
-        if len(tgv_dofs):
-            where = f"{len(tgv_dofs)} Dirichlet penalty rows (diagonal up to {diag.max():.3g} vs median {med:.3g})"
-            if tgv == "refuse":
-                raise SystemFileError(level.A, f"{where}; tgv: refuse (set tgv: eliminate, or export without them)")
-            on = _b_entries_on(B, tgv_dofs)
-            A, B = _remove(A, B, tgv_dofs)
-            removed += len(tgv_dofs)
-            notes.append(f"{level.A.name}: {where} eliminated (v = 0 there, the penalty's limit)"
-                         + (f"; B's {on} entries on them dropped" if on else ""))
-    off = A - sp.diags(A.diagonal())
-    off.eliminate_zeros()
-    lonely = np.flatnonzero((np.diff(off.tocsr().indptr) == 0) & (np.diff(off.tocsc().indptr) == 0))
-    if len(lonely) and A.shape[0] > 1:
-        touched = np.diff(sp.csc_matrix(B)[:, lonely].indptr) > 0
-        unit = lonely[touched & (A.diagonal()[lonely] == 1.0)]
-        if len(unit):
-            raise SystemFileError(level.A, f"{len(unit)} identity rows (diagonal exactly 1, coupled to nothing in A: "
-                                  f"constrained dofs left in A?) on which B ({level.B.name}) has entries: "
-                                  "B A^-1 B^T would count them; declare them under 'constrained' and export B "
-                                  "without those columns")
-        if touched.any():
-            notes.append(f"{level.A.name}: {int(touched.sum())} dofs coupled to nothing in A but touched by B "
-                         "(element bubbles?) kept")
-        free = lonely[~touched]
-        if len(free):
-            A, B = _remove(A, B, free)
-            removed += len(free)
-            notes.append(f"{level.A.name}: {len(free)} identity rows (uncoupled dofs B does not touch) removed")
+    mult, notes = constrained_multipliers(level, B, G, tgv)
+    dofs, more = constrained_displacements(level, A, B, constrained, tgv)
+    notes += more
+    keep_m = np.setdiff1d(np.arange(B.shape[0]), mult)
+    keep_n = np.setdiff1d(np.arange(A.shape[0]), dofs)
+    for left, path, what in ((keep_m, level.B, "multiplier rows"), (keep_n, level.A, "dofs")):
+        if not len(left):
+            raise SystemFileError(path, f"every one of its {what} is constrained ({'; '.join(notes)}): nothing "
+                                  "is left to compute beta_h on")
+    was_zero = np.diff(B.indptr)[keep_m] == 0
+    A, B = A[keep_n][:, keep_n], B[keep_m][:, keep_n]
+    G = sp.csr_matrix(G)[keep_m][:, keep_m] if sp.issparse(G) else np.asarray(G, float)[np.ix_(keep_m, keep_m)]
+    B.eliminate_zeros()
+    orphan = np.flatnonzero((np.diff(B.indptr) == 0) & ~was_zero)
+    if len(orphan):
+        notes.append(f"{level.B.name}: {len(orphan)} multipliers couple only to the removed dofs (rows "
+                     f"{_rows(keep_m[orphan])}): a kernel of B^T")
     check_symmetric(A, level.A, "A")
     G = check_gram(G, level.G)
     check_positive_definite(A, level.A)
-    return CheckedLevel(sp.csc_matrix(A), sp.csr_matrix(B), G, notes, removed)
+    return CheckedLevel(sp.csc_matrix(A), sp.csr_matrix(B), G, notes, len(dofs), len(mult))
 
 
 def check_symmetric(M, path, what: str) -> None:

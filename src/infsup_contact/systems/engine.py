@@ -31,6 +31,13 @@ bottom singular values by block subspace iteration, measured directly as ‖W v�
 by an inertia count, :func:`infsup_contact.solvers.kernel.bottom_kernel`). A declared kernel (``known_kernel`` in the manifest: the
 hydrostatic pressure of an enclosed Stokes flow) is the ``proven`` part; β_h is then the
 smallest eigenvalue above it, i.e. β_h on the complement of the declared kernel.
+
+The entries of B carry the producer's round-off: η includes 2 E(r), E(r) the bound on ‖δW‖_F
+from the entries' relative accuracy r (declared ``entry_rtol``, else estimated from B;
+:mod:`.roundoff`), and a ``clear`` decision is checked against the pencil's own bottom
+(:func:`~infsup_contact.solvers.kernel.pencil_cross_check`, λ_max by Lanczos): a first mode
+counted non-zero at the pencil's round-off level is ``close``, and :func:`close_advice` says
+what the user can do.
 """
 from __future__ import annotations
 
@@ -44,8 +51,10 @@ import scipy.sparse.linalg as spla
 
 from .. import resources
 from ..models.schur import gamma_factorization
-from ..solvers.bottom import SEED
-from ..solvers.kernel import KernelDecision, bottom_kernel, coupling_kernel
+from ..solvers.bottom import SEED, lam_max
+from ..solvers.kernel import (MARGIN_DECADES, KernelDecision, bottom_kernel, coupling_kernel,
+                              pencil_cross_check)
+from .roundoff import EntryRoundoff, entry_error_bound, entry_roundoff
 
 DENSE_MAX_M = 1500
 """Largest m for the dense pencil (above it shift-invert Lanczos is faster: scikit-fem P2–P0,
@@ -94,6 +103,13 @@ class LevelSpectrum:
         Dofs B touches.
     seconds : dict
         ``factorize``, ``eigen``, ``kernel`` wall times.
+    roundoff : EntryRoundoff
+        r, the entries' relative accuracy in η, and its source (:mod:`.roundoff`).
+    entry_error_unit : float
+        E(1): E(r) = r · E(1) is the bound on ‖δW‖_F in η (:mod:`.roundoff`, (1)).
+    pencil_margin : float
+        log10(λ_{d+1} / (m ε λ_max)): the first eigenvalue above the kernel over the pencil's
+        round-off level, in decades (the cross-check of the kernel decision).
     """
 
     beta: float
@@ -104,6 +120,9 @@ class LevelSpectrum:
     residual: float
     n_touched: int
     seconds: dict = field(default_factory=dict)
+    roundoff: EntryRoundoff | None = None
+    entry_error_unit: float = 0.0
+    pencil_margin: float = np.inf
 
 
 def touched_dofs(B: sp.spmatrix) -> np.ndarray:
@@ -142,15 +161,18 @@ def choose_route(n: int, m: int, n_touched: int, sparse_g: bool = False) -> str:
     return "gamma-dense" if gamma_bytes <= solves_bytes else "solves-dense"
 
 
-def scaled_coupling(A, B, G, touched) -> sp.csr_matrix:
-    """W = D_A^{-1/2} Bᵀ D_G^{-1/2} on the touched dofs (D = the diagonals)."""
+def scaled_coupling(A, B, G, touched, with_bound: bool = False):
+    """W = D_A^{-1/2} Bᵀ D_G^{-1/2} on the touched dofs (D = the diagonals); ``with_bound``:
+    (W, E(1)) with E(r) = r · E(1) the bound on the round-off ‖δW‖_F of entries accurate to
+    r · max |b| (:func:`.roundoff.entry_error_bound`)."""
     da = np.sqrt(sp.csr_matrix(A).diagonal()[touched])
     dg = np.sqrt(np.asarray(G.diagonal() if sp.issparse(G) else np.diag(G), float))
     Bt = sp.csc_matrix(B)[:, touched].T.tocsr()
-    return sp.diags(1.0 / da) @ Bt @ sp.diags(1.0 / dg)
+    W = sp.diags(1.0 / da) @ Bt @ sp.diags(1.0 / dg)
+    return (W, entry_error_bound(Bt, da, dg, 1.0)) if with_bound else W
 
 
-def level_spectrum(A, B, G, known_kernel: int = 0, route: str = "auto") -> LevelSpectrum:
+def level_spectrum(A, B, G, known_kernel: int = 0, route: str = "auto", entry_rtol=None) -> LevelSpectrum:
     """β_h and the bottom of the pencil for one level (checked matrices: :mod:`.checks`).
 
     Parameters
@@ -162,6 +184,9 @@ def level_spectrum(A, B, G, known_kernel: int = 0, route: str = "auto") -> Level
         Dimension of a kernel of Bᵀ the producer declares (``proven``).
     route : str
         One of :data:`ROUTES`.
+    entry_rtol : float, optional
+        The declared accuracy of B's entries relative to max |b_ij| (manifest ``entry_rtol``);
+        raised to what the data show (:func:`.roundoff.entry_roundoff`).
     """
     A = sp.csc_matrix(A)
     B = sp.csr_matrix(B)
@@ -171,12 +196,14 @@ def level_spectrum(A, B, G, known_kernel: int = 0, route: str = "auto") -> Level
         route = choose_route(n, m, len(touched), sp.issparse(G))
     seconds = {}
     t0 = time.perf_counter()
-    W = scaled_coupling(A, B, G, touched)
+    roundoff = entry_roundoff(B, entry_rtol)
+    W, unit = scaled_coupling(A, B, G, touched, with_bound=True)
+    E = roundoff.rtol * unit
     deflate = route == "shift-invert"  # the kernel's basis is deflated there (:func:`_shift_invert`)
     if 8.0 * W.shape[0] * W.shape[1] <= SVD_MAX_BYTES:
-        kernel = coupling_kernel(W.toarray(), known_kernel, vectors=deflate)
+        kernel = coupling_kernel(W.toarray(), known_kernel, entry_error=E, vectors=deflate)
     else:
-        kernel = bottom_kernel(W, known_kernel)
+        kernel = bottom_kernel(W, known_kernel, entry_error=E)
     seconds["kernel"] = time.perf_counter() - t0
     # Only the *declared* kernel is discounted. The decision counts m − (touched dofs) as a
     # proof (exact zero singular values), but a foreign B with a zero row, duplicate rows or
@@ -186,15 +213,52 @@ def level_spectrum(A, B, G, known_kernel: int = 0, route: str = "auto") -> Level
     if deflate:
         dg = np.sqrt(np.asarray(G.diagonal() if sp.issparse(G) else np.diag(G), float))
         Z = kernel.vectors[:, :kernel.dim] / dg[:, None] if kernel.dim else None  # W v = 0 ⇔ Bᵀ (v / dg) = 0
-        ev, resid, sec = _shift_invert(A, B, G, N_ABOVE, float(kernel.singular[-1]) ** 2, Z)
+        ev, resid, sec, top = _shift_invert(A, B, G, N_ABOVE, float(kernel.singular[-1]) ** 2, Z)
     else:
-        ev, resid, sec = _dense(A, B, G, touched, route, kernel.dim + N_BOTTOM)
+        ev, resid, sec, top = _dense(A, B, G, touched, route, kernel.dim + N_BOTTOM)
     seconds.update(sec)
+    kernel, pencil_margin = pencil_cross_check(kernel, ev, top, m, zeros_computed=not deflate)
     d = kernel.dim
     above = float(np.sqrt(max(ev[d], 0.0))) if d < len(ev) else np.nan
     p = min(kernel.proven, len(ev) - 1)
     beta = 0.0 if kernel.detected > 0 else float(np.sqrt(max(ev[p], 0.0)))
-    return LevelSpectrum(beta, above, kernel, ev, route, resid, len(touched), seconds)
+    return LevelSpectrum(beta, above, kernel, ev, route, resid, len(touched), seconds, roundoff, unit, pencil_margin)
+
+
+def _pencil_words(margin: float) -> str:
+    """Where the first eigenvalue above the kernel stands against the pencil's round-off level."""
+    if margin <= 0.0:  # at or below it (a zero eigenvalue gives log10 of the tiniest float)
+        return "the first eigenvalue above the kernel is at or below the pencil's round-off level"
+    return f"the first eigenvalue above the kernel is only {margin:.2f} decades above the pencil's round-off"
+
+
+def close_advice(res: LevelSpectrum) -> str:
+    """What the user of a ``close`` decision can do, in one line: the accuracy r* of B's entries
+    that would put η at 20 × the singular value below the widest gap of the bottom of the
+    spectrum, if that gap leaves the next value 20 × above η too (the decision would then be
+    clear by 1.3 decades on both sides; rounding r* to one digit keeps more than one) — to
+    declare only if the entries are that accurate — and the export with 17 significant digits."""
+    k = res.kernel
+    r = res.roundoff.rtol if res.roundoff is not None else 0.0
+    where = (f"kernel decision close (margin {k.margin_decades:.2f} decades from eta = {k.tol:.2g}; entry "
+             f"round-off {r:.2g} x max|b|, {res.roundoff.source if res.roundoff else 'exact'}"
+             + (f"; {_pencil_words(res.pencil_margin)}: the entries carry more round-off than eta assumes"
+                if res.pencil_margin < MARGIN_DECADES else "") + ")")
+    s = np.asarray(k.singular[:-1], float)  # the bottom values (σ_max last on the large-W route)
+    s = s[s > 0]
+    advice = ""
+    if len(s) >= 2 and res.entry_error_unit > 0:
+        gaps = np.log10(s[1:] / s[:-1])
+        j = int(np.argmax(gaps))
+        svd = k.tol - 2.0 * r * res.entry_error_unit  # η = svd + 2 r E(1)
+        lift = 2.0 * 10.0 ** MARGIN_DECADES  # η at 20 s_j: the counted zeros 1.3 decades below it
+        want = (lift * s[j] - svd) / (2.0 * res.entry_error_unit)
+        if gaps[j] >= 2.0 * np.log10(lift) and want > r:
+            advice = (f"if B's entries are accurate to {float(f'{want:.1g}'):g} x max|b| (the singular values of the "
+                      f"scaled B^T jump from {s[j]:.2g} to {s[j + 1]:.2g}), declare entry_rtol: "
+                      f"{float(f'{want:.1g}'):g} in the manifest; ")
+    return (f"{where}: {advice}export B with 17 significant digits (a text format with fewer digits rounds every "
+            "entry), or declare entry_rtol: the accuracy of B's entries relative to max|b|")
 
 
 def _dense(A, B, G, touched, route, n_pairs):
@@ -216,7 +280,10 @@ def _dense(A, B, G, touched, route, n_pairs):
     ev, x = sla.eigh(S, Gd, subset_by_index=[0, k - 1])
     res = np.linalg.norm(S @ x - (Gd @ x) * ev[:k], axis=0)
     scale = (np.linalg.norm(S, 2) + np.abs(ev[:k]) * np.linalg.norm(Gd, 2)) * np.linalg.norm(x, axis=0)
-    return ev, float(np.max(res / scale)), {"factorize": t1 - t0, "eigen": time.perf_counter() - t1}
+    t2 = time.perf_counter()
+    top = lam_max(S, sla.cholesky(Gd, lower=True, check_finite=False)) if k < S.shape[0] else float(ev[-1])
+    return (ev, float(np.max(res / scale)),
+            {"factorize": t1 - t0, "eigen": t2 - t1, "lam_max": time.perf_counter() - t2}, top)
 
 
 def kernel_projector(Z, G):
@@ -250,7 +317,7 @@ def _shift_invert(A, B, G, n_values, smax2, Z=None):
     m = B.shape[0]
     d = 0 if Z is None else Z.shape[1]
     if d >= m:  # Bᵀ = 0: everything is kernel, nothing to factorize
-        return np.zeros(d), 0.0, {"factorize": 0.0, "eigen": 0.0, "residual": 0.0}
+        return np.zeros(d), 0.0, {"factorize": 0.0, "eigen": 0.0, "residual": 0.0}, 0.0
     Gs = sp.csc_matrix(G)
     delta = SHIFT * smax2
     t0 = time.perf_counter()
@@ -290,4 +357,20 @@ def _shift_invert(A, B, G, n_values, smax2, Z=None):
     g_norm = float(spla.eigsh(Gs, k=1, which="LA", tol=1e-3, return_eigenvectors=False)[0])
     res = np.linalg.norm(Sx - Gx * ev, axis=0) / ((s_norm + np.abs(ev) * g_norm) * np.linalg.norm(x, axis=0))
     ev = np.concatenate([np.zeros(d), np.sort(ev)])  # a kernel of Bᵀ is one of S: exact zeros
-    return ev, float(np.max(res)), {"factorize": t1 - t0, "eigen": t2 - t1, "residual": time.perf_counter() - t2}
+    t3 = time.perf_counter()
+    top = _pencil_top(schur, Gs)
+    return ev, float(np.max(res)), {"factorize": t1 - t0, "eigen": t2 - t1, "residual": t3 - t2,
+                                    "lam_max": time.perf_counter() - t3}, top
+
+
+def _pencil_top(schur, Gs) -> float:
+    """λ_max of (S, G), ``schur(x)`` = S x, by Lanczos to
+    :data:`~infsup_contact.solvers.bottom.LAM_MAX_RTOL` (a round-off level needs no more), G⁻¹
+    from one sparse LU of G."""
+    from ..solvers.bottom import LAM_MAX_RTOL
+
+    S_op = spla.LinearOperator(Gs.shape, matvec=schur, dtype=float)
+    luG = spla.splu(sp.csc_matrix(Gs))
+    Minv = spla.LinearOperator(Gs.shape, matvec=lambda y: luG.solve(np.ravel(y)), dtype=float)
+    return float(spla.eigsh(S_op, k=1, M=Gs, Minv=Minv, which="LA", tol=LAM_MAX_RTOL,
+                            v0=np.ones(Gs.shape[0]), return_eigenvectors=False)[0])

@@ -1,7 +1,10 @@
 """A manifest's levels → one β row per level → the verdict, by ``verdict --case``'s criterion.
 
 The rows carry what :func:`infsup_contact.study.verdict.stability_verdict` reads (``N2`` is
-1/h, so its h is the manifest's) plus the route, residual, kernel decision and notes. The
+1/h, so its h is the manifest's) plus the route, residual, kernel decision, the entries'
+round-off in η (``entry_rtol_used``, ``entry_rtol_source``), the pencil's cross-check
+(``pencil_margin_decades``), what a close decision asks of the user (``kernel_advice``), the
+constrained rows removed (``removed_dofs``, ``removed_multipliers``) and notes. The
 norm caveats (module :mod:`.manifest`, key ``norm``) are part of every row.
 """
 from __future__ import annotations
@@ -14,7 +17,8 @@ import scipy.sparse as sp
 
 from ..study.verdict import stability_verdict
 from .checks import check_level, check_sequence
-from .engine import level_spectrum
+from .engine import close_advice, level_spectrum
+from .hints import system_hints, transposed_b_hint
 from .manifest import Manifest, constrained_dofs
 from .readers import SystemFileError, read_matrix
 
@@ -32,7 +36,8 @@ def load_level(manifest: Manifest, level):
     A, B, G = (read_matrix(p) for p in (level.A, level.B, level.G))
     A = sp.csr_matrix(A) if not sp.issparse(A) else A
     B = sp.csr_matrix(B) if not sp.issparse(B) else B
-    checked = check_level(level, A, B, G, constrained_dofs(level, A.shape[0]), manifest.tgv)
+    with transposed_b_hint(A, B, G):
+        checked = check_level(level, A, B, G, constrained_dofs(level, A.shape[0]), manifest.tgv)
     if manifest.norm == "h-L2":
         checked.G = checked.G * level.h
     return checked
@@ -44,26 +49,31 @@ def system_rows(manifest: Manifest, route: str = "auto", notes=sys.stderr) -> li
     for level in manifest.levels:
         t0 = time.perf_counter()
         lv = load_level(manifest, level)
-        shapes.append((lv.A.shape[0] + lv.removed, lv.B.shape[0]))
+        shapes.append((lv.A.shape[0] + lv.removed, lv.B.shape[0] + lv.removed_multipliers))
         check_sequence(manifest, shapes)
         t_read = time.perf_counter() - t0
         if manifest.known_kernel >= lv.B.shape[0]:
             raise SystemFileError(manifest.path, f"known_kernel = {manifest.known_kernel} >= m = {lv.B.shape[0]} "
                                   f"multipliers at levels[{level.index}]")
-        res = level_spectrum(lv.A, lv.B, lv.G, manifest.known_kernel, route)
+        res = level_spectrum(lv.A, lv.B, lv.G, manifest.known_kernel, route, manifest.entry_rtol)
         k = res.kernel
         if k.numerical < k.proven:
             raise SystemFileError(manifest.path, f"known_kernel = {k.proven}, but at levels[{level.index}] only "
                                   f"{k.numerical} singular values of the scaled B^T are <= eta = {k.tol:.2g}: the "
                                   "declared kernel is not a kernel of B^T")
-        for note in lv.notes:
+        if res.roundoff.source != "exact":  # what η was raised by, and why
+            lv.notes.append(f"{level.B.name}: {res.roundoff.evidence}")
+        advice = close_advice(res) if k.decision == "close" else ""
+        for note in lv.notes + ([advice] if advice else []):
             print(f"infsup-contact: note: {note}", file=notes)
         rows.append(dict(
             system=manifest.name, level=level.index, h=level.h, N2=1.0 / level.h, n=lv.A.shape[0], m=lv.B.shape[0],
             n_touched=res.n_touched, kernel_structural=max(lv.B.shape[0] - res.n_touched, 0),
-            removed_dofs=lv.removed, norm=manifest.norm,
+            removed_dofs=lv.removed, removed_multipliers=lv.removed_multipliers, norm=manifest.norm,
             beta=res.beta, kernel_dim=k.dim, known_kernel=k.proven, kernel_detected=k.detected,
             kernel_margin_decades=k.margin_decades, kernel_decision=k.decision, kernel_tol=k.tol,
+            entry_rtol_used=res.roundoff.rtol, entry_rtol_source=res.roundoff.source,
+            pencil_margin_decades=res.pencil_margin, kernel_advice=advice,
             smallest_nonzero=res.smallest_nonzero, route=res.route, residual=res.residual,
             t_read=t_read, t_factorize=res.seconds.get("factorize", np.nan),
             t_eigen=res.seconds.get("eigen", np.nan), t_kernel=res.seconds["kernel"],
@@ -72,14 +82,16 @@ def system_rows(manifest: Manifest, route: str = "auto", notes=sys.stderr) -> li
 
 
 def system_verdict(manifest: Manifest, *, tol: float, floor: float, confidence: float, route: str = "auto",
-                   notes=sys.stderr) -> tuple:
+                   notes=None) -> tuple:
     """(verdict row, level rows). The criterion of ``verdict --case``
     (:func:`~infsup_contact.study.verdict.stability_verdict`) on the kernel *beyond* the
     declared one: a kernel of Bᵀ larger than ``known_kernel`` on any level is UNSTABLE; a
     ``close`` kernel decision on any level makes the verdict INCONCLUSIVE (both by
-    ``stability_verdict`` itself). The entries of an exported B are taken as exact (the
-    producer's quadrature round-off is not known here: ``entry_error`` = 0 in η)."""
+    ``stability_verdict`` itself), the evidence saying what the user can do. η includes the
+    round-off of B's entries, declared (``entry_rtol``) or estimated (:mod:`.roundoff`). Its
+    ``hints`` (:mod:`.hints`, also on ``notes``) say what mistake the numbers suggest."""
     t0 = time.perf_counter()
+    notes = sys.stderr if notes is None else notes  # the stream of now (a default would bind import time's)
     rows = system_rows(manifest, route, notes)
     series = [dict(r, kernel_dim=r["kernel_detected"], case=manifest.name) for r in rows]
     out = stability_verdict(series, tol, floor, confidence)  # a close kernel decision: INCONCLUSIVE
@@ -94,8 +106,12 @@ def system_verdict(manifest: Manifest, *, tol: float, floor: float, confidence: 
                               if any(structural) else "")
                            + "; slope of the eigenvalue above the kernel; declare the kernel with known_kernel "
                            "if it is meant (e.g. a constant pressure)")
+    close = [r for r in rows if r["kernel_decision"] == "close"]
+    if out["verdict"] == "INCONCLUSIVE" and close:
+        out["evidence"] += f"; levels[{close[0]['level']}]: {close[0]['kernel_advice']}"
     head = dict(system=manifest.name, norm=manifest.norm, known_kernel=manifest.known_kernel)
     head.update(out)
+    head["hints"] = "; ".join(system_hints(rows, out, tol, confidence, notes))  # the verdict unchanged
     head.update(h_list=" ".join(f"{r['h']:g}" for r in rows), routes=" ".join(sorted({r["route"] for r in rows})),
                 max_residual=max(r["residual"] for r in rows), norm_note=NORM_NOTES[manifest.norm],
                 seconds=time.perf_counter() - t0)
@@ -116,7 +132,8 @@ def dry_check(manifest: Manifest, route: str = "auto"):
         for mat, path in zip(mats, (level.A, level.B, level.G)):
             check_finite(mat, path)
         A, B, G = mats
-        check_shapes(level, A, B, G)
+        with transposed_b_hint(A, B, G):
+            check_shapes(level, A, B, G)
         constrained_dofs(level, A.shape[0])
         shapes.append((A.shape[0], B.shape[0]))
         check_sequence(manifest, shapes)

@@ -20,7 +20,14 @@ A (n × n) SPD, B (m × n), G (m × m) the multiplier norm. Optional keys:
     dimension of a kernel of Bᵀ the producer knows of (the constant pressure of an enclosed
     Stokes flow: 1); β_h is reported on its complement, and a larger kernel is UNSTABLE;
 ``tgv``
-    ``eliminate`` (default) or ``refuse`` dofs fixed by a huge diagonal penalty;
+    ``eliminate`` (default) or ``refuse`` dofs fixed by a huge diagonal penalty (in A or G);
+``entry_rtol``
+    the accuracy of B's entries relative to max |b_ij| (a number in [0, 1); ``1e-15`` for
+    entries summed from quadrature products): it raises the kernel threshold η (module
+    :mod:`.roundoff`); where the data show more round-off than declared, that is used;
+``expect``
+    ``stable`` or ``unstable``: the verdict the producer expects (the exit code of ``verdict``
+    without ``--expect`` and of the pre-commit hook follows it);
 per level, ``constrained``
     the 0-based dofs the producer fixed but left in A (identity or penalty rows): a list,
     or a file (``.txt``: whitespace-separated integers, ``.npy``); they are removed.
@@ -41,7 +48,8 @@ from .readers import SystemFileError
 NORMS = ("given", "L2", "h-L2")
 TGV_POLICIES = ("eliminate", "refuse")
 LEVEL_KEYS = ("h", "A", "B", "G", "constrained")
-TOP_KEYS = ("levels", "name", "norm", "known_kernel", "tgv")
+TOP_KEYS = ("levels", "name", "norm", "known_kernel", "tgv", "expect", "entry_rtol")
+EXPECTS = ("stable", "unstable")
 MANIFEST_MAX_BYTES = 1 << 20
 """Largest manifest read (a manifest of 1,000 levels is ~60 kB)."""
 MIN_LEVELS = 3
@@ -70,6 +78,8 @@ class Manifest:
     known_kernel: int
     tgv: str
     levels: tuple
+    expect: str | None = None
+    entry_rtol: float | None = None
 
 
 def load_manifest(path, min_levels: int = MIN_LEVELS) -> Manifest:
@@ -114,13 +124,32 @@ def load_manifest(path, min_levels: int = MIN_LEVELS) -> Manifest:
     known = data.get("known_kernel", 0)
     if isinstance(known, bool) or not isinstance(known, int) or known < 0:
         raise SystemFileError(path, f"known_kernel: expected an integer >= 0 (found {known!r})")
+    expect = data.get("expect")
+    if expect is not None and expect not in EXPECTS:
+        raise SystemFileError(path, f"expect: {expect!r} is not one of {', '.join(EXPECTS)}")
+    entry_rtol = _entry_rtol(path, data.get("entry_rtol"))
     parsed = tuple(_level(path, i, entry) for i, entry in enumerate(levels))
     hs = [lv.h for lv in parsed]
     for i in range(1, len(hs)):
         if not hs[i] < hs[i - 1]:
             raise SystemFileError(path, f"levels[{i}].h = {hs[i]:g} does not decrease (levels[{i - 1}].h = "
                                   f"{hs[i - 1]:g}): list the levels coarse to fine, each h once")
-    return Manifest(path, str(name), norm, known, tgv, parsed)
+    return Manifest(path, str(name), norm, known, tgv, parsed, expect=expect, entry_rtol=entry_rtol)
+
+
+def _entry_rtol(path, value):
+    """The declared ``entry_rtol`` (None when absent). YAML 1.1 reads ``1e-15`` (no dot) as text,
+    so a string that is a plain number is taken as that number."""
+    if value is None:
+        return None
+    try:
+        rtol = float(value) if isinstance(value, (str, int, float)) and not isinstance(value, bool) else math.nan
+    except ValueError:
+        rtol = math.nan
+    if not (math.isfinite(rtol) and 0.0 <= rtol < 1.0):
+        raise SystemFileError(path, f"entry_rtol: expected a number in [0, 1), the accuracy of B's entries relative "
+                              f"to max |b_ij| (e.g. 1e-15; found {value!r:.40})")
+    return rtol
 
 
 def _one_line(path, key: str, text: str) -> None:

@@ -1,0 +1,299 @@
+"""The verdict as a gate other projects call: CSV (default), JSON or JUnit XML, on stdout or
+atomically into ``--output``; the exit codes in one table.
+
+One verdict is a :class:`VerdictResult`: the verdict row (the fields of
+:func:`infsup_contact.study.verdict.stability_verdict` and the form's own), the per-level rows of
+a foreign system, the expectation and the exit code. The three renderers read only it:
+
+* CSV is the row as ``verdict`` always printed it (lists space-separated, ``%.6g``);
+* JSON is one object (``allow_nan=False``: NaN and ±inf are ``null``, numbers are numbers,
+  lists are lists), with ``levels`` for ``--system``, ``criterion`` and ``exit_code``;
+* JUnit XML is one ``<testsuite>`` with one ``<testcase>`` (name: the space or system,
+  classname ``infsup-contact``); ``<failure>`` exactly when the exit code is 1 (``--expect``
+  not met, INCONCLUSIVE included: it never matches), ``<skipped>`` for INCONCLUSIVE without an
+  expectation (the question is open, and nothing failed), a pass otherwise. β_min, β_max, the
+  slope and its interval, the kernel and the criterion are properties of the suite (the Ant
+  JUnit schema allows ``<properties>`` there only).
+"""
+from __future__ import annotations
+
+import argparse
+import math
+import os
+import re
+from dataclasses import dataclass, field
+
+FORMATS = ("csv", "json", "junit")
+CLASSNAME = "infsup-contact"
+SCHEMA = "infsup-contact-verdict/1"
+"""The JSON document's ``schema``: raised when a field changes meaning or disappears."""
+
+EXIT_CODES = (
+    (0, "done: the verdict is computed and written and, where an expectation is set (--expect, or a "
+        "manifest's expect:), it is the expected one; also --dry-run, and a reader that closes the pipe early"),
+    (1, "the expectation is not met: the verdict differs (INCONCLUSIVE never matches); the result is written all "
+        "the same"),
+    (2, "bad input, nothing computed: a flag, the manifest, a matrix file or --output refused, or the estimated "
+        "memory over the available memory; one line on stderr naming it"),
+    (74, "the result cannot be written: stdout closed (>&-) or full (> /dev/full), or --output failing at the end "
+         "(a full disk); one line"),
+    (130, "interrupted (Ctrl-C); one line, no result written"),
+)
+"""``verdict``'s exit codes (the ``--help`` epilog and the README table are this table)."""
+
+
+@dataclass
+class VerdictResult:
+    """One verdict as the renderers read it.
+
+    Attributes
+    ----------
+    form : str
+        ``case``, ``space`` or ``system``: which of the three forms produced it.
+    row : dict
+        The verdict row (``verdict``, ``beta_min``, ``slope``, ``evidence``, ...).
+    expect : str or None
+        The expected verdict (``STABLE``/``UNSTABLE``) or None.
+    criterion : dict
+        ``slope_tolerance``, ``beta_floor``, ``confidence`` of the run.
+    levels : list of dict or None
+        The per-level rows of a foreign system (``--system``), else None.
+    source : str or None
+        The file the verdict is about (manifest or space file), for annotations.
+    """
+
+    form: str
+    row: dict
+    expect: str | None
+    criterion: dict
+    levels: list | None = None
+    source: str | None = None
+    exit_code: int = field(init=False)
+
+    def __post_init__(self):
+        self.exit_code = 0 if self.expect is None or self.row["verdict"] == self.expect else 1
+
+    @property
+    def name(self) -> str:
+        return str(self.row["system"] if self.form == "system" else self.row["space"])
+
+
+# ---------------------------------------------------------------- the command line
+class _EpilogFormatter(argparse.HelpFormatter):
+    """argparse's reflowing formatter, but the exit-code table keeps its lines."""
+
+    def _fill_text(self, text, width, indent):
+        if text.startswith("exit codes:"):
+            return "\n".join(indent + line for line in text.splitlines())
+        return super()._fill_text(text, width, indent)
+
+
+def exit_code_table(width: int = 100) -> str:
+    """:data:`EXIT_CODES` as plain text, one wrapped entry per code."""
+    import textwrap
+
+    lines = ["exit codes:"]
+    for code, text in EXIT_CODES:
+        lines += textwrap.wrap(text, width, initial_indent=f"  {code:>3}  ", subsequent_indent=" " * 7)
+    return "\n".join(lines)
+
+
+def output_path(text: str) -> str:
+    """argparse ``type`` of ``--output``: refused before anything is computed when it names a
+    directory or a place that cannot be created or written."""
+    from pathlib import Path
+
+    path = Path(text)
+    if text == "-":  # stdout, as without --output
+        return text
+    if not text or path.is_dir():
+        raise argparse.ArgumentTypeError(f"{text!r} is a directory or empty: expected a file name to write")
+    parent = path.absolute().parent
+    while not parent.exists():
+        parent = parent.parent
+    if not parent.is_dir():
+        raise argparse.ArgumentTypeError(f"{text!r}: {parent} is a file, not a directory")
+    if not os.access(parent, os.W_OK | os.X_OK):
+        raise argparse.ArgumentTypeError(f"{text!r}: the directory {parent} is not writable")
+    return text
+
+
+def add_output_args(p) -> None:
+    """``--format`` and ``--output`` of ``verdict``, and the exit-code table as its epilog."""
+    p.add_argument("--format", default="csv", choices=FORMATS,
+                   help="csv: one row (default); json: one object, the per-level rows of --system included; "
+                   "junit: JUnit XML, one testcase (a failure when --expect is not met)")
+    p.add_argument("--output", metavar="FILE", type=output_path, default=None,
+                   help="write the result to FILE (atomically: a temporary file renamed) instead of stdout (- : stdout)")
+    p.epilog = exit_code_table()
+    p.formatter_class = _EpilogFormatter
+
+
+def emit(args, row: dict, levels=None, manifest_expect=None) -> int:
+    """Write the verdict of ``args`` in ``args.format`` (to ``args.output`` or stdout), then
+    the GitHub annotations and step summary where GitHub Actions asks for them; the exit code.
+
+    ``--expect`` is the expectation; without it a manifest's ``expect:`` (``manifest_expect``)."""
+    from .github import report
+
+    expect = args.expect or manifest_expect
+    form = "system" if args.system is not None else "space" if args.space is not None else "case"
+    source = args.system if form == "system" else args.space.rsplit(":", 1)[0] if form == "space" else None
+    result = VerdictResult(form, row, None if expect is None else expect.upper(),
+                           {k: getattr(args, k) for k in ("slope_tolerance", "beta_floor", "confidence")},
+                           levels, source)
+    if args.output not in (None, "-"):
+        check_not_an_input(args.output, args)
+    write_result(render(result, args.format), args.output)
+    report(result)
+    return result.exit_code
+
+
+def check_not_an_input(output, args) -> None:
+    """:class:`InputError` (key ``output``) when ``output`` is a file the verdict was computed
+    from (the manifest, a level's matrix, the space file): writing it would destroy the input."""
+    from pathlib import Path
+
+    from ..errors import InputError
+
+    inputs = []
+    if args.system is not None:
+        inputs = [Path(args.system)] + [p for lv in args.manifest.levels for p in (lv.A, lv.B, lv.G, lv.constrained)
+                                        if isinstance(p, Path)]
+    elif args.space is not None:
+        inputs = [Path(args.space.rsplit(":", 1)[0])]
+    target = Path(output).resolve()
+    if any(p.resolve() == target for p in inputs):
+        raise InputError("output", "a file other than the inputs of the verdict (it would be overwritten)",
+                         got=str(output))
+
+
+def write_result(text: str, output) -> None:
+    """``text`` on stdout (``output`` None or ``-``), into a device or pipe as it is
+    (``/dev/stdout``: a rename would replace the device node), else into the file ``output``
+    atomically (:func:`infsup_contact.io.write_bytes_atomic`); UTF-8 whatever the locale."""
+    import stat
+
+    from ..io import write_bytes_atomic
+    from .common import OutputError, write_text
+
+    if output in (None, "-"):
+        write_text(text)
+        return
+    try:
+        if os.path.exists(output) and not stat.S_ISREG(os.stat(output).st_mode):
+            with open(output, "wb") as fh:
+                fh.write(text.encode("utf-8"))
+        else:
+            write_bytes_atomic(output, text.encode("utf-8"))
+    except OSError as err:
+        raise OutputError(f"cannot write the result to {output} ({err.strerror or err})") from None
+
+
+def render(result: VerdictResult, fmt: str) -> str:
+    """The result as text in ``fmt`` (:data:`FORMATS`)."""
+    return {"csv": render_csv, "json": render_json, "junit": render_junit}[fmt](result)
+
+
+# ---------------------------------------------------------------- the three formats
+def render_csv(result: VerdictResult) -> str:
+    """The verdict row as one CSV row under its header, lists space-separated."""
+    import pandas as pd
+
+    row = {k: " ".join(str(x) for x in v) if isinstance(v, (list, tuple)) else v for k, v in result.row.items()}
+    return pd.DataFrame([row]).to_csv(index=False, float_format="%.6g")
+
+
+def plain(value):
+    """``value`` as JSON takes it: numpy scalars as Python numbers, NaN and ±inf as None
+    (JSON has no such numbers), tuples and arrays as lists."""
+    import numpy as np
+
+    if isinstance(value, dict):
+        return {str(k): plain(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple, np.ndarray)):
+        return [plain(v) for v in value]
+    if isinstance(value, (bool, np.bool_)):
+        return bool(value)
+    if isinstance(value, (int, np.integer)):
+        return int(value)
+    if isinstance(value, (float, np.floating)):
+        return float(value) if math.isfinite(value) else None
+    return value
+
+
+def json_record(result: VerdictResult) -> dict:
+    """The JSON object: the row's fields, the form, expectation, criterion, exit code and, for a
+    system, the per-level rows (``h_list`` and ``routes`` as lists, ``h`` exact from the levels)."""
+    record = dict(result.row)
+    if result.levels is not None:
+        record["h_list"] = [lv["h"] for lv in result.levels]
+        record["routes"] = sorted({lv["route"] for lv in result.levels})
+    record.update(schema=SCHEMA, form=result.form, expect=result.expect, criterion=result.criterion,
+                  exit_code=result.exit_code)
+    if result.levels is not None:
+        record["levels"] = result.levels
+    return plain(record)
+
+
+def render_json(result: VerdictResult) -> str:
+    import json
+
+    return json.dumps(json_record(result), allow_nan=False, ensure_ascii=False, indent=2) + "\n"
+
+
+PROPERTIES = ("verdict", "expect", "beta_min", "beta_max", "slope", "slope_lo", "slope_hi", "kernel_dim",
+              "known_kernel", "norm", "k", "family", "multiplier_mesh", "N_list", "h_list")
+"""Row fields written as ``<property>`` of the JUnit suite (those the row has)."""
+
+
+_NOT_XML = re.compile("[\x00-\x08\x0b\x0c\x0e-\x1f\ufffe\uffff]")
+"""Characters XML 1.0 cannot hold at all, not even escaped (ElementTree writes them as they are)."""
+
+
+def _text(value) -> str:
+    """A property value or message: floats in full precision (``repr``), lists space-separated,
+    characters XML cannot hold replaced by U+FFFD."""
+    if isinstance(value, (list, tuple)):
+        return " ".join(_text(v) for v in value)
+    return _NOT_XML.sub("\ufffd", repr(float(value)) if isinstance(value, float) else str(value))
+
+
+def render_junit(result: VerdictResult) -> str:
+    """One ``<testsuite>`` with one ``<testcase>`` (module docstring: when it fails or is skipped)."""
+    import socket
+    import xml.etree.ElementTree as ET
+    from datetime import datetime, timezone
+
+    row = result.row
+    failed = result.exit_code == 1
+    skipped = not failed and row["verdict"] == "INCONCLUSIVE"
+    seconds = f"{float(row.get('seconds', 0.0)):.3f}"
+    suite = ET.Element("testsuite", name="infsup-contact verdict", tests="1", failures=str(int(failed)), errors="0",
+                       skipped=str(int(skipped)), time=seconds, hostname=socket.gethostname(),
+                       timestamp=datetime.now(timezone.utc).strftime("%Y-%m-%dT%H:%M:%S"))
+    props = ET.SubElement(suite, "properties")
+    values = dict(row, expect=result.expect or "", **result.criterion)
+    for key in [*PROPERTIES, *result.criterion]:
+        if key in values:
+            ET.SubElement(props, "property", name=key, value=_text(values[key]))
+    case = ET.SubElement(suite, "testcase", name=_text(result.name), classname=CLASSNAME, time=seconds)
+    evidence = _text(row["evidence"])
+    if failed:
+        fail = ET.SubElement(case, "failure", message=f"{row['verdict']}, expected {result.expect}: {evidence}",
+                             type="VerdictMismatch")
+        fail.text = _text(render_csv(result))
+    elif skipped:
+        ET.SubElement(case, "skipped", message=f"INCONCLUSIVE: {evidence}")
+    ET.SubElement(case, "system-out").text = _text(render_csv(result) + _levels_text(result))
+    ET.indent(suite)
+    return ET.tostring(suite, encoding="unicode", xml_declaration=True) + "\n"
+
+
+def _levels_text(result: VerdictResult) -> str:
+    """The per-level rows of a system as CSV (nothing for --case/--space)."""
+    import pandas as pd
+
+    if not result.levels:
+        return ""
+    return "\n" + pd.DataFrame(result.levels).to_csv(index=False, float_format="%.6g")

@@ -1,0 +1,73 @@
+"""``infsup-contact verdict-hook MANIFEST...``: the pre-commit hook's entry point
+(``.pre-commit-hooks.yaml``, id ``infsup-contact-verdict``).
+
+Each manifest given is checked as ``verdict --system`` checks it (the same parser, validation
+and memory gate) and its verdict compared with the manifest's ``expect:`` key, ``stable`` when
+it has none: a commit of a manifest whose verdict is UNSTABLE, INCONCLUSIVE or not the declared
+one is stopped. One line per manifest on stdout; a manifest refused is one line on stderr and
+the others are still checked. Exit code: 2 if any was refused, else 1 if any verdict differs
+from its expectation, else 0 (the codes of ``verdict``).
+"""
+from __future__ import annotations
+
+import sys
+
+from ..errors import InputError
+from ..io import TableError
+from .common import write_text
+from .verdict import VERDICT_DEFAULTS
+
+DEFAULT_EXPECT = "stable"
+"""A manifest without ``expect:`` is expected STABLE (a hook that passed UNSTABLE would gate nothing)."""
+
+
+def add(sub) -> None:
+    p = sub.add_parser(
+        "verdict-hook", help="pre-commit hook: verdict --system on each manifest given, exit 1 if a verdict "
+        "is not the manifest's expect: (default stable)",
+        description=__doc__.split("\n\n", 1)[1].replace("\n", " ").replace("``", ""))
+    p.add_argument("manifests", nargs="+", metavar="LEVELS.yaml", help="the manifests to check (pre-commit "
+                   "passes the changed files matching the hook's files: pattern)")
+    for key in ("slope_tolerance", "beta_floor", "confidence"):
+        p.add_argument("--" + key.replace("_", "-"), dest=key, type=float, default=VERDICT_DEFAULTS[key],
+                       help=f"as verdict's (default {VERDICT_DEFAULTS[key]:g})")
+    p.set_defaults(run=run_hook)
+
+
+def check_one(path: str, criterion: dict) -> tuple[int, str]:
+    """(exit code, line) of one manifest: 0 or 1 and its verdict line; 2 and the error line."""
+    from . import build_parser, check, parse
+    from ..systems.levels import system_verdict
+
+    argv = ["verdict", f"--system={path}", *(f"--{k.replace('_', '-')}={v!r}" for k, v in criterion.items())]
+    parser = build_parser()
+    try:
+        args = parse(parser, argv)
+        check(args)  # verdict's own validation: files, shapes, criterion, memory
+        row, _ = system_verdict(args.manifest, tol=args.slope_tolerance, floor=args.beta_floor,
+                                confidence=args.confidence, notes=sys.stderr)
+    except (InputError, TableError) as err:
+        from . import _message
+
+        return 2, f"infsup-contact: error: {_message(err, parser, 'verdict')}"
+    expect = args.manifest.expect or DEFAULT_EXPECT
+    ok = row["verdict"] == expect.upper()
+    line = (f"{path}: {row['verdict']} ({'as expected' if ok else 'expected ' + expect.upper()}); "
+            f"β_min {row['beta_min']:.4g}, slope {row['slope']:.3g} [{row['slope_lo']:.3g}, {row['slope_hi']:.3g}]")
+    return (0, line) if ok else (1, f"{line}; {row['evidence']}")
+
+
+def run_hook(args) -> int:
+    from ..study.verdict import check_criterion
+
+    criterion = {k: getattr(args, k) for k in ("slope_tolerance", "beta_floor", "confidence")}
+    check_criterion(*criterion.values())  # once, not once per manifest
+    worst = 0
+    for path in args.manifests:
+        code, line = check_one(path, criterion)
+        if code == 2:
+            print(line, file=sys.stderr, flush=True)
+        else:
+            write_text(line + "\n")
+        worst = max(worst, code)
+    return worst

@@ -1,0 +1,201 @@
+"""The producers stage: other codes' exporters run, their systems certified in each norm.
+
+A producer (``examples/producers/<code>/export.py``) obeys one contract: run by its code's
+own interpreter as ``export.py --out DIR --space SPACE --N ... [--offset K]`` it writes
+``DIR/levels.yaml`` (``norm: H``, the multipliers described on Γ, G the L² mass) and the
+level matrices, prints nothing on stdout and exits 0. This module runs it for each space and
+offset, certifies the manifest in each requested norm (``H`` as written; ``L2``, ``h-L2`` on
+copies with ``norm`` changed and the multiplier description left out) by the library call
+``verdict --system`` makes, and returns one table row per (producer, space, offset, norm).
+A producer whose interpreter or code is missing gives one row ``status: not installed`` with
+its install command, never a failure.
+"""
+from __future__ import annotations
+
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import InputError
+from ..yaml_limits import load as yaml_load
+
+COLUMNS = ("producer", "version", "space", "offset", "norm", "status", "verdict", "kernel_dim", "beta_levels",
+           "kernel_levels", "h_levels", "slope", "slope_lo", "slope_hi", "evidence", "seconds", "install", "system")
+NOT_RUN = "-"
+"""The space, norm and level cells of a row of a producer that did not run."""
+H_ONLY_KEYS = ("gamma",)
+H_LEVEL_KEYS = ("multipliers",)
+EXPORT_TIMEOUT = 600.0
+"""Seconds an exporter may take for all its levels (Kratos, N = 4..32: ~2 s)."""
+
+
+def installed_version(python: str, distribution: str) -> str | None:
+    """The producer's code version as its own interpreter sees it, or None (interpreter or
+    distribution missing)."""
+    if not Path(python).is_file():
+        return None
+    probe = f"import importlib.metadata as m; print(m.version({distribution!r}))"
+    try:
+        done = subprocess.run([python, "-c", probe], capture_output=True, text=True, timeout=120)
+    except (OSError, subprocess.TimeoutExpired):
+        return None
+    return done.stdout.strip() if done.returncode == 0 and done.stdout.strip() else None
+
+
+def run_export(python: str, script: Path, out: Path, space: str, ns, offset: int) -> float:
+    """Run one export by the contract; its seconds. :class:`InputError` naming the exporter
+    when it exits non-zero, prints on stdout or writes no manifest."""
+    cmd = [python, str(script), "--out", str(out), "--space", space, "--N", *map(str, ns), "--offset", str(offset)]
+    t0 = time.perf_counter()
+    done = subprocess.run(cmd, capture_output=True, text=True, timeout=EXPORT_TIMEOUT)
+    seconds = time.perf_counter() - t0
+    sys.stderr.write(done.stderr)
+    last = (done.stderr.strip().splitlines() or [""])[-1]
+    if done.returncode != 0:
+        raise InputError(str(script), f"exit {done.returncode} for --space {space} --offset {offset}: {last}")
+    if done.stdout.strip():
+        raise InputError(str(script), f"printed on stdout (the contract: nothing): {done.stdout.strip()[:80]!r}")
+    if not (out / "levels.yaml").is_file():
+        raise InputError(str(script), f"exit 0 but no {out / 'levels.yaml'}")
+    return seconds
+
+
+def norm_copy(manifest: Path, norm: str) -> Path:
+    """The manifest itself for ``H``; for another norm a copy beside it with ``norm`` changed
+    and the Γ description (``gamma``, per level ``multipliers``) left out."""
+    import yaml
+
+    if norm == "H":
+        return manifest
+    data = yaml_load(manifest.read_text())
+    data["norm"] = norm
+    for key in H_ONLY_KEYS:
+        data.pop(key, None)
+    for level in data.get("levels", []):
+        for key in H_LEVEL_KEYS:
+            level.pop(key, None)
+    path = manifest.with_name(f"levels-{norm}.yaml")
+    path.write_text(yaml.safe_dump(data, sort_keys=False, allow_unicode=True))
+    return path
+
+
+def certify(manifest: Path, criterion: dict) -> dict:
+    """The verdict of ``verdict --system`` on ``manifest`` and its per-level β_h and kernel
+    dimensions; a manifest the certifier refuses gives ``status: refused: <its line>``."""
+    from ..systems.levels import system_verdict
+    from ..systems.manifest import load_manifest
+    from ..systems.readers import SystemFileError
+
+    t0 = time.perf_counter()
+    try:
+        head, rows = system_verdict(load_manifest(manifest), tol=criterion["slope_tolerance"],
+                                    floor=criterion["beta_floor"], confidence=criterion["confidence"])
+    except (SystemFileError, InputError) as err:
+        return dict(status=f"refused: {' '.join(str(err).split())}", verdict="", seconds=time.perf_counter() - t0)
+    return dict(status="ok", verdict=head["verdict"], kernel_dim=int(head["kernel_dim"]),
+                beta_levels=" ".join(f"{r['beta']:.6g}" for r in rows),
+                kernel_levels=" ".join(str(int(r["kernel_detected"])) for r in rows),
+                h_levels=" ".join(f"{r['h']:g}" for r in rows),
+                slope=_num(head.get("slope")), slope_lo=_num(head.get("slope_lo")), slope_hi=_num(head.get("slope_hi")),
+                evidence=" ".join(str(head["evidence"]).split()), system=head["system"],
+                seconds=time.perf_counter() - t0)
+
+
+def _num(value) -> float:
+    """A finite float or NaN: an unbounded slope interval (−inf, inf) is said in the evidence."""
+    try:
+        value = float(value)
+    except (TypeError, ValueError):
+        return float("nan")
+    return value if np.isfinite(value) else float("nan")
+
+
+def producer_rows(name: str, spec: dict, cfg: dict, workdir: Path, root: Path = Path(".")) -> list:
+    """Every row of one producer (``cfg``: the config's ``producers`` section; ``spec`` its
+    entry under ``codes``): exports under ``workdir/<name>/<space>_k<offset>``."""
+    python = str(root / spec["python"]) if not Path(spec["python"]).is_absolute() else spec["python"]
+    base = dict(producer=name, install=spec["install"])
+    version = installed_version(python, spec["distribution"])
+    if version is None:
+        return [dict(base, version="", space=NOT_RUN, offset=0, norm=NOT_RUN, status="not installed",
+                     verdict="", evidence=f"{spec['distribution']} not importable by {spec['python']}: "
+                     f"run `{spec['install']}`")]
+    out = []
+    script = root / spec["export"]
+    for space in spec["spaces"]:
+        for offset in cfg["offsets"]:
+            target = workdir / name / f"{space}_k{offset}"
+            _empty_dir(target)
+            seconds = run_export(python, script, target, space, cfg["N"], offset)
+            for norm in cfg["norms"]:
+                row = certify(norm_copy(target / "levels.yaml", norm), cfg["criterion"])
+                row["seconds"] = row["seconds"] + (seconds if norm == cfg["norms"][0] else 0.0)
+                out.append(dict(base, version=version, space=space, offset=int(offset), norm=norm, **row))
+    return out
+
+
+def _empty_dir(path: Path) -> None:
+    """A fresh export directory (the exporters refuse a non-empty one)."""
+    import shutil
+
+    if path.exists():
+        shutil.rmtree(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+
+
+def producers_table(cfg: dict, workdir: Path, root: Path = Path(".")):
+    """The producers table (:data:`COLUMNS`), one producer after the other."""
+    import pandas as pd
+
+    rows = [r for name, spec in cfg["codes"].items() for r in producer_rows(name, spec, cfg, Path(workdir), root)]
+    frame = pd.DataFrame(rows)
+    for col in COLUMNS:
+        if col not in frame:
+            frame[col] = np.nan if col in ("kernel_dim", "slope", "slope_lo", "slope_hi", "seconds") else ""
+    for col in ("beta_levels", "kernel_levels", "h_levels", "evidence", "system", "verdict", "version"):
+        frame[col] = frame[col].fillna("").astype(str)
+    return frame[list(COLUMNS)]
+
+
+def producers_claims(frame, cfg: dict):
+    """One ledger claim per (producer, space) with a prediction in the config
+    (``codes.<name>.predictions.<space>``: ``verdicts`` per norm, optionally ``kernel``, the
+    dimension of the kernel of Bᵀ on every level), over every offset and norm it ran in.
+    PASS when every certificate is the predicted one; FAIL when a decided certificate
+    (STABLE/UNSTABLE) differs; INCONCLUSIVE when one is INCONCLUSIVE or refused. A producer
+    that is not installed gives no claim (its table row says so)."""
+    import pandas as pd
+
+    from .claims import FAIL, INCONCLUSIVE, PASS, row
+
+    out = []
+    for name, spec in cfg["codes"].items():
+        for space, pred in (spec.get("predictions") or {}).items():
+            rows = frame[(frame.producer == name) & (frame.space == space)]
+            if rows.empty:
+                continue
+            wrong, open_, seen = [], [], []
+            for r in rows.itertuples():
+                where = f"offset {r.offset} {r.norm}"
+                expect = pred["verdicts"].get(r.norm)
+                if r.status != "ok":
+                    open_.append(f"{where}: {r.status}")
+                    continue
+                kernels = [int(k) for k in str(r.kernel_levels).split()]
+                seen.append(f"{where} {r.verdict} kernel {kernels}")
+                if r.verdict == INCONCLUSIVE:
+                    open_.append(f"{where}: INCONCLUSIVE ({r.evidence[:90]})")
+                elif r.verdict != expect or ("kernel" in pred and any(k != pred["kernel"] for k in kernels)):
+                    wrong.append(f"{where}: {r.verdict} kernel {kernels}")
+            verdict = FAIL if wrong else INCONCLUSIVE if open_ else PASS
+            evidence = "; ".join(wrong or open_ or seen)
+            kernel = f", kernel of B^T of dim {pred['kernel']} on every level" if "kernel" in pred else ""
+            statement = (f"{rows.system.iloc[0] or name + ' ' + space}: verdicts "
+                         + ", ".join(f"{n} {v}" for n, v in pred["verdicts"].items()) + kernel
+                         + f" (offsets {sorted(set(rows.offset))}); {pred['why']}")
+            out.append(row(f"producer-{name}-{space}", "beyond the paper (Certifying production codes)",
+                           statement, (verdict, evidence)))
+    return pd.DataFrame(out, columns=["claim_id", "paper_ref", "statement", "evidence", "verdict", "predicted"])

@@ -1,0 +1,42 @@
+# Producers stage: other codes' exporters (examples/producers/<code>/export.py) run for their spaces,
+# matching and non-matching, each export certified by verdict --system in the norms of the config
+# (study/producers.py). A producer not installed is a row saying so, with its install command.
+# Only with a `producers` config section (the CI profile has none: Kratos is an optional install).
+PRODUCERS = config.get("producers")
+PRODUCERS_TABLES = ["results/tables/producers.csv", "results/tables/producers_claims.csv"] if PRODUCERS else []
+PRODUCERS_PAPER = ["results/paper/producers.tex"] if PRODUCERS else []
+
+if PRODUCERS:
+
+    rule producers:
+        output:
+            table="results/tables/producers.csv",
+            claims="results/tables/producers_claims.csv",
+        input:
+            exporters=sorted({spec["export"] for spec in PRODUCERS["codes"].values()}),
+            src=PACKAGE_SOURCES,
+        params:
+            cfg=lambda wc: dict(PRODUCERS, criterion=config["claims"]),
+            workdir="results/producers",
+        threads: 1
+        benchmark:
+            "results/benchmarks/rules/producers.tsv"
+        log:
+            "results/logs/producers.log",
+        script:
+            "../scripts/producers_job.py"
+
+    rule producers_paper:
+        output:
+            "results/paper/producers.tex",
+        input:
+            table="results/tables/producers.csv",
+            claims="results/tables/producers_claims.csv",
+            paragraphs=[p for p in (f"examples/producers/{n}/paper.tex" for n in PRODUCERS["codes"]) if Path(p).is_file()],
+            src=REPORT_SOURCES,
+        benchmark:
+            "results/benchmarks/rules/producers_paper.tsv"
+        log:
+            "results/logs/producers_paper.log",
+        script:
+            "../scripts/producers_paper.py"

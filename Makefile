@@ -7,7 +7,7 @@ STAMP  := $(VENV)/.installed-from-lock
 # workflow rules call `python` and `infsup-contact`: they must resolve to the venv
 export PATH := $(CURDIR)/$(BIN):$(PATH)
 
-.PHONY: reproduce-all test env clean-env producers-kratos
+.PHONY: reproduce-all test env clean-env producers-kratos producers-dolfinx producers-getfem
 
 env: $(STAMP)
 
@@ -41,3 +41,29 @@ $(VENV)/.producers-kratos: environment-producers.lock $(STAMP)
 
 clean-env:
 	rm -rf $(VENV)
+
+# Foreign producers (examples/producers/): each code in its own interpreter, not in .venv.
+# DOLFINx wheels need Python >= 3.12; the lock pins them with their hashes.
+# (the first candidate that runs: a pyenv shim exists but fails where 3.12 is not selected)
+PYTHON312 ?= $(shell for p in python3.12 python3.13 $(wildcard $(HOME)/.pyenv/versions/3.1[2-9]*/bin/python); do \
+  $$p -c 'import sys; sys.exit(sys.version_info[:2] < (3, 12))' 2>/dev/null && { command -v $$p; break; }; done)
+DOLFINX_VENV  := .venv-dolfinx
+DOLFINX_STAMP := $(DOLFINX_VENV)/.installed-from-lock
+
+producers-dolfinx: $(DOLFINX_STAMP)
+
+$(DOLFINX_STAMP): examples/producers/dolfinx/requirements.lock
+	@[ -n "$(PYTHON312)" ] && $(PYTHON312) -c 'import sys; sys.exit(sys.version_info[:2] < (3, 12))' || \
+	  { echo "error: DOLFINx 0.11 wheels need Python >= 3.12 (found '$(PYTHON312)'); set PYTHON312=/path/to/python3.12"; exit 1; }
+	rm -rf $(DOLFINX_VENV)
+	$(PYTHON312) -m venv $(DOLFINX_VENV)
+	$(DOLFINX_VENV)/bin/pip install --quiet --require-hashes -r examples/producers/dolfinx/requirements.lock
+	touch $@
+
+# GetFEM from Debian (python3-getfem 5.4 for the system /usr/bin/python3): needs root.
+producers-getfem:
+	@/usr/bin/python3 -c 'import getfem, scipy, yaml' 2>/dev/null || \
+	  { [ "$$(id -u)" = 0 ] && apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq \
+	      --no-install-recommends python3-getfem python3-scipy python3-yaml >/dev/null; } || \
+	  { echo "error: GetFEM is installed from Debian as root: apt-get install python3-getfem python3-scipy python3-yaml"; exit 1; }
+	@/usr/bin/python3 -c 'import getfem; print("GetFEM", getfem.getfem_env("release"), "for /usr/bin/python3")'

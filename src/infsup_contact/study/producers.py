@@ -27,17 +27,18 @@ COLUMNS = ("producer", "version", "space", "offset", "norm", "status", "verdict"
 NOT_RUN = "-"
 """The space, norm and level cells of a row of a producer that did not run."""
 H_ONLY_KEYS = ("gamma",)
-H_LEVEL_KEYS = ("multipliers",)
+H_LEVEL_KEYS = ("multipliers", "traces")
 EXPORT_TIMEOUT = 600.0
 """Seconds an exporter may take for all its levels (Kratos, N = 4..32: ~2 s)."""
 
 
-def installed_version(python: str, distribution: str) -> str | None:
+def installed_version(python: str, distribution: str, probe: str | None = None) -> str | None:
     """The producer's code version as its own interpreter sees it, or None (interpreter or
-    distribution missing)."""
+    distribution missing). ``probe``: Python code printing it, for a code installed without
+    package metadata (Debian's python3-getfem); default the distribution's metadata."""
     if not Path(python).is_file():
         return None
-    probe = f"import importlib.metadata as m; print(m.version({distribution!r}))"
+    probe = probe or f"import importlib.metadata as m; print(m.version({distribution!r}))"
     try:
         done = subprocess.run([python, "-c", probe], capture_output=True, text=True, timeout=120)
     except (OSError, subprocess.TimeoutExpired):
@@ -118,7 +119,7 @@ def producer_rows(name: str, spec: dict, cfg: dict, workdir: Path, root: Path = 
     entry under ``codes``): exports under ``workdir/<name>/<space>_k<offset>``."""
     python = str(root / spec["python"]) if not Path(spec["python"]).is_absolute() else spec["python"]
     base = dict(producer=name, install=spec["install"])
-    version = installed_version(python, spec["distribution"])
+    version = installed_version(python, spec["distribution"], spec.get("version"))
     if version is None:
         return [dict(base, version="", space=NOT_RUN, offset=0, norm=NOT_RUN, status="not installed",
                      verdict="", evidence=f"{spec['distribution']} not importable by {spec['python']}: "
@@ -126,7 +127,7 @@ def producer_rows(name: str, spec: dict, cfg: dict, workdir: Path, root: Path = 
     out = []
     script = root / spec["export"]
     for space in spec["spaces"]:
-        for offset in cfg["offsets"]:
+        for offset in spec.get("offsets", cfg["offsets"]):  # a code's own: DOLFINx ties matching meshes only
             target = workdir / name / f"{space}_k{offset}"
             _empty_dir(target)
             seconds = run_export(python, script, target, space, cfg["N"], offset)

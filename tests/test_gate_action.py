@@ -102,7 +102,8 @@ def test_action_step_writes_the_outputs_and_exits_with_the_verdicts_code(systems
 
 def test_action_norm_override_scales_beta_by_h_to_the_minus_half(systems, tmp_path):
     """norm: h-L2 makes G = h·G, so each β_h becomes β_h / √h (the pencil's eigenvalues / h):
-    the override must give exactly that, and leave the user's directory as it was."""
+    the override must give exactly that, and leave the user's directory as it was. The export is
+    a ``norm: H`` manifest whose G is the L² mass: its β in G is the row's ``beta_L2``."""
     workdir = systems["stable"].parent.parent
     before = sorted(p.name for p in systems["stable"].parent.iterdir())
     got, err, outputs, _ = run_action_step(tmp_path, {"system": "exports/levels.yaml", "norm": "h-L2"}, workdir)
@@ -112,7 +113,7 @@ def test_action_norm_override_scales_beta_by_h_to_the_minus_half(systems, tmp_pa
     _, plain, _ = run_in_process(["verdict", "--system", str(systems["stable"]), "--format", "json"])
     given = json.loads(plain)["levels"]
     for lv, ref in zip(record["levels"], given):
-        assert abs(lv["beta"] - ref["beta"] / ref["h"] ** 0.5) <= 1e-12 * lv["beta"]
+        assert abs(lv["beta"] - ref["beta_L2"] / ref["h"] ** 0.5) <= 1e-12 * lv["beta"]
     assert float(outputs["beta_min"]) == min(lv["beta"] for lv in record["levels"])
     assert sorted(p.name for p in systems["stable"].parent.iterdir()) == before  # the copy removed
 

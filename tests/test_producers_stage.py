@@ -62,7 +62,9 @@ def _cfg(tmp_path, python=sys.executable, distribution="numpy", install="make pr
     return {"N": [4, 8, 16], "offsets": [0, 1], "norms": ["H", "L2", "h-L2"], "criterion": CRITERION,
             "codes": {"fake": {"python": str(python), "export": str(script), "distribution": distribution,
                                "spaces": ["p0"], "install": install,
-                               "predictions": {"p0": {"verdicts": {"H": "STABLE", "L2": "UNSTABLE", "h-L2": "STABLE"},
+                               # B A⁻¹ Bᵀ = h²/2 I: h-L2 (G = h² I) β² = 1/2; L2 (G = h I) β² = h/2; H: the
+                               # H^-1/2 Gram of P0 holds the constant, 1ᵀG1/N = 7ζ(3)/(π³ N) ~ 0.27 h, so β² ≲ 2h
+                               "predictions": {"p0": {"verdicts": {"H": "UNSTABLE", "L2": "UNSTABLE", "h-L2": "STABLE"},
                                                       "kernel": 0, "why": "a diagonal coupling"}}}}}
 
 

@@ -102,7 +102,7 @@ def _run_beta(args) -> None:
     if args.system is not None:
         from ..systems.levels import NORM_NOTES, system_rows
 
-        if args.manifest.norm != "given":
+        if args.manifest.norm not in ("given", "H"):  # H: the paper's norm, no caveat
             print(f"infsup-contact: note: {NORM_NOTES[args.manifest.norm]}", file=sys.stderr)
         write_csv(pd.DataFrame(system_rows(args.manifest)).drop(columns="N2"), float_format="%.12g")
         return

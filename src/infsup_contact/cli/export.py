@@ -26,7 +26,10 @@ def add(sub) -> None:
     p.add_argument("--N1-offset", type=int, default=0, help="N1 = N + offset (non-matching pairs; default 0)")
     p.add_argument("--family", default="structured", choices=FAMILIES)
     p.add_argument("--norm", default="H", choices=["H", "L2"],
-                   help="G: H^{-1/2}_00(Γ) (manifest norm: given) or the L² mass (manifest norm: L2)")
+                   help="H: manifest norm: H, the multipliers described on Γ and G = their L² mass (the "
+                   "H^{-1/2}_00(Γ) Gram is assembled by the reader; a space the description cannot express, "
+                   "a face's cellwise or triangle space: norm: given, G = the H Gram); L2: G = the L² mass "
+                   "(manifest norm: L2)")
     p.add_argument("--multiplier-mesh", default="omega2", choices=["omega2", "omega1", "union"])
     p.add_argument("--format", default="mtx", choices=sorted(EXPORT_FORMATS))
     p.add_argument("--out", required=True, help="directory to write into (created; refused if it holds "
@@ -103,19 +106,16 @@ def _refuse_nonempty(out, args) -> None:
 
 
 def _run_export(args) -> None:
-    from ..systems.export import suite_system, write_system
+    from ..systems.export import suite_levels, write_system
 
     kwargs = dict(args.mesh_kwargs)
-    levels = []
-    for n in args.N:
-        A, B, G = suite_system(args.case, args.k, n + args.N1_offset, n, args.family, args.norm,
-                               args.multiplier_mesh, model=args.model_obj, **kwargs)
-        levels.append((1.0 / n, A, B, G))
+    levels, norm, gamma = suite_levels(args.case, args.k, args.N, args.N1_offset, args.family, args.norm,
+                                       args.multiplier_mesh, model=args.model_obj, **kwargs)
     name = "-".join([args.case, f"k{args.k}", args.model, *kwargs.values()]
                     + ([f"N1{args.N1_offset:+d}"] if args.N1_offset else []))
     out = Path(args.out)
     before = {p.name for p in out.iterdir()} if out.is_dir() else set()
-    path = write_system(args.out, levels, args.format, name, norm="given" if args.norm == "H" else "L2")
+    path = write_system(args.out, levels, args.format, name, norm=norm, gamma=gamma)
     stale = sorted(before - set(_targets(args)))
     if stale:  # --force: what the new manifest does not name is left, and said so
         print(f"infsup-contact: note: --force: {len(stale)} file(s) not written by this export left in {out} "

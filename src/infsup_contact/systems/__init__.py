@@ -4,7 +4,10 @@
 (MatrixMarket, scipy ``.npz``/``.npy``, Harwell-Boeing, PETSc binary), ``checks`` finds what
 real exports look like (Dirichlet penalties, identity rows, asymmetry, NaN, …) and says so in
 one line, ``engine`` computes β_h² = min eig(B A⁻¹ Bᵀ, G) per level, ``levels`` turns a manifest
-into rows and a verdict, ``export`` writes this suite's own systems in the same layout. Imports ``errors``, ``io``, ``models`` and ``solvers``.
+into rows and a verdict, ``export`` writes this suite's own systems in the same layout;
+``multiplier_basis`` / ``multiplier_gram`` turn a ``norm: H`` manifest's description of the
+multipliers on Γ into their exact H^{-1/2}_00 Gram, ``mortar_distance`` measures B against the
+exact coupling of described traces. Imports ``errors``, ``io``, ``models`` and ``solvers``.
 """
 from .readers import SystemFileError
 

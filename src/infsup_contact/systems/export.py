@@ -6,6 +6,13 @@ B = [−B_1 0 | B_2 0] with the couplings B_i on the Γ columns, G the Gram matr
 multiplier norm (H^{-1/2}_00(Γ) by the log kernel, or L²(Γ)). Then B A⁻¹ Bᵀ = Σ_i B_i X_i B_iᵀ
 exactly as ``beta`` forms it, so ``verdict --system`` on an export must reproduce
 ``verdict --case`` (``tests/test_systems_roundtrip.py``). h = 1/N2 as in ``verdict --case``.
+
+With ``norm="H"`` :func:`suite_levels` writes what a producer writes (``norm: H``): Γ
+(``gamma``), per level the ``multipliers`` description (:mod:`.multiplier_basis`; the helper
+form of a registered Lagrange or dual space, else the general form) and G = the L² mass; the
+H^{-1/2}_00 Gram is then assembled by the reader. A space the description cannot express (the
+face's cellwise element spaces, P_s on triangles) keeps ``norm: given`` with G = the H Gram.
+A face space's rows are reordered to the description's default, row i + n_x j for ψ_i(x) ψ_j(y).
 """
 from __future__ import annotations
 
@@ -15,6 +22,7 @@ from pathlib import Path
 import numpy as np
 import scipy.sparse as sp
 
+from ..errors import InputError
 from ..io import write_atomic, write_bytes_atomic
 from .readers import petsc_binary_bytes
 
@@ -24,6 +32,13 @@ EXPORT_FORMATS = {"mtx": ".mtx", "npz": ".npz", "petsc": ".petsc"}
 def suite_system(case: str, k: int, n1: int, n2: int, family: str = "structured", norm: str = "H",
                  multiplier_mesh: str = "omega2", model=None, **mesh_kwargs):
     """(A, B, G) of ``case`` on the pair (N1, N2) of ``model`` (default: membranes)."""
+    A, B, space, gamma, _ = _suite_parts(case, k, n1, n2, family, multiplier_mesh, model, **mesh_kwargs)
+    G, _ = gamma.gram(space, norm)
+    return A, B, np.asarray(G, float)
+
+
+def _suite_parts(case, k, n1, n2, family, multiplier_mesh, model, **mesh_kwargs):
+    """(A, B, the multiplier space, Γ, the two side operators) of ``case`` on the pair (N1, N2)."""
     from ..discretization import registry
     from ..discretization.coupling import coupling_matrix
     from ..models.membranes import MEMBRANES
@@ -40,8 +55,136 @@ def suite_system(case: str, k: int, n1: int, n2: int, family: str = "structured"
         full[:, side.ndof - Bi.shape[1]:] = sign * Bi
         blocks.append(sp.csr_matrix(full))
     A = sp.block_diag([s.stiffness for s in sides], format="csr")
-    G, _ = gamma.gram(space, norm)
-    return A, sp.hstack(blocks, format="csr"), np.asarray(G, float)
+    return A, sp.hstack(blocks, format="csr"), space, gamma, sides
+
+
+def suite_levels(case: str, k: int, ns, offset: int = 0, family: str = "structured", norm: str = "H",
+                 multiplier_mesh: str = "omega2", model=None, **mesh_kwargs) -> tuple:
+    """(levels, manifest norm, gamma) of ``case`` on N1 = N + offset, N2 = N for N in ``ns``, as
+    :func:`write_system` takes them (module docstring: ``norm: H`` with the description where the
+    space has one)."""
+    from ..discretization.registry import space_spec
+
+    spec, levels, described = space_spec(case), [], norm == "H"
+    parts = [_suite_parts(case, k, n + offset, n, family, multiplier_mesh, model, **mesh_kwargs) for n in ns]
+    described = described and all(description(spec, p[2]) is not None for p in parts)
+    for n, (A, B, space, gamma, sides) in zip(ns, parts):
+        if not described:
+            G, _ = gamma.gram(space, norm)
+            levels.append((1.0 / n, A, B, np.asarray(G, float)))
+            continue
+        mult, order = description(spec, space)
+        G, _ = gamma.gram(space, "L2")
+        levels.append((1.0 / n, A, B[order], np.asarray(G, float)[np.ix_(order, order)], mult,
+                       trace_forms(sides, k)))
+    if described:
+        face = hasattr(parts[0][2], "factors")
+        gamma = {"shape": "rectangle", "size": [1.0, 1.0]} if face else {"shape": "segment", "length": 1.0}
+        return levels, "H", gamma
+    return levels, "given" if norm == "H" else "L2", None
+
+
+def description(spec, space):
+    """(the ``multipliers`` mapping of ``space``, the order of its basis functions as the
+    description counts them) or None where it has none (module docstring)."""
+    from ..discretization.face_spaces import FaceSpace
+    from ..discretization.multipliers import MultiplierSpace
+
+    if isinstance(space, MultiplierSpace):
+        return segment_form(spec, space), np.arange(space.dim)
+    if type(space) is FaceSpace and all(isinstance(f, MultiplierSpace) for f in space.factors):
+        sx, sy = space.factors
+        i, j = np.divmod(np.arange(space.dim), sy.dim)  # FaceSpace's row i n_y + j; counted i + n_x j
+        return {"x": segment_form(spec, sx), "y": segment_form(spec, sy)}, np.argsort(i + sx.dim * j)
+    return None
+
+
+def trace_forms(sides, k: int):
+    """The ``traces`` of the two bodies (:mod:`.mortar_distance`): on the segment the general form
+    of each side's Γ-dof basis (its values at the equispaced Lagrange nodes of every trace
+    interval: the coefficients of those shapes), ``columns`` = the dof of A (Γ dofs last in each
+    block, in the trace's order). On a hexahedral face at k = 1 the bilinear hats, the tensor
+    product of the 1D hats (:func:`_face_trace_forms`); None on other faces (NGSolve's Q_k, k ≥ 2,
+    and P_k bases are not tensor products of 1D Lagrange shapes)."""
+    from ..discretization.multipliers import reference_nodes
+
+    if sides[0].trace.gamma.dim != 1:
+        return _face_trace_forms(sides) if k == 1 and getattr(sides[0].trace.gamma, "cell", "") == "quad" else None
+    out, offset = [], 0
+    for sign, side in zip((-1, 1), sides):
+        tr = side.trace
+        if not len(tr.gamma_dofs):  # a body with no free dof on Γ (N = 1, k = 1) meets no multiplier
+            offset += side.ndof
+            continue
+        x = np.asarray(tr.breakpoints, float)
+        nodes = (x[:-1, None] + np.diff(x)[:, None] * reference_nodes(k)[None, :])  # (N, k + 1)
+        V = tr.gamma.trace_basis(tr, nodes.ravel()).reshape(len(x) - 1, k + 1, -1)  # (N, node, Γ dof)
+        dofs, coef = -np.ones((len(x) - 1, k + 1), int), np.zeros((len(x) - 1, k + 1, k + 1))
+        for e in range(len(x) - 1):
+            live = np.flatnonzero(np.any(V[e] != 0.0, axis=0))  # a degree-k function zero at k + 1 nodes is 0
+            dofs[e, :len(live)] = live
+            coef[e, :len(live)] = V[e][:, live].T
+        first = offset + side.ndof - len(tr.gamma_dofs)
+        out.append({"breakpoints": x.tolist(), "degree": int(k), "dofs": dofs.tolist(), "coefficients": coef.tolist(),
+                    "columns": list(range(first, first + len(tr.gamma_dofs))), "sign": sign})
+        offset += side.ndof
+    return out or None
+
+
+def _face_trace_forms(sides) -> list:
+    """The bilinear hats of each side's face trace as {x, y} Lagrange P_1 forms (ends dropped: Γ's
+    boundary is fixed); ``columns[i + n_x j]`` = the dof of A whose basis function is 1 at the
+    node (x_{i+1}, y_{j+1}), read off the trace basis there (it must be a permutation)."""
+    out, offset = [], 0
+    for sign, side in zip((-1, 1), sides):
+        tr = side.trace
+        if not len(tr.gamma_dofs):  # no free dof on Γ (one cell per direction at k = 1)
+            offset += side.ndof
+            continue
+        xs, ys = (np.asarray(g, float) for g in (tr.partition.xs, tr.partition.ys))
+        X, Y = np.meshgrid(xs[1:-1], ys[1:-1], indexing="xy")  # node i + n_x j at row j, column i
+        V = np.asarray(tr.gamma.trace_basis(tr, np.column_stack([X.ravel(), Y.ravel()])))
+        p = np.argmax(np.abs(V), axis=1)
+        if V.shape[0] != V.shape[1] or not np.allclose(V[np.arange(len(p)), p], 1.0, atol=1e-12) \
+                or len(np.unique(p)) != len(p) or not np.allclose(np.abs(V).sum(axis=1), 1.0, atol=1e-12):
+            return None  # not the nodal hats: no description written
+        first = offset + side.ndof - len(tr.gamma_dofs)
+        axis = [{"basis": "lagrange", "degree": 1, "breakpoints": g.tolist(), "ends": "drop"} for g in (xs, ys)]
+        out.append({"x": axis[0], "y": axis[1], "columns": (first + p).tolist(), "sign": sign})
+        offset += side.ndof
+    return out or None
+
+
+def segment_form(spec, space) -> dict:
+    """The helper form of a registered Lagrange / dual space (``spec.lagrange``, ``spec.dual``) when
+    it builds exactly ``space``; else the general form (breakpoints, degree, dofs, coefficients)."""
+    from .multiplier_basis import _segment
+
+    x = [float(v) for v in space.breakpoints]
+    if spec is not None and getattr(spec, "lagrange", None) is not None:
+        continuous, vanish = spec.lagrange
+        form = {"basis": "dual" if spec.dual else ("lagrange" if continuous else "discontinuous"),
+                "degree": int(space.degree), "breakpoints": x}
+        if vanish and (continuous or space.degree > 0):
+            form["ends"] = "drop"
+        try:
+            built, _ = _segment("export", "multipliers", form, Path("."), 1.0, face=False)
+        except InputError:
+            built = None
+        if built is not None and _same(built, space):
+            return form
+    form = {"breakpoints": x, "degree": int(space.degree), "dofs": space.dofs.tolist()}
+    if space.local_coefficients is not None:
+        form["coefficients"] = np.asarray(space.local_coefficients, float).tolist()
+    return form
+
+
+def _same(a, b) -> bool:
+    """Whether two 1D spaces have the same partition, numbering and local basis."""
+    ca = a.local_coefficients
+    cb = b.local_coefficients
+    return (np.array_equal(a.breakpoints, b.breakpoints) and np.array_equal(a.dofs, b.dofs)
+            and (ca is None) == (cb is None) and (ca is None or np.array_equal(ca, cb)))
 
 
 def matrix_bytes(mat, fmt: str) -> bytes:
@@ -63,19 +206,35 @@ def matrix_bytes(mat, fmt: str) -> bytes:
     return buf.getvalue()
 
 
-def write_system(directory, levels, fmt: str, name: str, norm: str = "given", known_kernel: int = 0) -> Path:
+def write_system(directory, levels, fmt: str, name: str, norm: str = "given", known_kernel: int = 0,
+                 gamma: dict | None = None) -> Path:
     """Write each level's A, B, G as ``{A,B,G}<i>.<ext>`` and ``levels.yaml`` (atomically);
-    ``levels``: (h, A, B, G) coarse to fine. Returns the manifest's path."""
+    ``levels``: (h, A, B, G[, multipliers[, traces]]) coarse to fine (G None: not written;
+    ``multipliers`` a mapping and ``traces`` a list written inline, with ``gamma`` for ``norm: H``).
+    Returns the manifest's path."""
     directory = Path(directory)
     ext = EXPORT_FORMATS[fmt]
     lines = [f"name: {name}", f"norm: {norm}"] + ([f"known_kernel: {known_kernel}"] if known_kernel else [])
+    if gamma is not None:
+        lines.append(f"gamma: {_flow(gamma)}")
     lines.append("levels:")
-    for i, (h, A, B, G) in enumerate(levels):
+    for i, (h, A, B, G, *described) in enumerate(levels):
         names = {}
         for key, mat in (("A", A), ("B", B), ("G", G)):
-            names[key] = f"{key}{i}{ext}"
-            write_bytes_atomic(directory / names[key], matrix_bytes(mat, fmt))
-        lines.append(f"  - {{h: {h!r}, A: {names['A']}, B: {names['B']}, G: {names['G']}}}")
+            if mat is not None:
+                names[key] = f"{key}{i}{ext}"
+                write_bytes_atomic(directory / names[key], matrix_bytes(mat, fmt))
+        files = "".join(f", {key}: {file}" for key, file in names.items())
+        mult, traces = (list(described) + [None, None])[:2]
+        lines.append(f"  - {{h: {h!r}{files}" + (f", multipliers: {_flow(mult)}" if mult else "")
+                     + (f", traces: {_flow(traces)}" if traces else "") + "}")
     path = directory / "levels.yaml"
     write_atomic(path, "\n".join(lines) + "\n")
     return path
+
+
+def _flow(value) -> str:
+    """``value`` as one line of YAML flow style (floats as repr: they read back exactly)."""
+    import yaml
+
+    return yaml.safe_dump(value, default_flow_style=True, width=float("inf"), sort_keys=False).strip()

@@ -28,19 +28,36 @@ NORM_NOTES = {
            "(Remark 3.1), so this is not the H^-1/2 verdict"),
     "h-L2": ("h-weighted L2 (G = h*M): a mesh-dependent norm weaker than H^-1/2 on quasi-uniform meshes "
              "(h^1/2|mu|_L2 <~ |mu|_H^-1/2); STABLE here does not prove H^-1/2 stability"),
+    "H": ("H^-1/2_00(Gamma) verdict: G assembled from the multipliers described on Gamma (gamma, multipliers); "
+          "a G file, where given, is their L2 mass (checked against the description; its verdict is verdict_L2)"),
 }
 
 
 def load_level(manifest: Manifest, level):
-    """Read and check one level: a :class:`~.checks.CheckedLevel` (G scaled by h for ``h-L2``)."""
-    A, B, G = (read_matrix(p) for p in (level.A, level.B, level.G))
+    """Read and check one level: a :class:`~.checks.CheckedLevel` (G scaled by h for ``h-L2``;
+    for ``H`` the Gram of the described multipliers, :func:`.multiplier_gram.described_grams`)."""
+    return _load_level(manifest, level)[0]
+
+
+def _load_level(manifest: Manifest, level):
+    """(checked level, the L² mass of a ``norm: H`` level given as G or None, the H Gram's info)."""
+    A, B = (read_matrix(p) for p in (level.A, level.B))
+    G = None if level.G is None else read_matrix(level.G)
     A = sp.csr_matrix(A) if not sp.issparse(A) else A
     B = sp.csr_matrix(B) if not sp.issparse(B) else B
+    mass, info = None, None
+    if level.multipliers is not None:
+        from .multiplier_gram import described_grams
+
+        level, B, G, mass, info = described_grams(manifest, level, B, G)
     with transposed_b_hint(A, B, G):
         checked = check_level(level, A, B, G, constrained_dofs(level, A.shape[0]), manifest.tgv)
+    if info and info.get("removed_multipliers"):  # constrained rows the description's Gram left out
+        checked.notes[:0] = info["notes"]
+        checked.removed_multipliers += info["removed_multipliers"]
     if manifest.norm == "h-L2":
         checked.G = checked.G * level.h
-    return checked
+    return checked, mass, info
 
 
 def system_rows(manifest: Manifest, route: str = "auto", notes=sys.stderr) -> list:
@@ -48,7 +65,7 @@ def system_rows(manifest: Manifest, route: str = "auto", notes=sys.stderr) -> li
     rows, shapes = [], []
     for level in manifest.levels:
         t0 = time.perf_counter()
-        lv = load_level(manifest, level)
+        lv, mass, info = _load_level(manifest, level)
         shapes.append((lv.A.shape[0] + lv.removed, lv.B.shape[0] + lv.removed_multipliers))
         check_sequence(manifest, shapes)
         t_read = time.perf_counter() - t0
@@ -78,6 +95,14 @@ def system_rows(manifest: Manifest, route: str = "auto", notes=sys.stderr) -> li
             t_read=t_read, t_factorize=res.seconds.get("factorize", np.nan),
             t_eigen=res.seconds.get("eigen", np.nan), t_kernel=res.seconds["kernel"],
             notes="; ".join(lv.notes)))
+        if info is not None:  # described: B's distance to the exact coupling of described traces
+            rows[-1]["coupling_distance"] = info["coupling_distance"]
+        if manifest.norm == "H":  # the Gram's stated error, and the L2 row beside it where G is given
+            rows[-1]["gram_rel_error"] = info["nmax_rel_error"]
+            l2 = (level_spectrum(lv.A, lv.B, mass, manifest.known_kernel, route)
+                  if mass is not None and mass.shape[0] == lv.B.shape[0] else None)
+            rows[-1].update(beta_L2=np.nan if l2 is None else l2.beta,
+                            smallest_nonzero_L2=np.nan if l2 is None else l2.smallest_nonzero)
     return rows
 
 
@@ -96,6 +121,12 @@ def system_verdict(manifest: Manifest, *, tol: float, floor: float, confidence: 
     series = [dict(r, kernel_dim=r["kernel_detected"], case=manifest.name) for r in rows]
     out = stability_verdict(series, tol, floor, confidence)  # a close kernel decision: INCONCLUSIVE
     out["evidence"] = out["evidence"].replace("over N = ", "over 1/h = ").replace("(N = ", "(1/h = ")
+    if manifest.norm == "H" and all(np.isfinite(r["beta_L2"]) for r in rows):  # the given L2 mass, for comparison
+        l2 = stability_verdict([dict(r, beta=r["beta_L2"], smallest_nonzero=r["smallest_nonzero_L2"]) for r in series],
+                               tol, floor, confidence)
+        out.update(verdict_L2=l2["verdict"], beta_min_L2=l2["beta_min"], slope_L2=l2["slope"])
+    if any(np.isfinite(r.get("coupling_distance", np.nan)) for r in rows):
+        out["coupling_distance_max"] = float(np.nanmax([r["coupling_distance"] for r in rows]))
     if out["verdict"] == "UNSTABLE" and out["kernel_dim"] > 0:  # name the kernel nobody declared
         dims = [r["kernel_detected"] for r in rows]
         structural = [r["kernel_structural"] for r in rows]
@@ -127,11 +158,18 @@ def dry_check(manifest: Manifest, route: str = "auto"):
     from .engine import choose_route, touched_dofs
 
     sizes, shapes = [], []
+    extra = 0.0
     for level in manifest.levels:
-        mats = [read_matrix(p) for p in (level.A, level.B, level.G)]
+        mats = [None if p is None else read_matrix(p) for p in (level.A, level.B, level.G)]
         for mat, path in zip(mats, (level.A, level.B, level.G)):
-            check_finite(mat, path)
+            if mat is not None:
+                check_finite(mat, path)
         A, B, G = mats
+        if level.multipliers is not None:  # the description read, its Gram's memory counted (never made here)
+            from .multiplier_gram import check_description
+
+            level, G, bytes_, _ = check_description(manifest, level, B, G)
+            extra = max(extra, bytes_)
         with transposed_b_hint(A, B, G):
             check_shapes(level, A, B, G)
         constrained_dofs(level, A.shape[0])
@@ -140,4 +178,5 @@ def dry_check(manifest: Manifest, route: str = "auto"):
         nt = len(touched_dofs(sp.csr_matrix(B)))
         r = choose_route(A.shape[0], B.shape[0], nt, sp.issparse(G)) if route == "auto" else route
         sizes.append((A.shape[0], B.shape[0], nt, sp.csr_matrix(A).nnz, r))
-    return resources.system_estimate(sizes)
+    est = resources.system_estimate(sizes)
+    return resources.Estimate(est.bytes + extra, est.seconds) if extra else est

@@ -15,7 +15,10 @@ A (n × n) SPD, B (m × n), G (m × m) the multiplier norm. Optional keys:
     what G is: ``given`` (default: the norm the inf-sup condition is stated in, e.g. the
     pressure L² mass of Stokes, or an H^{-1/2} Gram), ``L2`` (the L² mass of *contact*
     multipliers, whose proper norm is H^{-1/2}: the row is the L² verdict, Remark 3.1) or
-    ``h-L2`` (G replaced by h·G, the mesh-dependent norm, with its caveat printed);
+    ``h-L2`` (G replaced by h·G, the mesh-dependent norm, with its caveat printed) or ``H``
+    (the H^{-1/2}_00(Γ) Gram assembled here from a description of the multipliers: the top
+    key ``gamma`` and per level ``multipliers``, :mod:`.multiplier_basis`; G is then
+    optional and, where given, the L² mass of the described basis, checked against it);
 ``known_kernel``
     dimension of a kernel of Bᵀ the producer knows of (the constant pressure of an enclosed
     Stokes flow: 1); β_h is reported on its complement, and a larger kernel is UNSTABLE;
@@ -30,7 +33,12 @@ A (n × n) SPD, B (m × n), G (m × m) the multiplier norm. Optional keys:
     without ``--expect`` and of the pre-commit hook follows it);
 per level, ``constrained``
     the 0-based dofs the producer fixed but left in A (identity or penalty rows): a list,
-    or a file (``.txt``: whitespace-separated integers, ``.npy``); they are removed.
+    or a file (``.txt``: whitespace-separated integers, ``.npy``); they are removed;
+per level, ``multipliers`` (required with ``norm: H``) and ``traces``, with the top key ``gamma``
+    the description of B's rows on Γ (:mod:`.multiplier_basis`) and of the bodies' trace bases
+    (:mod:`.mortar_distance`). With ``norm: H`` G is optional and the Gram is assembled from the
+    description; with ``L2`` or ``h-L2`` G (the L² mass) is checked against it; with ``given``
+    G is taken as it is. ``traces`` add B's distance to the exact coupling to the row.
 """
 from __future__ import annotations
 
@@ -45,10 +53,10 @@ from ..io import TableError, read_integer_list
 
 from .readers import SystemFileError
 
-NORMS = ("given", "L2", "h-L2")
+NORMS = ("given", "L2", "h-L2", "H")
 TGV_POLICIES = ("eliminate", "refuse")
-LEVEL_KEYS = ("h", "A", "B", "G", "constrained")
-TOP_KEYS = ("levels", "name", "norm", "known_kernel", "tgv", "expect", "entry_rtol")
+LEVEL_KEYS = ("h", "A", "B", "G", "constrained", "multipliers", "traces")
+TOP_KEYS = ("levels", "name", "norm", "known_kernel", "tgv", "expect", "entry_rtol", "gamma")
 EXPECTS = ("stable", "unstable")
 MANIFEST_MAX_BYTES = 1 << 20
 """Largest manifest read (a manifest of 1,000 levels is ~60 kB)."""
@@ -58,14 +66,17 @@ MIN_LEVELS = 3
 
 @dataclass(frozen=True)
 class Level:
-    """One mesh level: its size and its three files (absolute paths)."""
+    """One mesh level: its size and its three files (absolute paths; G None when ``norm: H``
+    leaves it out)."""
 
     index: int
     h: float
     A: Path
     B: Path
-    G: Path
+    G: Path | None
     constrained: object = None  # None, a list of ints, or a Path
+    multipliers: object = None  # with norm H: the description (a mapping) or its file (a str)
+    traces: object = None  # with norm H, optional: the bodies' trace bases (mortar_distance)
 
 
 @dataclass(frozen=True)
@@ -80,6 +91,7 @@ class Manifest:
     levels: tuple
     expect: str | None = None
     entry_rtol: float | None = None
+    gamma: object = None  # with norm H: a multiplier_basis.Gamma
 
 
 def load_manifest(path, min_levels: int = MIN_LEVELS) -> Manifest:
@@ -128,13 +140,33 @@ def load_manifest(path, min_levels: int = MIN_LEVELS) -> Manifest:
     if expect is not None and expect not in EXPECTS:
         raise SystemFileError(path, f"expect: {expect!r} is not one of {', '.join(EXPECTS)}")
     entry_rtol = _entry_rtol(path, data.get("entry_rtol"))
-    parsed = tuple(_level(path, i, entry) for i, entry in enumerate(levels))
+    parsed = tuple(_level(path, i, entry, norm) for i, entry in enumerate(levels))
+    gamma = _gamma(path, data, norm, parsed)
     hs = [lv.h for lv in parsed]
     for i in range(1, len(hs)):
         if not hs[i] < hs[i - 1]:
             raise SystemFileError(path, f"levels[{i}].h = {hs[i]:g} does not decrease (levels[{i - 1}].h = "
                                   f"{hs[i - 1]:g}): list the levels coarse to fine, each h once")
-    return Manifest(path, str(name), norm, known, tgv, parsed, expect=expect, entry_rtol=entry_rtol)
+    return Manifest(path, str(name), norm, known, tgv, parsed, expect=expect, entry_rtol=entry_rtol,
+                    gamma=gamma)
+
+
+def _gamma(path, data, norm: str, levels):
+    """The top key ``gamma``: required with norm H, and wherever a level describes its multipliers
+    (with norm L2 or h-L2 they check G, the L² mass, and give the traces' distance); refused
+    where nothing is described (it would be read for nothing)."""
+    from .multiplier_basis import parse_gamma
+
+    described = [lv.index for lv in levels if lv.multipliers is not None]
+    if "gamma" not in data:
+        if norm == "H" or described:
+            raise SystemFileError(path, "norm: H and a level's 'multipliers' need the key 'gamma' ({shape: segment, "
+                                  "length: L} or {shape: rectangle, size: [a, b]})")
+        return None
+    if not described:
+        raise SystemFileError(path, "gamma: no level describes its multipliers (levels[i].multipliers), so Γ "
+                              "has no use here")
+    return parse_gamma(path, data["gamma"])
 
 
 def _entry_rtol(path, value):
@@ -161,21 +193,35 @@ def _one_line(path, key: str, text: str) -> None:
                                   "a name or file name is one line of printable text")
 
 
-def _level(path: Path, i: int, entry) -> Level:
+def _level(path: Path, i: int, entry, norm: str = "given") -> Level:
     where = f"levels[{i}]"
     if not isinstance(entry, dict):
         raise SystemFileError(path, f"{where}: expected a mapping {{h, A, B, G}} (found {entry!r:.60})")
     unknown = sorted(set(map(str, entry)) - set(LEVEL_KEYS))
     if unknown:
         raise SystemFileError(path, f"{where}: unknown key {unknown[0]!r} (allowed: {', '.join(LEVEL_KEYS)})")
-    missing = [k for k in ("h", "A", "B", "G") if k not in entry]
+    needed = ("h", "A", "B", "multipliers") if norm == "H" else ("h", "A", "B", "G")
+    missing = [k for k in needed if k not in entry]
     if missing:
-        raise SystemFileError(path, f"{where}: missing key {missing[0]!r} (each level needs h, A, B, G)")
+        raise SystemFileError(path, f"{where}: missing key {missing[0]!r} (each level needs {', '.join(needed)}"
+                              + (")" if norm != "H" else "; G optional: the L2 mass)"))
+    if "traces" in entry and "multipliers" not in entry:
+        raise SystemFileError(path, f"{where}.traces: only with {where}.multipliers (the coupling is measured "
+                              "against the described multipliers)")
+    mult = entry.get("multipliers")
+    if isinstance(mult, str):
+        _one_line(path, f"{where}.multipliers", mult)
+    elif mult is not None and not isinstance(mult, dict):
+        raise SystemFileError(path, f"{where}.multipliers: expected a mapping or a .yaml file name "
+                              f"(found {mult!r:.60})")
     h = entry["h"]
     if isinstance(h, bool) or not isinstance(h, (int, float)) or not math.isfinite(h) or h <= 0:
         raise SystemFileError(path, f"{where}.h: expected a finite number > 0 (found {h!r})")
     files = {}
     for key in ("A", "B", "G"):
+        if key == "G" and "G" not in entry:
+            files[key] = None
+            continue
         if not isinstance(entry[key], str) or not entry[key]:
             raise SystemFileError(path, f"{where}.{key}: expected a file name (found {entry[key]!r})")
         _one_line(path, f"{where}.{key}", entry[key])
@@ -187,7 +233,7 @@ def _level(path: Path, i: int, entry) -> Level:
     elif con is not None:
         if not isinstance(con, list) or any(isinstance(c, bool) or not isinstance(c, int) or c < 0 for c in con):
             raise SystemFileError(path, f"{where}.constrained: expected a file or a list of integers >= 0")
-    return Level(i, float(h), files["A"], files["B"], files["G"], con)
+    return Level(i, float(h), files["A"], files["B"], files["G"], con, mult, entry.get("traces"))
 
 
 def constrained_dofs(level: Level, n: int) -> np.ndarray:

@@ -258,6 +258,23 @@ def tables(tmp_path_factory):
     return paths
 
 
+def _tiny_manifest(folder):
+    """levels.yaml of three levels (A = 2I, B = [I 0], G = I; n = 2m): valid, never computed here."""
+    import scipy.io
+    import scipy.sparse as sp
+
+    folder.mkdir(exist_ok=True)
+    lines = ["levels:"]
+    for i, m in enumerate((2, 4, 8)):
+        mats = {"A": 2 * sp.identity(2 * m), "B": sp.hstack([sp.identity(m), sp.csr_matrix((m, m))]),
+                "G": sp.identity(m)}
+        for key, mat in mats.items():
+            scipy.io.mmwrite(folder / f"{key}{i}.mtx", sp.coo_matrix(mat))
+        lines.append(f"  - {{h: {1 / m}, A: A{i}.mtx, B: B{i}.mtx, G: G{i}.mtx}}")
+    (folder / "levels.yaml").write_text("\n".join(lines) + "\n")
+    return folder / "levels.yaml"
+
+
 def base_commands(tables):
     return {
         "beta": ["beta", "--k", "1", "--N1", "4", "--N2", "4"],
@@ -267,6 +284,9 @@ def base_commands(tables):
         "verdict": ["verdict", "--case", "T3", "--k", "1"],
         "export": ["export", "--case", "T3", "--k", "1", "--N", "4", "--out", str(tables["good"].parent / "export")],
         "provenance": ["provenance"],
+        # a valid manifest of three tiny levels (--dry-run checks it; the manifests' own faults:
+        # tests/test_systems_*.py, tests/test_gate_action.py)
+        "verdict-hook": ["verdict-hook", str(_tiny_manifest(tables["good"].parent / "hook"))],
     }
 
 

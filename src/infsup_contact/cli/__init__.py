@@ -89,9 +89,11 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def flag_names(parser: argparse.ArgumentParser, command: str) -> dict:
-    """dest → the flag as typed (``n_ref`` → ``--n-ref``) for the options of ``command``."""
+    """dest → the flag as typed (``n_ref`` → ``--n-ref``) for the options of ``command``, and
+    dest → dest for its positionals (``verdict-hook``'s ``manifests``)."""
     sub = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction)).choices[command]
-    return {a.dest: max(a.option_strings, key=len) for a in sub._actions if a.option_strings}
+    return {a.dest: max(a.option_strings, key=len) if a.option_strings else a.dest for a in sub._actions
+            if a.option_strings or a.dest != argparse.SUPPRESS}
 
 
 def _message(err: Exception, parser, command: str) -> str:

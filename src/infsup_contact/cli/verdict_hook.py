@@ -14,7 +14,7 @@ import sys
 
 from ..errors import InputError
 from ..io import TableError
-from .common import write_text
+from .common import declare_flag_uses, write_text
 from .verdict import VERDICT_DEFAULTS
 
 DEFAULT_EXPECT = "stable"
@@ -31,7 +31,33 @@ def add(sub) -> None:
     for key in ("slope_tolerance", "beta_floor", "confidence"):
         p.add_argument("--" + key.replace("_", "-"), dest=key, type=float, default=VERDICT_DEFAULTS[key],
                        help=f"as verdict's (default {VERDICT_DEFAULTS[key]:g})")
-    p.set_defaults(run=run_hook)
+    p.add_argument("--dry-run", action="store_true",
+                   help="check each manifest (files, shapes, memory) as verdict --system --dry-run does, "
+                   "without computing a verdict")
+    declare_flag_uses(p, [])  # every flag applies to every manifest: none conditional
+    p.set_defaults(run=run_hook, check=check_hook)
+
+
+def check_hook(args):
+    """The criterion, once; with ``--dry-run`` also every manifest as ``verdict --system
+    --dry-run`` checks it (the first refused one is the error), and the largest estimate."""
+    from ..study.verdict import check_criterion
+
+    check_criterion(args.slope_tolerance, args.beta_floor, args.confidence)
+    if not args.dry_run:
+        return None  # a real run checks each manifest itself and goes on after a refused one
+    from . import build_parser, check, parse
+
+    from ..systems.readers import SystemFileError
+
+    estimates = []
+    for path in args.manifests:
+        try:
+            estimates.append(check(parse(build_parser(), ["verdict", f"--system={path}"])))
+        except SystemFileError as err:
+            err.key = "manifests"  # the positional that named the file, as verdict names --system
+            raise
+    return max(estimates, key=lambda e: e.bytes)
 
 
 def check_one(path: str, criterion: dict) -> tuple[int, str]:
@@ -58,10 +84,7 @@ def check_one(path: str, criterion: dict) -> tuple[int, str]:
 
 
 def run_hook(args) -> int:
-    from ..study.verdict import check_criterion
-
     criterion = {k: getattr(args, k) for k in ("slope_tolerance", "beta_floor", "confidence")}
-    check_criterion(*criterion.values())  # once, not once per manifest
     worst = 0
     for path in args.manifests:
         code, line = check_one(path, criterion)

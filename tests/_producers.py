@@ -99,12 +99,21 @@ def described_space(desc: dict):
     return space, rows
 
 
-def mass_mismatch(G, desc) -> float:
-    """max |G[rows, rows] − L² mass of the described basis| / max |G|."""
+def mass_mismatch(G, desc, constrained=()) -> float:
+    """max |G[rows, rows] − L² mass of the described basis| / max |G|, over the described
+    functions whose row of B is not in ``constrained`` (a dirichletbc's unit rows of G)."""
     space, rows = described_space(desc)
     M = gram_l2(space)
-    Gd = G.toarray()[np.ix_(rows, rows)]
-    return float(np.abs(Gd - M).max() / np.abs(G).max())
+    j = np.flatnonzero(~np.isin(rows, np.asarray(constrained, int)))
+    Gd = G.toarray()[np.ix_(rows[j], rows[j])]
+    return float(np.abs(Gd - M[np.ix_(j, j)]).max() / np.abs(G).max())
+
+
+def constrained_rows(B, G) -> np.ndarray:
+    """Rows of a dirichletbc on the multipliers: B's row zero, G's row a unit row."""
+    Bd, Gd = B.toarray(), G.toarray()
+    return np.array([r for r in range(Bd.shape[0]) if not Bd[r].any() and Gd[r, r] == 1.0
+                     and np.count_nonzero(Gd[r]) == 1], int)
 
 
 def trace_space(coords: np.ndarray, cols: np.ndarray, k: int):

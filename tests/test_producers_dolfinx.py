@@ -69,20 +69,23 @@ def test_A_spd_G_mass_B_exact(export, space):
     for i, n in enumerate(NS):
         lv, A, B, G = P.read_level(manifest, i)
         P.check_spd(A)
-        assert P.mass_mismatch(G, lv["multipliers"]) <= P.ROUNDOFF
+        constrained = P.constrained_rows(B, G)  # the dirichletbc's rows: zero in B, unit in G
+        assert len(constrained) == (2 if space.startswith("T3") else 0)
+        assert P.mass_mismatch(G, lv["multipliers"], constrained) <= P.ROUNDOFF
         coords, n1 = P.body_coordinates(PYTHON, SCRIPT, n, space, ns=NS)
         exact, on_gamma = P.exact_coupling(lv["multipliers"], coords, n1, SPACES[space])
         _, rows = P.described_space(lv["multipliers"])
+        assert sorted(rows) == list(range(B.shape[0]))  # the whole space described, ends included
+        rows = rows[~np.isin(rows, constrained)]
         Bd = B.toarray()
         ends = on_gamma & (np.isclose(coords[:, 0], 0.0) | np.isclose(coords[:, 0], 1.0))
         assert np.all(Bd[:, ~on_gamma | ends] == 0)
         inner = on_gamma & ~ends
         assert np.abs(Bd[np.ix_(rows, inner)] - exact[np.ix_(rows, inner)]).max() <= P.ROUNDOFF * np.abs(exact).max()
-        constrained = np.setdiff1d(np.arange(B.shape[0]), rows)
-        assert len(constrained) == (2 if space.startswith("T3") else 0)
-        Gd = G.toarray()
-        for r in constrained:  # dirichletbc on the multipliers: zero row of B, unit row of G
-            assert np.all(Bd[r] == 0) and Gd[r, r] == 1.0 and np.count_nonzero(Gd[r]) == 1
+        if space.startswith("T3"):  # the constrained rows are the functions at Γ's two ends
+            space_, all_rows = P.described_space(lv["multipliers"])
+            ends_at = space_.nodes()[np.isin(all_rows, constrained)]
+            assert np.allclose(np.sort(ends_at), [0.0, 1.0])
 
 
 @pytest.mark.parametrize("space", ["T3-k2", "R5.4-k1", "T5-k2"])
@@ -94,13 +97,14 @@ def test_B_on_a_polynomial_trace(export, space):
     coords, n1 = P.body_coordinates(PYTHON, SCRIPT, NS[1], space, ns=NS)
     v = np.where(np.arange(len(coords)) < n1, coords[:, 0] * (1 - coords[:, 0]) * coords[:, 1], 0.0)
     exact, _ = P.exact_coupling(lv["multipliers"], coords, n1, k)
-    _, rows = P.described_space(lv["multipliers"])
+    space_, rows = P.described_space(lv["multipliers"])
+    free = ~np.isin(rows, P.constrained_rows(B, G))  # the dirichletbc zeroed the others' rows of B
+    rows = rows[free]
     Bv, want = B @ v, exact @ v
     assert np.abs(Bv[rows] - want[rows]).max() <= P.ROUNDOFF * np.abs(B).sum(axis=1).max() * np.abs(v).max()
     if k == 2:  # the trace is x(1 - x) itself: ∫ x(1 − x) μ by Gauss on the multipliers' partition
-        space_, rows = P.described_space(lv["multipliers"])
         x, w = P.gauss_on_union(space_.breakpoints)
-        direct = -(space_.evaluate(x) * (w * x * (1 - x))[:, None]).sum(axis=0)
+        direct = -(space_.evaluate(x) * (w * x * (1 - x))[:, None]).sum(axis=0)[free]
         assert np.abs(Bv[rows] - direct).max() <= P.ROUNDOFF * np.abs(direct).max()
 
 
@@ -140,36 +144,24 @@ def test_T3_without_its_constrained_rows_matches_beta_case(export, tmp_path):
         assert row["kernel_dim"] == "0"
 
 
-def _h_norm_read() -> bool:
-    from infsup_contact.systems.manifest import NORMS
-
-    return "H" in NORMS
-
-
 @pytest.mark.parametrize("space", SPACES)
 def test_manifest_dry_run(export, space):
-    """The L² and h-L² copies validate; the ``norm: H`` manifest itself once the certifier
-    reads it (skipped until then; T3 below)."""
+    """The L² and h-L² copies validate, and the ``norm: H`` manifest itself (T3's rows the
+    dirichletbc constrained included)."""
     for norm in ("L2", "h-L2"):
         code, _, err = P.verdict_row(P.strip_manifest(export(space), norm), "--dry-run")
         assert code == 0, err
-    if not _h_norm_read():
-        pytest.skip("norm: H is not read by this certifier yet (branch h-norm-h)")
-    if space.startswith("T3"):
-        pytest.skip("T3's constrained rows under norm: H: test_T3_norm_H")
     code, _, err = P.verdict_row(export(space), "--dry-run")
     assert code == 0, err
 
 
-@pytest.mark.xfail(strict=True, reason="norm: H compares the description (m - 2 functions, `rows` naming B's "
-                   "non-constrained rows) with B's m rows before the constrained rows (zero in B, unit in G) are "
-                   "removed: the certifier refuses DOLFINx's T3")
-def test_T3_norm_H(export):
+def test_T3_norm_H(tmp_path):
     """T3 with DOLFINx's dirichletbc on the multipliers is Thm 3's space: STABLE in H^{-1/2}_00
-    once the two constrained end rows are set aside (as the h-L² copy's are)."""
-    if not _h_norm_read():
-        pytest.skip("norm: H is not read by this certifier yet (branch h-norm-h)")
-    code, row, err = P.verdict_row(export("T3-k2"))
+    once the two constrained end rows are set aside (as the h-L² copy's are): the manifest
+    describes DOLFINx's whole P_2 space, the certifier removes the two rows its dirichletbc
+    constrained."""
+    manifest = P.run_export(PYTHON, SCRIPT, tmp_path, "T3-k2", (8, 16, 32))  # N = 4: pre-asymptotic
+    code, row, err = P.verdict_row(manifest)
     assert row is not None and row["verdict"] == "STABLE", err
 
 
@@ -180,8 +172,6 @@ def test_verdicts(tmp_path, space, verdict, norm):
     """R5.2 has a kernel (dim M − dim of the Γ traces > 0: UNSTABLE in any norm); T4 and T5 are
     H^{-1/2}-stable (Thms 4, 5), hence stable in the weaker h-L² norm too. On N = 8, 16, 32:
     T5's h-L² β rises 0.412 → 0.433 from N = 4 to 8 (pre-asymptotic: INCONCLUSIVE on 4, 8, 16)."""
-    if norm == "H" and not _h_norm_read():
-        pytest.skip("norm: H is not read by this certifier yet (branch h-norm-h)")
     manifest = P.run_export(PYTHON, SCRIPT, tmp_path, space, (8, 16, 32))
     code, row, err = P.verdict_row(manifest if norm == "H" else P.strip_manifest(manifest, norm))
     assert row is not None, err
@@ -192,7 +182,5 @@ def test_verdicts(tmp_path, space, verdict, norm):
 def test_certifier_coupling_distance(export, space):
     """With the manifest's ``traces`` the certifier measures B's distance to the exact mortar
     coupling itself: round-off here (matching meshes, FFCx's quadrature exact)."""
-    if not _h_norm_read():
-        pytest.skip("norm: H (and traces) not read by this certifier yet (branch h-norm-h)")
     for row in P.beta_rows(export(space)):
         assert float(row["coupling_distance"]) <= 10 * P.ROUNDOFF

@@ -193,14 +193,8 @@ def test_verdicts_ends_kept_never_stable(exports, space):
 
 @pytest.mark.parametrize("space", SPACES)
 def test_norm_H_manifest(exports, space):
-    """The manifest as written (norm: H): accepted and certified once the certifier reads the
-    multiplier description (STABLE for the ends-fixed space, never STABLE with the ends kept)."""
-    try:
-        manifest = load_manifest(exports[space, 0])
-    except SystemFileError as err:
-        if "gamma" in str(err) or "norm" in str(err):
-            pytest.skip(f"norm: H not accepted by this certifier yet ({err})")
-        raise
+    """The manifest as written (norm: H): accepted and certified from the multiplier description (STABLE for the ends-fixed space, never STABLE with the ends kept)."""
+    manifest = load_manifest(exports[space, 0])
     out, _ = system_verdict(manifest, **CRITERION, notes=io.StringIO())
     if space == "dual-ends-fixed":
         assert out["verdict"] == "STABLE", out["evidence"]

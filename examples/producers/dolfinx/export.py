@@ -164,14 +164,15 @@ def assemble_level(n: int, space: str) -> dict:
     constrained_rows = np.sort(bcq[0].dof_indices()[0]) if bcq else np.zeros(0, int)
     coords = np.vstack([V1.tabulate_dof_coordinates(), V2.tabulate_dof_coordinates()])
     return {"A": A, "B": B, "G": G, "coords": coords, "n1": K1.shape[0],
-            "multipliers": describe_multipliers(Q, family, s, ends_bc, constrained_rows)}
+            "multipliers": describe_multipliers(Q, family, s)}
 
 
-def describe_multipliers(Q, family: str, s: int, ends_bc: bool, constrained_rows) -> dict:
+def describe_multipliers(Q, family: str, s: int) -> dict:
     """The ``norm: H`` description of Q's basis (normH spec): the helper form, the breakpoints
     being Γ's vertices as DOLFINx placed them, ``rows`` DOLFINx's dof numbers left to right.
-    The T3 end dofs are not basis functions of the space (``ends: drop``): their rows of B are
-    zero and their rows of G unit rows, as DOLFINx's dirichletbc leaves them."""
+    Q is the whole P_s space (``ends: keep``), as in DOLFINx: the T3 condition μ = 0 at Γ's ends
+    is a dirichletbc on Q, which leaves the end dofs' rows of B zero and of G unit rows; the
+    certifier's constrained-row rule removes them (``removed_multipliers``, with a note)."""
     gamma = Q.mesh
     x = gamma.geometry.x[:, 0]
     breakpoints = np.unique(np.round(x, 15))
@@ -183,9 +184,8 @@ def describe_multipliers(Q, family: str, s: int, ends_bc: bool, constrained_rows
         rows = [int(d) for c in np.argsort(mid) for d in sorted(cell_dofs[c], key=lambda d: dof_x[d])]
         return {"basis": "discontinuous", "degree": s, "breakpoints": breakpoints.tolist(), "rows": rows}
     order = np.argsort(dof_x, kind="stable")
-    rows = [int(d) for d in order if d not in set(constrained_rows.tolist())]
-    return {"basis": "lagrange", "degree": s, "breakpoints": breakpoints.tolist(),
-            "ends": "drop" if ends_bc else "keep", "rows": rows}
+    rows = [int(d) for d in order]
+    return {"basis": "lagrange", "degree": s, "breakpoints": breakpoints.tolist(), "ends": "keep", "rows": rows}
 
 
 def describe_traces(coords: np.ndarray, n1: int, k: int) -> list:

@@ -200,6 +200,8 @@ def constrained_multipliers(level, B, G, tgv: str) -> tuple:
     Gs = sp.csr_matrix(G)
     Gs.eliminate_zeros()
     gdiag = Gs.diagonal()
+    B = sp.csr_matrix(B, copy=True)
+    B.eliminate_zeros()  # a stored 0.0 is a zero (DOLFINx keeps the pattern of the rows its bc zeroed)
     zero_b = np.diff(B.indptr) == 0
     notes, remove = [], [np.zeros(0, int)]
     pen, med = _penalty_rows(gdiag)

@@ -74,11 +74,13 @@ def test_a_declared_kernel_is_discounted(tmp_path):
     assert all(r["known_kernel"] == 1 and r["kernel_dim"] == 1 and r["beta"] > 0.7 for r in rows)
 
 
-def test_a_nearly_repeated_row_is_inconclusive_not_stable(tmp_path):
+def test_a_nearly_repeated_row_is_unstable_either_way_never_stable(tmp_path):
     """Two rows of B equal but for 1e-14: the kernel decision is within a decade of round-off on
     a level (1e-14 x the row's max is a producer zero, so η holds that round-off and the pair
-    is a kernel up to it: close on the coarse levels), so the verdict is INCONCLUSIVE (never
-    STABLE), the margins named."""
+    is a kernel up to it: close on the coarse levels). The mode in question has β ~ 1e-14: as a
+    kernel it is UNSTABLE, as a non-zero mode it is below the β floor, UNSTABLE too — so the
+    verdict is UNSTABLE, saying so. With a floor below that β the two readings differ and the
+    verdict is INCONCLUSIVE, the margins and the advice named. Never STABLE."""
     levels = []
     for N in NS:
         h, A, B, G = _level(N, "ok")
@@ -88,9 +90,14 @@ def test_a_nearly_repeated_row_is_inconclusive_not_stable(tmp_path):
         levels.append((h, A, B.tocsr(), G))
     path = write_system(tmp_path, levels, "npz", "near")
     out, rows = system_verdict(load_manifest(path), **CRITERION, notes=io.StringIO())
-    assert out["verdict"] == "INCONCLUSIVE" and any(r["kernel_decision"] == "close" for r in rows)
-    assert all(r["kernel_decision"] == "close" or r["kernel_dim"] == 1 for r in rows)
-    assert "margins" in out["evidence"] and "entry_rtol" in out["evidence"]
+    close = [r for r in rows if r["kernel_decision"] == "close"]
+    assert close and all(r["kernel_decision"] == "close" or r["kernel_dim"] == 1 for r in rows)
+    assert all(r["beta_uncertain"] < CRITERION["floor"] for r in close)
+    assert out["verdict"] == "UNSTABLE" and "whichever way it is counted" in out["evidence"]
+    below = min(r["beta_uncertain"] for r in close) / 10.0
+    if below > 0.0:  # a floor under the mode's β: the count decides, and it is not decided
+        out, _ = system_verdict(load_manifest(path), **dict(CRITERION, floor=below), notes=io.StringIO())
+        assert out["verdict"] == "INCONCLUSIVE" and "margins" in out["evidence"] and "entry_rtol" in out["evidence"]
     assert main(["verdict", "--system", str(path), "--expect", "stable"]) == 1
 
 

@@ -115,4 +115,11 @@ def test_a_close_kernel_decision_is_inconclusive(tmp_path):
     margins = [r["kernel_margin_decades"] for r in rows]
     if all(r["kernel_decision"] == "clear" for r in rows):
         pytest.fail(f"the constructed near-dependence was decided clearly: margins {margins}")
+    # the nearly dependent mode has β ~ 2η: UNSTABLE counted either way (said so); under a floor
+    # below it the count decides the verdict, and it is open: INCONCLUSIVE
+    close = [r for r in rows if r["kernel_decision"] == "close"]
+    assert all(r["beta_uncertain"] < CRITERION["floor"] for r in close)
+    assert out["verdict"] == "UNSTABLE" and "whichever way it is counted" in out["evidence"], out["evidence"]
+    floor = min(r["beta_uncertain"] for r in close) / 10.0
+    out, rows = system_verdict(manifest, **dict(CRITERION, floor=floor), notes=io.StringIO())
     assert out["verdict"] == "INCONCLUSIVE", out["evidence"]

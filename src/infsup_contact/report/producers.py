@@ -71,7 +71,7 @@ copies with the norm changed; by Remark~3.1 a stable space is UNSTABLE in $L^2$.
                 rf"\label{{tab:producer-{latex_id(name)}}}", r"\end{table}", ""]
         mine = claims[claims.claim_id.str.startswith(f"producer-{name}-")]
         if len(mine):
-            out += ["Its claims (predicted before the stage first ran): "
+            out += ["Its claims (predicted from the theorems and remarks of Sections 4--5 and the code's documented space, config/config.yaml): "
                     + "; ".join(rf"\texttt{{{latex_id(c.space_id)}}} {latex_id(c.verdict)}"
                                 for c in mine.assign(space_id=mine.claim_id.str[len(f"producer-{name}-"):]).itertuples())
                     + ".", ""]

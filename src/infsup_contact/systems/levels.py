@@ -15,6 +15,7 @@ import time
 import numpy as np
 import scipy.sparse as sp
 
+from ..solvers.kernel import MARGIN_DECADES
 from ..study.verdict import stability_verdict
 from .checks import check_level, check_sequence
 from .engine import close_advice, level_spectrum
@@ -90,7 +91,7 @@ def system_rows(manifest: Manifest, route: str = "auto", notes=sys.stderr) -> li
             beta=res.beta, kernel_dim=k.dim, known_kernel=k.proven, kernel_detected=k.detected,
             kernel_margin_decades=k.margin_decades, kernel_decision=k.decision, kernel_tol=k.tol,
             entry_rtol_used=res.roundoff.rtol, entry_rtol_source=res.roundoff.source,
-            pencil_margin_decades=res.pencil_margin, kernel_advice=advice,
+            pencil_margin_decades=res.pencil_margin, kernel_advice=advice, beta_uncertain=uncertain_beta(res),
             smallest_nonzero=res.smallest_nonzero, route=res.route, residual=res.residual,
             t_read=t_read, t_factorize=res.seconds.get("factorize", np.nan),
             t_eigen=res.seconds.get("eigen", np.nan), t_kernel=res.seconds["kernel"],
@@ -106,6 +107,33 @@ def system_rows(manifest: Manifest, route: str = "auto", notes=sys.stderr) -> li
     return rows
 
 
+def uncertain_beta(res) -> float:
+    """√λ of the pencil mode whose count a ``close`` kernel decision leaves open — the last mode
+    counted zero (the zero side) or the first counted non-zero (the other side; both if both are
+    close) — the largest of them; NaN where it was not computed (the shift-invert route sets
+    the kernel's eigenvalues to 0 without computing them) or where the open count is that of
+    the declared kernel.
+
+    If it is below the verdict's β floor, the decision cannot change the verdict: counted as
+    kernel the level is UNSTABLE (an undeclared kernel), counted non-zero its β_h is that
+    value, below the floor, and the series is UNSTABLE by the floor (:func:`system_verdict`)."""
+    k = res.kernel
+    if k.decision != "close" or res.route == "shift-invert":
+        return np.nan
+    d, s, ev = k.dim, np.asarray(k.singular, float), np.asarray(res.bottom, float)
+    margin = 10.0 ** MARGIN_DECADES
+    sides = []
+    if d >= 1 and (s[d - 1] <= 0 or k.tol / s[d - 1] < margin):
+        sides.append(d - 1)
+    if d < len(s) - 1 and (s[d] / k.tol < margin or res.pencil_margin < MARGIN_DECADES):
+        sides.append(d)
+    if not sides:  # the decision's own margin did not say which: both neighbours of the count
+        sides = [i for i in (d - 1, d) if 0 <= i]
+    if min(sides) < k.proven or max(sides) >= len(ev):
+        return np.nan
+    return float(max(np.sqrt(max(ev[i], 0.0)) for i in sides))
+
+
 def system_verdict(manifest: Manifest, *, tol: float, floor: float, confidence: float, route: str = "auto",
                    notes=None) -> tuple:
     """(verdict row, level rows). The criterion of ``verdict --case``
@@ -118,7 +146,9 @@ def system_verdict(manifest: Manifest, *, tol: float, floor: float, confidence: 
     t0 = time.perf_counter()
     notes = sys.stderr if notes is None else notes  # the stream of now (a default would bind import time's)
     rows = system_rows(manifest, route, notes)
-    series = [dict(r, kernel_dim=r["kernel_detected"], case=manifest.name) for r in rows]
+    immaterial = [r for r in rows if r["kernel_decision"] == "close" and r["beta_uncertain"] < floor]
+    series = [dict(r, kernel_dim=r["kernel_detected"], case=manifest.name,
+                   kernel_decision="clear" if r in immaterial else r["kernel_decision"]) for r in rows]
     out = stability_verdict(series, tol, floor, confidence)  # a close kernel decision: INCONCLUSIVE
     out["evidence"] = out["evidence"].replace("over N = ", "over 1/h = ").replace("(N = ", "(1/h = ")
     if manifest.norm == "H" and all(np.isfinite(r["beta_L2"]) for r in rows):  # the given L2 mass, for comparison
@@ -137,7 +167,11 @@ def system_verdict(manifest: Manifest, *, tol: float, floor: float, confidence: 
                               if any(structural) else "")
                            + "; slope of the eigenvalue above the kernel; declare the kernel with known_kernel "
                            "if it is meant (e.g. a constant pressure)")
-    close = [r for r in rows if r["kernel_decision"] == "close"]
+    if immaterial:
+        out["evidence"] += "; " + "; ".join(
+            f"levels[{r['level']}]: kernel decision close, but the mode in question has beta {r['beta_uncertain']:.2g} "
+            f"<= floor {floor:g}: UNSTABLE whichever way it is counted" for r in immaterial)
+    close = [r for r in rows if r["kernel_decision"] == "close" and r not in immaterial]
     if out["verdict"] == "INCONCLUSIVE" and close:
         out["evidence"] += f"; levels[{close[0]['level']}]: {close[0]['kernel_advice']}"
     head = dict(system=manifest.name, norm=manifest.norm, known_kernel=manifest.known_kernel)

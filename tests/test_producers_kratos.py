@@ -215,5 +215,5 @@ def test_list_spaces_and_bad_arguments(tmp_path):
                               capture_output=True, text=True)
         assert done.returncode == 2 and done.stdout == "" and len(done.stderr.strip().splitlines()) == 1, args
     done = _export(tmp_path / "full", "dual", 0)
-    assert done.returncode == 2 and "not a new or empty directory" in done.stderr
+    assert done.returncode == 2 and "holds a system already" in done.stderr
     assert not (tmp_path / "new").exists()

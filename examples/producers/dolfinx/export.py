@@ -24,21 +24,20 @@ supermesh of two unrelated meshes' Γ, so ``--offset K`` with K ≠ 0 is refused
 """
 from __future__ import annotations
 
-import argparse
-import os
 import sys
 from pathlib import Path
 
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # examples/producers: the contract
+
 import dolfinx_solver  # noqa: F401  (must come first: loads mpi4py's libmpi before DOLFINx's bindings)
 import numpy as np
-import scipy.io
 import scipy.sparse as sp
 import ufl
-import yaml
 from dolfinx import __version__ as DOLFINX_VERSION
 from dolfinx import fem, mesh
 from dolfinx.cpp.fem import compute_integration_domains
 from mpi4py import MPI
+from contract import describe_traces, level_entry, run, write_manifest  # noqa: E402
 
 # id: (body degree k, multiplier family, multiplier degree s, μ = 0 at Γ's ends, description)
 SPACES = {
@@ -51,47 +50,7 @@ SPACES = {
     "R5.4-k2": (2, "DG", 1, False, "Rem 5.4, k = 2: P2 bodies, discontinuous P1 multipliers"),
     "T5-k2": (2, "Lagrange", 1, False, "Thm 5, k = 2: P2 bodies, continuous P1 multipliers"),
 }
-N_MAX = 512
-"""Largest N accepted (N = 512 at k = 2 is 2.1 million body dofs; larger is a typo)."""
 GAMMA_TAG = 1
-
-
-class ArgumentError(Exception):
-    """A bad command line: one line on stderr, exit 2."""
-
-
-class _Parser(argparse.ArgumentParser):
-    def error(self, message):
-        raise ArgumentError(message)
-
-
-def parse_args(argv):
-    """The contract's command line; :class:`ArgumentError` for anything else."""
-    p = _Parser(prog="export.py", add_help=True)
-    p.add_argument("--out", type=Path)
-    p.add_argument("--space")
-    p.add_argument("--N", type=int, nargs="+")
-    p.add_argument("--offset", type=int, default=0)
-    p.add_argument("--list-spaces", action="store_true")
-    args = p.parse_args(argv)
-    if args.list_spaces:
-        return args
-    for key in ("out", "space", "N"):
-        if getattr(args, key) is None:
-            raise ArgumentError(f"--{key} is required (or --list-spaces)")
-    if args.space not in SPACES:
-        raise ArgumentError(f"--space {args.space!r} is not one of {', '.join(SPACES)}")
-    if args.offset != 0:
-        raise ArgumentError(f"--offset {args.offset}: DOLFINx assembles a form over one mesh and its submeshes; "
-                            "non-matching Γ meshes would need a supermesh DOLFINx does not provide (only --offset 0)")
-    bad = [n for n in args.N if not 1 <= n <= N_MAX]
-    if bad:
-        raise ArgumentError(f"--N {bad[0]}: each N must be in 1..{N_MAX}")
-    if sorted(set(args.N)) != args.N:
-        raise ArgumentError(f"--N {' '.join(map(str, args.N))}: give distinct N in increasing order")
-    if args.out.exists() and not args.out.is_dir():
-        raise ArgumentError(f"--out {args.out}: exists and is not a directory")
-    return args
 
 
 def interface_measure(msh, omega1_map):
@@ -161,7 +120,6 @@ def assemble_level(n: int, space: str) -> dict:
 
     A = sp.block_diag([K1, K2], format="csr")
     B = sp.hstack([-B1, B2], format="csr")
-    constrained_rows = np.sort(bcq[0].dof_indices()[0]) if bcq else np.zeros(0, int)
     coords = np.vstack([V1.tabulate_dof_coordinates(), V2.tabulate_dof_coordinates()])
     return {"A": A, "B": B, "G": G, "coords": coords, "n1": K1.shape[0],
             "multipliers": describe_multipliers(Q, family, s)}
@@ -188,74 +146,23 @@ def describe_multipliers(Q, family: str, s: int) -> dict:
     return {"basis": "lagrange", "degree": s, "breakpoints": breakpoints.tolist(), "ends": "keep", "rows": rows}
 
 
-def describe_traces(coords: np.ndarray, n1: int, k: int) -> list:
-    """The bodies' trace bases on Γ for the certifier's distance to the exact mortar coupling
-    (``traces``, normH spec): per body continuous P_k on its Γ nodes, ``columns`` the column of
-    B (A's dof) of each trace function left to right, −1 at Γ's ends (Dirichlet dofs: B's
-    columns there are zeroed), sign −1 for Ω1 and +1 for Ω2 (B = [−B1 | B2])."""
-    out = []
-    for lo, hi, sign in ((0, n1, -1), (n1, len(coords), 1)):
-        cols = lo + np.where(np.isclose(coords[lo:hi, 1], 1.0))[0]
-        x = coords[cols, 0]
-        order = np.argsort(x, kind="stable")
-        cols, x = cols[order], x[order]
-        columns = np.where(np.isclose(x, 0.0) | np.isclose(x, 1.0), -1, cols)
-        out.append({"basis": "lagrange", "degree": k, "breakpoints": x[::k].tolist(), "ends": "keep",
-                    "columns": [int(c) for c in columns], "sign": sign})
-    return out
-
-
-def write_atomic(path: Path, writer) -> None:
-    """Write through a temporary file and rename (a killed run leaves no half file); the
-    temporary name keeps the suffix (``mmwrite`` appends ``.mtx`` to a name without it)."""
-    tmp = path.with_name(f".{path.stem}.tmp{path.suffix}")
-    writer(tmp)
-    os.replace(tmp, path)
-
-
-def export(out: Path, space: str, ns) -> Path:
-    """Write every level's matrices and ``levels.yaml`` into ``out``; return the manifest path."""
-    out.mkdir(parents=True, exist_ok=True)
-    k, family, s, ends_bc, desc = SPACES[space]
+def export(args) -> Path:
+    """Every level's matrices and ``levels.yaml`` into ``args.out`` (the contract's writers)."""
+    k, family, s, ends_bc, _ = SPACES[args.space]
     levels = []
-    for n in ns:
-        lv = assemble_level(n, space)
-        entry = {"h": 1.0 / n}
-        for key in ("A", "B", "G"):
-            name = f"{key}{n}.mtx"
-            write_atomic(out / name, lambda t, M=lv[key]: scipy.io.mmwrite(t, M, precision=17))
-            entry[key] = name
-        entry["multipliers"] = lv["multipliers"]
-        entry["traces"] = describe_traces(lv["coords"], lv["n1"], k)
-        levels.append(entry)
-    manifest = {
-        "name": f"dolfinx-{DOLFINX_VERSION} {space} P{k} bodies, {family} {s} multipliers on a facet submesh"
-                + (" (mu = 0 at Gamma's ends by dirichletbc)" if ends_bc else ""),
-        "norm": "H",
-        "gamma": {"shape": "segment", "length": 1.0},
-        "levels": levels,
-    }
-    target = out / "levels.yaml"
-    write_atomic(target, lambda t: t.write_text(yaml.safe_dump(manifest, sort_keys=False, default_flow_style=None)))
-    return target
+    for n in args.N:
+        lv = assemble_level(n, args.space)
+        levels.append(level_entry(args.out, n, lv["A"], lv["B"], lv["G"], lv["multipliers"],
+                                  describe_traces(lv["coords"], lv["n1"], k)))
+    name = (f"dolfinx-{DOLFINX_VERSION} {args.space} P{k} bodies, {family} {s} multipliers on a facet submesh"
+            + (" (mu = 0 at Gamma's ends by dirichletbc)" if ends_bc else ""))
+    return write_manifest(args.out, name, levels)
 
 
 def main(argv=None) -> int:
-    try:
-        args = parse_args(sys.argv[1:] if argv is None else argv)
-    except ArgumentError as err:
-        print(f"export.py: {err}", file=sys.stderr)
-        return 2
-    if args.list_spaces:
-        for sid, spec in SPACES.items():
-            print(f"{sid}\t{spec[-1]}")
-        return 0
-    try:
-        export(args.out, args.space, args.N)
-    except OSError as err:
-        print(f"export.py: --out {args.out}: {err.strerror or err}", file=sys.stderr)
-        return 2
-    return 0
+    return run(argv, SPACES, export, offsets=(0,), offset_reason=(
+        "DOLFINx assembles a form over one mesh and its submeshes; non-matching Γ meshes would need a "
+        "supermesh DOLFINx does not provide (only --offset 0)"))
 
 
 if __name__ == "__main__":

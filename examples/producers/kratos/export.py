@@ -19,13 +19,14 @@ Nothing else goes to stdout: Kratos' banner and log are sent to stderr.
 """
 from __future__ import annotations
 
-import argparse
-import json
 import os
 import sys
 import time
 from contextlib import contextmanager
 from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # examples/producers: the contract
+from contract import run, write_manifest  # noqa: E402
 
 SPACES = {
     "dual": "Kratos' default: dual P1 multipliers on every slave node (the Dirichlet ends kept), "
@@ -35,35 +36,6 @@ SPACES = {
     "dual-ends-fixed": "unscaled, SCALAR_LAGRANGE_MULTIPLIER fixed at Γ's two end nodes and Kratos' elimination "
                        "builder (a user's fix for the Dirichlet ends)",
 }
-MAX_N = 512  # a level of N = 512 has ~5e5 dofs: far past what a certificate of this problem needs
-
-
-class _Parser(argparse.ArgumentParser):
-    def error(self, message):  # one line, exit 2 (the contract)
-        sys.stderr.write(f"export.py: {message}\n")
-        sys.exit(2)
-
-
-def _args(argv):
-    p = _Parser(description=__doc__.splitlines()[0])
-    p.add_argument("--out", type=Path)
-    p.add_argument("--space", choices=sorted(SPACES))
-    p.add_argument("--N", type=int, nargs="+")
-    p.add_argument("--offset", type=int, default=0)
-    p.add_argument("--list-spaces", action="store_true")
-    a = p.parse_args(argv)
-    if a.list_spaces:
-        return a
-    for key in ("out", "space", "N"):
-        if getattr(a, key) is None:
-            p.error(f"--{key} is required (or --list-spaces)")
-    if any(n < 2 or n > MAX_N for n in a.N) or sorted(set(a.N)) != a.N:
-        p.error(f"--N: increasing integers in 2..{MAX_N} (found {' '.join(map(str, a.N))})")
-    if not 0 <= a.offset <= 8:
-        p.error(f"--offset: an integer in 0..8 (found {a.offset})")
-    if a.out.exists() and (not a.out.is_dir() or any(a.out.iterdir())):
-        p.error(f"--out {a.out}: not a new or empty directory")
-    return a
 
 
 @contextmanager
@@ -80,36 +52,24 @@ def _stdout_to_stderr():
         os.close(saved)
 
 
-def main(argv=None) -> int:
-    a = _args(sys.argv[1:] if argv is None else argv)
-    if a.list_spaces:
-        for key, text in SPACES.items():
-            print(f"{key}\t{text}")
-        return 0
+def export(args) -> Path:
+    """Every level through Kratos (its banner and log on stderr) and ``levels.yaml``."""
     with _stdout_to_stderr():
         import kratos_model
-        a.out.mkdir(parents=True, exist_ok=True)
+
         levels = []
-        for n in a.N:
+        for n in args.N:
             t0 = time.perf_counter()
-            levels.append(kratos_model.write_level(a.out, n, a.offset, a.space))
+            lv = kratos_model.write_level(args.out, n, args.offset, args.space)
+            levels.append({"h": lv["h"], "A": lv["A"], "B": lv["B"], "G": lv["G"], "multipliers": lv["multipliers"]})
             print(f"export.py: N = {n}: {time.perf_counter() - t0:.2f} s", file=sys.stderr)
-        _write_manifest(a.out, a.space, a.offset, levels, kratos_model.version())
-    return 0
+        name = f"kratos-{kratos_model.version()} mesh-tying {args.space} P1 (offset {args.offset})"
+    return write_manifest(args.out, name, levels)
 
 
-def _write_manifest(out: Path, space: str, offset: int, levels, version: str) -> None:
-    """levels.yaml in the ``norm: H`` form, written atomically (JSON values are YAML)."""
-    lines = [f"name: {json.dumps(f'kratos-{version} mesh-tying {space} P1 (offset {offset})')}",
-             "norm: H", "gamma: {shape: segment, length: 1.0}", "levels:"]
-    for lv in levels:
-        lines.append(f"  - h: {lv['h']!r}")
-        for key in ("A", "B", "G"):
-            lines.append(f"    {key}: {lv[key]}")
-        lines.append(f"    multipliers: {json.dumps(lv['multipliers'])}")
-    tmp = out / ".levels.yaml.tmp"
-    tmp.write_text("\n".join(lines) + "\n")
-    os.replace(tmp, out / "levels.yaml")
+def main(argv=None) -> int:
+    return run(argv, SPACES, export, describe=lambda text: text, n_min=2, offsets=range(0, 9),
+               offset_reason="an integer in 0..8")
 
 
 if __name__ == "__main__":

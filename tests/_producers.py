@@ -229,3 +229,15 @@ def python_has(python, module: str) -> bool:
 
 
 __all__ = [n for n in dir(sys.modules[__name__]) if not n.startswith("_")]
+
+
+def check_refused(python, script, tmp_path, args, names) -> None:
+    """The exporter run with a bad command line (``OUT``: a new directory, ``FILE``: a file, both
+    in ``tmp_path``): exit 2, nothing on stdout, one line on stderr naming ``names``, nothing
+    written."""
+    (tmp_path / "FILE").write_text("not a directory")
+    args = [str(tmp_path / a) if a in ("OUT", "FILE") else a for a in args]
+    code, out, err = run_cli(python, script, *args)
+    assert code == 2 and out == ""
+    assert len(err.strip().splitlines()) == 1 and names in err, err
+    assert not (tmp_path / "OUT").exists()

@@ -52,12 +52,7 @@ def test_list_spaces():
     (("--out", "/proc/no/such/dir", "--space", "T3-k1", "--N", "4", "5", "6"), "--out /proc/no/such/dir"),
 ])
 def test_bad_arguments_one_line_exit_2(tmp_path, args, names):
-    (tmp_path / "FILE").write_text("not a directory")
-    args = [str(tmp_path / a) if a in ("OUT", "FILE") else a for a in args]
-    code, out, err = P.run_cli(PYTHON, SCRIPT, *args)
-    assert code == 2 and out == ""
-    assert len(err.strip().splitlines()) == 1 and names in err, err
-    assert not (tmp_path / "OUT").exists()
+    P.check_refused(PYTHON, SCRIPT, tmp_path, args, names)
 
 
 def _level(export, space, offset, i):

@@ -39,7 +39,7 @@ def add(sub) -> None:
     which.add_argument("--space", metavar="FILE.py:FUNC", help=SPACE_HELP)
     which.add_argument("--system", metavar="LEVELS.yaml",
                        help="a saddle-point system exported by another code: a manifest of mesh levels "
-                       "{h, A, B, G} (README, 'Certify a discretization from another code'); --k, --family, "
+                       "{h, A, B, G} (docs/foreign-systems.md); --k, --family, "
                        "--N, --N1-offset, --norm and --multiplier-mesh do not apply")
     p.add_argument("--k", type=int, default=None, help="displacement degree, 1..4 (with --case/--space)")
     p.add_argument("--family", default="structured", choices=FAMILIES)

@@ -39,7 +39,7 @@ EXIT_CODES = (
          "(a full disk); one line"),
     (130, "interrupted (Ctrl-C); one line, no result written"),
 )
-"""``verdict``'s exit codes (the ``--help`` epilog and the README table are this table)."""
+"""``verdict``'s exit codes (the ``--help`` epilog and the table of docs/cli.md are this table)."""
 
 
 @dataclass

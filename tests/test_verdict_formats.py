@@ -76,7 +76,7 @@ def test_csv_is_the_default_and_the_case_header_is_the_documented_one():
     assert code == code_csv == 0
     strip = [re.sub(r",[^,]*\n$", "\n", text) for text in (default, explicit)]  # `seconds` differs
     assert strip[0] == strip[1]
-    readme = (ROOT / "README.md").read_text()
+    readme = (ROOT / "docs" / "cli.md").read_text()
     documented = re.search(r"`(space,k,model,element,family,norm,multiplier_mesh,N1_offset,verdict,[^`]*)`", readme).group(1)
     assert default.splitlines()[0] == documented
     assert pd.read_csv(io.StringIO(default), dtype={"N_list": str}).N_list[0] == "4 8 16"
@@ -327,12 +327,13 @@ def test_exit_code_table_is_in_help_and_readme():
     code, out, _ = run_in_process(["verdict", "--help"])
     assert code == 0
     epilog = out[out.index("exit codes:"):]
-    readme = (ROOT / "README.md").read_text()
-    section = readme[readme.index("## Certify a discretization from another code"):]
-    section = section[:section.index("\n## ", 5)]
+    readme = (ROOT / "docs" / "cli.md").read_text()
+    section = readme[readme.index("## Exit codes"):]
+    end = section.find("\n## ", 5)  # the next section, if any
+    section = section if end < 0 else section[:end]
     for code, text in EXIT_CODES:
         assert re.search(rf"^\s+{code}\s+{re.escape(text.split()[0])}", epilog, flags=re.M), code
-        assert re.search(rf"^\| {code} \| ", section, flags=re.M), f"README table lacks exit code {code}"
+        assert re.search(rf"^\| {code} \| ", section, flags=re.M), f"docs/cli.md table lacks exit code {code}"
 
 
 @pytest.mark.parametrize("which", ["manifest", "matrix"])

@@ -4,3 +4,7 @@ Reproduces and extends K.J. Bathe & F. Brezzi, *Stability of finite element mixe
 interpolations for contact problems*, Rend. Lincei Mat. Appl. 12 (2001) 167–183.
 """
 __version__ = "0.1.0"
+
+from .api import beta, certify, verdict  # noqa: E402  (the notebook API: docs/api.md)
+
+__all__ = ["beta", "verdict", "certify", "__version__"]

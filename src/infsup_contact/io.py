@@ -162,6 +162,9 @@ SCHEMAS = {
                          "beta_L2": "float", "beta_H_resolved": "bool", "beta_L2_resolved": "bool",
                          "beta_L2_kappa": "float?", "beta_L2_kappa_resolved": "bool", "fit_theta_max": "float"},
                         key=("case", "k", "N", "theta")),
+    # results/benchmarks/dag.csv (bench/dag.py: per rule of a run), read by the docs' generator
+    "dag": Schema({"rule": "str", "jobs": "int", "wall_s_sum": "float", "wall_s_max": "float",
+                   "cpu_s_sum": "float?", "max_rss_mb": "float?"}, key=("rule",), label="a DAG timing table"),
     # Snakemake's `benchmark:` files (bench/dag.py), tab-separated
     "rule_benchmark": Schema({"s": "float"}, optional={"max_rss": "float?", "cpu_time": "float?"},
                              label="a Snakemake benchmark file", sep="\t"),
@@ -306,7 +309,7 @@ def concat_tables(frames, kind: str, name: str):
 class SourceLines(tuple):
     """The file line of each row of a table (``frame.attrs["lines"]``). Immutable, so a copy is
     the object itself: pandas deep-copies ``attrs`` on every derived frame, and a plain list of
-    50,000 line numbers made the full ledger 30x slower (4 s → 140 s)."""
+    50,000 line numbers made the full ledger 35× slower."""
 
     def __deepcopy__(self, memo):
         return self

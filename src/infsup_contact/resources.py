@@ -17,8 +17,8 @@ matrices (dim M × n_Γ, quadrature points × n_Γ) are added explicitly; so is 
 of the H^{-1/2}_00 norm (the log kernel holds one (s+1)² block and its quadrature per pair
 of multiplier intervals; the sine-series route ~1600 (dim M)² bytes) and the dense
 eigenproblem (a few (dim M)² doubles). The constants were measured with
-``/usr/bin/time -v`` (maximum resident set size) and ``tracemalloc`` on this package (see the
-README, "What is refused"); the estimate is an upper bound within ~10–40 % at sizes where the
+``/usr/bin/time -v`` (maximum resident set size) and ``tracemalloc`` on this package (see
+docs/refusals.md, "The memory estimate"); the estimate is an upper bound within ~10–40 % at sizes where the
 request dominates the interpreter (≥ 100k dofs).
 
 The time is rough (order of magnitude): a sparse LU is O(nd^1.5) in 2D.
@@ -136,8 +136,8 @@ The estimate is above each; the ``pardiso`` route adds :data:`MKL_BYTES` for the
 MKL_BYTES = 64 * MIB
 """Resident size of MKL once PARDISO is loaded (measured: 42 MB more than the package alone)."""
 SECONDS_PER_DOF2_3D = 1.3e-8
-"""Seconds per nd² of the ``nested`` route (the sparse LU: 27 s at N = 16 and 96 s at N = 20,
-k = 2; 118 s at N = 40, k = 1); PARDISO's routes: :data:`DENSE_ROUTE_SECONDS_3D`,
+"""Seconds per nd² of the ``nested`` route (the sparse LU, fitted to N = 16 and 20 at k = 2 and
+N = 40 at k = 1); PARDISO's routes: :data:`DENSE_ROUTE_SECONDS_3D`,
 :data:`LARGE_ROUTE_3D`."""
 
 
@@ -161,11 +161,10 @@ couplings, exponential-sum Grams in the reflections' parity blocks, bottom penci
 bytes a Σ nd + b m² and seconds c Σ nd + d m³ beyond the process, m = (k N₂ + 1)² (R5.2 on
 G_h = the trace of Ω2). Non-negative least squares, relative residuals, on ``beta --model
 membranes3d --case all --norm all`` (hexahedra, every space the face builds: 5 at k = 1, 12 at
-k = 2; 2 BLAS/MKL threads, quiet machine, ``/usr/bin/time``, 2026-11-25):
+k = 2; 2 BLAS/MKL threads, quiet machine, ``/usr/bin/time``; the wall times in CHANGELOG.md):
 
-- k = 1: N = 40 1.02 GB, 12.5 s; N = 48 1.73 GB, 22 s; N = 64 4.58 GB, 74 s;
-- k = 2: N = 20 1.19 GB, 24 s; N = 24 1.94 GB, 37 s; N = 28 3.16 GB, 64 s; N = 32 4.73 GB,
-  110 s; N = 36 7.32 GB, 227 s.
+- k = 1: N = 40 1.02 GB; N = 48 1.73 GB; N = 64 4.58 GB;
+- k = 2: N = 20 1.19 GB; N = 24 1.94 GB; N = 28 3.16 GB; N = 32 4.73 GB; N = 36 7.32 GB.
 
 The sparse factors grow like nd here (nd^{4/3} only asymptotically), the Grams, the pencils' and
 the shared series' dense arrays like m², their factorizations like m³. The estimate multiplies
@@ -173,8 +172,9 @@ the fit by :data:`LARGE_ROUTE_MARGIN`, so it lies above every measurement (by 3 
 LARGE_ROUTE_MARGIN = 1.2
 DENSE_ROUTE_SECONDS_3D = {1: 2.2e-9, 2: 5.4e-9}
 """d of c Σ nd + d m³ seconds (c of :data:`LARGE_ROUTE_3D`) on PARDISO's dense route, where the
-dense SVDs and pencils cost more per m³: k = 1, N = 32 9 s; k = 2, N = 16 16 s (``--case all``).
-At the gate the large route is the faster one (k = 1: N = 32 dense 9 s, N = 40 large 14 s)."""
+dense SVDs and pencils cost more per m³ (fitted at k = 1, N = 32 and k = 2, N = 16, ``--case
+all``). At the gate the large route is the faster one (k = 1: the large route at N = 40 takes
+about 1.5× the dense route at N = 32, for twice the multipliers)."""
 
 
 def _large_route_dim(k: int, n: int, components: int) -> int:
@@ -321,7 +321,7 @@ SYSTEM_BYTES_3D = 900.0
 3D): a membranes3d export, R5.2, k = 2, N = 20 (121,680 dofs, two bodies, ``gamma-dense``)
 peaked at 4.4 GB, i.e. C ≈ 900 on n^{4/3} of one body's half, times two."""
 SYSTEM_SECONDS_3D = 3e-9
-"""Seconds per n² of a 3D system (the same export: 42 s)."""
+"""Seconds per n² of a 3D system (fitted to the same export)."""
 
 
 def looks_3d(n: int, n_touched: int) -> bool:
@@ -341,7 +341,7 @@ def system_estimate(levels) -> Estimate:
     1.02 GiB; the margin makes it an upper bound until more systems are measured. Where B touches
     a 3D body's surface (:func:`looks_3d`) the sparse part is at least the 3D fill
     :data:`SYSTEM_BYTES_3D` (n/2)^{4/3} per body and the time gains :data:`SYSTEM_SECONDS_3D` n²:
-    the 2D formula gave 1.41 GiB and 12 s where a 3D export took 4.4 GB and 42 s."""
+    the 2D formula gave a third of the memory and of the time a 3D export took."""
     peak, seconds = 0.0, START_SECONDS
     for n, m, nt, nnz, route in levels:
         sparse = _side_bytes(n + m, "beta") + 2 * 12.0 * nnz

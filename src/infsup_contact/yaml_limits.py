@@ -4,7 +4,7 @@
 
 * a key given twice keeps the second value without a word (``h``, ``norm``);
 * aliases: nine anchors of nine aliases each (a 400-byte "billion laughs" file) are 9⁹ values
-  once anything walks or prints the data — ``repr`` in an error message took 10 s and 2.5 GB
+  once anything walks or prints the data — ``repr`` in an error message took gigabytes
   before it failed with a MemoryError.
 
 :class:`LimitedLoader` is a ``SafeLoader`` that checks the node tree of each document before

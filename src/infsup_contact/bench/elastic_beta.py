@@ -1,4 +1,4 @@
-"""Speed of the elastic β_h (issue 12, item 6): the Γ-reduced route against the same limit as
+"""Speed of the elastic β_h: the Γ-reduced route against the same limit as
 for the membranes (:mod:`infsup_contact.bench.beta_routes`) — one sparse factorization per
 body (SuperLU's best order, symmetric mode) + one dense generalized ``eigh`` of multiplier
 size per case, the interface operators and Gram matrices given. Every registered space

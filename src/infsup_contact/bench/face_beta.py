@@ -1,4 +1,4 @@
-"""Speed of the 3D β_h (issue 28, item 7): the Γ-reduced route on the contact face of
+"""Speed of the 3D β_h: the Γ-reduced route on the contact face of
 :data:`~infsup_contact.models.membranes3d.MEMBRANES3D` as a ratio to its limit — one sparse
 factorization per body + one dense generalized ``eigh`` of multiplier size per (case, norm).
 The problem is the one of :mod:`.beta_routes` one dimension up: every registered space valid
@@ -28,7 +28,7 @@ The Schur complement alone (``what`` = ``face_schur``): each body's S = K_ΓΓ �
 by :func:`~infsup_contact.models.schur.gamma_factorization`'s routes, ``ratio_to_ours``
 against PARDISO's partial factorization: the measurement behind the route ``"auto"`` takes on
 a face (CHOLMOD and MUMPS have no wheel for this Python and numpy on PyPI; scikit-sparse and
-python-mumps 0.0.2 were tried, see the README).
+python-mumps 0.0.2 were tried, see docs/models.md).
 
 ``max_abs_diff``: the largest |β_route − β_ours| over all (case, norm), β being the first
 value above the kernel ``ours`` decided (β_h itself for the stable spaces); ``limit`` solves the

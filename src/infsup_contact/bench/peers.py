@@ -78,7 +78,7 @@ def solve_osqp(A, B, F, tol: float = 1e-6, *, polishing: bool = True, polish_ref
     thousand iterations) to reproduce a solution to 1e-8. ``polish_refine_iter`` = 10
     (OSQP's default is 3): the polished KKT system is regularized (delta = 1e-6) and on
     the finer meshes 3 refinement steps leave a relative error ~1e-7 in λ, 10 reach
-    round-off at a cost of ~0.1 s (N = 256, k = 1). ``time_limit`` in seconds, 0 = none.
+    round-off at a small cost (N = 256, k = 1). ``time_limit`` in seconds, 0 = none.
     """
     import osqp
 

@@ -97,15 +97,22 @@ def _check_beta(args):
 
 
 def _run_beta(args) -> None:
-    import pandas as pd
-
     if args.system is not None:
-        from ..systems.levels import NORM_NOTES, system_rows
+        from ..systems.levels import NORM_NOTES
 
         if args.manifest.norm not in ("given", "H"):  # H: the paper's norm, no caveat
             print(f"infsup-contact: note: {NORM_NOTES[args.manifest.norm]}", file=sys.stderr)
-        write_csv(pd.DataFrame(system_rows(args.manifest)).drop(columns="N2"), float_format="%.12g")
-        return
+    write_csv(beta_frame(args), float_format="%.12g")
+
+
+def beta_frame(args):
+    """The table of a validated ``beta`` request (what ``beta`` writes; :mod:`infsup_contact.api`)."""
+    import pandas as pd
+
+    if args.system is not None:
+        from ..systems.levels import system_rows
+
+        return pd.DataFrame(system_rows(args.manifest)).drop(columns="N2")
 
     from ..solvers.infsup import beta_rows
 
@@ -117,5 +124,4 @@ def _run_beta(args) -> None:
     frame = pd.DataFrame(rows)
     for i, (name, value) in enumerate(args.mesh_kwargs.items()):  # e.g. element, after family
         frame.insert(frame.columns.get_loc("family") + 1 + i, name, value)
-    frame = material_columns(frame, args)
-    write_csv(frame, float_format="%.12g")
+    return material_columns(frame, args)

@@ -39,7 +39,7 @@ def add(sub) -> None:
     which.add_argument("--space", metavar="FILE.py:FUNC", help=SPACE_HELP)
     which.add_argument("--system", metavar="LEVELS.yaml",
                        help="a saddle-point system exported by another code: a manifest of mesh levels "
-                       "{h, A, B, G} (README, 'Certify a discretization from another code'); --k, --family, "
+                       "{h, A, B, G} (docs/foreign-systems.md); --k, --family, "
                        "--N, --N1-offset, --norm and --multiplier-mesh do not apply")
     p.add_argument("--k", type=int, default=None, help="displacement degree, 1..4 (with --case/--space)")
     p.add_argument("--family", default="structured", choices=FAMILIES)
@@ -110,20 +110,27 @@ def _check_verdict(args):
 
 
 def _run_verdict(args) -> int:
+    row, levels = verdict_row(args)
+    if args.system is not None:
+        if row["norm"] not in ("given", "H"):  # H: the paper's norm, no caveat
+            print(f"infsup-contact: note: {row['norm_note']}", file=sys.stderr)
+        return emit(args, row, levels, manifest_expect=args.manifest.expect)
+    return emit(args, row)
+
+
+def verdict_row(args) -> tuple:
+    """The verdict row of a validated ``verdict`` request and, for ``--system``, its per-level
+    rows (else None): what ``verdict`` renders (:mod:`infsup_contact.api`)."""
     if args.system is not None:
         from ..systems.levels import system_verdict
 
-        out, levels = system_verdict(args.manifest, tol=args.slope_tolerance, floor=args.beta_floor,
-                                     confidence=args.confidence)
-        if out["norm"] not in ("given", "H"):  # H: the paper's norm, no caveat
-            print(f"infsup-contact: note: {out['norm_note']}", file=sys.stderr)
-        return emit(args, out, levels, manifest_expect=args.manifest.expect)
+        return system_verdict(args.manifest, tol=args.slope_tolerance, floor=args.beta_floor,
+                              confidence=args.confidence)
 
     from ..study.verdict import verdict_rows
 
-    space = args.space_or_case
-    out = verdict_rows(space, args.k, args.family, args.N, args.norm,
+    out = verdict_rows(args.space_or_case, args.k, args.family, args.N, args.norm,
                        tol=args.slope_tolerance, floor=args.beta_floor, confidence=args.confidence,
                        multiplier_mesh=args.multiplier_mesh, model=args.model_obj, n1_offset=args.N1_offset,
                        **args.mesh_kwargs)
-    return emit(args, out)
+    return out, None

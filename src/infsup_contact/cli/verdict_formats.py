@@ -39,7 +39,7 @@ EXIT_CODES = (
          "(a full disk); one line"),
     (130, "interrupted (Ctrl-C); one line, no result written"),
 )
-"""``verdict``'s exit codes (the ``--help`` epilog and the README table are this table)."""
+"""``verdict``'s exit codes (the ``--help`` epilog and the table of docs/cli.md are this table)."""
 
 
 @dataclass
@@ -198,10 +198,15 @@ def render(result: VerdictResult, fmt: str) -> str:
 # ---------------------------------------------------------------- the three formats
 def render_csv(result: VerdictResult) -> str:
     """The verdict row as one CSV row under its header, lists space-separated."""
+    return verdict_frame(result.row).to_csv(index=False, float_format="%.6g")
+
+
+def verdict_frame(row: dict):
+    """The verdict row as a one-row DataFrame, lists space-separated (the CSV's columns)."""
     import pandas as pd
 
-    row = {k: " ".join(str(x) for x in v) if isinstance(v, (list, tuple)) else v for k, v in result.row.items()}
-    return pd.DataFrame([row]).to_csv(index=False, float_format="%.6g")
+    return pd.DataFrame([{k: " ".join(str(x) for x in v) if isinstance(v, (list, tuple)) else v
+                          for k, v in row.items()}])
 
 
 def plain(value):

@@ -4,5 +4,5 @@ Everything the paper's Sections 4–5 define before any solve: Γ, the interface
 asks for partitions, trace dofs, quadrature, Gram matrices and spaces (``interface``), mesh pairs (``meshes``), the
 spaces M_h and their registry (``multipliers``), B_i (``coupling``), the Gram matrices of
 L²(Γ) and H^{-1/2}_00(Γ) (``norms``, ``logkernel``). Imports only ``errors`` and each other.
-Issue 28's 2D face: elements, (transformed) dual bases, grid spaces (``face_elements``, ``face_dual``, ``face_cells``).
+The 2D face: elements, (transformed) dual bases, grid spaces (``face_elements``, ``face_dual``, ``face_cells``).
 """

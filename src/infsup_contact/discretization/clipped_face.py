@@ -1,5 +1,5 @@
 """A face multiplier space cut off at x = L: Γ = (0, L) × (0, 1), the part of Ω1's face that a
-smaller Ω2 covers (issue 28, item 5, "edge dropping").
+smaller Ω2 covers ("edge dropping").
 
 The multipliers are defined on Ω1's face (0, 1)² (multiplier mesh ``omega1``: a tensor space
 M^x ⊗ M^y of :mod:`.face_spaces`) and restricted to Γ. Only x is cut: with the breakpoints

@@ -1,4 +1,4 @@
-"""Multiplier spaces on a tensor grid of rectangles of the face (0, 1)² (issue 28).
+"""Multiplier spaces on a tensor grid of rectangles of the face (0, 1)².
 
 :class:`CellwiseFaceSpace` puts one reference quadrilateral (QUAD4, QUAD8 or QUAD9 of
 :mod:`.face_elements`) on every rectangle of a :class:`~.square.TensorPartition` and numbers

@@ -1,4 +1,4 @@
-"""Dual and transformed-dual mortar bases on the reference face elements (issue 28).
+"""Dual and transformed-dual mortar bases on the reference face elements.
 
 Standard dual basis (Wohlmuth, SIAM J. Numer. Anal. 38 (2000) 989–1012): with the element's
 nodal basis N, the weights d_k = ∫ N_k, D = diag(d) and the mass matrix M_kl = ∫ N_k N_l,

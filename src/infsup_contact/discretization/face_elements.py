@@ -1,4 +1,4 @@
-"""Reference elements of a 2D contact face (issue 28): QUAD4, QUAD8, QUAD9, TRI3, TRI6.
+"""Reference elements of a 2D contact face: QUAD4, QUAD8, QUAD9, TRI3, TRI6.
 
 Quadrilaterals live on [−1, 1]², triangles on the unit triangle {ξ, η ≥ 0, ξ + η ≤ 1}. The
 node numbering is the common one (4C / BACI ``Mortar::Element::shape_functions``, also

@@ -1,4 +1,4 @@
-"""The face's H Gram series in the four parity blocks of the axis reflections (issue 28, large N).
+"""The face's H Gram series in the four parity blocks of the axis reflections (large N).
 
 Where both 1D factors of a tensor space M^x ⊗ M^y (:mod:`.face_spaces`; the piece space P of a
 cellwise one, :mod:`.face_cellwise_norms`) are symmetric under x → 1 − x, i.e. the reflection

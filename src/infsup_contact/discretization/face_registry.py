@@ -1,4 +1,4 @@
-"""The registry entries of the quadratic face elements (issue 28): spaces of QUAD8/QUAD9 cells
+"""The registry entries of the quadratic face elements: spaces of QUAD8/QUAD9 cells
 (hexahedral faces, :mod:`.face_cells`) and TRI6 cells (tetrahedral faces, :mod:`.face_tri6`) on
 G_h, defined on the face only (the segment refuses them in one line). :mod:`.registry` calls
 :func:`register_face_cases` with its own ``register``, ``SpaceSpec`` and colours, after the

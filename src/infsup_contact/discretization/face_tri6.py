@@ -1,4 +1,4 @@
-"""Multipliers of the quadratic triangle face TRI6 (issue 28, item 3): the tetrahedral (P2) analogues
+"""Multipliers of the quadratic triangle face TRI6: the tetrahedral (P2) analogues
 of the QUAD8 / QUAD9 entries of the registry, on the triangles of a tensor partition G_h of the face
 (every rectangle cut by its diagonal from (x_i, y_j) to (x_{i+1}, y_{j+1}), :mod:`.face_triangles`).
 

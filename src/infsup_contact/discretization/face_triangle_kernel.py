@@ -1,4 +1,4 @@
-"""Lower bounds of the non-matching kernel on the Kuhn-triangulated face (issue 28, tetrahedra).
+"""Lower bounds of the non-matching kernel on the Kuhn-triangulated face (tetrahedra).
 
 The face Γ = (0, 1)² of the structured tetrahedral meshes is a Kuhn triangulation: every cell
 of the N × N grid cut by its diagonal from (x_i, y_j) to (x_{i+1}, y_{j+1})

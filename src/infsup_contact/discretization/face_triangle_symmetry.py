@@ -1,4 +1,4 @@
-"""Symmetries of Γ = (0, 1)² and the H Gram of a triangle space (issue 28): the point reflection
+"""Symmetries of Γ = (0, 1)² and the H Gram of a triangle space: the point reflection
 below, and the transposition (x, y) → (y, x) of a square grid (:func:`transposition`, used by
 :func:`~.face_triangle_norms.partial_gram`).
 

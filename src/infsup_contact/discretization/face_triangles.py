@@ -1,4 +1,4 @@
-"""Multiplier spaces of P_s on the triangles of a tensor partition of the face (issue 28).
+"""Multiplier spaces of P_s on the triangles of a tensor partition of the face.
 
 The trace on Γ of the six-tetrahedra (Kuhn) split of a structured grid is P_k on the triangles
 that the diagonal from (x_i, y_j) to (x_{i+1}, y_{j+1}) cuts every rectangle of the grid into

@@ -1,4 +1,4 @@
-"""P_s multiplier spaces on a general triangulation G_h of the face (issue 28).
+"""P_s multiplier spaces on a general triangulation G_h of the face.
 
 The spaces of :mod:`.face_triangles` (the paper's M^1_{0,s}, M^1_s, M^0_s, eqs. (5.3), (5.5),
 and the dual bases TRI3 / TRI6) on any :class:`~.triangulation.Triangulation`, not only on the

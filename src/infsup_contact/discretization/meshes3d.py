@@ -1,4 +1,4 @@
-"""Unstructured and perturbed meshes of the 3D bodies Ω1 = (0,1)³, Ω2 = (0,1)²×(1,2) (issue 28).
+"""Unstructured and perturbed meshes of the 3D bodies Ω1 = (0,1)³, Ω2 = (0,1)²×(1,2).
 
 Families beside ``structured`` (``ngsolve.meshes.MakeStructured3DMesh``, built in
 :func:`infsup_contact.models.membranes3d.subdomain_mesh`):

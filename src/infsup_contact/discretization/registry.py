@@ -391,7 +391,7 @@ register(SpaceSpec(
     expected="unstable", dimension=lambda k, n: n * k + 1, color=OKABE_ITO["sky_blue"], marker="h",
     nodal_basis=False, claim_tag="DUAL-ALL", lagrange=(True, False), dual=True))
 
-# --- face element spaces of the 3D models (issue 28): declared in their own module -----
+# --- face element spaces of the 3D models: declared in their own module -----
 register_face_cases(register, SpaceSpec, OKABE_ITO)
 
 

@@ -193,8 +193,8 @@ def _standard_form_norm(E: np.ndarray, L: np.ndarray) -> float:
 
 RELATIVE_DENSE_MAX = 400
 """Largest order for which :func:`relative_step` forms the standard form and all its eigenvalues;
-above it Lanczos (at order 1,500 the dense route took 0.7 s a step, 176 s of a k = 2, N = 20
-face request's 445; Lanczos needs a few dozen O(n²) products)."""
+above it Lanczos (at order 1,500 the dense route took about 40 % of a k = 2, N = 20
+face request; Lanczos needs a few dozen O(n²) products)."""
 
 
 NORM2_DENSE_MAX = 400
@@ -220,6 +220,6 @@ def _norm2(A: np.ndarray) -> float:
 NORM2_SHORT_KRYLOV_MIN = 1500
 """Order above which :func:`_norm2` restarts Lanczos with :data:`NORM2_SHORT_KRYLOV` vectors
 instead of ARPACK's default 20: the top of a Gram matrix (or of a Richardson step) is well
-separated, 11 products reach the same 1e-8 where the default takes 21 (a dense product is 12 ms
+separated, 11 products reach the same 1e-8 where the default takes 21 (a dense product each,
 at order 4,225); the default DAG's Grams, all below, keep their digits."""
 NORM2_SHORT_KRYLOV = 10

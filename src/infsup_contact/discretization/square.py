@@ -1,4 +1,4 @@
-"""Γ = (0, 1)² × {1}, the contact face of the 3D model problem (issue 28).
+"""Γ = (0, 1)² × {1}, the contact face of the 3D model problem.
 
 A partition of the face is, for now, a tensor grid of rectangles (:class:`TensorPartition`):
 the trace of a structured hexahedral mesh, and the common refinement of two such traces.

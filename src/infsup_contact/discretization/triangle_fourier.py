@@ -1,4 +1,4 @@
-"""Gram matrices of P_s spaces on general triangulations of Γ = (0, 1)² (issue 28).
+"""Gram matrices of P_s spaces on general triangulations of Γ = (0, 1)².
 
 L²(Γ): exact, the Duffy rule of :mod:`.face_quadrature` on the triangles of G_h (degree 2s).
 

@@ -1,4 +1,4 @@
-"""General triangulations of the face Γ = (0, 1)² and their common refinement (issue 28).
+"""General triangulations of the face Γ = (0, 1)² and their common refinement.
 
 A :class:`Triangulation` is a vertex array and a triangle array: the trace on Γ of any
 tetrahedral mesh (Netgen's unstructured meshes, perturbed structured ones), not only the

@@ -5,17 +5,10 @@ by spinning. When another process holds a core, a multi-threaded call waits for 
 not scheduled, and a request of thousands of medium-sized calls (the face's kernel decisions,
 pencils and Grams) slows down by far more than the core it lost. Measured on this project's
 2-core machine (AMD EPYC, Zen 4) with five other processes running, the same
-``beta --model membranes3d --element hex --case all --k 2 --norm all`` request took
-
-=====  ===============================  ==============================
-N      OPENBLAS_NUM_THREADS=2           OPENBLAS_NUM_THREADS=1
-=====  ===============================  ==============================
-12     110 s wall, 70.5 s user          16.9 s wall, 10.2 s user
-20     393 s wall, 223 s user           29.6 s wall, 19.8 s user
-=====  ===============================  ==============================
-
-(MKL's threads, PARDISO's, did not matter: 16.2 s with MKL at 2 and OpenBLAS at 1;
-``OPENBLAS_THREAD_TIMEOUT=4`` cut the first to 40 s, still 2.5× the one-thread run). The rule
+``beta --model membranes3d --element hex --case all --k 2 --norm all`` request took 6.5×
+(N = 12) and 13× (N = 20) the wall time with OPENBLAS_NUM_THREADS=2 that it took with 1
+(MKL's threads, PARDISO's, did not matter; ``OPENBLAS_THREAD_TIMEOUT=4`` cut the slowdown to
+2.5× the one-thread run; the measurements are in CHANGELOG.md). The rule
 (:func:`fitted_threads`): run OpenBLAS on as many threads as cores are idle at the start
 (sampled from /proc/stat), never more than asked, never fewer than one. ``INFSUP_BLAS_FIT=0``
 keeps the count asked for (benchmarks that measure the threads themselves).

@@ -1,7 +1,7 @@
 """Dense-result products that scipy and numpy run on one core, split over the BLAS threads.
 
 scipy's sparse × dense product (``csr_matvecs``) and numpy's element-wise passes are
-single-threaded. On the large face route (k = 2, N = 32) they held about 45 s of a 200 s
+single-threaded. On the large face route (k = 2, N = 32) they held about a fifth of a
 β_h request while the second core waited: the sandwiches B X Bᵀ of the interface operator
 (:mod:`infsup_contact.models.schur`) and R S_P Rᵀ of the cellwise H Grams
 (:mod:`infsup_contact.discretization.face_cellwise_norms`), and the reordering of the face
@@ -11,7 +11,7 @@ the same kernel, in the same order, as the one-thread product: the results are b
 (tests/test_la_threaded.py).
 
 A second cost was hidden in scipy's ``A @ Y.T``: a C-contiguous copy of the transposed
-operand, a strided pass over memory (2.2 s for a 9,216² operand). :func:`symmetric_sandwich`
+operand, a strided pass over memory (the largest single cost of a 9,216² product). :func:`symmetric_sandwich`
 never transposes a large operand: X Aᵀ is formed row block by row block from small copies.
 
 The number of threads is the BLAS's (MKL_NUM_THREADS, else OPENBLAS_NUM_THREADS, else 1, as
@@ -31,8 +31,8 @@ MIN_ENTRIES = 2 ** 20
 """Fewest entries of :func:`symmetric_pairs`' result worth threads."""
 BLOCK = 32
 """Rows of X per block of :func:`times_transpose`: the product's (m × BLOCK) result is written
-transposed, a pass that stays in cache at this width (one thread, R S_P Rᵀ at dim 9,216:
-0.75 s at 32, 1.34 s at 256; B X Bᵀ at n_Γ = 3,969: 0.19 s against 0.36 s)."""
+transposed, a pass that stays in cache at this width (one thread: R S_P Rᵀ at dim 9,216 and
+B X Bᵀ at n_Γ = 3,969 take about half the time of BLOCK = 256)."""
 
 
 def threads() -> int:
@@ -61,7 +61,7 @@ def _row_blocks(n_rows: int, weights: np.ndarray | None = None, min_rows: int = 
 
 _pools: dict = {}
 """One pool per thread count, kept for the process: a pool made per call started two threads
-each time (2,400 thread starts, 3.4 s of a k = 2, N = 32 request)."""
+each time (2,400 thread starts in a k = 2, N = 32 request)."""
 
 
 os.register_at_fork(after_in_child=_pools.clear)  # a forked child has none of the threads

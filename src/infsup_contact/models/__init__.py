@@ -4,7 +4,7 @@
 loads, lifts and u_h of a contact scene); ``schur`` is the shared Γ Schur complement / Steklov
 inverse machinery, ``ordering`` its Γ-last nested dissection; ``membranes`` is the paper's
 model, ``elastic`` plane-strain elasticity (its Section 2), ``membranes3d`` the membranes
-in 3D with a 2D contact face (issue 28), ``elastic3d`` the linear-elastic bodies on that
+in 3D with a 2D contact face, ``elastic3d`` the linear-elastic bodies on that
 face, ``plane_strain`` the material law
 the elastic scenes measure with. Imports ``discretization`` and ``errors`` only.
 

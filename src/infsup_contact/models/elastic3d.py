@@ -1,5 +1,5 @@
-"""Linear elasticity of two 3D bodies through the model seam (issue 28, item 1: "then the
-elastic bodies through the same model contract").
+"""Linear elasticity of two 3D bodies through the model seam: the elastic bodies through the
+same model contract as the membranes.
 
 Ω1 = (0,1)³ and Ω2 = (0,1)²×(1,2) meet on the face Γ = (0,1)²×{1}, normal n = e_z (from Ω1
 into Ω2). Displacements are continuous vector Q_k on hexahedra or P_k on tetrahedra (NGSolve

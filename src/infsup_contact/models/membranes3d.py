@@ -1,4 +1,4 @@
-"""The membranes in 3D (issue 28): −c_i Δu_i = f_i on Ω1 = (0,1)³ and Ω2 = (0,1)²×(1,2),
+"""The membranes in 3D: −c_i Δu_i = f_i on Ω1 = (0,1)³ and Ω2 = (0,1)²×(1,2),
 u_i = 0 on ∂Ω_i∖Γ, Γ = (0,1)²×{1} the contact face, b(v, μ) = ∫_Γ (v2 − v1) μ.
 
 The paper's model problem (Section 3) one dimension up: the side operator is the Laplace

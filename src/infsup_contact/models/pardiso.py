@@ -5,11 +5,11 @@ returns S = A_ΓΓ − A_ΓI A_II⁻¹ A_IΓ as a dense matrix (``iparm[35]``, t
 in ``perm``) after one supernodal, BLAS-3 factorization of A_II in its own nested-dissection
 order (METIS). It is the Γ-last Schur complement of :mod:`infsup_contact.models.schur`
 computed by a sparse direct solver built for it: on a 3D body (Q2 hexahedra, 254,016 dofs,
-n_Γ = 3,969) it takes 23 s and 2.8 GB, where SuperLU with the Γ-last nested dissection needs
-minutes and tens of GB (``results/benchmarks``). :func:`gamma_schur` frees the interior factor
+n_Γ = 3,969) it fits in a few GB, where SuperLU with the Γ-last nested dissection needs
+tens of GB (``results/benchmarks/face.csv``, ``bench --what face``). :func:`gamma_schur` frees the interior factor
 at once (``iparm[35] = 1``: a β_h sweep never solves); :class:`SchurFactor` keeps it
 (``iparm[35] = 2``) and solves A x = b with it and S, so a contact scene factorizes each body
-once (face patch, membranes3d, k = 2, one body N = 20: the first solve 5.4 s → 0.4 s).
+once (face patch, membranes3d, k = 2, one body N = 20: the first solve an order of magnitude faster).
 
 The library is Intel oneMKL from the ``mkl`` wheel (``environment.lock``), called through
 ctypes with the documented C interface ``pardiso(pt, maxfct, mnum, mtype, phase, n, a, ia,

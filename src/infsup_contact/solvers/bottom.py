@@ -58,7 +58,7 @@ this accuracy: 6 steps reach ~5e-4 where the default 20 reached ~2e-4 (k = 2, N 
 SOLVE_BLOCK = 512
 """Columns per block of the triangular solve K = R⁻¹ L in :func:`inverse_standard_form`."""
 SOLVE_BLOCK_MKL = 1024
-"""The same on the in-place MKL route (0.18 s for the solves at m = 4,225, two threads; 512: the same)."""
+"""The same on the in-place MKL route (at m = 4,225 on two threads 512 does as well: measured by ``bench --what face``)."""
 VALUE_RTOL = 1e-3
 """Relative change at which the first value above the counted ones has settled in
 :func:`bottom_singular` (a margin in decades to ~1e-3, where a decision needs 1 decade; the
@@ -237,7 +237,8 @@ def inverse_standard_form(R: np.ndarray, L: np.ndarray) -> np.ndarray:
     triangular K is LAPACK lauum (m³/3, where syrk costs m³). Both agree with the plain route to
     round-off (tests/test_bottom.py). With MKL the blocks are solved in place on a copy of L
     (:func:`~infsup_contact.la.mkl.trailing_solve`; L's zeros above its diagonal make the rows
-    above j of block j vanish): 0.99 s → 0.49 s at m = 4,225, two threads, the same K to 5e-16."""
+    above j of block j vanish): half the time of the copying route at m = 4,225 on two threads,
+    the same K to 5e-16."""
     m = R.shape[0]
     if mkl.available():  # in place on the sub-blocks: no copy of R[j:, j:] per block
         K, R = np.array(L, dtype=float, order="F"), np.asfortranarray(R, dtype=float)

@@ -71,7 +71,7 @@ KERNEL_CRITERION = (
     "INCONCLUSIVE), else clear; above dim M = 1500 the bottom singular values come from block inverse "
     "iteration on W^T W, measured as ||W v|| and certified by a Cholesky factorization of "
     "W^T W - tau I + smax^2 Z Z^T (Weyl; solvers/bottom.py)")
-"""The rule of :func:`coupling_kernel`, as stated in ``infsup-contact beta --help`` and the README."""
+"""The rule of :func:`coupling_kernel`, as stated in ``infsup-contact beta --help`` and docs/method.md."""
 CLEAR, CLOSE = "clear", "close"
 
 

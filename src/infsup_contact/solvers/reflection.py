@@ -1,4 +1,4 @@
-"""The large route's pencils split by the reflections of the face (issue 28, large N).
+"""The large route's pencils split by the reflections of the face (large N).
 
 On a face mesh pair symmetric about the centre of Γ = (0, 1)² (the structured hexahedra, any
 N1, N2), the point reflection R(x, y) = (1 − x, 1 − y) maps the multiplier basis onto itself,
@@ -80,7 +80,7 @@ class ReflectionSplit:
 
         Row combinations Q_aᵀ M (sparse × dense: whole rows, threaded), then (Q_aᵀ M) Q_b by
         :func:`~infsup_contact.la.threaded.times_transpose` (small transposed blocks): fancy
-        column gathers M[:, j] of a C-ordered 4,225² matrix took 0.12 s each."""
+        column gathers M[:, j] of a C-ordered 4,225² matrix were a strided pass each."""
         QT = [Q.T.tocsr() for Q in self.bases]
         M = np.ascontiguousarray(M, dtype=float)
         T = [sparse_times_dense(Q, M) for Q in QT]

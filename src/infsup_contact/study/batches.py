@@ -15,8 +15,8 @@ def pair_cost(family: str, k: int, n1: int, n2: int) -> float:
     """Rough seconds of one pair's β_h rows (every case, multiplier mesh, c pair and norm,
     :func:`~infsup_contact.solvers.infsup.beta_rows_all`) on one core, N = max(N1, N2):
     0.026 + 6.8e-4 (1 + 2 [N1 ≠ N2]) N k + 2.4e-5 (N k)² s, unstructured meshes × 1.3.
-    Least squares over the 64 pairs of the full config, perturbed, k = 2 and 4 (2026-11-23,
-    AMD EPYC, one BLAS thread; largest error 0.32 s, total exact). A non-matching pair has
+    Least squares over the 64 pairs of the full config, perturbed, k = 2 and 4 (AMD EPYC,
+    one BLAS thread; the total exact). A non-matching pair has
     three multiplier partitions, a matching one one (their rows are shared)."""
     n = max(n1, n2)
     t = 0.026 + 6.8e-4 * (1 + 2 * (n1 != n2)) * n * k + 2.4e-5 * (n * k) ** 2
@@ -29,7 +29,7 @@ def beta_batches(ic: dict, budget: float = 25.0) -> dict:
     All pairs of every series of one (family, k), each pair once, cheapest first, cut into
     the fewest consecutive chunks of about equal estimated seconds that keep each near
     ``budget`` (:func:`pair_cost`, × the number of seeds on perturbed meshes), so that
-    NGSolve's start-up (~1 s a process) is paid once per batch and not once per pair.
+    NGSolve's start-up (once per process) is paid once per batch and not once per pair.
     Batch id ``{family}_k{k}_{chunk}``.
     """
     ks = sorted({k for klist in ic["cases"].values() for k in klist})

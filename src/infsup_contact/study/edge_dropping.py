@@ -1,4 +1,4 @@
-"""Edge dropping (issue 28, item 5): β_h and the conditioning of the multiplier block when Ω2's
+"""Edge dropping: β_h and the conditioning of the multiplier block when Ω2's
 face covers Ω1's only partially.
 
 Setting (membranes, −Δu_i = f_i, u_i = 0 on ∂Ω_i∖Γ, b(v, μ) = ∫_Γ (v2 − v1) μ):
@@ -76,7 +76,7 @@ from ..models.schur import combine_terms, interface_terms
 from ..solvers.infsup import gram_factor, spectrum
 
 THETAS = (1.0, 0.5, 0.25, 0.1, 0.05, 0.01, 0.001)
-"""The covered fractions of the last column swept by default (issue 28)."""
+"""The covered fractions of the last column swept by default."""
 
 
 def theta_allowed(n: int) -> str:

@@ -1,4 +1,4 @@
-"""The 3D elastic contact patch test on the face Γ = (0,1)²×{1} (issue 28, item 1).
+"""The 3D elastic contact patch test on the face Γ = (0,1)²×{1}.
 
 Two isotropic linear-elastic bodies, Ω1 = (0,1)³ (Young's modulus E1) and Ω2 = (0,1)²×(1,2)
 (E2), Poisson ratio ν, on non-matching structured meshes (N1 ≠ N2 cells per direction on Γ),

@@ -1,4 +1,4 @@
-"""Ledger claims of the 3D contact face Γ = (0,1)²×{1} (issue 28; models/membranes3d.py).
+"""Ledger claims of the 3D contact face Γ = (0,1)²×{1} (models/membranes3d.py).
 
 Same criteria as the paper's ledger (:mod:`infsup_contact.study.claims`: the slope interval of
 log β_h vs log h inside s0 ± τ, min β_h > floor, exact kernel counts, INCONCLUSIVE where a

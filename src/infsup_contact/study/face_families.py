@@ -1,4 +1,4 @@
-"""Kernels on the non-matching families of the face (issue 28, item 1): the √2 pairs in 3D.
+"""Kernels on the non-matching families of the face: the √2 pairs in 3D.
 
 The 2D study's families (:mod:`~infsup_contact.discretization.series`) change the overlap pattern
 of the two traces with N; ``sqrt2`` (round(√2 n)) makes the two grids share no interior line when

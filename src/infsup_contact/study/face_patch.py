@@ -1,4 +1,4 @@
-"""The 3D contact patch test on the face Γ = (0,1)²×{1} (issue 28, item 6).
+"""The 3D contact patch test on the face Γ = (0,1)²×{1}.
 
 Two scalar bodies, Ω1 = (0,1)³ and Ω2 = (0,1)²×(1,2), −c_i Δu_i = 0, on non-matching
 structured meshes (N1 ≠ N2 cells per direction on Γ): u1 = 0 on Ω1's far face z = 0,

@@ -1,4 +1,4 @@
-"""Ledger claims of the face's three studies (issue 28, items 6 and 7): the 3D patch test, the
+"""Ledger claims of the face's three studies: the 3D patch test, the
 α sweep of the transformed dual bases and edge dropping (``results/face/{patch,alpha,edge_dropping}.csv``,
 rules/face_studies.smk), appended to ``results/claims.csv`` like :mod:`.face_claims`.
 

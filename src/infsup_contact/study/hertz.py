@@ -1,4 +1,4 @@
-"""The Hertz scene of the plane-strain elastic pair (issue 12, item 3).
+"""The Hertz scene of the plane-strain elastic pair.
 
 Ω1 = (0,1)² below, Ω2 = (0,1)×(1,2) above, on the flat potential contact surface Γ; the
 curvature of the upper body is the initial gap g0(x) = (x − 1/2)²/(2R) (the Hertz

@@ -145,7 +145,7 @@ FACE_SWEEP = {1: ((14, 14), (14, 16)), 2: ((7, 7), (7, 8))}
 """Hexahedral pairs of the face sweep (membranes3d) by k: the smallest whose sides' Schur
 complements come from PARDISO (n · n_Γ above :data:`~infsup_contact.models.schur.SOLVES_MAX_WORK`),
 a matching and a non-matching pair each; G_h = Ω2's partition only (the union of the
-non-matching pairs, kernels of 336 to 448 modes, would take 4 of the sweep's 6 s)."""
+non-matching pairs, kernels of 336 to 448 modes, would take two thirds of the sweep's time)."""
 VERDICT_N = (4, 8, 16)
 """Matching meshes of each verdict (a slope interval needs three)."""
 VERDICT_CRITERION = dict(tol=0.15, floor=1e-3, confidence=0.95)

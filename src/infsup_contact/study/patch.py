@@ -1,4 +1,4 @@
-"""The contact patch test of the plane-strain elastic pair (issue 12, item 4).
+"""The contact patch test of the plane-strain elastic pair.
 
 Two blocks Ω1 = (0,1)² and Ω2 = (0,1)×(1,2) on non-matching structured meshes (N1 ≠ N2
 segments on Γ), lateral sides x = 0, 1 on rollers (u_x = 0, free to slide vertically), the

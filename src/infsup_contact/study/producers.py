@@ -29,7 +29,7 @@ NOT_RUN = "-"
 H_ONLY_KEYS = ("gamma",)
 H_LEVEL_KEYS = ("multipliers", "traces")
 EXPORT_TIMEOUT = 600.0
-"""Seconds an exporter may take for all its levels (Kratos, N = 4..32: ~2 s)."""
+"""Seconds an exporter may take for all its levels (far above what the exporters take for N = 4..32)."""
 
 
 def installed_version(python: str, distribution: str, probe: str | None = None) -> str | None:

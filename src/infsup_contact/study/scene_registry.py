@@ -33,7 +33,7 @@ an N_ref = 128 reference; fitted slope): k = 3, N_ref = 8: +83 %, slope 1.51; N_
 (1x): +18 %, 1.84; N_ref = 32 (2x): +4.5 %, 1.93; N_ref = 64 (4x): +0.8 %, 1.95 (vs 1.96).
 k = 1, N_ref = 8: slope 0.85 instead of 0.92 (the issue's case). A margin of 2 keeps the
 slope within 0.04 of its converged value, well inside claims.rate_tolerance (0.15); the
-configs use exactly 2 (64 for N <= 32, 32 for N <= 16). See the README, "What is refused"."""
+configs use exactly 2 (64 for N <= 32, 32 for N <= 16). See docs/refusals.md."""
 
 
 @dataclass(frozen=True)

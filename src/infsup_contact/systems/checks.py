@@ -307,7 +307,7 @@ def check_positive_definite(A, path, what: str = "A"):
     certified it: from :data:`PARDISO_CHECK_MIN` rows, its Bunch–Kaufman LDLᵀ with n positive
     pivots, none negative and none perturbed below 1e-8 ‖A‖ is accepted at once; anything else
     goes to SuperLU, whose diagnosis names the failure. On a 3D export, membranes3d k = 2, N = 20,
-    121,680 rows, SuperLU's LDLᵀ took 113 s)."""
+    121,680 rows, SuperLU's LDLᵀ was most of the check)."""
     A = sp.csc_matrix(A)
     n = A.shape[0]
     if n >= PARDISO_CHECK_MIN and pardiso.available():

@@ -17,8 +17,8 @@ import numpy as np
 import scipy.io
 import yaml
 
-from infsup_contact.discretization.multipliers import make_space
-from infsup_contact.discretization.norms import gram_l2
+from infsup_contact.discretization.segment.multipliers import make_space
+from infsup_contact.discretization.segment.norms import gram_l2
 
 ROOT = Path(__file__).resolve().parents[1]
 EPS = np.finfo(float).eps

@@ -7,7 +7,7 @@ import re
 import tokenize
 from pathlib import Path
 
-from infsup_contact.discretization.registry import SPACES
+from infsup_contact.discretization.spaces.registry import SPACES
 
 ROOT = Path(__file__).resolve().parents[1]
 FOLDERS = ("src/infsup_contact/report", "workflow/rules", "workflow/scripts")
@@ -77,8 +77,8 @@ def test_elastic_stage_runs_the_configs_spaces(name):
     of the segment (the 2D DAG's; the face spaces of the 3D models are not its) and their user
     space, so the elastic stage runs what it ran when it took every registered space (the
     tables stay as they were)."""
-    from infsup_contact.discretization.registry import space_ids
-    from infsup_contact.discretization.user_spaces import load_user_space
+    from infsup_contact.discretization.spaces.registry import space_ids
+    from infsup_contact.discretization.spaces.user_spaces import load_user_space
 
     cfg = yaml.safe_load((ROOT / "config" / name).read_text())
     users = [load_user_space(ref).id for ref in cfg["spaces"]]

@@ -1,13 +1,13 @@
-"""1 ∈ M_h computed on the space a solver uses (discretization/constants.py): on the segment it
+"""1 ∈ M_h computed on the space a solver uses (discretization/gamma/constants.py): on the segment it
 agrees with the registry's rule for every space and degree; on the six-tetrahedra face the TRI3
 dual loses the constants at its two corner triangles (all three vertices on ∂Γ), and the patch
 test fails exactly there."""
 import numpy as np
 import pytest
 
-from infsup_contact.discretization import registry
-from infsup_contact.discretization.constants import interior_samples, spans_constants
-from infsup_contact.discretization.square import SQUARE, SQUARE_TRIG
+from infsup_contact.discretization.spaces import registry
+from infsup_contact.discretization.gamma.constants import interior_samples, spans_constants
+from infsup_contact.discretization.face.square import SQUARE, SQUARE_TRIG
 from infsup_contact.study import face_patch
 
 

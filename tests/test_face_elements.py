@@ -7,13 +7,13 @@ from math import factorial
 import numpy as np
 import pytest
 
-from infsup_contact.discretization.dual import dual_space
-from infsup_contact.discretization.face_dual import (
+from infsup_contact.discretization.segment.dual import dual_space
+from infsup_contact.discretization.face.spaces.dual_bases import (
     SWEEP_ALPHAS, alpha_sweep, dual_coefficients, dual_shapes, mass_matrix, transformation, weights)
-from infsup_contact.discretization.face_elements import (
+from infsup_contact.discretization.face.spaces.reference_elements import (
     ELEMENT_NAMES, cell_quadrature, pwlin_shapes, pwlin_subelements, reference_element)
-from infsup_contact.discretization.face_cells import CellwiseFaceSpace
-from infsup_contact.discretization.square import TensorPartition
+from infsup_contact.discretization.face.spaces.cellwise import CellwiseFaceSpace
+from infsup_contact.discretization.face.square import TensorPartition
 from infsup_contact.errors import InputError
 
 # the spaces by definition (not read from the module): which ξ^a η^b, a, b <= 2, they contain

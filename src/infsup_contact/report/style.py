@@ -25,8 +25,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from ..discretization.registry import OKABE_ITO as _OKABE_ITO  # noqa: E402
-from ..discretization.registry import SPACES, space_spec  # noqa: E402
+from ..discretization.spaces.registry import OKABE_ITO as _OKABE_ITO  # noqa: E402
+from ..discretization.spaces.registry import SPACES, space_spec  # noqa: E402
 
 #: Okabe & Ito (2008), "Color Universal Design" (the registry's palette).
 OKABE_ITO = MappingProxyType(_OKABE_ITO)

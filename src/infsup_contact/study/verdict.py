@@ -25,8 +25,8 @@ import time
 import numpy as np
 import pandas as pd
 
-from ..discretization import registry
-from ..discretization.norms import NORMS
+from ..discretization.spaces import registry
+from ..discretization.segment.norms import NORMS
 from ..errors import InputError
 from ..models import DEFAULT_MODEL
 from ..solvers.infsup import beta_rows
@@ -101,7 +101,7 @@ def verdict_rows(case_or_spec, k: int, family: str, ns, norm: str, *, tol: float
     Parameters
     ----------
     case_or_spec : str or SpaceSpec
-        A registry id (``T3``) or a registered :class:`~infsup_contact.discretization.registry.SpaceSpec`.
+        A registry id (``T3``) or a registered :class:`~infsup_contact.discretization.spaces.registry.SpaceSpec`.
     k : int
         Displacement degree (1..4, at least the space's ``min_k``).
     family : str

@@ -39,8 +39,8 @@ def suite_system(case: str, k: int, n1: int, n2: int, family: str = "structured"
 
 def _suite_parts(case, k, n1, n2, family, multiplier_mesh, model, **mesh_kwargs):
     """(A, B, the multiplier space, Γ, the two side operators) of ``case`` on the pair (N1, N2)."""
-    from ..discretization import registry
-    from ..discretization.coupling import coupling_matrix
+    from ..discretization.spaces import registry
+    from ..discretization.gamma.coupling import coupling_matrix
     from ..models.membranes import MEMBRANES
     from ..models.side_cache import SideCache
 
@@ -63,7 +63,7 @@ def suite_levels(case: str, k: int, ns, offset: int = 0, family: str = "structur
     """(levels, manifest norm, gamma) of ``case`` on N1 = N + offset, N2 = N for N in ``ns``, as
     :func:`write_system` takes them (module docstring: ``norm: H`` with the description where the
     space has one)."""
-    from ..discretization.registry import space_spec
+    from ..discretization.spaces.registry import space_spec
 
     spec, levels, described = space_spec(case), [], norm == "H"
     parts = [_suite_parts(case, k, n + offset, n, family, multiplier_mesh, model, **mesh_kwargs) for n in ns]
@@ -87,8 +87,8 @@ def suite_levels(case: str, k: int, ns, offset: int = 0, family: str = "structur
 def description(spec, space):
     """(the ``multipliers`` mapping of ``space``, the order of its basis functions as the
     description counts them) or None where it has none (module docstring)."""
-    from ..discretization.face_spaces import FaceSpace
-    from ..discretization.multipliers import MultiplierSpace
+    from ..discretization.face.spaces.tensor import FaceSpace
+    from ..discretization.segment.multipliers import MultiplierSpace
 
     if isinstance(space, MultiplierSpace):
         return segment_form(spec, space), np.arange(space.dim)
@@ -106,7 +106,7 @@ def trace_forms(sides, k: int):
     block, in the trace's order). On a hexahedral face at k = 1 the bilinear hats, the tensor
     product of the 1D hats (:func:`_face_trace_forms`); None on other faces (NGSolve's Q_k, k ≥ 2,
     and P_k bases are not tensor products of 1D Lagrange shapes)."""
-    from ..discretization.multipliers import reference_nodes
+    from ..discretization.segment.multipliers import reference_nodes
 
     if sides[0].trace.gamma.dim != 1:
         return _face_trace_forms(sides) if k == 1 and getattr(sides[0].trace.gamma, "cell", "") == "quad" else None

@@ -85,7 +85,7 @@ def read_level(manifest: Path, i: int):
 
 
 def described_space(desc: dict):
-    """The MultiplierSpace the manifest's helper form describes, and ``rows`` (row of B of
+    """The SegmentSpace the manifest's helper form describes, and ``rows`` (row of B of
     the j-th basis function left to right)."""
     bp = np.asarray(desc["breakpoints"], float)
     if desc["basis"] == "lagrange":

@@ -37,7 +37,7 @@ MALFORMED = {
                    "[[np.inf, 0], [0, 1]])", "None", "coefficients"),
     "dependent": ("return local_basis_space(x, 1, np.arange(2 * (len(x) - 1)).reshape(-1, 2), "
                   "[[1, 1], [2, 2]])", "None", "linearly independent"),
-    "not-a-space": ("return np.eye(3)", "None", "MultiplierSpace"),
+    "not-a-space": ("return np.eye(3)", "None", "SegmentSpace"),
 }
 
 

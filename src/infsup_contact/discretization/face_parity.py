@@ -37,7 +37,7 @@ INTERTWINE_RTOL = 1e-10
 
 
 def axis_parity(space) -> tuple | None:
-    """(Q_e, Q_o) of a 1D space (:class:`~.segment.multipliers.MultiplierSpace`) under x → 1 − x,
+    """(Q_e, Q_o) of a 1D space (:class:`~.segment.multipliers.SegmentSpace`) under x → 1 − x,
     checked at 4 Gauss points per interval, or None where the reflection does not map its basis."""
     t, _ = gauss_legendre(4)
     g = np.asarray(space.breakpoints, float)

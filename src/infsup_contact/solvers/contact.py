@@ -37,7 +37,7 @@ class ContactSolution:
 
     Attributes
     ----------
-    space : MultiplierSpace
+    space : SegmentSpace
         M_h; ``lam`` are its dof values (nodal, so the cone is lam >= 0).
     sides : list of SideOperator
     u : list of ngsolve.GridFunction
@@ -56,7 +56,7 @@ class ContactSolution:
         seconds.
     """
 
-    space: multipliers.MultiplierSpace
+    space: multipliers.SegmentSpace
     sides: list
     u: list
     lam: np.ndarray

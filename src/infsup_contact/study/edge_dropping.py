@@ -66,7 +66,7 @@ import numpy as np
 from ..discretization.spaces import registry
 from ..discretization.face.spaces.clipped import SLIVER_MIN, ClippedFace, edge_cases, min_covered_fraction
 from ..discretization.face.spaces.tensor import FaceSpace
-from ..discretization.segment.multipliers import MultiplierSpace, make_space
+from ..discretization.segment.multipliers import SegmentSpace, make_space
 from ..discretization.segment.norms import gram_l2
 from ..discretization.gamma.quadrature import gauss_legendre_01
 from ..discretization.face.square import SQUARE, Square, TensorPartition
@@ -111,13 +111,13 @@ def _merged(*grids, upper: float = 1.0) -> np.ndarray:
     return g[np.concatenate([[True], np.diff(g) > 1e-13])]
 
 
-def primal_twin(space: MultiplierSpace) -> MultiplierSpace:
+def primal_twin(space: SegmentSpace) -> SegmentSpace:
     """The Lagrange basis with the numbering of ``space`` (the N_j of κ_j)."""
-    return MultiplierSpace(space.breakpoints, space.degree, space.continuous, space.vanish_at_ends,
+    return SegmentSpace(space.breakpoints, space.degree, space.continuous, space.vanish_at_ends,
                            space.dofs, space.dim)
 
 
-def kappa_1d(space: MultiplierSpace, L: float) -> np.ndarray:
+def kappa_1d(space: SegmentSpace, L: float) -> np.ndarray:
     """κ_j = ∫_0^L |N_j| / ∫_0^1 |N_j| of the primal twin of the x factor (module docstring)."""
     twin = primal_twin(space)
     grid = _merged(space.breakpoints, [L])
@@ -213,7 +213,7 @@ def nodal_twin(full, L: float):
         return None
     cut = ClippedFace.of(full, L)
     sx = cut.space.sx
-    x = MultiplierSpace(sx.breakpoints, sx.degree, sx.continuous, False, sx.dofs, sx.dim)
+    x = SegmentSpace(sx.breakpoints, sx.degree, sx.continuous, False, sx.dofs, sx.dim)
     return ClippedFace.of(FaceSpace(x, full.sy, cut.space.breakpoints), L, cut=False)
 
 

@@ -218,8 +218,8 @@ def check_model_case(case: str, k: int, model, family: str = "structured", **mes
     allowed = registry.ids_built_on(k, gamma, g_h)
     if case in allowed:
         return
-    if not getattr(gamma, "builds", lambda s: True)(spec):
-        why = (f"built on {', '.join(spec.face_cells)} face cells only" if hasattr(gamma, "cell")
+    if not gamma.builds(spec):
+        why = (f"built on {', '.join(spec.face_cells)} face cells only" if gamma.cell is not None
                else "not built on a general triangulation of Γ: only Lagrange cases and their duals are")
     else:
         try:

@@ -78,7 +78,7 @@ def suite_levels(case: str, k: int, ns, offset: int = 0, family: str = "structur
         levels.append((1.0 / n, A, B[order], np.asarray(G, float)[np.ix_(order, order)], mult,
                        trace_forms(sides, k)))
     if described:
-        face = hasattr(parts[0][2], "factors")
+        face = parts[0][2].factors is not None
         gamma = {"shape": "rectangle", "size": [1.0, 1.0]} if face else {"shape": "segment", "length": 1.0}
         return levels, "H", gamma
     return levels, "given" if norm == "H" else "L2", None
@@ -88,11 +88,11 @@ def description(spec, space):
     """(the ``multipliers`` mapping of ``space``, the order of its basis functions as the
     description counts them) or None where it has none (module docstring)."""
     from ..discretization.face.spaces.tensor import FaceSpace
-    from ..discretization.segment.multipliers import MultiplierSpace
+    from ..discretization.segment.multipliers import SegmentSpace
 
-    if isinstance(space, MultiplierSpace):
+    if isinstance(space, SegmentSpace):
         return segment_form(spec, space), np.arange(space.dim)
-    if type(space) is FaceSpace and all(isinstance(f, MultiplierSpace) for f in space.factors):
+    if type(space) is FaceSpace and all(isinstance(f, SegmentSpace) for f in space.factors):
         sx, sy = space.factors
         i, j = np.divmod(np.arange(space.dim), sy.dim)  # FaceSpace's row i n_y + j; counted i + n_x j
         return {"x": segment_form(spec, sx), "y": segment_form(spec, sy)}, np.argsort(i + sx.dim * j)
@@ -109,7 +109,7 @@ def trace_forms(sides, k: int):
     from ..discretization.segment.multipliers import reference_nodes
 
     if sides[0].trace.gamma.dim != 1:
-        return _face_trace_forms(sides) if k == 1 and getattr(sides[0].trace.gamma, "cell", "") == "quad" else None
+        return _face_trace_forms(sides) if k == 1 and sides[0].trace.gamma.cell == "quad" else None
     out, offset = [], 0
     for sign, side in zip((-1, 1), sides):
         tr = side.trace
@@ -161,7 +161,7 @@ def segment_form(spec, space) -> dict:
     from .multiplier_basis import _segment
 
     x = [float(v) for v in space.breakpoints]
-    if spec is not None and getattr(spec, "lagrange", None) is not None:
+    if spec is not None and spec.lagrange is not None:
         continuous, vanish = spec.lagrange
         form = {"basis": "dual" if spec.dual else ("lagrange" if continuous else "discontinuous"),
                 "degree": int(space.degree), "breakpoints": x}

@@ -196,7 +196,7 @@ def _keys(where, key, value, allowed, what):
 
 
 def _segment(where, key, value, base, length: float, face: bool):
-    """(MultiplierSpace on the pull-back (0, 1), rows of B in its numbering) of a segment form."""
+    """(SegmentSpace on the pull-back (0, 1), rows of B in its numbering) of a segment form."""
     from ..discretization.segment.dual import dual_space
     from ..discretization.segment.multipliers import local_basis_space, make_space
 

@@ -79,7 +79,7 @@ def permutations(space) -> dict | None:
     the space is not a triangle space mapped onto itself."""
     if space.dim == 0:
         return {g: np.zeros(0, dtype=int) for g in ("T", "R", "TR")}
-    if not hasattr(space, "triangles"):
+    if not space.lives_on_triangles:
         return None
     t, r = transposition(space), reflection(space)
     if t is None or r is None:

@@ -288,10 +288,10 @@ class Square(Interface):
         every rectangle is cut by the diagonal of the trace cell containing it
         (:func:`~.face.quadrature.split_rule`), exact for the P_k × Q_s products. A space that is
         polynomial only on a finer tensor partition (its ``pieces``: 4C pwlin) is integrated on those."""
-        pieces = getattr(space, "pieces", space.breakpoints)
+        pieces = space.pieces
         if pieces is None:
             raise InputError("space", "a face space polynomial on the rectangles of a tensor partition",
-                             got=getattr(space, "element", space))
+                             got=space.element)
         if self.cell == "quad":
             return self.quadrature(self.common_refinement(trace.partition, pieces), degree)
         return split_rule(self.common_refinement(trace.partition, pieces), trace.partition, 2 * degree,
@@ -309,7 +309,7 @@ class Square(Interface):
 
         if isinstance(space, TriangleSpace):
             return gram_triangles(space, norm, **kwargs)
-        return (gram if hasattr(space, "factors") else gram_cellwise)(space, norm, **kwargs)
+        return (gram if space.factors is not None else gram_cellwise)(space, norm, **kwargs)
 
     def gram_session(self):
         """Spaces on one G_h that share a piece space reuse its series
@@ -320,7 +320,7 @@ class Square(Interface):
 
     def builds(self, spec) -> bool:
         """Whether ``spec`` is defined on this face's cells (``spec.face_cells``)."""
-        return self.cell in getattr(spec, "face_cells", CELL_SHAPES)
+        return self.cell in spec.face_cells
 
     def space(self, spec, k: int, partition):
         """The tensor product of ``spec``'s 1D space on xs and on ys (:class:`.face.spaces.tensor.FaceSpace`),
@@ -338,10 +338,10 @@ class Square(Interface):
         if not self.builds(spec):
             raise InputError("case", f"a space defined on faces of {self.cell} cells ({spec.id} pairs with "
                              f"{', '.join(spec.face_cells)} faces)", got=spec.id)
-        if getattr(spec, "face_build", None) is not None:
+        if spec.face_build is not None:
             return spec.face_build(k, partition)
-        s, dual = int(spec.degree(k)), getattr(spec, "dual", False)
-        if self.cell == "trig" and getattr(spec, "lagrange", None) is not None and (not dual or s in DUAL_ELEMENTS):
+        s, dual = int(spec.degree(k)), spec.dual
+        if self.cell == "trig" and spec.lagrange is not None and (not dual or s in DUAL_ELEMENTS):
             return TriangleSpace(partition, s, *spec.lagrange, dual=dual)
         return FaceSpace(spec.build(k, np.asarray(partition.xs, float)),
                          spec.build(k, np.asarray(partition.ys, float)), partition)
@@ -385,7 +385,7 @@ class Square(Interface):
         dimension count says (T4 at k = 2 on tetrahedra: the count is 0, the kernel 1). Not
         for P_k, k ≠ 2 (P_1 and P_3 vertex functions have non-zero integrals), nor where a trace's
         triangles differ from G_h's (non-matching meshes)."""
-        if self.cell != "trig" or k != 2 or getattr(space, "s", None) != 0 or getattr(space, "continuous", True):
+        if self.cell != "trig" or k != 2 or not space.lives_on_triangles or space.degree != 0 or space.continuous:
             return 0
         key = self.partition_key(space.breakpoints)
         return int(all(self.partition_key(p) == key for p in trace_partitions))

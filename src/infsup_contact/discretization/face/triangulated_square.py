@@ -189,7 +189,7 @@ class TriangulatedSquare(Interface):
     def builds(self, spec) -> bool:
         """Whether ``spec`` has a space on triangles of a general G_h: a Lagrange case, its dual
         of degree 1 or 2 (checked when built)."""
-        return getattr(spec, "lagrange", None) is not None and "trig" in getattr(spec, "face_cells", ("trig",))
+        return spec.lagrange is not None and "trig" in spec.face_cells
 
     def space(self, spec, k: int, partition):
         """P_s on the triangles of G_h (:class:`~.face.spaces.unstructured.MeshTriangleSpace`,
@@ -203,7 +203,7 @@ class TriangulatedSquare(Interface):
             raise InputError("case", f"a Lagrange case or its dual on a general triangulation of Γ "
                              f"({spec.id} has no space on triangles)", got=spec.id)
         continuous, vanish = spec.lagrange
-        return mesh_space(partition, int(spec.degree(k)), continuous, vanish, getattr(spec, "dual", False))
+        return mesh_space(partition, int(spec.degree(k)), continuous, vanish, spec.dual)
 
     # --- counts
     def trace_dimension(self, k: int, cells: int) -> int:
@@ -232,9 +232,11 @@ class TriangulatedSquare(Interface):
         c lies (one space for both sides when both contain S). Σ_c max(dim M_S − U, 0) is a lower
         bound of dim ker Bᵀ (the M_S of different corners are independent)."""
         glob = max(space.dim - dim_w, 0)
-        dofs = getattr(space, "_dofs", None)
-        if not isinstance(getattr(space, "breakpoints", None), Triangulation) or dofs is None:
+        from .spaces.unstructured import MeshTriangleSpace
+
+        if not isinstance(space, MeshTriangleSpace):
             return glob
+        dofs = space._dofs
         g_h = space.breakpoints
         count = np.bincount(dofs[dofs >= 0], minlength=space.dim)
         q = k * (k - 1) // 2

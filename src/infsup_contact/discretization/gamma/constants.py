@@ -46,7 +46,7 @@ def interior_samples(partition, per: int = SAMPLES_PER_DIRECTION) -> np.ndarray:
 def spans_constants(space) -> bool:
     """Whether the least-squares fit of the constant 1 by ``space``'s basis leaves no residual
     (≤ :data:`RESIDUAL_TOL`) at points inside every cell of the partition it is polynomial on."""
-    partition = getattr(space, "pieces", None) or space.breakpoints
+    partition = space.breakpoints if space.pieces is None else space.pieces
     x = interior_samples(partition)
     phi = space.evaluate(x)
     coef = np.linalg.lstsq(phi, np.ones(len(x)), rcond=None)[0]

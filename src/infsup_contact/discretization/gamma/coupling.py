@@ -13,7 +13,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from .interface import GammaTrace
-from ..segment.multipliers import MultiplierSpace
+from .protocol import MultiplierSpace
 
 
 def coupling_matrix(trace: GammaTrace, space: MultiplierSpace, k: int, extra_degree: int = 0,
@@ -47,7 +47,7 @@ def weighted_values(space, x: np.ndarray, w: np.ndarray) -> sp.csr_matrix:
     (the same products, sorted indices, no stored zeros), built from the space's nonzero pattern
     (``space.local_values``: each point sees (s + 1)^d basis functions) without the dense
     n_q × dim M array where the space has one, else from :meth:`evaluate`."""
-    local = space.local_values(x) if hasattr(space, "local_values") else None
+    local = space.local_values(x)
     if local is None:
         return sp.csr_matrix(space.evaluate(x) * w[:, None])
     vals, dofs = local

@@ -18,7 +18,7 @@ sides of a mesh pair finds Γ there (the trace itself: :mod:`.gamma.trace`).
 :class:`~.segment.interface.Segment` — Γ = (0, 1) × {1}, the paper's — is the first implementation
 (module :mod:`.segment.interface`); its partition
 is the sorted array of breakpoints (abscissae x of the vertices on Γ), the representation
-:class:`~.segment.multipliers.MultiplierSpace` and users' spaces (``build(k, x)``) are built on.
+:class:`~.segment.multipliers.SegmentSpace` and users' spaces (``build(k, x)``) are built on.
 The 2D contact face Γ = (0, 1)² × {1} of the 3D models is the second,
 :class:`~.face.square.Square` (tensor partitions; spaces are tensor products of the 1D builds,
 :meth:`Interface.space`); the same face traced by unstructured or perturbed tetrahedral meshes is
@@ -48,6 +48,10 @@ class Interface(abc.ABC):
     ``trace.partition``, ``space.breakpoints``) and pass them back — to the interface, or with it
     to ``registry.case_space(case, k, partition, gamma)`` — never inspecting them.
     """
+
+    cell: str | None = None
+    """The cell shape of a face's partitions (``quad``, ``trig``) where the spaces differ by it;
+    None for an interface whose spaces do not (the segment, general triangulations)."""
 
     # --- geometry -------------------------------------------------------------------------
     @property
@@ -221,6 +225,11 @@ class Interface(abc.ABC):
             Read-only (values may be cached on the trace).
         """
 
+    def sparse_trace_basis(self, trace: GammaTrace, x: np.ndarray):
+        """:meth:`trace_basis` as CSR made without the dense values, or None (the default): the
+        caller then converts the dense values (:meth:`GammaTrace.cached_sparse_basis`)."""
+        return None
+
     # --- quadrature and norms ---------------------------------------------------------------
     @abc.abstractmethod
     def quadrature(self, partition, degree: int) -> tuple:
@@ -343,6 +352,11 @@ class Interface(abc.ABC):
         int
         """
         return max(space.dim - dim_w, 0)
+
+    def builds(self, spec) -> bool:
+        """Whether this interface has a space of the registry entry ``spec`` (its cells permitting);
+        every entry defined on its dimension by default."""
+        return True
 
     def space(self, spec, k: int, partition):
         """The multiplier space of a registry entry on a partition of this interface.

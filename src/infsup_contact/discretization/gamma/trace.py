@@ -75,8 +75,9 @@ class GammaTrace:
         key = _points_key(x)
         phi = self.sparse_cache.get(key)
         if phi is None:
-            sparse = getattr(self.gamma, "sparse_trace_basis", None)
-            phi = sp.csr_matrix(self.gamma.trace_basis(self, x)) if sparse is None else sparse(self, x)
+            phi = self.gamma.sparse_trace_basis(self, x)
+            if phi is None:
+                phi = sp.csr_matrix(self.gamma.trace_basis(self, x))
             if len(self.sparse_cache) >= BASIS_CACHE_SIZE:
                 self.sparse_cache.clear()
             self.sparse_cache[key] = phi

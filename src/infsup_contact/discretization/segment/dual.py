@@ -34,7 +34,7 @@ from functools import lru_cache
 import numpy as np
 
 from ...errors import InputError
-from .multipliers import MultiplierSpace, local_shapes, make_space, reference_nodes
+from .multipliers import SegmentSpace, local_shapes, make_space, reference_nodes
 from ..gamma.quadrature import gauss_legendre_01
 
 
@@ -93,7 +93,7 @@ def _local_dual_coefficients(k: int, live: tuple) -> np.ndarray:
     return C
 
 
-def dual_space(breakpoints, k: int, vanish_at_ends: bool) -> MultiplierSpace:
+def dual_space(breakpoints, k: int, vanish_at_ends: bool) -> SegmentSpace:
     """The dual basis of W_h on ``breakpoints``: ``DUAL`` (vanish_at_ends) or ``DUAL-ALL``."""
     if not isinstance(k, (int, np.integer)) or k < 1:
         raise InputError("k", "an integer >= 1", got=k)
@@ -103,4 +103,4 @@ def dual_space(breakpoints, k: int, vanish_at_ends: bool) -> MultiplierSpace:
         live = np.flatnonzero(row >= 0)
         # an interval without a live node (one interval, k = 1, ends vanishing) has no dual function
         C[e] = local_dual_coefficients(k, live) if len(live) else 0.0
-    return MultiplierSpace(base.breakpoints, k, False, vanish_at_ends, base.dofs, base.dim, C)
+    return SegmentSpace(base.breakpoints, k, False, vanish_at_ends, base.dofs, base.dim, C)

@@ -11,7 +11,7 @@ series identity Σ_{n≥1} cos(nθ)/n = −ln|2 sin(θ/2)| (θ ∉ 2πℤ) gives
     ‖μ‖²_M = (1/π) ∬_{Γ×Γ} μ(x) μ(y) k(x, y) dx dy,
     k(x, y) = ln| sin(π(x+y)/2) / sin(π(x−y)/2) |.
 
-This module assembles G_ij = (1/π) ∬ φ_i φ_j k for a :class:`MultiplierSpace` without
+This module assembles G_ij = (1/π) ∬ φ_i φ_j k for a :class:`SegmentSpace` without
 truncating the series; :mod:`norms` computes the same matrix by the truncated series.
 
 Quadrature
@@ -58,7 +58,7 @@ from functools import lru_cache
 import numpy as np
 
 from ...errors import InputError
-from .multipliers import MultiplierSpace, local_shapes
+from .multipliers import SegmentSpace, local_shapes
 from ..gamma.quadrature import gauss_legendre_01
 
 __all__ = ["gram_h_logkernel", "log_kernel"]
@@ -269,7 +269,7 @@ def _local_blocks(xb_bytes: bytes, s: int, scale: int) -> np.ndarray:
     return loc
 
 
-def gram_h_logkernel(space: MultiplierSpace, *, quad_scale: int = 1) -> np.ndarray:
+def gram_h_logkernel(space: SegmentSpace, *, quad_scale: int = 1) -> np.ndarray:
     """Gram matrix of the H^{1/2}_00(Γ)-dual norm by the log-kernel double integral.
 
     G_ij = (1/π) ∬_{(0,1)²} φ_i(x) φ_j(y) k(x, y) dx dy with
@@ -280,7 +280,7 @@ def gram_h_logkernel(space: MultiplierSpace, *, quad_scale: int = 1) -> np.ndarr
 
     Parameters
     ----------
-    space : MultiplierSpace
+    space : SegmentSpace
         Multiplier space on a partition of Γ = (0, 1) (first breakpoint 0, last 1).
     quad_scale : int, optional
         Multiplies every quadrature order (for convergence checks); default 1.
@@ -293,11 +293,11 @@ def gram_h_logkernel(space: MultiplierSpace, *, quad_scale: int = 1) -> np.ndarr
     Raises
     ------
     InputError
-        If ``space`` is not a :class:`MultiplierSpace`, its breakpoints do not span
+        If ``space`` is not a :class:`SegmentSpace`, its breakpoints do not span
         [0, 1], or ``quad_scale`` is not a positive integer.
     """
-    if not isinstance(space, MultiplierSpace):
-        raise InputError("space", "a MultiplierSpace", got=type(space).__name__)
+    if not isinstance(space, SegmentSpace):
+        raise InputError("space", "a SegmentSpace", got=type(space).__name__)
     if isinstance(quad_scale, bool) or not isinstance(quad_scale, (int, np.integer)) or quad_scale < 1:
         raise InputError("quad_scale", "a positive integer", got=quad_scale)
     xb = np.asarray(space.breakpoints, dtype=float)

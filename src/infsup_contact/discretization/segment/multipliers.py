@@ -26,9 +26,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...errors import InputError
+from ..gamma.protocol import SpaceDefaults
 
 @dataclass(frozen=True)
-class MultiplierSpace:
+class SegmentSpace(SpaceDefaults):
     """A 1D piecewise-polynomial space on the partition ``breakpoints`` of Γ.
 
     Attributes
@@ -146,7 +147,7 @@ def local_monomial_coefficients(s: int) -> np.ndarray:
     return np.linalg.inv(vander).T
 
 
-def make_space(breakpoints, degree: int, continuous: bool, vanish_at_ends: bool) -> MultiplierSpace:
+def make_space(breakpoints, degree: int, continuous: bool, vanish_at_ends: bool) -> SegmentSpace:
     """Build the general space ``M^r_s`` or ``M^r_{0,s}`` on the partition ``breakpoints``.
 
     Raises
@@ -179,11 +180,11 @@ def make_space(breakpoints, degree: int, continuous: bool, vanish_at_ends: bool)
         elif vanish_at_ends:
             raise InputError("vanish_at_ends", "False for discontinuous P_0 (no endpoint nodes)")
     dim = int(dofs.max()) + 1
-    return MultiplierSpace(x, s, continuous, vanish_at_ends, dofs, dim)
+    return SegmentSpace(x, s, continuous, vanish_at_ends, dofs, dim)
 
 
 def local_basis_space(breakpoints, degree: int, dofs, coefficients=None, *, continuous: bool = False,
-                      vanish_at_ends: bool = False) -> MultiplierSpace:
+                      vanish_at_ends: bool = False) -> SegmentSpace:
     """A space given by its local basis and global numbering — the public way to define one.
 
     Parameters
@@ -226,5 +227,5 @@ def local_basis_space(breakpoints, degree: int, dofs, coefficients=None, *, cont
         if C.shape != (n, s + 1, s + 1) or not np.all(np.isfinite(C)):
             raise InputError("coefficients", "finite numbers of shape (s + 1, s + 1) or (N, s + 1, s + 1)",
                              got=C.shape)
-    return MultiplierSpace(x, s, bool(continuous), bool(vanish_at_ends), dofs.astype(int), len(used), C)
+    return SegmentSpace(x, s, bool(continuous), bool(vanish_at_ends), dofs.astype(int), len(used), C)
 

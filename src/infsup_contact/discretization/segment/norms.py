@@ -21,7 +21,7 @@ import numpy as np
 
 from ...errors import InputError
 from .logkernel import gram_h_logkernel
-from .multipliers import MultiplierSpace, local_monomial_coefficients, local_shapes
+from .multipliers import SegmentSpace, local_monomial_coefficients, local_shapes
 from ..gamma.quadrature import gauss_legendre_01
 from ..richardson import extrapolate
 
@@ -45,12 +45,12 @@ _CHUNK_ELEMENTS = 2**22
 
 
 # --------------------------------------------------------------------------- L² norm
-def gram_l2(space: MultiplierSpace) -> np.ndarray:
+def gram_l2(space: SegmentSpace) -> np.ndarray:
     """Exact L²(Γ) mass matrix of ``space``.
 
     Parameters
     ----------
-    space : MultiplierSpace
+    space : SegmentSpace
         The multiplier space.
 
     Returns
@@ -76,7 +76,7 @@ def gram_l2(space: MultiplierSpace) -> np.ndarray:
 
 
 # --------------------------------------------------------------- sine coefficients
-def sine_coefficients(space: MultiplierSpace, n, switch: float = IBP_SWITCH) -> np.ndarray:
+def sine_coefficients(space: SegmentSpace, n, switch: float = IBP_SWITCH) -> np.ndarray:
     """Sine coefficients φ_{j,n} = √2 ∫_0^1 φ_j(x) sin(nπx) dx of all basis functions.
 
     Per interval [a, b] (h = b − a, Ω = nπh) the integral of the local polynomial is taken
@@ -86,7 +86,7 @@ def sine_coefficients(space: MultiplierSpace, n, switch: float = IBP_SWITCH) -> 
 
     Parameters
     ----------
-    space : MultiplierSpace
+    space : SegmentSpace
         The multiplier space.
     n : array_like of int, shape (m,)
         Sine indices (n ≥ 1; n = 0 gives zeros).
@@ -112,7 +112,7 @@ def sine_coefficients(space: MultiplierSpace, n, switch: float = IBP_SWITCH) -> 
     return np.sqrt(2.0) * _scatter(space, space.to_local_basis(_local_sine_integrals(space, omega, switch)))
 
 
-def _local_sine_integrals(space: MultiplierSpace, omega: np.ndarray, switch: float) -> np.ndarray:
+def _local_sine_integrals(space: SegmentSpace, omega: np.ndarray, switch: float) -> np.ndarray:
     """∫_{x_e}^{x_{e+1}} ψ_{e,a}(x) sin(ωx) dx for all intervals e, shapes a, ω; (N, s+1, m)."""
     h = np.diff(space.breakpoints)
     big_omega = h[:, None] * omega[None, :]           # Ω = ωh, (N, m)
@@ -125,7 +125,7 @@ def _local_sine_integrals(space: MultiplierSpace, omega: np.ndarray, switch: flo
     return out
 
 
-def _ibp_integrals(space: MultiplierSpace, omega: np.ndarray, big_omega: np.ndarray) -> np.ndarray:
+def _ibp_integrals(space: SegmentSpace, omega: np.ndarray, big_omega: np.ndarray) -> np.ndarray:
     """Integration by parts, exact for polynomials: with x = a + h t, q(t) = p(x),
 
     ∫_a^b p(x) sin(ωx) dx = h Σ_{m=0}^{s} [q^{(m)}(t) F_m(ωx) / Ω^{m+1}]_{t=0}^{t=1},
@@ -157,7 +157,7 @@ def _endpoint_derivatives(s: int) -> tuple[np.ndarray, np.ndarray]:
     return d0, d1
 
 
-def _gauss_integrals(space: MultiplierSpace, omega, e_idx, n_idx) -> np.ndarray:
+def _gauss_integrals(space: SegmentSpace, omega, e_idx, n_idx) -> np.ndarray:
     """Gauss–Legendre integrals for the listed (interval, ω) pairs; shape (K, s+1)."""
     s = space.degree
     t, w = gauss_legendre_01(s + _GAUSS_EXTRA)
@@ -169,7 +169,7 @@ def _gauss_integrals(space: MultiplierSpace, omega, e_idx, n_idx) -> np.ndarray:
     return h[:, None] * ((sines * w[None, :]) @ vals)
 
 
-def _scatter(space: MultiplierSpace, local: np.ndarray) -> np.ndarray:
+def _scatter(space: SegmentSpace, local: np.ndarray) -> np.ndarray:
     """Sum local (N, s+1, m) contributions into global rows (dim, m) via ``dofs``.
 
     Continuous spaces share a dof between neighbouring intervals, hence the summation.
@@ -186,7 +186,7 @@ def _scatter(space: MultiplierSpace, local: np.ndarray) -> np.ndarray:
 
 
 # ------------------------------------------------------------------------- M norm
-def gram_h(space: MultiplierSpace, rtol: float = 1e-6, n_start: int | None = None,
+def gram_h(space: SegmentSpace, rtol: float = 1e-6, n_start: int | None = None,
            n_cap: int = N_MAX_CAP, switch: float = IBP_SWITCH) -> tuple[np.ndarray, dict]:
     """Gram matrix of the M = (H^{1/2}_00(Γ))' norm (Bathe & Brezzi 2001, eq. (3.9)).
 
@@ -201,7 +201,7 @@ def gram_h(space: MultiplierSpace, rtol: float = 1e-6, n_start: int | None = Non
 
     Parameters
     ----------
-    space : MultiplierSpace
+    space : SegmentSpace
         The multiplier space.
     rtol : float, optional
         Target of the stated relative truncation error (in G's metric: it bounds every
@@ -244,7 +244,7 @@ def gram_h(space: MultiplierSpace, rtol: float = 1e-6, n_start: int | None = Non
     return extrapolate(partial, 2.0, n0, n_cap, rtol)
 
 
-def _partial_gram(space: MultiplierSpace, n_first: int, n_last: int, switch: float) -> np.ndarray:
+def _partial_gram(space: SegmentSpace, n_first: int, n_last: int, switch: float) -> np.ndarray:
     """Σ_{n=n_first}^{n_last} φ_n φ_nᵀ / (nπ), in chunks so memory stays bounded."""
     G = np.zeros((space.dim, space.dim))
     chunk = max(1, _CHUNK_ELEMENTS // (space.n_intervals * (space.degree + 1)))
@@ -295,7 +295,7 @@ def gram_by_norm(norm: str, l2, h, **kwargs) -> tuple[np.ndarray, dict]:
     raise InputError("norm", ", ".join(NORMS), got=norm)
 
 
-def gram_h_route(space: MultiplierSpace, h_route: str = "logkernel", **kwargs) -> tuple[np.ndarray, dict]:
+def gram_h_route(space: SegmentSpace, h_route: str = "logkernel", **kwargs) -> tuple[np.ndarray, dict]:
     """The segment's H Gram matrix by ``h_route`` ∈ :data:`H_ROUTES`: the closed-form log kernel
     (no truncation; :data:`L2_INFO` reported) or the truncated, extrapolated sine series
     (:func:`gram_h`, ``kwargs`` passed on)."""
@@ -306,12 +306,12 @@ def gram_h_route(space: MultiplierSpace, h_route: str = "logkernel", **kwargs) -
     raise InputError("h_route", ", ".join(H_ROUTES), got=h_route)
 
 
-def gram(space: MultiplierSpace, norm: str, h_route: str = "logkernel", **kwargs) -> tuple[np.ndarray, dict]:
+def gram(space: SegmentSpace, norm: str, h_route: str = "logkernel", **kwargs) -> tuple[np.ndarray, dict]:
     """Gram matrix of ``space`` for ``norm`` ∈ {"H", "L2"}.
 
     Parameters
     ----------
-    space : MultiplierSpace
+    space : SegmentSpace
         The multiplier space.
     norm : {"H", "L2"}
         "H": the M = (H^{1/2}_00(Γ))' norm of Bathe & Brezzi (2001), eq. (3.9), see

@@ -21,7 +21,7 @@ from ..segment.dual import dual_space
 from .face_entries import register_face_cases
 from ..gamma.interface import MULTIPLIER_MESHES
 from ..segment.interface import SEGMENT
-from ..segment.multipliers import MultiplierSpace, make_space
+from ..segment.multipliers import SegmentSpace, make_space
 
 #: Okabe & Ito (2008), "Color Universal Design": distinguishable under the common
 #: colour-vision deficiencies.
@@ -51,7 +51,7 @@ class SpaceSpec:
     definition : str
         The space in the paper's notation (``M^1_{0,k}``).
     build : callable
-        ``build(k, breakpoints) -> MultiplierSpace`` on the partition G_h.
+        ``build(k, breakpoints) -> SegmentSpace`` on the partition G_h.
     degree : callable
         Local polynomial degree s(k) of the multipliers.
     min_k : int
@@ -102,7 +102,7 @@ class SpaceSpec:
     id: str
     paper_ref: str
     definition: str
-    build: Callable[[int, np.ndarray], MultiplierSpace]
+    build: Callable[[int, np.ndarray], SegmentSpace]
     degree: Callable[[int], int]
     min_k: int = 1
     expected: str = "unknown"
@@ -222,7 +222,7 @@ def ids_built_on(k: int, gamma, partition) -> list:
     ≤ 0 such as DUAL-Q8, raises :class:`InputError` "case" naming its remedy; it is left out)."""
     out = []
     for case in ids_valid_for(k, gamma_dim=gamma.dim):
-        if not getattr(gamma, "builds", lambda spec: True)(SPACES[case]):
+        if not gamma.builds(SPACES[case]):
             continue
         try:
             gamma.space(SPACES[case], k, partition)
@@ -241,7 +241,7 @@ def check_case(case: str, k: int) -> None:
         raise InputError("k", f"k >= {spec.min_k} for case {case} ({spec.paper_ref} needs k >= {spec.min_k})")
 
 
-def case_space(case: str, k: int, partition, gamma=SEGMENT) -> MultiplierSpace:
+def case_space(case: str, k: int, partition, gamma=SEGMENT) -> SegmentSpace:
     """The multiplier space of a registered case for displacement degree k on G_h, a
     ``partition`` of Γ = ``gamma`` (:mod:`.gamma.interface`; for the paper's segment the sorted
     breakpoints of G_h, what ``SpaceSpec.build(k, x)`` receives; for the face

@@ -2,7 +2,7 @@
 
 A user space is a function of no arguments returning a
 :class:`~infsup_contact.discretization.spaces.registry.SpaceSpec` whose ``build(k, breakpoints)``
-returns a :class:`~infsup_contact.discretization.segment.multipliers.MultiplierSpace` — usually from
+returns a :class:`~infsup_contact.discretization.segment.multipliers.SegmentSpace` — usually from
 :func:`~infsup_contact.discretization.segment.multipliers.make_space` (Lagrange, (5.3)/(5.5)) or
 :func:`~infsup_contact.discretization.segment.multipliers.local_basis_space` (any local basis and
 numbering). ``examples/macro_p0.py`` is one.
@@ -42,7 +42,7 @@ from pathlib import Path
 import numpy as np
 
 from ...errors import InputError
-from ..segment.multipliers import MultiplierSpace
+from ..segment.multipliers import SegmentSpace
 from .registry import K_RANGE, SPACES, SpaceSpec, register
 
 _LOADED: dict[str, SpaceSpec] = {}
@@ -145,14 +145,14 @@ def check_fields(spec, ref: str) -> None:
         raise InputError(f"space {spec.id!r}", "dimension a function dimension(k, N) or None", got=spec.dimension)
 
 
-def built_on(spec: SpaceSpec, ref: str, k: int, x: np.ndarray) -> MultiplierSpace:
-    """``spec.build(k, x)`` under the guard, checked to be a MultiplierSpace on the partition
+def built_on(spec: SpaceSpec, ref: str, k: int, x: np.ndarray) -> SegmentSpace:
+    """``spec.build(k, x)`` under the guard, checked to be a SegmentSpace on the partition
     ``x`` (same breakpoints, one row of dofs per interval) with the stated dimension."""
     n = len(x) - 1
     name = f"space {spec.id!r} from {ref}"
     space = run_user(ref, f"{spec.id}'s build(k={k}, breakpoints) on N = {n} intervals", spec.build, k, x.copy())
-    if not isinstance(space, MultiplierSpace):
-        raise InputError(name, f"build(k, breakpoints) returning a MultiplierSpace (got {type(space).__name__} "
+    if not isinstance(space, SegmentSpace):
+        raise InputError(name, f"build(k, breakpoints) returning a SegmentSpace (got {type(space).__name__} "
                          f"at k = {k}, N = {n})")
     bp = np.asarray(space.breakpoints, dtype=float)
     if bp.shape != x.shape or not np.allclose(bp, x, rtol=0.0, atol=1e-14):
@@ -181,7 +181,7 @@ def check_space(spec: SpaceSpec, ref: str = "", intervals=()) -> None:
     """Build ``spec`` for every k it allows on :data:`CHECK_PARTITION` and on the uniform
     partition of each N in ``intervals``, and check it.
 
-    Checked: :func:`built_on` (a MultiplierSpace on the given partition, of the stated
+    Checked: :func:`built_on` (a SegmentSpace on the given partition, of the stated
     dimension); its local degree is ``degree(k)``; basis values are finite; the basis is
     linearly independent (its L²(Γ) Gram matrix is positive definite to 1e-12 relative). A
     space of dimension 0 passes here: the N it is empty on is refused where N is given

@@ -28,6 +28,7 @@ from __future__ import annotations
 import numpy as np
 
 from ....errors import InputError
+from ...gamma.protocol import SpaceDefaults
 from .dual_bases import POPP_ALPHA, dual_coefficients, transformation
 from .reference_elements import pwlin_shapes, reference_element
 
@@ -55,7 +56,7 @@ def _nearest_live(nodes: np.ndarray, live: np.ndarray, dead: np.ndarray) -> np.n
     return R
 
 
-class CellwiseFaceSpace:
+class CellwiseFaceSpace(SpaceDefaults):
     """A multiplier space on the rectangles of ``partition`` (see the module docstring).
 
     Parameters

@@ -11,7 +11,7 @@ cell keep their values, restricted: ψ_a(θ t) = Σ_b ψ_a(θ τ_b) L_b(t) on th
 reference cell (exact for the degree-s polynomials, τ_b the Lagrange nodes).
 
 The restricted 1D space is stored pulled back to (0, 1), s = x / L, as a
-:class:`~.segment.multipliers.MultiplierSpace` (:func:`~.segment.multipliers.local_basis_space`), so the segment's
+:class:`~.segment.multipliers.SegmentSpace` (:func:`~.segment.multipliers.local_basis_space`), so the segment's
 machinery (sine coefficients, L² Gram) applies unchanged; the rectangle enters the norms only
 through the factor L of dx and the anisotropic weights of :func:`~.face.norms.tensor.partial_gram`
 (``aspect`` = L): ‖μ‖²_{H^{-1/2}_00(Γ)} = L Σ μ̃_mn² / (π√((m/L)² + n²)).
@@ -60,7 +60,7 @@ def clip_1d(space, L: float, scale=None, tol: float = CLIP_TOL):
 
     Parameters
     ----------
-    space : MultiplierSpace
+    space : SegmentSpace
         A 1D space on a partition of (0, 1).
     L : float
         The cut, 0 < L ≤ 1.
@@ -69,7 +69,7 @@ def clip_1d(space, L: float, scale=None, tol: float = CLIP_TOL):
 
     Returns
     -------
-    clipped : MultiplierSpace
+    clipped : SegmentSpace
         On the breakpoints (x_0, …, x_{e*}, L) / L.
     kept : ndarray of int
         The dofs of ``space`` kept, in the order of ``clipped``'s dofs.

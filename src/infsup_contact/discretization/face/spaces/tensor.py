@@ -21,14 +21,16 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ...gamma.protocol import SpaceDefaults
+
 
 @dataclass(frozen=True)
-class FaceSpace:
+class FaceSpace(SpaceDefaults):
     """M^x ⊗ M^y on a tensor partition of the face.
 
     Attributes
     ----------
-    sx, sy : MultiplierSpace
+    sx, sy : SegmentSpace
         The 1D factors on ``breakpoints.xs`` and ``breakpoints.ys``.
     breakpoints : TensorPartition
         G_h (what :meth:`~.gamma.interface.Interface.coupling_quadrature` reads).
@@ -62,7 +64,7 @@ class FaceSpace:
 
     def local_values(self, x: np.ndarray):
         """The nonzero pattern of :meth:`evaluate` (the face-splitting product of the 1D
-        patterns, :meth:`~.segment.multipliers.MultiplierSpace.local_values`): (values, dofs), each
+        patterns, :meth:`~.segment.multipliers.SegmentSpace.local_values`): (values, dofs), each
         (n, (s_x + 1)(s_y + 1)), dof −1 where a 1D factor dropped its shape. Every value is the
         same product μ^x_a(x) μ^y_b(y) :meth:`evaluate` forms, so the two agree bit for bit
         (up to the sign of zeros); None where a factor has no such pattern."""

@@ -34,6 +34,7 @@ from functools import cached_property
 import numpy as np
 
 from ....errors import InputError
+from ...gamma.protocol import SpaceDefaults
 
 
 def local_lattice(s: int) -> np.ndarray:
@@ -84,7 +85,7 @@ def dual_local(s: int, alpha: float | None = None) -> np.ndarray:
 
 
 @dataclass(frozen=True, eq=False)
-class TriangleSpace:
+class TriangleSpace(SpaceDefaults):
     """P_s (continuous or not, optionally vanishing on ∂Γ) on the triangulated tensor partition.
 
     Attributes
@@ -225,6 +226,8 @@ class TriangleSpace:
                                          ys[j] + pos[:, 1] * (ys[j + 1] - ys[j])])
                     out[g[g >= 0]] = p[g >= 0]
         return out
+
+    lives_on_triangles = True
 
     def triangles(self) -> np.ndarray:
         """The triangles (2 n_x n_y, 3, 2) of G_h, in (i, j, lower/upper) order."""

@@ -24,12 +24,13 @@ import numpy as np
 import scipy.sparse as sp
 
 from ....errors import InputError
+from ...gamma.protocol import SpaceDefaults
 from .triangles import DUAL_ELEMENTS, TriangleSpace, lagrange_barycentric, local_lattice
 from ..triangulation import Triangulation, lattice, locate, on_boundary
 
 
 @dataclass(frozen=True, eq=False)
-class MeshTriangleSpace:
+class MeshTriangleSpace(SpaceDefaults):
     """P_s (continuous or not, optionally vanishing on ∂Γ, optionally its dual basis) on the
     triangles of a :class:`~.face.triangulation.Triangulation` ``breakpoints`` (G_h).
 
@@ -100,6 +101,8 @@ class MeshTriangleSpace:
     def nodes(self) -> np.ndarray:
         """Coordinates (dim, 2) of the Lagrange nodes (centroids for s = 0)."""
         return self._lattice[0]
+
+    lives_on_triangles = True
 
     def triangles(self) -> np.ndarray:
         """The triangles (nt, 3, 2) of G_h."""

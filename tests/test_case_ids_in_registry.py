@@ -31,11 +31,26 @@ def code_strings(text: str):
             yield tok.start[0], tok.string
 
 
+STYLE_TABLE = ROOT / "src/infsup_contact/report/case_styles.py"
+"""The one table keyed by id on purpose: how each built-in space is drawn (data, no branch)."""
+
+
 def files():
     for folder in FOLDERS:
         for path in sorted((ROOT / folder).rglob("*")):
-            if path.suffix in (".py", ".smk") or path.name == "Snakefile":
+            if (path.suffix in (".py", ".smk") or path.name == "Snakefile") and path != STYLE_TABLE:
                 yield path
+
+
+def test_the_style_table_holds_data_only():
+    """case_styles.py is exempt from the scan above, so it must hold assignments only (no def,
+    no if): a colour per id cannot become a special case of the id."""
+    import ast
+
+    tree = ast.parse(STYLE_TABLE.read_text())
+    assert all(isinstance(node, (ast.Expr, ast.Assign, ast.ImportFrom, ast.Import)) for node in tree.body)
+    assert not any(isinstance(node, (ast.If, ast.IfExp, ast.Compare, ast.FunctionDef, ast.Lambda))
+                   for node in ast.walk(tree))
 
 
 def test_scanner_sees_code_and_skips_docs():

@@ -268,7 +268,7 @@ def test_n_equal_one_in_every_n_list(path):
 HEADER = """
 import numpy as np
 from infsup_contact.discretization.segment.multipliers import make_space
-from infsup_contact.discretization.spaces.registry import SpaceSpec
+from infsup_contact.discretization.spaces.spec import SpaceSpec
 
 def good_build(k, x):
     return make_space(x, k, True, True)

@@ -28,7 +28,7 @@ def forget_user_spaces():
 HEADER = """
 import numpy as np
 from infsup_contact.discretization.segment.multipliers import local_basis_space, make_space
-from infsup_contact.discretization.spaces.registry import SpaceSpec
+from infsup_contact.discretization.spaces.spec import SpaceSpec
 """
 MALFORMED = {
     # (build body, dimension, what the error must say)

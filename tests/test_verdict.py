@@ -202,7 +202,7 @@ def test_user_space_equal_to_r54_gets_r54_verdict(tmp_path):
     path = tmp_path / "copy_r54.py"
     path.write_text(
         "from infsup_contact.discretization.segment.multipliers import make_space\n"
-        "from infsup_contact.discretization.spaces.registry import SpaceSpec\n\n"
+        "from infsup_contact.discretization.spaces.spec import SpaceSpec\n\n"
         "def space():\n"
         "    return SpaceSpec('COPY-R5.4', 'user', 'M^0_{k-1}', lambda k, x: make_space(x, k - 1, False, False),\n"
         "                     lambda k: k - 1, dimension=lambda k, n: n * k)\n")

@@ -21,6 +21,7 @@ from scipy.linalg import lapack
 
 from ..discretization.segment import meshes, multipliers
 from ..discretization.spaces import registry
+from ..discretization.spaces.spec import SpaceSpec
 from ..discretization.gamma.coupling import coupling_matrix, trace_l2_norms
 from ..errors import InputError, check_prestress
 from . import bottom, reflection
@@ -206,12 +207,12 @@ def check_inputs(case, k, family, n1, n2, c1, c2, norm, multiplier_mesh) -> None
 
 def _space(case, k, partition, gamma=SEGMENT):
     """A named case on G_h = ``partition`` of ``gamma``, an unregistered
-    :class:`~infsup_contact.discretization.spaces.registry.SpaceSpec` (a study's variant, e.g. the α
+    :class:`~infsup_contact.discretization.spaces.spec.SpaceSpec` (a study's variant, e.g. the α
     sweep of study/face_alpha.py), or a general triple ``(label, s, continuous, vanish)``
     (eqs. 5.3, 5.5; spaces of the segment)."""
     if isinstance(case, str):
         return registry.case_space(case, k, partition, gamma)
-    if isinstance(case, registry.SpaceSpec):
+    if isinstance(case, SpaceSpec):
         return gamma.space(case, k, partition)
     _, s, continuous, vanish = case
     return multipliers.make_space(partition, s, continuous, vanish)

@@ -33,7 +33,7 @@ from ..discretization.face.spaces.dual_bases import alpha_sweep, transformation
 from ..discretization.face.spaces.reference_elements import reference_element
 from ..discretization.face.spaces.tri6 import triangle_builder
 from ..discretization.face.square import TensorPartition
-from ..discretization.spaces.registry import SpaceSpec
+from ..discretization.spaces.spec import SpaceSpec
 from ..errors import InputError
 
 ALPHAS = (0.05, 0.1, 0.125, 0.15, 0.2, 0.25, 0.3, 1.0 / 3.0, 0.4, 0.45)
@@ -54,7 +54,7 @@ def transformed_dual_spec(element: str, alpha: float) -> SpaceSpec:
     build = (cellwise_builder(element, "transformed_dual", True, alpha) if cell == "quad"
              else triangle_builder("transformed_dual", alpha))
     return SpaceSpec(f"TDUAL-{element}-a{alpha:.4g}", "Popp et al. 2010", f"transformed dual {element}, α = {alpha:.4g}",
-                     lambda k, x: None, lambda k: 2, min_k=2, gamma_dims=(2,), face_build=build, face_cells=(cell,))
+                     None, lambda k: 2, min_k=2, gamma_dims=(2,), face_build=build, face_cells=(cell,))
 
 
 def element_of(model: str, reference: str) -> str:

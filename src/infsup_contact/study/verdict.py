@@ -26,6 +26,7 @@ import numpy as np
 import pandas as pd
 
 from ..discretization.spaces import registry
+from ..discretization.spaces.spec import SpaceSpec
 from ..discretization.segment.norms import NORMS
 from ..errors import InputError
 from ..models import DEFAULT_MODEL
@@ -101,7 +102,7 @@ def verdict_rows(case_or_spec, k: int, family: str, ns, norm: str, *, tol: float
     Parameters
     ----------
     case_or_spec : str or SpaceSpec
-        A registry id (``T3``) or a registered :class:`~infsup_contact.discretization.spaces.registry.SpaceSpec`.
+        A registry id (``T3``) or a registered :class:`~infsup_contact.discretization.spaces.spec.SpaceSpec`.
     k : int
         Displacement degree (1..4, at least the space's ``min_k``).
     family : str
@@ -252,7 +253,7 @@ def check_criterion(tol: float, floor: float, confidence: float) -> None:
 
 
 def _case_id(case_or_spec) -> str:
-    if isinstance(case_or_spec, registry.SpaceSpec):
+    if isinstance(case_or_spec, SpaceSpec):
         if registry.SPACES.get(case_or_spec.id) is not case_or_spec:
             raise ValueError(f"space {case_or_spec.id!r} is not registered (registry.register it first)")
         return case_or_spec.id

@@ -1,188 +1,25 @@
 """One registry of multiplier spaces: every consumer asks it, none special-cases a case id.
 
-An entry (:class:`SpaceSpec`) carries what the suite needs to know about a space besides
-its basis: how to build it on a partition G_h for displacement degree k, the degrees it
-allows, its label and paper reference, what is expected of it (stable, or the dimension of
-its kernel on matching meshes, where a count is known), and its colour and marker in every
-figure. β_h, the contact solver, the ledger, the figures and the paper iterate over the
-registry; a new space (built in, or a user's, :func:`register`) appears in all of them.
+An entry (:class:`~.spec.SpaceSpec`) carries what the suite needs to know about a space besides
+its basis (how to build it, on which Γ, for which k, what is expected of it). β_h, the contact
+solver, the ledger, the figures and the paper iterate over the registry; a new space (built in,
+or a user's, :func:`register`) appears in all of them, drawn in the colour and marker the
+report's style gives its id.
 
-The paper's five cases (Section 5, eqs. (5.3)/(5.5)) are registered here, in the paper's order.
+The paper's five cases (Section 5, eqs. (5.3)/(5.5)) are registered here, in the paper's order,
+then the dual bases, then the face-only spaces of :mod:`.face_entries`.
 """
 from __future__ import annotations
-
-from dataclasses import dataclass, field
-from typing import Callable
 
 import numpy as np
 
 from ...errors import InputError
-from ..segment.dual import dual_space
-from .face_entries import register_face_cases
 from ..gamma.interface import MULTIPLIER_MESHES
+from ..segment.dual import dual_space
 from ..segment.interface import SEGMENT
 from ..segment.multipliers import SegmentSpace, make_space
-
-#: Okabe & Ito (2008), "Color Universal Design": distinguishable under the common
-#: colour-vision deficiencies.
-OKABE_ITO = {
-    "black": "#000000", "orange": "#E69F00", "sky_blue": "#56B4E9", "bluish_green": "#009E73",
-    "yellow": "#F0E442", "blue": "#0072B2", "vermillion": "#D55E00", "reddish_purple": "#CC79A7",
-}
-K_RANGE = (1, 4)
-"""Displacement degrees the suite supports."""
-
-
-WIDE_MARKERS = ("o", "s", "^", "v", "<", ">", "D", "d", "p", "h", "H", "8")
-"""Markers with a body: the figures tell k apart by the marker's fill style (none, full, left
-half, top half), which thin markers such as ``P``, ``X``, ``+``, ``x`` and ``*`` do not show."""
-
-
-@dataclass(frozen=True)
-class SpaceSpec:
-    """A multiplier space as the suite knows it.
-
-    Attributes
-    ----------
-    id : str
-        The case id used on the command line, in configs and in tables (``T3``).
-    paper_ref : str
-        Where the space and its verdict come from (``Thm 3``, ``Rem 5.2``).
-    definition : str
-        The space in the paper's notation (``M^1_{0,k}``).
-    build : callable
-        ``build(k, breakpoints) -> SegmentSpace`` on the partition G_h.
-    degree : callable
-        Local polynomial degree s(k) of the multipliers.
-    min_k : int
-        Smallest displacement degree the space is defined for.
-    expected : str
-        ``"stable"`` (β_h bounded away from 0), ``"unstable"`` or ``"unknown"``.
-    dimension : callable or None
-        ``dimension(k, N) -> int``: dim M_h on N intervals (the paper's counts for its cases),
-        None where no count is stated; it gives the structural kernel
-        (:meth:`structural_kernel`).
-    color, marker : str
-        Matplotlib colour and marker; stable spaces are drawn solid, others dashed. The
-        marker has a body (one of :data:`WIDE_MARKERS`): its fill style tells k apart.
-    nodal_basis : bool
-        True for Lagrange bases (a coefficient is a nodal value, so for s ≤ 1 the cone
-        "coefficients ≥ 0" is "λ_h ≥ 0 pointwise", (5.4)); False for other bases, whose
-        cone constrains coefficients only.
-    finding_meshes : tuple of str
-        Multiplier meshes (``omega2``, ``union``) on which the ledger records a finding
-        beyond the paper for non-matching pairs.
-    claim_tag : str or None
-        Prefix of the space's ledger claim ids; default the paper reference without spaces
-        (``Thm3-k1-structured-evenN``).
-    gamma_dims : tuple of int
-        Dimensions of the interfaces Γ the space is defined on: 1 the segment (the paper's
-        2D models), 2 the face (0, 1)² of the 3D models. The paper's cases are both (on the
-        face, the tensor products of their 1D builds); the face element spaces are (2,), and
-        :func:`space_ids` / :func:`ids_valid_for` list the segment's by default, so the 2D
-        consumers (configs, figures, the paper) never see them.
-    face_build : callable or None
-        ``face_build(k, partition) -> space`` on a tensor partition of the face, for a space
-        that is not a tensor product of ``build`` (:mod:`.face.spaces.cellwise`); ``dimension(k, N)`` is
-        then dim M_h on an N × N grid.
-    face_cells : tuple of str
-        The face cells (``quad``, ``trig``: :data:`~.face.square.CELL_SHAPES`) whose traces the space
-        is defined against: the quadratic quadrilateral elements' multipliers pair with QUAD9
-        traces (hexahedra) only, the TRI6 ones with P2 triangle traces (tetrahedra) only.
-    lagrange : tuple or None
-        ``(continuous, vanish)`` when ``build`` is the Lagrange space M^r_s / M^r_{0,s} of degree
-        s = ``degree(k)`` (:func:`~.segment.multipliers.make_space`): the description an interface
-        reads to build the analogue on other cells (P_s on triangles,
-        :meth:`~.face.square.Square.space`); None for other bases.
-    dual : bool
-        With ``lagrange``: the space is the dual (biorthogonal) basis of that Lagrange space
-        (:mod:`.segment.dual`; on triangles :class:`~.face.spaces.triangles.TriangleSpace` with ``dual=True``).
-    """
-
-    id: str
-    paper_ref: str
-    definition: str
-    build: Callable[[int, np.ndarray], SegmentSpace]
-    degree: Callable[[int], int]
-    min_k: int = 1
-    expected: str = "unknown"
-    dimension: Callable[[int, int], int] | None = None
-    color: str = "#4d4d4d"
-    marker: str = "8"
-    nodal_basis: bool = True
-    finding_meshes: tuple = field(default=())
-    claim_tag: str | None = None
-    gamma_dims: tuple = (1, 2)
-    face_build: Callable | None = None
-    face_cells: tuple = ("quad", "trig")
-
-    def defined_on(self, gamma_dim: int) -> bool:
-        """Whether the space exists on an interface Γ of dimension ``gamma_dim``."""
-        return gamma_dim in self.gamma_dims
-
-    def face_space(self, k: int, n: int):
-        """The space on the uniform n × n grid of the face: the square's build on the first face
-        cell shape the entry is defined on (``face_cells``: rectangles, else triangles)."""
-        from ..face.square import CELL_SHAPES, Square, TensorPartition
-
-        x = np.linspace(0.0, 1.0, n + 1)
-        cell = next(c for c in CELL_SHAPES if c in self.face_cells)
-        return Square(cell=cell).space(self, k, TensorPartition(x, x))
-    lagrange: tuple | None = None
-    dual: bool = False
-
-    @property
-    def tag(self) -> str:
-        return self.claim_tag or self.paper_ref.replace(" ", "")
-
-    @property
-    def stable(self) -> bool:
-        return self.expected == "stable"
-
-    def valid_for(self, k: int) -> bool:
-        return self.min_k <= k <= K_RANGE[1]
-
-    def contains_constants(self, k: int, n: int = 6) -> bool:
-        """Whether 1 ∈ M_h for displacement degree k, computed (not declared): the least-squares
-        fit of the constant by M_h on N = ``n`` uniform intervals leaves no residual at sample
-        points. What a patch test of a uniform pressure asks of M_h (study/patch.py). A
-        face-only space: its own check on the n × n grid of the face."""
-        if not self.defined_on(1):
-            space = self.face_space(k, n)
-            if hasattr(space, "contains_constants"):
-                return bool(space.contains_constants)
-            from ..face.spaces.tri6 import contains_constants
-
-            return contains_constants(space)
-        space = self.build(k, np.linspace(0.0, 1.0, n + 1))
-        x = np.linspace(0.0, 1.0, 8 * n * (self.degree(k) + 1) + 1)
-        phi = space.evaluate(x)
-        coef = np.linalg.lstsq(phi, np.ones_like(x), rcond=None)[0]
-        return bool(np.max(np.abs(phi @ coef - 1.0)) < 1e-10)
-
-    def structural_kernel(self, k: int, n: int) -> int | None:
-        """max(dim M − dim W, 0) on matching meshes with N intervals (W = the trace space),
-        None without a dimension count; a face-only space: on the n × n grid of the face."""
-        if self.dimension is None:
-            return None
-        if not self.defined_on(1):
-            from ..face.square import SQUARE
-
-            return max(self.dimension(k, n) - SQUARE.trace_dimension(k, n), 0)
-        return max(self.dimension(k, n) - SEGMENT.trace_dimension(k, n), 0)
-
-    def cone(self, k: int) -> str:
-        """``pointwise`` (λ_h ≥ 0 everywhere), ``nodal`` (at the Lagrange nodes) or
-        ``coefficients`` (the basis is not nodal)."""
-        if not self.nodal_basis:
-            return "coefficients"
-        return "pointwise" if self.degree(k) <= 1 else "nodal"
-
-    def label(self, k: int | None = None) -> str:
-        """Legend text: ``T3 (Thm 3)`` or ``T3 (Thm 3), k=2``."""
-        text = f"{self.id} ({self.paper_ref})"
-        return text if k is None else f"{text}, k={int(k)}"
-
+from .face_entries import FACE_SPACES
+from .spec import SpaceSpec
 
 SPACES: dict[str, SpaceSpec] = {}
 """Every registered space by id, in registration order (the paper's first)."""
@@ -355,27 +192,21 @@ def structural_kernel_dim(case: str, k: int, n_intervals: int) -> int:
     return space_spec(case).structural_kernel(k, n_intervals)
 
 
-def _paper_case(id, ref, definition, s_of_k, continuous, vanish, min_k, dimension, color, marker,
-                finding_meshes=()):
+def _paper_case(id, ref, definition, s_of_k, continuous, vanish, min_k, dimension, finding_meshes=()):
     def build(k, x):
         return make_space(x, s_of_k(k), continuous, vanish)
     return register(SpaceSpec(id, ref, definition, build, s_of_k, min_k,
                               expected="unstable" if ref.startswith("Rem") else "stable",
-                              dimension=dimension, color=color, marker=marker,
-                              finding_meshes=finding_meshes, lagrange=(continuous, vanish)))
+                              dimension=dimension, finding_meshes=finding_meshes, lagrange=(continuous, vanish)))
 
 
 # --- the paper's five cases (Section 5), in the paper's order ---------------------------
-_paper_case("T3", "Thm 3", "M^1_{0,k}", lambda k: k, True, True, 1, lambda k, n: n * k - 1,
-            OKABE_ITO["blue"], "o", finding_meshes=("union",))
-_paper_case("R5.2", "Rem 5.2", "M^1_k", lambda k: k, True, False, 1, lambda k, n: n * k + 1,
-            OKABE_ITO["orange"], "s", finding_meshes=("omega2",))
-_paper_case("T4", "Thm 4", "M^0_{k-2}", lambda k: k - 2, False, False, 2, lambda k, n: n * (k - 1),
-            OKABE_ITO["bluish_green"], "^")
+_paper_case("T3", "Thm 3", "M^1_{0,k}", lambda k: k, True, True, 1, lambda k, n: n * k - 1, finding_meshes=("union",))
+_paper_case("R5.2", "Rem 5.2", "M^1_k", lambda k: k, True, False, 1, lambda k, n: n * k + 1, finding_meshes=("omega2",))
+_paper_case("T4", "Thm 4", "M^0_{k-2}", lambda k: k - 2, False, False, 2, lambda k, n: n * (k - 1))
 _paper_case("R5.4", "Rem 5.4", "M^0_{k-1}", lambda k: k - 1, False, False, 1, lambda k, n: n * k,
-            OKABE_ITO["vermillion"], "D", finding_meshes=("omega2",))
-_paper_case("T5", "Thm 5", "M^1_{k-1}", lambda k: k - 1, True, False, 2, lambda k, n: n * (k - 1) + 1,
-            OKABE_ITO["reddish_purple"], "v")
+            finding_meshes=("omega2",))
+_paper_case("T5", "Thm 5", "M^1_{k-1}", lambda k: k - 1, True, False, 2, lambda k, n: n * (k - 1) + 1)
 
 PAPER_CASES = tuple(SPACES)
 """The paper's five case ids, in its order."""
@@ -383,16 +214,17 @@ PAPER_CASES = tuple(SPACES)
 # --- dual (biorthogonal) mortar multipliers (module dual) ---------------------------------
 register(SpaceSpec(
     "DUAL", "Wohlmuth 2000", "dual basis of M^1_{0,k} (on tetrahedral faces at k = 2, where the TRI6 "
-    "vertex weights ∫N = 0 leave no plain dual basis: the Popp-transformed one, α = 1/5, i.e. TDUAL-T6)", lambda k, x: dual_space(x, k, True), lambda k: k,
-    expected="stable", dimension=lambda k, n: n * k - 1, color=OKABE_ITO["black"], marker="p",
+    "vertex weights ∫N = 0 leave no plain dual basis: the Popp-transformed one, α = 1/5, i.e. TDUAL-T6)",
+    lambda k, x: dual_space(x, k, True), lambda k: k, expected="stable", dimension=lambda k, n: n * k - 1,
     nodal_basis=False, claim_tag="DUAL", finding_meshes=("omega2", "union"), lagrange=(True, True), dual=True))
 register(SpaceSpec(
     "DUAL-ALL", "dual of Rem 5.2", "dual basis of M^1_k", lambda k, x: dual_space(x, k, False), lambda k: k,
-    expected="unstable", dimension=lambda k, n: n * k + 1, color=OKABE_ITO["sky_blue"], marker="h",
-    nodal_basis=False, claim_tag="DUAL-ALL", lagrange=(True, False), dual=True))
+    expected="unstable", dimension=lambda k, n: n * k + 1, nodal_basis=False, claim_tag="DUAL-ALL",
+    lagrange=(True, False), dual=True))
 
-# --- face element spaces of the 3D models (issue 28): declared in their own module -----
-register_face_cases(register, SpaceSpec, OKABE_ITO)
+# --- spaces of the face only (the 3D models' quadratic elements) -------------------------
+for _spec in FACE_SPACES:
+    register(_spec)
 
 
 # --- roles the study gives to particular spaces (the one place they are spelled) --------

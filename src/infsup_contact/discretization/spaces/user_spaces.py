@@ -1,7 +1,7 @@
 """Users' multiplier spaces: ``FILE.py:FUNC`` or ``module:FUNC`` → a checked registry entry.
 
 A user space is a function of no arguments returning a
-:class:`~infsup_contact.discretization.spaces.registry.SpaceSpec` whose ``build(k, breakpoints)``
+:class:`~infsup_contact.discretization.spaces.spec.SpaceSpec` whose ``build(k, breakpoints)``
 returns a :class:`~infsup_contact.discretization.segment.multipliers.SegmentSpace` — usually from
 :func:`~infsup_contact.discretization.segment.multipliers.make_space` (Lagrange, (5.3)/(5.5)) or
 :func:`~infsup_contact.discretization.segment.multipliers.local_basis_space` (any local basis and
@@ -43,7 +43,8 @@ import numpy as np
 
 from ...errors import InputError
 from ..segment.multipliers import SegmentSpace
-from .registry import K_RANGE, SPACES, SpaceSpec, register
+from .registry import SPACES, register
+from .spec import K_RANGE, SpaceSpec
 
 _LOADED: dict[str, SpaceSpec] = {}
 _CHECKED: dict[str, set] = {}

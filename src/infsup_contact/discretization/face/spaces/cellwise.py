@@ -206,16 +206,10 @@ class CellwiseFaceSpace(SpaceDefaults):
         I, J = np.broadcast_to(I, (nx, ny, el.n_nodes)), np.broadcast_to(J, (nx, ny, el.n_nodes))
         return ((I == 0) | (I == 2 * nx) | (J == 0) | (J == 2 * ny)).reshape(nx * ny, el.n_nodes)
 
-    @property
-    def contains_constants(self) -> bool:
-        """Whether Σ of all basis functions ≡ 1 (checked at every cell's Gauss points)."""
-        pts, _ = self.quadrature(4)
-        return bool(np.max(np.abs(self.evaluate(pts).sum(1) - 1.0)) < 1e-10)
-
 
 def cellwise_builder(element: str, basis: str, vanish_on_boundary: bool = True, alpha=None,
                      refuse_with: str = ""):
-    """``build(k, partition)`` of a registry entry (:attr:`.spaces.registry.SpaceSpec.face_build`):
+    """``build(k, partition)`` of a registry entry (:attr:`.spaces.spec.SpaceSpec.face_build`):
     :class:`CellwiseFaceSpace` on the tensor partition G_h (k does not enter: the element
     fixes the multiplier degree). ``refuse_with`` is appended to the refusal of a dual basis
     with a weight ≤ 0 (the registered id of the remedy)."""

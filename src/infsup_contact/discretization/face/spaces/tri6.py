@@ -72,7 +72,7 @@ def tri6_space(partition, basis: str, alpha: float | None = None) -> TriangleSpa
 
 
 def triangle_builder(basis: str, alpha: float | None = None, refuse_with: str = ""):
-    """``face_build(k, partition)`` of a registry entry (:attr:`.spaces.registry.SpaceSpec.face_build`):
+    """``face_build(k, partition)`` of a registry entry (:attr:`.spaces.spec.SpaceSpec.face_build`):
     :func:`tri6_space` on G_h (k does not enter: TRI6 fixes the multiplier degree). ``refuse_with``
     replaces the generic remedy of a refused dual basis (the registered id of the remedy), as
     :func:`.face.spaces.cellwise.cellwise_builder` does for QUAD8."""
@@ -86,16 +86,3 @@ def triangle_builder(basis: str, alpha: float | None = None, refuse_with: str = 
                                  got=err.got) from None
             raise
     return build
-
-
-def contains_constants(space, per_cell: int = 3) -> bool:
-    """Whether 1 ∈ span of ``space`` (any face space with ``evaluate`` and ``breakpoints``): the
-    least-squares fit of 1 leaves no residual at the sample points of the tensor grid refined
-    ``per_cell`` times per direction, interior and cell edges included."""
-    from ..square import SQUARE
-
-    pts = SQUARE.sample(space.breakpoints, per_cell)
-    pts = np.vstack([pts, 0.5 * (pts[:-1] + pts[1:])])           # points off the grid lines too
-    phi = space.evaluate(pts)
-    coef = np.linalg.lstsq(phi, np.ones(len(pts)), rcond=None)[0]
-    return bool(np.max(np.abs(phi @ coef - 1.0)) < 1e-10)

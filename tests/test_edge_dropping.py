@@ -8,7 +8,8 @@ from infsup_contact.discretization.face.spaces.clipped import ClippedFace, clip_
 from infsup_contact.discretization.face.norms.tensor import partial_gram
 from infsup_contact.discretization.segment.norms import sine_coefficients
 from infsup_contact.discretization.gamma.quadrature import gauss_legendre_01
-from infsup_contact.discretization.face.square import SQUARE, TensorPartition
+from infsup_contact.discretization.face.square import SQUARE
+from infsup_contact.discretization.face.tensor_grid import TensorPartition
 from infsup_contact.errors import InputError
 from infsup_contact.solvers.infsup import spectrum
 from infsup_contact.study.edge_dropping import (edge_cases, edge_row, geometry, interface_operator,

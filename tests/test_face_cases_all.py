@@ -9,7 +9,8 @@ import pytest
 from _cli import run_in_process
 from infsup_contact.discretization.spaces.registry import SPACES, ids_built_on, ids_valid_for
 from infsup_contact.discretization.segment.interface import SEGMENT
-from infsup_contact.discretization.face.square import SQUARE, SQUARE_TRIG, TensorPartition
+from infsup_contact.discretization.face.square import SQUARE, SQUARE_TRIG
+from infsup_contact.discretization.face.tensor_grid import TensorPartition
 
 GRID = TensorPartition(np.linspace(0, 1, 3), np.linspace(0, 1, 3))
 

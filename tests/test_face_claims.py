@@ -202,7 +202,7 @@ def test_quadrilateral_element_spaces_are_not_built_on_triangles():
     quad_only = [s for s in SPACES.values() if s.face_cells == ("quad",)]
     assert quad_only and all(SQUARE.builds(s) and not SQUARE_TRIG.builds(s) for s in quad_only)
     x = __import__("numpy").linspace(0.0, 1.0, 3)
-    from infsup_contact.discretization.face.square import TensorPartition
+    from infsup_contact.discretization.face.tensor_grid import TensorPartition
 
     with pytest.raises(InputError, match="faces"):
         SQUARE_TRIG.space(quad_only[0], 2, TensorPartition(x, x))

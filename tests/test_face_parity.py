@@ -10,7 +10,8 @@ from infsup_contact.discretization.face.norms import tensor as fn
 from infsup_contact.discretization import face_parity as fp
 from infsup_contact.discretization.spaces import registry
 from infsup_contact.discretization.segment.norms import sine_coefficients
-from infsup_contact.discretization.face.square import SQUARE, TensorPartition
+from infsup_contact.discretization.face.square import SQUARE
+from infsup_contact.discretization.face.tensor_grid import TensorPartition
 
 
 def _space(case, k, xs):

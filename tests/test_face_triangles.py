@@ -12,7 +12,8 @@ from infsup_contact.discretization.face.quadrature import triangles_rule
 from infsup_contact.discretization.face.spaces.tensor import FaceSpace
 from infsup_contact.discretization.face.spaces.triangles import TriangleSpace
 from infsup_contact.discretization.spaces.registry import SPACES, case_space, ids_valid_for
-from infsup_contact.discretization.face.square import SQUARE, SQUARE_TRIG, TensorPartition
+from infsup_contact.discretization.face.square import SQUARE, SQUARE_TRIG
+from infsup_contact.discretization.face.tensor_grid import TensorPartition
 from infsup_contact.errors import InputError
 from infsup_contact.models import make_model
 from infsup_contact.models.side_cache import SideCache

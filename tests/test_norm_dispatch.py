@@ -15,7 +15,8 @@ from infsup_contact.discretization.face.spaces.triangles import TriangleSpace
 from infsup_contact.discretization.face.spaces.unstructured import mesh_space
 from infsup_contact.discretization.segment.multipliers import make_space
 from infsup_contact.discretization.spaces.registry import case_space
-from infsup_contact.discretization.face.square import SQUARE, TensorPartition
+from infsup_contact.discretization.face.square import SQUARE
+from infsup_contact.discretization.face.tensor_grid import TensorPartition
 from infsup_contact.discretization.face.triangulation import from_elements
 from infsup_contact.errors import InputError
 

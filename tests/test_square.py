@@ -6,7 +6,8 @@ import ngsolve
 import pytest
 
 from infsup_contact.discretization.gamma.interface import Interface
-from infsup_contact.discretization.face.square import SQUARE, SQUARE_TRIG, Square, TensorPartition
+from infsup_contact.discretization.face.square import SQUARE, SQUARE_TRIG, Square
+from infsup_contact.discretization.face.tensor_grid import TensorPartition
 from infsup_contact.errors import InputError
 from infsup_contact.models.membranes3d import displacement_space, subdomain_mesh
 

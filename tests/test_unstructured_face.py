@@ -17,7 +17,8 @@ from infsup_contact.discretization.face.norms import unstructured as tf
 from infsup_contact.discretization.face.spaces.triangles import TriangleSpace
 from infsup_contact.discretization.face.spaces.unstructured import MeshTriangleSpace, mesh_space
 from infsup_contact.discretization.spaces.registry import SPACES, case_space
-from infsup_contact.discretization.face.square import SQUARE_TRIG, TensorPartition
+from infsup_contact.discretization.face.square import SQUARE_TRIG
+from infsup_contact.discretization.face.tensor_grid import TensorPartition
 from infsup_contact.discretization.face.triangulated_square import TRIANGULATED
 from infsup_contact.discretization.face.triangulation import Triangulation, barycentric, locate, overlay
 from infsup_contact.errors import InputError

@@ -69,7 +69,8 @@ from ..discretization.face.spaces.tensor import FaceSpace
 from ..discretization.segment.multipliers import SegmentSpace, make_space
 from ..discretization.segment.norms import gram_l2
 from ..discretization.gamma.quadrature import gauss_legendre_01
-from ..discretization.face.square import SQUARE, Square, TensorPartition
+from ..discretization.face.square import SQUARE, Square
+from ..discretization.face.tensor_grid import TensorPartition
 from ..errors import InputError
 from ..models import model_of_dim
 from ..models.schur import combine_terms, interface_terms

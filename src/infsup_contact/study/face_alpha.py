@@ -32,7 +32,7 @@ from ..discretization.face.spaces.cellwise import cellwise_builder
 from ..discretization.face.spaces.dual_bases import alpha_sweep, transformation
 from ..discretization.face.spaces.reference_elements import reference_element
 from ..discretization.face.spaces.tri6 import triangle_builder
-from ..discretization.face.square import TensorPartition
+from ..discretization.face.tensor_grid import TensorPartition
 from ..discretization.spaces.spec import SpaceSpec
 from ..errors import InputError
 

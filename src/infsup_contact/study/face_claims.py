@@ -45,7 +45,8 @@ import pandas as pd
 from ..discretization.spaces.registry import SPACES
 from ..errors import InputError
 from ..discretization.face.kernel_bounds import symmetric_kernel_bound
-from ..discretization.face.square import SQUARE, SQUARE_TRIG, Square, TensorPartition
+from ..discretization.face.square import SQUARE, SQUARE_TRIG, Square
+from ..discretization.face.tensor_grid import TensorPartition
 from .claims import FAIL, INCONCLUSIVE, PASS, bounded_claim, close_decisions, close_text, finest, kernel_claim, row, \
     slope_verdict
 

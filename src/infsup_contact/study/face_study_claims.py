@@ -41,7 +41,7 @@ import pandas as pd
 from ..discretization.gamma.constants import spans_constants
 from ..discretization.face.spaces.dual_bases import weights
 from ..discretization.spaces.registry import SPACES
-from ..discretization.face.square import TensorPartition
+from ..discretization.face.tensor_grid import TensorPartition
 from .claims import COLUMNS, FAIL, INCONCLUSIVE, PASS, row, slope_verdict
 from .face_claims import face_dimension
 

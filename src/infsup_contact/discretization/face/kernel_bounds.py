@@ -52,7 +52,7 @@ from ..gamma.coupling import weighted_values
 from .quadrature import split_triangles, triangles_rule
 from .symmetry import reflection, transposition
 from .spaces.triangles import TriangleSpace
-from .square import TensorPartition
+from .tensor_grid import TensorPartition
 
 #: The isotypic components (χ(T), χ(R)) of G = {id, T, R, TR}; χ(TR) = χ(T) χ(R).
 COMPONENTS = ((1, 1), (1, -1), (-1, 1), (-1, -1))

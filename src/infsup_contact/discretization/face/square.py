@@ -27,41 +27,13 @@ import numpy as np
 import scipy.sparse as sp
 
 from ...errors import InputError
-from ..gamma.interface import GammaTrace, Interface, check_choice
+from ..gamma.interface import Interface, check_choice
+from ..gamma.trace import GammaTrace
 from .quadrature import split_rule
+from .tensor_grid import TensorPartition, coarsening_cells, merge_breakpoints
 from ..gamma.quadrature import gauss_legendre
 
 CELL_SHAPES = ("quad", "trig")
-
-
-@dataclass(frozen=True, eq=False)
-class TensorPartition:
-    """The rectangles [xs[i], xs[i+1]] × [ys[j], ys[j+1]] of the face (0, 1)².
-
-    Attributes
-    ----------
-    xs, ys : ndarray
-        Sorted breakpoints in x and in y, from 0 to 1.
-    """
-
-    xs: np.ndarray
-    ys: np.ndarray
-
-    @property
-    def cells(self) -> int:
-        """Number of rectangles."""
-        return (len(self.xs) - 1) * (len(self.ys) - 1)
-
-
-def _merge(x: np.ndarray, tol: float) -> np.ndarray:
-    """Sorted unique values of ``x``, values closer than ``tol`` merged into the first."""
-    x = np.unique(np.asarray(x, dtype=float))
-    return x[np.concatenate([[True], np.diff(x) > tol])]
-
-
-def _coarsening_cells(a: np.ndarray, b: np.ndarray, tol: float = 1e-12) -> int:
-    """Cells of the common coarsening of two 1D partitions (their shared breakpoints)."""
-    return int(np.sum(np.min(np.abs(a[:, None] - b[None, :]), axis=1) < tol)) - 1
 
 
 @dataclass(frozen=True)
@@ -117,7 +89,7 @@ class Square(Interface):
         if not elements:
             raise InputError("mesh", f"boundary elements named {self.boundary!r} on Γ")
         pts = np.vstack([v for _, v in elements])
-        part = TensorPartition(_merge(pts[:, 0], tol), _merge(pts[:, 1], tol))
+        part = TensorPartition(merge_breakpoints(pts[:, 0], tol), merge_breakpoints(pts[:, 1], tol))
         per_cell = 1 if self.cell == "quad" else 2
         nv = 4 if self.cell == "quad" else 3
         lo = np.array([v.min(axis=0) for _, v in elements])
@@ -142,8 +114,8 @@ class Square(Interface):
     def common_refinement(self, *partitions, tol: float = 1e-12) -> TensorPartition:
         """Union of the x breakpoints and of the y breakpoints, merging within ``tol`` (for
         triangles the tensor grid under them: :meth:`coupling_quadrature` cuts its cells)."""
-        return TensorPartition(_merge(np.concatenate([p.xs for p in partitions]), tol),
-                               _merge(np.concatenate([p.ys for p in partitions]), tol))
+        return TensorPartition(merge_breakpoints(np.concatenate([p.xs for p in partitions]), tol),
+                               merge_breakpoints(np.concatenate([p.ys for p in partitions]), tol))
 
     def multiplier_partition(self, trace1, trace2, choice: str = "omega2", tol: float = 1e-12):
         check_choice(choice)
@@ -364,7 +336,7 @@ class Square(Interface):
         equals the numerical rank of both trace bases on every pair tested (k = 1..3)."""
         d = [(len(p.xs) - 1) * k - 1 for p in (trace1, trace2)]
         e = [(len(p.ys) - 1) * k - 1 for p in (trace1, trace2)]
-        dc = (_coarsening_cells(trace1.xs, trace2.xs) * k - 1) * (_coarsening_cells(trace1.ys, trace2.ys) * k - 1)
+        dc = (coarsening_cells(trace1.xs, trace2.xs) * k - 1) * (coarsening_cells(trace1.ys, trace2.ys) * k - 1)
         return d[0] * e[0] + d[1] * e[1] - max(dc, 0)
 
     def proven_kernel(self, space, k: int, traces, dim_w: int) -> int:

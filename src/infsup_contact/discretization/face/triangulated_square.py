@@ -29,7 +29,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ...errors import InputError
-from ..gamma.interface import GammaTrace, Interface, check_choice
+from ..gamma.interface import Interface, check_choice
+from ..gamma.trace import GammaTrace
 from .square import SQUARE_TRIG
 from .triangulation import (CORNERS, Triangulation, contains, corner_triangles, from_elements, interior_nodes,
                             locate, matched_interior_nodes, on_boundary, overlay)

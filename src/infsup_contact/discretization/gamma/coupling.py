@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
-from .interface import GammaTrace
+from .trace import GammaTrace
 from .protocol import MultiplierSpace
 
 

@@ -15,10 +15,9 @@ partition apart. A partition is opaque to them: they obtain it from the interfac
 back to it. A side's trace carries its interface (``trace.gamma``), so a consumer holding the
 sides of a mesh pair finds Γ there (the trace itself: :mod:`.gamma.trace`).
 
-:class:`~.segment.interface.Segment` — Γ = (0, 1) × {1}, the paper's — is the first implementation
-(module :mod:`.segment.interface`); its partition
-is the sorted array of breakpoints (abscissae x of the vertices on Γ), the representation
-:class:`~.segment.multipliers.SegmentSpace` and users' spaces (``build(k, x)``) are built on.
+:class:`~.segment.interface.Segment` — Γ = (0, 1) × {1}, the paper's — is the first implementation;
+its partition is the sorted array of breakpoints (abscissae x of the vertices on Γ), the
+representation :class:`~.segment.multipliers.SegmentSpace` and users' spaces (``build(k, x)``) are built on.
 The 2D contact face Γ = (0, 1)² × {1} of the 3D models is the second,
 :class:`~.face.square.Square` (tensor partitions; spaces are tensor products of the 1D builds,
 :meth:`Interface.space`); the same face traced by unstructured or perturbed tetrahedral meshes is
@@ -33,7 +32,7 @@ import contextlib
 import numpy as np
 
 from ...errors import InputError
-from .trace import BASIS_CACHE_SIZE, GammaTrace  # noqa: F401  (a side's trace, re-exported)
+from .trace import GammaTrace
 
 MULTIPLIER_MESHES = ("omega2", "omega1", "union")
 """The choices of G_h: the trace partition of Ω2 (the paper's default), of Ω1, or their union."""
@@ -50,8 +49,7 @@ class Interface(abc.ABC):
     """
 
     cell: str | None = None
-    """The cell shape of a face's partitions (``quad``, ``trig``) where the spaces differ by it;
-    None for an interface whose spaces do not (the segment, general triangulations)."""
+    """A face's cell shape (``quad``, ``trig``) where its spaces depend on it, else None."""
 
     # --- geometry -------------------------------------------------------------------------
     @property
@@ -226,8 +224,7 @@ class Interface(abc.ABC):
         """
 
     def sparse_trace_basis(self, trace: GammaTrace, x: np.ndarray):
-        """:meth:`trace_basis` as CSR made without the dense values, or None (the default): the
-        caller then converts the dense values (:meth:`GammaTrace.cached_sparse_basis`)."""
+        """:meth:`trace_basis` as CSR without the dense values; None (default): convert the dense."""
         return None
 
     # --- quadrature and norms ---------------------------------------------------------------
@@ -354,8 +351,7 @@ class Interface(abc.ABC):
         return max(space.dim - dim_w, 0)
 
     def builds(self, spec) -> bool:
-        """Whether this interface has a space of the registry entry ``spec`` (its cells permitting);
-        every entry defined on its dimension by default."""
+        """Whether this interface has a space of the registry entry ``spec``; default: every one."""
         return True
 
     def space(self, spec, k: int, partition):
@@ -370,13 +366,12 @@ class Interface(abc.ABC):
             A registry entry (:mod:`.spaces.registry`).
         k : int
             Displacement degree.
-        partition : partition
-            G_h.
+        partition : G_h
 
         Returns
         -------
-        space
-            With ``dim``, ``degree``, ``breakpoints`` (= ``partition``) and ``evaluate(x)``.
+        MultiplierSpace
+            On ``partition`` (:mod:`.protocol`).
 
         Raises
         ------

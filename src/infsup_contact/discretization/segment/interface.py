@@ -7,7 +7,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..gamma.interface import GammaTrace, Interface, check_choice
+from ..gamma.interface import Interface, check_choice
+from ..gamma.trace import GammaTrace
 from ..gamma.quadrature import gauss_legendre
 
 

@@ -110,7 +110,8 @@ class SpaceSpec:
     def face_space(self, k: int, n: int):
         """The space on the uniform n × n grid of the face: the square's build on the first face
         cell shape the entry is defined on (``face_cells``: rectangles, else triangles)."""
-        from ..face.square import CELL_SHAPES, Square, TensorPartition
+        from ..face.square import CELL_SHAPES, Square
+        from ..face.tensor_grid import TensorPartition
 
         x = np.linspace(0.0, 1.0, n + 1)
         cell = next(c for c in CELL_SHAPES if c in self.face_cells)

@@ -88,7 +88,8 @@ def _check_edge_dropping(fc, ed) -> None:
     """Each θ is one the geometry resolves at the largest N (a narrower cut column was dropped
     whole: θ = 1e-12 computed θ = 0), and each k has an edge case among ``face.cases`` (a k
     without one computed nothing)."""
-    from .discretization.face.spaces.clipped import SLIVER_MIN, edge_cases, min_covered_fraction
+    from .discretization.face.spaces.clipped import SLIVER_MIN, min_covered_fraction
+    from .discretization.spaces.registry import edge_cases
 
     n = max(ed["N"])
     for i, theta in enumerate(ed["theta"]):

@@ -64,7 +64,8 @@ from functools import lru_cache
 import numpy as np
 
 from ..discretization.spaces import registry
-from ..discretization.face.spaces.clipped import SLIVER_MIN, ClippedFace, edge_cases, min_covered_fraction
+from ..discretization.face.spaces.clipped import SLIVER_MIN, ClippedFace, min_covered_fraction
+from ..discretization.spaces.registry import edge_cases
 from ..discretization.face.spaces.tensor import FaceSpace
 from ..discretization.segment.multipliers import SegmentSpace, make_space
 from ..discretization.segment.norms import gram_l2

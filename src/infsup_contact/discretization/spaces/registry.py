@@ -71,6 +71,15 @@ def ids_built_on(k: int, gamma, partition) -> list:
     return out
 
 
+def edge_cases(k: int) -> list:
+    """Registered spaces that make sense on a moving face boundary (edge dropping, a face clipped
+    at x = L, :mod:`infsup_contact.study.edge_dropping`): every case valid for k whose 1D factor does not
+    vanish at the ends (a space vanishing on ∂(Ω1's face) does not vanish on the edge x = L of
+    Γ: not the natural analogue)."""
+    x = np.linspace(0.0, 1.0, 5)
+    return [c for c in ids_valid_for(k) if not space_spec(c).build(k, x).vanish_at_ends]
+
+
 def check_case(case: str, k: int) -> None:
     """Raise :class:`InputError` unless ``case`` is registered and valid for degree ``k``."""
     spec = space_spec(case)

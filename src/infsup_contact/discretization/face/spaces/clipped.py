@@ -43,18 +43,6 @@ def min_covered_fraction(n: int) -> float:
     return SLIVER_MIN * n
 
 
-def edge_cases(k: int) -> list:
-    """Registered spaces that make sense on a moving face boundary (edge dropping,
-    :mod:`infsup_contact.study.edge_dropping`): every case valid for k whose 1D factor does not
-    vanish at the ends (a space vanishing on ∂(Ω1's face) does not vanish on the edge x = L of
-    Γ: not the natural analogue)."""
-    from ...spaces import registry
-
-    x = np.linspace(0.0, 1.0, 5)
-    return [c for c in registry.ids_valid_for(k)
-            if not registry.space_spec(c).build(k, x).vanish_at_ends]
-
-
 def clip_1d(space, L: float, scale=None, tol: float = CLIP_TOL):
     """The 1D space restricted to [0, L] and pulled back to (0, 1); see the module docstring.
 

@@ -263,7 +263,7 @@ class Square(Interface):
         pieces = space.pieces
         if pieces is None:
             raise InputError("space", "a face space polynomial on the rectangles of a tensor partition",
-                             got=space.element)
+                             got=space.name)
         if self.cell == "quad":
             return self.quadrature(self.common_refinement(trace.partition, pieces), degree)
         return split_rule(self.common_refinement(trace.partition, pieces), trace.partition, 2 * degree,

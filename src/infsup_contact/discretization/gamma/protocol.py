@@ -28,6 +28,10 @@ class MultiplierSpace(Protocol):
     degree : int
         Local polynomial degree s of the basis (per variable on rectangles, total on
         triangles): it sets the Gauss order of the coupling ∫_Γ μ_j φ_d.
+    continuous : bool
+        Whether every μ_j is continuous on Γ (r = 1 in the paper's M^r_s); the face's Gram of a
+        non-tensor space then takes its nodal values on the continuous piece space as its
+        projection.
     evaluate(x) -> ndarray, shape (len(x), dim)
         The values μ_j(x_i) at points of Γ (shape (n,) on the segment, (n, 2) on the face).
 
@@ -48,11 +52,24 @@ class MultiplierSpace(Protocol):
     lives_on_triangles : bool
         Whether the cells of ``breakpoints`` are triangles (the Kuhn or a general triangulation
         of the face), whose symmetries the kernel bounds use; default False.
+    name : str
+        What an error message calls the space; default the class name.
+
+    Optional, read by the Gram matrices of a face space that is not a tensor product (its
+    basis projected onto discontinuous tensor pieces, :mod:`..face.norms.cellwise`)
+    -----------------------------------------------------------------------------------
+    piece_degree : int
+        Degree per variable on a cell of ``pieces``; default ``degree``.
+    smooth_tail : bool
+        Whether every μ_j is continuous and vanishes on ∂Γ, so that its sine coefficients decay
+        like 1/(m² n²) (the extrapolation's exponent 4); default False (exponent 2: slower,
+        never wrong).
     """
 
     breakpoints: object
     dim: int
     degree: int
+    continuous: bool
 
     def evaluate(self, x: np.ndarray) -> np.ndarray: ...
 
@@ -67,6 +84,9 @@ class MultiplierSpace(Protocol):
     @property
     def lives_on_triangles(self) -> bool: ...
 
+    @property
+    def name(self) -> str: ...
+
 
 class SpaceDefaults:
     """The optional attributes of :class:`MultiplierSpace` with their defaults (a mixin: a space
@@ -74,6 +94,17 @@ class SpaceDefaults:
 
     factors = None
     lives_on_triangles = False
+    smooth_tail = False
+
+    @property
+    def name(self) -> str:
+        """The class name (a message's ``got``)."""
+        return type(self).__name__
+
+    @property
+    def piece_degree(self) -> int:
+        """The degree: one polynomial of degree ``degree`` per piece."""
+        return self.degree
 
     @property
     def pieces(self):

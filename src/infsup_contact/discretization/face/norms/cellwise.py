@@ -110,7 +110,7 @@ def piece_space(space) -> FaceSpace:
     pieces = space.pieces
     if pieces is None:
         raise InputError("space", "a face space that is polynomial on the rectangles of a tensor partition "
-                         "(4C pwlin on QUAD8 has triangular pieces)", got=space.element)
+                         "(4C pwlin on QUAD8 has triangular pieces)", got=space.name)
     s, cont = space.piece_degree, bool(space.continuous)
     return FaceSpace(make_space(pieces.xs, s, cont, False), make_space(pieces.ys, s, cont, False), pieces)
 
@@ -155,7 +155,7 @@ def projection(space) -> tuple[sp.csr_matrix, FaceSpace]:
     err = abs(mu - _at(P, xc) @ R.T).max() / max(abs(mu).max(), 1e-300)
     if err > PROJECTION_TOL:
         raise InputError("space", f"a face space in Q_{s} on each piece (projection residual {err:.2e})",
-                         got=space.element)
+                         got=space.name)
     return R, P
 
 

@@ -136,8 +136,7 @@ def start_level(n0: int, p: float, dim: int) -> int:
 
 def smooth_tail(space) -> bool:
     """Whether every basis function is continuous and vanishes on ∂Γ (tail exponent 4, else 2)."""
-    return all(s.continuous and s.vanish_at_ends
-               and s.local_coefficients is None for s in space.factors)
+    return space.smooth_tail
 
 
 def tail_exponent(space, n_max: int) -> float:

@@ -181,6 +181,11 @@ class CellwiseFaceSpace(SpaceDefaults):
         return TensorPartition(*half)
 
     @property
+    def name(self) -> str:
+        """The reference element (QUAD4, QUAD8, QUAD9)."""
+        return self.element
+
+    @property
     def piece_degree(self) -> int:
         """Degree per variable on a piece of :attr:`pieces` (1 for ``pwlin``)."""
         return 1 if self.basis == "pwlin" else self.degree

@@ -51,6 +51,17 @@ class FaceSpace(SpaceDefaults):
         return self.sx.dim * self.sy.dim
 
     @property
+    def continuous(self) -> bool:
+        """Whether both factors are continuous (then so is every product μ^x_a μ^y_b)."""
+        return bool(self.sx.continuous and self.sy.continuous)
+
+    @property
+    def smooth_tail(self) -> bool:
+        """Whether every basis function is continuous and vanishes on ∂Γ, in the Lagrange basis of
+        both factors (sine coefficients ~ 1/(m² n²): the series' tail exponent 4, else 2)."""
+        return all(s.continuous and s.vanish_at_ends and s.local_coefficients is None for s in self.factors)
+
+    @property
     def degree(self) -> int:
         """Polynomial degree per variable (Q_s: a coupling with Q_k traces has degree k + s per variable)."""
         return max(self.sx.degree, self.sy.degree)

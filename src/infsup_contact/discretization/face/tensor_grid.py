@@ -7,6 +7,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..gamma.constants import axis_samples
+
 
 @dataclass(frozen=True, eq=False)
 class TensorPartition:
@@ -25,6 +27,12 @@ class TensorPartition:
     def cells(self) -> int:
         """Number of rectangles."""
         return (len(self.xs) - 1) * (len(self.ys) - 1)
+
+    def interior_points(self, per: int) -> np.ndarray:
+        """per² points strictly inside every rectangle, (n, 2): different offsets in x and y, so
+        that none lies on a diagonal (the interior edges of the triangle faces)."""
+        X, Y = np.meshgrid(axis_samples(self.xs, per, 0.31), axis_samples(self.ys, per, 0.67), indexing="ij")
+        return np.column_stack([X.ravel(), Y.ravel()])
 
 
 def merge_breakpoints(x: np.ndarray, tol: float) -> np.ndarray:

@@ -56,6 +56,16 @@ class Triangulation:
     def cells(self) -> int:
         return len(self.triangles)
 
+    def interior_points(self, per: int) -> np.ndarray:
+        """A barycentric grid of points strictly inside every triangle, (n, 2)."""
+        i, j = np.meshgrid(np.arange(per), np.arange(per), indexing="ij")
+        keep = (i + j) < per
+        a, b = (i[keep] + 0.31) / (per + 1), (j[keep] + 0.29) / (per + 1)  # a, b > 0, a + b < 1
+        c = np.asarray(self.points)[np.asarray(self.triangles)]
+        pts = c[:, 0, None] + a[None, :, None] * (c[:, 1, None] - c[:, 0, None]) \
+            + b[None, :, None] * (c[:, 2, None] - c[:, 0, None])
+        return pts.reshape(-1, 2)
+
     @cached_property
     def corners(self) -> np.ndarray:
         """Vertex coordinates (nt, 3, 2)."""

@@ -18,29 +18,20 @@ RESIDUAL_TOL = 1e-10
 """Largest |fit − 1| for which the constant counts as in the span."""
 
 
+def axis_samples(breakpoints, per: int, offset: float) -> np.ndarray:
+    """``per`` points strictly inside every interval of a 1D partition, at (a + offset/per … ) of
+    each, in order."""
+    g = np.asarray(breakpoints, dtype=float)
+    t = (np.arange(per) + offset) / per
+    return (g[:-1, None] + np.outer(np.diff(g), t)).ravel()
+
+
 def interior_samples(partition, per: int = SAMPLES_PER_DIRECTION) -> np.ndarray:
-    """Points strictly inside every cell of a segment partition (1D array of breakpoints), a
-    tensor face partition (``xs``, ``ys``; different offsets in x and y so that none lies on a
-    cell's diagonal, the triangle faces' interior edges) or a triangulation (``points``,
-    ``triangles``: a barycentric grid strictly inside every triangle)."""
-    if hasattr(partition, "triangles"):
-        i, j = np.meshgrid(np.arange(per), np.arange(per), indexing="ij")
-        keep = (i + j) < per
-        a, b = (i[keep] + 0.31) / (per + 1), (j[keep] + 0.29) / (per + 1)  # a, b > 0, a + b < 1
-        c = np.asarray(partition.points)[np.asarray(partition.triangles)]
-        pts = c[:, 0, None] + a[None, :, None] * (c[:, 1, None] - c[:, 0, None]) \
-            + b[None, :, None] * (c[:, 2, None] - c[:, 0, None])
-        return pts.reshape(-1, 2)
-
-    def axis(g, offset):
-        g = np.asarray(g, dtype=float)
-        t = (np.arange(per) + offset) / per
-        return (g[:-1, None] + np.outer(np.diff(g), t)).ravel()
-
-    if not hasattr(partition, "xs"):
-        return axis(partition, 0.31)
-    X, Y = np.meshgrid(axis(partition.xs, 0.31), axis(partition.ys, 0.67), indexing="ij")
-    return np.column_stack([X.ravel(), Y.ravel()])
+    """Points strictly inside every cell of a segment partition (1D array of breakpoints) or of a
+    face partition (its ``interior_points``: off the cells' edges and diagonals)."""
+    if np.ndim(partition) == 1:
+        return axis_samples(partition, per, 0.31)
+    return partition.interior_points(per)
 
 
 def spans_constants(space) -> bool:

@@ -1,4 +1,4 @@
-"""The bottom of the spectrum without dense eigensolvers (solvers/bottom.py, kernel.bottom_kernel,
+"""The bottom of the spectrum without dense eigensolvers (la/bottom.py, kernel.bottom_kernel,
 infsup.bottom_spectrum): each against the dense route it replaces above DENSE_MAX_M."""
 from dataclasses import replace
 
@@ -7,7 +7,8 @@ import pytest
 import scipy.linalg as sla
 import scipy.sparse as sp
 
-from infsup_contact.solvers import bottom, infsup
+from infsup_contact.la import bottom
+from infsup_contact.solvers import infsup
 from infsup_contact.solvers.kernel import MARGIN_DECADES, bottom_kernel, coupling_kernel
 
 

@@ -1,4 +1,4 @@
-"""The large route's pencils (solvers/bottom.bottom_pencil, infsup.bottom_spectra, infsup.betas_v1_zero):
+"""The large route's pencils (la/bottom.bottom_pencil, infsup.bottom_spectra, infsup.betas_v1_zero):
 the blocked shift-invert operator against the plain one, the pencil against the dense eigh(S, G),
 the factor shared between norms against unshared pencils, and β(v1 = 0) between the routes."""
 import numpy as np
@@ -7,7 +7,8 @@ import scipy.linalg as sla
 from scipy.linalg import blas
 
 from infsup_contact.la import mkl
-from infsup_contact.solvers import bottom, infsup
+from infsup_contact.la import bottom
+from infsup_contact.solvers import infsup
 from infsup_contact.solvers.kernel import coupling_kernel
 
 

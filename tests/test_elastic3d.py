@@ -17,7 +17,7 @@ from infsup_contact.models import MODELS, make_model, model_of_dim, model_taking
 from infsup_contact.models.elastic3d import (ELASTIC3D, elastic_stiffness, side_operator, subdomain_mesh,
                                              vector_space)
 from infsup_contact.models.plane_strain import lame
-from infsup_contact.models.schur import schur_by_solves
+from infsup_contact.models.contract import schur_by_solves
 from infsup_contact.solvers.contact import solve_contact_on
 from infsup_contact.solvers.infsup import beta_rows_all
 from infsup_contact.study import elastic_face_patch as efp

@@ -3,8 +3,9 @@ import numpy as np
 import pytest
 import scipy.linalg as sla
 
-from infsup_contact.discretization import exponential_sum, face_norms, registry
-from infsup_contact.discretization.exponential_sum import inverse_sqrt
+from infsup_contact.discretization import face_norms, registry
+from infsup_contact.la import exponential_sum
+from infsup_contact.la.exponential_sum import inverse_sqrt
 from infsup_contact.discretization.square import SQUARE, TensorPartition
 from infsup_contact.errors import InputError
 

@@ -17,7 +17,7 @@ from infsup_contact.discretization.segment import SEGMENT
 from infsup_contact.discretization.square import SQUARE, TensorPartition
 from infsup_contact.errors import InputError
 from infsup_contact.models import make_model
-from infsup_contact.models.side_cache import SideCache
+from infsup_contact.solvers.side_cache import SideCache
 from infsup_contact.solvers.infsup import beta_rows, saddle_point_beta
 from infsup_contact.solvers.contact import contact_qp
 

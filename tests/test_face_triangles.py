@@ -15,7 +15,7 @@ from infsup_contact.discretization.registry import SPACES, case_space, ids_valid
 from infsup_contact.discretization.square import SQUARE, SQUARE_TRIG, TensorPartition
 from infsup_contact.errors import InputError
 from infsup_contact.models import make_model
-from infsup_contact.models.side_cache import SideCache
+from infsup_contact.solvers.side_cache import SideCache
 from infsup_contact.solvers.infsup import beta_rows
 from infsup_contact.solvers.contact import contact_qp
 

@@ -8,8 +8,8 @@ import scipy.linalg as sla
 from infsup_contact.discretization.coupling import coupling_matrix, trace_l2_norms
 from infsup_contact.discretization.norms import gram
 from infsup_contact.models.membranes import MEMBRANES
-from infsup_contact.models.schur import combine_terms, interface_terms
-from infsup_contact.models.side_cache import SideCache
+from infsup_contact.solvers.interface_operator import combine_terms, interface_terms
+from infsup_contact.solvers.side_cache import SideCache
 from infsup_contact.solvers.infsup import _space, beta_rows, space_kernel, spectrum
 from infsup_contact.solvers.kernel import (CLOSE, GAP_DECADES, MARGIN_DECADES, coupling_kernel, kernel_from_gap,
                                            scaled_couplings)

@@ -6,7 +6,7 @@ import pytest
 from infsup_contact.discretization.segment import SEGMENT
 from infsup_contact.errors import InputError
 from infsup_contact.models.membranes import MEMBRANES
-from infsup_contact.models.side_cache import SideCache, side_keys
+from infsup_contact.solvers.side_cache import SideCache, side_keys
 from infsup_contact.solvers.infsup import beta_rows_all
 
 

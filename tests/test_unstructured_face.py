@@ -23,7 +23,7 @@ from infsup_contact.discretization.triangulation import Triangulation, barycentr
 from infsup_contact.errors import InputError
 from infsup_contact.models import make_model
 from infsup_contact.models import membranes3d
-from infsup_contact.models.side_cache import SideCache
+from infsup_contact.solvers.side_cache import SideCache
 from infsup_contact.solvers.infsup import beta_rows
 
 MODEL = make_model("membranes3d")

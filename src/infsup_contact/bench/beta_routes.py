@@ -42,7 +42,8 @@ import scipy.sparse.linalg as spla
 from ..discretization import meshes, registry
 from ..discretization.coupling import coupling_matrix
 from ..models.membranes import side_operator
-from ..models.schur import SideOperator, interface_operator
+from ..models.contract import SideOperator
+from ..solvers.interface_operator import interface_operator
 from ..solvers.infsup import beta_rows
 from .harness import ROUTE_BUDGET, _log, _row, run_interleaved
 
@@ -68,7 +69,7 @@ def _bottom(beta2: np.ndarray, kern: int):
 def _factorize_side(side: SideOperator) -> SideOperator:
     """The Γ-last factorization + Schur complement of an assembled side: the linear
     algebra of :func:`~infsup_contact.models.membranes.side_operator` without the NGSolve assembly."""
-    from ..models.schur import factorized_side
+    from ..models.contract import factorized_side
 
     return factorized_side(side.trace, side.free, side.stiffness)
 

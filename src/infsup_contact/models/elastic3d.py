@@ -19,7 +19,7 @@ the z-component dofs on Γ only: the side's trace (``trace.fes``) is the z compo
 dofs are ordered [interior, Γ x, Γ y, Γ z]; eliminating the tangential Γ dofs with the interior
 (block elimination), the Schur complement onto the Γ z dofs is ((A⁻¹)_ΓΓ)_zz⁻¹, the zz block
 of the full Γ Steklov inverse, exactly as the 2D model does with its normal dofs
-(:mod:`.elastic`): :func:`~infsup_contact.models.schur.factorized_side` with the z dofs as its
+(:mod:`.elastic`): :func:`~infsup_contact.models.contract.factorized_side` with the z dofs as its
 Γ block gives the interface operator unchanged. **Sign**: A_1 u_1 = F_1 − B_1ᵀ λ,
 A_2 u_2 = F_2 + B_2ᵀ λ (:data:`~.contract.B_SIGN`), λ = −σ_zz on Γ (compression positive).
 
@@ -60,7 +60,7 @@ from .elastic import PARAMS
 from .membranes3d import ELEMENTS, FAMILIES_3D, FAR, LATERAL, face_of
 from .membranes3d import subdomain_mesh as cube_mesh
 from .plane_strain import check_nu, lame
-from .schur import SideOperator, factorized_side
+from .contract import SideOperator, factorized_side
 
 BETA_DIRICHLET = f"{FAR}|{LATERAL}|{SYMMETRY_X}|{SYMMETRY_Y}"
 """All of ∂Ω_i∖Γ (an NGSolve boundary regexp): where β_h's sides vanish, every component."""
@@ -159,7 +159,7 @@ def side_operator(mesh, k: int, nu: float = 0.3, supports=CLAMPED, route: str = 
                   gamma=None, keep_factor: bool = False) -> Elastic3DSide:
     """One elastic body factorized once (E = 1), Γ dofs of x, y, z last, the z ones at the very
     end; its Γ Schur complement is that of the z dofs (module docstring). ``route`` as in
-    :func:`~infsup_contact.models.schur.gamma_factorization`; ``gamma`` the interface (default
+    :func:`~infsup_contact.la.schur.gamma_factorization`; ``gamma`` the interface (default
     :func:`~infsup_contact.models.membranes3d.face_of` the mesh); ``keep_factor``: the
     factorization that gives S also serves the solves (a scene's side)."""
     nu = check_nu(nu)

@@ -3,7 +3,7 @@ u_i = 0 on ∂Ω_i∖Γ, Γ = (0,1)²×{1} the contact face, b(v, μ) = ∫_Γ (
 
 The paper's model problem (Section 3) one dimension up: the side operator is the Laplace
 stiffness of continuous Q_k (hexahedra) or P_k (tetrahedra) with the Γ dofs last and its Γ
-Schur complement (:func:`~infsup_contact.models.schur.factorized_side`; the nested-dissection
+Schur complement (:func:`~infsup_contact.models.contract.factorized_side`; the nested-dissection
 ordering is graph based, so it serves 3D meshes as it is). Γ is the face
 :class:`~infsup_contact.discretization.square.Square`: the traces are tensor grids, the
 multiplier spaces tensor products (:mod:`infsup_contact.discretization.face_spaces`) on
@@ -50,7 +50,7 @@ import scipy.sparse as sp
 
 from .contract import MaterialParam, Model
 from .membranes import field, interpolate, laplace_stiffness
-from .schur import SideOperator, factorized_side
+from .contract import SideOperator, factorized_side
 
 ELEMENTS = ("hex", "tet")
 FAMILIES_3D = ("structured", "perturbed", "unstructured")

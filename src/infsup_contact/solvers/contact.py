@@ -27,7 +27,7 @@ from .pdas import PdasResult, solve_pdas
 from ..discretization.coupling import coupling_matrix
 from ..models import DEFAULT_MODEL
 from ..models.contract import B_SIGN
-from ..models.schur import interface_operator
+from .interface_operator import interface_operator
 
 
 @dataclass
@@ -90,7 +90,7 @@ def contact_qp(sides, Bs, F, c=(1.0, 1.0)):
     Parameters
     ----------
     sides : sequence of two objects with ``stiffness`` (csc, free dofs, Γ last) and
-        ``trace.gamma_dofs`` — :class:`~infsup_contact.models.schur.SideOperator`.
+        ``trace.gamma_dofs`` — :class:`~infsup_contact.models.contract.SideOperator`.
     Bs : two dense (m, n_Γ,i) coupling matrices B1, B2.
     F : two load vectors on the free dofs.
     c : (c1, c2).

@@ -2,7 +2,7 @@
 
 β_h = inf_μ sup_v b(v, μ) / (‖v‖_a ‖μ‖_M), so β_h² is the smallest eigenvalue of the
 generalized symmetric eigenproblem (B A⁻¹ Bᵀ) m = β² G m on the multiplier space,
-with B A⁻¹ Bᵀ the interface operator (:mod:`infsup_contact.models.schur`) and G the Gram
+with B A⁻¹ Bᵀ the interface operator (:mod:`infsup_contact.la.schur`) and G the Gram
 matrix of the multiplier norm. Partitions, spaces and Gram matrices come from Γ, the
 interface the sides' traces live on (``trace.gamma``,
 :mod:`infsup_contact.discretization.interface`).
@@ -22,10 +22,11 @@ from scipy.linalg import lapack
 from ..discretization import meshes, multipliers, registry
 from ..discretization.coupling import coupling_matrix, trace_l2_norms
 from ..errors import InputError, check_prestress
-from . import bottom, reflection
-from ..models.schur import combine_terms, interface_terms
+from ..la import bottom, reflection
+from . import symmetry
+from .interface_operator import combine_terms, interface_terms
 from ..models import DEFAULT_MODEL
-from ..models.side_cache import SideCache
+from .side_cache import SideCache
 from ..discretization.interface import check_choice
 from ..discretization.segment import SEGMENT
 from ..discretization.norms import NORMS
@@ -106,15 +107,15 @@ N_BOTTOM = 1
 
 def bottom_spectrum(S: np.ndarray, factor: np.ndarray, kernel: KernelDecision | None = None,
                     s_factor: np.ndarray | None = None) -> Spectrum:
-    """:func:`spectrum` without a dense eigensolver (dim M > :data:`.bottom.DENSE_MAX_M`).
+    """:func:`spectrum` without a dense eigensolver (dim M > :data:`~infsup_contact.la.bottom.DENSE_MAX_M`).
 
     The kernel (its dimension d and its basis ``kernel.vectors`` in multiplier coordinates, from
     :func:`space_kernel` with ``iterative``) is deflated and the :data:`N_BOTTOM` eigenvalues
-    above it come from shift-invert Lanczos (:func:`.bottom.bottom_pencil`); λ_max for the
+    above it come from shift-invert Lanczos (:func:`~infsup_contact.la.bottom.bottom_pencil`); λ_max for the
     round-off level from Lanczos too. ``bottom`` holds the d kernel eigenvalues as exact zeros
     (a kernel of Bᵀ is one of S), then those. Without ``kernel``, the smallest eigenvalue
     (β with v1 = 0), 0 when at round-off level. ``s_factor``: the Cholesky factor of S
-    (:func:`.bottom.definite_factor`) where no kernel is deflated, shared by the norms
+    (:func:`~infsup_contact.la.bottom.definite_factor`) where no kernel is deflated, shared by the norms
     (:func:`bottom_spectra`).
     """
     d = 0 if kernel is None else kernel.dim
@@ -140,8 +141,8 @@ def _spectrum_above(m: int, d: int, values: np.ndarray, lam_max: float) -> Spect
 def split_spectra(split, S: np.ndarray, factors: dict, kernel: KernelDecision | None = None,
                   parts=None) -> dict:
     """:func:`bottom_spectra` on the components of a reflection-invariant pencil
-    (:mod:`.reflection`): ``factors`` {norm: (L_0, L_1, ...)} of the blocks of G, ``parts`` the
-    kernel's bases per component (:meth:`~.reflection.ReflectionSplit.components`). None where S is
+    (:mod:`infsup_contact.la.reflection`): ``factors`` {norm: (L_0, L_1, ...)} of the blocks of G, ``parts`` the
+    kernel's bases per component (:meth:`~infsup_contact.la.reflection.ReflectionSplit.components`). None where S is
     not reflection invariant (the caller solves it unsplit)."""
     d = 0 if kernel is None else kernel.dim
     pencils = reflection.split_pencils(split, S, factors, parts if d else None, N_BOTTOM)
@@ -163,7 +164,7 @@ def bottom_spectra(S: np.ndarray, factors: dict, kernel: KernelDecision | None =
     """:func:`bottom_spectrum` of S with each Gram factor in ``factors`` ({norm: factor}).
 
     Where no kernel is deflated, the shift-invert operator of every norm factors S itself
-    (:func:`.bottom.bottom_pencil`): one Cholesky factorization serves them all (where S is not
+    (:func:`~infsup_contact.la.bottom.bottom_pencil`): one Cholesky factorization serves them all (where S is not
     numerically definite each pencil falls back to its own floored factorization)."""
     shared = bottom.definite_factor(S) if kernel is None or not kernel.dim else None
     return {norm: bottom_spectrum(S, L, kernel, s_factor=shared) for norm, L in factors.items()}
@@ -248,13 +249,13 @@ def beta_rows_all(family, k, n1, n2, cases=None, multiplier_meshes=("omega2",), 
     same numbers: its rows are copies of the earlier ones, with their own ``multiplier_mesh``
     and zero timings.
 
-    ``side_cache``: a :class:`~infsup_contact.models.side_cache.SideCache` the side operators
+    ``side_cache``: a :class:`~infsup_contact.solvers.side_cache.SideCache` the side operators
     are taken from (a sweep over pairs that share a side builds it once); default: built here.
 
     Timing columns (seconds): ``t_interface`` getting the two side operators (meshes and
     factorizations; about 0 for sides the cache already holds), ``t_assemble`` the case's
     couplings B_i, ``t_eig`` one eigenproblem (sygst and syevd; not the Gram matrix's
-    Cholesky factor, which the c pairs share; above :data:`.bottom.DENSE_MAX_M` the norms'
+    Cholesky factor, which the c pairs share; above :data:`~infsup_contact.la.bottom.DENSE_MAX_M` the norms'
     share of :func:`bottom_spectra`).
     """
     cases = registry.ids_valid_for(k) if cases is None else list(cases)
@@ -286,7 +287,7 @@ def beta_rows_all(family, k, n1, n2, cases=None, multiplier_meshes=("omega2",), 
                 t_coupling = time.perf_counter() - tc
                 grams = {norm: gamma.gram(space, norm, h_route=h_route) for norm in norms}
                 structural = gamma.proven_kernel(space, k, [s.trace for s in sides], dim_w)
-                split = reflection.split_of(space, gamma, g_h, k) if iterative else None
+                split = symmetry.split_of(space, gamma, g_h, k) if iterative else None
                 kernel = space_kernel(couplings, sides, space, k, structural,
                                       grams["L2"][0] if "L2" in grams else None, iterative=iterative,
                                       trace_norms=trace_norms, split=split)
@@ -348,12 +349,12 @@ def space_kernel(couplings, sides, space, k: int, structural: int, l2_gram=None,
     every norm and every (c1, c2): the kernel of B A⁻¹ Bᵀ depends on neither.
 
     ``iterative``: the bottom singular values only
-    (:func:`~infsup_contact.solvers.kernel.bottom_kernel`, for dim M > :data:`.bottom.DENSE_MAX_M`),
+    (:func:`~infsup_contact.solvers.kernel.bottom_kernel`, for dim M > :data:`~infsup_contact.la.bottom.DENSE_MAX_M`),
     W' from a rule :data:`LONGER_RULE_LARGE` longer, the couplings sparse (W sparse, the same
     entries); its ``vectors`` are returned in multiplier coordinates (a basis of the kernel of Bᵀ).
     ``trace_norms``: the sides' :func:`~.coupling.trace_l2_norms`, if already computed (they
     depend on the sides only, not on the space). ``split``: the reflections'
-    (:func:`.reflection.split_bottom_kernel` decides on the components where it holds)."""
+    (:func:`.symmetry.split_bottom_kernel` decides on the components where it holds)."""
     G = sides[0].trace.gamma.gram(space, "L2")[0] if l2_gram is None else l2_gram
     rows = [trace_l2_norms(s.trace, k) for s in sides] if trace_norms is None else trace_norms
     cols = np.sqrt(np.diag(G))
@@ -364,7 +365,7 @@ def space_kernel(couplings, sides, space, k: int, structural: int, l2_gram=None,
     if not iterative:
         return coupling_kernel(W, structural, entry_error=np.linalg.norm(W - longer))
     W, error = sp.csr_matrix(W), spla.norm(sp.csr_matrix(W - longer))
-    decision = reflection.split_bottom_kernel(W, split, structural, error) if split is not None else None
+    decision = symmetry.split_bottom_kernel(W, split, structural, error) if split is not None else None
     decision = bottom_kernel(W, structural, entry_error=error) if decision is None else decision
     return replace(decision, vectors=decision.vectors / cols[:, None])  # W v = 0 ⇔ Bᵀ (v / cols) = 0
 
@@ -372,7 +373,7 @@ def space_kernel(couplings, sides, space, k: int, structural: int, l2_gram=None,
 LONGER_RULE = 6
 """Degree the entry-round-off rule W' of :func:`space_kernel` adds (three Gauss points more)."""
 LONGER_RULE_LARGE = 2
-"""The same above dim M = :data:`.bottom.DENSE_MAX_M` (one point more, 16 instead of 36 points
+"""The same above dim M = :data:`~infsup_contact.la.bottom.DENSE_MAX_M` (one point more, 16 instead of 36 points
 per cell at k = s = 2: still exact, so W − W' is still round-off only; half the cost)."""
 
 

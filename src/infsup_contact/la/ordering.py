@@ -3,7 +3,7 @@
 Why this exists
 ---------------
 The Γ Schur complement S = K_ΓΓ − K_ΓI K_II⁻¹ K_IΓ is the trailing block of the LU factors,
-S = L_ΓΓ U_ΓΓ, provided the Γ dofs are eliminated last (:mod:`infsup_contact.models.schur`). SuperLU
+S = L_ΓΓ U_ΓΓ, provided the Γ dofs are eliminated last (:mod:`infsup_contact.la.schur`). SuperLU
 (``scipy.sparse.linalg.splu``) accepts no user ordering: it either computes its own column
 order, which mixes Γ into the interior, or takes the matrix as given
 (``permc_spec="NATURAL"``). So the order has to be computed here and the matrix permuted

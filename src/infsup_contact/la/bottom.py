@@ -37,7 +37,7 @@ from scipy.linalg import blas, lapack
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from ..la import mkl
+from . import mkl
 
 DENSE_MAX_M = 1500
 """Largest dim M decided and solved densely (SVD of W, dense pencil); above it, this module.

@@ -10,7 +10,7 @@ from infsup_contact.discretization.norms import sine_coefficients
 from infsup_contact.discretization.quadrature import gauss_legendre_01
 from infsup_contact.discretization.square import SQUARE, TensorPartition
 from infsup_contact.errors import InputError
-from infsup_contact.solvers.infsup import spectrum
+from infsup_contact.solvers.spectra import spectrum
 from infsup_contact.study.edge_dropping import (edge_cases, edge_row, geometry, interface_operator,
                                                 kappa_1d, scaled_cond, side_pair)
 

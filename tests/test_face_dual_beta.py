@@ -101,11 +101,11 @@ def test_dual_q8_is_refused_with_its_weights_and_the_remedy():
 
 def test_an_empty_face_space_is_refused_before_any_computation():
     """TDUAL-Q8 on one cell: QUAD8 has no node inside (0, 1)², dim M_h = 0 = the count."""
-    from infsup_contact.solvers.infsup import check_inputs
+    from infsup_contact.solvers.request import BetaRequest
 
     assert registry.SPACES["TDUAL-Q8"].dimension(2, 1) == 0
     with pytest.raises(InputError, match="dim M_h = 0"):
-        check_inputs(["TDUAL-Q8"], 2, "structured", 1, 1, 1.0, 1.0, ["H"], "omega2")
+        BetaRequest("structured", 2, 1, 1, ("TDUAL-Q8",), norms=("H",))
 
 
 def test_face_spaces_stay_off_the_segment():

@@ -9,7 +9,8 @@ import scipy.linalg as sla
 from infsup_contact.discretization import registry
 from infsup_contact.discretization.square import SQUARE, SQUARE_TRIG, TensorPartition
 from infsup_contact.la import bottom, reflection
-from infsup_contact.solvers import infsup, symmetry
+from infsup_contact.solvers import infsup, spectra, symmetry
+from infsup_contact.solvers.kernel import KernelDecision
 
 
 def _space(case, k, n, gamma=SQUARE):
@@ -108,13 +109,13 @@ def test_split_pencils_equal_the_unsplit_route(dims):
         A = 0.5 * (A + A.T)
     G = _invariant_spd(split, 3, shift=0.2)
     d = Z.shape[1]
-    kernel = infsup.KernelDecision(d, d, 0, np.inf, "clear", 0.0, np.zeros(0), d, Z if d else None)
-    plain = infsup.bottom_spectra(A, {"H": infsup.gram_factor(G)}, kernel if d else None)["H"]
+    kernel = KernelDecision(d, d, 0, np.inf, "clear", 0.0, np.zeros(0), d, Z if d else None)
+    plain = spectra.bottom_spectra(A, {"H": spectra.gram_factor(G)}, kernel if d else None)["H"]
     parts = split.components(Z) if d else None
     if d:
         assert tuple(P.shape[1] for P in parts) == dims
-    factors = {"H": tuple(infsup.gram_factor(b) for b in split.blocks(G)[:-1])}
-    halves = infsup.split_spectra(split, A, factors, kernel if d else None, parts)["H"]
+    factors = {"H": tuple(spectra.gram_factor(b) for b in split.blocks(G)[:-1])}
+    halves = spectra.split_spectra(split, A, factors, kernel if d else None, parts)["H"]
     assert halves.kernel_dim == plain.kernel_dim == d
     assert halves.smallest_nonzero == pytest.approx(plain.smallest_nonzero, rel=1e-9)
     assert halves.beta == pytest.approx(plain.beta, rel=1e-9, abs=0.0)
@@ -134,8 +135,8 @@ def test_face_rows_with_and_without_the_split(case, monkeypatch):
     and with it switched off: the same kernels, β to 1e-9."""
     from infsup_contact.models import MODELS
     monkeypatch.setattr(bottom, "DENSE_MAX_M", 0)
-    calls, split_spectra = [], infsup.split_spectra
-    monkeypatch.setattr(infsup, "split_spectra", lambda *a, **kw: calls.append(1) or split_spectra(*a, **kw))
+    calls, split_spectra = [], spectra.split_spectra
+    monkeypatch.setattr(spectra, "split_spectra", lambda *a, **kw: calls.append(1) or split_spectra(*a, **kw))
     rows = {}
     for on in (True, False):
         if not on:
@@ -183,8 +184,8 @@ def test_an_interface_operator_that_is_not_invariant_is_solved_unsplit():
     space, part = _space("R5.2", 2, 4)
     split = symmetry.reflection_split(space, SQUARE.quadrature(part, 4)[0])
     S, G = _invariant_spd(split, 5), _invariant_spd(split, 6)
-    factors = {"H": tuple(infsup.gram_factor(b) for b in split.blocks(G)[:-1])}
-    assert infsup.split_spectra(split, S, factors) is not None
+    factors = {"H": tuple(spectra.gram_factor(b) for b in split.blocks(G)[:-1])}
+    assert spectra.split_spectra(split, S, factors) is not None
     S[0, 2] += 1e-8 * np.abs(S).max()
     S[2, 0] = S[0, 2]
-    assert infsup.split_spectra(split, S, factors) is None
+    assert spectra.split_spectra(split, S, factors) is None

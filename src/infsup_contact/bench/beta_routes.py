@@ -134,7 +134,7 @@ def beta_ours(n: int, k: int):
 
 def beta_ours_core(setup: BetaSetup):
     """Γ-reduced route given the assembled stiffness: factorization, couplings,
-    interface operator, Gram, dense eigh (:func:`~infsup_contact.solvers.infsup.spectrum` without the extras)."""
+    interface operator, Gram, dense eigh (:func:`~infsup_contact.solvers.spectra.spectrum` without the extras)."""
     sides = [_factorize_side(s) for s in setup.sides]
     out = {}
     for c in setup.cases:

@@ -105,7 +105,7 @@ class ReflectionSplit:
 def usable(split: ReflectionSplit | None, grams: dict, kernel):
     """(split, kernel parts, {norm: blocks of G}) where every Gram matrix is invariant under
     ``split`` and the kernel splits, else (None, None, None). Each interface operator S is checked where it
-    is split (:func:`split_pencils`; :func:`~infsup_contact.solvers.infsup.split_spectra` solves it unsplit where it is not)."""
+    is split (:func:`split_pencils`; :func:`~infsup_contact.solvers.spectra.split_spectra` solves it unsplit where it is not)."""
     if split is None:
         return None, None, None
     halves = {}
@@ -125,7 +125,7 @@ def split_pencils(split: ReflectionSplit, S: np.ndarray, factors: dict, kernel_p
 
     ``factors``: {norm: (L_0, L_1, ...)} the Cholesky factors of the blocks of G; ``kernel_parts``:
     (Z_0, Z_1, ...) from :meth:`ReflectionSplit.components` (None: no kernel deflated; a block whose
-    S is definite then shares its factor between the norms, as :func:`~infsup_contact.solvers.infsup.bottom_spectra`)."""
+    S is definite then shares its factor between the norms, as :func:`~infsup_contact.solvers.spectra.bottom_spectra`)."""
     *halves, distance = split.blocks(S)
     if distance > INVARIANCE_RTOL:
         return None

@@ -73,7 +73,7 @@ from ..discretization.square import SQUARE, Square, TensorPartition
 from ..errors import InputError
 from ..models import model_of_dim
 from ..solvers.interface_operator import combine_terms, interface_terms
-from ..solvers.infsup import gram_factor, spectrum
+from ..solvers.spectra import gram_factor, spectrum
 
 THETAS = (1.0, 0.5, 0.25, 0.1, 0.05, 0.01, 0.001)
 """The covered fractions of the last column swept by default (issue 28)."""

@@ -222,7 +222,7 @@ def test_narrow_side_mesh():
     assert len(side2.trace.gamma_dofs) == (n2 * k - 1) ** 2 == SQUARE.trace_dimension(k, n2)
     assert side1.trace.partition.xs[-1] == 1.0
     with pytest.raises(InputError, match="tensor grid"):
-        Square(width=L).partition_of(subdomain_mesh("structured", n2, 2))
+        Square(width=L).partition_of(subdomain_mesh("structured", n2, 2).mesh)
     with pytest.raises(InputError, match="width"):
         subdomain_mesh("structured", n2, 2, width=1.5)
 

@@ -54,6 +54,24 @@ from ..la.schur import SteklovProduct
 
 
 @dataclass(frozen=True)
+class Body:
+    """A body's mesh and its Γ, as a 3D model's mesh builder returns them (``Model.mesh``): which
+    interface the face is (rectangles, structured triangles, a general triangulation) is the
+    builder's to say, from the request (family, element), and is never attached to the mesh.
+
+    Attributes
+    ----------
+    mesh : ngsolve.Mesh
+        The mesh of Ω_side, its Γ named as ``interface`` expects.
+    interface : Interface
+        Γ (:class:`~infsup_contact.discretization.interface.Interface`) whose trace the side takes.
+    """
+
+    mesh: object
+    interface: object
+
+
+@dataclass(frozen=True)
 class MaterialParam:
     """One material parameter of a model, as the command line and the tables see it.
 
@@ -105,8 +123,8 @@ class Model:
     components : int
         Displacement components per node (the memory estimate's factor).
     mesh : callable or None
-        ``mesh(family, n, side, **mesh_kwargs) -> ngsolve.Mesh``: the mesh of Ω_side with n cells
-        on Γ (per direction on a face); None: the paper's 2D meshes
+        ``mesh(family, n, side, **mesh_kwargs) -> Body``: the mesh of Ω_side with n cells on Γ
+        (per direction on a face) and its Γ, what ``side_operator`` takes; None: the paper's 2D meshes
         (:func:`~infsup_contact.discretization.meshes.subdomain_mesh`).
     mesh_options : tuple of (str, tuple)
         Mesh keywords the model's ``mesh`` takes beyond the 2D ones, with their allowed values

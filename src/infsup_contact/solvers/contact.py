@@ -182,7 +182,8 @@ class ContactPair:
 
     Attributes
     ----------
-    meshes : tuple of ngsolve.Mesh
+    meshes : tuple of ngsolve.Mesh or Body
+        What the model's ``side_operator`` takes (a 3D model's builder returns a Body: mesh and Γ).
     sides : list of SideOperator
     F : list of ndarray
         Loads on the free dofs of each side.

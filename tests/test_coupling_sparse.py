@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
-from infsup_contact.discretization import coupling
-from infsup_contact.discretization.coupling import coupling_matrix, weighted_values
-from infsup_contact.discretization.registry import case_space, ids_valid_for
+from infsup_contact.discretization.gamma import coupling
+from infsup_contact.discretization.gamma.coupling import coupling_matrix, weighted_values
+from infsup_contact.discretization.spaces.registry import case_space, ids_valid_for
 from infsup_contact.errors import InputError
 from infsup_contact.models import make_model
 
@@ -46,7 +46,7 @@ def setup(request):
     m = make_model(model)
     build = getattr(m, "mesh", None)
     if build is None:
-        from infsup_contact.discretization.meshes import subdomain_mesh as build
+        from infsup_contact.discretization.segment.meshes import subdomain_mesh as build
     sides = [m.side_operator(build("structured", n, i + 1, **kw), k) for i, n in enumerate((n1, n2))]
     gamma = sides[0].trace.gamma
     part = gamma.multiplier_partition(*(s.trace.partition for s in sides), mm)
@@ -130,7 +130,7 @@ def test_the_face_trace_basis_is_the_csr_of_its_dense_values(setup):
 def test_sparse_couplings_and_their_scaling_are_the_dense_ones_bit_for_bit(setup, monkeypatch, extra):
     """The large route's CSR B (``sparse=True``) and its scaled W (kernel.scaled_couplings) hold
     the dense route's entries exactly, with many chunks as with one."""
-    from infsup_contact.discretization.coupling import trace_l2_norms
+    from infsup_contact.discretization.gamma.coupling import trace_l2_norms
     from infsup_contact.solvers.kernel import scaled_couplings
 
     sides, spaces, k = setup

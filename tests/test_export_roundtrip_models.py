@@ -21,7 +21,7 @@ import scipy.linalg as sla
 import scipy.sparse.linalg as spla
 
 from infsup_contact.cli import main
-from infsup_contact.discretization.registry import ids_valid_for
+from infsup_contact.discretization.spaces.registry import ids_valid_for
 from infsup_contact.models import MODELS
 from infsup_contact.solvers.infsup import beta_rows
 from infsup_contact.study.verdict import model_case_ids

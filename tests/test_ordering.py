@@ -5,11 +5,11 @@ import scipy.sparse as sp
 import scipy.sparse.csgraph  # noqa: F401  (sp.csgraph)
 import scipy.sparse.linalg as spla
 
-from infsup_contact.discretization.segment import SEGMENT
+from infsup_contact.discretization.segment.interface import SEGMENT
 from infsup_contact.models.membranes import displacement_space, laplace_stiffness, side_operator
 from infsup_contact.la.schur import _gamma_last_lu, schur_from_lu
 from infsup_contact.models.contract import schur_by_solves
-from infsup_contact.discretization.meshes import mesh_pair
+from infsup_contact.discretization.segment.meshes import mesh_pair
 from infsup_contact.la.ordering import _Graph, _Twins, nested_dissection_gamma_last
 
 SUPERLU_SPD = dict(diag_pivot_thresh=0.0, options=dict(SymmetricMode=True))

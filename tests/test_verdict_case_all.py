@@ -10,7 +10,7 @@ import io
 import pytest
 
 from infsup_contact.cli import main
-from infsup_contact.discretization.registry import SPACES, ids_valid_for
+from infsup_contact.discretization.spaces.registry import SPACES, ids_valid_for
 from infsup_contact.models import MODELS
 from infsup_contact.solvers.infsup import beta_rows
 from infsup_contact.systems.levels import system_verdict

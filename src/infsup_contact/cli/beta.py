@@ -8,8 +8,8 @@ from .common import (FlagUse, declare_flag_uses, material_columns, mesh_options,
 
 
 def add(sub) -> None:
-    from ..discretization.meshes import FAMILIES
-    from ..discretization.registry import space_ids
+    from ..discretization.segment.meshes import FAMILIES
+    from ..discretization.spaces.registry import space_ids
 
     from ..solvers.kernel import KERNEL_CRITERION
 
@@ -95,7 +95,7 @@ def _check_beta(args):
 def request(args):
     """The :class:`~infsup_contact.solvers.request.BetaRequest` of the command line, validated once
     (the perturbed family's seed and α with it); the engine runs it unchecked."""
-    from ..discretization.meshes import check_perturbation
+    from ..discretization.segment.meshes import check_perturbation
     from ..solvers.request import BetaRequest, MeshOptions
 
     perturbed = dict(seed=args.seed, alpha=args.alpha) if args.family == "perturbed" else {}

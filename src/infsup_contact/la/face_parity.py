@@ -1,10 +1,10 @@
 """The face's H Gram series in the four parity blocks of the axis reflections (issue 28, large N).
 
-Where both 1D factors of a tensor space M^x ⊗ M^y (:mod:`infsup_contact.discretization.face_spaces`; the piece space P of a
-cellwise one, :mod:`infsup_contact.discretization.face_cellwise_norms`) are symmetric under x → 1 − x, i.e. the reflection
+Where both 1D factors of a tensor space M^x ⊗ M^y (:mod:`infsup_contact.discretization.face.spaces.tensor`; the piece space P of a
+cellwise one, :mod:`infsup_contact.discretization.face.norms.cellwise`) are symmetric under x → 1 − x, i.e. the reflection
 maps the basis onto itself (:func:`~infsup_contact.discretization.face_parity_bases.axis_parity`, found and checked as the face's reflections,
-:func:`~infsup_contact.discretization.basis_symmetry.induced_permutation`), their bases split into even and odd functions,
-Q^x_e and Q^x_o (:func:`~infsup_contact.discretization.basis_symmetry.isotypic_bases`). Because
+:func:`~infsup_contact.discretization.gamma.symmetry.induced_permutation`), their bases split into even and odd functions,
+Q^x_e and Q^x_o (:func:`~infsup_contact.discretization.gamma.symmetry.isotypic_bases`). Because
 sin(mπ(1 − x)) = (−1)^{m+1} sin(mπx), an even function has sine coefficients at odd m only, an
 odd one at even m only. So the double series
 

@@ -3,7 +3,7 @@
 On a face mesh pair symmetric about the centre of Γ = (0, 1)² (the structured hexahedra, any
 N1, N2), the point reflection R(x, y) = (1 − x, 1 − y) maps the multiplier basis onto itself,
 μ_j ∘ R = μ_π(j) with π an involution (:func:`~infsup_contact.solvers.symmetry.reflection_split`, found and checked on Gauss
-points of G_h, :func:`~infsup_contact.discretization.basis_symmetry.induced_permutation`), and
+points of G_h, :func:`~infsup_contact.discretization.gamma.symmetry.induced_permutation`), and
 the interface operator S = Σ_i B_i X_i B_iᵀ and every Gram matrix G commute with the
 permutation: P S Pᵀ = S, P G Pᵀ = G. In the orthonormal basis Q = [Q_e, Q_o] of the even and
 odd functions ((e_j ± e_π(j))/√2 for the pairs j < π(j), e_j for the fixed points in Q_e)
@@ -61,7 +61,7 @@ class ReflectionSplit:
     pis: tuple
     bases: tuple = field(compare=False)
     """(Q_0, ..., Q_{2^g − 1}), sparse with orthonormal columns
-    (:func:`~infsup_contact.discretization.basis_symmetry.isotypic_bases` of ``pis``)."""
+    (:func:`~infsup_contact.discretization.gamma.symmetry.isotypic_bases` of ``pis``)."""
 
     @property
     def sizes(self) -> tuple:

@@ -5,7 +5,7 @@ generalized symmetric eigenproblem (B A⁻¹ Bᵀ) m = β² G m on the multiplie
 B A⁻¹ Bᵀ = Σ_i B_i X_i B_iᵀ / c_i the interface operator (:mod:`.interface_operator`, X_i from
 the sides' Schur complements, :mod:`infsup_contact.la.schur`) and G the Gram matrix of the
 multiplier norm. Partitions, spaces and Gram matrices come from Γ, the interface the sides'
-traces live on (``trace.gamma``, :mod:`infsup_contact.discretization.interface`). How each
+traces live on (``trace.gamma``, :mod:`infsup_contact.discretization.gamma.interface`). How each
 space's pencil is solved is its route (:func:`~.routes.choose_route`, the fast layer
 :mod:`infsup_contact.la` behind it); the request was validated when it was built.
 """
@@ -17,10 +17,13 @@ import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
 
-from ..discretization import multipliers, registry
-from ..discretization.coupling import coupling_matrix, trace_l2_norms
-from ..discretization.norms import NORMS
-from ..discretization.segment import SEGMENT
+from ..discretization.segment import multipliers
+
+from ..discretization.spaces import registry
+from ..discretization.spaces.spec import SpaceSpec
+from ..discretization.gamma.coupling import coupling_matrix, trace_l2_norms
+from ..discretization.segment.norms import NORMS
+from ..discretization.segment.interface import SEGMENT
 from ..models import DEFAULT_MODEL
 from .interface_operator import combine_terms, interface_terms
 from .kernel import kernel_check
@@ -105,12 +108,12 @@ def _row(r, case, c1, c2, norm, spec, kernel, structural, beta_v1_zero, dim_m, d
 
 def _space(case, k, partition, gamma=SEGMENT):
     """A named case on G_h = ``partition`` of ``gamma``, an unregistered
-    :class:`~infsup_contact.discretization.registry.SpaceSpec` (a study's variant, e.g. the α
+    :class:`~infsup_contact.discretization.spaces.spec.SpaceSpec` (a study's variant, e.g. the α
     sweep of study/face_alpha.py), or a general triple ``(label, s, continuous, vanish)``
     (eqs. 5.3, 5.5; spaces of the segment)."""
     if isinstance(case, str):
         return registry.case_space(case, k, partition, gamma)
-    if isinstance(case, registry.SpaceSpec):
+    if isinstance(case, SpaceSpec):
         return gamma.space(case, k, partition)
     _, s, continuous, vanish = case
     return multipliers.make_space(partition, s, continuous, vanish)

@@ -12,9 +12,11 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
-from ..discretization import meshes, registry
-from ..discretization.interface import check_choice
-from ..discretization.norms import NORMS
+from ..discretization.segment import meshes
+
+from ..discretization.spaces import registry
+from ..discretization.gamma.interface import check_choice
+from ..discretization.segment.norms import NORMS
 from ..errors import InputError, check_prestress
 from ..models import DEFAULT_MODEL
 from ..models.contract import Model
@@ -50,7 +52,7 @@ class BetaRequest:
 
     Building it validates it (:meth:`__post_init__`); ``cases`` None means every registered
     space defined for k. A case is a registry id, an unregistered
-    :class:`~infsup_contact.discretization.registry.SpaceSpec` or a general triple
+    :class:`~infsup_contact.discretization.spaces.registry.SpaceSpec` or a general triple
     ``(label, s, continuous, vanish)`` (those two are the caller's, not checked here).
     """
 

@@ -17,7 +17,7 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from ..discretization.coupling import coupling_matrix, trace_l2_norms
+from ..discretization.gamma.coupling import coupling_matrix, trace_l2_norms
 from ..la import bottom, reflection
 from . import spectra, symmetry
 from .kernel import KernelDecision, bottom_kernel, coupling_kernel, scaled_couplings

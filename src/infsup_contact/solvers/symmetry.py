@@ -3,7 +3,7 @@
 The linear algebra of a reflection-invariant pencil (its isotypic blocks, the components'
 pencils) is :mod:`infsup_contact.la.reflection`; here the split is found on a space's basis
 (:func:`reflection_split`, checked at Gauss points of G_h with
-:func:`~infsup_contact.discretization.basis_symmetry.induced_permutation`) and the kernel of Bᵀ
+:func:`~infsup_contact.discretization.gamma.symmetry.induced_permutation`) and the kernel of Bᵀ
 is decided on the split's components (:func:`split_bottom_kernel`, the certificates of
 :mod:`.kernel`).
 """
@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
-from ..discretization.basis_symmetry import axis_reflections, induced_permutation, isotypic_bases, reflect
+from ..discretization.gamma.symmetry import axis_reflections, induced_permutation, isotypic_bases, reflect
 from ..la import bottom
 from ..la.reflection import ReflectionSplit
 from .kernel import BLOCK_EXTRA, KernelDecision, certified_bottom, certify_floor, decide, error_level

@@ -7,7 +7,7 @@ later passes by config alone), a non-matching pair has N1 ≠ N2, and the face s
 (:func:`check_face_studies`). Each raises one
 :class:`~infsup_contact.config_schema.ConfigError` naming the key.
 
-Non-matching families (``face.nonmatching_families``: family → element → N1 list, issue 28 item 1):
+Non-matching families (``face.nonmatching_families``: family → element → N1 list):
 the rules of the 2D study's families (:data:`~infsup_contact.discretization.gamma.mesh_series.FAMILY_RULES`:
 ``sqrt2`` n → round(√2 n), ``plus1`` n → n + 1) give the *finer* side from the coarser one, and on
 the face Ω2 is the finer side as in ``face.nonmatching`` (G_h = the trace of Ω2): N2 = rule(N1),

@@ -1,4 +1,4 @@
-"""The α sweep of the transformed dual bases on the face (issue 28): β_h against α.
+"""The α sweep of the transformed dual bases on the face: β_h against α.
 
 Popp, Gitterle, Gee, Wall (Int. J. Numer. Meth. Engng 83 (2010) 1428–1465) and 4C transform a
 quadratic face element's basis, Ñ = T(α) N (:func:`~infsup_contact.discretization.face.spaces.dual_bases.transformation`),
@@ -13,7 +13,7 @@ construction's own decision (:func:`accepted_by_construction`), ``weights_positi
 ``min_weight`` / ``min_weight_gauss`` the weights by two quadratures, so a table can show
 whether the two agree (the ledger's ``face-alpha-accept`` claims, :mod:`.face_study_claims`).
 
-TRI6 (issue 28, item 3): the same sweep on the triangles of tetrahedral faces (P2 displacements,
+TRI6: the same sweep on the triangles of tetrahedral faces (P2 displacements,
 :func:`~infsup_contact.discretization.face.spaces.tri6.tri6_space`). Its weights are ∫Ñ_vertex = α/3 and
 ∫Ñ_edge = (1 − 2α)/6 (fractions 2α/3 and (1 − 2α)/3 of the area 1/2): positive on all of (0, 1/2),
 the plain dual (α = 0) is the only one refused. The mesh element of each reference element is the
@@ -37,10 +37,10 @@ from ..discretization.spaces.spec import SpaceSpec
 from ..errors import InputError
 
 ALPHAS = (0.05, 0.1, 0.125, 0.15, 0.2, 0.25, 0.3, 1.0 / 3.0, 0.4, 0.45)
-"""The sweep of issue 28 (0.125: the QUAD8 corner weight is exactly 0; 0.2: 4C's)."""
+"""The sweep (0.125: the QUAD8 corner weight is exactly 0; 0.2: 4C's)."""
 ELEMENTS = ("QUAD8", "QUAD9")
 TRI_ALPHAS = (0.05, 0.1, 0.15, 0.2, 0.25, 0.3, 1.0 / 3.0, 0.4, 0.45)
-"""The TRI6 sweep of issue 28 (no α in (0, 1/2) makes a TRI6 weight vanish)."""
+"""The TRI6 sweep (no α in (0, 1/2) makes a TRI6 weight vanish)."""
 SWEEP_ELEMENTS = ("QUAD8", "QUAD9", "TRI6")
 FACE_CELL = {"quad": "quad", "tri": "trig"}
 """Reference cell of an element (:attr:`~.face_elements.ReferenceElement.cell`) → face cell shape

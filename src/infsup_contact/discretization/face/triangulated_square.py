@@ -2,7 +2,7 @@
 
 :class:`TriangulatedSquare` is the third implementation of :class:`~.gamma.interface.Interface`, a
 sibling of :class:`~.face.square.Square` (whose partitions are tensor grids): the face of
-unstructured (Netgen) and perturbed tetrahedral meshes (issue 28), Ω1 and Ω2 meshed
+unstructured (Netgen) and perturbed tetrahedral meshes, Ω1 and Ω2 meshed
 independently, so their traces do not match. Its partition is a
 :class:`~.face.triangulation.Triangulation`; the common refinement is the polygon overlay of two
 triangulations (shapely, :func:`~.face.triangulation.overlay`), fanned into triangles, on which a

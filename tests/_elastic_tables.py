@@ -10,7 +10,7 @@ def small_elastic_tables() -> dict:
 
     from infsup_contact.bench.elastic_beta import bench_elastic_beta
     from infsup_contact.study.elastic_beta import elastic_beta_rows, nu_sweep_rows
-    from infsup_contact.study.elastic_claims import elastic_claims, hertz_claims, patch_claims
+    from infsup_contact.study.claims.elastic import elastic_claims, hertz_claims, patch_claims
     from infsup_contact.study.hertz import discretization_rows, modeling_rows
     from infsup_contact.study.patch import patch_rows
 

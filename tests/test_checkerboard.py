@@ -7,7 +7,7 @@ from infsup_contact.discretization.registry import SPACES
 from infsup_contact.discretization.square import SQUARE, SQUARE_TRIG, TensorPartition
 from infsup_contact.models import MODELS
 from infsup_contact.solvers import infsup
-from infsup_contact.study.face_claims import checkerboard, face_predictions
+from infsup_contact.study.claims.membranes3d import checkerboard, face_predictions
 
 
 def _grid(n):

@@ -19,7 +19,7 @@ from infsup_contact.discretization.face_dual import ZERO_WEIGHT_RTOL, weight_fra
 from infsup_contact.discretization.registry import SPACES, ids_valid_for
 from infsup_contact.discretization.square import SQUARE, SQUARE_TRIG
 from infsup_contact.io import read_table
-from infsup_contact.study import face_study_claims as fsc
+from infsup_contact.study.claims import membranes3d_studies as fsc
 
 ROOT = Path(__file__).resolve().parents[1]
 ENV = {"PYTHONPATH": str(ROOT / "src"), "OPENBLAS_NUM_THREADS": "1", "PATH": str(Path(sys.executable).parent)}

@@ -7,7 +7,7 @@ from _glue import log_to, read_table, register_user_spaces  # noqa: E402
 log_to(snakemake.log[0])  # noqa: F821
 register_user_spaces(snakemake.config)  # noqa: F821
 
-from infsup_contact.study.claims import ledger  # noqa: E402
+from infsup_contact.study.claims.membranes import ledger  # noqa: E402
 from infsup_contact.io import write_csv_atomic  # noqa: E402
 
 inp = snakemake.input  # noqa: F821

@@ -10,7 +10,7 @@ register_user_spaces(snakemake.config)  # noqa: F821
 from infsup_contact.io import write_csv_atomic  # noqa: E402
 import pandas as pd  # noqa: E402
 
-from infsup_contact.study.elastic_claims import elastic_claims, hertz_claims, patch_claims  # noqa: E402
+from infsup_contact.study.claims.elastic import elastic_claims, hertz_claims, patch_claims  # noqa: E402
 
 inp = snakemake.input  # noqa: F821
 table = pd.concat([elastic_claims(read_table(inp.beta, "elastic_beta"), read_table(inp.sweep, "elastic_beta"),

@@ -8,7 +8,7 @@ log_to(snakemake.log[0])  # noqa: F821
 register_user_spaces(snakemake.config)  # noqa: F821
 
 from infsup_contact.io import write_csv_atomic  # noqa: E402
-from infsup_contact.study.face_claims import element_interfaces, face_claims  # noqa: E402
+from infsup_contact.study.claims.membranes3d import element_interfaces, face_claims  # noqa: E402
 
 fc = snakemake.params.fc  # noqa: F821
 table = face_claims(read_table(snakemake.input.beta, "face_beta"), snakemake.params.cfg,  # noqa: F821

@@ -10,8 +10,8 @@ log_to(snakemake.log[0])  # noqa: F821
 register_user_spaces(snakemake.config)  # noqa: F821
 
 from infsup_contact.io import write_csv_atomic  # noqa: E402
-from infsup_contact.study.face_claims import element_interfaces  # noqa: E402
-from infsup_contact.study.face_elastic_claims import face_elastic_claims  # noqa: E402
+from infsup_contact.study.claims.membranes3d import element_interfaces  # noqa: E402
+from infsup_contact.study.claims.elastic3d import face_elastic_claims  # noqa: E402
 
 inp, fe = snakemake.input, snakemake.params.fe  # noqa: F821
 membranes = read_table(inp.membranes[0], "face_beta") if len(inp.membranes) else None

@@ -8,8 +8,8 @@ log_to(snakemake.log[0])  # noqa: F821
 register_user_spaces(snakemake.config)  # noqa: F821
 
 from infsup_contact.io import write_csv_atomic  # noqa: E402
-from infsup_contact.study.face_claims import element_interfaces  # noqa: E402
-from infsup_contact.study.face_study_claims import face_study_claims  # noqa: E402
+from infsup_contact.study.claims.membranes3d import element_interfaces  # noqa: E402
+from infsup_contact.study.claims.membranes3d_studies import face_study_claims  # noqa: E402
 
 inp, fc = snakemake.input, snakemake.params.fc  # noqa: F821
 table = face_study_claims(read_table(inp.patch, "face_patch"), read_table(inp.alpha, "face_alpha"),

@@ -21,7 +21,7 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-from .claims import FAIL, INCONCLUSIVE, PASS
+from .claims.criteria import FAIL, INCONCLUSIVE, PASS
 
 FINDING = "finding"
 VERDICTS = (PASS, FAIL, INCONCLUSIVE)

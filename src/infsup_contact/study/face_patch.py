@@ -48,7 +48,7 @@ minimum-norm λ_h is not the constant (errors 0.1–1.3), so ``passes`` is False
 1 ∈ M_h; T4 and T5 (no kernel) still pass.
 
 **In the DAG** (rule ``face_study_job``, :func:`face_patch_table`; ledger claims
-:mod:`.face_study_claims`): at k = 1 on tetrahedra DUAL fails (λ error 1, at the corner triangles):
+:mod:`.claims.membranes3d_studies`): at k = 1 on tetrahedra DUAL fails (λ error 1, at the corner triangles):
 the boundary-modified TRI3 dual has no live node on a corner triangle whose three vertices lie
 on ∂Γ, so its face space lacks the constants although the 1D ``contains_constants`` (this
 module's ``predicted`` column) holds; the ledger's prediction checks 1 ∈ M_h on the space the
@@ -221,7 +221,7 @@ def face_patch_table(cases, ks, pairs, elements, model: str | None = None) -> li
     for every element of ``model`` (default the scene's first), restricted to the ``cases``
     that element's face builds (``Interface.builds``: the QUAD9-element spaces pair with
     rectangles only), every k and every non-matching pair."""
-    from .face_claims import element_interfaces
+    from .claims.membranes3d import element_interfaces
 
     name = FACE_PATCH.models[0] if model is None else model
     gammas = element_interfaces(name, elements)

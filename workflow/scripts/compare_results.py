@@ -4,7 +4,8 @@ Usage::
 
     python workflow/scripts/compare_results.py BASE/results NEW/results
 
-Compared: ``claims.csv`` and every ``*.csv`` under ``tables/`` (in either tree). Each file is
+Compared: ``claims.csv`` and every ``*.csv`` under ``tables/`` and ``face/`` (the face studies'
+tables the ledger is made of), in either tree. Each file is
 read with the csv module as text, so "identical" means the same characters in every compared
 cell, not numbers equal to a tolerance. Columns left out (:data:`IGNORED`):
 
@@ -31,9 +32,13 @@ MAX_CELLS = 5
 """Differing cells printed per file (the count is always printed)."""
 
 
+TABLE_DIRS = ("tables", "face")
+"""The folders of a results tree whose ``*.csv`` files are compared (with ``claims.csv``)."""
+
+
 def compared_files(root: Path) -> set:
     """The ledger and the tables of a results tree, as paths relative to it."""
-    files = {p.relative_to(root) for p in (root / "tables").rglob("*.csv")} if (root / "tables").is_dir() else set()
+    files = {p.relative_to(root) for d in TABLE_DIRS for p in (root / d).rglob("*.csv")}
     return files | ({Path("claims.csv")} if (root / "claims.csv").is_file() else set())
 
 

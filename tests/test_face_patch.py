@@ -12,7 +12,7 @@ from infsup_contact.discretization import registry
 from infsup_contact.discretization.square import SQUARE, TensorPartition
 from infsup_contact.errors import InputError
 from infsup_contact.solvers.contact import gamma_values, solve_contact_on
-from infsup_contact.study import face_patch
+from infsup_contact.study.patch import face as face_patch
 from infsup_contact.study.scene_registry import FACE_PATCH
 
 

@@ -1,7 +1,7 @@
 # The 3D elastic bodies on the contact face (issue 28; config face_elastic, models/elastic3d.py):
 # β_H of the face spaces per element (all k, the table's ν on every mesh pair, the ν → 1/2 sweep
 # on its meshes: study/face_elastic.py), the table results/tables/face_elastic_beta.csv, the
-# elastic face patch test results/face/elastic_patch.csv (study/elastic_face_patch.py), their
+# elastic face patch test results/face/elastic_patch.csv (study/patch/face_elastic.py), their
 # ledger claims results/tables/face_elastic_claims.csv (study/claims/elastic3d.py; appended to
 # results/claims.csv through FACE_CLAIMS) and the generated subsection results/paper/face_elastic.tex
 # of the face section (report/face_elastic.py). Sized for seconds; a config without a

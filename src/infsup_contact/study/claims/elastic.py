@@ -121,7 +121,7 @@ def _scaling(x, beta, tol, conf):
 
 
 def patch_claims(patch: pd.DataFrame) -> pd.DataFrame:
-    """Patch-test claims (:mod:`infsup_contact.study.patch`): per case and k, λ_h = p and u_h = u
+    """Patch-test claims (:mod:`infsup_contact.study.patch.segment`): per case and k, λ_h = p and u_h = u
     to 1e-10 on every pair (predicted iff 1 ∈ M_h: every case but T3); T3's error confined to
     a boundary layer (the middle-half error falls ≥ 10x when the pair is refined at a fixed
     ratio, the end-interval error stays 1)."""
@@ -161,7 +161,7 @@ def patch_claims(patch: pd.DataFrame) -> pd.DataFrame:
 
 def _patch_prediction(spec, k: int) -> str:
     """PASS where 1 ∈ M_h (a uniform pressure is in the space: the discrete solution is exact,
-    study/patch.py), FAIL where it is not; a space outside the registry is predicted to pass."""
+    study/patch/segment.py), FAIL where it is not; a space outside the registry is predicted to pass."""
     return FAIL if spec is not None and not spec.contains_constants(k) else PASS
 
 

@@ -7,7 +7,7 @@ INCONCLUSIVE, slope claims by the Student-t interval inside s0 ± τ, and a deci
 round-off is INCONCLUSIVE. Every ``predicted`` column is computed here from the registry's
 properties and the construction of the spaces (never from a case id, never from the tables):
 
-* **Patch test** (``face-patch-<tag>-k<k>-<element>``, :mod:`.face_patch`): the uniform pressure
+* **Patch test** (``face-patch-<tag>-k<k>-<element>``, :mod:`..patch.face`): the uniform pressure
   is reproduced (λ_h = λ and u_h = u to :data:`PATCH_RTOL`) on every non-matching pair iff
   1 ∈ M_h and K has no kernel on G_h = the trace of Ω2. 1 ∈ M_h is checked on the space the
   element's face builds (:func:`face_contains_constants`; the registry's 1D

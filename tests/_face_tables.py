@@ -7,7 +7,7 @@ import pandas as pd
 
 from infsup_contact.discretization.spaces.registry import SPACES
 from infsup_contact.discretization.face.square import SQUARE, SQUARE_TRIG
-from infsup_contact.study.face_claims import face_claims, matching_kernel, planar_kernel
+from infsup_contact.study.claims.membranes3d import face_claims, matching_kernel, planar_kernel
 
 CLAIMS_CFG = {"slope_tolerance": 0.15, "beta_floor": 1e-3, "confidence": 0.95, "fit_window": 5}
 NS = (4, 6, 8, 10, 12)
@@ -82,7 +82,7 @@ def small_study_tables() -> dict:
     """``patch``, ``alpha``, ``edge`` and their ``study_claims`` (hexahedra): a space with and one
     without the constants, QUAD8 around its threshold, a full-order k = 1 space decaying like θ
     and a stable lower-order k = 2 space bounded."""
-    from infsup_contact.study.face_study_claims import face_study_claims
+    from infsup_contact.study.claims.membranes3d_studies import face_study_claims
 
     patch = pd.concat([patch_rows("R5.2", 1), patch_rows("T3", 1, passes=False)], ignore_index=True)
     alpha = alpha_rows()

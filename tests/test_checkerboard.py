@@ -10,7 +10,7 @@ from infsup_contact.models import MODELS
 from infsup_contact.discretization.gamma.coupling import coupling_matrix
 from infsup_contact.solvers import infsup
 from infsup_contact.solvers.side_cache import SideCache
-from infsup_contact.study.face_claims import checkerboard, face_predictions
+from infsup_contact.study.claims.membranes3d import checkerboard, face_predictions
 
 
 def _grid(n):

@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from infsup_contact.study.claims import sign_check
+from infsup_contact.study.claims.membranes import sign_check
 from infsup_contact.solvers.kkt import solve_kkt_sparse
 from infsup_contact.models.membranes import load_vector
 from infsup_contact.solvers.contact import contact_qp, solve_contact

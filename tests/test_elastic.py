@@ -23,7 +23,7 @@ from infsup_contact.solvers.interface_operator import interface_operator
 from infsup_contact.solvers.contact import contact_qp
 from infsup_contact.solvers.infsup import beta_rows, saddle_point_beta
 from infsup_contact.solvers.pdas import solve_pdas
-from infsup_contact.study.patch import PASS_RTOL
+from infsup_contact.study.patch.segment import PASS_RTOL
 
 
 def test_registered():
@@ -200,7 +200,7 @@ def test_patch_passes_with_constants_and_t3_fails_at_the_ends():
     """5:4 non-matching blocks, k = 2: T5 (contains the constants) reproduces λ = p and the
     linear displacement to round-off; T3 (zero at Γ's ends) cannot: λ_h(0) = 0, error 1 at the
     ends, and its displacement is wrong."""
-    from infsup_contact.study.patch import exact_pressure, solve_patch
+    from infsup_contact.study.patch.segment import exact_pressure, solve_patch
 
     good = solve_patch("T5", 2, 5, 4, nu=0.3, E=(1.0, 2.0))
     assert good["passes"] and max(good["lambda_max_rel_error"], good["u_max_rel_error"]) < PASS_RTOL
@@ -212,7 +212,7 @@ def test_patch_passes_with_constants_and_t3_fails_at_the_ends():
 def test_patch_pressure_is_the_uniform_stress():
     """p = δ/(1/M1 + 1/M2) is the stress of two stacked constrained layers: with E1 = E2 and
     ν = 0 (M = E) it is δE/2."""
-    from infsup_contact.study.patch import exact_pressure
+    from infsup_contact.study.patch.segment import exact_pressure
 
     assert exact_pressure(0.2, 0.0, (3.0, 3.0)) == pytest.approx(0.3)
 

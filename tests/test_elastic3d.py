@@ -20,8 +20,8 @@ from infsup_contact.models.plane_strain import lame
 from infsup_contact.models.contract import Body, schur_by_solves
 from infsup_contact.solvers.contact import solve_contact_on
 from infsup_contact.solvers.infsup import beta_rows_all
-from infsup_contact.study import elastic_face_patch as efp
-from infsup_contact.study.face_patch import PASS_RTOL
+from infsup_contact.study.patch import face_elastic as efp
+from infsup_contact.study.patch.face import PASS_RTOL
 from infsup_contact.study.scene_registry import ELASTIC_FACE_PATCH
 
 FREE = ("nothing",) * 3

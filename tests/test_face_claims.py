@@ -15,8 +15,8 @@ import yaml
 from infsup_contact.discretization.spaces.registry import SPACES
 from infsup_contact.errors import InputError
 from infsup_contact.discretization.face.square import SQUARE, SQUARE_TRIG
-from infsup_contact.study.claims import FAIL, INCONCLUSIVE, PASS
-from infsup_contact.study.face_claims import (face_claims, face_dimension, face_predictions, kernel_formula,
+from infsup_contact.study.claims.criteria import FAIL, INCONCLUSIVE, PASS
+from infsup_contact.study.claims.membranes3d import (face_claims, face_dimension, face_predictions, kernel_formula,
                                               planar_kernel, tensor_kernel_bound)
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -213,7 +213,7 @@ def test_kuhn_faces_predict_fail_where_the_triangle_bound_exceeds_the_count():
     triangle_kernel_bound: FAIL where it exceeds the planar count on a config pair (R5.2 at
     k = 2, 4:5: corner modes), FINDING where it does not (R5.2 at k = 1, 4:5), PASS for a
     stable space; never from the data."""
-    from infsup_contact.study.face_claims import FINDING, face_predictions, triangle_kernel_bound
+    from infsup_contact.study.claims.membranes3d import FINDING, face_predictions, triangle_kernel_bound
     r52 = SPACES["R5.2"]
     assert triangle_kernel_bound(r52, 2, 4, 5) > planar_kernel(r52, 2, 4, 5, SQUARE_TRIG)
     assert face_predictions(r52, 2, [(4, 5)], False, SQUARE_TRIG)["nonmatching"] == FAIL

@@ -14,11 +14,11 @@ import yaml
 
 from infsup_contact.discretization.spaces.registry import SPACES
 from infsup_contact.discretization.face.square import SQUARE
-from infsup_contact.study.claims import FAIL, INCONCLUSIVE, PASS
-from infsup_contact.study.face_claims import matching_kernel
+from infsup_contact.study.claims.criteria import FAIL, INCONCLUSIVE, PASS
+from infsup_contact.study.claims.membranes3d import matching_kernel
 from infsup_contact.study.face_elastic import nu_pairs
-from infsup_contact.study.face_elastic_claims import FINDING, claim_id, face_elastic_claims, nu_slope
-from infsup_contact.study.face_study_claims import face_contains_constants
+from infsup_contact.study.claims.elastic3d import FINDING, claim_id, face_elastic_claims, nu_slope
+from infsup_contact.study.claims.membranes3d_studies import face_contains_constants
 
 ROOT = Path(__file__).resolve().parents[1]
 CLAIMS_CFG = {"slope_tolerance": 0.15, "beta_floor": 1e-3, "confidence": 0.95, "fit_window": 5}

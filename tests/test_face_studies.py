@@ -19,7 +19,7 @@ from infsup_contact.discretization.face.spaces.dual_bases import ZERO_WEIGHT_RTO
 from infsup_contact.discretization.spaces.registry import SPACES, ids_valid_for
 from infsup_contact.discretization.face.square import SQUARE, SQUARE_TRIG
 from infsup_contact.io import read_table
-from infsup_contact.study import face_study_claims as fsc
+from infsup_contact.study.claims import membranes3d_studies as fsc
 
 ROOT = Path(__file__).resolve().parents[1]
 ENV = {"PYTHONPATH": str(ROOT / "src"), "OPENBLAS_NUM_THREADS": "1", "PATH": str(Path(sys.executable).parent)}

@@ -216,7 +216,7 @@ def test_alpha_sweep_runs_tri6_on_tetrahedra():
 def test_patch_test_passes_iff_the_space_holds_the_constants():
     """The 3D patch test (study/face_patch.py) on non-matching tetrahedra 3:4, k = 2: TDUAL-T6 keeps the
     constants and reproduces the uniform pressure; PWLIN-T6 vanishes on ∂Γ and does not, as predicted."""
-    from infsup_contact.study import face_patch
+    from infsup_contact.study.patch import face as face_patch
 
     rows = face_patch.face_patch_rows(["TDUAL-T6", "PWLIN-T6"], [2], [(3, 4)], element="tet")
     assert len(rows) == 2

@@ -347,7 +347,7 @@ def test_ctrl_c_is_one_line_and_exit_130():
 
 
 # ------------------------------------------------------------------ the CI gate (issue 39, item 5)
-from infsup_contact.study.claims_gate import GateError, gate  # noqa: E402
+from infsup_contact.study.claims.gate import GateError, gate  # noqa: E402
 
 
 def _ledger(rows) -> pd.DataFrame:

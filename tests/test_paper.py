@@ -17,7 +17,7 @@ import yaml
 
 from infsup_contact import report as pt
 from infsup_contact.discretization.spaces.registry import PAPER_CASES
-from infsup_contact.study.claims import REM55_INSTANCES, ledger, nonmatching_claims
+from infsup_contact.study.claims.membranes import REM55_INSTANCES, ledger, nonmatching_claims
 
 ROOT = Path(__file__).resolve().parents[1]
 PAPER = ROOT / "paper" / "paper.tex"

@@ -88,7 +88,7 @@ def face_sides():
     """The face patch scene's sides of one body, route "pardiso": the factor kept or freed."""
     from infsup_contact.models import make_model
     from infsup_contact.models import membranes3d
-    from infsup_contact.study import face_patch
+    from infsup_contact.study.patch import face as face_patch
     from infsup_contact.study.scene_registry import FACE_PATCH
 
     model = make_model(FACE_PATCH.models[0])
@@ -122,14 +122,14 @@ def test_on_a_face_the_kept_factor_solves_as_a_second_factorization(face_sides):
 
 def _membrane_rows():
     from infsup_contact.discretization.spaces import registry
-    from infsup_contact.study import face_patch
+    from infsup_contact.study.patch import face as face_patch
 
     return face_patch.face_patch_rows(registry.space_ids(), [2], [(3, 4)])
 
 
 def _elastic_rows():
     from infsup_contact.discretization.spaces import registry
-    from infsup_contact.study import elastic_face_patch
+    from infsup_contact.study.patch import face_elastic as elastic_face_patch
 
     return elastic_face_patch.elastic_face_patch_rows(registry.space_ids(), [1], [(2, 3)])
 
@@ -142,8 +142,8 @@ def test_the_face_patch_contact_solution_is_unchanged(monkeypatch, patch_rows):
     not within the other route's round-off digits (1e-14..1e-12, which differ between CPUs);
     where it fails (T3), the errors are the discretization's, O(1e-2..1), and agree as the
     solutions do (cond ≈ 3e4: to ~1e-11, asked to 1e-6)."""
-    from infsup_contact.la import schur
-    from infsup_contact.study.face_patch import PASS_RTOL
+    from infsup_contact.models import schur
+    from infsup_contact.study.patch.face import PASS_RTOL
 
     real = schur.gamma_factorization
     kept = []

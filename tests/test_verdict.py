@@ -21,7 +21,7 @@ import yaml
 
 from infsup_contact import cli
 from infsup_contact.discretization.spaces import registry
-from infsup_contact.study import claims
+from infsup_contact.study.claims import criteria as claims
 from infsup_contact.study.verdict import INCONCLUSIVE, STABLE, UNSTABLE, stability_verdict
 
 ROOT = Path(__file__).resolve().parents[1]

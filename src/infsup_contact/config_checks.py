@@ -282,7 +282,7 @@ def mesh_uses(cfg, with_cases: bool = True):
     yield "figures.elastic_profiles.N", n, n, n, pairs if with_cases else {}, ("omega2",)
     rem55 = {}
     if with_cases:
-        from .study.claims import REM55_INSTANCES
+        from .study.claims.membranes import REM55_INSTANCES
 
         for _, _, k, triple, _ in REM55_INSTANCES:
             rem55.setdefault(k, []).append(triple)

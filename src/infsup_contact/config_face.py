@@ -171,7 +171,7 @@ def _check_face_cases(cfg, fc, options) -> None:
     """Each face case is built by the face of one of the configured elements (``face.elements``
     or ``face.patch.elements``): a space no configured element carries (PWLIN-T6 with hexahedra
     only) was accepted and silently never computed."""
-    from .study.face_claims import element_interfaces
+    from .study.claims.membranes3d import element_interfaces
 
     patch = [e for e in fc["patch"]["elements"] if e in options]  # the others: check_face_studies
     elements = list(dict.fromkeys([*fc["elements"], *patch]))

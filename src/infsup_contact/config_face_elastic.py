@@ -76,7 +76,7 @@ def _check_nus(fe) -> None:
 
 def _check_cases(cfg, fe, model) -> None:
     from .config_face import check_face_case_ids
-    from .study.face_claims import element_interfaces
+    from .study.claims.membranes3d import element_interfaces
 
     faces = element_interfaces(model, sorted(set(fe["elements"]) | set(fe["patch"]["elements"])))
     check_face_case_ids(cfg, "face_elastic", fe["cases"], fe["k"], list(faces.values()), need_builder=True)

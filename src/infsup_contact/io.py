@@ -124,7 +124,7 @@ SCHEMAS = {
     "mesh_quality": Schema({"family": "str", "N1": "int", "N2": "int", "side": "int", "h_max": "float",
                             "h_min": "float", "min_angle": "float"}, optional={"seed": "int?"},
                            key=("family", "N1", "N2", "side", "seed")),
-    # elastic stage (study/elastic_beta.py, study/patch.py, study/hertz.py)
+    # elastic stage (study/elastic_beta.py, study/patch/segment.py, study/hertz.py)
     "elastic_beta": Schema(_ELASTIC_BETA, key=("model", "case", "k", "family", "N1", "N2", "multiplier_mesh", "E1",
                                                "E2", "nu", "norm")),
     "elastic_patch": Schema({"case": "str", "k": "int", "N1": "int", "N2": "int", "p": "float", "kernel_dim": "int",
@@ -150,7 +150,7 @@ SCHEMAS = {
                                   "E1": "float", "E2": "float", "nu": "float", "lambda_max_rel_error": "float",
                                   "u_max_rel_error": "float", "kernel_dim": "int", "passes": "bool"},
                                  key=("element", "case", "k", "N1", "N2", "E1", "E2", "nu")),
-    # the face studies (rules/face_studies.smk: study/face_patch.py, face_alpha.py, edge_dropping.py);
+    # the face studies (rules/face_studies.smk: study/patch/face.py, face_alpha.py, edge_dropping.py);
     # condition numbers may be inf (singular to working precision): extra columns, not declared
     "face_patch": Schema({"element": "str", "case": "str", "k": "int", "N1": "int", "N2": "int",
                           "lambda_max_rel_error": "float", "u_max_rel_error": "float", "kernel_dim": "int",

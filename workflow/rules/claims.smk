@@ -21,7 +21,7 @@ rule claims_extra:
 # The tables the ledger is made of (rule claims below), each with the schema it reads under, and
 # one stage further up the contact table the rates are fitted on: the gate (verify-claims,
 # workflow/Snakefile) needs each of them, checks it and refuses a ledger older than them
-# (study/claims_gate.py).
+# (study/claims/gate.py).
 LEDGER_TABLES = {
     "results/tables/beta.csv": "beta",
     "results/tables/rates.csv": "rates",

@@ -1,8 +1,8 @@
 # The 3D elastic bodies on the contact face (issue 28; config face_elastic, models/elastic3d.py):
 # β_H of the face spaces per element (all k, the table's ν on every mesh pair, the ν → 1/2 sweep
 # on its meshes: study/face_elastic.py), the table results/tables/face_elastic_beta.csv, the
-# elastic face patch test results/face/elastic_patch.csv (study/elastic_face_patch.py), their
-# ledger claims results/tables/face_elastic_claims.csv (study/face_elastic_claims.py; appended to
+# elastic face patch test results/face/elastic_patch.csv (study/patch/face_elastic.py), their
+# ledger claims results/tables/face_elastic_claims.csv (study/claims/elastic3d.py; appended to
 # results/claims.csv through FACE_CLAIMS) and the generated subsection results/paper/face_elastic.tex
 # of the face section (report/face_elastic.py). Sized for seconds; a config without a
 # `face_elastic` section has no such stage.
@@ -91,7 +91,7 @@ rule face_elastic_paper:
         beta="results/tables/face_elastic_beta.csv",
         patch="results/face/elastic_patch.csv",
         claims="results/tables/face_elastic_claims.csv",
-        src=REPORT_SOURCES + ["src/infsup_contact/study/face_elastic_claims.py"],  # its slope fit
+        src=REPORT_SOURCES + ["src/infsup_contact/study/claims/elastic3d.py"],  # its slope fit
     params:
         fe=lambda wc: config["face_elastic"],
     benchmark:

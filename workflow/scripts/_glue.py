@@ -57,3 +57,13 @@ def read_table(path, kind: str, **kwargs):
         if name.startswith("tmp") and name.count(".") > 1:  # Snakemake's copy: tmp<random>.claims.py
             name = name.split(".", 1)[1]
         fail(f"{name}: {err}")
+
+
+def write_claims(path, table) -> None:
+    """Write a claims table (the ledger or one model's claims, columns
+    ``infsup_contact.study.claims.criteria.COLUMNS``) atomically and list its ids, verdicts and
+    predictions in the job's log: every claims job writes through here."""
+    from infsup_contact.io import write_csv_atomic
+
+    write_csv_atomic(path, table)
+    print(table[["claim_id", "verdict", "predicted"]].to_string(), file=sys.stderr)

@@ -2,13 +2,12 @@
 import sys
 
 sys.path.insert(0, "workflow/scripts")
-from _glue import log_to, read_table, register_user_spaces  # noqa: E402
+from _glue import log_to, read_table, register_user_spaces, write_claims  # noqa: E402
 
 log_to(snakemake.log[0])  # noqa: F821
 register_user_spaces(snakemake.config)  # noqa: F821
 
-from infsup_contact.study.claims import ledger  # noqa: E402
-from infsup_contact.io import write_csv_atomic  # noqa: E402
+from infsup_contact.study.claims.membranes import ledger  # noqa: E402
 
 inp = snakemake.input  # noqa: F821
 table = ledger(read_table(inp.beta, "beta"), read_table(inp.rates, "rates"), read_table(inp.extra, "claims"),
@@ -19,5 +18,4 @@ import pandas as pd  # noqa: E402
 table = pd.concat([table, read_table(inp.elastic, "claims")]
                   + [read_table(p, "claims") for p in inp.face]  # rules/face.smk
                   + [read_table(p, "claims") for p in inp.producers], ignore_index=True)  # rules/producers.smk
-write_csv_atomic(snakemake.output[0], table)  # noqa: F821
-print(table[["claim_id", "verdict", "predicted"]].to_string(), file=sys.stderr)
+write_claims(snakemake.output[0], table)  # noqa: F821

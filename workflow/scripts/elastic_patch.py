@@ -1,4 +1,4 @@
-"""The contact patch test of the elastic pair (study/patch.py): every space of infsup.cases
+"""The contact patch test of the elastic pair (study/patch/segment.py): every space of infsup.cases
 defined for each k of elastic.patch_k, every pair of elastic.patch_pairs."""
 import sys
 
@@ -12,7 +12,7 @@ register_user_spaces(snakemake.config)  # noqa: F821
 import pandas as pd  # noqa: E402
 
 from infsup_contact.io import write_csv_atomic  # noqa: E402
-from infsup_contact.study.patch import patch_rows  # noqa: E402
+from infsup_contact.study.patch.segment import patch_rows  # noqa: E402
 
 ec = snakemake.params.ec  # noqa: F821
 frame = pd.DataFrame(patch_rows(snakemake.params.cases, ec["patch_k"], [tuple(p) for p in ec["patch_pairs"]], ec["nu"], tuple(ec["E"])))

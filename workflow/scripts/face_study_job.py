@@ -1,5 +1,5 @@
 """One face study table (rules/face_studies.smk, config ``face.<study>``): the 3D patch test
-(study/face_patch.py), the α sweep of the transformed dual bases (study/face_alpha.py) or edge
+(study/patch/face.py), the α sweep of the transformed dual bases (study/face_alpha.py) or edge
 dropping (study/edge_dropping.py), chosen by the rule's ``params.study`` among
 study/face_study_tables.py's FACE_STUDIES, written atomically with provenance columns."""
 import sys

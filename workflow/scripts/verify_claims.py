@@ -1,12 +1,12 @@
 """The CI gate: fail unless the ledger is there, built from the current, valid tables, and every
-claim of the paper has the verdict the paper predicts (study/claims_gate.py); print the ledger."""
+claim of the paper has the verdict the paper predicts (study/claims/gate.py); print the ledger."""
 import sys
 
 sys.path.insert(0, "workflow/scripts")
 from _glue import fail  # noqa: E402
 
 from infsup_contact.io import TableError  # noqa: E402
-from infsup_contact.study.claims_gate import GateError, gate  # noqa: E402
+from infsup_contact.study.claims.gate import GateError, gate  # noqa: E402
 
 try:
     ledger, summary = gate(snakemake.input.ledger, snakemake.params.stages)  # noqa: F821

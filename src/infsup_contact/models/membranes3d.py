@@ -26,7 +26,7 @@ common refinement by polygon clipping).
 Boundaries: ``gamma`` (Γ), ``dir`` (the far face: z = 0 of Ω1, z = 2 of Ω2) and ``side`` (the
 four lateral faces). β_h clamps both (:data:`BETA_DIRICHLET`, the paper's u_i = 0 on ∂Ω_i∖Γ);
 a contact scene may clamp fewer (its ``supports``: the face patch test keeps the lateral faces
-natural, :mod:`infsup_contact.study.face_patch`).
+natural, :mod:`infsup_contact.study.patch.face`).
 
 **Contact** (the model contract, :mod:`.contract`, with n = e_z for e_y): a scene gives its
 material scales ``c1``, ``c2``, its far-face displacements ``far_displacement`` (u_i on ``dir``,

@@ -18,7 +18,7 @@ from .texnames import Macro, macro_name
 FACE_FILES = ("face_macros.tex", "face_beta_table.tex")
 KINDS = (("kernel", "face-kernel-"), ("nonmatching", "face-nonmatching-kernel-"), ("ltwo", "face-Rem3.1-"),
          ("bounded", "face-"))
-"""Claim kinds by id prefix (study/face_claims.py), the first matching prefix wins."""
+"""Claim kinds by id prefix (study/claims/membranes3d.py), the first matching prefix wins."""
 VERDICTS = ("PASS", "FAIL", "INCONCLUSIVE")
 
 

@@ -35,7 +35,7 @@ def _counts(claims: pd.DataFrame) -> dict:
 
 
 def _slope(rows: pd.DataFrame, fit_nu_min: float) -> float:
-    from ..study.face_elastic_claims import nu_slope
+    from ..study.claims.elastic3d import nu_slope
 
     return nu_slope(rows, fit_nu_min)[0]
 

@@ -2,7 +2,7 @@
 the transformed dual bases and edge dropping, with the macros their outcome sentences use.
 
 Pure functions from ``results/face/{patch,alpha,edge_dropping}.csv`` and the studies' claims
-(``results/tables/face_study_claims.csv``, :mod:`infsup_contact.study.face_study_claims`) to
+(``results/tables/face_study_claims.csv``, :mod:`infsup_contact.study.claims.membranes3d_studies`) to
 LaTeX text; :func:`infsup_contact.report.face.face_paper_files` adds them to the section's files.
 Every number is a cell of a table or a macro computed here from the tables; each outcome macro
 (``\\faceOutcome…``) aggregates the verdicts of one kind of claim for ``\\byverdict``.
@@ -12,8 +12,8 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from ..study.claims import slope_interval
-from ..study.face_study_claims import edge_claim_id, patch_claim_id
+from ..study.claims.criteria import slope_interval
+from ..study.claims.membranes3d_studies import edge_claim_id, patch_claim_id
 from .texformat import PaperTexError, case_order, fmt_fixed, fmt_int, fmt_sci, latex_id
 from .texnames import Macro, macro_name
 

@@ -178,7 +178,7 @@ def series_macros(claims: pd.DataFrame) -> list[Macro]:
     (``nSeriesStable…``) and its unstable ones R5.2, R5.4 (``nSeriesUnstable…``): the groups
     are the registry's paper cases split by ``SpaceSpec.stable``, in the paper's order."""
     from ..discretization.spaces.registry import PAPER_CASES, SPACES
-    from ..study.claims import nonmatching_claims
+    from ..study.claims.membranes import nonmatching_claims
 
     nm = nonmatching_claims(_claims_checked(claims))
     out = []

@@ -111,7 +111,7 @@ def nonmatching_table(claims: pd.DataFrame) -> str:
     (case, k), columns series × multiplier mesh, each cell the verdicts on the structured,
     perturbed and unstructured meshes as three letters (P pass, F fail, I inconclusive,
     - no claim)."""
-    from ..study.claims import nonmatching_claims
+    from ..study.claims.membranes import nonmatching_claims
 
     nm = nonmatching_claims(_claims_checked(claims))
     series = [s for s in SERIES_ORDER if s in set(nm.series)] + sorted(set(nm.series) - set(SERIES_ORDER))
@@ -141,7 +141,7 @@ def claims_table(claims: pd.DataFrame) -> str:
     """The ledger as a longtable: id, paper reference, verdict, statement and evidence; the
     non-matching bounded claims are the grid of :func:`nonmatching_table` instead (hundreds
     of rows; each is in claims.csv)."""
-    from ..study.claims import NONMATCHING_ID
+    from ..study.claims.membranes import NONMATCHING_ID
 
     claims = _claims_checked(claims)
     claims = claims[~claims.claim_id.astype(str).str.match(NONMATCHING_ID)]

@@ -70,7 +70,7 @@ UNICODE_LATEX = {
     "…": r"\dots{}", "∈": r"$\in$", "ε": r"$\varepsilon$", "σ": r"$\sigma$", "φ": r"$\varphi$",
     "ψ": r"$\psi$", "∇": r"$\nabla$", "Π": r"$\Pi$", "⁻": r"$^{-}$", "¹": r"\textsuperscript{1}",
     "ᵀ": r"$^{\mathsf T}$", "\u00a0": "~",
-    "ν": r"$\nu$", "∝": r"$\propto$", "δ": r"$\delta$",  # the elastic claims (study/elastic_claims.py)
+    "ν": r"$\nu$", "∝": r"$\propto$", "δ": r"$\delta$",  # the elastic claims (study/claims/elastic.py)
     "α": r"$\alpha$", "θ": r"$\theta$", "κ": r"$\kappa$", "Ñ": r"$\tilde N$",  # the face studies' claims
 }
 _SPECIAL = {"\\": r"\textbackslash{}", "&": r"\&", "%": r"\%", "$": r"\$", "#": r"\#", "_": r"\_",

@@ -11,7 +11,7 @@ with Q2 displacements (k = 2, hexahedra) on matching N × N meshes. An α with a
 refused, as the registry's DUAL-Q8 is (the row says so; no β): ``accepted`` is the
 construction's own decision (:func:`accepted_by_construction`), ``weights_positive`` and
 ``min_weight`` / ``min_weight_gauss`` the weights by two quadratures, so a table can show
-whether the two agree (the ledger's ``face-alpha-accept`` claims, :mod:`.face_study_claims`).
+whether the two agree (the ledger's ``face-alpha-accept`` claims, :mod:`.claims.membranes3d_studies`).
 
 TRI6: the same sweep on the triangles of tetrahedral faces (P2 displacements,
 :func:`~infsup_contact.discretization.face.spaces.tri6.tri6_space`). Its weights are ∫Ñ_vertex = α/3 and
@@ -60,9 +60,9 @@ def transformed_dual_spec(element: str, alpha: float) -> SpaceSpec:
 def element_of(model: str, reference: str) -> str:
     """The mesh element (``--element``) of ``model`` whose face cells have the shape of the
     reference element ``reference`` (QUAD8 → hexahedra, TRI6 → tetrahedra), asked of the faces
-    (:func:`~.face_claims.element_interfaces`)."""
+    (:func:`~.claims.membranes3d.element_interfaces`)."""
     from ..models import MODELS
-    from .face_claims import element_interfaces
+    from .claims.membranes3d import element_interfaces
 
     options = dict(MODELS[model].mesh_options).get("element", ())
     want = FACE_CELL[reference_element(reference).cell]

@@ -7,9 +7,9 @@ Pure functions of the config section returning DataFrames; the job scripts only 
   (:mod:`infsup_contact.models.elastic3d`) for one element, every k, every case the element's
   face builds: at ν = ``face_elastic.nu`` on every matching N and non-matching pair, and at
   every ν of ``face_elastic.nu_sweep`` on its matching meshes (the ν → 1/2 sweep of
-  :mod:`.face_elastic_claims`). Each (ν, pair) is computed once, through the one β batch path
+  :mod:`.claims.elastic3d`). Each (ν, pair) is computed once, through the one β batch path
   of every model (:func:`~.beta_batches.beta_batch_rows`, the model built with ``nu``).
-* :func:`patch_frame`: the elastic face patch test (:mod:`.elastic_face_patch`) on the pairs of
+* :func:`patch_frame`: the elastic face patch test (:mod:`.patch.face_elastic`) on the pairs of
   ``face_elastic.patch`` at ν = ``face_elastic.nu``, E1 = E2 = 1.
 """
 from __future__ import annotations
@@ -41,7 +41,7 @@ def beta_frame(fe: dict, element: str) -> pd.DataFrame:
     """β_H rows of one element (module docstring), columns of the β table plus ``model``,
     ``element`` and ``nu`` (timings dropped: they belong to the benchmark tree)."""
     from .beta_batches import beta_batch_rows
-    from .face_claims import element_interfaces
+    from .claims.membranes3d import element_interfaces
 
     gamma = element_interfaces(fe["model"], [element])[element]
     frames = []
@@ -64,8 +64,8 @@ def patch_frame(fe: dict) -> pd.DataFrame:
     """The elastic face patch test (:func:`~.elastic_face_patch.elastic_face_patch_rows`) for
     every element of ``face_elastic.patch``, the cases its face builds, every k and pair."""
     from ..models import make_model
-    from .elastic_face_patch import elastic_face_patch_rows
-    from .face_claims import element_interfaces
+    from .patch.face_elastic import elastic_face_patch_rows
+    from .claims.membranes3d import element_interfaces
 
     pc = fe["patch"]
     model = make_model(fe["model"], nu=float(fe["nu"]))

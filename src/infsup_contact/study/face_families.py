@@ -7,12 +7,12 @@ dim(W1 ∩ W2) = 0 on rectangles (:meth:`~infsup_contact.discretization.face.squ
 On the face Ω2 is the finer side, N2 = round(√2 N1) (:mod:`infsup_contact.config_face`).
 
 For every space, k and element on such a pair this compares three numbers
-(:mod:`.face_claims`' reasoning):
+(:mod:`.claims.membranes3d`' reasoning):
 
-* ``planar`` — the dimension argument max(dim M − dim(W1 + W2), 0) (:func:`~.face_claims.planar_kernel`),
+* ``planar`` — the dimension argument max(dim M − dim(W1 + W2), 0) (:func:`~.claims.membranes3d.planar_kernel`),
   a lower bound of dim ker(B A⁻¹ Bᵀ) on any face;
 * ``tensor`` — on rectangle faces, for the tensor-product spaces, 2 a1 a2 − min(a1, a2)² with the 1D
-  counts a_i (:func:`~.face_claims.tensor_kernel_bound`), also a lower bound (None elsewhere);
+  counts a_i (:func:`~.claims.membranes3d.tensor_kernel_bound`), also a lower bound (None elsewhere);
 * ``tensor_1d`` — on rectangle faces, for the tensor-product spaces, the kernel itself from the 1D
   factors alone (:func:`tensor_kernel_1d`): B_i = A_i ⊗ A_i, so dim ker = dim M − rank [A1 ⊗ A1; A2 ⊗ A2]
   with 1D integrals only — a route independent of the 3D meshes, solves and eigenproblem;
@@ -20,7 +20,7 @@ For every space, k and element on such a pair this compares three numbers
   Gram: the kernel of the pencil does not depend on the SPD Gram), with its decision
   (``clear`` or ``close``).
 
-``prediction`` is :func:`~.face_claims.face_predictions`' verdict of "kernel = planar count" on this
+``prediction`` is :func:`~.claims.membranes3d.face_predictions`' verdict of "kernel = planar count" on this
 pair alone (PASS, FAIL where the tensor bound exceeds the count, ``finding`` where only lower bounds
 are known); ``as_predicted`` whether the numbers bear it out.
 
@@ -35,8 +35,8 @@ import numpy as np
 from ..discretization.spaces.registry import SPACES, ids_valid_for
 from ..discretization.gamma.mesh_series import FAMILY_RULES
 from ..errors import InputError
-from .claims import FAIL, PASS
-from .face_claims import element_interfaces, face_predictions, is_tensor, planar_kernel, tensor_kernel_bound
+from .claims.criteria import FAIL, PASS
+from .claims.membranes3d import element_interfaces, face_predictions, is_tensor, planar_kernel, tensor_kernel_bound
 
 
 def family_pair(family: str, n1: int) -> tuple:

@@ -10,7 +10,7 @@ import pandas as pd
 def patch_frame(fc: dict) -> pd.DataFrame:
     """The 3D contact patch test (:func:`.face_patch.face_patch_table`): every case of
     ``face.cases`` the element's face builds, each k and non-matching pair of ``face.patch``."""
-    from .face_patch import face_patch_table
+    from .patch.face import face_patch_table
 
     sc = fc["patch"]
     return pd.DataFrame(face_patch_table(fc["cases"], sc["k"], [tuple(p) for p in sc["pairs"]], sc["elements"],

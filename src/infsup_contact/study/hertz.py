@@ -25,8 +25,8 @@ converge with oscillation ~0; R5.4 (one zero mode on matching meshes) oscillates
 contact zone at every mesh; R5.2 and DUAL-ALL have their zero modes at Γ's ends, outside the
 contact zone, so the minimum-norm λ_h does not see them; the modeling error shrinks with a/W.
 
-Outcome: results/tables/elastic_hertz.csv and the ledger (study/elastic_claims.py,
-:func:`~infsup_contact.study.elastic_claims.hertz_claims`); the paper's elastic section.
+Outcome: results/tables/elastic_hertz.csv and the ledger (study/claims/elastic.py,
+:func:`~infsup_contact.study.claims.elastic.hertz_claims`); the paper's elastic section.
 """
 from __future__ import annotations
 

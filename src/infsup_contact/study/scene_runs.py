@@ -6,7 +6,8 @@ from __future__ import annotations
 
 from .. import resources
 from ..errors import InputError
-from . import elastic_face_patch, face_patch, hertz, patch
+from . import hertz
+from .patch import face as face_patch, face_elastic as elastic_face_patch, segment as patch
 from .contact_rows import contact_row, reference_solution
 from .scene_registry import REFERENCE_MARGIN, scene_data, scene_spec
 

@@ -2,7 +2,7 @@
 
 β_h is the discrete inf-sup constant of eq. (4.5), computed by
 :func:`infsup_contact.solvers.infsup.beta_rows`. The verdict uses the claims ledger's own
-criterion (:mod:`infsup_contact.study.claims`), so ``infsup-contact verdict`` and
+criterion (:mod:`infsup_contact.study.claims.criteria`), so ``infsup-contact verdict`` and
 ``results/claims.csv`` cannot disagree about the same series:
 
 * a kernel decision closer than the stated margin to its error level on any mesh
@@ -10,7 +10,7 @@ criterion (:mod:`infsup_contact.study.claims`), so ``infsup-contact verdict`` an
   is INCONCLUSIVE: the verdict must not depend on one BLAS kernel's rounding;
 * a kernel on any mesh (``kernel_dim > 0``: β_h = 0, as for Rem 5.2 and Rem 5.4; proven by
   the dimension count or decided from Bᵀ) is UNSTABLE;
-* otherwise :func:`~infsup_contact.study.claims.bounded_claim` ("β_h bounded away from
+* otherwise :func:`~infsup_contact.study.claims.criteria.bounded_claim` ("β_h bounded away from
   zero": min β_h above a floor and the confidence interval of the slope of log β_h vs log h
   inside [−τ, τ]) decides: PASS → STABLE, FAIL → UNSTABLE, INCONCLUSIVE → INCONCLUSIVE.
 
@@ -31,10 +31,10 @@ from ..discretization.segment.norms import NORMS
 from ..errors import InputError
 from ..models import DEFAULT_MODEL
 from ..solvers.infsup import beta_rows
-from . import claims
+from .claims import criteria
 
 STABLE, UNSTABLE, INCONCLUSIVE = "STABLE", "UNSTABLE", "INCONCLUSIVE"
-FROM_LEDGER = {claims.PASS: STABLE, claims.FAIL: UNSTABLE, claims.INCONCLUSIVE: INCONCLUSIVE}
+FROM_LEDGER = {criteria.PASS: STABLE, criteria.FAIL: UNSTABLE, criteria.INCONCLUSIVE: INCONCLUSIVE}
 """The ledger's verdict on "β_h bounded away from 0" as a stability verdict."""
 MIN_MESHES = 3
 """Fewest meshes of a series: a slope's confidence interval needs n − 2 >= 1 dof."""
@@ -63,7 +63,7 @@ def stability_verdict(rows, tol: float, floor: float, confidence: float) -> dict
         ``verdict``; ``kernel_dim`` (the largest numerical kernel dimension over the meshes);
         ``beta_min``, ``beta_max`` (β_h of eq. (4.5) over the meshes); ``slope``,
         ``slope_lo``, ``slope_hi`` (least-squares slope and its interval,
-        :func:`~infsup_contact.study.claims.slope_interval`) of log β_h vs log h, or, where
+        :func:`~infsup_contact.study.claims.criteria.slope_interval`) of log β_h vs log h, or, where
         there is a kernel, of log(smallest_nonzero) (β above the kernel) vs log h; NaN when
         fewer than two positive values; ``evidence`` (one line of text).
 
@@ -76,16 +76,16 @@ def stability_verdict(rows, tol: float, floor: float, confidence: float) -> dict
     h = 1.0 / frame.N2.to_numpy(float)
     beta = frame.beta.to_numpy(float)
     kernel_dim = int(frame.kernel_dim.max())
-    close = claims.close_decisions(frame)
+    close = criteria.close_decisions(frame)
     if len(close):
         verdict, fitted = INCONCLUSIVE, frame.smallest_nonzero.to_numpy(float) if kernel_dim > 0 else beta
-        evidence = claims.close_text(close)
+        evidence = criteria.close_text(close)
     elif kernel_dim > 0:
         verdict, fitted = UNSTABLE, frame.smallest_nonzero.to_numpy(float)
         evidence = (f"β_h = 0: kernel dims {frame.kernel_dim.astype(int).tolist()} over N = "
-                    f"{claims._ns(frame)}; fit of the eigenvalue above the kernel")
+                    f"{criteria.ns_text(frame)}; fit of the eigenvalue above the kernel")
     else:
-        ledger_verdict, evidence = claims.bounded_claim(frame, tol, floor, confidence)
+        ledger_verdict, evidence = criteria.bounded_claim(frame, tol, floor, confidence)
         verdict, fitted = FROM_LEDGER[ledger_verdict], beta
     slope, lo, hi = _fit(h, fitted, confidence)
     return dict(verdict=verdict, kernel_dim=kernel_dim, beta_min=float(beta.min()),
@@ -278,4 +278,4 @@ def _fit(h, y, confidence):
     ok = np.isfinite(y) & (y > 0)
     if ok.sum() < 2:
         return np.nan, np.nan, np.nan
-    return tuple(float(v) for v in claims.slope_interval(h[ok], y[ok], confidence))
+    return tuple(float(v) for v in criteria.slope_interval(h[ok], y[ok], confidence))

@@ -1,6 +1,6 @@
 """Ledger claims of the elastic scene: does the paper's verdict carry over to plane strain?
 
-Same criteria as the membranes (:mod:`infsup_contact.study.claims`: slope interval of log β_h
+Same criteria as the membranes (:mod:`infsup_contact.study.claims.criteria`: slope interval of log β_h
 vs log h inside ±τ and min β_h > floor for "bounded"; exact kernel counts). Each claim's
 ``predicted`` column was written before the tables existed; the reasoning:
 
@@ -29,8 +29,8 @@ from __future__ import annotations
 
 import pandas as pd
 
-from ..discretization.spaces.registry import SPACES
-from .claims import (FAIL, INCONCLUSIVE, PASS, bounded_claim, close_decisions, close_text, finest, kernel_claim,
+from ...discretization.spaces.registry import SPACES
+from .criteria import (FAIL, INCONCLUSIVE, PASS, bounded_claim, close_decisions, close_text, finest, kernel_claim,
                      predicted_kernel, row, slope_verdict)
 
 REF = "beyond the paper (its Section 2: elastic bodies)"
@@ -121,7 +121,7 @@ def _scaling(x, beta, tol, conf):
 
 
 def patch_claims(patch: pd.DataFrame) -> pd.DataFrame:
-    """Patch-test claims (:mod:`infsup_contact.study.patch`): per case and k, λ_h = p and u_h = u
+    """Patch-test claims (:mod:`infsup_contact.study.patch.segment`): per case and k, λ_h = p and u_h = u
     to 1e-10 on every pair (predicted iff 1 ∈ M_h: every case but T3); T3's error confined to
     a boundary layer (the middle-half error falls ≥ 10x when the pair is refined at a fixed
     ratio, the end-interval error stays 1)."""
@@ -161,7 +161,7 @@ def patch_claims(patch: pd.DataFrame) -> pd.DataFrame:
 
 def _patch_prediction(spec, k: int) -> str:
     """PASS where 1 ∈ M_h (a uniform pressure is in the space: the discrete solution is exact,
-    study/patch.py), FAIL where it is not; a space outside the registry is predicted to pass."""
+    study/patch/segment.py), FAIL where it is not; a space outside the registry is predicted to pass."""
     return FAIL if spec is not None and not spec.contains_constants(k) else PASS
 
 

@@ -46,18 +46,18 @@ import time
 
 import ngsolve
 import numpy as np
-import scipy.linalg as sla
 
-from ..discretization.segment import meshes
-from ..discretization.spaces import registry
-from ..models import make_model
-from ..models.plane_strain import check_modulus, check_nu
-from ..solvers.contact import contact_pair, solve_contact_on
-from .blocks import SIDE, PressedBlocks, block_mesh
-from .scene_registry import PATCH
+from ...discretization.segment import meshes
+from ...discretization.spaces import registry
+from ...models import make_model
+from ...models.plane_strain import check_modulus, check_nu
+from ...solvers.contact import contact_pair, solve_contact_on
+from ..blocks import SIDE, PressedBlocks, block_mesh
+from ..scene_registry import PATCH
+from . import table
 
 SCENE = PATCH.id
-"""This scene's registry id (:mod:`.scene_registry` declares it and the models it is defined for)."""
+"""This scene's registry id (:mod:`..scene_registry` declares it and the models it is defined for)."""
 SCENE_MODELS = PATCH.models
 """The models the scene is defined for (the first is its default)."""
 X_DIRICHLET, Y_DIRICHLET = f"{meshes.DIRICHLET}|{SIDE}", meshes.DIRICHLET
@@ -101,13 +101,11 @@ def _where(gamma, x, g):
 
 
 def patch_rows(cases, ks, pairs, nu=0.3, E=(1.0, 1.0)) -> list:
-    """:func:`solve_patch` for every case defined for each k and every (N1, N2) pair."""
-    rows = []
-    for n1, n2 in pairs:
-        for k in ks:
-            blocks = patch_pair(k, n1, n2, nu, E)  # one factorization per body for every case
-            rows += [solve_patch(case, k, n1, n2, nu, E, pair=blocks) for case in registry.ids_valid_for(k, cases)]
-    return rows
+    """:func:`solve_patch` for every case defined for each k and every (N1, N2) pair
+    (:func:`.table.patch_rows`)."""
+    return table.patch_rows(lambda k, n1, n2: patch_pair(k, n1, n2, nu, E),
+                            lambda case, k, n1, n2, pair: solve_patch(case, k, n1, n2, nu, E, pair=pair),
+                            cases, ks, pairs)
 
 
 def patch_pair(k: int, n1: int, n2: int, nu: float, E, delta: float = DELTA):
@@ -152,10 +150,9 @@ def solve_patch(case: str, k: int, n1: int, n2: int, nu: float = 0.3, E=(1.0, 1.
     err = np.abs(space.evaluate(x) @ res.lam - p) / p
     ends, near, middle = _where(gamma, x, g)
     G, _ = gamma.gram(space, "L2")
-    ev = sla.eigh(K, G, eigvals_only=True)
     lam_err = float(err.max())
     return dict(scene=SCENE, case=case, k=k, family="structured", N1=n1, N2=n2, E1=E[0], E2=E[1], nu=nu,
-                delta=delta, p=p, dim_M=space.dim, kernel_dim=int(np.sum(ev < 1e-8 * ev[-1])),
+                delta=delta, p=p, dim_M=space.dim, kernel_dim=table.kernel_dim(K, G),
                 iterations=res.iterations, n_active=int(res.active.sum()), nonunique=bool(res.nonunique),
                 lambda_max_rel_error=lam_err,
                 lambda_end_rel_error=float(err[ends].max()),

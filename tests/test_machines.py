@@ -16,6 +16,8 @@ from pathlib import Path
 import pandas as pd
 import pytest
 
+from helpers.once import once
+
 from infsup_contact.errors import InputError
 from infsup_contact.io import SCHEMAS
 from infsup_contact.study import machines
@@ -64,19 +66,27 @@ def _pytest_under(name, args):
     assert run.returncode == 0, run.stdout[-3000:]
 
 
-@pytest.fixture(scope="module")
-def runs(tmp_path_factory):
-    """path name → output folder of the sweep run on it (None when this CPU cannot take it)."""
+def _sweeps(root: Path) -> dict:
+    """path name → output folder (a string) of the sweep run on it, None where this CPU cannot take it."""
     out = {}
     for path in machines.PATHS:
         if not machines.runnable(path.name)[0]:
             out[path.name] = None
             continue
-        folder = tmp_path_factory.mktemp(path.wildcard)
+        folder = root / path.wildcard
+        folder.mkdir()
         subprocess.run([sys.executable, "-m", "infsup_contact.study.machines", str(folder)], cwd=ROOT,
                        env=_env(path.name), check=True, capture_output=True, timeout=600)
-        out[path.name] = folder
+        out[path.name] = str(folder)
     return out
+
+
+@pytest.fixture
+def runs(tmp_path_factory):
+    """path name → output folder of the sweep run on it (None when this CPU cannot take it): the
+    sweeps made once per pytest run, whichever workers the tests reading them land on."""
+    made = once(tmp_path_factory, "machines_runs", _sweeps)
+    return {name: None if folder is None else Path(folder) for name, folder in made.items()}
 
 
 def test_cpu_flags_and_vendor_decide_what_can_run():
@@ -181,7 +191,6 @@ def test_mkl_refuses_the_branches_skipped_for_the_vendor(name):
         assert branch == "AUTO", f"MKL took {branch} on a {machines.cpu_vendor()} CPU: the vendor rule is too strict"
 
 
-@pytest.mark.xdist_group("machines_runs")  # one worker makes the sweeps of ``runs`` once
 @pytest.mark.parametrize("name", PATHS)
 def test_the_path_took_effect(runs, name):
     if runs[name] is None:
@@ -194,7 +203,6 @@ def test_the_path_took_effect(runs, name):
     assert probe["branch"] == machines.expected_mkl_branch(name)
 
 
-@pytest.mark.xdist_group("machines_runs")
 def test_mkl_branches_change_the_digits_and_openblas_does_not(runs):
     """The MKL probe's digits (PARDISO's S and a solve): COMPATIBLE's differ from the default's
     (on the AMD EPYC of 2026-11 the default, AUTO and COMPATIBLE gave three distinct results;
@@ -209,7 +217,6 @@ def test_mkl_branches_change_the_digits_and_openblas_does_not(runs):
     assert openblas <= {mkl.get("mkl:default")}
 
 
-@pytest.mark.xdist_group("machines_runs")
 def test_sweep_and_verdicts_identical_across_paths(runs):
     done = {n: f for n, f in runs.items() if f is not None}
     if len(done) < 2:

@@ -490,4 +490,4 @@ def test_every_subcommand_declares_its_conditional_flags():
     """The rule is applied to every computing subcommand: each declares its flag uses (rates: none)."""
     for command, parser in subcommands().items():
         if command != "provenance":
-            assert "flag_uses" in parser._defaults, command
+            assert parser.get_default("flag_uses") is not None, command  # set_defaults(flag_uses=...)

@@ -1,9 +1,10 @@
 """End to end: the DAG verifies the paper's claims; reruns are deterministic and survive kills.
 
-These run real Snakemake jobs in temporary copies of the workflow (a few minutes in all). Under
-xdist (``--dist loadgroup``) each group of tests sharing a run stays on one worker, so the run
-is made once: ``ci_run`` (verify-claims, then the paper) and ``clean_targets`` (the reference
-run the determinism and the kill tests both compare with).
+These run real Snakemake jobs in temporary copies of the workflow (a few minutes in all). The
+runs two tests share are made once per pytest run, whichever xdist workers the tests land on
+(:func:`helpers.once.once`): ``ci_run`` (verify-claims; the paper test works on a copy of it)
+and ``clean_targets`` (the reference run the determinism and the kill tests both compare with);
+the tests only read them.
 """
 import os
 import re
@@ -15,6 +16,8 @@ import time
 from pathlib import Path
 
 import pytest
+
+from helpers.once import once
 
 from infsup_contact.io import read_table
 
@@ -49,16 +52,19 @@ KEY_CLAIMS = ["Thm3-k1-structured-evenN", "Thm3-k2-unstructured-oddN", "Thm4-k2-
               "eq3.13-sign", "rate-T3-k1", "rate-T5-k2"]
 
 
-@pytest.fixture(scope="module")
-def ci_run(tmp_path_factory):
-    """One `verify-claims` run on the quick profile, shared by the tests below."""
-    wd = _copy_workflow(tmp_path_factory.mktemp("ci"))
+def _verify_claims(wd: Path) -> str:
+    _copy_workflow(wd)
     run = _snakemake(wd, "verify-claims", "--profile", "profiles/ci")
     assert run.returncode == 0, run.stderr[-4000:]
-    return wd
+    return str(wd)
 
 
-@pytest.mark.xdist_group("e2e_ci_run")
+@pytest.fixture
+def ci_run(tmp_path_factory):
+    """One `verify-claims` run on the quick profile, shared (read only) by the tests below."""
+    return Path(once(tmp_path_factory, "e2e_ci_run", _verify_claims))
+
+
 def test_verify_claims_ci_profile(ci_run):
     """`snakemake verify-claims --profile profiles/ci`: every claim as the paper predicts."""
     wd = ci_run
@@ -85,9 +91,8 @@ def _macro(macros: Path, name: str) -> str:
     return found.group(1)
 
 
-@pytest.mark.xdist_group("e2e_ci_run")
 @pytest.mark.skipif(not HAVE_TEX, reason="TeX (latexmk, pdflatex) or pdftotext missing: .ci/run installs them")
-def test_paper_numbers_follow_tables_and_config(ci_run):
+def test_paper_numbers_follow_tables_and_config(ci_run, tmp_path):
     """`snakemake paper --profile profiles/ci` builds the PDF; its numbers come from the tables,
     and changing one config value (the rate-fit window) changes the number in the PDF."""
     wd = ci_run
@@ -134,14 +139,13 @@ def _clean_run(wd: Path) -> Path:
     return wd
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture
 def clean_targets(tmp_path_factory):
-    """One clean run of ``TARGETS``: the first of the two compared below and the reference of
-    the killed run (each test made its own before, the same run)."""
-    return _clean_run(tmp_path_factory.mktemp("clean") / "a")
+    """One clean run of ``TARGETS`` per pytest run: the first of the two compared below and the
+    reference of the killed run (read only)."""
+    return Path(once(tmp_path_factory, "e2e_targets", lambda folder: str(_clean_run(folder / "a"))))
 
 
-@pytest.mark.xdist_group("e2e_targets")
 def test_two_clean_runs_are_byte_identical(clean_targets, tmp_path):
     outs = [[(wd / t).read_bytes() for t in TARGETS] for wd in (clean_targets, _clean_run(tmp_path / "b"))]
     assert outs[0] == outs[1]
@@ -160,7 +164,6 @@ def _job_pids(wd: Path):
     return pids
 
 
-@pytest.mark.xdist_group("e2e_targets")
 def test_killed_job_then_rerun_completes_identically(clean_targets, tmp_path):
     """SIGKILL a job mid-run, run again: same tables as an uninterrupted run (``clean_targets``)."""
     clean = clean_targets

@@ -17,6 +17,8 @@ from pathlib import Path
 import pytest
 import yaml
 
+from helpers.once import once, shared_root
+
 ROOT = Path(__file__).resolve().parents[1]
 SNAKEMAKE = Path(sys.prefix) / "bin" / "snakemake"
 ENV = {**os.environ, "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"}
@@ -132,37 +134,74 @@ BAD_CONFIGS = {
 }
 
 
-@pytest.mark.parametrize("mutate, needles", list(BAD_CONFIGS.values()), ids=list(BAD_CONFIGS))
-def test_bad_config_fails_before_any_job(workdir, mutate, needles):
+def checked_as_the_workflow_does(path: Path) -> str:
+    """The checks workflow/rules/common.smk runs while Snakemake parses the workflow, on the one
+    config file ``--configfile`` names (the Snakefile loads no other then): the file's YAML,
+    :func:`check_config` with the workflow's schema and, a local run, the job-memory check. The
+    one line a bad config gets (common.smk prints it and exits 1 before any DAG), or "" if accepted."""
+    from infsup_contact import resources
+    from infsup_contact.config_checks import ConfigError, check_config
+    from infsup_contact.config_memory import check_job_memory
+    from infsup_contact.config_yaml import check_config_files
+
+    try:
+        check_config_files([path])
+        check_config(yaml.safe_load(path.read_text()), ROOT / "workflow" / "schemas" / "config.schema.yaml")
+        check_job_memory(yaml.safe_load(path.read_text()), resources.total_bytes())
+    except ConfigError as err:
+        return str(err)
+    return ""
+
+
+def _write_bad(folder: Path, mutate) -> Path:
     cfg = copy.deepcopy(CI_CONFIG)
     mutate(cfg)
-    (workdir / "bad.yaml").write_text(yaml.safe_dump(cfg, sort_keys=False))
+    path = folder / "bad.yaml"
+    path.write_text(yaml.safe_dump(cfg, sort_keys=False))
+    return path
+
+
+@pytest.mark.parametrize("mutate, needles", list(BAD_CONFIGS.values()), ids=list(BAD_CONFIGS))
+def test_bad_config_is_refused_in_one_line_naming_the_key(tmp_path, mutate, needles):
+    """In process, the checks the workflow runs (the Snakemake run below shows it prints this line)."""
+    line = checked_as_the_workflow_does(_write_bad(tmp_path, mutate))
+    assert line.startswith("config key ") and "\n" not in line, line
+    for needle in needles:
+        assert needle in line, f"{needle!r} not in the message: {line}"
+
+
+@pytest.mark.parametrize("name", ["T4-k1", "job-larger-than-machine"])
+def test_bad_config_fails_before_any_job(workdir, name):
+    """The real thing for two of the cases above (a registry rule, the memory check): Snakemake
+    exits 1 with exactly the line of the in-process check, before building a DAG or writing a table."""
+    expected = checked_as_the_workflow_does(_write_bad(workdir, BAD_CONFIGS[name][0]))
 
     rc, out = snakemake(workdir, "-n", "reproduce-all", "--cores", "1",
                         "--configfile", "bad.yaml")
 
     assert rc == 1, f"bad config accepted (exit {rc}):\n{out}"
     # one line naming the key (config_checks.check_config, run by common.smk), nothing else
-    assert config_error_lines(out) == [l for l in out.splitlines() if l.startswith("config key ")], out
-    assert len(config_error_lines(out)) == 1, out
+    assert config_error_lines(out) == [expected], out
     # validation runs while the Snakefile is parsed: no DAG, so no job, was ever built
     assert "Building DAG of jobs" not in out, out
     assert produced_tables(workdir) == [], "results/ written for a bad config"
-    for needle in needles:
-        assert needle in out, f"{needle!r} not in the output:\n{out}"
 
 
 # --------------------------------------------------------------- good configs
 
-@pytest.fixture(scope="module")
+@pytest.fixture
 def ci_dry_run(tmp_path_factory) -> tuple[Path, int, str]:
-    """`snakemake -n reproduce-all` on config/ci.yaml, once for the two tests reading it
-    (both ran the same command before); the copy it ran in, its exit code and output."""
-    wd = copy_workflow(tmp_path_factory.mktemp("ci_dry_run"))
-    return (wd, *snakemake(wd, "-n", "reproduce-all", "--cores", "1", "--configfile", "config/ci.yaml"))
+    """`snakemake -n reproduce-all` on config/ci.yaml, once per run for the two tests reading it
+    (on whichever xdist workers they land: :func:`helpers.once.once`); the copy it ran in, its
+    exit code and output."""
+    def run(folder):
+        return snakemake(copy_workflow(folder), "-n", "reproduce-all", "--cores", "1",
+                         "--configfile", "config/ci.yaml")
+
+    rc, out = once(tmp_path_factory, "ci_dry_run", run)
+    return shared_root(tmp_path_factory) / "ci_dry_run", rc, out
 
 
-@pytest.mark.xdist_group("ci_dry_run")
 def test_ci_config_dry_run_lists_beta_jobs(ci_dry_run):
     workdir, rc, out = ci_dry_run
     assert rc == 0, out
@@ -172,7 +211,6 @@ def test_ci_config_dry_run_lists_beta_jobs(ci_dry_run):
     assert produced_tables(workdir) == []
 
 
-@pytest.mark.xdist_group("ci_dry_run")
 def test_fit_window_shrink_is_logged_and_mem_mb_follows_the_estimate(ci_dry_run):
     """ci.yaml has 4 odd N and fit_window 5: accepted, with the shrink said in one line; each
     β/contact job asks for mem_mb from resources.py (larger meshes, more memory)."""

@@ -141,7 +141,7 @@ def cycles(graph) -> list:
 
 def test_the_scanner_sees_absolute_and_relative_imports():
     graph = import_graph()
-    assert "discretization" in graph["solvers"]              # e.g. solvers/infsup.py
+    assert any(p.startswith("discretization") for p in graph["solvers"])  # e.g. solvers/infsup.py
     assert graph["models"]["errors"]                         # relative: from ..errors import InputError
     assert cycles({"a": {"b": []}, "b": {"c": []}, "c": {"a": []}, "d": {"a": []}}) == [["a", "b", "c"]]
 

@@ -16,8 +16,8 @@ and in the workflow with `spaces: [examples/macro_p0.py:space]` and `P0-2h: [1, 
 """
 import numpy as np
 
-from infsup_contact.discretization.multipliers import local_basis_space
-from infsup_contact.discretization.registry import SpaceSpec
+from infsup_contact.discretization.segment.multipliers import local_basis_space
+from infsup_contact.discretization.spaces.spec import SpaceSpec
 
 
 def macro_p0(k, breakpoints):

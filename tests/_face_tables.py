@@ -5,8 +5,8 @@ from __future__ import annotations
 
 import pandas as pd
 
-from infsup_contact.discretization.registry import SPACES
-from infsup_contact.discretization.square import SQUARE, SQUARE_TRIG
+from infsup_contact.discretization.spaces.registry import SPACES
+from infsup_contact.discretization.face.square import SQUARE, SQUARE_TRIG
 from infsup_contact.study.face_claims import face_claims, matching_kernel, planar_kernel
 
 CLAIMS_CFG = {"slope_tolerance": 0.15, "beta_floor": 1e-3, "confidence": 0.95, "fit_window": 5}
@@ -53,7 +53,7 @@ def patch_rows(case, k, element="hex", err=lambda passes: 1e-13 if passes else 1
 def alpha_rows(element="QUAD8", alphas=(0.1, 0.125, 0.2, 0.3), n=4) -> pd.DataFrame:
     """Rows of results/face/alpha.csv: the weights from face_dual (two evaluations of the same
     numbers here), accepted where positive, β_h = 1 there."""
-    from infsup_contact.discretization.face_dual import weight_fractions
+    from infsup_contact.discretization.face.spaces.dual_bases import weight_fractions
 
     out = []
     for a in alphas:

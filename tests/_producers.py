@@ -17,8 +17,8 @@ import numpy as np
 import scipy.io
 import yaml
 
-from infsup_contact.discretization.multipliers import make_space
-from infsup_contact.discretization.norms import gram_l2
+from infsup_contact.discretization.segment.multipliers import make_space
+from infsup_contact.discretization.segment.norms import gram_l2
 
 ROOT = Path(__file__).resolve().parents[1]
 EPS = np.finfo(float).eps
@@ -85,7 +85,7 @@ def read_level(manifest: Path, i: int):
 
 
 def described_space(desc: dict):
-    """The MultiplierSpace the manifest's helper form describes, and ``rows`` (row of B of
+    """The SegmentSpace the manifest's helper form describes, and ``rows`` (row of B of
     the j-th basis function left to right)."""
     bp = np.asarray(desc["breakpoints"], float)
     if desc["basis"] == "lagrange":

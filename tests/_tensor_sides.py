@@ -3,7 +3,7 @@ operators of boxes meshed by tensor grids, assembled from 1D matrices, and the c
 Kronecker products of 1D Gauss sums.
 
 On a box meshed by the tensor grid xs × ys × zs, continuous Q_k is the tensor product of the
-1D continuous P_k Lagrange spaces (:func:`~infsup_contact.discretization.multipliers.make_space`),
+1D continuous P_k Lagrange spaces (:func:`~infsup_contact.discretization.segment.multipliers.make_space`),
 and the Laplace stiffness is exactly
 
     K = K_x ⊗ M_y ⊗ M_z + M_x ⊗ K_y ⊗ M_z + M_x ⊗ M_y ⊗ K_z
@@ -25,9 +25,9 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from infsup_contact.discretization.multipliers import local_monomial_coefficients, make_space
-from infsup_contact.discretization.norms import gram_l2
-from infsup_contact.discretization.quadrature import gauss_legendre_01
+from infsup_contact.discretization.segment.multipliers import local_monomial_coefficients, make_space
+from infsup_contact.discretization.segment.norms import gram_l2
+from infsup_contact.discretization.gamma.quadrature import gauss_legendre_01
 from infsup_contact.errors import InputError
 
 

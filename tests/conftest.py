@@ -37,8 +37,8 @@ def registry_as_found():
     every test leaves the registry as it found it, so no test depends on which tests ran
     before it in the same worker (a ``--space`` test left ``P0-2h`` registered for the
     next file's catalogue checks)."""
-    from infsup_contact.discretization.registry import SPACES
-    from infsup_contact.discretization.user_spaces import forget_since
+    from infsup_contact.discretization.spaces.registry import SPACES
+    from infsup_contact.discretization.spaces.user_spaces import forget_since
 
     before = set(SPACES)
     yield

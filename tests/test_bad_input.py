@@ -52,8 +52,8 @@ def log(*parts) -> None:
 @pytest.fixture(autouse=True)
 def _at_root_registry_as_found(monkeypatch):
     """Run from the repository (user spaces resolve from it); leave the registry as found."""
-    from infsup_contact.discretization import user_spaces
-    from infsup_contact.discretization.registry import SPACES
+    from infsup_contact.discretization.spaces import user_spaces
+    from infsup_contact.discretization.spaces.registry import SPACES
 
     monkeypatch.chdir(ROOT)
     before = set(SPACES)

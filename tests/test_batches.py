@@ -1,5 +1,5 @@
 """The β_h jobs of the workflow (study/batches.py): every pair of every series once per (family, k)."""
-from infsup_contact.discretization.series import series_of_pairs
+from infsup_contact.discretization.gamma.mesh_series import series_of_pairs
 from infsup_contact.study.batches import beta_batches
 
 IC = {"N": [4, 8, 16], "nonmatching": [[6, 4], [12, 8], [16, 8], [6, 8]],

@@ -8,12 +8,12 @@ import pandas as pd
 import pytest
 
 from infsup_contact.bench import face_beta
-from infsup_contact.discretization.coupling import coupling_matrix
+from infsup_contact.discretization.gamma.coupling import coupling_matrix
 from infsup_contact.solvers.infsup import saddle_point_beta
 from infsup_contact.solvers.contact import contact_qp
 
 from _cli import run_in_process
-from infsup_contact.discretization import registry
+from infsup_contact.discretization.spaces import registry
 
 
 @pytest.mark.parametrize("n", [2, 3])

@@ -7,7 +7,7 @@ import re
 import tokenize
 from pathlib import Path
 
-from infsup_contact.discretization.registry import SPACES
+from infsup_contact.discretization.spaces.registry import SPACES
 
 ROOT = Path(__file__).resolve().parents[1]
 FOLDERS = ("src/infsup_contact/report", "workflow/rules", "workflow/scripts")
@@ -31,11 +31,26 @@ def code_strings(text: str):
             yield tok.start[0], tok.string
 
 
+STYLE_TABLE = ROOT / "src/infsup_contact/report/case_styles.py"
+"""The one table keyed by id on purpose: how each built-in space is drawn (data, no branch)."""
+
+
 def files():
     for folder in FOLDERS:
         for path in sorted((ROOT / folder).rglob("*")):
-            if path.suffix in (".py", ".smk") or path.name == "Snakefile":
+            if (path.suffix in (".py", ".smk") or path.name == "Snakefile") and path != STYLE_TABLE:
                 yield path
+
+
+def test_the_style_table_holds_data_only():
+    """case_styles.py is exempt from the scan above, so it must hold assignments only (no def,
+    no if): a colour per id cannot become a special case of the id."""
+    import ast
+
+    tree = ast.parse(STYLE_TABLE.read_text())
+    assert all(isinstance(node, (ast.Expr, ast.Assign, ast.ImportFrom, ast.Import)) for node in tree.body)
+    assert not any(isinstance(node, (ast.If, ast.IfExp, ast.Compare, ast.FunctionDef, ast.Lambda))
+                   for node in ast.walk(tree))
 
 
 def test_scanner_sees_code_and_skips_docs():
@@ -77,8 +92,8 @@ def test_elastic_stage_runs_the_configs_spaces(name):
     of the segment (the 2D DAG's; the face spaces of the 3D models are not its) and their user
     space, so the elastic stage runs what it ran when it took every registered space (the
     tables stay as they were)."""
-    from infsup_contact.discretization.registry import space_ids
-    from infsup_contact.discretization.user_spaces import load_user_space
+    from infsup_contact.discretization.spaces.registry import space_ids
+    from infsup_contact.discretization.spaces.user_spaces import load_user_space
 
     cfg = yaml.safe_load((ROOT / "config" / name).read_text())
     users = [load_user_space(ref).id for ref in cfg["spaces"]]

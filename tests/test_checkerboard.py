@@ -3,8 +3,9 @@
 import numpy as np
 import pytest
 
-from infsup_contact.discretization.registry import SPACES
-from infsup_contact.discretization.square import SQUARE, SQUARE_TRIG, TensorPartition
+from infsup_contact.discretization.spaces.registry import SPACES
+from infsup_contact.discretization.face.square import SQUARE, SQUARE_TRIG
+from infsup_contact.discretization.face.tensor_grid import TensorPartition
 from infsup_contact.models import MODELS
 from infsup_contact.solvers import infsup
 from infsup_contact.study.face_claims import checkerboard, face_predictions

@@ -1,13 +1,14 @@
-"""1 ∈ M_h computed on the space a solver uses (discretization/constants.py): on the segment it
+"""1 ∈ M_h computed on the space a solver uses (discretization/gamma/constants.py): on the segment it
 agrees with the registry's rule for every space and degree; on the six-tetrahedra face the TRI3
 dual loses the constants at its two corner triangles (all three vertices on ∂Γ), and the patch
 test fails exactly there."""
 import numpy as np
 import pytest
 
-from infsup_contact.discretization import registry
-from infsup_contact.discretization.constants import interior_samples, spans_constants
-from infsup_contact.discretization.square import SQUARE, SQUARE_TRIG
+from infsup_contact.discretization.spaces import registry
+from infsup_contact.discretization.gamma.constants import interior_samples, spans_constants
+from infsup_contact.discretization.face.square import SQUARE, SQUARE_TRIG
+from infsup_contact.discretization.face.tensor_grid import TensorPartition
 from infsup_contact.study import face_patch
 
 
@@ -23,7 +24,7 @@ def test_segment_spaces_agree_with_the_registry_rule(k):
 
 def test_samples_avoid_cell_boundaries_and_diagonals():
     xs, ys = np.linspace(0, 1, 4), np.array([0.0, 0.3, 1.0])
-    p = interior_samples(type("P", (), {"xs": xs, "ys": ys})())
+    p = interior_samples(TensorPartition(xs, ys))
     assert len(p) == 3 * 2 * 25
     assert not np.isin(p[:, 0], xs).any() and not np.isin(p[:, 1], ys).any()
     ix, iy = np.searchsorted(xs, p[:, 0]) - 1, np.searchsorted(ys, p[:, 1]) - 1

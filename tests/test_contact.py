@@ -25,7 +25,7 @@ def test_gamma_reduced_pdas_equals_full_sparse_kkt(case, k, n1, n2):
 
 
 def _couplings(sol):
-    from infsup_contact.discretization.coupling import coupling_matrix
+    from infsup_contact.discretization.gamma.coupling import coupling_matrix
     return [coupling_matrix(s.trace, sol.space, s.trace.fes.globalorder) for s in sol.sides]
 
 
@@ -73,7 +73,7 @@ def test_load_from_exact_solution_equals_quadrature_of_f():
     """Green's formula: c(∇u, ∇v) − ∫_Γ c ∂u/∂n v equals ∫ f v (smooth case, where f is benign)."""
     from infsup_contact.models.membranes import load_vector_from_exact
     from infsup_contact.models.membranes import side_operator
-    from infsup_contact.discretization.meshes import mesh_pair
+    from infsup_contact.discretization.segment.meshes import mesh_pair
 
     sc = manufactured(c1=1.0, c2=3.0, p=6.0, q=6.0)  # f smooth enough for its quadrature to be exact-ish
     for mesh, f, g, c, ny in zip(mesh_pair("perturbed", 6, 6), (sc.f1, sc.f2), (sc.grad_u1, sc.grad_u2),

@@ -3,11 +3,11 @@ import ngsolve
 import numpy as np
 import pytest
 
-from infsup_contact.discretization.coupling import coupling_matrix
-from infsup_contact.discretization.segment import SEGMENT
+from infsup_contact.discretization.gamma.coupling import coupling_matrix
+from infsup_contact.discretization.segment.interface import SEGMENT
 from infsup_contact.models.membranes import displacement_space
-from infsup_contact.discretization.meshes import mesh_pair
-from infsup_contact.discretization.multipliers import make_space
+from infsup_contact.discretization.segment.meshes import mesh_pair
+from infsup_contact.discretization.segment.multipliers import make_space
 
 
 def _gauss_reference(space, f, n=40):

@@ -2,13 +2,13 @@
 import numpy as np
 import pytest
 
-from infsup_contact.discretization.coupling import coupling_matrix
-from infsup_contact.discretization.segment import SEGMENT
-from infsup_contact.discretization.dual import local_dual_coefficients, nodal_integrals
-from infsup_contact.discretization.meshes import mesh_pair, multiplier_breakpoints
-from infsup_contact.discretization.multipliers import local_basis_space, local_shapes
-from infsup_contact.discretization.norms import gram, gram_h
-from infsup_contact.discretization.registry import SPACES, case_space
+from infsup_contact.discretization.gamma.coupling import coupling_matrix
+from infsup_contact.discretization.segment.interface import SEGMENT
+from infsup_contact.discretization.segment.dual import local_dual_coefficients, nodal_integrals
+from infsup_contact.discretization.segment.meshes import mesh_pair, multiplier_breakpoints
+from infsup_contact.discretization.segment.multipliers import local_basis_space, local_shapes
+from infsup_contact.discretization.segment.norms import gram, gram_h
+from infsup_contact.discretization.spaces.registry import SPACES, case_space
 from infsup_contact.errors import InputError
 from infsup_contact.models.membranes import side_operator
 

@@ -3,12 +3,13 @@ without κ scaling (:mod:`infsup_contact.study.edge_dropping`)."""
 import numpy as np
 import pytest
 
-from infsup_contact.discretization import registry
-from infsup_contact.discretization.clipped_face import ClippedFace, clip_1d
-from infsup_contact.discretization.face_norms import partial_gram
-from infsup_contact.discretization.norms import sine_coefficients
-from infsup_contact.discretization.quadrature import gauss_legendre_01
-from infsup_contact.discretization.square import SQUARE, TensorPartition
+from infsup_contact.discretization.spaces import registry
+from infsup_contact.discretization.face.spaces.clipped import ClippedFace, clip_1d
+from infsup_contact.discretization.face.norms.tensor import partial_gram
+from infsup_contact.discretization.segment.norms import sine_coefficients
+from infsup_contact.discretization.gamma.quadrature import gauss_legendre_01
+from infsup_contact.discretization.face.square import SQUARE
+from infsup_contact.discretization.face.tensor_grid import TensorPartition
 from infsup_contact.errors import InputError
 from infsup_contact.solvers.infsup import spectrum
 from infsup_contact.study.edge_dropping import (edge_cases, edge_row, geometry, interface_operator,
@@ -211,7 +212,7 @@ def test_ngsolve_route_equals_tensor_route(k):
 def test_narrow_side_mesh():
     """Ω2 = (0, L) × (0, 1) × (1, 2) from MakeStructured3DMesh: its Γ trace is the uniform
     grid of (0, L) × (0, 1) with (N2 k − 1)² dofs and Square(width = L) checks its extent."""
-    from infsup_contact.discretization.square import Square
+    from infsup_contact.discretization.face.square import Square
     from infsup_contact.models.membranes3d import subdomain_mesh
 
     n, n2, theta, k = 2, 3, 0.4, 2
@@ -241,7 +242,7 @@ def test_theta_below_the_geometry_is_refused():
     """θ = 1e-12 at N = 4 used to drop the cut column whole (dim M 20 instead of 25): β_H 0.55, the
     θ = 0 space, instead of ~θ. Now refused naming theta and the range; the smallest θ allowed
     keeps the column."""
-    from infsup_contact.discretization.clipped_face import min_covered_fraction
+    from infsup_contact.discretization.face.spaces.clipped import min_covered_fraction
     from infsup_contact.study.edge_dropping import edge_plan
 
     for call in (lambda: edge_row("R5.2", 1, 4, 8, 1e-12), lambda: edge_plan([1], [4], [1.0, 1e-12])):

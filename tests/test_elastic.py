@@ -11,9 +11,10 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from infsup_contact.discretization import meshes, registry
-from infsup_contact.discretization.coupling import coupling_matrix
-from infsup_contact.discretization.norms import gram
+from infsup_contact.discretization.segment import meshes
+from infsup_contact.discretization.spaces import registry
+from infsup_contact.discretization.gamma.coupling import coupling_matrix
+from infsup_contact.discretization.segment.norms import gram
 from infsup_contact.errors import InputError
 from infsup_contact.models import MODELS
 from infsup_contact.models.elastic import (ELASTIC, check_nu, elastic_model, elastic_space, elastic_stiffness,

@@ -12,7 +12,7 @@ import scipy.sparse as sp
 
 from _cli import run_in_process
 
-from infsup_contact.discretization import registry
+from infsup_contact.discretization.spaces import registry
 from infsup_contact.models import MODELS, make_model, model_of_dim, model_taking
 from infsup_contact.models.elastic3d import (ELASTIC3D, elastic_stiffness, side_operator, subdomain_mesh,
                                              vector_space)

@@ -8,10 +8,10 @@ import pandas as pd
 import pytest
 
 from _cli import run_in_process
-from infsup_contact.discretization.coupling import coupling_matrix
-from infsup_contact.discretization.multipliers import make_space
-from infsup_contact.discretization.registry import SPACES, case_space, ids_valid_for
-from infsup_contact.discretization.segment import SEGMENT
+from infsup_contact.discretization.gamma.coupling import coupling_matrix
+from infsup_contact.discretization.segment.multipliers import make_space
+from infsup_contact.discretization.spaces.registry import SPACES, case_space, ids_valid_for
+from infsup_contact.discretization.segment.interface import SEGMENT
 from infsup_contact.models import make_model
 from infsup_contact.models.side_cache import SideCache
 from infsup_contact.solvers.infsup import beta_rows, saddle_point_beta
@@ -179,7 +179,7 @@ def test_every_schur_route_agrees_in_3d(element):
 def test_auto_route_takes_pardiso_on_a_face_and_superlu_on_the_segment():
     """Above the solves route's work limit a face takes PARDISO, the segment SuperLU's nested
     dissection (both measured in models/schur.gamma_factorization's docstring)."""
-    from infsup_contact.discretization.meshes import subdomain_mesh as mesh_2d
+    from infsup_contact.discretization.segment.meshes import subdomain_mesh as mesh_2d
     from infsup_contact.models.membranes import side_operator as side_2d
     from infsup_contact.models.membranes3d import side_operator, subdomain_mesh
     from infsup_contact.models.schur import SOLVES_MAX_WORK, gamma_factorization

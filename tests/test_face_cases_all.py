@@ -1,5 +1,5 @@
 """``--case all`` on a 3D model: the paper's spaces, the duals and every space the face builds
-(:func:`~infsup_contact.discretization.registry.ids_built_on`)."""
+(:func:`~infsup_contact.discretization.spaces.registry.ids_built_on`)."""
 import io
 
 import numpy as np
@@ -7,9 +7,10 @@ import pandas as pd
 import pytest
 
 from _cli import run_in_process
-from infsup_contact.discretization.registry import SPACES, ids_built_on, ids_valid_for
-from infsup_contact.discretization.segment import SEGMENT
-from infsup_contact.discretization.square import SQUARE, SQUARE_TRIG, TensorPartition
+from infsup_contact.discretization.spaces.registry import SPACES, ids_built_on, ids_valid_for
+from infsup_contact.discretization.segment.interface import SEGMENT
+from infsup_contact.discretization.face.square import SQUARE, SQUARE_TRIG
+from infsup_contact.discretization.face.tensor_grid import TensorPartition
 
 GRID = TensorPartition(np.linspace(0, 1, 3), np.linspace(0, 1, 3))
 

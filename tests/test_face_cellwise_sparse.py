@@ -1,19 +1,20 @@
 """The sparse projection of the cellwise face spaces and the shared series of their piece space
-(:mod:`infsup_contact.discretization.face_cellwise_norms`): two routes agree, the sharing
+(:mod:`infsup_contact.discretization.face.norms.cellwise`): two routes agree, the sharing
 changes no number, and it holds one piece space at a time."""
 import contextlib
 
 import numpy as np
 import pytest
 
-from infsup_contact.discretization import face_cellwise_norms as fcn
-from infsup_contact.discretization.coupling import weighted_values
-from infsup_contact.discretization.face_cells import CellwiseFaceSpace
-from infsup_contact.discretization.face_norms import gram_l2_face
-from infsup_contact.discretization.multipliers import make_space
-from infsup_contact.discretization.norms import gram_l2
-from infsup_contact.discretization.segment import SEGMENT
-from infsup_contact.discretization.square import SQUARE, TensorPartition
+from infsup_contact.discretization.face.norms import cellwise as fcn
+from infsup_contact.discretization.gamma.coupling import weighted_values
+from infsup_contact.discretization.face.spaces.cellwise import CellwiseFaceSpace
+from infsup_contact.discretization.face.norms.tensor import gram_l2_face
+from infsup_contact.discretization.segment.multipliers import make_space
+from infsup_contact.discretization.segment.norms import gram_l2
+from infsup_contact.discretization.segment.interface import SEGMENT
+from infsup_contact.discretization.face.square import SQUARE
+from infsup_contact.discretization.face.tensor_grid import TensorPartition
 from infsup_contact.errors import InputError
 
 GRID = TensorPartition(np.array([0.0, 0.2, 0.45, 0.7, 1.0]), np.array([0.0, 0.35, 0.6, 1.0]))
@@ -97,8 +98,8 @@ def test_the_raised_start_gives_the_same_gram_when_the_last_levels_agree():
     """start_level: on the exponential-sum route a p = 2 series starts 4 n0 higher; the
     extrapolation uses the last three levels only, so it returns the very matrix of the
     levels from n0 whenever both stop at the same n_max."""
-    from infsup_contact.discretization import face_norms as fn
-    from infsup_contact.discretization.face_spaces import FaceSpace
+    from infsup_contact.discretization.face.norms import tensor as fn
+    from infsup_contact.discretization.face.spaces.tensor import FaceSpace
 
     f = make_space(np.linspace(0, 1, 21), 1, False, False)      # dim 40² = 1600 > 1500, p = 2
     space = FaceSpace(f, f, TensorPartition(np.linspace(0, 1, 21), np.linspace(0, 1, 21)))

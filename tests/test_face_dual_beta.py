@@ -6,15 +6,16 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from infsup_contact.discretization import registry
-from infsup_contact.discretization.coupling import coupling_matrix
-from infsup_contact.discretization.dual import dual_space
-from infsup_contact.discretization.face_cells import CellwiseFaceSpace
-from infsup_contact.discretization.face_dual import weights
-from infsup_contact.discretization.face_spaces import FaceSpace
-from infsup_contact.discretization.multipliers import make_space
-from infsup_contact.discretization.segment import SEGMENT
-from infsup_contact.discretization.square import SQUARE, TensorPartition
+from infsup_contact.discretization.spaces import registry
+from infsup_contact.discretization.gamma.coupling import coupling_matrix
+from infsup_contact.discretization.segment.dual import dual_space
+from infsup_contact.discretization.face.spaces.cellwise import CellwiseFaceSpace
+from infsup_contact.discretization.face.spaces.dual_bases import weights
+from infsup_contact.discretization.face.spaces.tensor import FaceSpace
+from infsup_contact.discretization.segment.multipliers import make_space
+from infsup_contact.discretization.segment.interface import SEGMENT
+from infsup_contact.discretization.face.square import SQUARE
+from infsup_contact.discretization.face.tensor_grid import TensorPartition
 from infsup_contact.errors import InputError
 from infsup_contact.models import make_model
 from infsup_contact.models.side_cache import SideCache

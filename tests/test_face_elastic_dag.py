@@ -12,8 +12,8 @@ import pandas as pd
 import pytest
 import yaml
 
-from infsup_contact.discretization.registry import SPACES
-from infsup_contact.discretization.square import SQUARE
+from infsup_contact.discretization.spaces.registry import SPACES
+from infsup_contact.discretization.face.square import SQUARE
 from infsup_contact.study.claims import FAIL, INCONCLUSIVE, PASS
 from infsup_contact.study.face_claims import matching_kernel
 from infsup_contact.study.face_elastic import nu_pairs

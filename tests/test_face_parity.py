@@ -5,12 +5,13 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
-from infsup_contact.discretization import face_cellwise_norms as fc
-from infsup_contact.discretization import face_norms as fn
+from infsup_contact.discretization.face.norms import cellwise as fc
+from infsup_contact.discretization.face.norms import tensor as fn
 from infsup_contact.discretization import face_parity as fp
-from infsup_contact.discretization import registry
-from infsup_contact.discretization.norms import sine_coefficients
-from infsup_contact.discretization.square import SQUARE, TensorPartition
+from infsup_contact.discretization.spaces import registry
+from infsup_contact.discretization.segment.norms import sine_coefficients
+from infsup_contact.discretization.face.square import SQUARE
+from infsup_contact.discretization.face.tensor_grid import TensorPartition
 
 
 def _space(case, k, xs):
@@ -71,7 +72,7 @@ def test_an_r_that_does_not_intertwine_is_refused():
     """Q_aᵀ R T_b must vanish for a ≠ b: a perturbed R is refused, the exact one accepted."""
     space = _space("DUAL-Q9", 2, np.linspace(0.0, 1.0, 5))
     R, P = fc.projection(space)
-    from infsup_contact.discretization.basis_symmetry import axis_reflections, isotypic_bases
+    from infsup_contact.discretization.gamma.symmetry import axis_reflections, isotypic_bases
     bases = isotypic_bases(axis_reflections(space, fc.piece_rule(P.breakpoints, 3)[0]))
     T = fp.tensor_bases(fp.tensor_parities(P))
     assert fp.intertwined(R, bases, T) is not None

@@ -8,8 +8,9 @@ import pytest
 
 from _cli import run_in_process
 
-from infsup_contact.discretization import registry
-from infsup_contact.discretization.square import SQUARE, TensorPartition
+from infsup_contact.discretization.spaces import registry
+from infsup_contact.discretization.face.square import SQUARE
+from infsup_contact.discretization.face.tensor_grid import TensorPartition
 from infsup_contact.errors import InputError
 from infsup_contact.solvers.contact import gamma_values, solve_contact_on
 from infsup_contact.study import face_patch

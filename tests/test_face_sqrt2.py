@@ -14,8 +14,9 @@ import yaml
 
 from infsup_contact.config_checks import ConfigError, check_config
 from infsup_contact.config_face import face_pairs, family_pairs
-from infsup_contact.discretization.registry import SPACES
-from infsup_contact.discretization.square import SQUARE, TensorPartition
+from infsup_contact.discretization.spaces.registry import SPACES
+from infsup_contact.discretization.face.square import SQUARE
+from infsup_contact.discretization.face.tensor_grid import TensorPartition
 from infsup_contact.study.face_families import family_kernels, family_pair
 from _cli import run_in_process
 

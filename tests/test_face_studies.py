@@ -15,9 +15,9 @@ import yaml
 from _face_tables import (CLAIMS_CFG, FIT_THETA_MAX, THETAS, alpha_rows, edge_rows, patch_rows,
                           small_face_tables)
 
-from infsup_contact.discretization.face_dual import ZERO_WEIGHT_RTOL, weight_fractions
-from infsup_contact.discretization.registry import SPACES, ids_valid_for
-from infsup_contact.discretization.square import SQUARE, SQUARE_TRIG
+from infsup_contact.discretization.face.spaces.dual_bases import ZERO_WEIGHT_RTOL, weight_fractions
+from infsup_contact.discretization.spaces.registry import SPACES, ids_valid_for
+from infsup_contact.discretization.face.square import SQUARE, SQUARE_TRIG
 from infsup_contact.io import read_table
 from infsup_contact.study import face_study_claims as fsc
 

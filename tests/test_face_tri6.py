@@ -1,4 +1,4 @@
-"""The TRI6 multipliers of tetrahedral faces (issue 28, item 3; discretization/face_tri6.py): exact
+"""The TRI6 multipliers of tetrahedral faces (issue 28, item 3; discretization/face/spaces/tri6.py): exact
 weights in rationals, biorthogonality and span of the transformed dual, the pwlin split against P1
 and against the global space, the refusals, DUAL = TDUAL-T6 at k = 2, and β_H bounded in N."""
 from fractions import Fraction
@@ -8,13 +8,14 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from infsup_contact.discretization import registry
-from infsup_contact.discretization.face_dual import ZERO_WEIGHT_RTOL, dual_coefficients, transformation, weights
-from infsup_contact.discretization.face_elements import (cell_quadrature, pwlin_shapes, pwlin_subelements,
+from infsup_contact.discretization.spaces import registry
+from infsup_contact.discretization.face.spaces.dual_bases import ZERO_WEIGHT_RTOL, dual_coefficients, transformation, weights
+from infsup_contact.discretization.face.spaces.reference_elements import (cell_quadrature, pwlin_shapes, pwlin_subelements,
                                                          reference_element)
-from infsup_contact.discretization.face_tri6 import halved, tri6_space
-from infsup_contact.discretization.segment import SEGMENT
-from infsup_contact.discretization.square import SQUARE, SQUARE_TRIG, TensorPartition
+from infsup_contact.discretization.face.spaces.tri6 import halved, tri6_space
+from infsup_contact.discretization.segment.interface import SEGMENT
+from infsup_contact.discretization.face.square import SQUARE, SQUARE_TRIG
+from infsup_contact.discretization.face.tensor_grid import TensorPartition
 from infsup_contact.errors import InputError
 
 TRI6 = reference_element("TRI6")
@@ -178,7 +179,7 @@ def test_beta_h_is_bounded_in_n_on_tetrahedra(monkeypatch):
     The H Grams to rtol 1e-4 (a ratio test does not need the default 1e-6: 4 s instead of 22 s at N = 8)."""
     from functools import partial
 
-    from infsup_contact.discretization import face_triangle_norms
+    from infsup_contact.discretization.face.norms import triangles as face_triangle_norms
     from infsup_contact.models import make_model
     from infsup_contact.models.side_cache import SideCache
     from infsup_contact.solvers.infsup import beta_rows_all

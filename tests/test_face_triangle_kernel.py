@@ -1,4 +1,4 @@
-"""The Kuhn face's kernel bound (discretization/face_triangle_kernel.py, study/face_claims.py
+"""The Kuhn face's kernel bound (discretization/face/kernel_bounds.py, study/face_claims.py
 ``triangle_kernel_bound``) against kernels computed through the membranes3d tetrahedra (NGSolve
 traces, the suite's couplings): the components partition every space, the bound holds in every
 isotypic component of the computed kernel, and it is the kernel on the R5.2 pairs where the
@@ -8,12 +8,12 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from infsup_contact.discretization.coupling import coupling_matrix, trace_l2_norms
-from infsup_contact.discretization.face_triangle_kernel import (COMPONENTS, class_dimensions, component_basis,
+from infsup_contact.discretization.gamma.coupling import coupling_matrix, trace_l2_norms
+from infsup_contact.discretization.face.kernel_bounds import (COMPONENTS, class_dimensions, component_basis,
                                                                  permutations, symmetric_kernel_bound, trace_space,
                                                                  uniform)
-from infsup_contact.discretization.registry import SPACES, case_space
-from infsup_contact.discretization.square import SQUARE, SQUARE_TRIG
+from infsup_contact.discretization.spaces.registry import SPACES, case_space
+from infsup_contact.discretization.face.square import SQUARE, SQUARE_TRIG
 from infsup_contact.errors import InputError
 from infsup_contact.models import make_model
 from infsup_contact.models.side_cache import SideCache

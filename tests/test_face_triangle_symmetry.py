@@ -5,11 +5,12 @@ lacks the symmetry; the partial H Gram through them equals the plain product."""
 import numpy as np
 import pytest
 
-from infsup_contact.discretization import face_triangle_norms as ftn
-from infsup_contact.discretization.face_triangle_symmetry import reflection, transposition
-from infsup_contact.discretization.face_triangles import TriangleSpace
-from infsup_contact.discretization.registry import case_space
-from infsup_contact.discretization.square import SQUARE_TRIG, TensorPartition
+from infsup_contact.discretization.face.norms import triangles as ftn
+from infsup_contact.discretization.face.symmetry import reflection, transposition
+from infsup_contact.discretization.face.spaces.triangles import TriangleSpace
+from infsup_contact.discretization.spaces.registry import case_space
+from infsup_contact.discretization.face.square import SQUARE_TRIG
+from infsup_contact.discretization.face.tensor_grid import TensorPartition
 
 FAMILIES = [  # (s, continuous, vanish, dual)
     (0, False, False, False), (1, False, False, False), (2, False, False, False),
@@ -82,7 +83,7 @@ def test_face_cases_of_the_tetrahedral_study_are_symmetric():
 
 
 def test_halves_need_consecutive_frequencies():
-    from infsup_contact.discretization.face_triangle_symmetry import ReflectedGram
+    from infsup_contact.discretization.face.symmetry import ReflectedGram
     from infsup_contact.errors import InputError
 
     space = TriangleSpace(UNIFORM, 1, True, False)

@@ -5,9 +5,9 @@ graded and interleaved-width partitions; and the partial H Grams by both routes.
 import numpy as np
 import pytest
 
-from infsup_contact.discretization import face_triangle_norms as ftn
-from infsup_contact.discretization.face_triangles import TriangleSpace
-from infsup_contact.discretization.square import TensorPartition
+from infsup_contact.discretization.face.norms import triangles as ftn
+from infsup_contact.discretization.face.spaces.triangles import TriangleSpace
+from infsup_contact.discretization.face.tensor_grid import TensorPartition
 
 FAMILIES = [  # (s, continuous, vanish, dual)
     (0, False, False, False), (1, False, False, False), (2, False, False, False),

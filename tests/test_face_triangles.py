@@ -6,13 +6,14 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from infsup_contact.discretization import face_triangle_norms as ftn
-from infsup_contact.discretization.coupling import coupling_matrix
-from infsup_contact.discretization.face_quadrature import triangles_rule
-from infsup_contact.discretization.face_spaces import FaceSpace
-from infsup_contact.discretization.face_triangles import TriangleSpace
-from infsup_contact.discretization.registry import SPACES, case_space, ids_valid_for
-from infsup_contact.discretization.square import SQUARE, SQUARE_TRIG, TensorPartition
+from infsup_contact.discretization.face.norms import triangles as ftn
+from infsup_contact.discretization.gamma.coupling import coupling_matrix
+from infsup_contact.discretization.face.quadrature import triangles_rule
+from infsup_contact.discretization.face.spaces.tensor import FaceSpace
+from infsup_contact.discretization.face.spaces.triangles import TriangleSpace
+from infsup_contact.discretization.spaces.registry import SPACES, case_space, ids_valid_for
+from infsup_contact.discretization.face.square import SQUARE, SQUARE_TRIG
+from infsup_contact.discretization.face.tensor_grid import TensorPartition
 from infsup_contact.errors import InputError
 from infsup_contact.models import make_model
 from infsup_contact.models.side_cache import SideCache
@@ -219,7 +220,7 @@ def test_p0_coupling_by_triangle_triangle_intersections():
     """B[T, j] = ∫_T w_j for P_0 on the triangles T of G_h (k = 2, non-matching 3 / 2): against
     Σ_τ ∫_{T∩τ} w_j over the trace's triangles τ, T∩τ clipped by T's three edges (a different
     decomposition from the rectangles-cut-by-diagonals of the coupling)."""
-    from infsup_contact.discretization.face_quadrature import _clip
+    from infsup_contact.discretization.face.quadrature import _clip
 
     k = 2
     sides = SideCache().pair(MODEL, "structured", k, 3, 2, element="tet")

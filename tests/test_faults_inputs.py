@@ -20,9 +20,10 @@ import yaml
 from infsup_contact.cli import main as cli_main
 from infsup_contact.config_checks import ConfigError, check_config, key_path, mesh_uses
 from infsup_contact.config_yaml import check_config_file
-from infsup_contact.discretization import meshes, registry
-from infsup_contact.discretization.registry import SPACES
-from infsup_contact.discretization.user_spaces import load_user_space
+from infsup_contact.discretization.segment import meshes
+from infsup_contact.discretization.spaces import registry
+from infsup_contact.discretization.spaces.registry import SPACES
+from infsup_contact.discretization.spaces.user_spaces import load_user_space
 from infsup_contact.errors import InputError
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -39,7 +40,7 @@ def one_line(text) -> str:
 @pytest.fixture(autouse=True)
 def forget_user_spaces():
     """Each test registers what it loads; the registry is left as the other tests expect it."""
-    from infsup_contact.discretization import user_spaces
+    from infsup_contact.discretization.spaces import user_spaces
 
     before = set(SPACES)
     yield
@@ -266,8 +267,8 @@ def test_n_equal_one_in_every_n_list(path):
 
 HEADER = """
 import numpy as np
-from infsup_contact.discretization.multipliers import make_space
-from infsup_contact.discretization.registry import SpaceSpec
+from infsup_contact.discretization.segment.multipliers import make_space
+from infsup_contact.discretization.spaces.spec import SpaceSpec
 
 def good_build(k, x):
     return make_space(x, k, True, True)

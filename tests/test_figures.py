@@ -8,7 +8,7 @@ import pandas as pd
 import pytest
 
 from infsup_contact.report import style as plotting
-from infsup_contact.discretization.registry import PAPER_CASES
+from infsup_contact.discretization.spaces.registry import PAPER_CASES
 
 CASE_IDS = (*PAPER_CASES, "DUAL", "DUAL-ALL")  # the built-in spaces (users' spaces register later)
 
@@ -195,6 +195,6 @@ def test_profiles_columns_on_tiny_mesh():
 
 def test_every_registered_marker_shows_its_fill_style():
     """Figures tell k apart by the marker's fill style: every space's marker has a body."""
-    from infsup_contact.discretization.registry import SPACES, WIDE_MARKERS
+    from infsup_contact.report.style import CASE_MARKERS, WIDE_MARKERS
 
-    assert {s.id: s.marker for s in SPACES.values() if s.marker not in WIDE_MARKERS} == {}
+    assert {case: m for case, m in CASE_MARKERS.items() if m not in WIDE_MARKERS} == {}

@@ -8,11 +8,11 @@ import numpy as np
 import pytest
 
 import infsup_contact
-from infsup_contact.discretization import meshes, norms
-from infsup_contact.discretization.coupling import coupling_matrix
-from infsup_contact.discretization.interface import Interface
-from infsup_contact.discretization.segment import SEGMENT, Segment
-from infsup_contact.discretization.registry import case_space
+from infsup_contact.discretization.segment import meshes, norms
+from infsup_contact.discretization.gamma.coupling import coupling_matrix
+from infsup_contact.discretization.gamma.interface import Interface
+from infsup_contact.discretization.segment.interface import SEGMENT, Segment
+from infsup_contact.discretization.spaces.registry import case_space
 from infsup_contact.errors import InputError
 from infsup_contact.models import make_model
 from infsup_contact.models.side_cache import SideCache
@@ -147,7 +147,7 @@ def test_no_solver_or_study_takes_partitions_apart(folder):
 
 
 def test_the_old_free_functions_are_gone():
-    from infsup_contact.discretization import coupling
+    from infsup_contact.discretization.gamma import coupling
 
     for mod, names in ((coupling, ("union_breakpoints", "quadrature_on", "gamma_trace", "trace_basis_at")),
                        (meshes, ("gamma_breakpoints", "partition_choice"))):

@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
-from infsup_contact.discretization.coupling import coupling_matrix
-from infsup_contact.discretization.registry import case_space, ids_valid_for
+from infsup_contact.discretization.gamma.coupling import coupling_matrix
+from infsup_contact.discretization.spaces.registry import case_space, ids_valid_for
 from infsup_contact.errors import InputError
 from infsup_contact.models import make_model, schur
 

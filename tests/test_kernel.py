@@ -5,8 +5,8 @@ import pandas as pd
 import pytest
 import scipy.linalg as sla
 
-from infsup_contact.discretization.coupling import coupling_matrix, trace_l2_norms
-from infsup_contact.discretization.norms import gram
+from infsup_contact.discretization.gamma.coupling import coupling_matrix, trace_l2_norms
+from infsup_contact.discretization.segment.norms import gram
 from infsup_contact.models.membranes import MEMBRANES
 from infsup_contact.models.schur import combine_terms, interface_terms
 from infsup_contact.models.side_cache import SideCache

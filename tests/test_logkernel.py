@@ -8,9 +8,9 @@ import pytest
 from scipy.special import zeta
 
 from infsup_contact.errors import InputError
-from infsup_contact.discretization.logkernel import gram_h_logkernel, log_kernel
-from infsup_contact.discretization.multipliers import local_shapes, make_space
-from infsup_contact.discretization.registry import PAPER_CASES, SPACES, case_space
+from infsup_contact.discretization.segment.logkernel import gram_h_logkernel, log_kernel
+from infsup_contact.discretization.segment.multipliers import local_shapes, make_space
+from infsup_contact.discretization.spaces.registry import PAPER_CASES, SPACES, case_space
 
 NONUNIFORM = np.array([0.0, 0.07, 0.21, 0.5, 0.56, 0.83, 1.0])
 GRADED = np.array([0.0, 1e-3, 1e-2, 0.1, 0.3, 1.0])

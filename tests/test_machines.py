@@ -230,7 +230,7 @@ def test_sweep_and_verdicts_identical_across_paths(runs):
     assert scaled <= 1.0
     # the paper's kernels on every path: on matching meshes the dimension counts are exact
     # (R5.2 two zero modes, R5.4 one, the stable spaces none), on the union of 17:16 too
-    from infsup_contact.discretization.registry import SPACES
+    from infsup_contact.discretization.spaces.registry import SPACES
 
     for frame in sweeps.values():
         seg = frame[frame.model == "membranes"]

@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 
 from infsup_contact.errors import InputError
-from infsup_contact.discretization.segment import SEGMENT
-from infsup_contact.discretization.meshes import FAMILIES, mesh_pair, mesh_quality, multiplier_breakpoints
+from infsup_contact.discretization.segment.interface import SEGMENT
+from infsup_contact.discretization.segment.meshes import FAMILIES, mesh_pair, mesh_quality, multiplier_breakpoints
 
 gamma_breakpoints = SEGMENT.partition_of
 

@@ -3,8 +3,8 @@ import numpy as np
 import pytest
 
 from infsup_contact.errors import InputError
-from infsup_contact.discretization.multipliers import make_space
-from infsup_contact.discretization.registry import (PAPER_CASES as CASE_IDS, SPACES, case_space, paper_dimension,
+from infsup_contact.discretization.segment.multipliers import make_space
+from infsup_contact.discretization.spaces.registry import (PAPER_CASES as CASE_IDS, SPACES, case_space, paper_dimension,
                                                     structural_kernel_dim)
 
 VALID = [(c, k) for c in CASE_IDS for k in range(1, 5) if k >= SPACES[c].min_k]

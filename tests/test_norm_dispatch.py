@@ -1,22 +1,23 @@
-"""The one dispatch on the norm (:func:`~infsup_contact.discretization.norms.gram_by_norm`) for every
+"""The one dispatch on the norm (:func:`~infsup_contact.discretization.segment.norms.gram_by_norm`) for every
 Γ: each module's ``gram`` returns exactly (bit for bit) what its own L² and H routes return, calls
 only the route asked for, and rejects any other norm with the one InputError naming ``norm`` and
-the allowed values :data:`~infsup_contact.discretization.norms.NORMS`."""
+the allowed values :data:`~infsup_contact.discretization.segment.norms.NORMS`."""
 import numpy as np
 import pytest
 
-from infsup_contact.discretization import face_cellwise_norms as fcn
-from infsup_contact.discretization import face_norms as fn
-from infsup_contact.discretization import face_triangle_norms as ftn
-from infsup_contact.discretization import norms
-from infsup_contact.discretization import triangle_fourier as tf
-from infsup_contact.discretization.face_cells import CellwiseFaceSpace
-from infsup_contact.discretization.face_triangles import TriangleSpace
-from infsup_contact.discretization.mesh_triangles import mesh_space
-from infsup_contact.discretization.multipliers import make_space
-from infsup_contact.discretization.registry import case_space
-from infsup_contact.discretization.square import SQUARE, TensorPartition
-from infsup_contact.discretization.triangulation import from_elements
+from infsup_contact.discretization.face.norms import cellwise as fcn
+from infsup_contact.discretization.face.norms import tensor as fn
+from infsup_contact.discretization.face.norms import triangles as ftn
+from infsup_contact.discretization.segment import norms
+from infsup_contact.discretization.face.norms import unstructured as tf
+from infsup_contact.discretization.face.spaces.cellwise import CellwiseFaceSpace
+from infsup_contact.discretization.face.spaces.triangles import TriangleSpace
+from infsup_contact.discretization.face.spaces.unstructured import mesh_space
+from infsup_contact.discretization.segment.multipliers import make_space
+from infsup_contact.discretization.spaces.registry import case_space
+from infsup_contact.discretization.face.square import SQUARE
+from infsup_contact.discretization.face.tensor_grid import TensorPartition
+from infsup_contact.discretization.face.triangulation import from_elements
 from infsup_contact.errors import InputError
 
 GRID = TensorPartition(np.array([0.0, 0.3, 0.55, 1.0]), np.array([0.0, 0.45, 1.0]))

@@ -11,9 +11,9 @@ from scipy.integrate import quad
 from scipy.special import zeta
 
 from infsup_contact.errors import InputError
-from infsup_contact.discretization.multipliers import make_space
-from infsup_contact.discretization.registry import PAPER_CASES, SPACES, case_space
-from infsup_contact.discretization.norms import gram, gram_h, gram_l2, sine_coefficients
+from infsup_contact.discretization.segment.multipliers import make_space
+from infsup_contact.discretization.spaces.registry import PAPER_CASES, SPACES, case_space
+from infsup_contact.discretization.segment.norms import gram, gram_h, gram_l2, sine_coefficients
 
 UNIFORM7 = np.linspace(0.0, 1.0, 8)
 NONUNIFORM5 = np.array([0.0, 0.07, 0.3, 0.35, 0.8, 1.0])

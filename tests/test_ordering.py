@@ -5,10 +5,10 @@ import scipy.sparse as sp
 import scipy.sparse.csgraph  # noqa: F401  (sp.csgraph)
 import scipy.sparse.linalg as spla
 
-from infsup_contact.discretization.segment import SEGMENT
+from infsup_contact.discretization.segment.interface import SEGMENT
 from infsup_contact.models.membranes import displacement_space, laplace_stiffness, side_operator
 from infsup_contact.models.schur import _gamma_last_lu, schur_by_solves, schur_from_lu
-from infsup_contact.discretization.meshes import mesh_pair
+from infsup_contact.discretization.segment.meshes import mesh_pair
 from infsup_contact.models.ordering import _Graph, _Twins, nested_dissection_gamma_last
 
 SUPERLU_SPD = dict(diag_pivot_thresh=0.0, options=dict(SymmetricMode=True))

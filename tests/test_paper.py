@@ -16,7 +16,7 @@ import pytest
 import yaml
 
 from infsup_contact import report as pt
-from infsup_contact.discretization.registry import PAPER_CASES
+from infsup_contact.discretization.spaces.registry import PAPER_CASES
 from infsup_contact.study.claims import REM55_INSTANCES, ledger, nonmatching_claims
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -121,14 +121,14 @@ def test_on_a_face_the_kept_factor_solves_as_a_second_factorization(face_sides):
 
 
 def _membrane_rows():
-    from infsup_contact.discretization import registry
+    from infsup_contact.discretization.spaces import registry
     from infsup_contact.study import face_patch
 
     return face_patch.face_patch_rows(registry.space_ids(), [2], [(3, 4)])
 
 
 def _elastic_rows():
-    from infsup_contact.discretization import registry
+    from infsup_contact.discretization.spaces import registry
     from infsup_contact.study import elastic_face_patch
 
     return elastic_face_patch.elastic_face_patch_rows(registry.space_ids(), [1], [(2, 3)])

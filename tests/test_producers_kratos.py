@@ -3,7 +3,7 @@ certified. Skipped, with the reason, where Kratos is not installed (``make produ
 
 Kratos' mesh tying couples the slave side (Ω1) by B = s (D | −M), D_ij = ∫ ψ_i φ_j on the slave
 trace, M_ij = ∫ ψ_i φ_j^master, ψ the dual P1 basis and s Kratos' scale factor. Checked here by an
-independent route: the suite's own dual basis (discretization/dual.py, built from moments) and
+independent route: the suite's own dual basis (discretization/segment/dual.py, built from moments) and
 Gauss-Legendre on the common refinement of both traces.
 """
 from __future__ import annotations
@@ -23,8 +23,8 @@ import scipy.sparse as sp
 pytestmark = pytest.mark.skipif(importlib.util.find_spec("KratosMultiphysics") is None,
                                 reason="Kratos not installed (make producers-kratos)")
 
-from infsup_contact.discretization.dual import dual_space  # noqa: E402
-from infsup_contact.discretization.norms import gram_l2  # noqa: E402
+from infsup_contact.discretization.segment.dual import dual_space  # noqa: E402
+from infsup_contact.discretization.segment.norms import gram_l2  # noqa: E402
 from infsup_contact.study.producers import norm_copy  # noqa: E402
 from infsup_contact.systems.levels import system_verdict  # noqa: E402
 from infsup_contact.systems.manifest import load_manifest  # noqa: E402

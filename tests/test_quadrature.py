@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from infsup_contact.discretization.quadrature import gauss_legendre, gauss_legendre_01
+from infsup_contact.discretization.gamma.quadrature import gauss_legendre, gauss_legendre_01
 
 
 @pytest.mark.parametrize("n", [1, 2, 5, 9])

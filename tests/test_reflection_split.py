@@ -6,8 +6,9 @@ import numpy as np
 import pytest
 import scipy.linalg as sla
 
-from infsup_contact.discretization import registry
-from infsup_contact.discretization.square import SQUARE, SQUARE_TRIG, TensorPartition
+from infsup_contact.discretization.spaces import registry
+from infsup_contact.discretization.face.square import SQUARE, SQUARE_TRIG
+from infsup_contact.discretization.face.tensor_grid import TensorPartition
 from infsup_contact.solvers import bottom, infsup, reflection
 
 

@@ -28,9 +28,10 @@ import itertools
 import numpy as np
 import pytest
 
-from infsup_contact.discretization.registry import SPACES
-from infsup_contact.discretization.segment import SEGMENT
-from infsup_contact.discretization.square import CELL_SHAPES, Square, TensorPartition
+from infsup_contact.discretization.spaces.registry import SPACES
+from infsup_contact.discretization.segment.interface import SEGMENT
+from infsup_contact.discretization.face.square import CELL_SHAPES, Square
+from infsup_contact.discretization.face.tensor_grid import TensorPartition
 from infsup_contact.errors import InputError
 
 SEGMENT_N = (2, 3, 5)
@@ -83,13 +84,13 @@ def _build(case, gamma, k, n):
 def _trace_space(gamma, k, n):
     """W_h: continuous degree-k Lagrange functions vanishing on ∂Γ on the same cells (the traces of
     the displacements of either body on matching meshes), built as the Lagrange space M^1_{0,k}."""
-    from infsup_contact.discretization.multipliers import make_space
+    from infsup_contact.discretization.segment.multipliers import make_space
 
     x = np.linspace(0.0, 1.0, n + 1)
     if gamma.dim == 1:
         return make_space(x, k, True, True)
-    from infsup_contact.discretization.face_spaces import FaceSpace
-    from infsup_contact.discretization.face_triangles import TriangleSpace
+    from infsup_contact.discretization.face.spaces.tensor import FaceSpace
+    from infsup_contact.discretization.face.spaces.triangles import TriangleSpace
 
     part = TensorPartition(x, x)
     if gamma.cell == "trig":

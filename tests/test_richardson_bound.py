@@ -8,8 +8,8 @@ import pytest
 import scipy.linalg as sla
 from scipy.special import zeta
 
-from infsup_contact.discretization.coupling import coupling_matrix
-from infsup_contact.discretization.face_norms import gram_h_face
+from infsup_contact.discretization.gamma.coupling import coupling_matrix
+from infsup_contact.discretization.face.norms.tensor import gram_h_face
 from infsup_contact.discretization.richardson import extrapolate, lookahead_bound, relative_step
 from infsup_contact.models import MODELS
 from infsup_contact.models.schur import combine_terms, interface_terms

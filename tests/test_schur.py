@@ -3,14 +3,14 @@ import numpy as np
 import pytest
 import scipy.linalg as sla
 
-from infsup_contact.discretization.coupling import coupling_matrix
+from infsup_contact.discretization.gamma.coupling import coupling_matrix
 from infsup_contact.solvers.infsup import beta_rows, gram_factor, saddle_point_beta, spectrum
 from infsup_contact.solvers.kernel import pencil_roundoff
 from infsup_contact.models.schur import interface_operator, schur_by_solves
 from infsup_contact.models.membranes import side_operator
-from infsup_contact.discretization.meshes import mesh_pair, multiplier_breakpoints
-from infsup_contact.discretization.registry import case_space
-from infsup_contact.discretization.norms import gram
+from infsup_contact.discretization.segment.meshes import mesh_pair, multiplier_breakpoints
+from infsup_contact.discretization.spaces.registry import case_space
+from infsup_contact.discretization.segment.norms import gram
 
 EPS = np.finfo(float).eps
 

@@ -1,11 +1,11 @@
-"""Mesh series of the β study (discretization/series.py) and seed pooling in the ledger."""
+"""Mesh series of the β study (discretization/gamma/mesh_series.py) and seed pooling in the ledger."""
 import math
 
 import numpy as np
 import pandas as pd
 import pytest
 
-from infsup_contact.discretization import series as S
+from infsup_contact.discretization.gamma import mesh_series as S
 from infsup_contact.study.claims import bounded_claim, finest
 
 IC = {"N": [4, 8, 16], "nonmatching": [[6, 4], [12, 8], [16, 8], [6, 8]],

@@ -3,7 +3,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from infsup_contact.discretization.segment import SEGMENT
+from infsup_contact.discretization.segment.interface import SEGMENT
 from infsup_contact.errors import InputError
 from infsup_contact.models.membranes import MEMBRANES
 from infsup_contact.models.side_cache import SideCache, side_keys

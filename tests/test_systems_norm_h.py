@@ -14,7 +14,7 @@ import pytest
 import scipy.sparse as sp
 
 from infsup_contact.cli import main
-from infsup_contact.discretization.registry import ids_valid_for, space_ids, space_spec
+from infsup_contact.discretization.spaces.registry import ids_valid_for, space_ids, space_spec
 from infsup_contact.models import make_model
 from infsup_contact.solvers.infsup import beta_rows
 from infsup_contact.systems.export import segment_form, suite_levels, write_system
@@ -445,8 +445,8 @@ def test_slave_side_quadrature_is_exact_only_on_matching_meshes(tmp_path, k):
     """B_1 integrated by the Gauss rule of the multiplier mesh (= Ω2's trace, the slave side) only,
     as codes without segmentation do: its distance to the exact coupling is round-off on matching
     meshes and the integration error on non-matching ones, equal to ‖B_slave − B‖ / ‖B‖ with the
-    suite's B (the exact coupling of :mod:`~infsup_contact.discretization.coupling`: a second route)."""
-    from infsup_contact.discretization.coupling import weighted_values
+    suite's B (the exact coupling of :mod:`~infsup_contact.discretization.gamma.coupling`: a second route)."""
+    from infsup_contact.discretization.gamma.coupling import weighted_values
     from infsup_contact.systems.export import _suite_parts
 
     out = {}

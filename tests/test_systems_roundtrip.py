@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from infsup_contact.cli import main
-from infsup_contact.discretization.registry import ids_valid_for
+from infsup_contact.discretization.spaces.registry import ids_valid_for
 from infsup_contact.models.elastic import ELASTIC
 from infsup_contact.solvers.infsup import beta_rows
 from infsup_contact.study.verdict import verdict_rows

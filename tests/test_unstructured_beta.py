@@ -9,7 +9,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from infsup_contact.discretization.registry import SPACES
+from infsup_contact.discretization.spaces.registry import SPACES
 from infsup_contact.models import make_model
 from infsup_contact.solvers.infsup import beta_rows
 

@@ -6,8 +6,8 @@ from pathlib import Path
 
 import pytest
 
-from infsup_contact.discretization.registry import SPACES
-from infsup_contact.discretization.user_spaces import load_user_space
+from infsup_contact.discretization.spaces.registry import SPACES
+from infsup_contact.discretization.spaces.user_spaces import load_user_space
 from infsup_contact.errors import InputError
 from infsup_contact.solvers.infsup import beta_rows
 
@@ -18,7 +18,7 @@ ENV = {**os.environ, "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"}
 @pytest.fixture(autouse=True)
 def forget_user_spaces():
     """Each test registers what it loads; the registry is left as the other tests expect it."""
-    from infsup_contact.discretization import user_spaces
+    from infsup_contact.discretization.spaces import user_spaces
 
     before = set(SPACES)
     yield
@@ -27,8 +27,8 @@ def forget_user_spaces():
 
 HEADER = """
 import numpy as np
-from infsup_contact.discretization.multipliers import local_basis_space, make_space
-from infsup_contact.discretization.registry import SpaceSpec
+from infsup_contact.discretization.segment.multipliers import local_basis_space, make_space
+from infsup_contact.discretization.spaces.spec import SpaceSpec
 """
 MALFORMED = {
     # (build body, dimension, what the error must say)
@@ -37,7 +37,7 @@ MALFORMED = {
                    "[[np.inf, 0], [0, 1]])", "None", "coefficients"),
     "dependent": ("return local_basis_space(x, 1, np.arange(2 * (len(x) - 1)).reshape(-1, 2), "
                   "[[1, 1], [2, 2]])", "None", "linearly independent"),
-    "not-a-space": ("return np.eye(3)", "None", "MultiplierSpace"),
+    "not-a-space": ("return np.eye(3)", "None", "SegmentSpace"),
 }
 
 

@@ -20,7 +20,7 @@ import pytest
 import yaml
 
 from infsup_contact import cli
-from infsup_contact.discretization import registry
+from infsup_contact.discretization.spaces import registry
 from infsup_contact.study import claims
 from infsup_contact.study.verdict import INCONCLUSIVE, STABLE, UNSTABLE, stability_verdict
 
@@ -201,8 +201,8 @@ def test_user_space_equal_to_r54_gets_r54_verdict(tmp_path):
     # a user's copy of Rem 5.4's M^0_{k-1} under another id: the same space, the same kernel
     path = tmp_path / "copy_r54.py"
     path.write_text(
-        "from infsup_contact.discretization.multipliers import make_space\n"
-        "from infsup_contact.discretization.registry import SpaceSpec\n\n"
+        "from infsup_contact.discretization.segment.multipliers import make_space\n"
+        "from infsup_contact.discretization.spaces.spec import SpaceSpec\n\n"
         "def space():\n"
         "    return SpaceSpec('COPY-R5.4', 'user', 'M^0_{k-1}', lambda k, x: make_space(x, k - 1, False, False),\n"
         "                     lambda k: k - 1, dimension=lambda k, n: n * k)\n")

@@ -11,8 +11,9 @@ import numpy as np
 import pytest
 
 from infsup_contact.cli import main
-from infsup_contact.discretization.registry import SPACES, ids_built_on, ids_valid_for
-from infsup_contact.discretization.square import SQUARE, SQUARE_TRIG, TensorPartition
+from infsup_contact.discretization.spaces.registry import SPACES, ids_built_on, ids_valid_for
+from infsup_contact.discretization.face.square import SQUARE, SQUARE_TRIG
+from infsup_contact.discretization.face.tensor_grid import TensorPartition
 from infsup_contact.models import MODELS
 from infsup_contact.solvers.infsup import beta_rows
 from infsup_contact.systems.levels import system_verdict

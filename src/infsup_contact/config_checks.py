@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import re
 
-from .discretization.user_spaces import config_case_ids
+from .discretization.spaces.user_spaces import config_case_ids
 from .config_schema import (ConfigError, check_finite, describe, key_path, load_schema,  # noqa: F401
                             schema_error, show)
 from .errors import InputError
@@ -35,7 +35,7 @@ MIN_FIT_POINTS = 3
 
 def load_spaces(cfg) -> list:
     """Register the user spaces of key ``spaces``; their ``.py`` files (workflow inputs)."""
-    from .discretization.user_spaces import load_user_space
+    from .discretization.spaces.user_spaces import load_user_space
 
     refs = cfg.get("spaces") if isinstance(cfg, dict) else None
     refs = [] if refs is None else refs
@@ -56,7 +56,7 @@ def load_spaces(cfg) -> list:
 
 def check_cases(cfg) -> None:
     """Case ids are registered spaces; each k is one the space allows (T4, T5: k >= 2)."""
-    from .discretization.registry import SPACES
+    from .discretization.spaces.registry import SPACES
 
     ids = config_case_ids(cfg)
     for stage in ("infsup", "contact"):
@@ -90,7 +90,7 @@ def figure_cases(cfg):
 def check_figures(cfg) -> None:
     """A figure's case ids are registered spaces (the built-in ones and the config's own user
     spaces) defined for its k; its scene is a name under contact.scenes or a scene kind."""
-    from .discretization.registry import SPACES
+    from .discretization.spaces.registry import SPACES
 
     ids = config_case_ids(cfg)
     for key, case, k in figure_cases(cfg):
@@ -230,8 +230,8 @@ def mesh_uses(cfg, with_cases: bool = True):
     run with it, as the stages run them (the elastic stages, every space of infsup.cases defined
     for k; the benchmarks, the paper's cases and the reference space; the figures, their cases). ``with_cases=False``: the
     meshes only ({} for the cases; no registry lookups, usable before the user spaces load)."""
-    from .discretization.registry import PAPER_CASES, REFERENCE_SPACE, ids_valid_for
-    from .discretization.series import FAMILY_RULES
+    from .discretization.spaces.registry import PAPER_CASES, REFERENCE_SPACE, ids_valid_for
+    from .discretization.gamma.mesh_series import FAMILY_RULES
 
     def by_k(cases: dict) -> dict:
         if not with_cases:
@@ -293,7 +293,7 @@ def mesh_uses(cfg, with_cases: bool = True):
 def config_intervals(cfg, limit: int = 1024) -> set:
     """Numbers of intervals of every multiplier mesh of the config (best effort: a config
     that is not yet validated may lack keys), for checking the user spaces on each."""
-    from .discretization.registry import MULTIPLIER_CHOICES, multiplier_intervals
+    from .discretization.spaces.registry import MULTIPLIER_CHOICES, multiplier_intervals
 
     out = set()
     try:
@@ -308,7 +308,7 @@ def config_intervals(cfg, limit: int = 1024) -> set:
 def check_space_meshes(cfg) -> None:
     """Every N list gets the minimum its spaces need: a case whose dim M_h is 0 on a mesh of
     the list (T3 and DUAL with k = 1 on N = 1) is refused, naming the key, the case and k."""
-    from .discretization.registry import case_name, is_empty, min_intervals, multiplier_intervals
+    from .discretization.spaces.registry import case_name, is_empty, min_intervals, multiplier_intervals
 
     for key, value, n1, n2, cases_by_k, choices in mesh_uses(cfg):
         for k, cases in cases_by_k.items():
@@ -362,8 +362,8 @@ CROSS_KEY_RULES = {
 
 def beta_series(cfg) -> dict:
     """The mesh series the claims ledger fits (per family, case, k and norm alike): matching
-    even and odd N, and every non-matching series (discretization/series.py) by N2."""
-    from .discretization.series import beta_series as series, describe
+    even and odd N, and every non-matching series (discretization/gamma/mesh_series.py) by N2."""
+    from .discretization.gamma.mesh_series import beta_series as series, describe
 
     ic = cfg["infsup"]
     ns = sorted(ic["N"])

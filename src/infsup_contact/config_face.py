@@ -7,8 +7,8 @@ later passes by config alone), a non-matching pair has N1 ≠ N2, and the face s
 (:func:`check_face_studies`). Each raises one
 :class:`~infsup_contact.config_schema.ConfigError` naming the key.
 
-Non-matching families (``face.nonmatching_families``: family → element → N1 list, issue 28 item 1):
-the rules of the 2D study's families (:data:`~infsup_contact.discretization.series.FAMILY_RULES`:
+Non-matching families (``face.nonmatching_families``: family → element → N1 list):
+the rules of the 2D study's families (:data:`~infsup_contact.discretization.gamma.mesh_series.FAMILY_RULES`:
 ``sqrt2`` n → round(√2 n), ``plus1`` n → n + 1) give the *finer* side from the coarser one, and on
 the face Ω2 is the finer side as in ``face.nonmatching`` (G_h = the trace of Ω2): N2 = rule(N1),
 e.g. sqrt2 5:7, 7:10, 10:14. They are listed per element and explicitly, so ``face.max_N`` does not
@@ -59,8 +59,8 @@ def check_face_studies(fc, model_name: str, options) -> None:
     test's elements are the model's, its pairs non-matching; the α sweep's elements are face
     elements with a transformed (non-identity) basis; edge dropping keeps at least 3 θ at or
     below ``fit_theta_max`` (a slope fit). Each raises one ConfigError naming the key."""
-    from .discretization.face_cells import QUAD_ELEMENTS
-    from .discretization.face_dual import transformation
+    from .discretization.face.spaces.cellwise import QUAD_ELEMENTS
+    from .discretization.face.spaces.dual_bases import transformation
 
     for i, element in enumerate(fc["patch"]["elements"]):
         if element not in options:
@@ -88,7 +88,8 @@ def _check_edge_dropping(fc, ed) -> None:
     """Each θ is one the geometry resolves at the largest N (a narrower cut column was dropped
     whole: θ = 1e-12 computed θ = 0), and each k has an edge case among ``face.cases`` (a k
     without one computed nothing)."""
-    from .discretization.clipped_face import SLIVER_MIN, edge_cases, min_covered_fraction
+    from .discretization.face.spaces.clipped import SLIVER_MIN, min_covered_fraction
+    from .discretization.spaces.registry import edge_cases
 
     n = max(ed["N"])
     for i, theta in enumerate(ed["theta"]):
@@ -105,7 +106,7 @@ def _check_edge_dropping(fc, ed) -> None:
 
 
 def _check_face_families(fc) -> None:
-    from .discretization.series import FAMILY_RULES
+    from .discretization.gamma.mesh_series import FAMILY_RULES
 
     for name, per_element in (fc.get("nonmatching_families") or {}).items():
         key = f"face.nonmatching_families.{name}"
@@ -124,7 +125,7 @@ def _check_face_families(fc) -> None:
 def family_pairs(fc, element: str) -> list:
     """(N1, N2 = rule(N1)) of every ``face.nonmatching_families`` entry of ``element`` (module
     docstring: Ω2 the finer side), in the config's order."""
-    from .discretization.series import FAMILY_RULES
+    from .discretization.gamma.mesh_series import FAMILY_RULES
 
     return [(int(n1), FAMILY_RULES[name][0](int(n1)))
             for name, per_element in (fc.get("nonmatching_families") or {}).items()
@@ -182,9 +183,10 @@ def check_face_case_ids(cfg, section: str, cases, ks_config, faces, need_builder
     """Each id of ``<section>.cases``: registered, defined for one of ``<section>.k``, and built
     on every face of ``faces`` (a list, or element → face) that builds it; ``need_builder``: at
     least one face must (the error names the elements and the ids their faces build)."""
-    from .discretization.user_spaces import config_case_ids
-    from .discretization.registry import SPACES
-    from .discretization.square import SQUARE, TensorPartition
+    from .discretization.spaces.user_spaces import config_case_ids
+    from .discretization.spaces.registry import SPACES
+    from .discretization.face.square import SQUARE
+    from .discretization.face.tensor_grid import TensorPartition
 
     ids = config_case_ids(cfg, gamma_dim=SQUARE.dim)
     names = list(faces) if isinstance(faces, dict) else None

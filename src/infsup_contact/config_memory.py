@@ -17,7 +17,7 @@ def job_estimates(cfg):
     contact per mesh, the Rem 5.5 instances of claims_extra, the two bench stages."""
     ic, cc, bc = cfg["infsup"], cfg["contact"], cfg["benchmarks"]
     ks = sorted({k for klist in ic["cases"].values() for k in klist})
-    from .discretization.series import series_of_pairs
+    from .discretization.gamma.mesh_series import series_of_pairs
 
     for (n1, n2), names in series_of_pairs(ic).items():
         key = ("infsup.N" if "matching" in names else

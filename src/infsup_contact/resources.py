@@ -28,7 +28,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from .discretization.segment import SEGMENT
+from .discretization.segment.interface import SEGMENT
 
 MIB = 1024 ** 2
 

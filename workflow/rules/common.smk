@@ -10,7 +10,7 @@ from infsup_contact.config_checks import ConfigError, check_config, speed_accura
 from infsup_contact.config_face import face_pairs, l2_only_sizes
 from infsup_contact.config_yaml import check_config_files
 from infsup_contact.config_memory import check_job_memory, memory_notes
-from infsup_contact.discretization.series import seeds, series_of_pairs
+from infsup_contact.discretization.gamma.mesh_series import seeds, series_of_pairs
 from infsup_contact.study.batches import beta_batches
 from infsup_contact.study.scene_registry import scene_spec
 
@@ -42,7 +42,7 @@ BENCH_SOURCES = sorted(str(p) for p in (_PKG / "bench").glob("*.py"))
 
 def beta_pairs():
     """(N1, N2) mesh pairs of the β_h study: every pair of every series (matching, the
-    fixed-ratio pairs, the non-matching families), each once (discretization/series.py)."""
+    fixed-ratio pairs, the non-matching families), each once (discretization/gamma/mesh_series.py)."""
     return sorted(series_of_pairs(config["infsup"]), key=lambda p: (max(p), p))
 
 

@@ -97,7 +97,7 @@ rule fig4_families:
     input:
         beta="results/tables/beta.csv",
         style=PLOT_STYLE,
-        meshes="src/infsup_contact/discretization/meshes.py",  # the mesh panels are drawn from mesh_pair
+        meshes="src/infsup_contact/discretization/segment/meshes.py",  # the mesh panels are drawn from mesh_pair
     params:
         seed=lambda wc: seeds(config["infsup"])[0],  # the figure draws the first seed's meshes
         alpha=lambda wc: config["infsup"]["alpha"],

@@ -1,5 +1,5 @@
 # β_h stage: one job per batch of mesh pairs of one (family, k) (BETA_BATCHES, common.smk;
-# discretization/series.py): every pair of every series (matching, fixed ratios, the
+# discretization/gamma/mesh_series.py): every pair of every series (matching, fixed ratios, the
 # non-matching families), every seed of the perturbed family, and every case, norm,
 # multiplier mesh and c pair of the config, from one side factorization per mesh pair.
 # A batch is a few dozen seconds of work, so NGSolve's start-up is paid once per batch.

@@ -27,7 +27,7 @@ def add_provenance(frame, cfg):
 def register_user_spaces(config) -> None:
     """Register the config's user-defined spaces (key ``spaces``) in this job's process, so
     that its case ids resolve here as they did when the config was validated."""
-    from infsup_contact.discretization.user_spaces import load_user_spaces
+    from infsup_contact.discretization.spaces.user_spaces import load_user_spaces
 
     load_user_spaces(config.get("spaces") or [])
 

@@ -2,7 +2,7 @@
 
 For each α: over seeds 0..S−1, N = 4..32 and both sides, the smallest signed area of a
 triangle relative to the unperturbed one (h²/2) and the smallest angle, next to the
-guaranteed bounds of :func:`infsup_contact.discretization.meshes.perturbation_bounds`
+guaranteed bounds of :func:`infsup_contact.discretization.segment.meshes.perturbation_bounds`
 (every seed). Vertex arithmetic only (numpy): no NGSolve mesh is built.
 
     python workflow/scripts/alpha_bound.py [--seeds 200] [--csv out.csv]
@@ -14,7 +14,7 @@ import argparse
 import numpy as np
 import pandas as pd
 
-from infsup_contact.discretization.meshes import perturb, perturbation_bounds, signed_areas, structured_arrays
+from infsup_contact.discretization.segment.meshes import perturb, perturbation_bounds, signed_areas, structured_arrays
 
 ALPHAS = (0.1, 0.15, 0.2, 0.22, 0.25, 0.3, 0.35, 0.4, 0.45)
 

@@ -15,7 +15,7 @@ limit_threads(snakemake.threads)  # noqa: F821
 log_to(snakemake.log[0])  # noqa: F821
 register_user_spaces(snakemake.config)  # noqa: F821
 
-from infsup_contact.discretization.series import seeds, series_of_pairs  # noqa: E402
+from infsup_contact.discretization.gamma.mesh_series import seeds, series_of_pairs  # noqa: E402
 from infsup_contact.io import write_csv_atomic  # noqa: E402
 from infsup_contact.models import DEFAULT_MODEL  # noqa: E402
 from infsup_contact.study.beta_batches import beta_batch_rows  # noqa: E402

@@ -11,7 +11,7 @@ register_user_spaces(snakemake.config)  # noqa: F821
 
 import time  # noqa: E402
 
-from infsup_contact.discretization.registry import ids_valid_for  # noqa: E402
+from infsup_contact.discretization.spaces.registry import ids_valid_for  # noqa: E402
 from infsup_contact.io import write_csv_atomic  # noqa: E402
 from infsup_contact.study.elastic_beta import elastic_beta_rows, nu_sweep_rows  # noqa: E402
 

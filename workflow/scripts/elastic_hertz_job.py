@@ -11,7 +11,7 @@ register_user_spaces(snakemake.config)  # noqa: F821
 
 import pandas as pd  # noqa: E402
 
-from infsup_contact.discretization.registry import REFERENCE_SPACE  # noqa: E402
+from infsup_contact.discretization.spaces.registry import REFERENCE_SPACE  # noqa: E402
 from infsup_contact.io import write_csv_atomic  # noqa: E402
 from infsup_contact.study.hertz import discretization_rows, modeling_rows  # noqa: E402
 

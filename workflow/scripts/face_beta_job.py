@@ -16,7 +16,7 @@ register_user_spaces(snakemake.config)  # noqa: F821
 import time  # noqa: E402
 
 from infsup_contact.config_face import face_pairs, l2_only_sizes  # noqa: E402
-from infsup_contact.discretization.registry import SPACES, ids_valid_for  # noqa: E402
+from infsup_contact.discretization.spaces.registry import SPACES, ids_valid_for  # noqa: E402
 from infsup_contact.io import write_csv_atomic  # noqa: E402
 from infsup_contact.study.beta_batches import beta_batch_rows  # noqa: E402
 from infsup_contact.study.face_claims import element_interfaces  # noqa: E402

@@ -1,7 +1,7 @@
 """Figure 4: mesh families and the choice of the multiplier mesh G_h.
 
 Top: a structured, a perturbed and an unstructured matching pair and a perturbed
-non-matching pair (drawn from ``infsup_contact.discretization.meshes.mesh_pair``: mesh geometry only,
+non-matching pair (drawn from ``infsup_contact.discretization.segment.meshes.mesh_pair``: mesh geometry only,
 cheap). Below: β_h (H norm) of a stable case (T3) against h for each family (columns)
 and k (rows): matching pairs N×N, and the non-matching pairs of the most frequent ratio
 N1:N2 (3:2 in the configs) with each multiplier mesh omega2 / omega1 / union of the β
@@ -25,7 +25,7 @@ import pandas as pd  # noqa: E402
 from matplotlib.collections import LineCollection  # noqa: E402
 from matplotlib.lines import Line2D  # noqa: E402
 
-from infsup_contact.discretization.registry import REFERENCE_SPACE  # noqa: E402
+from infsup_contact.discretization.spaces.registry import REFERENCE_SPACE  # noqa: E402
 from infsup_contact.report.style import (h_ticks, CASE_COLORS, LABELS, NEUTRAL, case_style, mesh_size,  # noqa: E402
                                      save_figure, style)
 
@@ -45,7 +45,7 @@ def mesh_arrays(family: str, n1: int, n2: int, **kwargs):
     """[(points, triangles) of Ω1, (points, triangles) of Ω2] of a library mesh pair."""
     import ngsolve
 
-    from infsup_contact.discretization.meshes import mesh_pair
+    from infsup_contact.discretization.segment.meshes import mesh_pair
 
     out = []
     for mesh in mesh_pair(family, n1, n2, **kwargs):

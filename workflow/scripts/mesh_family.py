@@ -13,8 +13,8 @@ log_to(snakemake.log[0])  # noqa: F821
 import pandas as pd  # noqa: E402
 
 from infsup_contact.io import write_csv_atomic  # noqa: E402
-from infsup_contact.discretization.meshes import mesh_pair, mesh_quality  # noqa: E402
-from infsup_contact.discretization.series import seeds  # noqa: E402
+from infsup_contact.discretization.segment.meshes import mesh_pair, mesh_quality  # noqa: E402
+from infsup_contact.discretization.gamma.mesh_series import seeds  # noqa: E402
 
 family, ic = snakemake.wildcards.family, snakemake.params.ic  # noqa: F821
 seed_list = seeds(ic) if family == "perturbed" else [None]

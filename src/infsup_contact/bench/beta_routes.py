@@ -39,8 +39,9 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from ..discretization import meshes, registry
-from ..discretization.coupling import coupling_matrix
+from ..discretization.segment import meshes
+from ..discretization.spaces import registry
+from ..discretization.gamma.coupling import coupling_matrix
 from ..models.membranes import side_operator
 from ..models.schur import SideOperator, interface_operator
 from ..solvers.infsup import beta_rows

@@ -34,9 +34,10 @@ import time
 import numpy as np
 import scipy.sparse.linalg as spla
 
-from ..discretization import meshes, registry
-from ..discretization.registry import REFERENCE_SPACE
-from ..discretization.coupling import coupling_matrix
+from ..discretization.segment import meshes
+from ..discretization.spaces import registry
+from ..discretization.spaces.registry import REFERENCE_SPACE
+from ..discretization.gamma.coupling import coupling_matrix
 from ..models.membranes import side_operator
 from .harness import ROUTE_BUDGET, _log, _row, run_interleaved
 

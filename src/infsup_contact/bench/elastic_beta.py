@@ -23,8 +23,9 @@ import numpy as np
 import scipy.linalg as sla
 import scipy.sparse.linalg as spla
 
-from ..discretization import meshes, registry
-from ..discretization.coupling import coupling_matrix
+from ..discretization.segment import meshes
+from ..discretization.spaces import registry
+from ..discretization.gamma.coupling import coupling_matrix
 from ..models.elastic import elastic_model
 from ..models.schur import factorized_side, interface_operator
 from ..solvers.infsup import beta_rows

@@ -40,8 +40,8 @@ import numpy as np
 import scipy.linalg as sla
 import scipy.sparse.linalg as spla
 
-from ..discretization import registry
-from ..discretization.coupling import coupling_matrix
+from ..discretization.spaces import registry
+from ..discretization.gamma.coupling import coupling_matrix
 from ..errors import InputError
 from ..models.membranes3d import ELEMENTS, MEMBRANES3D
 from ..models import pardiso

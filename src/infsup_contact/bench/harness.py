@@ -22,7 +22,7 @@ import time
 
 import numpy as np
 
-from ..discretization.logkernel import clear_partition_cache
+from ..discretization.segment.logkernel import clear_partition_cache
 
 
 PEER_LIBRARIES = ("osqp", "clarabel", "qpsolvers", "scikit-sparse")

@@ -51,7 +51,7 @@ def _check_bench(args):
                 raise InputError(key, allowed, got=v)
         if len(set(values)) < len(values):
             raise InputError(key, f"{allowed}, each once", got=" ".join(map(str, values)))
-    from ..discretization.registry import check_pair_spaces, ids_valid_for
+    from ..discretization.spaces.registry import check_pair_spaces, ids_valid_for
 
     if args.what == "face":
         _check_face(args)

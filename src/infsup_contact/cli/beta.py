@@ -8,8 +8,8 @@ from .common import (FlagUse, declare_flag_uses, material_columns, mesh_options,
 
 
 def add(sub) -> None:
-    from ..discretization.meshes import FAMILIES
-    from ..discretization.registry import space_ids
+    from ..discretization.segment.meshes import FAMILIES
+    from ..discretization.spaces.registry import space_ids
 
     from ..solvers.kernel import KERNEL_CRITERION
 
@@ -66,7 +66,7 @@ FLAG_USES = [
 
 def _check_beta(args):
     from .. import resources
-    from ..discretization.meshes import check_perturbation
+    from ..discretization.segment.meshes import check_perturbation
     from ..errors import InputError
     from ..solvers.infsup import check_inputs
 

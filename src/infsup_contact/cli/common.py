@@ -16,8 +16,8 @@ SPACE_HELP = ("a user-defined multiplier space: a file or module and a function 
 def cases(args) -> list:
     """Case ids of a request: --space (loaded, checked, registered), else --case (all: every
     registered space defined for k)."""
-    from ..discretization.registry import ids_valid_for
-    from ..discretization.user_spaces import load_user_space
+    from ..discretization.spaces.registry import ids_valid_for
+    from ..discretization.spaces.user_spaces import load_user_space
 
     if args.space is not None:
         if args.case not in (None,):
@@ -35,7 +35,7 @@ def face_cases(args) -> list:
     other registered space the model's face builds for k (the quadratic face elements' on
     hexahedra or tetrahedra; those refused by construction, e.g. DUAL-Q8, left out), found on
     the model's coarsest mesh (one cell per direction; ``args.mesh_kwargs`` set)."""
-    from ..discretization.registry import ids_built_on
+    from ..discretization.spaces.registry import ids_built_on
 
     base = list(args.cases)
     if args.case not in (None, "all") or args.space is not None or args.model_obj.dim != 3:
@@ -52,7 +52,7 @@ def run_intervals(args, limit: int = 1024) -> set:
     --multiplier-mesh, or the --N list with N1 = N + --N1-offset), for checking a user space on each.
     Sizes that are not valid N are left to their own checks; above ``limit`` the space is
     checked as it is built (user_spaces.guarded_build), not before."""
-    from ..discretization.registry import multiplier_intervals
+    from ..discretization.spaces.registry import multiplier_intervals
 
     choice = getattr(args, "multiplier_mesh", "omega2")
     pairs = ([(getattr(args, "N1", None), getattr(args, "N2", None))] if hasattr(args, "N1")

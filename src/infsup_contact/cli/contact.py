@@ -9,8 +9,8 @@ from .common import (FlagUse, add_dry_run, add_model, cases, check_memory, decla
 
 
 def add(sub) -> None:
-    from ..discretization.meshes import FAMILIES
-    from ..discretization.registry import space_ids
+    from ..discretization.segment.meshes import FAMILIES
+    from ..discretization.spaces.registry import space_ids
     from ..study.scene_registry import allowed_pairs, scene_ids
 
     p = sub.add_parser("contact", help="solve (4.1) for one case and mesh pair (CSV: one row)")
@@ -52,7 +52,8 @@ def scene_flag_uses() -> list:
 
 
 def _check_contact(args):
-    from ..discretization import meshes, registry
+    from ..discretization.segment import meshes
+    from ..discretization.spaces import registry
     from ..study.scene_registry import check_pair
     from ..study.scenes import _exponent
 

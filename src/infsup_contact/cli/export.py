@@ -10,8 +10,8 @@ from .common import (add_dry_run, add_model, check_memory, declare_flag_uses, ma
 
 
 def add(sub) -> None:
-    from ..discretization.meshes import FAMILIES
-    from ..discretization.registry import space_ids
+    from ..discretization.segment.meshes import FAMILIES
+    from ..discretization.spaces.registry import space_ids
     from ..systems.export import EXPORT_FORMATS
 
     p = sub.add_parser("export", help="write A, B, G of a registered space on several meshes and a "
@@ -46,7 +46,8 @@ def _check_export(args):
     from pathlib import Path
 
     from .. import resources
-    from ..discretization import meshes, registry
+    from ..discretization.segment import meshes
+    from ..discretization.spaces import registry
     from ..study.verdict import check_model_case, check_n1_offset
 
     material(args)

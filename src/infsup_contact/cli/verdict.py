@@ -18,8 +18,8 @@ _EXPECT = {"stable": "STABLE", "unstable": "UNSTABLE"}
 
 
 def add(sub) -> None:
-    from ..discretization.meshes import FAMILIES
-    from ..discretization.registry import space_ids
+    from ..discretization.segment.meshes import FAMILIES
+    from ..discretization.spaces.registry import space_ids
 
     p = sub.add_parser(
         "verdict", help="is a multiplier space stable? β_h over a series of meshes → STABLE, "
@@ -80,8 +80,9 @@ def _check_verdict(args):
         return est
     if args.k is None:
         raise InputError("k", "an integer in 1..4 (required with --case and --space)")
-    from ..discretization import meshes, registry
-    from ..discretization.user_spaces import load_user_space
+    from ..discretization.segment import meshes
+    from ..discretization.spaces import registry
+    from ..discretization.spaces.user_spaces import load_user_space
     from ..study.verdict import check_criterion, check_mesh_sizes, check_model_case, check_n1_offset
 
     args.space_or_case = args.case if args.space is None else load_user_space(args.space, run_intervals(args))

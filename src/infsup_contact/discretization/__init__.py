@@ -1,8 +1,10 @@
-"""Discretization: meshes of Ω1, Ω2, multiplier spaces on G_h, the coupling b(v, μ), the norms of μ.
+"""Discretization: Γ, the multiplier spaces M_h on G_h, the coupling b(v, μ), the norms of μ.
 
-Everything the paper's Sections 4–5 define before any solve: Γ, the interface object every consumer
-asks for partitions, trace dofs, quadrature, Gram matrices and spaces (``interface``), mesh pairs (``meshes``), the
-spaces M_h and their registry (``multipliers``), B_i (``coupling``), the Gram matrices of
-L²(Γ) and H^{-1/2}_00(Γ) (``norms``, ``logkernel``). Imports only ``errors`` and each other.
-Issue 28's 2D face: elements, (transformed) dual bases, grid spaces (``face_elements``, ``face_dual``, ``face_cells``).
+Everything the paper's Sections 4–5 define before any solve, Γ first:
+
+``gamma``    what every Γ shares: the ``Interface``, the ``MultiplierSpace`` protocol, traces,
+             coupling, quadrature, symmetries, "is 1 ∈ M_h?".
+``segment``  the paper's segment Γ = (0, 1): meshes, spaces, norms.
+``face``     the 3D contact face Γ = (0, 1)²: partitions, spaces, norms, its interfaces and meshes.
+``spaces``   the registry of spaces (as data) and users' spaces.
 """

@@ -1,10 +1,10 @@
 """The face's H Gram series in the four parity blocks of the axis reflections (issue 28, large N).
 
-Where both 1D factors of a tensor space M^x ⊗ M^y (:mod:`.face_spaces`; the piece space P of a
-cellwise one, :mod:`.face_cellwise_norms`) are symmetric under x → 1 − x, i.e. the reflection
+Where both 1D factors of a tensor space M^x ⊗ M^y (:mod:`.face.spaces.tensor`; the piece space P of a
+cellwise one, :mod:`.face.norms.cellwise`) are symmetric under x → 1 − x, i.e. the reflection
 maps the basis onto itself (:func:`axis_parity`, found and checked as the face's reflections,
-:func:`~.basis_symmetry.induced_permutation`), their bases split into even and odd functions,
-Q^x_e and Q^x_o (:func:`~.basis_symmetry.isotypic_bases`). Because
+:func:`~.gamma.symmetry.induced_permutation`), their bases split into even and odd functions,
+Q^x_e and Q^x_o (:func:`~.gamma.symmetry.isotypic_bases`). Because
 sin(mπ(1 − x)) = (−1)^{m+1} sin(mπx), an even function has sine coefficients at odd m only, an
 odd one at even m only. So the double series
 
@@ -28,16 +28,16 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..la.threaded import signed_gather_sum, symmetric_pairs, symmetric_part, symmetric_sandwich
-from .basis_symmetry import induced_permutation, isotypic_bases, reflect
-from .norms import sine_coefficients
-from .quadrature import gauss_legendre
+from .gamma.symmetry import induced_permutation, isotypic_bases, reflect
+from .segment.norms import sine_coefficients
+from .gamma.quadrature import gauss_legendre
 
 INTERTWINE_RTOL = 1e-10
 """Largest ‖Q_aᵀ R T_b‖_F / ‖R‖_F (a ≠ b) for which R counts as intertwining the reflections."""
 
 
 def axis_parity(space) -> tuple | None:
-    """(Q_e, Q_o) of a 1D space (:class:`~.multipliers.MultiplierSpace`) under x → 1 − x,
+    """(Q_e, Q_o) of a 1D space (:class:`~.segment.multipliers.SegmentSpace`) under x → 1 − x,
     checked at 4 Gauss points per interval, or None where the reflection does not map its basis."""
     t, _ = gauss_legendre(4)
     g = np.asarray(space.breakpoints, float)
@@ -62,9 +62,9 @@ def tensor_bases(parities) -> list:
 
 
 def partial_gram_blocks(space, n_max: int, parities, separable_sum) -> list:
-    """[S_c(n_max)], c = 0..3: the blocks T_cᵀ S(n_max) T_c of :func:`~.face_norms.partial_gram`
+    """[S_c(n_max)], c = 0..3: the blocks T_cᵀ S(n_max) T_c of :func:`~.face.norms.tensor.partial_gram`
     (module text), each by ``separable_sum(A, B, m, n)`` (the exponential-sum product
-    :func:`~.face_norms._separable_sum` over the index sets m of x and n of y)."""
+    :func:`~.face.norms.tensor._separable_sum` over the index sets m of x and n of y)."""
     n = np.arange(1, n_max + 1, dtype=float)
     index = (n[0::2], n[1::2])                      # odd m for even functions, even m for odd ones
     coeffs = [[(Q.T @ sine_coefficients(f, idx))  # (dim_p, len(idx)) per parity p

@@ -4,8 +4,8 @@ scipy's sparse × dense product (``csr_matvecs``) and numpy's element-wise passe
 single-threaded. On the large face route (k = 2, N = 32) they held about 45 s of a 200 s
 β_h request while the second core waited: the sandwiches B X Bᵀ of the interface operator
 (:mod:`infsup_contact.models.schur`) and R S_P Rᵀ of the cellwise H Grams
-(:mod:`infsup_contact.discretization.face_cellwise_norms`), and the reordering of the face
-series (:mod:`infsup_contact.discretization.face_norms`). Both release the GIL, so threads
+(:mod:`infsup_contact.discretization.face.norms.cellwise`), and the reordering of the face
+series (:mod:`infsup_contact.discretization.face.norms.tensor`). Both release the GIL, so threads
 over disjoint row blocks of the result use every core. Each row of a result is computed by
 the same kernel, in the same order, as the one-thread product: the results are bit-identical
 (tests/test_la_threaded.py).

@@ -6,11 +6,11 @@ never ask which one it is. A model is one function, ``side_operator(mesh, k)``, 
 each mesh of a pair; the :class:`~infsup_contact.models.schur.SideOperator` it returns carries
 
 * ``trace`` — the Γ trace of the side's displacement space: its interface (``trace.gamma``,
-  the :class:`~infsup_contact.discretization.interface.Interface` every consumer asks for
+  the :class:`~infsup_contact.discretization.gamma.interface.Interface` every consumer asks for
   partitions, quadrature, Gram matrices and spaces), its partition of Γ (``trace.partition``,
   opaque outside the interface), its Γ dofs (``trace.gamma_dofs``, the components b(v, μ) sees:
   for a scalar membrane v itself, for an elastic body v·n) and the NGSolve space, from which
-  :func:`~infsup_contact.discretization.coupling.coupling_matrix` builds B_i;
+  :func:`~infsup_contact.discretization.gamma.coupling.coupling_matrix` builds B_i;
 * ``steklov_times(M)`` — X_i M with X_i = (A_i⁻¹)_ΓΓ at unit material scale: the interface
   operator Σ_i B_i X_i B_iᵀ / c_i is assembled from it for every multiplier space and norm
   (above ``schur.SPARSE_PRODUCT_MIN_DIM`` from ``steklov_sandwich(B)`` = B X_i Bᵀ where the side
@@ -98,7 +98,7 @@ class Model:
     mesh : callable or None
         ``mesh(family, n, side, **mesh_kwargs) -> ngsolve.Mesh``: the mesh of Ω_side with n cells
         on Γ (per direction on a face); None: the paper's 2D meshes
-        (:func:`~infsup_contact.discretization.meshes.subdomain_mesh`).
+        (:func:`~infsup_contact.discretization.segment.meshes.subdomain_mesh`).
     mesh_options : tuple of (str, tuple)
         Mesh keywords the model's ``mesh`` takes beyond the 2D ones, with their allowed values
         (``(("element", ("hex", "tet")),)``; a tuple, so that a model stays hashable, a side
@@ -126,7 +126,7 @@ class Model:
     def subdomain_mesh(self, family: str, n: int, side: int, **mesh_kwargs):
         """The mesh of Ω_side the model's sides are built on (its ``mesh`` builder, else the 2D one)."""
         if self.mesh is None:
-            from ..discretization import meshes
+            from ..discretization.segment import meshes
 
             return meshes.subdomain_mesh(family, n, side, **mesh_kwargs)
         return self.mesh(family, n, side, **mesh_kwargs)

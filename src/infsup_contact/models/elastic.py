@@ -31,8 +31,8 @@ import numpy as np
 import ngsolve
 import scipy.sparse as sp
 
-from ..discretization.segment import SEGMENT
-from ..discretization.meshes import DIRICHLET
+from ..discretization.segment.interface import SEGMENT
+from ..discretization.segment.meshes import DIRICHLET
 from .contract import MaterialParam, Model
 from .plane_strain import E_RANGE, NU_RANGE, check_modulus, check_nu, lame  # noqa: F401 (the model's material law)
 from .schur import SideOperator, factorized_side

@@ -53,7 +53,7 @@ import numpy as np
 import ngsolve
 import scipy.sparse as sp
 
-from ..discretization.meshes import SYMMETRY_X, SYMMETRY_Y
+from ..discretization.segment.meshes import SYMMETRY_X, SYMMETRY_Y
 from ..errors import InputError
 from .contract import Model
 from .elastic import PARAMS
@@ -123,7 +123,7 @@ def elastic_stiffness(fes, nu: float) -> sp.csr_matrix:
 
 def free_order(fes, gamma) -> tuple:
     """Free dofs ordered [interior, Γ x, Γ y, Γ z] (product numbering), the z component's
-    :class:`~infsup_contact.discretization.interface.GammaTrace` on ``gamma`` (its dofs numbered
+    :class:`~infsup_contact.discretization.gamma.interface.GammaTrace` on ``gamma`` (its dofs numbered
     in the component, as B_i sees them) and the number of tangential Γ dofs."""
     off = offsets(fes)
     traces = [gamma.trace(c) for c in fes.components]

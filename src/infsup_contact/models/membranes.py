@@ -10,7 +10,7 @@ import numpy as np
 import ngsolve
 import scipy.sparse as sp
 
-from ..discretization.segment import SEGMENT
+from ..discretization.segment.interface import SEGMENT
 from ..errors import check_prestress
 from .contract import OUTWARD_NORMAL_Y, MaterialParam, Model
 from .schur import SideOperator, factorized_side

@@ -5,22 +5,22 @@ The paper's model problem (Section 3) one dimension up: the side operator is the
 stiffness of continuous Q_k (hexahedra) or P_k (tetrahedra) with the Γ dofs last and its Γ
 Schur complement (:func:`~infsup_contact.models.schur.factorized_side`; the nested-dissection
 ordering is graph based, so it serves 3D meshes as it is). Γ is the face
-:class:`~infsup_contact.discretization.square.Square`: the traces are tensor grids, the
-multiplier spaces tensor products (:mod:`infsup_contact.discretization.face_spaces`) on
+:class:`~infsup_contact.discretization.face.square.Square`: the traces are tensor grids, the
+multiplier spaces tensor products (:mod:`infsup_contact.discretization.face.spaces.tensor`) on
 hexahedra and P_s on the triangles of G_h on tetrahedra
-(:mod:`infsup_contact.discretization.face_triangles`).
+(:mod:`infsup_contact.discretization.face.spaces.triangles`).
 
 Meshes (:func:`subdomain_mesh`, the model's ``mesh`` builder): the structured family,
 N × N × N cells of each body (N = cells per direction on Γ) from
 ``ngsolve.meshes.MakeStructured3DMesh``: ``element="hex"`` gives hexahedra,
 ``element="tet"`` the six-tetrahedra (Kuhn) split of every cube, whose faces on Γ are the
 rectangles cut by the diagonal from (x_i, y_j) to (x_{i+1}, y_{j+1}) — on both bodies, so the
-trace is a tensor grid of triangles (:data:`~infsup_contact.discretization.square.SQUARE_TRIG`).
+trace is a tensor grid of triangles (:data:`~infsup_contact.discretization.face.square.SQUARE_TRIG`).
 The ``unstructured`` family (Netgen tetrahedra, maxh = 1/N, each body meshed on its own) and
 the ``perturbed`` one (structured, vertices moved; on hexahedra only off Γ and in z, so the
-face stays a tensor grid) are built in :mod:`infsup_contact.discretization.meshes3d`; their
+face stays a tensor grid) are built in :mod:`infsup_contact.discretization.face.meshes`; their
 tetrahedral faces are general triangulations, Γ
-:data:`~infsup_contact.discretization.triangulated_square.TRIANGULATED` (non-matching traces,
+:data:`~infsup_contact.discretization.face.triangulated_square.TRIANGULATED` (non-matching traces,
 common refinement by polygon clipping).
 
 Boundaries: ``gamma`` (Γ), ``dir`` (the far face: z = 0 of Ω1, z = 2 of Ω2) and ``side`` (the
@@ -39,10 +39,10 @@ import numpy as np
 import ngsolve
 from ngsolve import meshes as ngmeshes
 
-from ..discretization.meshes import DIRICHLET
-from ..discretization import meshes3d
-from ..discretization.square import SQUARE, SQUARE_TRIG
-from ..discretization.triangulated_square import TRIANGULATED
+from ..discretization.segment.meshes import DIRICHLET
+from ..discretization.face import meshes as meshes3d
+from ..discretization.face.square import SQUARE, SQUARE_TRIG
+from ..discretization.face.triangulated_square import TRIANGULATED
 from ..errors import InputError, check_prestress
 from dataclasses import dataclass
 
@@ -69,7 +69,7 @@ def subdomain_mesh(family: str, n: int, side: int, *, element: str = "hex", widt
     """The mesh of Ω_side of a family: Γ named ``gamma``, the far face :data:`FAR`, the
     lateral faces :data:`LATERAL`. ``structured``: N × N × N cells; ``unstructured`` (tetrahedra,
     maxh = 1/N) and ``perturbed`` (the structured mesh, vertices moved by U(−αh, αh) per free
-    direction, seeded; on hexahedra off Γ and in z only): :mod:`~infsup_contact.discretization.meshes3d`.
+    direction, seeded; on hexahedra off Γ and in z only): :mod:`~infsup_contact.discretization.face.meshes`.
     A tetrahedral mesh of those two families carries ``face_interface`` = the general
     triangulated face (:func:`face_of`).
 

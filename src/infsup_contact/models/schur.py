@@ -32,7 +32,7 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from ..discretization.interface import GammaTrace
+from ..discretization.gamma.trace import GammaTrace
 from ..errors import InputError
 from ..la.threaded import symmetric_part, symmetric_sandwich
 from . import pardiso

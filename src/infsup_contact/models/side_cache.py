@@ -2,7 +2,7 @@
 
 A side operator (:mod:`infsup_contact.models.contract`) depends on its own mesh and k only,
 and the mesh of Ω_i is addressed by (family, N_i, side, mesh parameters), never by the other
-side's N (:func:`~infsup_contact.discretization.meshes.subdomain_mesh`). So the pairs
+side's N (:func:`~infsup_contact.discretization.segment.meshes.subdomain_mesh`). So the pairs
 (16, 16), (17, 16) and (24, 16) of one sweep share the operator of Ω2: of the 64 sides of
 the β_h study's 32 pairs, 34 are distinct.
 
@@ -16,7 +16,7 @@ from __future__ import annotations
 
 from collections import Counter
 
-from ..discretization import meshes
+from ..discretization.segment import meshes
 
 
 def side_keys(model, family: str, k: int, n1: int, n2: int, **mesh_kwargs) -> list:

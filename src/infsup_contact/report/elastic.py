@@ -31,7 +31,7 @@ def elastic_macros(beta, sweep, patch, hertz, claims, speed, nu_slope_cases=None
     against log(1 − 2ν) gets a macro (config key figures.nu_slope_cases; None: every case of
     the sweep without a kernel). The patch errors are those of the spaces whose M_h contains the
     constants (``SpaceSpec.contains_constants``, registry): the others fail by design."""
-    from ..discretization.registry import SPACES
+    from ..discretization.spaces.registry import SPACES
 
     out = []
     checked = claims[claims.predicted.isin(["PASS", "FAIL"])]

@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from ..discretization.registry import SPACES
+from ..discretization.spaces.registry import SPACES
 from .texformat import PaperTexError, case_order, fmt_fixed, fmt_int, latex_id
 
 KINDS = ("kernel", "bounded", "nu", "patch")

@@ -177,7 +177,7 @@ def series_macros(claims: pd.DataFrame) -> list[Macro]:
     (``nSeries{Claims,Pass,Fail,Inconclusive}``), the paper's stable spaces T3, T4, T5
     (``nSeriesStable…``) and its unstable ones R5.2, R5.4 (``nSeriesUnstable…``): the groups
     are the registry's paper cases split by ``SpaceSpec.stable``, in the paper's order."""
-    from ..discretization.registry import PAPER_CASES, SPACES
+    from ..discretization.spaces.registry import PAPER_CASES, SPACES
     from ..study.claims import nonmatching_claims
 
     nm = nonmatching_claims(_claims_checked(claims))
@@ -288,7 +288,7 @@ def config_macros(cfg: dict) -> list[Macro]:
     if "alpha" in ic:
         out.append(Macro("cfgPerturbAlpha", f"{float(ic['alpha']):g}", "config: infsup.alpha"))
     if "seed" in ic:
-        from ..discretization.series import seeds
+        from ..discretization.gamma.mesh_series import seeds
         out.append(Macro("cfgNSeeds", fmt_int(len(seeds(ic))), "config: infsup.seed (number of seeds)"))
     return out
 

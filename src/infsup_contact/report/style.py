@@ -25,11 +25,16 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from ..discretization.registry import OKABE_ITO as _OKABE_ITO  # noqa: E402
-from ..discretization.registry import SPACES, space_spec  # noqa: E402
+from ..discretization.spaces.registry import SPACES, space_spec  # noqa: E402
+from .case_styles import CASE_STYLES, NEUTRAL, OKABE_ITO, WIDE_MARKERS  # noqa: E402
 
-#: Okabe & Ito (2008), "Color Universal Design" (the registry's palette).
-OKABE_ITO = MappingProxyType(_OKABE_ITO)
+
+def _color(spec) -> str:
+    return OKABE_ITO[CASE_STYLES[spec.id][0]] if spec.id in CASE_STYLES else NEUTRAL
+
+
+def _marker(spec) -> str:
+    return CASE_STYLES[spec.id][1] if spec.id in CASE_STYLES else "8"
 
 
 class _RegistryView(Mapping):
@@ -52,16 +57,13 @@ class _RegistryView(Mapping):
 
 
 #: case → colour; THE map every figure uses (read-only, from the registry).
-CASE_COLORS = _RegistryView(lambda s: s.color)
+CASE_COLORS = _RegistryView(_color)
 #: case → marker.
-CASE_MARKERS = _RegistryView(lambda s: s.marker)
+CASE_MARKERS = _RegistryView(_marker)
 #: paper reference of each case (legend text).
 CASE_REFS = _RegistryView(lambda s: s.paper_ref)
 #: displacement degree → marker fill style.
 K_FILL = MappingProxyType({1: "none", 2: "full", 3: "left", 4: "top"})
-#: colour for things that are not a case (references, Pareto front, meshes).
-NEUTRAL = "#4d4d4d"
-
 #: axis labels used by every figure.
 LABELS = MappingProxyType({
     "h": r"mesh size $h = 1/N_2$",

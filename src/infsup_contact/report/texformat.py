@@ -12,7 +12,7 @@ import re
 import numpy as np
 import pandas as pd
 
-from ..discretization.registry import space_ids
+from ..discretization.spaces.registry import space_ids
 
 VERDICTS = ("PASS", "FAIL", "INCONCLUSIVE")
 MEASURES = {"energy_error": "Energy", "l2_error": "Ltwo", "lambda_l2_error": "LambdaLtwo",

@@ -22,9 +22,10 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from ..discretization import meshes, multipliers, registry
+from ..discretization.segment import meshes, multipliers
+from ..discretization.spaces import registry
 from .pdas import PdasResult, solve_pdas
-from ..discretization.coupling import coupling_matrix
+from ..discretization.gamma.coupling import coupling_matrix
 from ..models import DEFAULT_MODEL
 from ..models.contract import B_SIGN
 from ..models.schur import interface_operator
@@ -36,7 +37,7 @@ class ContactSolution:
 
     Attributes
     ----------
-    space : MultiplierSpace
+    space : SegmentSpace
         M_h; ``lam`` are its dof values (nodal, so the cone is lam >= 0).
     sides : list of SideOperator
     u : list of ngsolve.GridFunction
@@ -55,7 +56,7 @@ class ContactSolution:
         seconds.
     """
 
-    space: multipliers.MultiplierSpace
+    space: multipliers.SegmentSpace
     sides: list
     u: list
     lam: np.ndarray
@@ -71,7 +72,7 @@ class ContactSolution:
 
     @property
     def gamma(self):
-        """Γ, the interface of the sides (:mod:`infsup_contact.discretization.interface`)."""
+        """Γ, the interface of the sides (:mod:`infsup_contact.discretization.gamma.interface`)."""
         return self.sides[0].trace.gamma
 
     def pressure(self, x: np.ndarray) -> np.ndarray:

@@ -5,7 +5,7 @@ generalized symmetric eigenproblem (B A⁻¹ Bᵀ) m = β² G m on the multiplie
 with B A⁻¹ Bᵀ the interface operator (:mod:`infsup_contact.models.schur`) and G the Gram
 matrix of the multiplier norm. Partitions, spaces and Gram matrices come from Γ, the
 interface the sides' traces live on (``trace.gamma``,
-:mod:`infsup_contact.discretization.interface`).
+:mod:`infsup_contact.discretization.gamma.interface`).
 """
 from __future__ import annotations
 
@@ -19,16 +19,18 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from scipy.linalg import lapack
 
-from ..discretization import meshes, multipliers, registry
-from ..discretization.coupling import coupling_matrix, trace_l2_norms
+from ..discretization.segment import meshes, multipliers
+from ..discretization.spaces import registry
+from ..discretization.spaces.spec import SpaceSpec
+from ..discretization.gamma.coupling import coupling_matrix, trace_l2_norms
 from ..errors import InputError, check_prestress
 from . import bottom, reflection
 from ..models.schur import combine_terms, interface_terms
 from ..models import DEFAULT_MODEL
 from ..models.side_cache import SideCache
-from ..discretization.interface import check_choice
-from ..discretization.segment import SEGMENT
-from ..discretization.norms import NORMS
+from ..discretization.gamma.interface import check_choice
+from ..discretization.segment.interface import SEGMENT
+from ..discretization.segment.norms import NORMS
 from .kernel import (GAP_DECADES, KERNEL_CRITERION, KernelDecision, bottom_kernel, coupling_kernel,  # noqa: F401
                      gap_over_roundoff, kernel_check, kernel_from_gap, scaled_couplings)
 
@@ -205,12 +207,12 @@ def check_inputs(case, k, family, n1, n2, c1, c2, norm, multiplier_mesh) -> None
 
 def _space(case, k, partition, gamma=SEGMENT):
     """A named case on G_h = ``partition`` of ``gamma``, an unregistered
-    :class:`~infsup_contact.discretization.registry.SpaceSpec` (a study's variant, e.g. the α
+    :class:`~infsup_contact.discretization.spaces.spec.SpaceSpec` (a study's variant, e.g. the α
     sweep of study/face_alpha.py), or a general triple ``(label, s, continuous, vanish)``
     (eqs. 5.3, 5.5; spaces of the segment)."""
     if isinstance(case, str):
         return registry.case_space(case, k, partition, gamma)
-    if isinstance(case, registry.SpaceSpec):
+    if isinstance(case, SpaceSpec):
         return gamma.space(case, k, partition)
     _, s, continuous, vanish = case
     return multipliers.make_space(partition, s, continuous, vanish)

@@ -3,7 +3,7 @@
 On a face mesh pair symmetric about the centre of Γ = (0, 1)² (the structured hexahedra, any
 N1, N2), the point reflection R(x, y) = (1 − x, 1 − y) maps the multiplier basis onto itself,
 μ_j ∘ R = μ_π(j) with π an involution (:func:`reflection_split`, found and checked on Gauss
-points of G_h, :func:`~infsup_contact.discretization.basis_symmetry.induced_permutation`), and
+points of G_h, :func:`~infsup_contact.discretization.gamma.symmetry.induced_permutation`), and
 the interface operator S = Σ_i B_i X_i B_iᵀ and every Gram matrix G commute with the
 permutation: P S Pᵀ = S, P G Pᵀ = G. In the orthonormal basis Q = [Q_e, Q_o] of the even and
 odd functions ((e_j ± e_π(j))/√2 for the pairs j < π(j), e_j for the fixed points in Q_e)
@@ -37,7 +37,7 @@ import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
 
-from ..discretization.basis_symmetry import axis_reflections, induced_permutation, isotypic_bases, reflect
+from ..discretization.gamma.symmetry import axis_reflections, induced_permutation, isotypic_bases, reflect
 from ..la.threaded import sparse_times_dense, symmetric_part, times_transpose
 from . import bottom
 from .kernel import BLOCK_EXTRA, KernelDecision, certified_bottom, certify_floor, decide, error_level
@@ -66,7 +66,7 @@ class ReflectionSplit:
     @cached_property
     def bases(self) -> tuple:
         """(Q_0, ..., Q_{2^g − 1}), sparse with orthonormal columns
-        (:func:`~infsup_contact.discretization.basis_symmetry.isotypic_bases`)."""
+        (:func:`~infsup_contact.discretization.gamma.symmetry.isotypic_bases`)."""
         return isotypic_bases(self.pis)
 
     @property

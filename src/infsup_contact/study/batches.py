@@ -1,14 +1,14 @@
 """The β_h jobs of the workflow: a cost model of one mesh pair and the batches it cuts.
 
 The series themselves (which pairs a claim is decided on) are
-:mod:`infsup_contact.discretization.series`; this module only decides how the workflow
+:mod:`infsup_contact.discretization.gamma.mesh_series`; this module only decides how the workflow
 groups those pairs into processes. Pure Python (the workflow imports it while building the DAG).
 """
 from __future__ import annotations
 
 import math
 
-from ..discretization.series import seeds, series_of_pairs
+from ..discretization.gamma.mesh_series import seeds, series_of_pairs
 
 
 def pair_cost(family: str, k: int, n1: int, n2: int) -> float:

@@ -32,7 +32,7 @@ import numpy as np
 import pandas as pd
 from scipy import stats
 
-from ..discretization.registry import PAPER_CASES, SIGN_CHECK_SPACE, SPACES
+from ..discretization.spaces.registry import PAPER_CASES, SIGN_CHECK_SPACE, SPACES
 from ..solvers.kernel import CLOSE
 
 PASS, FAIL, INCONCLUSIVE = "PASS", "FAIL", "INCONCLUSIVE"
@@ -278,7 +278,7 @@ def worst_case_claims(beta: pd.DataFrame) -> list:
     and mesh family. The paper's own claim is the structured fixed-ratio series (where Ω1's
     trace pattern repeats); the families N1 = N2 + 1 and N1 = round(√2 N2), the perturbed and
     unstructured meshes and a coarser Ω1 are findings."""
-    from ..discretization.series import describe
+    from ..discretization.gamma.mesh_series import describe
 
     rows = []
     nm = beta[beta.N1 != beta.N2]
@@ -319,7 +319,7 @@ MM_TEXT = {"omega2": "G_h = trace of Ω2", "omega1": "G_h = trace of Ω1",
 def nonmatching_series(beta: pd.DataFrame) -> list:
     """The non-matching series of a β table (column ``series``; without it, pairs grouped by
     their reduced ratio as ``ratio3-2``), in order of appearance."""
-    from ..discretization.series import ratio_series
+    from ..discretization.gamma.mesh_series import ratio_series
 
     nm = beta[beta.N1 != beta.N2]
     if "series" not in nm.columns:
@@ -330,11 +330,11 @@ def nonmatching_series(beta: pd.DataFrame) -> list:
 def findings(beta: pd.DataFrame, cfg: dict) -> list:
     """What the paper does not say but the tables show: on every non-matching series
     (a fixed ratio such as 3:2, or a family N1 = N2 + 1, N1 = round(√2 N2):
-    :mod:`infsup_contact.discretization.series`), for every mesh family, multiplier mesh,
+    :mod:`infsup_contact.discretization.gamma.mesh_series`), for every mesh family, multiplier mesh,
     case and k, "β_h bounded away from 0" by :func:`bounded_claim` over the series' finest
     meshes (every seed). One claim per series: a statement that holds on one series and not
     on another shows as two rows with different verdicts."""
-    from ..discretization.series import describe, ratio_series
+    from ..discretization.gamma.mesh_series import describe, ratio_series
 
     tol, floor, conf, win = cfg["slope_tolerance"], cfg["beta_floor"], cfg["confidence"], cfg["fit_window"]
     rows = []

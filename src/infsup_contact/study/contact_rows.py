@@ -4,7 +4,7 @@ from __future__ import annotations
 from . import accuracy
 from ..solvers.contact import ContactSolution, contact_pair, solve_contact, solve_contact_on
 from ..errors import InputError, check_prestress
-from ..discretization.registry import REFERENCE_SPACE, check_case, space_spec
+from ..discretization.spaces.registry import REFERENCE_SPACE, check_case, space_spec
 from .scenes import scene as make_scene
 
 def cone_kind(case: str, k: int) -> str:
@@ -36,12 +36,12 @@ def save_reference(path, ref: ContactSolution) -> None:
 
     import numpy as np
 
-    from ..discretization.multipliers import MultiplierSpace
+    from ..discretization.segment.multipliers import SegmentSpace
     from ..io import write_bytes_atomic
     from .accuracy import reference_quadrature
 
-    if type(ref.space) is not MultiplierSpace:
-        raise InputError("reference", "a reference whose M_h is a plain MultiplierSpace", got=type(ref.space).__name__)
+    if type(ref.space) is not SegmentSpace:
+        raise InputError("reference", "a reference whose M_h is a plain SegmentSpace", got=type(ref.space).__name__)
     arrays = {"format": np.array(REFERENCE_FORMAT), "lam": np.asarray(ref.lam, float),
               "c": np.asarray(ref.c, float)}
     for name in _SPACE_FIELDS:
@@ -71,7 +71,7 @@ def load_reference(path):
 
     import numpy as np
 
-    from ..discretization.multipliers import MultiplierSpace
+    from ..discretization.segment.multipliers import SegmentSpace
     from .accuracy import with_reference_quadrature
 
     allowed = f"a reference written by save_reference ({REFERENCE_FORMAT!r}: an .npz of plain arrays, no pickle)"
@@ -110,7 +110,7 @@ def load_reference(path):
     if (len(bp) < 2 or dofs.shape != (len(bp) - 1, degree + 1) or len(lam) != dim or dofs.max() >= dim
             or len(c) != 2 or (coeff is not None and coeff.shape != (len(bp) - 1, degree + 1, degree + 1))):
         raise bad("entries of inconsistent shapes")
-    space = MultiplierSpace(bp.astype(float), degree, bool(get("space_continuous", 0, "b")),
+    space = SegmentSpace(bp.astype(float), degree, bool(get("space_continuous", 0, "b")),
                             bool(get("space_vanish_at_ends", 0, "b")), dofs.astype(int), dim, coeff)
     quadrature = []
     for side in range(2):

@@ -7,7 +7,7 @@ on the uniform N2 × N2 × N2 grid, L = (N − 1 + θ)/N, so Ω2 covers the last
 cells by the fraction θ ∈ (0, 1]. Γ = (0, L) × (0, 1) × {1}. Ω1's whole top face is natural
 (u1 is free on the uncovered strip too), so its Γ-side dofs are all interior nodes of its face
 (those beyond L give zero couplings). The multipliers are a registered face space on Ω1's face
-(multiplier mesh ``omega1``) restricted to Γ (:class:`~infsup_contact.discretization.clipped_face.ClippedFace`:
+(multiplier mesh ``omega1``) restricted to Γ (:class:`~infsup_contact.discretization.face.spaces.clipped.ClippedFace`:
 functions whose support misses Γ dropped, those of the partially covered column kept, cut).
 The norms are L²(Γ) and the exact H^{1/2}_00(Γ)' of the rectangle.
 
@@ -63,13 +63,15 @@ from functools import lru_cache
 
 import numpy as np
 
-from ..discretization import registry
-from ..discretization.clipped_face import SLIVER_MIN, ClippedFace, edge_cases, min_covered_fraction
-from ..discretization.face_spaces import FaceSpace
-from ..discretization.multipliers import MultiplierSpace, make_space
-from ..discretization.norms import gram_l2
-from ..discretization.quadrature import gauss_legendre_01
-from ..discretization.square import SQUARE, Square, TensorPartition
+from ..discretization.spaces import registry
+from ..discretization.face.spaces.clipped import SLIVER_MIN, ClippedFace, min_covered_fraction
+from ..discretization.spaces.registry import edge_cases
+from ..discretization.face.spaces.tensor import FaceSpace
+from ..discretization.segment.multipliers import SegmentSpace, make_space
+from ..discretization.segment.norms import gram_l2
+from ..discretization.gamma.quadrature import gauss_legendre_01
+from ..discretization.face.square import SQUARE, Square
+from ..discretization.face.tensor_grid import TensorPartition
 from ..errors import InputError
 from ..models import model_of_dim
 from ..models.schur import combine_terms, interface_terms
@@ -86,7 +88,7 @@ def theta_allowed(n: int) -> str:
 
 
 def check_theta(theta, n: int) -> float:
-    """θ as a float in [:func:`~infsup_contact.discretization.clipped_face.min_covered_fraction`, 1];
+    """θ as a float in [:func:`~infsup_contact.discretization.face.spaces.clipped.min_covered_fraction`, 1];
     :class:`InputError` naming ``theta`` and the range otherwise (never θ silently taken as 0)."""
     try:
         t = float(theta)
@@ -111,13 +113,13 @@ def _merged(*grids, upper: float = 1.0) -> np.ndarray:
     return g[np.concatenate([[True], np.diff(g) > 1e-13])]
 
 
-def primal_twin(space: MultiplierSpace) -> MultiplierSpace:
+def primal_twin(space: SegmentSpace) -> SegmentSpace:
     """The Lagrange basis with the numbering of ``space`` (the N_j of κ_j)."""
-    return MultiplierSpace(space.breakpoints, space.degree, space.continuous, space.vanish_at_ends,
+    return SegmentSpace(space.breakpoints, space.degree, space.continuous, space.vanish_at_ends,
                            space.dofs, space.dim)
 
 
-def kappa_1d(space: MultiplierSpace, L: float) -> np.ndarray:
+def kappa_1d(space: SegmentSpace, L: float) -> np.ndarray:
     """κ_j = ∫_0^L |N_j| / ∫_0^1 |N_j| of the primal twin of the x factor (module docstring)."""
     twin = primal_twin(space)
     grid = _merged(space.breakpoints, [L])
@@ -131,7 +133,7 @@ def couplings(face: ClippedFace, partition: TensorPartition, values, degree: int
     """∫_Γ μ_j φ_d of the clipped face multipliers μ_j against functions φ_d given by
     ``values`` (points (n, 2) ↦ (n, dim)), piecewise polynomial of degree ≤ ``degree`` − s on the
     rectangles of ``partition`` (a side's trace): the tensor Gauss rule of
-    :meth:`Square.quadrature <infsup_contact.discretization.square.Square.quadrature>` per
+    :meth:`Square.quadrature <infsup_contact.discretization.face.square.Square.quadrature>` per
     rectangle of the common refinement of ``partition`` and G_h, clipped at x = L (exact)."""
     L = face.L
     xs = _merged(partition.xs, np.asarray(face.space.sx.breakpoints) * L, upper=L)
@@ -213,7 +215,7 @@ def nodal_twin(full, L: float):
         return None
     cut = ClippedFace.of(full, L)
     sx = cut.space.sx
-    x = MultiplierSpace(sx.breakpoints, sx.degree, sx.continuous, False, sx.dofs, sx.dim)
+    x = SegmentSpace(sx.breakpoints, sx.degree, sx.continuous, False, sx.dofs, sx.dim)
     return ClippedFace.of(FaceSpace(x, full.sy, cut.space.breakpoints), L, cut=False)
 
 
@@ -224,7 +226,7 @@ def beta_on(face: ClippedFace, base, operator, norms, h_rtol: float, cut: bool, 
     :meth:`ClippedFace.of`), rebuilt x-normalized for the H series so that its relative error
     is per function, not relative to the largest one. ``operator``: ClippedFace ↦ its interface
     operator S (:func:`interface_operator` of :func:`side_pair`). ``h_cap``: the largest n_max of
-    the H series (default that of :func:`~infsup_contact.discretization.face_norms.gram_h_face`).
+    the H series (default that of :func:`~infsup_contact.discretization.face.norms.tensor.gram_h_face`).
 
     ``beta_<norm>_resolved``: β² above the pencil's round-off level
     100 · dim · ε · ‖S‖ ‖G⁻¹‖ (normalized basis); below it the digits are noise."""

@@ -18,7 +18,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from ..discretization import registry
+from ..discretization.spaces import registry
 from ..models import DEFAULT_MODEL, model_taking
 from ..models.plane_strain import lame
 from .beta_batches import beta_batch_rows

@@ -29,7 +29,7 @@ from __future__ import annotations
 
 import pandas as pd
 
-from ..discretization.registry import SPACES
+from ..discretization.spaces.registry import SPACES
 from .claims import (FAIL, INCONCLUSIVE, PASS, bounded_claim, close_decisions, close_text, finest, kernel_claim,
                      predicted_kernel, row, slope_verdict)
 

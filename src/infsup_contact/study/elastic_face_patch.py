@@ -7,7 +7,7 @@ frictionless contact on Γ with b(v, μ) = ∫_Γ (v_{2,z} − v_{1,z}) μ
 uniaxial compression:
 
 * far faces (``dir``): u_z = 0 on z = 0 of Ω1, u_z = −δ on z = 2 of Ω2, u_x, u_y free;
-* the lateral faces x = 0 and y = 0 (symmetry planes, :data:`~infsup_contact.discretization.meshes.SYMMETRY_X`,
+* the lateral faces x = 0 and y = 0 (symmetry planes, :data:`~infsup_contact.discretization.segment.meshes.SYMMETRY_X`,
   ``SYMMETRY_Y``): u_x = 0 and u_y = 0 respectively, the other components free;
 * the lateral faces x = 1 and y = 1: traction free.
 
@@ -32,7 +32,7 @@ Q_k / P_k, k ≥ 1) and its z traces coincide (B(u_2 − u_1) = 0). If 1 ∈ M_h
 the discrete system exactly — B_iᵀ(p 1) are the consistent nodal forces of the uniform
 traction and A_i u_i = F_i ∓ B_iᵀ(p 1) by Green's formula — so λ_h = p and u_h = u to
 round-off on non-matching faces iff 1 ∈ M_h, computed on the space the solve uses
-(:func:`~infsup_contact.discretization.constants.spans_constants`); T3 (vanishing on ∂Γ)
+(:func:`~infsup_contact.discretization.gamma.constants.spans_constants`); T3 (vanishing on ∂Γ)
 fails. The z traces do not vanish on ∂Γ (u_z is free on the lateral faces), as in the
 membranes' face patch test (:mod:`.face_patch`), whose solve and measures this scene shares
 (:func:`~.face_patch.solve_face_patch` with this scene's data).
@@ -58,8 +58,8 @@ from dataclasses import dataclass
 import ngsolve
 import numpy as np
 
-from ..discretization import registry
-from ..discretization.meshes import DIRICHLET, SYMMETRY_X, SYMMETRY_Y
+from ..discretization.spaces import registry
+from ..discretization.segment.meshes import DIRICHLET, SYMMETRY_X, SYMMETRY_Y
 from ..errors import InputError
 from ..models import make_model
 from ..models.plane_strain import check_modulus, check_nu

@@ -1,20 +1,20 @@
-"""The α sweep of the transformed dual bases on the face (issue 28): β_h against α.
+"""The α sweep of the transformed dual bases on the face: β_h against α.
 
 Popp, Gitterle, Gee, Wall (Int. J. Numer. Meth. Engng 83 (2010) 1428–1465) and 4C transform a
-quadratic face element's basis, Ñ = T(α) N (:func:`~infsup_contact.discretization.face_dual.transformation`),
+quadratic face element's basis, Ñ = T(α) N (:func:`~infsup_contact.discretization.face.spaces.dual_bases.transformation`),
 so that the weights ∫Ñ_k are all positive and the dual basis ψ̃ = Ã Ñ exists; 4C fixes α = 1/5.
 For QUAD8 the corner weight is ∫Ñ_corner = (8α − 1)/3 (reference area 4): the dual basis exists
 for α > 1/8 only. This module measures, for each α, the smallest weight, cond₂(Ã) and β_h
 (H^{1/2}_00(Γ)' norm, :func:`~infsup_contact.solvers.infsup.beta_rows_all`) of the transformed
-dual space (∂Γ dofs dropped, constants kept, :class:`~infsup_contact.discretization.face_cells.CellwiseFaceSpace`)
+dual space (∂Γ dofs dropped, constants kept, :class:`~infsup_contact.discretization.face.spaces.cellwise.CellwiseFaceSpace`)
 with Q2 displacements (k = 2, hexahedra) on matching N × N meshes. An α with a weight ≤ 0 is
 refused, as the registry's DUAL-Q8 is (the row says so; no β): ``accepted`` is the
 construction's own decision (:func:`accepted_by_construction`), ``weights_positive`` and
 ``min_weight`` / ``min_weight_gauss`` the weights by two quadratures, so a table can show
 whether the two agree (the ledger's ``face-alpha-accept`` claims, :mod:`.face_study_claims`).
 
-TRI6 (issue 28, item 3): the same sweep on the triangles of tetrahedral faces (P2 displacements,
-:func:`~infsup_contact.discretization.face_tri6.tri6_space`). Its weights are ∫Ñ_vertex = α/3 and
+TRI6: the same sweep on the triangles of tetrahedral faces (P2 displacements,
+:func:`~infsup_contact.discretization.face.spaces.tri6.tri6_space`). Its weights are ∫Ñ_vertex = α/3 and
 ∫Ñ_edge = (1 − 2α)/6 (fractions 2α/3 and (1 − 2α)/3 of the area 1/2): positive on all of (0, 1/2),
 the plain dual (α = 0) is the only one refused. The mesh element of each reference element is the
 model's element whose face cells have its shape (:func:`element_of`), not a name.
@@ -28,23 +28,23 @@ import sys
 
 import numpy as np
 
-from ..discretization.face_cells import cellwise_builder
-from ..discretization.face_dual import alpha_sweep, transformation
-from ..discretization.face_elements import reference_element
-from ..discretization.face_tri6 import triangle_builder
-from ..discretization.square import TensorPartition
-from ..discretization.registry import SpaceSpec
+from ..discretization.face.spaces.cellwise import cellwise_builder
+from ..discretization.face.spaces.dual_bases import alpha_sweep, transformation
+from ..discretization.face.spaces.reference_elements import reference_element
+from ..discretization.face.spaces.tri6 import triangle_builder
+from ..discretization.face.tensor_grid import TensorPartition
+from ..discretization.spaces.spec import SpaceSpec
 from ..errors import InputError
 
 ALPHAS = (0.05, 0.1, 0.125, 0.15, 0.2, 0.25, 0.3, 1.0 / 3.0, 0.4, 0.45)
-"""The sweep of issue 28 (0.125: the QUAD8 corner weight is exactly 0; 0.2: 4C's)."""
+"""The sweep (0.125: the QUAD8 corner weight is exactly 0; 0.2: 4C's)."""
 ELEMENTS = ("QUAD8", "QUAD9")
 TRI_ALPHAS = (0.05, 0.1, 0.15, 0.2, 0.25, 0.3, 1.0 / 3.0, 0.4, 0.45)
-"""The TRI6 sweep of issue 28 (no α in (0, 1/2) makes a TRI6 weight vanish)."""
+"""The TRI6 sweep (no α in (0, 1/2) makes a TRI6 weight vanish)."""
 SWEEP_ELEMENTS = ("QUAD8", "QUAD9", "TRI6")
 FACE_CELL = {"quad": "quad", "tri": "trig"}
 """Reference cell of an element (:attr:`~.face_elements.ReferenceElement.cell`) → face cell shape
-(:data:`~infsup_contact.discretization.square.CELL_SHAPES`)."""
+(:data:`~infsup_contact.discretization.face.square.CELL_SHAPES`)."""
 
 
 def transformed_dual_spec(element: str, alpha: float) -> SpaceSpec:
@@ -54,7 +54,7 @@ def transformed_dual_spec(element: str, alpha: float) -> SpaceSpec:
     build = (cellwise_builder(element, "transformed_dual", True, alpha) if cell == "quad"
              else triangle_builder("transformed_dual", alpha))
     return SpaceSpec(f"TDUAL-{element}-a{alpha:.4g}", "Popp et al. 2010", f"transformed dual {element}, α = {alpha:.4g}",
-                     lambda k, x: None, lambda k: 2, min_k=2, gamma_dims=(2,), face_build=build, face_cells=(cell,))
+                     None, lambda k: 2, min_k=2, gamma_dims=(2,), face_build=build, face_cells=(cell,))
 
 
 def element_of(model: str, reference: str) -> str:
@@ -77,7 +77,7 @@ def gauss_min_weight(element: str, alpha: float) -> float:
     summed against a Gauss–Legendre product rule (5 × 5 points) of the reference cell — the
     square [−1, 1]², or the unit triangle collapsed from the unit square (Duffy: x = u,
     y = (1 − u) v, Jacobian 1 − u) — exact for the (bi)quadratic N, not the moments of
-    :func:`~infsup_contact.discretization.face_dual.weights`."""
+    :func:`~infsup_contact.discretization.face.spaces.dual_bases.weights`."""
     el = reference_element(element)
     t, w = np.polynomial.legendre.leggauss(5)
     if el.cell == "quad":

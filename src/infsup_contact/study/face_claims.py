@@ -42,10 +42,11 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from ..discretization.registry import SPACES
+from ..discretization.spaces.registry import SPACES
 from ..errors import InputError
-from ..discretization.face_triangle_kernel import symmetric_kernel_bound
-from ..discretization.square import SQUARE, SQUARE_TRIG, Square, TensorPartition
+from ..discretization.face.kernel_bounds import symmetric_kernel_bound
+from ..discretization.face.square import SQUARE, SQUARE_TRIG, Square
+from ..discretization.face.tensor_grid import TensorPartition
 from .claims import FAIL, INCONCLUSIVE, PASS, bounded_claim, close_decisions, close_text, finest, kernel_claim, row, \
     slope_verdict
 
@@ -92,7 +93,7 @@ def _uniform(n: int) -> TensorPartition:
 
 def checkerboard(spec, k: int, gamma=SQUARE) -> bool:
     """Whether ``gamma`` proves the checkerboard mode of ``spec`` at degree k on matching meshes
-    (:meth:`~infsup_contact.discretization.square.Square.checkerboard_modes`: P_0 multipliers
+    (:meth:`~infsup_contact.discretization.face.square.Square.checkerboard_modes`: P_0 multipliers
     against P_2 traces on the same triangles; independent of N)."""
     modes = getattr(gamma, "checkerboard_modes", None)
     if modes is None or not gamma.builds(spec):
@@ -123,7 +124,7 @@ def triangle_kernel_bound(spec, k: int, n1: int, n2: int, gamma=SQUARE_TRIG) -> 
     """Lower bound of the kernel on Kuhn-triangulated (structured tetrahedral) faces, G_h = the
     trace of Ω2: Σ_c max(dim M_c − dim(W1 + W2)_c, boundary-layer modes in c, 0) over the four
     isotypic components c of the square's symmetries {id, T, R, TR} that preserve the diagonals
-    (:func:`~infsup_contact.discretization.face_triangle_kernel.symmetric_kernel_bound`;
+    (:func:`~infsup_contact.discretization.face.kernel_bounds.symmetric_kernel_bound`;
     docs/tet_kernel.md). It is >= :func:`planar_kernel` (the components' counts sum to the
     global one) and exceeds it where the components' counts differ in sign or the modes of the
     cells along ∂Γ outnumber a component's count: R5.2 at k = 1, 6:7 → 5 (count 3), 7:8 → 4

@@ -32,7 +32,7 @@ def nu_pairs(fe: dict) -> list:
 
 def face_cases(fe: dict, k: int, gamma) -> list:
     """The cases of ``face_elastic.cases`` defined for k and built by the face ``gamma``."""
-    from ..discretization.registry import SPACES, ids_valid_for
+    from ..discretization.spaces.registry import SPACES, ids_valid_for
 
     return [c for c in ids_valid_for(k, fe["cases"]) if gamma.builds(SPACES[c])]
 

@@ -29,7 +29,7 @@ the config — never from a case id and never from the measured tables. The reas
   bounds are C (1 − 2ν)^{1/2}: the slope of log β_H against log(1 − 2ν) tends to 1/2; it is fitted
   (np.polyfit) over ν >= ``nu_sweep.fit_nu_min`` and PASS within ``nu_sweep.slope_tolerance``.
   Predicted PASS where 1 ∈ M_h (:func:`.face_study_claims.face_contains_constants`, computed by
-  :func:`~infsup_contact.discretization.constants.spans_constants` on the built face space) and the
+  :func:`~infsup_contact.discretization.gamma.constants.spans_constants` on the built face space) and the
   kernel count is 0; without the constants only the lower bound holds (slope ≤ 1/2): a finding.
 * **Patch test** (``face-elastic-patch-<tag>-k<k>-<element>``, :mod:`.elastic_face_patch`): the
   uniform compression is reproduced to round-off iff 1 ∈ M_h (spans_constants of the built space)
@@ -41,7 +41,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from ..discretization.registry import SPACES
+from ..discretization.spaces.registry import SPACES
 from .claims import COLUMNS, FAIL, INCONCLUSIVE, PASS, close_decisions, close_text, row
 from .face_claims import matching_kernel
 from .face_study_claims import face_contains_constants, patch_prediction, patch_verdict

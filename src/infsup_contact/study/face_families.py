@@ -1,9 +1,9 @@
 """Kernels on the non-matching families of the face (issue 28, item 1): the √2 pairs in 3D.
 
-The 2D study's families (:mod:`~infsup_contact.discretization.series`) change the overlap pattern
+The 2D study's families (:mod:`~infsup_contact.discretization.gamma.mesh_series`) change the overlap pattern
 of the two traces with N; ``sqrt2`` (round(√2 n)) makes the two grids share no interior line when
 gcd(N1, N2) = 1 (5:7, 7:10), so the common coarsening of the traces is the single cell and
-dim(W1 ∩ W2) = 0 on rectangles (:meth:`~infsup_contact.discretization.square.Square.trace_sum_dimension`).
+dim(W1 ∩ W2) = 0 on rectangles (:meth:`~infsup_contact.discretization.face.square.Square.trace_sum_dimension`).
 On the face Ω2 is the finer side, N2 = round(√2 N1) (:mod:`infsup_contact.config_face`).
 
 For every space, k and element on such a pair this compares three numbers
@@ -32,8 +32,8 @@ import sys
 
 import numpy as np
 
-from ..discretization.registry import SPACES, ids_valid_for
-from ..discretization.series import FAMILY_RULES
+from ..discretization.spaces.registry import SPACES, ids_valid_for
+from ..discretization.gamma.mesh_series import FAMILY_RULES
 from ..errors import InputError
 from .claims import FAIL, PASS
 from .face_claims import element_interfaces, face_predictions, is_tensor, planar_kernel, tensor_kernel_bound
@@ -50,8 +50,8 @@ def coupling_1d(space, n: int, k: int) -> np.ndarray:
     """A[j, l] = ∫_0^1 w_j μ_l with w_j the basis of continuous P_k vanishing at 0 and 1 on n uniform
     intervals (the 1D factor of a Q_k trace vanishing on ∂Γ) and μ_l the basis of the 1D ``space``:
     Gauss–Legendre on the union of both breakpoint sets, exact for the degree k + s products."""
-    from ..discretization.multipliers import make_space
-    from ..discretization.quadrature import gauss_legendre_01
+    from ..discretization.segment.multipliers import make_space
+    from ..discretization.gamma.quadrature import gauss_legendre_01
 
     w = make_space(np.linspace(0.0, 1.0, n + 1), k, True, True)
     cuts = np.union1d(np.linspace(0.0, 1.0, n + 1), np.asarray(space.breakpoints, float))

@@ -27,10 +27,10 @@ and its coefficients λ·(coefficients of 1) are ≥ 0 in the cone of every regi
 (a nodal basis of 1 has coefficients 1; the dual bases are partitions of unity where they
 hold 1). So the test passes — u_h = u and λ_h = λ to round-off, whatever the seams of the
 non-matching traces — iff 1 ∈ M_h, computed on the face space itself
-(:func:`~infsup_contact.discretization.constants.spans_constants`; the registry's
+(:func:`~infsup_contact.discretization.gamma.constants.spans_constants`; the registry's
 ``SpaceSpec.contains_constants(k)`` is the segment's answer and differs for DUAL at k = 1 on
 the six-tetrahedra faces, whose two corner triangles have no vertex off ∂Γ) (the face space
-is the tensor product of the 1D one, :mod:`~infsup_contact.discretization.face_spaces`, and
+is the tensor product of the 1D one, :mod:`~infsup_contact.discretization.face.spaces.tensor`, and
 1 ⊗ 1 = 1). T3 (Q_k vanishing on ∂Γ) fails. A kernel of K (λ_h not unique) leaves u_h unique;
 the PDAS's representative (minimum norm, :mod:`infsup_contact.solvers.pdas`) need not be the
 constant, so a space with a kernel may reproduce u but not λ: ``kernel_dim`` and ``nonunique``
@@ -64,9 +64,9 @@ import ngsolve
 import numpy as np
 import scipy.linalg as sla
 
-from ..discretization.constants import spans_constants
-from ..discretization import registry
-from ..discretization.meshes import DIRICHLET
+from ..discretization.gamma.constants import spans_constants
+from ..discretization.spaces import registry
+from ..discretization.segment.meshes import DIRICHLET
 from ..errors import InputError
 from ..models import make_model
 from ..solvers.contact import contact_pair, solve_contact_on
@@ -153,7 +153,7 @@ def solve_face_patch(case: str, k: int, n1: int, n2: int, c=(1.0, 1.0), delta: f
         ``u_max_rel_error`` = max |u_h − u| / δ at the same number of points per direction of
         every cell of both bodies (:func:`body_points`);
         ``passes`` (both ≤ :data:`PASS_RTOL`); ``predicted`` (1 ∈ M_h, computed on the space
-        the solve uses: :func:`~infsup_contact.discretization.constants.spans_constants`) and
+        the solve uses: :func:`~infsup_contact.discretization.gamma.constants.spans_constants`) and
         ``segment_rule`` (the registry's ``contains_constants(k)``, the segment's answer);
         ``kernel_dim`` of K against the L²(Γ) Gram matrix; PDAS ``nonunique``, iterations.
     """

@@ -13,7 +13,7 @@ properties and the construction of the spaces (never from a case id, never from 
   element's face builds (:func:`face_contains_constants`; the registry's 1D
   ``contains_constants`` is the same on rectangles, but on triangles the boundary-modified TRI3
   dual loses 1 on the corner triangles whose three vertices lie on ∂Γ,
-  :mod:`~infsup_contact.discretization.face_triangles`), and the kernel by the dimension count
+  :mod:`~infsup_contact.discretization.face.spaces.triangles`), and the kernel by the dimension count
   max(dim M − dim(W1 + W2), 0) of the scene's traces, which do not vanish on ∂Γ
   (:func:`natural_kernel_count`). Predicted PASS when 1 ∈ M_h
   and the count is 0 on every pair, FAIL when 1 ∉ M_h, a finding otherwise (a kernel leaves
@@ -38,10 +38,10 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from ..discretization.constants import spans_constants
-from ..discretization.face_dual import weights
-from ..discretization.registry import SPACES
-from ..discretization.square import TensorPartition
+from ..discretization.gamma.constants import spans_constants
+from ..discretization.face.spaces.dual_bases import weights
+from ..discretization.spaces.registry import SPACES
+from ..discretization.face.tensor_grid import TensorPartition
 from .claims import COLUMNS, FAIL, INCONCLUSIVE, PASS, row, slope_verdict
 from .face_claims import face_dimension
 
@@ -69,7 +69,7 @@ def edge_claim_id(kind: str, case: str, k: int, n: int) -> str:
 
 def face_contains_constants(spec, k: int, gamma, n: int = 6) -> bool:
     """Whether 1 ∈ M_h for the space ``gamma`` builds on its uniform n × n partition
-    (:func:`~infsup_contact.discretization.constants.spans_constants` of that space)."""
+    (:func:`~infsup_contact.discretization.gamma.constants.spans_constants` of that space)."""
     x = np.linspace(0.0, 1.0, n + 1)
     return spans_constants(gamma.space(spec, k, TensorPartition(x, x)))
 

@@ -35,7 +35,7 @@ import time
 import ngsolve
 import numpy as np
 
-from ..discretization import registry
+from ..discretization.spaces import registry
 from ..models import make_model
 from ..models.plane_strain import check_modulus, check_nu, lame
 from ..solvers.contact import contact_pair, solve_contact_on
@@ -124,7 +124,7 @@ def hertz_row(case: str, k: int, n1: int, n2: int, R: float, d: float, nu: float
 
 
 def sample_points(sol, per_interval: int = 24) -> np.ndarray:
-    """``per_interval`` + 1 points per interval of G_h (:meth:`~infsup_contact.discretization.interface.Interface.sample`)."""
+    """``per_interval`` + 1 points per interval of G_h (:meth:`~infsup_contact.discretization.gamma.interface.Interface.sample`)."""
     return sol.gamma.sample(sol.space.breakpoints, per_interval)
 
 

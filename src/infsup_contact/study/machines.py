@@ -269,7 +269,7 @@ def sweep_rows() -> pd.DataFrame:
     """β rows of the paper's five cases, k = 1..4, both norms: matching N = 4, 8 (every
     multiplier mesh is the same partition there) and the union partition of the 17:16 pair;
     and :func:`face_sweep_rows`. Column ``model`` tells them apart."""
-    from ..discretization.registry import PAPER_CASES, SPACES
+    from ..discretization.spaces.registry import PAPER_CASES, SPACES
     from ..solvers.infsup import beta_rows
 
     rows = []
@@ -286,7 +286,7 @@ def face_sweep_rows() -> pd.DataFrame:
     complement from MKL PARDISO, so MKL's path reaches the kernel columns (measured, k = 2, 7:8:
     the default, AUTO and COMPATIBLE branches give both sides' S other bits and move β in its
     15th digit, below the 12 the table keeps)."""
-    from ..discretization.registry import PAPER_CASES, SPACES
+    from ..discretization.spaces.registry import PAPER_CASES, SPACES
     from ..models import make_model
     from ..solvers.infsup import beta_rows_all
 
@@ -301,7 +301,7 @@ def face_sweep_rows() -> pd.DataFrame:
 
 def verdict_rows() -> pd.DataFrame:
     """The stability verdict of each case, k and norm over matching N = 4, 8, 16."""
-    from ..discretization.registry import PAPER_CASES, SPACES
+    from ..discretization.spaces.registry import PAPER_CASES, SPACES
     from .verdict import verdict_rows as one
 
     out = []

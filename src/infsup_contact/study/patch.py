@@ -48,7 +48,8 @@ import ngsolve
 import numpy as np
 import scipy.linalg as sla
 
-from ..discretization import meshes, registry
+from ..discretization.segment import meshes
+from ..discretization.spaces import registry
 from ..models import make_model
 from ..models.plane_strain import check_modulus, check_nu
 from ..solvers.contact import contact_pair, solve_contact_on

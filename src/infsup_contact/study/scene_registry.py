@@ -1,5 +1,5 @@
 """The registry of contact scenes, like the registry of spaces
-(:mod:`infsup_contact.discretization.registry`): every scene id with the models it is defined
+(:mod:`infsup_contact.discretization.spaces.registry`): every scene id with the models it is defined
 for, its data, its exact or reference solution, what it measures and the rows of one
 ``infsup-contact contact`` call.
 

@@ -25,8 +25,9 @@ import time
 import numpy as np
 import pandas as pd
 
-from ..discretization import registry
-from ..discretization.norms import NORMS
+from ..discretization.spaces import registry
+from ..discretization.spaces.spec import SpaceSpec
+from ..discretization.segment.norms import NORMS
 from ..errors import InputError
 from ..models import DEFAULT_MODEL
 from ..solvers.infsup import beta_rows
@@ -101,7 +102,7 @@ def verdict_rows(case_or_spec, k: int, family: str, ns, norm: str, *, tol: float
     Parameters
     ----------
     case_or_spec : str or SpaceSpec
-        A registry id (``T3``) or a registered :class:`~infsup_contact.discretization.registry.SpaceSpec`.
+        A registry id (``T3``) or a registered :class:`~infsup_contact.discretization.spaces.spec.SpaceSpec`.
     k : int
         Displacement degree (1..4, at least the space's ``min_k``).
     family : str
@@ -218,8 +219,8 @@ def check_model_case(case: str, k: int, model, family: str = "structured", **mes
     allowed = registry.ids_built_on(k, gamma, g_h)
     if case in allowed:
         return
-    if not getattr(gamma, "builds", lambda s: True)(spec):
-        why = (f"built on {', '.join(spec.face_cells)} face cells only" if hasattr(gamma, "cell")
+    if not gamma.builds(spec):
+        why = (f"built on {', '.join(spec.face_cells)} face cells only" if gamma.cell is not None
                else "not built on a general triangulation of Γ: only Lagrange cases and their duals are")
     else:
         try:
@@ -252,7 +253,7 @@ def check_criterion(tol: float, floor: float, confidence: float) -> None:
 
 
 def _case_id(case_or_spec) -> str:
-    if isinstance(case_or_spec, registry.SpaceSpec):
+    if isinstance(case_or_spec, SpaceSpec):
         if registry.SPACES.get(case_or_spec.id) is not case_or_spec:
             raise ValueError(f"space {case_or_spec.id!r} is not registered (registry.register it first)")
         return case_or_spec.id

@@ -39,8 +39,8 @@ def suite_system(case: str, k: int, n1: int, n2: int, family: str = "structured"
 
 def _suite_parts(case, k, n1, n2, family, multiplier_mesh, model, **mesh_kwargs):
     """(A, B, the multiplier space, Γ, the two side operators) of ``case`` on the pair (N1, N2)."""
-    from ..discretization import registry
-    from ..discretization.coupling import coupling_matrix
+    from ..discretization.spaces import registry
+    from ..discretization.gamma.coupling import coupling_matrix
     from ..models.membranes import MEMBRANES
     from ..models.side_cache import SideCache
 
@@ -63,7 +63,7 @@ def suite_levels(case: str, k: int, ns, offset: int = 0, family: str = "structur
     """(levels, manifest norm, gamma) of ``case`` on N1 = N + offset, N2 = N for N in ``ns``, as
     :func:`write_system` takes them (module docstring: ``norm: H`` with the description where the
     space has one)."""
-    from ..discretization.registry import space_spec
+    from ..discretization.spaces.registry import space_spec
 
     spec, levels, described = space_spec(case), [], norm == "H"
     parts = [_suite_parts(case, k, n + offset, n, family, multiplier_mesh, model, **mesh_kwargs) for n in ns]
@@ -78,7 +78,7 @@ def suite_levels(case: str, k: int, ns, offset: int = 0, family: str = "structur
         levels.append((1.0 / n, A, B[order], np.asarray(G, float)[np.ix_(order, order)], mult,
                        trace_forms(sides, k)))
     if described:
-        face = hasattr(parts[0][2], "factors")
+        face = parts[0][2].factors is not None
         gamma = {"shape": "rectangle", "size": [1.0, 1.0]} if face else {"shape": "segment", "length": 1.0}
         return levels, "H", gamma
     return levels, "given" if norm == "H" else "L2", None
@@ -87,12 +87,12 @@ def suite_levels(case: str, k: int, ns, offset: int = 0, family: str = "structur
 def description(spec, space):
     """(the ``multipliers`` mapping of ``space``, the order of its basis functions as the
     description counts them) or None where it has none (module docstring)."""
-    from ..discretization.face_spaces import FaceSpace
-    from ..discretization.multipliers import MultiplierSpace
+    from ..discretization.face.spaces.tensor import FaceSpace
+    from ..discretization.segment.multipliers import SegmentSpace
 
-    if isinstance(space, MultiplierSpace):
+    if isinstance(space, SegmentSpace):
         return segment_form(spec, space), np.arange(space.dim)
-    if type(space) is FaceSpace and all(isinstance(f, MultiplierSpace) for f in space.factors):
+    if type(space) is FaceSpace and all(isinstance(f, SegmentSpace) for f in space.factors):
         sx, sy = space.factors
         i, j = np.divmod(np.arange(space.dim), sy.dim)  # FaceSpace's row i n_y + j; counted i + n_x j
         return {"x": segment_form(spec, sx), "y": segment_form(spec, sy)}, np.argsort(i + sx.dim * j)
@@ -106,10 +106,10 @@ def trace_forms(sides, k: int):
     block, in the trace's order). On a hexahedral face at k = 1 the bilinear hats, the tensor
     product of the 1D hats (:func:`_face_trace_forms`); None on other faces (NGSolve's Q_k, k ≥ 2,
     and P_k bases are not tensor products of 1D Lagrange shapes)."""
-    from ..discretization.multipliers import reference_nodes
+    from ..discretization.segment.multipliers import reference_nodes
 
     if sides[0].trace.gamma.dim != 1:
-        return _face_trace_forms(sides) if k == 1 and getattr(sides[0].trace.gamma, "cell", "") == "quad" else None
+        return _face_trace_forms(sides) if k == 1 and sides[0].trace.gamma.cell == "quad" else None
     out, offset = [], 0
     for sign, side in zip((-1, 1), sides):
         tr = side.trace
@@ -161,7 +161,7 @@ def segment_form(spec, space) -> dict:
     from .multiplier_basis import _segment
 
     x = [float(v) for v in space.breakpoints]
-    if spec is not None and getattr(spec, "lagrange", None) is not None:
+    if spec is not None and spec.lagrange is not None:
         continuous, vanish = spec.lagrange
         form = {"basis": "dual" if spec.dual else ("lagrange" if continuous else "discontinuous"),
                 "degree": int(space.degree), "breakpoints": x}

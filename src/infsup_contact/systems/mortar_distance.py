@@ -9,7 +9,7 @@ first and +1 for the second, b(v, μ) = ∫_Γ (v2 − v1) μ). The exact coupli
     B_exact[row of ψ_j, column of φ_l] = sign · ∫_Γ ψ_j φ_l,
 
 integrated on the common refinement of the two partitions by the interface's Gauss rule, exact
-for the product's degree (the suite's own coupling, :mod:`~infsup_contact.discretization.coupling`),
+for the product's degree (the suite's own coupling, :mod:`~infsup_contact.discretization.gamma.coupling`),
 times |Γ| for the pull-back. The row reports ‖B − B_exact‖_F / ‖B_exact‖_F (``coupling_distance``):
 round-off for an exact producer; a code that integrates on one side's quadrature only is exact on
 matching meshes and off by the integration error on non-matching ones.
@@ -59,7 +59,7 @@ def _traces(manifest, level, n: int) -> list:
 
 def exact_coupling(described, traces, n: int) -> sp.csr_matrix:
     """B_exact (m × n, rows in B's order) of the described multipliers against ``traces``."""
-    from ..discretization.coupling import weighted_values
+    from ..discretization.gamma.coupling import weighted_values
 
     gamma = _interface(described)
     scale = float(np.prod(described.gamma.size))
@@ -77,8 +77,8 @@ def exact_coupling(described, traces, n: int) -> sp.csr_matrix:
 
 
 def _interface(described):
-    from ..discretization.segment import SEGMENT
-    from ..discretization.square import SQUARE
+    from ..discretization.segment.interface import SEGMENT
+    from ..discretization.face.square import SQUARE
 
     return SEGMENT if described.gamma.shape == "segment" else SQUARE
 

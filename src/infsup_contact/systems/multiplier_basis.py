@@ -4,10 +4,10 @@ A code cannot export the H^{-1/2}_00(Γ) Gram of its multipliers; it can say wha
 multipliers are. With ``norm: H`` the manifest gives Γ (``gamma``: a segment of length L, or a
 rectangle a × b) and per level ``multipliers``: row i of B as a function on Γ. This module
 reads that description (inline mapping or a ``.yaml`` file), builds the space with the suite's
-own constructors (:func:`~infsup_contact.discretization.multipliers.local_basis_space`,
-:func:`~infsup_contact.discretization.multipliers.make_space`,
-:func:`~infsup_contact.discretization.dual.dual_space`, tensor products
-:class:`~infsup_contact.discretization.face_spaces.FaceSpace`) and assembles its Gram by the
+own constructors (:func:`~infsup_contact.discretization.segment.multipliers.local_basis_space`,
+:func:`~infsup_contact.discretization.segment.multipliers.make_space`,
+:func:`~infsup_contact.discretization.segment.dual.dual_space`, tensor products
+:class:`~infsup_contact.discretization.face.spaces.tensor.FaceSpace`) and assembles its Gram by the
 routes ``beta --norm H`` uses (:mod:`.multiplier_gram`).
 
 Segment forms (coordinate t ∈ [0, L] along Γ)::
@@ -148,8 +148,8 @@ def _read_yaml(path: Path):
 
 
 def _face(where, key, value, base, gamma):
-    from ..discretization.face_spaces import FaceSpace
-    from ..discretization.square import TensorPartition
+    from ..discretization.face.spaces.tensor import FaceSpace
+    from ..discretization.face.tensor_grid import TensorPartition
 
     _keys(where, key, value, FACE_KEYS, "a rectangle's multipliers")
     factors = []
@@ -196,9 +196,9 @@ def _keys(where, key, value, allowed, what):
 
 
 def _segment(where, key, value, base, length: float, face: bool):
-    """(MultiplierSpace on the pull-back (0, 1), rows of B in its numbering) of a segment form."""
-    from ..discretization.dual import dual_space
-    from ..discretization.multipliers import local_basis_space, make_space
+    """(SegmentSpace on the pull-back (0, 1), rows of B in its numbering) of a segment form."""
+    from ..discretization.segment.dual import dual_space
+    from ..discretization.segment.multipliers import local_basis_space, make_space
 
     _keys(where, key, value, SEGMENT_KEYS, "a segment form")
     basis = value.get("basis")

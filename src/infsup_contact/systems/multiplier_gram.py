@@ -2,8 +2,8 @@
 
 The space is held on the pull-back of Γ: the unit interval, or the unit square. Its Grams there
 are those ``beta --norm H`` computes (the log kernel on the segment,
-:func:`~infsup_contact.discretization.norms.gram`; the double sine series on the face,
-:func:`~infsup_contact.discretization.face_norms.gram_h_face`), and Γ's size enters as a factor:
+:func:`~infsup_contact.discretization.segment.norms.gram`; the double sine series on the face,
+:func:`~infsup_contact.discretization.face.norms.tensor.gram_h_face`), and Γ's size enters as a factor:
 
 **Segment Γ = (0, L).** The Dirichlet Laplacian of (0, L) has the L²-orthonormal eigenfunctions
 √(2/L) sin(nπx/L), eigenvalues (nπ/L)², so ‖μ‖²_{H^{-1/2}_00(0,L)} = Σ_n μ_n² L/(nπ) with
@@ -47,8 +47,8 @@ holds the Grams, the pencils and the series' arrays: 132 to 197)."""
 
 def gram(described, norm: str) -> tuple:
     """(G, info): the Gram of ``norm`` ∈ {"H", "L2"} in the order of B's rows, scaled to Γ."""
-    from ..discretization.face_norms import gram_h_face, gram_l2_face
-    from ..discretization.segment import SEGMENT
+    from ..discretization.face.norms.tensor import gram_h_face, gram_l2_face
+    from ..discretization.segment.interface import SEGMENT
 
     space, size = described.space, described.gamma.size
     if described.gamma.shape == "segment":

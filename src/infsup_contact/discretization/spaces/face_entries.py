@@ -1,0 +1,56 @@
+"""The registry entries of the quadratic face elements: spaces of QUAD8/QUAD9 cells (hexahedral
+faces, :mod:`..face.spaces.cellwise`) and TRI6 cells (tetrahedral faces, :mod:`..face.spaces.tri6`)
+on G_h. They live on the face only (``gamma_dims=(2,)``, no segment ``build``): the registry
+lists them for a face and refuses them on the segment in one line (``registry.case_space``).
+"""
+from __future__ import annotations
+
+from ..face.spaces.cellwise import cellwise_builder
+from ..face.spaces.reference_elements import reference_element
+from ..face.spaces.tri6 import triangle_builder
+from .spec import SpaceSpec
+
+
+def _face_spec(id, ref, definition, element, basis, dimension, vanish=True, expected="unknown", refuse_with=""):
+    """A space of quadratic face elements on G_h (k ≥ 2), paired with the face cells of the element's
+    reference cell: QUAD8/QUAD9 on rectangles (hexahedra), TRI6 on triangles (tetrahedra, always
+    without the ∂Γ nodes)."""
+    quad = reference_element(element).cell == "quad"
+    build = (cellwise_builder(element, basis, vanish, refuse_with=refuse_with) if quad
+             else triangle_builder(basis, refuse_with=refuse_with))
+    return SpaceSpec(
+        id, ref, definition, None, lambda k: 2, min_k=2, expected=expected,
+        dimension=dimension, nodal_basis=basis in ("standard", "pwlin"),
+        claim_tag=id, gamma_dims=(2,), face_build=build, face_cells=("quad",) if quad else ("trig",))
+
+
+def _interior(n):       # nodes of the QUAD9 (= P2 triangle) lattice inside (0, 1)² on an n × n grid
+    return (2 * n - 1) ** 2
+
+
+_TDUAL_Q8 = "use case TDUAL-Q8 (the transformed dual basis, Popp et al. 2012, α = 1/5)"
+_TDUAL_T6 = "use case TDUAL-T6 (the transformed dual basis, Popp et al. 2012, α = 1/5)"
+
+FACE_SPACES = (
+    _face_spec("DUAL-Q9", "Wohlmuth 2000; Popp, Gitterle, Gee, Wall 2010", "dual basis of QUAD9 on ∂Γ-free nodes, "
+               "constants kept", "QUAD9", "dual", lambda k, n: _interior(n)),
+    _face_spec("DUAL-Q9-ALL", "Wohlmuth 2000 (all nodes)", "dual basis of QUAD9 on all nodes", "QUAD9", "dual",
+               lambda k, n: (2 * n + 1) ** 2, vanish=False, expected="unstable"),
+    _face_spec("DUAL-Q8", "Wohlmuth 2000 (QUAD8)", "dual basis of QUAD8 (refused: corner weights ∫N = −1/3 < 0)",
+               "QUAD8", "dual", lambda k, n: _interior(n) - n * n, refuse_with=_TDUAL_Q8),
+    _face_spec("TDUAL-Q8", "Popp, Gitterle, Gee, Wall 2010; 4C", "transformed dual basis of QUAD8, α = 1/5",
+               "QUAD8", "transformed_dual", lambda k, n: _interior(n) - n * n),
+    _face_spec("TDUAL-Q9", "Popp, Gitterle, Gee, Wall 2010; 4C", "transformed dual basis of QUAD9, α = 1/5",
+               "QUAD9", "transformed_dual", lambda k, n: _interior(n)),
+    _face_spec("PWLIN-Q9", "4C LM_QUAD pwlin (Popp 2009)", "piecewise bilinear on the 4 sub-quads of QUAD9",
+               "QUAD9", "pwlin", lambda k, n: _interior(n)),
+    # TRI6 (P2 traces: k = 2 tetrahedra): dim M_h = (2N − 1)², the interior P2 nodes
+    _face_spec("DUAL-T6", "Wohlmuth 2000 (TRI6)", "dual basis of TRI6 (refused: vertex weights ∫N = 0)", "TRI6", "dual",
+               lambda k, n: _interior(n), refuse_with=_TDUAL_T6),
+    _face_spec("TDUAL-T6", "Popp, Wohlmuth, Gee, Wall 2012; 4C", "transformed dual basis of TRI6, α = 1/5, on "
+               "∂Γ-free nodes, constants kept (= DUAL at k = 2 on tetrahedral faces)", "TRI6", "transformed_dual",
+               lambda k, n: _interior(n)),
+    _face_spec("PWLIN-T6", "4C LM_QUAD pwlin (Popp 2009)", "piecewise linear on the 4 sub-triangles of TRI6, "
+               "vanishing on ∂Γ", "TRI6", "pwlin", lambda k, n: _interior(n)),
+)
+"""The face-only entries, in registration order."""

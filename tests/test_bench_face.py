@@ -102,7 +102,7 @@ def test_the_face_estimate_grows_with_n_across_the_large_route(monkeypatch, k):
     DENSE_MAX_M; memory still grows with N through the switch, time within each route (the
     large route is the faster one at the gate: that is what it is for)."""
     from infsup_contact import resources
-    from infsup_contact.solvers.bottom import DENSE_MAX_M
+    from infsup_contact.la.bottom import DENSE_MAX_M
 
     monkeypatch.setattr(resources, "face_route", lambda: "pardiso")
     ests = [resources.face_beta_estimate(k, n, n) for n in range(4, 80 // k)]

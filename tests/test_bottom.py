@@ -1,5 +1,5 @@
-"""The bottom of the spectrum without dense eigensolvers (solvers/bottom.py, kernel.bottom_kernel,
-infsup.bottom_spectrum): each against the dense route it replaces above DENSE_MAX_M."""
+"""The bottom of the spectrum without dense eigensolvers (la/bottom.py, kernel.bottom_kernel,
+spectra.bottom_spectrum): each against the dense route it replaces above DENSE_MAX_M."""
 from dataclasses import replace
 
 import numpy as np
@@ -7,7 +7,8 @@ import pytest
 import scipy.linalg as sla
 import scipy.sparse as sp
 
-from infsup_contact.solvers import bottom, infsup
+from infsup_contact.la import bottom
+from infsup_contact.solvers import infsup, routes, spectra
 from infsup_contact.solvers.kernel import MARGIN_DECADES, bottom_kernel, coupling_kernel
 
 
@@ -72,11 +73,11 @@ def _pencil(m, d, seed):
 @pytest.mark.parametrize("d", [0, 5])
 def test_bottom_spectrum_equals_the_dense_pencil(d):
     S, G, Z = _pencil(200, d, seed=d)
-    L = infsup.gram_factor(G)
+    L = spectra.gram_factor(G)
     W = np.vstack([S, np.zeros((10, 200))])  # a kernel decision with that kernel
     kernel = coupling_kernel(W, proven=d)
-    dense = infsup.spectrum(S, factor=L, kernel=kernel)
-    it = infsup.bottom_spectrum(S, L, replace(kernel, vectors=Z))
+    dense = spectra.spectrum(S, factor=L, kernel=kernel)
+    it = spectra.bottom_spectrum(S, L, replace(kernel, vectors=Z))
     assert (it.kernel_dim, it.beta == 0.0) == (dense.kernel_dim, d > 0)
     assert it.smallest_nonzero == pytest.approx(dense.smallest_nonzero, rel=1e-9)
     assert it.beta == pytest.approx(dense.beta, rel=1e-9)
@@ -85,7 +86,7 @@ def test_bottom_spectrum_equals_the_dense_pencil(d):
     assert it.gap == pytest.approx(dense.gap, rel=1e-2)
     if d:
         with pytest.raises(ValueError, match="needs its basis"):
-            infsup.bottom_spectrum(S, L, kernel)
+            spectra.bottom_spectrum(S, L, kernel)
 
 
 @pytest.mark.parametrize("case", ["T3", "R5.2", "R5.4", "DUAL-ALL"])
@@ -93,7 +94,7 @@ def test_face_rows_agree_between_routes(case, monkeypatch):
     """β rows of a real face (k = 2, hexahedra, 5:6: modes beyond the proof) by the dense and
     the iterative route."""
     rows = {}
-    monkeypatch.setattr(infsup, "LONGER_RULE_LARGE", infsup.LONGER_RULE)  # the same W' both ways
+    monkeypatch.setattr(routes, "LONGER_RULE_LARGE", routes.LONGER_RULE)  # the same W' both ways
     for limit in (10 ** 9, 0):
         monkeypatch.setattr(bottom, "DENSE_MAX_M", limit)
         from infsup_contact.models import MODELS
@@ -126,8 +127,8 @@ def test_the_shorter_entry_rule_moves_the_margin_little(monkeypatch):
     from infsup_contact.models import MODELS
     monkeypatch.setattr(bottom, "DENSE_MAX_M", 0)
     margins = []
-    for extra in (infsup.LONGER_RULE, 2):
-        monkeypatch.setattr(infsup, "LONGER_RULE_LARGE", extra)
+    for extra in (routes.LONGER_RULE, 2):
+        monkeypatch.setattr(routes, "LONGER_RULE_LARGE", extra)
         row = infsup.beta_rows("structured", 2, 5, 6, ["T3"], model=MODELS["membranes3d"], element="hex",
                                norms=("L2",))[0]
         margins.append(row["kernel_margin_decades"])

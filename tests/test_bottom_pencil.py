@@ -1,4 +1,4 @@
-"""The large route's pencils (solvers/bottom.bottom_pencil, infsup.bottom_spectra, infsup.betas_v1_zero):
+"""The large route's pencils (la/bottom.bottom_pencil, spectra.bottom_spectra, spectra.betas_v1_zero):
 the blocked shift-invert operator against the plain one, the pencil against the dense eigh(S, G),
 the factor shared between norms against unshared pencils, and β(v1 = 0) between the routes."""
 import numpy as np
@@ -7,7 +7,8 @@ import scipy.linalg as sla
 from scipy.linalg import blas
 
 from infsup_contact.la import mkl
-from infsup_contact.solvers import bottom, infsup
+from infsup_contact.la import bottom
+from infsup_contact.solvers import spectra
 from infsup_contact.solvers.kernel import coupling_kernel
 
 
@@ -65,13 +66,13 @@ def test_shared_factor_changes_no_bit():
     """Two Gram matrices, no kernel: bottom_spectra (one Cholesky factor of S for both norms)
     gives bit for bit the spectra of the unshared calls, and those equal the dense route."""
     S, _, _ = _pencil(200, 0, seed=4)
-    factors = {"A": infsup.gram_factor(_spd(200, 5, 10.0)), "B": infsup.gram_factor(_spd(200, 6, 100.0))}
-    shared = infsup.bottom_spectra(S, factors)
+    factors = {"A": spectra.gram_factor(_spd(200, 5, 10.0)), "B": spectra.gram_factor(_spd(200, 6, 100.0))}
+    shared = spectra.bottom_spectra(S, factors)
     for norm, L in factors.items():
-        alone = infsup.bottom_spectrum(S, L)
+        alone = spectra.bottom_spectrum(S, L)
         assert (shared[norm].beta, shared[norm].gap) == (alone.beta, alone.gap)
         assert np.array_equal(shared[norm].bottom, alone.bottom)
-        dense = infsup.spectrum(S, factor=L)
+        dense = spectra.spectrum(S, factor=L)
         assert shared[norm].beta == pytest.approx(dense.beta, rel=1e-10)
 
 
@@ -82,12 +83,12 @@ def test_singular_s_without_kernel_falls_back_to_the_floor():
     S, G, _ = _pencil(200, 4, seed=7)
     assert bottom.definite_factor(S) is None
     assert bottom.definite_factor(G) is not None
-    L = infsup.gram_factor(G)
-    it = infsup.bottom_spectrum(S, L)
-    dense = infsup.spectrum(S, factor=L)
+    L = spectra.gram_factor(G)
+    it = spectra.bottom_spectrum(S, L)
+    dense = spectra.spectrum(S, factor=L)
     assert it.beta == 0.0
     assert dense.beta <= np.sqrt(200 * np.finfo(float).eps * sla.eigh(S, G, eigvals_only=True)[-1])
-    assert (infsup.bottom_spectra(S, {"H": L})["H"].beta, it.beta) == (0.0, 0.0)
+    assert (spectra.bottom_spectra(S, {"H": L})["H"].beta, it.beta) == (0.0, 0.0)
 
 
 def _terms_and_factors(m, d, seed):
@@ -99,7 +100,7 @@ def _terms_and_factors(m, d, seed):
     for i in range(2):
         C = rng.standard_normal((m + 5, m)) @ P
         terms.append(C.T @ C)
-    return terms, {"H": infsup.gram_factor(_spd(m, seed + 1, 10.0)), "L2": infsup.gram_factor(_spd(m, seed + 2))}, Z
+    return terms, {"H": spectra.gram_factor(_spd(m, seed + 1, 10.0)), "L2": spectra.gram_factor(_spd(m, seed + 2))}, Z
 
 
 @pytest.mark.parametrize("d", [0, 6])
@@ -111,11 +112,11 @@ def test_beta_v1_zero_between_routes(d, monkeypatch):
     W = np.vstack([terms[0] + terms[1], np.zeros((3, 160))])
     kernel = coupling_kernel(W, proven=d)
     assert kernel.dim == d
-    dense = infsup.betas_v1_zero(terms, factors, kernel, iterative=False)
-    assert dense == {n: infsup.spectrum(terms[1], factor=L).beta for n, L in factors.items()}  # as before
+    dense = spectra.betas_v1_zero(terms, factors, kernel, iterative=False)
+    assert dense == {n: spectra.spectrum(terms[1], factor=L).beta for n, L in factors.items()}  # as before
     if d:
-        monkeypatch.setattr(infsup, "bottom_spectra", lambda *a, **k: pytest.fail("computed"))
-    large = infsup.betas_v1_zero(terms, factors, kernel, iterative=True)
+        monkeypatch.setattr(spectra, "bottom_spectra", lambda *a, **k: pytest.fail("computed"))
+    large = spectra.betas_v1_zero(terms, factors, kernel, iterative=True)
     for norm, L in factors.items():
         if d:
             top = sla.eigh(terms[1], L @ L.T, eigvals_only=True)[-1]

@@ -7,7 +7,9 @@ from infsup_contact.discretization.spaces.registry import SPACES
 from infsup_contact.discretization.face.square import SQUARE, SQUARE_TRIG
 from infsup_contact.discretization.face.tensor_grid import TensorPartition
 from infsup_contact.models import MODELS
+from infsup_contact.discretization.gamma.coupling import coupling_matrix
 from infsup_contact.solvers import infsup
+from infsup_contact.solvers.side_cache import SideCache
 from infsup_contact.study.face_claims import checkerboard, face_predictions
 
 
@@ -31,7 +33,7 @@ def test_the_checkerboard_is_in_the_kernel_of_the_couplings():
     rows = infsup.beta_rows("structured", 2, 3, 3, ["T4"], model=MODELS["membranes3d"], element="tet",
                             norms=("L2",))
     assert (rows[0]["kernel_dim"], rows[0]["structural_kernel_dim"], rows[0]["kernel_check"]) == (1, 1, "agree")
-    sides = infsup.SideCache().pair(MODELS["membranes3d"], "structured", 2, 3, 3, element="tet")
+    sides = SideCache().pair(MODELS["membranes3d"], "structured", 2, 3, 3, element="tet")
     gamma = sides[0].trace.gamma
     space = gamma.space(SPACES["T4"], 2, sides[1].trace.partition)
     tri = space.triangles()
@@ -40,7 +42,7 @@ def test_the_checkerboard_is_in_the_kernel_of_the_couplings():
     nodes = np.mean(tri, axis=1)  # one point per triangle: P_0 basis index = triangle index
     assert np.allclose(space.evaluate(nodes), np.eye(len(tri)))
     for side in sides:
-        B = infsup.coupling_matrix(side.trace, space, 2)
+        B = coupling_matrix(side.trace, space, 2)
         assert np.linalg.norm(B.T @ mu) <= 1e-12 * np.linalg.norm(B, 2) * np.linalg.norm(mu)
     rows = infsup.beta_rows("structured", 2, 3, 4, ["T4"], model=MODELS["membranes3d"], element="tet", norms=("L2",))
     assert rows[0]["structural_kernel_dim"] == 0  # non-matching: no proof (and no mode)

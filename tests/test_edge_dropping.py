@@ -11,7 +11,7 @@ from infsup_contact.discretization.gamma.quadrature import gauss_legendre_01
 from infsup_contact.discretization.face.square import SQUARE
 from infsup_contact.discretization.face.tensor_grid import TensorPartition
 from infsup_contact.errors import InputError
-from infsup_contact.solvers.infsup import spectrum
+from infsup_contact.solvers.spectra import spectrum
 from infsup_contact.study.edge_dropping import (edge_cases, edge_row, geometry, interface_operator,
                                                 kappa_1d, scaled_cond, side_pair)
 
@@ -223,7 +223,7 @@ def test_narrow_side_mesh():
     assert len(side2.trace.gamma_dofs) == (n2 * k - 1) ** 2 == SQUARE.trace_dimension(k, n2)
     assert side1.trace.partition.xs[-1] == 1.0
     with pytest.raises(InputError, match="tensor grid"):
-        Square(width=L).partition_of(subdomain_mesh("structured", n2, 2))
+        Square(width=L).partition_of(subdomain_mesh("structured", n2, 2).mesh)
     with pytest.raises(InputError, match="width"):
         subdomain_mesh("structured", n2, 2, width=1.5)
 

@@ -17,7 +17,7 @@ from infsup_contact.models import MODELS, make_model, model_of_dim, model_taking
 from infsup_contact.models.elastic3d import (ELASTIC3D, elastic_stiffness, side_operator, subdomain_mesh,
                                              vector_space)
 from infsup_contact.models.plane_strain import lame
-from infsup_contact.models.schur import schur_by_solves
+from infsup_contact.models.contract import Body, schur_by_solves
 from infsup_contact.solvers.contact import solve_contact_on
 from infsup_contact.solvers.infsup import beta_rows_all
 from infsup_contact.study import elastic_face_patch as efp
@@ -52,7 +52,7 @@ def test_floating_body_has_exactly_the_six_rigid_modes(element, k):
     """No support: K r = 0 for the 3 translations and 3 rotations, and dim ker K = 6 exactly
     (eigenvalues of K against the mass matrix: NGSolve's hierarchical Q2 bubbles make K's own
     spectrum basis-scaled, ~1e-7 on a single cube even for the Laplacian)."""
-    fes = vector_space(subdomain_mesh("structured", 2, 2, element=element), k, FREE)
+    fes = vector_space(subdomain_mesh("structured", 2, 2, element=element).mesh, k, FREE)
     K = elastic_stiffness(fes, 0.3)
     x, y, z = ngsolve.x, ngsolve.y, ngsolve.z
     for r in ((1, 0, 0), (0, 1, 0), (0, 0, 1), (-y, x, 0), (0, -z, y), (z, 0, -x)):
@@ -68,7 +68,7 @@ def test_floating_body_has_exactly_the_six_rigid_modes(element, k):
 @pytest.mark.parametrize("nu", [0.0, 0.3, 0.49])
 def test_constant_strain_energy_is_exact(element, nu):
     """u = G x (G a random 3×3 matrix) lies in V_h: uᵀKu = |Ω| (2μ̂ ε:ε + λ̂ (tr ε)²), |Ω| = 1."""
-    fes = vector_space(subdomain_mesh("structured", 2, 1, element=element), 2, FREE)
+    fes = vector_space(subdomain_mesh("structured", 2, 1, element=element).mesh, 2, FREE)
     K = elastic_stiffness(fes, nu)
     G = np.random.default_rng(3).normal(size=(3, 3))
     X = (ngsolve.x, ngsolve.y, ngsolve.z)
@@ -100,7 +100,7 @@ def test_schur_is_spd_and_equals_the_reference_routes(side):
     S_all = K[-nb:, -nb:] - K[-nb:, :-nb] @ np.linalg.solve(K[:-nb, :-nb], K[:-nb, -nb:])
     X = side.steklov_inverse()
     assert np.allclose(np.linalg.inv(S_all)[nt:, nt:], X, rtol=1e-9, atol=1e-12 * abs(X).max())
-    nested = side_operator(side.trace.fes.mesh, side.trace.fes.globalorder, route="nested")
+    nested = side_operator(Body(side.trace.fes.mesh, side.trace.gamma), side.trace.fes.globalorder, route="nested")
     assert np.allclose(nested.schur, S, rtol=0, atol=1e-10 * scale)
 
 

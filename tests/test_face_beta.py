@@ -13,7 +13,7 @@ from infsup_contact.discretization.segment.multipliers import make_space
 from infsup_contact.discretization.spaces.registry import SPACES, case_space, ids_valid_for
 from infsup_contact.discretization.segment.interface import SEGMENT
 from infsup_contact.models import make_model
-from infsup_contact.models.side_cache import SideCache
+from infsup_contact.solvers.side_cache import SideCache
 from infsup_contact.solvers.infsup import beta_rows, saddle_point_beta
 from infsup_contact.solvers.contact import contact_qp
 
@@ -162,7 +162,7 @@ def test_every_schur_route_agrees_in_3d(element):
     within (3n + 1) ε (a Cholesky solve, Higham Thm 10.4), not an absolute 1e-10 (on the hexahedra
     ‖x‖ ≈ 3e6: the residual is 1e-12, round-off of that size)."""
     from infsup_contact.models.membranes3d import side_operator, subdomain_mesh
-    from infsup_contact.models.schur import schur_by_solves
+    from infsup_contact.models.contract import schur_by_solves
 
     mesh = subdomain_mesh("structured", 3, 1, element=element)
     sides = [side_operator(mesh, 2, route=r) for r in ("nested", "solves", "pardiso")]
@@ -178,11 +178,11 @@ def test_every_schur_route_agrees_in_3d(element):
 
 def test_auto_route_takes_pardiso_on_a_face_and_superlu_on_the_segment():
     """Above the solves route's work limit a face takes PARDISO, the segment SuperLU's nested
-    dissection (both measured in models/schur.gamma_factorization's docstring)."""
+    dissection (both measured in la/schur.gamma_factorization's docstring)."""
     from infsup_contact.discretization.segment.meshes import subdomain_mesh as mesh_2d
     from infsup_contact.models.membranes import side_operator as side_2d
     from infsup_contact.models.membranes3d import side_operator, subdomain_mesh
-    from infsup_contact.models.schur import SOLVES_MAX_WORK, gamma_factorization
+    from infsup_contact.la.schur import SOLVES_MAX_WORK, gamma_factorization
 
     face = side_operator(subdomain_mesh("structured", 8, 1), 2, route="solves")
     segment = side_2d(mesh_2d("structured", 64, 1), 2, route="solves")
@@ -195,7 +195,7 @@ def test_auto_route_takes_pardiso_on_a_face_and_superlu_on_the_segment():
 
 def test_pardiso_refuses_a_matrix_that_is_not_positive_definite():
     import scipy.sparse as sp
-    from infsup_contact.models.pardiso import PardisoError, gamma_schur
+    from infsup_contact.la.pardiso import PardisoError, gamma_schur
 
     diagonal = np.full(20, 2.0)
     diagonal[5] = -1.0
@@ -209,7 +209,7 @@ def test_pardiso_schur_on_small_matrices_equals_dense_elimination(n, n_gamma):
     """Tiny interiors (below pardiso.MIN_INTERIOR, where MKL reads out of bounds) and larger ones
     give the same S as dense elimination."""
     import scipy.sparse as sp
-    from infsup_contact.models.pardiso import gamma_schur
+    from infsup_contact.la.pardiso import gamma_schur
 
     D = np.diag(np.full(n, 4.0)) - np.diag(np.ones(n - 1), 1) - np.diag(np.ones(n - 1), -1)
     I, G = slice(0, n - n_gamma), slice(n - n_gamma, n)

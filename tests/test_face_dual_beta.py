@@ -18,7 +18,7 @@ from infsup_contact.discretization.face.square import SQUARE
 from infsup_contact.discretization.face.tensor_grid import TensorPartition
 from infsup_contact.errors import InputError
 from infsup_contact.models import make_model
-from infsup_contact.models.side_cache import SideCache
+from infsup_contact.solvers.side_cache import SideCache
 from infsup_contact.solvers.infsup import beta_rows, saddle_point_beta
 from infsup_contact.solvers.contact import contact_qp
 
@@ -102,11 +102,11 @@ def test_dual_q8_is_refused_with_its_weights_and_the_remedy():
 
 def test_an_empty_face_space_is_refused_before_any_computation():
     """TDUAL-Q8 on one cell: QUAD8 has no node inside (0, 1)², dim M_h = 0 = the count."""
-    from infsup_contact.solvers.infsup import check_inputs
+    from infsup_contact.solvers.request import BetaRequest
 
     assert registry.SPACES["TDUAL-Q8"].dimension(2, 1) == 0
     with pytest.raises(InputError, match="dim M_h = 0"):
-        check_inputs(["TDUAL-Q8"], 2, "structured", 1, 1, 1.0, 1.0, ["H"], "omega2")
+        BetaRequest("structured", 2, 1, 1, ("TDUAL-Q8",), norms=("H",))
 
 
 def test_face_spaces_stay_off_the_segment():

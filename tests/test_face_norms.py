@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from infsup_contact.discretization.face.norms import tensor as face_norms
-from infsup_contact.discretization.richardson import relative_step
+from infsup_contact.la.richardson import relative_step
 from infsup_contact.discretization.spaces.registry import case_space, space_spec
 from infsup_contact.discretization.face.square import SQUARE
 from infsup_contact.discretization.face.tensor_grid import TensorPartition
@@ -88,7 +88,7 @@ def test_norm2_above_the_short_krylov_gate_agrees_with_lapack():
     """The spectral norm of the Richardson loop above NORM2_SHORT_KRYLOV_MIN (Lanczos with 10
     vectors) equals the largest |eigenvalue| from LAPACK to the 1e-8 asked, for a Gram-like
     matrix (dominant top) and for an indefinite difference of two."""
-    from infsup_contact.discretization import richardson
+    from infsup_contact.la import richardson
     n = richardson.NORM2_SHORT_KRYLOV_MIN + 100
     rng = np.random.default_rng(3)
     X = rng.standard_normal((n, n)) / n

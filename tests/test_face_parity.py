@@ -1,4 +1,4 @@
-"""The face's H Gram series in the parity blocks of the axis reflections (discretization/face_parity.py):
+"""The face's H Gram series in the parity blocks of the axis reflections (la/face_parity.py, discretization/face_parity_bases.py):
 the sine coefficients' parity, the block route against the whole-matrix route (tensor and
 cellwise spaces), and the refusals (a graded partition, an R that does not intertwine)."""
 import numpy as np
@@ -7,7 +7,8 @@ import scipy.sparse as sp
 
 from infsup_contact.discretization.face.norms import cellwise as fc
 from infsup_contact.discretization.face.norms import tensor as fn
-from infsup_contact.discretization import face_parity as fp
+from infsup_contact.discretization.face.norms import parity_bases as fpb
+from infsup_contact.la import face_parity as fp
 from infsup_contact.discretization.spaces import registry
 from infsup_contact.discretization.segment.norms import sine_coefficients
 from infsup_contact.discretization.face.square import SQUARE
@@ -24,7 +25,7 @@ def test_even_functions_have_odd_sine_indices_only(case, k):
     """sin(mπ(1 − x)) = (−1)^{m+1} sin(mπx): an even function's coefficient vanishes at even m,
     an odd one's at odd m (to round-off), and the two parities span the 1D space."""
     sx = _space(case, k, np.linspace(0.0, 1.0, 8)).factors[0]
-    even, odd = fp.axis_parity(sx)
+    even, odd = fpb.axis_parity(sx)
     assert even.shape[1] + odd.shape[1] == sx.dim
     n = np.arange(1, 41, dtype=float)
     c = sine_coefficients(sx, n)
@@ -41,7 +42,7 @@ def test_tensor_blocks_equal_the_whole_series(monkeypatch, case, k, n):
     space = _space(case, k, np.linspace(0.0, 1.0, n + 1))
     monkeypatch.setattr(fn, "EXP_SUM_MIN_DIM", 0)
     G_blocks, info_blocks = fn.gram_h_face(space)
-    monkeypatch.setattr(fp, "tensor_parities", lambda s: None)
+    monkeypatch.setattr(fpb, "tensor_parities", lambda s: None)
     G_whole, info_whole = fn.gram_h_face(space)
     assert info_blocks["n_max"] == info_whole["n_max"]
     assert np.abs(G_blocks - G_whole).max() <= 1e-13 * np.abs(G_whole).max()
@@ -65,7 +66,7 @@ def test_cellwise_blocks_equal_the_whole_series(monkeypatch, case):
 
 def test_a_graded_partition_keeps_the_whole_series(monkeypatch):
     space = _space("R5.2", 1, np.array([0.0, 0.1, 0.35, 0.7, 1.0]))
-    assert fp.tensor_parities(space) is None
+    assert fpb.tensor_parities(space) is None
 
 
 def test_an_r_that_does_not_intertwine_is_refused():
@@ -74,7 +75,7 @@ def test_an_r_that_does_not_intertwine_is_refused():
     R, P = fc.projection(space)
     from infsup_contact.discretization.gamma.symmetry import axis_reflections, isotypic_bases
     bases = isotypic_bases(axis_reflections(space, fc.piece_rule(P.breakpoints, 3)[0]))
-    T = fp.tensor_bases(fp.tensor_parities(P))
+    T = fp.tensor_bases(fpb.tensor_parities(P))
     assert fp.intertwined(R, bases, T) is not None
     bad = R.tolil()
     bad[0, 0] += 1e-6 * abs(R).max()
@@ -84,7 +85,7 @@ def test_an_r_that_does_not_intertwine_is_refused():
 def test_assemble_inverts_the_blocks():
     """assemble(Q, [Q_cᵀ G Q_c]) = G for a G commuting with both reflections."""
     space = _space("R5.2", 2, np.linspace(0.0, 1.0, 5))
-    T = fp.tensor_bases(fp.tensor_parities(space))
+    T = fp.tensor_bases(fpb.tensor_parities(space))
     rng = np.random.default_rng(0)
     blocks = []
     for Q in T:

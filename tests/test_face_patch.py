@@ -123,8 +123,9 @@ def test_beta_sides_clamp_the_lateral_faces_the_scene_does_not(element):
     scene = face_patch.patch_scene()
     n, k = 3, 2
     for side in (1, 2):
-        mesh = model.subdomain_mesh("structured", n, side, element=element)
-        beta, contact = model.side_operator(mesh, k), model.side_for(scene, mesh, k)
+        body = model.subdomain_mesh("structured", n, side, element=element)
+        beta, contact = model.side_operator(body, k), model.side_for(scene, body, k)
+        mesh = body.mesh
         gamma = beta.trace.gamma
         assert len(beta.trace.gamma_dofs) == gamma.trace_dimension(k, n)
         assert len(contact.trace.gamma_dofs) == gamma.trace_nodes(k, n)

@@ -181,7 +181,7 @@ def test_beta_h_is_bounded_in_n_on_tetrahedra(monkeypatch):
 
     from infsup_contact.discretization.face.norms import triangles as face_triangle_norms
     from infsup_contact.models import make_model
-    from infsup_contact.models.side_cache import SideCache
+    from infsup_contact.solvers.side_cache import SideCache
     from infsup_contact.solvers.infsup import beta_rows_all
 
     monkeypatch.setattr(face_triangle_norms, "gram_h_tri", partial(face_triangle_norms.gram_h_tri, rtol=1e-4))

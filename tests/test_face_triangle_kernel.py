@@ -16,7 +16,7 @@ from infsup_contact.discretization.spaces.registry import SPACES, case_space
 from infsup_contact.discretization.face.square import SQUARE, SQUARE_TRIG
 from infsup_contact.errors import InputError
 from infsup_contact.models import make_model
-from infsup_contact.models.side_cache import SideCache
+from infsup_contact.solvers.side_cache import SideCache
 from infsup_contact.study.face_claims import planar_kernel, triangle_kernel_bound
 
 MODEL = make_model("membranes3d")

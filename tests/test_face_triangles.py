@@ -16,7 +16,7 @@ from infsup_contact.discretization.face.square import SQUARE, SQUARE_TRIG
 from infsup_contact.discretization.face.tensor_grid import TensorPartition
 from infsup_contact.errors import InputError
 from infsup_contact.models import make_model
-from infsup_contact.models.side_cache import SideCache
+from infsup_contact.solvers.side_cache import SideCache
 from infsup_contact.solvers.infsup import beta_rows
 from infsup_contact.solvers.contact import contact_qp
 

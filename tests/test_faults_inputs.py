@@ -154,13 +154,13 @@ def test_the_registry_has_empty_combinations():
 
 @pytest.mark.parametrize("case, k, n", EMPTY)
 def test_empty_space_is_refused_before_any_computation(case, k, n, capsys, monkeypatch):
-    from infsup_contact.solvers import infsup
+    from infsup_contact.solvers.request import BetaRequest
 
     def no_mesh(*a, **kw):  # "before any computation": no mesh may be built
         raise AssertionError("a mesh was built for an empty space")
     monkeypatch.setattr(meshes, "subdomain_mesh", no_mesh)
     with pytest.raises(InputError) as err:
-        infsup.check_inputs([case], k, "structured", n, n, 1.0, 1.0, ["H"], "omega2")
+        BetaRequest("structured", k, n, n, (case,), norms=("H",))
     text = one_line(err.value)
     assert f"case {case}" in text and f"k = {k}" in text and f"N = {n}" in text
     with pytest.raises(InputError):  # the backstop every consumer of the registry goes through

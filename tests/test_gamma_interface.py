@@ -15,7 +15,7 @@ from infsup_contact.discretization.segment.interface import SEGMENT, Segment
 from infsup_contact.discretization.spaces.registry import case_space
 from infsup_contact.errors import InputError
 from infsup_contact.models import make_model
-from infsup_contact.models.side_cache import SideCache
+from infsup_contact.solvers.side_cache import SideCache
 
 SRC = pathlib.Path(infsup_contact.__file__).parent
 

@@ -12,7 +12,8 @@ import scipy.sparse as sp
 from infsup_contact.discretization.gamma.coupling import coupling_matrix
 from infsup_contact.discretization.spaces.registry import case_space, ids_valid_for
 from infsup_contact.errors import InputError
-from infsup_contact.models import make_model, schur
+from infsup_contact.models import make_model
+from infsup_contact.solvers import interface_operator
 
 RTOL = 1e-12
 
@@ -56,13 +57,13 @@ def test_explicit_steklov_is_the_symmetric_inverse_of_s(setup):
 
 def test_large_route_agrees_with_the_solve_route(setup, monkeypatch):
     sides, spaces, k = setup
-    monkeypatch.setattr(schur, "SPARSE_PRODUCT_MIN_DIM", 0)
+    monkeypatch.setattr(interface_operator, "SPARSE_PRODUCT_MIN_DIM", 0)
     assert any(s.steklov is None for s in sides)  # the potri inverse is exercised
     for space in spaces:
         Bs = [coupling_matrix(s.trace, space, k) for s in sides[:2]]
         Bs += [Bs[i] for i, s in enumerate(sides[:2]) if s.steklov is not None]
-        assert space.dim > schur.SPARSE_PRODUCT_MIN_DIM
-        for T, B, side in zip(schur.interface_terms(Bs, sides), Bs, sides):
+        assert space.dim > interface_operator.SPARSE_PRODUCT_MIN_DIM
+        for T, B, side in zip(interface_operator.interface_terms(Bs, sides), Bs, sides):
             ref = _solve_route(B, side)
             assert T.shape == (space.dim, space.dim)
             assert np.linalg.norm(T - ref) <= RTOL * np.linalg.norm(ref)
@@ -74,15 +75,15 @@ def test_large_route_agrees_with_the_solve_route(setup, monkeypatch):
 def test_below_the_gate_the_terms_are_the_solve_routes_bit_for_bit(setup):
     sides, spaces, k = setup
     for space in spaces:
-        assert space.dim <= schur.SPARSE_PRODUCT_MIN_DIM
+        assert space.dim <= interface_operator.SPARSE_PRODUCT_MIN_DIM
         Bs = [coupling_matrix(s.trace, space, k) for s in sides[:2]]
-        for T, B, side in zip(schur.interface_terms(Bs, sides[:2]), Bs, sides[:2]):
+        for T, B, side in zip(interface_operator.interface_terms(Bs, sides[:2]), Bs, sides[:2]):
             assert np.array_equal(T, _solve_route(B, side))
 
 
 def test_a_side_without_a_sandwich_keeps_the_sparse_solve_route(setup, monkeypatch):
     sides, spaces, k = setup
-    monkeypatch.setattr(schur, "SPARSE_PRODUCT_MIN_DIM", 0)
+    monkeypatch.setattr(interface_operator, "SPARSE_PRODUCT_MIN_DIM", 0)
 
     class SolvesOnly:  # the side contract without steklov_sandwich
         def __init__(self, side):
@@ -90,7 +91,7 @@ def test_a_side_without_a_sandwich_keeps_the_sparse_solve_route(setup, monkeypat
 
     side, space = sides[0], spaces[0]
     B = coupling_matrix(side.trace, space, k)
-    (T,) = schur.interface_terms([B], [SolvesOnly(side)])
+    (T,) = interface_operator.interface_terms([B], [SolvesOnly(side)])
     assert np.array_equal(T, np.asarray(sp.csr_matrix(B) @ side.steklov_times(B.T)))
 
 

@@ -8,9 +8,11 @@ import scipy.linalg as sla
 from infsup_contact.discretization.gamma.coupling import coupling_matrix, trace_l2_norms
 from infsup_contact.discretization.segment.norms import gram
 from infsup_contact.models.membranes import MEMBRANES
-from infsup_contact.models.schur import combine_terms, interface_terms
-from infsup_contact.models.side_cache import SideCache
-from infsup_contact.solvers.infsup import _space, beta_rows, space_kernel, spectrum
+from infsup_contact.solvers.interface_operator import combine_terms, interface_terms
+from infsup_contact.solvers.side_cache import SideCache
+from infsup_contact.solvers.infsup import _space, beta_rows
+from infsup_contact.solvers.routes import space_kernel
+from infsup_contact.solvers.spectra import spectrum
 from infsup_contact.solvers.kernel import (CLOSE, GAP_DECADES, MARGIN_DECADES, coupling_kernel, kernel_from_gap,
                                            scaled_couplings)
 from infsup_contact.study import claims, verdict

@@ -3,7 +3,8 @@ import numpy as np
 import pytest
 import scipy.linalg as sla
 
-from infsup_contact.solvers.infsup import beta_rows, spectrum
+from infsup_contact.solvers.infsup import beta_rows
+from infsup_contact.solvers.spectra import spectrum
 from infsup_contact.solvers.kernel import GAP_DECADES, kernel_check, kernel_from_gap
 
 

@@ -7,9 +7,11 @@ import scipy.sparse.linalg as spla
 
 from infsup_contact.discretization.segment.interface import SEGMENT
 from infsup_contact.models.membranes import displacement_space, laplace_stiffness, side_operator
-from infsup_contact.models.schur import _gamma_last_lu, schur_by_solves, schur_from_lu
+from infsup_contact.la.schur import _gamma_last_lu, schur_from_lu
+from infsup_contact.models.contract import schur_by_solves
 from infsup_contact.discretization.segment.meshes import mesh_pair
-from infsup_contact.models.ordering import _Graph, _Twins, nested_dissection_gamma_last
+from infsup_contact.la.graph import Graph, Twins
+from infsup_contact.la.ordering import nested_dissection_gamma_last
 
 SUPERLU_SPD = dict(diag_pivot_thresh=0.0, options=dict(SymmetricMode=True))
 
@@ -120,7 +122,7 @@ def test_bfs_levels_are_graph_distances():
     """The levels read off scipy's BFS order (multi-source) are the true distances."""
     K, ng = _stiffness("unstructured", 7, 2)
     m = K.shape[0] - ng
-    graph = _Graph(K, m)
+    graph = Graph(K, m)
     starts = np.array([3, m // 2, m - 1])
     nodes, level = graph.bfs(starts)
     interior = K[:m, :m].tocsr()
@@ -135,7 +137,7 @@ def test_twins_of_cubic_elements_share_their_neighbourhoods():
     """P3: the two dofs inside an edge are twins, found and expanded consecutively."""
     K, ng = _stiffness("unstructured", 6, 3)
     m = K.shape[0] - ng
-    twins = _Twins.find(K, m)
+    twins = Twins.find(K, m)
     assert twins is not None and twins.count < m
     pattern = K.tocsc()
     rows = [frozenset(pattern.indices[pattern.indptr[i]:pattern.indptr[i + 1]]) for i in range(m)]
@@ -151,7 +153,7 @@ def test_twins_of_cubic_elements_share_their_neighbourhoods():
     for c in np.flatnonzero(sizes == 2):
         assert np.ptp(where[twins.members[klass == c]]) == 1
     K2, ng2 = _stiffness("unstructured", 6, 2)                 # P2: no twins worth it
-    assert _Twins.find(K2, K2.shape[0] - ng2) is None
+    assert Twins.find(K2, K2.shape[0] - ng2) is None
 
 
 def test_rejects_bad_arguments():

@@ -10,7 +10,7 @@ import pytest
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from infsup_contact.models import pardiso
+from infsup_contact.la import pardiso
 
 EPS = np.finfo(float).eps
 
@@ -142,7 +142,7 @@ def test_the_face_patch_contact_solution_is_unchanged(monkeypatch, patch_rows):
     not within the other route's round-off digits (1e-14..1e-12, which differ between CPUs);
     where it fails (T3), the errors are the discretization's, O(1e-2..1), and agree as the
     solutions do (cond ≈ 3e4: to ~1e-11, asked to 1e-6)."""
-    from infsup_contact.models import schur
+    from infsup_contact.la import schur
     from infsup_contact.study.face_patch import PASS_RTOL
 
     real = schur.gamma_factorization

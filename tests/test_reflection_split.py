@@ -1,4 +1,4 @@
-"""The large route's pencils split by the reflections of the face (solvers/reflection.py): the
+"""The large route's pencils split by the reflections of the face (la/reflection.py, solvers/symmetry.py): the
 permutations of real face bases and the character formula for the components' dimensions, the
 block identity Σ_c Q_c M_c Q_cᵀ = M, the kernel's components, and β rows identical (to the
 Lanczos accuracy) with and without the split."""
@@ -9,7 +9,9 @@ import scipy.linalg as sla
 from infsup_contact.discretization.spaces import registry
 from infsup_contact.discretization.face.square import SQUARE, SQUARE_TRIG
 from infsup_contact.discretization.face.tensor_grid import TensorPartition
-from infsup_contact.solvers import bottom, infsup, reflection
+from infsup_contact.la import bottom, reflection
+from infsup_contact.solvers import infsup, spectra, symmetry
+from infsup_contact.solvers.kernel import KernelDecision
 
 
 def _space(case, k, n, gamma=SQUARE):
@@ -47,7 +49,7 @@ def test_the_reflections_permute_the_basis(case, k, gamma):
     formula (1/|G|) Σ_b χ_c(b) tr P_b, and Q = [Q_0, ...] is orthogonal."""
     space, part = _space(case, k, 5, gamma)
     x = gamma.quadrature(part, 2 * k)[0]
-    split = reflection.reflection_split(space, x)
+    split = symmetry.reflection_split(space, x)
     assert split is not None
     maps = ([lambda y: np.column_stack([1.0 - y[:, 0], y[:, 1]]), lambda y: np.column_stack([y[:, 0], 1.0 - y[:, 1]])]
             if gamma is SQUARE else [lambda y: 1.0 - y])
@@ -70,12 +72,12 @@ def test_a_graded_partition_has_no_split():
     xs = np.array([0.0, 0.1, 0.35, 0.7, 1.0])
     part = TensorPartition(xs, xs)
     space = registry.case_space("R5.2", 1, part, SQUARE)
-    assert reflection.reflection_split(space, SQUARE.quadrature(part, 2)[0]) is None
+    assert symmetry.reflection_split(space, SQUARE.quadrature(part, 2)[0]) is None
 
 
 def test_blocks_reconstruct_an_invariant_matrix_and_detect_a_non_invariant_one():
     space, part = _space("R5.2", 2, 4)
-    split = reflection.reflection_split(space, SQUARE.quadrature(part, 4)[0])
+    split = symmetry.reflection_split(space, SQUARE.quadrature(part, 4)[0])
     M = _invariant_spd(split, 0)
     *blocks, distance = split.blocks(M)
     assert len(blocks) == 4 and distance <= reflection.INVARIANCE_RTOL  # the split's own test of invariance
@@ -91,7 +93,7 @@ def test_split_pencils_equal_the_unsplit_route(dims):
     """A synthetic invariant pencil with an invariant kernel of dims[c] modes in component c: the
     values above the kernel and λ_max of the blocks are the unsplit route's (bottom_spectra)."""
     space, part = _space("R5.2", 2, 4)
-    split = reflection.reflection_split(space, SQUARE.quadrature(part, 4)[0])
+    split = symmetry.reflection_split(space, SQUARE.quadrature(part, 4)[0])
     els, m = _elements(split), space.dim
     rng = np.random.default_rng(1)
     cols = []
@@ -108,13 +110,13 @@ def test_split_pencils_equal_the_unsplit_route(dims):
         A = 0.5 * (A + A.T)
     G = _invariant_spd(split, 3, shift=0.2)
     d = Z.shape[1]
-    kernel = infsup.KernelDecision(d, d, 0, np.inf, "clear", 0.0, np.zeros(0), d, Z if d else None)
-    plain = infsup.bottom_spectra(A, {"H": infsup.gram_factor(G)}, kernel if d else None)["H"]
+    kernel = KernelDecision(d, d, 0, np.inf, "clear", 0.0, np.zeros(0), d, Z if d else None)
+    plain = spectra.bottom_spectra(A, {"H": spectra.gram_factor(G)}, kernel if d else None)["H"]
     parts = split.components(Z) if d else None
     if d:
         assert tuple(P.shape[1] for P in parts) == dims
-    factors = {"H": tuple(infsup.gram_factor(b) for b in split.blocks(G)[:-1])}
-    halves = infsup.split_spectra(split, A, factors, kernel if d else None, parts)["H"]
+    factors = {"H": tuple(spectra.gram_factor(b) for b in split.blocks(G)[:-1])}
+    halves = spectra.split_spectra(split, A, factors, kernel if d else None, parts)["H"]
     assert halves.kernel_dim == plain.kernel_dim == d
     assert halves.smallest_nonzero == pytest.approx(plain.smallest_nonzero, rel=1e-9)
     assert halves.beta == pytest.approx(plain.beta, rel=1e-9, abs=0.0)
@@ -123,7 +125,7 @@ def test_split_pencils_equal_the_unsplit_route(dims):
 
 def test_a_kernel_that_is_not_the_sum_of_its_parts_is_refused():
     space, part = _space("R5.2", 2, 4)
-    split = reflection.reflection_split(space, SQUARE.quadrature(part, 4)[0])
+    split = symmetry.reflection_split(space, SQUARE.quadrature(part, 4)[0])
     v = np.random.default_rng(4).standard_normal(space.dim)
     assert split.components(v[:, None]) is None       # a generic vector: neither even nor odd
 
@@ -134,12 +136,12 @@ def test_face_rows_with_and_without_the_split(case, monkeypatch):
     and with it switched off: the same kernels, β to 1e-9."""
     from infsup_contact.models import MODELS
     monkeypatch.setattr(bottom, "DENSE_MAX_M", 0)
-    calls, split_spectra = [], infsup.split_spectra
-    monkeypatch.setattr(infsup, "split_spectra", lambda *a, **kw: calls.append(1) or split_spectra(*a, **kw))
+    calls, split_spectra = [], spectra.split_spectra
+    monkeypatch.setattr(spectra, "split_spectra", lambda *a, **kw: calls.append(1) or split_spectra(*a, **kw))
     rows = {}
     for on in (True, False):
         if not on:
-            monkeypatch.setattr(reflection, "reflection_split", lambda space, x: None)
+            monkeypatch.setattr(symmetry, "reflection_split", lambda space, x: None)
         rows[on] = infsup.beta_rows("structured", 2, 5, 6, [case], model=MODELS["membranes3d"], element="hex")
         assert bool(calls) == on  # the split was taken, and then switched off
         calls.clear()
@@ -159,14 +161,14 @@ def test_the_split_kernel_is_the_unsplit_one_on_a_real_face(monkeypatch):
     from infsup_contact.models import MODELS
     from infsup_contact.solvers.kernel import bottom_kernel
     captured = {}
-    original = reflection.split_bottom_kernel
+    original = symmetry.split_bottom_kernel
 
     def spy(W, split, proven, error):
         captured.update(W=W, split=split, proven=proven, error=error)
         return original(W, split, proven, error)
 
     monkeypatch.setattr(bottom, "DENSE_MAX_M", 0)
-    monkeypatch.setattr(reflection, "split_bottom_kernel", spy)
+    monkeypatch.setattr(symmetry, "split_bottom_kernel", spy)
     infsup.beta_rows("structured", 2, 5, 6, ["R5.2"], model=MODELS["membranes3d"], element="hex", norms=("L2",))
     W, split, proven, error = (captured[k] for k in ("W", "split", "proven", "error"))
     halves, whole = original(W, split, proven, error), bottom_kernel(W, proven, error)
@@ -181,10 +183,10 @@ def test_the_split_kernel_is_the_unsplit_one_on_a_real_face(monkeypatch):
 def test_an_interface_operator_that_is_not_invariant_is_solved_unsplit():
     """split_spectra returns None for an S off invariance (the caller's unsplit route)."""
     space, part = _space("R5.2", 2, 4)
-    split = reflection.reflection_split(space, SQUARE.quadrature(part, 4)[0])
+    split = symmetry.reflection_split(space, SQUARE.quadrature(part, 4)[0])
     S, G = _invariant_spd(split, 5), _invariant_spd(split, 6)
-    factors = {"H": tuple(infsup.gram_factor(b) for b in split.blocks(G)[:-1])}
-    assert infsup.split_spectra(split, S, factors) is not None
+    factors = {"H": tuple(spectra.gram_factor(b) for b in split.blocks(G)[:-1])}
+    assert spectra.split_spectra(split, S, factors) is not None
     S[0, 2] += 1e-8 * np.abs(S).max()
     S[2, 0] = S[0, 2]
-    assert infsup.split_spectra(split, S, factors) is None
+    assert spectra.split_spectra(split, S, factors) is None

@@ -1,4 +1,4 @@
-"""The H^{-1/2}_00 series' stated error is a bound (discretization/richardson.py): the Richardson
+"""The H^{-1/2}_00 series' stated error is a bound (la/richardson.py): the Richardson
 steps are measured in the Gram's own metric, which bounds the relative change of every eigenvalue
 of a pencil with it (Loewner order), with a one-level look-ahead on the steps' ratio. Checked on
 the face rows whose tail is slow (T5 and R5.2 at k = 2: jumps or boundary values, tail n^{-2})
@@ -10,10 +10,10 @@ from scipy.special import zeta
 
 from infsup_contact.discretization.gamma.coupling import coupling_matrix
 from infsup_contact.discretization.face.norms.tensor import gram_h_face
-from infsup_contact.discretization.richardson import extrapolate, lookahead_bound, relative_step
+from infsup_contact.la.richardson import extrapolate, lookahead_bound, relative_step
 from infsup_contact.models import MODELS
-from infsup_contact.models.schur import combine_terms, interface_terms
-from infsup_contact.models.side_cache import SideCache
+from infsup_contact.solvers.interface_operator import combine_terms, interface_terms
+from infsup_contact.solvers.side_cache import SideCache
 from infsup_contact.solvers import infsup
 
 

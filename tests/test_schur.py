@@ -4,9 +4,11 @@ import pytest
 import scipy.linalg as sla
 
 from infsup_contact.discretization.gamma.coupling import coupling_matrix
-from infsup_contact.solvers.infsup import beta_rows, gram_factor, saddle_point_beta, spectrum
+from infsup_contact.solvers.infsup import beta_rows, saddle_point_beta
+from infsup_contact.solvers.spectra import gram_factor, spectrum
 from infsup_contact.solvers.kernel import pencil_roundoff
-from infsup_contact.models.schur import interface_operator, schur_by_solves
+from infsup_contact.solvers.interface_operator import interface_operator
+from infsup_contact.models.contract import schur_by_solves
 from infsup_contact.models.membranes import side_operator
 from infsup_contact.discretization.segment.meshes import mesh_pair, multiplier_breakpoints
 from infsup_contact.discretization.spaces.registry import case_space

@@ -6,7 +6,7 @@ import pytest
 from infsup_contact.discretization.segment.interface import SEGMENT
 from infsup_contact.errors import InputError
 from infsup_contact.models.membranes import MEMBRANES
-from infsup_contact.models.side_cache import SideCache, side_keys
+from infsup_contact.solvers.side_cache import SideCache, side_keys
 from infsup_contact.solvers.infsup import beta_rows_all
 
 
@@ -20,6 +20,9 @@ class _Counting:
     def side_operator(self, mesh, k):
         self.builds += 1
         return MEMBRANES.side_operator(mesh, k)
+
+    def subdomain_mesh(self, family, n, side, **mesh_kwargs):
+        return MEMBRANES.subdomain_mesh(family, n, side, **mesh_kwargs)
 
 
 def test_pairs_sharing_a_side_build_it_once_and_drop_it_after_its_last_use():

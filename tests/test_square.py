@@ -28,14 +28,14 @@ def test_square_implements_every_abstract_method():
 @pytest.mark.parametrize("element,face", [("hex", SQUARE), ("tet", SQUARE_TRIG)])
 @pytest.mark.parametrize("side", [1, 2])
 def test_partition_of_a_structured_mesh(element, face, side):
-    p = face.partition_of(subdomain_mesh("structured", 3, side, element=element))
+    p = face.partition_of(subdomain_mesh("structured", 3, side, element=element).mesh)
     np.testing.assert_allclose(p.xs, np.linspace(0, 1, 4), atol=1e-15)
     np.testing.assert_allclose(p.ys, np.linspace(0, 1, 4), atol=1e-15)
     assert face.cells(p) == 9 and face.partition_key(p) == face.partition_key(grid(3))
 
 
 def test_a_face_that_is_no_tensor_grid_is_refused():
-    mesh = subdomain_mesh("structured", 3, 1)
+    mesh = subdomain_mesh("structured", 3, 1).mesh
     ngmesh = mesh.ngmesh
     for p in ngmesh.Points():  # move one interior vertex of Γ (z = 1) along x
         if abs(p[2] - 1) < 1e-12 and abs(p[0] - 1 / 3) < 1e-12 and abs(p[1] - 1 / 3) < 1e-12:
@@ -82,7 +82,7 @@ def test_quadrature_is_exact(degree):
 @pytest.mark.parametrize("element,face", [("hex", SQUARE), ("tet", SQUARE_TRIG)])
 @pytest.mark.parametrize("k", [1, 2, 3])
 def test_trace_basis_is_ngsolves_trace(element, face, k):
-    mesh = subdomain_mesh("structured", 2, 2, element=element)
+    mesh = subdomain_mesh("structured", 2, 2, element=element).mesh
     trace = face.trace(displacement_space(mesh, k))
     assert len(trace.gamma_dofs) == face.trace_dimension(k, 2)
     gf = ngsolve.GridFunction(trace.fes)
@@ -99,7 +99,7 @@ def test_trace_basis_is_ngsolves_trace(element, face, k):
 @pytest.mark.parametrize("k", [1, 2])
 @pytest.mark.parametrize("n1,n2", [(2, 2), (2, 3), (3, 4), (2, 4)])
 def test_trace_sum_dimension_is_the_rank_of_both_traces(element, face, k, n1, n2):
-    traces = [face.trace(displacement_space(subdomain_mesh("structured", n, side, element=element), k))
+    traces = [face.trace(displacement_space(subdomain_mesh("structured", n, side, element=element).mesh, k))
               for n, side in ((n1, 1), (n2, 2))]
     x = np.random.default_rng(1).uniform(size=(6 * (max(n1, n2) * k + 1) ** 2, 2))
     both = np.hstack([face.trace_basis(t, x) for t in traces])

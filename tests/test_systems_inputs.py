@@ -234,7 +234,7 @@ def test_pardiso_inertia_certifies_only_a_clean_spd_matrix(monkeypatch):
     """From PARDISO_CHECK_MIN rows PARDISO's LDLᵀ inertia certifies A at once (n positive pivots,
     none negative, none perturbed); a singular or indefinite A still gets SuperLU's diagnosis,
     the same messages as below the gate."""
-    from infsup_contact.models import pardiso
+    from infsup_contact.la import pardiso
     from infsup_contact.systems import checks
 
     if not pardiso.available():

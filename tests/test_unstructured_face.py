@@ -24,7 +24,7 @@ from infsup_contact.discretization.face.triangulation import Triangulation, bary
 from infsup_contact.errors import InputError
 from infsup_contact.models import make_model
 from infsup_contact.models import membranes3d
-from infsup_contact.models.side_cache import SideCache
+from infsup_contact.solvers.side_cache import SideCache
 from infsup_contact.solvers.infsup import beta_rows
 
 MODEL = make_model("membranes3d")
@@ -40,7 +40,7 @@ def rank(A, tol=1e-10):
 @pytest.fixture(scope="module")
 def unstructured():
     """Traces of the unstructured pair N1 = 3, N2 = 4 (Netgen, non-matching)."""
-    return [TRIANGULATED.partition_of(membranes3d.subdomain_mesh("unstructured", n, side, element="tet"))
+    return [TRIANGULATED.partition_of(membranes3d.subdomain_mesh("unstructured", n, side, element="tet").mesh)
             for n, side in ((3, 1), (4, 2))]
 
 
@@ -181,7 +181,7 @@ def test_bad_inputs():
         membranes3d.subdomain_mesh("unstructured", 2, 1, element="hex")
     with pytest.raises(InputError, match="alpha"):
         membranes3d.subdomain_mesh("perturbed", 2, 1, element="tet", alpha=0.5)
-    part = TRIANGULATED.partition_of(membranes3d.subdomain_mesh("unstructured", 2, 1, element="tet"))
+    part = TRIANGULATED.partition_of(membranes3d.subdomain_mesh("unstructured", 2, 1, element="tet").mesh)
     with pytest.raises(InputError, match="case"):
         case_space("DUAL-Q9", 2, part, TRIANGULATED)
     with pytest.raises(InputError, match="points"):
@@ -201,14 +201,14 @@ def test_perturbed_meshes_are_seeded_and_keep_the_planes(element):
     """Same seed, same mesh; another seed, another; every vertex within α h (per coordinate) of
     the structured one, on the same box planes; the hexahedra's face stays the tensor grid."""
     n, alpha = 3, 0.2
-    base = _points(membranes3d.subdomain_mesh("structured", n, 1, element=element))
-    a, b, c = (_points(membranes3d.subdomain_mesh("perturbed", n, 1, element=element, seed=s)) for s in (5, 5, 6))
+    base = _points(membranes3d.subdomain_mesh("structured", n, 1, element=element).mesh)
+    a, b, c = (_points(membranes3d.subdomain_mesh("perturbed", n, 1, element=element, seed=s).mesh) for s in (5, 5, 6))
     assert np.array_equal(a, b) and not np.array_equal(a, c)
     d = a - base
     assert np.abs(d).max() <= alpha / n and np.abs(d).max() > 0
     on_plane = np.abs(base - np.rint(base)) < 1e-12
     assert np.all(d[on_plane] == 0.0)
-    face = membranes3d.face_of(membranes3d.subdomain_mesh("perturbed", n, 1, element=element, seed=5))
+    face = membranes3d.subdomain_mesh("perturbed", n, 1, element=element, seed=5).interface
     assert (face is TRIANGULATED) == (element == "tet")
 
 

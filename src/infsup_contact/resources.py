@@ -143,8 +143,8 @@ k = 2; 118 s at N = 40, k = 1); PARDISO's routes: :data:`DENSE_ROUTE_SECONDS_3D`
 
 def face_route() -> str:
     """The Schur route a face takes above the solves route's limit: ``pardiso`` where MKL loads
-    (:func:`infsup_contact.models.schur.gamma_factorization`), else ``nested``."""
-    from .models import pardiso
+    (:func:`infsup_contact.la.schur.gamma_factorization`), else ``nested``."""
+    from .la import pardiso
 
     return "pardiso" if pardiso.available() else "nested"
 
@@ -156,7 +156,7 @@ def face_side_dofs(n: int, k: int) -> float:
 
 
 LARGE_ROUTE_3D = {1: (1530.0, 197.0, 6.06e-5, 5.28e-10), 2: (4350.0, 132.0, 1.31e-4, 6.49e-10)}
-"""(a, b, c, d) of the large route (dim M above :data:`~.solvers.bottom.DENSE_MAX_M`: sparse
+"""(a, b, c, d) of the large route (dim M above :data:`~.la.bottom.DENSE_MAX_M`: sparse
 couplings, exponential-sum Grams in the reflections' parity blocks, bottom pencils; PARDISO):
 bytes a Σ nd + b m² and seconds c Σ nd + d m³ beyond the process, m = (k N₂ + 1)² (R5.2 on
 G_h = the trace of Ω2). Non-negative least squares, relative residuals, on ``beta --model
@@ -184,9 +184,9 @@ def _large_route_dim(k: int, n: int, components: int) -> int:
 
 def face_beta_estimate(k: int, n1: int, n2: int, components: int = 1, process: bool = True) -> Estimate:
     """One ``beta_rows`` call of a 3D model (a contact face): both sides kept. The dense route
-    (dim M up to :data:`~.solvers.bottom.DENSE_MAX_M`, and every size on the ``nested`` route):
+    (dim M up to :data:`~.la.bottom.DENSE_MAX_M`, and every size on the ``nested`` route):
     C nd^{4/3} per side (:data:`SIDE_BYTES_3D`); above it with PARDISO, :data:`LARGE_ROUTE_3D`."""
-    from .solvers.bottom import DENSE_MAX_M
+    from .la.bottom import DENSE_MAX_M
 
     nds = [components * face_side_dofs(n, k) for n in (n1, n2)]
     route = face_route()

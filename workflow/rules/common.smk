@@ -80,7 +80,7 @@ def contact_reference(wildcards):
 def beta_mem_mb(wildcards):
     """mem_mb of a β_h batch: the largest estimate of src/infsup_contact/resources.py (+25 %)
     over its pairs: one pair is computed at a time, next to the side operators kept for later
-    pairs of the batch (models/side_cache.py); measured RSS 0.50-0.91 of this on the full config."""
+    pairs of the batch (solvers/side_cache.py); measured RSS 0.50-0.91 of this on the full config."""
     ic, batch = config["infsup"], BETA_BATCHES[wildcards.batch]
     return max(resources.job_mem_mb(resources.beta_estimate(
         batch["family"], batch["k"], n1, n2, ic["multiplier_meshes"], ic["norms"])) for n1, n2 in batch["pairs"])

@@ -43,7 +43,8 @@ from ..discretization.segment import meshes
 from ..discretization.spaces import registry
 from ..discretization.gamma.coupling import coupling_matrix
 from ..models.membranes import side_operator
-from ..models.schur import SideOperator, interface_operator
+from ..models.contract import SideOperator
+from ..solvers.interface_operator import interface_operator
 from ..solvers.infsup import beta_rows
 from .harness import ROUTE_BUDGET, _log, _row, run_interleaved
 
@@ -69,7 +70,7 @@ def _bottom(beta2: np.ndarray, kern: int):
 def _factorize_side(side: SideOperator) -> SideOperator:
     """The Γ-last factorization + Schur complement of an assembled side: the linear
     algebra of :func:`~infsup_contact.models.membranes.side_operator` without the NGSolve assembly."""
-    from ..models.schur import factorized_side
+    from ..models.contract import factorized_side
 
     return factorized_side(side.trace, side.free, side.stiffness)
 
@@ -134,7 +135,7 @@ def beta_ours(n: int, k: int):
 
 def beta_ours_core(setup: BetaSetup):
     """Γ-reduced route given the assembled stiffness: factorization, couplings,
-    interface operator, Gram, dense eigh (:func:`~infsup_contact.solvers.infsup.spectrum` without the extras)."""
+    interface operator, Gram, dense eigh (:func:`~infsup_contact.solvers.spectra.spectrum` without the extras)."""
     sides = [_factorize_side(s) for s in setup.sides]
     out = {}
     for c in setup.cases:

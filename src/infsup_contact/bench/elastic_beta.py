@@ -27,7 +27,8 @@ from ..discretization.segment import meshes
 from ..discretization.spaces import registry
 from ..discretization.gamma.coupling import coupling_matrix
 from ..models.elastic import elastic_model
-from ..models.schur import factorized_side, interface_operator
+from ..models.contract import factorized_side
+from ..solvers.interface_operator import interface_operator
 from ..solvers.infsup import beta_rows
 from .harness import _row, run_interleaved
 

@@ -25,7 +25,7 @@ Routes (``includes`` column), measured interleaved by :func:`~.harness.run_inter
     overhead of the Γ-reduced route (Bathe & Brezzi 2001: β_h² = λ_min(B A⁻¹ Bᵀ, G)).
 
 The Schur complement alone (``what`` = ``face_schur``): each body's S = K_ΓΓ − K_ΓI K_II⁻¹ K_IΓ
-by :func:`~infsup_contact.models.schur.gamma_factorization`'s routes, ``ratio_to_ours``
+by :func:`~infsup_contact.la.schur.gamma_factorization`'s routes, ``ratio_to_ours``
 against PARDISO's partial factorization: the measurement behind the route ``"auto"`` takes on
 a face (CHOLMOD and MUMPS have no wheel for this Python and numpy on PyPI; scikit-sparse and
 python-mumps 0.0.2 were tried, see the README).
@@ -44,9 +44,11 @@ from ..discretization.spaces import registry
 from ..discretization.gamma.coupling import coupling_matrix
 from ..errors import InputError
 from ..models.membranes3d import ELEMENTS, MEMBRANES3D
-from ..models import pardiso
-from ..models.schur import factorized_side, gamma_factorization, interface_operator
-from ..models.side_cache import SideCache
+from ..la import pardiso
+from ..models.contract import factorized_side
+from ..la.schur import gamma_factorization
+from ..solvers.interface_operator import interface_operator
+from ..solvers.side_cache import SideCache
 from ..solvers.infsup import beta_rows_all
 from .harness import ROUTE_BUDGET, _log, _row, run_interleaved
 
@@ -143,7 +145,7 @@ def face_limit(setup: FaceSetup, ops: dict):
 
 def schur_routes(setup: FaceSetup) -> dict:
     """{route: callable} giving both bodies' Schur complements by that route of
-    :func:`~infsup_contact.models.schur.gamma_factorization` (the solves route only while
+    :func:`~infsup_contact.la.schur.gamma_factorization` (the solves route only while
     n_Γ ≤ :data:`SOLVES_MAX_GAMMA`; PARDISO only where it loads)."""
     n_gamma = max(len(s.trace.gamma_dofs) for s in setup.sides)
     names = [r for r in SCHUR_ROUTES if (r != "solves" or n_gamma <= SOLVES_MAX_GAMMA)

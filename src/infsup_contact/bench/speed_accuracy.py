@@ -39,7 +39,7 @@ def time_contact_solves(cases, k: int, n: int, repeats: int = 3, scene: str = MA
     and the case's own part on it (:func:`~infsup_contact.solvers.contact.solve_contact_on`:
     space, couplings, interface operator, PDAS, recovery). The build is timed once for all
     cases; each case's part starts from the state a fresh build leaves (nothing an earlier
-    case cached on the sides, :meth:`~infsup_contact.models.schur.SideOperator.forget_cached`).
+    case cached on the sides, :meth:`~infsup_contact.models.contract.SideOperator.forget_cached`).
     Each part is repeated up to ``repeats`` times while its accumulated time is below
     ``budget`` seconds.
 

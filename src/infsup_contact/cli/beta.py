@@ -66,9 +66,7 @@ FLAG_USES = [
 
 def _check_beta(args):
     from .. import resources
-    from ..discretization.segment.meshes import check_perturbation
     from ..errors import InputError
-    from ..solvers.infsup import check_inputs
 
     if args.system is not None:
         from ..systems.levels import dry_check
@@ -86,14 +84,26 @@ def _check_beta(args):
     material(args)
     args.mesh_kwargs = mesh_options(args)
     args.cases = face_cases(args)
-    check_inputs([c for c in args.cases if isinstance(c, str)], args.k, args.family, args.N1, args.N2,
-                 args.c1, args.c2, norms(args), args.multiplier_mesh)
-    check_perturbation(args.alpha, args.seed)
+    args.request = request(args)
     est = resources.beta_estimate(args.family, args.k, args.N1, args.N2, args.multiplier_mesh,
                                   norms(args), args.h_route,
                                   components=args.model_obj.components, dim=args.model_obj.dim)
     check_memory(est, *(("N1", args.N1) if args.N1 >= args.N2 else ("N2", args.N2)))
     return est
+
+
+def request(args):
+    """The :class:`~infsup_contact.solvers.request.BetaRequest` of the command line, validated once
+    (the perturbed family's seed and α with it); the engine runs it unchecked."""
+    from ..discretization.segment.meshes import check_perturbation
+    from ..solvers.request import BetaRequest, MeshOptions
+
+    perturbed = dict(seed=args.seed, alpha=args.alpha) if args.family == "perturbed" else {}
+    out = BetaRequest(args.family, args.k, args.N1, args.N2, tuple(args.cases), (args.multiplier_mesh,),
+                      ((args.c1, args.c2),), norms(args), args.h_route, args.model_obj,
+                      MeshOptions(**args.mesh_kwargs, **perturbed))
+    check_perturbation(args.alpha, args.seed)
+    return out
 
 
 def _run_beta(args) -> None:
@@ -107,13 +117,9 @@ def _run_beta(args) -> None:
         write_csv(pd.DataFrame(system_rows(args.manifest)).drop(columns="N2"), float_format="%.12g")
         return
 
-    from ..solvers.infsup import beta_rows
+    from ..solvers.infsup import beta_table
 
-    kwargs = dict(args.mesh_kwargs)
-    if args.family == "perturbed":
-        kwargs.update(seed=args.seed, alpha=args.alpha)
-    rows = beta_rows(args.family, args.k, args.N1, args.N2, args.cases, args.multiplier_mesh,
-                     args.c1, args.c2, norms(args), h_route=args.h_route, model=args.model_obj, **kwargs)
+    rows = beta_table(args.request)
     frame = pd.DataFrame(rows)
     for i, (name, value) in enumerate(args.mesh_kwargs.items()):  # e.g. element, after family
         frame.insert(frame.columns.get_loc("family") + 1 + i, name, value)

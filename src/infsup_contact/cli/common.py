@@ -33,18 +33,20 @@ def cases(args) -> list:
 def face_cases(args) -> list:
     """``--case all`` on a 3D model: the paper's spaces and the duals (:func:`cases`), then every
     other registered space the model's face builds for k (the quadratic face elements' on
-    hexahedra or tetrahedra; those refused by construction, e.g. DUAL-Q8, left out), found on
-    the model's coarsest mesh (one cell per direction; ``args.mesh_kwargs`` set)."""
+    hexahedra or tetrahedra; those refused by construction, e.g. DUAL-Q8, left out), on the
+    partition of the model's coarsest mesh (one cell per direction; ``args.mesh_kwargs`` set) of
+    the Γ its mesh builder names for the request (no body is factorized)."""
     from ..discretization.spaces.registry import ids_built_on
 
     base = list(args.cases)
     if args.case not in (None, "all") or args.space is not None or args.model_obj.dim != 3:
         return base
     model = args.model_obj
-    mesh = model.subdomain_mesh(args.family, 1, 1, **args.mesh_kwargs)
-    trace = model.side_operator(mesh, args.k).trace
-    g_h = trace.gamma.multiplier_partition(trace.partition, trace.partition)
-    return base + [c for c in ids_built_on(args.k, trace.gamma, g_h) if c not in base]
+    body = model.subdomain_mesh(args.family, 1, 1, **args.mesh_kwargs)
+    gamma = body.interface
+    partition = gamma.partition_of(body.mesh)
+    g_h = gamma.multiplier_partition(partition, partition)
+    return base + [c for c in ids_built_on(args.k, gamma, g_h) if c not in base]
 
 
 def run_intervals(args, limit: int = 1024) -> set:

@@ -1,4 +1,4 @@
-"""Intel oneMKL, loaded once through ctypes: PARDISO (:mod:`infsup_contact.models.pardiso`)
+"""Intel oneMKL, loaded once through ctypes: PARDISO (:mod:`infsup_contact.la.pardiso`)
 and the pointer-level triangular solve of :func:`trailing_solve`; the code branch MKL runs
 (:func:`cbwr_branch`, for the cross-machine checks of :mod:`infsup_contact.study.machines`).
 
@@ -6,7 +6,7 @@ The library is the ``mkl`` wheel's ``mkl_rt`` (``environment.lock``), called wit
 C interfaces (oneMKL Developer Reference: "pardiso", "cblas_?trsm"). numpy and scipy keep their
 own OpenBLAS; MKL serves where scipy's wrappers cannot: PARDISO's Schur complement, and BLAS on
 a sub-block of a matrix in place (scipy's f2py wrappers copy every non-contiguous slice:
-0.55 s of copies per 4,225² inverse standard form, :func:`~infsup_contact.solvers.bottom.inverse_standard_form`).
+0.55 s of copies per 4,225² inverse standard form, :func:`~infsup_contact.la.bottom.inverse_standard_form`).
 Every caller keeps a scipy route for a machine without it (:func:`available`). Threads: as
 :func:`~infsup_contact.la.threaded.threads` (MKL_NUM_THREADS, else OPENBLAS_NUM_THREADS, else 1).
 """

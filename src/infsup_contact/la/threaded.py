@@ -3,7 +3,7 @@
 scipy's sparse × dense product (``csr_matvecs``) and numpy's element-wise passes are
 single-threaded. On the large face route (k = 2, N = 32) they held about 45 s of a 200 s
 β_h request while the second core waited: the sandwiches B X Bᵀ of the interface operator
-(:mod:`infsup_contact.models.schur`) and R S_P Rᵀ of the cellwise H Grams
+(:mod:`infsup_contact.la.schur`) and R S_P Rᵀ of the cellwise H Grams
 (:mod:`infsup_contact.discretization.face.norms.cellwise`), and the reordering of the face
 series (:mod:`infsup_contact.discretization.face.norms.tensor`). Both release the GIL, so threads
 over disjoint row blocks of the result use every core. Each row of a result is computed by
@@ -15,7 +15,7 @@ operand, a strided pass over memory (2.2 s for a 9,216² operand). :func:`symmet
 never transposes a large operand: X Aᵀ is formed row block by row block from small copies.
 
 The number of threads is the BLAS's (MKL_NUM_THREADS, else OPENBLAS_NUM_THREADS, else 1, as
-:mod:`infsup_contact.models.pardiso` reads it): a run asked to use one core uses one.
+:mod:`infsup_contact.la.pardiso` reads it): a run asked to use one core uses one.
 """
 from __future__ import annotations
 
@@ -180,7 +180,7 @@ def elementwise(f, *arrays: np.ndarray) -> np.ndarray:
     """f(*arrays) for an element-wise f of equally shaped dense arrays (numpy arithmetic),
     C-contiguous, row blocks over the threads: bit for bit ``f(*arrays)`` (each entry is the
     same operations on the same operands). For the Richardson steps of the large Gram series
-    (:func:`~infsup_contact.discretization.richardson.extrapolate`: R = S₂ + (S₂ − S₁)/(2^p − 1) and
+    (:func:`~infsup_contact.la.richardson.extrapolate`: R = S₂ + (S₂ − S₁)/(2^p − 1) and
     R(2n) − R(n) on 4,225² matrices, single-threaded passes in numpy)."""
     arrays = [np.asarray(a, dtype=float) for a in arrays]
     out = np.empty(arrays[0].shape)

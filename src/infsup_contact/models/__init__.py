@@ -1,12 +1,12 @@
 """Models: each physical model brings its interface operator and its scenes' needs, nothing else.
 
-``contract`` states what a model gives the engine (one factorized side per mesh, Γ last; the
-loads, lifts and u_h of a contact scene); ``schur`` is the shared Γ Schur complement / Steklov
-inverse machinery, ``ordering`` its Γ-last nested dissection; ``membranes`` is the paper's
+``contract`` states what a model gives the engine (one factorized side per mesh, Γ last, its
+:class:`~.contract.SideOperator` made by :mod:`infsup_contact.la.schur`; a 3D body's mesh with its
+Γ, :class:`~.contract.Body`; the loads, lifts and u_h of a contact scene); ``membranes`` is the paper's
 model, ``elastic`` plane-strain elasticity (its Section 2), ``membranes3d`` the membranes
 in 3D with a 2D contact face (issue 28), ``elastic3d`` the linear-elastic bodies on that
 face, ``plane_strain`` the material law
-the elastic scenes measure with. Imports ``discretization`` and ``errors`` only.
+the elastic scenes measure with. Imports ``discretization``, ``la`` and ``errors`` only.
 
 This file is the registry of models: the engine (``solvers``, ``study``) asks it for a model by
 name and never imports a concrete model.

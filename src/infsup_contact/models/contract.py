@@ -3,7 +3,7 @@
 β_h (:mod:`infsup_contact.solvers.infsup`), the contact solver
 (:mod:`infsup_contact.solvers.contact`), the ledger and the paper take a :class:`Model` and
 never ask which one it is. A model is one function, ``side_operator(mesh, k)``, applied to
-each mesh of a pair; the :class:`~infsup_contact.models.schur.SideOperator` it returns carries
+each mesh of a pair; the :class:`~infsup_contact.models.contract.SideOperator` it returns carries
 
 * ``trace`` — the Γ trace of the side's displacement space: its interface (``trace.gamma``,
   the :class:`~infsup_contact.discretization.gamma.interface.Interface` every consumer asks for
@@ -13,8 +13,8 @@ each mesh of a pair; the :class:`~infsup_contact.models.schur.SideOperator` it r
   :func:`~infsup_contact.discretization.gamma.coupling.coupling_matrix` builds B_i;
 * ``steklov_times(M)`` — X_i M with X_i = (A_i⁻¹)_ΓΓ at unit material scale: the interface
   operator Σ_i B_i X_i B_iᵀ / c_i is assembled from it for every multiplier space and norm
-  (above ``schur.SPARSE_PRODUCT_MIN_DIM`` from ``steklov_sandwich(B)`` = B X_i Bᵀ where the side
-  has it: :class:`~infsup_contact.models.schur.SideOperator` forms X_i once);
+  (above ``interface_operator.SPARSE_PRODUCT_MIN_DIM`` from ``steklov_sandwich(B)`` = B X_i Bᵀ where the side
+  has it: :class:`~infsup_contact.models.contract.SideOperator` forms X_i once);
 * ``solve``, ``free``, ``stiffness`` — the factorization and the free dofs (Γ last) with
   which the contact solver recovers u_h = A_i⁻¹ (F_i ∓ B_iᵀ λ_h).
 
@@ -42,6 +42,33 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from typing import Callable
+
+import numpy as np
+import scipy.linalg as sla
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+from ..discretization.gamma.trace import GammaTrace
+from ..la import schur
+from ..la.schur import SteklovProduct
+
+
+@dataclass(frozen=True)
+class Body:
+    """A body's mesh and its Γ, as a 3D model's mesh builder returns them (``Model.mesh``): which
+    interface the face is (rectangles, structured triangles, a general triangulation) is the
+    builder's to say, from the request (family, element), and is never attached to the mesh.
+
+    Attributes
+    ----------
+    mesh : ngsolve.Mesh
+        The mesh of Ω_side, its Γ named as ``interface`` expects.
+    interface : Interface
+        Γ (:class:`~infsup_contact.discretization.gamma.interface.Interface`) whose trace the side takes.
+    """
+
+    mesh: object
+    interface: object
 
 
 @dataclass(frozen=True)
@@ -96,8 +123,8 @@ class Model:
     components : int
         Displacement components per node (the memory estimate's factor).
     mesh : callable or None
-        ``mesh(family, n, side, **mesh_kwargs) -> ngsolve.Mesh``: the mesh of Ω_side with n cells
-        on Γ (per direction on a face); None: the paper's 2D meshes
+        ``mesh(family, n, side, **mesh_kwargs) -> Body``: the mesh of Ω_side with n cells on Γ
+        (per direction on a face) and its Γ, what ``side_operator`` takes; None: the paper's 2D meshes
         (:func:`~infsup_contact.discretization.segment.meshes.subdomain_mesh`).
     mesh_options : tuple of (str, tuple)
         Mesh keywords the model's ``mesh`` takes beyond the 2D ones, with their allowed values
@@ -147,3 +174,63 @@ B_SIGN = (-1.0, 1.0)
 """Sign of B_iᵀ λ in A_i u_i = F_i + sign_i B_iᵀ λ (Ω1, Ω2): b(v, μ) = ∫_Γ (v_2 − v_1)·n μ."""
 OUTWARD_NORMAL_Y = (1.0, -1.0)
 """y component of the outward normal of Ω1, Ω2 on Γ (Ω1 lies below Γ)."""
+
+
+@dataclass(frozen=True)
+class SideOperator(SteklovProduct):
+    """Factorized stiffness of one body and its Γ Schur complement (unit material scale).
+
+    Attributes
+    ----------
+    trace : GammaTrace
+        Γ dofs and trace elements of V_{h,i}.
+    free : ndarray of int
+        Free NGSolve dofs (the unknowns of A_i), Γ dofs included.
+    stiffness : scipy.sparse.csc_matrix
+        K_i restricted to free dofs, in the order of ``free``.
+    schur : ndarray
+        S_i = Schur complement of K_i onto the Γ dofs (order of ``trace.gamma_dofs``).
+    solve : callable
+        b ↦ K_i⁻¹ b on free dofs (reuses the factorization).
+    """
+
+    trace: GammaTrace
+    free: np.ndarray
+    stiffness: sp.csc_matrix
+    schur: np.ndarray
+    solve: object
+    steklov: np.ndarray | None = None
+
+    @property
+    def ndof(self) -> int:
+        return len(self.free)
+
+    def steklov_inverse(self, c: float = 1.0) -> np.ndarray:
+        """X_i = (A_i⁻¹)_ΓΓ = S_i⁻¹ / c_i, symmetric positive definite."""
+        X = self.steklov if self.steklov is not None else sla.inv(self.schur, check_finite=False)
+        return X / c
+
+    def forget_cached(self) -> None:
+        """Return to the state right after the build: drop what later calls cached on this
+        side (the Cholesky factor of S, the trace's basis values, dense and CSR). A benchmark
+        times each multiplier space's solve from this state, as a fresh build would give it."""
+        self.__dict__.pop("_schur_cholesky", None)
+        self.__dict__.pop("_steklov_explicit", None)
+        self.trace.forget_basis()
+
+
+
+def factorized_side(trace: GammaTrace, free: np.ndarray, K, route: str = "auto",
+                    keep_factor: bool = False) -> SideOperator:
+    """The SideOperator of an assembled stiffness K (free dofs, Γ last): one
+    :func:`gamma_factorization` (``keep_factor`` for a side that will solve: a contact scene's)."""
+    fac = schur.gamma_factorization(K, len(trace.gamma_dofs), route, trace.gamma.dim, keep_factor)
+    return SideOperator(trace, free, K, fac.schur, fac.solve, fac.steklov)
+
+
+def schur_by_solves(side: SideOperator) -> np.ndarray:
+    """Reference route: S = K_ΓΓ − K_ΓI K_II⁻¹ K_IΓ by a multi-right-hand-side solve."""
+    ng = len(side.trace.gamma_dofs)
+    K = side.stiffness
+    KII, KIG, KGG = K[:-ng, :-ng].tocsc(), K[:-ng, -ng:].toarray(), K[-ng:, -ng:].toarray()
+    return KGG - KIG.T @ spla.splu(KII).solve(KIG)

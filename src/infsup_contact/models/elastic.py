@@ -19,7 +19,7 @@ The Γ-reduced engine needs X_i = (A_i⁻¹)_nn, the normal-normal block of the 
 dofs of both components. The free dofs are ordered [interior, Γ tangential, Γ normal]: with
 both components of Γ last, the Schur complement onto the Γ normal dofs alone (eliminating the
 tangential ones with the interior) is exactly ((A⁻¹)_ΓΓ)_nn⁻¹ — block elimination — so
-:func:`~infsup_contact.models.schur.factorized_side` with the normal dofs as its Γ block gives
+:func:`~infsup_contact.models.contract.factorized_side` with the normal dofs as its Γ block gives
 the interface operator unchanged (tested against the nn block of the full Γ Schur inverse).
 """
 from __future__ import annotations
@@ -35,7 +35,7 @@ from ..discretization.segment.interface import SEGMENT
 from ..discretization.segment.meshes import DIRICHLET
 from .contract import MaterialParam, Model
 from .plane_strain import E_RANGE, NU_RANGE, check_modulus, check_nu, lame  # noqa: F401 (the model's material law)
-from .schur import SideOperator, factorized_side
+from .contract import SideOperator, factorized_side
 
 @dataclass(frozen=True)
 class ElasticSpace:
@@ -143,7 +143,7 @@ def side_operator(mesh, k: int, nu: float = 0.3, x_dirichlet: str = "dir", y_dir
                   route: str = "auto") -> ElasticSide:
     """One elastic body factorized once (E = 1), Γ dofs of both components last, the normal
     ones at the very end; its Γ Schur complement is that of the normal dofs (see the module
-    docstring), ``route`` as in :func:`~infsup_contact.models.schur.gamma_factorization`."""
+    docstring), ``route`` as in :func:`~infsup_contact.la.schur.gamma_factorization`."""
     nu = check_nu(nu)
     space = elastic_space(mesh, k, x_dirichlet, y_dirichlet)
     free, trace, n_t = free_order(space)

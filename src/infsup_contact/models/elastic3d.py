@@ -19,7 +19,7 @@ the z-component dofs on Γ only: the side's trace (``trace.fes``) is the z compo
 dofs are ordered [interior, Γ x, Γ y, Γ z]; eliminating the tangential Γ dofs with the interior
 (block elimination), the Schur complement onto the Γ z dofs is ((A⁻¹)_ΓΓ)_zz⁻¹, the zz block
 of the full Γ Steklov inverse, exactly as the 2D model does with its normal dofs
-(:mod:`.elastic`): :func:`~infsup_contact.models.schur.factorized_side` with the z dofs as its
+(:mod:`.elastic`): :func:`~infsup_contact.models.contract.factorized_side` with the z dofs as its
 Γ block gives the interface operator unchanged. **Sign**: A_1 u_1 = F_1 − B_1ᵀ λ,
 A_2 u_2 = F_2 + B_2ᵀ λ (:data:`~.contract.B_SIGN`), λ = −σ_zz on Γ (compression positive).
 
@@ -57,10 +57,10 @@ from ..discretization.segment.meshes import SYMMETRY_X, SYMMETRY_Y
 from ..errors import InputError
 from .contract import Model
 from .elastic import PARAMS
-from .membranes3d import ELEMENTS, FAMILIES_3D, FAR, LATERAL, face_of
+from .membranes3d import ELEMENTS, FAMILIES_3D, FAR, LATERAL
 from .membranes3d import subdomain_mesh as cube_mesh
 from .plane_strain import check_nu, lame
-from .schur import SideOperator, factorized_side
+from .contract import Body, SideOperator, factorized_side
 
 BETA_DIRICHLET = f"{FAR}|{LATERAL}|{SYMMETRY_X}|{SYMMETRY_Y}"
 """All of ∂Ω_i∖Γ (an NGSolve boundary regexp): where β_h's sides vanish, every component."""
@@ -69,11 +69,12 @@ CLAMPED = (BETA_DIRICHLET,) * 3
 
 
 def subdomain_mesh(family: str, n: int, side: int, *, element: str = "hex", width: float = 1.0,
-                   alpha: float = 0.2, seed: int = 0) -> ngsolve.Mesh:
+                   alpha: float = 0.2, seed: int = 0) -> Body:
     """The mesh of the 3D membranes (:func:`~infsup_contact.models.membranes3d.subdomain_mesh`,
     same arguments, families and checks) with the lateral faces x = 0 and y = 0 renamed
     :data:`SYMMETRY_X` and :data:`SYMMETRY_Y` (found by their vertices)."""
-    mesh = cube_mesh(family, n, side, element=element, width=width, alpha=alpha, seed=seed)
+    body = cube_mesh(family, n, side, element=element, width=width, alpha=alpha, seed=seed)
+    mesh = body.mesh
     names = {}
     for el in mesh.Elements(ngsolve.BND):
         if el.mat != LATERAL or el.index in names:
@@ -88,10 +89,7 @@ def subdomain_mesh(family: str, n: int, side: int, *, element: str = "hex", widt
     ngmesh = mesh.ngmesh
     for index, name in names.items():
         ngmesh.SetBCName(index, name)
-    out = ngsolve.Mesh(ngmesh)
-    if hasattr(mesh, "face_interface"):  # a triangulated face (perturbed / unstructured tetrahedra)
-        out.face_interface = mesh.face_interface
-    return out
+    return Body(ngsolve.Mesh(ngmesh), body.interface)
 
 
 def vector_space(mesh, k: int, supports=CLAMPED):
@@ -155,26 +153,26 @@ class Elastic3DSide(SideOperator):
     nu: float = 0.3
 
 
-def side_operator(mesh, k: int, nu: float = 0.3, supports=CLAMPED, route: str = "auto",
+def side_operator(body: Body, k: int, nu: float = 0.3, supports=CLAMPED, route: str = "auto",
                   gamma=None, keep_factor: bool = False) -> Elastic3DSide:
     """One elastic body factorized once (E = 1), Γ dofs of x, y, z last, the z ones at the very
     end; its Γ Schur complement is that of the z dofs (module docstring). ``route`` as in
-    :func:`~infsup_contact.models.schur.gamma_factorization`; ``gamma`` the interface (default
-    :func:`~infsup_contact.models.membranes3d.face_of` the mesh); ``keep_factor``: the
+    :func:`~infsup_contact.la.schur.gamma_factorization`; ``body`` the mesh and its Γ
+    (:func:`subdomain_mesh`), ``gamma`` another interface to take the trace on; ``keep_factor``: the
     factorization that gives S also serves the solves (a scene's side)."""
     nu = check_nu(nu)
-    fes = vector_space(mesh, k, supports)
-    free, trace, n_t = free_order(fes, face_of(mesh) if gamma is None else gamma)
+    fes = vector_space(body.mesh, k, supports)
+    free, trace, n_t = free_order(fes, body.interface if gamma is None else gamma)
     K_all = elastic_stiffness(fes, nu)
     base = factorized_side(trace, free, K_all[free][:, free].tocsc(), route, keep_factor)
     return Elastic3DSide(base.trace, base.free, base.stiffness, base.schur, base.solve, base.steklov,
                          fes=fes, n_tangential=n_t, stiffness_all=K_all, nu=nu)
 
 
-def scene_side(scene, mesh, k: int, nu: float = 0.3) -> Elastic3DSide:
+def scene_side(scene, body: Body, k: int, nu: float = 0.3) -> Elastic3DSide:
     """The side of a contact scene: its ``supports`` (x, y, z regexps) where it has them, else
     clamped on ∂Ω_i∖Γ."""
-    return side_operator(mesh, k, nu, getattr(scene, "supports", None) or CLAMPED, keep_factor=True)
+    return side_operator(body, k, nu, getattr(scene, "supports", None) or CLAMPED, keep_factor=True)
 
 
 def load(side: Elastic3DSide, scene, i: int):

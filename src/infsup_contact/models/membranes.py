@@ -1,7 +1,7 @@
 """The membranes model of the paper's Section 3: −c_i Δu_i = f_i, u_i = 0 on ∂Ω_i∖Γ.
 
 Its side operator is the Laplace stiffness K_i of continuous P_k (eq. (5.1)) with its Γ
-Schur complement (:mod:`infsup_contact.models.schur`); A_i = c_i K_i, so the material
+Schur complement (:mod:`infsup_contact.la.schur`); A_i = c_i K_i, so the material
 scale of side i is c_i.
 """
 from __future__ import annotations
@@ -13,7 +13,7 @@ import scipy.sparse as sp
 from ..discretization.segment.interface import SEGMENT
 from ..errors import check_prestress
 from .contract import OUTWARD_NORMAL_Y, MaterialParam, Model
-from .schur import SideOperator, factorized_side
+from .contract import SideOperator, factorized_side
 
 
 def displacement_space(mesh, k: int):

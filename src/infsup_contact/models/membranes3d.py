@@ -3,7 +3,7 @@ u_i = 0 on ∂Ω_i∖Γ, Γ = (0,1)²×{1} the contact face, b(v, μ) = ∫_Γ (
 
 The paper's model problem (Section 3) one dimension up: the side operator is the Laplace
 stiffness of continuous Q_k (hexahedra) or P_k (tetrahedra) with the Γ dofs last and its Γ
-Schur complement (:func:`~infsup_contact.models.schur.factorized_side`; the nested-dissection
+Schur complement (:func:`~infsup_contact.models.contract.factorized_side`; the nested-dissection
 ordering is graph based, so it serves 3D meshes as it is). Γ is the face
 :class:`~infsup_contact.discretization.face.square.Square`: the traces are tensor grids, the
 multiplier spaces tensor products (:mod:`infsup_contact.discretization.face.spaces.tensor`) on
@@ -48,9 +48,9 @@ from dataclasses import dataclass
 
 import scipy.sparse as sp
 
-from .contract import MaterialParam, Model
+from .contract import Body, MaterialParam, Model
 from .membranes import field, interpolate, laplace_stiffness
-from .schur import SideOperator, factorized_side
+from .contract import SideOperator, factorized_side
 
 ELEMENTS = ("hex", "tet")
 FAMILIES_3D = ("structured", "perturbed", "unstructured")
@@ -65,13 +65,13 @@ BETA_DIRICHLET = f"{FAR}|{LATERAL}"
 
 
 def subdomain_mesh(family: str, n: int, side: int, *, element: str = "hex", width: float = 1.0,
-                   alpha: float = 0.2, seed: int = 0) -> ngsolve.Mesh:
+                   alpha: float = 0.2, seed: int = 0) -> Body:
     """The mesh of Ω_side of a family: Γ named ``gamma``, the far face :data:`FAR`, the
     lateral faces :data:`LATERAL`. ``structured``: N × N × N cells; ``unstructured`` (tetrahedra,
     maxh = 1/N) and ``perturbed`` (the structured mesh, vertices moved by U(−αh, αh) per free
     direction, seeded; on hexahedra off Γ and in z only): :mod:`~infsup_contact.discretization.face.meshes`.
-    A tetrahedral mesh of those two families carries ``face_interface`` = the general
-    triangulated face (:func:`face_of`).
+    Returned with its Γ (:func:`interface_of`: the general triangulated face for the tetrahedra of
+    those two families).
 
     ``width``: the body's extent in x, (0, width) × (0, 1) × (side − 1, side) (the ``mapping`` of
     ``MakeStructured3DMesh`` scales x); 1 is the model's bodies. A narrower Ω2 covers Ω1's face
@@ -97,9 +97,7 @@ def subdomain_mesh(family: str, n: int, side: int, *, element: str = "hex", widt
     if family == "unstructured":
         if element not in UNSTRUCTURED_ELEMENTS:
             raise InputError("element", f"{', '.join(UNSTRUCTURED_ELEMENTS)} (the unstructured family)", got=element)
-        mesh = meshes3d.unstructured_box(int(n), side)
-        mesh.face_interface = TRIANGULATED
-        return mesh
+        return Body(meshes3d.unstructured_box(int(n), side), interface_of(family, element))
     mapping = None if width == 1.0 else (lambda x, y, z: (width * x, y, z))
     ngmesh = ngmeshes.MakeStructured3DMesh(hexes=element == "hex", nx=int(n), mapping=mapping).ngmesh
     if side == 2:
@@ -113,21 +111,16 @@ def subdomain_mesh(family: str, n: int, side: int, *, element: str = "hex", widt
     mesh = ngsolve.Mesh(ngmesh)
     if family == "perturbed":
         meshes3d.check_volume(mesh, f"family perturbed, N = {n}, side {side}, seed {seed}, alpha {alpha:g}")
-        if element == "tet":
-            mesh.face_interface = TRIANGULATED
-    return mesh
+    return Body(mesh, interface_of(family, element))
 
 
-def face_of(mesh):
-    """The interface of a mesh's Γ: the one its builder tagged (``face_interface``: a general
-    triangulation), else quadrilateral faces (hexahedra) or the structured triangles (tetrahedra)."""
-    tagged = getattr(mesh, "face_interface", None)
-    if tagged is not None:
-        return tagged
-    for el in mesh.Elements(ngsolve.BND):
-        if el.mat == SQUARE.boundary:
-            return SQUARE if len(el.vertices) == 4 else SQUARE_TRIG
-    raise InputError("mesh", f"boundary elements named {SQUARE.boundary!r}")
+def interface_of(family: str, element: str):
+    """Γ of a body of ``family`` with ``element`` cells: the structured tensor faces (rectangles on
+    hexahedra, their Kuhn triangles on tetrahedra), else, where the tetrahedra's face is no longer
+    a tensor grid (the perturbed and unstructured families), the general triangulated face."""
+    if element == "tet" and family != "structured":
+        return TRIANGULATED
+    return SQUARE if element == "hex" else SQUARE_TRIG
 
 
 def displacement_space(mesh, k: int, dirichlet: str = BETA_DIRICHLET):
@@ -143,17 +136,17 @@ class MembraneSide(SideOperator):
     stiffness_all: sp.csr_matrix | None = None
 
 
-def side_operator(mesh, k: int, route: str = "auto", dirichlet: str = BETA_DIRICHLET, gamma=None,
+def side_operator(body: Body, k: int, route: str = "auto", dirichlet: str = BETA_DIRICHLET, gamma=None,
                   keep_factor: bool = False) -> MembraneSide:
     """Factorize the Laplace stiffness K_i of Q_k / P_k once, Γ dofs last (c = 1), u_i = 0 on
     ``dirichlet`` (default all of ∂Ω_i∖Γ). With natural lateral faces the Γ dofs on ∂Γ are free:
     the trace spans continuous Q_k / P_k on the partition, ∂Γ included.
 
-    ``gamma``: the interface whose trace is taken (default :func:`face_of` the mesh, the unit
-    face; a narrower body passes ``Square(width=...)``); ``keep_factor``: the factorization that
+    ``body``: the mesh and its Γ (:func:`subdomain_mesh`); ``gamma``: another interface whose trace
+    is taken (a narrower body passes ``Square(width=...)``); ``keep_factor``: the factorization that
     gives S also serves the solves (:func:`~.schur.gamma_factorization`; a scene's side)."""
-    fes = displacement_space(mesh, k, dirichlet)
-    trace = (face_of(mesh) if gamma is None else gamma).trace(fes)
+    fes = displacement_space(body.mesh, k, dirichlet)
+    trace = (body.interface if gamma is None else gamma).trace(fes)
     free_mask = np.array(fes.FreeDofs(), dtype=bool)
     is_gamma = np.zeros(fes.ndof, dtype=bool)
     is_gamma[trace.gamma_dofs] = True
@@ -164,10 +157,10 @@ def side_operator(mesh, k: int, route: str = "auto", dirichlet: str = BETA_DIRIC
                         stiffness_all=K_all)
 
 
-def scene_side(scene, mesh, k: int) -> MembraneSide:
+def scene_side(scene, body: Body, k: int) -> MembraneSide:
     """The side of a contact scene: u_i prescribed on the scene's ``supports`` (an NGSolve
     boundary regexp; the face patch test: the far face only), else on all of ∂Ω_i∖Γ."""
-    return side_operator(mesh, k, dirichlet=getattr(scene, "supports", None) or BETA_DIRICHLET, keep_factor=True)
+    return side_operator(body, k, dirichlet=getattr(scene, "supports", None) or BETA_DIRICHLET, keep_factor=True)
 
 
 def load(side: MembraneSide, scene, i: int):

@@ -28,7 +28,7 @@ from .pdas import PdasResult, solve_pdas
 from ..discretization.gamma.coupling import coupling_matrix
 from ..models import DEFAULT_MODEL
 from ..models.contract import B_SIGN
-from ..models.schur import interface_operator
+from .interface_operator import interface_operator
 
 
 @dataclass
@@ -91,7 +91,7 @@ def contact_qp(sides, Bs, F, c=(1.0, 1.0)):
     Parameters
     ----------
     sides : sequence of two objects with ``stiffness`` (csc, free dofs, Γ last) and
-        ``trace.gamma_dofs`` — :class:`~infsup_contact.models.schur.SideOperator`.
+        ``trace.gamma_dofs`` — :class:`~infsup_contact.models.contract.SideOperator`.
     Bs : two dense (m, n_Γ,i) coupling matrices B1, B2.
     F : two load vectors on the free dofs.
     c : (c1, c2).
@@ -183,7 +183,8 @@ class ContactPair:
 
     Attributes
     ----------
-    meshes : tuple of ngsolve.Mesh
+    meshes : tuple of ngsolve.Mesh or Body
+        What the model's ``side_operator`` takes (a 3D model's builder returns a Body: mesh and Γ).
     sides : list of SideOperator
     F : list of ndarray
         Loads on the free dofs of each side.

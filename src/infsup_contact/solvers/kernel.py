@@ -52,7 +52,7 @@ import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
 
-from . import bottom
+from ..la import bottom
 
 MARGIN_DECADES = 1.0
 """A kernel decision whose margin from η is smaller than this many decades is ``close``."""
@@ -70,7 +70,7 @@ KERNEL_CRITERION = (
     "eta in decades; kernel_decision = close when below 1 decade (claims resting on it are "
     "INCONCLUSIVE), else clear; above dim M = 1500 the bottom singular values come from block inverse "
     "iteration on W^T W, measured as ||W v|| and certified by a Cholesky factorization of "
-    "W^T W - tau I + smax^2 Z Z^T (Weyl; solvers/bottom.py)")
+    "W^T W - tau I + smax^2 Z Z^T (Weyl; la/bottom.py)")
 """The rule of :func:`coupling_kernel`, as stated in ``infsup-contact beta --help`` and the README."""
 CLEAR, CLOSE = "clear", "close"
 
@@ -101,7 +101,7 @@ class KernelDecision:
         exceeded (``kernel_check`` reports ``below_structural`` then).
     vectors : ndarray or None
         an orthonormal basis (m × dim) of the kernel in W's column coordinates, where the route
-        computed one (:func:`bottom_kernel`; the deflation of :func:`.bottom.bottom_pencil`).
+        computed one (:func:`bottom_kernel`; the deflation of :func:`~infsup_contact.la.bottom.bottom_pencil`).
     """
 
     dim: int
@@ -178,16 +178,16 @@ round-off of WᵀW, max(rows, m) ε σ_max²; below it the dense SVD decides."""
 
 
 def bottom_kernel(W, proven: int = 0, entry_error: float = 0.0) -> KernelDecision:
-    """:func:`coupling_kernel` for W too large for a dense SVD (dim M > :data:`.bottom.DENSE_MAX_M`):
+    """:func:`coupling_kernel` for W too large for a dense SVD (dim M > :data:`~infsup_contact.la.bottom.DENSE_MAX_M`):
     the same η, the same count and the same margin, from the bottom singular values only.
 
     1. The singular values <= η, their right vectors and σ_{d+1} by block inverse subspace
-       iteration (:func:`.bottom.bottom_singular`; block p = proven + :data:`BLOCK_EXTRA`,
+       iteration (:func:`~infsup_contact.la.bottom.bottom_singular`; block p = proven + :data:`BLOCK_EXTRA`,
        doubled while too small, on one factorization). Each counted value is ‖W v‖ for an
        orthonormal block, an upper bound of σ_i(W): the d modes counted are certainly <= η.
     2. Nothing was missed below σ_{d+1}: WᵀW has at most d eigenvalues below τ = σ_{d+1}²/2,
        certified by one Cholesky factorization of WᵀW − τI + σ_max² Z Zᵀ with the d counted
-       vectors Z (:func:`.bottom.at_most_below`, Weyl's inequality); with the d Ritz values
+       vectors Z (:func:`~infsup_contact.la.bottom.at_most_below`, Weyl's inequality); with the d Ritz values
        <= η < τ, exactly d.
     Where either step fails (a count that differs, proven modes above η, τ within
     :data:`CERTIFY_FLOOR` of WᵀW's round-off) the dense SVD decides, vectors included.

@@ -9,7 +9,7 @@ with KKT conditions A u = F + Bᵀ λ, λ ≥ 0, B u ≥ 0, λ∘(B u) = 0 (the 
 data a general QP solver gets — (A, B, F), nothing about meshes or sides — and uses only one
 structural fact: B touches few unknowns (the Γ dofs, read off B's sparsity). With those
 unknowns Γ ordered last, one factorization of A gives X = (A⁻¹)_ΓΓ
-(:func:`~infsup_contact.models.schur.gamma_factorization`), the LCP g = g0 + K λ with K = B_Γ X B_Γᵀ and
+(:func:`~infsup_contact.la.schur.gamma_factorization`), the LCP g = g0 + K λ with K = B_Γ X B_Γᵀ and
 g0 = B A⁻¹ F is solved by :func:`~infsup_contact.solvers.pdas.solve_pdas` on the small dense multiplier space, and
 u = A⁻¹(F + Bᵀ λ) is recovered with the same factorization.
 
@@ -27,7 +27,7 @@ from scipy.sparse.csgraph import connected_components
 
 from .kkt import _check_kkt
 from .pdas import PdasResult, solve_pdas
-from ..models.schur import gamma_factorization
+from ..la.schur import gamma_factorization
 
 __all__ = ["ReducedQpSolution", "solve_reduced_qp", "touched_columns"]
 
@@ -46,7 +46,7 @@ class ReducedQpSolution:
     n_gamma : int
         Number of unknowns B touches.
     route : str
-        Route of the factorization (:func:`~infsup_contact.models.schur.gamma_factorization`).
+        Route of the factorization (:func:`~infsup_contact.la.schur.gamma_factorization`).
     """
 
     u: np.ndarray
@@ -75,7 +75,7 @@ def solve_reduced_qp(A, B, F, *, route: str = "auto", **pdas_options) -> Reduced
     B : (m, n) sparse
     F : (n,) array_like
     route : str
-        Factorization route of :func:`~infsup_contact.models.schur.gamma_factorization`.
+        Factorization route of :func:`~infsup_contact.la.schur.gamma_factorization`.
     **pdas_options
         Passed to :func:`~infsup_contact.solvers.pdas.solve_pdas` (``max_iter``, ``tol``, ``kernel_rtol``).
 

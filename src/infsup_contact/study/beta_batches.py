@@ -14,7 +14,7 @@ import pandas as pd
 
 from ..models import make_model
 from ..models.contract import Model
-from ..models.side_cache import SideCache
+from ..solvers.side_cache import SideCache
 from ..solvers.infsup import NORMS, beta_rows_all
 
 

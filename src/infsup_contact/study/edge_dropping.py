@@ -74,8 +74,8 @@ from ..discretization.face.square import SQUARE, Square
 from ..discretization.face.tensor_grid import TensorPartition
 from ..errors import InputError
 from ..models import model_of_dim
-from ..models.schur import combine_terms, interface_terms
-from ..solvers.infsup import gram_factor, spectrum
+from ..solvers.interface_operator import combine_terms, interface_terms
+from ..solvers.spectra import gram_factor, spectrum
 
 THETAS = (1.0, 0.5, 0.25, 0.1, 0.05, 0.01, 0.001)
 """The covered fractions of the last column swept by default (issue 28)."""
@@ -173,7 +173,7 @@ def interface_operator(face: ClippedFace, sides) -> np.ndarray:
     """S = Σ_i B_i X_i B_iᵀ (c1 = c2 = 1), X_i = (A_i⁻¹)_ΓΓ of the NGSolve side operators
     (:func:`side_pair`), B_i = ∫_Γ μ_j φ_d against the Γ basis of side i
     (:meth:`Square.trace_basis`, :func:`couplings`); the engine's
-    :func:`~infsup_contact.models.schur.interface_terms` and ``combine_terms``."""
+    :func:`~infsup_contact.solvers.interface_operator.interface_terms` and ``combine_terms``."""
     s = max(face.space.sx.degree, face.space.sy.degree)
     B = [couplings(face, side.trace.partition, lambda p, t=side.trace: t.gamma.trace_basis(t, p),
                    side.trace.fes.globalorder + s) for side in sides]

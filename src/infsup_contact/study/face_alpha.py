@@ -120,7 +120,7 @@ def sweep(ns=(4, 8), alphas=ALPHAS, elements=ELEMENTS, k: int = 2, norms=("H",),
     the first, :func:`face_models`; ``cell`` its --element, default the one whose face cells
     fit each element, :func:`element_of`)."""
     from ..models import make_model
-    from ..models.side_cache import SideCache
+    from ..solvers.side_cache import SideCache
 
     model = face_models()[0] if model is None else model
     from ..solvers.infsup import beta_rows_all

@@ -88,7 +88,7 @@ def family_kernels(pairs, ks=(1, 2), cases=None, elements=None, model: str | Non
     registered face space with a count; ``model`` default: the first registered 3D model
     (:func:`~.face_alpha.face_models`); ``elements`` default: all of its elements."""
     from ..models import MODELS, make_model
-    from ..models.side_cache import SideCache
+    from ..solvers.side_cache import SideCache
     from ..solvers.infsup import beta_rows_all
     from .face_alpha import face_models
 

@@ -1,7 +1,7 @@
 """Verdicts no machine can flip: the same checks under every code path of both BLAS libraries.
 
 OpenBLAS (numpy's and scipy's BLAS) and MKL (PARDISO's Schur complements on the 3D face,
-:mod:`infsup_contact.models.pardiso`; ``cblas_dtrsm``) pick their kernels by CPU, so round-off
+:mod:`infsup_contact.la.pardiso`; ``cblas_dtrsm``) pick their kernels by CPU, so round-off
 differs between machines. The kernel dimension and every verdict must not: they rest on
 decisions with a stated margin (:mod:`infsup_contact.solvers.kernel`). :data:`PATHS` names the
 code paths one CPU can be made to take — OpenBLAS's core types (``OPENBLAS_CORETYPE``) and
@@ -143,7 +143,7 @@ SWEEP_N = (4, 8)
 """Matching meshes of the β sweep (with the union partition of the 17:16 pair)."""
 FACE_SWEEP = {1: ((14, 14), (14, 16)), 2: ((7, 7), (7, 8))}
 """Hexahedral pairs of the face sweep (membranes3d) by k: the smallest whose sides' Schur
-complements come from PARDISO (n · n_Γ above :data:`~infsup_contact.models.schur.SOLVES_MAX_WORK`),
+complements come from PARDISO (n · n_Γ above :data:`~infsup_contact.la.schur.SOLVES_MAX_WORK`),
 a matching and a non-matching pair each; G_h = Ω2's partition only (the union of the
 non-matching pairs, kernels of 336 to 448 modes, would take 4 of the sweep's 6 s)."""
 VERDICT_N = (4, 8, 16)
@@ -216,7 +216,7 @@ def openblas_corenames() -> dict:
 
 PROBE_N, PROBE_N_GAMMA = 1000, 100
 """Size of the probe's SPD matrix and of its Schur block (:func:`mkl_probe`): PARDISO's
-supernodal route (interior far above :data:`~infsup_contact.models.pardiso.MIN_INTERIOR`)."""
+supernodal route (interior far above :data:`~infsup_contact.la.pardiso.MIN_INTERIOR`)."""
 
 
 def mkl_probe() -> dict:
@@ -227,7 +227,7 @@ def mkl_probe() -> dict:
     dict
         ``branch`` (:func:`~infsup_contact.la.mkl.cbwr_branch`: the one ``MKL_CBWR`` asked for
         when MKL took it), ``auto_branch``, ``digest`` (SHA-256 of PARDISO's Schur complement
-        :func:`~infsup_contact.models.pardiso.gamma_schur` and a solve of its full factorization
+        :func:`~infsup_contact.la.pardiso.gamma_schur` and a solve of its full factorization
         on a fixed random SPD matrix of size :data:`PROBE_N`: equal digests are equal digits),
         ``s00`` (S's first entry, all digits)
         and ``libraries`` (the MKL libraries loaded, /proc/self/maps: ``libmkl_def`` is the
@@ -236,7 +236,7 @@ def mkl_probe() -> dict:
     import scipy.sparse as sp
 
     from ..la import mkl
-    from ..models.pardiso import Factor, gamma_schur
+    from ..la.pardiso import Factor, gamma_schur
 
     if not mkl.available():
         return {}

@@ -64,7 +64,7 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from ..models import pardiso
+from ..la import pardiso
 from .readers import SystemFileError
 
 TGV_RATIO = 1e15

@@ -5,7 +5,7 @@ multiplier norm. Three routes, chosen by the sizes (:func:`choose_route`):
 
 ``gamma-dense``
     the dofs B touches (Γ) are few: they are ordered last and one sparse factorization of
-    A gives X = (A⁻¹)_ΓΓ (:func:`infsup_contact.models.schur.gamma_factorization`, the
+    A gives X = (A⁻¹)_ΓΓ (:func:`infsup_contact.la.schur.gamma_factorization`, the
     suite's own Γ-last machinery), S = B_Γ X B_Γᵀ, then the dense pencil
     ``scipy.linalg.eigh(S, G)``;
 ``solves-dense``
@@ -50,8 +50,8 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from .. import resources
-from ..models.schur import gamma_factorization
-from ..solvers.bottom import SEED, lam_max
+from ..la.schur import gamma_factorization
+from ..la.bottom import SEED, lam_max
 from ..solvers.kernel import (MARGIN_DECADES, KernelDecision, bottom_kernel, coupling_kernel,
                               pencil_cross_check)
 from .roundoff import EntryRoundoff, entry_error_bound, entry_roundoff
@@ -73,7 +73,7 @@ R5.2, k = 2, N = 12 face export, the same λ_{d+1} to 15 digits)."""
 SHIFT = 1e-8
 """δ of the shift-invert route relative to σ_max(W)², the Jacobi scale of the pencil."""
 NCV_MIN = 40
-"""Fewest Lanczos vectors of the shift-invert route (as :func:`~infsup_contact.solvers.bottom.bottom_pencil`:
+"""Fewest Lanczos vectors of the shift-invert route (as :func:`~infsup_contact.la.bottom.bottom_pencil`:
 the bottom of an H^{-1/2} pencil is clustered)."""
 
 ROUTES = ("auto", "gamma-dense", "solves-dense", "shift-invert")
@@ -303,7 +303,7 @@ def _shift_invert(A, B, G, n_values, smax2, Z=None):
     Jacobi scale that sets the shift δ. Returns (d zeros then the eigenvalues found, ascending;
     the residual of those; timings).
 
-    The kernel is deflated as :func:`infsup_contact.solvers.bottom.bottom_pencil` deflates it,
+    The kernel is deflated as :func:`infsup_contact.la.bottom.bottom_pencil` deflates it,
     in the limit γ → ∞: there Z is moved to λ = γ by S' = S + γ G Z (ZᵀGZ)⁻¹ ZᵀG; here the
     operator (S + δG)⁻¹ G is followed by the G-orthogonal projector P = I − Z (ZᵀGZ)⁻¹ ZᵀG.
     Z and its G-orthogonal complement are invariant subspaces of (S + δG)⁻¹ G (S Z = 0), so
@@ -365,9 +365,9 @@ def _shift_invert(A, B, G, n_values, smax2, Z=None):
 
 def _pencil_top(schur, Gs) -> float:
     """λ_max of (S, G), ``schur(x)`` = S x, by Lanczos to
-    :data:`~infsup_contact.solvers.bottom.LAM_MAX_RTOL` (a round-off level needs no more), G⁻¹
+    :data:`~infsup_contact.la.bottom.LAM_MAX_RTOL` (a round-off level needs no more), G⁻¹
     from one sparse LU of G."""
-    from ..solvers.bottom import LAM_MAX_RTOL
+    from ..la.bottom import LAM_MAX_RTOL
 
     S_op = spla.LinearOperator(Gs.shape, matvec=schur, dtype=float)
     luG = spla.splu(sp.csc_matrix(Gs))

@@ -42,7 +42,7 @@ def _suite_parts(case, k, n1, n2, family, multiplier_mesh, model, **mesh_kwargs)
     from ..discretization.spaces import registry
     from ..discretization.gamma.coupling import coupling_matrix
     from ..models.membranes import MEMBRANES
-    from ..models.side_cache import SideCache
+    from ..solvers.side_cache import SideCache
 
     sides = SideCache().pair(MEMBRANES if model is None else model, family, k, n1, n2, **mesh_kwargs)
     gamma = sides[0].trace.gamma

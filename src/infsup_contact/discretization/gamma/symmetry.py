@@ -4,7 +4,7 @@ A map T of Γ onto itself that maps the cells of G_h onto cells (the point refle
 face, its transposition, the reflection of the segment) maps a symmetric construction's basis onto
 itself. The permutation is found from the values at sample points and checked there; the callers
 use it to split the face's H Gram series (:mod:`.face.symmetry`) and the large route's
-pencils and kernel decisions (:mod:`infsup_contact.solvers.reflection`).
+pencils and kernel decisions (:mod:`infsup_contact.la.reflection`).
 """
 from __future__ import annotations
 

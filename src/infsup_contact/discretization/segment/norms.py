@@ -23,7 +23,7 @@ from ...errors import InputError
 from .logkernel import gram_h_logkernel
 from .multipliers import SegmentSpace, local_monomial_coefficients, local_shapes
 from ..gamma.quadrature import gauss_legendre_01
-from ..richardson import extrapolate
+from ...la.richardson import extrapolate
 
 NORMS = ("H", "L2")
 

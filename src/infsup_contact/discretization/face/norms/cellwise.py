@@ -37,13 +37,14 @@ import scipy.sparse as sp
 from ....errors import InputError
 from ....la.threaded import symmetric_part, symmetric_sandwich
 from ...gamma.coupling import weighted_values
-from ... import face_parity
+from ....la import face_parity
+from . import parity_bases
 from ...gamma.symmetry import axis_reflections, isotypic_bases
 from .tensor import EXP_SUM_MIN_DIM, default_cap, extrapolated, partial_gram, partial_gram_blocks, start_level
 from ..spaces.tensor import FaceSpace
 from ...segment.multipliers import make_space
 from ...segment.norms import gram_by_norm, gram_l2
-from ...richardson import BlockOps
+from ....la.richardson import BlockOps
 from ...gamma.quadrature import gauss_legendre
 
 #: Largest |μ − R P| / max|μ| accepted at the check points (round-off of the projection).
@@ -182,7 +183,7 @@ def gram_h_cellwise(space, rtol: float = 1e-6, n_start: int | None = None, n_cap
     n_cap = default_cap(P.dim) if n_cap is None else n_cap
 
     blocked = _parity_route(space, R, P)
-    if blocked is not None:  # the four parity blocks of the axis reflections (:mod:`.face_parity`)
+    if blocked is not None:  # the four parity blocks of the axis reflections (:mod:`infsup_contact.la.face_parity`)
         parities, Rs, bases = blocked
         G, info = extrapolated(lambda n: face_parity.sandwiched(Rs, piece_partial_gram(P, n, parities)),
                                p, n0, n_cap, rtol, ops=BlockOps)
@@ -200,7 +201,7 @@ def _parity_route(space, R, P):
     bases are symmetric under both axis reflections with R intertwining them, else None."""
     if P.dim <= EXP_SUM_MIN_DIM:
         return None
-    parities = face_parity.tensor_parities(P)
+    parities = parity_bases.tensor_parities(P)
     if parities is None:
         return None
     pis = axis_reflections(space, piece_rule(P.breakpoints, space.piece_degree + 1)[0])

@@ -23,17 +23,18 @@ import numpy as np
 
 from ....errors import InputError
 from ....la.threaded import symmetric_pairs
-from ... import face_parity
-from ...exponential_sum import inverse_sqrt
+from ....la import face_parity
+from . import parity_bases
+from ....la.exponential_sum import inverse_sqrt
 from ...segment.norms import N_MAX_CAP, gram_by_norm, gram_l2, sine_coefficients
-from ...richardson import BlockOps, _norm2, extrapolate
+from ....la.richardson import BlockOps, _norm2, extrapolate
 
 #: Rows of the weight matrix W[m, n] = 1/(π√(m² + n²)) handled at once (memory ~ chunk · n_max).
 _CHUNK = 512
 EXP_SUM_MIN_DIM = 1500
 """dim M above which :func:`partial_gram` takes the weight as an exponential sum
-(:mod:`.exponential_sum`): n_max · r (dim M^x² + dim M^y²) + r (dim M)² operations with r ≈ 260
-terms instead of n_max² dim M^y² + n_max (dim M)²; the same as :data:`.bottom.DENSE_MAX_M`, so
+(:mod:`infsup_contact.la.exponential_sum`): n_max · r (dim M^x² + dim M^y²) + r (dim M)² operations with r ≈ 260
+terms instead of n_max² dim M^y² + n_max (dim M)²; the same as :data:`~infsup_contact.la.bottom.DENSE_MAX_M`, so
 the default DAG's Grams (all below it) stay the direct sums, bit for bit."""
 EXP_SUM_START = 4
 """Factor of the first level on the exponential-sum route for a slow tail (:func:`start_level`):
@@ -86,7 +87,7 @@ def partial_gram(space, n_max: int, aspect: float = 1.0) -> np.ndarray:
 
 def _separable_sum(A: np.ndarray, B: np.ndarray, m: np.ndarray, n: np.ndarray, aspect: float) -> np.ndarray:
     """A W Bᵀ for W[m, n] = a / (π√((m/a)² + n²)) (A's columns at the indices ``m``, B's at ``n``) written as Σ_j w_j e^{−a_j (m/a)²} e^{−a_j n²}
-    (:func:`.exponential_sum.inverse_sqrt`, relative accuracy :data:`EXP_SUM_RTOL`):
+    (:func:`~infsup_contact.la.exponential_sum.inverse_sqrt`, relative accuracy :data:`EXP_SUM_RTOL`):
     (A E_x) diag(a w / π) (B E_y)ᵀ, never forming W (B E_y is A E_x itself when the two
     directions are the same: one product of dim² · n_max · r fewer).
 
@@ -187,7 +188,7 @@ def gram_h_face(space, rtol: float = 1e-6, n_start: int | None = None, n_cap: in
     if not aspect > 0:
         raise InputError("aspect", "a positive float", got=aspect)
     n_cap = default_cap(space.dim) if n_cap is None else n_cap
-    parities = face_parity.tensor_parities(space) if aspect == 1.0 and space.dim > EXP_SUM_MIN_DIM else None
+    parities = parity_bases.tensor_parities(space) if aspect == 1.0 and space.dim > EXP_SUM_MIN_DIM else None
     if parities is None:
         return extrapolated(lambda n: partial_gram(space, n, aspect), p, n0, n_cap, rtol)
     blocks, info = extrapolated(lambda n: partial_gram_blocks(space, n, parities), p, n0, n_cap, rtol,
@@ -197,8 +198,8 @@ def gram_h_face(space, rtol: float = 1e-6, n_start: int | None = None, n_cap: in
 
 def partial_gram_blocks(space, n_max: int, parities) -> list:
     """:func:`partial_gram` (exponential-sum route) in the four parity blocks of the axis
-    reflections (:func:`.face_parity.partial_gram_blocks`)."""
-    return face_parity.partial_gram_blocks(space, n_max, parities,
+    reflections (:func:`.parity_bases.partial_gram_blocks`)."""
+    return parity_bases.partial_gram_blocks(space, n_max, parities,
                                            lambda A, B, m, n: _separable_sum(A, B, m, n, 1.0))
 
 

@@ -34,7 +34,7 @@ from ..quadrature import triangles_rule
 from ..symmetry import ReflectedGram, reflection, transposition
 from ..spaces.triangles import lagrange_barycentric
 from ...segment.norms import N_MAX_CAP, gram_by_norm
-from ...richardson import _norm2
+from ....la.richardson import _norm2
 
 #: Values (float64) per working array of :func:`sine_coefficients_chunk` (2^23: 64 MB): its
 #: output (dim × rows of m × n_max) and its stacked U (:func:`chunk_rows`).

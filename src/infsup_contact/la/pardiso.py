@@ -3,7 +3,7 @@
 For an SPD matrix A whose last n_Γ unknowns are Γ, PARDISO eliminates the interior and
 returns S = A_ΓΓ − A_ΓI A_II⁻¹ A_IΓ as a dense matrix (``iparm[35]``, the Schur rows marked
 in ``perm``) after one supernodal, BLAS-3 factorization of A_II in its own nested-dissection
-order (METIS). It is the Γ-last Schur complement of :mod:`infsup_contact.models.schur`
+order (METIS). It is the Γ-last Schur complement of :mod:`infsup_contact.la.schur`
 computed by a sparse direct solver built for it: on a 3D body (Q2 hexahedra, 254,016 dofs,
 n_Γ = 3,969) it takes 23 s and 2.8 GB, where SuperLU with the Γ-last nested dissection needs
 minutes and tens of GB (``results/benchmarks``). :func:`gamma_schur` frees the interior factor
@@ -27,7 +27,7 @@ import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
 
-from ..la.mkl import mkl_rt
+from .mkl import mkl_rt
 
 _P = ctypes.POINTER
 _I32 = ctypes.c_int32

@@ -1,6 +1,6 @@
 """Richardson extrapolation of a series of Gram matrices in its truncation n_max, and the
-relative step in the Gram's own metric that stops it and bounds its error (the segment's sine series, :mod:`.segment.norms`; the face's double
-series, :mod:`.face.norms.tensor`, whole or in the parity blocks of :mod:`.face_parity`)."""
+relative step in the Gram's own metric that stops it and bounds its error (the segment's sine series, :mod:`.norms`; the face's double
+series, :mod:`infsup_contact.discretization.face.norms.tensor`, whole or in the parity blocks of :mod:`.face_parity`)."""
 from __future__ import annotations
 
 import numpy as np
@@ -9,7 +9,7 @@ import scipy.sparse.linalg as spla
 from scipy.linalg import lapack
 
 from ..errors import InputError
-from ..la.threaded import elementwise
+from .threaded import elementwise
 
 
 def extrapolate(partial, p: float, n0: int, n_cap: int, rtol: float, ops=None) -> tuple[np.ndarray, dict]:
@@ -17,8 +17,8 @@ def extrapolate(partial, p: float, n0: int, n_cap: int, rtol: float, ops=None) -
     sums S(n) = ``partial(n)`` at n = n0, 2n0, 4n0, ... (asked in increasing n), extrapolated
     R(n) = S(2n) + (S(2n) − S(n)) / (2^p − 1) and once more for a term n^{−(p+1)}
     (:func:`romberg_row`, :data:`STAGES`), until the stated error :func:`lookahead_bound`
-    of the newest R is ≤ rtol or 2n would pass ``n_cap`` (:func:`~.segment.norms.gram_h`; the face's
-    double series, :mod:`.face.norms.tensor`).
+    of the newest R is ≤ rtol or 2n would pass ``n_cap`` (:func:`~.norms.gram_h`; the face's
+    double series, :mod:`infsup_contact.discretization.face.norms.tensor`).
 
     The steps are measured in the Gram's own metric, δ = ‖R^{−1/2} (R(2n) − R(n)) R^{−1/2}‖₂
     (:func:`relative_step`), not against ‖R‖₂: (1 − ε) G ≤ R ≤ (1 + ε) G in the Loewner order

@@ -37,7 +37,7 @@ from scipy.linalg import blas, lapack
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from ..la import mkl
+from . import mkl
 
 DENSE_MAX_M = 1500
 """Largest dim M decided and solved densely (SVD of W, dense pencil); above it, this module.
@@ -257,7 +257,7 @@ def inverse_standard_form(R: np.ndarray, L: np.ndarray) -> np.ndarray:
 def bottom_pencil(S: np.ndarray, L: np.ndarray, n_values: int, Z: np.ndarray | None = None,
                   s_factor: np.ndarray | None = None) -> BottomPencil:
     """The n_values smallest eigenvalues of S x = λ G x, G = L Lᵀ (L lower triangular, zeros
-    above its diagonal: :func:`~.infsup.gram_factor`'s), above the kernel span Z.
+    above its diagonal: :func:`~infsup_contact.solvers.spectra.gram_factor`'s), above the kernel span Z.
 
     ``Z`` (m × d, S Z ≈ 0) is moved to λ = γ = 2 λ_max: the G-orthogonal complement of Z is
     invariant, so S' = S + γ G Z (ZᵀGZ)⁻¹ ZᵀG keeps the pencil's other eigenvalues, and it is

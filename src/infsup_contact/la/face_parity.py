@@ -1,10 +1,10 @@
 """The face's H Gram series in the four parity blocks of the axis reflections (issue 28, large N).
 
-Where both 1D factors of a tensor space M^x ⊗ M^y (:mod:`.face.spaces.tensor`; the piece space P of a
-cellwise one, :mod:`.face.norms.cellwise`) are symmetric under x → 1 − x, i.e. the reflection
-maps the basis onto itself (:func:`axis_parity`, found and checked as the face's reflections,
-:func:`~.gamma.symmetry.induced_permutation`), their bases split into even and odd functions,
-Q^x_e and Q^x_o (:func:`~.gamma.symmetry.isotypic_bases`). Because
+Where both 1D factors of a tensor space M^x ⊗ M^y (:mod:`infsup_contact.discretization.face.spaces.tensor`; the piece space P of a
+cellwise one, :mod:`infsup_contact.discretization.face.norms.cellwise`) are symmetric under x → 1 − x, i.e. the reflection
+maps the basis onto itself (:func:`~infsup_contact.discretization.face_parity_bases.axis_parity`, found and checked as the face's reflections,
+:func:`~infsup_contact.discretization.gamma.symmetry.induced_permutation`), their bases split into even and odd functions,
+Q^x_e and Q^x_o (:func:`~infsup_contact.discretization.gamma.symmetry.isotypic_bases`). Because
 sin(mπ(1 − x)) = (−1)^{m+1} sin(mπx), an even function has sine coefficients at odd m only, an
 odd one at even m only. So the double series
 
@@ -12,7 +12,7 @@ odd one at even m only. So the double series
 
 is block diagonal in the four bases T_c = Q^x_{p} ⊗ Q^y_{q} (c = p + 2q, bit set = odd), and
 block c is the same separable sum over the odd or even m and n' alone, of the coefficients
-(Q^x_p)ᵀ c^x and (Q^y_q)ᵀ c^y (:func:`partial_gram_blocks`). Each block has about a quarter of
+(Q^x_p)ᵀ c^x and (Q^y_q)ᵀ c^y (:func:`parity_blocks`). Each block has about a quarter of
 the dimension: the separable product (dim² r per block), its reordering, the Richardson steps and
 the spectral norms that stop them (:class:`~.richardson.BlockOps`) cost about a quarter of the whole matrix's, and a cellwise
 space's sandwich R S_P Rᵀ becomes R̃_c S_P,c R̃_cᵀ with R̃_c = Q_cᵀ R T_c (Q_c the multiplier
@@ -27,32 +27,10 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
-from ..la.threaded import signed_gather_sum, symmetric_pairs, symmetric_part, symmetric_sandwich
-from .gamma.symmetry import induced_permutation, isotypic_bases, reflect
-from .segment.norms import sine_coefficients
-from .gamma.quadrature import gauss_legendre
+from .threaded import signed_gather_sum, symmetric_pairs, symmetric_part, symmetric_sandwich
 
 INTERTWINE_RTOL = 1e-10
 """Largest ‖Q_aᵀ R T_b‖_F / ‖R‖_F (a ≠ b) for which R counts as intertwining the reflections."""
-
-
-def axis_parity(space) -> tuple | None:
-    """(Q_e, Q_o) of a 1D space (:class:`~.segment.multipliers.SegmentSpace`) under x → 1 − x,
-    checked at 4 Gauss points per interval, or None where the reflection does not map its basis."""
-    t, _ = gauss_legendre(4)
-    g = np.asarray(space.breakpoints, float)
-    x = (0.5 * (g[:-1, None] + g[1:, None]) + 0.5 * (g[1:, None] - g[:-1, None]) * t).ravel()
-    pi = induced_permutation(space, x, reflect())
-    return None if pi is None else isotypic_bases((pi,))
-
-
-def tensor_parities(space) -> tuple | None:
-    """((Q^x_e, Q^x_o), (Q^y_e, Q^y_o)) of a tensor space, or None (a factor not symmetric or
-    with an empty parity)."""
-    out = tuple(axis_parity(f) for f in space.factors)
-    if any(q is None or min(Q.shape[1] for Q in q) < 1 for q in out):
-        return None
-    return out
 
 
 def tensor_bases(parities) -> list:
@@ -61,14 +39,11 @@ def tensor_bases(parities) -> list:
     return [sp.kron(qx[c & 1], qy[c >> 1], format="csr") for c in range(4)]
 
 
-def partial_gram_blocks(space, n_max: int, parities, separable_sum) -> list:
-    """[S_c(n_max)], c = 0..3: the blocks T_cᵀ S(n_max) T_c of :func:`~.face.norms.tensor.partial_gram`
-    (module text), each by ``separable_sum(A, B, m, n)`` (the exponential-sum product
-    :func:`~.face.norms.tensor._separable_sum` over the index sets m of x and n of y)."""
-    n = np.arange(1, n_max + 1, dtype=float)
-    index = (n[0::2], n[1::2])                      # odd m for even functions, even m for odd ones
-    coeffs = [[(Q.T @ sine_coefficients(f, idx))  # (dim_p, len(idx)) per parity p
-               for Q, idx in zip(q, index)] for f, q in zip(space.factors, parities)]
+def parity_blocks(coeffs, index, separable_sum) -> list:
+    """[S_c(n_max)], c = 0..3: the four parity blocks of the double sine series (module text) from
+    the factors' coefficients in the parity bases, ``coeffs[axis][p]`` = (Q_p)ᵀ c (dim_p × len(index[p])),
+    and the sine indices ``index`` = (odd m, even m); each block by ``separable_sum(A, B, m, n)``
+    (the exponential-sum product over the index sets m of x and n of y)."""
     blocks = []
     for c in range(4):
         p, q = c & 1, c >> 1

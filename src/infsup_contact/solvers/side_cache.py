@@ -16,7 +16,6 @@ from __future__ import annotations
 
 from collections import Counter
 
-from ..discretization.segment import meshes
 
 
 def side_keys(model, family: str, k: int, n1: int, n2: int, **mesh_kwargs) -> list:
@@ -45,9 +44,8 @@ class SideCache:
             self._uses_left.update(side_keys(model, family, k, n1, n2, **mesh_kwargs))
 
     def pair(self, model, family: str, k: int, n1: int, n2: int, **mesh_kwargs) -> list:
-        """[side operator of Ω1 (N1 segments on Γ), side operator of Ω2 (N2)]."""
-        meshes.check_mesh_args(family, n1, "N1")
-        meshes.check_mesh_args(family, n2, "N2")
+        """[side operator of Ω1 (N1 segments on Γ), side operator of Ω2 (N2)]. The arguments are
+        a validated request's (:class:`~.request.BetaRequest`) or checked by the mesh builder."""
         return [self._get(key, model, family, k, **mesh_kwargs)
                 for key in side_keys(model, family, k, n1, n2, **mesh_kwargs)]
 
@@ -55,8 +53,7 @@ class SideCache:
         op = self._ops.pop(key, None)
         if op is None:
             n, side = key[3], key[4]
-            build = getattr(model, "mesh", None) or meshes.subdomain_mesh  # the model's own meshes (3D), else 2D
-            op = model.side_operator(build(family, n, side, **mesh_kwargs), k)
+            op = model.side_operator(model.subdomain_mesh(family, n, side, **mesh_kwargs), k)
         if self._uses_left[key] > 1:  # more uses announced: keep it for them
             self._uses_left[key] -= 1
             self._ops[key] = op

@@ -2,7 +2,7 @@
 
 On a face mesh pair symmetric about the centre of Γ = (0, 1)² (the structured hexahedra, any
 N1, N2), the point reflection R(x, y) = (1 − x, 1 − y) maps the multiplier basis onto itself,
-μ_j ∘ R = μ_π(j) with π an involution (:func:`reflection_split`, found and checked on Gauss
+μ_j ∘ R = μ_π(j) with π an involution (:func:`~infsup_contact.solvers.symmetry.reflection_split`, found and checked on Gauss
 points of G_h, :func:`~infsup_contact.discretization.gamma.symmetry.induced_permutation`), and
 the interface operator S = Σ_i B_i X_i B_iᵀ and every Gram matrix G commute with the
 permutation: P S Pᵀ = S, P G Pᵀ = G. In the orthonormal basis Q = [Q_e, Q_o] of the even and
@@ -19,7 +19,7 @@ Z2 × Z2), each a pencil of about a quarter of the size. A component of order m/
 (1/c)³ of the Cholesky factorizations, triangular solves and products of
 :func:`~.bottom.bottom_pencil` (m³/3 each), and (1/c)² of each Lanczos product. The kernel
 decision itself runs on the components' columns of the scaled coupling W
-(:func:`split_bottom_kernel`), with the unsplit η and a certificate per component.
+(:func:`~infsup_contact.solvers.symmetry.split_bottom_kernel`), with the unsplit η and a certificate per component.
 
 The computed S and G are invariant only to round-off (the sides' sparse factorizations order
 their dofs differently): the split is taken only where the dropped blocks Q_aᵀ M Q_b are at most
@@ -30,17 +30,14 @@ cubes, whose diagonals R reverses) keeps the unsplit route.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
-from functools import cached_property
+from dataclasses import dataclass, field
 
 import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
 
-from ..discretization.gamma.symmetry import axis_reflections, induced_permutation, isotypic_bases, reflect
-from ..la.threaded import sparse_times_dense, symmetric_part, times_transpose
+from .threaded import sparse_times_dense, symmetric_part, times_transpose
 from . import bottom
-from .kernel import BLOCK_EXTRA, KernelDecision, certified_bottom, certify_floor, decide, error_level
 
 INVARIANCE_RTOL = 1e-11
 """Largest (Σ_{a<b} ‖Q_aᵀ M Q_b‖_F²)^{1/2} / ‖M‖_F (the blocks the split drops) for which S
@@ -62,12 +59,9 @@ class ReflectionSplit:
     points e_j, and Q_o = (e_j − e_π(j))/√2 (the point reflection's even and odd functions)."""
 
     pis: tuple
-
-    @cached_property
-    def bases(self) -> tuple:
-        """(Q_0, ..., Q_{2^g − 1}), sparse with orthonormal columns
-        (:func:`~infsup_contact.discretization.gamma.symmetry.isotypic_bases`)."""
-        return isotypic_bases(self.pis)
+    bases: tuple = field(compare=False)
+    """(Q_0, ..., Q_{2^g − 1}), sparse with orthonormal columns
+    (:func:`~infsup_contact.discretization.gamma.symmetry.isotypic_bases` of ``pis``)."""
 
     @property
     def sizes(self) -> tuple:
@@ -108,36 +102,10 @@ class ReflectionSplit:
         return tuple(out)
 
 
-def reflection_split(space, points: np.ndarray) -> ReflectionSplit | None:
-    """The split of ``space`` by the reflections of Γ that map its basis onto itself, checked
-    at ``points`` (e.g. the Gauss points of G_h; (n,) on the segment, (n, 2) on the face), or None.
-
-    On the face the reflections x → 1 − x and y → 1 − y together (four components: a tensor
-    mesh pair symmetric in each direction, the structured hexahedra) where both map the basis,
-    else the point reflection (x, y) → (1 − x, 1 − y) alone (two: e.g. the Kuhn triangles,
-    whose diagonals the axis reflections reverse); on the segment x → 1 − x."""
-    x = np.asarray(points, float)
-    pis = axis_reflections(space, x) if x.ndim == 2 and x.shape[1] == 2 else None
-    if pis is None:
-        pi = induced_permutation(space, x, reflect())
-        pis = None if pi is None else (pi,)
-    return None if pis is None else ReflectionSplit(pis)
-
-
-def split_of(space, gamma, g_h, k: int) -> ReflectionSplit | None:
-    """The reflections' split of ``space`` (:func:`reflection_split`, checked at the Gauss
-    points of G_h), or None (no such symmetry, a Γ without a quadrature, or an empty component)."""
-    quadrature = getattr(gamma, "quadrature", None)
-    if quadrature is None:
-        return None
-    split = reflection_split(space, quadrature(g_h, 2 * k)[0])
-    return split if split is not None and min(split.sizes) >= 1 else None
-
-
-def usable(split: ReflectionSplit | None, grams: dict, kernel: KernelDecision):
+def usable(split: ReflectionSplit | None, grams: dict, kernel):
     """(split, kernel parts, {norm: blocks of G}) where every Gram matrix is invariant under
     ``split`` and the kernel splits, else (None, None, None). Each interface operator S is checked where it
-    is split (:func:`split_pencils`; :func:`~.infsup.split_spectra` solves it unsplit where it is not)."""
+    is split (:func:`split_pencils`; :func:`~infsup_contact.solvers.spectra.split_spectra` solves it unsplit where it is not)."""
     if split is None:
         return None, None, None
     halves = {}
@@ -157,7 +125,7 @@ def split_pencils(split: ReflectionSplit, S: np.ndarray, factors: dict, kernel_p
 
     ``factors``: {norm: (L_0, L_1, ...)} the Cholesky factors of the blocks of G; ``kernel_parts``:
     (Z_0, Z_1, ...) from :meth:`ReflectionSplit.components` (None: no kernel deflated; a block whose
-    S is definite then shares its factor between the norms, as :func:`~.infsup.bottom_spectra`)."""
+    S is definite then shares its factor between the norms, as :func:`~infsup_contact.solvers.spectra.bottom_spectra`)."""
     *halves, distance = split.blocks(S)
     if distance > INVARIANCE_RTOL:
         return None
@@ -181,49 +149,3 @@ def split_pencils(split: ReflectionSplit, S: np.ndarray, factors: dict, kernel_p
             top = max(top, res.lam_max)
         out[norm] = (np.sort(np.concatenate(values))[:max(n_values, 1)], top)
     return out
-
-
-def split_bottom_kernel(W, split: ReflectionSplit, proven: int = 0, entry_error: float = 0.0) -> KernelDecision | None:
-    """:func:`~.kernel.bottom_kernel` of W (trace dofs × multipliers, sparse) on the columns
-    W Q_c of each component, or None where the split does not hold.
-
-    With the traces' reflections W is equivariant, so WᵀW is block diagonal in Q = [Q_0, Q_1, ...]
-    and its eigenvalues are those of the blocks; the off-diagonal part O of the computed WᵀW
-    in Q is round-off, and moves each eigenvalue by at most ‖O‖₂ (Weyl; <= ‖C‖_F for the one
-    block C of two components, <= ‖O‖_F beyond). Each block goes through the same steps as the
-    unsplit route (block inverse iteration, counted values ‖W v‖ of orthonormal v, hence upper
-    bounds of singular values of W; the Cholesky certificate at τ_b = σ_{d_b+1}²/2 per block:
-    the block-diagonal WᵀW has at most d = Σ d_b eigenvalues below min τ_b, so the computed
-    one at most d below min τ_b − ‖O‖₂ >= min τ_b / 2), with the unsplit
-    η = max(rows, m) ε σ_max + 2 ‖δW‖_F. None (the caller takes the unsplit route) wherever a
-    step would fall back, or the bound on ‖O‖₂ > τ_b / 2."""
-    W = sp.csr_matrix(W)
-    rows, m = W.shape
-    proven = int(max(proven, m - rows, 0))
-    bases = split.bases
-    blocks = [sp.csr_matrix(W @ Q) for Q in bases]
-    grams = [sp.csr_matrix(B.T @ B) for B in blocks]
-    off = [float(sp.linalg.norm(blocks[a].T @ blocks[b])) for b in range(len(blocks)) for a in range(b)]
-    # ‖O‖₂ of the off-diagonal part O of WᵀW in Q: ‖C‖₂ <= ‖C‖_F for two blocks, ‖O‖_F beyond
-    cross = off[0] if len(off) == 1 else float(np.sqrt(2.0 * np.sum(np.square(off))))
-    smaxes = [bottom.largest_singular(B, g) if B.shape[1] else 0.0 for B, g in zip(blocks, grams)]
-    smax = max(smaxes)
-    tol = error_level(rows, m, smax, entry_error)
-    floor = max(certify_floor(rows, m, smax), 2.0 * cross)  # the whole W's certificate at τ − ‖O‖
-    counted, vectors, above = [], [], np.inf
-    for B, g, s_b, Q in zip(blocks, grams, smaxes, bases):
-        mb = B.shape[1]
-        if mb < 2:
-            return None
-        hint = int(np.ceil(proven * mb / m))  # a block size only: each half holds about its share
-        res = certified_bottom(B, g, min(hint + BLOCK_EXTRA, mb - 1), tol, s_b, floor)
-        if res is None:
-            return None
-        counted.append(res.values[:res.count])
-        vectors.append(np.asarray(Q @ res.vectors[:, :res.count]))
-        above = min(above, float(res.above))
-    d = sum(len(c) for c in counted)
-    if d < proven:
-        return None
-    s = np.concatenate([np.sort(np.concatenate(counted)), [above, smax]])
-    return decide(s, proven, tol, d, smax, np.hstack(vectors))

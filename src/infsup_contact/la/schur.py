@@ -1,13 +1,13 @@
-"""The Γ Schur complement and the interface operator, for any model (the engine's spine).
+"""The Γ Schur complement of one factorized body, for any model (the engine's spine).
 
 Because b(v, μ) touches only Γ dofs, B A⁻¹ Bᵀ = Σ_i B_i (A_i⁻¹)_ΓΓ B_iᵀ (paper, Section 4:
-the operator behind (4.5)). With the Γ dofs ordered last, (A⁻¹)_ΓΓ = S⁻¹ for the Schur
+the operator behind (4.5); assembled in :mod:`infsup_contact.solvers.interface_operator`). With the Γ dofs ordered last, (A⁻¹)_ΓΓ = S⁻¹ for the Schur
 complement S = A_ΓΓ − A_ΓI A_II⁻¹ A_IΓ, and for a sparse LU factorization P A Pᵀ = L U
 whose ordering keeps Γ last, S = L_ΓΓ U_ΓΓ: the Schur complement is the trailing block of
 the factors — no solve with many right-hand sides.
 
 SuperLU takes no user ordering beyond a pre-permuted matrix: the interior is ordered by a
-graph nested dissection (:mod:`infsup_contact.models.ordering`), Γ appended, and the
+graph nested dissection (:mod:`infsup_contact.la.ordering`), Γ appended, and the
 permuted matrix factorized once as given.
 
 On small problems the Python-side ordering costs more than it saves, so
@@ -32,14 +32,13 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from ..discretization.gamma.trace import GammaTrace
 from ..errors import InputError
-from ..la.threaded import symmetric_part, symmetric_sandwich
+from .threaded import symmetric_sandwich
 from . import pardiso
 from .ordering import nested_dissection_gamma_last
 
 
-class _SteklovProduct:
+class SteklovProduct:
     """X M for X = S⁻¹ = (A⁻¹)_ΓΓ, for a class with ``schur`` (S) and ``steklov`` (X or None):
     a product where X is known, else a solve with the Cholesky factor of S, computed on
     first use and kept (a β_h sweep asks for X M for every multiplier space on one side)."""
@@ -74,48 +73,6 @@ class _SteklovProduct:
         X += (np.tril(X, -1) if lower else np.triu(X, 1)).T
         return X
 
-
-@dataclass(frozen=True)
-class SideOperator(_SteklovProduct):
-    """Factorized stiffness of one body and its Γ Schur complement (unit material scale).
-
-    Attributes
-    ----------
-    trace : GammaTrace
-        Γ dofs and trace elements of V_{h,i}.
-    free : ndarray of int
-        Free NGSolve dofs (the unknowns of A_i), Γ dofs included.
-    stiffness : scipy.sparse.csc_matrix
-        K_i restricted to free dofs, in the order of ``free``.
-    schur : ndarray
-        S_i = Schur complement of K_i onto the Γ dofs (order of ``trace.gamma_dofs``).
-    solve : callable
-        b ↦ K_i⁻¹ b on free dofs (reuses the factorization).
-    """
-
-    trace: GammaTrace
-    free: np.ndarray
-    stiffness: sp.csc_matrix
-    schur: np.ndarray
-    solve: object
-    steklov: np.ndarray | None = None
-
-    @property
-    def ndof(self) -> int:
-        return len(self.free)
-
-    def steklov_inverse(self, c: float = 1.0) -> np.ndarray:
-        """X_i = (A_i⁻¹)_ΓΓ = S_i⁻¹ / c_i, symmetric positive definite."""
-        X = self.steklov if self.steklov is not None else sla.inv(self.schur, check_finite=False)
-        return X / c
-
-    def forget_cached(self) -> None:
-        """Return to the state right after the build: drop what later calls cached on this
-        side (the Cholesky factor of S, the trace's basis values, dense and CSR). A benchmark
-        times each multiplier space's solve from this state, as a fresh build would give it."""
-        self.__dict__.pop("_schur_cholesky", None)
-        self.__dict__.pop("_steklov_explicit", None)
-        self.trace.forget_basis()
 
 
 
@@ -166,7 +123,7 @@ class _LazyPardisoSolve:
 
 
 @dataclass(frozen=True)
-class GammaFactorization(_SteklovProduct):
+class GammaFactorization(SteklovProduct):
     """One factorization of A (Γ = its last n_Γ unknowns) and what Γ needs from it.
 
     Attributes
@@ -246,61 +203,3 @@ def schur_from_lu(lu: "_Reordered", n_gamma: int) -> np.ndarray:
     U = lu.lu.U[tail, tail].toarray()
     S = L @ U
     return 0.5 * (S + S.T)
-
-
-def factorized_side(trace: GammaTrace, free: np.ndarray, K, route: str = "auto",
-                    keep_factor: bool = False) -> SideOperator:
-    """The SideOperator of an assembled stiffness K (free dofs, Γ last): one
-    :func:`gamma_factorization` (``keep_factor`` for a side that will solve: a contact scene's)."""
-    fac = gamma_factorization(K, len(trace.gamma_dofs), route, trace.gamma.dim, keep_factor)
-    return SideOperator(trace, free, K, fac.schur, fac.solve, fac.steklov)
-
-
-def schur_by_solves(side: SideOperator) -> np.ndarray:
-    """Reference route: S = K_ΓΓ − K_ΓI K_II⁻¹ K_IΓ by a multi-right-hand-side solve."""
-    ng = len(side.trace.gamma_dofs)
-    K = side.stiffness
-    KII, KIG, KGG = K[:-ng, :-ng].tocsc(), K[:-ng, -ng:].toarray(), K[-ng:, -ng:].toarray()
-    return KGG - KIG.T @ spla.splu(KII).solve(KIG)
-
-
-SPARSE_PRODUCT_MIN_DIM = 1500
-"""dim M above which :func:`interface_terms` multiplies by B as a sparse matrix on both sides
-(B has (k + 1)^d (s + 1)^d-sized blocks: at dim M ≈ 4,000 on a face the dense products are 1e11
-flops) with the explicit X = S⁻¹ of the side (:meth:`_SteklovProduct.steklov_sandwich`); below it
-the dense products with the solves, whose results the default DAG holds bit for bit."""
-
-
-def interface_terms(couplings, sides) -> list:
-    """The terms B_i X_i B_iᵀ of the interface operator at unit material scale, one per side.
-
-    Above :data:`SPARSE_PRODUCT_MIN_DIM` by a side's ``steklov_sandwich`` where it has one (the
-    same matrix to round-off: X from potri instead of the triangular solves), else
-    ``B (X Bᵀ)`` by its ``steklov_times``."""
-    out = []
-    for B, side in zip(couplings, sides):
-        large = B.shape[0] > SPARSE_PRODUCT_MIN_DIM
-        if large and hasattr(side, "steklov_sandwich"):
-            out.append(side.steklov_sandwich(sp.csr_matrix(B)))
-            continue
-        Bl = sp.csr_matrix(B) if large else B
-        Bd = B.toarray() if sp.issparse(B) else B  # steklov_times solves with a dense right-hand side
-        out.append(np.asarray(Bl @ side.steklov_times(Bd.T)))
-    return out
-
-
-def combine_terms(terms, c) -> np.ndarray:
-    """Σ_i T_i / c_i, symmetrized: the interface operator for the material scales c (the
-    symmetrisation over the threads, :func:`~infsup_contact.la.threaded.symmetric_part`)."""
-    out = 0.0
-    for T, ci in zip(terms, c):
-        out = out + T / ci
-    return symmetric_part(out)
-
-
-def interface_operator(couplings, sides, c=(1.0, 1.0)) -> np.ndarray:
-    """Σ_i B_i X_i B_iᵀ / c_i = B A⁻¹ Bᵀ on the multiplier space (dense, symmetric PSD).
-
-    Its terms do not depend on c: a sweep over (c1, c2) computes them once
-    (:func:`interface_terms`) and combines them per pair (:func:`combine_terms`)."""
-    return combine_terms(interface_terms(couplings, sides), c)

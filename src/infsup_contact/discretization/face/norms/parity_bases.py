@@ -1,0 +1,46 @@
+"""The parity bases of a face space's 1D factors and its sine coefficients in them.
+
+Where both factors of a tensor space are symmetric under x → 1 − x their bases split into even
+and odd functions (:func:`axis_parity`); the double sine series of the H Gram matrix is then
+block diagonal in the four products of those bases (:mod:`infsup_contact.la.face_parity`, the
+linear algebra of the blocks), whose coefficients come from the factors here
+(:func:`partial_gram_blocks`).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ....la import face_parity
+from ...gamma.symmetry import induced_permutation, isotypic_bases, reflect
+from ...segment.norms import sine_coefficients
+from ...gamma.quadrature import gauss_legendre
+
+
+def axis_parity(space) -> tuple | None:
+    """(Q_e, Q_o) of a 1D space (:class:`~.multipliers.MultiplierSpace`) under x → 1 − x,
+    checked at 4 Gauss points per interval, or None where the reflection does not map its basis."""
+    t, _ = gauss_legendre(4)
+    g = np.asarray(space.breakpoints, float)
+    x = (0.5 * (g[:-1, None] + g[1:, None]) + 0.5 * (g[1:, None] - g[:-1, None]) * t).ravel()
+    pi = induced_permutation(space, x, reflect())
+    return None if pi is None else isotypic_bases((pi,))
+
+
+def tensor_parities(space) -> tuple | None:
+    """((Q^x_e, Q^x_o), (Q^y_e, Q^y_o)) of a tensor space, or None (a factor not symmetric or
+    with an empty parity)."""
+    out = tuple(axis_parity(f) for f in space.factors)
+    if any(q is None or min(Q.shape[1] for Q in q) < 1 for q in out):
+        return None
+    return out
+
+
+def partial_gram_blocks(space, n_max: int, parities, separable_sum) -> list:
+    """[S_c(n_max)], c = 0..3: the blocks T_cᵀ S(n_max) T_c of :func:`~.face_norms.partial_gram`
+    (module text), each by ``separable_sum(A, B, m, n)`` (the exponential-sum product
+    :func:`~.face_norms._separable_sum` over the index sets m of x and n of y)."""
+    n = np.arange(1, n_max + 1, dtype=float)
+    index = (n[0::2], n[1::2])                      # odd m for even functions, even m for odd ones
+    coeffs = [[(Q.T @ sine_coefficients(f, idx))  # (dim_p, len(idx)) per parity p
+               for Q, idx in zip(q, index)] for f, q in zip(space.factors, parities)]
+    return face_parity.parity_blocks(coeffs, index, separable_sum)

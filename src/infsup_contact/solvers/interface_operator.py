@@ -1,0 +1,56 @@
+"""The interface operator B A⁻¹ Bᵀ = Σ_i B_i X_i B_iᵀ / c_i on a multiplier space (paper, Section 4).
+
+Because b(v, μ) touches only Γ dofs, the operator behind (4.5) is a sum over the sides of
+B_i (A_i⁻¹)_ΓΓ B_iᵀ, with X_i = (A_i⁻¹)_ΓΓ the Steklov inverse of a side operator
+(:class:`~infsup_contact.models.contract.SideOperator`, its Schur complement from
+:mod:`infsup_contact.la.schur`). A model assembles its stiffness at unit material scale
+(A_i = c_i K_i), so the terms B_i X_i B_iᵀ serve every (c1, c2).
+"""
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+
+from ..la.threaded import symmetric_part
+
+
+SPARSE_PRODUCT_MIN_DIM = 1500
+"""dim M above which :func:`interface_terms` multiplies by B as a sparse matrix on both sides
+(B has (k + 1)^d (s + 1)^d-sized blocks: at dim M ≈ 4,000 on a face the dense products are 1e11
+flops) with the explicit X = S⁻¹ of the side (:meth:`~infsup_contact.la.schur.SteklovProduct.steklov_sandwich`); below it
+the dense products with the solves, whose results the default DAG holds bit for bit."""
+
+
+def interface_terms(couplings, sides) -> list:
+    """The terms B_i X_i B_iᵀ of the interface operator at unit material scale, one per side.
+
+    Above :data:`SPARSE_PRODUCT_MIN_DIM` by a side's ``steklov_sandwich`` where it has one (the
+    same matrix to round-off: X from potri instead of the triangular solves), else
+    ``B (X Bᵀ)`` by its ``steklov_times``."""
+    out = []
+    for B, side in zip(couplings, sides):
+        large = B.shape[0] > SPARSE_PRODUCT_MIN_DIM
+        if large and hasattr(side, "steklov_sandwich"):
+            out.append(side.steklov_sandwich(sp.csr_matrix(B)))
+            continue
+        Bl = sp.csr_matrix(B) if large else B
+        Bd = B.toarray() if sp.issparse(B) else B  # steklov_times solves with a dense right-hand side
+        out.append(np.asarray(Bl @ side.steklov_times(Bd.T)))
+    return out
+
+
+def combine_terms(terms, c) -> np.ndarray:
+    """Σ_i T_i / c_i, symmetrized: the interface operator for the material scales c (the
+    symmetrisation over the threads, :func:`~infsup_contact.la.threaded.symmetric_part`)."""
+    out = 0.0
+    for T, ci in zip(terms, c):
+        out = out + T / ci
+    return symmetric_part(out)
+
+
+def interface_operator(couplings, sides, c=(1.0, 1.0)) -> np.ndarray:
+    """Σ_i B_i X_i B_iᵀ / c_i = B A⁻¹ Bᵀ on the multiplier space (dense, symmetric PSD).
+
+    Its terms do not depend on c: a sweep over (c1, c2) computes them once
+    (:func:`interface_terms`) and combines them per pair (:func:`combine_terms`)."""
+    return combine_terms(interface_terms(couplings, sides), c)

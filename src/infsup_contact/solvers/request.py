@@ -1,0 +1,94 @@
+"""A β_h request, validated once at the edge into a typed, frozen object the engine trusts.
+
+The command line (:mod:`infsup_contact.cli.beta`) and the Python callers
+(:func:`~.infsup.beta_rows`, :func:`~.infsup.beta_rows_all`) build a :class:`BetaRequest`;
+building it checks every key (one :class:`~infsup_contact.errors.InputError` naming the first
+offending one) and :func:`~.infsup.beta_table` runs it without checking again. The mesh
+parameters travel as a :class:`MeshOptions`, not as keywords.
+"""
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass, field
+
+import numpy as np
+
+from ..discretization.segment import meshes
+
+from ..discretization.spaces import registry
+from ..discretization.gamma.interface import check_choice
+from ..discretization.segment.norms import NORMS
+from ..errors import InputError, check_prestress
+from ..models import DEFAULT_MODEL
+from ..models.contract import Model
+
+
+@dataclass(frozen=True)
+class MeshOptions:
+    """The mesh parameters of a request beyond (family, N): what a model's mesh builder takes.
+
+    Attributes
+    ----------
+    element : str or None
+        The 3D models' cells (``hex`` or ``tet``; the model's ``mesh_options``); None: the builder's default.
+    seed, alpha : int, float or None
+        The perturbed family's seed and amplitude α / h; None: the builder's default.
+    width : float or None
+        A 3D body's extent in x (a narrower Ω2, :mod:`infsup_contact.study.edge_dropping`).
+    """
+
+    element: str | None = None
+    seed: int | None = None
+    alpha: float | None = None
+    width: float | None = None
+
+    def kwargs(self) -> dict:
+        """The builder's keywords: the options that are set."""
+        return {key: value for key, value in asdict(self).items() if value is not None}
+
+
+@dataclass(frozen=True)
+class BetaRequest:
+    """β_h of (4.5) for the cases × multiplier meshes × (c1, c2) × norms of one mesh pair.
+
+    Building it validates it (:meth:`__post_init__`); ``cases`` None means every registered
+    space defined for k. A case is a registry id, an unregistered
+    :class:`~infsup_contact.discretization.spaces.registry.SpaceSpec` or a general triple
+    ``(label, s, continuous, vanish)`` (those two are the caller's, not checked here).
+    """
+
+    family: str
+    k: int
+    n1: int
+    n2: int
+    cases: tuple | None = None
+    multiplier_meshes: tuple = ("omega2",)
+    c_pairs: tuple = ((1.0, 1.0),)
+    norms: tuple = NORMS
+    h_route: str = "logkernel"
+    model: Model = DEFAULT_MODEL
+    mesh: MeshOptions = field(default_factory=MeshOptions)
+
+    def __post_init__(self):
+        check_k(self.k)
+        cases = registry.ids_valid_for(self.k) if self.cases is None else list(self.cases)
+        object.__setattr__(self, "cases", tuple(cases))
+        ids = [c for c in cases if isinstance(c, str)]
+        for c in ids:
+            registry.check_case(c, self.k)
+        meshes.check_mesh_args(self.family, self.n1, "N1")
+        meshes.check_mesh_args(self.family, self.n2, "N2")
+        for c1, c2 in self.c_pairs:
+            for key, c in (("c1", c1), ("c2", c2)):
+                check_prestress(key, c)
+        for nm in self.norms:
+            if nm not in NORMS:
+                raise InputError("norm", ", ".join(NORMS), got=nm)
+        for mm in self.multiplier_meshes:
+            check_choice(mm)
+            registry.check_pair_spaces(ids, self.k, self.n1, self.n2, (mm,))  # dim M_h = 0: refused here
+
+
+def check_k(k) -> None:
+    """:class:`InputError` unless k is an integer in 1..4."""
+    if not isinstance(k, (int, np.integer)) or not 1 <= k <= 4:
+        raise InputError("k", "an integer in 1..4", got=k)

@@ -1,0 +1,90 @@
+"""Γ's reflections for the engine: the split of a multiplier space and the kernel on its components.
+
+The linear algebra of a reflection-invariant pencil (its isotypic blocks, the components'
+pencils) is :mod:`infsup_contact.la.reflection`; here the split is found on a space's basis
+(:func:`reflection_split`, checked at Gauss points of G_h with
+:func:`~infsup_contact.discretization.gamma.symmetry.induced_permutation`) and the kernel of Bᵀ
+is decided on the split's components (:func:`split_bottom_kernel`, the certificates of
+:mod:`.kernel`).
+"""
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+
+from ..discretization.gamma.symmetry import axis_reflections, induced_permutation, isotypic_bases, reflect
+from ..la import bottom
+from ..la.reflection import ReflectionSplit
+from .kernel import BLOCK_EXTRA, KernelDecision, certified_bottom, certify_floor, decide, error_level
+
+
+def reflection_split(space, points: np.ndarray) -> ReflectionSplit | None:
+    """The split of ``space`` by the reflections of Γ that map its basis onto itself, checked
+    at ``points`` (e.g. the Gauss points of G_h; (n,) on the segment, (n, 2) on the face), or None.
+
+    On the face the reflections x → 1 − x and y → 1 − y together (four components: a tensor
+    mesh pair symmetric in each direction, the structured hexahedra) where both map the basis,
+    else the point reflection (x, y) → (1 − x, 1 − y) alone (two: e.g. the Kuhn triangles,
+    whose diagonals the axis reflections reverse); on the segment x → 1 − x."""
+    x = np.asarray(points, float)
+    pis = axis_reflections(space, x) if x.ndim == 2 and x.shape[1] == 2 else None
+    if pis is None:
+        pi = induced_permutation(space, x, reflect())
+        pis = None if pi is None else (pi,)
+    return None if pis is None else ReflectionSplit(pis, isotypic_bases(pis))
+
+
+def split_of(space, gamma, g_h, k: int) -> ReflectionSplit | None:
+    """The reflections' split of ``space`` (:func:`reflection_split`, checked at the Gauss
+    points of G_h), or None (no such symmetry, a Γ without a quadrature, or an empty component)."""
+    quadrature = getattr(gamma, "quadrature", None)
+    if quadrature is None:
+        return None
+    split = reflection_split(space, quadrature(g_h, 2 * k)[0])
+    return split if split is not None and min(split.sizes) >= 1 else None
+
+
+def split_bottom_kernel(W, split: ReflectionSplit, proven: int = 0, entry_error: float = 0.0) -> KernelDecision | None:
+    """:func:`~.kernel.bottom_kernel` of W (trace dofs × multipliers, sparse) on the columns
+    W Q_c of each component, or None where the split does not hold.
+
+    With the traces' reflections W is equivariant, so WᵀW is block diagonal in Q = [Q_0, Q_1, ...]
+    and its eigenvalues are those of the blocks; the off-diagonal part O of the computed WᵀW
+    in Q is round-off, and moves each eigenvalue by at most ‖O‖₂ (Weyl; <= ‖C‖_F for the one
+    block C of two components, <= ‖O‖_F beyond). Each block goes through the same steps as the
+    unsplit route (block inverse iteration, counted values ‖W v‖ of orthonormal v, hence upper
+    bounds of singular values of W; the Cholesky certificate at τ_b = σ_{d_b+1}²/2 per block:
+    the block-diagonal WᵀW has at most d = Σ d_b eigenvalues below min τ_b, so the computed
+    one at most d below min τ_b − ‖O‖₂ >= min τ_b / 2), with the unsplit
+    η = max(rows, m) ε σ_max + 2 ‖δW‖_F. None (the caller takes the unsplit route) wherever a
+    step would fall back, or the bound on ‖O‖₂ > τ_b / 2."""
+    W = sp.csr_matrix(W)
+    rows, m = W.shape
+    proven = int(max(proven, m - rows, 0))
+    bases = split.bases
+    blocks = [sp.csr_matrix(W @ Q) for Q in bases]
+    grams = [sp.csr_matrix(B.T @ B) for B in blocks]
+    off = [float(sp.linalg.norm(blocks[a].T @ blocks[b])) for b in range(len(blocks)) for a in range(b)]
+    # ‖O‖₂ of the off-diagonal part O of WᵀW in Q: ‖C‖₂ <= ‖C‖_F for two blocks, ‖O‖_F beyond
+    cross = off[0] if len(off) == 1 else float(np.sqrt(2.0 * np.sum(np.square(off))))
+    smaxes = [bottom.largest_singular(B, g) if B.shape[1] else 0.0 for B, g in zip(blocks, grams)]
+    smax = max(smaxes)
+    tol = error_level(rows, m, smax, entry_error)
+    floor = max(certify_floor(rows, m, smax), 2.0 * cross)  # the whole W's certificate at τ − ‖O‖
+    counted, vectors, above = [], [], np.inf
+    for B, g, s_b, Q in zip(blocks, grams, smaxes, bases):
+        mb = B.shape[1]
+        if mb < 2:
+            return None
+        hint = int(np.ceil(proven * mb / m))  # a block size only: each half holds about its share
+        res = certified_bottom(B, g, min(hint + BLOCK_EXTRA, mb - 1), tol, s_b, floor)
+        if res is None:
+            return None
+        counted.append(res.values[:res.count])
+        vectors.append(np.asarray(Q @ res.vectors[:, :res.count]))
+        above = min(above, float(res.above))
+    d = sum(len(c) for c in counted)
+    if d < proven:
+        return None
+    s = np.concatenate([np.sort(np.concatenate(counted)), [above, smax]])
+    return decide(s, proven, tol, d, smax, np.hstack(vectors))

@@ -1,0 +1,115 @@
+"""The 3D β_h benchmark (issue 28, item 7; bench/face_beta.py): its three routes give the same
+β_h, one of them checked against the full saddle-point pencil, and ``infsup-contact bench --what
+face`` writes the ratio columns and refuses bad input in one line."""
+import io
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from infsup_contact.bench import face_beta
+from infsup_contact.discretization.gamma.coupling import coupling_matrix
+from infsup_contact.solvers.infsup import saddle_point_beta
+from infsup_contact.solvers.contact import contact_qp
+
+from helpers.cli import run_in_process
+from infsup_contact.discretization.spaces import registry
+
+
+@pytest.mark.parametrize("n", [2, 3])
+def test_routes_agree_on_beta(n):
+    rows = face_beta.bench_face([n], [1], "hex", repeats=1)
+    beta = [r for r in rows if r["what"] == "face_beta"]
+    assert [r["route"] for r in beta] == ["ours", "ours_core", "limit"]
+    for r in beta:
+        assert r["max_abs_diff"] <= 1e-8, r
+        assert r["n_problems"] == 2 * len(registry.ids_valid_for(1))     # k = 1: no quadratic face elements
+
+
+def test_schur_routes_give_one_schur_complement():
+    """The face_schur rows: every route of gamma_factorization timed on the same bodies gives S to
+    round-off (relative to the first route, PARDISO), one row per route."""
+    rows = [r for r in face_beta.bench_face([3], [2], "hex", repeats=1) if r["what"] == "face_schur"]
+    assert [r["route"] for r in rows] == list(face_beta.SCHUR_ROUTES)
+    assert all(r["max_abs_diff"] <= 1e-12 for r in rows), rows
+    assert rows[0]["ratio_to_ours"] == 1.0
+
+
+def test_core_beta_equals_the_full_pencil():
+    """β_h of ours_core (Γ-reduced, B A⁻¹ Bᵀ m = β² G m) = β_h of the full pencil
+    [[A, Bᵀ], [B, 0]] x = σ [[A, 0], [0, G]] x, an independent dense route, for a stable space."""
+    setup = face_beta.FaceSetup(2, 1, "hex")
+    core = face_beta.face_ours_core(setup)
+    case = next(c for c in setup.cases if face_beta.face_ours(setup)[c, "H"][0] == 0)
+    Bs = [coupling_matrix(s.trace, setup.spaces[case], 1) for s in setup.sides]
+    A, B, _ = contact_qp(setup.sides, Bs, [np.zeros(s.ndof) for s in setup.sides])  # the assembled pencil
+    B = B.toarray()
+    for nm in face_beta.NORMS:
+        G = setup.gamma.gram(setup.spaces[case], nm)[0]
+        assert abs(np.sqrt(core[case, nm][0]) - saddle_point_beta(A, B, G)) <= 1e-10
+
+
+def test_cli_csv_has_the_ratio_columns():
+    code, out, err = run_in_process(["bench", "--what", "face", "--N", "2", "--k", "1", "--repeats", "1"])
+    assert code in (0, None), err
+    frame = pd.read_csv(io.StringIO(out))
+    assert set(face_beta.FACE_COLUMNS) <= set(frame.columns)
+    by = frame[frame["what"] == "face_beta"].set_index("route")
+    assert by.loc["limit", "ratio_to_limit"] == 1.0 and by.loc["ours", "ratio_to_ours"] == 1.0
+    assert np.isclose(by.loc["ours", "ratio_to_limit"],
+                      by.loc["ours", "seconds_median"] / by.loc["limit", "seconds_median"], rtol=1e-4)
+    assert (frame["element"] == "hex").all()
+
+
+@pytest.mark.parametrize("argv, key", [
+    (["--what", "face", "--element", "prism"], "--element"),
+    (["--what", "beta", "--element", "hex"], "--element"),
+    (["--what", "face", "--peers", "osqp"], "--peers"),
+    (["--what", "face", "--eigsh-max-N", "4"], "--eigsh-max-N"),
+    (["--what", "face", "--k", "5"], "--k"),
+])
+def test_bad_input_is_refused_in_one_line(argv, key):
+    argv = ["bench", "--N", "2", *(["--k", "1"] if "--k" not in argv else []), *argv]
+    code, out, err = run_in_process(argv)
+    assert code == 2 and out == ""
+    lines = [ln for ln in err.splitlines() if ln.strip()]
+    assert len(lines) == 1 and key in lines[0], err
+
+
+def test_setup_refuses_an_unknown_element():
+    from infsup_contact.errors import InputError
+
+    with pytest.raises(InputError, match="element"):
+        face_beta.FaceSetup(2, 1, "prism")
+
+
+def test_dry_run_estimates_the_face_routes():
+    """The estimate is the 3D model's (face_beta_estimate): it grows with N, and a size that does
+    not fit in memory is refused naming --N before anything is computed."""
+    from infsup_contact import resources
+
+    small, large = (resources.bench_estimate("face", [n], [2]) for n in (4, 12))
+    assert 0 < small.bytes < large.bytes and 0 < small.seconds < large.seconds
+    code, out, err = run_in_process(["bench", "--what", "face", "--N", "4", "--k", "1", "--dry-run"])
+    assert code in (0, None) and "dry run" in out + err
+    code, _, err = run_in_process(["bench", "--what", "face", "--N", "256", "--k", "2", "--dry-run"])
+    assert code == 2 and "--N" in err and len(err.strip().splitlines()) == 1
+
+
+@pytest.mark.parametrize("k", [1, 2])
+def test_the_face_estimate_grows_with_n_across_the_large_route(monkeypatch, k):
+    """On the PARDISO route the estimate switches to the large route's fit above dim M =
+    DENSE_MAX_M; memory still grows with N through the switch, time within each route (the
+    large route is the faster one at the gate: that is what it is for)."""
+    from infsup_contact import resources
+    from infsup_contact.la.bottom import DENSE_MAX_M
+
+    monkeypatch.setattr(resources, "face_route", lambda: "pardiso")
+    ests = [resources.face_beta_estimate(k, n, n) for n in range(4, 80 // k)]
+    switch = next(n for n in range(4, 80) if (k * n + 1) ** 2 > DENSE_MAX_M)
+    assert all(b.bytes >= a.bytes for a, b in zip(ests, ests[1:]))
+    assert all(b.seconds >= a.seconds for a, b in zip(ests, ests[1:]) if b is not ests[switch - 4])
+    a, b, c, d = resources.LARGE_ROUTE_3D[k]
+    nd = 2 * resources.face_side_dofs(switch, k)
+    e = resources.face_beta_estimate(k, switch, switch)
+    assert e.bytes > resources.LARGE_ROUTE_MARGIN * (a * nd + b * float((k * switch + 1) ** 2) ** 2)

@@ -235,7 +235,7 @@ def inverse_standard_form(R: np.ndarray, L: np.ndarray) -> np.ndarray:
     K[j:, j:j+b] = R[j:, j:]⁻¹ L[j:, j:j+b] needs only the trailing part of R, so the blocked
     solve costs m³/3 flops instead of the m³ of one solve with m right-hand sides; Kᵀ K of a
     triangular K is LAPACK lauum (m³/3, where syrk costs m³). Both agree with the plain route to
-    round-off (tests/test_bottom.py). With MKL the blocks are solved in place on a copy of L
+    round-off (tests/la/test_bottom.py). With MKL the blocks are solved in place on a copy of L
     (:func:`~infsup_contact.la.mkl.trailing_solve`; L's zeros above its diagonal make the rows
     above j of block j vanish): half the time of the copying route at m = 4,225 on two threads,
     the same K to 5e-16."""

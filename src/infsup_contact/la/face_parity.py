@@ -20,7 +20,7 @@ basis's own components under the same two reflections: R intertwines them, so th
 between different components vanish; checked, :func:`intertwined`). The Gram matrix is
 assembled once at the end, G = Σ_c Q_c G_c Q_cᵀ (:func:`assemble`). The coefficients the split
 drops (an even function's at even m) are zero mathematically, round-off numerically: G agrees
-with the unsplit series to round-off (tests/test_face_parity.py).
+with the unsplit series to round-off (tests/la/test_face_parity.py).
 """
 from __future__ import annotations
 

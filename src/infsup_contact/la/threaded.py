@@ -8,7 +8,7 @@ single-threaded. On the large face route (k = 2, N = 32) they held about a fifth
 series (:mod:`infsup_contact.discretization.face.norms.tensor`). Both release the GIL, so threads
 over disjoint row blocks of the result use every core. Each row of a result is computed by
 the same kernel, in the same order, as the one-thread product: the results are bit-identical
-(tests/test_la_threaded.py).
+(tests/la/test_la_threaded.py).
 
 A second cost was hidden in scipy's ``A @ Y.T``: a C-contiguous copy of the transposed
 operand, a strided pass over memory (the largest single cost of a 9,216² product). :func:`symmetric_sandwich`

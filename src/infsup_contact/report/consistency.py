@@ -5,7 +5,7 @@ A sentence that states an outcome is chosen by the verdict it rests on (``\\byve
 ``paper.tex``); the check here is what makes that a rule: :func:`render` expands the generated
 macros and resolves every ``\\byverdict``, :func:`contradictions` reads the clause in front of
 each verdict tag and flags a success phrase before FAIL or INCONCLUSIVE, a failure phrase
-before PASS or INCONCLUSIVE, and an undecided phrase before PASS or FAIL. ``tests/test_paper.py``
+before PASS or INCONCLUSIVE, and an undecided phrase before PASS or FAIL. ``tests/report/test_paper.py``
 renders the text under flipped ledgers (every verdict swapped, all INCONCLUSIVE, …).
 """
 from __future__ import annotations

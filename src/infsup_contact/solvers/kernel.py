@@ -22,7 +22,7 @@ numerical part (:data:`KERNEL_CRITERION`)
     W' is the same matrix from a Gauss rule three points longer, exact for the polynomials
     too, so W − W' is round-off only (it reaches ~100 ε‖W‖ for k = 4 on the union partition
     of 17:16: the high-order basis values carry it). A singular value <= η counts as zero.
-    ``tests/test_kernel.py`` checks both terms against η with independent estimates.
+    ``tests/solvers/test_kernel.py`` checks both terms against η with independent estimates.
 
 Working with Bᵀ and not with B A⁻¹ Bᵀ squares nothing: a mode with β ≈ 1e-6 sits at
 β² ≈ 1e-12 in the pencil — within three decades of the pencil's own round-off level
@@ -41,7 +41,7 @@ the pencil itself (:func:`pencil_cross_check`): a first mode counted non-zero mu
 decade above the pencil's round-off level n ε λ_max, else the decision is ``close``.
 
 The pencil's own gap rule (:func:`kernel_from_gap`) stays as the independent cross-check
-(``tests/test_kernel.py``: both agree wherever the pencil's gap is clear). Pure numpy/scipy:
+(``tests/solvers/test_kernel.py``: both agree wherever the pencil's gap is clear). Pure numpy/scipy:
 the command line states the rule without importing NGSolve.
 """
 from __future__ import annotations

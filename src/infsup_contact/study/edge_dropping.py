@@ -17,7 +17,7 @@ its Γ the face ``Square(width=L)``), X_i = (A_i⁻¹)_ΓΓ from the model's fac
 operator, the couplings B_i = ∫_Γ μ_j φ_d against NGSolve's Γ basis by tensor Gauss on the
 rectangles of the common refinement clipped at x = L, S by ``interface_terms`` /
 ``combine_terms`` and β_h by ``spectrum``. The tests check it against an independent route
-(1D Kronecker assembly of the box Laplacians, ``tests/_tensor_sides.py``).
+(1D Kronecker assembly of the box Laplacians, ``tests/helpers/tensor_sides.py``).
 
 The H series resolves the cut column, a sliver of width θ/N, only with n_max ≳ 1/(θ h) modes in
 x: at θ = 0.001 the default cap (8192) stops it with ``h_capped`` and a normwise estimate

@@ -35,7 +35,7 @@ instruction-set branches (AVX2, AVX512) are for Intel processors: on this AMD CP
 them (``MKL_CBWR_Set`` returns −3, MKL_CBWR_ERR_UNSUPPORTED_BRANCH; ``MKL_CBWR=AVX2`` runs AUTO),
 so those paths need ``GenuineIntel`` besides their flags and are skipped here with that reason.
 
-``tests/test_machines.py`` runs the sweep and the kernel, verdict and 3D kernel tests under
+``tests/study/test_machines.py`` runs the sweep and the kernel, verdict and 3D kernel tests under
 every path this CPU can take; the DAG target ``verify-machines`` compares the CI profile's
 ledgers and kernel tables (:data:`LEDGER_TABLES`).
 """

@@ -21,7 +21,7 @@ multiplier norm. Three routes, chosen by the sizes (:func:`choose_route`):
     below) is deflated first (:func:`_shift_invert`): Lanczos computes the :data:`N_ABOVE`
     eigenvalues above it, never the d-fold zero itself (single-vector Lanczos resolves a multiple
     eigenvalue copy by copy, through round-off only: on the d = 400, m = 1600 system of
-    ``tests/test_systems_deflation.py`` it found 351 of the zero modes and reported β_h = 0.5846
+    ``tests/systems/test_systems_deflation.py`` it found 351 of the zero modes and reported β_h = 0.5846
     with ``known_kernel: 400``, where the dense route gives 0.5473).
 
 The kernel of B A⁻¹ Bᵀ is the kernel of Bᵀ (A is SPD), decided from the singular values of

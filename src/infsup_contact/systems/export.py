@@ -5,7 +5,7 @@ both bodies at unit material scale (Γ dofs last in each block, as the model sea
 B = [−B_1 0 | B_2 0] with the couplings B_i on the Γ columns, G the Gram matrix of the
 multiplier norm (H^{-1/2}_00(Γ) by the log kernel, or L²(Γ)). Then B A⁻¹ Bᵀ = Σ_i B_i X_i B_iᵀ
 exactly as ``beta`` forms it, so ``verdict --system`` on an export must reproduce
-``verdict --case`` (``tests/test_systems_roundtrip.py``). h = 1/N2 as in ``verdict --case``.
+``verdict --case`` (``tests/systems/test_systems_roundtrip.py``). h = 1/N2 as in ``verdict --case``.
 
 With ``norm="H"`` :func:`suite_levels` writes what a producer writes (``norm: H``): Γ
 (``gamma``), per level the ``multipliers`` description (:mod:`.multiplier_basis`; the helper

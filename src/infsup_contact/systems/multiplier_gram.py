@@ -24,7 +24,7 @@ of side L: G_H = L³ G̃_H (the norm scales like L^{3/2}).
 
 **What is invariant.** Scaling the whole geometry by L leaves β_h unchanged: in 2D the
 stiffness A (∫∇u·∇v) is invariant, B (∫_Γ μ v) scales by L and G_H by L²; in 3D A scales by L,
-B by L², G_H by L³. Either way B A⁻¹ Bᵀ and G_H scale alike (tests/test_systems_norm_h.py).
+B by L², G_H by L³. Either way B A⁻¹ Bᵀ and G_H scale alike (tests/systems/test_systems_norm_h.py).
 """
 from __future__ import annotations
 

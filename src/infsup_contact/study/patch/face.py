@@ -38,7 +38,7 @@ are reported with each row. With natural lateral faces the traces do not vanish 
 the spaces' kernel on clamped traces (R5.2's boundary modes) has no counterpart here.
 
 **Outcome** (k = 1, 2, 3; hexahedra and tetrahedra; N1:N2 = 4:5 and 7:8; G_h = trace of Ω2;
-exploratory runs outside the DAG, the test ``tests/test_face_patch.py`` pins the rule):
+exploratory runs outside the DAG, the test ``tests/study/test_face_patch.py`` pins the rule):
 as predicted in all 76 rows — every space holding the constants reproduces λ to 1e-14..5e-11
 (R5.4 at k = 3 the largest) and u to ≤ 2e-14 of δ; T3 fails (λ error ≥ 1, at ∂Γ where it
 vanishes, u error ~1e-2 δ). No row has a kernel (``kernel_dim`` 0, ``nonunique`` False). On

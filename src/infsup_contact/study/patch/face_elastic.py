@@ -39,7 +39,7 @@ membranes' face patch test (:mod:`.face`), whose solve and measures this scene s
 
 **Outcome** (k = 1, 2, 3; hexahedra and tetrahedra; N1:N2 = 4:5; E = (1, 1) and (1, 3),
 ν = 0.3; G_h = trace of Ω2; 76 rows, an exploratory run outside the DAG, the test
-``tests/test_elastic3d.py`` pins the rule on 3:4): every space holding the constants reproduces
+``tests/models/test_elastic3d.py`` pins the rule on 3:4): every space holding the constants reproduces
 λ to 1e-14..6e-10 (R5.4 on tetrahedra the largest) and u to ≤ 1e-13 of δ, T3 fails (λ error
 1.2–2.4, u error 3e-2..0.16 δ) — as predicted, with one exception shared with the membranes'
 face patch test (same failure there, λ error 1): DUAL at k = 1 on tetrahedra (dim M = the

@@ -40,7 +40,7 @@ from ....la.richardson import _norm2
 #: output (dim × rows of m × n_max) and its stacked U (:func:`chunk_rows`).
 _BUDGET = 2 ** 23
 #: Tail exponents p (‖S(∞) − S(n)‖ ~ n^{−p}) measured by :func:`tail_exponent` on
-#: N = 2, 4, s = 0..2, n = 32, 128 (tests/test_face_triangles.py); keys :func:`tail_key`.
+#: N = 2, 4, s = 0..2, n = 32, 128 (tests/discretization/face/test_face_triangles.py); keys :func:`tail_key`.
 TAIL_EXPONENTS = {(True, True): 4.0, (True, False): 2.0, (False, False): 2.0}
 
 

@@ -4,7 +4,7 @@ from pathlib import Path
 
 import pytest
 
-SCRIPT = Path(__file__).resolve().parents[1] / "workflow" / "scripts" / "compare_results.py"
+SCRIPT = Path(__file__).resolve().parents[2] / "workflow" / "scripts" / "compare_results.py"
 spec = importlib.util.spec_from_file_location("compare_results", SCRIPT)
 compare_results = importlib.util.module_from_spec(spec)
 spec.loader.exec_module(compare_results)

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 SCRIPT = ROOT / "workflow" / "scripts" / "docs_performance.py"
 
 BETA = """what,route,k,N,seconds_median,seconds_min,seconds_max,ratio_to_ours,repeats,includes

@@ -16,7 +16,7 @@ from infsup_contact.discretization.spaces.registry import SPACES
 from infsup_contact.discretization.face.square import SQUARE
 from infsup_contact.study.claims.criteria import FAIL, INCONCLUSIVE, PASS
 from infsup_contact.study.claims.membranes3d import matching_kernel
-from infsup_contact.study.face_elastic import nu_pairs
+from infsup_contact.study.face.elastic import nu_pairs
 from infsup_contact.study.claims.elastic3d import FINDING, claim_id, face_elastic_claims, nu_slope
 from infsup_contact.study.claims.membranes3d_studies import face_contains_constants
 

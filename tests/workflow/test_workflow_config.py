@@ -227,7 +227,7 @@ def test_fit_window_shrink_is_logged_and_mem_mb_follows_the_estimate(ci_dry_run)
         found = [line for line in block.splitlines() if "mem_mb=" in line]
         if name in ("beta_job", "contact_job") and found:
             mem[output.strip()] = int(found[0].split("mem_mb=")[1].split(",")[0])
-    from infsup_contact.study.batches import beta_batches
+    from infsup_contact.study.beta.batches import beta_batches
 
     ic = CI_CONFIG["infsup"]
     batches = beta_batches(ic)  # a β job is a batch of pairs: it asks for its largest pair's estimate

@@ -11,8 +11,8 @@ from infsup_contact.config_face import face_pairs, l2_only_sizes
 from infsup_contact.config_yaml import check_config_files
 from infsup_contact.config_memory import check_job_memory, memory_notes
 from infsup_contact.discretization.gamma.mesh_series import seeds, series_of_pairs
-from infsup_contact.study.batches import beta_batches
-from infsup_contact.study.scene_registry import scene_spec
+from infsup_contact.study.beta.batches import beta_batches
+from infsup_contact.study.contact.registry import scene_spec
 
 # Every check a config gets, in one library function (src/infsup_contact/config_checks.py):
 # user spaces, non-finite numbers, the schema, the registry's degrees and the cross-key rules.
@@ -46,7 +46,7 @@ def beta_pairs():
     return sorted(series_of_pairs(config["infsup"]), key=lambda p: (max(p), p))
 
 
-# β_h jobs: one per batch of pairs of one (family, k) (study/batches.py: beta_batches)
+# β_h jobs: one per batch of pairs of one (family, k) (study/beta/batches.py: beta_batches)
 BETA_BATCHES = beta_batches(config["infsup"])
 
 

@@ -14,8 +14,8 @@ import numpy as np
 import pandas as pd
 from scipy import stats
 
-from ..io import SERIES_COLUMNS, TableError
-from .scene_registry import energy_rate
+from ...io import SERIES_COLUMNS, TableError
+from .registry import energy_rate
 
 MEASURES = ("energy_error", "l2_error", "lambda_l2_error", "lambda_hm12_error")
 

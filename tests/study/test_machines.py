@@ -19,7 +19,7 @@ import pytest
 from helpers.once import once
 
 from infsup_contact.errors import InputError
-from infsup_contact.io import SCHEMAS
+from infsup_contact.table_schemas import SCHEMAS
 from infsup_contact.study.machines import agreement, ledgers, paths as machines
 
 ROOT = Path(__file__).resolve().parents[2]

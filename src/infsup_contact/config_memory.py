@@ -8,8 +8,9 @@ accepted the config; a cluster job asks the scheduler for its own ``mem_mb`` ins
 from __future__ import annotations
 
 from . import resources as R
-from .config_checks import ConfigError, scene_meshes
-from .study.scene_registry import scene_spec
+from .config_checks import ConfigError
+from .config_meshes import scene_meshes
+from .study.contact.registry import scene_spec
 
 
 def job_estimates(cfg):

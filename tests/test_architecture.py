@@ -34,8 +34,7 @@ LAYERS = [
     {"resources"},                                   # memory and time estimates of a run
     {"systems"},                                     # foreign systems read and certified
     {"study"},                                       # the study: series, claims, ledger
-    {"config_schema", "config_yaml", "config_checks", "config_face", "config_face_elastic",
-     "config_memory", "config_meshes", "config"},                     # the workflow's config checks
+    {"config"},                                      # the workflow's config checks
     {"bench"},                                       # benchmarks of the routes
     {"report"},                                      # tables and figures drawn from results
     {"api", "cli"},                                  # the Python API and the command line

@@ -235,10 +235,10 @@ def test_billion_laughs_manifest_is_refused_at_once(tmp_path, capsys):
 
 
 def test_billion_laughs_config_is_refused_at_once(tmp_path):
-    """The workflow's config files go through the same loader (config_yaml.check_config_file, run by
+    """The workflow's config files go through the same loader (config.strict_yaml.check_config_file, run by
     workflow/rules/common.smk); before, the check itself walked the 9^9 values (> 60 s)."""
-    from infsup_contact.config_checks import ConfigError
-    from infsup_contact.config_yaml import check_config_file
+    from infsup_contact.config.checks import ConfigError
+    from infsup_contact.config.strict_yaml import check_config_file
     from infsup_contact.yaml_limits import load
 
     path = tmp_path / "config.yaml"

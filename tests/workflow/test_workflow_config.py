@@ -140,9 +140,9 @@ def checked_as_the_workflow_does(path: Path) -> str:
     :func:`check_config` with the workflow's schema and, a local run, the job-memory check. The
     one line a bad config gets (common.smk prints it and exits 1 before any DAG), or "" if accepted."""
     from infsup_contact import resources
-    from infsup_contact.config_checks import ConfigError, check_config
-    from infsup_contact.config_memory import check_job_memory
-    from infsup_contact.config_yaml import check_config_files
+    from infsup_contact.config.checks import ConfigError, check_config
+    from infsup_contact.config.memory import check_job_memory
+    from infsup_contact.config.strict_yaml import check_config_files
 
     try:
         check_config_files([path])
@@ -180,7 +180,7 @@ def test_bad_config_fails_before_any_job(workdir, name):
                         "--configfile", "bad.yaml")
 
     assert rc == 1, f"bad config accepted (exit {rc}):\n{out}"
-    # one line naming the key (config_checks.check_config, run by common.smk), nothing else
+    # one line naming the key (config.checks.check_config, run by common.smk), nothing else
     assert config_error_lines(out) == [expected], out
     # validation runs while the Snakefile is parsed: no DAG, so no job, was ever built
     assert "Building DAG of jobs" not in out, out

@@ -40,7 +40,7 @@ rule face_beta_job:
 
 
 rule face_l2_job:
-    # the matching N above face.max_N up to face.l2_max_N, L²(Γ) rows alone (config_face.l2_only_sizes):
+    # the matching N above face.max_N up to face.l2_max_N, L²(Γ) rows alone (config.face.l2_only_sizes):
     # a job of its own, so it runs beside the element's main job
     output:
         "results/tables/face/l2_{element}_k{k}.csv",

@@ -3,7 +3,7 @@
 both norms, G_h = trace of Ω2, through the one β batch path of every model
 (:func:`infsup_contact.study.beta.batch_rows.beta_batch_rows`). With ``params.l2_only`` (rule
 face_l2_job): the matching N of ``face.l2_max_N`` above ``face.max_N``, the L²(Γ) norm alone
-(:func:`infsup_contact.config_face.l2_only_sizes`)."""
+(:func:`infsup_contact.config.face.l2_only_sizes`)."""
 import sys
 
 sys.path.insert(0, "workflow/scripts")
@@ -15,7 +15,7 @@ register_user_spaces(snakemake.config)  # noqa: F821
 
 import time  # noqa: E402
 
-from infsup_contact.config_face import face_pairs, l2_only_sizes  # noqa: E402
+from infsup_contact.config.face import face_pairs, l2_only_sizes  # noqa: E402
 from infsup_contact.discretization.spaces.registry import SPACES, ids_valid_for  # noqa: E402
 from infsup_contact.io import write_csv_atomic  # noqa: E402
 from infsup_contact.study.beta.batch_rows import beta_batch_rows  # noqa: E402

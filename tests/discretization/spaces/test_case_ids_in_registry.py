@@ -78,7 +78,7 @@ import copy  # noqa: E402
 import pytest  # noqa: E402
 import yaml  # noqa: E402
 
-from infsup_contact.config_checks import ConfigError, check_config  # noqa: E402
+from infsup_contact.config.checks import ConfigError, check_config  # noqa: E402
 
 SCHEMA = ROOT / "workflow" / "schemas" / "config.schema.yaml"
 

@@ -1,11 +1,11 @@
 """The meshes of the workflow configuration and what runs on each: every mesh (pair) with its
 cases and multiplier meshes (:func:`mesh_uses`), and the check that every space has a
 multiplier on each of them (:func:`check_space_meshes`, a rule of
-:data:`~infsup_contact.config_checks.CROSS_KEY_RULES`)."""
+:data:`~infsup_contact.config.checks.CROSS_KEY_RULES`)."""
 from __future__ import annotations
 
-from .config_schema import ConfigError
-from .errors import InputError
+from .schema import ConfigError
+from ..errors import InputError
 
 
 def scene_meshes(cfg) -> dict:
@@ -20,8 +20,8 @@ def mesh_uses(cfg, with_cases: bool = True):
     run with it, as the stages run them (the elastic stages, every space of infsup.cases defined
     for k; the benchmarks, the paper's cases and the reference space; the figures, their cases). ``with_cases=False``: the
     meshes only ({} for the cases; no registry lookups, usable before the user spaces load)."""
-    from .discretization.spaces.registry import PAPER_CASES, REFERENCE_SPACE, ids_valid_for
-    from .discretization.gamma.mesh_series import FAMILY_RULES
+    from ..discretization.spaces.registry import PAPER_CASES, REFERENCE_SPACE, ids_valid_for
+    from ..discretization.gamma.mesh_series import FAMILY_RULES
 
     def by_k(cases: dict) -> dict:
         if not with_cases:
@@ -72,7 +72,7 @@ def mesh_uses(cfg, with_cases: bool = True):
     yield "figures.elastic_profiles.N", n, n, n, pairs if with_cases else {}, ("omega2",)
     rem55 = {}
     if with_cases:
-        from .study.claims.membranes import REM55_INSTANCES
+        from ..study.claims.membranes import REM55_INSTANCES
 
         for _, _, k, triple, _ in REM55_INSTANCES:
             rem55.setdefault(k, []).append(triple)
@@ -83,7 +83,7 @@ def mesh_uses(cfg, with_cases: bool = True):
 def config_intervals(cfg, limit: int = 1024) -> set:
     """Numbers of intervals of every multiplier mesh of the config (best effort: a config
     that is not yet validated may lack keys), for checking the user spaces on each."""
-    from .discretization.spaces.registry import MULTIPLIER_CHOICES, multiplier_intervals
+    from ..discretization.spaces.registry import MULTIPLIER_CHOICES, multiplier_intervals
 
     out = set()
     try:
@@ -98,7 +98,7 @@ def config_intervals(cfg, limit: int = 1024) -> set:
 def check_space_meshes(cfg) -> None:
     """Every N list gets the minimum its spaces need: a case whose dim M_h is 0 on a mesh of
     the list (T3 and DUAL with k = 1 on N = 1) is refused, naming the key, the case and k."""
-    from .discretization.spaces.registry import case_name, is_empty, min_intervals, multiplier_intervals
+    from ..discretization.spaces.registry import case_name, is_empty, min_intervals, multiplier_intervals
 
     for key, value, n1, n2, cases_by_k, choices in mesh_uses(cfg):
         for k, cases in cases_by_k.items():

@@ -20,12 +20,12 @@ from __future__ import annotations
 
 import re
 
-from .discretization.spaces.user_spaces import config_case_ids
-from .config_meshes import check_space_meshes, config_intervals, scene_meshes
-from .config_schema import (ConfigError, check_finite, describe, key_path, load_schema,  # noqa: F401
+from ..discretization.spaces.user_spaces import config_case_ids
+from .meshes import check_space_meshes, config_intervals, scene_meshes
+from .schema import (ConfigError, check_finite, describe, key_path, load_schema,  # noqa: F401
                             schema_error, show)
-from .errors import InputError
-from .study.contact.registry import REFERENCE_MARGIN, data_scene_ids, scene_spec
+from ..errors import InputError
+from ..study.contact.registry import REFERENCE_MARGIN, data_scene_ids, scene_spec
 
 
 MIN_FIT_POINTS = 3
@@ -36,7 +36,7 @@ MIN_FIT_POINTS = 3
 
 def load_spaces(cfg) -> list:
     """Register the user spaces of key ``spaces``; their ``.py`` files (workflow inputs)."""
-    from .discretization.spaces.user_spaces import load_user_space
+    from ..discretization.spaces.user_spaces import load_user_space
 
     refs = cfg.get("spaces") if isinstance(cfg, dict) else None
     refs = [] if refs is None else refs
@@ -57,7 +57,7 @@ def load_spaces(cfg) -> list:
 
 def check_cases(cfg) -> None:
     """Case ids are registered spaces; each k is one the space allows (T4, T5: k >= 2)."""
-    from .discretization.spaces.registry import SPACES
+    from ..discretization.spaces.registry import SPACES
 
     ids = config_case_ids(cfg)
     for stage in ("infsup", "contact"):
@@ -91,7 +91,7 @@ def figure_cases(cfg):
 def check_figures(cfg) -> None:
     """A figure's case ids are registered spaces (the built-in ones and the config's own user
     spaces) defined for its k; its scene is a name under contact.scenes or a scene kind."""
-    from .discretization.spaces.registry import SPACES
+    from ..discretization.spaces.registry import SPACES
 
     ids = config_case_ids(cfg)
     for key, case, k in figure_cases(cfg):
@@ -219,8 +219,8 @@ def check_hertz_reference(cfg) -> None:
                           allowed=f"N_ref >= {need}")
 
 
-from .config_face import check_face  # noqa: E402 (the face section's checks: config_face.py)
-from .config_face_elastic import check_face_elastic  # noqa: E402 (config_face_elastic.py)
+from .face import check_face  # noqa: E402 (the face section's checks: config/face.py)
+from .face_elastic import check_face_elastic  # noqa: E402 (config/face_elastic.py)
 
 CROSS_KEY_RULES = {
     # rule: the keys it relates (the error names the first; a change to any of them can trip it)
@@ -252,7 +252,7 @@ CROSS_KEY_RULES = {
 def beta_series(cfg) -> dict:
     """The mesh series the claims ledger fits (per family, case, k and norm alike): matching
     even and odd N, and every non-matching series (discretization/gamma/mesh_series.py) by N2."""
-    from .discretization.gamma.mesh_series import beta_series as series, describe
+    from ..discretization.gamma.mesh_series import beta_series as series, describe
 
     ic = cfg["infsup"]
     ns = sorted(ic["N"])

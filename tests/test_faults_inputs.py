@@ -18,8 +18,9 @@ import pytest
 import yaml
 
 from infsup_contact.cli import main as cli_main
-from infsup_contact.config_checks import ConfigError, check_config, key_path, mesh_uses
-from infsup_contact.config_yaml import check_config_file
+from infsup_contact.config.checks import ConfigError, check_config, key_path
+from infsup_contact.config.meshes import mesh_uses
+from infsup_contact.config.strict_yaml import check_config_file
 from infsup_contact.discretization.segment import meshes
 from infsup_contact.discretization.spaces import registry
 from infsup_contact.discretization.spaces.registry import SPACES
@@ -241,7 +242,7 @@ N_LISTS = {
 
 
 def test_every_n_list_is_covered():
-    """Every mesh key the config checks (config_checks.mesh_uses) is mutated here."""
+    """Every mesh key the config checks (config.meshes.mesh_uses) is mutated here."""
     keys = {key.split("[")[0] for key, *_ in mesh_uses(CI_CONFIG, with_cases=False)}
     assert keys <= {key_path(p) for p in N_LISTS}, keys - {key_path(p) for p in N_LISTS}
 

@@ -1,11 +1,13 @@
 """Atomic output (an interrupted run never leaves a half-written file behind) and checked input
-(every table is read through :func:`read_table`, against its declared :data:`SCHEMAS`: a damaged
+(every table is read through :func:`read_table`, against its declared schema (:mod:`.table_schemas`): a damaged
 table is one line naming the file and the row)."""
 from __future__ import annotations
 
 import os
 import tempfile
 from pathlib import Path
+
+from .table_schemas import SCHEMAS, Schema
 
 
 def _replace_atomic(path, data, mode: str) -> None:
@@ -40,139 +42,7 @@ def write_csv_atomic(path, frame) -> None:
 
 
 # ---------------------------------------------------------------- reading tables
-# Every table the package, the CLI and the workflow read is declared here: its columns (a
-# consumer's required ones and the producer's optional ones), their types, and its key.
-# Column types:
-#   int    an integer (finite)            int?   an integer or an empty cell
-#   float  a finite number                float? a number or an empty cell (NaN)
-#   str    non-empty text                 str?   text or an empty cell
-#   bool   True/False                     bool?  True/False or an empty cell
-# A type without "?" is one the producer always writes: an empty cell there is damage (a
-# truncated row, a number cut short), not a missing value. Extra columns are allowed (the
-# producers add provenance and diagnostics); only the declared ones are checked.
-
-_BETA = {"case": "str", "k": "int", "family": "str", "N1": "int", "N2": "int", "multiplier_mesh": "str",
-         "c1": "float", "c2": "float", "norm": "str", "beta": "float", "kernel_dim": "int",
-         "structural_kernel_dim": "int", "smallest_nonzero": "float?", "beta_v1_zero": "float?", "dim_M": "int",
-         "dim_W": "int", "ndof": "int"}
-_MEASURES = {"energy_error": "float", "l2_error": "float", "lambda_l2_error": "float", "lambda_hm12_error": "float"}
-_ELASTIC_BETA = {"model": "str", "case": "str", "k": "int", "family": "str", "N1": "int", "N2": "int",
-                 "multiplier_mesh": "str", "E1": "float", "E2": "float", "nu": "float", "norm": "str", "beta": "float",
-                 "kernel_dim": "int", "structural_kernel_dim": "int", "smallest_nonzero": "float?",
-                 "beta_v1_zero": "float?", "beta_membranes": "float?", "kernel_dim_membranes": "int",
-                 "bound_factor": "float?"}
-SERIES_COLUMNS = ("scene", "scene_kind", "case", "k", "family", "c1", "c2", "p", "q", "seed", "multiplier_mesh")
-"""Columns of a contact table that define a convergence series (those present): rates are
-fitted per series, and a series lists each mesh once."""
-
-
-class Schema:
-    """A table kind: ``columns`` (name → type, required), ``optional`` (checked when present),
-    ``key`` (columns, those present, that identify a row: no two rows share them), ``label``
-    (what the table is, for messages) and ``sep`` (the field separator)."""
-
-    def __init__(self, columns: dict, optional: dict | None = None, key: tuple = (), label: str | None = None,
-                 sep: str = ","):
-        self.columns, self.optional, self.key, self.label, self.sep = columns, optional or {}, key, label, sep
-
-    def types(self, present) -> dict:
-        """Type of every declared column among ``present``."""
-        every = {**self.optional, **self.columns}
-        return {c: every[c] for c in present if c in every}
-
-
-SCHEMAS = {
-    "beta": Schema(_BETA, optional={"seed": "int?", "series": "str"},
-                   key=("family", "case", "k", "N1", "N2", "seed", "multiplier_mesh", "c1", "c2", "norm", "series")),
-    "contact": Schema({"scene": "str", "case": "str", "k": "int", "family": "str", "N1": "int", "N2": "int",
-                       "c1": "float", "c2": "float", "ndof": "int", "dim_M": "int", "cone": "str", "iterations": "int",
-                       **_MEASURES, "min_lambda_pointwise": "float?", "max_penetration": "float?", "nonunique": "bool",
-                       "kernel_dim": "int"},
-                      optional={"p": "float?", "q": "float?", "seed": "int?", "scene_kind": "str"},
-                      key=("scene", "case", "k", "family", "N1", "N2", "c1", "c2", "p", "q", "seed")),
-    # `infsup-contact rates`: any contact table; its series and meshes are checked by study/rates.py
-    "contact_input": Schema({"scene": "str", "case": "str", "k": "int", "family": "str", "N1": "int", "N2": "int",
-                             **_MEASURES},
-                            optional={"c1": "float", "c2": "float", "p": "float?", "q": "float?", "seed": "int?",
-                                      "scene_kind": "str", "multiplier_mesh": "str"},
-                            label="a contact table (`infsup-contact contact` or results/tables/contact.csv)"),
-    "rates": Schema({"scene": "str", "case": "str", "k": "int", "family": "str", "measure": "str", "slope": "float?",
-                     "stderr": "float?", "points": "int", "h_min": "float", "expected": "float?"},
-                    optional={"c1": "float", "c2": "float", "p": "float?", "q": "float?", "seed": "int?",
-                              "scene_kind": "str", "multiplier_mesh": "str"},
-                    key=(*SERIES_COLUMNS, "measure")),
-    "producers": Schema({"producer": "str", "version": "str?", "space": "str", "offset": "int", "norm": "str",
-                         "status": "str", "verdict": "str?", "kernel_dim": "int?", "beta_levels": "str?",
-                         "kernel_levels": "str?", "h_levels": "str?", "slope": "float?", "slope_lo": "float?",
-                         "slope_hi": "float?", "evidence": "str?", "seconds": "float?", "install": "str",
-                         "system": "str?"}, key=("producer", "space", "offset", "norm"),
-                        label="the producers table (rules/producers.smk)"),
-    "claims": Schema({"claim_id": "str", "paper_ref": "str", "statement": "str", "evidence": "str", "verdict": "str",
-                      "predicted": "str"}, key=("claim_id",), label="a claims ledger"),
-    # no key: a sample 1e-9·h inside each end of an interval may print as its neighbour's x
-    "gamma_profiles": Schema({"case": "str", "k": "int", "N": "int", "x": "float", "quantity": "str",
-                              "value": "float?"}),
-    "field_values": Schema({"case": "str", "k": "int", "N": "int", "side": "int", "x": "float", "y": "float",
-                            "u": "float"}, key=("case", "k", "N", "side", "x", "y")),
-    "speed_accuracy": Schema({"scene": "str", "case": "str", "k": "int", "family": "str", "N": "int",
-                              "seconds": "float", "energy_error": "float", "lambda_hm12_error": "float",
-                              "ndof": "int", "dim_M": "int", "pareto_energy": "bool", "pareto_lambda": "bool"},
-                             key=("scene", "case", "k", "family", "N")),
-    "bench": Schema({"what": "str", "route": "str", "k": "int", "N": "int", "seconds_median": "float",
-                     "seconds_min": "float", "seconds_max": "float", "ratio_to_ours": "float?"},
-                    key=("what", "route", "k", "N"), label="a bench table"),
-    "mesh_quality": Schema({"family": "str", "N1": "int", "N2": "int", "side": "int", "h_max": "float",
-                            "h_min": "float", "min_angle": "float"}, optional={"seed": "int?"},
-                           key=("family", "N1", "N2", "side", "seed")),
-    # elastic stage (study/elastic_beta.py, study/patch/segment.py, study/hertz.py)
-    "elastic_beta": Schema(_ELASTIC_BETA, key=("model", "case", "k", "family", "N1", "N2", "multiplier_mesh", "E1",
-                                               "E2", "nu", "norm")),
-    "elastic_patch": Schema({"case": "str", "k": "int", "N1": "int", "N2": "int", "p": "float", "kernel_dim": "int",
-                             "lambda_max_rel_error": "float", "lambda_end_rel_error": "float",
-                             "lambda_middle_rel_error": "float", "u_max_rel_error": "float", "passes": "bool"},
-                            optional={"scene": "str", "family": "str", "E1": "float", "E2": "float", "nu": "float",
-                                      "delta": "float"},
-                            key=("scene", "case", "k", "family", "N1", "N2", "E1", "E2", "nu", "delta")),
-    "elastic_hertz": Schema({"study": "str", "case": "str", "k": "int", "N": "int", "d": "float", "P": "float",
-                             "p_max": "float", "half_width": "float", "oscillation": "float",
-                             "p_max_rel_error": "float?", "half_width_rel_error": "float?"},
-                            optional={"R": "float", "nu": "float", "E1": "float", "E2": "float"},
-                            key=("study", "case", "k", "N", "R", "d", "nu", "E1", "E2")),
-    # the 3D contact face (rules/face.smk: study/beta_batches.py with models/membranes3d.py)
-    "face_beta": Schema({**_BETA, "model": "str", "element": "str"},
-                        key=("model", "element", "family", "case", "k", "N1", "N2", "multiplier_mesh", "c1", "c2",
-                             "norm")),
-    # the 3D elastic bodies on the face (rules/face_elastic.smk: study/face_elastic.py): β_h per ν
-    "face_elastic_beta": Schema({**_BETA, "model": "str", "element": "str", "nu": "float"},
-                                key=("model", "element", "family", "case", "k", "N1", "N2", "multiplier_mesh", "c1",
-                                     "c2", "nu", "norm")),
-    "face_elastic_patch": Schema({"element": "str", "case": "str", "k": "int", "N1": "int", "N2": "int",
-                                  "E1": "float", "E2": "float", "nu": "float", "lambda_max_rel_error": "float",
-                                  "u_max_rel_error": "float", "kernel_dim": "int", "passes": "bool"},
-                                 key=("element", "case", "k", "N1", "N2", "E1", "E2", "nu")),
-    # the face studies (rules/face_studies.smk: study/patch/face.py, face_alpha.py, edge_dropping.py);
-    # condition numbers may be inf (singular to working precision): extra columns, not declared
-    "face_patch": Schema({"element": "str", "case": "str", "k": "int", "N1": "int", "N2": "int",
-                          "lambda_max_rel_error": "float", "u_max_rel_error": "float", "kernel_dim": "int",
-                          "passes": "bool"}, key=("element", "case", "k", "N1", "N2")),
-    "face_alpha": Schema({"element": "str", "alpha": "float", "N": "int", "norm": "str", "min_weight": "float",
-                          "min_weight_gauss": "float", "accepted": "bool", "beta": "float?"},
-                         key=("element", "alpha", "N", "norm")),
-    "face_edge": Schema({"case": "str", "k": "int", "N": "int", "theta": "float", "beta_H": "float",
-                         "beta_L2": "float", "beta_H_resolved": "bool", "beta_L2_resolved": "bool",
-                         "beta_L2_kappa": "float?", "beta_L2_kappa_resolved": "bool", "fit_theta_max": "float"},
-                        key=("case", "k", "N", "theta")),
-    # results/benchmarks/dag.csv (bench/dag.py: per rule of a run), read by the docs' generator
-    "dag": Schema({"rule": "str", "jobs": "int", "wall_s_sum": "float", "wall_s_max": "float",
-                   "cpu_s_sum": "float?", "max_rss_mb": "float?"}, key=("rule",), label="a DAG timing table"),
-    # Snakemake's `benchmark:` files (bench/dag.py), tab-separated
-    "rule_benchmark": Schema({"s": "float"}, optional={"max_rss": "float?", "cpu_time": "float?"},
-                             label="a Snakemake benchmark file", sep="\t"),
-}
-"""The declared tables (:func:`read_table`): one :class:`Schema` per kind."""
-
-TABLE_COLUMNS = {kind: tuple(s.columns) for kind, s in SCHEMAS.items()}
-"""Required columns per table kind (derived from :data:`SCHEMAS`)."""
+# against the declared tables of :mod:`infsup_contact.table_schemas`
 
 _TYPE_WORDS = {"int": "integers", "float": "finite numbers", "str": "non-empty text", "bool": "True or False"}
 

@@ -96,7 +96,7 @@ class LimitedLoader(yaml.SafeLoader):
 
 class ExpansionLoader(LimitedLoader):
     """:class:`LimitedLoader` checking the expansion only (a caller that reports duplicate keys
-    itself, with its own wording: :mod:`infsup_contact.config_yaml`)."""
+    itself, with its own wording: :mod:`infsup_contact.config.strict_yaml`)."""
 
     duplicates = False
 

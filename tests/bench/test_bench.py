@@ -94,7 +94,7 @@ def test_reduced_qp_equals_solve_contact(route):
     from infsup_contact.solvers.contact import solve_contact
     from infsup_contact.bench.peers import contact_qp
     from infsup_contact.solvers.reduced_qp import solve_reduced_qp
-    from infsup_contact.study.scenes import membranes
+    from infsup_contact.study.contact.scenes import membranes
 
     sc, sides, Bs, F = contact_routes._contact_problem(6, 2)
     sol = solve_contact(membranes(), "T3", 2, "structured", 6, 6, time_floor=False)
@@ -108,7 +108,7 @@ def test_reduced_qp_equals_solve_contact(route):
 
 # ------------------------------------------------------------------ speed–accuracy
 def test_speed_accuracy_table_from_contact_rows():
-    from infsup_contact.study.contact_rows import contact_row
+    from infsup_contact.study.contact.rows import contact_row
 
     rows = [contact_row("manufactured", case, k, "structured", n, n, time_floor=False)
             for case, k in (("T3", 1), ("T4", 2)) for n in (4, 6)]
@@ -125,7 +125,7 @@ def test_speed_accuracy_table_from_contact_rows():
 def test_split_timing_parts_are_ordered_and_a_shared_pair_solves_as_a_fresh_one():
     from infsup_contact.bench.speed_accuracy import time_contact_solves
     from infsup_contact.solvers.contact import contact_pair, solve_contact, solve_contact_on
-    from infsup_contact.study.scenes import membranes
+    from infsup_contact.study.contact.scenes import membranes
 
     t = time_contact_solves(["T3", "R5.4"], 2, 4, repeats=3)
     for med, lo, hi, runs in t.values():

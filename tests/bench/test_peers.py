@@ -5,7 +5,7 @@ import pytest
 from infsup_contact import bench
 from infsup_contact.bench import contact_routes, peers
 from infsup_contact.solvers.contact import solve_contact
-from infsup_contact.study.scenes import membranes
+from infsup_contact.study.contact.scenes import membranes
 
 
 @pytest.fixture(scope="module", params=[1, 2], ids=["k1", "k2"])

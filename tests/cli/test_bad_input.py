@@ -30,9 +30,9 @@ import yaml
 from helpers.cli import run_in_process
 
 from infsup_contact import cli, resources
-from infsup_contact.config_checks import (CROSS_KEY_RULES, REFERENCE_MARGIN, ConfigError, check_config,
+from infsup_contact.config.checks import (CROSS_KEY_RULES, REFERENCE_MARGIN, ConfigError, check_config,
                                           key_path, scene_meshes)
-from infsup_contact.config_memory import check_job_memory, memory_notes
+from infsup_contact.config.memory import check_job_memory, memory_notes
 
 ROOT = Path(__file__).resolve().parents[2]
 SCHEMA = yaml.safe_load((ROOT / "workflow" / "schemas" / "config.schema.yaml").read_text())

@@ -3,7 +3,7 @@ full stdout, Ctrl-C and a piped table.
 
 Each case asserts a refusal (exit != 0, or TableError) with ONE line naming the file and the
 row, or a documented acceptance. The tables are tiny and built from the declared schemas
-(io.SCHEMAS), so every table kind the workflow reads is damaged in every way; the CLI runs in
+(table_schemas.SCHEMAS), so every table kind the workflow reads is damaged in every way; the CLI runs in
 this process except where an exit status, a closed descriptor or a signal is the point.
 """
 from __future__ import annotations
@@ -22,8 +22,9 @@ import pandas as pd
 import pytest
 
 from infsup_contact import cli
-from infsup_contact.io import SCHEMAS, TableError, read_table
-from infsup_contact.study.rates import MEASURES, rate_table
+from infsup_contact.io import TableError, read_table
+from infsup_contact.table_schemas import SCHEMAS
+from infsup_contact.study.contact.rates import MEASURES, rate_table
 
 ROOT = Path(__file__).resolve().parents[2]
 ENV = {**os.environ, "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1",

@@ -9,9 +9,9 @@ def small_elastic_tables() -> dict:
     import pandas as pd
 
     from infsup_contact.bench.elastic_beta import bench_elastic_beta
-    from infsup_contact.study.elastic_beta import elastic_beta_rows, nu_sweep_rows
+    from infsup_contact.study.beta.elastic import elastic_beta_rows, nu_sweep_rows
     from infsup_contact.study.claims.elastic import elastic_claims, hertz_claims, patch_claims
-    from infsup_contact.study.hertz import discretization_rows, modeling_rows
+    from infsup_contact.study.contact.hertz import discretization_rows, modeling_rows
     from infsup_contact.study.patch.segment import patch_rows
 
     beta = elastic_beta_rows("structured", 1, [(2, 2), (3, 3), (4, 4), (3, 2), (6, 4), (9, 6)], cases=["T3", "R5.2"])

@@ -11,7 +11,7 @@ and the Laplace stiffness is exactly
 with the 1D stiffness and mass matrices (Gauss–Legendre, exact). This is a second route to the
 side operators of :mod:`infsup_contact.models.membranes3d` (hexahedra), independent of NGSolve,
 and it takes any tensor grid: the study of partially covered faces
-(:mod:`infsup_contact.study.edge_dropping`, whose production path uses NGSolve) has a body
+(:mod:`infsup_contact.study.face.edge_dropping`, whose production path uses NGSolve) has a body
 (0, L) × (0, 1) × (1, 2); the tests check that both routes give the same β_h and condition numbers.
 
 The side's contribution to the interface operator is B X Bᵀ with X = (K_ff⁻¹)_ΓΓ, the Γ block of
@@ -140,7 +140,7 @@ def couplings_1d(face, trace_space, axis: str, k: int) -> np.ndarray:
 def tensor_interface_operator(face, k: int, grids: dict) -> np.ndarray:
     """S = Σ_i B_i X_i B_iᵀ (c1 = c2 = 1) with B_i = B_i^x ⊗ B_i^y and X_i of
     :func:`box_gamma_block`; ``grids`` {side: (xs, ys, zs)} as
-    :func:`infsup_contact.study.edge_dropping.geometry` gives them."""
+    :func:`infsup_contact.study.face.edge_dropping.geometry` gives them."""
     S = np.zeros((face.dim, face.dim))
     for i, (xs, ys, zs) in grids.items():
         bx = couplings_1d(face, lagrange_1d(xs, k), "x", k)[:, face_dofs_1d(xs, k)]

@@ -89,7 +89,7 @@ def face_sides():
     from infsup_contact.models import make_model
     from infsup_contact.models import membranes3d
     from infsup_contact.study.patch import face as face_patch
-    from infsup_contact.study.scene_registry import FACE_PATCH
+    from infsup_contact.study.contact.registry import FACE_PATCH
 
     model = make_model(FACE_PATCH.models[0])
     scene = face_patch.patch_scene()

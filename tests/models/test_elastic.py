@@ -244,7 +244,7 @@ def test_cli_contact_elastic_refusals(argv, flag):
 
 def test_hertz_energy_error_of_the_reference_itself_is_zero():
     """energy_error(ref, ref) = 0 and a coarse solution's error against it is > 0."""
-    from infsup_contact.study.hertz import energy_error, reference_data, solve_hertz
+    from infsup_contact.study.contact.hertz import energy_error, reference_data, solve_hertz
 
     ref = solve_hertz("T3", 2, 8, 1.0, 0.05)
     assert energy_error(ref, reference_data(ref), 0.3) < 1e-12
@@ -255,7 +255,7 @@ def test_hertz_energy_error_of_the_reference_itself_is_zero():
 def test_hertz_modeling_error_falls_as_the_contact_zone_shrinks():
     """Against plane-strain Hertz for the measured P, the max-pressure error decreases with a/W
     (T3, k = 2, N = 32); the half-width a of Hertz grows with the indentation d."""
-    from infsup_contact.study.hertz import modeling_rows
+    from infsup_contact.study.contact.hertz import modeling_rows
 
     rows = modeling_rows("T3", 2, 32, 1.0, [0.02, 0.05, 0.1])
     err = [r["p_max_rel_error"] for r in rows]
@@ -265,7 +265,7 @@ def test_hertz_modeling_error_falls_as_the_contact_zone_shrinks():
 
 def test_hertz_formulas():
     """a = sqrt(4PR/(πE*)), p0 = 2P/(πa), and ∫ p = P for the Hertz profile (Gauss)."""
-    from infsup_contact.study.hertz import combined_modulus, hertz, hertz_pressure
+    from infsup_contact.study.contact.hertz import combined_modulus, hertz, hertz_pressure
 
     P, R, nu, E = 0.01, 2.0, 0.25, (1.0, 3.0)
     a, p0 = hertz(P, R, nu, E)

@@ -22,7 +22,7 @@ from infsup_contact.solvers.contact import solve_contact_on
 from infsup_contact.solvers.infsup import beta_rows_all
 from infsup_contact.study.patch import face_elastic as efp
 from infsup_contact.study.patch.face import PASS_RTOL
-from infsup_contact.study.scene_registry import ELASTIC_FACE_PATCH
+from infsup_contact.study.contact.registry import ELASTIC_FACE_PATCH
 
 FREE = ("nothing",) * 3
 """Supports matching no boundary: a floating body."""

@@ -14,7 +14,7 @@ from helpers.cli import run_in_process
 
 import infsup_contact
 from infsup_contact.models import MODELS
-from infsup_contact.study.scene_registry import allowed_pairs, scene_ids, scene_spec
+from infsup_contact.study.contact.registry import allowed_pairs, scene_ids, scene_spec
 
 PACKAGE = Path(infsup_contact.__file__).parent
 
@@ -86,8 +86,8 @@ def test_a_manufactured_gap_is_not_an_initial_gap():
     """A manufactured scene's ``gap`` is its exact g = u2 − u1, not data: the Γ solve adds only
     a scene's ``initial_gap`` (the Hertz curvature), so the membranes' pairs carry none."""
     from infsup_contact.solvers.contact import contact_pair
-    from infsup_contact.study.hertz import hertz_scene
-    from infsup_contact.study.scenes import manufactured
+    from infsup_contact.study.contact.hertz import hertz_scene
+    from infsup_contact.study.contact.scenes import manufactured
 
     assert contact_pair(manufactured(), 1, "structured", 2, 2).gap is None
     assert hertz_scene(1.0, 0.05).initial_gap(0.5) == 0.0
@@ -98,8 +98,8 @@ def test_lambda_values_of_a_saved_reference(tmp_path):
     import numpy as np
 
     from infsup_contact.solvers.contact import lambda_values, solve_contact
-    from infsup_contact.study.contact_rows import load_reference, save_reference
-    from infsup_contact.study.scenes import membranes
+    from infsup_contact.study.contact.rows import load_reference, save_reference
+    from infsup_contact.study.contact.scenes import membranes
 
     sol = solve_contact(membranes(), "T3", 1, "structured", 4, 4, time_floor=False)
     save_reference(tmp_path / "ref.npz", sol)

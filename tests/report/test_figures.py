@@ -143,7 +143,7 @@ def test_fig4_families(tmp_path, scripts, drawn):
 
 
 def test_fig5_contact_solutions_from_profiles(tmp_path, scripts, drawn):
-    from infsup_contact.study.profiles import contact_profiles
+    from infsup_contact.study.contact.profiles import contact_profiles
 
     gamma, field = contact_profiles(["T4", "R5.4"], 2, 4)
     scripts["fig_contact_solutions"].plot_contact_solutions(gamma, field, tmp_path / "f5.pdf", tmp_path / "f5.png")
@@ -176,7 +176,7 @@ def test_pareto_front():
 
 
 def test_profiles_columns_on_tiny_mesh():
-    from infsup_contact.study.profiles import FIELD_COLUMNS, GAMMA_COLUMNS, contact_profiles
+    from infsup_contact.study.contact.profiles import FIELD_COLUMNS, GAMMA_COLUMNS, contact_profiles
 
     gamma, field = contact_profiles(["T3"], 1, 4, per_interval=5)
     assert list(gamma.columns) == GAMMA_COLUMNS == ["case", "k", "N", "x", "quantity", "value"]

@@ -6,8 +6,8 @@ from infsup_contact.study.claims.membranes import sign_check
 from infsup_contact.solvers.kkt import solve_kkt_sparse
 from infsup_contact.models.membranes import load_vector
 from infsup_contact.solvers.contact import contact_qp, solve_contact
-from infsup_contact.study.scenes import manufactured, membranes
-from infsup_contact.study.contact_rows import contact_row
+from infsup_contact.study.contact.scenes import manufactured, membranes
+from infsup_contact.study.contact.rows import contact_row
 
 
 @pytest.mark.parametrize("case,k,n1,n2", [("T3", 1, 6, 6), ("T5", 2, 5, 4), ("T4", 2, 6, 6)])
@@ -89,7 +89,7 @@ def test_errors_against_a_reference_vanish_on_itself_and_do_not_depend_on_call_o
     """The reference's own samples are kept on it after the first measurement: measuring
     itself gives zero, and a solution measured before and after the cache fills gives the
     same errors (the cached samples are those a fresh evaluation would give)."""
-    from infsup_contact.study import accuracy
+    from infsup_contact.study.contact import accuracy
     sc = membranes(c1=1.0, c2=2.0)
     ref = solve_contact(sc, "T3", 1, "structured", 16, 16, time_floor=False)
     fresh = solve_contact(sc, "T3", 1, "structured", 16, 16, time_floor=False)
@@ -126,8 +126,8 @@ def test_cases_sharing_one_pair_solve_as_if_alone():
 def test_a_saved_reference_measures_exactly_as_the_solved_one(tmp_path):
     """save_reference writes plain arrays (.npz): the errors against the loaded reference equal,
     bit for bit, those against the solved one, and it reads with allow_pickle=False."""
-    from infsup_contact.study import accuracy
-    from infsup_contact.study.contact_rows import load_reference, save_reference
+    from infsup_contact.study.contact import accuracy
+    from infsup_contact.study.contact.rows import load_reference, save_reference
 
     sc = membranes(c1=1.0, c2=2.0)
     ref = solve_contact(sc, "T3", 2, "structured", 8, 8, time_floor=False)
@@ -165,7 +165,7 @@ def test_a_planted_or_damaged_reference_is_refused_unread(tmp_path, how):
     import pickle
 
     from infsup_contact.errors import InputError
-    from infsup_contact.study.contact_rows import load_reference, save_reference
+    from infsup_contact.study.contact.rows import load_reference, save_reference
 
     marker, path = tmp_path / "code-ran", tmp_path / "membranes_k1.npz"
     if how == "pickle":

@@ -1,6 +1,6 @@
-"""The β_h jobs of the workflow (study/batches.py): every pair of every series once per (family, k)."""
+"""The β_h jobs of the workflow (study/beta/batches.py): every pair of every series once per (family, k)."""
 from infsup_contact.discretization.gamma.mesh_series import series_of_pairs
-from infsup_contact.study.batches import beta_batches
+from infsup_contact.study.beta.batches import beta_batches
 
 IC = {"N": [4, 8, 16], "nonmatching": [[6, 4], [12, 8], [16, 8], [6, 8]],
       "nonmatching_families": {"plus1": [8, 12, 16], "sqrt2": [8, 12, 16]},

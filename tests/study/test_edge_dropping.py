@@ -1,9 +1,10 @@
 """Edge dropping (issue 28, item 5): multipliers of Ω1's face cut at x = L, β_h with and
-without κ scaling (:mod:`infsup_contact.study.edge_dropping`)."""
+without κ scaling (:mod:`infsup_contact.study.face.edge_dropping`)."""
 import numpy as np
 import pytest
 
 from infsup_contact.discretization.spaces import registry
+from infsup_contact.discretization.spaces.registry import edge_cases
 from infsup_contact.discretization.face.spaces.clipped import ClippedFace, clip_1d
 from infsup_contact.discretization.face.norms.tensor import partial_gram
 from infsup_contact.discretization.segment.norms import sine_coefficients
@@ -12,7 +13,7 @@ from infsup_contact.discretization.face.square import SQUARE
 from infsup_contact.discretization.face.tensor_grid import TensorPartition
 from infsup_contact.errors import InputError
 from infsup_contact.solvers.spectra import spectrum
-from infsup_contact.study.edge_dropping import (edge_cases, edge_row, geometry, interface_operator,
+from infsup_contact.study.face.edge_dropping import (edge_row, geometry, interface_operator,
                                                 kappa_1d, scaled_cond, side_pair)
 
 from helpers.tensor_sides import box_gamma_block, couplings_1d, lagrange_1d, tensor_interface_operator
@@ -150,7 +151,7 @@ def test_fast_diagonalization_equals_sparse_lu(k, gamma_top):
 def test_nodal_twin_spans_the_restriction(case, k):
     """For a nodal basis the space built on the clipped partition and the restricted registry
     space are the same space: equal β_h from the two bases (θ where both pencils are accurate)."""
-    from infsup_contact.study.edge_dropping import beta_on, nodal_twin
+    from infsup_contact.study.face.edge_dropping import beta_on, nodal_twin
 
     n, n2, theta = 3, 6, 0.3
     L = geometry(n, n2, theta)[0]
@@ -173,7 +174,7 @@ def test_csv_entry(capsys):
     import csv
     import io
 
-    from infsup_contact.study.edge_dropping import COLUMNS, main
+    from infsup_contact.study.face.edge_table import COLUMNS, main
 
     assert main(["--k", "1", "--N", "2", "--theta", "1", "0.5", "--norm", "L2"]) == 0
     rows = list(csv.DictReader(io.StringIO(capsys.readouterr().out)))
@@ -243,7 +244,7 @@ def test_theta_below_the_geometry_is_refused():
     θ = 0 space, instead of ~θ. Now refused naming theta and the range; the smallest θ allowed
     keeps the column."""
     from infsup_contact.discretization.face.spaces.clipped import min_covered_fraction
-    from infsup_contact.study.edge_dropping import edge_plan
+    from infsup_contact.study.face.edge_table import edge_plan
 
     for call in (lambda: edge_row("R5.2", 1, 4, 8, 1e-12), lambda: edge_plan([1], [4], [1.0, 1e-12])):
         with pytest.raises(InputError) as err:
@@ -255,16 +256,16 @@ def test_theta_below_the_geometry_is_refused():
 
 
 @pytest.mark.parametrize("module, argv, flag, allowed", [
-    ("edge_dropping", ["--k", "5", "--N", "4"], "--k", "1, 2, 3, 4"),          # was: a header, exit 0
-    ("edge_dropping", ["--k", "1", "--N", "4", "--theta", "0.5", "1e-12"], "--theta", "4e-09 <= θ <= 1"),
-    ("edge_dropping", ["--k", "2", "--N", "4", "--case", "PWLIN-T6"], "--case", "T3, R5.2"),
-    ("edge_dropping", ["--k", "1", "--N", "0"], "--N", ">= 1"),                # was: a traceback
-    ("edge_dropping", ["--k", "1", "--N", "4", "--n2-factor", "0"], "--n2-factor", ">= 1"),
-    ("edge_dropping", ["--k", "1", "--N", "4", "--norm", "X"], "--norm", "'H', 'L2'"),
-    ("face_alpha", ["--N", "0"], "--N", ">= 1"),
-    ("face_families", ["--k", "5"], "--k", "1..4"),
-    ("face_families", ["--element", "bogus"], "--element", "hex, tet"),
-    ("machines", [], "out_dir", "required"),
+    ("face.edge_table", ["--k", "5", "--N", "4"], "--k", "1, 2, 3, 4"),          # was: a header, exit 0
+    ("face.edge_table", ["--k", "1", "--N", "4", "--theta", "0.5", "1e-12"], "--theta", "4e-09 <= θ <= 1"),
+    ("face.edge_table", ["--k", "2", "--N", "4", "--case", "PWLIN-T6"], "--case", "T3, R5.2"),
+    ("face.edge_table", ["--k", "1", "--N", "0"], "--N", ">= 1"),                # was: a traceback
+    ("face.edge_table", ["--k", "1", "--N", "4", "--n2-factor", "0"], "--n2-factor", ">= 1"),
+    ("face.edge_table", ["--k", "1", "--N", "4", "--norm", "X"], "--norm", "'H', 'L2'"),
+    ("face.alpha", ["--N", "0"], "--N", ">= 1"),
+    ("face.families", ["--k", "5"], "--k", "1..4"),
+    ("face.families", ["--element", "bogus"], "--element", "hex, tet"),
+    ("machines.paths", [], "out_dir", "required"),
 ])
 def test_study_command_lines_refuse_in_one_line(module, argv, flag, allowed, capsys):
     """Every study module's ``python -m`` command: impossible input is one line naming the flag
@@ -272,7 +273,7 @@ def test_study_command_lines_refuse_in_one_line(module, argv, flag, allowed, cap
     import importlib
 
     mod = importlib.import_module(f"infsup_contact.study.{module}")
-    entry = mod.cli if module == "machines" else mod.main
+    entry = mod.cli if module == "machines.paths" else mod.main
     try:
         code = entry(argv)
     except SystemExit as exc:  # argparse's own refusals

@@ -1,5 +1,5 @@
 """The face stage's claims (study/face_claims.py), macros (report/face.py) and config checks
-(config_face.py) on synthetic tables: verdicts follow the data by the ledger's criteria, the
+(config/face.py) on synthetic tables: verdicts follow the data by the ledger's criteria, the
 predictions follow registry properties (not ids), a bad ``face:`` key is named."""
 from __future__ import annotations
 
@@ -145,7 +145,7 @@ def _ci():
     (lambda f: f.update(max_N={"hex": 8}, l2_max_N={"hex": 10}, norms=["H"]), "face.l2_max_N.hex"),
 ])
 def test_bad_face_key_is_named(mutate, key):
-    from infsup_contact.config_checks import ConfigError, check_config
+    from infsup_contact.config.checks import ConfigError, check_config
 
     cfg = copy.deepcopy(_ci())
     mutate(cfg["face"])
@@ -155,7 +155,7 @@ def test_bad_face_key_is_named(mutate, key):
 
 
 def test_config_without_face_section_is_valid():
-    from infsup_contact.config_checks import check_config
+    from infsup_contact.config.checks import check_config
 
     cfg = _ci()
     del cfg["face"]
@@ -180,7 +180,7 @@ def test_face_section_renders_under_any_verdict(verdict):
 
 
 def test_max_n_trims_the_pairs_of_its_element_only():
-    from infsup_contact.config_face import face_pairs
+    from infsup_contact.config.face import face_pairs
 
     fc = {"N": [4, 5, 6, 8, 12], "nonmatching": [[4, 5], [8, 9]], "max_N": {"tet": 6}}
     assert face_pairs(fc, "tet") == [(4, 4), (5, 5), (6, 6), (4, 5)]
@@ -188,7 +188,7 @@ def test_max_n_trims_the_pairs_of_its_element_only():
 
 
 def test_l2_max_n_adds_the_matching_meshes_above_max_n_of_its_element_only():
-    from infsup_contact.config_face import face_pairs, l2_only_sizes
+    from infsup_contact.config.face import face_pairs, l2_only_sizes
 
     fc = {"N": [4, 5, 6, 7, 8, 10, 12], "nonmatching": [[4, 5], [8, 9]], "max_N": {"tet": 6},
           "l2_max_N": {"tet": 10}}
@@ -229,7 +229,7 @@ def test_face_case_no_configured_element_carries_is_refused(patch, refused):
     hexahedra are configured was accepted and silently never computed. Refused, naming the key,
     the elements and the spaces their faces build; computed (accepted) where the patch test's
     tetrahedra carry it."""
-    from infsup_contact.config_checks import ConfigError, check_config
+    from infsup_contact.config.checks import ConfigError, check_config
 
     cfg = copy.deepcopy(_ci())
     cfg["face"]["cases"] = [*cfg["face"]["cases"], "PWLIN-T6"]

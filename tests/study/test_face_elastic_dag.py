@@ -16,7 +16,7 @@ from infsup_contact.discretization.spaces.registry import SPACES
 from infsup_contact.discretization.face.square import SQUARE
 from infsup_contact.study.claims.criteria import FAIL, INCONCLUSIVE, PASS
 from infsup_contact.study.claims.membranes3d import matching_kernel
-from infsup_contact.study.face_elastic import nu_pairs
+from infsup_contact.study.face.elastic import nu_pairs
 from infsup_contact.study.claims.elastic3d import FINDING, claim_id, face_elastic_claims, nu_slope
 from infsup_contact.study.claims.membranes3d_studies import face_contains_constants
 
@@ -158,7 +158,7 @@ def _ci():
     (lambda f: f.update(surprise=1), "face_elastic"),
 ])
 def test_bad_face_elastic_key_is_named(mutate, key):
-    from infsup_contact.config_checks import ConfigError, check_config
+    from infsup_contact.config.checks import ConfigError, check_config
 
     cfg = copy.deepcopy(_ci())
     mutate(cfg["face_elastic"])
@@ -169,7 +169,7 @@ def test_bad_face_elastic_key_is_named(mutate, key):
 
 @pytest.mark.parametrize("name", ["ci.yaml", "config.yaml"])
 def test_shipped_configs_pass_and_the_section_is_optional(name):
-    from infsup_contact.config_checks import check_config
+    from infsup_contact.config.checks import check_config
 
     cfg = yaml.safe_load((ROOT / "config" / name).read_text())
     check_config(cfg, ROOT / "workflow" / "schemas" / "config.schema.yaml")

@@ -14,7 +14,7 @@ from infsup_contact.discretization.face.tensor_grid import TensorPartition
 from infsup_contact.errors import InputError
 from infsup_contact.solvers.contact import gamma_values, solve_contact_on
 from infsup_contact.study.patch import face as face_patch
-from infsup_contact.study.scene_registry import FACE_PATCH
+from infsup_contact.study.contact.registry import FACE_PATCH
 
 
 @pytest.fixture(scope="module", params=[1, 2])

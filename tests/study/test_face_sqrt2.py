@@ -12,12 +12,12 @@ import pandas as pd
 import pytest
 import yaml
 
-from infsup_contact.config_checks import ConfigError, check_config
-from infsup_contact.config_face import face_pairs, family_pairs
+from infsup_contact.config.checks import ConfigError, check_config
+from infsup_contact.config.face import face_pairs, family_pairs
 from infsup_contact.discretization.spaces.registry import SPACES
 from infsup_contact.discretization.face.square import SQUARE
 from infsup_contact.discretization.face.tensor_grid import TensorPartition
-from infsup_contact.study.face_families import family_kernels, family_pair
+from infsup_contact.study.face.families import family_kernels, family_pair
 from helpers.cli import run_in_process
 
 ROOT = Path(__file__).resolve().parents[2]

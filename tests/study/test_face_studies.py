@@ -201,7 +201,7 @@ def test_study_tables_cite_every_row_and_verdict():
     (lambda f: f.pop("patch"), "face"),
 ])
 def test_bad_study_key_is_named(mutate, key):
-    from infsup_contact.config_checks import ConfigError, check_config
+    from infsup_contact.config.checks import ConfigError, check_config
 
     cfg = copy.deepcopy(yaml.safe_load((ROOT / "config" / "ci.yaml").read_text()))
     mutate(cfg["face"])

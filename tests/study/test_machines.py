@@ -1,5 +1,5 @@
 """The same verdicts on every CPU: the kernel and verdict tests, the 3D kernel tests and a small
-β sweep (the segment's and a face's) under each machine path of study/machines.py — OpenBLAS's
+β sweep (the segment's and a face's) under each machine path of study/machines/paths.py — OpenBLAS's
 core types and MKL's code branches. A path this CPU cannot take is skipped with the reason (its
 missing flags, or MKL's branch on another vendor); the README says which ones CI covered.
 
@@ -19,8 +19,8 @@ import pytest
 from helpers.once import once
 
 from infsup_contact.errors import InputError
-from infsup_contact.io import SCHEMAS
-from infsup_contact.study import machines
+from infsup_contact.table_schemas import SCHEMAS
+from infsup_contact.study.machines import agreement, ledgers, paths as machines
 
 ROOT = Path(__file__).resolve().parents[2]
 PATHS = [pytest.param(p.name, id=p.wildcard) for p in machines.PATHS]
@@ -75,7 +75,7 @@ def _sweeps(root: Path) -> dict:
             continue
         folder = root / path.wildcard
         folder.mkdir()
-        subprocess.run([sys.executable, "-m", "infsup_contact.study.machines", str(folder)], cwd=ROOT,
+        subprocess.run([sys.executable, "-m", "infsup_contact.study.machines.paths", str(folder)], cwd=ROOT,
                        env=_env(path.name), check=True, capture_output=True, timeout=600)
         out[path.name] = str(folder)
     return out
@@ -112,9 +112,9 @@ def test_a_path_sets_its_switch_and_drops_the_others():
 
 
 def _ledger(folder, kernel_dim=2, verdict="PASS", drop=None):
-    """A synthetic CI ledger: every table of machines.LEDGER_TABLES, valid under its schema (the
+    """A synthetic CI ledger: every table of ledgers.LEDGER_TABLES, valid under its schema (the
     comparison reads through io's checks), with a kernel column or two."""
-    for table, kind in machines.LEDGER_TABLES.items():
+    for table, kind in ledgers.LEDGER_TABLES.items():
         if table == drop:
             continue
         f = folder / table
@@ -138,22 +138,22 @@ def _valid_frame(kind, n=2):
 
 def test_ledgers_differ_where_a_verdict_or_kernel_column_does(tmp_path):
     same = {"a": _ledger(tmp_path / "a"), "b": _ledger(tmp_path / "b")}
-    summary, problems = machines.ledger_differences(same)
+    summary, problems = ledgers.ledger_differences(same)
     assert problems == [] and summary.identical.all()
-    assert {"verdict", "kernel_dim", "kernel_decision"} <= set(summary.column) <= set(machines.LEDGER_EXACT)
+    assert {"verdict", "kernel_dim", "kernel_decision"} <= set(summary.column) <= set(ledgers.LEDGER_EXACT)
     assert not {"kernel_margin_decades", "beta"} & set(summary.column)  # a margin and a number: not compared
-    _, problems = machines.ledger_differences({"a": same["a"], "c": _ledger(tmp_path / "c", kernel_dim=3)})
-    assert len(problems) == len(machines.LEDGER_TABLES) - 1
+    _, problems = ledgers.ledger_differences({"a": same["a"], "c": _ledger(tmp_path / "c", kernel_dim=3)})
+    assert len(problems) == len(ledgers.LEDGER_TABLES) - 1
     assert any(p.startswith("results/tables/beta.csv row 1 (") and "case R5.2" in p
                and p.endswith("kernel_dim 3 under c, 2 under a") for p in problems), problems
-    _, problems = machines.ledger_differences({"a": same["a"], "d": _ledger(tmp_path / "d", verdict="FAIL")})
+    _, problems = ledgers.ledger_differences({"a": same["a"], "d": _ledger(tmp_path / "d", verdict="FAIL")})
     assert problems == ["results/claims.csv row 1 (claim_id b): verdict FAIL under d, PASS under a"]
     dropped = _ledger(tmp_path / "e", drop="results/face/patch.csv")
-    _, problems = machines.ledger_differences({"a": same["a"], "e": dropped})
+    _, problems = ledgers.ledger_differences({"a": same["a"], "e": dropped})
     assert len(problems) == 1 and problems[0].startswith("results/face/patch.csv: missing under e")
     cut = _ledger(tmp_path / "f")
     (cut / "results/claims.csv").write_text((cut / "results/claims.csv").read_text()[:-3])  # a cut-off write
-    _, problems = machines.ledger_differences({"a": same["a"], "f": cut})
+    _, problems = ledgers.ledger_differences({"a": same["a"], "f": cut})
     assert len(problems) == 1 and problems[0].startswith("results/claims.csv: damaged under f: ")
 
 
@@ -172,7 +172,7 @@ def test_3d_kernel_tests_pass_under(name):
 
 
 def _probe(name):
-    run = subprocess.run([sys.executable, "-m", "infsup_contact.study.machines", "--probe"], cwd=ROOT,
+    run = subprocess.run([sys.executable, "-m", "infsup_contact.study.machines.paths", "--probe"], cwd=ROOT,
                          env=_env(name), capture_output=True, text=True, check=True, timeout=300)
     return json.loads(run.stdout)
 
@@ -225,8 +225,8 @@ def test_sweep_and_verdicts_identical_across_paths(runs):
     verdicts = {n: pd.read_csv(f / "verdicts.csv") for n, f in done.items()}
     kernels = {json.loads((f / "openblas.json").read_text())["scipy"] for f in done.values()}
     assert len(kernels) >= 2, f"every path ran the same OpenBLAS kernels ({kernels}): nothing compared"
-    assert machines.compare(sweeps, verdicts) == []
-    worst, scaled = machines.max_beta_difference(sweeps)
+    assert agreement.compare(sweeps, verdicts) == []
+    worst, scaled = agreement.max_beta_difference(sweeps)
     assert scaled <= 1.0
     # the paper's kernels on every path: on matching meshes the dimension counts are exact
     # (R5.2 two zero modes, R5.4 one, the stable spaces none), on the union of 17:16 too

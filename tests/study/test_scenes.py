@@ -13,7 +13,7 @@ from ngsolve import x, y
 from netgen.geom2d import SplineGeometry, unit_square
 
 from infsup_contact.errors import InputError
-from infsup_contact.study.scenes import (ManufacturedSolution, MembraneScene, manufactured,
+from infsup_contact.study.contact.scenes import (ManufacturedSolution, MembraneScene, manufactured,
                                    membranes, scene)
 
 VARIANTS = {

@@ -1,8 +1,8 @@
-"""The rows a figure or a single number shows (study/selection.py)."""
+"""The rows a figure or a single number shows (study/beta/selection.py)."""
 import numpy as np
 import pandas as pd
 
-from infsup_contact.study.selection import primary_rows
+from infsup_contact.study.beta.selection import primary_rows
 
 
 def test_primary_rows_keep_the_smallest_seed_and_each_pair_once():

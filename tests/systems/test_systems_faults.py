@@ -235,10 +235,10 @@ def test_billion_laughs_manifest_is_refused_at_once(tmp_path, capsys):
 
 
 def test_billion_laughs_config_is_refused_at_once(tmp_path):
-    """The workflow's config files go through the same loader (config_yaml.check_config_file, run by
+    """The workflow's config files go through the same loader (config.strict_yaml.check_config_file, run by
     workflow/rules/common.smk); before, the check itself walked the 9^9 values (> 60 s)."""
-    from infsup_contact.config_checks import ConfigError
-    from infsup_contact.config_yaml import check_config_file
+    from infsup_contact.config.checks import ConfigError
+    from infsup_contact.config.strict_yaml import check_config_file
     from infsup_contact.yaml_limits import load
 
     path = tmp_path / "config.yaml"
@@ -322,7 +322,8 @@ def test_petsc_header_is_checked_before_the_body_is_read(tmp_path, monkeypatch):
     was read first); a header declaring more than the file holds, or than the memory, is refused."""
     import tracemalloc
 
-    from infsup_contact.systems.readers import SystemFileError, petsc_binary_bytes, read_matrix
+    from infsup_contact.systems.hb_petsc import petsc_binary_bytes
+    from infsup_contact.systems.readers import SystemFileError, read_matrix
 
     M = sp.random(50, 40, density=0.2, random_state=2, format="csr")
     (tmp_path / "M.petsc").write_bytes(petsc_binary_bytes(M) + b"\0" * (40 * 2 ** 20))
@@ -331,7 +332,7 @@ def test_petsc_header_is_checked_before_the_body_is_read(tmp_path, monkeypatch):
     peak = tracemalloc.get_traced_memory()[1]
     tracemalloc.stop()
     assert np.array_equal(got.toarray(), M.toarray()) and peak < 4 * 2 ** 20
-    from infsup_contact.systems.readers import MAT_FILE_CLASSID
+    from infsup_contact.systems.hb_petsc import MAT_FILE_CLASSID
 
     (tmp_path / "D.petsc").write_bytes(np.array([MAT_FILE_CLASSID, 10 ** 5, 10 ** 5, -1], ">i4").tobytes()
                                        + b"\0" * 64)

@@ -16,8 +16,8 @@ from infsup_contact.systems.engine import level_spectrum
 from infsup_contact.systems.export import matrix_bytes, write_system
 from infsup_contact.systems.levels import load_level, system_rows
 from infsup_contact.systems.manifest import load_manifest
-from infsup_contact.systems.readers import (MAT_FILE_CLASSID, SystemFileError, petsc_binary_bytes,
-                                            read_matrix, read_petsc_binary)
+from infsup_contact.systems.hb_petsc import MAT_FILE_CLASSID, petsc_binary_bytes, read_petsc_binary
+from infsup_contact.systems.readers import SystemFileError, read_matrix
 
 DATA = Path(__file__).resolve().parents[1] / "data" / "petsc"
 

@@ -140,9 +140,9 @@ def checked_as_the_workflow_does(path: Path) -> str:
     :func:`check_config` with the workflow's schema and, a local run, the job-memory check. The
     one line a bad config gets (common.smk prints it and exits 1 before any DAG), or "" if accepted."""
     from infsup_contact import resources
-    from infsup_contact.config_checks import ConfigError, check_config
-    from infsup_contact.config_memory import check_job_memory
-    from infsup_contact.config_yaml import check_config_files
+    from infsup_contact.config.checks import ConfigError, check_config
+    from infsup_contact.config.memory import check_job_memory
+    from infsup_contact.config.strict_yaml import check_config_files
 
     try:
         check_config_files([path])
@@ -180,7 +180,7 @@ def test_bad_config_fails_before_any_job(workdir, name):
                         "--configfile", "bad.yaml")
 
     assert rc == 1, f"bad config accepted (exit {rc}):\n{out}"
-    # one line naming the key (config_checks.check_config, run by common.smk), nothing else
+    # one line naming the key (config.checks.check_config, run by common.smk), nothing else
     assert config_error_lines(out) == [expected], out
     # validation runs while the Snakefile is parsed: no DAG, so no job, was ever built
     assert "Building DAG of jobs" not in out, out
@@ -227,7 +227,7 @@ def test_fit_window_shrink_is_logged_and_mem_mb_follows_the_estimate(ci_dry_run)
         found = [line for line in block.splitlines() if "mem_mb=" in line]
         if name in ("beta_job", "contact_job") and found:
             mem[output.strip()] = int(found[0].split("mem_mb=")[1].split(",")[0])
-    from infsup_contact.study.batches import beta_batches
+    from infsup_contact.study.beta.batches import beta_batches
 
     ic = CI_CONFIG["infsup"]
     batches = beta_batches(ic)  # a β job is a batch of pairs: it asks for its largest pair's estimate

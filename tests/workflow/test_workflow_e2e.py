@@ -117,7 +117,7 @@ def _batch_with(family, k, pair):
     """The β batch of the CI config holding ``pair`` (a β job computes a batch of pairs)."""
     import yaml
 
-    from infsup_contact.study.batches import beta_batches
+    from infsup_contact.study.beta.batches import beta_batches
 
     ic = yaml.safe_load((ROOT / "config" / "ci.yaml").read_text())["infsup"]
     return next(f"results/tables/beta/{b}.csv" for b, v in beta_batches(ic).items()

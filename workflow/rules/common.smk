@@ -6,18 +6,18 @@ from snakemake.logging import logger
 from snakemake.utils import validate
 
 from infsup_contact import resources
-from infsup_contact.config_checks import ConfigError, check_config, speed_accuracy_scene
-from infsup_contact.config_face import face_pairs, l2_only_sizes
-from infsup_contact.config_yaml import check_config_files
-from infsup_contact.config_memory import check_job_memory, memory_notes
+from infsup_contact.config.checks import ConfigError, check_config, speed_accuracy_scene
+from infsup_contact.config.face import face_pairs, l2_only_sizes
+from infsup_contact.config.strict_yaml import check_config_files
+from infsup_contact.config.memory import check_job_memory, memory_notes
 from infsup_contact.discretization.gamma.mesh_series import seeds, series_of_pairs
-from infsup_contact.study.batches import beta_batches
-from infsup_contact.study.scene_registry import scene_spec
+from infsup_contact.study.beta.batches import beta_batches
+from infsup_contact.study.contact.registry import scene_spec
 
-# Every check a config gets, in one library function (src/infsup_contact/config_checks.py):
+# Every check a config gets, in one library function (src/infsup_contact/config/checks.py):
 # user spaces, non-finite numbers, the schema, the registry's degrees and the cross-key rules.
 # A bad value stops here with ONE line naming the key — before the DAG, so no job starts.
-# First the files themselves (config_yaml.py): duplicate keys, zero-padded numbers and 1e3-as-a-
+# First the files themselves (config/strict_yaml.py): duplicate keys, zero-padded numbers and 1e3-as-a-
 # string, which Snakemake's YAML 1.1 loader has already turned into other values without a word.
 try:
     check_config_files(workflow.configfiles)
@@ -46,7 +46,7 @@ def beta_pairs():
     return sorted(series_of_pairs(config["infsup"]), key=lambda p: (max(p), p))
 
 
-# β_h jobs: one per batch of pairs of one (family, k) (study/batches.py: beta_batches)
+# β_h jobs: one per batch of pairs of one (family, k) (study/beta/batches.py: beta_batches)
 BETA_BATCHES = beta_batches(config["infsup"])
 
 

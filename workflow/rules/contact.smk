@@ -53,7 +53,7 @@ rule contact_table:
     benchmark:
         "results/benchmarks/rules/contact_table.tsv"
     params:
-        kind="contact",  # the job tables' schema (infsup_contact.io.SCHEMAS)
+        kind="contact",  # the job tables' schema (infsup_contact.table_schemas.SCHEMAS)
     log:
         "results/logs/contact_table.log",
     script:

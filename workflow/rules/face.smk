@@ -1,6 +1,6 @@
 # 3D contact face stage (issue 28): β_h of the tensor face spaces on Γ = (0,1)²×{1} of the 3D
 # model (config face; models/membranes3d.py), one job per (element, k) with all its mesh pairs,
-# cases and norms in one process (study/beta_batches.py), the table results/tables/face_beta.csv,
+# cases and norms in one process (study/beta/batch_rows.py), the table results/tables/face_beta.csv,
 # the ledger claims results/tables/face_claims.csv (appended to results/claims.csv) and the
 # paper's face section (report/face.py). A config without a `face` section has no face stage.
 
@@ -40,7 +40,7 @@ rule face_beta_job:
 
 
 rule face_l2_job:
-    # the matching N above face.max_N up to face.l2_max_N, L²(Γ) rows alone (config_face.l2_only_sizes):
+    # the matching N above face.max_N up to face.l2_max_N, L²(Γ) rows alone (config.face.l2_only_sizes):
     # a job of its own, so it runs beside the element's main job
     output:
         "results/tables/face/l2_{element}_k{k}.csv",
@@ -70,7 +70,7 @@ rule face_table:
     input:
         FACE_BETA,
     params:
-        kind="face_beta",  # the job tables' schema (infsup_contact.io.SCHEMAS)
+        kind="face_beta",  # the job tables' schema (infsup_contact.table_schemas.SCHEMAS)
     benchmark:
         "results/benchmarks/rules/face_table.tsv"
     log:

@@ -1,6 +1,6 @@
 # The 3D elastic bodies on the contact face (issue 28; config face_elastic, models/elastic3d.py):
 # β_H of the face spaces per element (all k, the table's ν on every mesh pair, the ν → 1/2 sweep
-# on its meshes: study/face_elastic.py), the table results/tables/face_elastic_beta.csv, the
+# on its meshes: study/face/elastic.py), the table results/tables/face_elastic_beta.csv, the
 # elastic face patch test results/face/elastic_patch.csv (study/patch/face_elastic.py), their
 # ledger claims results/tables/face_elastic_claims.csv (study/claims/elastic3d.py; appended to
 # results/claims.csv through FACE_CLAIMS) and the generated subsection results/paper/face_elastic.tex
@@ -56,7 +56,7 @@ rule face_elastic_table:
     input:
         FACE_ELASTIC_BETA,
     params:
-        kind="face_elastic_beta",  # the job tables' schema (infsup_contact.io.SCHEMAS)
+        kind="face_elastic_beta",  # the job tables' schema (infsup_contact.table_schemas.SCHEMAS)
     benchmark:
         "results/benchmarks/rules/face_elastic_table.tsv"
     log:

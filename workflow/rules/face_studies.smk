@@ -1,6 +1,6 @@
 # Face studies stage (issue 28, items 6 and 7): the 3D contact patch test (study/patch/face.py),
-# the α sweep of the transformed dual bases (study/face_alpha.py) and edge dropping
-# (study/edge_dropping.py), one job per table (config face.patch, face.alpha, face.edge_dropping;
+# the α sweep of the transformed dual bases (study/face/alpha.py) and edge dropping
+# (study/face/edge_dropping.py), one job per table (config face.patch, face.alpha, face.edge_dropping;
 # workflow/scripts/face_study_job.py), their ledger claims results/tables/face_study_claims.csv
 # (study/claims/membranes3d_studies.py; appended to results/claims.csv) and their three tables in the
 # paper's face section (rule face_paper, report/face_studies.py). Sized for seconds: a config

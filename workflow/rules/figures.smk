@@ -18,7 +18,7 @@ FIGURES = [f"results/figures/{name}.{ext}" for name in FIGURE_NAMES for ext in (
 
 # Figure 5: a stable and an unstable pair on the same mesh; Figure 8: dual mortar multipliers
 # against the paper's T3 (β_h, λ_h on Γ, energy error). Cases, k, mesh, family, scene: config
-# keys figures.contact_solutions and figures.dual (config_checks.check_figures).
+# keys figures.contact_solutions and figures.dual (config.checks.check_figures).
 FIG5 = config["figures"]["contact_solutions"]
 FIG8 = config["figures"]["dual"]
 

@@ -35,7 +35,7 @@ rule beta_table:
     benchmark:
         "results/benchmarks/rules/beta_table.tsv"
     params:
-        kind="beta",  # the job tables' schema (infsup_contact.io.SCHEMAS)
+        kind="beta",  # the job tables' schema (infsup_contact.table_schemas.SCHEMAS)
     log:
         "results/logs/beta_table.log",
     script:

@@ -1,10 +1,10 @@
 # Machines stage (not part of reproduce-all): the CI profile's full ledger on every machine path
-# this CPU can take — OpenBLAS's core types and MKL's code branches (study/machines.py: PATHS) —
+# this CPU can take — OpenBLAS's core types and MKL's code branches (study/machines/paths.py: PATHS) —
 # each in a copy of the workflow of its own; `snakemake verify-machines` fails unless the ledger's
 # `verdict` column and the kernel columns of its tables (machines.LEDGER_TABLES) are byte-identical.
 import re
 
-from infsup_contact.study.machines import PATHS
+from infsup_contact.study.machines.paths import PATHS
 
 
 rule machine_ledger:

@@ -28,7 +28,7 @@ rule mesh_quality:
     benchmark:
         "results/benchmarks/rules/mesh_quality.tsv"
     params:
-        kind="mesh_quality",  # the job tables' schema (infsup_contact.io.SCHEMAS)
+        kind="mesh_quality",  # the job tables' schema (infsup_contact.table_schemas.SCHEMAS)
     log:
         "results/logs/mesh_quality.log",
     script:

@@ -3,7 +3,7 @@
 A row gets the series it belongs to (``series``: matching, ratio3-2, plus1, sqrt2, …; a
 pair of two series is computed once and written once per series) and, on perturbed
 meshes, its ``seed`` (empty on the deterministic families). The rows come from the one
-study path of every model (:func:`infsup_contact.study.beta_batches.beta_batch_rows`);
+study path of every model (:func:`infsup_contact.study.beta.batch_rows.beta_batch_rows`);
 the model is named by the rule (default: the paper's membranes).
 """
 import sys
@@ -18,7 +18,7 @@ register_user_spaces(snakemake.config)  # noqa: F821
 from infsup_contact.discretization.gamma.mesh_series import seeds, series_of_pairs  # noqa: E402
 from infsup_contact.io import write_csv_atomic  # noqa: E402
 from infsup_contact.models import DEFAULT_MODEL  # noqa: E402
-from infsup_contact.study.beta_batches import beta_batch_rows  # noqa: E402
+from infsup_contact.study.beta.batch_rows import beta_batch_rows  # noqa: E402
 
 ic, batch = snakemake.params.ic, snakemake.params.batch  # noqa: F821
 model = getattr(snakemake.params, "model", None) or DEFAULT_MODEL.name  # noqa: F821

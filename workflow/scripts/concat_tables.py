@@ -1,7 +1,7 @@
 """Concatenate per-job tables (in the given order) into one tidy table, atomically.
 
 Each job table is read through the checked reader (``params.kind``: its schema in
-``infsup_contact.io.SCHEMAS``), so a truncated, emptied or duplicated job table stops the
+``infsup_contact.table_schemas.SCHEMAS``), so a truncated, emptied or duplicated job table stops the
 join with one line naming the file and the row instead of being joined as NaN or garbage."""
 import sys
 

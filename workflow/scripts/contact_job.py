@@ -12,7 +12,7 @@ register_user_spaces(snakemake.config)  # noqa: F821
 import pandas as pd  # noqa: E402
 
 from infsup_contact.io import write_csv_atomic  # noqa: E402
-from infsup_contact.study.contact_rows import contact_rows, load_reference  # noqa: E402
+from infsup_contact.study.contact.rows import contact_rows, load_reference  # noqa: E402
 
 wc, cc = snakemake.wildcards, snakemake.params.cc  # noqa: F821
 k = int(wc.k)

@@ -13,7 +13,7 @@ import time  # noqa: E402
 
 from infsup_contact.discretization.spaces.registry import ids_valid_for  # noqa: E402
 from infsup_contact.io import write_csv_atomic  # noqa: E402
-from infsup_contact.study.elastic_beta import elastic_beta_rows, nu_sweep_rows  # noqa: E402
+from infsup_contact.study.beta.elastic import elastic_beta_rows, nu_sweep_rows  # noqa: E402
 
 wc, ec = snakemake.wildcards, snakemake.params.ec  # noqa: F821
 k = int(wc.k)

@@ -1,4 +1,4 @@
-"""One Hertz job (study/hertz.py): the discretization study of one k (every space of infsup.cases,
+"""One Hertz job (study/contact/hertz.py): the discretization study of one k (every space of infsup.cases,
 the meshes of elastic.hertz.N against the reference N_ref), or the modeling study vs Hertz."""
 import sys
 
@@ -13,13 +13,13 @@ import pandas as pd  # noqa: E402
 
 from infsup_contact.discretization.spaces.registry import REFERENCE_SPACE  # noqa: E402
 from infsup_contact.io import write_csv_atomic  # noqa: E402
-from infsup_contact.study.hertz import discretization_rows, modeling_rows  # noqa: E402
+from infsup_contact.study.contact.hertz import discretization_rows, modeling_rows  # noqa: E402
 
 ec = snakemake.params.ec  # noqa: F821
 study = snakemake.wildcards.get("study", "profiles")  # noqa: F821
 hz, E = ec["hertz"], tuple(ec["E"])
 if study == "profiles":
-    from infsup_contact.study.hertz import profile_rows
+    from infsup_contact.study.contact.hertz import profile_rows
 
     fig = snakemake.params.fig  # noqa: F821
     rows = profile_rows([tuple(p) for p in fig["pairs"]], fig["N"], hz["R"], hz["d"], ec["nu"], E)

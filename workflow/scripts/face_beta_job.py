@@ -1,9 +1,9 @@
 """One face β_h job (rule face_beta_job): every matching N and non-matching pair of one
 (element, k) of the 3D model (config ``face``), every case of ``face.cases`` defined for k,
 both norms, G_h = trace of Ω2, through the one β batch path of every model
-(:func:`infsup_contact.study.beta_batches.beta_batch_rows`). With ``params.l2_only`` (rule
+(:func:`infsup_contact.study.beta.batch_rows.beta_batch_rows`). With ``params.l2_only`` (rule
 face_l2_job): the matching N of ``face.l2_max_N`` above ``face.max_N``, the L²(Γ) norm alone
-(:func:`infsup_contact.config_face.l2_only_sizes`)."""
+(:func:`infsup_contact.config.face.l2_only_sizes`)."""
 import sys
 
 sys.path.insert(0, "workflow/scripts")
@@ -15,10 +15,10 @@ register_user_spaces(snakemake.config)  # noqa: F821
 
 import time  # noqa: E402
 
-from infsup_contact.config_face import face_pairs, l2_only_sizes  # noqa: E402
+from infsup_contact.config.face import face_pairs, l2_only_sizes  # noqa: E402
 from infsup_contact.discretization.spaces.registry import SPACES, ids_valid_for  # noqa: E402
 from infsup_contact.io import write_csv_atomic  # noqa: E402
-from infsup_contact.study.beta_batches import beta_batch_rows  # noqa: E402
+from infsup_contact.study.beta.batch_rows import beta_batch_rows  # noqa: E402
 from infsup_contact.study.claims.membranes3d import element_interfaces  # noqa: E402
 
 wc, fc = snakemake.wildcards, snakemake.params.fc  # noqa: F821

@@ -1,6 +1,6 @@
 """One job of the elastic face stage (rules/face_elastic.smk, config ``face_elastic``): the β_H
-rows of one element (rule face_elastic_beta_job, :func:`infsup_contact.study.face_elastic.beta_frame`)
-or the elastic face patch test (rule face_elastic_patch, :func:`~infsup_contact.study.face_elastic.patch_frame`),
+rows of one element (rule face_elastic_beta_job, :func:`infsup_contact.study.face.elastic.beta_frame`)
+or the elastic face patch test (rule face_elastic_patch, :func:`~infsup_contact.study.face.elastic.patch_frame`),
 written atomically with provenance columns."""
 import sys
 
@@ -14,7 +14,7 @@ register_user_spaces(snakemake.config)  # noqa: F821
 import time  # noqa: E402
 
 from infsup_contact.io import write_csv_atomic  # noqa: E402
-from infsup_contact.study.face_elastic import beta_frame, patch_frame  # noqa: E402
+from infsup_contact.study.face.elastic import beta_frame, patch_frame  # noqa: E402
 
 fe, t0 = snakemake.params.fe, time.perf_counter()  # noqa: F821
 if snakemake.rule == "face_elastic_patch":  # noqa: F821

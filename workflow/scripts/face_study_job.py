@@ -1,7 +1,7 @@
 """One face study table (rules/face_studies.smk, config ``face.<study>``): the 3D patch test
-(study/patch/face.py), the α sweep of the transformed dual bases (study/face_alpha.py) or edge
-dropping (study/edge_dropping.py), chosen by the rule's ``params.study`` among
-study/face_study_tables.py's FACE_STUDIES, written atomically with provenance columns."""
+(study/patch/face.py), the α sweep of the transformed dual bases (study/face/alpha.py) or edge
+dropping (study/face/edge_dropping.py), chosen by the rule's ``params.study`` among
+study/face/tables.py's FACE_STUDIES, written atomically with provenance columns."""
 import sys
 
 sys.path.insert(0, "workflow/scripts")
@@ -14,7 +14,7 @@ register_user_spaces(snakemake.config)  # noqa: F821
 import time  # noqa: E402
 
 from infsup_contact.io import write_csv_atomic  # noqa: E402
-from infsup_contact.study.face_study_tables import FACE_STUDIES  # noqa: E402
+from infsup_contact.study.face.tables import FACE_STUDIES  # noqa: E402
 
 study, fc = snakemake.params.study, snakemake.params.fc  # noqa: F821
 t0 = time.perf_counter()

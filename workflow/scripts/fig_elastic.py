@@ -14,7 +14,7 @@ register_user_spaces(snakemake.config)  # noqa: F821
 import matplotlib.pyplot as plt  # noqa: E402
 
 from infsup_contact.report.style import NEUTRAL, case_label, case_style, ordered_cases, save_figure, slope_triangle, style  # noqa: E402,E501
-from infsup_contact.study.scene_registry import HERTZ  # noqa: E402
+from infsup_contact.study.contact.registry import HERTZ  # noqa: E402
 
 inp, out = snakemake.input, snakemake.output  # noqa: F821
 sweep = read_table(inp.sweep, "elastic_beta")
@@ -37,7 +37,7 @@ with style():
     for (case, k), g in lam.groupby(["case", "k"], sort=False):
         kw = case_style(case, k)
         ax2.plot(g.x, g.value, color=kw["color"], linestyle=kw["linestyle"], lw=1.1, label=case_label(case, k))
-    h = prof[prof.quantity == HERTZ.id]  # the Hertz pressure for the measured P (study/hertz.py)
+    h = prof[prof.quantity == HERTZ.id]  # the Hertz pressure for the measured P (study/contact/hertz.py)
     ax2.plot(h.x, h.value, color=NEUTRAL, lw=0.8, linestyle=":", label="Hertz (measured P)")
     support = h[h.value > 0].x
     pad = 0.6 * (support.max() - support.min())

@@ -12,7 +12,7 @@ import sys
 if "snakemake" in globals():  # run by Snakemake: threads and log before numpy loads
     sys.path.insert(0, "workflow/scripts")
     from _glue import limit_threads, log_to, read_table
-    from infsup_contact.study.selection import primary_rows
+    from infsup_contact.study.beta.selection import primary_rows
 
     limit_threads(snakemake.threads)  # noqa: F821
     log_to(snakemake.log[0])  # noqa: F821

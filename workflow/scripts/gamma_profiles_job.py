@@ -2,7 +2,7 @@
 
 Writes results/tables/gamma_profiles.csv (case,k,N,x,quantity,value; quantity in gap,
 lambda, u1, u2) and results/tables/field_values.csv (case,k,N,side,x,y,u at the mesh
-vertices). All logic is in :func:`infsup_contact.study.profiles.contact_profiles`.
+vertices). All logic is in :func:`infsup_contact.study.contact.profiles.contact_profiles`.
 """
 import sys
 
@@ -14,8 +14,8 @@ log_to(snakemake.log[0])  # noqa: F821
 register_user_spaces(snakemake.config)  # noqa: F821
 
 from infsup_contact.io import write_csv_atomic  # noqa: E402
-from infsup_contact.study.profiles import contact_profiles  # noqa: E402
-from infsup_contact.study.scenes import scene as make_scene  # noqa: E402
+from infsup_contact.study.contact.profiles import contact_profiles  # noqa: E402
+from infsup_contact.study.contact.scenes import scene as make_scene  # noqa: E402
 
 p = snakemake.params  # noqa: F821
 spec = p.scene_spec

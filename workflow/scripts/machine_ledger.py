@@ -2,7 +2,7 @@
 
 usage: machine_ledger.py PATH OUTPUT.json CORES
 
-PATH is a path of infsup_contact.study.machines.PATHS by its wildcard (``openblas-Haswell``,
+PATH is a path of infsup_contact.study.machines.paths.PATHS by its wildcard (``openblas-Haswell``,
 ``mkl-COMPATIBLE``). Links the workflow's sources into results/machines/PATH/work, runs
 `snakemake results/claims.csv --profile profiles/ci` there in the path's environment
 (machines.machine_env), copies the tables of machines.LEDGER_TABLES to
@@ -18,7 +18,8 @@ import sys
 from pathlib import Path
 
 from infsup_contact.io import write_atomic
-from infsup_contact.study.machines import LEDGER_TABLES, SWITCHES, machine_env, machine_path, runnable
+from infsup_contact.study.machines.ledgers import LEDGER_TABLES
+from infsup_contact.study.machines.paths import SWITCHES, machine_env, machine_path, runnable
 
 SOURCES = ("Snakefile", "workflow", "src", "config", "profiles", "paper", "examples")
 
@@ -51,7 +52,7 @@ def main(wildcard: str, output: str, cores: str) -> None:
             sys.exit(f"machine_ledger: the CI run on {path.name} wrote no {table}")
         (ledger / table).parent.mkdir(parents=True, exist_ok=True)
         shutil.copyfile(src, ledger / table)
-    probe = subprocess.run([sys.executable, "-m", "infsup_contact.study.machines", "--probe"], env=env,
+    probe = subprocess.run([sys.executable, "-m", "infsup_contact.study.machines.paths", "--probe"], env=env,
                            capture_output=True, text=True, check=True).stdout
     write_atomic(out, json.dumps(dict(path=path.name, ran=True, reason="", env=switches, **json.loads(probe),
                                       ledger=str(ledger)), indent=1))

@@ -8,8 +8,8 @@ from _glue import limit_threads, log_to  # noqa: E402
 limit_threads(snakemake.threads)  # noqa: F821
 log_to(snakemake.log[0])  # noqa: F821
 
-from infsup_contact.study.contact_rows import reference_solution, save_reference  # noqa: E402
-from infsup_contact.study.scenes import scene as make_scene  # noqa: E402
+from infsup_contact.study.contact.rows import reference_solution, save_reference  # noqa: E402
+from infsup_contact.study.contact.scenes import scene as make_scene  # noqa: E402
 
 wc, cc = snakemake.wildcards, snakemake.params.cc  # noqa: F821
 spec = cc["scenes"][wc.scene]

@@ -10,7 +10,7 @@ sys.path.insert(0, "workflow/scripts")
 from _glue import fail, log_to  # noqa: E402
 
 from infsup_contact.io import read_table_text, write_csv_atomic  # noqa: E402
-from infsup_contact.study.machines import ledger_differences  # noqa: E402
+from infsup_contact.study.machines.ledgers import ledger_differences  # noqa: E402
 
 log_to(snakemake.log[0])  # noqa: F821
 runs = [json.loads(Path(p).read_text()) for p in snakemake.input]  # noqa: F821

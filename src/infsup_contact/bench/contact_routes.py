@@ -54,7 +54,7 @@ def _contact_problem(n: int, k: int, case: str = REFERENCE_SPACE):
     """Membranes scene on the structured N×N pair: sides, couplings, loads (c = 1), as
     :func:`infsup_contact.solvers.contact.solve_contact` builds them."""
     from ..models.membranes import MEMBRANES
-    from ..study.scenes import membranes
+    from ..study.contact.scenes import membranes
 
     sc = membranes()
     m1, m2 = meshes.mesh_pair("structured", n, n)
@@ -133,7 +133,7 @@ def bench_contact(ns, ks, repeats: int = 3, case: str = REFERENCE_SPACE, peers=(
     from ..solvers.kkt import solve_kkt_sparse
     from ..solvers.contact import linear_saddle_solve, solve_contact
     from ..solvers.reduced_qp import solve_reduced_qp
-    from ..study.scenes import membranes
+    from ..study.contact.scenes import membranes
 
     peer_options = {"clarabel": {"method": "faer"}} if peer_options is None else peer_options
     tolerances = tuple(tolerances or peer_mod.TOLERANCES)

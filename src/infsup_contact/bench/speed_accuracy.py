@@ -5,7 +5,7 @@ import time
 
 import numpy as np
 
-from ..study.scene_registry import MANUFACTURED
+from ..study.contact.registry import MANUFACTURED
 from .harness import _log, _stats, run_interleaved
 
 
@@ -50,7 +50,7 @@ def time_contact_solves(cases, k: int, n: int, repeats: int = 3, scene: str = MA
         ``runs``: how often the case's part ran.
     """
     from ..solvers.contact import contact_pair, solve_contact_on
-    from ..study.scenes import scene as make_scene
+    from ..study.contact.scenes import scene as make_scene
 
     sc = make_scene(scene, c1=c[0], c2=c[1], **(scene_params or {}))
     pair, build = run_interleaved({"build": lambda: contact_pair(sc, k, family, n, n)}, repeats, budget)["build"]

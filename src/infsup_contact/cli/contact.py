@@ -1,6 +1,6 @@
 """``infsup-contact contact``: the discrete contact problem (4.1) for one scene, case and mesh
 pair, CSV rows; the scenes and the models each is defined for come from the scene registry
-(:mod:`infsup_contact.study.scene_registry`)."""
+(:mod:`infsup_contact.study.contact.registry`)."""
 from __future__ import annotations
 
 from ..errors import InputError, check_prestress
@@ -11,7 +11,7 @@ from .common import (FlagUse, add_dry_run, add_model, cases, check_memory, decla
 def add(sub) -> None:
     from ..discretization.segment.meshes import FAMILIES
     from ..discretization.spaces.registry import space_ids
-    from ..study.scene_registry import allowed_pairs, scene_ids
+    from ..study.contact.registry import allowed_pairs, scene_ids
 
     p = sub.add_parser("contact", help="solve (4.1) for one case and mesh pair (CSV: one row)")
     p.add_argument("--scene", required=True, choices=scene_ids(),
@@ -38,9 +38,9 @@ def add(sub) -> None:
 
 def scene_flag_uses() -> list:
     """The scene parameters (``--p``, ``--q``, ``--n-ref``, ``--R``, ``--d``): each used by the
-    scenes that declare it (:attr:`~infsup_contact.study.scene_registry.SceneSpec.params`);
+    scenes that declare it (:attr:`~infsup_contact.study.contact.registry.SceneSpec.params`);
     refused with any other scene (:func:`~.common.refuse_unused`)."""
-    from ..study.scene_registry import scene_ids, scene_spec
+    from ..study.contact.registry import scene_ids, scene_spec
 
     def takers(name):
         return [s for s in scene_ids() if name in scene_spec(s).params]
@@ -54,8 +54,8 @@ def scene_flag_uses() -> list:
 def _check_contact(args):
     from ..discretization.segment import meshes
     from ..discretization.spaces import registry
-    from ..study.scene_registry import check_pair
-    from ..study.scenes import _exponent
+    from ..study.contact.registry import check_pair
+    from ..study.contact.scenes import _exponent
 
     if args.case is None and args.space is None:
         raise InputError("case", "one of --case ID|all or --space FILE.py:FUNC")
@@ -86,7 +86,7 @@ def _check_contact(args):
 def _run_contact(args) -> None:
     import pandas as pd
 
-    from ..study.scene_registry import scene_spec
+    from ..study.contact.registry import scene_spec
 
     spec = scene_spec(args.scene)
     rows = spec.rows(args.model_obj, args.cases, args.k, args.family, args.N1, args.N2, (args.c1, args.c2), args)

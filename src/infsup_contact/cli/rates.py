@@ -19,7 +19,7 @@ def add(sub) -> None:
 def _check_rates(args):
     from .. import resources
     from ..io import read_table
-    from ..study.rates import check_rate_input, series_sizes
+    from ..study.contact.rates import check_rate_input, series_sizes
 
     if args.window < 2:
         raise InputError("window", "an integer >= 2", got=args.window)
@@ -40,6 +40,6 @@ def _check_rates(args):
 
 
 def _run_rates(args) -> None:
-    from ..study.rates import rate_table
+    from ..study.contact.rates import rate_table
 
     write_csv(rate_table(args.frame, args.window, args.name), float_format="%.6g")

@@ -1,6 +1,6 @@
 """Intel oneMKL, loaded once through ctypes: PARDISO (:mod:`infsup_contact.la.pardiso`)
 and the pointer-level triangular solve of :func:`trailing_solve`; the code branch MKL runs
-(:func:`cbwr_branch`, for the cross-machine checks of :mod:`infsup_contact.study.machines`).
+(:func:`cbwr_branch`, for the cross-machine checks of :mod:`infsup_contact.study.machines.paths`).
 
 The library is the ``mkl`` wheel's ``mkl_rt`` (``environment.lock``), called with its documented
 C interfaces (oneMKL Developer Reference: "pardiso", "cblas_?trsm"). numpy and scipy keep their

@@ -42,7 +42,7 @@ def model_taking(param: str) -> Model:
 
 def model_of_dim(dim: int) -> Model:
     """The first registered model whose bodies have dimension ``dim`` (3: the membranes in 3D),
-    for a study of a geometry the command line does not offer (:mod:`infsup_contact.study.edge_dropping`)."""
+    for a study of a geometry the command line does not offer (:mod:`infsup_contact.study.face.edge_dropping`)."""
     for m in MODELS.values():
         if m.dim == dim:
             return m

@@ -75,7 +75,7 @@ def subdomain_mesh(family: str, n: int, side: int, *, element: str = "hex", widt
 
     ``width``: the body's extent in x, (0, width) × (0, 1) × (side − 1, side) (the ``mapping`` of
     ``MakeStructured3DMesh`` scales x); 1 is the model's bodies. A narrower Ω2 covers Ω1's face
-    partially (:mod:`infsup_contact.study.edge_dropping`); its Γ is then
+    partially (:mod:`infsup_contact.study.face.edge_dropping`); its Γ is then
     ``Square(width=width)``.
 
     Raises

@@ -1,7 +1,7 @@
 """The plane-strain material law of the elastic model: admissible ν and E, and the Lamé
 constants at unit Young's modulus.
 
-Its own module so that the elastic scenes (``study.patch``, ``study.hertz``) and the CLI
+Its own module so that the elastic scenes (``study.patch``, ``study.contact.hertz``) and the CLI
 check and measure with it without importing the concrete model
 (:mod:`infsup_contact.models.elastic`).
 """

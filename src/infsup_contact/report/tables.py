@@ -4,7 +4,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from ..study.selection import primary_rows
+from ..study.beta.selection import primary_rows
 
 from .texformat import (MEASURES, SPEED_COLUMNS, VERDICTS, PaperTexError, _require, case_order, case_rank,
                         fmt_fixed, fmt_sci, latex_escape, latex_id)

@@ -306,5 +306,5 @@ def gamma_values(sol: ContactSolution, x: np.ndarray):
 
 
 def lambda_values(sol: ContactSolution, x: np.ndarray) -> np.ndarray:
-    """λ_h(x); ``sol`` may be a saved reference (space and lam only, study.contact_rows)."""
+    """λ_h(x); ``sol`` may be a saved reference (space and lam only, study.contact.rows)."""
     return sol.space.evaluate(x) @ sol.lam

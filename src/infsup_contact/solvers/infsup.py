@@ -109,7 +109,7 @@ def _row(r, case, c1, c2, norm, spec, kernel, structural, beta_v1_zero, dim_m, d
 def _space(case, k, partition, gamma=SEGMENT):
     """A named case on G_h = ``partition`` of ``gamma``, an unregistered
     :class:`~infsup_contact.discretization.spaces.spec.SpaceSpec` (a study's variant, e.g. the α
-    sweep of study/face_alpha.py), or a general triple ``(label, s, continuous, vanish)``
+    sweep of study/face/alpha.py), or a general triple ``(label, s, continuous, vanish)``
     (eqs. 5.3, 5.5; spaces of the segment)."""
     if isinstance(case, str):
         return registry.case_space(case, k, partition, gamma)

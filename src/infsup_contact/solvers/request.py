@@ -33,7 +33,7 @@ class MeshOptions:
     seed, alpha : int, float or None
         The perturbed family's seed and amplitude α / h; None: the builder's default.
     width : float or None
-        A 3D body's extent in x (a narrower Ω2, :mod:`infsup_contact.study.edge_dropping`).
+        A 3D body's extent in x (a narrower Ω2, :mod:`infsup_contact.study.face.edge_dropping`).
     """
 
     element: str | None = None

@@ -1,11 +1,11 @@
 """The study: scenes with known answers, accuracy measures, convergence rates, the claims ledger,
 stability verdicts.
 
-``scenes`` (manufactured and membranes loads), ``accuracy`` and ``contact_rows`` (one solve →
-one tidy row), ``profiles`` (Γ profiles for figures), ``rates`` (fitted slopes), ``claims``
-(the ledger's criterion and every claim), ``verdict`` (one space's stability verdict by the
-ledger's criterion, ``infsup-contact verdict``), ``beta_batches`` (β_h of a batch of mesh pairs
-for any model: the one path of the membranes' and the elastic β_h tables), ``batches`` (how
-the workflow cuts the pairs into jobs), ``selection`` (the rows a figure shows). Imports
-``solvers`` and the stages below it.
+``contact/`` (the scenes and their registry, one solve → one tidy row, accuracy, Γ profiles,
+fitted rates), ``beta/`` (how the workflow cuts mesh pairs into jobs, β_h of a batch for any
+model, the elastic pair, the rows a figure shows), ``face/`` (the face studies of the 3D models
+and their tables), ``machines/`` (the checks under every BLAS code path and their ledgers),
+``claims/`` (the ledger's criterion and every claim), ``patch/`` (the patch tests), ``verdict``
+(one space's stability verdict by the ledger's criterion, ``infsup-contact verdict``) and
+``producers`` (other codes' systems certified). Imports ``solvers`` and the stages below it.
 """

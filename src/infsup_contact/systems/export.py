@@ -24,7 +24,7 @@ import scipy.sparse as sp
 
 from ..errors import InputError
 from ..io import write_atomic, write_bytes_atomic
-from .readers import petsc_binary_bytes
+from .hb_petsc import petsc_binary_bytes
 
 EXPORT_FORMATS = {"mtx": ".mtx", "npz": ".npz", "petsc": ".petsc"}
 
@@ -190,7 +190,7 @@ def _same(a, b) -> bool:
 def matrix_bytes(mat, fmt: str) -> bytes:
     """``mat`` serialized as ``fmt`` (mtx: MatrixMarket coordinate/array via scipy.io.mmwrite;
     npz: scipy.sparse.save_npz, or numpy.savez of one array for a dense matrix; petsc: PETSc
-    binary AIJ, :func:`~.readers.petsc_binary_bytes`)."""
+    binary AIJ, :func:`~.hb_petsc.petsc_binary_bytes`)."""
     buf = io.BytesIO()
     if fmt == "mtx":
         import scipy.io

@@ -123,7 +123,7 @@ def test_face_spaces_stay_off_the_segment():
 
 def test_alpha_sweep_refuses_nonpositive_weights():
     """QUAD8: ∫Ñ_corner = (8α − 1)/3 ≤ 0 for α ≤ 1/8 — refused rows carry no β."""
-    from infsup_contact.study.face_alpha import sweep
+    from infsup_contact.study.face.alpha import sweep
 
     rows = pd.DataFrame(sweep(ns=(2,), alphas=(0.1, 0.125, 0.2), elements=("QUAD8",)))
     assert list(rows.refused) == [True, True, False]

@@ -202,7 +202,7 @@ def test_beta_h_is_bounded_in_n_on_tetrahedra(monkeypatch):
 def test_alpha_sweep_runs_tri6_on_tetrahedra():
     """The TRI6 sweep picks the model's element whose faces are triangles (asked of the faces, not
     named) and reports the exact smallest weight fraction min(2α/3, (1 − 2α)/3) of the area."""
-    from infsup_contact.study.face_alpha import element_of, sweep
+    from infsup_contact.study.face.alpha import element_of, sweep
 
     assert SQUARE_TRIG.cell == "trig" and element_of("membranes3d", "TRI6") != element_of("membranes3d", "QUAD9")
     alphas = (Fraction(1, 10), Fraction(1, 4), Fraction(2, 5))

@@ -78,7 +78,7 @@ import copy  # noqa: E402
 import pytest  # noqa: E402
 import yaml  # noqa: E402
 
-from infsup_contact.config_checks import ConfigError, check_config  # noqa: E402
+from infsup_contact.config.checks import ConfigError, check_config  # noqa: E402
 
 SCHEMA = ROOT / "workflow" / "schemas" / "config.schema.yaml"
 
@@ -126,9 +126,9 @@ def test_figure_choices_are_checked(path, value, needle):
 import ast  # noqa: E402
 
 from infsup_contact.models import MODELS  # noqa: E402
-from infsup_contact.study.scene_registry import scene_ids  # noqa: E402
+from infsup_contact.study.contact.registry import scene_ids  # noqa: E402
 
-REGISTRIES = ("src/infsup_contact/study/scene_registry.py", "src/infsup_contact/models")
+REGISTRIES = ("src/infsup_contact/study/contact/registry.py", "src/infsup_contact/models")
 """Where scene and model ids are declared: the scene registry, and the model registry with its
 models (a model names itself)."""
 NAMED = sorted({*scene_ids(), *MODELS}, key=len, reverse=True)
@@ -179,7 +179,7 @@ def test_no_scene_or_model_id_special_cased_outside_its_registry():
 
 def test_config_scene_kinds_are_the_registrys_data_scenes():
     """The schema's enum of contact.scenes.*.kind lists exactly the registered scenes with data."""
-    from infsup_contact.study.scene_registry import data_scene_ids
+    from infsup_contact.study.contact.registry import data_scene_ids
 
     schema = yaml.safe_load(SCHEMA.read_text())
     kind = schema["properties"]["contact"]["properties"]["scenes"]["additionalProperties"]["properties"]["kind"]

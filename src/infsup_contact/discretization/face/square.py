@@ -51,7 +51,7 @@ class Square(Interface):
         rectangle cut in two triangles (a tetrahedral mesh).
     width : float
         Γ's extent in x (1: the unit face). A narrower face (0, width) × (0, 1) is the trace
-        of a narrower body (:mod:`infsup_contact.study.edge_dropping`); the trace
+        of a narrower body (:mod:`infsup_contact.study.face.edge_dropping`); the trace
         (:meth:`trace`, :meth:`trace_basis`, :meth:`quadrature`) serves it, the multiplier
         spaces, norms and counts of this class are those of the unit face.
     """

@@ -14,8 +14,8 @@ families (config ``infsup.nonmatching_families``: name → N2 list)
 
 Perturbed meshes come in several seeds (config ``infsup.seed``: one integer or a list);
 every seed of every pair is a mesh of the series. Pure Python (the workflow imports it
-while building the DAG). How the pairs are cut into jobs is :mod:`infsup_contact.study.batches`;
-which rows a figure shows is :func:`infsup_contact.study.selection.primary_rows`.
+while building the DAG). How the pairs are cut into jobs is :mod:`infsup_contact.study.beta.batches`;
+which rows a figure shows is :func:`infsup_contact.study.beta.selection.primary_rows`.
 """
 from __future__ import annotations
 

@@ -73,7 +73,7 @@ def ids_built_on(k: int, gamma, partition) -> list:
 
 def edge_cases(k: int) -> list:
     """Registered spaces that make sense on a moving face boundary (edge dropping, a face clipped
-    at x = L, :mod:`infsup_contact.study.edge_dropping`): every case valid for k whose 1D factor does not
+    at x = L, :mod:`infsup_contact.study.face.edge_dropping`): every case valid for k whose 1D factor does not
     vanish at the ends (a space vanishing on ∂(Ω1's face) does not vanish on the edge x = L of
     Γ: not the natural analogue)."""
     x = np.linspace(0.0, 1.0, 5)

@@ -9,7 +9,7 @@ vs log h inside ±τ and min β_h > floor for "bounded"; exact kernel counts). E
   over the same scalar trace spaces as the membranes' w_i (clamped: zero at Γ's ends). So the
   kernel dimension is the membranes' one on every row, matching or not, for every ν.
 * **Discrete bound** (``elastic-bound``, exact): β_h^el >= β_h^mem / sqrt(2μ̂ + λ̂) on every
-  row with no kernel (:mod:`infsup_contact.study.elastic_beta`); the elastic and membrane
+  row with no kernel (:mod:`infsup_contact.study.beta.elastic`); the elastic and membrane
   energies are equivalent with ν-dependent constants (this bound and Korn's inequality), so
   β_h^el is bounded away from 0 iff β_h^mem is, at every fixed ν < 1/2.
 * Hence **the paper's verdicts carry over**: T3, T4, T5, DUAL (and the user space) bounded
@@ -166,7 +166,7 @@ def _patch_prediction(spec, k: int) -> str:
 
 
 def hertz_claims(hertz: pd.DataFrame) -> pd.DataFrame:
-    """Hertz-scene claims (:mod:`infsup_contact.study.hertz`): the modeling error against
+    """Hertz-scene claims (:mod:`infsup_contact.study.contact.hertz`): the modeling error against
     plane-strain Hertz (max pressure) falls as the contact zone shrinks relative to the domain
     (predicted); per case and k the fitted energy-error rate and the oscillation of λ_h
     (findings: no prediction of their values was stated)."""

@@ -37,7 +37,7 @@ def _mtime(path) -> int:
 
 def check_stage(product, sources: dict) -> None:
     """``product`` (a file) is at least as new as each of ``sources`` (path → table kind of
-    :data:`~infsup_contact.io.SCHEMAS`), and each source exists and reads under its schema."""
+    :data:`~infsup_contact.table_schemas.SCHEMAS`), and each source exists and reads under its schema."""
     from ...io import TableError, read_table
 
     for path, kind in sources.items():

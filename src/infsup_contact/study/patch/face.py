@@ -69,7 +69,7 @@ from ...discretization.segment.meshes import DIRICHLET
 from ...errors import InputError
 from ...models import make_model
 from ...solvers.contact import contact_pair, solve_contact_on
-from ..scene_registry import FACE_PATCH
+from ..contact.registry import FACE_PATCH
 from . import table
 from .table import KERNEL_RTOL
 

@@ -64,7 +64,7 @@ from ...models import make_model
 from ...models.plane_strain import check_modulus, check_nu
 from ...solvers.contact import contact_pair
 from .face import DELTA, solve_face_patch
-from ..scene_registry import ELASTIC_FACE_PATCH
+from ..contact.registry import ELASTIC_FACE_PATCH
 from . import table
 
 SCENE = ELASTIC_FACE_PATCH.id

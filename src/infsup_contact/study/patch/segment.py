@@ -52,8 +52,8 @@ from ...discretization.spaces import registry
 from ...models import make_model
 from ...models.plane_strain import check_modulus, check_nu
 from ...solvers.contact import contact_pair, solve_contact_on
-from ..blocks import SIDE, PressedBlocks, block_mesh
-from ..scene_registry import PATCH
+from ..contact.blocks import SIDE, PressedBlocks, block_mesh
+from ..contact.registry import PATCH
 from . import table
 
 SCENE = PATCH.id

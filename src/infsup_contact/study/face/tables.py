@@ -10,7 +10,7 @@ import pandas as pd
 def patch_frame(fc: dict) -> pd.DataFrame:
     """The 3D contact patch test (:func:`.face_patch.face_patch_table`): every case of
     ``face.cases`` the element's face builds, each k and non-matching pair of ``face.patch``."""
-    from .patch.face import face_patch_table
+    from ..patch.face import face_patch_table
 
     sc = fc["patch"]
     return pd.DataFrame(face_patch_table(fc["cases"], sc["k"], [tuple(p) for p in sc["pairs"]], sc["elements"],
@@ -19,7 +19,7 @@ def patch_frame(fc: dict) -> pd.DataFrame:
 
 def alpha_frame(fc: dict) -> pd.DataFrame:
     """The α sweep of the transformed dual bases (:func:`.face_alpha.sweep`) in ``face.norms``."""
-    from .face_alpha import sweep
+    from .alpha import sweep
 
     sc = fc["alpha"]
     return pd.DataFrame(sweep(tuple(sc["N"]), tuple(sc["alphas"]), tuple(sc["elements"]), norms=tuple(fc["norms"]),
@@ -27,9 +27,9 @@ def alpha_frame(fc: dict) -> pd.DataFrame:
 
 
 def edge_frame(fc: dict) -> pd.DataFrame:
-    """Edge dropping (:func:`.edge_dropping.edge_table`) for the edge cases among ``face.cases``,
+    """Edge dropping (:func:`.edge_table.edge_table`) for the edge cases among ``face.cases``,
     its columns plus the claims' fit window ``fit_theta_max``."""
-    from .edge_dropping import COLUMNS, edge_table
+    from .edge_table import COLUMNS, edge_table
 
     sc = fc["edge_dropping"]
     frame = pd.DataFrame(edge_table(tuple(sc["k"]), tuple(sc["N"]), tuple(sc["theta"]), cases=fc["cases"],

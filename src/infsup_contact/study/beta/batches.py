@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import math
 
-from ..discretization.gamma.mesh_series import seeds, series_of_pairs
+from ...discretization.gamma.mesh_series import seeds, series_of_pairs
 
 
 def pair_cost(family: str, k: int, n1: int, n2: int) -> float:

@@ -2,14 +2,15 @@
 its memory estimate (:mod:`infsup_contact.resources`), against MemTotal — an error for a
 local run (:func:`check_job_memory`) — and against MemAvailable — a note (:func:`memory_notes`).
 
-``workflow/rules/common.smk`` runs both after :func:`~infsup_contact.config_checks.check_config`
+``workflow/rules/common.smk`` runs both after :func:`~infsup_contact.config.checks.check_config`
 accepted the config; a cluster job asks the scheduler for its own ``mem_mb`` instead.
 """
 from __future__ import annotations
 
-from . import resources as R
-from .config_checks import ConfigError, scene_meshes
-from .study.scene_registry import scene_spec
+from .. import resources as R
+from .checks import ConfigError
+from .meshes import scene_meshes
+from ..study.contact.registry import scene_spec
 
 
 def job_estimates(cfg):
@@ -17,7 +18,7 @@ def job_estimates(cfg):
     contact per mesh, the Rem 5.5 instances of claims_extra, the two bench stages."""
     ic, cc, bc = cfg["infsup"], cfg["contact"], cfg["benchmarks"]
     ks = sorted({k for klist in ic["cases"].values() for k in klist})
-    from .discretization.gamma.mesh_series import series_of_pairs
+    from ..discretization.gamma.mesh_series import series_of_pairs
 
     for (n1, n2), names in series_of_pairs(ic).items():
         key = ("infsup.N" if "matching" in names else

@@ -17,7 +17,7 @@ import inspect
 from dataclasses import dataclass, field
 from typing import Callable
 
-from ..errors import InputError
+from ...errors import InputError
 
 REFERENCE_MARGIN = 2
 """A reference solve (a scene without an exact solution: config ``contact.reference_N``, CLI
@@ -161,7 +161,7 @@ def check_pair(model: str, scene: str) -> SceneSpec:
 
 def scene_model(scene: str, **params):
     """The default model of ``scene`` (its first), with the model's ``params`` (elastic: nu)."""
-    from ..models import make_model
+    from ...models import make_model
 
     return make_model(scene_spec(scene).models[0], **params)
 
@@ -204,8 +204,8 @@ def _manufactured_rate(k: int, p: float, q: float) -> float:
 
 
 _ERRORS = ("energy_error", "l2_error", "lambda_l2_error", "lambda_hm12_error", "contact_set_error")
-_SCENES_MODULE = "infsup_contact.study.scenes"
-_RUNS = "infsup_contact.study.scene_runs"
+_SCENES_MODULE = "infsup_contact.study.contact.scenes"
+_RUNS = "infsup_contact.study.contact.runs"
 MANUFACTURED = register(SceneSpec(
     "manufactured", ("membranes",), "exact u, λ with contact on (0, a), gap on (a, 1); regularity p, q",
     "exact", _ERRORS, f"{_RUNS}:membrane_rows", f"{_RUNS}:membrane_check", params=("p", "q"),

@@ -18,10 +18,10 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from ..discretization.spaces import registry
-from ..models import DEFAULT_MODEL, model_taking
-from ..models.plane_strain import lame
-from .beta_batches import beta_batch_rows
+from ...discretization.spaces import registry
+from ...models import DEFAULT_MODEL, model_taking
+from ...models.plane_strain import lame
+from .batch_rows import beta_batch_rows
 
 ELASTIC = model_taking("nu").name
 """The model this study compares with the membranes: the registered one whose bodies take a
@@ -52,7 +52,7 @@ def elastic_beta_rows(family: str, k: int, pairs, nu: float = 0.3, E=(1.0, 1.0),
                       norms=("H",), membranes: pd.DataFrame | None = None, **mesh_kwargs) -> pd.DataFrame:
     """β_h of the elastic pair (and of the membranes, c = E) for each (N1, N2) in ``pairs``,
     every case valid for k (default) and norm; G_h = trace of Ω2 (the paper's choice). Both
-    come from the β_h batches' study path (:func:`~infsup_contact.study.beta_batches.beta_batch_rows`).
+    come from the β_h batches' study path (:func:`~infsup_contact.study.beta.batch_rows.beta_batch_rows`).
     ``membranes``: the membranes' rows of :func:`membranes_rows` where already computed."""
     cases = registry.ids_valid_for(k) if cases is None else list(cases)
     if membranes is None:

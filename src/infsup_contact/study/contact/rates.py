@@ -14,8 +14,9 @@ import numpy as np
 import pandas as pd
 from scipy import stats
 
-from ..io import SERIES_COLUMNS, TableError
-from .scene_registry import energy_rate
+from ...io import TableError
+from ...table_schemas import SERIES_COLUMNS
+from .registry import energy_rate
 
 MEASURES = ("energy_error", "l2_error", "lambda_l2_error", "lambda_hm12_error")
 
@@ -39,7 +40,7 @@ def expected_energy_rate(scene: str, k: int, p: float = 3.0, q: float = 3.0) -> 
 
 
 def series_columns(frame: pd.DataFrame) -> list:
-    """The columns of ``frame`` that define a series (:data:`~infsup_contact.io.SERIES_COLUMNS`,
+    """The columns of ``frame`` that define a series (:data:`~infsup_contact.table_schemas.SERIES_COLUMNS`,
     those present): two series concatenated in one table are fitted apart, never together."""
     return [c for c in SERIES_COLUMNS if c in frame.columns]
 

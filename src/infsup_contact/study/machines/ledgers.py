@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ..io import TableError, read_table_text
+from ...io import TableError, read_table_text
 
 LEDGER_TABLES = {"results/claims.csv": "claims", "results/tables/beta.csv": "beta",
                  "results/tables/contact.csv": "contact", "results/tables/elastic_beta.csv": "elastic_beta",

@@ -18,7 +18,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from ..solvers.contact import ContactSolution, gamma_values, lambda_values, solve_contact
+from ...solvers.contact import ContactSolution, gamma_values, lambda_values, solve_contact
 from .scenes import membranes
 
 GAMMA_COLUMNS = ["case", "k", "N", "x", "quantity", "value"]
@@ -82,8 +82,8 @@ def contact_profiles(cases, k: int, n: int, scene=None, family: str = "structure
     n : int
         Segments on Γ of both meshes (matching pair N1 = N2 = n).
     scene : scene object, optional
-        A :mod:`infsup_contact.study.scenes` scene; default the paper's Fig. 4 loads,
-        :func:`infsup_contact.study.scenes.membranes` with c1 = c2 = 1.
+        A :mod:`infsup_contact.study.contact.scenes` scene; default the paper's Fig. 4 loads,
+        :func:`infsup_contact.study.contact.scenes.membranes` with c1 = c2 = 1.
     family : str
         Mesh family (default structured).
     per_interval : int

@@ -5,7 +5,7 @@ one of its ``element`` mesh options, each case id is a registered space the face
 some k of ``face.k`` (built on the 2 × 2 grid of Γ: a face-only space added to the registry
 later passes by config alone), a non-matching pair has N1 ≠ N2, and the face studies' keys
 (:func:`check_face_studies`). Each raises one
-:class:`~infsup_contact.config_schema.ConfigError` naming the key.
+:class:`~infsup_contact.config.schema.ConfigError` naming the key.
 
 Non-matching families (``face.nonmatching_families``: family → element → N1 list):
 the rules of the 2D study's families (:data:`~infsup_contact.discretization.gamma.mesh_series.FAMILY_RULES`:
@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .config_schema import ConfigError
+from .schema import ConfigError
 
 
 def check_face(cfg) -> None:
@@ -26,7 +26,7 @@ def check_face(cfg) -> None:
     fc = cfg.get("face")
     if not fc:
         return
-    from .models import MODELS
+    from ..models import MODELS
 
     model = MODELS.get(fc["model"])
     if model is None or getattr(model, "dim", 2) != 3:
@@ -59,8 +59,8 @@ def check_face_studies(fc, model_name: str, options) -> None:
     test's elements are the model's, its pairs non-matching; the α sweep's elements are face
     elements with a transformed (non-identity) basis; edge dropping keeps at least 3 θ at or
     below ``fit_theta_max`` (a slope fit). Each raises one ConfigError naming the key."""
-    from .discretization.face.spaces.cellwise import QUAD_ELEMENTS
-    from .discretization.face.spaces.dual_bases import transformation
+    from ..discretization.face.spaces.cellwise import QUAD_ELEMENTS
+    from ..discretization.face.spaces.dual_bases import transformation
 
     for i, element in enumerate(fc["patch"]["elements"]):
         if element not in options:
@@ -88,8 +88,8 @@ def _check_edge_dropping(fc, ed) -> None:
     """Each θ is one the geometry resolves at the largest N (a narrower cut column was dropped
     whole: θ = 1e-12 computed θ = 0), and each k has an edge case among ``face.cases`` (a k
     without one computed nothing)."""
-    from .discretization.face.spaces.clipped import SLIVER_MIN, min_covered_fraction
-    from .discretization.spaces.registry import edge_cases
+    from ..discretization.face.spaces.clipped import SLIVER_MIN, min_covered_fraction
+    from ..discretization.spaces.registry import edge_cases
 
     n = max(ed["N"])
     for i, theta in enumerate(ed["theta"]):
@@ -106,7 +106,7 @@ def _check_edge_dropping(fc, ed) -> None:
 
 
 def _check_face_families(fc) -> None:
-    from .discretization.gamma.mesh_series import FAMILY_RULES
+    from ..discretization.gamma.mesh_series import FAMILY_RULES
 
     for name, per_element in (fc.get("nonmatching_families") or {}).items():
         key = f"face.nonmatching_families.{name}"
@@ -125,7 +125,7 @@ def _check_face_families(fc) -> None:
 def family_pairs(fc, element: str) -> list:
     """(N1, N2 = rule(N1)) of every ``face.nonmatching_families`` entry of ``element`` (module
     docstring: Ω2 the finer side), in the config's order."""
-    from .discretization.gamma.mesh_series import FAMILY_RULES
+    from ..discretization.gamma.mesh_series import FAMILY_RULES
 
     return [(int(n1), FAMILY_RULES[name][0](int(n1)))
             for name, per_element in (fc.get("nonmatching_families") or {}).items()
@@ -171,7 +171,7 @@ def _check_face_cases(cfg, fc, options) -> None:
     """Each face case is built by the face of one of the configured elements (``face.elements``
     or ``face.patch.elements``): a space no configured element carries (PWLIN-T6 with hexahedra
     only) was accepted and silently never computed."""
-    from .study.claims.membranes3d import element_interfaces
+    from ..study.claims.membranes3d import element_interfaces
 
     patch = [e for e in fc["patch"]["elements"] if e in options]  # the others: check_face_studies
     elements = list(dict.fromkeys([*fc["elements"], *patch]))
@@ -183,10 +183,10 @@ def check_face_case_ids(cfg, section: str, cases, ks_config, faces, need_builder
     """Each id of ``<section>.cases``: registered, defined for one of ``<section>.k``, and built
     on every face of ``faces`` (a list, or element → face) that builds it; ``need_builder``: at
     least one face must (the error names the elements and the ids their faces build)."""
-    from .discretization.spaces.user_spaces import config_case_ids
-    from .discretization.spaces.registry import SPACES
-    from .discretization.face.square import SQUARE
-    from .discretization.face.tensor_grid import TensorPartition
+    from ..discretization.spaces.user_spaces import config_case_ids
+    from ..discretization.spaces.registry import SPACES
+    from ..discretization.face.square import SQUARE
+    from ..discretization.face.tensor_grid import TensorPartition
 
     ids = config_case_ids(cfg, gamma_dim=SQUARE.dim)
     names = list(faces) if isinstance(faces, dict) else None

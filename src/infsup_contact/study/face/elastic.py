@@ -32,7 +32,7 @@ def nu_pairs(fe: dict) -> list:
 
 def face_cases(fe: dict, k: int, gamma) -> list:
     """The cases of ``face_elastic.cases`` defined for k and built by the face ``gamma``."""
-    from ..discretization.spaces.registry import SPACES, ids_valid_for
+    from ...discretization.spaces.registry import SPACES, ids_valid_for
 
     return [c for c in ids_valid_for(k, fe["cases"]) if gamma.builds(SPACES[c])]
 
@@ -40,8 +40,8 @@ def face_cases(fe: dict, k: int, gamma) -> list:
 def beta_frame(fe: dict, element: str) -> pd.DataFrame:
     """β_H rows of one element (module docstring), columns of the β table plus ``model``,
     ``element`` and ``nu`` (timings dropped: they belong to the benchmark tree)."""
-    from .beta_batches import beta_batch_rows
-    from .claims.membranes3d import element_interfaces
+    from ..beta.batch_rows import beta_batch_rows
+    from ..claims.membranes3d import element_interfaces
 
     gamma = element_interfaces(fe["model"], [element])[element]
     frames = []
@@ -63,9 +63,9 @@ def beta_frame(fe: dict, element: str) -> pd.DataFrame:
 def patch_frame(fe: dict) -> pd.DataFrame:
     """The elastic face patch test (:func:`~.elastic_face_patch.elastic_face_patch_rows`) for
     every element of ``face_elastic.patch``, the cases its face builds, every k and pair."""
-    from ..models import make_model
-    from .patch.face_elastic import elastic_face_patch_rows
-    from .claims.membranes3d import element_interfaces
+    from ...models import make_model
+    from ..patch.face_elastic import elastic_face_patch_rows
+    from ..claims.membranes3d import element_interfaces
 
     pc = fe["patch"]
     model = make_model(fe["model"], nu=float(fe["nu"]))

@@ -4,12 +4,12 @@ checks of a request (memory estimate included). The scene registry
 """
 from __future__ import annotations
 
-from .. import resources
-from ..errors import InputError
+from ... import resources
+from ...errors import InputError
 from . import hertz
-from .patch import face as face_patch, face_elastic as elastic_face_patch, segment as patch
-from .contact_rows import contact_row, reference_solution
-from .scene_registry import REFERENCE_MARGIN, scene_data, scene_spec
+from ..patch import face as face_patch, face_elastic as elastic_face_patch, segment as patch
+from .rows import contact_row, reference_solution
+from .registry import REFERENCE_MARGIN, scene_data, scene_spec
 
 
 def membrane_rows(model, cases, k, family, n1, n2, c, args) -> list:

@@ -11,8 +11,8 @@ YAML 1.1 rules turn a plausible file into other values without a word:
 
 :func:`check_config_file` re-reads each file as a node tree (``yaml.compose``: values with their
 line numbers, nothing constructed) and refuses these with one line naming the key, the file and
-the line: a :class:`~infsup_contact.config_checks.ConfigError`. ``workflow/rules/common.smk``
-runs it on ``workflow.configfiles`` before :func:`~infsup_contact.config_checks.check_config`.
+the line: a :class:`~infsup_contact.config.checks.ConfigError`. ``workflow/rules/common.smk``
+runs it on ``workflow.configfiles`` before :func:`~infsup_contact.config.checks.check_config`.
 A JSON file (Snakemake tries JSON first) is checked for duplicate keys only: JSON has neither
 octal nor the exponent rule.
 """
@@ -22,7 +22,7 @@ import json
 import re
 from pathlib import Path
 
-from .config_checks import ConfigError, key_path
+from .checks import ConfigError, key_path
 
 ZERO_PADDED = re.compile(r"[-+]?0[0-9_]+")
 """A plain scalar YAML 1.1 reads as octal (or as a string when a digit is 8 or 9)."""
@@ -124,7 +124,7 @@ def check_config_file(path) -> None:
     except ValueError as err:
         if isinstance(err, ConfigError):
             raise
-    from .yaml_limits import YamlLimitError, compose
+    from ..yaml_limits import YamlLimitError, compose
 
     try:
         root = compose(text, duplicates=False)  # an alias expansion refused here (yaml_limits), the rest below

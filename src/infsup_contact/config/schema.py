@@ -1,7 +1,7 @@
 """A workflow config against its schema: the one-line :class:`ConfigError`, the key paths it
 names, non-finite numbers, and the JSON schema's violations in words.
 
-:mod:`infsup_contact.config_checks` runs these first and then the checks a schema cannot
+:mod:`infsup_contact.config.checks` runs these first and then the checks a schema cannot
 state; pure functions, no Snakemake.
 """
 from __future__ import annotations
@@ -53,7 +53,7 @@ def check_finite(node, path=()) -> None:
 # ------------------------------------------------------------------ 3. the schema
 
 def load_schema(path) -> dict:
-    from .yaml_limits import load
+    from ..yaml_limits import load
 
     return load(Path(path).read_text())
 

@@ -4,7 +4,7 @@ The 2D study's families (:mod:`~infsup_contact.discretization.gamma.mesh_series`
 of the two traces with N; ``sqrt2`` (round(√2 n)) makes the two grids share no interior line when
 gcd(N1, N2) = 1 (5:7, 7:10), so the common coarsening of the traces is the single cell and
 dim(W1 ∩ W2) = 0 on rectangles (:meth:`~infsup_contact.discretization.face.square.Square.trace_sum_dimension`).
-On the face Ω2 is the finer side, N2 = round(√2 N1) (:mod:`infsup_contact.config_face`).
+On the face Ω2 is the finer side, N2 = round(√2 N1) (:mod:`infsup_contact.config.face`).
 
 For every space, k and element on such a pair this compares three numbers
 (:mod:`.claims.membranes3d`' reasoning):
@@ -24,7 +24,7 @@ For every space, k and element on such a pair this compares three numbers
 pair alone (PASS, FAIL where the tensor bound exceeds the count, ``finding`` where only lower bounds
 are known); ``as_predicted`` whether the numbers bear it out.
 
-Run: ``python -m infsup_contact.study.face_families --N1 5 --k 1 2`` (CSV on stdout).
+Run: ``python -m infsup_contact.study.face.families --N1 5 --k 1 2`` (CSV on stdout).
 """
 from __future__ import annotations
 
@@ -32,11 +32,11 @@ import sys
 
 import numpy as np
 
-from ..discretization.spaces.registry import SPACES, ids_valid_for
-from ..discretization.gamma.mesh_series import FAMILY_RULES
-from ..errors import InputError
-from .claims.criteria import FAIL, PASS
-from .claims.membranes3d import element_interfaces, face_predictions, is_tensor, planar_kernel, tensor_kernel_bound
+from ...discretization.spaces.registry import SPACES, ids_valid_for
+from ...discretization.gamma.mesh_series import FAMILY_RULES
+from ...errors import InputError
+from ..claims.criteria import FAIL, PASS
+from ..claims.membranes3d import element_interfaces, face_predictions, is_tensor, planar_kernel, tensor_kernel_bound
 
 
 def family_pair(family: str, n1: int) -> tuple:
@@ -50,8 +50,8 @@ def coupling_1d(space, n: int, k: int) -> np.ndarray:
     """A[j, l] = ∫_0^1 w_j μ_l with w_j the basis of continuous P_k vanishing at 0 and 1 on n uniform
     intervals (the 1D factor of a Q_k trace vanishing on ∂Γ) and μ_l the basis of the 1D ``space``:
     Gauss–Legendre on the union of both breakpoint sets, exact for the degree k + s products."""
-    from ..discretization.segment.multipliers import make_space
-    from ..discretization.gamma.quadrature import gauss_legendre_01
+    from ...discretization.segment.multipliers import make_space
+    from ...discretization.gamma.quadrature import gauss_legendre_01
 
     w = make_space(np.linspace(0.0, 1.0, n + 1), k, True, True)
     cuts = np.union1d(np.linspace(0.0, 1.0, n + 1), np.asarray(space.breakpoints, float))
@@ -87,10 +87,10 @@ def family_kernels(pairs, ks=(1, 2), cases=None, elements=None, model: str | Non
     ``kernel_dim``, ``kernel_decision``, ``prediction``, ``as_predicted``. ``cases`` default: every
     registered face space with a count; ``model`` default: the first registered 3D model
     (:func:`~.face_alpha.face_models`); ``elements`` default: all of its elements."""
-    from ..models import MODELS, make_model
-    from ..solvers.side_cache import SideCache
-    from ..solvers.infsup import beta_rows_all
-    from .face_alpha import face_models
+    from ...models import MODELS, make_model
+    from ...solvers.side_cache import SideCache
+    from ...solvers.infsup import beta_rows_all
+    from .alpha import face_models
 
     model = face_models()[0] if model is None else model
 
@@ -127,15 +127,15 @@ def family_kernels(pairs, ks=(1, 2), cases=None, elements=None, model: str | Non
 
 
 def main(argv=None) -> int:
-    """``python -m infsup_contact.study.face_families --N1 5 --k 1 2``: the kernels as CSV on stdout;
+    """``python -m infsup_contact.study.face.families --N1 5 --k 1 2``: the kernels as CSV on stdout;
     bad input is one line on stderr naming the flag, exit 2, before any row."""
     import pandas as pd
 
-    from ..cli.common import OneLineParser, run_study
-    from ..models import MODELS
-    from .face_alpha import face_models
+    from ...cli.common import OneLineParser, run_study
+    from ...models import MODELS
+    from .alpha import face_models
 
-    p = OneLineParser(prog="python -m infsup_contact.study.face_families", description=__doc__.split("\n")[0])
+    p = OneLineParser(prog="python -m infsup_contact.study.face.families", description=__doc__.split("\n")[0])
     p.add_argument("--family", default="sqrt2", choices=list(FAMILY_RULES))
     p.add_argument("--N1", type=int, nargs="+", default=[5], help="the coarser side; N2 = rule(N1)")
     p.add_argument("--k", type=int, nargs="+", default=[1, 2])

@@ -35,13 +35,13 @@ import time
 import ngsolve
 import numpy as np
 
-from ..discretization.spaces import registry
-from ..models import make_model
-from ..models.plane_strain import check_modulus, check_nu, lame
-from ..solvers.contact import contact_pair, solve_contact_on
+from ...discretization.spaces import registry
+from ...models import make_model
+from ...models.plane_strain import check_modulus, check_nu, lame
+from ...solvers.contact import contact_pair, solve_contact_on
 from .accuracy import _element_quadrature
 from .blocks import PressedBlocks
-from .scene_registry import HERTZ
+from .registry import HERTZ
 
 SCENE = HERTZ.id
 """This scene's registry id (:mod:`.scene_registry` declares it and the models it is defined for)."""
@@ -70,7 +70,7 @@ def hertz_pressure(x, P, R, nu, E):
 
 def check_geometry(R, d) -> tuple:
     """(R, d) as floats: 0 < R <= 1e6, 0 < d < 1/2; :class:`InputError` naming the key."""
-    from ..errors import InputError
+    from ...errors import InputError
 
     out = []
     for key, value, ok, allowed in (("R", R, lambda v: 0 < v <= 1e6, "a finite radius in (0, 1e6]"),

@@ -2,9 +2,9 @@
 from __future__ import annotations
 
 from . import accuracy
-from ..solvers.contact import ContactSolution, contact_pair, solve_contact, solve_contact_on
-from ..errors import InputError, check_prestress
-from ..discretization.spaces.registry import REFERENCE_SPACE, check_case, space_spec
+from ...solvers.contact import ContactSolution, contact_pair, solve_contact, solve_contact_on
+from ...errors import InputError, check_prestress
+from ...discretization.spaces.registry import REFERENCE_SPACE, check_case, space_spec
 from .scenes import scene as make_scene
 
 def cone_kind(case: str, k: int) -> str:
@@ -36,8 +36,8 @@ def save_reference(path, ref: ContactSolution) -> None:
 
     import numpy as np
 
-    from ..discretization.segment.multipliers import SegmentSpace
-    from ..io import write_bytes_atomic
+    from ...discretization.segment.multipliers import SegmentSpace
+    from ...io import write_bytes_atomic
     from .accuracy import reference_quadrature
 
     if type(ref.space) is not SegmentSpace:
@@ -71,7 +71,7 @@ def load_reference(path):
 
     import numpy as np
 
-    from ..discretization.segment.multipliers import SegmentSpace
+    from ...discretization.segment.multipliers import SegmentSpace
     from .accuracy import with_reference_quadrature
 
     allowed = f"a reference written by save_reference ({REFERENCE_FORMAT!r}: an .npz of plain arrays, no pickle)"

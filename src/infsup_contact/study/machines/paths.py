@@ -37,7 +37,7 @@ so those paths need ``GenuineIntel`` besides their flags and are skipped here wi
 
 ``tests/study/test_machines.py`` runs the sweep and the kernel, verdict and 3D kernel tests under
 every path this CPU can take; the DAG target ``verify-machines`` compares the CI profile's
-ledgers and kernel tables (:data:`LEDGER_TABLES`).
+ledgers and kernel tables (:data:`~.ledgers.LEDGER_TABLES`).
 """
 from __future__ import annotations
 
@@ -51,8 +51,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ..errors import InputError
-from .machine_ledgers import LEDGER_EXACT, LEDGER_TABLES, ROW_LABEL, ledger_differences  # noqa: F401
+from ...errors import InputError
 
 SWITCHES = ("OPENBLAS_CORETYPE", "MKL_CBWR", "MKL_ENABLE_INSTRUCTIONS")
 """The variables that select a library's code path: a path's environment drops every one it does
@@ -193,7 +192,7 @@ def runnable(name: str, flags: set | None = None, vendor: str | None = None,
     vendor = cpu_vendor() if vendor is None else vendor
     if path.library == "mkl":
         if mkl is None:
-            from ..la.mkl import available
+            from ...la.mkl import available
 
             mkl = available()
         if not mkl:
@@ -209,7 +208,7 @@ def runnable(name: str, flags: set | None = None, vendor: str | None = None,
 
 def openblas_corenames() -> dict:
     """The kernel set OpenBLAS chose in this process, for numpy's and scipy's copies."""
-    from ..la.openblas import corenames
+    from ...la.openblas import corenames
 
     return corenames()
 
@@ -235,8 +234,8 @@ def mkl_probe() -> dict:
     """
     import scipy.sparse as sp
 
-    from ..la import mkl
-    from ..la.pardiso import Factor, gamma_schur
+    from ...la import mkl
+    from ...la.pardiso import Factor, gamma_schur
 
     if not mkl.available():
         return {}
@@ -269,8 +268,8 @@ def sweep_rows() -> pd.DataFrame:
     """β rows of the paper's five cases, k = 1..4, both norms: matching N = 4, 8 (every
     multiplier mesh is the same partition there) and the union partition of the 17:16 pair;
     and :func:`face_sweep_rows`. Column ``model`` tells them apart."""
-    from ..discretization.spaces.registry import PAPER_CASES, SPACES
-    from ..solvers.infsup import beta_rows
+    from ...discretization.spaces.registry import PAPER_CASES, SPACES
+    from ...solvers.infsup import beta_rows
 
     rows = []
     for k in range(1, 5):
@@ -286,9 +285,9 @@ def face_sweep_rows() -> pd.DataFrame:
     complement from MKL PARDISO, so MKL's path reaches the kernel columns (measured, k = 2, 7:8:
     the default, AUTO and COMPATIBLE branches give both sides' S other bits and move β in its
     15th digit, below the 12 the table keeps)."""
-    from ..discretization.spaces.registry import PAPER_CASES, SPACES
-    from ..models import make_model
-    from ..solvers.infsup import beta_rows_all
+    from ...discretization.spaces.registry import PAPER_CASES, SPACES
+    from ...models import make_model
+    from ...solvers.infsup import beta_rows_all
 
     model, rows = make_model("membranes3d"), []
     for k, pairs in FACE_SWEEP.items():
@@ -301,8 +300,8 @@ def face_sweep_rows() -> pd.DataFrame:
 
 def verdict_rows() -> pd.DataFrame:
     """The stability verdict of each case, k and norm over matching N = 4, 8, 16."""
-    from ..discretization.spaces.registry import PAPER_CASES, SPACES
-    from .verdict import verdict_rows as one
+    from ...discretization.spaces.registry import PAPER_CASES, SPACES
+    from ..verdict import verdict_rows as one
 
     out = []
     for k in range(1, 5):
@@ -313,83 +312,9 @@ def verdict_rows() -> pd.DataFrame:
     return pd.DataFrame(out)
 
 
-KEYS = ["model", "case", "k", "N1", "N2", "multiplier_mesh", "norm"]
-EXACT = ["kernel_dim", "structural_kernel_dim", "kernel_detected", "kernel_decision", "kernel_check", "dim_M"]
-"""The sweep's columns that no code path may change (the kernel decisions and dimensions)."""
-
-
-def compare(sweeps: dict, verdicts: dict) -> list:
-    """Differences between the tables of several machine paths (empty: they agree).
-
-    Parameters
-    ----------
-    sweeps, verdicts : dict
-        path name → :func:`sweep_rows` / :func:`verdict_rows` of a process run on it; the first
-        is the reference.
-
-    Returns
-    -------
-    list of str
-        One line per disagreement: an exact column or a verdict that differs, or a resolved
-        β that differs by more than :func:`beta_tolerance`.
-    """
-    (ref_name, ref), *others = sweeps.items()
-    problems = []
-    for name, frame in others:
-        both = ref.merge(frame, on=KEYS, suffixes=("", "_other"))
-        if len(both) != len(ref) or len(frame) != len(ref):
-            problems.append(f"{name}: {len(frame)} rows vs {len(ref)} under {ref_name}")
-        for col in EXACT:
-            bad = both[both[col] != both[f"{col}_other"]]
-            problems += [f"{name} vs {ref_name}: {col} {r[col]} != {r[col + '_other']} at "
-                         f"{dict((c, r[c]) for c in KEYS)}" for _, r in bad.iterrows()]
-        for col in ("beta", "smallest_nonzero"):
-            a, b = both[col].to_numpy(float), both[f"{col}_other"].to_numpy(float)
-            rel = np.abs(a - b) / np.maximum(np.abs(a), np.finfo(float).tiny)
-            tol = beta_tolerance(both.gap_over_roundoff.to_numpy(float), both.gap_over_roundoff_other.to_numpy(float))
-            bad = both[rel > tol]
-            problems += [f"{name} vs {ref_name}: {col} {r[col]:.12g} vs {r[col + '_other']:.12g} at "
-                         f"{dict((c, r[c]) for c in KEYS)}" for _, r in bad.iterrows()]
-    (ref_name, ref), *others = verdicts.items()
-    for name, frame in others:
-        both = ref.merge(frame, on=["case", "k", "norm"], suffixes=("", "_other"))
-        if len(both) != len(ref) or len(frame) != len(ref):
-            problems.append(f"{name}: {len(frame)} verdicts vs {len(ref)} under {ref_name}")
-        bad = both[(both.verdict != both.verdict_other) | (both.kernel_dim != both.kernel_dim_other)]
-        problems += [f"{name} vs {ref_name}: verdict {r.verdict_other} (kernel {r.kernel_dim_other}) != "
-                     f"{r.verdict} (kernel {r.kernel_dim}) for {r.case} k={r.k} {r.norm}" for r in bad.itertuples()]
-    return problems
-
-
-def beta_tolerance(gap_a, gap_b) -> np.ndarray:
-    """Relative tolerance of β between two runs: 10**GAP_DECADES/gap_over_roundoff (module
-    docstring) where both resolve it, inf (digits of round-off) where either does not."""
-    from ..solvers.kernel import GAP_DECADES
-
-    gap = np.minimum(np.asarray(gap_a, float), np.asarray(gap_b, float))
-    with np.errstate(divide="ignore"):
-        return np.where(gap >= 10.0 ** GAP_DECADES, 10.0 ** GAP_DECADES / gap, np.inf)
-
-
-def max_beta_difference(sweeps: dict) -> tuple[float, float]:
-    """Largest relative difference of β between the paths over the resolved rows, and the
-    largest of those differences over its tolerance (<= 1: inside it)."""
-    (_, ref), *others = sweeps.items()
-    worst, worst_scaled = 0.0, 0.0
-    for _, frame in others:
-        both = ref.merge(frame, on=KEYS, suffixes=("", "_other"))
-        tol = beta_tolerance(both.gap_over_roundoff, both.gap_over_roundoff_other)
-        ok = np.isfinite(tol)
-        a, b = both.beta.to_numpy(float)[ok], both.beta_other.to_numpy(float)[ok]
-        if len(a):
-            rel = np.abs(a - b) / np.maximum(np.abs(a), np.finfo(float).tiny)
-            worst, worst_scaled = max(worst, float(rel.max())), max(worst_scaled, float((rel / tol[ok]).max()))
-    return worst, worst_scaled
-
-
 def main(out_dir: str) -> None:
     """Write this process's sweep, verdicts, OpenBLAS core names and MKL probe to ``out_dir``."""
-    from ..io import write_atomic, write_csv_atomic
+    from ...io import write_atomic, write_csv_atomic
 
     out = Path(out_dir)
     write_csv_atomic(out / "sweep.csv", sweep_rows().drop(columns=["t_assemble", "t_interface", "t_eig"]))
@@ -399,19 +324,19 @@ def main(out_dir: str) -> None:
 
 
 def cli(argv=None) -> int:
-    """``python -m infsup_contact.study.machines OUT_DIR``: :func:`main`; ``--probe``: print the
+    """``python -m infsup_contact.study.machines.paths OUT_DIR``: :func:`main`; ``--probe``: print the
     libraries' state (a path's evidence) only. A missing or unusable OUT_DIR is one line on
     stderr naming it, exit 2."""
     import sys
 
-    from ..cli.common import OneLineParser, run_study
-    from ..errors import InputError
+    from ...cli.common import OneLineParser, run_study
+    from ...errors import InputError
 
     argv = sys.argv[1:] if argv is None else list(argv)
     if argv == ["--probe"]:
         print(json.dumps(dict(openblas=openblas_corenames(), mkl=mkl_probe())))
         return 0
-    p = OneLineParser(prog="python -m infsup_contact.study.machines", description=main.__doc__)
+    p = OneLineParser(prog="python -m infsup_contact.study.machines.paths", description=main.__doc__)
     p.add_argument("out_dir", help="directory for sweep.csv, verdicts.csv, openblas.json and mkl.json (created)")
 
     def check(args):

@@ -19,7 +19,7 @@ TRI6: the same sweep on the triangles of tetrahedral faces (P2 displacements,
 the plain dual (α = 0) is the only one refused. The mesh element of each reference element is the
 model's element whose face cells have its shape (:func:`element_of`), not a name.
 
-Run: ``python -m infsup_contact.study.face_alpha --N 4 8`` (CSV on stdout);
+Run: ``python -m infsup_contact.study.face.alpha --N 4 8`` (CSV on stdout);
 ``--element TRI6 --N 4 6`` for the triangles.
 """
 from __future__ import annotations
@@ -28,13 +28,13 @@ import sys
 
 import numpy as np
 
-from ..discretization.face.spaces.cellwise import cellwise_builder
-from ..discretization.face.spaces.dual_bases import alpha_sweep, transformation
-from ..discretization.face.spaces.reference_elements import reference_element
-from ..discretization.face.spaces.tri6 import triangle_builder
-from ..discretization.face.tensor_grid import TensorPartition
-from ..discretization.spaces.spec import SpaceSpec
-from ..errors import InputError
+from ...discretization.face.spaces.cellwise import cellwise_builder
+from ...discretization.face.spaces.dual_bases import alpha_sweep, transformation
+from ...discretization.face.spaces.reference_elements import reference_element
+from ...discretization.face.spaces.tri6 import triangle_builder
+from ...discretization.face.tensor_grid import TensorPartition
+from ...discretization.spaces.spec import SpaceSpec
+from ...errors import InputError
 
 ALPHAS = (0.05, 0.1, 0.125, 0.15, 0.2, 0.25, 0.3, 1.0 / 3.0, 0.4, 0.45)
 """The sweep (0.125: the QUAD8 corner weight is exactly 0; 0.2: 4C's)."""
@@ -61,8 +61,8 @@ def element_of(model: str, reference: str) -> str:
     """The mesh element (``--element``) of ``model`` whose face cells have the shape of the
     reference element ``reference`` (QUAD8 → hexahedra, TRI6 → tetrahedra), asked of the faces
     (:func:`~.claims.membranes3d.element_interfaces`)."""
-    from ..models import MODELS
-    from .claims.membranes3d import element_interfaces
+    from ...models import MODELS
+    from ..claims.membranes3d import element_interfaces
 
     options = dict(MODELS[model].mesh_options).get("element", ())
     want = FACE_CELL[reference_element(reference).cell]
@@ -106,7 +106,7 @@ def accepted_by_construction(element: str, alpha: float, n: int, k: int = 2) -> 
 
 def face_models() -> list:
     """Names of the registered models whose contact interface is the face (dimension 3)."""
-    from ..models import MODELS
+    from ...models import MODELS
 
     return [name for name, m in MODELS.items() if m.dim == 3]
 
@@ -119,11 +119,11 @@ def sweep(ns=(4, 8), alphas=ALPHAS, elements=ELEMENTS, k: int = 2, norms=("H",),
     accepted, β_h, kernel_dim, dim M, dim W, n_max (``model``: a registered 3D model, default
     the first, :func:`face_models`; ``cell`` its --element, default the one whose face cells
     fit each element, :func:`element_of`)."""
-    from ..models import make_model
-    from ..solvers.side_cache import SideCache
+    from ...models import make_model
+    from ...solvers.side_cache import SideCache
 
     model = face_models()[0] if model is None else model
-    from ..solvers.infsup import beta_rows_all
+    from ...solvers.infsup import beta_rows_all
 
     cache, rows = SideCache(), []
     for n in ns:
@@ -145,13 +145,13 @@ def sweep(ns=(4, 8), alphas=ALPHAS, elements=ELEMENTS, k: int = 2, norms=("H",),
 
 
 def main(argv=None) -> int:
-    """``python -m infsup_contact.study.face_alpha --N 4``: the sweep as CSV on stdout; bad input
+    """``python -m infsup_contact.study.face.alpha --N 4``: the sweep as CSV on stdout; bad input
     is one line on stderr naming the flag, exit 2, before any row."""
     import pandas as pd
 
-    from ..cli.common import OneLineParser, run_study
+    from ...cli.common import OneLineParser, run_study
 
-    p = OneLineParser(prog="python -m infsup_contact.study.face_alpha", description=__doc__.split("\n")[0])
+    p = OneLineParser(prog="python -m infsup_contact.study.face.alpha", description=__doc__.split("\n")[0])
     p.add_argument("--N", type=int, nargs="+", default=[4, 8], help="cells per direction (matching meshes)")
     p.add_argument("--norm", default="H", choices=["H", "L2", "all"])
     p.add_argument("--model", default=None, choices=face_models(), help="a 3D model (default: the first)")

@@ -2,7 +2,7 @@
 
 The membranes' batches (``workflow/scripts/beta_job.py``: every pair of one (family, k) ×
 seed × case × multiplier mesh × c pair × norm, rows tagged with their series) and the elastic
-ones (:mod:`infsup_contact.study.elastic_beta`, ``workflow/scripts/elastic_beta_job.py``) both
+ones (:mod:`infsup_contact.study.beta.elastic`, ``workflow/scripts/elastic_beta_job.py``) both
 call :func:`beta_batch_rows`; the model is named (``models.make_model``) or passed, never
 imported here. The pairs of a batch share one side cache, so a side common to several pairs
 ((16, 16), (17, 16), (24, 16): Ω2's) is factorized once.
@@ -12,10 +12,10 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from ..models import make_model
-from ..models.contract import Model
-from ..solvers.side_cache import SideCache
-from ..solvers.infsup import NORMS, beta_rows_all
+from ...models import make_model
+from ...models.contract import Model
+from ...solvers.side_cache import SideCache
+from ...solvers.infsup import NORMS, beta_rows_all
 
 
 def as_model(model, **params) -> Model:

@@ -7,13 +7,13 @@ each element is one of its ``element`` mesh options, every ν lies in (−1, 1/2
 (:func:`~infsup_contact.models.plane_strain.check_nu`), at least 3 of the sweep's ν lie at or
 above ``fit_nu_min`` (a slope fit), the sweep's meshes are among ``N``, non-matching pairs have
 N1 ≠ N2, and each case is a registered space defined for some k of ``k`` and built by the face
-of some listed element. Each raises one :class:`~infsup_contact.config_schema.ConfigError`
+of some listed element. Each raises one :class:`~infsup_contact.config.schema.ConfigError`
 naming the key.
 """
 from __future__ import annotations
 
-from .config_schema import ConfigError
-from .errors import InputError
+from .schema import ConfigError
+from ..errors import InputError
 
 MIN_FIT_POINTS = 3
 """A slope fit of the ν sweep needs this many ν >= fit_nu_min."""
@@ -24,7 +24,7 @@ def check_face_elastic(cfg) -> None:
     fe = cfg.get("face_elastic")
     if not fe:
         return
-    from .models import MODELS
+    from ..models import MODELS
 
     model = MODELS.get(fe["model"])
     taking = [m.name for m in MODELS.values() if getattr(m, "dim", 2) == 3 and _takes_nu(m)]
@@ -57,7 +57,7 @@ def _takes_nu(model) -> bool:
 
 
 def _check_nus(fe) -> None:
-    from .models.plane_strain import check_nu
+    from ..models.plane_strain import check_nu
 
     sweep = fe["nu_sweep"]
     for key, value in [("face_elastic.nu", fe["nu"])] + [(f"face_elastic.nu_sweep.nu[{i}]", v)
@@ -75,8 +75,8 @@ def _check_nus(fe) -> None:
 
 
 def _check_cases(cfg, fe, model) -> None:
-    from .config_face import check_face_case_ids
-    from .study.claims.membranes3d import element_interfaces
+    from .face import check_face_case_ids
+    from ..study.claims.membranes3d import element_interfaces
 
     faces = element_interfaces(model, sorted(set(fe["elements"]) | set(fe["patch"]["elements"])))
     check_face_case_ids(cfg, "face_elastic", fe["cases"], fe["k"], list(faces.values()), need_builder=True)

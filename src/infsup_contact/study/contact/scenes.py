@@ -35,8 +35,8 @@ from typing import Callable
 import numpy as np
 from ngsolve import CoefficientFunction, IfPos, cos, pi, sin, x, y
 
-from ..errors import InputError, check_prestress
-from .scene_registry import MANUFACTURED, MEMBRANES, scene_data
+from ...errors import InputError, check_prestress
+from .registry import MANUFACTURED, MEMBRANES, scene_data
 
 #: Regularity threshold: λ'' ~ (a − x)₊^(p−2) and g'' ~ (x − a)₊^(q−2) are in L² iff the
 #: exponent exceeds 1.5, i.e. f = −c Δu ∈ L²(Ω) as required by (3.7).

@@ -8,8 +8,8 @@ import ngsolve
 import numpy as np
 import scipy.fft
 
-from ..solvers.contact import ContactSolution, gamma_values, lambda_values
-from ..discretization.segment.norms import sine_coefficients
+from ...solvers.contact import ContactSolution, gamma_values, lambda_values
+from ...discretization.segment.norms import sine_coefficients
 from .profiles import gamma_sample_points
 
 N_SAMPLE = 4001

@@ -16,7 +16,7 @@ from typing import Callable
 
 import ngsolve
 
-from ..discretization.segment import meshes
+from ...discretization.segment import meshes
 
 SIDE = "side"
 """Boundary name of the lateral sides x = 0, 1."""

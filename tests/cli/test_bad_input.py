@@ -420,7 +420,11 @@ def test_every_table_is_read_through_the_check():
     code = [*(ROOT / "src").rglob("*.py"), *(ROOT / "workflow" / "scripts").glob("*.py"),
             *(ROOT / "workflow").rglob("*.smk"), ROOT / "workflow" / "Snakefile"]
     plain = re.compile(r"read_csv\(|pd\.read_table\(|read_fwf\(|csv\.(reader|DictReader)\(|loadtxt\(|genfromtxt\(")
-    offenders = [str(p.relative_to(ROOT)) for p in sorted(code) if p.name != "io.py" and plain.search(p.read_text())]
+    # compare_results.py compares two results trees cell by cell *as text* (a schema's parsing
+    # would hide a changed digit), so it reads CSV rows without io.read_table on purpose
+    as_text = {"compare_results.py"}
+    offenders = [str(p.relative_to(ROOT)) for p in sorted(code)
+                 if p.name != "io.py" and p.name not in as_text and plain.search(p.read_text())]
     assert not offenders, f"read tables with io.read_table (via _glue.read_table): {offenders}"
 
 

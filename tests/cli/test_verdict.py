@@ -21,8 +21,8 @@ import yaml
 
 from infsup_contact import cli
 from infsup_contact.discretization.spaces import registry
-from infsup_contact.study.claims import criteria as claims
-from infsup_contact.study.verdict import INCONCLUSIVE, STABLE, UNSTABLE, stability_verdict
+from infsup_contact.criteria import claims
+from infsup_contact.criteria.stability import INCONCLUSIVE, STABLE, UNSTABLE, stability_verdict
 
 ROOT = Path(__file__).resolve().parents[2]
 ENV_THREADS = {"OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"}

@@ -15,8 +15,8 @@ from infsup_contact.solvers.routes import space_kernel
 from infsup_contact.solvers.spectra import spectrum
 from infsup_contact.solvers.kernel import (CLOSE, GAP_DECADES, MARGIN_DECADES, coupling_kernel, kernel_from_gap,
                                            scaled_couplings)
-from infsup_contact.study import verdict
-from infsup_contact.study.claims import criteria as claims
+from infsup_contact.criteria import stability as verdict
+from infsup_contact.criteria import claims
 
 EPS = np.finfo(float).eps
 

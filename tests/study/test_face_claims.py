@@ -15,7 +15,7 @@ import yaml
 from infsup_contact.discretization.spaces.registry import SPACES
 from infsup_contact.errors import InputError
 from infsup_contact.discretization.face.square import SQUARE, SQUARE_TRIG
-from infsup_contact.study.claims.criteria import FAIL, INCONCLUSIVE, PASS
+from infsup_contact.criteria.claims import FAIL, INCONCLUSIVE, PASS
 from infsup_contact.study.claims.membranes3d import (face_claims, face_dimension, face_predictions, kernel_formula,
                                               planar_kernel, tensor_kernel_bound)
 

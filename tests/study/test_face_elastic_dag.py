@@ -14,7 +14,7 @@ import yaml
 
 from infsup_contact.discretization.spaces.registry import SPACES
 from infsup_contact.discretization.face.square import SQUARE
-from infsup_contact.study.claims.criteria import FAIL, INCONCLUSIVE, PASS
+from infsup_contact.criteria.claims import FAIL, INCONCLUSIVE, PASS
 from infsup_contact.study.claims.membranes3d import matching_kernel
 from infsup_contact.study.face.elastic import nu_pairs
 from infsup_contact.study.claims.elastic3d import FINDING, claim_id, face_elastic_claims, nu_slope

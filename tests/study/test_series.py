@@ -6,7 +6,7 @@ import pandas as pd
 import pytest
 
 from infsup_contact.discretization.gamma import mesh_series as S
-from infsup_contact.study.claims.criteria import bounded_claim, finest
+from infsup_contact.criteria.claims import bounded_claim, finest
 
 IC = {"N": [4, 8, 16], "nonmatching": [[6, 4], [12, 8], [16, 8], [6, 8]],
       "nonmatching_families": {"plus1": [8, 12, 16], "sqrt2": [8, 12, 16]},

@@ -61,7 +61,7 @@ def read_table(path, kind: str, **kwargs):
 
 def write_claims(path, table) -> None:
     """Write a claims table (the ledger or one model's claims, columns
-    ``infsup_contact.study.claims.criteria.COLUMNS``) atomically and list its ids, verdicts and
+    ``infsup_contact.criteria.claims.COLUMNS``) atomically and list its ids, verdicts and
     predictions in the job's log: every claims job writes through here."""
     from infsup_contact.io import write_csv_atomic
 

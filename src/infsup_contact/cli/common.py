@@ -273,42 +273,6 @@ def model_flag_uses() -> list:
                     request) for name in [*_material_params(), *_mesh_options()]]
 
 
-# ---------------------------------------------------------------- the study modules' command lines
-class OneLineParser(argparse.ArgumentParser):
-    """An argparse parser whose errors are one line, ``<prog>: error: <message>``, exit 2."""
-
-    def error(self, message):
-        self.exit(2, f"{self.prog}: error: {message}\n")
-
-
-def error_line(err: Exception, flags: dict) -> str:
-    """The one line of an InputError, its key spelled as the flag (``flags``: dest → flag)."""
-    text = " ".join(str(err).split())
-    key = getattr(err, "key", None)
-    flag = flags.get(key) if key else None
-    if flag and text.startswith(f"invalid {key}"):
-        text = f"invalid {flag}" + text[len(f"invalid {key}"):]
-    return text
-
-
-def run_study(parser, argv, check, run) -> int:
-    """A study module's ``python -m`` command: parse ``argv``, ``check(args)`` the whole request
-    before any output, then ``run(args)``. Bad input (:class:`InputError`) is one line on stderr,
-    ``<prog>: error: invalid --flag (got …): expected …``, and exit 2: never a traceback, never a
-    table of its header only."""
-    import sys
-
-    args = parser.parse_args(argv)
-    flags = {a.dest: max(a.option_strings, key=len) for a in parser._actions if a.option_strings}
-    try:
-        check(args)
-        run(args)
-    except InputError as err:
-        print(f"{parser.prog}: error: {error_line(err, flags)}", file=sys.stderr)
-        return 2
-    return 0
-
-
 # ---------------------------------------------------------------- output
 EXIT_OUTPUT = 74
 """Exit status when the output cannot be written (closed or full stdout; sysexits' EX_IOERR),

@@ -2,7 +2,7 @@
 atomically into ``--output``; the exit codes in one table.
 
 One verdict is a :class:`VerdictResult`: the verdict row (the fields of
-:func:`infsup_contact.study.verdict.stability_verdict` and the form's own), the per-level rows of
+:func:`infsup_contact.criteria.stability.stability_verdict` and the form's own), the per-level rows of
 a foreign system, the expectation and the exit code. The three renderers read only it:
 
 * CSV is the row as ``verdict`` always printed it (lists space-separated, ``%.6g``);

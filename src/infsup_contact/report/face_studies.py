@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from ..study.claims.criteria import slope_interval
+from ..criteria.claims import slope_interval
 from ..study.claims.membranes3d_studies import edge_claim_id, patch_claim_id
 from .texformat import PaperTexError, case_order, fmt_fixed, fmt_int, fmt_sci, latex_id
 from .texnames import Macro, macro_name

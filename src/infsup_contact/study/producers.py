@@ -170,7 +170,7 @@ def producers_claims(frame, cfg: dict):
     that is not installed gives no claim (its table row says so)."""
     import pandas as pd
 
-    from .claims.criteria import FAIL, INCONCLUSIVE, PASS, row
+    from ..criteria.claims import FAIL, INCONCLUSIVE, PASS, row
 
     out = []
     for name, spec in cfg["codes"].items():

@@ -40,7 +40,7 @@ MIN_LEVELS_FINE = 3
 def system_hints(rows, out: dict, tol: float, confidence: float, notes=None) -> list:
     """The hints for one verdict, each also written to ``notes`` (stderr) as
     ``infsup-contact: hint: …``: ``rows`` of :func:`~.levels.system_rows` (coarse to fine),
-    ``out`` the verdict of :func:`~infsup_contact.study.verdict.stability_verdict` on them."""
+    ``out`` the verdict of :func:`~infsup_contact.criteria.stability.stability_verdict` on them."""
     h = np.array([r["h"] for r in rows], float)
     dims = [int(r["kernel_detected"]) for r in rows]
     hints = [scale_hint(out, tol), vanishing_kernel_hint(h, dims)]

@@ -1,6 +1,6 @@
 """A manifest's levels → one β row per level → the verdict, by ``verdict --case``'s criterion.
 
-The rows carry what :func:`infsup_contact.study.verdict.stability_verdict` reads (``N2`` is
+The rows carry what :func:`infsup_contact.criteria.stability.stability_verdict` reads (``N2`` is
 1/h, so its h is the manifest's) plus the route, residual, kernel decision, the entries'
 round-off in η (``entry_rtol_used``, ``entry_rtol_source``), the pencil's cross-check
 (``pencil_margin_decades``), what a close decision asks of the user (``kernel_advice``), the
@@ -16,7 +16,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..solvers.kernel import MARGIN_DECADES
-from ..study.verdict import stability_verdict
+from ..criteria.stability import stability_verdict
 from .checks import check_level, check_sequence
 from .engine import close_advice, level_spectrum
 from .hints import system_hints, transposed_b_hint
@@ -137,7 +137,7 @@ def uncertain_beta(res) -> float:
 def system_verdict(manifest: Manifest, *, tol: float, floor: float, confidence: float, route: str = "auto",
                    notes=None) -> tuple:
     """(verdict row, level rows). The criterion of ``verdict --case``
-    (:func:`~infsup_contact.study.verdict.stability_verdict`) on the kernel *beyond* the
+    (:func:`~infsup_contact.criteria.stability.stability_verdict`) on the kernel *beyond* the
     declared one: a kernel of Bᵀ larger than ``known_kernel`` on any level is UNSTABLE; a
     ``close`` kernel decision on any level makes the verdict INCONCLUSIVE (both by
     ``stability_verdict`` itself), the evidence saying what the user can do. η includes the

@@ -1,6 +1,6 @@
 """Ledger claims of the elastic scene: does the paper's verdict carry over to plane strain?
 
-Same criteria as the membranes (:mod:`infsup_contact.study.claims.criteria`: slope interval of log β_h
+Same criteria as the membranes (:mod:`infsup_contact.criteria.claims`: slope interval of log β_h
 vs log h inside ±τ and min β_h > floor for "bounded"; exact kernel counts). Each claim's
 ``predicted`` column was written before the tables existed; the reasoning:
 
@@ -30,7 +30,7 @@ from __future__ import annotations
 import pandas as pd
 
 from ...discretization.spaces.registry import SPACES
-from .criteria import (FAIL, INCONCLUSIVE, PASS, bounded_claim, close_decisions, close_text, finest, kernel_claim,
+from ...criteria.claims import (FAIL, INCONCLUSIVE, PASS, bounded_claim, close_decisions, close_text, finest, kernel_claim,
                      predicted_kernel, row, slope_verdict)
 
 REF = "beyond the paper (its Section 2: elastic bodies)"

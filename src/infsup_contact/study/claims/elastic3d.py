@@ -2,7 +2,7 @@
 ``results/tables/face_elastic_beta.csv`` and ``results/face/elastic_patch.csv``), appended to
 ``results/claims.csv`` like :mod:`.membranes3d`.
 
-Same verdicts as the paper's ledger (:mod:`infsup_contact.study.claims.criteria`): PASS / FAIL /
+Same verdicts as the paper's ledger (:mod:`infsup_contact.criteria.claims`): PASS / FAIL /
 INCONCLUSIVE, a kernel decision too close to round-off is INCONCLUSIVE. Every ``predicted``
 column is computed here from the registry's properties, the construction of the face spaces and
 the config — never from a case id and never from the measured tables. The reasoning
@@ -42,7 +42,7 @@ import numpy as np
 import pandas as pd
 
 from ...discretization.spaces.registry import SPACES
-from .criteria import COLUMNS, FAIL, FINDING, INCONCLUSIVE, PASS, close_decisions, close_text, row
+from ...criteria.claims import COLUMNS, FAIL, FINDING, INCONCLUSIVE, PASS, close_decisions, close_text, row
 from .membranes3d import matching_kernel
 from .membranes3d_studies import face_contains_constants, patch_prediction, patch_verdict
 

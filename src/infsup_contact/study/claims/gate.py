@@ -21,7 +21,7 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-from .criteria import FAIL, FINDING, INCONCLUSIVE, PASS
+from ...criteria.claims import FAIL, FINDING, INCONCLUSIVE, PASS
 
 VERDICTS = (PASS, FAIL, INCONCLUSIVE)
 PREDICTIONS = (PASS, FAIL, FINDING)

@@ -9,7 +9,7 @@ import numpy as np
 import pandas as pd
 
 from ...discretization.spaces.registry import PAPER_CASES, SIGN_CHECK_SPACE, SPACES
-from .criteria import (BEYOND, COLUMNS, FAIL, INCONCLUSIVE, PASS, bounded_claim, finest, kernel_at_least, kernel_claim,
+from ...criteria.claims import (BEYOND, COLUMNS, FAIL, INCONCLUSIVE, PASS, bounded_claim, finest, kernel_at_least, kernel_claim,
                        ns_text, predicted_kernel, row, seeds_text, slope_verdict)
 
 

@@ -1,6 +1,6 @@
 """Ledger claims of the 3D contact face Γ = (0,1)²×{1} (models/membranes3d.py).
 
-Same criteria as the paper's ledger (:mod:`infsup_contact.study.claims.criteria`: the slope interval of
+Same criteria as the paper's ledger (:mod:`infsup_contact.criteria.claims`: the slope interval of
 log β_h vs log h inside s0 ± τ, min β_h > floor, exact kernel counts, INCONCLUSIVE where a
 kernel decision is ``close``). Each claim's ``predicted`` column comes from the registry's
 properties (``stable``, the 1D ``dimension`` count) and the config's meshes alone — never from
@@ -47,7 +47,7 @@ from ...errors import InputError
 from ...discretization.face.kernel_bounds import symmetric_kernel_bound
 from ...discretization.face.square import SQUARE, SQUARE_TRIG, Square
 from ...discretization.face.tensor_grid import TensorPartition
-from .criteria import FAIL, FINDING, INCONCLUSIVE, PASS, bounded_claim, close_decisions, close_text, finest, kernel_claim, \
+from ...criteria.claims import FAIL, FINDING, INCONCLUSIVE, PASS, bounded_claim, close_decisions, close_text, finest, kernel_claim, \
     row, slope_verdict
 
 REF = "beyond the paper (issue 28: the 3D contact face)"

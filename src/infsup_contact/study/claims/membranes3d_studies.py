@@ -2,7 +2,7 @@
 α sweep of the transformed dual bases and edge dropping (``results/face/{patch,alpha,edge_dropping}.csv``,
 rules/face_studies.smk), appended to ``results/claims.csv`` like :mod:`.membranes3d`.
 
-Same verdicts as the paper's ledger (:mod:`infsup_contact.study.claims.criteria`): PASS / FAIL /
+Same verdicts as the paper's ledger (:mod:`infsup_contact.criteria.claims`): PASS / FAIL /
 INCONCLUSIVE, slope claims by the Student-t interval inside s0 ± τ, and a decision too close to
 round-off is INCONCLUSIVE. Every ``predicted`` column is computed here from the registry's
 properties and the construction of the spaces (never from a case id, never from the tables):
@@ -42,7 +42,7 @@ from ...discretization.gamma.constants import spans_constants
 from ...discretization.face.spaces.dual_bases import weights
 from ...discretization.spaces.registry import SPACES
 from ...discretization.face.tensor_grid import TensorPartition
-from .criteria import COLUMNS, FAIL, FINDING, INCONCLUSIVE, PASS, row, slope_verdict
+from ...criteria.claims import COLUMNS, FAIL, FINDING, INCONCLUSIVE, PASS, row, slope_verdict
 from .membranes3d import REF, face_dimension
 
 PATCH_RTOL = 1e-8

@@ -149,7 +149,7 @@ def main(argv=None) -> int:
     is one line on stderr naming the flag, exit 2, before any row."""
     import pandas as pd
 
-    from ...cli.common import OneLineParser, run_study
+    from ...command_line import OneLineParser, run_study
 
     p = OneLineParser(prog="python -m infsup_contact.study.face.alpha", description=__doc__.split("\n")[0])
     p.add_argument("--N", type=int, nargs="+", default=[4, 8], help="cells per direction (matching meshes)")

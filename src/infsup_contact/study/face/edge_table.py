@@ -88,7 +88,7 @@ def edge_table(ks=(1,), ns=(4, 8), thetas=THETAS, cases=None, n2_factor: int = 2
 def main(argv=None) -> int:
     """``python -m infsup_contact.study.face.edge_table --k 1 2 --N 4 8``: the table as CSV on stdout;
     bad input is one line on stderr naming the flag, exit 2, before any row."""
-    from ...cli.common import OneLineParser, run_study
+    from ...command_line import OneLineParser, run_study
 
     ap = OneLineParser(prog="python -m infsup_contact.study.face.edge_table", description=__doc__.splitlines()[0])
     ap.add_argument("--k", type=int, nargs="+", default=[1],

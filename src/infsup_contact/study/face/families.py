@@ -35,7 +35,7 @@ import numpy as np
 from ...discretization.spaces.registry import SPACES, ids_valid_for
 from ...discretization.gamma.mesh_series import FAMILY_RULES
 from ...errors import InputError
-from ..claims.criteria import FAIL, PASS
+from ...criteria.claims import FAIL, PASS
 from ..claims.membranes3d import element_interfaces, face_predictions, is_tensor, planar_kernel, tensor_kernel_bound
 
 
@@ -131,7 +131,7 @@ def main(argv=None) -> int:
     bad input is one line on stderr naming the flag, exit 2, before any row."""
     import pandas as pd
 
-    from ...cli.common import OneLineParser, run_study
+    from ...command_line import OneLineParser, run_study
     from ...models import MODELS
     from .alpha import face_models
 

@@ -329,7 +329,7 @@ def cli(argv=None) -> int:
     stderr naming it, exit 2."""
     import sys
 
-    from ...cli.common import OneLineParser, run_study
+    from ...command_line import OneLineParser, run_study
     from ...errors import InputError
 
     argv = sys.argv[1:] if argv is None else list(argv)

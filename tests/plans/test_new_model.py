@@ -123,3 +123,13 @@ def test_the_workflow_runs_a_new_model_from_its_entry(tmp_path):
     section = (tmp_path / "results/paper/orthotropic/orthotropic.tex").read_text()
     assert r"\subsection{The model \texttt{orthotropic}}" in section and r"\begin{tabular}" in section
     assert (tmp_path / "results/paper/model_sections.tex").read_text() == "\\input{orthotropic}\n"
+
+
+def test_an_entry_too_large_for_this_machine_is_refused_before_any_job():
+    from infsup_contact.config.memory import check_job_memory
+
+    config = yaml.safe_load((ROOT / "config" / "ci.yaml").read_text())
+    config["models"]["huge"] = dict(ENTRY, model="membranes3d", elements=["hex"], k=[4], N=[8, 16, 200])
+    with pytest.raises(ConfigError) as err:
+        check_job_memory(config, 24e9)
+    assert "models.huge.N" in str(err.value) and "model_job huge k=4 200x200" in str(err.value)

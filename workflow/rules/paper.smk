@@ -80,7 +80,7 @@ rule paper_pdf:
         generated=rules.paper_macros.output,
         figures=PAPER_FIGURES,
         elastic_tex="paper/elastic.tex",  # the elastic section (model table: elastic)
-        elastic_figure="results/figures/fig9_elastic.pdf",
+        elastic_figure=["results/figures/fig9_elastic.pdf"] if "elastic" in MODEL_STUDIES else [],
         face_tex="paper/face.tex",  # the face section (model table: face; its elastic subsection: face_elastic)
         models=MODEL_PAPER,  # each study's generated files (rule model_paper), \input by name
         model_sections="results/paper/model_sections.tex",  # the generated model subsections (rule model_sections)

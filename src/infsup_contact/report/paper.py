@@ -14,9 +14,10 @@ from .texnames import is_generated_name
 
 GENERATED_FILES = ("macros.tex", "claims_table.tex", "rates_table.tex", "beta_table.tex",
                    "speed_table.tex", "front_table.tex", "nonmatching_table.tex")
-SOURCE_INPUTS = ("elastic", "face")
-"""Sections of the paper kept in their own source files (paper/elastic.tex: the elastic scene,
-with its own generated files, :mod:`infsup_contact.report.elastic`)."""
+SOURCE_INPUTS = ("elastic", "face", "model_sections")
+"""Sections of the paper kept in their own files: the model table's studies' sections
+(paper/elastic.tex, paper/face.tex, with their own generated files) and the list of the generated
+model subsections (``model_sections.tex``, rule model_sections)."""
 
 
 def paper_files(beta, contact, rates, claims, speed, bench_beta, bench_contact, cfg, prov) -> dict[str, str]:

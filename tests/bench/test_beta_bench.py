@@ -67,3 +67,8 @@ def test_cli_elastic_bench():
     assert list(frame.route) == ["ours", "ours_core", "limit"] and (frame.what == "elastic_beta").all()
     assert (frame.n_problems == 2).all() and (frame.max_abs_diff <= 1e-8).all()
     assert frame.set_index("route").loc["limit", "ratio_to_limit"] == 1.0
+
+
+def test_an_unknown_benchmark_is_refused_naming_the_choices():
+    with pytest.raises(InputError, match="what.*beta, elastic, face"):
+        bench_for("contact")

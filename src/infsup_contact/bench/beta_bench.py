@@ -38,7 +38,7 @@ import scipy.sparse.linalg as spla
 from ..discretization.gamma.coupling import coupling_matrix
 from ..discretization.spaces import registry
 from ..errors import InputError
-from ..models.contract import factorized_side
+from ..models.contract import Model, factorized_side
 from ..solvers.infsup import beta_rows
 from ..solvers.interface_operator import interface_operator
 from ..solvers.side_cache import SideCache
@@ -83,7 +83,7 @@ class BetaBench:
     """
 
     what: str
-    model: object
+    model: Model
     norms: tuple
     columns: tuple
     second_ratio: str
@@ -258,7 +258,7 @@ def bench_beta(bench: BetaBench, ns, ks, repeats: int = 3, budget: float = ROUTE
     rows = []
     for k in ks:
         for n in ns:
-            _log(f"{bench.what} {mesh_options or ''} k={k} N={n}: setup")
+            _log(f"{bench.what} {' '.join(f'{o}={v}' for o, v in mesh_options.items())} k={k} N={n}: setup")
             setup = BetaSetup(bench, n, k, cases, **mesh_options)
             rows += _setup_rows(setup, repeats, budget)
             if bench.extra_rows:

@@ -18,6 +18,7 @@ from __future__ import annotations
 from functools import partial
 
 from ..discretization.spaces import registry
+from ..errors import InputError
 from ..la import pardiso
 from ..models.elastic import elastic_model
 from ..models.membranes import MEMBRANES
@@ -89,9 +90,13 @@ FACE_BENCH = BetaBench(
 """The 3D membranes' face benchmark (``element`` is a mesh option of ``bench_beta``)."""
 
 
+BENCHES = {"beta": membranes_bench, "elastic": elastic_bench, "face": lambda: FACE_BENCH}
+"""``bench --what`` → the builder of that model's benchmark (its keywords: the options it takes)."""
+
+
 def bench_for(what: str, **options) -> BetaBench:
     """The benchmark ``bench --what`` names: ``beta`` (options ``dense_max_size``, ``eigsh_max_n``),
-    ``elastic`` (``nu``) or ``face``."""
-    if what == "face":
-        return FACE_BENCH
-    return membranes_bench(**options) if what == "beta" else elastic_bench(**options)
+    ``elastic`` (``nu``) or ``face`` (none; its ``element`` is a mesh option of ``bench_beta``)."""
+    if what not in BENCHES:
+        raise InputError("what", ", ".join(BENCHES), got=what)
+    return BENCHES[what](**options)

@@ -72,3 +72,10 @@ def test_cli_elastic_bench():
 def test_an_unknown_benchmark_is_refused_naming_the_choices():
     with pytest.raises(InputError, match="what.*beta, elastic, face"):
         bench_for("contact")
+
+
+@pytest.mark.parametrize("what, options", [("beta", {}), ("elastic", {}), ("face", {"element": "tet"})])
+def test_the_given_cases_are_the_ones_run_where_defined(what, options):
+    """``cases`` narrows every model's default list; T4 (discontinuous P_(k-2)) needs k >= 2."""
+    setup = BetaSetup(bench_for(what), 2, 1, cases=["T3", "T4"], **options)
+    assert setup.cases == ["T3"] and set(setup.spaces) == {"T3"}

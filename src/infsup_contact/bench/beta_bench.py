@@ -106,7 +106,8 @@ def check_mesh_options(model, mesh_options: dict) -> None:
     allowed = dict(model.mesh_options)
     for key, value in mesh_options.items():
         if key not in allowed:
-            raise InputError(key, "a mesh option of " + (", ".join(allowed) or "none"), got=value)
+            takes = f"takes {', '.join(allowed)}" if allowed else "takes no mesh option"
+            raise InputError(key, f"nothing: model {model.name} {takes}", got=value)
         if value not in allowed[key]:
             raise InputError(key, ", ".join(allowed[key]), got=value)
 
@@ -224,7 +225,7 @@ def _setup_rows(setup: BetaSetup, repeats: int, budget: float) -> list:
     dim_m = max(s.dim for s in setup.spaces.values())
     rows = []
     for name, (got, times) in res.items():
-        if name == "ours":
+        if name == "ours":  # the reference itself; its kernel values are its β of a kernel case
             diff, kok = 0.0, bool(all(np.all(k < KERNEL_BETA) for k, _ in ref.values()))
         elif name == "limit" and not bench.compare_limit:
             diff, kok = np.nan, np.nan
@@ -232,7 +233,7 @@ def _setup_rows(setup: BetaSetup, repeats: int, budget: float) -> list:
             diff, kok = compare(got, ref)
         rows.append(_row(bench.what, name, setup.k, setup.n, times, med_ours, med_second, other=bench.second_ratio,
                          max_abs_diff=diff, kernel_ok=kok, n_problems=len(setup.keys()), ndof=setup.ndof,
-                         dim_M_max=dim_m, includes=bench.includes[name], **setup.mesh_options))
+                         dim_M_max=dim_m, includes=bench.includes[name], **setup.mesh_options))  # options: columns
         _log(f"  {name:10s} {np.median(times):9.4f} s  diff {diff:.2e}")
     return rows
 

@@ -4,7 +4,8 @@ import pandas as pd
 import pytest
 
 from infsup_contact import bench
-from infsup_contact.bench import beta_routes, contact_routes
+from infsup_contact.bench import beta_bench, contact_routes
+from infsup_contact.bench.beta_models import membranes_bench
 
 BETA_REQUIRED = {"what", "route", "k", "N", "seconds_median", "seconds_min", "seconds_max",
                  "ratio_to_ours", "max_abs_diff"}
@@ -55,7 +56,7 @@ def test_run_interleaved_order_budget_and_caps():
 
 # ------------------------------------------------------------------ bench tables
 def test_bench_beta_columns_and_agreement():
-    frame = pd.DataFrame(bench.bench_beta([4], [1, 2], repeats=1))
+    frame = pd.DataFrame(bench.bench_beta(bench.bench_for("beta"), [4], [1, 2], repeats=1))
     assert BETA_REQUIRED <= set(frame.columns)
     assert set(frame.route) == {"ours", "ours_core", "limit", "eigsh", "dense"}
     assert len(frame) == 10
@@ -79,13 +80,15 @@ def test_bench_contact_columns_and_agreement():
 
 
 def test_beta_limit_and_core_routes_agree_with_ours():
-    setup = beta_routes.BetaSetup(4, 2)
-    ref = beta_routes.beta_ours(4, 2)
-    core = beta_routes.beta_ours_core(setup)
-    diff, kernel_ok = beta_routes._compare(core, ref)
+    setup = beta_bench.BetaSetup(membranes_bench(), 4, 2)
+    ref = beta_bench.reference(setup, beta_bench.beta_ours(setup))
+    core = beta_bench.beta_ours_core(setup)
+    diff, kernel_ok = beta_bench.compare(core, ref)
     assert diff <= 1e-12 and kernel_ok
-    lim = beta_routes.beta_limit(setup)()
+    lim = beta_bench.beta_limit(setup)()
     assert set(lim) == set(ref)
+    diff, kernel_ok = beta_bench.compare(lim, ref)  # the same (S, G): the eigensolve alone differs
+    assert diff <= 1e-12 and kernel_ok
 
 
 @pytest.mark.parametrize("route", ["solves", "nested"])

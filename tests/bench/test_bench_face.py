@@ -1,4 +1,4 @@
-"""The 3D β_h benchmark (issue 28, item 7; bench/face_beta.py): its three routes give the same
+"""The 3D β_h benchmark (bench/beta_models.py FACE_BENCH, bench/face_schur.py): its three routes give the same
 β_h, one of them checked against the full saddle-point pencil, and ``infsup-contact bench --what
 face`` writes the ratio columns and refuses bad input in one line."""
 import io
@@ -7,7 +7,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from infsup_contact.bench import face_beta
+from infsup_contact.bench import beta_bench, face_schur
+from infsup_contact.bench.beta_models import FACE_BENCH, FACE_COLUMNS
 from infsup_contact.discretization.gamma.coupling import coupling_matrix
 from infsup_contact.solvers.infsup import saddle_point_beta
 from infsup_contact.solvers.contact import contact_qp
@@ -18,7 +19,7 @@ from infsup_contact.discretization.spaces import registry
 
 @pytest.mark.parametrize("n", [2, 3])
 def test_routes_agree_on_beta(n):
-    rows = face_beta.bench_face([n], [1], "hex", repeats=1)
+    rows = beta_bench.bench_beta(FACE_BENCH, [n], [1], repeats=1, element="hex")
     beta = [r for r in rows if r["what"] == "face_beta"]
     assert [r["route"] for r in beta] == ["ours", "ours_core", "limit"]
     for r in beta:
@@ -29,8 +30,9 @@ def test_routes_agree_on_beta(n):
 def test_schur_routes_give_one_schur_complement():
     """The face_schur rows: every route of gamma_factorization timed on the same bodies gives S to
     round-off (relative to the first route, PARDISO), one row per route."""
-    rows = [r for r in face_beta.bench_face([3], [2], "hex", repeats=1) if r["what"] == "face_schur"]
-    assert [r["route"] for r in rows] == list(face_beta.SCHUR_ROUTES)
+    rows = [r for r in beta_bench.bench_beta(FACE_BENCH, [3], [2], repeats=1, element="hex")
+            if r["what"] == "face_schur"]
+    assert [r["route"] for r in rows] == list(face_schur.SCHUR_ROUTES)
     assert all(r["max_abs_diff"] <= 1e-12 for r in rows), rows
     assert rows[0]["ratio_to_ours"] == 1.0
 
@@ -38,13 +40,13 @@ def test_schur_routes_give_one_schur_complement():
 def test_core_beta_equals_the_full_pencil():
     """β_h of ours_core (Γ-reduced, B A⁻¹ Bᵀ m = β² G m) = β_h of the full pencil
     [[A, Bᵀ], [B, 0]] x = σ [[A, 0], [0, G]] x, an independent dense route, for a stable space."""
-    setup = face_beta.FaceSetup(2, 1, "hex")
-    core = face_beta.face_ours_core(setup)
-    case = next(c for c in setup.cases if face_beta.face_ours(setup)[c, "H"][0] == 0)
+    setup = beta_bench.BetaSetup(FACE_BENCH, 2, 1, element="hex")
+    core = beta_bench.beta_ours_core(setup)
+    case = next(c for c in setup.cases if beta_bench.beta_ours(setup)[c, "H"]["kernel_dim"] == 0)
     Bs = [coupling_matrix(s.trace, setup.spaces[case], 1) for s in setup.sides]
     A, B, _ = contact_qp(setup.sides, Bs, [np.zeros(s.ndof) for s in setup.sides])  # the assembled pencil
     B = B.toarray()
-    for nm in face_beta.NORMS:
+    for nm in FACE_BENCH.norms:
         G = setup.gamma.gram(setup.spaces[case], nm)[0]
         assert abs(np.sqrt(core[case, nm][0]) - saddle_point_beta(A, B, G)) <= 1e-10
 
@@ -53,7 +55,7 @@ def test_cli_csv_has_the_ratio_columns():
     code, out, err = run_in_process(["bench", "--what", "face", "--N", "2", "--k", "1", "--repeats", "1"])
     assert code in (0, None), err
     frame = pd.read_csv(io.StringIO(out))
-    assert set(face_beta.FACE_COLUMNS) <= set(frame.columns)
+    assert list(FACE_COLUMNS) == list(frame.columns)
     by = frame[frame["what"] == "face_beta"].set_index("route")
     assert by.loc["limit", "ratio_to_limit"] == 1.0 and by.loc["ours", "ratio_to_ours"] == 1.0
     assert np.isclose(by.loc["ours", "ratio_to_limit"],
@@ -80,7 +82,7 @@ def test_setup_refuses_an_unknown_element():
     from infsup_contact.errors import InputError
 
     with pytest.raises(InputError, match="element"):
-        face_beta.FaceSetup(2, 1, "prism")
+        beta_bench.BetaSetup(FACE_BENCH, 2, 1, element="prism")
 
 
 def test_dry_run_estimates_the_face_routes():

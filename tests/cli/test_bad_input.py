@@ -457,6 +457,10 @@ UNUSED = [  # (argv, flag, who uses it)
      "--what beta"),
     (["bench", "--what", "face", "--N", "2", "--k", "1", "--eigsh-max-N", "4"], "--eigsh-max-N", "--what beta"),
     (["bench", "--what", "contact", "--N", "4", "--k", "1", "--element", "hex"], "--element", "--what face"),
+    (["bench", "--what", "beta", "--N", "4", "--k", "1", "--nu", "0.3"], "--nu", "--what elastic"),
+    (["bench", "--what", "face", "--N", "2", "--k", "1", "--case", "T3"], "--case", "--what elastic"),
+    (["bench", "--what", "elastic", "--N", "4", "--k", "1", "--dense-max-size", "10"], "--dense-max-size",
+     "--what beta"),
 ]
 
 
@@ -484,6 +488,7 @@ def test_a_flag_the_request_does_not_use_is_refused(argv, flag, users):
     ["bench", "--what", "beta", "--N", "4", "--k", "1", "--eigsh-max-N", "2", "--dense-max-size", "2500"],
     ["bench", "--what", "contact", "--N", "4", "--k", "1", "--peers", "osqp", "clarabel", "--kkt-max-N", "64"],
     ["bench", "--what", "face", "--N", "2", "--k", "1", "--element", "tet"],
+    ["bench", "--what", "elastic", "--N", "4", "--k", "1", "--nu", "0.25", "--case", "T3", "DUAL"],
 ])
 def test_a_flag_the_request_uses_is_accepted(argv):
     code, out, err = run_in_process([*argv, "--dry-run"])

@@ -224,6 +224,8 @@ def test_bench_beta_csv_without_eigsh():
     (["--what", "beta", "--N", "4", "--k", "7"], "k"),
     (["--what", "beta", "--N", "4", "--k", "1", "--repeats", "0"], "repeats"),
     (["--what", "gamma", "--N", "4", "--k", "1"], "--what"),
+    (["--what", "elastic", "--N", "4", "--k", "1", "--nu", "0.5"], "nu"),
+    (["--what", "elastic", "--N", "4", "--k", "1", "--case", "T9"], "case"),
 ])
 def test_bench_bad_input_one_line_exit_2(args, key):
     proc = run("bench", *args)

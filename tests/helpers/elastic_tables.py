@@ -8,7 +8,7 @@ def small_elastic_tables() -> dict:
     """beta, sweep, patch, hertz, claims, speed as the workflow writes them, on tiny meshes."""
     import pandas as pd
 
-    from infsup_contact.bench.elastic_beta import bench_elastic_beta
+    from infsup_contact.bench import bench_beta, bench_for
     from infsup_contact.study.beta.elastic import elastic_beta_rows, nu_sweep_rows
     from infsup_contact.study.claims.elastic import elastic_claims, hertz_claims, patch_claims
     from infsup_contact.study.contact.hertz import discretization_rows, modeling_rows
@@ -21,5 +21,5 @@ def small_elastic_tables() -> dict:
                          + modeling_rows("T3", 2, 8, 1.0, [0.05, 0.1]))
     cfg = dict(slope_tolerance=0.15, beta_floor=0.001, confidence=0.95, fit_window=5)
     claims = pd.concat([elastic_claims(beta, sweep, cfg), patch_claims(patch), hertz_claims(hertz)])
-    speed = pd.DataFrame(bench_elastic_beta([2], [1, 2, 4], repeats=1))
+    speed = pd.DataFrame(bench_beta(bench_for("elastic"), [2], [1, 2, 4], repeats=1))
     return dict(beta=beta, sweep=sweep, patch=patch, hertz=hertz, claims=claims, speed=speed)

@@ -29,7 +29,7 @@ OPEN = re.compile(r"^<!-- generated: \S+ -->$", re.M)
 CLOSE = re.compile(r"^<!-- end generated -->$", re.M)
 
 ROUTE_TABLES = {"beta.csv", "contact.csv", "elastic_beta.csv", "face.csv"}
-"""Sources written by ``infsup-contact bench`` and ``bench/elastic_beta.py``: one row per route, k, N."""
+"""Sources written by ``infsup-contact bench`` (``--what beta``, ``contact``, ``face``, ``elastic``): one row per route, k, N."""
 
 
 class DocsError(ValueError):

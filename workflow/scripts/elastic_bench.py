@@ -1,4 +1,5 @@
-"""results/benchmarks/elastic_beta.csv: the elastic β_h against the limit (bench/elastic_beta.py)."""
+"""results/benchmarks/elastic_beta.csv: the elastic β_h against the limit (``bench --what elastic``,
+bench/beta_models.py)."""
 import sys
 
 sys.path.insert(0, "workflow/scripts")
@@ -10,11 +11,12 @@ register_user_spaces(snakemake.config)  # noqa: F821
 
 import pandas as pd  # noqa: E402
 
-from infsup_contact.bench.elastic_beta import bench_elastic_beta  # noqa: E402
+from infsup_contact.bench import bench_beta, bench_for  # noqa: E402
 from infsup_contact.io import write_csv_atomic  # noqa: E402
 
 ec = snakemake.params.ec  # noqa: F821
-frame = pd.DataFrame(bench_elastic_beta(ec["bench_N"], ec["bench_k"], repeats=3, nu=ec["nu"],
-                                        cases=snakemake.params.cases))  # noqa: F821
+# every route repeated 3 times, whatever its time (no budget): the table's repeats column
+frame = pd.DataFrame(bench_beta(bench_for("elastic", nu=ec["nu"]), ec["bench_N"], ec["bench_k"], repeats=3,
+                                budget=float("inf"), cases=snakemake.params.cases))  # noqa: F821
 write_csv_atomic(snakemake.output[0], frame)  # noqa: F821
 print(frame.drop(columns=["includes"]).to_string(), file=sys.stderr)

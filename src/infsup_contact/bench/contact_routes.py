@@ -32,13 +32,13 @@ import json
 import time
 
 import numpy as np
-import scipy.sparse.linalg as spla
 
 from ..discretization.segment import meshes
 from ..discretization.spaces import registry
 from ..discretization.spaces.registry import REFERENCE_SPACE
 from ..discretization.gamma.coupling import coupling_matrix
 from ..models.membranes import side_operator
+from .beta_bench import splu_best_order
 from .harness import ROUTE_BUDGET, _log, _row, run_interleaved
 
 
@@ -71,9 +71,7 @@ def contact_limit(sides, F, c=(1.0, 1.0)):
 
     def run():
         for s, Fi, ci in zip(sides, F, c):
-            lu = spla.splu(ci * s.stiffness, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
-                           options=dict(SymmetricMode=True))
-            lu.solve(Fi)
+            splu_best_order(ci * s.stiffness).solve(Fi)
 
     return run
 
@@ -250,6 +248,3 @@ def tune_peer(solver, A, B, F, u_ref, lam_ref, tolerances, start=None, opts=None
             return tolerances[j], results[j], True, trials
     last = max(results) if results else len(tolerances) - 1
     return tolerances[last], results.get(last), False, trials
-
-
-# ================================================================ speed–accuracy

@@ -8,7 +8,7 @@ seconds; β tables add ``ratio_to_ours_core`` (/ ``ours_core``), contact tables
 factorization). All ratios are of medians.
 Run with one BLAS thread (``OPENBLAS_NUM_THREADS=1``, the CLI's default).
 
-The routes: :mod:`.beta_routes` (β_h), :mod:`.contact_routes` (contact, with the peers of
+The routes: :mod:`.beta_bench` (β_h of any model), :mod:`.contact_routes` (contact, with the peers of
 :mod:`.peers`); :mod:`.speed_accuracy` relates time to error.
 """
 from __future__ import annotations
@@ -139,6 +139,3 @@ def write_machine_info(path) -> None:
     from ..io import write_atomic
 
     write_atomic(path, json.dumps(machine_info(), indent=2) + "\n")
-
-
-# ===================================================================== β_h routes

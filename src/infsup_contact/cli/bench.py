@@ -1,4 +1,4 @@
-"""``infsup-contact bench``: speed as ratios in one run (β_h or contact routes, CSV)."""
+"""``infsup-contact bench``: speed as ratios in one run (β_h of a model or contact routes, CSV)."""
 from __future__ import annotations
 
 from ..errors import InputError
@@ -7,8 +7,9 @@ from .common import FlagUse, add_dry_run, check_memory, declare_flag_uses, write
 
 def add(sub) -> None:
     p = sub.add_parser("bench", help="speed as ratios in one run (CSV)")
-    p.add_argument("--what", required=True, choices=["beta", "contact", "face"],
-                   help="beta / contact: the 2D membranes; face: β_h of the 3D membranes (--model membranes3d)")
+    p.add_argument("--what", required=True, choices=["beta", "contact", "face", "elastic"],
+                   help="beta / contact: the 2D membranes; face: β_h of the 3D membranes (--model membranes3d); "
+                        "elastic: β_h of the plane-strain bodies (--model elastic)")
     p.add_argument("--N", type=int, nargs="+", required=True)
     p.add_argument("--k", type=int, nargs="+", required=True)
     p.add_argument("--repeats", type=int, default=3)
@@ -25,6 +26,9 @@ def add(sub) -> None:
                         "time is below this, so slow routes run once (default 10)")
     p.add_argument("--element", default=None,
                    help="face: the 3D bodies' elements (hex, tet; default hex)")
+    p.add_argument("--nu", type=float, default=None, help="elastic: Poisson ratio of both bodies (default 0.3)")
+    p.add_argument("--case", nargs="+", default=None,
+                   help="elastic: the space ids to run, each where defined for k (default every registered one)")
     add_dry_run(p)
     declare_flag_uses(p, FLAG_USES)
     p.set_defaults(run=_run_bench, check=_check_bench)
@@ -36,7 +40,8 @@ def _what(*whats):
 
 FLAG_USES = [FlagUse(dest, _what(what), f"--what {what}", lambda a: f"--what {a.what}")
              for dest, what in (("peers", "contact"), ("kkt_max_n", "contact"), ("eigsh_max_n", "beta"),
-                                ("dense_max_size", "beta"), ("element", "face"))]
+                                ("dense_max_size", "beta"), ("element", "face"), ("nu", "elastic"),
+                                ("case", "elastic"))]
 """The flags of ``bench`` only one ``--what`` uses (:func:`~.common.refuse_unused`)."""
 
 
@@ -55,6 +60,8 @@ def _check_bench(args):
 
     if args.what == "face":
         _check_face(args)
+    if args.what == "elastic":
+        _check_elastic(args)
     for k in args.k:  # every registered space defined for k: a superset of what the routes run
         for n in args.N:
             check_pair_spaces(ids_valid_for(k), k, n, n, key="N")
@@ -92,6 +99,16 @@ def _check_face(args) -> None:
         raise InputError("element", ", ".join(ELEMENTS), got=args.element)
 
 
+def _check_elastic(args) -> None:
+    """``--what elastic``: ν in the model's range, every ``--case`` a registered id."""
+    from ..discretization.spaces.registry import space_spec
+    from ..models.plane_strain import check_nu
+
+    args.nu = check_nu(0.3 if args.nu is None else args.nu)
+    for case in args.case or ():
+        space_spec(case)
+
+
 def _run_bench(args) -> None:
     import pandas as pd
 
@@ -99,10 +116,15 @@ def _run_bench(args) -> None:
 
     peers = args.peer_list
     if args.what == "face":
-        rows = bench.bench_face(args.N, args.k, args.element, args.repeats, budget=args.route_budget)
+        rows = bench.bench_beta(bench.bench_for("face"), args.N, args.k, args.repeats, args.route_budget,
+                                element=args.element)
     elif args.what == "beta":
-        rows = bench.bench_beta(args.N, args.k, args.repeats, dense_max_size=args.dense_max_size,
-                                eigsh_max_n=args.eigsh_max_n, budget=args.route_budget)
+        rows = bench.bench_beta(bench.bench_for("beta", dense_max_size=args.dense_max_size,
+                                                eigsh_max_n=args.eigsh_max_n), args.N, args.k, args.repeats,
+                                args.route_budget)
+    elif args.what == "elastic":
+        rows = bench.bench_beta(bench.bench_for("elastic", nu=args.nu), args.N, args.k, args.repeats,
+                                args.route_budget, cases=args.case)
     else:
         rows = bench.bench_contact(args.N, args.k, args.repeats, peers=tuple(peers),
                                    kkt_max_n=args.kkt_max_n, budget=args.route_budget)

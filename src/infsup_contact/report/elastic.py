@@ -13,7 +13,7 @@ import numpy as np
 import pandas as pd
 
 from .sections import check_section_tex, claim_count_macros, section_macros_tex
-from .templates import (Group, at, beta_cell, blank, block_keys, body_lines, case_keys, case_table, error_cells,
+from .templates import (Group, at, beta_cell, blank, body_lines, case_keys, case_table, error_cells,
                         head_lines, multicolumn, tabular)
 from .texformat import case_order, fmt_fixed, fmt_int, fmt_sci, latex_id
 from .texnames import Macro, _k, macro_name
@@ -119,7 +119,7 @@ def elastic_beta_table(beta: pd.DataFrame, sweep: pd.DataFrame) -> str:
     note = rf"$\nu \to 1/2$, structured, $N={int(fin.N2.max())}$; columns: " + ", ".join(rf"$\nu={v:g}$" for v in nus)
     families = [f for f in FAMILIES if f in set(m.family)]
     return tabular("ll" + "r" * width, head_lines(("family", "case"), groups),
-                   [body_lines(sum(block_keys(m, "family", families), []),
+                   [body_lines(case_keys(m, "family", order=families),
                                lambda key: [f"{key[0][:6]}.", latex_id(key[1])], groups),
                     [multicolumn(2 + width, note, "l") + r" \\"],
                     body_lines(case_keys(fin, "k"), lambda key: [rf"$k={key[0]}$", latex_id(key[1])], sweep_groups)])

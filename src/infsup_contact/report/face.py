@@ -13,7 +13,7 @@ import pandas as pd
 
 from .sections import (check_section_tex, claim_count_macros, n_as_predicted, outcome, section_macros_tex,
                        verdict_macros)
-from .templates import Group, beta_cell, block_keys, case_table, ids_tex, ints_tex, kernel_cell, pair_tex, pairs_tex
+from .templates import Group, beta_cell, case_blocks, case_table, ids_tex, ints_tex, kernel_cell, pair_tex, pairs_tex
 from .texformat import PaperTexError, fmt_fixed, fmt_int, latex_id
 from .texnames import Macro, macro_name
 
@@ -99,7 +99,7 @@ def face_beta_table(beta: pd.DataFrame) -> str:
     return case_table("ll" + "rrr" * len(ks) + ("r" * len(ks) if pair is not None else ""), ("element", "case"),
                       lambda key: [latex_id(key[0]), latex_id(key[1])],
                       [Group(heads, cells(k), f"$k={k}$") for k in ks],
-                      block_keys(m, "element", dict.fromkeys(beta.element)), after=[f"% finest matching N = {n}{note}"])
+                      case_blocks(m, "element", order=dict.fromkeys(beta.element)), after=[f"% finest matching N = {n}{note}"])
 
 
 def face_paper_files(beta: pd.DataFrame, claims: pd.DataFrame, patch: pd.DataFrame | None = None,

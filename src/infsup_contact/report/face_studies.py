@@ -9,12 +9,14 @@ Every number is a cell of a table or a macro computed here from the tables; each
 """
 from __future__ import annotations
 
-import numpy as np
 import pandas as pd
 
 from ..criteria.claims import slope_interval
 from ..study.claims.membranes3d_studies import edge_claim_id, patch_claim_id
-from .texformat import PaperTexError, case_order, fmt_fixed, fmt_int, fmt_sci, latex_id
+from .sections import claim_count_macros, verdict_macros
+from .templates import (Group, at, case_blocks, case_table, error_cells, ids_tex, ints_tex, pairs_tex,
+                        verdict_cell)
+from .texformat import PaperTexError, fmt_fixed, fmt_int, fmt_sci, latex_id
 from .texnames import Macro, macro_name
 
 STUDY_FILES = ("face_patch_table.tex", "face_alpha_table.tex", "face_edge_table.tex")
@@ -24,52 +26,29 @@ _COLUMNS = {"patch": ("element", "case", "k", "N1", "N2", "lambda_max_rel_error"
                      "cond_S_kappa", "fit_theta_max")}
 EDGE_KINDS = {"decay": "d", "bounded": "b", "kappa-cond": "c", "kappa-beta": "i"}
 """Edge claim kinds and their letters in the table's verdict column."""
-VERDICT_SHORT = {"PASS": "P", "FAIL": "F", "INCONCLUSIVE": "I"}
 
 
 def _name(*labels) -> str:
     return macro_name("face", *labels)
 
 
-def outcome(verdicts) -> str:
-    """PASS if every verdict is PASS, FAIL if every one is FAIL, else INCONCLUSIVE (none: INCONCLUSIVE)."""
-    vs = set(verdicts)
-    return "PASS" if vs == {"PASS"} else "FAIL" if vs == {"FAIL"} else "INCONCLUSIVE"
-
-
 def _kind_macros(claims: pd.DataFrame, label: str, prefix: str, predicted: str | None = None) -> list:
-    """Count, outcome and per-verdict counts of the claims whose id starts with ``prefix``
-    (and, given, whose prediction is ``predicted``)."""
+    """:func:`~.sections.verdict_macros` of the claims whose id starts with ``prefix`` (and,
+    given, whose prediction is ``predicted``)."""
     rows = claims[claims.claim_id.str.startswith(prefix)]
     if predicted is not None:
         rows = rows[rows.predicted == predicted]
     src = f"face_study_claims.csv: {prefix}* claims" + (f" predicted {predicted}" if predicted else "")
-    out = [Macro(_name("N", label), fmt_int(len(rows)), src),
-           Macro(_name("Outcome", label), outcome(rows.verdict), f"{src}: all PASS / all FAIL / else")]
-    out += [Macro(_name("N", label, v.lower()), fmt_int(int((rows.verdict == v).sum())), f"{src}, verdict {v}")
-            for v in VERDICT_SHORT]
-    return out
-
-
-def _verdict(claims: pd.DataFrame, claim_id: str) -> str:
-    hit = claims[claims.claim_id == claim_id]
-    return VERDICT_SHORT.get(hit.verdict.iloc[0], "?") + ("" if hit.predicted.iloc[0] in ("PASS", "FAIL") else "*") \
-        if len(hit) else "--"
+    return verdict_macros(rows, _name, label, src, "{src}: all PASS / all FAIL / else", "{src}, verdict {v}")
 
 
 def study_macros(patch: pd.DataFrame, alpha: pd.DataFrame, edge: pd.DataFrame, claims: pd.DataFrame) -> list:
     """Every number of the studies' text in paper/face.tex (module docstring)."""
-    checked = claims[claims.predicted.isin(["PASS", "FAIL"])]
-    out = [Macro(_name("Study", "N claims"), fmt_int(len(claims)), "face_study_claims.csv: rows"),
-           Macro(_name("Study", "N predicted"), fmt_int(len(checked)), "face_study_claims.csv: predicted PASS/FAIL"),
-           Macro(_name("Study", "N as predicted"), fmt_int(int((checked.verdict == checked.predicted).sum())),
-                 "face_study_claims.csv: verdict == predicted")]
+    out = claim_count_macros(claims, lambda *labels: _name("Study", *labels), "face_study_claims.csv", findings=False)
     # patch test
-    nm = sorted({(int(a), int(b)) for a, b in zip(patch.N1, patch.N2)})
-    out += [Macro(_name("Patch", "pairs"), ", ".join(f"${a}{{:}}{b}$" for a, b in nm), "patch.csv: pairs"),
-            Macro(_name("Patch", "elements"), ", ".join(latex_id(e) for e in dict.fromkeys(patch.element)),
-                  "patch.csv: elements"),
-            Macro(_name("Patch", "degrees"), ", ".join(str(int(k)) for k in sorted(set(patch.k))), "patch.csv: k")]
+    out += [Macro(_name("Patch", "pairs"), pairs_tex(patch.N1, patch.N2), "patch.csv: pairs"),
+            Macro(_name("Patch", "elements"), ids_tex(patch.element), "patch.csv: elements"),
+            Macro(_name("Patch", "degrees"), ints_tex(patch.k), "patch.csv: k")]
     out += _kind_macros(claims, "Patch holding", "face-patch-", "PASS")
     out += _kind_macros(claims, "Patch lacking", "face-patch-", "FAIL")
     ids = [patch_claim_id(c, k, e) for c, k, e in zip(patch.case, patch.k, patch.element)]
@@ -106,26 +85,21 @@ def patch_table(patch: pd.DataFrame, claims: pd.DataFrame) -> str:
     """Rows (element, case); per k: the largest relative λ and u errors over the pairs, the
     kernel dimensions seen, and the claim's verdict (``*``: a finding, no prediction)."""
     ks = sorted(int(k) for k in set(patch.k))
-    lines = [r"\begin{tabular}{ll" + "rrcc" * len(ks) + "}", r"\toprule",
-             " & & " + " & ".join(rf"\multicolumn{{4}}{{c}}{{$k={k}$}}" for k in ks) + r" \\",
-             "element & case & " + " & ".join([r"$\lambda$ err.", "$u$ err.", "kernel", "verdict"] * len(ks)) + r" \\",
-             r"\midrule"]
-    for element in dict.fromkeys(patch.element):
-        pe = patch[patch.element == element]
-        for case in case_order(pe.case.unique()):
-            cells = []
-            for k in ks:
-                r = pe[(pe.case == case) & (pe.k == k)]
-                if r.empty:
-                    cells += ["--"] * 4
-                    continue
-                dims = sorted(set(r.kernel_dim.astype(int).tolist()))
-                cells += [fmt_sci(r.lambda_max_rel_error.max(), 2), fmt_sci(r.u_max_rel_error.max(), 2),
-                          ",".join(map(str, dims)), _verdict(claims, patch_claim_id(case, k, element))]
-            lines.append(f"{latex_id(element)} & {latex_id(case)} & " + " & ".join(cells) + r" \\")
-        lines.append(r"\midrule")
-    lines[-1] = r"\bottomrule"
-    return "\n".join(lines + [r"\end{tabular}"]) + "\n"
+
+    def cells(k):
+        def at_k(key):
+            r = patch[(patch.element == key[0]) & (patch.case == key[1]) & (patch.k == k)]
+            if r.empty:
+                return ["--"] * 4
+            return error_cells(r, ("lambda_max_rel_error", "u_max_rel_error")) + [
+                ",".join(map(str, sorted(set(r.kernel_dim.astype(int).tolist())))),
+                verdict_cell(claims, patch_claim_id(key[1], k, key[0]))]
+        return at_k
+
+    heads = (r"$\lambda$ err.", "$u$ err.", "kernel", "verdict")
+    return case_table("ll" + "rrcc" * len(ks), ("element", "case"), lambda key: [latex_id(key[0]), latex_id(key[1])],
+                      [Group(heads, cells(k), f"$k={k}$") for k in ks],
+                      case_blocks(patch, "element", order=dict.fromkeys(patch.element)))
 
 
 def alpha_table(alpha: pd.DataFrame, claims: pd.DataFrame) -> str:
@@ -133,25 +107,22 @@ def alpha_table(alpha: pd.DataFrame, claims: pd.DataFrame) -> str:
     accepted or refused, β_h in the H norm (-- where refused)."""
     elements = list(dict.fromkeys(alpha.element))
     h = alpha[alpha.norm == "H"] if (alpha.norm == "H").any() else alpha.drop_duplicates(["element", "alpha", "N"])
-    lines = [r"\begin{tabular}{r" + "rcr" * len(elements) + "}", r"\toprule",
-             " & " + " & ".join(rf"\multicolumn{{3}}{{c}}{{{latex_id(e)} ({_verdict(claims, f'face-alpha-accept-{e}')})}}"
-                                for e in elements) + r" \\",
-             r"$\alpha$ & " + " & ".join([r"$\min\int\tilde N_k/|K|$", "built", r"$\beta_h$"] * len(elements)) + r" \\",
-             r"\midrule"]
-    for a in sorted(set(h.alpha)):
-        cells = []
-        for e in elements:
-            r = h[(h.element == e) & np.isclose(h.alpha, a, rtol=0, atol=1e-12)]
+
+    def cells(element):
+        def at_alpha(key):
+            r = at(h[h.element == element], "alpha", key[0], rtol=0, atol=1e-12)
             if r.empty:
-                cells += ["--"] * 3
-                continue
+                return ["--"] * 3
             r = r.iloc[0]
             acc = bool(r.accepted)
-            cells += [fmt_sci(r.min_weight, 2) if abs(r.min_weight) > 1e-12 else "0", "yes" if acc else "no",
-                      fmt_fixed(r.beta, 4) if acc else "--"]
-        lines.append(f"{a:.4g} & " + " & ".join(cells) + r" \\")
-    lines += [r"\bottomrule", r"\end{tabular}"]
-    return "\n".join(lines) + "\n"
+            return [fmt_sci(r.min_weight, 2) if abs(r.min_weight) > 1e-12 else "0", "yes" if acc else "no",
+                    fmt_fixed(r.beta, 4) if acc else "--"]
+        return at_alpha
+
+    groups = [Group((r"$\min\int\tilde N_k/|K|$", "built", r"$\beta_h$"), cells(e),
+                    f"{latex_id(e)} ({verdict_cell(claims, f'face-alpha-accept-{e}')})") for e in elements]
+    return case_table("r" + "rcr" * len(elements), (r"$\alpha$",), lambda key: [f"{key[0]:.4g}"], groups,
+                      [[(a,) for a in sorted(set(h.alpha))]])
 
 
 def edge_table(edge: pd.DataFrame, claims: pd.DataFrame) -> str:
@@ -159,25 +130,23 @@ def edge_table(edge: pd.DataFrame, claims: pd.DataFrame) -> str:
     slope of log β_H against log θ over the resolved θ ≤ fit_theta_max, cond₂ of D and S
     without and with κ scaling at the smallest θ, and the verdicts of the case's claims."""
     top = float(edge.fit_theta_max.iloc[0])
-    lines = [r"\begin{tabular}{llrrrrrrrl}", r"\toprule",
-             r"$k$ & case & $\beta_H(1)$ & $\beta_H(\theta_{\min})$ & slope & cond $D$ & cond $D_\kappa$ & "
-             r"cond $S$ & cond $S_\kappa$ & verdicts \\", r"\midrule"]
-    for (k, n), ek in edge.groupby(["k", "N"], sort=True):
-        for case in case_order(ek.case.unique()):
-            r = ek[ek.case == case].sort_values("theta")
-            last, first = r.iloc[0], r.iloc[-1]
-            fit = r[(r.theta <= top + 1e-12) & r.beta_H_resolved.astype(bool)]
-            slope = fmt_fixed(slope_interval(fit.theta, fit.beta_H)[0], 2) if len(fit) >= 2 else "--"
-            low = fmt_sci(last.beta_H, 2) if bool(last.beta_H_resolved) else "n.r."
-            verdicts = " ".join(f"{tag}:{_verdict(claims, edge_claim_id(kind, case, k, n))}"
-                                for kind, tag in EDGE_KINDS.items()
-                                if (claims.claim_id == edge_claim_id(kind, case, k, n)).any())
-            lines.append(f"{int(k)} & {latex_id(case)} & {fmt_fixed(first.beta_H, 4)} & {low} & {slope} & "
-                         + " & ".join(fmt_sci(last[c], 3) for c in ("cond_D", "cond_D_kappa", "cond_S", "cond_S_kappa"))
-                         + f" & {verdicts}" + r" \\")
-        lines.append(r"\midrule")
-    lines[-1] = r"\bottomrule"
-    return "\n".join(lines + [r"\end{tabular}"]) + "\n"
+
+    def cells(key):
+        k, n, case = key
+        r = edge[(edge.k == k) & (edge.N == n) & (edge.case == case)].sort_values("theta")
+        last, first = r.iloc[0], r.iloc[-1]
+        fit = r[(r.theta <= top + 1e-12) & r.beta_H_resolved.astype(bool)]
+        verdicts = " ".join(f"{tag}:{verdict_cell(claims, edge_claim_id(kind, case, k, n))}"
+                            for kind, tag in EDGE_KINDS.items()
+                            if (claims.claim_id == edge_claim_id(kind, case, k, n)).any())
+        return [fmt_fixed(first.beta_H, 4), fmt_sci(last.beta_H, 2) if bool(last.beta_H_resolved) else "n.r.",
+                fmt_fixed(slope_interval(fit.theta, fit.beta_H)[0], 2) if len(fit) >= 2 else "--",
+                *(fmt_sci(last[c], 3) for c in ("cond_D", "cond_D_kappa", "cond_S", "cond_S_kappa")), verdicts]
+
+    heads = (r"$\beta_H(1)$", r"$\beta_H(\theta_{\min})$", "slope", "cond $D$", r"cond $D_\kappa$", "cond $S$",
+             r"cond $S_\kappa$", "verdicts")
+    return case_table("llrrrrrrrl", ("$k$", "case"), lambda key: [str(int(key[0])), latex_id(key[2])],
+                      [Group(heads, cells)], case_blocks(edge, "k", "N"))
 
 
 def study_files(patch: pd.DataFrame, alpha: pd.DataFrame, edge: pd.DataFrame, claims: pd.DataFrame) -> tuple:

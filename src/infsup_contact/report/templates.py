@@ -17,7 +17,7 @@ from typing import Callable, Sequence
 import numpy as np
 import pandas as pd
 
-from .texformat import fmt_fixed, fmt_sci, latex_id
+from .texformat import case_order, fmt_fixed, fmt_sci, latex_id
 
 VERDICT_SHORT = {"PASS": "P", "FAIL": "F", "INCONCLUSIVE": "I"}
 """A verdict's letter in a table cell."""
@@ -99,20 +99,22 @@ def case_table(spec: str, lead: Sequence[str], label: Callable, groups: Sequence
                    [body_lines(keys, label, groups) for keys in blocks], after)
 
 
-def case_keys(frame: pd.DataFrame, *by: str) -> list[tuple]:
-    """Keys ``(*values of by, case)`` of ``frame``: per group of ``by`` (sorted), the cases in
+def case_blocks(frame: pd.DataFrame, *by: str, order: Sequence | None = None) -> list[list[tuple]]:
+    """Keys ``(*values of by, case)`` of ``frame``, one block per group of ``by`` (sorted; or,
+    given ``order``, per value of the one column ``by`` in that order), the cases of a block in
     the paper's order (:func:`~.texformat.case_order`)."""
-    from .texformat import case_order
-
     if not by:
-        return [(case,) for case in case_order(frame.case.unique())]
-    return [(*(key if isinstance(key, tuple) else (key,)), case)
-            for key, g in frame.groupby(list(by), sort=True) for case in case_order(g.case.unique())]
+        groups = [((), frame)]
+    elif order is not None:
+        groups = [((value,), frame[frame[by[0]] == value]) for value in order]
+    else:
+        groups = [(key if isinstance(key, tuple) else (key,), g) for key, g in frame.groupby(list(by), sort=True)]
+    return [[(*key, case) for case in case_order(g.case.unique())] for key, g in groups]
 
 
-def block_keys(frame: pd.DataFrame, column: str, order: Sequence) -> list[list[tuple]]:
-    """One block of :func:`case_keys` ``(value, case)`` per value of ``column`` in ``order``."""
-    return [[(value, *key) for key in case_keys(frame[frame[column] == value])] for value in order]
+def case_keys(frame: pd.DataFrame, *by: str, order: Sequence | None = None) -> list[tuple]:
+    """The keys of :func:`case_blocks` in one list (one block)."""
+    return [key for block in case_blocks(frame, *by, order=order) for key in block]
 
 
 # --------------------------------------------------------------------------- cells of the kinds

@@ -1,6 +1,6 @@
 """The face studies in the DAG (issue 28, items 6 and 7): the job script of rules/face_studies.smk
 on tiny inputs, the claims of study/face_study_claims.py (predictions from properties; verdicts
-that flip when the data flips) and the three paper tables (report/face_studies.py)."""
+that flip when the data flips) and the three paper tables (report/face.py)."""
 import copy
 import math
 import subprocess

@@ -149,12 +149,16 @@ def elastic_hertz_table(hertz: pd.DataFrame) -> str:
     energy error, p_max error and oscillation; modeling study: a/W and the errors vs Hertz."""
     d = hertz[hertz.study == "discretization"]
     ns = sorted(int(n) for n in set(d.N))
-    rows = lambda key: d[(d.k == key[0]) & (d.case == key[1])].set_index("N").sort_index()  # noqa: E731
+    def rows(key):
+        return d[(d.k == key[0]) & (d.case == key[1])].set_index("N").sort_index()
+
+    def per_mesh(head, column, fmt):
+        return Group(tuple(f"{head} {n}" for n in ns), lambda key: [fmt(rows(key)[column][n], 2) for n in ns])
+
     groups = [Group(("slope",), lambda key: [fmt_fixed(-_slope(rows(key).index.to_numpy(float),
                                                                 rows(key).energy_error), 2)]),
-              Group(tuple(rf"$e_a$ {n}" for n in ns), lambda key: [fmt_sci(rows(key).energy_error[n], 2) for n in ns]),
-              Group(tuple(rf"$e_p$ {n}" for n in ns), lambda key: [fmt_sci(rows(key).p_max_rel_error[n], 2) for n in ns]),
-              Group(tuple(rf"osc {n}" for n in ns), lambda key: [fmt_fixed(rows(key).oscillation[n], 2) for n in ns])]
+              per_mesh("$e_a$", "energy_error", fmt_sci), per_mesh("$e_p$", "p_max_rel_error", fmt_sci),
+              per_mesh("osc", "oscillation", fmt_fixed)]
     blocks = [body_lines(case_keys(d, "k"), lambda key: [str(key[0]), latex_id(key[1])], groups)]
     mod = hertz[hertz.study == "modeling"].sort_values("d")
     if len(mod):

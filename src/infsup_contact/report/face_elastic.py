@@ -46,7 +46,10 @@ def face_elastic_table(beta: pd.DataFrame, fit_nu_min: float, base_nu: float, sw
     m = h[h.N1 == h.N2]
     n = int(at(m, "nu", base_nu).N2.max())
     nus = sorted(v for v in set(m[m.N2 == sweep_n].nu) if not np.isclose(v, base_nu))
-    rows = lambda key, mesh: m[(m.element == key[0]) & (m.k == key[1]) & (m.case == key[2]) & (m.N2 == mesh)]  # noqa: E731
+
+    def rows(key, mesh):
+        return m[(m.element == key[0]) & (m.k == key[1]) & (m.case == key[2]) & (m.N2 == mesh)]
+
     keys = [key for key in case_keys(m, "element", "k") if len(at(rows(key, n), "nu", base_nu))]
 
     def cells(key):

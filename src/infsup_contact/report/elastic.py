@@ -1,4 +1,5 @@
-"""The elastic section's generated files (paper/elastic.tex): macros and three tables.
+"""The elastic section's generated files (paper/elastic.tex): macros and three tables, each
+declared through the section templates (:mod:`.templates`, :mod:`.sections`).
 
 Pure functions from the elastic tables (results/tables/elastic_*.csv, the elastic claims and
 results/benchmarks/elastic_beta.csv) to LaTeX text; ``workflow/scripts/elastic_paper.py``

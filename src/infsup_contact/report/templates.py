@@ -1,13 +1,15 @@
-"""Templates of the sections' generated tables (paper/elastic.tex, paper/face.tex), one per kind.
+"""Templates of the sections' generated tables (paper/elastic.tex, paper/face.tex).
 
 Every table of a section is a booktabs tabular (:func:`tabular`): head lines, then blocks of
-rows split by ``\\midrule``. The kinds differ in their rows and cells, which a model declares
-as data: :func:`case_table` lays out rows keyed by (block, …, case), each row's label cells
-and a list of column :class:`Group` s, each group optionally under a spanning title (the β_h
-table per k or per mesh, the patch table per k, the α sweep per element). The cells of a
-kind are here too: β_h with its kernel (:func:`beta_cell`, :func:`kernel_cell`), the patch
-test's error maxima (:func:`error_cells`), a claim's verdict (:func:`verdict_cell`) and the
-row of a sweep at one parameter value (:func:`at`).
+rows split by ``\\midrule``. The kinds of table — a model's β_h table, its patch-test table,
+a sweep table (ν, α, θ) — differ in their rows, columns and cells, which a model declares as
+data: :func:`case_table` lays out rows keyed by (block, …, case) (:func:`case_blocks`), each
+row's label cells and a list of column :class:`Group` s, each group optionally under a
+spanning title (the β_h table per k or per mesh, the patch table per k, the α sweep per
+element). The cells of each kind are here: β_h with its kernel (:func:`beta_cell`,
+:func:`kernel_cell`), the patch test's error maxima (:func:`error_cells`), a claim's verdict
+(:func:`verdict_cell`) and the rows of a sweep at one parameter value (:func:`at`). The
+macro blocks of a model's claims are :mod:`.sections`'.
 """
 from __future__ import annotations
 
@@ -78,7 +80,7 @@ def body_lines(keys: Sequence[tuple], label: Callable[[tuple], list], groups: Se
 def case_table(spec: str, lead: Sequence[str], label: Callable, groups: Sequence[Group],
                blocks: Sequence[Sequence[tuple]], head_after: Sequence[str] = (), after: Sequence[str] = ()) -> str:
     """A table of keyed rows: heads ``lead`` + the groups' heads, then one block of rows per
-    list of keys in ``blocks`` (:func:`case_keys`).
+    list of keys in ``blocks`` (:func:`case_blocks`).
 
     Parameters
     ----------

@@ -38,6 +38,7 @@ LAYERS = [
     {"config"},                                      # the workflow's config checks
     {"bench"},                                       # benchmarks of the routes
     {"report"},                                      # tables and figures drawn from results
+    {"plans"},                                       # the model table: each study's jobs, claims, paper
     {"api", "cli"},                                  # the Python API and the command line
 ]
 """Bottom to top: a part may import its own layer's parts and those below, never above."""

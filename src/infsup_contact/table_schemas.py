@@ -105,6 +105,10 @@ SCHEMAS = {
     "face_beta": Schema({**_BETA, "model": "str", "element": "str"},
                         key=("model", "element", "family", "case", "k", "N1", "N2", "multiplier_mesh", "c1", "c2",
                              "norm")),
+    # β_h of any model of the model table (plans/beta.py): the face's columns, element "-" for a model without one
+    "model_beta": Schema({**_BETA, "model": "str", "element": "str"},
+                         key=("model", "element", "family", "case", "k", "N1", "N2", "multiplier_mesh", "c1", "c2",
+                              "norm")),
     # the 3D elastic bodies on the face (rules/face_elastic.smk: study/face/elastic.py): β_h per ν
     "face_elastic_beta": Schema({**_BETA, "model": "str", "element": "str", "nu": "float"},
                                 key=("model", "element", "family", "case", "k", "N1", "N2", "multiplier_mesh", "c1",

@@ -1,4 +1,4 @@
-"""The face studies in the DAG (issue 28, items 6 and 7): the job script of rules/face_studies.smk
+"""The face studies in the DAG: the model job script (rule model_job) of the face study
 on tiny inputs, the claims of study/face_study_claims.py (predictions from properties; verdicts
 that flip when the data flips) and the three paper tables (report/face.py)."""
 import copy
@@ -26,9 +26,10 @@ ENV = {"PYTHONPATH": str(ROOT / "src"), "OPENBLAS_NUM_THREADS": "1", "PATH": str
 
 JOB = """
 import runpy, sys, types
-snakemake = types.SimpleNamespace(output=[sys.out], log=[sys.log], threads=1, config={"spaces": []},
-                                  params=types.SimpleNamespace(study=sys.study, fc=sys.fc))
-runpy.run_path("workflow/scripts/face_study_job.py", init_globals={"snakemake": snakemake})
+snakemake = types.SimpleNamespace(output=[sys.out], log=[sys.log], threads=1,
+                                  config={"spaces": [], "models": {"face": {"study": "face"}}, "face": sys.fc},
+                                  wildcards=types.SimpleNamespace(model="face", job=sys.study))
+runpy.run_path("workflow/scripts/model_job.py", init_globals={"snakemake": snakemake})
 """
 TINY = {"model": "membranes3d", "cases": ["T3", "R5.2", "T4", "T5"], "norms": ["L2"],
         "patch": {"elements": ["hex", "tet"], "pairs": [[2, 3]], "k": [1]},

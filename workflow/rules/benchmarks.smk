@@ -113,3 +113,23 @@ rule speed_accuracy:
         "results/logs/speed_accuracy.log",
     script:
         "../scripts/speed_accuracy_job.py"
+
+
+rule elastic_bench:
+    # speed of the elastic β_h vs the limit (one factorization per body + one eigh per case);
+    # the whole machine to itself locally (ratios are single-thread ratios)
+    output:
+        "results/benchmarks/elastic_beta.csv",
+    input:
+        PACKAGE_SOURCES,
+        BENCH_SOURCES,
+    params:
+        ec=lambda wc: config["elastic"],
+        cases=lambda wc: list(config["infsup"]["cases"]),
+    threads: workflow.cores
+    benchmark:
+        "results/benchmarks/rules/elastic_bench.tsv"
+    log:
+        "results/logs/elastic_bench.log",
+    script:
+        "../scripts/elastic_bench.py"

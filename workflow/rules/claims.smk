@@ -26,8 +26,7 @@ LEDGER_TABLES = {
     "results/tables/beta.csv": "beta",
     "results/tables/rates.csv": "rates",
     "results/tables/claims_extra.csv": "claims",
-    "results/tables/elastic_claims.csv": "claims",
-    **{path: "claims" for path in FACE_CLAIMS},
+    **{path: "claims" for path in MODEL_CLAIMS},  # the model table's studies (rule model_claims)
     **{path: "claims" for path in PRODUCERS_TABLES[1:]},  # rules/producers.smk
 }
 GATE_STAGES = [
@@ -43,8 +42,7 @@ rule claims:
         beta="results/tables/beta.csv",
         rates="results/tables/rates.csv",
         extra="results/tables/claims_extra.csv",
-        elastic="results/tables/elastic_claims.csv",  # the elastic stage's claims (rules/elastic.smk)
-        face=FACE_CLAIMS,  # the face stage's claims (rules/face.smk), when the config has a face section
+        models=MODEL_CLAIMS,  # the model table's studies' claims (rule model_claims below), in its order
         producers=PRODUCERS_TABLES[1:],  # the producers' claims (rules/producers.smk), with a producers section
         src=PACKAGE_SOURCES,
     params:
@@ -56,3 +54,22 @@ rule claims:
         "results/logs/claims.log",
     script:
         "../scripts/claims.py"
+
+
+rule model_claims:
+    # one study of the model table: its plan's claims from its tables (plans/<study>.py)
+    output:
+        "results/tables/{model}_claims.csv",
+    input:
+        lambda wc: [path for path, _ in MODEL_STUDIES[wc.model].claim_inputs().files.values()],
+        src=PACKAGE_SOURCES,
+    params:
+        cfg=lambda wc: config["claims"],
+    wildcard_constraints:
+        model=MODEL_NAMES_RE,
+    benchmark:
+        "results/benchmarks/rules/model_claims/{model}.tsv"
+    log:
+        "results/logs/{model}/claims.log",
+    script:
+        "../scripts/model_claims.py"

@@ -7,7 +7,7 @@ from snakemake.utils import validate
 
 from infsup_contact import resources
 from infsup_contact.config.checks import ConfigError, check_config, speed_accuracy_scene
-from infsup_contact.config.face import face_pairs, l2_only_sizes
+from infsup_contact.plans import claims_path, job_path, model_table, study_of, table_path
 from infsup_contact.config.strict_yaml import check_config_files
 from infsup_contact.config.memory import check_job_memory, memory_notes
 from infsup_contact.discretization.gamma.mesh_series import seeds, series_of_pairs
@@ -102,23 +102,23 @@ def reference_mem_mb(wildcards):
         "structured", int(wildcards.k), 1, 1, cc["reference_N"], 1))
 
 
-# the 3D face stage's outputs (rules/face.smk); none without a `face` config section
-FACE = config.get("face")
+# the face benchmark (rules/benchmarks.smk), with benchmarks.face_N
 FACE_BENCH = ["results/benchmarks/face.csv"] if config["benchmarks"].get("face_N") else []
-FACE_BETA = [f"results/tables/face/beta_{e}_k{k}.csv" for e in FACE["elements"] for k in FACE["k"]] if FACE else []
-# the L²-only rows above face.max_N (face.l2_max_N; rule face_l2_job), where an element has them
-FACE_BETA += [f"results/tables/face/l2_{e}_k{k}.csv" for e in FACE["elements"] for k in FACE["k"]
-              if l2_only_sizes(FACE, e)] if FACE else []
-# the face studies (rules/face_studies.smk): their tables, claims and paper tables
-FACE_STUDIES = {s: f"results/face/{s}.csv" for s in ("patch", "alpha", "edge_dropping")} if FACE else {}
-FACE_CLAIMS = ["results/tables/face_claims.csv", "results/tables/face_study_claims.csv"] if FACE else []
-FACE_PAPER = ["results/paper/face_macros.tex", "results/paper/face_beta_table.tex",
-              "results/paper/face_patch_table.tex", "results/paper/face_alpha_table.tex",
-              "results/paper/face_edge_table.tex"] if FACE else []
-# the 3D elastic bodies on the face (rules/face_elastic.smk); none without a `face_elastic` section.
-# Their claims join FACE_CLAIMS (the ledger appends every file of it); their subsection of the
-# face section needs the face section (paper/face.tex reads it if present)
-FACE_ELASTIC = config.get("face_elastic")
-FACE_ELASTIC_BETA = [f"results/tables/face_elastic/beta_{e}.csv" for e in FACE_ELASTIC["elements"]] if FACE_ELASTIC else []
-FACE_CLAIMS += ["results/tables/face_elastic_claims.csv"] if FACE_ELASTIC else []
-FACE_ELASTIC_PAPER = ["results/paper/face_elastic.tex"] if FACE_ELASTIC and FACE else []
+
+# The model table (config key `models`; src/infsup_contact/plans/): each study by name, the {model}
+# wildcard of rules/models.smk (jobs, joined tables), claims.smk (model_claims) and paper.smk (model_paper).
+MODEL_TABLE = model_table(config)
+MODEL_STUDIES = {name: study_of(config, name) for name in MODEL_TABLE}
+# longest first: "face_elastic_beta" is {model}=face_elastic, {table}=beta, never face + elastic_beta
+MODEL_NAMES_RE = "|".join(sorted(MODEL_STUDIES, key=len, reverse=True)) or "(?!)"
+MODEL_TABLE_NAMES_RE = "|".join(sorted({t for s in MODEL_STUDIES.values() for t in s.tables()}, key=len,
+                                       reverse=True)) or "(?!)"
+MODEL_TABLES = [table_path(m, t) for m, s in MODEL_STUDIES.items() for t in s.tables()]
+MODEL_CLAIMS = [claims_path(m) for m in MODEL_STUDIES]  # appended to the ledger in this order
+MODEL_PAPER = [f"results/paper/{m}" for m, s in MODEL_STUDIES.items() if s.in_paper]
+# the generated model subsections (plans/beta.py) paper/paper.tex reads through model_sections.tex
+MODEL_SECTIONS = [m for m, s in MODEL_STUDIES.items() if s.in_paper and s.model_section]
+
+
+def model_job_path(model, job):
+    return job_path(model, job)

@@ -230,3 +230,40 @@ rule fig8_dual:
         "results/logs/figures/fig8_dual.log",
     script:
         "../scripts/fig_dual.py"
+
+
+# Figure data: λ_h on Γ, stable vs unstable, the Hertz scene's d and R on one mesh; the (case,
+# k) pairs and the mesh: config key figures.elastic_profiles.
+
+
+rule elastic_hertz_profiles:
+    output:
+        "results/tables/elastic_hertz_profiles.csv",
+    input:
+        PACKAGE_SOURCES,
+    params:
+        ec=lambda wc: config["elastic"],
+        fig=lambda wc: config["figures"]["elastic_profiles"],
+    threads: 1
+    benchmark:
+        "results/benchmarks/rules/elastic_hertz_profiles.tsv"
+    log:
+        "results/logs/elastic/hertz_profiles.log",
+    script:
+        "../scripts/hertz_profiles_job.py"
+
+
+rule elastic_figure:
+    output:
+        pdf="results/figures/fig9_elastic.pdf",
+        png="results/figures/fig9_elastic.png",
+    input:
+        sweep="results/tables/elastic_nu_sweep.csv",
+        profiles="results/tables/elastic_hertz_profiles.csv",
+        style=PLOT_STYLE,
+    benchmark:
+        "results/benchmarks/rules/elastic_figure.tsv"
+    log:
+        "results/logs/figures/fig9_elastic.log",
+    script:
+        "../scripts/fig_elastic.py"

@@ -36,6 +36,41 @@ rule paper_macros:
         "../scripts/paper_macros.py"
 
 
+rule model_paper:
+    # one study of the model table: its generated LaTeX (plans/<study>.py), into results/paper/{model}/
+    output:
+        directory("results/paper/{model}"),
+    input:
+        lambda wc: [path for path, _ in MODEL_STUDIES[wc.model].paper_inputs().files.values()],
+        tex=lambda wc: [MODEL_STUDIES[wc.model].tex_source] if MODEL_STUDIES[wc.model].tex_source else [],
+        src=REPORT_SOURCES,
+    params:
+        nu_slope_cases=lambda wc: config["figures"]["nu_slope_cases"],
+    wildcard_constraints:
+        model=MODEL_NAMES_RE,
+    benchmark:
+        "results/benchmarks/rules/model_paper/{model}.tsv"
+    log:
+        "results/logs/{model}/paper.log",
+    script:
+        "../scripts/model_paper.py"
+
+
+rule model_sections:
+    # \input of each generated model subsection (plans/beta.py), read by paper/paper.tex
+    output:
+        "results/paper/model_sections.tex",
+    params:
+        names=MODEL_SECTIONS,
+    log:
+        "results/logs/model_sections.log",
+    run:
+        from infsup_contact.io import write_atomic
+        from infsup_contact.report.model_section import sections_index_tex
+
+        write_atomic(output[0], sections_index_tex(params.names))
+
+
 rule paper_pdf:
     output:
         "results/paper/paper.pdf",
@@ -44,12 +79,11 @@ rule paper_pdf:
         bib="paper/references.bib",
         generated=rules.paper_macros.output,
         figures=PAPER_FIGURES,
-        elastic_tex="paper/elastic.tex",  # the elastic section (rules/elastic.smk)
-        elastic=rules.elastic_paper.output,
-        elastic_figure="results/figures/fig9_elastic.pdf",
-        face_tex="paper/face.tex",  # the face section (rules/face.smk)
-        face=FACE_PAPER,
-        face_elastic=FACE_ELASTIC_PAPER,  # its subsection (rules/face_elastic.smk), \InputIfFileExists in face.tex
+        elastic_tex="paper/elastic.tex",  # the elastic section (model table: elastic)
+        elastic_figure=["results/figures/fig9_elastic.pdf"] if "elastic" in MODEL_STUDIES else [],
+        face_tex="paper/face.tex",  # the face section (model table: face; its elastic subsection: face_elastic)
+        models=MODEL_PAPER,  # each study's generated files (rule model_paper), \input by name
+        model_sections="results/paper/model_sections.tex",  # the generated model subsections (rule model_sections)
         producers=PRODUCERS_PAPER,  # "Certifying production codes" (rules/producers.smk), \InputIfFileExists in paper.tex
     benchmark:
         "results/benchmarks/rules/paper_pdf.tsv"
@@ -57,6 +91,9 @@ rule paper_pdf:
         "results/logs/paper_pdf.log",
     params:
         build="results/paper/build",
+        # the generated files: results/paper/ and each study's folder (rule model_paper)
+        texinputs=lambda wc: ":".join(["$root/results/paper", *(f"$root/{d}" for d in MODEL_PAPER),
+                                       "$root/results/figures"]),
     shell:
         # ensure_tex.sh: TeX present, installed (root, Debian) or one line on what to install.
         # Then a fresh build dir; TEXINPUTS finds the generated .tex and the figures; a fixed
@@ -67,7 +104,7 @@ rule paper_pdf:
         rm -rf {params.build} && mkdir -p {params.build}
         cp {input.tex} {input.bib} {input.elastic_tex} {input.face_tex} {params.build}/
         cd {params.build}
-        export TEXINPUTS="$root/results/paper:$root/results/figures:" SOURCE_DATE_EPOCH=0 FORCE_SOURCE_DATE=1
+        export TEXINPUTS="{params.texinputs}:" SOURCE_DATE_EPOCH=0 FORCE_SOURCE_DATE=1
         if ! latexmk -pdf -interaction=nonstopmode -halt-on-error -file-line-error paper.tex > "$root/{log}" 2>&1; then
             echo "paper_pdf: LaTeX failed (full log: {log}); first error:" >&2
             grep -m1 -A3 -E '^([.]/)?paper[.]tex:[0-9]+:|^! ' "$root/{log}" >&2 || true

@@ -12,10 +12,9 @@ from infsup_contact.study.claims.membranes import ledger  # noqa: E402
 inp = snakemake.input  # noqa: F821
 table = ledger(read_table(inp.beta, "beta"), read_table(inp.rates, "rates"), read_table(inp.extra, "claims"),
                snakemake.params.cfg, snakemake.params.rate_scene)  # noqa: F821
-# the elastic stage's claims (rules/elastic.smk) follow the membranes' ones
+# the model table's studies' claims (rule model_claims) follow the membranes' ones, in the table's order
 import pandas as pd  # noqa: E402
 
-table = pd.concat([table, read_table(inp.elastic, "claims")]
-                  + [read_table(p, "claims") for p in inp.face]  # rules/face.smk
+table = pd.concat([table] + [read_table(p, "claims") for p in inp.models]
                   + [read_table(p, "claims") for p in inp.producers], ignore_index=True)  # rules/producers.smk
 write_claims(snakemake.output[0], table)  # noqa: F821

@@ -2,7 +2,7 @@
 
 Usage::
 
-    python workflow/scripts/compare_results.py BASE/results NEW/results
+    python workflow/scripts/compare_results.py BASE/results NEW/results [OLD=NEW ...]
 
 Compared: ``claims.csv`` and every ``*.csv`` under ``tables/`` and ``face/`` (the face studies'
 tables the ledger is made of), in either tree. Each file is
@@ -67,22 +67,32 @@ def compare_file(base: Path, new: Path) -> list:
     return out
 
 
-def compare_trees(base: Path, new: Path) -> list:
-    """(relative path, difference) pairs over the ledger and tables of two results trees."""
+def compare_trees(base: Path, new: Path, moved: dict | None = None) -> list:
+    """(relative path, difference) pairs over the ledger and tables of two results trees;
+    ``moved`` maps a base path to the new path the same table has in the new tree."""
+    moved = {Path(a): Path(b) for a, b in (moved or {}).items()}
     fb, fn = compared_files(base), compared_files(new)
-    diffs = [(p, "only in base") for p in sorted(fb - fn)] + [(p, "only in new") for p in sorted(fn - fb)]
-    for p in sorted(fb & fn):
-        diffs += [(p, d) for d in compare_file(base / p, new / p)]
+    pairs = [(p, moved.get(p, p)) for p in sorted(fb)]
+    matched = {q for _, q in pairs if q in fn}
+    diffs = [(p, "only in base") for p, q in pairs if q not in fn]
+    diffs += [(p, "only in new") for p in sorted(fn - matched)]
+    for p, q in pairs:
+        if q in fn:
+            diffs += [(p if p == q else Path(f"{p} -> {q}"), d) for d in compare_file(base / p, new / q)]
     return diffs
 
 
+USAGE = ("usage: compare_results.py BASE_RESULTS_DIR NEW_RESULTS_DIR [OLD=NEW ...] (two existing results "
+         "trees; OLD=NEW: a table the new tree keeps under another path, relative to the trees)")
+
+
 def main(argv: list) -> int:
-    if len(argv) != 2 or not all(Path(a).is_dir() for a in argv):
-        print("usage: compare_results.py BASE_RESULTS_DIR NEW_RESULTS_DIR (two existing results trees)",
-              file=sys.stderr)
+    dirs, moves = [a for a in argv if "=" not in a], [a.split("=", 1) for a in argv if "=" in a]
+    if len(dirs) != 2 or not all(Path(a).is_dir() for a in dirs) or any(not a or not b for a, b in moves):
+        print(USAGE, file=sys.stderr)
         return 2
-    base, new = map(Path, argv)
-    diffs = compare_trees(base, new)
+    base, new = map(Path, dirs)
+    diffs = compare_trees(base, new, dict(moves))
     for path, text in diffs:
         print(f"{path}: {text}")
     n = len(compared_files(base) | compared_files(new))

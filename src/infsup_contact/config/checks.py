@@ -221,6 +221,7 @@ def check_hertz_reference(cfg) -> None:
 
 from .face import check_face  # noqa: E402 (the face section's checks: config/face.py)
 from .face_elastic import check_face_elastic  # noqa: E402 (config/face_elastic.py)
+from .models import check_models  # noqa: E402 (the model table: config/models.py)
 
 CROSS_KEY_RULES = {
     # rule: the keys it relates (the error names the first; a change to any of them can trip it)
@@ -239,6 +240,7 @@ CROSS_KEY_RULES = {
                  "face.max_N", "face.l2_max_N", "face.norms", "spaces"),
     check_face_elastic: ("face_elastic.model", "face_elastic.elements", "face_elastic.nu", "face_elastic.nu_sweep",
                          "face_elastic.nonmatching", "face_elastic.cases", "face_elastic.patch", "spaces"),
+    check_models: ("models", "elastic", "face", "face_elastic", "spaces"),
     check_space_meshes: ("infsup.N", "infsup.nonmatching", "infsup.nonmatching_families", "contact.N",
                          "contact.scenes", "elastic.N", "elastic.nonmatching", "elastic.patch_pairs",
                          "elastic.bench_N", "elastic.hertz.N", "elastic.hertz.modeling_N", "benchmarks.beta_N",

@@ -61,10 +61,27 @@ def job_estimates(cfg):
         for k in ec["patch_k"]:
             yield "elastic.patch_pairs", f"elastic_patch k={k} {n1}x{n2}", R.beta_estimate(
                 "structured", k, n1, n2, "omega2", ("L2",), components=2)
+    yield from _model_table_estimates(cfg)
     for what in ("beta", "contact"):
         yield (f"benchmarks.{what}_N", f"bench_{what}", R.bench_estimate(
             what, bc[f"{what}_N"], bc[f"{what}_k"], bc["repeats"], bc.get("eigsh_max_N"),
             bc.get("kkt_max_N", 64)))
+
+
+def _model_table_estimates(cfg):
+    """The β jobs of the model table's ``beta`` studies (one per element and k: its largest pair)."""
+    from ..models.user_models import model_named
+
+    for name, entry in (cfg.get("models") or {}).items():
+        if entry.get("study") != "beta":
+            continue  # the built-in studies' jobs are counted under their sections above
+        model = model_named(entry["model"])
+        for n1, n2 in [(n, n) for n in entry["N"]] + [tuple(p) for p in entry.get("nonmatching", [])]:
+            key = f"models.{name}.N" if n1 == n2 else f"models.{name}.nonmatching"
+            for k in entry["k"]:
+                yield key, f"model_job {name} k={k} {n1}x{n2}", R.beta_estimate(
+                    "structured", k, n1, n2, "omega2", tuple(entry.get("norms", ("H", "L2"))),
+                    components=model.components, dim=model.dim)
 
 
 def check_job_memory(cfg, limit: float | None) -> None:

@@ -158,6 +158,15 @@ class Model:
             return meshes.subdomain_mesh(family, n, side, **mesh_kwargs)
         return self.mesh(family, n, side, **mesh_kwargs)
 
+    def gamma(self, **mesh_kwargs):
+        """The Γ of the model's meshes with these options (an element's face; the paper's segment
+        for the 2D meshes), asked of its coarsest mesh: a property of the request, not of N."""
+        if self.mesh is None:
+            from ..discretization.segment.interface import SEGMENT
+
+            return SEGMENT
+        return self.mesh("structured", 1, 1, **mesh_kwargs).interface
+
     def param_names(self) -> list:
         """The names of the model's material parameters (its flags without ``--``)."""
         return [p.name for p in self.params]

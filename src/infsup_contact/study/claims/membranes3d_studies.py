@@ -45,6 +45,9 @@ from ...discretization.face.tensor_grid import TensorPartition
 from ...criteria.claims import COLUMNS, FAIL, FINDING, INCONCLUSIVE, PASS, row, slope_verdict
 from .membranes3d import REF, face_dimension
 
+STUDY_CLAIM_PREFIXES = ("face-patch-", "face-alpha-", "face-edge-")
+"""Every claim id this module writes starts with one of these (and no claim of the face's β table
+does): the face's claims table holds both kinds, and the paper counts them apart."""
 PATCH_RTOL = 1e-8
 """λ_h = λ and u_h = u to this relative accuracy: the patch test is passed (round-off)."""
 PATCH_FAIL_RTOL = 1e-5

@@ -1,0 +1,90 @@
+"""Cross-key checks of the config's model table (key ``models``; :mod:`infsup_contact.plans`).
+
+What the schema cannot state: a built-in study (``elastic``, ``face``, ``face_elastic``) is the
+entry of the config section of its name, and that section exists; a ``beta`` study names a model
+(registered, or ``FILE.py:NAME`` imported here once, so a wrong file stops the run before any job)
+and its scenes ``k``, ``N`` and ``cases``; each element is one of the model's ``element`` options
+(none for a model without them); each case is a registered space defined for some k and built by
+the model's Γ; a study's name does not shadow a folder the other stages write under
+``results/tables/`` (:data:`RESERVED`). Each raises one
+:class:`~infsup_contact.config.schema.ConfigError` naming the key.
+"""
+from __future__ import annotations
+
+from ..errors import InputError
+from .schema import ConfigError
+
+BUILT_IN = ("elastic", "face", "face_elastic")
+"""Studies whose scenes are the config section of the entry's name."""
+RESERVED = ("beta", "contact", "mesh_quality", "claims", "producers", "references", "rates")
+"""Names the other stages' tables use (``results/tables/<name>/`` or ``<name>_*.csv``)."""
+BETA_KEYS = ("model", "k", "N", "cases")
+"""What a ``beta`` study's entry must state."""
+
+
+def check_models(cfg) -> None:
+    """Check ``cfg["models"]`` (absent: the built-in sections present are the table)."""
+    table = cfg.get("models")
+    if table is None:
+        return
+    for name, entry in table.items():
+        key = f"models.{name}"
+        if name in RESERVED:
+            raise ConfigError(key, "a name the other stages' tables use", got=name,
+                              allowed=f"any other name (not {', '.join(RESERVED)})")
+        study = entry["study"]
+        if study in BUILT_IN:
+            _check_built_in(cfg, key, name, entry)
+        else:
+            _check_beta(key, entry)
+
+
+def _check_built_in(cfg, key: str, name: str, entry: dict) -> None:
+    if name != entry["study"]:
+        raise ConfigError(f"{key}.study", f"the study {entry['study']} reads the config section "
+                          f"{entry['study']!r}: its entry must have that name", got=name,
+                          allowed=f"models: {{{entry['study']}: {{study: {entry['study']}}}}}")
+    if cfg.get(name) is None:
+        raise ConfigError(key, f"the study reads the config section {name!r}, which the config lacks",
+                          got=name, allowed=f"a `{name}:` section (config/config.yaml has one) or no such entry")
+    extra = sorted(set(entry) - {"study"})
+    if extra:
+        raise ConfigError(f"{key}.{extra[0]}", f"the {name} study's scenes live in the section {name!r}",
+                          got=entry[extra[0]], allowed="only `study` in a built-in study's entry")
+
+
+def _check_beta(key: str, entry: dict) -> None:
+    from ..discretization.spaces.registry import SPACES
+    from ..models.user_models import model_named
+
+    missing = [k for k in BETA_KEYS if k not in entry]
+    if missing:
+        raise ConfigError(f"{key}.{missing[0]}", "required by a beta study", got=None,
+                          allowed=", ".join(BETA_KEYS) + " (elements, nonmatching, norms optional)")
+    try:
+        model = model_named(entry["model"])
+    except InputError as err:
+        raise ConfigError(f"{key}.model", err.allowed, got=entry["model"]) from None
+    options = dict(model.mesh_options).get("element", ())
+    elements = entry.get("elements")
+    for i, element in enumerate(elements or []):
+        if element not in options:
+            raise ConfigError(f"{key}.elements[{i}]", f"not an element of {model.name}", got=element,
+                              allowed=", ".join(options) or "none: the model has no element option (drop the key)")
+    if options and not elements:
+        raise ConfigError(f"{key}.elements", f"{model.name} builds several elements: name them", got=None,
+                          allowed=", ".join(options))
+    for i, (n1, n2) in enumerate(entry.get("nonmatching", [])):
+        if n1 == n2:
+            raise ConfigError(f"{key}.nonmatching[{i}]", "a non-matching pair needs N1 != N2", got=[n1, n2],
+                              allowed="[N1, N2] with N1 != N2 (matching meshes go under N)")
+    gammas = [model.gamma(element=e) for e in elements] if elements else [model.gamma()]
+    ks = [int(k) for k in entry["k"]]
+    for i, case in enumerate(entry["cases"]):
+        spec = SPACES.get(case)
+        if spec is None:
+            raise ConfigError(f"{key}.cases[{i}]", "not a registered space", got=case, allowed=", ".join(SPACES))
+        if not any(spec.valid_for(k) for k in ks) or not any(g.builds(spec) for g in gammas):
+            raise ConfigError(f"{key}.cases[{i}]", f"not defined for k in {ks} on the model's Γ", got=case,
+                              allowed=", ".join(c for c, s in SPACES.items()
+                                                if any(s.valid_for(k) for k in ks) and any(g.builds(s) for g in gammas)))

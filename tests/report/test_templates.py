@@ -1,5 +1,5 @@
 """The section templates (report/templates.py, report/sections.py) and the section tables declared
-through them (report/elastic.py, report/face.py, report/face_elastic.py): every row of a generated
+through them (report/elastic.py, face.py, face_elastic.py, model_section.py): every row of a generated
 tabular has the tabular's column count, blocks and rows come in the paper's order, the cells
 say what the rows hold, and the claim counts add up under any ledger."""
 import re
@@ -82,9 +82,21 @@ def _face_elastic_table(which: str) -> dict:
     return {"face_elastic table": face_elastic_table(_face_elastic_beta(nus=nus), 0.49, 0.3, 4)}
 
 
+def _model_section(which: str) -> dict:
+    from helpers.face_tables import small_face_tables
+
+    from infsup_contact.report.model_section import model_section_tex
+
+    t = small_face_tables()
+    beta = t["beta"].assign(model="orthotropic")
+    return {"model section": model_section_tex("ortho", {}, beta if which == "both norms" else beta[beta.norm == "H"],
+                                               t["claims"])}
+
+
 @pytest.mark.parametrize("files, which", [(_elastic_files, "as run"), (_elastic_files, "matching, no modeling"),
                                           (_face_files, "as run"), (_face_files, "matching, no studies"),
-                                          (_face_elastic_table, "sweep"), (_face_elastic_table, "no other nu")])
+                                          (_face_elastic_table, "sweep"), (_face_elastic_table, "no other nu"),
+                                          (_model_section, "both norms"), (_model_section, "H only")])
 def test_every_row_fills_its_tabular(files, which):
     """A row with more or fewer cells than the tabular's columns is a LaTeX error or a shifted
     column; the head rows, the spanning titles and the notes count too."""

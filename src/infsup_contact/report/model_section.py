@@ -10,28 +10,17 @@ from __future__ import annotations
 import pandas as pd
 
 from .sections import n_as_predicted, predicted
-from .templates import Group, body_lines, case_keys, multicolumn, row, tabular
-from .texformat import PaperTexError, fmt_fixed, latex_escape, latex_id
-
-NORM_TITLES = {"H": r"$\|\cdot\|_M$ = dual norm of $H^{1/2}_{00}(\Gamma)$",
-               "L2": r"$\|\cdot\|_M$ = $L^2(\Gamma)$ norm (Remark 3.1)"}
-
+from .templates import beta_by_mesh_table
+from .texformat import PaperTexError, latex_escape, latex_id
 
 def matching_beta_table(beta: pd.DataFrame) -> str:
-    """Tabular of β_h on matching meshes: rows (norm, element, k, case), columns N."""
+    """Tabular of β_h on matching meshes: rows (norm, element, k, case), columns N
+    (:func:`~.templates.beta_by_mesh_table`)."""
     b = beta[beta.N1 == beta.N2]
     if b.empty:
         raise PaperTexError("the model's β table has no matching rows")
-    ns = sorted({int(n) for n in b.N2})
-    val = b.set_index(["norm", "element", "k", "case", "N2"]).beta
-    heads, blocks = tuple(rf"$N={n}$" for n in ns), []
-    for norm in [n for n in NORM_TITLES if n in set(b.norm)]:
-        cells = Group(heads, lambda key, norm=norm: [fmt_fixed(val[(norm, *key, n)], 4) if (norm, *key, n) in val.index
-                                                     else "--" for n in ns])
-        blocks += [[multicolumn(len(ns) + 3, NORM_TITLES[norm], "l") + r" \\"],
-                   body_lines(case_keys(b[b.norm == norm], "element", "k"),
-                              lambda key: [latex_escape(key[0]), str(key[1]), latex_id(key[2])], [cells])]
-    return tabular("lll" + "r" * len(ns), [row("element", "$k$", "case", *heads)], blocks)
+    return beta_by_mesh_table(b, sorted({int(n) for n in b.N2}), ("element", "k"), ("element", "$k$", "case"),
+                              lambda key: [latex_escape(key[0]), str(key[1]), latex_id(key[2])])
 
 
 def model_section_tex(name: str, entry: dict, beta: pd.DataFrame, claims: pd.DataFrame) -> str:

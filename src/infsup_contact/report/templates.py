@@ -23,6 +23,9 @@ from .texformat import case_order, fmt_fixed, fmt_sci, latex_id
 
 VERDICT_SHORT = {"PASS": "P", "FAIL": "F", "INCONCLUSIVE": "I"}
 """A verdict's letter in a table cell."""
+NORM_TITLES = {"H": r"$\|\cdot\|_M$ = dual norm of $H^{1/2}_{00}(\Gamma)$",
+               "L2": r"$\|\cdot\|_M$ = $L^2(\Gamma)$ norm (Remark 3.1)"}
+"""The norms of M_h, in the order a β_h table shows them, with the title of their block."""
 
 
 # --------------------------------------------------------------------------- the tabular skeleton
@@ -117,6 +120,32 @@ def case_blocks(frame: pd.DataFrame, *by: str, order: Sequence | None = None) ->
 def case_keys(frame: pd.DataFrame, *by: str, order: Sequence | None = None) -> list[tuple]:
     """The keys of :func:`case_blocks` in one list (one block)."""
     return [key for block in case_blocks(frame, *by, order=order) for key in block]
+
+
+def beta_by_mesh_table(beta: pd.DataFrame, ns: Sequence[int], by: Sequence[str], lead: Sequence[str],
+                       label: Callable) -> str:
+    """The β_h table of a model's meshes: one block per norm (:data:`NORM_TITLES`) under its
+    title, rows keyed by ``(*by, case)`` (:func:`case_keys`), one column per N in ``ns``
+    (``--`` where that N was not run).
+
+    Parameters
+    ----------
+    beta : DataFrame
+        Rows with columns norm, ``by``, case, N2 and beta, one per (norm, *by, case, N2).
+    ns : sequence of int
+    by : sequence of str
+        The key columns before the case (``("k",)``, ``("element", "k")``).
+    lead, label
+        Heads of the label columns and key → label cells (:func:`case_table`).
+    """
+    val = beta.set_index(["norm", *by, "case", "N2"]).beta
+    heads, blocks = tuple(rf"$N={n}$" for n in ns), []
+    for norm in [n for n in NORM_TITLES if n in set(beta.norm)]:
+        cells = Group(heads, lambda key, norm=norm: [fmt_fixed(val[(norm, *key, n)], 4) if (norm, *key, n) in val.index
+                                                     else "--" for n in ns])
+        blocks += [[multicolumn(len(lead) + len(ns), NORM_TITLES[norm], "l") + r" \\"],
+                   body_lines(case_keys(beta[beta.norm == norm], *by), label, [cells])]
+    return tabular("l" * len(lead) + "r" * len(ns), [row(*lead, *heads)], blocks)
 
 
 # --------------------------------------------------------------------------- cells of the kinds

@@ -9,8 +9,8 @@ import pandas as pd
 import pytest
 
 from infsup_contact.report.sections import claim_count_macros, n_as_predicted, outcome, predicted, verdict_macros
-from infsup_contact.report.templates import (Group, at, beta_cell, case_blocks, case_table, kernel_cell, pairs_tex,
-                                             tabular, verdict_cell)
+from infsup_contact.report.templates import (NORM_TITLES, Group, at, beta_by_mesh_table, beta_cell, case_blocks,
+                                             case_table, kernel_cell, pairs_tex, tabular, verdict_cell)
 from infsup_contact.report.texformat import case_order, fmt_fixed
 from infsup_contact.report.texnames import macro_name
 
@@ -147,6 +147,17 @@ def test_case_table_titles_span_their_groups():
     text = case_table("lrrr", ("case",), lambda key: [key[0]], groups, [[("T3",)]])
     assert r" & \multicolumn{2}{c}{$k=1$} &  \\" in text  # an untitled group: blank in the title row
     assert "case & x & y & z \\\\" in text and "T3 & 1 & 2 & 3 \\\\" in text
+    assert _rows_that_misfit(text) == []
+
+
+def test_beta_by_mesh_table_has_a_block_per_norm_and_marks_a_mesh_not_run():
+    """H before L², each under its title; a (k, case) without a row on some N shows ``--`` there."""
+    rows = [dict(norm=norm, k=1, case=case, N2=n, beta=0.5) for norm in ("L2", "H") for case in ("R5.2", "T3")
+            for n in (4, 8) if not (case == "R5.2" and n == 8)]
+    text = beta_by_mesh_table(pd.DataFrame(rows), [4, 8], ("k",), ("$k$", "case"), lambda key: [str(key[0]), key[1]])
+    assert text.index(NORM_TITLES["H"]) < text.index(NORM_TITLES["L2"])
+    assert text.count("1 & T3 & 0.5000 & 0.5000 \\\\") == 2 and text.count("1 & R5.2 & 0.5000 & -- \\\\") == 2
+    assert text.index("1 & T3") < text.index("1 & R5.2")  # the paper's order of the cases
     assert _rows_that_misfit(text) == []
 
 

@@ -168,7 +168,7 @@ def test_face_section_renders_under_any_verdict(verdict):
     it renders (every macro expanded, every branch resolved) whatever the ledger says."""
     from infsup_contact.report.consistency import render
     from infsup_contact.report.face import face_macros
-    from infsup_contact.report.face_studies import study_files
+    from infsup_contact.report.face import study_files
 
     from helpers.face_tables import small_face_tables
 

@@ -1,6 +1,6 @@
 """The face studies in the DAG: the model job script (rule model_job) of the face study
 on tiny inputs, the claims of study/face_study_claims.py (predictions from properties; verdicts
-that flip when the data flips) and the three paper tables (report/face_studies.py)."""
+that flip when the data flips) and the three paper tables (report/face.py)."""
 import copy
 import math
 import subprocess

@@ -2,8 +2,10 @@
 
 ``style`` (one colour and marker per space, from the registry), ``texnames`` / ``texformat``
 (macro names, number formatting, escaping), ``macros`` and ``tables`` (generated LaTeX),
-``paper`` (the generated files and the check of ``paper.tex``), ``elastic`` (the elastic section's). Reads tables only; imports
-``discretization`` (the registry) and nothing that computes.
+``paper`` (the generated files and the check of ``paper.tex``); the sections kept in their own
+sources: one template per kind of their tables (``templates``) and of their macro blocks
+(``sections``), and per section its declarations (``elastic``, ``face``, ``face_elastic``).
+Reads tables only; imports ``discretization`` (the registry) and nothing that computes.
 """
 from .macros import all_macros, macros_tex, speed_macros
 from .paper import GENERATED_FILES, SOURCE_INPUTS, check_paper, defined_macros, paper_files, used_generated_macros, used_inputs

@@ -1,4 +1,5 @@
-"""The elastic section's generated files (paper/elastic.tex): macros and three tables.
+"""The elastic section's generated files (paper/elastic.tex): macros and three tables, each
+declared through the section templates (:mod:`.templates`, :mod:`.sections`).
 
 Pure functions from the elastic tables (results/tables/elastic_*.csv, the elastic claims and
 results/benchmarks/elastic_beta.csv) to LaTeX text; ``workflow/scripts/elastic_paper.py``
@@ -7,15 +8,22 @@ they stay apart from the main paper's generated namespace.
 """
 from __future__ import annotations
 
+from typing import Callable
 
 import numpy as np
 import pandas as pd
 
-from .sections import check_section_tex, section_macros_tex
+from .sections import check_section_tex, claim_count_macros, section_macros_tex
+from .templates import (Group, at, beta_cell, blank, body_lines, case_keys, case_table, error_cells,
+                        head_lines, multicolumn, tabular)
 from .texformat import case_order, fmt_fixed, fmt_int, fmt_sci, latex_id
 from .texnames import Macro, _k, macro_name
 
 ELASTIC_FILES = ("elastic_macros.tex", "elastic_beta_table.tex", "elastic_patch_table.tex", "elastic_hertz_table.tex")
+FAMILIES = ("structured", "perturbed", "unstructured")
+"""The mesh families of the β_h table, in its row order."""
+PATCH_ERRORS = ("lambda_max_rel_error", "lambda_end_rel_error", "lambda_middle_rel_error", "u_max_rel_error")
+"""The patch table's error columns (elastic_patch.csv)."""
 
 
 def _name(*labels) -> str:
@@ -33,13 +41,7 @@ def elastic_macros(beta, sweep, patch, hertz, claims, speed, nu_slope_cases=None
     constants (``SpaceSpec.contains_constants``, registry): the others fail by design."""
     from ..discretization.spaces.registry import SPACES
 
-    out = []
-    checked = claims[claims.predicted.isin(["PASS", "FAIL"])]
-    out += [Macro(_name("NClaims"), fmt_int(len(claims)), "elastic_claims.csv: rows"),
-            Macro(_name("NPredicted"), fmt_int(len(checked)), "elastic_claims.csv: predicted PASS/FAIL"),
-            Macro(_name("NAsPredicted"), fmt_int(int((checked.verdict == checked.predicted).sum())),
-                  "elastic_claims.csv: verdict == predicted"),
-            Macro(_name("NFindings"), fmt_int(len(claims) - len(checked)), "elastic_claims.csv: findings")]
+    out = claim_count_macros(claims, _name, "elastic_claims.csv")
     h = beta[(beta.norm == "H")]
     m = h[h.N1 == h.N2]
     out += [Macro(_name("Nu"), f"{beta.nu.iloc[0]:g}", "elastic_beta.csv: nu"),
@@ -102,61 +104,45 @@ def elastic_beta_table(beta: pd.DataFrame, sweep: pd.DataFrame) -> str:
     structured mesh, rows (k, case), columns ν."""
     h = beta[beta.norm == "H"]
     m, nm = h[h.N1 == h.N2], h[h.N1 != h.N2]
-    n1 = int(m.N2.max())
-    pair = nm.sort_values("N2").iloc[-1] if len(nm) else None
     ks = sorted(int(k) for k in set(h.k))
-    groups = [("matching", m[m.N2 == n1], rf"$N_1=N_2={n1}$")]
-    if pair is not None:
-        groups.append(("pair", nm[(nm.N1 == pair.N1) & (nm.N2 == pair.N2)],
+    meshes = [(m[m.N2 == m.N2.max()], rf"$N_1=N_2={int(m.N2.max())}$")]
+    if len(nm):
+        pair = nm.sort_values("N2").iloc[-1]
+        meshes.append((nm[(nm.N1 == pair.N1) & (nm.N2 == pair.N2)],
                        rf"$N_1{{:}}N_2={int(pair.N1)}{{:}}{int(pair.N2)}$"))
     fin = sweep[sweep.N2 == sweep.N2.max()]
     nus = sorted(set(fin.nu))
-    ncol = 2 + max(len(ks) * len(groups), len(nus))
-    pad = [""] * (ncol - 2 - len(ks) * len(groups))
+    width = max(len(ks) * len(meshes), len(nus))  # the value columns both parts share
+    groups = [Group(tuple(rf"$k={k}$" for k in ks), _mesh_cells(rows, ks), title) for rows, title in meshes]
+    groups.append(blank(width - len(ks) * len(meshes)))
+    sweep_groups = [Group((), lambda key: [beta_cell(at(fin[(fin.k == key[0]) & (fin.case == key[1])], "nu", v), True)
+                                           for v in nus]), blank(width - len(nus))]
+    note = rf"$\nu \to 1/2$, structured, $N={int(fin.N2.max())}$; columns: " + ", ".join(rf"$\nu={v:g}$" for v in nus)
+    families = [f for f in FAMILIES if f in set(m.family)]
+    return tabular("ll" + "r" * width, head_lines(("family", "case"), groups),
+                   [body_lines(case_keys(m, "family", order=families),
+                               lambda key: [f"{key[0][:6]}.", latex_id(key[1])], groups),
+                    [multicolumn(2 + width, note, "l") + r" \\"],
+                    body_lines(case_keys(fin, "k"), lambda key: [rf"$k={key[0]}$", latex_id(key[1])], sweep_groups)])
 
-    def cell(rows, fam, case, k):
-        r = rows[(rows.family == fam) & (rows.case == case) & (rows.k == k)]
-        if r.empty:
-            return "--"
-        r = r.iloc[0]
-        return fmt_fixed(r.beta, 4) if r.kernel_dim == 0 else f"0 [{int(r.kernel_dim)}]"
 
-    lines = [r"\begin{tabular}{ll" + "r" * (ncol - 2) + "}", r"\toprule",
-             " & & " + " & ".join([rf"\multicolumn{{{len(ks)}}}{{c}}{{{title}}}" for _, _, title in groups] + pad)
-             + r" \\",
-             "family & case & " + " & ".join([rf"$k={k}$" for _ in groups for k in ks] + pad) + r" \\", r"\midrule"]
-    for fam in [f for f in ("structured", "perturbed", "unstructured") if f in set(m.family)]:
-        for case in case_order(m[m.family == fam].case.unique()):
-            lines.append(f"{fam[:6]}. & {latex_id(case)} & "
-                         + " & ".join([cell(rows, fam, case, k) for _, rows, _ in groups for k in ks] + pad) + r" \\")
-    lines += [r"\midrule", rf"\multicolumn{{{ncol}}}{{l}}{{$\nu \to 1/2$, structured, $N={int(fin.N2.max())}$; "
-              r"columns: " + ", ".join(rf"$\nu={v:g}$" for v in nus) + r"} \\", r"\midrule"]
-    for k in sorted(set(fin.k)):
-        for case in case_order(fin[fin.k == k].case.unique()):
-            r = fin[(fin.k == k) & (fin.case == case)].set_index("nu")
-            cells = [fmt_fixed(r.beta[v], 4) if r.kernel_dim[v] == 0 else f"0 [{int(r.kernel_dim[v])}]" for v in nus]
-            cells += [""] * max(ncol - 2 - len(nus), 0)
-            lines.append(rf"$k={k}$ & {latex_id(case)} & " + " & ".join(cells) + r" \\")
-    lines += [r"\bottomrule", r"\end{tabular}", ""]
-    return "\n".join(lines)
+def _mesh_cells(rows: pd.DataFrame, ks) -> Callable:
+    """key (family, case) → β_h per k on one mesh (:func:`~.templates.beta_cell`, with its kernel)."""
+    return lambda key: [beta_cell(rows[(rows.family == key[0]) & (rows.case == key[1]) & (rows.k == k)], True)
+                        for k in ks]
 
 
 def elastic_patch_table(patch: pd.DataFrame) -> str:
     """Rows (case, k): passes on every pair, max relative errors of λ_h (all, end intervals,
     middle half) and of u_h, kernel dimension."""
     pairs = ", ".join(f"{a}:{b}" for a, b in patch[["N1", "N2"]].drop_duplicates().itertuples(index=False))
-    lines = [r"\begin{tabular}{llcrrrr}", r"\toprule",
-             r"case & $k$ & pass & $\max|\lambda_h-p|/p$ & end int. & middle & $\max|u_h-u|/\delta$ \\",
-             rf"\multicolumn{{7}}{{l}}{{pairs $N_1{{:}}N_2$ = {pairs}}} \\", r"\midrule"]
-    for case in case_order(patch.case.unique()):
-        for k, g in patch[patch.case == case].groupby("k"):
-            ok = bool(g.passes.astype(bool).all())
-            lines.append(f"{latex_id(case)} & {k} & {'yes' if ok else 'no'} & "
-                         + " & ".join(fmt_sci(g[c].max(), 2) for c in ("lambda_max_rel_error", "lambda_end_rel_error",
-                                                                       "lambda_middle_rel_error", "u_max_rel_error"))
-                         + r" \\")
-    lines += [r"\bottomrule", r"\end{tabular}", ""]
-    return "\n".join(lines)
+    keys = [(case, k) for case in case_order(patch.case.unique()) for k in sorted(set(patch[patch.case == case].k))]
+    rows = lambda key: patch[(patch.case == key[0]) & (patch.k == key[1])]  # noqa: E731
+    groups = [Group(("pass",), lambda key: ["yes" if rows(key).passes.astype(bool).all() else "no"]),
+              Group((r"$\max|\lambda_h-p|/p$", "end int.", "middle", r"$\max|u_h-u|/\delta$"),
+                    lambda key: error_cells(rows(key), PATCH_ERRORS))]
+    return case_table("llcrrrr", ("case", "$k$"), lambda key: [latex_id(key[0]), str(key[1])], groups, [keys],
+                      head_after=[multicolumn(7, f"pairs $N_1{{:}}N_2$ = {pairs}", "l") + r" \\"])
 
 
 def elastic_hertz_table(hertz: pd.DataFrame) -> str:
@@ -164,28 +150,26 @@ def elastic_hertz_table(hertz: pd.DataFrame) -> str:
     energy error, p_max error and oscillation; modeling study: a/W and the errors vs Hertz."""
     d = hertz[hertz.study == "discretization"]
     ns = sorted(int(n) for n in set(d.N))
-    lines = [r"\begin{tabular}{ll" + "r" * (1 + 3 * len(ns)) + "}", r"\toprule",
-             r"$k$ & case & slope & " + " & ".join(rf"$e_a$ {n}" for n in ns) + " & "
-             + " & ".join(rf"$e_p$ {n}" for n in ns) + " & " + " & ".join(rf"osc {n}" for n in ns) + r" \\",
-             r"\midrule"]
-    for k in sorted(set(d.k)):
-        for case in case_order(d[d.k == k].case.unique()):
-            g = d[(d.k == k) & (d.case == case)].set_index("N").sort_index()
-            slope = -_slope(g.index.to_numpy(float), g.energy_error)
-            cells = [fmt_fixed(slope, 2)] + [fmt_sci(g.energy_error[n], 2) for n in ns] \
-                + [fmt_sci(g.p_max_rel_error[n], 2) for n in ns] + [fmt_fixed(g.oscillation[n], 2) for n in ns]
-            lines.append(f"{k} & {latex_id(case)} & " + " & ".join(cells) + r" \\")
+    def rows(key):
+        return d[(d.k == key[0]) & (d.case == key[1])].set_index("N").sort_index()
+
+    def per_mesh(head, column, fmt):
+        return Group(tuple(f"{head} {n}" for n in ns), lambda key: [fmt(rows(key)[column][n], 2) for n in ns])
+
+    groups = [Group(("slope",), lambda key: [fmt_fixed(-_slope(rows(key).index.to_numpy(float),
+                                                                rows(key).energy_error), 2)]),
+              per_mesh("$e_a$", "energy_error", fmt_sci), per_mesh("$e_p$", "p_max_rel_error", fmt_sci),
+              per_mesh("osc", "oscillation", fmt_fixed)]
+    blocks = [body_lines(case_keys(d, "k"), lambda key: [str(key[0]), latex_id(key[1])], groups)]
     mod = hertz[hertz.study == "modeling"].sort_values("d")
     if len(mod):
-        lines += [r"\midrule", rf"\multicolumn{{{2 + 1 + 3 * len(ns)}}}{{l}}{{modeling error vs plane-strain Hertz "
-                  rf"({latex_id(mod.case.iloc[0])}, $k={int(mod.k.iloc[0])}$, $N={int(mod.N.iloc[0])}$): $a/W$, $e_p$, "
-                  r"half-width error} \\", r"\midrule"]
-        for _, r in mod.iterrows():
-            lines.append(rf"\multicolumn{{2}}{{l}}{{$d={r.d:g}$}} & {fmt_fixed(r.hertz_a, 3)} & "
-                         f"{fmt_sci(r.p_max_rel_error, 2)} & {fmt_sci(r.half_width_rel_error, 2)}"
-                         + " &" * (3 * len(ns) - 2) + r" \\")
-    lines += [r"\bottomrule", r"\end{tabular}", ""]
-    return "\n".join(lines)
+        blocks += [[multicolumn(2 + 1 + 3 * len(ns), rf"modeling error vs plane-strain Hertz "
+                                rf"({latex_id(mod.case.iloc[0])}, $k={int(mod.k.iloc[0])}$, $N={int(mod.N.iloc[0])}$): "
+                                r"$a/W$, $e_p$, half-width error", "l") + r" \\"],
+                   [rf"\multicolumn{{2}}{{l}}{{$d={r.d:g}$}} & {fmt_fixed(r.hertz_a, 3)} & "
+                    f"{fmt_sci(r.p_max_rel_error, 2)} & {fmt_sci(r.half_width_rel_error, 2)}"
+                    + " &" * (3 * len(ns) - 2) + r" \\" for _, r in mod.iterrows()]]
+    return tabular("ll" + "r" * (1 + 3 * len(ns)), head_lines(("$k$", "case"), groups), blocks)
 
 
 def elastic_paper_files(beta, sweep, patch, hertz, claims, speed, nu_slope_cases=None) -> dict[str, str]:

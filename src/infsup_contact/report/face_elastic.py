@@ -13,6 +13,8 @@ import numpy as np
 import pandas as pd
 
 from ..discretization.spaces.registry import SPACES
+from .sections import n_as_predicted, predicted
+from .templates import Group, at, beta_cell, case_keys, case_table, kernel_cell
 from .texformat import PaperTexError, case_order, fmt_fixed, fmt_int, latex_id
 
 KINDS = ("kernel", "bounded", "nu", "patch")
@@ -25,13 +27,9 @@ def _kind(claim_id: str) -> str:
 
 def _counts(claims: pd.DataFrame) -> dict:
     """kind → (claims, predicted PASS/FAIL, as predicted, PASS)."""
-    out = {}
     kinds = claims.claim_id.map(_kind)
-    for kind in KINDS:
-        rows = claims[kinds == kind]
-        pred = rows[rows.predicted.isin(["PASS", "FAIL"])]
-        out[kind] = (len(rows), len(pred), int((pred.verdict == pred.predicted).sum()), int((rows.verdict == "PASS").sum()))
-    return out
+    return {kind: (len(rows), len(predicted(rows)), n_as_predicted(rows), int((rows.verdict == "PASS").sum()))
+            for kind, rows in ((kind, claims[kinds == kind]) for kind in KINDS)}
 
 
 def _slope(rows: pd.DataFrame, fit_nu_min: float) -> float:
@@ -46,30 +44,23 @@ def face_elastic_table(beta: pd.DataFrame, fit_nu_min: float, base_nu: float, sw
     slope of log β_H against log(1 − 2ν) over ν >= ``fit_nu_min``."""
     h = beta[beta.norm == "H"]
     m = h[h.N1 == h.N2]
-    base = m[np.isclose(m.nu, base_nu)]
-    n = int(base.N2.max())
+    n = int(at(m, "nu", base_nu).N2.max())
     nus = sorted(v for v in set(m[m.N2 == sweep_n].nu) if not np.isclose(v, base_nu))
-    lines = [r"\begin{tabular}{llr" + "r" * (1 + len(nus)) + "rr}", r"\toprule",
-             rf"element & $k$ & case & $\beta_H$, $N={n}$, $\nu={base_nu:g}$ & kernel & "
-             + " & ".join(rf"$\nu={v:g}$" for v in nus) + r" & slope \\", r"\midrule"]
-    for (element, k), rk in m.groupby(["element", "k"], sort=True):
-        for case in case_order(rk.case.unique()):
-            rc = rk[rk.case == case]
-            r0 = rc[(rc.N2 == n) & np.isclose(rc.nu, base_nu)]
-            if r0.empty:
-                continue
-            r0 = r0.iloc[0]
-            cells = [fmt_fixed(r0.beta, 4) if r0.kernel_dim == 0 else "0",
-                     f"{int(r0.kernel_dim)} ({int(r0.structural_kernel_dim)})"]
-            rs = rc[rc.N2 == sweep_n]
-            for v in nus:
-                rv = rs[np.isclose(rs.nu, v)]
-                cells.append("--" if rv.empty else fmt_fixed(rv.beta.iloc[0], 4) if rv.kernel_dim.iloc[0] == 0 else "0")
-            slope = _slope(rs, fit_nu_min) if len(rs) and not rs.kernel_dim.any() else np.nan
-            cells.append(fmt_fixed(slope, 3) if np.isfinite(slope) else "--")
-            lines.append(f"{latex_id(element)} & {fmt_int(k)} & {latex_id(case)} & " + " & ".join(cells) + r" \\")
-    lines += [r"\bottomrule", r"\end{tabular}"]
-    return "\n".join(lines) + "\n"
+
+    def rows(key, mesh):
+        return m[(m.element == key[0]) & (m.k == key[1]) & (m.case == key[2]) & (m.N2 == mesh)]
+
+    keys = [key for key in case_keys(m, "element", "k") if len(at(rows(key, n), "nu", base_nu))]
+
+    def cells(key):
+        base, rs = at(rows(key, n), "nu", base_nu), rows(key, sweep_n)
+        slope = _slope(rs, fit_nu_min) if len(rs) and not rs.kernel_dim.any() else np.nan
+        return [beta_cell(base), kernel_cell(base), *(beta_cell(at(rs, "nu", v)) for v in nus),
+                fmt_fixed(slope, 3) if np.isfinite(slope) else "--"]
+
+    heads = (rf"$\beta_H$, $N={n}$, $\nu={base_nu:g}$", "kernel", *(rf"$\nu={v:g}$" for v in nus), "slope")
+    return case_table("llr" + "r" * (1 + len(nus)) + "rr", ("element", "$k$", "case"),
+                      lambda key: [latex_id(key[0]), fmt_int(key[1]), latex_id(key[2])], [Group(heads, cells)], [keys])
 
 
 def face_elastic_tex(beta: pd.DataFrame, patch: pd.DataFrame | None, claims: pd.DataFrame, fe: dict) -> str:
@@ -79,8 +70,7 @@ def face_elastic_tex(beta: pd.DataFrame, patch: pd.DataFrame | None, claims: pd.
             raise PaperTexError(f"face_elastic_beta.csv lacks column {col!r}")
     sweep = fe["nu_sweep"]
     c = _counts(claims)
-    pred = claims[claims.predicted.isin(["PASS", "FAIL"])]
-    as_pred = int((pred.verdict == pred.predicted).sum())
+    pred, as_pred = predicted(claims), n_as_predicted(claims)
     stable = [s for s in case_order(beta.case.unique()) if SPACES[s].stable]
     sweep_n = int(min(sweep["N"]))
     ns = sorted({int(x) for x in beta[(beta.N1 == beta.N2) & np.isclose(beta.nu, fe["nu"])].N2})

@@ -9,35 +9,23 @@ from __future__ import annotations
 
 import pandas as pd
 
-from .texformat import PaperTexError, case_order, fmt_fixed, latex_escape, latex_id
-
-NORM_TITLES = {"H": r"$\|\cdot\|_M$ = dual norm of $H^{1/2}_{00}(\Gamma)$",
-               "L2": r"$\|\cdot\|_M$ = $L^2(\Gamma)$ norm (Remark 3.1)"}
-
+from .sections import n_as_predicted, predicted
+from .templates import beta_by_mesh_table
+from .texformat import PaperTexError, latex_escape, latex_id
 
 def matching_beta_table(beta: pd.DataFrame) -> str:
-    """Tabular of β_h on matching meshes: rows (norm, element, k, case), columns N."""
+    """Tabular of β_h on matching meshes: rows (norm, element, k, case), columns N
+    (:func:`~.templates.beta_by_mesh_table`)."""
     b = beta[beta.N1 == beta.N2]
     if b.empty:
         raise PaperTexError("the model's β table has no matching rows")
-    ns = sorted({int(n) for n in b.N2})
-    val = b.set_index(["norm", "element", "k", "case", "N2"]).beta
-    lines = [r"\begin{tabular}{lll" + "r" * len(ns) + "}", r"\toprule",
-             r"element & $k$ & case & " + " & ".join(rf"$N={n}$" for n in ns) + r" \\"]
-    for norm in [n for n in NORM_TITLES if n in set(b.norm)]:
-        lines += [r"\midrule", rf"\multicolumn{{{len(ns) + 3}}}{{l}}{{{NORM_TITLES[norm]}}} \\", r"\midrule"]
-        for (element, k), rows in b[b.norm == norm].groupby(["element", "k"], sort=True):
-            for case in case_order(rows.case):
-                cells = [fmt_fixed(val[key], 4) if (key := (norm, element, k, case, n)) in val.index else "--"
-                         for n in ns]
-                lines.append(f"{latex_escape(element)} & {k} & {latex_id(case)} & " + " & ".join(cells) + r" \\")
-    return "\n".join(lines + [r"\bottomrule", r"\end{tabular}", ""])
+    return beta_by_mesh_table(b, sorted({int(n) for n in b.N2}), ("element", "k"), ("element", "$k$", "case"),
+                              lambda key: [latex_escape(key[0]), str(key[1]), latex_id(key[2])])
 
 
 def model_section_tex(name: str, entry: dict, beta: pd.DataFrame, claims: pd.DataFrame) -> str:
     """The subsection of the model-table entry ``name`` (module docstring)."""
-    checked = claims[claims.predicted.isin(["PASS", "FAIL"])]
-    agree = int((checked.verdict == checked.predicted).sum())
+    checked, agree = predicted(claims), n_as_predicted(claims)
     model = latex_escape(str(beta.model.iloc[0]))
     return "\n".join([
         rf"\subsection{{The model \texttt{{{latex_escape(name)}}}}}\label{{sec:model-{name}}}",

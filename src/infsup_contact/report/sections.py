@@ -1,12 +1,59 @@
 """Generated files of a paper section kept in its own source (paper/elastic.tex, paper/face.tex):
+the macro blocks a model's claims give (:func:`claim_count_macros`, :func:`verdict_macros`),
 its macro file, whose names all start with the section's prefix, and the check that the
 section's source uses only macros and inputs that were generated."""
 from __future__ import annotations
 
 import re
+from typing import Callable
 
-from .texformat import PaperTexError
+import pandas as pd
+
+from .texformat import VERDICTS, PaperTexError, fmt_int
 from .texnames import Macro
+
+
+def predicted(claims: pd.DataFrame) -> pd.DataFrame:
+    """The claims with a prediction (PASS or FAIL); the others are findings."""
+    return claims[claims.predicted.isin(["PASS", "FAIL"])]
+
+
+def n_as_predicted(claims: pd.DataFrame) -> int:
+    """How many of the predicted claims have the predicted verdict."""
+    checked = predicted(claims)
+    return int((checked.verdict == checked.predicted).sum())
+
+
+def outcome(verdicts) -> str:
+    """PASS if every verdict is PASS, FAIL if every one is FAIL, else (mixed, or none) INCONCLUSIVE:
+    the word ``\\byverdict`` chooses a sentence by."""
+    vs = set(verdicts)
+    return "PASS" if vs == {"PASS"} else "FAIL" if vs == {"FAIL"} else "INCONCLUSIVE"
+
+
+def claim_count_macros(claims: pd.DataFrame, name: Callable[..., str], table: str,
+                       findings: bool = True) -> list[Macro]:
+    """A model's headline counts: its claims, the predicted ones, those as predicted and (if
+    ``findings``) the findings; ``name(label)`` is the macro name, ``table`` the claims file."""
+    checked = predicted(claims)
+    out = [Macro(name("N claims"), fmt_int(len(claims)), f"{table}: rows"),
+           Macro(name("N predicted"), fmt_int(len(checked)), f"{table}: predicted PASS/FAIL"),
+           Macro(name("N as predicted"), fmt_int(n_as_predicted(claims)), f"{table}: verdict == predicted")]
+    if findings:
+        out.append(Macro(name("N findings"), fmt_int(len(claims) - len(checked)), f"{table}: findings"))
+    return out
+
+
+def verdict_macros(rows: pd.DataFrame, name: Callable[..., str], label: str, src: str,
+                   outcome_note: str = "{src}, all PASS / all FAIL / else",
+                   verdict_note: str = "{src} with verdict {v}") -> list[Macro]:
+    """The claims of one kind (``rows``): their count ``N<label>``, aggregate outcome
+    ``Outcome<label>`` (:func:`outcome`) and count per verdict ``N<label><verdict>``; the notes
+    format their sources from ``src``."""
+    out = [Macro(name("N", label), fmt_int(len(rows)), src),
+           Macro(name("Outcome", label), outcome(rows.verdict), outcome_note.format(src=src))]
+    return out + [Macro(name("N", label, v.lower()), fmt_int(int((rows.verdict == v).sum())),
+                        verdict_note.format(src=src, v=v)) for v in VERDICTS]
 
 
 def section_macros_tex(macros: list[Macro], prefix: str, origin: str) -> str:

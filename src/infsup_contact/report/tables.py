@@ -6,7 +6,8 @@ import pandas as pd
 
 from ..study.beta.selection import primary_rows
 
-from .texformat import (MEASURES, SPEED_COLUMNS, VERDICTS, PaperTexError, _require, case_order, case_rank,
+from .templates import beta_by_mesh_table
+from .texformat import (MEASURES, SPEED_COLUMNS, VERDICTS, PaperTexError, _require, case_rank,
                         fmt_fixed, fmt_sci, latex_escape, latex_id)
 
 
@@ -29,20 +30,7 @@ def beta_table(beta: pd.DataFrame, ks=(1, 2, 3), even_only: bool = True) -> str:
     if b.empty:
         raise PaperTexError(f"beta.csv: no structured rows with k in {list(ks)}")
     ns = sorted({int(n) for n in b.N2 if (n % 2 == 0 or not even_only)})
-    val = b.set_index(["norm", "k", "case", "N2"]).beta
-    lines = [r"\begin{tabular}{ll" + "r" * len(ns) + "}", r"\toprule",
-             r"$k$ & case & " + " & ".join(rf"$N={n}$" for n in ns) + r" \\"]
-    for norm in [n for n in ("H", "L2") if n in set(b.norm)]:
-        title = (r"$\|\cdot\|_M$ = dual norm of $H^{1/2}_{00}(\Gamma)$" if norm == "H"
-                 else r"$\|\cdot\|_M$ = $L^2(\Gamma)$ norm (Remark 3.1)")
-        lines += [r"\midrule", rf"\multicolumn{{{len(ns) + 2}}}{{l}}{{{title}}} \\", r"\midrule"]
-        for k in sorted(set(b.k)):
-            for case in case_order(b[(b.k == k) & (b.norm == norm)].case):
-                cells = [fmt_fixed(val[(norm, k, case, n)], 4) if (norm, k, case, n) in val.index else "--"
-                         for n in ns]
-                lines.append(f"{k} & {latex_id(case)} & " + " & ".join(cells) + r" \\")
-    lines += [r"\bottomrule", r"\end{tabular}", ""]
-    return "\n".join(lines)
+    return beta_by_mesh_table(b, ns, ("k",), ("$k$", "case"), lambda key: [str(key[0]), latex_id(key[1])])
 
 
 def rates_table(rates: pd.DataFrame, primary: str) -> str:

@@ -157,8 +157,13 @@ def test_bad_face_key_is_named(mutate, key):
 def test_config_without_face_section_is_valid():
     from infsup_contact.config.checks import check_config
 
+    from infsup_contact.config.schema import ConfigError
+
     cfg = _ci()
     del cfg["face"]
+    with pytest.raises(ConfigError, match="models.face"):  # its model-table entry reads it: one line
+        check_config(cfg, ROOT / "workflow" / "schemas" / "config.schema.yaml")
+    del cfg["models"]["face"]
     check_config(cfg, ROOT / "workflow" / "schemas" / "config.schema.yaml")
 
 

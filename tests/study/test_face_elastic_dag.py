@@ -170,8 +170,12 @@ def test_bad_face_elastic_key_is_named(mutate, key):
 @pytest.mark.parametrize("name", ["ci.yaml", "config.yaml"])
 def test_shipped_configs_pass_and_the_section_is_optional(name):
     from infsup_contact.config.checks import check_config
+    from infsup_contact.config.schema import ConfigError
 
     cfg = yaml.safe_load((ROOT / "config" / name).read_text())
     check_config(cfg, ROOT / "workflow" / "schemas" / "config.schema.yaml")
     del cfg["face_elastic"]
+    with pytest.raises(ConfigError, match="models.face_elastic"):  # its model-table entry reads it
+        check_config(cfg, ROOT / "workflow" / "schemas" / "config.schema.yaml")
+    del cfg["models"]["face_elastic"]
     check_config(cfg, ROOT / "workflow" / "schemas" / "config.schema.yaml")

@@ -26,10 +26,10 @@ def matching_beta_table(beta: pd.DataFrame) -> str:
 def model_section_tex(name: str, entry: dict, beta: pd.DataFrame, claims: pd.DataFrame) -> str:
     """The subsection of the model-table entry ``name`` (module docstring)."""
     checked, agree = predicted(claims), n_as_predicted(claims)
-    model = latex_escape(str(beta.model.iloc[0]))
+    model = latex_id(str(beta.model.iloc[0]))
     return "\n".join([
-        rf"\subsection{{The model \texttt{{{latex_escape(name)}}}}}\label{{sec:model-{name}}}",
-        rf"Model \texttt{{{model}}} of the model table (\texttt{{config: models.{latex_escape(name)}}}): $\beta_h$ "
+        rf"\subsection{{The model \texttt{{{latex_id(name)}}}}}\label{{sec:model-{name}}}",
+        rf"Model \texttt{{{model}}} of the model table (\texttt{{config: models.{latex_id(name)}}}): $\beta_h$ "
         rf"of {len(set(beta.case))} multiplier spaces, $k \in \{{{', '.join(map(str, sorted(set(beta.k))))}\}}$, "
         rf"{len(beta)} rows. Of its {len(claims)} ledger claims, {len(checked)} carry a prediction and "
         rf"{agree} came out as predicted.",

@@ -33,7 +33,9 @@ from .quadrature import split_rule
 from .tensor_grid import TensorPartition, coarsening_cells, merge_breakpoints
 from ..gamma.quadrature import gauss_legendre
 
-CELL_SHAPES = ("quad", "trig")
+CELL_SHAPES = ("quad", "trig", "quad8")
+"""Boundary cells of a face: rectangles of Q_k hexahedra, their Kuhn triangles, QUAD8 rectangles of
+serendipity HEX20 bodies (:mod:`.face.serendipity`)."""
 
 
 @dataclass(frozen=True)
@@ -264,7 +266,7 @@ class Square(Interface):
         if pieces is None:
             raise InputError("space", "a face space polynomial on the rectangles of a tensor partition",
                              got=space.name)
-        if self.cell == "quad":
+        if self.cell != "trig":
             return self.quadrature(self.common_refinement(trace.partition, pieces), degree)
         return split_rule(self.common_refinement(trace.partition, pieces), trace.partition, 2 * degree,
                           space.breakpoints)

@@ -1,0 +1,177 @@
+"""Γ = (0, 1)² × {1} traced by serendipity HEX20 bodies: QUAD8 faces.
+
+The trace of a 20-node hexahedron on a face is the 8-node serendipity quadrilateral QUAD8 =
+P2 + {ξ²η, ξη²} (:mod:`.face.spaces.reference_elements`): nodal values at the four corners and
+the four edge midpoints, no centre node. :class:`SerendipitySquare` is :class:`~.square.Square`
+with that trace: the same tensor partitions, quadrature, multiplier spaces and norms, but
+
+* the trace is read from a nodal displacement space that is not NGSolve's (:class:`NodalDofs`:
+  the dof locations and free dofs of scikit-fem's ``ElementHexS2``, :mod:`infsup_contact.models.hex20`);
+* its basis on Γ is the QUAD8 nodal basis on every rectangle of the trace partition;
+* its counts: dim W_h = (n − 1)² vertices + 2 n (n − 1) edge midpoints = (3n − 1)(n − 1) inside Γ on
+  an n × n grid (QUAD9 has (2n − 1)²: the n² centres are missing);
+* it builds the registry entries that name ``quad8`` among their ``face_cells``.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+
+from ...errors import InputError
+from ..gamma.trace import GammaTrace
+from .spaces.reference_elements import reference_element
+from .square import Square
+from .tensor_grid import TensorPartition, coarsening_cells, merge_breakpoints
+
+QUAD8 = reference_element("QUAD8")
+
+
+@dataclass(frozen=True, eq=False)
+class NodalDofs:
+    """A nodal displacement space as its face trace needs it (the role of ``ngsolve.H1``).
+
+    Attributes
+    ----------
+    points : ndarray, shape (ndof, 3)
+        Location of every dof (the node whose value it is).
+    free : ndarray of bool, shape (ndof,)
+        Dofs not fixed by the Dirichlet condition.
+    vertices : ndarray, shape (nv, 3)
+        The mesh vertices (the trace partition is read from those on Γ).
+    basis : object
+        The library's basis (scikit-fem ``CellBasis``), kept for consumers that interpolate.
+    """
+
+    points: np.ndarray
+    free: np.ndarray
+    vertices: np.ndarray
+    basis: object = None
+
+    @property
+    def ndof(self) -> int:
+        return len(self.points)
+
+
+def interior_dimension(nx: int, ny: int) -> int:
+    """QUAD8 nodes strictly inside Γ on an nx × ny grid: vertices, then x- and y-edge midpoints."""
+    return max(nx - 1, 0) * max(ny - 1, 0) + nx * max(ny - 1, 0) + max(nx - 1, 0) * ny
+
+
+@dataclass(frozen=True)
+class SerendipitySquare(Square):
+    """The face of HEX20 bodies (module docstring); ``cell`` is ``quad8``."""
+
+    cell: str = "quad8"
+
+    # --- partitions and the trace
+    def _on_gamma(self, points: np.ndarray, tol: float = 1e-12) -> np.ndarray:
+        return np.abs(points[:, 2] - self.z) < tol
+
+    def partition_of(self, mesh) -> TensorPartition:
+        """The tensor grid of the vertices on Γ of a scikit-fem mesh (``mesh.p``, shape (3, nv))."""
+        return self._partition_of_vertices(np.asarray(mesh.p, float).T)
+
+    def _partition_of_vertices(self, vertices: np.ndarray, tol: float = 1e-12) -> TensorPartition:
+        on = vertices[self._on_gamma(vertices)]
+        if not len(on):
+            raise InputError("mesh", f"vertices on Γ (z = {self.z:g})")
+        part = TensorPartition(merge_breakpoints(on[:, 0], tol), merge_breakpoints(on[:, 1], tol))
+        if (len(on) != len(part.xs) * len(part.ys) or part.xs[0] != 0.0 or part.ys[0] != 0.0
+                or part.xs[-1] != self.width or part.ys[-1] != 1.0):
+            raise InputError("mesh", f"a face Γ tiled by a tensor grid of rectangles ({len(on)} vertices on Γ)")
+        return part
+
+    def trace(self, fes: NodalDofs) -> GammaTrace:
+        """The free Γ dofs of ``fes`` and, per rectangle of the trace partition, the Γ-dof positions of
+        its QUAD8 nodes (in the reference element's order; −1 for a fixed dof). :class:`InputError`
+        unless the dofs on Γ are exactly the QUAD8 nodes of the grid (corners and edge midpoints)."""
+        part = self._partition_of_vertices(np.asarray(fes.vertices, float))
+        pts = np.asarray(fes.points, float)
+        on = np.flatnonzero(self._on_gamma(pts))
+        lattice = self._lattice_index(part, pts[on, :2])
+        nx, ny = len(part.xs) - 1, len(part.ys) - 1
+        centre = (lattice[:, 0] % 2 == 1) & (lattice[:, 1] % 2 == 1)
+        n_nodes = (nx + 1) * (ny + 1) + nx * (ny + 1) + ny * (nx + 1)
+        if np.any(lattice < 0) or np.any(centre) or len(on) != n_nodes:
+            raise InputError("mesh", f"a serendipity (QUAD8) trace: {n_nodes} Γ dofs at the corners and edge "
+                             f"midpoints of the {nx} x {ny} grid (got {len(on)})")
+        gamma_dofs = np.sort(on[np.asarray(fes.free, bool)[on]])
+        position = -np.ones((2 * nx + 1, 2 * ny + 1), dtype=int)
+        live = np.asarray(fes.free, bool)[on]
+        position[lattice[live, 0], lattice[live, 1]] = np.searchsorted(gamma_dofs, on[live])
+        I = 2 * np.arange(nx)[:, None, None] + (QUAD8.nodes[:, 0] + 1).astype(int)[None, None, :]
+        J = 2 * np.arange(ny)[None, :, None] + (QUAD8.nodes[:, 1] + 1).astype(int)[None, None, :]
+        cells = position[I, J].reshape(nx * ny, QUAD8.n_nodes)  # cell c = i ny + j
+        return GammaTrace(fes, gamma_dofs, [cells], part, self)
+
+    @staticmethod
+    def _lattice_index(part: TensorPartition, xy: np.ndarray, tol: float = 1e-10) -> np.ndarray:
+        """(I, J) on the lattice of half cells (I = 2 i + ξ + 1), −1 where a point is on none."""
+        out = []
+        for d, g in enumerate((np.asarray(part.xs), np.asarray(part.ys))):
+            half = np.sort(np.concatenate([g, 0.5 * (g[:-1] + g[1:])]))
+            i = np.argmin(np.abs(half[None, :] - xy[:, d, None]), axis=1)
+            out.append(np.where(np.abs(half[i] - xy[:, d]) < tol, i, -1))
+        return np.column_stack(out)
+
+    # --- the trace basis: QUAD8 on every rectangle
+    def _local(self, trace: GammaTrace, x: np.ndarray) -> tuple:
+        """(values (n, 8), Γ-dof positions (n, 8)) of the QUAD8 functions of the cell holding each
+        point (a point on a cell boundary takes the cell on its upper / right side: the trace is
+        continuous, so the choice does not change a value)."""
+        part = trace.breakpoints
+        ix, iy = self._cell_index(part, x)
+        xs, ys = np.asarray(part.xs), np.asarray(part.ys)
+        ref = np.column_stack([2 * (x[:, 0] - xs[ix]) / (xs[ix + 1] - xs[ix]) - 1,
+                               2 * (x[:, 1] - ys[iy]) / (ys[iy + 1] - ys[iy]) - 1])
+        return QUAD8.shapes(ref), trace.elements[0][ix * (len(ys) - 1) + iy]
+
+    def trace_values(self, trace: GammaTrace, x: np.ndarray) -> np.ndarray:
+        """Dense values (len(x), number of Γ dofs) of the Γ-dof basis at points x of Γ."""
+        return self.sparse_trace_basis(trace, x).toarray()
+
+    def sparse_trace_basis(self, trace: GammaTrace, x: np.ndarray):
+        """The Γ-dof basis at points x as CSR (sorted indices, no stored zeros)."""
+        x = np.asarray(x, dtype=float).reshape(-1, 2)
+        vals, pos = self._local(trace, x)
+        keep = (pos >= 0) & (vals != 0)
+        rows = np.broadcast_to(np.arange(len(x))[:, None], pos.shape)
+        phi = sp.coo_matrix((vals[keep], (rows[keep], pos[keep])), shape=(len(x), len(trace.gamma_dofs))).tocsr()
+        phi.sum_duplicates()  # sorts the column indices (the 8 local dofs are distinct)
+        return phi
+
+    # --- counts
+    def _check_k(self, k: int) -> None:
+        if k != 2:
+            raise InputError("k", "2 (the serendipity HEX20 element is quadratic)", got=k)
+
+    def trace_dimension(self, k: int, cells: int) -> int:
+        """dim W_h = (3n − 1)(n − 1): the QUAD8 nodes inside Γ on an n × n grid."""
+        self._check_k(k)
+        return interior_dimension(cells, cells)
+
+    def trace_sum_dimension(self, k: int, trace1, trace2) -> int:
+        """dim W1 + dim W2 − dim W_c, W_c the QUAD8 trace on the common coarsening (shared
+        breakpoints). Serendipity Q2 is invariant under axis-aligned affine maps, so W_c ⊂ W1 ∩ W2 and
+        this is an upper bound of dim(W1 + W2) (the proven kernel stays a lower bound); equal on
+        matching meshes."""
+        self._check_k(k)
+        d = [interior_dimension(len(p.xs) - 1, len(p.ys) - 1) for p in (trace1, trace2)]
+        dc = interior_dimension(coarsening_cells(trace1.xs, trace2.xs), coarsening_cells(trace1.ys, trace2.ys))
+        return d[0] + d[1] - dc
+
+    def trace_nodes(self, k: int, cells: int) -> int:
+        """3n² + 4n + 1 QUAD8 nodes of a side on an n × n grid, boundary included."""
+        self._check_k(k)
+        return (cells + 1) ** 2 + 2 * cells * (cells + 1)
+
+
+SERENDIPITY = SerendipitySquare()
+"""Γ = (0, 1)² × {1} of the HEX20 bodies."""
+
+
+def face_of(cell: str) -> Square:
+    """The face whose boundary cells are ``cell`` (one of :data:`~.square.CELL_SHAPES`)."""
+    return SERENDIPITY if cell == "quad8" else Square(cell=cell)

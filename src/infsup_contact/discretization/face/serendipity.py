@@ -162,6 +162,15 @@ class SerendipitySquare(Square):
         dc = interior_dimension(coarsening_cells(trace1.xs, trace2.xs), coarsening_cells(trace1.ys, trace2.ys))
         return d[0] + d[1] - dc
 
+    def proven_kernel(self, space, k: int, traces, dim_w: int) -> int:
+        """max(dim M − dim(W1 + W2), 0), and for a tensor product space M = Mˣ ⊗ Mʸ on the G_h of
+        both traces the kernel of the serendipity structure (:func:`tensor_modes`), whichever is larger."""
+        glob = max(space.dim - dim_w, 0)
+        key = self.partition_key(space.breakpoints)
+        if getattr(space, "factors", None) is None or any(self.partition_key(t.partition) != key for t in traces):
+            return glob
+        return max(glob, tensor_modes(*space.factors))
+
     def trace_nodes(self, k: int, cells: int) -> int:
         """3n² + 4n + 1 QUAD8 nodes of a side on an n × n grid, boundary included."""
         self._check_k(k)
@@ -175,3 +184,40 @@ SERENDIPITY = SerendipitySquare()
 def face_of(cell: str) -> Square:
     """The face whose boundary cells are ``cell`` (one of :data:`~.square.CELL_SHAPES`)."""
     return SERENDIPITY if cell == "quad8" else Square(cell=cell)
+
+
+def tensor_modes(mx, my, rtol: float = 1e-10) -> int:
+    """dim ker Bᵀ of a tensor space M = Mˣ ⊗ Mʸ against the QUAD8 trace on the grid of its factors.
+
+    The QUAD8 functions vanishing on ∂Γ are the hats, the x-edge bubbles times y-hats and the
+    x-hats times y-edge bubbles (no cell bubbles: those are QUAD9's centres), so
+    W = P2_0ˣ ⊗ P1_0ʸ + P1_0ˣ ⊗ P2_0ʸ with P1_0, P2_0 the 1D continuous P1, P2 vanishing at the
+    ends. With K_d = Mᵈ ∩ (P_d,0)^⊥ (d = 1, 2; K_2 ⊂ K_1), a ⊗ b is orthogonal to W when a ⊥ P2_0ˣ,
+    when b ⊥ P2_0ʸ, or when a ⊥ P1_0ˣ and b ⊥ P1_0ʸ; splitting each Mᵈ into K_2 ⊕ (K_1 ⊖ K_2) ⊕ rest,
+    the kernel is spanned by the products of basis classes with either factor in K_2 or both in K_1:
+    dim = m_x m_y − (m_x − k2_x)(m_y − k2_y) + (k1_x − k2_x)(k1_y − k2_y), and no other product
+    class is orthogonal to W. The 1D dimensions k_d = m − rank of the exact 1D coupling.
+    E.g. continuous Q1 (T5 at k = 2): k1 = 2, k2 = 0, four modes a ⊗ b, a and b the P1 functions
+    with nodal values (−(2 − √3))^i from either end; discontinuous Q0 (T4 at k = 2): the checkerboard."""
+    k1, k2 = zip(*(_orthogonal_dims(f, rtol) for f in (mx, my)))
+    m = (mx.dim, my.dim)
+    return m[0] * m[1] - (m[0] - k2[0]) * (m[1] - k2[1]) + (k1[0] - k2[0]) * (k1[1] - k2[1])
+
+
+def _orthogonal_dims(factor, rtol: float) -> tuple:
+    """(dim M ∩ P1_0^⊥, dim M ∩ P2_0^⊥) of a 1D space on its breakpoints (exact Gauss rule per interval)."""
+    from ..gamma.quadrature import gauss_legendre
+    from ..segment.multipliers import make_space
+
+    x = np.asarray(factor.breakpoints, float)
+    t, w = gauss_legendre(factor.degree // 2 + 3)
+    a, b = x[:-1, None], x[1:, None]
+    pts, wts = (0.5 * (a + b) + 0.5 * (b - a) * t).ravel(), (0.5 * (b - a) * w).ravel()
+    mu = factor.evaluate(pts) * wts[:, None]
+    out = []
+    for degree in (1, 2):
+        A = mu.T @ make_space(x, degree, True, True).evaluate(pts)
+        s = np.linalg.svd(A, compute_uv=False) if A.size else np.zeros(0)
+        rank = int(np.sum(s > rtol * s.max())) if s.size and s.max() > 0 else 0
+        out.append(factor.dim - rank)
+    return tuple(out)

@@ -143,8 +143,12 @@ class SerendipitySquare(Square):
         return phi
 
     # --- counts
+    def allows(self, k: int) -> bool:
+        """HEX20 bodies have k = 2 only."""
+        return k == 2
+
     def _check_k(self, k: int) -> None:
-        if k != 2:
+        if not self.allows(k):
             raise InputError("k", "2 (the serendipity HEX20 element is quadratic)", got=k)
 
     def trace_dimension(self, k: int, cells: int) -> int:

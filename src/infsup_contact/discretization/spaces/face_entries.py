@@ -5,7 +5,7 @@ lists them for a face and refuses them on the segment in one line (``registry.ca
 """
 from __future__ import annotations
 
-from ..face.spaces.cellwise import cellwise_builder
+from ..face.spaces.cellwise import DiscontinuousP1Space, cellwise_builder
 from ..face.spaces.reference_elements import reference_element
 from ..face.spaces.tri6 import triangle_builder
 from .spec import SpaceSpec
@@ -63,5 +63,10 @@ FACE_SPACES = (
                "QUAD8", "standard", lambda k, n: _interior(n) - n * n, expected="stable", cells=("quad8",)),
     _face_spec("Q8-ALL", "standard mortar on QUAD8 faces, all nodes", "continuous QUAD8 on all nodes", "QUAD8",
                "standard", lambda k, n: _quad8_nodes(n), vanish=False, expected="unstable", cells=("quad8",)),
+    # dim 3N² > dim W_h = 3N² − 4N + 1: at least 4N − 1 zero modes on matching meshes
+    SpaceSpec("DISC-P1", "discontinuous P1 on QUAD8 faces", "discontinuous P1 on every rectangle of G_h", None,
+              lambda k: 1, min_k=2, expected="unstable", dimension=lambda k, n: 3 * n * n, nodal_basis=False,
+              claim_tag="DISC-P1", gamma_dims=(2,), face_build=lambda k, partition: DiscontinuousP1Space(partition),
+              face_cells=("quad8",)),
 )
 """The face-only entries, in registration order."""

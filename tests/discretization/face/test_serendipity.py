@@ -15,7 +15,7 @@ from infsup_contact.discretization.spaces.registry import SPACES, ids_built_on, 
 from infsup_contact.models import hex20
 from infsup_contact.models.membranes3d import MEMBRANES3D
 
-QUAD8_SPACES = ["TDUAL-Q8", "Q8", "Q8-ALL", "DISC-P1"]
+QUAD8_SPACES = ["TDUAL-Q8", "Q8", "Q8-ALL", "LIN0-Q8", "DISC-P1"]
 
 
 def grid(n):
@@ -29,8 +29,9 @@ def predicted_kernel(case, n):
     dim_w = (3 * n - 1) * (n - 1)
     count = {"T3": (2 * n - 1) ** 2, "DUAL": (2 * n - 1) ** 2, "R5.2": (2 * n + 1) ** 2,
              "DUAL-ALL": (2 * n + 1) ** 2, "R5.4": 4 * n * n, "Q8": dim_w, "TDUAL-Q8": dim_w,
-             "Q8-ALL": 3 * n * n + 4 * n + 1, "DISC-P1": 3 * n * n}
-    return {"T4": 1, "T5": 4}.get(case, count.get(case, 0) - dim_w)
+             "Q8-ALL": 3 * n * n + 4 * n + 1, "DISC-P1": 3 * n * n,
+             "LIN0-Q8": (n - 1) ** 2}
+    return {"T4": 1, "T5": 4}.get(case, max(count.get(case, 0) - dim_w, 0))
 
 
 def test_the_quad8_face_builds_the_tensor_spaces_and_the_quad8_ones_only():

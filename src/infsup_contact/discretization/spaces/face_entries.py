@@ -8,6 +8,8 @@ from __future__ import annotations
 from ..face.spaces.cellwise import DiscontinuousP1Space, cellwise_builder
 from ..face.spaces.reference_elements import reference_element
 from ..face.spaces.tri6 import triangle_builder
+from ..face.spaces.tensor import FaceSpace
+from ..segment.multipliers import make_space
 from .spec import SpaceSpec
 
 
@@ -32,6 +34,10 @@ def _interior(n):       # nodes of the QUAD9 (= P2 triangle) lattice inside (0, 
 
 def _quad8_nodes(n):    # QUAD8 nodes (corners and edge midpoints) on an n × n grid, ∂Γ included
     return (n + 1) ** 2 + 2 * n * (n + 1)
+
+
+def _interior_q1(k, partition):  # continuous Q1 vanishing on ∂Γ: the tensor product of the 1D hats
+    return FaceSpace(*(make_space(g, 1, True, True) for g in (partition.xs, partition.ys)), partition)
 
 
 _TDUAL_Q8 = "use case TDUAL-Q8 (the transformed dual basis, Popp et al. 2012, α = 1/5)"
@@ -63,6 +69,11 @@ FACE_SPACES = (
                "QUAD8", "standard", lambda k, n: _interior(n) - n * n, expected="stable", cells=("quad8",)),
     _face_spec("Q8-ALL", "standard mortar on QUAD8 faces, all nodes", "continuous QUAD8 on all nodes", "QUAD8",
                "standard", lambda k, n: _quad8_nodes(n), vanish=False, expected="unstable", cells=("quad8",)),
+    # the linear multiplier on the vertices of G_h (MOOSE lm_space = LINEAR, CalculiX LINMORTAR) is
+    # T5 at k = 2 (continuous Q1, ∂Γ included); this one drops the ∂Γ vertices, as T3 / Q8 do
+    SpaceSpec("LIN0-Q8", "linear mortar on QUAD8 faces, ∂Γ vertices dropped", "continuous Q1 on the interior "
+              "vertices of G_h", None, lambda k: 1, min_k=2, expected="stable", dimension=lambda k, n: (n - 1) ** 2,
+              claim_tag="LIN0-Q8", gamma_dims=(2,), face_build=_interior_q1, face_cells=("quad8",)),
     # dim 3N² > dim W_h = 3N² − 4N + 1: at least 4N − 1 zero modes on matching meshes
     SpaceSpec("DISC-P1", "discontinuous P1 on QUAD8 faces", "discontinuous P1 on every rectangle of G_h", None,
               lambda k: 1, min_k=2, expected="unstable", dimension=lambda k, n: 3 * n * n, nodal_basis=False,

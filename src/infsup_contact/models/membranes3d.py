@@ -23,6 +23,10 @@ tetrahedral faces are general triangulations, Γ
 :data:`~infsup_contact.discretization.face.triangulated_square.TRIANGULATED` (non-matching traces,
 common refinement by polygon clipping).
 
+``element="hex20"``: serendipity HEX20 bodies on the same structured cells, assembled by scikit-fem
+(:mod:`.hex20`; k = 2, β_h only), Γ the QUAD8 face
+:data:`~infsup_contact.discretization.face.serendipity.SERENDIPITY`.
+
 Boundaries: ``gamma`` (Γ), ``dir`` (the far face: z = 0 of Ω1, z = 2 of Ω2) and ``side`` (the
 four lateral faces). β_h clamps both (:data:`BETA_DIRICHLET`, the paper's u_i = 0 on ∂Ω_i∖Γ);
 a contact scene may clamp fewer (its ``supports``: the face patch test keeps the lateral faces
@@ -85,8 +89,9 @@ def subdomain_mesh(family: str, n: int, side: int, *, element: str = "hex", widt
     Raises
     ------
     InputError
-        For a family not in :data:`FAMILIES_3D`, an element not in :data:`ELEMENTS` (the
-        unstructured family: :data:`UNSTRUCTURED_ELEMENTS`), N < 1, a width outside (0, 1] (or
+        For a family not in :data:`FAMILIES_3D`, an element not in :data:`MEMBRANE_ELEMENTS` (the
+        unstructured family: :data:`UNSTRUCTURED_ELEMENTS`; ``hex20``: structured, width 1), N < 1,
+        a width outside (0, 1] (or
         other than 1 for the unstructured and perturbed families), α or seed out of range.
     """
     if family not in FAMILIES_3D:
@@ -194,7 +199,8 @@ def load(side: MembraneSide, scene, i: int):
 
 
 MEMBRANES3D = Model("membranes3d", side_operator,
-                    "two 3D bodies (0,1)^3 and (0,1)^2x(1,2), -c_i Δu_i = f_i, scalar Q_k (hex) or P_k (tet), "
+                    "two 3D bodies (0,1)^3 and (0,1)^2x(1,2), -c_i Δu_i = f_i, scalar Q_k (hex), P_k (tet) or "
+                    "serendipity Q2 (hex20, k = 2), "
                     "contact face Γ = (0,1)^2x{1}; structured, perturbed or unstructured (tet) meshes, "
                     "N cells per direction or maxh = 1/N (--element)",
                     scene_side=scene_side, load=load, field=field, interpolate=interpolate,

@@ -48,9 +48,10 @@ class Square(Interface):
         Name of Γ's boundary region in the meshes (``gamma``).
     z : float
         Height of Γ.
-    cell : {"quad", "trig"}
+    cell : {"quad", "trig", "quad8"}
         Shape of the boundary elements on Γ: rectangles of a hexahedral mesh, or each
-        rectangle cut in two triangles (a tetrahedral mesh).
+        rectangle cut in two triangles (a tetrahedral mesh); ``quad8``: the QUAD8 rectangles of
+        serendipity HEX20 bodies, whose trace is :class:`~.face.serendipity.SerendipitySquare`'s.
     width : float
         Γ's extent in x (1: the unit face). A narrower face (0, width) × (0, 1) is the trace
         of a narrower body (:mod:`infsup_contact.study.face.edge_dropping`); the trace

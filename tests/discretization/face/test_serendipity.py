@@ -23,9 +23,10 @@ def grid(n):
 
 
 def predicted_kernel(case, n):
-    """Kernel of Bᵀ on matching n × n meshes, k = 2, written before the runs from
-    dim M − dim W, dim W = (3n − 1)(n − 1) (QUAD9-type spaces: M ⊃ W, so exactly the count), and for
-    T4 / T5, whose count is 0, from the tensor structure: the checkerboard and the four corner products."""
+    """Kernel of Bᵀ on matching n × n meshes, k = 2: dim M − dim W, dim W = (3n − 1)(n − 1), written
+    before the runs (QUAD9-type spaces: M ⊃ W, so exactly the count); T4 / T5, whose count is 0, showed
+    modes in the first run, since proven from the tensor structure (the checkerboard, the four
+    corner products a ⊗ b; :func:`~infsup_contact.discretization.face.serendipity.tensor_modes`)."""
     dim_w = (3 * n - 1) * (n - 1)
     count = {"T3": (2 * n - 1) ** 2, "DUAL": (2 * n - 1) ** 2, "R5.2": (2 * n + 1) ** 2,
              "DUAL-ALL": (2 * n + 1) ** 2, "R5.4": 4 * n * n, "Q8": dim_w, "TDUAL-Q8": dim_w,

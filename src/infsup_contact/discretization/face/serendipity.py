@@ -14,6 +14,7 @@ with that trace: the same tensor partitions, quadrature, multiplier spaces and n
 """
 from __future__ import annotations
 
+import itertools
 from dataclasses import dataclass
 
 import numpy as np
@@ -167,13 +168,18 @@ class SerendipitySquare(Square):
         return d[0] + d[1] - dc
 
     def proven_kernel(self, space, k: int, traces, dim_w: int) -> int:
-        """max(dim M − dim(W1 + W2), 0), and for a tensor product space M = Mˣ ⊗ Mʸ on the G_h of
-        both traces the kernel of the serendipity structure (:func:`tensor_modes`), whichever is larger."""
+        """max(dim M − dim(W1 + W2), 0), and for a tensor product space M = Mˣ ⊗ Mʸ the modes of the
+        serendipity structure, whichever is larger: on the G_h of both traces :func:`tensor_modes`
+        (the kernel), on non-matching traces :func:`product_modes` (a lower bound; up to
+        :data:`PRODUCT_MODES_MAX_DIM`)."""
         glob = max(space.dim - dim_w, 0)
-        key = self.partition_key(space.breakpoints)
-        if getattr(space, "factors", None) is None or any(self.partition_key(t.partition) != key for t in traces):
+        if getattr(space, "factors", None) is None:
             return glob
-        return max(glob, tensor_modes(*space.factors))
+        key = self.partition_key(space.breakpoints)
+        if all(self.partition_key(t.partition) == key for t in traces):
+            return max(glob, tensor_modes(*space.factors))
+        modes = product_modes(*space.factors, [t.partition for t in traces])
+        return glob if modes is None else max(glob, modes)
 
     def trace_nodes(self, k: int, cells: int) -> int:
         """3n² + 4n + 1 QUAD8 nodes of a side on an n × n grid, boundary included."""
@@ -206,6 +212,54 @@ def tensor_modes(mx, my, rtol: float = 1e-10) -> int:
     k1, k2 = zip(*(_orthogonal_dims(f, rtol) for f in (mx, my)))
     m = (mx.dim, my.dim)
     return m[0] * m[1] - (m[0] - k2[0]) * (m[1] - k2[1]) + (k1[0] - k2[0]) * (k1[1] - k2[1])
+
+
+PRODUCT_MODES_MAX_DIM = 2500
+"""Largest dim M whose non-matching product modes :func:`product_modes` counts (one dense eigensolve)."""
+
+
+def product_modes(mx, my, partitions, rtol: float = 1e-10) -> int | None:
+    """dim of the span of the products A ⊗ B ⊂ Mˣ ⊗ Mʸ orthogonal to the QUAD8 traces on every
+    partition of ``partitions``: a lower bound of dim ker Bᵀ (None above :data:`PRODUCT_MODES_MAX_DIM`).
+
+    Side i's trace is P2_0ˣ ⊗ P1_0ʸ + P1_0ˣ ⊗ P2_0ʸ on its grid (:func:`tensor_modes`), so A ⊗ B is
+    orthogonal to it when (A ⊥ P2_0ˣ or B ⊥ P1_0ʸ) and (A ⊥ P1_0ˣ or B ⊥ P2_0ʸ): four choices per
+    side; for each combination A and B are the largest subspaces meeting the chosen 1D conditions,
+    and the span of all these products is the range of Σ Π_A ⊗ Π_B (orthogonal projectors in the
+    coefficients), whose rank is counted. On matching traces it is :func:`tensor_modes`."""
+    if mx.dim * my.dim > PRODUCT_MODES_MAX_DIM:
+        return None
+    per_side = [(("x", 2, p.xs), ("y", 1, p.ys)) for p in partitions]
+    second = [(("x", 1, p.xs), ("y", 2, p.ys)) for p in partitions]
+    choices = [[(a, b) for a in f for b in g] for f, g in zip(per_side, second)]
+    total = np.zeros((mx.dim * my.dim,) * 2)
+    for combo in itertools.product(*choices):
+        conds = [c for pair in combo for c in pair]
+        A = _perpendicular(mx, [(d, g) for axis, d, g in conds if axis == "x"], rtol)
+        B = _perpendicular(my, [(d, g) for axis, d, g in conds if axis == "y"], rtol)
+        if A.shape[1] and B.shape[1]:
+            total += np.kron(A @ A.T, B @ B.T)
+    eig = np.linalg.eigvalsh(total)
+    return int(np.sum(eig > rtol * max(eig.max(), 1.0)))
+
+
+def _perpendicular(factor, conditions, rtol: float) -> np.ndarray:
+    """Orthonormal coefficients of the functions of a 1D space orthogonal to P_d,0 on each grid of
+    ``conditions`` ((d, breakpoints) pairs; exact Gauss rule on the common refinement)."""
+    from scipy.linalg import null_space
+
+    from ..gamma.quadrature import gauss_legendre
+    from ..segment.multipliers import make_space
+
+    if not conditions:
+        return np.eye(factor.dim)
+    x = np.unique(np.concatenate([np.asarray(factor.breakpoints, float)] + [np.asarray(g, float) for _, g in conditions]))
+    t, w = gauss_legendre(factor.degree // 2 + 3)
+    a, b = x[:-1, None], x[1:, None]
+    pts, wts = (0.5 * (a + b) + 0.5 * (b - a) * t).ravel(), (0.5 * (b - a) * w).ravel()
+    mu = factor.evaluate(pts) * wts[:, None]
+    G = np.hstack([mu.T @ make_space(np.asarray(g, float), d, True, True).evaluate(pts) for d, g in conditions])
+    return null_space(G.T, rcond=rtol)
 
 
 def _orthogonal_dims(factor, rtol: float) -> tuple:

@@ -23,6 +23,10 @@ tetrahedral faces are general triangulations, Γ
 :data:`~infsup_contact.discretization.face.triangulated_square.TRIANGULATED` (non-matching traces,
 common refinement by polygon clipping).
 
+``element="hex20"``: serendipity HEX20 bodies on the same structured cells, assembled by scikit-fem
+(:mod:`.hex20`; k = 2, β_h only), Γ the QUAD8 face
+:data:`~infsup_contact.discretization.face.serendipity.SERENDIPITY`.
+
 Boundaries: ``gamma`` (Γ), ``dir`` (the far face: z = 0 of Ω1, z = 2 of Ω2) and ``side`` (the
 four lateral faces). β_h clamps both (:data:`BETA_DIRICHLET`, the paper's u_i = 0 on ∂Ω_i∖Γ);
 a contact scene may clamp fewer (its ``supports``: the face patch test keeps the lateral faces
@@ -51,8 +55,12 @@ import scipy.sparse as sp
 from .contract import Body, MaterialParam, Model
 from .membranes import field, interpolate, laplace_stiffness
 from .contract import SideOperator, factorized_side
+from . import hex20
 
 ELEMENTS = ("hex", "tet")
+"""Elements of the NGSolve bodies (the 3D elastic model's too)."""
+MEMBRANE_ELEMENTS = ELEMENTS + ("hex20",)
+"""Elements of the membranes: also serendipity HEX20 (scikit-fem, :mod:`.hex20`; k = 2, structured)."""
 FAMILIES_3D = ("structured", "perturbed", "unstructured")
 UNSTRUCTURED_ELEMENTS = ("tet",)
 """Elements of the unstructured family (Netgen meshes tetrahedra)."""
@@ -81,16 +89,22 @@ def subdomain_mesh(family: str, n: int, side: int, *, element: str = "hex", widt
     Raises
     ------
     InputError
-        For a family not in :data:`FAMILIES_3D`, an element not in :data:`ELEMENTS` (the
-        unstructured family: :data:`UNSTRUCTURED_ELEMENTS`), N < 1, a width outside (0, 1] (or
+        For a family not in :data:`FAMILIES_3D`, an element not in :data:`MEMBRANE_ELEMENTS` (the
+        unstructured family: :data:`UNSTRUCTURED_ELEMENTS`; ``hex20``: structured, width 1), N < 1,
+        a width outside (0, 1] (or
         other than 1 for the unstructured and perturbed families), α or seed out of range.
     """
     if family not in FAMILIES_3D:
         raise InputError("family", f"{', '.join(FAMILIES_3D)} (the 3D model's meshes)", got=family)
-    if element not in ELEMENTS:
-        raise InputError("element", ", ".join(ELEMENTS), got=element)
+    if element not in MEMBRANE_ELEMENTS:
+        raise InputError("element", ", ".join(MEMBRANE_ELEMENTS), got=element)
     if not isinstance(n, (int, np.integer)) or n < 1:
         raise InputError("N", "an integer >= 1", got=n)
+    if element == "hex20":
+        if family != "structured" or width != 1.0:
+            raise InputError("family" if family != "structured" else "width",
+                             "structured, width 1 (the HEX20 bodies)", got=family if family != "structured" else width)
+        return hex20.subdomain_mesh(int(n), side)
     if not 0.0 < width <= 1.0 or (family != "structured" and width != 1.0):
         raise InputError("width", "a width 0 < width <= 1 of the body in x (1 for the unstructured and "
                          "perturbed families)", got=width)
@@ -144,7 +158,13 @@ def side_operator(body: Body, k: int, route: str = "auto", dirichlet: str = BETA
 
     ``body``: the mesh and its Γ (:func:`subdomain_mesh`); ``gamma``: another interface whose trace
     is taken (a narrower body passes ``Square(width=...)``); ``keep_factor``: the factorization that
-    gives S also serves the solves (:func:`~.schur.gamma_factorization`; a scene's side)."""
+    gives S also serves the solves (:func:`~.schur.gamma_factorization`; a scene's side). A HEX20
+    body (:mod:`.hex20`) is assembled by scikit-fem, u_i = 0 on all of ∂Ω_i∖Γ only."""
+    if hex20.is_hex20(body):
+        if dirichlet != BETA_DIRICHLET or gamma is not None:
+            raise InputError("element", "hex, tet (supports other than ∂Ω_i∖Γ, a narrower Γ); hex20 serves β_h",
+                             got="hex20")
+        return hex20.side_operator(body, k, route, keep_factor)
     fes = displacement_space(body.mesh, k, dirichlet)
     trace = (body.interface if gamma is None else gamma).trace(fes)
     free_mask = np.array(fes.FreeDofs(), dtype=bool)
@@ -159,7 +179,10 @@ def side_operator(body: Body, k: int, route: str = "auto", dirichlet: str = BETA
 
 def scene_side(scene, body: Body, k: int) -> MembraneSide:
     """The side of a contact scene: u_i prescribed on the scene's ``supports`` (an NGSolve
-    boundary regexp; the face patch test: the far face only), else on all of ∂Ω_i∖Γ."""
+    boundary regexp; the face patch test: the far face only), else on all of ∂Ω_i∖Γ. HEX20 bodies
+    serve β_h only (a scene's fields and loads are NGSolve's)."""
+    if hex20.is_hex20(body):
+        raise InputError("element", "hex, tet (contact scenes; hex20 serves beta and verdict)", got="hex20")
     return side_operator(body, k, dirichlet=getattr(scene, "supports", None) or BETA_DIRICHLET, keep_factor=True)
 
 
@@ -176,12 +199,13 @@ def load(side: MembraneSide, scene, i: int):
 
 
 MEMBRANES3D = Model("membranes3d", side_operator,
-                    "two 3D bodies (0,1)^3 and (0,1)^2x(1,2), -c_i Δu_i = f_i, scalar Q_k (hex) or P_k (tet), "
+                    "two 3D bodies (0,1)^3 and (0,1)^2x(1,2), -c_i Δu_i = f_i, scalar Q_k (hex), P_k (tet) or "
+                    "serendipity Q2 (hex20, k = 2), "
                     "contact face Γ = (0,1)^2x{1}; structured, perturbed or unstructured (tet) meshes, "
                     "N cells per direction or maxh = 1/N (--element)",
                     scene_side=scene_side, load=load, field=field, interpolate=interpolate,
                     params=tuple(MaterialParam(f"c{i + 1}", 1.0, lambda v, key: check_prestress(key, v),
                                                "1e-150 <= c <= 1e150", f"prestress c{i + 1} of Ω{i + 1}", side=i)
                                  for i in range(2)),
-                    mesh=subdomain_mesh, mesh_options=(("element", ELEMENTS),), families=FAMILIES_3D, dim=3)
+                    mesh=subdomain_mesh, mesh_options=(("element", MEMBRANE_ELEMENTS),), families=FAMILIES_3D, dim=3)
 """The 3D membranes through the model seam (β_h, and contact scenes with far-face displacements)."""

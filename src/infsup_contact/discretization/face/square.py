@@ -33,7 +33,9 @@ from .quadrature import split_rule
 from .tensor_grid import TensorPartition, coarsening_cells, merge_breakpoints
 from ..gamma.quadrature import gauss_legendre
 
-CELL_SHAPES = ("quad", "trig")
+CELL_SHAPES = ("quad", "trig", "quad8")
+"""Boundary cells of a face: rectangles of Q_k hexahedra, their Kuhn triangles, QUAD8 rectangles of
+serendipity HEX20 bodies (:mod:`.face.serendipity`)."""
 
 
 @dataclass(frozen=True)
@@ -46,9 +48,10 @@ class Square(Interface):
         Name of Γ's boundary region in the meshes (``gamma``).
     z : float
         Height of Γ.
-    cell : {"quad", "trig"}
+    cell : {"quad", "trig", "quad8"}
         Shape of the boundary elements on Γ: rectangles of a hexahedral mesh, or each
-        rectangle cut in two triangles (a tetrahedral mesh).
+        rectangle cut in two triangles (a tetrahedral mesh); ``quad8``: the QUAD8 rectangles of
+        serendipity HEX20 bodies, whose trace is :class:`~.face.serendipity.SerendipitySquare`'s.
     width : float
         Γ's extent in x (1: the unit face). A narrower face (0, width) × (0, 1) is the trace
         of a narrower body (:mod:`infsup_contact.study.face.edge_dropping`); the trace
@@ -264,7 +267,7 @@ class Square(Interface):
         if pieces is None:
             raise InputError("space", "a face space polynomial on the rectangles of a tensor partition",
                              got=space.name)
-        if self.cell == "quad":
+        if self.cell != "trig":
             return self.quadrature(self.common_refinement(trace.partition, pieces), degree)
         return split_rule(self.common_refinement(trace.partition, pieces), trace.partition, 2 * degree,
                           space.breakpoints)
@@ -289,6 +292,10 @@ class Square(Interface):
         from .norms.cellwise import shared_piece_sums
 
         return shared_piece_sums()
+
+    def allows(self, k: int) -> bool:
+        """Whether the bodies of this face exist for displacement degree k (every k here)."""
+        return True
 
     def builds(self, spec) -> bool:
         """Whether ``spec`` is defined on this face's cells (``spec.face_cells``)."""

@@ -5,27 +5,39 @@ lists them for a face and refuses them on the segment in one line (``registry.ca
 """
 from __future__ import annotations
 
-from ..face.spaces.cellwise import cellwise_builder
+from ..face.spaces.cellwise import DiscontinuousP1Space, cellwise_builder
 from ..face.spaces.reference_elements import reference_element
 from ..face.spaces.tri6 import triangle_builder
+from ..face.spaces.tensor import FaceSpace
+from ..segment.multipliers import make_space
 from .spec import SpaceSpec
 
 
-def _face_spec(id, ref, definition, element, basis, dimension, vanish=True, expected="unknown", refuse_with=""):
+def _face_spec(id, ref, definition, element, basis, dimension, vanish=True, expected="unknown", refuse_with="",
+               cells=None):
     """A space of quadratic face elements on G_h (k ≥ 2), paired with the face cells of the element's
     reference cell: QUAD8/QUAD9 on rectangles (hexahedra), TRI6 on triangles (tetrahedra, always
-    without the ∂Γ nodes)."""
+    without the ∂Γ nodes); ``cells`` overrides the pairing (``quad8``: the QUAD8 traces of HEX20 bodies)."""
     quad = reference_element(element).cell == "quad"
     build = (cellwise_builder(element, basis, vanish, refuse_with=refuse_with) if quad
              else triangle_builder(basis, refuse_with=refuse_with))
     return SpaceSpec(
         id, ref, definition, None, lambda k: 2, min_k=2, expected=expected,
         dimension=dimension, nodal_basis=basis in ("standard", "pwlin"),
-        claim_tag=id, gamma_dims=(2,), face_build=build, face_cells=("quad",) if quad else ("trig",))
+        claim_tag=id, gamma_dims=(2,), face_build=build,
+        face_cells=cells or (("quad",) if quad else ("trig",)))
 
 
 def _interior(n):       # nodes of the QUAD9 (= P2 triangle) lattice inside (0, 1)² on an n × n grid
     return (2 * n - 1) ** 2
+
+
+def _quad8_nodes(n):    # QUAD8 nodes (corners and edge midpoints) on an n × n grid, ∂Γ included
+    return (n + 1) ** 2 + 2 * n * (n + 1)
+
+
+def _interior_q1(k, partition):  # continuous Q1 vanishing on ∂Γ: the tensor product of the 1D hats
+    return FaceSpace(*(make_space(g, 1, True, True) for g in (partition.xs, partition.ys)), partition)
 
 
 _TDUAL_Q8 = "use case TDUAL-Q8 (the transformed dual basis, Popp et al. 2012, α = 1/5)"
@@ -37,9 +49,9 @@ FACE_SPACES = (
     _face_spec("DUAL-Q9-ALL", "Wohlmuth 2000 (all nodes)", "dual basis of QUAD9 on all nodes", "QUAD9", "dual",
                lambda k, n: (2 * n + 1) ** 2, vanish=False, expected="unstable"),
     _face_spec("DUAL-Q8", "Wohlmuth 2000 (QUAD8)", "dual basis of QUAD8 (refused: corner weights ∫N = −1/3 < 0)",
-               "QUAD8", "dual", lambda k, n: _interior(n) - n * n, refuse_with=_TDUAL_Q8),
+               "QUAD8", "dual", lambda k, n: _interior(n) - n * n, refuse_with=_TDUAL_Q8, cells=("quad", "quad8")),
     _face_spec("TDUAL-Q8", "Popp, Gitterle, Gee, Wall 2010; 4C", "transformed dual basis of QUAD8, α = 1/5",
-               "QUAD8", "transformed_dual", lambda k, n: _interior(n) - n * n),
+               "QUAD8", "transformed_dual", lambda k, n: _interior(n) - n * n, cells=("quad", "quad8")),
     _face_spec("TDUAL-Q9", "Popp, Gitterle, Gee, Wall 2010; 4C", "transformed dual basis of QUAD9, α = 1/5",
                "QUAD9", "transformed_dual", lambda k, n: _interior(n)),
     _face_spec("PWLIN-Q9", "4C LM_QUAD pwlin (Popp 2009)", "piecewise bilinear on the 4 sub-quads of QUAD9",
@@ -52,5 +64,20 @@ FACE_SPACES = (
                lambda k, n: _interior(n)),
     _face_spec("PWLIN-T6", "4C LM_QUAD pwlin (Popp 2009)", "piecewise linear on the 4 sub-triangles of TRI6, "
                "vanishing on ∂Γ", "TRI6", "pwlin", lambda k, n: _interior(n)),
+    # QUAD8 traces (serendipity HEX20 bodies, k = 2): dim W_h = (2N − 1)² − N², the interior QUAD8 nodes
+    _face_spec("Q8", "standard mortar on QUAD8 faces (MOOSE; CalculiX MORTAR)", "continuous QUAD8 on ∂Γ-free nodes",
+               "QUAD8", "standard", lambda k, n: _interior(n) - n * n, expected="stable", cells=("quad8",)),
+    _face_spec("Q8-ALL", "standard mortar on QUAD8 faces, all nodes", "continuous QUAD8 on all nodes", "QUAD8",
+               "standard", lambda k, n: _quad8_nodes(n), vanish=False, expected="unstable", cells=("quad8",)),
+    # the linear multiplier on the vertices of G_h (MOOSE lm_space = LINEAR, CalculiX LINMORTAR) is
+    # T5 at k = 2 (continuous Q1, ∂Γ included); this one drops the ∂Γ vertices, as T3 / Q8 do
+    SpaceSpec("LIN0-Q8", "linear mortar on QUAD8 faces, ∂Γ vertices dropped", "continuous Q1 on the interior "
+              "vertices of G_h", None, lambda k: 1, min_k=2, expected="stable", dimension=lambda k, n: (n - 1) ** 2,
+              claim_tag="LIN0-Q8", gamma_dims=(2,), face_build=_interior_q1, face_cells=("quad8",)),
+    # dim 3N² > dim W_h = 3N² − 4N + 1: at least 4N − 1 zero modes on matching meshes
+    SpaceSpec("DISC-P1", "discontinuous P1 on QUAD8 faces", "discontinuous P1 on every rectangle of G_h", None,
+              lambda k: 1, min_k=2, expected="unstable", dimension=lambda k, n: 3 * n * n, nodal_basis=False,
+              claim_tag="DISC-P1", gamma_dims=(2,), face_build=lambda k, partition: DiscontinuousP1Space(partition),
+              face_cells=("quad8",)),
 )
 """The face-only entries, in registration order."""

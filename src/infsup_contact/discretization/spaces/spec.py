@@ -70,7 +70,9 @@ class SpaceSpec:
     face_cells : tuple of str
         The face cells (``quad``, ``trig``: :data:`~.face.square.CELL_SHAPES`) whose traces the space
         is defined against: the quadratic quadrilateral elements' multipliers pair with QUAD9
-        traces (hexahedra) only, the TRI6 ones with P2 triangle traces (tetrahedra) only.
+        traces (hexahedra) only, the TRI6 ones with P2 triangle traces (tetrahedra) only; ``quad8``:
+        the QUAD8 traces of serendipity HEX20 bodies (:mod:`.face.serendipity`), which every tensor
+        product space (the default) and the QUAD8 element spaces build on.
     lagrange : tuple or None
         ``(continuous, vanish)`` when ``build`` is the Lagrange space M^r_s / M^r_{0,s} of degree
         s = ``degree(k)`` (:func:`~.segment.multipliers.make_space`): the description an interface
@@ -94,7 +96,7 @@ class SpaceSpec:
     claim_tag: str | None = None
     gamma_dims: tuple = (1, 2)
     face_build: Callable | None = None
-    face_cells: tuple = ("quad", "trig")
+    face_cells: tuple = ("quad", "trig", "quad8")
     lagrange: tuple | None = None
     dual: bool = False
 
@@ -110,12 +112,13 @@ class SpaceSpec:
     def face_space(self, k: int, n: int):
         """The space on the uniform n × n grid of the face: the square's build on the first face
         cell shape the entry is defined on (``face_cells``: rectangles, else triangles)."""
-        from ..face.square import CELL_SHAPES, Square
+        from ..face.serendipity import face_of
+        from ..face.square import CELL_SHAPES
         from ..face.tensor_grid import TensorPartition
 
         x = np.linspace(0.0, 1.0, n + 1)
         cell = next(c for c in CELL_SHAPES if c in self.face_cells)
-        return Square(cell=cell).space(self, k, TensorPartition(x, x))
+        return face_of(cell).space(self, k, TensorPartition(x, x))
 
     @property
     def tag(self) -> str:
@@ -142,9 +145,11 @@ class SpaceSpec:
         if self.dimension is None:
             return None
         if not self.defined_on(1):
-            from ..face.square import SQUARE  # the face builds on the segment's spaces: imported late
+            from ..face.serendipity import face_of  # the face builds on the segment's spaces: imported late
+            from ..face.square import CELL_SHAPES
 
-            return max(self.dimension(k, n) - SQUARE.trace_dimension(k, n), 0)
+            face = face_of(next(c for c in CELL_SHAPES if c in self.face_cells))
+            return max(self.dimension(k, n) - face.trace_dimension(k, n), 0)
         return max(self.dimension(k, n) - SEGMENT.trace_dimension(k, n), 0)
 
     def cone(self, k: int) -> str:

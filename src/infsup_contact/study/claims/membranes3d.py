@@ -138,12 +138,13 @@ def triangle_kernel_bound(spec, k: int, n1: int, n2: int, gamma=SQUARE_TRIG) -> 
 
 
 def element_interfaces(model, elements) -> dict:
-    """The face interface of each element of ``model`` (rectangles or triangles), asked of a
-    1 × 1 × 1 mesh of each: a property, not an element name."""
+    """The face interface of each element of ``model`` (rectangles, triangles, QUAD8 rectangles),
+    asked of a 1 × 1 × 1 mesh of each (the mesh builder names it: ``Body.interface``, the Γ its
+    sides trace): a property, not an element name."""
     from ...models import make_model
 
     m = make_model(model) if isinstance(model, str) else model
-    return {e: m.side_operator(m.mesh("structured", 1, 1, element=e), 1).trace.gamma for e in elements}
+    return {e: m.mesh("structured", 1, 1, element=e).interface for e in elements}
 
 
 def kuhn(gamma) -> bool:

@@ -99,7 +99,7 @@ def family_kernels(pairs, ks=(1, 2), cases=None, elements=None, model: str | Non
     m, cache, rows = make_model(model), SideCache(), []
     for element in elements:
         gamma = faces[element]
-        for k in ks:
+        for k in (k for k in ks if gamma.allows(k)):  # HEX20 bodies: k = 2 only
             ids = [c for c in ids_valid_for(k, cases, gamma_dim=2) if gamma.builds(SPACES[c])
                    and SPACES[c].dimension is not None]
             for n1, n2 in pairs:

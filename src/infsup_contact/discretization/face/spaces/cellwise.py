@@ -212,6 +212,38 @@ class CellwiseFaceSpace(SpaceDefaults):
         return ((I == 0) | (I == 2 * nx) | (J == 0) | (J == 2 * ny)).reshape(nx * ny, el.n_nodes)
 
 
+class DiscontinuousP1Space(CellwiseFaceSpace):
+    """Discontinuous P1 on the rectangles of ``partition``: 1, ξ, η on every cell (ξ, η the cell's
+    reference coordinates in [−1, 1]², so the functions are affine in x and y), three dofs per
+    cell, written as combinations of the QUAD4 shapes (1 = Σ N_a, ξ = Σ ξ_a N_a, η = Σ η_a N_a) so
+    that evaluation, the pieces and the Grams are :class:`CellwiseFaceSpace`'s."""
+
+    def __init__(self, partition):
+        super().__init__(partition, "QUAD4", "standard")
+        nodes = reference_element("QUAD4").nodes
+        C = np.zeros((4, 4))
+        C[0], C[1], C[2] = 1.0, nodes[:, 0], nodes[:, 1]
+        cells = (len(self.xs) - 1) * (len(self.ys) - 1)
+        self.coefficients = np.broadcast_to(C, (cells, 4, 4)).copy()
+        self.dofs = np.column_stack([3 * np.arange(cells)[:, None] + np.arange(3), -np.ones(cells, int)])
+        self.dim = 3 * cells
+        self.basis = "p1"
+
+    def nodes(self) -> np.ndarray:
+        """The centre of each dof's cell, shape (dim, 2)."""
+        cx, cy = 0.5 * (self.xs[:-1] + self.xs[1:]), 0.5 * (self.ys[:-1] + self.ys[1:])
+        X, Y = np.meshgrid(cx, cy, indexing="ij")
+        return np.repeat(np.column_stack([X.ravel(), Y.ravel()]), 3, axis=0)
+
+    @property
+    def name(self) -> str:
+        return "P1-discontinuous"
+
+    @property
+    def continuous(self) -> bool:
+        return False
+
+
 def cellwise_builder(element: str, basis: str, vanish_on_boundary: bool = True, alpha=None,
                      refuse_with: str = ""):
     """``build(k, partition)`` of a registry entry (:attr:`.spaces.spec.SpaceSpec.face_build`):

@@ -251,6 +251,10 @@ def verdict_estimate(family: str, k: int, ns, norm: str, multiplier_mesh: str = 
     return Estimate(max(e.bytes for e in ests), START_SECONDS + sum(e.seconds - START_SECONDS for e in ests))
 
 
+VECTOR_BENCHES = ("elastic",)
+"""``bench --what`` targets whose bodies carry two displacement components (the plane-strain β routes)."""
+
+
 def bench_estimate(what: str, ns, ks, repeats: int = 3, eigsh_max_n=None, kkt_max_n: int = 64,
                    n_problems: int = 10) -> Estimate:
     """``bench``: every (N, k) in turn, each route next to ours (factor :data:`BENCH_FACTOR`);
@@ -265,7 +269,7 @@ def bench_estimate(what: str, ns, ks, repeats: int = 3, eigsh_max_n=None, kkt_ma
                 seconds += repeats * 3 * (inner.seconds - START_SECONDS)
                 continue
             nd_total = 2 * side_dofs("structured", n, k)
-            if what == "elastic":  # two components per node, the H norm; no pencil route
+            if what in VECTOR_BENCHES:  # two components per node, the H norm; no pencil route
                 inner = beta_estimate("structured", k, n, n, norms=("H",), process=False, components=2)
             elif what == "beta":
                 inner = beta_estimate("structured", k, n, n, process=False)

@@ -58,10 +58,7 @@ def _check_bench(args):
             raise InputError(key, f"{allowed}, each once", got=" ".join(map(str, values)))
     from ..discretization.spaces.registry import check_pair_spaces, ids_valid_for
 
-    if args.what == "face":
-        _check_face(args)
-    if args.what == "elastic":
-        _check_elastic(args)
+    TARGET_CHECKS.get(args.what, lambda _: None)(args)  # a target's own flags
     for k in args.k:  # every registered space defined for k: a superset of what the routes run
         for n in args.N:
             check_pair_spaces(ids_valid_for(k), k, n, n, key="N")
@@ -109,6 +106,12 @@ def _check_elastic(args) -> None:
         space_spec(case)
 
 
+TARGET_CHECKS = {"face": _check_face, "elastic": _check_elastic}
+"""The ``--what`` targets with flags of their own, and their checks."""
+PLANE_STRAIN = ("elastic",)
+"""The ``--what`` targets of the plane-strain β routes (``--nu``, ``--case``)."""
+
+
 def _run_bench(args) -> None:
     import pandas as pd
 
@@ -122,8 +125,8 @@ def _run_bench(args) -> None:
         rows = bench.bench_beta(bench.bench_for("beta", dense_max_size=args.dense_max_size,
                                                 eigsh_max_n=args.eigsh_max_n), args.N, args.k, args.repeats,
                                 args.route_budget)
-    elif args.what == "elastic":
-        rows = bench.bench_beta(bench.bench_for("elastic", nu=args.nu), args.N, args.k, args.repeats,
+    elif args.what in PLANE_STRAIN:
+        rows = bench.bench_beta(bench.bench_for(args.what, nu=args.nu), args.N, args.k, args.repeats,
                                 args.route_budget, cases=args.case)
     else:
         rows = bench.bench_contact(args.N, args.k, args.repeats, peers=tuple(peers),

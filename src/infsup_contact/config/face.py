@@ -37,6 +37,7 @@ def check_face(cfg) -> None:
         if element not in options:
             raise ConfigError(f"face.elements[{i}]", f"not an element of {model.name}", got=element,
                               allowed=", ".join(options))
+        _check_degrees(f"face.elements[{i}]", model, element, fc["k"], "face.k")
     for element, top in (fc.get("max_N") or {}).items():
         if element not in fc["elements"]:
             raise ConfigError(f"face.max_N.{element}", "not an element of face.elements", got=element,
@@ -54,6 +55,15 @@ def check_face(cfg) -> None:
     check_face_studies(fc, model.name, options)
 
 
+def _check_degrees(key: str, model, element: str, ks, k_key: str) -> None:
+    """ConfigError unless the element's bodies exist for every k of ``ks`` (HEX20: k = 2 only)."""
+    gamma = model.gamma(element=element)
+    bad = [int(k) for k in ks if not gamma.allows(int(k))]
+    if bad:
+        raise ConfigError(key, f"the {element} bodies have no degree k = {bad[0]} ({k_key})", got=element,
+                          allowed=f"an element with every degree of {k_key}, or {k_key} without {bad[0]}")
+
+
 def check_face_studies(fc, model_name: str, options) -> None:
     """The face studies' keys (rules/face_studies.smk) the schema cannot state: the patch
     test's elements are the model's, its pairs non-matching; the α sweep's elements are face
@@ -62,10 +72,18 @@ def check_face_studies(fc, model_name: str, options) -> None:
     from ..discretization.face.spaces.cellwise import QUAD_ELEMENTS
     from ..discretization.face.spaces.dual_bases import transformation
 
+    from ..models import MODELS
+
     for i, element in enumerate(fc["patch"]["elements"]):
         if element not in options:
             raise ConfigError(f"face.patch.elements[{i}]", f"not an element of {model_name}", got=element,
                               allowed=", ".join(options))
+        gamma = MODELS[model_name].gamma(element=element)
+        if not gamma.contact:
+            raise ConfigError(f"face.patch.elements[{i}]", f"the {element} bodies serve β_h only (no contact "
+                              "scene, so no patch test)", got=element,
+                              allowed=", ".join(e for e in options if MODELS[model_name].gamma(element=e).contact))
+        _check_degrees(f"face.patch.elements[{i}]", MODELS[model_name], element, fc["patch"]["k"], "face.patch.k")
     for i, pair in enumerate(fc["patch"]["pairs"]):
         if pair[0] == pair[1]:
             raise ConfigError(f"face.patch.pairs[{i}]", "the patch test's pairs are non-matching: N1 != N2",

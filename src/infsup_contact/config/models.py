@@ -80,6 +80,12 @@ def _check_beta(key: str, entry: dict) -> None:
                               allowed="[N1, N2] with N1 != N2 (matching meshes go under N)")
     gammas = [model.gamma(element=e) for e in elements] if elements else [model.gamma()]
     ks = [int(k) for k in entry["k"]]
+    for i, gamma in enumerate(gammas):
+        bad = [k for k in ks if not gamma.allows(k)]
+        if bad:
+            raise ConfigError(f"{key}.elements[{i}]" if elements else f"{key}.k", f"the model's bodies have no "
+                              f"degree k = {bad[0]}", got=elements[i] if elements else bad[0],
+                              allowed="degrees every listed element has (k)")
     for i, case in enumerate(entry["cases"]):
         spec = SPACES.get(case)
         if spec is None:

@@ -144,6 +144,9 @@ class SerendipitySquare(Square):
         return phi
 
     # --- counts
+    contact = False
+    """HEX20 bodies serve β_h and verdict only (contact scenes need NGSolve fields)."""
+
     def allows(self, k: int) -> bool:
         """HEX20 bodies have k = 2 only."""
         return k == 2

@@ -293,10 +293,6 @@ class Square(Interface):
 
         return shared_piece_sums()
 
-    def allows(self, k: int) -> bool:
-        """Whether the bodies of this face exist for displacement degree k (every k here)."""
-        return True
-
     def builds(self, spec) -> bool:
         """Whether ``spec`` is defined on this face's cells (``spec.face_cells``)."""
         return self.cell in spec.face_cells

@@ -9,20 +9,14 @@ use. Multiplier spaces are built on it: ``registry.case_space(case, k, partition
 builds a registered space on a partition of ``gamma`` (the registry imports this module, never
 the other way round).
 
-Coupling (:mod:`.gamma.coupling`), β_h (:mod:`infsup_contact.solvers.infsup`), contact
-(:mod:`infsup_contact.solvers.contact`) and the scenes ask the interface; they never take a
-partition apart. A partition is opaque to them: they obtain it from the interface and hand it
-back to it. A side's trace carries its interface (``trace.gamma``), so a consumer holding the
-sides of a mesh pair finds Γ there (the trace itself: :mod:`.gamma.trace`).
+Coupling, β_h, contact and the scenes ask the interface and never take a partition apart (it is
+opaque: obtained from the interface, handed back to it); a side's trace carries its interface
+(``trace.gamma``, :mod:`.gamma.trace`).
 
-:class:`~.segment.interface.Segment` — Γ = (0, 1) × {1}, the paper's — is the first implementation;
-its partition is the sorted array of breakpoints (abscissae x of the vertices on Γ), the
-representation :class:`~.segment.multipliers.SegmentSpace` and users' spaces (``build(k, x)``) are built on.
-The 2D contact face Γ = (0, 1)² × {1} of the 3D models is the second,
-:class:`~.face.square.Square` (tensor partitions; spaces are tensor products of the 1D builds,
-:meth:`Interface.space`); the same face traced by unstructured or perturbed tetrahedral meshes is
-the third, :class:`~.face.triangulated_square.TriangulatedSquare` (general triangulations, their
-common refinement by polygon clipping).
+Implementations: the paper's segment (:class:`~.segment.interface.Segment`, partitions = sorted
+breakpoints, what users' ``build(k, x)`` receive); the face (0, 1)² × {1} with tensor partitions
+(:class:`~.face.square.Square`; QUAD8 traces: :class:`~.face.serendipity.SerendipitySquare`) and
+with general triangulations (:class:`~.face.triangulated_square.TriangulatedSquare`, clipped).
 """
 from __future__ import annotations
 
@@ -352,6 +346,12 @@ class Interface(abc.ABC):
 
     def builds(self, spec) -> bool:
         """Whether this interface has a space of the registry entry ``spec``; default: every one."""
+        return True
+
+    contact = True  # whether contact scenes (the patch test among them) run on this Γ's bodies
+
+    def allows(self, k: int) -> bool:
+        """Whether this Γ's bodies exist for displacement degree k (default: every k)."""
         return True
 
     def space(self, spec, k: int, partition):

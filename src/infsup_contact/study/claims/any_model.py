@@ -11,8 +11,10 @@ the membranes' on each body (so nothing here reads the model):
   to Σ|v_i|²₁ changes β_h by bounded factors only, so a space registered stable keeps β_h bounded
   away from 0 on matching meshes (slope of log β_h vs log h within ±τ, min β_h above the floor).
 * **Zero modes stay** (same id scheme): the kernel depends on B alone; on a 2D model (Γ the paper's
-  segment, scalar P_k traces) it is the registry's count on every matching mesh, on a face at
-  least one mode.
+  segment, scalar P_k traces) it is the registry's count on every matching mesh; where the row's
+  proof (``structural_kernel_dim``, the interface's count of the modes b cannot see) is positive on
+  every matching mesh the kernel is exactly that (a registered-stable space included: a face can
+  give it modes the segment does not); otherwise an unstable space has at least one mode.
 """
 from __future__ import annotations
 
@@ -49,7 +51,8 @@ def model_claims(beta: pd.DataFrame, cfg: dict, name: str, dim: int) -> pd.DataF
             continue
         cid = f"{name}-{spec.tag}-k{k}" + ("" if element == "-" else f"-{element}")
         where = f"{name}, {case}, k={k}" + ("" if element == "-" else f", {element}")
-        if spec.stable:
+        proven = rows.structural_kernel_dim.to_numpy(int)
+        if spec.stable and not proven.any():
             out.append(row(cid, REF, f"{where}: β_h bounded away from 0 on matching meshes (H^-1/2_00 norm)",
                            bounded_claim(finest(rows, win), tol, floor, conf)))
         elif spec.expected == "unstable" and dim == 2 and spec.dimension is not None:
@@ -57,6 +60,9 @@ def model_claims(beta: pd.DataFrame, cfg: dict, name: str, dim: int) -> pd.DataF
             text = expected if np.isscalar(expected) else "the registry's count"
             out.append(row(cid, REF, f"{where}: kernel of dimension {text} on matching meshes",
                            kernel_claim(rows, expected)))
+        elif proven.all():  # the face's proof counts the modes (a stable space can lose them on a face)
+            out.append(row(cid, REF, f"{where}: the kernel is the proven one on matching meshes "
+                           f"({', '.join(map(str, proven))})", kernel_claim(rows, proven)))
         elif spec.expected == "unstable":
             out.append(row(cid, REF, f"{where}: β_h = 0 (a kernel) on matching meshes", kernel_at_least(rows, 1)))
     return pd.DataFrame(out)

@@ -21,8 +21,8 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from ...criteria.claims import FAIL, INCONCLUSIVE, PASS, bounded_claim, close_decisions, close_text, finest, kernel_at_least, \
-    kernel_claim, predicted_kernel, row
+from ...criteria.claims import (FAIL, FINDING, INCONCLUSIVE, PASS, bounded_claim, close_decisions, close_text,
+                                finest, kernel_at_least, kernel_claim, predicted_kernel, row)
 from ...discretization.spaces.registry import SPACES
 
 REF = "beyond the paper (a model of the model table)"
@@ -65,4 +65,7 @@ def model_claims(beta: pd.DataFrame, cfg: dict, name: str, dim: int) -> pd.DataF
                            f"({', '.join(map(str, proven))})", kernel_claim(rows, proven)))
         elif spec.expected == "unstable":
             out.append(row(cid, REF, f"{where}: β_h = 0 (a kernel) on matching meshes", kernel_at_least(rows, 1)))
+        else:  # no expectation registered and no proven mode: what β_h does is a finding
+            out.append(row(cid, REF, f"{where}: β_h bounded away from 0 on matching meshes? (a finding)",
+                           bounded_claim(finest(rows, win), tol, floor, conf), predicted=FINDING))
     return pd.DataFrame(out)

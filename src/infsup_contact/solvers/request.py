@@ -8,7 +8,7 @@ parameters travel as a :class:`MeshOptions`, not as keywords.
 """
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass
 
 import numpy as np
 
@@ -46,6 +46,10 @@ class MeshOptions:
         return {key: value for key, value in asdict(self).items() if value is not None}
 
 
+NO_OPTIONS = MeshOptions()
+"""No mesh option set: the builder's defaults."""
+
+
 @dataclass(frozen=True)
 class BetaRequest:
     """β_h of (4.5) for the cases × multiplier meshes × (c1, c2) × norms of one mesh pair.
@@ -66,7 +70,7 @@ class BetaRequest:
     norms: tuple = NORMS
     h_route: str = "logkernel"
     model: Model = DEFAULT_MODEL
-    mesh: MeshOptions = field(default_factory=MeshOptions)
+    mesh: MeshOptions = NO_OPTIONS
 
     def __post_init__(self):
         check_k(self.k)

@@ -83,12 +83,12 @@ def _check_verdict(args):
     from ..discretization.segment import meshes
     from ..discretization.spaces import registry
     from ..discretization.spaces.user_spaces import load_user_space
+    from ..solvers.request import check_k
     from ..study.verdict import check_criterion, check_mesh_sizes, check_model_case, check_n1_offset
 
     args.space_or_case = args.case if args.space is None else load_user_space(args.space, run_intervals(args))
     case = args.case if args.space is None else args.space_or_case.id
-    if not 1 <= args.k <= 4:
-        raise InputError("k", "an integer in 1..4", got=args.k)
+    check_k(args.k)
     registry.check_case(case, args.k)
     from ..models import make_model
 

@@ -27,11 +27,10 @@ import pandas as pd
 
 from ..discretization.spaces import registry
 from ..discretization.spaces.spec import SpaceSpec
-from ..discretization.segment.norms import NORMS
 from ..errors import InputError
 from ..models import DEFAULT_MODEL
 from ..solvers.infsup import beta_rows
-from ..solvers.request import NO_OPTIONS, MeshOptions
+from ..solvers.request import NO_OPTIONS, MeshOptions, check_norm
 from ..criteria import claims as criteria
 from ..criteria.stability import MIN_MESHES, stability_verdict
 
@@ -85,8 +84,7 @@ def verdict_rows(case_or_spec, k: int, family: str, ns, norm: str, *, tol: float
     ns = check_mesh_sizes(ns)
     check_n1_offset(ns, n1_offset)
     check_criterion(tol, floor, confidence)
-    if norm not in NORMS:
-        raise InputError("norm", ", ".join(NORMS), got=norm)
+    check_norm(norm)
     model = DEFAULT_MODEL if model is None else model
     rows = [r for n in ns for r in beta_rows(family, k, n + n1_offset, n, [case], multiplier_mesh,
                                              norms=(norm,), model=model, mesh=mesh)]

@@ -14,7 +14,9 @@ tests call it directly. In order, it
 Every failure is a :class:`ConfigError` whose message is one line,
 ``config key <key>: <what> (got <value>; allowed <allowed>)``. What is allowed but worth
 knowing (a fit window longer than a β series, shrunk explicitly) comes back as notes that the
-workflow logs. Pure functions: no Snakemake, no solver imports.
+workflow logs. Pure functions: no Snakemake; a field a β_h request has is checked by the
+request's own rule (:mod:`infsup_contact.solvers.request`, the registry), imported where used
+and run under the config key (:func:`~.schema.naming_key`).
 """
 from __future__ import annotations
 

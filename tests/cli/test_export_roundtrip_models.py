@@ -26,6 +26,7 @@ from infsup_contact.discretization.face.square import SQUARE, SQUARE_TRIG
 from infsup_contact.discretization.face.tensor_grid import TensorPartition
 from infsup_contact.models import MODELS
 from infsup_contact.solvers.infsup import beta_rows
+from infsup_contact.solvers.request import MeshOptions
 from infsup_contact.study.verdict import model_case_ids
 from infsup_contact.systems.levels import load_level, system_rows
 from infsup_contact.systems.manifest import load_manifest
@@ -70,12 +71,12 @@ def _lambda_max(level):
 @pytest.mark.parametrize("model_name, element, k, offset, n", _settings())
 def test_export_round_trip_agrees_with_beta(tmp_path, capsys, model_name, element, k, offset, n):
     model = MODELS[model_name]
-    mesh_kwargs = {} if element is None else {"element": element}
-    cases = model_case_ids(model, k, **mesh_kwargs)
+    mesh = MeshOptions(element=element)
+    cases = model_case_ids(model, k, mesh=mesh)
     face_only = sorted(set(cases) - set(ids_valid_for(k)))
     assert face_only == _face_only(element, k)
     refs = {r["case"]: r for r in beta_rows("structured", k, n + offset, n, cases, norms=("H",), model=model,
-                                            **mesh_kwargs)}
+                                            mesh=mesh)}
     for case in cases:
         out = tmp_path / case
         argv = ["export", "--model", model_name, "--case", case, "--k", str(k), "--N", str(n),

@@ -16,6 +16,7 @@ from infsup_contact.discretization.face.square import SQUARE, SQUARE_TRIG
 from infsup_contact.discretization.face.tensor_grid import TensorPartition
 from infsup_contact.models import MODELS
 from infsup_contact.solvers.infsup import beta_rows
+from infsup_contact.solvers.request import MeshOptions
 from infsup_contact.systems.levels import system_verdict
 from infsup_contact.systems.manifest import load_manifest
 
@@ -133,9 +134,9 @@ def test_non_matching_verdict_case_equals_export_then_system(tmp_path, capsys, f
     system, _ = system_verdict(load_manifest(tmp_path / "levels.yaml"), **CRITERION, notes=io.StringIO())
     assert system["verdict"] == row["verdict"] and system["kernel_dim"] == int(row["kernel_dim"])
     model = MODELS[flags[1] if flags else "membranes"]
-    kw = {"element": flags[3]} if len(flags) > 2 else {}
+    mesh = MeshOptions(element=flags[3]) if len(flags) > 2 else MeshOptions()
     refs = [r for n in map(int, ns) for r in beta_rows("structured", k, n + offset, n, [case], norms=("H",),
-                                                        model=model, **kw)]
+                                                        model=model, mesh=mesh)]
     assert [int(r["N1"]) for r in refs] == [int(n) + offset for n in ns]
     beta_min = min(r["beta"] for r in refs)
     for value in (float(row["beta_min"]), system["beta_min"]):  # CSV: 6 digits

@@ -10,6 +10,7 @@ import scipy.sparse as sp
 from infsup_contact.la import bottom
 from infsup_contact.solvers import infsup, routes, spectra
 from infsup_contact.solvers.kernel import MARGIN_DECADES, bottom_kernel, coupling_kernel
+from infsup_contact.solvers.request import MeshOptions
 
 
 @pytest.mark.parametrize("m, d", [(5, 0), (60, 3), (300, 40)])
@@ -98,7 +99,7 @@ def test_face_rows_agree_between_routes(case, monkeypatch):
     for limit in (10 ** 9, 0):
         monkeypatch.setattr(bottom, "DENSE_MAX_M", limit)
         from infsup_contact.models import MODELS
-        rows[limit] = infsup.beta_rows("structured", 2, 5, 6, [case], model=MODELS["membranes3d"], element="hex")
+        rows[limit] = infsup.beta_rows("structured", 2, 5, 6, [case], model=MODELS["membranes3d"], mesh=MeshOptions(element="hex"))
     for a, b in zip(rows[10 ** 9], rows[0]):
         assert (a["kernel_dim"], a["kernel_decision"], a["kernel_check"]) == \
             (b["kernel_dim"], b["kernel_decision"], b["kernel_check"])
@@ -129,7 +130,7 @@ def test_the_shorter_entry_rule_moves_the_margin_little(monkeypatch):
     margins = []
     for extra in (routes.LONGER_RULE, 2):
         monkeypatch.setattr(routes, "LONGER_RULE_LARGE", extra)
-        row = infsup.beta_rows("structured", 2, 5, 6, ["T3"], model=MODELS["membranes3d"], element="hex",
+        row = infsup.beta_rows("structured", 2, 5, 6, ["T3"], model=MODELS["membranes3d"], mesh=MeshOptions(element="hex"),
                                norms=("L2",))[0]
         margins.append(row["kernel_margin_decades"])
     assert abs(margins[0] - margins[1]) < np.log10(2.0)

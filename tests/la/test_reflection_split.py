@@ -12,6 +12,7 @@ from infsup_contact.discretization.face.tensor_grid import TensorPartition
 from infsup_contact.la import bottom, reflection
 from infsup_contact.solvers import infsup, spectra, symmetry
 from infsup_contact.solvers.kernel import KernelDecision
+from infsup_contact.solvers.request import MeshOptions
 
 
 def _space(case, k, n, gamma=SQUARE):
@@ -142,7 +143,7 @@ def test_face_rows_with_and_without_the_split(case, monkeypatch):
     for on in (True, False):
         if not on:
             monkeypatch.setattr(symmetry, "reflection_split", lambda space, x: None)
-        rows[on] = infsup.beta_rows("structured", 2, 5, 6, [case], model=MODELS["membranes3d"], element="hex")
+        rows[on] = infsup.beta_rows("structured", 2, 5, 6, [case], model=MODELS["membranes3d"], mesh=MeshOptions(element="hex"))
         assert bool(calls) == on  # the split was taken, and then switched off
         calls.clear()
     for a, b in zip(rows[True], rows[False]):
@@ -169,7 +170,7 @@ def test_the_split_kernel_is_the_unsplit_one_on_a_real_face(monkeypatch):
 
     monkeypatch.setattr(bottom, "DENSE_MAX_M", 0)
     monkeypatch.setattr(symmetry, "split_bottom_kernel", spy)
-    infsup.beta_rows("structured", 2, 5, 6, ["R5.2"], model=MODELS["membranes3d"], element="hex", norms=("L2",))
+    infsup.beta_rows("structured", 2, 5, 6, ["R5.2"], model=MODELS["membranes3d"], mesh=MeshOptions(element="hex"), norms=("L2",))
     W, split, proven, error = (captured[k] for k in ("W", "split", "proven", "error"))
     halves, whole = original(W, split, proven, error), bottom_kernel(W, proven, error)
     assert halves is not None and halves.dim == whole.dim > 0 and halves.detected == whole.detected

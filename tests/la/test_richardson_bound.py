@@ -15,6 +15,7 @@ from infsup_contact.models import MODELS
 from infsup_contact.solvers.interface_operator import combine_terms, interface_terms
 from infsup_contact.solvers.side_cache import SideCache
 from infsup_contact.solvers import infsup
+from infsup_contact.solvers.request import MeshOptions
 
 
 def test_lookahead_states_the_step_while_it_shrinks_and_no_bound_when_it_stops():
@@ -52,7 +53,7 @@ def test_the_stated_error_bounds_zeta_also_where_the_tail_is_slower_than_assumed
 
 @pytest.fixture(scope="module")
 def face_sides():
-    return SideCache().pair(MODELS["membranes3d"], "structured", 2, 6, 7, element="hex")
+    return SideCache().pair(MODELS["membranes3d"], "structured", 2, 6, 7, MeshOptions(element="hex"))
 
 
 @pytest.mark.parametrize("case", ["T5", "R5.2"])
@@ -60,7 +61,7 @@ def test_stated_h_error_bounds_beta_against_a_series_carried_further(face_sides,
     """Every eigenvalue of (S, G) moves by at most the stated relative error, so β above the
     kernel (``smallest_nonzero``; β itself for T5) is within it of the converged pencil's."""
     row, = infsup.beta_rows("structured", 2, 6, 7, [case], norms=("H",), model=MODELS["membranes3d"],
-                            side_cache=_cache(face_sides), element="hex")
+                            side_cache=_cache(face_sides), mesh=MeshOptions(element="hex"))
     assert 0 < row["nmax_rel_error"] <= 1e-6
     gamma = face_sides[0].trace.gamma
     partition = gamma.multiplier_partition(*(s.trace.partition for s in face_sides), "omega2")

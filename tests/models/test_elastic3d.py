@@ -23,6 +23,7 @@ from infsup_contact.solvers.infsup import beta_rows_all
 from infsup_contact.study.patch import face_elastic as efp
 from infsup_contact.study.patch.face import PASS_RTOL
 from infsup_contact.study.contact.registry import ELASTIC_FACE_PATCH
+from infsup_contact.solvers.request import MeshOptions
 
 FREE = ("nothing",) * 3
 """Supports matching no boundary: a floating body."""
@@ -111,7 +112,7 @@ def matching_rows():
     for name in ("elastic3d", "membranes3d"):
         for k in (1, 2):
             out[name, k] = beta_rows_all("structured", k, 3, 3, registry.ids_valid_for(k), norms=("H", "L2"),
-                                         model=MODELS[name], element="hex")
+                                         model=MODELS[name], mesh=MeshOptions(element="hex"))
     return out
 
 
@@ -143,7 +144,7 @@ def test_elastic_and_membranes_share_kernels_and_both_are_stable_for_t3(matching
 
 def test_non_matching_kernels_equal_the_membranes():
     """On a non-matching pair (tetrahedra 2:3) both models see the same couplings: equal kernels."""
-    kw = dict(norms=("L2",), element="tet")
+    kw = dict(norms=("L2",), mesh=MeshOptions(element="tet"))
     el = beta_rows_all("structured", 1, 2, 3, registry.ids_valid_for(1), model=ELASTIC3D, **kw)
     mem = beta_rows_all("structured", 1, 2, 3, registry.ids_valid_for(1), model=MODELS["membranes3d"], **kw)
     assert [(r["case"], r["kernel_dim"]) for r in el] == [(r["case"], r["kernel_dim"]) for r in mem]

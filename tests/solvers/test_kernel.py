@@ -70,8 +70,8 @@ def test_a_smoothly_decaying_bottom_is_not_a_kernel_unless_it_reaches_the_error_
 
 # ------------------------------------------------------------------ on the paper's spaces
 
-def _sides(family, k, n1, n2, **kw):
-    return SideCache().pair(MEMBRANES, family, k, n1, n2, **kw)
+def _sides(family, k, n1, n2):
+    return SideCache().pair(MEMBRANES, family, k, n1, n2)
 
 
 def _kernel_pieces(case, k, n1, n2, mm="omega2", family="structured"):

@@ -8,6 +8,7 @@ from infsup_contact.errors import InputError
 from infsup_contact.models.membranes import MEMBRANES
 from infsup_contact.solvers.side_cache import SideCache, side_keys
 from infsup_contact.solvers.infsup import beta_rows_all
+from infsup_contact.solvers.request import MeshOptions
 
 
 class _Counting:
@@ -52,7 +53,7 @@ def test_unannounced_pairs_are_built_and_not_kept():
 
 
 def test_seeds_are_distinct_sides():
-    keys = [side_keys(MEMBRANES, "perturbed", 2, 5, 4, seed=s, alpha=0.2) for s in (0, 1)]
+    keys = [side_keys(MEMBRANES, "perturbed", 2, 5, 4, MeshOptions(seed=s, alpha=0.2)) for s in (0, 1)]
     assert not set(keys[0]) & set(keys[1])
     assert side_keys(MEMBRANES, "structured", 2, 5, 4)[1] == side_keys(MEMBRANES, "structured", 2, 7, 4)[1]
 
@@ -60,9 +61,9 @@ def test_seeds_are_distinct_sides():
 def test_cached_sweep_gives_the_rows_of_fresh_builds_bitwise():
     pairs = [(6, 4), (4, 4), (5, 4)]
     cache = SideCache()
-    cache.expect(MEMBRANES, "perturbed", 2, pairs, seed=1, alpha=0.2)
+    cache.expect(MEMBRANES, "perturbed", 2, pairs, MeshOptions(seed=1, alpha=0.2))
     kw = dict(cases=["T3", "R5.4"], multiplier_meshes=("omega2", "union"), c_pairs=((1.0, 1.0), (1.0, 10.0)),
-              seed=1, alpha=0.2)
+              mesh=MeshOptions(seed=1, alpha=0.2))
     cached = pd.DataFrame([r for p in pairs for r in beta_rows_all("perturbed", 2, *p, side_cache=cache, **kw)])
     fresh = pd.DataFrame([r for p in pairs for r in beta_rows_all("perturbed", 2, *p, **kw)])
     cols = [c for c in fresh.columns if not c.startswith("t_")]

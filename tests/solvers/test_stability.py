@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from infsup_contact.solvers.infsup import beta_rows
+from infsup_contact.solvers.request import MeshOptions
 
 STABLE = [("T3", k) for k in (1, 2, 3, 4)] + [("T4", k) for k in (2, 3, 4)] + [("T5", k) for k in (2, 3, 4)]
 
@@ -57,9 +58,9 @@ def test_multiplier_meshes_with_one_partition_share_rows_equal_to_separate_runs(
     numbers = ["beta", "kernel_dim", "smallest_nonzero", "beta_v1_zero", "dim_M"]
     mms = ["omega2", "omega1", "union"]
     for n1, n2, shared in ((6, 6, True), (7, 6, False)):
-        together = beta_rows_all("perturbed", 2, n1, n2, ["T3", "R5.4"], mms, ((1.0, 2.0),), ("H",), seed=3)
+        together = beta_rows_all("perturbed", 2, n1, n2, ["T3", "R5.4"], mms, ((1.0, 2.0),), ("H",), mesh=MeshOptions(seed=3))
         for mm in mms:
-            alone = beta_rows("perturbed", 2, n1, n2, ["T3", "R5.4"], mm, 1.0, 2.0, ("H",), seed=3)
+            alone = beta_rows("perturbed", 2, n1, n2, ["T3", "R5.4"], mm, 1.0, 2.0, ("H",), mesh=MeshOptions(seed=3))
             got = [r for r in together if r["multiplier_mesh"] == mm]
             assert [[r[c] for c in numbers] for r in got] == [[r[c] for c in numbers] for r in alone]
         betas = {mm: [r["beta"] for r in together if r["multiplier_mesh"] == mm] for mm in mms}

@@ -12,6 +12,7 @@ import pytest
 from infsup_contact.discretization.spaces.registry import SPACES
 from infsup_contact.models import make_model
 from infsup_contact.solvers.infsup import beta_rows
+from infsup_contact.solvers.request import MeshOptions
 
 MODEL = make_model("membranes3d")
 LEVELS = (3, 4, 6)
@@ -20,7 +21,7 @@ LEVELS = (3, 4, 6)
 @pytest.mark.slow_first  # one of the longest tests: started first under xdist (tests/conftest.py)
 def test_stable_beta_is_bounded_on_unstructured_refinements():
     case = next(c for c, s in SPACES.items() if s.lagrange == (True, True) and not s.dual and s.degree(1) == 1)
-    rows = [pd.DataFrame(beta_rows("unstructured", 1, n, n, cases=[case], model=MODEL, element="tet"))
+    rows = [pd.DataFrame(beta_rows("unstructured", 1, n, n, cases=[case], model=MODEL, mesh=MeshOptions(element="tet")))
             .set_index("norm").beta for n in LEVELS]
     beta_h = np.array([r["H"] for r in rows])
     beta_l2 = np.array([r["L2"] for r in rows])

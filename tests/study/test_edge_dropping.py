@@ -15,6 +15,7 @@ from infsup_contact.errors import InputError
 from infsup_contact.solvers.spectra import spectrum
 from infsup_contact.study.face.edge_dropping import (edge_row, geometry, interface_operator,
                                                 kappa_1d, scaled_cond, side_pair)
+from infsup_contact.solvers.request import MeshOptions
 
 from helpers.tensor_sides import box_gamma_block, couplings_1d, lagrange_1d, tensor_interface_operator
 
@@ -32,7 +33,7 @@ def test_full_cover_equals_the_face_engine(k, n, n2):
     from infsup_contact.solvers.infsup import beta_rows_all
 
     cases = edge_cases(k)
-    rows = beta_rows_all("structured", k, n, n2, cases, ("omega1",), model=MEMBRANES3D, element="hex")
+    rows = beta_rows_all("structured", k, n, n2, cases, ("omega1",), model=MEMBRANES3D, mesh=MeshOptions(element="hex"))
     for case in cases:
         mine = edge_row(case, k, n, n2, 1.0)
         ref = {r["norm"]: r["beta"] for r in rows if r["case"] == case}

@@ -23,6 +23,7 @@ from infsup_contact.systems.manifest import load_manifest
 from infsup_contact.systems.multiplier_basis import Gamma, describe
 from infsup_contact.systems.multiplier_gram import gram
 from infsup_contact.systems.readers import SystemFileError
+from infsup_contact.solvers.request import MeshOptions
 
 NS = (4, 8)
 RTOL = 1e-8
@@ -119,10 +120,10 @@ def test_described_face_reproduces_beta_case(tmp_path, case, k):
     """The tensor face spaces on hexahedral faces, N = 2, 3 (N1 = N2 + 1 at k = 1)."""
     offset = 1 if k == 1 else 0
     ns = (2, 3)
-    m = _manifest(tmp_path, case, k, offset, ns, model=FACE_MODEL, element="hex")
+    m = _manifest(tmp_path, case, k, offset, ns, model=FACE_MODEL, mesh=MeshOptions(element="hex"))
     assert m.gamma == Gamma("rectangle", (1.0, 1.0))
     for n, row in zip(ns, system_rows(m, notes=io.StringIO())):
-        ref, = beta_rows("structured", k, n + offset, n, [case], norms=("H",), model=FACE_MODEL, element="hex")
+        ref, = beta_rows("structured", k, n + offset, n, [case], norms=("H",), model=FACE_MODEL, mesh=MeshOptions(element="hex"))
         _agree(row, ref)
         if k == 1:  # the bilinear hats of the traces described too: B is the exact coupling
             assert row["coupling_distance"] <= 1e-14
@@ -131,7 +132,7 @@ def test_described_face_reproduces_beta_case(tmp_path, case, k):
 
 
 def test_face_only_and_triangle_spaces_keep_the_given_gram():
-    levels, norm, gamma = suite_levels("T3", 1, (2,), model=FACE_MODEL, element="tet")
+    levels, norm, gamma = suite_levels("T3", 1, (2,), model=FACE_MODEL, mesh=MeshOptions(element="tet"))
     assert norm == "given" and gamma is None and len(levels[0]) == 4
 
 

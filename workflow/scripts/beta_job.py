@@ -18,6 +18,7 @@ register_user_spaces(snakemake.config)  # noqa: F821
 from infsup_contact.discretization.gamma.mesh_series import seeds, series_of_pairs  # noqa: E402
 from infsup_contact.io import write_csv_atomic  # noqa: E402
 from infsup_contact.models import DEFAULT_MODEL  # noqa: E402
+from infsup_contact.solvers.request import NO_OPTIONS, MeshOptions  # noqa: E402
 from infsup_contact.study.beta.batch_rows import beta_batch_rows  # noqa: E402
 
 ic, batch = snakemake.params.ic, snakemake.params.batch  # noqa: F821
@@ -27,7 +28,7 @@ perturbed = family == "perturbed"
 frame = beta_batch_rows(model, family, k, batch["pairs"], [c for c, klist in ic["cases"].items() if k in klist],
                         ic["multiplier_meshes"], ic["c"], ic["norms"],
                         seeds=seeds(ic) if perturbed else [None], series=series_of_pairs(ic),
-                        **({"alpha": ic["alpha"]} if perturbed else {}))
+                        mesh=MeshOptions(alpha=ic["alpha"]) if perturbed else NO_OPTIONS)
 timing = [c for c in frame.columns if c.startswith("t_")]
 # timings vary run to run: they live in the benchmark tree, result tables stay deterministic
 write_csv_atomic(snakemake.output[0], add_provenance(frame.drop(columns=timing), ic))  # noqa: F821

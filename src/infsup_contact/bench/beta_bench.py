@@ -41,6 +41,7 @@ from ..errors import InputError
 from ..models.contract import Model, factorized_side
 from ..solvers.infsup import beta_rows
 from ..solvers.interface_operator import interface_operator
+from ..solvers.request import MeshOptions
 from ..solvers.side_cache import SideCache
 from .harness import ROUTE_BUDGET, _log, _row, run_interleaved
 
@@ -119,7 +120,7 @@ class BetaSetup:
     def __init__(self, bench: BetaBench, n: int, k: int, cases=None, **mesh_options):
         check_mesh_options(bench.model, mesh_options)
         self.bench, self.n, self.k, self.mesh_options = bench, n, k, mesh_options
-        self.sides = SideCache().pair(bench.model, FAMILY, k, n, n, **mesh_options)
+        self.sides = SideCache().pair(bench.model, FAMILY, k, n, n, MeshOptions(**mesh_options))
         self.gamma = self.sides[0].trace.gamma
         g_h = self.gamma.multiplier_partition(*(s.trace.partition for s in self.sides), "omega2")
         self.cases = bench.cases(k, self.gamma, g_h, cases)
@@ -147,7 +148,7 @@ def _eigvals(S, G) -> np.ndarray:
 def beta_ours(setup: BetaSetup) -> dict:
     """{(case, norm): row of ``beta_rows``} for the setup's pair, end to end."""
     rows = beta_rows(FAMILY, setup.k, setup.n, setup.n, setup.cases, norms=setup.bench.norms,
-                     model=setup.bench.model, **setup.mesh_options)
+                     model=setup.bench.model, mesh=MeshOptions(**setup.mesh_options))
     return {(r["case"], r["norm"]): r for r in rows}
 
 

@@ -82,7 +82,7 @@ def _check_beta(args):
 
     args.cases = cases(args)
     material(args)
-    args.mesh_kwargs = mesh_options(args)
+    args.mesh = mesh_options(args)
     args.cases = face_cases(args)
     args.request = request(args)
     est = resources.beta_estimate(args.family, args.k, args.N1, args.N2, args.multiplier_mesh,
@@ -96,12 +96,14 @@ def request(args):
     """The :class:`~infsup_contact.solvers.request.BetaRequest` of the command line, validated once
     (the perturbed family's seed and α with it); the engine runs it unchecked."""
     from ..discretization.segment.meshes import check_perturbation
-    from ..solvers.request import BetaRequest, MeshOptions
+    from dataclasses import replace
+
+    from ..solvers.request import BetaRequest
 
     perturbed = dict(seed=args.seed, alpha=args.alpha) if args.family == "perturbed" else {}
     out = BetaRequest(args.family, args.k, args.N1, args.N2, tuple(args.cases), (args.multiplier_mesh,),
                       ((args.c1, args.c2),), norms(args), args.h_route, args.model_obj,
-                      MeshOptions(**args.mesh_kwargs, **perturbed))
+                      replace(args.mesh, **perturbed))
     check_perturbation(args.alpha, args.seed)
     return out
 
@@ -128,6 +130,6 @@ def beta_frame(args):
 
     rows = beta_table(args.request)
     frame = pd.DataFrame(rows)
-    for i, (name, value) in enumerate(args.mesh_kwargs.items()):  # e.g. element, after family
+    for i, (name, value) in enumerate(args.mesh.kwargs().items()):  # e.g. element, after family
         frame.insert(frame.columns.get_loc("family") + 1 + i, name, value)
     return material_columns(frame, args)

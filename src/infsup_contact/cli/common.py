@@ -18,14 +18,14 @@ def cases(args) -> list:
     registered space defined for k)."""
     from ..discretization.spaces.registry import ids_valid_for
     from ..discretization.spaces.user_spaces import load_user_space
+    from ..solvers.request import check_k
 
     if args.space is not None:
         if args.case not in (None,):
             raise InputError("case", "either --case or --space, not both", got=args.case)
         return [load_user_space(args.space, run_intervals(args)).id]
     if args.case in (None, "all"):
-        if not 1 <= args.k <= 4:
-            raise InputError("k", "an integer in 1..4", got=args.k)
+        check_k(args.k)
         return ids_valid_for(args.k)
     return [args.case]
 
@@ -34,7 +34,7 @@ def face_cases(args) -> list:
     """``--case all`` on a 3D model: the paper's spaces and the duals (:func:`cases`), then every
     other registered space the model's face builds for k (the quadratic face elements' on
     hexahedra or tetrahedra; those refused by construction, e.g. DUAL-Q8, left out), on the
-    partition of the model's coarsest mesh (one cell per direction; ``args.mesh_kwargs`` set) of
+    partition of the model's coarsest mesh (one cell per direction; ``args.mesh`` set) of
     the Γ its mesh builder names for the request (no body is factorized)."""
     from ..discretization.spaces.registry import ids_built_on
 
@@ -42,7 +42,7 @@ def face_cases(args) -> list:
     if args.case not in (None, "all") or args.space is not None or args.model_obj.dim != 3:
         return base
     model = args.model_obj
-    body = model.subdomain_mesh(args.family, 1, 1, **args.mesh_kwargs)
+    body = model.subdomain_mesh(args.family, 1, 1, **args.mesh.kwargs())  # the model contract
     gamma = body.interface
     partition = gamma.partition_of(body.mesh)
     g_h = gamma.multiplier_partition(partition, partition)
@@ -105,10 +105,14 @@ def _mesh_options() -> dict:
     return out
 
 
-def mesh_options(args) -> dict:
-    """The mesh keywords of a request for its model (``args.model_obj``), defaults filled in; a
-    family the model's mesh builder does not build (``Model.families``) is refused (a mesh flag
-    the model does not take was refused before, :func:`refuse_unused`)."""
+def mesh_options(args):
+    """The :class:`~infsup_contact.solvers.request.MeshOptions` of a request for its model
+    (``args.model_obj``), defaults filled in, each flag checked by the request's own rule
+    (:func:`~infsup_contact.solvers.request.check_mesh_option`); a family the model's mesh builder
+    does not build (``Model.families``) is refused (a mesh flag the model does not take was
+    refused before, :func:`refuse_unused`)."""
+    from ..solvers.request import MeshOptions, check_mesh_option
+
     model = args.model_obj
     if model.families is not None and getattr(args, "family", None) not in model.families:
         raise InputError("family", f"{', '.join(model.families)} (the meshes of --model {model.name})",
@@ -119,10 +123,10 @@ def mesh_options(args) -> dict:
         given = getattr(args, name, None)
         if name not in own:  # another model's flag: refused before (refuse_unused)
             continue
-        if given is not None and given not in own[name]:
-            raise InputError(name, ", ".join(own[name]), got=given)
+        if given is not None:
+            check_mesh_option(model, name, given)
         out[name] = own[name][0] if given is None else given
-    return out
+    return MeshOptions(**out)
 
 
 def material(args):

@@ -54,6 +54,7 @@ def scene_flag_uses() -> list:
 def _check_contact(args):
     from ..discretization.segment import meshes
     from ..discretization.spaces import registry
+    from ..solvers.request import check_k
     from ..study.contact.registry import check_pair
     from ..study.contact.scenes import _exponent
 
@@ -61,10 +62,9 @@ def _check_contact(args):
         raise InputError("case", "one of --case ID|all or --space FILE.py:FUNC")
     args.cases = cases(args)
     material(args)
-    args.mesh_kwargs = mesh_options(args)  # a mesh flag of another model is refused; the scene's rows read them
+    args.mesh = mesh_options(args)  # a mesh flag of another model is refused; the scene's rows read them
     spec = check_pair(args.model, args.scene)
-    if not 1 <= args.k <= 4:
-        raise InputError("k", "an integer in 1..4", got=args.k)
+    check_k(args.k)
     for case in args.cases:
         registry.check_case(case, args.k)
     meshes.check_mesh_args(args.family, args.N1, "N1")

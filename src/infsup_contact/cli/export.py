@@ -48,15 +48,15 @@ def _check_export(args):
     from .. import resources
     from ..discretization.segment import meshes
     from ..discretization.spaces import registry
+    from ..solvers.request import check_k
     from ..study.verdict import check_model_case, check_n1_offset
 
     material(args)
-    args.mesh_kwargs = mesh_options(args)
+    args.mesh = mesh_options(args)
     for prm in args.model_obj.params:  # the sides' scales c_i (E_i of the elastic bodies)
         if prm.side is not None and getattr(args, prm.name) != 1.0:
             raise InputError(prm.name, "1 (an export is at unit material scale)", got=getattr(args, prm.name))
-    if not 1 <= args.k <= 4:
-        raise InputError("k", "an integer in 1..4", got=args.k)
+    check_k(args.k)
     registry.check_case(args.case, args.k)
     ns = list(args.N)
     for n in ns:
@@ -66,7 +66,7 @@ def _check_export(args):
     check_n1_offset(ns, args.N1_offset)
     for n in ns:
         meshes.check_mesh_args(args.family, n + args.N1_offset, "N1_offset")
-    check_model_case(args.case, args.k, args.model_obj, args.family, **args.mesh_kwargs)
+    check_model_case(args.case, args.k, args.model_obj, args.family, args.mesh)
     for n in ns:  # an empty space on a small N: refused here, before any file is written
         registry.check_pair_spaces([args.case], args.k, n + args.N1_offset, n, (args.multiplier_mesh,), key="N")
     out = Path(args.out)
@@ -109,10 +109,9 @@ def _refuse_nonempty(out, args) -> None:
 def _run_export(args) -> None:
     from ..systems.export import suite_levels, write_system
 
-    kwargs = dict(args.mesh_kwargs)
     levels, norm, gamma = suite_levels(args.case, args.k, args.N, args.N1_offset, args.family, args.norm,
-                                       args.multiplier_mesh, model=args.model_obj, **kwargs)
-    name = "-".join([args.case, f"k{args.k}", args.model, *kwargs.values()]
+                                       args.multiplier_mesh, model=args.model_obj, mesh=args.mesh)
+    name = "-".join([args.case, f"k{args.k}", args.model, *args.mesh.kwargs().values()]
                     + ([f"N1{args.N1_offset:+d}"] if args.N1_offset else []))
     out = Path(args.out)
     before = {p.name for p in out.iterdir()} if out.is_dir() else set()

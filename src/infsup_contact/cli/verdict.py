@@ -83,24 +83,24 @@ def _check_verdict(args):
     from ..discretization.segment import meshes
     from ..discretization.spaces import registry
     from ..discretization.spaces.user_spaces import load_user_space
+    from ..solvers.request import check_k
     from ..study.verdict import check_criterion, check_mesh_sizes, check_model_case, check_n1_offset
 
     args.space_or_case = args.case if args.space is None else load_user_space(args.space, run_intervals(args))
     case = args.case if args.space is None else args.space_or_case.id
-    if not 1 <= args.k <= 4:
-        raise InputError("k", "an integer in 1..4", got=args.k)
+    check_k(args.k)
     registry.check_case(case, args.k)
     from ..models import make_model
 
     args.model_obj = make_model(args.model)
-    args.mesh_kwargs = mesh_options(args)
+    args.mesh = mesh_options(args)
     meshes.check_mesh_args(args.family, 1)
     ns = check_mesh_sizes(args.N)
     check_n1_offset(ns, args.N1_offset)
     for n in ns:
         meshes.check_mesh_args(args.family, n + args.N1_offset, "N1_offset")
     if args.space is None:  # a face-only id on a 2D model, a face space of the other element: one line
-        check_model_case(case, args.k, args.model_obj, args.family, **args.mesh_kwargs)
+        check_model_case(case, args.k, args.model_obj, args.family, args.mesh)
     for n in ns:  # an empty space on a small N is refused here, before any β_h
         registry.check_pair_spaces([case], args.k, n + args.N1_offset, n, (args.multiplier_mesh,), key="N")
     check_criterion(args.slope_tolerance, args.beta_floor, args.confidence)
@@ -133,5 +133,5 @@ def verdict_row(args) -> tuple:
     out = verdict_rows(args.space_or_case, args.k, args.family, args.N, args.norm,
                        tol=args.slope_tolerance, floor=args.beta_floor, confidence=args.confidence,
                        multiplier_mesh=args.multiplier_mesh, model=args.model_obj, n1_offset=args.N1_offset,
-                       **args.mesh_kwargs)
+                       mesh=args.mesh)
     return out, None

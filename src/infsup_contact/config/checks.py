@@ -14,7 +14,9 @@ tests call it directly. In order, it
 Every failure is a :class:`ConfigError` whose message is one line,
 ``config key <key>: <what> (got <value>; allowed <allowed>)``. What is allowed but worth
 knowing (a fit window longer than a β series, shrunk explicitly) comes back as notes that the
-workflow logs. Pure functions: no Snakemake, no solver imports.
+workflow logs. Pure functions: no Snakemake; a field a β_h request has is checked by the
+request's own rule (:mod:`infsup_contact.solvers.request`, the registry), imported where used
+and run under the config key (:func:`~.schema.naming_key`).
 """
 from __future__ import annotations
 
@@ -23,7 +25,7 @@ import re
 from ..discretization.spaces.user_spaces import config_case_ids
 from .meshes import check_space_meshes, config_intervals, scene_meshes
 from .schema import (ConfigError, check_finite, describe, key_path, load_schema,  # noqa: F401
-                            schema_error, show)
+                            naming_key, schema_error, show)
 from ..errors import InputError
 from ..study.contact.registry import REFERENCE_MARGIN, data_scene_ids, scene_spec
 
@@ -56,8 +58,9 @@ def load_spaces(cfg) -> list:
 # ------------------------------------------------------------------ 4. the registry
 
 def check_cases(cfg) -> None:
-    """Case ids are registered spaces; each k is one the space allows (T4, T5: k >= 2)."""
-    from ..discretization.spaces.registry import SPACES
+    """Case ids are registered spaces; each k is one the space allows (T4, T5: k >= 2; the
+    request's rule, :func:`~infsup_contact.discretization.spaces.registry.check_case`)."""
+    from ..discretization.spaces.registry import SPACES, check_case
 
     ids = config_case_ids(cfg)
     for stage in ("infsup", "contact"):
@@ -69,10 +72,10 @@ def check_cases(cfg) -> None:
                                   + ("" if case not in SPACES else f" ({case} is a face space of the 3D models)"
                                      if not SPACES[case].defined_on(1) else f" ({case} is a user space: list it under spaces)"))
             spec = SPACES[case]
-            low = [k for k in ks if not spec.valid_for(k)]
-            if low:
-                raise ConfigError(f"{stage}.cases.{case}", f"{case} needs k >= {spec.min_k} ({spec.paper_ref})",
-                                  got=ks, allowed=f"degrees {spec.min_k}..4")
+            with naming_key(f"{stage}.cases.{case}", f"{case} needs k >= {spec.min_k} ({spec.paper_ref})",
+                            got=ks, allowed=f"degrees {spec.min_k}..4"):
+                for k in ks:
+                    check_case(case, k)
 
 
 def figure_cases(cfg):
@@ -90,8 +93,9 @@ def figure_cases(cfg):
 
 def check_figures(cfg) -> None:
     """A figure's case ids are registered spaces (the built-in ones and the config's own user
-    spaces) defined for its k; its scene is a name under contact.scenes or a scene kind."""
-    from ..discretization.spaces.registry import SPACES
+    spaces) defined for its k (the request's rule, as :func:`check_cases`); its scene is a name
+    under contact.scenes or a scene kind."""
+    from ..discretization.spaces.registry import SPACES, check_case
 
     ids = config_case_ids(cfg)
     for key, case, k in figure_cases(cfg):
@@ -99,9 +103,10 @@ def check_figures(cfg) -> None:
             raise ConfigError(key, f"{case!r} is not a registered space", got=case,
                               allowed="registered spaces: " + ", ".join(ids))
         spec = SPACES[case]
-        if k is not None and not spec.valid_for(k):
-            raise ConfigError(key, f"{case} needs k >= {spec.min_k} ({spec.paper_ref}), the figure has k = {k}",
-                              got=case, allowed=f"spaces defined for k = {k}")
+        if k is not None:
+            with naming_key(key, f"{case} needs k >= {spec.min_k} ({spec.paper_ref}), the figure has k = {k}",
+                            got=case, allowed=f"spaces defined for k = {k}"):
+                check_case(case, k)
     kinds = data_scene_ids()
     for name in ("contact_solutions", "dual"):
         scene = cfg["figures"][name]["scene"]

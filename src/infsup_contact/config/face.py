@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .schema import ConfigError
+from .schema import ConfigError, naming_key
 
 
 def check_face(cfg) -> None:
@@ -34,9 +34,7 @@ def check_face(cfg) -> None:
                           allowed=", ".join(m.name for m in MODELS.values() if getattr(m, "dim", 2) == 3))
     options = dict(model.mesh_options).get("element", ())
     for i, element in enumerate(fc["elements"]):
-        if element not in options:
-            raise ConfigError(f"face.elements[{i}]", f"not an element of {model.name}", got=element,
-                              allowed=", ".join(options))
+        check_element(f"face.elements[{i}]", model, element)
         _check_degrees(f"face.elements[{i}]", model, element, fc["k"], "face.k")
     for element, top in (fc.get("max_N") or {}).items():
         if element not in fc["elements"]:
@@ -52,7 +50,7 @@ def check_face(cfg) -> None:
                               allowed="[N1, N2] with N1 != N2 (matching meshes go under face.N)")
     _check_face_families(fc)
     _check_face_cases(cfg, fc, options)
-    check_face_studies(fc, model.name, options)
+    check_face_studies(fc, model)
 
 
 def _check_degrees(key: str, model, element: str, ks, k_key: str) -> None:
@@ -64,7 +62,7 @@ def _check_degrees(key: str, model, element: str, ks, k_key: str) -> None:
                           allowed=f"an element with every degree of {k_key}, or {k_key} without {bad[0]}")
 
 
-def check_face_studies(fc, model_name: str, options) -> None:
+def check_face_studies(fc, model) -> None:
     """The face studies' keys (rules/face_studies.smk) the schema cannot state: the patch
     test's elements are the model's, its pairs non-matching; the α sweep's elements are face
     elements with a transformed (non-identity) basis; edge dropping keeps at least 3 θ at or
@@ -72,18 +70,15 @@ def check_face_studies(fc, model_name: str, options) -> None:
     from ..discretization.face.spaces.cellwise import QUAD_ELEMENTS
     from ..discretization.face.spaces.dual_bases import transformation
 
-    from ..models import MODELS
-
+    options = dict(model.mesh_options).get("element", ())
     for i, element in enumerate(fc["patch"]["elements"]):
-        if element not in options:
-            raise ConfigError(f"face.patch.elements[{i}]", f"not an element of {model_name}", got=element,
-                              allowed=", ".join(options))
-        gamma = MODELS[model_name].gamma(element=element)
+        check_element(f"face.patch.elements[{i}]", model, element)
+        gamma = model.gamma(element=element)
         if not gamma.contact:
             raise ConfigError(f"face.patch.elements[{i}]", f"the {element} bodies serve β_h only (no contact "
                               "scene, so no patch test)", got=element,
-                              allowed=", ".join(e for e in options if MODELS[model_name].gamma(element=e).contact))
-        _check_degrees(f"face.patch.elements[{i}]", MODELS[model_name], element, fc["patch"]["k"], "face.patch.k")
+                              allowed=", ".join(e for e in options if model.gamma(element=e).contact))
+        _check_degrees(f"face.patch.elements[{i}]", model, element, fc["patch"]["k"], "face.patch.k")
     for i, pair in enumerate(fc["patch"]["pairs"]):
         if pair[0] == pair[1]:
             raise ConfigError(f"face.patch.pairs[{i}]", "the patch test's pairs are non-matching: N1 != N2",
@@ -100,6 +95,15 @@ def check_face_studies(fc, model_name: str, options) -> None:
         raise ConfigError("face.edge_dropping.fit_theta_max", "keeps fewer than 3 of face.edge_dropping.theta "
                           "(a slope fit needs 3)", got=ed["fit_theta_max"],
                           allowed=f">= {sorted(ed['theta'])[2]}" if len(ed["theta"]) >= 3 else "more θ")
+
+
+def check_element(key: str, model, element) -> None:
+    """``element`` is one of ``model``'s: the request's rule for its mesh option
+    (:func:`~infsup_contact.solvers.request.check_mesh_option`), the error naming ``key``."""
+    from ..solvers.request import check_mesh_option
+
+    with naming_key(key, f"not an element of {model.name}"):
+        check_mesh_option(model, "element", element)
 
 
 def _check_edge_dropping(fc, ed) -> None:

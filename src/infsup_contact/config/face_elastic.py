@@ -12,8 +12,8 @@ naming the key.
 """
 from __future__ import annotations
 
-from .schema import ConfigError
-from ..errors import InputError
+from .face import check_element
+from .schema import ConfigError, naming_key
 
 MIN_FIT_POINTS = 3
 """A slope fit of the ν sweep needs this many ν >= fit_nu_min."""
@@ -31,13 +31,10 @@ def check_face_elastic(cfg) -> None:
     if model is None or model.name not in taking:
         raise ConfigError("face_elastic.model", "not a registered 3D model taking the Poisson ratio nu",
                           got=fe["model"], allowed=", ".join(taking))
-    options = dict(model.mesh_options).get("element", ())
     for key, elements in (("face_elastic.elements", fe["elements"]),
                           ("face_elastic.patch.elements", fe["patch"]["elements"])):
         for i, element in enumerate(elements):
-            if element not in options:
-                raise ConfigError(f"{key}[{i}]", f"not an element of {model.name}", got=element,
-                                  allowed=", ".join(options))
+            check_element(f"{key}[{i}]", model, element)
     _check_nus(fe)
     for key, pairs in (("face_elastic.nonmatching", fe["nonmatching"]), ("face_elastic.patch.pairs",
                                                                          fe["patch"]["pairs"])):
@@ -62,10 +59,8 @@ def _check_nus(fe) -> None:
     sweep = fe["nu_sweep"]
     for key, value in [("face_elastic.nu", fe["nu"])] + [(f"face_elastic.nu_sweep.nu[{i}]", v)
                                                          for i, v in enumerate(sweep["nu"])]:
-        try:
+        with naming_key(key, "not a Poisson ratio", got=value, allowed="-1 < nu < 0.5"):
             check_nu(value, key)
-        except InputError:
-            raise ConfigError(key, "not a Poisson ratio", got=value, allowed="-1 < nu < 0.5") from None
     kept = sorted(v for v in sweep["nu"] if v >= sweep["fit_nu_min"])
     if len(kept) < MIN_FIT_POINTS:
         raise ConfigError("face_elastic.nu_sweep.fit_nu_min", f"keeps fewer than {MIN_FIT_POINTS} of "

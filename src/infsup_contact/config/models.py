@@ -12,7 +12,7 @@ the model's Γ; a study's name does not shadow a folder the other stages write u
 from __future__ import annotations
 
 from ..errors import InputError
-from .schema import ConfigError
+from .schema import ConfigError, naming_key
 
 BUILT_IN = ("elastic", "face", "face_elastic")
 """Studies whose scenes are the config section of the entry's name."""
@@ -56,6 +56,7 @@ def _check_built_in(cfg, key: str, name: str, entry: dict) -> None:
 def _check_beta(key: str, entry: dict) -> None:
     from ..discretization.spaces.registry import SPACES
     from ..models.user_models import model_named
+    from ..solvers.request import check_mesh_option
 
     missing = [k for k in BETA_KEYS if k not in entry]
     if missing:
@@ -67,10 +68,10 @@ def _check_beta(key: str, entry: dict) -> None:
         raise ConfigError(f"{key}.model", err.allowed, got=entry["model"]) from None
     options = dict(model.mesh_options).get("element", ())
     elements = entry.get("elements")
-    for i, element in enumerate(elements or []):
-        if element not in options:
-            raise ConfigError(f"{key}.elements[{i}]", f"not an element of {model.name}", got=element,
-                              allowed=", ".join(options) or "none: the model has no element option (drop the key)")
+    for i, element in enumerate(elements or []):  # the request's rule (solvers/request.py), named by key
+        with naming_key(f"{key}.elements[{i}]", f"not an element of {model.name}",
+                        allowed=None if options else "none: the model has no element option (drop the key)"):
+            check_mesh_option(model, "element", element)
     if options and not elements:
         raise ConfigError(f"{key}.elements", f"{model.name} builds several elements: name them", got=None,
                           allowed=", ".join(options))

@@ -1,5 +1,6 @@
 """A workflow config against its schema: the one-line :class:`ConfigError`, the key paths it
-names, non-finite numbers, and the JSON schema's violations in words.
+names, non-finite numbers, and the JSON schema's violations in words; a request's own field
+check run under a config key (:func:`naming_key`).
 
 :mod:`infsup_contact.config.checks` runs these first and then the checks a schema cannot
 state; pure functions, no Snakemake.
@@ -7,6 +8,7 @@ state; pure functions, no Snakemake.
 from __future__ import annotations
 
 import math
+from contextlib import contextmanager
 from pathlib import Path
 
 
@@ -18,6 +20,21 @@ class ConfigError(ValueError):
         detail = "; ".join(p for p in (None if got is None else f"got {show(got)}",
                                        None if allowed is None else f"allowed {allowed}") if p)
         super().__init__(f"config key {key}: {what}" + (f" ({detail})" if detail else ""))
+
+
+@contextmanager
+def naming_key(key: str, what: str, got=None, allowed: str | None = None):
+    """Run the rule a request field has (:mod:`infsup_contact.solvers.request`, the registry) on a
+    config value: its :class:`~infsup_contact.errors.InputError` becomes one :class:`ConfigError`
+    naming the config ``key`` in the config's words ``what`` (``got``, ``allowed``: default the
+    error's own), so a field has one rule and its message names the key the user wrote."""
+    from ..errors import InputError
+
+    try:
+        yield
+    except InputError as err:
+        raise ConfigError(key, what, got=err.got if got is None else got,
+                          allowed=err.allowed if allowed is None else allowed) from None
 
 
 def show(value, limit: int = 80) -> str:

@@ -46,19 +46,22 @@ class BetaStudy:
         return model_named(self.cfg["model"])
 
     @staticmethod
-    def options(element: str) -> dict:
-        """The mesh options of an element of the table (none for the model's one element)."""
-        return {} if element == NO_ELEMENT else {"element": element}
+    def options(element: str):
+        """The :class:`~infsup_contact.solvers.request.MeshOptions` of an element of the table
+        (none set for the model's one element)."""
+        from ..solvers.request import MeshOptions
+
+        return MeshOptions() if element == NO_ELEMENT else MeshOptions(element=element)
 
     def _beta(self, element: str, k: int) -> pd.DataFrame:
         from ..discretization.spaces.registry import SPACES, ids_valid_for
         from ..study.beta.batch_rows import beta_batch_rows
 
-        model, kw = self.model(), self.options(element)
-        gamma = model.gamma(**kw)
+        model, mesh = self.model(), self.options(element)
+        gamma = model.gamma(**mesh.kwargs())  # the model contract takes keywords
         cases = [c for c in ids_valid_for(k, self.cfg["cases"]) if gamma.builds(SPACES[c])]
         frame = beta_batch_rows(model, "structured", k, pairs_of(self.cfg), cases, ("omega2",),
-                                norms=tuple(self.cfg.get("norms", ("H", "L2"))), **kw)
+                                norms=tuple(self.cfg.get("norms", ("H", "L2"))), mesh=mesh)
         frame = frame.drop(columns=[c for c in frame.columns if c.startswith("t_")])  # timings: benchmark tree
         frame.insert(0, "element", element)
         frame.insert(0, "model", model.name)

@@ -37,6 +37,7 @@ class FaceStudy:
 
     def _beta(self, element: str, k: int, l2_only: bool) -> pd.DataFrame:
         from ..discretization.spaces.registry import SPACES, ids_valid_for
+        from ..solvers.request import MeshOptions
         from ..study.beta.batch_rows import beta_batch_rows
         from ..study.claims.membranes3d import element_interfaces
 
@@ -45,7 +46,8 @@ class FaceStudy:
         norms = ("L2",) if l2_only else tuple(fc["norms"])
         gamma = element_interfaces(fc["model"], [element])[element]
         cases = [c for c in ids_valid_for(k, fc["cases"]) if gamma.builds(SPACES[c])]  # QUAD9 spaces: rectangles
-        frame = beta_batch_rows(fc["model"], "structured", k, pairs, cases, ("omega2",), norms=norms, element=element)
+        frame = beta_batch_rows(fc["model"], "structured", k, pairs, cases, ("omega2",), norms=norms,
+                                mesh=MeshOptions(element=element))
         frame = frame.drop(columns=[c for c in frame.columns if c.startswith("t_")])  # timings: benchmark tree
         frame.insert(0, "element", element)
         frame.insert(0, "model", fc["model"])

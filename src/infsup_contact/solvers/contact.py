@@ -29,6 +29,7 @@ from ..discretization.gamma.coupling import coupling_matrix
 from ..models import DEFAULT_MODEL
 from ..models.contract import B_SIGN
 from .interface_operator import interface_operator
+from .request import NO_OPTIONS, MeshOptions
 
 
 @dataclass
@@ -218,19 +219,22 @@ class ContactPair:
     gap_degree: int = 0
 
 
-def contact_pair(scene, k: int, family: str, n1: int, n2: int, model=None, **mesh_kwargs) -> ContactPair:
+def contact_pair(scene, k: int, family: str, n1: int, n2: int, model=None,
+                 mesh: MeshOptions = NO_OPTIONS) -> ContactPair:
     """Mesh, factorize and load both sides of ``scene`` with ``model`` (default: the registry's,
     the paper's membranes; see :class:`ContactPair`); the scene's ``mesh_pair`` where it has
     one (structured blocks of the elastic scenes), else the model's mesh builder where it has
-    one (``Model.mesh``: the 3D bodies, ``mesh_kwargs`` such as ``element``), else the family's."""
+    one (``Model.mesh``: the 3D bodies, ``mesh`` options such as ``element``), else the family's.
+    The builders take the options as keywords (the model contract)."""
     model = DEFAULT_MODEL if model is None else model
     build = getattr(scene, "mesh_pair", None)
+    kw = mesh.kwargs()
     if build is not None:
-        mesh_pair = build(family, n1, n2, **mesh_kwargs)
+        mesh_pair = build(family, n1, n2, **kw)
     elif model.mesh is not None:
-        mesh_pair = tuple(model.subdomain_mesh(family, n, side, **mesh_kwargs) for n, side in ((n1, 1), (n2, 2)))
+        mesh_pair = tuple(model.subdomain_mesh(family, n, side, **kw) for n, side in ((n1, 1), (n2, 2)))
     else:
-        mesh_pair = meshes.mesh_pair(family, n1, n2, **mesh_kwargs)
+        mesh_pair = meshes.mesh_pair(family, n1, n2, **kw)
     c = (scene.c1, scene.c2)
     t0 = time.perf_counter()
     sides = [model.side_for(scene, m, k) for m in mesh_pair]
@@ -284,11 +288,11 @@ def solve_contact_on(pair: ContactPair, case: str, multiplier_mesh: str = "omega
 
 def solve_contact(scene, case: str, k: int, family: str, n1: int, n2: int,
                   multiplier_mesh: str = "omega2", time_floor: bool = True, model=None,
-                  **mesh_kwargs) -> ContactSolution:
+                  mesh: MeshOptions = NO_OPTIONS) -> ContactSolution:
     """Solve (4.1) for a scene (``scenes.scene``) with the multipliers of ``case`` (a registry
     id); ``model`` gives the side operators, loads and u_h (:mod:`infsup_contact.models.contract`)."""
     registry.check_case(case, k)
-    pair = contact_pair(scene, k, family, n1, n2, model=model, **mesh_kwargs)
+    pair = contact_pair(scene, k, family, n1, n2, model=model, mesh=mesh)
     return solve_contact_on(pair, case, multiplier_mesh, time_floor)
 
 

@@ -27,7 +27,7 @@ from ..discretization.segment.interface import SEGMENT
 from ..models import DEFAULT_MODEL
 from .interface_operator import combine_terms, interface_terms
 from .kernel import kernel_check
-from .request import BetaRequest, MeshOptions
+from .request import NO_OPTIONS, BetaRequest, MeshOptions
 from .routes import choose_route, is_large
 from .side_cache import SideCache
 
@@ -49,7 +49,7 @@ def beta_table(request: BetaRequest, side_cache: SideCache | None = None) -> lis
     r = request
     t0 = time.perf_counter()
     cache = SideCache() if side_cache is None else side_cache
-    sides = cache.pair(r.model, r.family, r.k, r.n1, r.n2, **r.mesh.kwargs())       # Ω1, Ω2 with Γ last
+    sides = cache.pair(r.model, r.family, r.k, r.n1, r.n2, r.mesh)                 # Ω1, Ω2 with Γ last
     t_sides = time.perf_counter() - t0
     gamma = sides[0].trace.gamma
     p1, p2 = (s.trace.partition for s in sides)
@@ -121,7 +121,7 @@ def _space(case, k, partition, gamma=SEGMENT):
 
 def beta_rows(family, k, n1, n2, cases=None, multiplier_mesh="omega2",
               c1=1.0, c2=1.0, norms=NORMS, h_route="logkernel", model=DEFAULT_MODEL, side_cache=None,
-              **mesh_options):
+              mesh: MeshOptions = NO_OPTIONS):
     """β_h for several cases and norms on one mesh pair: :func:`beta_rows_all` with one
     multiplier mesh and one (c1, c2).
 
@@ -131,16 +131,17 @@ def beta_rows(family, k, n1, n2, cases=None, multiplier_mesh="omega2",
         One row per (case, norm) with the columns of ``infsup-contact beta``.
     """
     return beta_rows_all(family, k, n1, n2, cases, (multiplier_mesh,), ((c1, c2),), norms,
-                         h_route=h_route, model=model, side_cache=side_cache, **mesh_options)
+                         h_route=h_route, model=model, side_cache=side_cache, mesh=mesh)
 
 
 def beta_rows_all(family, k, n1, n2, cases=None, multiplier_meshes=("omega2",), c_pairs=((1.0, 1.0),),
-                  norms=NORMS, h_route="logkernel", model=DEFAULT_MODEL, side_cache=None, **mesh_options):
+                  norms=NORMS, h_route="logkernel", model=DEFAULT_MODEL, side_cache=None,
+                  mesh: MeshOptions = NO_OPTIONS):
     """:func:`beta_table` of the :class:`~.request.BetaRequest` these arguments make (validated
     here, once: a bad one raises :class:`~infsup_contact.errors.InputError` naming its key);
-    ``mesh_options`` the fields of :class:`~.request.MeshOptions` (``element``, ``seed``, ...)."""
+    ``mesh``: the mesh parameters beyond (family, N), e.g. ``MeshOptions(element="hex")``."""
     request = BetaRequest(family, k, n1, n2, None if cases is None else tuple(cases), tuple(multiplier_meshes),
-                          tuple(tuple(c) for c in c_pairs), tuple(norms), h_route, model, MeshOptions(**mesh_options))
+                          tuple(tuple(c) for c in c_pairs), tuple(norms), h_route, model, mesh)
     return beta_table(request, side_cache)
 
 

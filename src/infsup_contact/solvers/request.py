@@ -8,7 +8,7 @@ parameters travel as a :class:`MeshOptions`, not as keywords.
 """
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass
 
 import numpy as np
 
@@ -46,6 +46,10 @@ class MeshOptions:
         return {key: value for key, value in asdict(self).items() if value is not None}
 
 
+NO_OPTIONS = MeshOptions()
+"""No mesh option set: the builder's defaults."""
+
+
 @dataclass(frozen=True)
 class BetaRequest:
     """β_h of (4.5) for the cases × multiplier meshes × (c1, c2) × norms of one mesh pair.
@@ -66,7 +70,7 @@ class BetaRequest:
     norms: tuple = NORMS
     h_route: str = "logkernel"
     model: Model = DEFAULT_MODEL
-    mesh: MeshOptions = field(default_factory=MeshOptions)
+    mesh: MeshOptions = NO_OPTIONS
 
     def __post_init__(self):
         check_k(self.k)
@@ -75,17 +79,36 @@ class BetaRequest:
         ids = [c for c in cases if isinstance(c, str)]
         for c in ids:
             registry.check_case(c, self.k)
+        if not isinstance(self.mesh, MeshOptions):  # a caller's slip, not input: say what it should be
+            raise TypeError(f"BetaRequest.mesh must be a MeshOptions, not {type(self.mesh).__name__}")
+        declared = dict(getattr(self.model, "mesh_options", ()))
+        for name, value in self.mesh.kwargs().items():
+            if name in declared:  # the options the model's builder declares (seed, α: the family's)
+                check_mesh_option(self.model, name, value)
         meshes.check_mesh_args(self.family, self.n1, "N1")
         meshes.check_mesh_args(self.family, self.n2, "N2")
         for c1, c2 in self.c_pairs:
             for key, c in (("c1", c1), ("c2", c2)):
                 check_prestress(key, c)
         for nm in self.norms:
-            if nm not in NORMS:
-                raise InputError("norm", ", ".join(NORMS), got=nm)
+            check_norm(nm)
         for mm in self.multiplier_meshes:
             check_choice(mm)
             registry.check_pair_spaces(ids, self.k, self.n1, self.n2, (mm,))  # dim M_h = 0: refused here
+
+
+def check_mesh_option(model, name: str, value) -> None:
+    """:class:`InputError` (key ``name``) unless ``value`` is one of ``model``'s values of its mesh
+    option ``name`` (``Model.mesh_options``, e.g. ``element``: ``hex``, ``tet``)."""
+    allowed = dict(model.mesh_options).get(name, ())
+    if value not in allowed:
+        raise InputError(name, ", ".join(allowed), got=value)
+
+
+def check_norm(norm) -> None:
+    """:class:`InputError` unless ``norm`` is a multiplier norm of :data:`NORMS` (H, L2)."""
+    if norm not in NORMS:
+        raise InputError("norm", ", ".join(NORMS), got=norm)
 
 
 def check_k(k) -> None:

@@ -27,17 +27,17 @@ import pandas as pd
 
 from ..discretization.spaces import registry
 from ..discretization.spaces.spec import SpaceSpec
-from ..discretization.segment.norms import NORMS
 from ..errors import InputError
 from ..models import DEFAULT_MODEL
 from ..solvers.infsup import beta_rows
+from ..solvers.request import NO_OPTIONS, MeshOptions, check_norm
 from ..criteria import claims as criteria
 from ..criteria.stability import MIN_MESHES, stability_verdict
 
 
 def verdict_rows(case_or_spec, k: int, family: str, ns, norm: str, *, tol: float, floor: float,
                  confidence: float, multiplier_mesh: str = "omega2", model=None, n1_offset: int = 0,
-                 **mesh_kwargs) -> dict:
+                 mesh: MeshOptions = NO_OPTIONS) -> dict:
     """β_h on the mesh pairs N1 = N + ``n1_offset``, N2 = N for each N in ``ns`` (matching
     meshes by default), and its stability verdict.
 
@@ -62,9 +62,9 @@ def verdict_rows(case_or_spec, k: int, family: str, ns, norm: str, *, tol: float
         The physical model (:mod:`infsup_contact.models`); default the paper's membranes.
     n1_offset : int
         N1 − N2 of every pair (non-matching meshes; :func:`check_n1_offset`); h = 1/N2.
-    **mesh_kwargs
-        Passed to the mesh generator (``seed``, ``alpha`` of the perturbed family; the 3D
-        model's ``element``).
+    mesh : MeshOptions
+        The mesh parameters (``seed``, ``alpha`` of the perturbed family; the 3D model's
+        ``element``); default: the builder's.
 
     Returns
     -------
@@ -84,12 +84,11 @@ def verdict_rows(case_or_spec, k: int, family: str, ns, norm: str, *, tol: float
     ns = check_mesh_sizes(ns)
     check_n1_offset(ns, n1_offset)
     check_criterion(tol, floor, confidence)
-    if norm not in NORMS:
-        raise InputError("norm", ", ".join(NORMS), got=norm)
+    check_norm(norm)
     model = DEFAULT_MODEL if model is None else model
     rows = [r for n in ns for r in beta_rows(family, k, n + n1_offset, n, [case], multiplier_mesh,
-                                             norms=(norm,), model=model, **mesh_kwargs)]
-    out = dict(space=case, k=k, model=model.name, element=mesh_kwargs.get("element"), family=family, norm=norm,
+                                             norms=(norm,), model=model, mesh=mesh)]
+    out = dict(space=case, k=k, model=model.name, element=mesh.element, family=family, norm=norm,
                multiplier_mesh=multiplier_mesh, N1_offset=n1_offset,
                **stability_verdict(rows, tol, floor, confidence), N_list=ns)
     out["seconds"] = time.perf_counter() - t0
@@ -121,7 +120,7 @@ def check_n1_offset(ns, offset) -> int:
     return int(offset)
 
 
-def model_case_ids(model, k: int, family: str = "structured", **mesh_kwargs) -> list:
+def model_case_ids(model, k: int, family: str = "structured", mesh: MeshOptions = NO_OPTIONS) -> list:
     """The registered ids ``model`` builds for degree k: on a 2D model the segment's spaces
     defined for k; on a 3D model also the face-only ones its element's face cells carry
     (QUAD8/QUAD9 spaces on hexahedra, TRI6 spaces on tetrahedra), those refused by
@@ -130,16 +129,16 @@ def model_case_ids(model, k: int, family: str = "structured", **mesh_kwargs) -> 
     every space of its dimension)."""
     if model.dim == 2:
         return registry.ids_valid_for(k, gamma_dim=1)
-    return registry.ids_built_on(k, *_coarsest_multiplier_mesh(model, k, family, **mesh_kwargs))
+    return registry.ids_built_on(k, *_coarsest_multiplier_mesh(model, k, family, mesh))
 
 
-def _coarsest_multiplier_mesh(model, k, family, **mesh_kwargs):
+def _coarsest_multiplier_mesh(model, k, family, mesh: MeshOptions):
     """(Γ, G_h) of ``model`` on its coarsest matching mesh pair (one cell per direction)."""
-    trace = model.side_operator(model.subdomain_mesh(family, 1, 1, **mesh_kwargs), k).trace
+    trace = model.side_operator(model.subdomain_mesh(family, 1, 1, **mesh.kwargs()), k).trace  # the model contract
     return trace.gamma, trace.gamma.multiplier_partition(trace.partition, trace.partition)
 
 
-def check_model_case(case: str, k: int, model, family: str = "structured", **mesh_kwargs) -> None:
+def check_model_case(case: str, k: int, model, family: str = "structured", mesh: MeshOptions = NO_OPTIONS) -> None:
     """:class:`InputError` unless ``model`` (with its mesh options, e.g. ``element``) builds the
     registered space ``case`` for degree k (:func:`model_case_ids`): one line naming the key
     (``case`` or ``k``) and the values allowed for this model, element and k. The id and k are
@@ -148,16 +147,16 @@ def check_model_case(case: str, k: int, model, family: str = "structured", **mes
     if not spec.valid_for(k):
         ks = [j for j in range(registry.K_RANGE[0], registry.K_RANGE[1] + 1) if spec.valid_for(j)]
         raise InputError("k", f"k in {ks[0]}..{ks[-1]} for case {case} ({spec.paper_ref})", got=k)
-    where = " ".join([f"--model {model.name}", *(f"--{key} {value}" for key, value in mesh_kwargs.items()),
+    where = " ".join([f"--model {model.name}", *(f"--{key} {value}" for key, value in mesh.kwargs().items()),
                       *([f"--family {family}"] if family != "structured" else [])])
     if not spec.defined_on(model.dim - 1):
         why = (f"defined on the face of a 3D model only: --model {', '.join(_models(3))}" if model.dim == 2
                else "defined on the segment Γ of the 2D models only")
-        allowed = model_case_ids(model, k, family, **mesh_kwargs)
+        allowed = model_case_ids(model, k, family, mesh)
         raise InputError("case", f"a space of {where} with k = {k}: {', '.join(allowed)} ({case} is {why})", got=case)
     if model.dim == 2:
         return
-    gamma, g_h = _coarsest_multiplier_mesh(model, k, family, **mesh_kwargs)
+    gamma, g_h = _coarsest_multiplier_mesh(model, k, family, mesh)
     allowed = registry.ids_built_on(k, gamma, g_h)
     if case in allowed:
         return

@@ -30,21 +30,25 @@ EXPORT_FORMATS = {"mtx": ".mtx", "npz": ".npz", "petsc": ".petsc"}
 
 
 def suite_system(case: str, k: int, n1: int, n2: int, family: str = "structured", norm: str = "H",
-                 multiplier_mesh: str = "omega2", model=None, **mesh_kwargs):
-    """(A, B, G) of ``case`` on the pair (N1, N2) of ``model`` (default: membranes)."""
-    A, B, space, gamma, _ = _suite_parts(case, k, n1, n2, family, multiplier_mesh, model, **mesh_kwargs)
+                 multiplier_mesh: str = "omega2", model=None, mesh=None):
+    """(A, B, G) of ``case`` on the pair (N1, N2) of ``model`` (default: membranes) with the mesh
+    options ``mesh`` (a :class:`~infsup_contact.solvers.request.MeshOptions`; None: the builder's
+    defaults)."""
+    A, B, space, gamma, _ = _suite_parts(case, k, n1, n2, family, multiplier_mesh, model, mesh)
     G, _ = gamma.gram(space, norm)
     return A, B, np.asarray(G, float)
 
 
-def _suite_parts(case, k, n1, n2, family, multiplier_mesh, model, **mesh_kwargs):
+def _suite_parts(case, k, n1, n2, family, multiplier_mesh, model, mesh=None):
     """(A, B, the multiplier space, Γ, the two side operators) of ``case`` on the pair (N1, N2)."""
     from ..discretization.spaces import registry
     from ..discretization.gamma.coupling import coupling_matrix
     from ..models.membranes import MEMBRANES
+    from ..solvers.request import NO_OPTIONS
     from ..solvers.side_cache import SideCache
 
-    sides = SideCache().pair(MEMBRANES if model is None else model, family, k, n1, n2, **mesh_kwargs)
+    sides = SideCache().pair(MEMBRANES if model is None else model, family, k, n1, n2,
+                             NO_OPTIONS if mesh is None else mesh)
     gamma = sides[0].trace.gamma
     g_h = gamma.multiplier_partition(*(s.trace.partition for s in sides), multiplier_mesh)
     space = registry.case_space(case, k, g_h, gamma)
@@ -59,14 +63,14 @@ def _suite_parts(case, k, n1, n2, family, multiplier_mesh, model, **mesh_kwargs)
 
 
 def suite_levels(case: str, k: int, ns, offset: int = 0, family: str = "structured", norm: str = "H",
-                 multiplier_mesh: str = "omega2", model=None, **mesh_kwargs) -> tuple:
+                 multiplier_mesh: str = "omega2", model=None, mesh=None) -> tuple:
     """(levels, manifest norm, gamma) of ``case`` on N1 = N + offset, N2 = N for N in ``ns``, as
     :func:`write_system` takes them (module docstring: ``norm: H`` with the description where the
-    space has one)."""
+    space has one; ``mesh`` as in :func:`suite_system`)."""
     from ..discretization.spaces.registry import space_spec
 
     spec, levels, described = space_spec(case), [], norm == "H"
-    parts = [_suite_parts(case, k, n + offset, n, family, multiplier_mesh, model, **mesh_kwargs) for n in ns]
+    parts = [_suite_parts(case, k, n + offset, n, family, multiplier_mesh, model, mesh) for n in ns]
     described = described and all(description(spec, p[2]) is not None for p in parts)
     for n, (A, B, space, gamma, sides) in zip(ns, parts):
         if not described:

@@ -11,6 +11,7 @@ from infsup_contact.discretization.gamma.coupling import coupling_matrix
 from infsup_contact.solvers import infsup
 from infsup_contact.solvers.side_cache import SideCache
 from infsup_contact.study.claims.membranes3d import checkerboard, face_predictions
+from infsup_contact.solvers.request import MeshOptions
 
 
 def _grid(n):
@@ -30,10 +31,10 @@ def test_the_rule_holds_only_for_p0_against_p2_on_triangles(case, k, gamma, expe
 def test_the_checkerboard_is_in_the_kernel_of_the_couplings():
     """μ = ±1/|T| (lower +, upper −) is orthogonal to both sides' P_2 traces, and the numerical
     kernel of T4 at k = 2 on matching tetrahedral meshes is exactly that one mode."""
-    rows = infsup.beta_rows("structured", 2, 3, 3, ["T4"], model=MODELS["membranes3d"], element="tet",
+    rows = infsup.beta_rows("structured", 2, 3, 3, ["T4"], model=MODELS["membranes3d"], mesh=MeshOptions(element="tet"),
                             norms=("L2",))
     assert (rows[0]["kernel_dim"], rows[0]["structural_kernel_dim"], rows[0]["kernel_check"]) == (1, 1, "agree")
-    sides = SideCache().pair(MODELS["membranes3d"], "structured", 2, 3, 3, element="tet")
+    sides = SideCache().pair(MODELS["membranes3d"], "structured", 2, 3, 3, MeshOptions(element="tet"))
     gamma = sides[0].trace.gamma
     space = gamma.space(SPACES["T4"], 2, sides[1].trace.partition)
     tri = space.triangles()
@@ -44,7 +45,7 @@ def test_the_checkerboard_is_in_the_kernel_of_the_couplings():
     for side in sides:
         B = coupling_matrix(side.trace, space, 2)
         assert np.linalg.norm(B.T @ mu) <= 1e-12 * np.linalg.norm(B, 2) * np.linalg.norm(mu)
-    rows = infsup.beta_rows("structured", 2, 3, 4, ["T4"], model=MODELS["membranes3d"], element="tet", norms=("L2",))
+    rows = infsup.beta_rows("structured", 2, 3, 4, ["T4"], model=MODELS["membranes3d"], mesh=MeshOptions(element="tet"), norms=("L2",))
     assert rows[0]["structural_kernel_dim"] == 0  # non-matching: no proof (and no mode)
 
 

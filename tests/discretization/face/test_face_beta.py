@@ -16,12 +16,13 @@ from infsup_contact.models import make_model
 from infsup_contact.solvers.side_cache import SideCache
 from infsup_contact.solvers.infsup import beta_rows, saddle_point_beta
 from infsup_contact.solvers.contact import contact_qp
+from infsup_contact.solvers.request import MeshOptions
 
 MODEL = make_model("membranes3d")
 
 
 def rows_of(k, n1, n2, element="hex", **kw):
-    return pd.DataFrame(beta_rows("structured", k, n1, n2, model=MODEL, element=element, **kw))
+    return pd.DataFrame(beta_rows("structured", k, n1, n2, model=MODEL, mesh=MeshOptions(element=element), **kw))
 
 
 def tensor_kernel(space, partitions, k) -> int:
@@ -48,7 +49,7 @@ def tensor_kernel(space, partitions, k) -> int:
 @pytest.mark.parametrize("n1,n2", [(2, 2), (3, 3), (3, 4), (2, 3)])
 def test_kernel_is_the_dimension_count(k, n1, n2):
     frame = rows_of(k, n1, n2)
-    sides = SideCache().pair(MODEL, "structured", k, n1, n2, element="hex")
+    sides = SideCache().pair(MODEL, "structured", k, n1, n2, MeshOptions(element="hex"))
     parts = [s.trace.partition for s in sides]
     assert set(frame.case) == set(ids_valid_for(k))
     for case, rows in frame.groupby("case"):
@@ -97,7 +98,7 @@ def test_beta_agrees_with_the_saddle_point_pencil(element, n1, n2, case):
     """The Γ-reduced route (Schur complements, Γ last) against the dense pencil of the whole
     system [[A, Bᵀ], [B, 0]] x = σ [[A, 0], [0, G]] x (solvers.infsup.saddle_point_beta)."""
     k = 2
-    sides = SideCache().pair(MODEL, "structured", k, n1, n2, element=element)
+    sides = SideCache().pair(MODEL, "structured", k, n1, n2, MeshOptions(element=element))
     gamma = sides[0].trace.gamma
     space = case_space(case, k, gamma.multiplier_partition(*(s.trace.partition for s in sides)), gamma)
     Bs = [coupling_matrix(s.trace, space, k) for s in sides]

@@ -21,6 +21,7 @@ from infsup_contact.models import make_model
 from infsup_contact.solvers.side_cache import SideCache
 from infsup_contact.solvers.infsup import beta_rows, saddle_point_beta
 from infsup_contact.solvers.contact import contact_qp
+from infsup_contact.solvers.request import MeshOptions
 
 MODEL = make_model("membranes3d")
 FACE_IDS = [c for c in registry.space_ids(None) if not registry.SPACES[c].defined_on(1)]
@@ -67,7 +68,7 @@ def test_dimensions_kernel_and_beta_on_matching_meshes():
     """dim M_h is the registry's count and kernel_dim the dimension argument max(dim M − dim W, 0)."""
     for n in (2, 3):
         frame = pd.DataFrame(beta_rows("structured", 2, n, n, cases=BUILDABLE, norms=("H",), model=MODEL,
-                                       element="hex"))
+                                       mesh=MeshOptions(element="hex")))
         for _, row in frame.iterrows():
             spec = registry.SPACES[row.case]
             assert row.dim_M == spec.dimension(2, n), row.case
@@ -79,13 +80,13 @@ def test_dimensions_kernel_and_beta_on_matching_meshes():
 @pytest.mark.parametrize("case,n1,n2", [("TDUAL-Q8", 2, 3), ("PWLIN-Q9", 2, 2)])
 def test_beta_agrees_with_the_saddle_point_pencil(case, n1, n2):
     k = 2
-    sides = SideCache().pair(MODEL, "structured", k, n1, n2, element="hex")
+    sides = SideCache().pair(MODEL, "structured", k, n1, n2, MeshOptions(element="hex"))
     gamma = sides[0].trace.gamma
     space = registry.case_space(case, k, gamma.multiplier_partition(*(s.trace.partition for s in sides)), gamma)
     Bs = [coupling_matrix(s.trace, space, k) for s in sides]
     A, B, _ = contact_qp(sides, Bs, [np.zeros(s.ndof) for s in sides])  # the assembled pencil's blocks
     B = B.toarray()
-    frame = pd.DataFrame(beta_rows("structured", k, n1, n2, cases=[case], model=MODEL, element="hex"))
+    frame = pd.DataFrame(beta_rows("structured", k, n1, n2, cases=[case], model=MODEL, mesh=MeshOptions(element="hex")))
     for norm, row in frame.set_index("norm").iterrows():
         assert saddle_point_beta(A, B, gamma.gram(space, norm)[0]) == pytest.approx(row.beta, rel=1e-8)
 
@@ -136,7 +137,7 @@ def test_coupling_is_exact_on_the_pieces(case):
     """B_ij = ∫ μ_i φ_j against a rule on the grid refined 4× per direction (every piece of pwlin
     a union of its rectangles), exact per variable to degree 9."""
     k = 2
-    side = SideCache().pair(MODEL, "structured", k, 2, 3, element="hex")[0]
+    side = SideCache().pair(MODEL, "structured", k, 2, 3, MeshOptions(element="hex"))[0]
     part = side.trace.partition
     space = registry.case_space(case, k, part, SQUARE)
     fine = [np.linspace(0, 1, 4 * (len(g) - 1) + 1) for g in (part.xs, part.ys)]

@@ -17,6 +17,7 @@ from infsup_contact.discretization.segment.interface import SEGMENT
 from infsup_contact.discretization.face.square import SQUARE, SQUARE_TRIG
 from infsup_contact.discretization.face.tensor_grid import TensorPartition
 from infsup_contact.errors import InputError
+from infsup_contact.solvers.request import MeshOptions
 
 TRI6 = reference_element("TRI6")
 ALPHAS = (Fraction(0), Fraction(1, 10), Fraction(1, 5), Fraction(1, 4), Fraction(1, 3), Fraction(9, 20))
@@ -188,7 +189,7 @@ def test_beta_h_is_bounded_in_n_on_tetrahedra(monkeypatch):
     model, cache, rows = make_model("membranes3d"), SideCache(), []
     for n in (4, 6, 8):
         rows += beta_rows_all("structured", 2, n, n, ["TDUAL-T6", "PWLIN-T6"], norms=("H", "L2"), model=model,
-                              side_cache=cache, element="tet")
+                              side_cache=cache, mesh=MeshOptions(element="tet"))
     frame = pd.DataFrame(rows)
     assert (frame.kernel_dim == 0).all() and (frame.kernel_decision == "clear").all()
     for (case, norm), r in frame.groupby(["case", "norm"]):

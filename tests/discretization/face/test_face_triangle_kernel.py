@@ -18,6 +18,7 @@ from infsup_contact.errors import InputError
 from infsup_contact.models import make_model
 from infsup_contact.solvers.side_cache import SideCache
 from infsup_contact.study.claims.membranes3d import planar_kernel, triangle_kernel_bound
+from infsup_contact.solvers.request import MeshOptions
 
 MODEL = make_model("membranes3d")
 _CACHE = SideCache()
@@ -56,7 +57,7 @@ def test_components_partition_the_space(case, k, n):
 def _computed_kernel(case, k, n1, n2):
     """A basis of ker Bᵀ = {μ : μ ⊥ W1, μ ⊥ W2} from the tetrahedra's NGSolve traces (the
     suite's exact couplings, scaled by the trace norms), with its multiplier space."""
-    sides = _CACHE.pair(MODEL, "structured", k, n1, n2, element="tet")
+    sides = _CACHE.pair(MODEL, "structured", k, n1, n2, MeshOptions(element="tet"))
     gamma = sides[0].trace.gamma
     space = case_space(case, k, gamma.multiplier_partition(*(s.trace.partition for s in sides)), gamma)
     B = np.hstack([coupling_matrix(s.trace, space, k) / trace_l2_norms(s.trace, k) for s in sides])

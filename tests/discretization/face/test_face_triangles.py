@@ -19,6 +19,7 @@ from infsup_contact.models import make_model
 from infsup_contact.solvers.side_cache import SideCache
 from infsup_contact.solvers.infsup import beta_rows
 from infsup_contact.solvers.contact import contact_qp
+from infsup_contact.solvers.request import MeshOptions
 
 FAMILIES = [(1, True, True), (2, True, True), (1, True, False), (3, True, False), (0, False, False),
             (2, False, False)]
@@ -135,8 +136,8 @@ def trace_sum_rank(sides) -> int:
 def test_kernel_is_the_dimension_count_on_tetrahedra(k, n):
     """dim ker Bᵀ = dim M − dim(W1 + W2) on matching meshes, for every case, by the engine and by
     the rank of the coupling matrices; dim(W1 + W2) by trace_sum_dimension and by rank."""
-    frame = pd.DataFrame(beta_rows("structured", k, n, n, model=MODEL, element="tet", norms=("L2",)))
-    sides = SideCache().pair(MODEL, "structured", k, n, n, element="tet")
+    frame = pd.DataFrame(beta_rows("structured", k, n, n, model=MODEL, mesh=MeshOptions(element="tet"), norms=("L2",)))
+    sides = SideCache().pair(MODEL, "structured", k, n, n, MeshOptions(element="tet"))
     gamma = sides[0].trace.gamma
     dim_w = gamma.trace_sum_dimension(k, *(s.trace.partition for s in sides))
     assert dim_w == trace_sum_rank(sides)
@@ -164,14 +165,14 @@ def test_beta_agrees_with_the_saddle_point_pencil_on_triangles():
 
     k, n1, n2 = 2, 2, 3
     case = next(c for c in ids_valid_for(k) if SPACES[c].lagrange == (True, True) and SPACES[c].degree(k) == k)
-    sides = SideCache().pair(MODEL, "structured", k, n1, n2, element="tet")
+    sides = SideCache().pair(MODEL, "structured", k, n1, n2, MeshOptions(element="tet"))
     gamma = sides[0].trace.gamma
     space = case_space(case, k, sides[1].trace.partition, gamma)
     assert isinstance(space, TriangleSpace)
     Bs = [coupling_matrix(s.trace, space, k) for s in sides]
     A, B, _ = contact_qp(sides, Bs, [np.zeros(s.ndof) for s in sides])  # the assembled pencil's blocks
     B = B.toarray()
-    frame = pd.DataFrame(beta_rows("structured", k, n1, n2, model=MODEL, element="tet", cases=[case]))
+    frame = pd.DataFrame(beta_rows("structured", k, n1, n2, model=MODEL, mesh=MeshOptions(element="tet"), cases=[case]))
     for norm, row in frame.set_index("norm").iterrows():
         assert saddle_point_beta(A, B, gamma.gram(space, norm)[0]) == pytest.approx(row.beta, rel=1e-8)
 
@@ -203,7 +204,7 @@ def test_couplings_on_non_matching_pairs_sum_to_the_trace_integrals(k, n1, n2):
     """Σ_i μ_i = 1 for the Lagrange spaces without the ∂Γ condition, so 1ᵀ B_s = (∫_Γ w_j)_j:
     the coupling on the pieces cut by the diagonals of both grids against the trace's own
     triangles (Square.quadrature of the trace partition, no multiplier involved)."""
-    sides = SideCache().pair(MODEL, "structured", k, n1, n2, element="tet")
+    sides = SideCache().pair(MODEL, "structured", k, n1, n2, MeshOptions(element="tet"))
     gamma = sides[0].trace.gamma
     for case in ids_valid_for(k):
         spec = SPACES[case]
@@ -223,7 +224,7 @@ def test_p0_coupling_by_triangle_triangle_intersections():
     from infsup_contact.discretization.face.quadrature import _clip
 
     k = 2
-    sides = SideCache().pair(MODEL, "structured", k, 3, 2, element="tet")
+    sides = SideCache().pair(MODEL, "structured", k, 3, 2, MeshOptions(element="tet"))
     gamma = sides[0].trace.gamma
     space = TriangleSpace(sides[1].trace.partition, 0, False)
     trace = sides[0].trace

@@ -26,6 +26,7 @@ from infsup_contact.models import make_model
 from infsup_contact.models import membranes3d
 from infsup_contact.solvers.side_cache import SideCache
 from infsup_contact.solvers.infsup import beta_rows
+from infsup_contact.solvers.request import MeshOptions
 
 MODEL = make_model("membranes3d")
 GENERAL = dataclasses.replace(MODEL, side_operator=lambda mesh, k: membranes3d.side_operator(mesh, k, gamma=TRIANGULATED))
@@ -82,7 +83,7 @@ def test_quadrature_on_the_refinement_is_exact(unstructured, degree):
 def test_trace_dimensions_are_ngsolves(k):
     """dim W_h (P_k lattice nodes off ∂Γ) = NGSolve's free Γ dofs; on the pair, dim(W1 + W2) =
     trace_sum_dimension = the rank of both trace bases at common points (non-matching: W1 ∩ W2 = 0)."""
-    sides = SideCache().pair(MODEL, "unstructured", k, 2, 3, element="tet")
+    sides = SideCache().pair(MODEL, "unstructured", k, 2, 3, MeshOptions(element="tet"))
     gamma = sides[0].trace.gamma
     assert gamma is TRIANGULATED
     for s in sides:
@@ -147,7 +148,7 @@ def test_general_route_gives_the_structured_beta(k):
         # are compared in test_general_spaces_are_the_structured_ones)
         split = [(cases, ("L2",)), (cases[:2], ("H",))]
         frames = [r for c, norms in split
-                  for r in beta_rows("structured", k, 2, 3, cases=c, model=model, element="tet", norms=norms)]
+                  for r in beta_rows("structured", k, 2, 3, cases=c, model=model, mesh=MeshOptions(element="tet"), norms=norms)]
         rows[name] = pd.DataFrame(frames).set_index(["case", "norm"])
     a, b = rows["structured"], rows["general"]
     assert (a.kernel_dim == b.kernel_dim).all() and (a.dim_M == b.dim_M).all()
@@ -163,7 +164,7 @@ def test_unstructured_kernels_and_beta(k):
     count is positive somewhere (the global one alone would miss those modes); β_L² > 0 exactly
     where there is no kernel, and for T3 and the dual basis."""
     cases = [c for c in ("T3", "R5.2", "T4", "R5.4", "T5", "DUAL") if SPACES[c].valid_for(k)]
-    frame = pd.DataFrame(beta_rows("unstructured", k, 3, 4, cases=cases, model=MODEL, element="tet", norms=("L2",)))
+    frame = pd.DataFrame(beta_rows("unstructured", k, 3, 4, cases=cases, model=MODEL, mesh=MeshOptions(element="tet"), norms=("L2",)))
     for _, row in frame.iterrows():
         assert row.kernel_decision == "clear"
         assert row.kernel_dim == row.structural_kernel_dim and row.kernel_check == "agree", row.case
@@ -216,12 +217,12 @@ def test_perturbed_matching_pair_counts_are_exact():
     """N1 = N2: both perturbed faces are the same triangulation (shifts drawn from (seed, N));
     dim(W1 + W2) = dim W, the kernel of every continuous case is dim M − dim W exactly."""
     k, n = 1, 3
-    sides = SideCache().pair(MODEL, "perturbed", k, n, n, element="tet", seed=2)
+    sides = SideCache().pair(MODEL, "perturbed", k, n, n, MeshOptions(element="tet", seed=2))
     p1, p2 = (s.trace.partition for s in sides)
     assert p1.key == p2.key
     assert TRIANGULATED.trace_sum_dimension(k, p1, p2) == TRIANGULATED.trace_dimension_of(k, p1)
-    frame = pd.DataFrame(beta_rows("perturbed", k, n, n, cases=["T3", "R5.2", "DUAL"], model=MODEL, element="tet",
-                                   norms=("L2",), seed=2))
+    frame = pd.DataFrame(beta_rows("perturbed", k, n, n, cases=["T3", "R5.2", "DUAL"], model=MODEL,
+                                   mesh=MeshOptions(element="tet", seed=2), norms=("L2",)))
     assert (frame.kernel_dim == frame.structural_kernel_dim).all() and (frame.kernel_check == "agree").all()
 
 

@@ -16,13 +16,14 @@ from infsup_contact.discretization.spaces.registry import case_space
 from infsup_contact.errors import InputError
 from infsup_contact.models import make_model
 from infsup_contact.solvers.side_cache import SideCache
+from infsup_contact.solvers.request import MeshOptions
 
 SRC = pathlib.Path(infsup_contact.__file__).parent
 
 
 @pytest.fixture(scope="module")
 def perturbed_sides():
-    return SideCache().pair(make_model("membranes"), "perturbed", 2, 5, 3, seed=3, alpha=0.2)
+    return SideCache().pair(make_model("membranes"), "perturbed", 2, 5, 3, MeshOptions(seed=3, alpha=0.2))
 
 
 def test_the_segment_is_an_interface_and_the_abc_is_abstract():

@@ -9,11 +9,14 @@ imported here. The pairs of a batch share one side cache, so a side common to se
 """
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pandas as pd
 
 from ...models import make_model
 from ...models.contract import Model
+from ...solvers.request import NO_OPTIONS, MeshOptions
 from ...solvers.side_cache import SideCache
 from ...solvers.infsup import NORMS, beta_rows_all
 
@@ -29,7 +32,7 @@ def as_model(model, **params) -> Model:
 
 def beta_batch_rows(model, family: str, k: int, pairs, cases=None, multiplier_meshes=("omega2",),
                     c_pairs=((1.0, 1.0),), norms=NORMS, *, seeds=None, series=None, model_params=None,
-                    side_cache: SideCache | None = None, **mesh_kwargs) -> pd.DataFrame:
+                    side_cache: SideCache | None = None, mesh: MeshOptions = NO_OPTIONS) -> pd.DataFrame:
     """β_h rows of ``model`` on every (N1, N2) of ``pairs``, one frame.
 
     Parameters
@@ -40,7 +43,7 @@ def beta_batch_rows(model, family: str, k: int, pairs, cases=None, multiplier_me
         As in :func:`~infsup_contact.solvers.infsup.beta_rows_all` (``cases=None``: every
         registered space defined for k).
     seeds
-        Perturbed meshes: the seeds, each a mesh of every pair (``seed`` mesh keyword); the
+        Perturbed meshes: the seeds, each a mesh of every pair (the ``seed`` of ``mesh``); the
         rows get a ``seed`` column (empty for a seed ``None``: a deterministic family in a
         table that has seeds). ``None``: one mesh per pair and no ``seed`` column.
     series
@@ -48,24 +51,24 @@ def beta_batch_rows(model, family: str, k: int, pairs, cases=None, multiplier_me
         with a ``series`` column. ``None``: once, no ``series`` column.
     side_cache
         Side operators already built (default: a cache for this batch).
-    mesh_kwargs
-        Mesh parameters of every pair (e.g. ``alpha`` of the perturbed family).
+    mesh
+        Mesh parameters of every pair (e.g. ``MeshOptions(alpha=0.2)`` of the perturbed family).
 
     Rows in the order pair, seed, series, then :func:`beta_rows_all`'s (multiplier mesh,
     case, c pair, norm).
     """
     model = as_model(model, **(model_params or {}))
-    variants = {None: dict(mesh_kwargs)} if seeds is None else {
-        s: dict(mesh_kwargs) if s is None else dict(mesh_kwargs, seed=int(s)) for s in seeds}
+    variants = {None: mesh} if seeds is None else {
+        s: mesh if s is None else replace(mesh, seed=int(s)) for s in seeds}
     sides = SideCache() if side_cache is None else side_cache
-    for kw in variants.values():
-        sides.expect(model, family, k, pairs, **kw)
+    for options in variants.values():
+        sides.expect(model, family, k, pairs, options)
     frames = []
     for n1, n2 in pairs:
-        for seed, kw in variants.items():
+        for seed, options in variants.items():
             rows = pd.DataFrame(beta_rows_all(family, k, n1, n2, cases, tuple(multiplier_meshes),
                                               [tuple(c) for c in c_pairs], norms, model=model,
-                                              side_cache=sides, **kw))
+                                              side_cache=sides, mesh=options))
             if seeds is not None:
                 rows["seed"] = np.nan if seed is None else seed
             for name in ([None] if series is None else series[(n1, n2)]):

@@ -21,6 +21,7 @@ import pandas as pd
 from ...discretization.spaces import registry
 from ...models import DEFAULT_MODEL, model_taking
 from ...models.plane_strain import lame
+from ...solvers.request import NO_OPTIONS, MeshOptions
 from .batch_rows import beta_batch_rows
 
 ELASTIC = model_taking("nu").name
@@ -41,24 +42,25 @@ def bound_factor(nu: float) -> float:
 
 
 def membranes_rows(family: str, k: int, pairs, E=(1.0, 1.0), cases=None, norms=("H",),
-                   **mesh_kwargs) -> pd.DataFrame:
+                   mesh: MeshOptions = NO_OPTIONS) -> pd.DataFrame:
     """The membranes' β_h rows (c = E) on every pair, G_h = trace of Ω2: they do not depend on
     ν, so a ν sweep computes them once."""
     cases = registry.ids_valid_for(k) if cases is None else list(cases)
-    return beta_batch_rows(MEMBRANES, family, k, pairs, cases, ("omega2",), (tuple(E),), norms, **mesh_kwargs)
+    return beta_batch_rows(MEMBRANES, family, k, pairs, cases, ("omega2",), (tuple(E),), norms, mesh=mesh)
 
 
 def elastic_beta_rows(family: str, k: int, pairs, nu: float = 0.3, E=(1.0, 1.0), cases=None,
-                      norms=("H",), membranes: pd.DataFrame | None = None, **mesh_kwargs) -> pd.DataFrame:
+                      norms=("H",), membranes: pd.DataFrame | None = None,
+                      mesh: MeshOptions = NO_OPTIONS) -> pd.DataFrame:
     """β_h of the elastic pair (and of the membranes, c = E) for each (N1, N2) in ``pairs``,
     every case valid for k (default) and norm; G_h = trace of Ω2 (the paper's choice). Both
     come from the β_h batches' study path (:func:`~infsup_contact.study.beta.batch_rows.beta_batch_rows`).
     ``membranes``: the membranes' rows of :func:`membranes_rows` where already computed."""
     cases = registry.ids_valid_for(k) if cases is None else list(cases)
     if membranes is None:
-        membranes = membranes_rows(family, k, pairs, E, cases, norms, **mesh_kwargs)
+        membranes = membranes_rows(family, k, pairs, E, cases, norms, mesh)
     el = beta_batch_rows(ELASTIC, family, k, pairs, cases, ("omega2",), (tuple(E),), norms,
-                         model_params={"nu": nu}, **mesh_kwargs)
+                         model_params={"nu": nu}, mesh=mesh)
     out = []
     for r, m in zip(el.to_dict("records"), membranes.to_dict("records"), strict=True):
         assert (r["N1"], r["N2"], r["case"], r["norm"]) == (m["N1"], m["N2"], m["case"], m["norm"])

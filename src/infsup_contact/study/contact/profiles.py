@@ -19,6 +19,7 @@ import numpy as np
 import pandas as pd
 
 from ...solvers.contact import ContactSolution, gamma_values, lambda_values, solve_contact
+from ...solvers.request import NO_OPTIONS, MeshOptions
 from .scenes import membranes
 
 GAMMA_COLUMNS = ["case", "k", "N", "x", "quantity", "value"]
@@ -70,7 +71,7 @@ def field_frame(sol: ContactSolution, case: str, k: int, n: int) -> pd.DataFrame
 
 
 def contact_profiles(cases, k: int, n: int, scene=None, family: str = "structured",
-                     per_interval: int = 9, **mesh_kwargs):
+                     per_interval: int = 9, mesh: MeshOptions = NO_OPTIONS):
     """Solve (4.1) for each case on one N×N mesh pair; return (Γ profiles, field values).
 
     Parameters
@@ -88,6 +89,8 @@ def contact_profiles(cases, k: int, n: int, scene=None, family: str = "structure
         Mesh family (default structured).
     per_interval : int
         Samples per interval of G_h for the Γ profiles.
+    mesh : MeshOptions
+        The mesh parameters (default: the builder's).
 
     Returns
     -------
@@ -97,7 +100,7 @@ def contact_profiles(cases, k: int, n: int, scene=None, family: str = "structure
     scene = scene if scene is not None else membranes()
     gammas, fields = [], []
     for case in cases:
-        sol = solve_contact(scene, case, k, family, n, n, time_floor=False, **mesh_kwargs)
+        sol = solve_contact(scene, case, k, family, n, n, time_floor=False, mesh=mesh)
         gammas.append(gamma_profile_frame(sol, case, k, n, per_interval))
         fields.append(field_frame(sol, case, k, n))
     return pd.concat(gammas, ignore_index=True), pd.concat(fields, ignore_index=True)

@@ -3,6 +3,7 @@ from __future__ import annotations
 
 from . import accuracy
 from ...solvers.contact import ContactSolution, contact_pair, solve_contact, solve_contact_on
+from ...solvers.request import NO_OPTIONS, MeshOptions, check_k
 from ...errors import InputError, check_prestress
 from ...discretization.spaces.registry import REFERENCE_SPACE, check_case, space_spec
 from .scenes import scene as make_scene
@@ -125,20 +126,19 @@ def load_reference(path):
 def contact_row(scene_name: str, case: str, k: int, family: str, n1: int, n2: int,
                 c1: float = 1.0, c2: float = 1.0, reference: ContactSolution | None = None,
                 n_ref: int = 64, time_floor: bool = True, scene_params: dict | None = None, model=None,
-                **mesh_kwargs) -> dict:
+                mesh: MeshOptions = NO_OPTIONS) -> dict:
     """Solve one instance of (4.1) and measure it; errors vs exact (manufactured) or reference."""
     return contact_rows(scene_name, [case], k, family, n1, n2, c1, c2, reference, n_ref,
-                        time_floor, scene_params, model=model, **mesh_kwargs)[0]
+                        time_floor, scene_params, model=model, mesh=mesh)[0]
 
 
 def contact_rows(scene_name: str, cases, k: int, family: str, n1: int, n2: int,
                  c1: float = 1.0, c2: float = 1.0, reference: ContactSolution | None = None,
                  n_ref: int = 64, time_floor: bool = True, scene_params: dict | None = None,
-                 model=None, **mesh_kwargs) -> list[dict]:
+                 model=None, mesh: MeshOptions = NO_OPTIONS) -> list[dict]:
     """:func:`contact_row` for several multiplier cases on one mesh pair, which is meshed,
     factorized and loaded once (:func:`~infsup_contact.solvers.contact.contact_pair`)."""
-    if not 1 <= k <= 4:
-        raise InputError("k", "an integer in 1..4", got=k)
+    check_k(k)
     for case in cases:
         check_case(case, k)
     for key, c in (("c1", c1), ("c2", c2)):
@@ -146,7 +146,7 @@ def contact_rows(scene_name: str, cases, k: int, family: str, n1: int, n2: int,
     sc = make_scene(scene_name, c1=c1, c2=c2, **(scene_params or {}))
     if not sc.has_exact:
         reference = reference or reference_solution(sc, k, n_ref, model)
-    pair = contact_pair(sc, k, family, n1, n2, model=model, **mesh_kwargs)
+    pair = contact_pair(sc, k, family, n1, n2, model=model, mesh=mesh)
     rows = []
     for case in cases:
         sol = solve_contact_on(pair, case, time_floor=time_floor)

@@ -67,8 +67,14 @@ def hertz_rows(model, cases, k, family, n1, n2, c, args) -> list:
 
 def face_patch_rows(model, cases, k, family, n1, n2, c, args) -> list:
     """The 3D patch test's rows on the pair, on the request's element (``--element``)."""
-    return face_patch.face_patch_rows(cases, [k], [(n1, n2)], c, element=getattr(args, "mesh_kwargs", {}).get(
-        "element", "hex"), model=model)
+    return face_patch.face_patch_rows(cases, [k], [(n1, n2)], c, element=_element(args), model=model)
+
+
+def _element(args) -> str:
+    """The request's 3D element (``--element``, :class:`~infsup_contact.solvers.request.MeshOptions`
+    in ``args.mesh``); ``hex`` where the request has none."""
+    mesh = getattr(args, "mesh", None)
+    return "hex" if mesh is None or mesh.element is None else mesh.element
 
 
 def face_check(args):
@@ -81,7 +87,7 @@ def elastic_face_patch_rows(model, cases, k, family, n1, n2, c, args) -> list:
     """The 3D elastic patch test's rows on the pair (moduli ``c`` = (E1, E2), ``--nu`` built into
     ``model``), on the request's element (``--element``)."""
     return elastic_face_patch.elastic_face_patch_rows(
-        cases, [k], [(n1, n2)], c, args.nu, element=getattr(args, "mesh_kwargs", {}).get("element", "hex"),
+        cases, [k], [(n1, n2)], c, args.nu, element=_element(args),
         model=model)
 
 

@@ -120,6 +120,7 @@ def sweep(ns=(4, 8), alphas=ALPHAS, elements=ELEMENTS, k: int = 2, norms=("H",),
     the first, :func:`face_models`; ``cell`` its --element, default the one whose face cells
     fit each element, :func:`element_of`)."""
     from ...models import make_model
+    from ...solvers.request import MeshOptions
     from ...solvers.side_cache import SideCache
 
     model = face_models()[0] if model is None else model
@@ -138,7 +139,8 @@ def sweep(ns=(4, 8), alphas=ALPHAS, elements=ELEMENTS, k: int = 2, norms=("H",),
                     continue
                 mesh_element = cell or element_of(model, element)
                 for r in beta_rows_all("structured", k, n, n, [transformed_dual_spec(element, info["alpha"])],
-                                       norms=norms, model=make_model(model), side_cache=cache, element=mesh_element):
+                                       norms=norms, model=make_model(model), side_cache=cache,
+                                       mesh=MeshOptions(element=mesh_element)):
                     rows.append(dict(base, norm=r["norm"], beta=r["beta"], kernel_dim=r["kernel_dim"],
                                      dim_M=r["dim_M"], dim_W=r["dim_W"], n_max=r["n_max"]))
     return rows

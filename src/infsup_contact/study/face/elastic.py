@@ -40,6 +40,7 @@ def face_cases(fe: dict, k: int, gamma) -> list:
 def beta_frame(fe: dict, element: str) -> pd.DataFrame:
     """β_H rows of one element (module docstring), columns of the β table plus ``model``,
     ``element`` and ``nu`` (timings dropped: they belong to the benchmark tree)."""
+    from ...solvers.request import MeshOptions
     from ..beta.batch_rows import beta_batch_rows
     from ..claims.membranes3d import element_interfaces
 
@@ -51,7 +52,7 @@ def beta_frame(fe: dict, element: str) -> pd.DataFrame:
             continue
         for nu, pairs in nu_pairs(fe):
             rows = beta_batch_rows(fe["model"], "structured", int(k), pairs, cases, ("omega2",), norms=NORMS,
-                                   model_params={"nu": nu}, element=element)
+                                   model_params={"nu": nu}, mesh=MeshOptions(element=element))
             frames.append(rows.assign(nu=nu))
     frame = pd.concat(frames, ignore_index=True)
     frame = frame.drop(columns=[c for c in frame.columns if c.startswith("t_")])

@@ -88,6 +88,7 @@ def family_kernels(pairs, ks=(1, 2), cases=None, elements=None, model: str | Non
     registered face space with a count; ``model`` default: the first registered 3D model
     (:func:`~.face_alpha.face_models`); ``elements`` default: all of its elements."""
     from ...models import MODELS, make_model
+    from ...solvers.request import MeshOptions
     from ...solvers.side_cache import SideCache
     from ...solvers.infsup import beta_rows_all
     from .alpha import face_models
@@ -112,7 +113,7 @@ def family_kernels(pairs, ks=(1, 2), cases=None, elements=None, model: str | Non
                     built.append((c, planar))
                 found = {r["case"]: r for r in beta_rows_all("structured", k, n1, n2, [c for c, _ in built],
                                                              norms=("L2",), model=m, side_cache=cache,
-                                                             element=element)}
+                                                             mesh=MeshOptions(element=element))}
                 for c, planar in built:
                     spec, r = SPACES[c], found[c]
                     product = is_tensor(gamma) and spec.face_build is None

@@ -40,6 +40,7 @@ def hex20_table(ns=NS, norms=("H", "L2"), cases=None, criterion=None) -> list[di
     β request (both sides factorized once, every space and norm)."""
     from ...models.membranes3d import MEMBRANES3D
     from ...solvers.infsup import beta_rows_all
+    from ...solvers.request import MeshOptions
     from ...solvers.side_cache import SideCache
 
     ns = sorted({int(n) for n in ns})
@@ -51,7 +52,7 @@ def hex20_table(ns=NS, norms=("H", "L2"), cases=None, criterion=None) -> list[di
     for n in ns:
         t0 = time.perf_counter()
         found = beta_rows_all("structured", 2, n, n, cases, norms=tuple(norms), model=MEMBRANES3D,
-                              side_cache=cache, element="hex20")
+                              side_cache=cache, mesh=MeshOptions(element="hex20"))
         seconds = time.perf_counter() - t0
         rows += [dict(r, N=n, seconds=seconds) for r in found]
     out = []

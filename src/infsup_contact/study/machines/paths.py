@@ -288,13 +288,14 @@ def face_sweep_rows() -> pd.DataFrame:
     from ...discretization.spaces.registry import PAPER_CASES, SPACES
     from ...models import make_model
     from ...solvers.infsup import beta_rows_all
+    from ...solvers.request import MeshOptions
 
     model, rows = make_model("membranes3d"), []
     for k, pairs in FACE_SWEEP.items():
         cases = [c for c in PAPER_CASES if SPACES[c].valid_for(k)]
         for n1, n2 in pairs:
             rows += beta_rows_all("structured", k, n1, n2, cases, ("omega2",), norms=("H", "L2"),
-                                  model=model, element="hex")
+                                  model=model, mesh=MeshOptions(element="hex"))
     return pd.DataFrame(rows).assign(model=model.name)
 
 

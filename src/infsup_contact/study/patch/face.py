@@ -69,6 +69,7 @@ from ...discretization.segment.meshes import DIRICHLET
 from ...errors import InputError
 from ...models import make_model
 from ...solvers.contact import contact_pair, solve_contact_on
+from ...solvers.request import MeshOptions
 from ..contact.registry import FACE_PATCH
 from . import table
 from .table import KERNEL_RTOL
@@ -129,7 +130,7 @@ def patch_scene(c=(1.0, 1.0), delta: float = DELTA) -> PressedCubes:
 def patch_pair(k: int, n1: int, n2: int, c=(1.0, 1.0), delta: float = DELTA, element: str = "hex", model=None):
     """Both factorized bodies of the scene (one per body, shared by every case)."""
     model = make_model(FACE_PATCH.models[0]) if model is None else model
-    return contact_pair(patch_scene(c, delta), k, "structured", n1, n2, model, element=element)
+    return contact_pair(patch_scene(c, delta), k, "structured", n1, n2, model, MeshOptions(element=element))
 
 
 def solve_face_patch(case: str, k: int, n1: int, n2: int, c=(1.0, 1.0), delta: float = DELTA,

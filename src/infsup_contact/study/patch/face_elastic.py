@@ -63,6 +63,7 @@ from ...errors import InputError
 from ...models import make_model
 from ...models.plane_strain import check_modulus, check_nu
 from ...solvers.contact import contact_pair
+from ...solvers.request import MeshOptions
 from .face import DELTA, solve_face_patch
 from ..contact.registry import ELASTIC_FACE_PATCH
 from . import table
@@ -131,7 +132,7 @@ def patch_pair(k: int, n1: int, n2: int, E=(1.0, 1.0), nu: float = 0.3, delta: f
     """Both factorized bodies of the scene (shared by every case); ``model``: the scene's
     model built with ``nu`` (default from the registry)."""
     model = make_model(ELASTIC_FACE_PATCH.models[0], nu=nu) if model is None else model
-    return contact_pair(patch_scene(E, nu, delta), k, "structured", n1, n2, model, element=element)
+    return contact_pair(patch_scene(E, nu, delta), k, "structured", n1, n2, model, MeshOptions(element=element))
 
 
 def solve_elastic_face_patch(case: str, k: int, n1: int, n2: int, E=(1.0, 1.0), nu: float = 0.3,

@@ -64,11 +64,8 @@ rule model_sections:
         names=MODEL_SECTIONS,
     log:
         "results/logs/model_sections.log",
-    run:
-        from infsup_contact.io import write_atomic
-        from infsup_contact.report.model_section import sections_index_tex
-
-        write_atomic(output[0], sections_index_tex(params.names))
+    script:
+        "../scripts/model_sections.py"
 
 
 rule paper_pdf:

@@ -69,8 +69,7 @@ def test_the_exact_solution_meets_supports_contact_and_flux_continuity(c):
 
 
 def test_the_scene_side_leaves_the_lateral_sides_and_gammas_ends_free():
-    """Natural lateral sides: both end dofs of Γ are unknowns; the beta side of the same mesh
-    clamps nothing more (the membranes mesh of the workflow names all of ∂Ω_i∖Γ ``dir``)."""
+    """Natural lateral sides: both end dofs of Γ are unknowns, Γ dofs of the trace."""
     mesh = block_mesh(3, 2)
     side = MODELS["membranes"].side_for(patch.patch_scene(C), mesh, 1)
     free = np.array(side.trace.fes.FreeDofs(), dtype=bool)

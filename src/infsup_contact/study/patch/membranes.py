@@ -22,11 +22,18 @@ solves the discrete system exactly (B_iᵀ(λ 1) are the consistent nodal fluxes
 formula) and its coefficients lie in every registered cone, so λ_h = λ and u_h = u to
 round-off whatever the seams; if 1 ∉ M_h, λ_h ≠ λ. The natural lateral sides leave the Γ
 traces free at Γ's ends, so the spaces' end conditions do not matter: every case holding the
-constants passes (R5.2, R5.4, T4, T5, DUAL-ALL, P0-2h, DUAL), T3 (zero at Γ's ends) fails. The
-column ``predicted`` is 1 ∈ M_h computed on the space the solve builds
+constants passes, T3 (zero at Γ's ends) fails. The column ``predicted`` is 1 ∈ M_h computed
+on the space the solve builds
 (:func:`~infsup_contact.discretization.gamma.constants.spans_constants`), never read off a case id.
 
-Not in the workflow: :func:`membranes_patch_rows` is run by hand (docs/models.md).
+**Outcome** (k = 1, 2, 3; N1:N2 = 5:4 and 7:3; c = (1, 3); every registered case, 38 rows; an
+exploratory run outside the DAG, ``tests/study/test_membranes_patch.py`` pins the rule): as
+predicted in every row. R5.2, T4, R5.4, T5, DUAL and DUAL-ALL hold the constants and reproduce
+λ to ≤ 3e-13 and u to ≤ 2e-13 δ; T3 fails with λ error 1 (it vanishes at Γ's ends) and u error
+4e-2..1e-1 δ. No row has a kernel (``kernel_dim`` 0).
+
+Not in the workflow (the ledger stays as it is): :func:`membranes_patch_rows` is run by hand
+(docs/models.md).
 """
 from __future__ import annotations
 

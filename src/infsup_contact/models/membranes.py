@@ -16,9 +16,9 @@ from .contract import OUTWARD_NORMAL_Y, MaterialParam, Model
 from .contract import SideOperator, factorized_side
 
 
-def displacement_space(mesh, k: int):
-    """V_{h,i}: continuous P_k, u_i = 0 on ∂Ω_i∖Γ (eq. (5.1))."""
-    return ngsolve.H1(mesh, order=k, dirichlet="dir")
+def displacement_space(mesh, k: int, dirichlet: str = "dir"):
+    """V_{h,i}: continuous P_k, u_i = 0 on ``dirichlet`` (default ∂Ω_i∖Γ, eq. (5.1))."""
+    return ngsolve.H1(mesh, order=k, dirichlet=dirichlet)
 
 
 def laplace_stiffness(fes) -> sp.csr_matrix:
@@ -33,10 +33,10 @@ def laplace_stiffness(fes) -> sp.csr_matrix:
     return sp.csr_matrix((data, cols, rows), shape=(mat.height, mat.width))
 
 
-def side_operator(mesh, k: int, route: str = "auto") -> SideOperator:
+def side_operator(mesh, k: int, route: str = "auto", dirichlet: str = "dir") -> SideOperator:
     """Factorize K_i once and extract its Γ Schur complement (c = 1); ``route`` as in
-    :func:`gamma_factorization`."""
-    fes = displacement_space(mesh, k)
+    :func:`gamma_factorization`, u_i = 0 on ``dirichlet``."""
+    fes = displacement_space(mesh, k, dirichlet)
     trace = SEGMENT.trace(fes)
     free_mask = np.array(fes.FreeDofs(), dtype=bool)
     is_gamma = np.zeros(fes.ndof, dtype=bool)
@@ -72,11 +72,34 @@ def load_vector_from_exact(side: SideOperator, grad_u, c: float, normal_y: float
     return lf.vec.FV().NumPy()[side.free].copy()
 
 
+def scene_side(scene, mesh, k: int) -> SideOperator:
+    """The side of a contact scene: u_i prescribed on the scene's ``supports`` (one NGSolve boundary
+    regexp in a tuple, the patch test's far faces ``dir`` with the lateral sides natural) where it
+    has them, else on ``dir`` (the β_h side)."""
+    (dirichlet,) = getattr(scene, "supports", None) or ("dir",)
+    return side_operator(mesh, k, dirichlet=dirichlet)
+
+
+def far_face_load(side: SideOperator, scene, i: int):
+    """(F_i, u_{D,i}): the lift u_{D,i} = ``scene.far_displacement_y[i]`` on the boundary ``dir``
+    (0 on every free dof), F_i = −c_i (K u_{D,i}) on the free dofs (no body force)."""
+    fes = side.trace.fes
+    gf = ngsolve.GridFunction(fes)
+    gf.Set(float(scene.far_displacement_y[i]), definedon=fes.mesh.Boundaries("dir"))
+    lift = gf.vec.FV().NumPy().copy()
+    lift[np.array(fes.FreeDofs(), dtype=bool)] = 0.0  # only the supports carry the lift
+    c = (scene.c1, scene.c2)[i]
+    return -c * (laplace_stiffness(fes) @ lift)[side.free], lift
+
+
 def load(side: SideOperator, scene, i: int):
-    """(F_i, no lift): from the exact solution's gradient where the scene has one, else ∫ f_i v."""
+    """(F_i, lift): from the exact solution's gradient where the scene has one (no lift), from a
+    prescribed far-face displacement where it has one (:func:`far_face_load`), else ∫ f_i v."""
     if getattr(scene, "has_exact", False):
         grad, c = (scene.grad_u1, scene.grad_u2)[i], (scene.c1, scene.c2)[i]
         return load_vector_from_exact(side, grad, c, OUTWARD_NORMAL_Y[i]), None
+    if hasattr(scene, "far_displacement_y"):
+        return far_face_load(side, scene, i)
     return load_vector(side, (scene.f1, scene.f2)[i]), None
 
 
@@ -98,7 +121,7 @@ def interpolate(side: SideOperator, components) -> np.ndarray:
 
 MEMBRANES = Model("membranes", side_operator,
                   "two membranes, −c_i Δu_i = f_i, scalar P_k (the paper's Section 3)",
-                  load=load, field=field, interpolate=interpolate,
+                  scene_side=scene_side, load=load, field=field, interpolate=interpolate,
                   params=tuple(MaterialParam(f"c{i + 1}", 1.0, lambda v, key: check_prestress(key, v),
                                              "1e-150 <= c <= 1e150", f"prestress c{i + 1} of Ω{i + 1}", side=i)
                                for i in range(2)))

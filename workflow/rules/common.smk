@@ -118,7 +118,3 @@ MODEL_CLAIMS = [claims_path(m) for m in MODEL_STUDIES]  # appended to the ledger
 MODEL_PAPER = [f"results/paper/{m}" for m, s in MODEL_STUDIES.items() if s.in_paper]
 # the generated model subsections (plans/beta.py) paper/paper.tex reads through model_sections.tex
 MODEL_SECTIONS = [m for m, s in MODEL_STUDIES.items() if s.in_paper and s.model_section]
-
-
-def model_job_path(model, job):
-    return job_path(model, job)

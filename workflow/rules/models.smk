@@ -17,7 +17,7 @@ def model_job(wildcards):
 def model_table_jobs(wildcards):
     """The job tables a joined table concatenates, in order."""
     table = MODEL_STUDIES[wildcards.model].tables()[wildcards.table]
-    return [model_job_path(wildcards.model, j) for j in table.jobs]
+    return [job_path(wildcards.model, j) for j in table.jobs]
 
 
 rule model_job:

@@ -78,6 +78,7 @@ def add_model(p, materials: bool = True) -> None:
     """--model, every registered model's material flags (the model contract's ``params``; not
     with ``materials=False``) and mesh flags (``mesh_options``)."""
     from ..models import DEFAULT_MODEL, MODELS
+    from ..models.contract import OptionalChoice
 
     p.add_argument("--model", default=DEFAULT_MODEL.name, choices=list(MODELS),
                    help="; ".join(f"{m.name}: {m.description}" + (" (default)" if m is DEFAULT_MODEL else "")
@@ -87,10 +88,20 @@ def add_model(p, materials: bool = True) -> None:
                        help="; ".join(f"{model}: {prm.help}, {prm.allowed} (default {prm.default:g})"
                                       for model, prm in owners))
     for name, owners in _mesh_options().items():
-        allowed = sorted({v for _, values in owners for v in values})
-        p.add_argument(f"--{name}", default=None, choices=allowed,
-                       help="; ".join(f"{model}: one of {', '.join(values)} (default {values[0]})"
+        numbers = [values for _, values in owners if isinstance(values, OptionalChoice) and values.above is not None]
+        allowed = None if numbers else sorted({v for _, values in owners for v in values})
+        p.add_argument(f"--{name}", default=None, choices=allowed, type=numbers[0].parse if numbers else str,
+                       help="; ".join(f"{model}: {_option_help(values)}"
                                       for model, values in owners) + " (other models: not allowed)")
+
+
+def _option_help(values) -> str:
+    """A mesh flag's allowed values and default for ``--help``."""
+    from ..models.contract import OptionalChoice
+
+    if isinstance(values, OptionalChoice):
+        return f"{values} (default: unset)"
+    return f"one of {', '.join(values)} (default {values[0]})"
 
 
 def _mesh_options() -> dict:
@@ -101,7 +112,7 @@ def _mesh_options() -> dict:
     out = {}
     for m in MODELS.values():
         for name, values in m.mesh_options:
-            out.setdefault(name, []).append((m.name, tuple(values)))
+            out.setdefault(name, []).append((m.name, values))
     return out
 
 
@@ -111,6 +122,7 @@ def mesh_options(args):
     (:func:`~infsup_contact.solvers.request.check_mesh_option`); a family the model's mesh builder
     does not build (``Model.families``) is refused (a mesh flag the model does not take was
     refused before, :func:`refuse_unused`)."""
+    from ..models.contract import OptionalChoice
     from ..solvers.request import MeshOptions, check_mesh_option
 
     model = args.model_obj
@@ -125,6 +137,8 @@ def mesh_options(args):
             continue
         if given is not None:
             check_mesh_option(model, name, given)
+        elif isinstance(own[name], OptionalChoice):  # unset: the builder's default, no column
+            continue
         out[name] = own[name][0] if given is None else given
     return MeshOptions(**out)
 

@@ -72,6 +72,47 @@ class Body:
 
 
 @dataclass(frozen=True)
+class OptionalChoice:
+    """The allowed values of a mesh option a request may leave unset (then the builder's default
+    applies and the table has no column for it), unlike a tuple of choices, whose first is filled in.
+
+    Attributes
+    ----------
+    values : tuple of str
+        The allowed strings (empty for a number).
+    text : str
+        The allowed values in words (a number's range).
+    above : float or None
+        A number option: the values are the numbers > ``above`` (inf included, nan not).
+    """
+
+    values: tuple = ()
+    text: str = ""
+    above: float | None = None
+
+    def __contains__(self, value) -> bool:
+        if self.above is None:
+            return value in self.values
+        return isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, bool) \
+            and value > self.above
+
+    def __iter__(self):
+        return iter(self.values)
+
+    def __str__(self) -> str:
+        return self.text or ", ".join(self.values)
+
+    def parse(self, text: str):
+        """The command line's value: a float for a number option (``inf`` too), else the string."""
+        if self.above is None:
+            return text
+        try:
+            return float(text)
+        except ValueError:
+            return text  # refused with the allowed range by the request's check
+
+
+@dataclass(frozen=True)
 class MaterialParam:
     """One material parameter of a model, as the command line and the tables see it.
 
@@ -126,9 +167,10 @@ class Model:
         ``mesh(family, n, side, **mesh_kwargs) -> Body``: the mesh of Ω_side with n cells on Γ
         (per direction on a face) and its Γ, what ``side_operator`` takes; None: the paper's 2D meshes
         (:func:`~infsup_contact.discretization.segment.meshes.subdomain_mesh`).
-    mesh_options : tuple of (str, tuple)
+    mesh_options : tuple of (str, tuple or OptionalChoice)
         Mesh keywords the model's ``mesh`` takes beyond the 2D ones, with their allowed values
-        (``(("element", ("hex", "tet")),)``; a tuple, so that a model stays hashable, a side
+        (``(("element", ("hex", "tet")),)``, the first the default; an :class:`OptionalChoice` for
+        an option left unset unless given; a tuple, so that a model stays hashable, a side
         cache key): what the command line offers for this model only.
     families : tuple of str or None
         Mesh families the model's ``mesh`` builds (None: every 2D family).
@@ -154,17 +196,21 @@ class Model:
         """The mesh of Ω_side the model's sides are built on (its ``mesh`` builder, else the 2D one)."""
         if self.mesh is None:
             from ..discretization.segment import meshes
+            from ..discretization.segment.arc import arc_of
 
-            return meshes.subdomain_mesh(family, n, side, **mesh_kwargs)
+            arc = arc_of(*(mesh_kwargs.pop(key, None) for key in ("gamma", "radius", "coupling")))
+            mesh = meshes.subdomain_mesh(family, n, side, **mesh_kwargs)
+            return mesh if arc is None else Body(mesh, arc)  # the square's mesh, curved with the side
         return self.mesh(family, n, side, **mesh_kwargs)
 
     def gamma(self, **mesh_kwargs):
         """The Γ of the model's meshes with these options (an element's face; the paper's segment
         for the 2D meshes), asked of its coarsest mesh: a property of the request, not of N."""
         if self.mesh is None:
+            from ..discretization.segment.arc import arc_of
             from ..discretization.segment.interface import SEGMENT
 
-            return SEGMENT
+            return arc_of(*(mesh_kwargs.get(key) for key in ("gamma", "radius", "coupling"))) or SEGMENT
         return self.mesh("structured", 1, 1, **mesh_kwargs).interface
 
     def param_names(self) -> list:

@@ -12,7 +12,8 @@ import scipy.sparse as sp
 
 from ..discretization.segment.interface import SEGMENT
 from ..errors import check_prestress
-from .contract import OUTWARD_NORMAL_Y, MaterialParam, Model
+from .contract import OUTWARD_NORMAL_Y, Body, MaterialParam, Model, OptionalChoice
+from ..discretization.segment.arc import COUPLINGS, GAMMAS, RADIUS_ALLOWED
 from .contract import SideOperator, factorized_side
 
 
@@ -35,9 +36,15 @@ def laplace_stiffness(fes) -> sp.csr_matrix:
 
 def side_operator(mesh, k: int, route: str = "auto", dirichlet: str = "dir") -> SideOperator:
     """Factorize K_i once and extract its Γ Schur complement (c = 1); ``route`` as in
-    :func:`gamma_factorization`, u_i = 0 on ``dirichlet``."""
+    :func:`gamma_factorization`, u_i = 0 on ``dirichlet``. ``mesh``: a body of the paper's, or a
+    :class:`~.contract.Body` whose Γ is an :class:`~infsup_contact.discretization.segment.arc.Arc`
+    (the mesh of its square, curved here at the body's degree k)."""
+    gamma = SEGMENT
+    if isinstance(mesh, Body):
+        mesh, gamma = mesh.mesh, mesh.interface
+        gamma.curve(mesh, k)
     fes = displacement_space(mesh, k, dirichlet)
-    trace = SEGMENT.trace(fes)
+    trace = gamma.trace(fes)
     free_mask = np.array(fes.FreeDofs(), dtype=bool)
     is_gamma = np.zeros(fes.ndof, dtype=bool)
     is_gamma[trace.gamma_dofs] = True
@@ -124,5 +131,8 @@ MEMBRANES = Model("membranes", side_operator,
                   scene_side=scene_side, load=load, field=field, interpolate=interpolate,
                   params=tuple(MaterialParam(f"c{i + 1}", 1.0, lambda v, key: check_prestress(key, v),
                                              "1e-150 <= c <= 1e150", f"prestress c{i + 1} of Ω{i + 1}", side=i)
-                               for i in range(2)))
+                               for i in range(2)),
+                  mesh_options=(("gamma", OptionalChoice(GAMMAS)),
+                                ("radius", OptionalChoice(text=RADIUS_ALLOWED + ", with --gamma arc", above=1.0)),
+                                ("coupling", OptionalChoice(COUPLINGS))))
 """The paper's model problem through the model seam (:mod:`infsup_contact.models.contract`)."""

@@ -24,6 +24,7 @@ import scipy.sparse.linalg as spla
 
 from ..discretization.segment import meshes, multipliers
 from ..discretization.spaces import registry
+from ..errors import InputError
 from .pdas import PdasResult, solve_pdas
 from ..discretization.gamma.coupling import coupling_matrix
 from ..models import DEFAULT_MODEL
@@ -229,6 +230,10 @@ def contact_pair(scene, k: int, family: str, n1: int, n2: int, model=None,
     model = DEFAULT_MODEL if model is None else model
     build = getattr(scene, "mesh_pair", None)
     kw = mesh.kwargs()
+    if kw.pop("gamma", "segment") != "segment" or kw.pop("radius", None) is not None:
+        raise InputError("gamma", "segment (contact scenes on the arc are not built: beta and verdict take "
+                         "--gamma arc)", got=mesh.gamma)
+    kw.pop("coupling", None)
     if build is not None:
         mesh_pair = build(family, n1, n2, **kw)
     elif model.mesh is not None:

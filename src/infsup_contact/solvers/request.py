@@ -34,12 +34,19 @@ class MeshOptions:
         The perturbed family's seed and amplitude α / h; None: the builder's default.
     width : float or None
         A 3D body's extent in x (a narrower Ω2, :mod:`infsup_contact.study.face.edge_dropping`).
+    gamma, radius, coupling : str, float, str or None
+        A curved Γ (``arc`` of the 2D membranes, :mod:`infsup_contact.discretization.segment.arc`),
+        its radius R (inf: flat) and how the sides are coupled on it (``exact``, ``projection``);
+        None: the flat Γ.
     """
 
     element: str | None = None
     seed: int | None = None
     alpha: float | None = None
     width: float | None = None
+    gamma: str | None = None
+    radius: float | None = None
+    coupling: str | None = None
 
     def kwargs(self) -> dict:
         """The builder's keywords: the options that are set."""
@@ -102,7 +109,12 @@ def check_mesh_option(model, name: str, value) -> None:
     option ``name`` (``Model.mesh_options``, e.g. ``element``: ``hex``, ``tet``)."""
     allowed = dict(model.mesh_options).get(name, ())
     if value not in allowed:
-        raise InputError(name, ", ".join(allowed), got=value)
+        raise InputError(name, allowed_text(allowed), got=value)
+
+
+def allowed_text(allowed) -> str:
+    """The allowed values of a mesh option in words: its choices, or a :class:`~infsup_contact.models.contract.Range`'s text."""
+    return allowed if isinstance(allowed, str) else ", ".join(allowed) if isinstance(allowed, tuple) else str(allowed)
 
 
 def check_norm(norm) -> None:

@@ -48,7 +48,8 @@ class SideCache:
     def pair(self, model, family: str, k: int, n1: int, n2: int, mesh: MeshOptions = NO_OPTIONS) -> list:
         """[side operator of Ω1 (N1 segments on Γ), side operator of Ω2 (N2)]. The arguments are
         a validated request's (:class:`~.request.BetaRequest`) or checked by the mesh builder."""
-        return [self._get(key) for key in side_keys(model, family, k, n1, n2, mesh)]
+        sides = [self._get(key) for key in side_keys(model, family, k, n1, n2, mesh)]
+        return sides[0].trace.gamma.paired(sides)  # a Γ coupled by projection ties the two
 
     def _get(self, key):
         op = self._ops.pop(key, None)

@@ -24,8 +24,9 @@ def coupling_matrix(trace: GammaTrace, space: MultiplierSpace, k: int, extra_deg
     to round-off, which is how the kernel decision measures the round-off of the entries.
     ``sparse``: the same entries, bit for bit, as a CSR matrix (the large route: a face's B at
     dim M ≈ 4,000 is 130 MB dense and 99.8 % zeros)."""
-    x, w = trace.gamma.coupling_quadrature(trace, space, k + space.degree + extra_degree)
-    phi = trace.cached_sparse_basis(x)  # CSR, made once per point set for a sweep of spaces
+    # μ and the trace at their own points: the same ones unless Γ couples the sides by projection
+    x, x_trace, w = trace.gamma.coupling_points(trace, space, k + space.degree + extra_degree)
+    phi = trace.cached_sparse_basis(x_trace)  # CSR, made once per point set for a sweep of spaces
     out = sp.csr_matrix((space.dim, phi.shape[1])) if sparse else np.zeros((space.dim, phi.shape[1]))
     # each point sees (k + 1)^d trace and (s + 1)^d multiplier functions: a sparse product
     # costs O(n_q) where the dense one costs n_q · dim M · n_Γ (a face at N = 32: 1e11 flops)

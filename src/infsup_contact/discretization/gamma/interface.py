@@ -125,16 +125,7 @@ class Interface(abc.ABC):
 
     @abc.abstractmethod
     def cells(self, partition) -> int:
-        """Number of cells (intervals, faces) of ``partition``.
-
-        Parameters
-        ----------
-        partition : partition
-
-        Returns
-        -------
-        int
-        """
+        """Number of cells (intervals, faces) of a partition."""
 
     @abc.abstractmethod
     def partition_key(self, partition) -> bytes:
@@ -157,16 +148,14 @@ class Interface(abc.ABC):
         Parameters
         ----------
         partition : partition
-        per_cell : int
-            Subdivisions of each cell.
+        per_cell : int: subdivisions of each cell
         upper : float, optional
             Points are clipped into Γ; ``upper`` lowers the upper clip (a point exactly on the
             far end of Γ belongs to no cell of a half-open search).
 
         Returns
         -------
-        ndarray
-            Points in Γ's parameters, sorted.
+        ndarray: points in Γ's parameters, sorted
         """
 
     @abc.abstractmethod
@@ -177,8 +166,7 @@ class Interface(abc.ABC):
         Parameters
         ----------
         partition : partition
-        x : ndarray
-            Points of Γ.
+        x : ndarray: points of Γ
 
         Returns
         -------
@@ -213,8 +201,7 @@ class Interface(abc.ABC):
 
         Returns
         -------
-        ndarray, shape (len(x), len(trace.gamma_dofs))
-            Read-only (values may be cached on the trace).
+        ndarray, shape (len(x), len(trace.gamma_dofs)): read-only (values may be cached on the trace)
         """
 
     def sparse_trace_basis(self, trace: GammaTrace, x: np.ndarray):
@@ -235,8 +222,7 @@ class Interface(abc.ABC):
 
         Returns
         -------
-        x, w : ndarray
-            Points (Γ's parameters) and weights.
+        x, w : ndarray: points (Γ's parameters) and weights
         """
 
     @abc.abstractmethod
@@ -254,15 +240,12 @@ class Interface(abc.ABC):
 
         Returns
         -------
-        G : ndarray, shape (dim M, dim M)
-            Symmetric positive definite.
-        info : dict
-            ``n_max`` and ``nmax_rel_error`` of a truncated route (0 for exact ones).
+        G : ndarray, shape (dim M, dim M), symmetric positive definite
+        info : dict: ``n_max`` and ``nmax_rel_error`` of a truncated route (0 for exact ones)
         """
 
     def gram_session(self):
-        """A context in which :meth:`gram` may share work between the spaces of one G_h (the
-        same matrices as without it, only computed once); nothing to share by default."""
+        """A context in which :meth:`gram` may share the spaces' work on one G_h (default: none)."""
         return contextlib.nullcontext()
 
     # --- spaces and dimension counts --------------------------------------------------------
@@ -392,6 +375,16 @@ class Interface(abc.ABC):
     def coupling_quadrature(self, trace: GammaTrace, space, degree: int) -> tuple:
         """Quadrature exact for ``degree`` on the common refinement of a trace and G_h."""
         return self.quadrature(self.common_refinement(trace.partition, space.breakpoints), degree)
+
+    def coupling_points(self, trace: GammaTrace, space, degree: int) -> tuple:
+        """(x_μ, x_trace, w): B_i = Σ_q w_q μ(x_μ,q) φ(x_trace,q). The same points (:meth:`coupling_quadrature`)
+        unless the sides are coupled by projection (:mod:`..segment.projection`)."""
+        x, w = self.coupling_quadrature(trace, space, degree)
+        return x, x, w
+
+    def paired(self, sides: list) -> list:
+        """The sides of a pair as the coupling sees them (a projection ties each to the other): as built."""
+        return sides
 
 
 def check_choice(choice: str) -> None:

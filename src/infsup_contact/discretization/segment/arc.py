@@ -1,0 +1,125 @@
+"""Γ a circular arc of radius R and length 1: the paper's segment, curved.
+
+The bodies are Ω1 = {R − 1 < r < R} and Ω2 = {R < r < R + 1}, 0 < θ < 1/R, each of unit
+thickness, so that R = ∞ is the paper's two squares. Each body is the image of the paper's mesh
+of its square (every family: structured, perturbed, unstructured) under the polar map
+
+    Φ(x, y) = ((R − 1 + y) sin(x/R), (R − 1 + y) cos(x/R) − R + 1),
+
+which takes Γ = (0, 1) × {1} to the arc r = R (centre (0, 1 − R)) and the square's x to the arc
+length s = x. The curved mesh is isoparametric: NGSolve's ``SetDeformation`` by the interpolant
+of Φ − id in continuous P_k, the body's own degree (:meth:`Arc.curve`), so the vertices lie on the
+arc and the discrete Γ of each side is a degree-k curve through them.
+
+Everything on Γ is parametrized by the arc length s ∈ (0, 1) (the reference x): partitions,
+multiplier spaces, the L² norm and the H^{-1/2}_00 norm, which is the segment's in s — an
+equivalent norm of the arc's, exact for R → ∞. How the sides are coupled is the ``coupling``:
+
+``exact``
+    Both traces mapped to the exact arc by arc length (vertex to vertex, the reference
+    parametrization): b(v, μ) = ∫_0^1 (v_2 − v_1) μ ds, the segment's coupling, exact.
+``projection``
+    As mortar codes do it: the integral over the discretized side that carries G_h (the
+    slave: Ω2 for ``omega2`` and ``union``, Ω1 for ``omega1``), its trace and μ at the slave's
+    point, the other side's trace at the point hit along the slave's averaged nodal normal
+    (:mod:`.projection`).
+
+R = ∞ builds the paper's meshes unchanged; ``exact`` then is the paper's β_h, bit for bit.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ...errors import InputError
+from .interface import Segment
+
+GAMMAS = ("segment", "arc")
+"""The Γ of the 2D membranes: the paper's segment, or the arc of radius R."""
+COUPLINGS = ("exact", "projection")
+"""How the sides are coupled on the arc (module docstring)."""
+RADIUS_ALLOWED = "a number R > 1, or inf (the flat segment)"
+"""R = 1 would make Ω1 a sector whose square map collapses its far side into the centre."""
+
+
+def check_arc_options(gamma, radius, coupling) -> None:
+    """:class:`InputError` naming the key: ``gamma`` in :data:`GAMMAS`; with ``arc`` a radius R > 1
+    (inf allowed) and a coupling in :data:`COUPLINGS`; without it neither."""
+    if gamma not in (None,) + GAMMAS:
+        raise InputError("gamma", ", ".join(GAMMAS), got=gamma)
+    if gamma != "arc":
+        for key, value in (("radius", radius), ("coupling", coupling)):
+            if value is not None:
+                raise InputError(key, "only with gamma arc (--gamma arc)", got=value)
+        return
+    if radius is None or isinstance(radius, bool) or not isinstance(radius, (int, float, np.number)) \
+            or not radius > 1:
+        raise InputError("radius", RADIUS_ALLOWED + " (required with gamma arc)", got=radius)
+    if coupling not in COUPLINGS:
+        raise InputError("coupling", ", ".join(COUPLINGS), got=coupling)
+
+
+@dataclass(frozen=True)
+class Arc(Segment):
+    """Γ the arc of radius ``radius`` and length 1, parametrized by arc length (module docstring).
+
+    Attributes
+    ----------
+    radius : float
+        R > 1, or inf (the paper's segment).
+    coupling : str
+        One of :data:`COUPLINGS`.
+    """
+
+    radius: float = math.inf
+    coupling: str = "exact"
+
+    @property
+    def curved(self) -> bool:
+        return math.isfinite(self.radius)
+
+    def polar_map(self):
+        """Φ − id as an NGSolve coefficient function of the square's (x, y) (module docstring)."""
+        import ngsolve
+
+        R = float(self.radius)
+        r = R - 1.0 + ngsolve.y
+        return ngsolve.CF((r * ngsolve.sin(ngsolve.x / R) - ngsolve.x,
+                           r * ngsolve.cos(ngsolve.x / R) - R + 1.0 - ngsolve.y))
+
+    def curve(self, mesh, k: int) -> None:
+        """Make ``mesh`` (a square of the paper's) the isoparametric image of its body under Φ:
+        its deformation is the P_k interpolant of Φ − id. Nothing on a flat Γ."""
+        import ngsolve
+
+        if not self.curved:
+            return
+        deformation = ngsolve.GridFunction(ngsolve.VectorH1(mesh, order=int(k)))
+        deformation.Set(self.polar_map())
+        mesh.SetDeformation(deformation)
+
+    def embed(self, x):
+        """Points of the exact arc at arc lengths ``x`` (the body's coordinates)."""
+        x = np.asarray(x, dtype=float)
+        if not self.curved:
+            return super().embed(x)
+        R = float(self.radius)
+        return R * np.sin(x / R), R * np.cos(x / R) - R + 1.0
+
+    def paired(self, sides: list) -> list:
+        """With ``projection`` on a curved arc, the sides' traces tied to each other
+        (:func:`.projection.project_pair`); else as built."""
+        if self.coupling != "projection":
+            return sides
+        from .projection import project_pair
+
+        return project_pair(self, sides)
+
+
+def arc_of(gamma=None, radius=None, coupling=None):
+    """The Γ of the mesh options: None for the paper's segment (no option given, or ``segment``),
+    else the checked :class:`Arc`."""
+    check_arc_options(gamma, radius, coupling)
+    return None if gamma != "arc" else Arc(radius=float(radius), coupling=coupling)

@@ -46,7 +46,7 @@ RADIUS_ALLOWED = "a number R > 1, or inf (the flat segment)"
 
 def check_arc_options(gamma, radius, coupling) -> None:
     """:class:`InputError` naming the key: ``gamma`` in :data:`GAMMAS`; with ``arc`` a radius R > 1
-    (inf allowed) and a coupling in :data:`COUPLINGS`; without it neither."""
+    (inf allowed) and a coupling in :data:`COUPLINGS` (None: ``exact``); without it neither."""
     if gamma not in (None,) + GAMMAS:
         raise InputError("gamma", ", ".join(GAMMAS), got=gamma)
     if gamma != "arc":
@@ -57,6 +57,8 @@ def check_arc_options(gamma, radius, coupling) -> None:
     if radius is None or isinstance(radius, bool) or not isinstance(radius, (int, float, np.number)) \
             or not radius > 1:
         raise InputError("radius", RADIUS_ALLOWED + " (required with gamma arc)", got=radius)
+    if coupling is None:
+        coupling = "exact"
     if coupling not in COUPLINGS:
         raise InputError("coupling", ", ".join(COUPLINGS), got=coupling)
 
@@ -85,19 +87,22 @@ class Arc(Segment):
         import ngsolve
 
         R = float(self.radius)
-        r = R - 1.0 + ngsolve.y
-        return ngsolve.CF((r * ngsolve.sin(ngsolve.x / R) - ngsolve.x,
-                           r * ngsolve.cos(ngsolve.x / R) - R + 1.0 - ngsolve.y))
+        r, half = R - 1.0 + ngsolve.y, ngsolve.sin(ngsolve.x / (2.0 * R))
+        # r cos θ − R + 1 − y = −2 r sin²(θ/2): no cancellation of R against R at a large radius
+        return ngsolve.CF((r * ngsolve.sin(ngsolve.x / R) - ngsolve.x, -2.0 * r * half * half))
 
     def curve(self, mesh, k: int) -> None:
         """Make ``mesh`` (a square of the paper's) the isoparametric image of its body under Φ:
-        its deformation is the P_k interpolant of Φ − id. Nothing on a flat Γ."""
+        its deformation is the P_k interpolant of Φ − id, by NGSolve's dual (moment) interpolation, so
+        that an edge's curve depends on the edge alone: the two sides of matching meshes share their
+        discrete Γ exactly (the default ``Set`` projects element by element, and the sides' curves
+        then differ by ~1e-6). Nothing on a flat Γ."""
         import ngsolve
 
         if not self.curved:
             return
         deformation = ngsolve.GridFunction(ngsolve.VectorH1(mesh, order=int(k)))
-        deformation.Set(self.polar_map())
+        deformation.Set(self.polar_map(), dual=True)
         mesh.SetDeformation(deformation)
 
     def embed(self, x):
@@ -106,7 +111,7 @@ class Arc(Segment):
         if not self.curved:
             return super().embed(x)
         R = float(self.radius)
-        return R * np.sin(x / R), R * np.cos(x / R) - R + 1.0
+        return R * np.sin(x / R), 1.0 - 2.0 * R * np.sin(x / (2.0 * R)) ** 2
 
     def paired(self, sides: list) -> list:
         """With ``projection`` on a curved arc, the sides' traces tied to each other
@@ -122,4 +127,4 @@ def arc_of(gamma=None, radius=None, coupling=None):
     """The Γ of the mesh options: None for the paper's segment (no option given, or ``segment``),
     else the checked :class:`Arc`."""
     check_arc_options(gamma, radius, coupling)
-    return None if gamma != "arc" else Arc(radius=float(radius), coupling=coupling)
+    return None if gamma != "arc" else Arc(radius=float(radius), coupling=coupling or "exact")

@@ -158,10 +158,11 @@ class ProjectedArc(Arc):
         return x, np.clip(y, 0.0, 1.0), w * inside
 
     def proven_kernel(self, space, k: int, traces, dim_w: int) -> int:
-        """The count of matching meshes (identical curves, P = id); else only dim M − n1 − n2 (the
-        rank of Bᵀ is at most the number of Γ dofs): the projected traces do not share W1 ∩ W2."""
+        """The segment's count where P = id (a flat Γ; matching meshes, whose curves are one, the
+        deformation being interpolated edge by edge); else only dim M − n1 − n2 (the rank of Bᵀ is
+        at most the number of Γ dofs): the projected traces do not share W1 ∩ W2."""
         p1, p2 = (t.partition for t in traces)
-        if len(p1) == len(p2) and np.allclose(p1, p2, rtol=0, atol=1e-12):
+        if not self.curved or len(p1) == len(p2) and np.allclose(p1, p2, rtol=0, atol=1e-12):
             return super().proven_kernel(space, k, traces, dim_w)
         return max(space.dim - sum(len(t.gamma_dofs) for t in traces), 0)
 

@@ -1,0 +1,72 @@
+"""β_h on the curved segment: every registered space on the arc of radius R, both couplings.
+
+What curvature and the projection do to β_h, to the kernels and to the verdicts
+(:mod:`infsup_contact.discretization.segment.arc`, :mod:`~infsup_contact.discretization.segment.projection`):
+the membranes' β_h table over radii × couplings × mesh pairs, R = ∞ being the paper's segment,
+and the stability verdict of each space over each series of pairs (matching N:N, N:N+1, and
+N:≈√2 N), per radius and coupling.
+"""
+from __future__ import annotations
+
+import math
+
+import pandas as pd
+
+from ...criteria.stability import stability_verdict
+from ...discretization.segment.arc import COUPLINGS
+from ...solvers.request import MeshOptions
+from .batch_rows import beta_batch_rows
+
+SERIES_KEYS = ("radius", "coupling", "series", "case", "k", "family", "norm", "multiplier_mesh")
+
+
+def arc_rows(radii, series: dict, k: int, cases=None, couplings=COUPLINGS, family: str = "structured",
+             norms=("H", "L2")) -> pd.DataFrame:
+    """β_h rows of the membranes on the arc for every radius × coupling × pair of ``series``.
+
+    Parameters
+    ----------
+    radii : sequence of float
+        R > 1, or inf (the paper's flat segment, built by the same code).
+    series : dict
+        Series id → list of (N1, N2) pairs (e.g. ``{"matching": [(8, 8), (16, 16)]}``).
+    k : int
+    cases : list of str or None
+        Registered segment spaces (None: every one defined for k).
+    couplings : sequence of str
+        ``exact`` and/or ``projection``.
+
+    Returns
+    -------
+    pandas.DataFrame
+        ``beta``'s columns plus ``radius``, ``coupling`` and ``series``.
+    """
+    pairs = sorted({tuple(p) for ps in series.values() for p in ps})
+    by_pair = {p: [s for s, ps in series.items() if p in {tuple(q) for q in ps}] for p in pairs}
+    frames = []
+    for radius in radii:
+        for coupling in couplings:
+            mesh = MeshOptions(gamma="arc", radius=float(radius), coupling=coupling)
+            frame = beta_batch_rows("membranes", family, k, pairs, cases, norms=norms, series=by_pair, mesh=mesh)
+            frame.insert(0, "coupling", coupling)
+            frame.insert(0, "radius", float(radius))
+            frames.append(frame)
+    return pd.concat(frames, ignore_index=True)
+
+
+def arc_verdicts(frame: pd.DataFrame, tol: float, floor: float, confidence: float) -> pd.DataFrame:
+    """The stability verdict (:func:`~infsup_contact.criteria.stability.stability_verdict`) of every
+    space over every series, per radius, coupling and norm, with its kernel dimensions."""
+    out = []
+    for key, rows in frame.groupby(list(SERIES_KEYS), sort=False):
+        rows = rows.sort_values("N2")
+        verdict = stability_verdict(rows, tol, floor, confidence)
+        out.append(dict(zip(SERIES_KEYS, key), verdict=verdict["verdict"], min_beta=float(rows.beta.min()),
+                        kernel_dims="/".join(str(int(d)) for d in rows.kernel_dim),
+                        structural_kernel_dims="/".join(str(int(d)) for d in rows.structural_kernel_dim)))
+    return pd.DataFrame(out)
+
+
+def flat_radius(radius) -> bool:
+    """Whether a radius is the flat segment's (R = ∞)."""
+    return math.isinf(float(radius))

@@ -138,6 +138,9 @@ def mesh_options(args):
         if given is not None:
             check_mesh_option(model, name, given)
         elif isinstance(own[name], OptionalChoice):  # unset: the builder's default, no column
+            when = own[name].filled_when
+            if when and getattr(args, when[0], None) == when[1]:
+                out[name] = own[name].values[0]
             continue
         out[name] = own[name][0] if given is None else given
     return MeshOptions(**out)

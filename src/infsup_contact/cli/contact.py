@@ -63,6 +63,9 @@ def _check_contact(args):
     args.cases = cases(args)
     material(args)
     args.mesh = mesh_options(args)  # a mesh flag of another model is refused; the scene's rows read them
+    if args.mesh.gamma not in (None, "segment"):
+        raise InputError("gamma", "segment (contact scenes on a curved Γ are not built: beta and verdict take "
+                         "--gamma)", got=args.mesh.gamma)
     spec = check_pair(args.model, args.scene)
     check_k(args.k)
     for case in args.cases:

@@ -84,11 +84,15 @@ class OptionalChoice:
         The allowed values in words (a number's range).
     above : float or None
         A number option: the values are the numbers > ``above`` (inf included, nan not).
+    filled_when : tuple
+        (option, value): the first of ``values`` is filled in when that other option has that value
+        (the arc's ``coupling`` once ``gamma`` is ``arc``); () never.
     """
 
     values: tuple = ()
     text: str = ""
     above: float | None = None
+    filled_when: tuple = ()
 
     def __contains__(self, value) -> bool:
         if self.above is None:

@@ -134,5 +134,5 @@ MEMBRANES = Model("membranes", side_operator,
                                for i in range(2)),
                   mesh_options=(("gamma", OptionalChoice(GAMMAS)),
                                 ("radius", OptionalChoice(text=RADIUS_ALLOWED + ", with --gamma arc", above=1.0)),
-                                ("coupling", OptionalChoice(COUPLINGS))))
+                                ("coupling", OptionalChoice(COUPLINGS, filled_when=("gamma", "arc")))))
 """The paper's model problem through the model seam (:mod:`infsup_contact.models.contract`)."""

@@ -101,6 +101,7 @@ class Arc(Segment):
 
         if not self.curved:
             return
+        mesh.UnsetDeformation()  # Φ is a map of the square: never of an already curved mesh
         deformation = ngsolve.GridFunction(ngsolve.VectorH1(mesh, order=int(k)))
         deformation.Set(self.polar_map(), dual=True)
         mesh.SetDeformation(deformation)

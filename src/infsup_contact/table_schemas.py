@@ -109,6 +109,11 @@ SCHEMAS = {
     "model_beta": Schema({**_BETA, "model": "str", "element": "str"},
                          key=("model", "element", "family", "case", "k", "N1", "N2", "multiplier_mesh", "c1", "c2",
                               "norm")),
+    # the curved segment (plans/arc.py: study/beta/arc.py): β_h per curvature 1/R (0: flat) and coupling
+    # (exact, projection; "paper": the flat segment's own code), rows tagged with their series
+    "arc_beta": Schema({**_BETA, "curvature": "float", "coupling": "str", "series": "str"},
+                       key=("curvature", "coupling", "series", "family", "case", "k", "N1", "N2", "multiplier_mesh",
+                            "c1", "c2", "norm")),
     # the 3D elastic bodies on the face (rules/face_elastic.smk: study/face/elastic.py): β_h per ν
     "face_elastic_beta": Schema({**_BETA, "model": "str", "element": "str", "nu": "float"},
                                 key=("model", "element", "family", "case", "k", "N1", "N2", "multiplier_mesh", "c1",

@@ -46,6 +46,7 @@ rule model_paper:
         src=REPORT_SOURCES,
     params:
         nu_slope_cases=lambda wc: config["figures"]["nu_slope_cases"],
+        claims=lambda wc: config["claims"],  # the arc's verdicts: slope tolerance, floor, confidence
     wildcard_constraints:
         model=MODEL_NAMES_RE,
     benchmark:

@@ -35,6 +35,8 @@ def check_models(cfg) -> None:
         study = entry["study"]
         if study in BUILT_IN:
             _check_built_in(cfg, key, name, entry)
+        elif study == "arc":
+            _check_arc(key, entry)
         else:
             _check_beta(key, entry)
 
@@ -95,3 +97,32 @@ def _check_beta(key: str, entry: dict) -> None:
             raise ConfigError(f"{key}.cases[{i}]", f"not defined for k in {ks} on the model's Γ", got=case,
                               allowed=", ".join(c for c, s in SPACES.items()
                                                 if any(s.valid_for(k) for k in ks) and any(g.builds(s) for g in gammas)))
+
+
+ARC_KEYS = ("k", "radii", "couplings", "series", "cases")
+"""What an ``arc`` study's entry must state."""
+ARC_FOREIGN = ("model", "elements", "N", "nonmatching", "norms")
+"""Keys of a ``beta`` study an arc entry does not read (its model is the 2D membranes)."""
+
+
+def _check_arc(key: str, entry: dict) -> None:
+    from ..discretization.spaces.registry import SPACES
+
+    missing = [k for k in ARC_KEYS if k not in entry]
+    if missing:
+        raise ConfigError(f"{key}.{missing[0]}", "required by an arc study", got=None, allowed=", ".join(ARC_KEYS))
+    foreign = [k for k in ARC_FOREIGN if k in entry]
+    if foreign:
+        raise ConfigError(f"{key}.{foreign[0]}", "not read by an arc study (the 2D membranes, both norms)",
+                          got=entry[foreign[0]], allowed=", ".join(ARC_KEYS))
+    ks = [int(k) for k in entry["k"]]
+    for name, pairs in entry["series"].items():
+        if len({tuple(p) for p in pairs}) < 3:
+            raise ConfigError(f"{key}.series.{name}", "a verdict fits a slope over at least 3 distinct pairs",
+                              got=pairs, allowed="3 or more distinct [N1, N2] pairs")
+    for i, case in enumerate(entry["cases"]):
+        spec = SPACES.get(case)
+        if spec is None or 1 not in spec.gamma_dims or not any(spec.valid_for(k) for k in ks):
+            raise ConfigError(f"{key}.cases[{i}]", f"not a segment space defined for k in {ks}", got=case,
+                              allowed=", ".join(c for c, s in SPACES.items()
+                                                if 1 in s.gamma_dims and any(s.valid_for(k) for k in ks)))

@@ -11,7 +11,7 @@ import pandas as pd
 
 from .sections import n_as_predicted, predicted
 from .templates import beta_by_mesh_table
-from .texformat import PaperTexError, latex_escape, latex_id
+from .texformat import PaperTexError, case_order, fmt_sci, latex_escape, latex_id
 
 def matching_beta_table(beta: pd.DataFrame) -> str:
     """Tabular of β_h on matching meshes: rows (norm, element, k, case), columns N
@@ -39,3 +39,56 @@ def model_section_tex(name: str, entry: dict, beta: pd.DataFrame, claims: pd.Dat
 def sections_index_tex(names) -> str:
     """``model_sections.tex``: one ``\\input`` per generated model subsection (empty without any)."""
     return "".join(rf"\input{{{name}}}" + "\n" for name in names)
+
+
+VERDICT_MARK = {"STABLE": "", "UNSTABLE": r"$^{u}$", "INCONCLUSIVE": r"$^{?}$"}
+"""How a cell of the arc's table marks its series' verdict (stable: no mark)."""
+
+
+def arc_beta_table(beta: pd.DataFrame, verdicts: pd.DataFrame, coupling: str, series: str) -> str:
+    """Tabular of β_h (H norm) on the finest pair of ``series``: rows case, columns R, each cell
+    marked with the series' verdict at that radius (u unstable, ? undecided)."""
+    b = beta[(beta.coupling == coupling) & (beta.series == series) & (beta.norm == "H")]
+    b = b[b.N2 == b.N2.max()]
+    v = verdicts[(verdicts.coupling == coupling) & (verdicts.series == series) & (verdicts.norm == "H")]
+    kappas = sorted(set(b.curvature), reverse=True)  # R ascending, ∞ last
+    head = " & ".join(["case"] + [r"$R=\infty$" if c == 0 else f"$R={1 / c:g}$" for c in kappas])
+    lines = [r"\begin{tabular}{l" + "r" * len(kappas) + "}", r"\hline", head + r" \\", r"\hline"]
+    for case in case_order(set(b.case)):
+        cells = []
+        for c in kappas:
+            cell = b[(b.case == case) & (b.curvature == c)]
+            mark = v[(v.case == case) & (v.curvature == c)].verdict
+            cells.append(fmt_sci(float(cell.beta.iloc[0]), 3) + (VERDICT_MARK[mark.iloc[0]] if len(mark) else ""))
+        lines.append(" & ".join([latex_id(case)] + cells) + r" \\")
+    return "\n".join(lines + [r"\hline", r"\end{tabular}"])
+
+
+def arc_section_tex(name: str, beta: pd.DataFrame, verdicts: pd.DataFrame, claims: pd.DataFrame) -> str:
+    """The subsection of the arc study ``name`` (:mod:`infsup_contact.plans.arc`): what was run, the
+    claims, and β_h of the finest non-matching pair per coupling and radius."""
+    checked, agree = predicted(claims), n_as_predicted(claims)
+    series = [s for s in dict.fromkeys(beta.series) if (beta[beta.series == s].N1 != beta[beta.series == s].N2).any()]
+    shown = series[0] if series else beta.series.iloc[0]
+    pair = beta[beta.series == shown].sort_values("N2").iloc[-1]
+    couplings = [c for c in ("exact", "projection") if (beta.coupling == c).any()]
+    radii = sorted({1 / c for c in beta.curvature if c > 0})
+    text = [rf"\subsection{{The curved segment \texttt{{{latex_id(name)}}}}}\label{{sec:model-{name}}}",
+            r"$\Gamma$ is the arc of radius $R$ and length 1 between $\Omega_1=\{R-1<r<R\}$ and "
+            r"$\Omega_2=\{R<r<R+1\}$, $0<\theta<1/R$: each body is the paper's mesh of its square mapped by polar "
+            r"coordinates and curved isoparametrically at its own degree, so that $R=\infty$ is the paper's "
+            r"segment. Everything on $\Gamma$ is parametrized by arc length; the $H^{-1/2}_{00}$ norm is the "
+            r"segment's in that parameter, an equivalent norm of the arc's, exact as $R\to\infty$. The "
+            r"\emph{exact} coupling maps both traces to the arc by arc length; the \emph{projection} integrates "
+            r"on the discretized side that carries $G_h$ and evaluates the other side along its averaged "
+            r"nodal normal, as mortar codes do. "
+            rf"Radii $R\in\{{{', '.join(f'{r:g}' for r in radii)}, \infty\}}$, $k\in\{{{', '.join(map(str, sorted(set(beta.k))))}\}}$, "
+            rf"{len(set(beta.case))} spaces, {len(beta)} rows. Of the study's {len(claims)} ledger claims, "
+            rf"{len(checked)} carry a prediction and {agree} came out as predicted.", ""]
+    for coupling in couplings:
+        text += [r"\begin{center}", r"\small",
+                 rf"$\beta_h$ ($H^{{-1/2}}_{{00}}$ norm), {coupling} coupling, $N_1{{:}}N_2 = "
+                 rf"{int(pair.N1)}{{:}}{int(pair.N2)}$ (series \texttt{{{latex_id(shown)}}}; "
+                 r"$^{u}$ unstable, $^{?}$ undecided over the series)\\[2pt]",
+                 arc_beta_table(beta, verdicts, coupling, shown), r"\end{center}", ""]
+    return "\n".join(text)

@@ -17,11 +17,13 @@ from ...discretization.segment.arc import COUPLINGS
 from ...solvers.request import MeshOptions
 from .batch_rows import beta_batch_rows
 
-SERIES_KEYS = ("radius", "coupling", "series", "case", "k", "family", "norm", "multiplier_mesh")
+PAPER = "paper"
+"""The ``coupling`` of the rows computed by the flat segment's own code."""
+SERIES_KEYS = ("curvature", "coupling", "series", "case", "k", "family", "norm", "multiplier_mesh")
 
 
 def arc_rows(radii, series: dict, k: int, cases=None, couplings=COUPLINGS, family: str = "structured",
-             norms=("H", "L2")) -> pd.DataFrame:
+             norms=("H", "L2"), paper: bool = False) -> pd.DataFrame:
     """β_h rows of the membranes on the arc for every radius × coupling × pair of ``series``.
 
     Parameters
@@ -35,22 +37,28 @@ def arc_rows(radii, series: dict, k: int, cases=None, couplings=COUPLINGS, famil
         Registered segment spaces (None: every one defined for k).
     couplings : sequence of str
         ``exact`` and/or ``projection``.
+    paper : bool
+        Also the rows of the paper's flat segment by its own code (no Γ option), coupling
+        :data:`PAPER`, curvature 0: what R = ∞ must reproduce.
 
     Returns
     -------
     pandas.DataFrame
-        ``beta``'s columns plus ``radius``, ``coupling`` and ``series``.
+        ``beta``'s columns (timings dropped) plus ``curvature`` 1/R (0: flat; finite in a table,
+        where R = ∞ is not), ``coupling`` and ``series``.
     """
     pairs = sorted({tuple(p) for ps in series.values() for p in ps})
     by_pair = {p: [s for s, ps in series.items() if p in {tuple(q) for q in ps}] for p in pairs}
+    runs = [(curvature(r), c, MeshOptions(gamma="arc", radius=float(r), coupling=c)) for r in radii for c in couplings]
+    if paper:
+        runs.append((0.0, PAPER, MeshOptions()))
     frames = []
-    for radius in radii:
-        for coupling in couplings:
-            mesh = MeshOptions(gamma="arc", radius=float(radius), coupling=coupling)
-            frame = beta_batch_rows("membranes", family, k, pairs, cases, norms=norms, series=by_pair, mesh=mesh)
-            frame.insert(0, "coupling", coupling)
-            frame.insert(0, "radius", float(radius))
-            frames.append(frame)
+    for kappa, coupling, mesh in runs:
+        frame = beta_batch_rows("membranes", family, k, pairs, cases, norms=norms, series=by_pair, mesh=mesh)
+        frame = frame.drop(columns=[c for c in frame.columns if c.startswith("t_")])  # timings: benchmark tree
+        frame.insert(0, "coupling", coupling)
+        frame.insert(0, "curvature", kappa)
+        frames.append(frame)
     return pd.concat(frames, ignore_index=True)
 
 
@@ -67,6 +75,11 @@ def arc_verdicts(frame: pd.DataFrame, tol: float, floor: float, confidence: floa
     return pd.DataFrame(out)
 
 
-def flat_radius(radius) -> bool:
-    """Whether a radius is the flat segment's (R = ∞)."""
-    return math.isinf(float(radius))
+def curvature(radius) -> float:
+    """1/R (0 for R = ∞): how the tables name a radius."""
+    return 0.0 if math.isinf(float(radius)) else 1.0 / float(radius)
+
+
+def radius_of(kappa: float) -> float:
+    """R = 1/κ (∞ for κ = 0)."""
+    return math.inf if kappa == 0 else 1.0 / kappa

@@ -114,6 +114,12 @@ SCHEMAS = {
     "arc_beta": Schema({**_BETA, "curvature": "float", "coupling": "str", "series": "str"},
                        key=("curvature", "coupling", "series", "family", "case", "k", "N1", "N2", "multiplier_mesh",
                             "c1", "c2", "norm")),
+    # the patch test on the arc (plans/arc.py: study/patch/arc.py): λ and u errors per curvature and coupling
+    "arc_patch": Schema({"curvature": "float", "coupling": "str", "scene": "str", "case": "str", "k": "int",
+                         "N1": "int", "N2": "int", "c1": "float", "c2": "float", "pressure": "float",
+                         "kernel_dim": "int", "lambda_max_rel_error": "float", "lambda_interior_rel_error": "float?",
+                         "u_max_rel_error": "float", "holds_constants": "bool"},
+                        key=("curvature", "coupling", "case", "k", "N1", "N2")),
     # the 3D elastic bodies on the face (rules/face_elastic.smk: study/face/elastic.py): β_h per ν
     "face_elastic_beta": Schema({**_BETA, "model": "str", "element": "str", "nu": "float"},
                                 key=("model", "element", "family", "case", "k", "N1", "N2", "multiplier_mesh", "c1",

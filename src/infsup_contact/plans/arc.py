@@ -2,9 +2,11 @@
 
 The entry (config ``models.<name>`` with ``study: arc``, :mod:`infsup_contact.config.models`) carries
 its scenes: degrees ``k``, ``radii`` (finite R > 1; R = ∞ always runs too), the ``couplings``, the
-mesh ``series`` (name → [N1, N2] pairs, each at least 3: a verdict fits a slope) and the ``cases``.
+mesh ``series`` (name → [N1, N2] pairs, each at least 3: a verdict fits a slope), the ``cases`` and
+optionally the ``patch`` test (its ``k``, ``pairs`` refined by a common factor, prestresses ``c``).
 Jobs: one per k, every radius × coupling × pair, plus the paper's own flat rows
-(:func:`infsup_contact.study.beta.arc.arc_rows`). Claims: :mod:`infsup_contact.study.claims.arc`.
+(:func:`infsup_contact.study.beta.arc.arc_rows`); the patch test (:mod:`infsup_contact.study.patch.arc`).
+Claims: :mod:`infsup_contact.study.claims.arc`.
 Paper: one generated subsection (:func:`infsup_contact.report.model_section.arc_section_tex`).
 """
 from __future__ import annotations
@@ -43,25 +45,50 @@ class ArcStudy:
         return max(resources.job_mem_mb(resources.beta_estimate("structured", k, n1, n2, "omega2", ("H", "L2")))
                    for n1, n2 in pairs)
 
+    def _patch(self) -> pd.DataFrame:
+        from ..discretization.spaces.registry import ids_valid_for
+        from ..study.beta.arc import curvature
+        from ..study.patch.arc import arc_patch_rows
+
+        p = self.cfg["patch"]
+        radii = [float(r) for r in self.cfg["radii"]] + [math.inf]
+        rows = pd.DataFrame(arc_patch_rows(sorted({c for k in p["k"] for c in ids_valid_for(int(k), self.cfg["cases"])}),
+                                           [int(k) for k in p["k"]], [tuple(q) for q in p["pairs"]], radii,
+                                           tuple(self.cfg["couplings"]), c=tuple(p["c"])))
+        rows.insert(0, "curvature", [curvature(r) for r in rows.pop("radius")])  # a table holds no inf
+        return rows
+
     def jobs(self) -> dict:
         shown = ("curvature", "coupling", "series", "case", "k", "N1", "N2", "norm", "beta", "kernel_dim")
-        return {f"arc_k{k}": Job(lambda k=int(k): self._rows(k), self.cfg, lambda k=int(k): self._mem_mb(k), shown)
+        jobs = {f"arc_k{k}": Job(lambda k=int(k): self._rows(k), self.cfg, lambda k=int(k): self._mem_mb(k), shown)
                 for k in self.cfg["k"]}
+        if self.cfg.get("patch"):
+            jobs["patch"] = Job(self._patch, self.cfg, lambda: 1000, ("curvature", "coupling", "case", "k", "N1", "N2",
+                                                                     "lambda_max_rel_error", "u_max_rel_error"))
+        return jobs
 
     def tables(self) -> dict:
-        return {"beta": Table("arc_beta", tuple(self.jobs()))}
+        out = {"beta": Table("arc_beta", tuple(j for j in self.jobs() if j != "patch"))}
+        if self.cfg.get("patch"):
+            out["patch"] = Table("arc_patch", ("patch",))
+        return out
 
     def claim_inputs(self) -> Inputs:
-        return Inputs({"beta": (table_path(self.name, "beta"), "arc_beta")})
+        files = {"beta": (table_path(self.name, "beta"), "arc_beta")}
+        if self.cfg.get("patch"):
+            files["patch"] = (table_path(self.name, "patch"), "arc_patch")
+        return Inputs(files)
 
     def claims(self, frames: dict, claims_cfg: dict) -> pd.DataFrame:
-        from ..study.claims.arc import arc_claims
+        from ..study.claims.arc import arc_claims, arc_patch_claims
 
-        return arc_claims(frames["beta"], claims_cfg, self.name)
+        out = arc_claims(frames["beta"], claims_cfg, self.name)
+        return pd.concat([out, arc_patch_claims(frames["patch"], self.name, claims_cfg["fit_window"])],
+                         ignore_index=True) \
+            if "patch" in frames else out
 
     def paper_inputs(self) -> Inputs:
-        return Inputs({"beta": (table_path(self.name, "beta"), "arc_beta"),
-                       "claims": (claims_path(self.name), "claims")})
+        return Inputs({**self.claim_inputs().files, "claims": (claims_path(self.name), "claims")})
 
     def paper_files(self, frames: dict, params: dict) -> dict:
         from ..report.model_section import arc_section_tex
@@ -69,7 +96,8 @@ class ArcStudy:
 
         c = params["claims"]
         verdicts = arc_verdicts(frames["beta"], c["slope_tolerance"], c["beta_floor"], c["confidence"])
-        return {f"{self.name}.tex": arc_section_tex(self.name, frames["beta"], verdicts, frames["claims"])}
+        return {f"{self.name}.tex": arc_section_tex(self.name, frames["beta"], verdicts, frames["claims"],
+                                                    frames.get("patch"))}
 
     def check_tex(self, tex: str, files: dict) -> None:
         """No hand-written source: the subsection is generated whole."""

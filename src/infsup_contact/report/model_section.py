@@ -64,7 +64,26 @@ def arc_beta_table(beta: pd.DataFrame, verdicts: pd.DataFrame, coupling: str, se
     return "\n".join(lines + [r"\hline", r"\end{tabular}"])
 
 
-def arc_section_tex(name: str, beta: pd.DataFrame, verdicts: pd.DataFrame, claims: pd.DataFrame) -> str:
+def arc_patch_table(patch: pd.DataFrame) -> str:
+    """Tabular of the patch test's max |λ_h − λ|/λ on the finest pair: rows (case, k), columns
+    (R, coupling), R = ∞ with the exact coupling first."""
+    p = patch[patch.N2 == patch.N2.max()]
+    runs = [(0.0, "exact")] + [(c, cp) for c in sorted(set(p.curvature[p.curvature > 0])) for cp in ("exact", "projection")
+                               if ((p.curvature == c) & (p.coupling == cp)).any()]
+    head = " & ".join(["case", "$k$"] + [(r"$R=\infty$" if c == 0 else f"$R={1 / c:g}$") + (", proj." if cp == "projection"
+                                                                                          else "") for c, cp in runs])
+    lines = [r"\begin{tabular}{lr" + "r" * len(runs) + "}", r"\hline", head + r" \\", r"\hline"]
+    for case in case_order(set(p.case)):
+        for k in sorted(set(p.k[p.case == case])):
+            cells = [p[(p.case == case) & (p.k == k) & (p.curvature == c) & (p.coupling == cp)].lambda_max_rel_error
+                     for c, cp in runs]
+            lines.append(" & ".join([latex_id(case), str(k)] + [fmt_sci(float(v.iloc[0]), 2) if len(v) else "--"
+                                                                 for v in cells]) + r" \\")
+    return "\n".join(lines + [r"\hline", r"\end{tabular}"])
+
+
+def arc_section_tex(name: str, beta: pd.DataFrame, verdicts: pd.DataFrame, claims: pd.DataFrame,
+                    patch: pd.DataFrame | None = None) -> str:
     """The subsection of the arc study ``name`` (:mod:`infsup_contact.plans.arc`): what was run, the
     claims, and β_h of the finest non-matching pair per coupling and radius."""
     checked, agree = predicted(claims), n_as_predicted(claims)
@@ -91,4 +110,12 @@ def arc_section_tex(name: str, beta: pd.DataFrame, verdicts: pd.DataFrame, claim
                  rf"{int(pair.N1)}{{:}}{int(pair.N2)}$ (series \texttt{{{latex_id(shown)}}}; "
                  r"$^{u}$ unstable, $^{?}$ undecided over the series)\\[2pt]",
                  arc_beta_table(beta, verdicts, coupling, shown), r"\end{center}", ""]
+    if patch is not None and len(patch):
+        last = patch.sort_values("N2").iloc[-1]
+        text += [r"The patch test on the arc (uniform normal pressure $\lambda=-c_1\partial_r u_1$; $u_1=0$ on $r=R-1$, "
+                 r"$u_2=-\delta$ on $r=R+1$, the radial sides natural): the solution $a+b\ln r$ is not in $V_h$, so no "
+                 r"space reproduces $\lambda$ at finite $R$; the spaces holding the constants converge and those "
+                 r"without keep an $O(1)$ error at $\Gamma$'s ends. Max $|\lambda_h-\lambda|/\lambda$ on "
+                 rf"$N_1{{:}}N_2 = {int(last.N1)}{{:}}{int(last.N2)}$:",
+                 r"\begin{center}", r"\small", arc_patch_table(patch), r"\end{center}", ""]
     return "\n".join(text)

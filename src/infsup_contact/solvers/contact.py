@@ -243,6 +243,7 @@ def contact_pair(scene, k: int, family: str, n1: int, n2: int, model=None,
     c = (scene.c1, scene.c2)
     t0 = time.perf_counter()
     sides = [model.side_for(scene, m, k) for m in mesh_pair]
+    sides = sides[0].trace.gamma.paired(sides)  # a Γ coupled by projection ties the two
     F, lifts = zip(*(model.load(s, scene, i) for i, s in enumerate(sides)))
     u0 = [s.solve(Fi) / ci for s, Fi, ci in zip(sides, F, c)]
     return ContactPair(tuple(mesh_pair), sides, list(F), u0, c, k, time.perf_counter() - t0, model,

@@ -113,3 +113,50 @@ def arc_claims(beta: pd.DataFrame, cfg: dict, name: str) -> pd.DataFrame:
                        "at every radius with the projection? (a finding)", _verdicts_as_flat(verdicts, "projection"),
                        predicted=FINDING))
     return pd.DataFrame(out)
+
+
+PATCH_PASS_RTOL = 1e-8
+"""λ_h = λ to this relative accuracy counts as reproduced (the flat membranes' patch test's bound)."""
+CONVERGES_SLOPE = 1.0
+"""Smallest slope of log max|λ_h − λ| against log h that counts as converging (the body's map
+is O(h^{k+1}) and ln r is smooth: first order is the least a consistent space shows)."""
+
+
+PATCH_FIT_PAIRS = 3
+"""The patch claim fits the λ error over the finest pairs only (at most the ledger's ``fit_window``):
+the coarsest pair of the config's four, N2 = 4, is pre-asymptotic (the dual k = 2 error rises from
+N2 = 4 to 8 before falling like h²)."""
+
+
+def arc_patch_claims(patch: pd.DataFrame, name: str, window: int) -> pd.DataFrame:
+    """The patch test's claims (:mod:`infsup_contact.study.patch.arc`, predictions in its docstring):
+    at R = ∞ λ_h = λ iff 1 ∈ M_h; at finite R every space holding the constants converges (slope of
+    the λ error ≥ :data:`CONVERGES_SLOPE` over the ``window`` finest pairs: the claim is about h → 0,
+    as the ledger's fits are) and T3-like spaces do not."""
+    flat = patch[patch.curvature == 0]
+    hit = (flat.lambda_max_rel_error < PATCH_PASS_RTOL) == flat.holds_constants.astype(bool)
+    out = [row(f"{name}-patch-flat-iff-constants", REF, f"{name}: on the flat segment the patch test's λ is "
+               "reproduced to round-off iff 1 ∈ M_h", ((PASS if len(flat) and hit.all() else FAIL),
+                                                      f"{int(hit.sum())}/{len(flat)} rows as 1 ∈ M_h says"))]
+    curved = patch[patch.curvature > 0]
+    slopes, bad = [], []
+    for key, rows in curved[curved.holds_constants.astype(bool)].groupby(["curvature", "coupling", "case", "k"]):
+        rows = rows[rows.N2.isin(sorted(set(rows.N2))[-min(window, PATCH_FIT_PAIRS):])]
+        h, err = 1.0 / rows.N2.to_numpy(float), rows.lambda_max_rel_error.to_numpy(float)
+        slope = float(np.polyfit(np.log(h), np.log(err), 1)[0]) if len(rows) > 1 else np.nan
+        slopes.append(slope)
+        if not slope >= CONVERGES_SLOPE:
+            bad.append(f"{key[2]} k={key[3]} R={radius_of(key[0]):g} {key[1]}: {slope:.2f}")
+    text = (f"{len(slopes)} series, slopes of the λ error in [{np.nanmin(slopes):.2f}, {np.nanmax(slopes):.2f}]"
+            if slopes else "no series") + (f"; below {CONVERGES_SLOPE}: {', '.join(bad)}" if bad else "")
+    out.append(row(f"{name}-patch-curved-converges", REF, f"{name}: on the arc every space holding the constants "
+                   f"converges to the uniform pressure (slope of max|λ_h − λ| ≥ {CONVERGES_SLOPE:g})",
+                   ((PASS if slopes and not bad else FAIL), text)))
+    no_constants = curved[~curved.holds_constants.astype(bool)]
+    finest = no_constants[no_constants.N2 == no_constants.N2.max()] if len(no_constants) else no_constants
+    out.append(row(f"{name}-patch-curved-no-constants-fail", REF, f"{name}: on the arc a space without the "
+                   "constants keeps an O(1) λ error at Γ's ends on the finest pair",
+                   ((PASS if len(finest) and (finest.lambda_max_rel_error > 0.5).all() else FAIL),
+                    f"{len(finest)} rows, λ errors in [{finest.lambda_max_rel_error.min():.2g}, "
+                    f"{finest.lambda_max_rel_error.max():.2g}]" if len(finest) else "no row")))
+    return pd.DataFrame(out)

@@ -54,6 +54,7 @@ def scene_flag_uses() -> list:
 def _check_contact(args):
     from ..discretization.segment import meshes
     from ..discretization.spaces import registry
+    from ..solvers.contact import check_flat_gamma
     from ..solvers.request import check_k
     from ..study.contact.registry import check_pair
     from ..study.contact.scenes import _exponent
@@ -63,9 +64,7 @@ def _check_contact(args):
     args.cases = cases(args)
     material(args)
     args.mesh = mesh_options(args)  # a mesh flag of another model is refused; the scene's rows read them
-    if args.mesh.gamma not in (None, "segment"):
-        raise InputError("gamma", "segment (contact scenes on a curved Γ are not built: beta and verdict take "
-                         "--gamma)", got=args.mesh.gamma)
+    check_flat_gamma(args.mesh)
     spec = check_pair(args.model, args.scene)
     check_k(args.k)
     for case in args.cases:

@@ -45,14 +45,16 @@ from ngsolve import meshes as ngmeshes
 
 from ..discretization.segment.meshes import DIRICHLET
 from ..discretization.face import meshes as meshes3d
+from ..discretization.face.cylinder import GAMMAS, RADIUS_ALLOWED, Cylinder, cylinder_of
 from ..discretization.face.square import SQUARE, SQUARE_TRIG
+from ..discretization.segment.arc import COUPLINGS
 from ..discretization.face.triangulated_square import TRIANGULATED
 from ..errors import InputError, check_prestress
 from dataclasses import dataclass
 
 import scipy.sparse as sp
 
-from .contract import Body, MaterialParam, Model
+from .contract import Body, MaterialParam, Model, OptionalChoice
 from .membranes import field, interpolate, laplace_stiffness
 from .contract import SideOperator, factorized_side
 from . import hex20
@@ -73,7 +75,8 @@ BETA_DIRICHLET = f"{FAR}|{LATERAL}"
 
 
 def subdomain_mesh(family: str, n: int, side: int, *, element: str = "hex", width: float = 1.0,
-                   alpha: float = 0.2, seed: int = 0) -> Body:
+                   alpha: float = 0.2, seed: int = 0, gamma: str | None = None, radius: float | None = None,
+                   coupling: str | None = None) -> Body:
     """The mesh of Ω_side of a family: Γ named ``gamma``, the far face :data:`FAR`, the
     lateral faces :data:`LATERAL`. ``structured``: N × N × N cells; ``unstructured`` (tetrahedra,
     maxh = 1/N) and ``perturbed`` (the structured mesh, vertices moved by U(−αh, αh) per free
@@ -86,14 +89,24 @@ def subdomain_mesh(family: str, n: int, side: int, *, element: str = "hex", widt
     partially (:mod:`infsup_contact.study.face.edge_dropping`); its Γ is then
     ``Square(width=width)``.
 
+    ``gamma``, ``radius``, ``coupling``: Γ the cylinder of radius R
+    (:mod:`~infsup_contact.discretization.face.cylinder`): the box is built as here and curved by
+    :func:`side_operator`, where the body's degree is known; hexahedra (both couplings) and
+    structured tetrahedra (``exact``), width 1.
+
     Raises
     ------
     InputError
         For a family not in :data:`FAMILIES_3D`, an element not in :data:`MEMBRANE_ELEMENTS` (the
         unstructured family: :data:`UNSTRUCTURED_ELEMENTS`; ``hex20``: structured, width 1), N < 1,
         a width outside (0, 1] (or
-        other than 1 for the unstructured and perturbed families), α or seed out of range.
+        other than 1 for the unstructured and perturbed families), α or seed out of range, a
+        cylinder's options (:func:`~infsup_contact.discretization.face.cylinder.check_cylinder_options`)
+        or a body it does not curve.
     """
+    if gamma is not None or radius is not None or coupling is not None:
+        body = subdomain_mesh(family, n, side, element=element, width=width, alpha=alpha, seed=seed)
+        return _on_cylinder(body, family, element, width, gamma, radius, coupling)
     if family not in FAMILIES_3D:
         raise InputError("family", f"{', '.join(FAMILIES_3D)} (the 3D model's meshes)", got=family)
     if element not in MEMBRANE_ELEMENTS:
@@ -126,6 +139,22 @@ def subdomain_mesh(family: str, n: int, side: int, *, element: str = "hex", widt
     if family == "perturbed":
         meshes3d.check_volume(mesh, f"family perturbed, N = {n}, side {side}, seed {seed}, alpha {alpha:g}")
     return Body(mesh, interface_of(family, element))
+
+
+def _on_cylinder(body: Body, family: str, element: str, width: float, gamma, radius, coupling) -> Body:
+    """``body`` with its Γ the cylinder of the options (flat: as built); refused where its face is
+    no tensor grid of :class:`~infsup_contact.discretization.face.square.Square` (HEX20's QUAD8
+    face, the triangulated faces of the perturbed and unstructured tetrahedra) or narrower."""
+    if gamma == "cylinder":
+        if element == "hex20":
+            raise InputError("element", "hex, tet (the bodies curved to the cylinder)", got=element)
+        if body.interface not in (SQUARE, SQUARE_TRIG):
+            raise InputError("family", "structured, or perturbed with element hex (the faces curved to the "
+                             "cylinder)", got=f"{family} with element {element}")
+        if width != 1.0:
+            raise InputError("width", "1 (the cylinder's bodies)", got=width)
+    cylinder = cylinder_of(body.interface, gamma, radius, coupling)
+    return body if cylinder is None else Body(body.mesh, cylinder)
 
 
 def interface_of(family: str, element: str):
@@ -165,6 +194,8 @@ def side_operator(body: Body, k: int, route: str = "auto", dirichlet: str = BETA
             raise InputError("element", "hex, tet (supports other than ∂Ω_i∖Γ, a narrower Γ); hex20 serves β_h",
                              got="hex20")
         return hex20.side_operator(body, k, route, keep_factor)
+    if isinstance(body.interface, Cylinder):
+        body.interface.curve(body.mesh, k)  # the isoparametric body: degree k is known here
     fes = displacement_space(body.mesh, k, dirichlet)
     trace = (body.interface if gamma is None else gamma).trace(fes)
     free_mask = np.array(fes.FreeDofs(), dtype=bool)
@@ -207,5 +238,9 @@ MEMBRANES3D = Model("membranes3d", side_operator,
                     params=tuple(MaterialParam(f"c{i + 1}", 1.0, lambda v, key: check_prestress(key, v),
                                                "1e-150 <= c <= 1e150", f"prestress c{i + 1} of Ω{i + 1}", side=i)
                                  for i in range(2)),
-                    mesh=subdomain_mesh, mesh_options=(("element", MEMBRANE_ELEMENTS),), families=FAMILIES_3D, dim=3)
+                    mesh=subdomain_mesh, families=FAMILIES_3D, dim=3,
+                    mesh_options=(("element", MEMBRANE_ELEMENTS), ("gamma", OptionalChoice(GAMMAS)),
+                                  ("radius", OptionalChoice(text=RADIUS_ALLOWED + ", with --gamma cylinder",
+                                                            above=1.0)),
+                                  ("coupling", OptionalChoice(COUPLINGS))))
 """The 3D membranes through the model seam (β_h, and contact scenes with far-face displacements)."""

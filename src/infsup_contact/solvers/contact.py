@@ -32,6 +32,9 @@ from ..models.contract import B_SIGN
 from .interface_operator import interface_operator
 from .request import NO_OPTIONS, MeshOptions
 
+FLAT_GAMMAS = (None, "segment", "square")
+"""The Γ options of the flat interfaces (unset, the segment, the face), the only ones of the contact scenes."""
+
 
 @dataclass
 class ContactSolution:
@@ -220,6 +223,18 @@ class ContactPair:
     gap_degree: int = 0
 
 
+def check_flat_gamma(mesh: MeshOptions) -> None:
+    """:class:`InputError` naming the key unless ``mesh`` leaves Γ flat: contact scenes are built
+    on the segment and the face only (β_h and the verdicts take the arc and the cylinder)."""
+    if mesh.gamma not in FLAT_GAMMAS:
+        raise InputError("gamma", f"{', '.join(FLAT_GAMMAS[1:])} (contact scenes on the arc and the cylinder are "
+                         "not built: beta and verdict take --gamma arc, cylinder)", got=mesh.gamma)
+    for key in ("radius", "coupling"):
+        if getattr(mesh, key) is not None:
+            raise InputError(key, "unset (contact scenes: a flat Γ; beta and verdict take --gamma arc, cylinder)",
+                             got=getattr(mesh, key))
+
+
 def contact_pair(scene, k: int, family: str, n1: int, n2: int, model=None,
                  mesh: MeshOptions = NO_OPTIONS) -> ContactPair:
     """Mesh, factorize and load both sides of ``scene`` with ``model`` (default: the registry's,
@@ -230,10 +245,9 @@ def contact_pair(scene, k: int, family: str, n1: int, n2: int, model=None,
     model = DEFAULT_MODEL if model is None else model
     build = getattr(scene, "mesh_pair", None)
     kw = mesh.kwargs()
-    if kw.pop("gamma", "segment") != "segment" or kw.pop("radius", None) is not None:
-        raise InputError("gamma", "segment (contact scenes on the arc are not built: beta and verdict take "
-                         "--gamma arc)", got=mesh.gamma)
-    kw.pop("coupling", None)
+    check_flat_gamma(mesh)
+    for key in ("gamma", "radius", "coupling"):
+        kw.pop(key, None)
     if build is not None:
         mesh_pair = build(family, n1, n2, **kw)
     elif model.mesh is not None:

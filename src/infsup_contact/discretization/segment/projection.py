@@ -75,17 +75,31 @@ class SideCurve:
         return n / np.linalg.norm(n, axis=1)[:, None]
 
 
+def curve_nodes(k: int) -> np.ndarray:
+    """The k + 1 points of [0, 1] (Chebyshev–Lobatto) at which a cell's curve is sampled and fitted."""
+    return 0.5 - 0.5 * np.cos(np.pi * np.arange(k + 1) / max(k, 1))
+
+
 def side_curve(trace, k: int) -> SideCurve:
     """The :class:`SideCurve` of a side's trace, read from its (deformed) mesh's element maps."""
     mesh = trace.fes.mesh
     g = np.asarray(trace.breakpoints, float)
-    u = 0.5 - 0.5 * np.cos(np.pi * np.arange(k + 1) / max(k, 1))      # k + 1 points of [0, 1]
-    coefficients, tangents = [], []
+    u = curve_nodes(k)
+    cell_points = []
     for (x_first, x_second, _, el), left, right in zip(trace.elements, g[:-1], g[1:]):
         trafo = mesh.GetTrafo(el)
         # the reference coordinate t runs from the second vertex (0) to the first (1)
-        pts = np.array([np.asarray(trafo((left + ui * (right - left) - x_second) / (x_first - x_second)).point)[:2]
-                        for ui in u])
+        cell_points.append(np.array([np.asarray(trafo((left + ui * (right - left) - x_second)
+                                                      / (x_first - x_second)).point)[:2] for ui in u]))
+    return fit_curve(g, cell_points, k)
+
+
+def fit_curve(g: np.ndarray, cell_points, k: int) -> SideCurve:
+    """The :class:`SideCurve` on the partition ``g`` through each cell's points (k + 1, 2) at
+    :func:`curve_nodes` (the curve's coordinates: along Γ, then along the normal from Ω1 to Ω2)."""
+    u = curve_nodes(k)
+    coefficients, tangents = [], []
+    for pts in cell_points:
         c = np.polynomial.polynomial.polyfit(u, pts, k).T               # (2, k + 1)
         coefficients.append(c)
         d = c[:, 1:] * np.arange(1, k + 1)
@@ -96,7 +110,7 @@ def side_curve(trace, k: int) -> SideCurve:
         normals[e] += unit(start)
         normals[e + 1] += unit(end)
     normals /= np.linalg.norm(normals, axis=1)[:, None]
-    return SideCurve(g, np.array(coefficients), normals)
+    return SideCurve(np.asarray(g, float), np.array(coefficients), normals)
 
 
 def project(slave: SideCurve, master: SideCurve, x: np.ndarray) -> np.ndarray:

@@ -1,0 +1,136 @@
+"""Γ a part of a cylinder of radius R and area 1: the face (0, 1)² × {1}, curved in x.
+
+The bodies are the images of the 3D membranes' boxes Ω1 = (0,1)³ and Ω2 = (0,1)²×(1,2) under
+
+    Φ(x, y, z) = ((R − 1 + z) sin(x/R), y, (R − 1 + z) cos(x/R) − R + 1),
+
+the arc's polar map (:mod:`..segment.arc`) in (x, z) times the identity in y: Γ (z = 1) goes to
+the cylinder r = R about the axis {X = 0, Z = 1 − R} along y, x to the arc length, and R = ∞ is
+the flat face. Ω1 = {R − 1 < r < R}, Ω2 = {R < r < R + 1}, 0 < θ < 1/R, 0 < y < 1. The curved
+mesh is isoparametric: NGSolve's ``SetDeformation`` by the interpolant of Φ − id in the body's
+own Q_k / P_k (:meth:`Cylinder.curve`), with dual (interpolating) degrees of freedom, so the
+vertices lie on Φ's image and the volume and area errors fall as h^{2k} (tested).
+
+Everything on Γ is parametrized by (arc length, y) ∈ (0, 1)², the reference face: partitions,
+multiplier spaces, the L² norm (the cylinder's area element is ds dy, so this L² is the
+cylinder's) and the H^{-1/2}_00 norm of the parameter square, an equivalent norm of the
+cylinder's, exact for R → ∞. How the sides are coupled is the ``coupling``:
+
+``exact``
+    Both traces mapped to the exact cylinder by (arc length, y): the flat face's coupling, exact
+    (tetrahedra too).
+``projection``
+    As mortar codes do it: the integral over the slave's discrete surface, the master evaluated
+    where the slave's averaged nodal normal meets it (:mod:`.cylinder_projection`; hexahedra).
+
+R = ∞ builds the flat meshes unchanged; ``exact`` then gives the flat face's β_h bit for bit.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ...errors import InputError
+from ..segment.arc import COUPLINGS
+from .square import Square
+
+GAMMAS = ("square", "cylinder")
+"""The Γ of the 3D membranes: the flat face, or the part of the cylinder of radius R."""
+RADIUS_ALLOWED = "a number R > 1, or inf (the flat face)"
+"""R = 1 would collapse Ω1's far face onto the cylinder's axis."""
+DEFAULT_COUPLING = "exact"
+"""The coupling of a cylinder whose request names none."""
+
+
+def check_cylinder_options(gamma, radius, coupling) -> None:
+    """:class:`InputError` naming the key: ``gamma`` in :data:`GAMMAS`; with ``cylinder`` a radius
+    R > 1 (inf allowed) and a coupling in :data:`~..segment.arc.COUPLINGS` or none; without it neither."""
+    if gamma not in (None,) + GAMMAS:
+        raise InputError("gamma", ", ".join(GAMMAS), got=gamma)
+    if gamma != "cylinder":
+        for key, value in (("radius", radius), ("coupling", coupling)):
+            if value is not None:
+                raise InputError(key, "only with gamma cylinder (--gamma cylinder)", got=value)
+        return
+    if radius is None or isinstance(radius, bool) or not isinstance(radius, (int, float, np.number)) \
+            or not radius > 1:
+        raise InputError("radius", RADIUS_ALLOWED + " (required with gamma cylinder)", got=radius)
+    if coupling not in (None,) + COUPLINGS:
+        raise InputError("coupling", ", ".join(COUPLINGS), got=coupling)
+
+
+@dataclass(frozen=True)
+class Cylinder(Square):
+    """Γ the part of the cylinder of radius ``radius``, parametrized by (arc length, y) (module docstring).
+
+    Attributes
+    ----------
+    radius : float
+        R > 1, or inf (the flat face).
+    coupling : str
+        One of :data:`~..segment.arc.COUPLINGS`.
+    """
+
+    radius: float = math.inf
+    coupling: str = DEFAULT_COUPLING
+
+    @property
+    def curved(self) -> bool:
+        return math.isfinite(self.radius)
+
+    def cylinder_map(self):
+        """Φ − id as an NGSolve coefficient function of the boxes' (x, y, z) (module docstring)."""
+        import ngsolve
+
+        R = float(self.radius)
+        r = R - 1.0 + ngsolve.z
+        return ngsolve.CF((r * ngsolve.sin(ngsolve.x / R) - ngsolve.x, 0.0,
+                           r * ngsolve.cos(ngsolve.x / R) - R + 1.0 - ngsolve.z))
+
+    def curve(self, mesh, k: int) -> None:
+        """Make ``mesh`` (a box of the 3D membranes) the isoparametric image of its body under Φ:
+        its deformation is the interpolant of Φ − id in the body's degree-k space. The dual
+        degrees of freedom interpolate (vertex values exact); NGSolve's default ``Set`` is a
+        local projection that moves the vertices off the cylinder and loses the h^{2k} rate.
+        Nothing on a flat Γ."""
+        import ngsolve
+
+        if not self.curved:
+            return
+        mesh.UnsetDeformation()  # the map is of the box's coordinates, not of a curved mesh's
+        deformation = ngsolve.GridFunction(ngsolve.VectorH1(mesh, order=int(k)))
+        deformation.Set(self.cylinder_map(), dual=True)
+        mesh.SetDeformation(deformation)
+
+    def embed(self, x):
+        """Points of the exact cylinder at (arc length, y) ``x`` (n, 2)."""
+        if not self.curved:
+            return super().embed(x)
+        x = np.asarray(x, dtype=float).reshape(-1, 2)
+        R = float(self.radius)
+        return R * np.sin(x[:, 0] / R), x[:, 1], R * np.cos(x[:, 0] / R) - R + 1.0
+
+    def paired(self, sides: list) -> list:
+        """With ``projection``, the sides' traces tied to each other
+        (:func:`.cylinder_projection.project_pair`); else as built."""
+        if self.coupling != "projection":
+            return sides
+        from .cylinder_projection import project_pair
+
+        return project_pair(self, sides)
+
+
+def cylinder_of(face: Square, gamma=None, radius=None, coupling=None):
+    """The Γ of the mesh options on a body whose flat face is ``face``: None for the flat face (no
+    option given, or ``square``), else the checked :class:`Cylinder` of its cells. Projection
+    is on tensor-product surfaces only: refused on tetrahedra, whose triangles' master images
+    are curved in the slave's parameters."""
+    check_cylinder_options(gamma, radius, coupling)
+    if gamma != "cylinder":
+        return None
+    coupling = DEFAULT_COUPLING if coupling is None else coupling
+    if coupling == "projection" and face.cell != "quad":
+        raise InputError("coupling", "exact on tetrahedra (projection: element hex)", got=coupling)
+    return Cylinder(face.boundary, face.z, face.cell, face.width, float(radius), coupling)

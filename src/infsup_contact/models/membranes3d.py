@@ -242,5 +242,5 @@ MEMBRANES3D = Model("membranes3d", side_operator,
                     mesh_options=(("element", MEMBRANE_ELEMENTS), ("gamma", OptionalChoice(GAMMAS)),
                                   ("radius", OptionalChoice(text=RADIUS_ALLOWED + ", with --gamma cylinder",
                                                             above=1.0)),
-                                  ("coupling", OptionalChoice(COUPLINGS))))
+                                  ("coupling", OptionalChoice(COUPLINGS, filled_when=("gamma", "cylinder")))))
 """The 3D membranes through the model seam (β_h, and contact scenes with far-face displacements)."""

@@ -70,7 +70,7 @@ def verdict_rows(case_or_spec, k: int, family: str, ns, norm: str, *, tol: float
     -------
     dict
         ``space``, ``k``, ``model``, ``element`` (the 3D models' mesh element, else None),
-        ``family``, ``norm``, ``multiplier_mesh``, ``N1_offset``, the fields of
+        ``gamma``, ``radius``, ``coupling`` (a curved Γ's, where set), ``family``, ``norm``, ``multiplier_mesh``, ``N1_offset``, the fields of
         :func:`stability_verdict`, ``N_list`` (the sorted N2) and ``seconds`` (wall time of
         the whole call).
 
@@ -88,7 +88,8 @@ def verdict_rows(case_or_spec, k: int, family: str, ns, norm: str, *, tol: float
     model = DEFAULT_MODEL if model is None else model
     rows = [r for n in ns for r in beta_rows(family, k, n + n1_offset, n, [case], multiplier_mesh,
                                              norms=(norm,), model=model, mesh=mesh)]
-    out = dict(space=case, k=k, model=model.name, element=mesh.element, family=family, norm=norm,
+    curved = {key: getattr(mesh, key) for key in ("gamma", "radius", "coupling") if getattr(mesh, key) is not None}
+    out = dict(space=case, k=k, model=model.name, element=mesh.element, **curved, family=family, norm=norm,
                multiplier_mesh=multiplier_mesh, N1_offset=n1_offset,
                **stability_verdict(rows, tol, floor, confidence), N_list=ns)
     out["seconds"] = time.perf_counter() - t0

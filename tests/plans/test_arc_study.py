@@ -77,3 +77,30 @@ def test_a_bad_entry_is_one_line_naming_its_key(change, key):
         check_models({"models": {"arc": entry}})
     text = str(err.value)
     assert key in text and "\n" not in text
+
+
+CYLINDER = {"study": "cylinder", "k": [1], "radii": [2], "couplings": ["exact", "projection"],
+            "series": {"matching": [[2, 2], [3, 3], [4, 4]], "plus1": [[2, 3], [3, 4], [4, 5]]},
+            "cases": ["T3", "R5.2", "DUAL-ALL"]}
+
+
+def test_the_cylinder_study_runs_and_its_predictions_hold():
+    """The same study on the 3D membranes (hexahedra, Γ a part of the cylinder): the flat face is
+    reproduced bit for bit, the exact coupling keeps every kernel, no verdict flips."""
+    config = {"models": {"cyl": CYLINDER}, "claims": CLAIMS}
+    check_models(config)
+    study = study_of(config, "cyl")
+    beta = pd.concat([job.run() for job in study.jobs().values()], ignore_index=True)
+    claims = study.claims({"beta": beta}, CLAIMS)
+    checked = claims[claims.predicted != "finding"]
+    assert len(checked) >= 5 and (checked.verdict == checked.predicted).all(), checked[["claim_id", "evidence"]]
+    tex = study.paper_files({"beta": beta, "claims": claims}, {"claims": CLAIMS})["cyl.tex"]
+    assert r"\subsection{The curved face \texttt{cyl}}" in tex
+
+
+@pytest.mark.parametrize("change, key", [({"patch": {"k": [1], "pairs": [[3, 2], [6, 4]], "c": [1, 1]}}, "models.cyl.patch"),
+                                         ({"cases": ["T3", "Q8"]}, "models.cyl.cases[1]")])
+def test_a_bad_cylinder_entry_is_one_line_naming_its_key(change, key):
+    with pytest.raises(ConfigError) as err:
+        check_models({"models": {"cyl": dict(CYLINDER, **change)}})
+    assert key in str(err.value) and "\n" not in str(err.value)

@@ -35,8 +35,8 @@ def check_models(cfg) -> None:
         study = entry["study"]
         if study in BUILT_IN:
             _check_built_in(cfg, key, name, entry)
-        elif study == "arc":
-            _check_arc(key, entry)
+        elif study in ("arc", "cylinder"):
+            _check_arc(key, entry, 1 if study == "arc" else 2)
         else:
             _check_beta(key, entry)
 
@@ -105,7 +105,7 @@ ARC_FOREIGN = ("model", "elements", "N", "nonmatching", "norms")
 """Keys of a ``beta`` study an arc entry does not read (its model is the 2D membranes)."""
 
 
-def _check_arc(key: str, entry: dict) -> None:
+def _check_arc(key: str, entry: dict, gamma_dim: int) -> None:
     from ..discretization.spaces.registry import SPACES
 
     missing = [k for k in ARC_KEYS if k not in entry]
@@ -122,7 +122,11 @@ def _check_arc(key: str, entry: dict) -> None:
                               got=pairs, allowed="3 or more distinct [N1, N2] pairs")
     for i, case in enumerate(entry["cases"]):
         spec = SPACES.get(case)
-        if spec is None or 1 not in spec.gamma_dims or not any(spec.valid_for(k) for k in ks):
-            raise ConfigError(f"{key}.cases[{i}]", f"not a segment space defined for k in {ks}", got=case,
+        if spec is None or gamma_dim not in spec.gamma_dims or not any(spec.valid_for(k) for k in ks):
+            raise ConfigError(f"{key}.cases[{i}]", f"not a space of the {'segment' if gamma_dim == 1 else 'face'} "
+                              f"defined for k in {ks}", got=case,
                               allowed=", ".join(c for c, s in SPACES.items()
-                                                if 1 in s.gamma_dims and any(s.valid_for(k) for k in ks)))
+                                                if gamma_dim in s.gamma_dims and any(s.valid_for(k) for k in ks)))
+    if gamma_dim == 2 and entry.get("patch"):
+        raise ConfigError(f"{key}.patch", "a cylinder study has no patch test (contact scenes are not built on a "
+                          "curved face)", got=entry["patch"], allowed="no patch key")

@@ -6,7 +6,7 @@ study's name as their ``{model}`` wildcard and ask this package everything else.
 """
 from __future__ import annotations
 
-from .arc import ArcStudy
+from .arc import ArcStudy, CylinderStudy
 from .beta import BetaStudy
 from .elastic import ElasticStudy
 from .face import FaceStudy
@@ -14,9 +14,10 @@ from .face_elastic import FaceElasticStudy
 from .protocol import Inputs, Job, ModelStudy, Table, claims_path, job_path, table_path
 
 STUDIES = {"elastic": ElasticStudy, "face": FaceStudy, "face_elastic": FaceElasticStudy, "beta": BetaStudy,
-           "arc": ArcStudy}
+           "arc": ArcStudy, "cylinder": CylinderStudy}
 """What a model-table entry's ``study`` may be. The first three read the config section named like
-the entry (their scenes predate the table); ``beta`` and ``arc`` read their scenes from the entry itself."""
+the entry (their scenes predate the table); ``beta``, ``arc`` and ``cylinder`` read their scenes from the entry
+itself."""
 SECTION_STUDIES = ("elastic", "face", "face_elastic")
 """Built-in studies whose scenes live in the config section of the entry's name."""
 
@@ -34,7 +35,7 @@ def study_of(config: dict, name: str) -> ModelStudy:
     table = model_table(config)
     entry = table[name]
     kind = entry["study"]
-    if kind in ("beta", "arc"):
+    if kind in ("beta", "arc", "cylinder"):
         return STUDIES[kind](name, entry)
     if kind == "face_elastic":  # its kernel claims compare with a face study's table, when there is one
         membranes = next((n for n, e in table.items() if e["study"] == "face"), None)

@@ -32,13 +32,16 @@ class ArcStudy:
     def series(self) -> dict:
         return {s: [tuple(int(n) for n in p) for p in pairs] for s, pairs in self.cfg["series"].items()}
 
+    element = None
+    """The 3D membranes' element (the cylinder), None for the 2D membranes (the arc)."""
+
     def _rows(self, k: int) -> pd.DataFrame:
         from ..discretization.spaces.registry import ids_valid_for
         from ..study.beta.arc import arc_rows
 
         radii = [float(r) for r in self.cfg["radii"]] + [math.inf]  # R = ∞: the reference of every claim
-        return arc_rows(radii, self.series(), k, ids_valid_for(k, self.cfg["cases"]),
-                        tuple(self.cfg["couplings"]), paper=True)
+        cases = ids_valid_for(k, self.cfg["cases"], gamma_dim=1 if self.element is None else 2)
+        return arc_rows(radii, self.series(), k, cases, tuple(self.cfg["couplings"]), paper=True, element=self.element)
 
     def _mem_mb(self, k: int) -> int:
         pairs = {p for ps in self.series().values() for p in ps}
@@ -97,8 +100,16 @@ class ArcStudy:
         c = params["claims"]
         verdicts = arc_verdicts(frames["beta"], c["slope_tolerance"], c["beta_floor"], c["confidence"])
         return {f"{self.name}.tex": arc_section_tex(self.name, frames["beta"], verdicts, frames["claims"],
-                                                    frames.get("patch"))}
+                                                    frames.get("patch"), self.element)}
 
     def check_tex(self, tex: str, files: dict) -> None:
         """No hand-written source: the subsection is generated whole."""
 
+
+
+class CylinderStudy(ArcStudy):
+    """The same study one dimension up: the 3D membranes on hexahedra, Γ the part of the cylinder of
+    radius R (:mod:`infsup_contact.discretization.face.cylinder`); no patch test (contact scenes are
+    not built on a curved face)."""
+
+    element = "hex"

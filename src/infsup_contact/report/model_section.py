@@ -82,8 +82,25 @@ def arc_patch_table(patch: pd.DataFrame) -> str:
     return "\n".join(lines + [r"\hline", r"\end{tabular}"])
 
 
+GEOMETRY_TEX = {
+    None: (r"The curved segment",
+           r"$\Gamma$ is the arc of radius $R$ and length 1 between $\Omega_1=\{R-1<r<R\}$ and "
+           r"$\Omega_2=\{R<r<R+1\}$, $0<\theta<1/R$: each body is the paper's mesh of its square mapped by polar "
+           r"coordinates and curved isoparametrically at its own degree, so that $R=\infty$ is the paper's "
+           r"segment. Everything on $\Gamma$ is parametrized by arc length; the $H^{-1/2}_{00}$ norm is the "
+           r"segment's in that parameter, an equivalent norm of the arc's, exact as $R\to\infty$."),
+    "hex": (r"The curved face",
+            r"$\Gamma$ is the part $r=R$, $0<\theta<1/R$, $0<y<1$ of a cylinder between the 3D membranes "
+            r"$\Omega_1=\{R-1<r<R\}$ and $\Omega_2=\{R<r<R+1\}$ on hexahedra: each body is the face study's box "
+            r"mapped by cylindrical coordinates and curved isoparametrically at its own degree, so that $R=\infty$ "
+            r"is the flat face. $\Gamma$ is parametrized by (arc length, $y$); the $H^{-1/2}_{00}$ norm is the "
+            r"unit square's in those parameters, an equivalent norm, exact as $R\to\infty$."),
+}
+"""Title and geometry paragraph of a curved Γ's subsection, by the bodies' element (None: the 2D membranes)."""
+
+
 def arc_section_tex(name: str, beta: pd.DataFrame, verdicts: pd.DataFrame, claims: pd.DataFrame,
-                    patch: pd.DataFrame | None = None) -> str:
+                    patch: pd.DataFrame | None = None, element: str | None = None) -> str:
     """The subsection of the arc study ``name`` (:mod:`infsup_contact.plans.arc`): what was run, the
     claims, and β_h of the finest non-matching pair per coupling and radius."""
     checked, agree = predicted(claims), n_as_predicted(claims)
@@ -92,13 +109,10 @@ def arc_section_tex(name: str, beta: pd.DataFrame, verdicts: pd.DataFrame, claim
     pair = beta[beta.series == shown].sort_values("N2").iloc[-1]
     couplings = [c for c in ("exact", "projection") if (beta.coupling == c).any()]
     radii = sorted({1 / c for c in beta.curvature if c > 0})
-    text = [rf"\subsection{{The curved segment \texttt{{{latex_id(name)}}}}}\label{{sec:model-{name}}}",
-            r"$\Gamma$ is the arc of radius $R$ and length 1 between $\Omega_1=\{R-1<r<R\}$ and "
-            r"$\Omega_2=\{R<r<R+1\}$, $0<\theta<1/R$: each body is the paper's mesh of its square mapped by polar "
-            r"coordinates and curved isoparametrically at its own degree, so that $R=\infty$ is the paper's "
-            r"segment. Everything on $\Gamma$ is parametrized by arc length; the $H^{-1/2}_{00}$ norm is the "
-            r"segment's in that parameter, an equivalent norm of the arc's, exact as $R\to\infty$. The "
-            r"\emph{exact} coupling maps both traces to the arc by arc length; the \emph{projection} integrates "
+    title, geometry = GEOMETRY_TEX[element]
+    text = [rf"\subsection{{{title} \texttt{{{latex_id(name)}}}}}\label{{sec:model-{name}}}",
+            geometry + r" The "
+            r"\emph{exact} coupling maps both traces to $\Gamma$ by arc length; the \emph{projection} integrates "
             r"on the discretized side that carries $G_h$ and evaluates the other side along its averaged "
             r"nodal normal, as mortar codes do. "
             rf"Radii $R\in\{{{', '.join(f'{r:g}' for r in radii)}, \infty\}}$, $k\in\{{{', '.join(map(str, sorted(set(beta.k))))}\}}$, "

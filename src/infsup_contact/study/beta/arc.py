@@ -23,7 +23,7 @@ SERIES_KEYS = ("curvature", "coupling", "series", "case", "k", "family", "norm",
 
 
 def arc_rows(radii, series: dict, k: int, cases=None, couplings=COUPLINGS, family: str = "structured",
-             norms=("H", "L2"), paper: bool = False) -> pd.DataFrame:
+             norms=("H", "L2"), paper: bool = False, element: str | None = None) -> pd.DataFrame:
     """β_h rows of the membranes on the arc for every radius × coupling × pair of ``series``.
 
     Parameters
@@ -40,6 +40,9 @@ def arc_rows(radii, series: dict, k: int, cases=None, couplings=COUPLINGS, famil
     paper : bool
         Also the rows of the paper's flat segment by its own code (no Γ option), coupling
         :data:`PAPER`, curvature 0: what R = ∞ must reproduce.
+    element : str or None
+        None: the 2D membranes, Γ the arc; an element of the 3D membranes (``hex``, ``tet``): Γ the
+        part of the cylinder (:mod:`infsup_contact.discretization.face.cylinder`), the flat face the reference.
 
     Returns
     -------
@@ -49,12 +52,14 @@ def arc_rows(radii, series: dict, k: int, cases=None, couplings=COUPLINGS, famil
     """
     pairs = sorted({tuple(p) for ps in series.values() for p in ps})
     by_pair = {p: [s for s, ps in series.items() if p in {tuple(q) for q in ps}] for p in pairs}
-    runs = [(curvature(r), c, MeshOptions(gamma="arc", radius=float(r), coupling=c)) for r in radii for c in couplings]
+    model, gamma = ("membranes", "arc") if element is None else ("membranes3d", "cylinder")
+    runs = [(curvature(r), c, MeshOptions(element=element, gamma=gamma, radius=float(r), coupling=c))
+            for r in radii for c in couplings]
     if paper:
-        runs.append((0.0, PAPER, MeshOptions()))
+        runs.append((0.0, PAPER, MeshOptions(element=element)))
     frames = []
     for kappa, coupling, mesh in runs:
-        frame = beta_batch_rows("membranes", family, k, pairs, cases, norms=norms, series=by_pair, mesh=mesh)
+        frame = beta_batch_rows(model, family, k, pairs, cases, norms=norms, series=by_pair, mesh=mesh)
         frame = frame.drop(columns=[c for c in frame.columns if c.startswith("t_")])  # timings: benchmark tree
         frame.insert(0, "coupling", coupling)
         frame.insert(0, "curvature", kappa)

@@ -74,7 +74,7 @@ def _verdicts_as_flat(verdicts: pd.DataFrame, coupling: str, undecided_ok: bool 
     differ = mine.verdict.to_numpy() != expected
     undecided = differ & (mine.verdict == UNDECIDED).to_numpy()
     bad = mine[differ & ~(undecided & undecided_ok)]
-    text = (f"{int((~differ).sum())}/{len(mine)} (radius, series, case, norm) verdicts as on the flat segment, "
+    text = (f"{int((~differ).sum())}/{len(mine)} (radius, series, case, norm) verdicts as on the flat Γ, "
             f"{int(undecided.sum())} undecided, {int((differ & ~undecided).sum())} opposite "
             f"({len(flat)} decisive flat verdicts)")
     if len(bad):

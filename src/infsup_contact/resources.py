@@ -45,7 +45,7 @@ CONTACT_EXTRA_BYTES = 150 * MIB
 
 FAMILY_DOF_FACTOR = {"structured": 1.0, "perturbed": 1.0, "unstructured": 1.3}
 
-BENCH_FACTOR = {"beta": 2.7, "contact": 1.6, "face": 2.7, "elastic": 2.7}
+BENCH_FACTOR = {"beta": 2.7, "contact": 1.6, "face": 2.7, "elastic": 2.7, "arc": 2.7}
 """Bench holds each route's own factorization (eigsh: the full pencil; peers: the full KKT)
 next to ours: measured 2.3× (β, N = 128, k = 2) and 1.4× (contact, N = 64, k = 2)."""
 
@@ -271,7 +271,7 @@ def bench_estimate(what: str, ns, ks, repeats: int = 3, eigsh_max_n=None, kkt_ma
             nd_total = 2 * side_dofs("structured", n, k)
             if what in VECTOR_BENCHES:  # two components per node, the H norm; no pencil route
                 inner = beta_estimate("structured", k, n, n, norms=("H",), process=False, components=2)
-            elif what == "beta":
+            elif what in ("beta", "arc"):  # arc: flat, exact and projection β side by side, all spaces
                 inner = beta_estimate("structured", k, n, n, process=False)
                 if eigsh_max_n is None or n <= eigsh_max_n:
                     seconds += SECONDS_PER_DOF15["eigsh"] * nd_total ** 1.5 * n_problems

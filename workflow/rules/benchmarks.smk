@@ -133,3 +133,27 @@ rule elastic_bench:
         "results/logs/elastic_bench.log",
     script:
         "../scripts/elastic_bench.py"
+
+
+rule bench_arc:
+    # what a curved Γ costs: β_h on the arc, exact and projected couplings, beside the flat segment
+    # and the limit (bench/curved.py); the whole machine to itself locally
+    output:
+        "results/benchmarks/arc.csv",
+    input:
+        PACKAGE_SOURCES,
+        BENCH_SOURCES,
+    params:
+        N=lambda wc: config["benchmarks"]["arc_N"],
+        k=lambda wc: config["benchmarks"]["arc_k"],
+        radius=lambda wc: config["benchmarks"]["arc_radius"],
+        repeats=lambda wc: config["benchmarks"]["repeats"],
+        budget=lambda wc: config["benchmarks"].get("route_budget_s", 10),
+    threads: workflow.cores
+    benchmark:
+        "results/benchmarks/rules/bench_arc.tsv"
+    log:
+        "results/logs/bench_arc.log",
+    shell:
+        _BLAS1 + "infsup-contact bench --what arc --N {params.N} --k {params.k} --radius {params.radius}"
+        " --repeats {params.repeats} --route-budget {params.budget} > {output}.tmp 2> {log} && mv {output}.tmp {output}"

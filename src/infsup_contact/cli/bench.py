@@ -7,9 +7,10 @@ from .common import FlagUse, add_dry_run, check_memory, declare_flag_uses, write
 
 def add(sub) -> None:
     p = sub.add_parser("bench", help="speed as ratios in one run (CSV)")
-    p.add_argument("--what", required=True, choices=["beta", "contact", "face", "elastic"],
+    p.add_argument("--what", required=True, choices=["beta", "contact", "face", "elastic", "arc"],
                    help="beta / contact: the 2D membranes; face: β_h of the 3D membranes (--model membranes3d); "
-                        "elastic: β_h of the plane-strain bodies (--model elastic)")
+                        "elastic: β_h of the plane-strain bodies (--model elastic); arc: β_h on the curved "
+                        "segment, both couplings, beside the flat one (pairs N:N+1)")
     p.add_argument("--N", type=int, nargs="+", required=True)
     p.add_argument("--k", type=int, nargs="+", required=True)
     p.add_argument("--repeats", type=int, default=3)
@@ -27,6 +28,7 @@ def add(sub) -> None:
     p.add_argument("--element", default=None,
                    help="face: the 3D bodies' elements (hex, tet; default hex)")
     p.add_argument("--nu", type=float, default=None, help="elastic: Poisson ratio of both bodies (default 0.3)")
+    p.add_argument("--radius", type=float, default=None, help="arc: the radius R > 1 of Γ (default 2)")
     p.add_argument("--case", nargs="+", default=None,
                    help="elastic: the space ids to run, each where defined for k (default every registered one)")
     add_dry_run(p)
@@ -41,7 +43,7 @@ def _what(*whats):
 FLAG_USES = [FlagUse(dest, _what(what), f"--what {what}", lambda a: f"--what {a.what}")
              for dest, what in (("peers", "contact"), ("kkt_max_n", "contact"), ("eigsh_max_n", "beta"),
                                 ("dense_max_size", "beta"), ("element", "face"), ("nu", "elastic"),
-                                ("case", "elastic"))]
+                                ("case", "elastic"), ("radius", "arc"))]
 """The flags of ``bench`` only one ``--what`` uses (:func:`~.common.refuse_unused`)."""
 
 
@@ -106,7 +108,18 @@ def _check_elastic(args) -> None:
         space_spec(case)
 
 
-TARGET_CHECKS = {"face": _check_face, "elastic": _check_elastic}
+def _check_arc(args) -> None:
+    """``--what arc``: the radius R > 1 (finite: the flat segment is its reference route)."""
+    from ..discretization.segment.arc import RADIUS_ALLOWED, check_arc_options
+
+    args.radius = 2.0 if args.radius is None else args.radius
+    check_arc_options("arc", args.radius, "exact")
+    if args.radius == float("inf"):
+        raise InputError("radius", RADIUS_ALLOWED.replace(", or inf (the flat segment)", " (finite: the flat "
+                                                          "segment is the reference route)"), got=args.radius)
+
+
+TARGET_CHECKS = {"face": _check_face, "elastic": _check_elastic, "arc": _check_arc}
 """The ``--what`` targets with flags of their own, and their checks."""
 PLANE_STRAIN = ("elastic",)
 """The ``--what`` targets of the plane-strain β routes (``--nu``, ``--case``)."""
@@ -125,6 +138,12 @@ def _run_bench(args) -> None:
         rows = bench.bench_beta(bench.bench_for("beta", dense_max_size=args.dense_max_size,
                                                 eigsh_max_n=args.eigsh_max_n), args.N, args.k, args.repeats,
                                 args.route_budget)
+    elif args.what == "arc":
+        from ..bench.curved import COLUMNS, curved_rows
+
+        write_csv(pd.DataFrame(curved_rows(args.N, args.k, args.radius, args.repeats, args.route_budget),
+                               columns=list(COLUMNS)), float_format="%.6g")
+        return
     elif args.what in PLANE_STRAIN:
         rows = bench.bench_beta(bench.bench_for(args.what, nu=args.nu), args.N, args.k, args.repeats,
                                 args.route_budget, cases=args.case)

@@ -150,6 +150,9 @@ class ProjectedArc(Arc):
 
     curves: tuple = field(default=(), compare=False, repr=False)
     side: int = 0
+    rules: dict = field(default_factory=dict, compare=False, repr=False)
+    """The slave's points, weights and master points per (slave, G_h, degree), shared by the pair's
+    two views: both sides' B_i of a space integrate over the same points."""
 
     def slave_of(self, g_h) -> int:
         """0 (Ω1) when G_h is Ω1's trace and not Ω2's, else 1 (Ω2)."""
@@ -158,18 +161,27 @@ class ProjectedArc(Arc):
         return 0 if same(g_h, p1) and not same(g_h, p2) else 1
 
     def coupling_points(self, trace, space, degree: int) -> tuple:
-        slave = self.slave_of(np.asarray(space.breakpoints))
+        g_h = np.asarray(space.breakpoints, float)
+        slave = self.slave_of(g_h)
+        key = (slave, g_h.tobytes(), degree)
+        if key not in self.rules:
+            if len(self.rules) >= 16:
+                self.rules.clear()
+            self.rules[key] = self._rule(slave, g_h, degree)
+        x, w, y, inside = self.rules[key]
+        return (x, x, w) if self.side == slave else (x, y, w * inside)
+
+    def _rule(self, slave: int, g_h, degree: int) -> tuple:
+        """(x, w, P(x) clipped to Γ, whether the normal meets the master's curve) of the module docstring."""
         s, m = self.curves[slave], self.curves[1 - slave]
-        cuts = self.common_refinement(s.breakpoints, space.breakpoints, preimages(s, m, m.breakpoints))
+        cuts = self.common_refinement(s.breakpoints, g_h, preimages(s, m, m.breakpoints))
         t, w = gauss_legendre(degree // 2 + 1 + EXTRA_POINTS)
         a, b = cuts[:-1, None], cuts[1:, None]
         x = (0.5 * (a + b) + 0.5 * (b - a) * t[None, :]).ravel()
         w = (0.5 * (b - a) * w[None, :]).ravel() * np.linalg.norm(s.point(x)[1], axis=1)  # dS = |p_s'| dx
-        if self.side == slave:
-            return x, x, w
         y = project(s, m, x)
         inside = (y >= 0.0) & (y <= 1.0)  # the normal misses the master's curve: no master there
-        return x, np.clip(y, 0.0, 1.0), w * inside
+        return x, w, np.clip(y, 0.0, 1.0), inside
 
     def proven_kernel(self, space, k: int, traces, dim_w: int) -> int:
         """The segment's count where P = id (a flat Γ; matching meshes, whose curves are one, the
@@ -188,9 +200,9 @@ def project_pair(arc: Arc, sides: list) -> list:
     """The two sides with traces whose Γ is the :class:`ProjectedArc` of the pair (fresh caches:
     the master's basis is asked at projected points)."""
     k = int(sides[0].trace.fes.globalorder)
-    curves = tuple(side_curve(s.trace, k) for s in sides)
+    curves, rules = tuple(side_curve(s.trace, k) for s in sides), {}
     out = []
     for i, s in enumerate(sides):
-        view = ProjectedArc(arc.boundary, arc.y, arc.radius, arc.coupling, curves, i)
+        view = ProjectedArc(arc.boundary, arc.y, arc.radius, arc.coupling, curves, i, rules)
         out.append(replace(s, trace=replace(s.trace, gamma=view, basis_cache={}, sparse_cache={})))
     return out

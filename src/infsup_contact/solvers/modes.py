@@ -24,8 +24,9 @@ from scipy.linalg import lapack
 from ..la import bottom
 
 MODE_SAMPLES = 6
-"""Subdivisions of each cell of G_h at which a mode is sampled (``gamma.sample``): on triangles the
-P_6 lattice, which holds every triangle's centroid (a discontinuous P_0 mode is seen inside its cell)."""
+"""Subdivisions of each cell of G_h at which a mode is sampled (``gamma.sample``): sixths, so that
+the centroids of triangles (thirds: the Kuhn triangles of a tensor grid, the P_6 lattice of a
+triangulation) are sample points and a discontinuous P_0 mode is seen inside its cells."""
 
 
 @dataclass(frozen=True)

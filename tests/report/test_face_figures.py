@@ -96,6 +96,19 @@ def test_face_beta_figure(tmp_path, drawn):
         assert np.allclose(sorted(line.get_xdata()), [1 / 8, 1 / 6, 1 / 4])
 
 
+def test_face_beta_figure_with_hex20(tmp_path, drawn):
+    hex20 = pd.DataFrame([dict(case=case, N=n, norm=norm, dim_M=1, dim_W=1, kernel_dim=kernel, structural_kernel_dim=kernel,
+                               kernel_decision="clear", beta=0.0 if kernel else 0.7, verdict="STABLE")
+                          for case, kernel in (("Q8", 0), ("Q8-ALL", 3), ("LIN0-Q8", 0))
+                          for n in (4, 6, 8) for norm in ("H", "L2")])
+    face_figures.plot_face_beta(face_beta(), tmp_path / "f.pdf", tmp_path / "f.png", hex20=hex20)
+    assert_written(tmp_path, "f")
+    third = drawn[0][2]
+    assert "HEX20" in third.get_title()
+    assert {line.get_label() for line in third.get_lines()} == {"Q8, k=2", "LIN0-Q8, k=2"}
+    assert plotting.CASE_COLORS["Q8"] != plotting.CASE_COLORS["LIN0-Q8"]  # the QUAD8 spaces told apart
+
+
 def test_face_beta_without_rows_is_one_clear_error(tmp_path):
     beta = face_beta().assign(kernel_dim=1)
     with pytest.raises(ValueError, match="no matching-mesh H rows"):

@@ -279,6 +279,27 @@ if FACE_FIGURE_NAMES:
     # whose one kernel mode is the checkerboard. A kernel vector does not depend on the norm, so the
     # cheap L2 Gram serves; N = 4 shows the pattern (32 triangles) in well under a second.
     FACE_MODE = dict(model="membranes3d", element="tet", case="T4", k=2, N=4, norm="L2")
+    # HEX20 bodies (k = 2, QUAD8 faces) for the third panel of fig10_face_beta: β_h of every QUAD8
+    # space in both norms on these matching meshes, one job (study/face/hex20.py); [] for no panel
+    FACE_HEX20_N = [4, 6, 8]
+
+    rule face_hex20_beta:
+        output:
+            "results/tables/face_hex20_beta.csv",
+        input:
+            PACKAGE_SOURCES,
+        params:
+            N=" ".join(map(str, FACE_HEX20_N)),
+        threads: 1
+        resources:
+            mem_mb=1000,
+            runtime=5,
+        benchmark:
+            "results/benchmarks/rules/face_hex20_beta.tsv"
+        log:
+            "results/logs/figures/face_hex20_beta.log",
+        shell:
+            _BLAS1 + "python -m infsup_contact.study.face.hex20 --N {params.N} > {output} 2> {log}"
 
     rule face_worst_mode:
         output:
@@ -311,6 +332,7 @@ if FACE_FIGURE_NAMES:
             edge=job_path(FACE_STUDY, "edge_dropping"),
             alpha=job_path(FACE_STUDY, "alpha"),
             modes="results/tables/face_worst_mode.csv",
+            hex20=["results/tables/face_hex20_beta.csv"] if FACE_HEX20_N else [],
             style=PLOT_STYLE,
             figures="src/infsup_contact/report/figures/face.py",
         benchmark:

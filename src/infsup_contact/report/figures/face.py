@@ -36,17 +36,28 @@ def matching_series(beta, norm: str = "H"):
     return rows.assign(h=1.0 / rows.N2)
 
 
-def plot_face_beta(beta, pdf, png, norm: str = "H") -> None:
-    """β_h against h per (space, k), one panel per element of ``beta`` (module docstring)."""
+def hex20_rows(hex20):
+    """A HEX20 table (``face_hex20``: ``python -m infsup_contact.study.face.hex20``) as face_beta
+    rows: element ``hex20``, k = 2, matching meshes N1 = N2 = N."""
+    return hex20.assign(element="hex20", k=2, N1=hex20.N, N2=hex20.N)
+
+
+def plot_face_beta(beta, pdf, png, norm: str = "H", hex20=None) -> None:
+    """β_h against h per (space, k), one panel per element of ``beta`` and of the HEX20 table
+    ``hex20`` where given (module docstring)."""
+    import pandas as pd
+
     from ..style import case_style, h_ticks, ordered_cases, save_figure, style
 
     plt = _plt()
+    if hex20 is not None:
+        beta = pd.concat([beta, hex20_rows(hex20)], ignore_index=True)
     series = matching_series(beta, norm)
     elements = [e for e in ELEMENT_TITLES if e in set(series.element)]
     if not elements:
         raise ValueError(f"no matching-mesh {norm} rows without a kernel to draw")
     with style():
-        fig, axes = plt.subplots(1, len(elements), figsize=(3.6 * len(elements), 3.9), sharey=True,
+        fig, axes = plt.subplots(1, len(elements), figsize=(7.2, 4.2), sharey=True,
                                  layout="constrained", squeeze=False)
         for ax, element in zip(axes[0], elements):
             s = series[series.element == element]
@@ -56,8 +67,11 @@ def plot_face_beta(beta, pdf, png, norm: str = "H") -> None:
                     ax.loglog(g.h, g.beta, label=f"{case}, k={k}", **case_style(case, k, markersize=4))
             h_ticks(ax, s.h, powers_of_two=False)
             ax.set_xlabel("$h = 1/N$")
-            ax.set_title(ELEMENT_TITLES[element], fontsize=9)
-            ax.legend(fontsize=6, ncol=3, loc="upper center", bbox_to_anchor=(0.5, -0.18), frameon=False)
+            ax.set_title(ELEMENT_TITLES[element], fontsize=8)
+        handles = {}  # one legend for the panels: a (space, k) drawn alike in each
+        for ax in axes[0]:
+            handles.update(zip(*reversed(ax.get_legend_handles_labels())))
+        fig.legend(handles.values(), handles.keys(), fontsize=6, ncol=5, loc="outside lower center", frameon=False)
         axes[0][0].set_ylabel(r"$\beta_h$ ($H^{-1/2}_{00}(\Gamma)$)" if norm == "H" else r"$\beta_h$ ($L^2(\Gamma)$)")
         save_figure(fig, pdf, png)
 

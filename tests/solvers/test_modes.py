@@ -46,13 +46,15 @@ def rayleigh_gap(request, mode):
     return abs(m @ S @ m / (m @ G @ m) - mode.beta ** 2) / lam_max, 100 * len(m) * EPS
 
 
+@pytest.mark.parametrize("family", ["structured", "perturbed"])
 @pytest.mark.parametrize("large", [False, True])
-def test_rayleigh_quotient_is_beta_squared(monkeypatch, large):
+def test_rayleigh_quotient_is_beta_squared(monkeypatch, large, family):
     """T3 and R5.2 (no kernel on 6:7), k = 2, both norms, on the dense route and on the Lanczos
-    route (DENSE_MAX_M lowered: bottom_pencil asked for its vector)."""
+    route (DENSE_MAX_M lowered: bottom_pencil asked for its vector; the structured meshes take the
+    reflections' split route, the perturbed ones the plain one)."""
     if large:
         monkeypatch.setattr(bottom, "DENSE_MAX_M", 5)
-    request = BetaRequest("structured", 2, 6, 7, ("T3", "R5.2"), ("omega2",), ((1.0, 1.0), (1.0, 4.0)), ("H", "L2"))
+    request = BetaRequest(family, 2, 6, 7, ("T3", "R5.2"), ("omega2",), ((1.0, 1.0), (1.0, 4.0)), ("H", "L2"))
     rows, found = worst(request)
     for mode in found:
         assert not mode.in_kernel and mode.beta > 0
@@ -70,13 +72,14 @@ def test_the_two_routes_give_the_same_mode(monkeypatch):
         assert np.max(np.abs(mode_on_gamma(a)[1] - mode_on_gamma(b)[1])) < 1e-9, a.keys
 
 
+@pytest.mark.parametrize("family", ["structured", "perturbed"])
 @pytest.mark.parametrize("large", [False, True])
-def test_unstable_mode_is_in_the_kernel_of_bt(monkeypatch, large):
+def test_unstable_mode_is_in_the_kernel_of_bt(monkeypatch, large, family):
     """R5.4 on matching meshes, k = 1 (Remark 5.4: a kernel): ‖B_iᵀ m‖ at round-off, relative to
     ‖B_i‖ ‖m‖ (bound: 100 (rows + m) ε, the SVD's backward error with room)."""
     if large:
         monkeypatch.setattr(bottom, "DENSE_MAX_M", 5)
-    request = BetaRequest("structured", 1, 8, 8, ("R5.4",), ("omega2",), ((1.0, 1.0),), ("H", "L2"))
+    request = BetaRequest(family, 1, 8, 8, ("R5.4",), ("omega2",), ((1.0, 1.0),), ("H", "L2"))
     rows, found = worst(request)
     for row, mode in zip(rows, found):
         assert row["kernel_dim"] >= 1 and row["beta"] == 0.0 and mode.in_kernel
@@ -131,3 +134,23 @@ def test_beta_alone_computes_no_vector(monkeypatch):
     monkeypatch.setattr(modes_mod, "mode_vector", refuse)
     request = BetaRequest("structured", 1, 4, 4, ("R5.4", "T3"), ("omega2",), ((1.0, 1.0),), ("H",))
     assert len(beta_table(request)) == 2
+
+
+@pytest.mark.parametrize("model, element, case, k, n", [
+    ("membranes", None, "T3", 2, 4), ("elastic", None, "T3", 1, 4),
+    ("membranes3d", "hex", "T3", 1, 3), ("membranes3d", "tet", "T3", 1, 3), ("membranes3d", "hex20", "Q8", 2, 2),
+    ("elastic3d", "hex", "T3", 1, 2), ("elastic3d", "tet", "T3", 1, 2),
+])
+def test_every_model_gives_the_eigenvector(model, element, case, k, n):
+    """Segment and face models, scalar and vector bodies: the mode's Rayleigh quotient is β_h², and
+    its samples cover Γ (a segment: x; a face: x and y) with max |μ_h| = 1."""
+    mesh = MeshOptions(element=element) if element else MeshOptions()
+    request = BetaRequest("structured", k, n, n, (case,), ("omega2",), ((1.0, 1.0),), ("H", "L2"),
+                          model=MODELS[model], mesh=mesh)
+    rows, found = worst(request)
+    for mode in found:
+        gap, bound = rayleigh_gap(request, mode)
+        assert gap <= bound, (model, element, mode.keys, gap)
+        x, mu = mode_on_gamma(mode)
+        assert np.ndim(x) == (1 if MODELS[model].dim == 2 else 2)
+        assert np.max(np.abs(mu)) == pytest.approx(1.0) and np.isclose(np.max(mu), 1.0)

@@ -136,21 +136,26 @@ def test_beta_alone_computes_no_vector(monkeypatch):
     assert len(beta_table(request)) == 2
 
 
-@pytest.mark.parametrize("model, element, case, k, n", [
-    ("membranes", None, "T3", 2, 4), ("elastic", None, "T3", 1, 4),
-    ("membranes3d", "hex", "T3", 1, 3), ("membranes3d", "tet", "T3", 1, 3), ("membranes3d", "hex20", "Q8", 2, 2),
-    ("elastic3d", "hex", "T3", 1, 2), ("elastic3d", "tet", "T3", 1, 2),
+ARC = dict(gamma="arc", radius=2.0, coupling="projection")
+CYLINDER = dict(gamma="cylinder", radius=2.0, coupling="exact")
+
+
+@pytest.mark.parametrize("model, options, case, k, n", [
+    ("membranes", {}, "T3", 2, 4), ("elastic", {}, "T3", 1, 4), ("membranes", ARC, "R5.2", 1, 5),
+    ("membranes3d", {"element": "hex"}, "T3", 1, 3), ("membranes3d", {"element": "tet"}, "T3", 1, 3),
+    ("membranes3d", {"element": "hex20"}, "Q8", 2, 2), ("membranes3d", dict(CYLINDER, element="hex"), "T3", 1, 3),
+    ("elastic3d", {"element": "hex"}, "T3", 1, 2), ("elastic3d", {"element": "tet"}, "T3", 1, 2),
 ])
-def test_every_model_gives_the_eigenvector(model, element, case, k, n):
-    """Segment and face models, scalar and vector bodies: the mode's Rayleigh quotient is β_h², and
-    its samples cover Γ (a segment: x; a face: x and y) with max |μ_h| = 1."""
-    mesh = MeshOptions(element=element) if element else MeshOptions()
+def test_every_model_gives_the_eigenvector(model, options, case, k, n):
+    """Segment and face models, scalar and vector bodies, flat and curved Γ: the mode's Rayleigh
+    quotient is β_h², and its samples cover Γ (a segment: x; a face: x and y) with max |μ_h| = 1."""
+    mesh = MeshOptions(**options)
     request = BetaRequest("structured", k, n, n, (case,), ("omega2",), ((1.0, 1.0),), ("H", "L2"),
                           model=MODELS[model], mesh=mesh)
     rows, found = worst(request)
     for mode in found:
         gap, bound = rayleigh_gap(request, mode)
-        assert gap <= bound, (model, element, mode.keys, gap)
+        assert gap <= bound, (model, options, mode.keys, gap)
         x, mu = mode_on_gamma(mode)
         assert np.ndim(x) == (1 if MODELS[model].dim == 2 else 2)
         assert np.max(np.abs(mu)) == pytest.approx(1.0) and np.isclose(np.max(mu), 1.0)

@@ -140,6 +140,14 @@ SCHEMAS = {
                          "beta_L2": "float", "beta_H_resolved": "bool", "beta_L2_resolved": "bool",
                          "beta_L2_kappa": "float?", "beta_L2_kappa_resolved": "bool", "fit_theta_max": "float"},
                         key=("case", "k", "N", "theta")),
+    # HEX20 bodies' QUAD8 faces (python -m infsup_contact.study.face.hex20; rule face_hex20_beta): β_h per N
+    "face_hex20": Schema({"case": "str", "N": "int", "norm": "str", "dim_M": "int", "dim_W": "int", "kernel_dim": "int",
+                          "structural_kernel_dim": "int", "kernel_decision": "str", "beta": "float", "verdict": "str"},
+                         key=("case", "N", "norm")),
+    # `beta --worst-mode FILE` (cli/worst_mode.py): a mode per β row sampled on Γ; y on a face
+    "worst_mode": Schema({"case": "str", "multiplier_mesh": "str", "c1": "float", "c2": "float", "norm": "str",
+                          "beta": "float", "x": "float", "mu": "float"}, optional={"y": "float"},
+                         key=("case", "multiplier_mesh", "c1", "c2", "norm", "x", "y"), label="a worst-mode table"),
     # results/benchmarks/dag.csv (bench/dag.py: per rule of a run), read by the docs' generator
     "dag": Schema({"rule": "str", "jobs": "int", "wall_s_sum": "float", "wall_s_max": "float",
                    "cpu_s_sum": "float?", "max_rss_mb": "float?"}, key=("rule",), label="a DAG timing table"),

@@ -420,6 +420,8 @@ def test_pdf_builds_and_shows_generated_numbers(tables, tmp_path):
     for name, text in face_paper_files(**small_face_tables()).items():
         (gen / name).write_text(text)
     shutil.copy(ROOT / "paper" / "face.tex", build)
+    for name in ("fig10_face_beta", "fig11_face_studies"):  # its figures (rule face_figures)
+        (figs / f"{name}.pdf").write_bytes(placeholder_pdf(name))
     (gen / "model_sections.tex").write_text("")  # rule model_sections: no generated model subsection here
     shutil.copy(PAPER, build)
     shutil.copy(ROOT / "paper" / "references.bib", build)

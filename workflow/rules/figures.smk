@@ -13,6 +13,11 @@ FIGURE_NAMES = [
     "fig7_speed_accuracy",
     "fig8_dual",
 ]
+# The face section's figures (paper/face.tex), where the model table has the face study: both
+# drawn by one rule (rule face_figures: one job, one Python start), the worst mode by one small job.
+FACE_STUDY = "face"
+FACE_FIGURE_NAMES = ["fig10_face_beta", "fig11_face_studies"] if FACE_STUDY in MODEL_STUDIES else []
+FIGURE_NAMES += FACE_FIGURE_NAMES
 # Every figure output (pdf and png): inputs of `rule figures` and of reproduce-all.
 FIGURES = [f"results/figures/{name}.{ext}" for name in FIGURE_NAMES for ext in ("pdf", "png")]
 
@@ -267,3 +272,72 @@ rule elastic_figure:
         "results/logs/figures/fig9_elastic.log",
     script:
         "../scripts/fig_elastic.py"
+
+
+if FACE_FIGURE_NAMES:
+    # The worst mode of panel (d): the tetrahedra's T4 at k = 2 (P_0 on the Kuhn triangles of Γ),
+    # whose one kernel mode is the checkerboard. A kernel vector does not depend on the norm, so the
+    # cheap L2 Gram serves; N = 4 shows the pattern (32 triangles) in well under a second.
+    FACE_MODE = dict(model="membranes3d", element="tet", case="T4", k=2, N=4, norm="L2")
+    # HEX20 bodies (k = 2, QUAD8 faces) for the third panel of fig10_face_beta: β_h of every QUAD8
+    # space in both norms on these matching meshes, one job (study/face/hex20.py); [] for no panel
+    FACE_HEX20_N = [4, 6, 8]
+
+    rule face_hex20_beta:
+        output:
+            "results/tables/face_hex20_beta.csv",
+        input:
+            PACKAGE_SOURCES,
+        params:
+            N=" ".join(map(str, FACE_HEX20_N)),
+        threads: 1
+        resources:
+            mem_mb=1000,
+            runtime=5,
+        benchmark:
+            "results/benchmarks/rules/face_hex20_beta.tsv"
+        log:
+            "results/logs/figures/face_hex20_beta.log",
+        shell:
+            _BLAS1 + "python -m infsup_contact.study.face.hex20 --N {params.N} > {output} 2> {log}"
+
+    rule face_worst_mode:
+        output:
+            "results/tables/face_worst_mode.csv",
+        input:
+            PACKAGE_SOURCES,
+        params:
+            args=(f"--model {FACE_MODE['model']} --element {FACE_MODE['element']} --case {FACE_MODE['case']} "
+                  f"--k {FACE_MODE['k']} --N1 {FACE_MODE['N']} --N2 {FACE_MODE['N']} --norm {FACE_MODE['norm']}"),
+        threads: 1
+        resources:
+            mem_mb=1000,
+            runtime=5,
+        benchmark:
+            "results/benchmarks/rules/face_worst_mode.tsv"
+        log:
+            "results/logs/figures/face_worst_mode.log",
+        shell:
+            # the β row goes to the log; the modes' table is written atomically by --worst-mode
+            _BLAS1 + "python -m infsup_contact beta {params.args} --worst-mode {output} > {log} 2>&1"
+
+    rule face_figures:
+        output:
+            beta_pdf=FIGURE_OUT["fig10_face_beta"]["pdf"],
+            beta_png=FIGURE_OUT["fig10_face_beta"]["png"],
+            studies_pdf=FIGURE_OUT["fig11_face_studies"]["pdf"],
+            studies_png=FIGURE_OUT["fig11_face_studies"]["png"],
+        input:
+            beta=table_path(FACE_STUDY, "beta"),
+            edge=job_path(FACE_STUDY, "edge_dropping"),
+            alpha=job_path(FACE_STUDY, "alpha"),
+            modes="results/tables/face_worst_mode.csv",
+            hex20=["results/tables/face_hex20_beta.csv"] if FACE_HEX20_N else [],
+            style=PLOT_STYLE,
+            figures="src/infsup_contact/report/figures/face.py",
+        benchmark:
+            "results/benchmarks/rules/face_figures.tsv"
+        log:
+            "results/logs/figures/face_figures.log",
+        script:
+            "../scripts/fig_face.py"

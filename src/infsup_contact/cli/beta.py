@@ -3,6 +3,8 @@ from __future__ import annotations
 
 import sys
 
+from .verdict_formats import output_path
+from .worst_mode import check_worst_mode, mode_frame, write_modes
 from .common import (FlagUse, declare_flag_uses, material_columns, mesh_options, model_flag_uses, system_flag_uses,
                      add_dry_run, add_model, cases, face_cases, check_memory, material, norms, SPACE_HELP, write_csv)
 
@@ -43,8 +45,15 @@ def add(sub) -> None:
                    "model's contact face: always the extrapolated double sine series)")
     p.add_argument("--seed", type=int, default=0, help="seed of the perturbed family (>= 0)")
     p.add_argument("--alpha", type=float, default=0.2, help="perturbation amplitude / h, in [0, 0.2] (larger can invert triangles)")
+    p.add_argument("--worst-mode", metavar="FILE", type=output_path, default=None,
+                   help="also write, for every row, the worst mode on Γ to FILE (CSV, atomically): the "
+                   "eigenvector of the smallest eigenvalue of S m = beta^2 G m (a kernel vector where beta = 0) "
+                   "as mu_h = sum m_j mu_j at sample points of Γ, max |mu_h| = 1; columns case, multiplier_mesh, "
+                   "c1, c2, norm, beta, x (, y on a face), mu. With --system: one mode per level, for a manifest "
+                   "describing its multipliers (gamma, levels[i].multipliers)")
     add_dry_run(p)
-    declare_flag_uses(p, [*system_flag_uses(p), *FLAG_USES, *model_flag_uses()])
+    system_uses = [u for u in system_flag_uses(p) if u.dest != "worst_mode"]  # a mode per level (worst_mode.py)
+    declare_flag_uses(p, [*system_uses, *FLAG_USES, *model_flag_uses()])
     p.set_defaults(run=_run_beta, check=_check_beta)
 
 
@@ -73,6 +82,8 @@ def _check_beta(args):
         from ..systems.manifest import load_manifest
 
         args.manifest = load_manifest(args.system, min_levels=1)
+        if args.worst_mode is not None:
+            check_worst_mode(args)
         est = dry_check(args.manifest)
         check_memory(est, "system", args.system)
         return est
@@ -85,6 +96,8 @@ def _check_beta(args):
     args.mesh = mesh_options(args)
     args.cases = face_cases(args)
     args.request = request(args)
+    if args.worst_mode is not None:
+        check_worst_mode(args)
     est = resources.beta_estimate(args.family, args.k, args.N1, args.N2, args.multiplier_mesh,
                                   norms(args), args.h_route,
                                   components=args.model_obj.components, dim=args.model_obj.dim)
@@ -114,21 +127,26 @@ def _run_beta(args) -> None:
 
         if args.manifest.norm not in ("given", "H"):  # H: the paper's norm, no caveat
             print(f"infsup-contact: note: {NORM_NOTES[args.manifest.norm]}", file=sys.stderr)
-    write_csv(beta_frame(args), float_format="%.12g")
+    modes = None if args.worst_mode is None else []
+    frame = beta_frame(args, modes)
+    if modes is not None:
+        write_modes(args.worst_mode, mode_frame(modes))
+    write_csv(frame, float_format="%.12g")
 
 
-def beta_frame(args):
-    """The table of a validated ``beta`` request (what ``beta`` writes; :mod:`infsup_contact.api`)."""
+def beta_frame(args, modes: list | None = None):
+    """The table of a validated ``beta`` request (what ``beta`` writes; :mod:`infsup_contact.api`);
+    ``modes`` receives each row's worst mode (:mod:`infsup_contact.solvers.modes`) where given."""
     import pandas as pd
 
     if args.system is not None:
         from ..systems.levels import system_rows
 
-        return pd.DataFrame(system_rows(args.manifest)).drop(columns="N2")
+        return pd.DataFrame(system_rows(args.manifest, modes=modes)).drop(columns="N2")
 
     from ..solvers.infsup import beta_table
 
-    rows = beta_table(args.request)
+    rows = beta_table(args.request, modes=modes)
     frame = pd.DataFrame(rows)
     for i, (name, value) in enumerate(args.mesh.kwargs().items()):  # e.g. element, after family
         frame.insert(frame.columns.get_loc("family") + 1 + i, name, value)

@@ -191,10 +191,13 @@ class BottomPencil:
         λ_{d+1} <= … (ascending; as many as Lanczos converged, up to the number asked).
     lam_max : float
         λ_max of the pencil (Lanczos, relative accuracy :data:`LAM_MAX_RTOL`).
+    vectors : ndarray or None
+        The eigenvectors x of ``values`` (columns, same order) where asked for, else None.
     """
 
     values: np.ndarray
     lam_max: float
+    vectors: np.ndarray | None = None
 
 
 def _standard_form(S: np.ndarray, L: np.ndarray) -> spla.LinearOperator:
@@ -256,7 +259,7 @@ def inverse_standard_form(R: np.ndarray, L: np.ndarray) -> np.ndarray:
 
 
 def bottom_pencil(S: np.ndarray, L: np.ndarray, n_values: int, Z: np.ndarray | None = None,
-                  s_factor: np.ndarray | None = None) -> BottomPencil:
+                  s_factor: np.ndarray | None = None, vectors: bool = False) -> BottomPencil:
     """The n_values smallest eigenvalues of S x = λ G x, G = L Lᵀ (L lower triangular, zeros
     above its diagonal: :func:`~infsup_contact.solvers.spectra.gram_factor`'s), above the kernel span Z.
 
@@ -270,6 +273,10 @@ def bottom_pencil(S: np.ndarray, L: np.ndarray, n_values: int, Z: np.ndarray | N
     ``s_factor`` = :func:`definite_factor` of S, if known: the pencils of one S with several
     Gram matrices share it); where potrf fails (a singular S), a floor 1e-14 λ_max diag(G) is
     added and λ ≈ 0 (its round-off), as the dense route gives.
+
+    ``vectors``: also the eigenvectors x = L⁻ᵀ y of the Lanczos vectors y of Kᵀ K (Kᵀ K y = θ y
+    ⇔ S' x = (1/θ) G x; in the G-orthogonal complement of Z, S' x = S x). Only a caller that
+    draws a mode asks: Lanczos costs the same, the vectors one triangular solve.
     """
     m = S.shape[0]
     top = lam_max(S, L)
@@ -294,6 +301,11 @@ def bottom_pencil(S: np.ndarray, L: np.ndarray, n_values: int, Z: np.ndarray | N
     k = min(n_values, m - 1)
     op = spla.LinearOperator((m, m), matvec=mv, dtype=float)
     v0 = np.random.default_rng(SEED).standard_normal(m)
-    theta = spla.eigsh(op, k=k, which="LA", tol=1e-12, v0=v0, ncv=min(m, max(2 * k + 1, 40)),
-                       return_eigenvectors=False)
-    return BottomPencil(np.sort(1.0 / theta), top)
+    out = spla.eigsh(op, k=k, which="LA", tol=1e-12, v0=v0, ncv=min(m, max(2 * k + 1, 40)),
+                     return_eigenvectors=vectors)
+    if not vectors:
+        return BottomPencil(np.sort(1.0 / out), top)
+    theta, y = out
+    order = np.argsort(1.0 / theta)
+    x = sla.solve_triangular(L, y[:, order], lower=True, trans="T", check_finite=False)
+    return BottomPencil(1.0 / theta[order], top, x)

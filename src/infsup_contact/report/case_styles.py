@@ -23,4 +23,5 @@ CASE_STYLES = MappingProxyType({
     "DUAL-Q9": ("black", "H"), "DUAL-Q9-ALL": ("sky_blue", "d"), "DUAL-Q8": ("vermillion", "<"),
     "TDUAL-Q8": ("orange", ">"), "TDUAL-Q9": ("bluish_green", "8"), "PWLIN-Q9": ("reddish_purple", "p"),
     "DUAL-T6": ("vermillion", "h"), "TDUAL-T6": ("bluish_green", "d"), "PWLIN-T6": ("reddish_purple", "H"),
+    "Q8": ("blue", "s"), "Q8-ALL": ("sky_blue", "s"), "LIN0-Q8": ("bluish_green", "o"), "DISC-P1": ("vermillion", "v"),
 })

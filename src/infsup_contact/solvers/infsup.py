@@ -12,6 +12,7 @@ space's pencil is solved is its route (:func:`~.routes.choose_route`, the fast l
 from __future__ import annotations
 
 import time
+from dataclasses import replace
 
 import numpy as np
 import scipy.linalg as sla
@@ -27,12 +28,13 @@ from ..discretization.segment.interface import SEGMENT
 from ..models import DEFAULT_MODEL
 from .interface_operator import combine_terms, interface_terms
 from .kernel import kernel_check
+from .modes import worst_modes
 from .request import NO_OPTIONS, BetaRequest, MeshOptions
 from .routes import choose_route, is_large
 from .side_cache import SideCache
 
 
-def beta_table(request: BetaRequest, side_cache: SideCache | None = None) -> list:
+def beta_table(request: BetaRequest, side_cache: SideCache | None = None, modes: list | None = None) -> list:
     """β_h of (4.5) for every case, multiplier mesh, (c1, c2) and norm of a validated ``request``.
 
     The sides (meshes, factorizations) are built once, the couplings B_i and Gram matrices G once
@@ -45,6 +47,9 @@ def beta_table(request: BetaRequest, side_cache: SideCache | None = None) -> lis
     Rows in the order multiplier mesh, case, c pair, norm. Timing columns (seconds):
     ``t_interface`` the two sides, ``t_assemble`` the case's couplings, ``t_eig`` one eigenproblem
     (above :data:`~infsup_contact.la.bottom.DENSE_MAX_M`: the norms' share, :meth:`.routes.Route.spectra`).
+
+    ``modes``: a list that receives the worst mode of every row, in the rows' order
+    (:class:`~.modes.Mode`); None (the default) computes no vector.
     """
     r = request
     t0 = time.perf_counter()
@@ -62,17 +67,23 @@ def beta_table(request: BetaRequest, side_cache: SideCache | None = None) -> lis
             key = gamma.partition_key(g_h)
             if key in by_partition:
                 rows += [dict(row, multiplier_mesh=multiplier_mesh, t_assemble=0.0, t_interface=0.0, t_eig=0.0)
-                         for row in by_partition[key]]
+                         for row in by_partition[key][0]]
+                if modes is not None:
+                    modes += [replace(m, keys={**m.keys, "multiplier_mesh": multiplier_mesh}) for m in by_partition[key][1]]
                 continue
-            by_partition[key] = [row for case in r.cases
-                                 for row in _case_rows(r, case, g_h, sides, dim_w, trace_norms)]
-            rows += [dict(row, multiplier_mesh=multiplier_mesh, t_interface=t_sides) for row in by_partition[key]]
+            found = None if modes is None else []
+            by_partition[key] = ([row for case in r.cases
+                                  for row in _case_rows(r, case, g_h, sides, dim_w, trace_norms, found)], found)
+            if modes is not None:
+                modes += [replace(m, keys={**m.keys, "multiplier_mesh": multiplier_mesh}) for m in found]
+            rows += [dict(row, multiplier_mesh=multiplier_mesh, t_interface=t_sides) for row in by_partition[key][0]]
     return rows
 
 
-def _case_rows(r: BetaRequest, case, g_h, sides, dim_w: int, trace_norms) -> list:
+def _case_rows(r: BetaRequest, case, g_h, sides, dim_w: int, trace_norms, modes: list | None = None) -> list:
     """The rows of one case on G_h: M_h, its couplings B_i and Grams G, its route, then per
-    (c1, c2) the interface operator S and the bottom of S m = β² G m for every norm."""
+    (c1, c2) the interface operator S and the bottom of S m = β² G m for every norm (and its
+    worst mode, appended to ``modes`` where given)."""
     gamma = sides[0].trace.gamma
     space = _space(case, r.k, g_h, gamma)                                          # M_h on G_h
     tc = time.perf_counter()
@@ -80,15 +91,18 @@ def _case_rows(r: BetaRequest, case, g_h, sides, dim_w: int, trace_norms) -> lis
     t_coupling = time.perf_counter() - tc
     grams = {norm: gamma.gram(space, norm, h_route=r.h_route) for norm in r.norms}      # G per norm
     structural = gamma.proven_kernel(space, r.k, [s.trace for s in sides], dim_w)
-    route = choose_route(space, couplings, sides, grams, structural, g_h, r.k, trace_norms)
+    route = choose_route(space, couplings, sides, grams, structural, g_h, r.k, trace_norms, vectors=modes is not None)
     terms = interface_terms(couplings, sides)                                      # B_i X_i B_iᵀ
     v1_zero = route.betas_v1_zero(terms)
     rows = []
     for c1, c2 in r.c_pairs:
-        spectra, seconds = route.spectra(combine_terms(terms, (c1, c2)), r.norms)  # S m = β² G m
+        S = combine_terms(terms, (c1, c2))
+        spectra, seconds = route.spectra(S, r.norms)  # S m = β² G m
         rows += [_row(r, case, c1, c2, norm, spectra[norm], route.kernel, structural, v1_zero[norm] / np.sqrt(c2),
                       space.dim, dim_w, grams[norm][1], sum(s.ndof for s in sides), t_coupling, seconds[norm])
                  for norm in r.norms]
+        if modes is not None:
+            modes += worst_modes(route, S, rows[-len(r.norms):], space, gamma)
     return rows
 
 

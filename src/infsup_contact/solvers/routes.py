@@ -78,15 +78,17 @@ class Route:
         return spectra.betas_v1_zero(terms, self.factors, self.kernel, self.iterative, self.split)
 
 
-def choose_route(space, couplings, sides, grams: dict, structural: int, g_h, k: int, trace_norms) -> Route:
+def choose_route(space, couplings, sides, grams: dict, structural: int, g_h, k: int, trace_norms,
+                 vectors: bool = False) -> Route:
     """The :class:`Route` of ``space`` on G_h = ``g_h``: its size decides dense or large; on the
     large route the reflections' split (:func:`.symmetry.split_of`) is taken where every Gram matrix
     and the kernel split (:func:`~infsup_contact.la.reflection.usable`). ``grams`` {norm: (G, info)},
-    ``structural`` the proven kernel dimension, ``trace_norms`` the sides' :func:`~.coupling.trace_l2_norms`."""
+    ``structural`` the proven kernel dimension, ``trace_norms`` the sides' :func:`~.coupling.trace_l2_norms`;
+    ``vectors``: the kernel's basis on the dense route too (a worst mode, :mod:`.modes`)."""
     large = is_large(space)
     split = symmetry.split_of(space, sides[0].trace.gamma, g_h, k) if large else None
     kernel = space_kernel(couplings, sides, space, k, structural, grams["L2"][0] if "L2" in grams else None,
-                          iterative=large, trace_norms=trace_norms, split=split)
+                          iterative=large, trace_norms=trace_norms, split=split, vectors=vectors)
     split, parts, halves = reflection.usable(split, grams, kernel)
     if split is not None:
         return Route("split", kernel, spectra.SplitFactors(grams, halves), split, parts)
@@ -94,7 +96,7 @@ def choose_route(space, couplings, sides, grams: dict, structural: int, g_h, k: 
 
 
 def space_kernel(couplings, sides, space, k: int, structural: int, l2_gram=None,
-                 iterative: bool = False, trace_norms=None, split=None) -> KernelDecision:
+                 iterative: bool = False, trace_norms=None, split=None, vectors: bool = False) -> KernelDecision:
     """The kernel of Bᵀ on ``space`` (:func:`~infsup_contact.solvers.kernel.coupling_kernel`):
     the couplings scaled by the L²(Γ) norms of the sides' trace basis functions and of the
     multiplier basis functions (the diagonal of the L² Gram matrix, computed if not given);
@@ -107,7 +109,8 @@ def space_kernel(couplings, sides, space, k: int, structural: int, l2_gram=None,
     entries); its ``vectors`` are returned in multiplier coordinates (a basis of the kernel of Bᵀ).
     ``trace_norms``: the sides' :func:`~.coupling.trace_l2_norms`, if already computed (they
     depend on the sides only, not on the space). ``split``: the reflections'
-    (:func:`.symmetry.split_bottom_kernel` decides on the components where it holds)."""
+    (:func:`.symmetry.split_bottom_kernel` decides on the components where it holds). ``vectors``: the
+    dense decision returns the kernel's basis too (the iterative one always does), in multiplier coordinates."""
     G = sides[0].trace.gamma.gram(space, "L2")[0] if l2_gram is None else l2_gram
     rows = [trace_l2_norms(s.trace, k) for s in sides] if trace_norms is None else trace_norms
     cols = np.sqrt(np.diag(G))
@@ -116,7 +119,8 @@ def space_kernel(couplings, sides, space, k: int, structural: int, l2_gram=None,
     longer = scaled_couplings([coupling_matrix(s.trace, space, k, extra_degree=extra, sparse=iterative)
                                for s in sides], rows, cols)
     if not iterative:
-        return coupling_kernel(W, structural, entry_error=np.linalg.norm(W - longer))
+        decision = coupling_kernel(W, structural, entry_error=np.linalg.norm(W - longer), vectors=vectors)
+        return decision if decision.vectors is None else replace(decision, vectors=decision.vectors / cols[:, None])
     W, error = sp.csr_matrix(W), spla.norm(sp.csr_matrix(W - longer))
     decision = symmetry.split_bottom_kernel(W, split, structural, error) if split is not None else None
     decision = bottom_kernel(W, structural, entry_error=error) if decision is None else decision

@@ -87,6 +87,7 @@ class CheckedLevel:
     notes: list = field(default_factory=list)
     removed: int = 0
     removed_multipliers: int = 0
+    kept_multipliers: np.ndarray | None = None  # the rows of B as read that B here holds, in order
 
 
 def check_finite(mat, path) -> None:
@@ -274,7 +275,7 @@ def check_level(level, A, B, G, constrained=np.zeros(0, int), tgv: str = "elimin
     check_symmetric(A, level.A, "A")
     G = check_gram(G, level.G)
     check_positive_definite(A, level.A)
-    return CheckedLevel(sp.csc_matrix(A), sp.csr_matrix(B), G, notes, len(dofs), len(mult))
+    return CheckedLevel(sp.csc_matrix(A), sp.csr_matrix(B), G, notes, len(dofs), len(mult), keep_m)
 
 
 def check_symmetric(M, path, what: str) -> None:

@@ -110,6 +110,10 @@ class LevelSpectrum:
     pencil_margin : float
         log10(λ_{d+1} / (m ε λ_max)): the first eigenvalue above the kernel over the pencil's
         round-off level, in decades (the cross-check of the kernel decision).
+    mode : ndarray or None
+        The worst mode where asked for (``vectors``): the eigenvector of β_h² (the smallest
+        eigenvalue above the declared kernel), or where β_h = 0 the first kernel vector of Bᵀ
+        beyond the declared count (ascending singular values); in B's rows, Euclidean norm 1.
     """
 
     beta: float
@@ -123,6 +127,7 @@ class LevelSpectrum:
     roundoff: EntryRoundoff | None = None
     entry_error_unit: float = 0.0
     pencil_margin: float = np.inf
+    mode: np.ndarray | None = None
 
 
 def touched_dofs(B: sp.spmatrix) -> np.ndarray:
@@ -172,7 +177,8 @@ def scaled_coupling(A, B, G, touched, with_bound: bool = False):
     return (W, entry_error_bound(Bt, da, dg, 1.0)) if with_bound else W
 
 
-def level_spectrum(A, B, G, known_kernel: int = 0, route: str = "auto", entry_rtol=None) -> LevelSpectrum:
+def level_spectrum(A, B, G, known_kernel: int = 0, route: str = "auto", entry_rtol=None,
+                   vectors: bool = False) -> LevelSpectrum:
     """β_h and the bottom of the pencil for one level (checked matrices: :mod:`.checks`).
 
     Parameters
@@ -187,6 +193,8 @@ def level_spectrum(A, B, G, known_kernel: int = 0, route: str = "auto", entry_rt
     entry_rtol : float, optional
         The declared accuracy of B's entries relative to max |b_ij| (manifest ``entry_rtol``);
         raised to what the data show (:func:`.roundoff.entry_roundoff`).
+    vectors : bool
+        Also the worst mode (``LevelSpectrum.mode``): the kernel's basis from the dense SVD too.
     """
     A = sp.csc_matrix(A)
     B = sp.csr_matrix(B)
@@ -201,7 +209,7 @@ def level_spectrum(A, B, G, known_kernel: int = 0, route: str = "auto", entry_rt
     E = roundoff.rtol * unit
     deflate = route == "shift-invert"  # the kernel's basis is deflated there (:func:`_shift_invert`)
     if 8.0 * W.shape[0] * W.shape[1] <= SVD_MAX_BYTES:
-        kernel = coupling_kernel(W.toarray(), known_kernel, entry_error=E, vectors=deflate)
+        kernel = coupling_kernel(W.toarray(), known_kernel, entry_error=E, vectors=deflate or vectors)
     else:
         kernel = bottom_kernel(W, known_kernel, entry_error=E)
     seconds["kernel"] = time.perf_counter() - t0
@@ -210,19 +218,25 @@ def level_spectrum(A, B, G, known_kernel: int = 0, route: str = "auto", entry_rt
     # more rows than the dofs it touches has that kernel whether or not anyone declared it:
     # it is part of ``detected`` (UNSTABLE), never of ``proven``.
     kernel = replace(kernel, proven=int(known_kernel), detected=int(kernel.dim - known_kernel))
+    dg = np.sqrt(np.asarray(G.diagonal() if sp.issparse(G) else np.diag(G), float))
     if deflate:
-        dg = np.sqrt(np.asarray(G.diagonal() if sp.issparse(G) else np.diag(G), float))
         Z = kernel.vectors[:, :kernel.dim] / dg[:, None] if kernel.dim else None  # W v = 0 ⇔ Bᵀ (v / dg) = 0
-        ev, resid, sec, top = _shift_invert(A, B, G, N_ABOVE, float(kernel.singular[-1]) ** 2, Z)
+        ev, resid, sec, top, x = _shift_invert(A, B, G, N_ABOVE, float(kernel.singular[-1]) ** 2, Z)
     else:
-        ev, resid, sec, top = _dense(A, B, G, touched, route, kernel.dim + N_BOTTOM)
+        ev, resid, sec, top, x = _dense(A, B, G, touched, route, kernel.dim + N_BOTTOM)
     seconds.update(sec)
     kernel, pencil_margin = pencil_cross_check(kernel, ev, top, m, zeros_computed=not deflate)
     d = kernel.dim
     above = float(np.sqrt(max(ev[d], 0.0))) if d < len(ev) else np.nan
     p = min(kernel.proven, len(ev) - 1)
     beta = 0.0 if kernel.detected > 0 else float(np.sqrt(max(ev[p], 0.0)))
-    return LevelSpectrum(beta, above, kernel, ev, route, resid, len(touched), seconds, roundoff, unit, pencil_margin)
+    mode = None
+    if vectors:
+        mode = (kernel.vectors[:, kernel.proven] / dg if kernel.detected > 0  # W v = 0 ⇔ Bᵀ (v / dg) = 0
+                else x[:, p - (len(ev) - x.shape[1])])  # x: the eigenvectors of ev's last columns
+        mode = mode / np.linalg.norm(mode)
+    return LevelSpectrum(beta, above, kernel, ev, route, resid, len(touched), seconds, roundoff, unit, pencil_margin,
+                         mode)
 
 
 def _pencil_words(margin: float) -> str:
@@ -283,7 +297,7 @@ def _dense(A, B, G, touched, route, n_pairs):
     t2 = time.perf_counter()
     top = lam_max(S, sla.cholesky(Gd, lower=True, check_finite=False)) if k < S.shape[0] else float(ev[-1])
     return (ev, float(np.max(res / scale)),
-            {"factorize": t1 - t0, "eigen": t2 - t1, "lam_max": time.perf_counter() - t2}, top)
+            {"factorize": t1 - t0, "eigen": t2 - t1, "lam_max": time.perf_counter() - t2}, top, x)
 
 
 def kernel_projector(Z, G):
@@ -301,7 +315,7 @@ def _shift_invert(A, B, G, n_values, smax2, Z=None):
     """The n_values smallest eigenvalues of the pencil above the kernel span ``Z`` (m × d, Bᵀ Z = 0;
     None: no kernel) by shift-invert Lanczos (module docstring); ``smax2`` = σ_max(W)², the
     Jacobi scale that sets the shift δ. Returns (d zeros then the eigenvalues found, ascending;
-    the residual of those; timings).
+    the residual of those; timings; λ_max; the eigenvectors of the eigenvalues found, in their order).
 
     The kernel is deflated as :func:`infsup_contact.la.bottom.bottom_pencil` deflates it,
     in the limit γ → ∞: there Z is moved to λ = γ by S' = S + γ G Z (ZᵀGZ)⁻¹ ZᵀG; here the
@@ -317,7 +331,7 @@ def _shift_invert(A, B, G, n_values, smax2, Z=None):
     m = B.shape[0]
     d = 0 if Z is None else Z.shape[1]
     if d >= m:  # Bᵀ = 0: everything is kernel, nothing to factorize
-        return np.zeros(d), 0.0, {"factorize": 0.0, "eigen": 0.0, "residual": 0.0}, 0.0
+        return np.zeros(d), 0.0, {"factorize": 0.0, "eigen": 0.0, "residual": 0.0}, 0.0, np.zeros((m, 0))
     Gs = sp.csc_matrix(G)
     delta = SHIFT * smax2
     t0 = time.perf_counter()
@@ -356,11 +370,12 @@ def _shift_invert(A, B, G, n_values, smax2, Z=None):
     ev = np.einsum("ij,ij->j", x, Sx) / np.einsum("ij,ij->j", x, Gx)  # Rayleigh quotients, exact S
     g_norm = float(spla.eigsh(Gs, k=1, which="LA", tol=1e-3, return_eigenvectors=False)[0])
     res = np.linalg.norm(Sx - Gx * ev, axis=0) / ((s_norm + np.abs(ev) * g_norm) * np.linalg.norm(x, axis=0))
-    ev = np.concatenate([np.zeros(d), np.sort(ev)])  # a kernel of Bᵀ is one of S: exact zeros
+    order = np.argsort(ev)
+    ev = np.concatenate([np.zeros(d), ev[order]])  # a kernel of Bᵀ is one of S: exact zeros
     t3 = time.perf_counter()
     top = _pencil_top(schur, Gs)
     return ev, float(np.max(res)), {"factorize": t1 - t0, "eigen": t2 - t1, "residual": t3 - t2,
-                                    "lam_max": time.perf_counter() - t3}, top
+                                    "lam_max": time.perf_counter() - t3}, top, x[:, order]
 
 
 def _pencil_top(schur, Gs) -> float:

@@ -61,8 +61,9 @@ def _load_level(manifest: Manifest, level):
     return checked, mass, info
 
 
-def system_rows(manifest: Manifest, route: str = "auto", notes=sys.stderr) -> list:
-    """One row per level: β_h, the kernel decision, the route and its residual."""
+def system_rows(manifest: Manifest, route: str = "auto", notes=sys.stderr, modes: list | None = None) -> list:
+    """One row per level: β_h, the kernel decision, the route and its residual. ``modes``: a list
+    that receives each level's worst mode (:func:`level_mode`; the levels describe their multipliers)."""
     rows, shapes = [], []
     for level in manifest.levels:
         t0 = time.perf_counter()
@@ -73,7 +74,10 @@ def system_rows(manifest: Manifest, route: str = "auto", notes=sys.stderr) -> li
         if manifest.known_kernel >= lv.B.shape[0]:
             raise SystemFileError(manifest.path, f"known_kernel = {manifest.known_kernel} >= m = {lv.B.shape[0]} "
                                   f"multipliers at levels[{level.index}]")
-        res = level_spectrum(lv.A, lv.B, lv.G, manifest.known_kernel, route, manifest.entry_rtol)
+        res = level_spectrum(lv.A, lv.B, lv.G, manifest.known_kernel, route, manifest.entry_rtol,
+                             vectors=modes is not None)
+        if modes is not None:
+            modes.append(level_mode(manifest, level, lv, info, res))
         k = res.kernel
         if k.numerical < k.proven:
             raise SystemFileError(manifest.path, f"known_kernel = {k.proven}, but at levels[{level.index}] only "
@@ -105,6 +109,24 @@ def system_rows(manifest: Manifest, route: str = "auto", notes=sys.stderr) -> li
             rows[-1].update(beta_L2=np.nan if l2 is None else l2.beta,
                             smallest_nonzero_L2=np.nan if l2 is None else l2.smallest_nonzero)
     return rows
+
+
+def level_mode(manifest: Manifest, level, lv, info: dict, res):
+    """The worst mode of one level (``res.mode``, in the rows of B the checks kept) as a
+    :class:`~infsup_contact.solvers.modes.Mode` of the described basis: row r of B as read holds
+    basis function j with ``rows[j] = r``; a multiplier the producer constrained is 0."""
+    from ..discretization.face.square import SQUARE
+    from ..discretization.segment.interface import SEGMENT
+    from ..solvers.modes import Mode
+
+    described = info["described"]
+    rows = np.zeros(described.m)
+    kept = info["kept"] if lv.kept_multipliers is None else info["kept"][lv.kept_multipliers]
+    rows[kept] = res.mode
+    keys = dict(system=manifest.name, level=level.index, h=level.h, norm=manifest.norm)
+    gamma = SEGMENT if described.gamma.shape == "segment" else SQUARE
+    size = described.gamma.size if len(described.gamma.size) == 2 else described.gamma.size * 2
+    return Mode(keys, res.beta, rows[described.rows], res.kernel.detected > 0, described.space, gamma, size)
 
 
 def uncertain_beta(res) -> float:

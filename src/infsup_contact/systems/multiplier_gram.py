@@ -151,7 +151,8 @@ def described_grams(manifest, level, B, G_file) -> tuple:
     removed from B and the Gram here (μ_i = 0: the Gram of the constrained space), counted in
     ``info["removed_multipliers"]`` with ``info["notes"]``. ``info["coupling_distance"]``: B's
     distance to the exact coupling of the described traces on the rows kept (:mod:`.mortar_distance`;
-    NaN without ``traces``)."""
+    NaN without ``traces``); ``info["described"]``, ``info["kept"]``: the description and the rows of
+    B as read that the returned B holds (a mode is drawn with them, :func:`.levels.level_mode`)."""
     import scipy.sparse as sp
 
     from .checks import check_finite, check_gram, constrained_multipliers
@@ -165,7 +166,7 @@ def described_grams(manifest, level, B, G_file) -> tuple:
         keep = np.setdiff1d(keep, drop)
     distance = coupling_distance(manifest, level, d, B, keep)
     if manifest.norm == "given":
-        return level, B, G_file, None, {"coupling_distance": distance}
+        return level, B, G_file, None, {"coupling_distance": distance, "described": d, "kept": np.arange(d.m)}
     M = gram(d, "L2")[0]
     _independent(d, M)
     G, info = gram(d, "H") if manifest.norm == "H" else (G_file, {})
@@ -177,14 +178,14 @@ def described_grams(manifest, level, B, G_file) -> tuple:
             raise SystemFileError(level.G, f"differs from the L2 mass of levels[{level.index}].multipliers by "
                                   f"{dist:.3g} relative (Frobenius; round-off is below {MASS_RTOL:g}): B's rows in "
                                   "another order than the description (rows:), another basis, or other breakpoints?")
-    info = dict(info, coupling_distance=distance)
+    info = dict(info, coupling_distance=distance, described=d, kept=np.arange(d.m))  # B's rows as returned
     if manifest.norm != "H":  # the checks remove the constrained rows of the file's G themselves
         return labelled, B, G, mass, info
     if len(keep) < d.m:
         B, G = sp.csr_matrix(B)[keep], G[np.ix_(keep, keep)]
         G_file = None if G_file is None else (sp.csr_matrix(G_file)[keep][:, keep] if sp.issparse(G_file)
                                               else np.asarray(G_file)[np.ix_(keep, keep)])
-        info.update(removed_multipliers=d.m - len(keep), notes=notes)
+        info.update(removed_multipliers=d.m - len(keep), notes=notes, kept=keep)
     if G_file is not None:
         mass = check_gram(G_file, level.G)
     return labelled, B, G, mass, info

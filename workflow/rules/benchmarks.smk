@@ -1,5 +1,8 @@
-# Benchmarks stage: speed as ratios measured side by side in one job (all cores to itself,
-# one BLAS thread: the ratios are single-thread ratios), plus the speed–accuracy points.
+# Benchmarks stage: speed as ratios measured side by side in one job (one core and one BLAS thread:
+# the ratios are single-thread ratios), plus the speed–accuracy points. A benchmark shares the
+# machine with the other core's jobs: its routes run interleaved, round-robin, so a background
+# load slows every route of a ratio alike (bench/harness.py); absolute seconds carry that load,
+# as they carry the machine's drift (docs/performance.md). Alone: `snakemake benchmarks --cores 1`.
 # Optional config keys (with their defaults): benchmarks.peers ([osqp, clarabel]),
 # benchmarks.eigsh_max_N (no limit), benchmarks.dense_max_size (2500),
 # benchmarks.route_budget_s (10), benchmarks.kkt_max_N (64), benchmarks.speed_accuracy_repeats (3),
@@ -35,7 +38,7 @@ rule bench_beta:
                           if "eigsh_max_N" in config["benchmarks"] else ""),
         dense=lambda wc: config["benchmarks"].get("dense_max_size", 2500),
         budget=lambda wc: config["benchmarks"].get("route_budget_s", 10),
-    threads: workflow.cores
+    threads: 1
     benchmark:
         "results/benchmarks/rules/bench_beta.tsv"
     log:
@@ -60,7 +63,7 @@ rule bench_face:
         k=lambda wc: config["benchmarks"].get("face_k", [2]),
         repeats=lambda wc: config["benchmarks"]["repeats"],
         budget=lambda wc: config["benchmarks"].get("route_budget_s", 10),
-    threads: workflow.cores
+    threads: 1
     benchmark:
         "results/benchmarks/rules/bench_face.tsv"
     log:
@@ -83,7 +86,7 @@ rule bench_contact:
         peers=lambda wc: " ".join(config["benchmarks"].get("peers", ["osqp", "clarabel"])) or "none",
         budget=lambda wc: config["benchmarks"].get("route_budget_s", 10),
         kkt=lambda wc: config["benchmarks"].get("kkt_max_N", 64),
-    threads: workflow.cores
+    threads: 1
     benchmark:
         "results/benchmarks/rules/bench_contact.tsv"
     log:
@@ -106,7 +109,7 @@ rule speed_accuracy:
         repeats=lambda wc: config["benchmarks"].get("speed_accuracy_repeats", 3),
         budget=lambda wc: config["benchmarks"].get("speed_accuracy_budget_s", 10),
         scene=lambda wc: speed_accuracy_scene(config),
-    threads: workflow.cores
+    threads: 1
     benchmark:
         "results/benchmarks/rules/speed_accuracy.tsv"
     log:
@@ -116,8 +119,7 @@ rule speed_accuracy:
 
 
 rule elastic_bench:
-    # speed of the elastic β_h vs the limit (one factorization per body + one eigh per case);
-    # the whole machine to itself locally (ratios are single-thread ratios)
+    # speed of the elastic β_h vs the limit (one factorization per body + one eigh per case)
     output:
         "results/benchmarks/elastic_beta.csv",
     input:
@@ -126,7 +128,7 @@ rule elastic_bench:
     params:
         ec=lambda wc: config["elastic"],
         cases=lambda wc: list(config["infsup"]["cases"]),
-    threads: workflow.cores
+    threads: 1
     benchmark:
         "results/benchmarks/rules/elastic_bench.tsv"
     log:
@@ -137,7 +139,7 @@ rule elastic_bench:
 
 rule bench_arc:
     # what a curved Γ costs: β_h on the arc, exact and projected couplings, beside the flat segment
-    # and the limit (bench/curved.py); the whole machine to itself locally
+    # and the limit (bench/curved.py)
     output:
         "results/benchmarks/arc.csv",
     input:
@@ -149,7 +151,7 @@ rule bench_arc:
         radius=lambda wc: config["benchmarks"]["arc_radius"],
         repeats=lambda wc: config["benchmarks"]["repeats"],
         budget=lambda wc: config["benchmarks"].get("route_budget_s", 10),
-    threads: workflow.cores
+    threads: 1
     benchmark:
         "results/benchmarks/rules/bench_arc.tsv"
     log:

@@ -72,6 +72,7 @@ UNICODE_LATEX = {
     "ᵀ": r"$^{\mathsf T}$", "\u00a0": "~",
     "ν": r"$\nu$", "∝": r"$\propto$", "δ": r"$\delta$",  # the elastic claims (study/claims/elastic.py)
     "α": r"$\alpha$", "θ": r"$\theta$", "κ": r"$\kappa$", "Ñ": r"$\tilde N$",  # the face studies' claims
+    "Δ": r"$\Delta$",  # the curved Γ's claims (study/claims/arc.py)
 }
 _SPECIAL = {"\\": r"\textbackslash{}", "&": r"\&", "%": r"\%", "$": r"\$", "#": r"\#", "_": r"\_",
             "{": r"\{", "}": r"\}", "~": r"\textasciitilde{}", "^": r"\textasciicircum{}",

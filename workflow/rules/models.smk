@@ -31,6 +31,9 @@ rule model_job:
         model=MODEL_NAMES_RE,
         job="[a-z0-9_]+",
     threads: 1
+    # ahead of the β batches and contact jobs: the longest jobs of a run are model jobs (the face's
+    # tetrahedra), and a long job started last is the run's tail
+    priority: 1
     resources:
         mem_mb=lambda wc: model_job(wc).mem_mb() + (0 if workflow.local_exec else 500),
         runtime=10,

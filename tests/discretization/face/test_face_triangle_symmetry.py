@@ -90,3 +90,19 @@ def test_halves_need_consecutive_frequencies():
     acc = ReflectedGram(reflection(space))
     with pytest.raises(InputError, match="m/n"):
         acc.add(np.zeros((space.dim, 2, 3)), np.array([1.0, 3.0]), np.arange(1.0, 4.0))
+
+
+@pytest.mark.parametrize("part", [UNIFORM, SQUARE_GRID, SYMMETRIC_SQUARE], ids=["uniform", "square", "symmetric"])
+@pytest.mark.parametrize("s,continuous,vanish,dual", [(0, False, False, False), (2, True, True, False),
+                                                      (1, True, False, True)])
+def test_the_richardson_sums_grow_by_increments(monkeypatch, part, s, continuous, vanish, dual):
+    """S(n) + (terms with max(m, n') > n, up to 2n) = S(2n) summed afresh, to round-off, with every
+    symmetry on or off and in blocks of 5 rows that straddle n (the loop's n0, 2n0, 4n0)."""
+    space = TriangleSpace(part, s, continuous, vanish, dual)
+    monkeypatch.setattr(ftn, "chunk_rows", lambda space, n_max: 5)
+    for use in (ftn._symmetries(space), (None, None)):
+        monkeypatch.setattr(ftn, "_symmetries", lambda space, use=use: use)
+        partial = ftn.incremental_partial_gram(space)
+        for n in (12, 24, 48):
+            fresh = ftn.partial_gram(space, n)
+            assert np.abs(partial(n) - fresh).max() < 1e-13 * np.abs(fresh).max()

@@ -253,22 +253,30 @@ def _symmetries(space) -> tuple:
     return reflection(space), transposition(space)
 
 
-def partial_gram(space, n_max: int) -> np.ndarray:
+def partial_gram(space, n_max: int, n_min: int = 0) -> np.ndarray:
     """S(n_max) = Σ_{m,n ≤ n_max} μ_mn μ_mnᵀ / (π√(m² + n²)), in row blocks of m
     (:func:`chunk_rows`), using the symmetries of Γ that map the space onto itself
     (:mod:`.face.symmetry`): the transposition σ (μ_nm = μ_mn ∘ σ) sums n ≥ m only,
     H = Σ_{n>m} + ½ Σ_{n=m}, S = H + H[σ, σ] (half the coefficients and half the product); the
     point reflection sums H through its symmetric and antisymmetric halves (coefficients of about
-    half the dofs, a quarter of the product's flops)."""
+    half the dofs, a quarter of the product's flops). ``n_min`` > 0: only the terms with
+    max(m, n) > n_min, S(n_max) − S(n_min) (what the Richardson loop adds from one truncation to
+    the next, :func:`incremental_partial_gram`)."""
     n = np.arange(1, n_max + 1, dtype=float)
     pi, sigma = _symmetries(space)
     halves = None if pi is None else ReflectedGram(pi)
     G = np.zeros((space.dim, space.dim))
     shapes = {}
     rows = chunk_rows(space, n_max)
-    for start in range(0, n_max, rows):
-        m = n[start:start + rows]
-        n_from = 1 if sigma is None else int(m[0])
+    n_min = int(min(max(n_min, 0), n_max))
+    starts = [(s, min(s + rows, n_min)) for s in range(0, n_min, rows)] + \
+             [(s, min(s + rows, n_max)) for s in range(n_min, n_max, rows)]
+    for start, stop in starts:
+        m = n[start:stop]
+        if stop <= n_min:  # rows inside the old square: only its new columns n > n_min (all above m)
+            n_from = n_min + 1
+        else:
+            n_from = 1 if sigma is None else int(m[0])
         nn = n[n_from - 1:]
         C = _coefficients(space, m, n_max, shapes=shapes, dofs_out=None if halves is None else halves.even_rows,
                           n_from=n_from)
@@ -299,6 +307,23 @@ def tail_key(space) -> tuple:
     return (space.continuous and not space.dual, space.vanish and not space.dual)
 
 
+def incremental_partial_gram(space):
+    """``partial(n)`` = :func:`partial_gram` (space, n) for increasing n, each from the last one plus
+    the terms it lacks (the Richardson loop asks n0, 2 n0, 4 n0, ...: a quarter of each sum is
+    the previous one); a smaller or repeated n is summed afresh."""
+    last = {}
+
+    def partial(n_max: int) -> np.ndarray:
+        prev = last.get("n")
+        if prev is None or prev >= n_max:
+            S = partial_gram(space, n_max)
+        else:
+            S = last["S"] + partial_gram(space, n_max, n_min=prev)
+        last.update(n=n_max, S=S)
+        return S
+    return partial
+
+
 def gram_h_tri(space, rtol: float = 1e-6, n_start: int | None = None, n_cap: int = N_MAX_CAP // 64,
                exponent: float | None = None) -> tuple[np.ndarray, dict]:
     """Gram matrix of the H^{1/2}_00(Γ)' norm of a triangle space (module docstring), partial
@@ -310,7 +335,7 @@ def gram_h_tri(space, rtol: float = 1e-6, n_start: int | None = None, n_cap: int
     n0 = max(16, 2 * (space.degree + 1) * max(space.shape)) if n_start is None else int(n_start)
     if n0 < 1 or n_cap < 1:
         raise InputError("n_start/n_cap", "positive integers", got=(n_start, n_cap))
-    return extrapolated(lambda k: partial_gram(space, k), p, n0, n_cap, rtol)
+    return extrapolated(incremental_partial_gram(space), p, n0, n_cap, rtol)
 
 
 def gram(space, norm: str, **kwargs) -> tuple[np.ndarray, dict]:

@@ -18,6 +18,11 @@ FIGURE_NAMES = [
 FACE_STUDY = "face"
 FACE_FIGURE_NAMES = ["fig10_face_beta", "fig11_face_studies"] if FACE_STUDY in MODEL_STUDIES else []
 FIGURE_NAMES += FACE_FIGURE_NAMES
+# The curved segment's figure (the arc study's generated subsection), where the model table has it
+from infsup_contact.plans.arc import FIGURE as ARC_FIGURE, FIGURE_STUDY as ARC_STUDY
+ARC_FIGURE_NAMES = ([ARC_FIGURE] if ARC_STUDY in MODEL_STUDIES and MODEL_STUDIES[ARC_STUDY].cfg.get("patch")
+                    and MODEL_STUDIES[ARC_STUDY].element is None else [])
+FIGURE_NAMES += ARC_FIGURE_NAMES
 # Every figure output (pdf and png): inputs of `rule figures` and of reproduce-all.
 FIGURES = [f"results/figures/{name}.{ext}" for name in FIGURE_NAMES for ext in ("pdf", "png")]
 
@@ -341,3 +346,46 @@ if FACE_FIGURE_NAMES:
             "results/logs/figures/face_figures.log",
         script:
             "../scripts/fig_face.py"
+
+
+if ARC_FIGURE_NAMES:
+    # Panel (c): DUAL-ALL on the most curved arc of the study, non-matching 16:17, projected: the flat
+    # segment's two end modes lifted to β_h > 0 (a kernel vector would not depend on the norm; this
+    # mode does, H is the study's norm)
+    ARC_MODE = dict(case="DUAL-ALL", k=2, N1=16, N2=17, radius=min(MODEL_STUDIES[ARC_STUDY].cfg["radii"]))
+
+    rule arc_worst_mode:
+        output:
+            "results/tables/arc_worst_mode.csv",
+        input:
+            PACKAGE_SOURCES,
+        params:
+            args=(f"--gamma arc --radius {ARC_MODE['radius']} --coupling projection --case {ARC_MODE['case']} "
+                  f"--k {ARC_MODE['k']} --N1 {ARC_MODE['N1']} --N2 {ARC_MODE['N2']} --norm H"),
+        threads: 1
+        resources:
+            mem_mb=1000,
+            runtime=5,
+        benchmark:
+            "results/benchmarks/rules/arc_worst_mode.tsv"
+        log:
+            "results/logs/figures/arc_worst_mode.log",
+        shell:
+            _BLAS1 + "python -m infsup_contact beta {params.args} --worst-mode {output} > {log} 2>&1"
+
+    rule curved_figure:
+        output:
+            pdf=FIGURE_OUT["fig12_curved"]["pdf"],
+            png=FIGURE_OUT["fig12_curved"]["png"],
+        input:
+            beta=table_path(ARC_STUDY, "beta"),
+            patch=table_path(ARC_STUDY, "patch"),
+            modes="results/tables/arc_worst_mode.csv",
+            style=PLOT_STYLE,
+            figures="src/infsup_contact/report/figures/curved.py",
+        benchmark:
+            "results/benchmarks/rules/curved_figure.tsv"
+        log:
+            "results/logs/figures/curved_figure.log",
+        script:
+            "../scripts/fig_curved.py"

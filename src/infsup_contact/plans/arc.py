@@ -19,6 +19,12 @@ from .. import resources
 from .protocol import Inputs, Job, Table, claims_path, table_path
 
 
+FIGURE_STUDY = "arc"
+"""The arc study the figures stage draws (fig12_curved, ``workflow/rules/figures.smk``) where it has a patch
+test; its generated subsection includes the figure."""
+FIGURE = "fig12_curved"
+
+
 class ArcStudy:
     """β_h, kernels, verdicts and their claims on the curved segment (module docstring)."""
 
@@ -99,8 +105,9 @@ class ArcStudy:
 
         c = params["claims"]
         verdicts = arc_verdicts(frames["beta"], c["slope_tolerance"], c["beta_floor"], c["confidence"])
+        figure = FIGURE if self.name == FIGURE_STUDY and self.element is None and self.cfg.get("patch") else None
         return {f"{self.name}.tex": arc_section_tex(self.name, frames["beta"], verdicts, frames["claims"],
-                                                    frames.get("patch"), self.element)}
+                                                    frames.get("patch"), self.element, figure)}
 
     def check_tex(self, tex: str, files: dict) -> None:
         """No hand-written source: the subsection is generated whole."""

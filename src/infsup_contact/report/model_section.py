@@ -100,7 +100,7 @@ GEOMETRY_TEX = {
 
 
 def arc_section_tex(name: str, beta: pd.DataFrame, verdicts: pd.DataFrame, claims: pd.DataFrame,
-                    patch: pd.DataFrame | None = None, element: str | None = None) -> str:
+                    patch: pd.DataFrame | None = None, element: str | None = None, figure: str | None = None) -> str:
     """The subsection of the arc study ``name`` (:mod:`infsup_contact.plans.arc`): what was run, the
     claims, and β_h of the finest non-matching pair per coupling and radius."""
     checked, agree = predicted(claims), n_as_predicted(claims)
@@ -132,4 +132,12 @@ def arc_section_tex(name: str, beta: pd.DataFrame, verdicts: pd.DataFrame, claim
                  r"without keep an $O(1)$ error at $\Gamma$'s ends. Max $|\lambda_h-\lambda|/\lambda$ on "
                  rf"$N_1{{:}}N_2 = {int(last.N1)}{{:}}{int(last.N2)}$:",
                  r"\begin{center}", r"\small", arc_patch_table(patch), r"\end{center}", ""]
+    if figure:
+        text += [r"\begin{figure}[htbp]", r"\centering",
+                 rf"\includegraphics[width=\linewidth,keepaspectratio]{{{figure}.pdf}}",
+                 r"\caption{The curved segment. (a) $\beta_h$ ($H^{-1/2}_{00}$) against $h$ on the pairs $N{:}N+1$, "
+                 r"the flat segment dashed, the most curved arc solid: curvature moves the stable spaces a little "
+                 r"and leaves the unstable ones falling. (b) The patch test on that arc: the spaces holding the "
+                 r"constants converge like $h^2$. (c) The projection's worst mode of DUAL-ALL: the flat segment's "
+                 rf"two end modes, lifted to $\beta_h>0$.}}\label{{fig:{figure}}}", r"\end{figure}", ""]
     return "\n".join(text)

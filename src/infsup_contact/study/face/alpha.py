@@ -20,7 +20,8 @@ the plain dual (α = 0) is the only one refused. The mesh element of each refere
 model's element whose face cells have its shape (:func:`element_of`), not a name.
 
 Run: ``python -m infsup_contact.study.face.alpha --N 4 8`` (CSV on stdout);
-``--element TRI6 --N 4 6`` for the triangles.
+``--element TRI6 --N 4 6`` for the triangles; ``--element QUAD8 --bodies hex20`` for the QUAD8 faces of
+serendipity HEX20 bodies (:mod:`infsup_contact.models.hex20`) instead of Q2 hexahedra's QUAD9 traces.
 """
 from __future__ import annotations
 
@@ -53,8 +54,9 @@ def transformed_dual_spec(element: str, alpha: float) -> SpaceSpec:
     cell = FACE_CELL[reference_element(element).cell]
     build = (cellwise_builder(element, "transformed_dual", True, alpha) if cell == "quad"
              else triangle_builder("transformed_dual", alpha))
+    cells = (cell, "quad8") if element == "QUAD8" else (cell,)  # QUAD8: also the HEX20 bodies' QUAD8 faces
     return SpaceSpec(f"TDUAL-{element}-a{alpha:.4g}", "Popp et al. 2010", f"transformed dual {element}, α = {alpha:.4g}",
-                     None, lambda k: 2, min_k=2, gamma_dims=(2,), face_build=build, face_cells=(cell,))
+                     None, lambda k: 2, min_k=2, gamma_dims=(2,), face_build=build, face_cells=cells)
 
 
 def element_of(model: str, reference: str) -> str:
@@ -159,18 +161,30 @@ def main(argv=None) -> int:
     p.add_argument("--model", default=None, choices=face_models(), help="a 3D model (default: the first)")
     p.add_argument("--element", nargs="+", default=list(ELEMENTS), choices=SWEEP_ELEMENTS,
                    help="reference elements (QUAD8/QUAD9: hexahedra, TRI6: tetrahedra)")
+    p.add_argument("--bodies", default=None,
+                   help="the model's element of the bodies (its --element: hex20 puts QUAD8 on serendipity "
+                        "bodies' QUAD8 faces; default: the one whose faces carry each reference element)")
 
     def check(args):
+        from ...solvers.request import check_mesh_option
+
         if any(n < 1 for n in args.N):
             raise InputError("N", "integers >= 1", got=args.N)
         args.model = face_models()[0] if args.model is None else args.model
         for element in args.element:  # a reference element the model's faces do not carry
             element_of(args.model, element)
+        if args.bodies is not None:
+            from ...models import MODELS
+
+            check_mesh_option(MODELS[args.model], "element", args.bodies)
+            if args.bodies == "hex20" and args.element != ["QUAD8"]:
+                raise InputError("element", "QUAD8 (the HEX20 bodies' faces)", got=" ".join(args.element))
 
     def run(args):
         norms = ("H", "L2") if args.norm == "all" else (args.norm,)
         quad = any(FACE_CELL[reference_element(e).cell] == "quad" for e in args.element)
-        rows = sweep(tuple(args.N), ALPHAS if quad else TRI_ALPHAS, tuple(args.element), norms=norms, model=args.model)
+        rows = sweep(tuple(args.N), ALPHAS if quad else TRI_ALPHAS, tuple(args.element), norms=norms, model=args.model,
+                     cell=args.bodies)
         pd.DataFrame(rows).to_csv(sys.stdout, index=False, float_format="%.6g")
 
     return run_study(p, argv, check, run)

@@ -5,6 +5,7 @@ import numpy as np
 import pandas as pd
 
 from infsup_contact.plans import study_of
+from infsup_contact.plans.arc import PATCH
 from infsup_contact.report.figures.curved import plot_curved
 
 ENTRY = {"study": "arc", "k": [1], "radii": [2], "couplings": ["exact"],
@@ -15,8 +16,8 @@ ENTRY = {"study": "arc", "k": [1], "radii": [2], "couplings": ["exact"],
 def test_the_curved_figure_is_drawn_from_the_study_tables(tmp_path):
     study = study_of({"models": {"arc": ENTRY}}, "arc")
     jobs = study.jobs()
-    beta = pd.concat([jobs[j].run() for j in jobs if j != "patch"], ignore_index=True)
-    patch = jobs["patch"].run()
+    beta = pd.concat([jobs[j].run() for j in jobs if j != PATCH], ignore_index=True)
+    patch = jobs[PATCH].run()
     x = np.linspace(0.0, 1.0, 41)
     modes = pd.DataFrame(dict(case="DUAL-ALL", multiplier_mesh="omega2", c1=1.0, c2=1.0, norm="H", beta=1e-6, x=x,
                               mu=np.exp(-50 * x)))

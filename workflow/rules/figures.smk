@@ -16,12 +16,13 @@ FIGURE_NAMES = [
 # The face section's figures (paper/face.tex), where the model table has the face study: both
 # drawn by one rule (rule face_figures: one job, one Python start), the worst mode by one small job.
 FACE_STUDY = "face"
-FACE_FIGURE_NAMES = ["fig10_face_beta", "fig11_face_studies"] if FACE_STUDY in MODEL_STUDIES else []
+FACE_FIGURE_NAMES = (["fig10_face_beta", "fig11_face_studies"]
+                     if FACE_STUDY in MODEL_STUDIES and config["figures"].get("face_mode") else [])
 FIGURE_NAMES += FACE_FIGURE_NAMES
 # The curved segment's figure (the arc study's generated subsection), where the model table has it
-from infsup_contact.plans.arc import FIGURE as ARC_FIGURE, FIGURE_STUDY as ARC_STUDY
+from infsup_contact.plans.arc import FIGURE as ARC_FIGURE, FIGURE_STUDY as ARC_STUDY, PATCH as ARC_PATCH
 ARC_FIGURE_NAMES = ([ARC_FIGURE] if ARC_STUDY in MODEL_STUDIES and MODEL_STUDIES[ARC_STUDY].cfg.get("patch")
-                    and MODEL_STUDIES[ARC_STUDY].element is None else [])
+                    and MODEL_STUDIES[ARC_STUDY].element is None and config["figures"].get("arc_mode") else [])
 FIGURE_NAMES += ARC_FIGURE_NAMES
 # Every figure output (pdf and png): inputs of `rule figures` and of reproduce-all.
 FIGURES = [f"results/figures/{name}.{ext}" for name in FIGURE_NAMES for ext in ("pdf", "png")]
@@ -280,10 +281,10 @@ rule elastic_figure:
 
 
 if FACE_FIGURE_NAMES:
-    # The worst mode of panel (d): the tetrahedra's T4 at k = 2 (P_0 on the Kuhn triangles of Γ),
+    # The worst mode of panel (d), config figures.face_mode (the tetrahedra's P_0 at k = 2 on the Kuhn triangles of Γ),
     # whose one kernel mode is the checkerboard. A kernel vector does not depend on the norm, so the
     # cheap L2 Gram serves; N = 4 shows the pattern (32 triangles) in well under a second.
-    FACE_MODE = dict(model="membranes3d", element="tet", case="T4", k=2, N=4, norm="L2")
+    FACE_MODE = dict(config["figures"]["face_mode"], model=config["face"]["model"], norm="L2")
     # HEX20 bodies (k = 2, QUAD8 faces) for the third panel of fig10_face_beta: β_h of every QUAD8
     # space in both norms on these matching meshes, one job (study/face/hex20.py); [] for no panel
     FACE_HEX20_N = [4, 6, 8]
@@ -349,10 +350,10 @@ if FACE_FIGURE_NAMES:
 
 
 if ARC_FIGURE_NAMES:
-    # Panel (c): DUAL-ALL on the most curved arc of the study, non-matching 16:17, projected: the flat
+    # Panel (c), config figures.arc_mode, on the most curved arc of the study, non-matching, projected: the flat
     # segment's two end modes lifted to β_h > 0 (a kernel vector would not depend on the norm; this
     # mode does, H is the study's norm)
-    ARC_MODE = dict(case="DUAL-ALL", k=2, N1=16, N2=17, radius=min(MODEL_STUDIES[ARC_STUDY].cfg["radii"]))
+    ARC_MODE = dict(config["figures"]["arc_mode"], radius=min(MODEL_STUDIES[ARC_STUDY].cfg["radii"]))
 
     rule arc_worst_mode:
         output:
@@ -379,7 +380,7 @@ if ARC_FIGURE_NAMES:
             png=FIGURE_OUT["fig12_curved"]["png"],
         input:
             beta=table_path(ARC_STUDY, "beta"),
-            patch=table_path(ARC_STUDY, "patch"),
+            patch=table_path(ARC_STUDY, ARC_PATCH),
             modes="results/tables/arc_worst_mode.csv",
             style=PLOT_STYLE,
             figures="src/infsup_contact/report/figures/curved.py",

@@ -89,6 +89,9 @@ def figure_cases(cfg):
         yield f"figures.elastic_profiles.pairs[{i}]", case, k
     for i, case in enumerate(fc["nu_slope_cases"]):
         yield f"figures.nu_slope_cases[{i}]", case, None
+    for name in ("face_mode", "arc_mode"):  # optional: drawn where the face / arc study runs
+        if fc.get(name):
+            yield f"figures.{name}.case", fc[name]["case"], fc[name]["k"]
 
 
 def check_figures(cfg) -> None:
@@ -107,6 +110,19 @@ def check_figures(cfg) -> None:
             with naming_key(key, f"{case} needs k >= {spec.min_k} ({spec.paper_ref}), the figure has k = {k}",
                             got=case, allowed=f"spaces defined for k = {k}"):
                 check_case(case, k)
+    mode = cfg["figures"].get("face_mode")
+    if mode and cfg.get("face"):
+        from ..models import MODELS
+        from ..solvers.request import check_mesh_option
+
+        model = MODELS.get(cfg["face"]["model"])  # an unknown model is face.model's own refusal
+        if model is not None:
+            with naming_key("figures.face_mode.element", f"not an element of the face model {model.name}"):
+                check_mesh_option(model, "element", mode["element"])
+    arc = cfg["figures"].get("arc_mode")
+    if arc and arc["N1"] == arc["N2"]:
+        raise ConfigError("figures.arc_mode.N2", "a non-matching pair: the projection is the identity on matching "
+                          "meshes", got=arc["N2"], allowed=f"N2 != N1 = {arc['N1']}")
     kinds = data_scene_ids()
     for name in ("contact_solutions", "dual"):
         scene = cfg["figures"][name]["scene"]

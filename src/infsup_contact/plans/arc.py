@@ -23,6 +23,8 @@ FIGURE_STUDY = "arc"
 """The arc study the figures stage draws (fig12_curved, ``workflow/rules/figures.smk``) where it has a patch
 test; its generated subsection includes the figure."""
 FIGURE = "fig12_curved"
+PATCH = "uniform_pressure"
+"""The patch test's job and table (``results/tables/<name>_uniform_pressure.csv``)."""
 
 
 class ArcStudy:
@@ -72,29 +74,29 @@ class ArcStudy:
         jobs = {f"arc_k{k}": Job(lambda k=int(k): self._rows(k), self.cfg, lambda k=int(k): self._mem_mb(k), shown)
                 for k in self.cfg["k"]}
         if self.cfg.get("patch"):
-            jobs["patch"] = Job(self._patch, self.cfg, lambda: 1000, ("curvature", "coupling", "case", "k", "N1", "N2",
+            jobs[PATCH] = Job(self._patch, self.cfg, lambda: 1000, ("curvature", "coupling", "case", "k", "N1", "N2",
                                                                      "lambda_max_rel_error", "u_max_rel_error"))
         return jobs
 
     def tables(self) -> dict:
-        out = {"beta": Table("arc_beta", tuple(j for j in self.jobs() if j != "patch"))}
+        out = {"beta": Table("arc_beta", tuple(j for j in self.jobs() if j != PATCH))}
         if self.cfg.get("patch"):
-            out["patch"] = Table("arc_patch", ("patch",))
+            out[PATCH] = Table("arc_patch", (PATCH,))
         return out
 
     def claim_inputs(self) -> Inputs:
         files = {"beta": (table_path(self.name, "beta"), "arc_beta")}
         if self.cfg.get("patch"):
-            files["patch"] = (table_path(self.name, "patch"), "arc_patch")
+            files[PATCH] = (table_path(self.name, PATCH), "arc_patch")
         return Inputs(files)
 
     def claims(self, frames: dict, claims_cfg: dict) -> pd.DataFrame:
         from ..study.claims.arc import arc_claims, arc_patch_claims
 
         out = arc_claims(frames["beta"], claims_cfg, self.name)
-        return pd.concat([out, arc_patch_claims(frames["patch"], self.name, claims_cfg["fit_window"])],
+        return pd.concat([out, arc_patch_claims(frames[PATCH], self.name, claims_cfg["fit_window"])],
                          ignore_index=True) \
-            if "patch" in frames else out
+            if PATCH in frames else out
 
     def paper_inputs(self) -> Inputs:
         return Inputs({**self.claim_inputs().files, "claims": (claims_path(self.name), "claims")})
@@ -107,7 +109,7 @@ class ArcStudy:
         verdicts = arc_verdicts(frames["beta"], c["slope_tolerance"], c["beta_floor"], c["confidence"])
         figure = FIGURE if self.name == FIGURE_STUDY and self.element is None and self.cfg.get("patch") else None
         return {f"{self.name}.tex": arc_section_tex(self.name, frames["beta"], verdicts, frames["claims"],
-                                                    frames.get("patch"), self.element, figure)}
+                                                    frames.get(PATCH), self.element, figure)}
 
     def check_tex(self, tex: str, files: dict) -> None:
         """No hand-written source: the subsection is generated whole."""

@@ -138,6 +138,7 @@ def arc_section_tex(name: str, beta: pd.DataFrame, verdicts: pd.DataFrame, claim
                  r"\caption{The curved segment. (a) $\beta_h$ ($H^{-1/2}_{00}$) against $h$ on the pairs $N{:}N+1$, "
                  r"the flat segment dashed, the most curved arc solid: curvature moves the stable spaces a little "
                  r"and leaves the unstable ones falling. (b) The patch test on that arc: the spaces holding the "
-                 r"constants converge like $h^2$. (c) The projection's worst mode of DUAL-ALL: the flat segment's "
-                 rf"two end modes, lifted to $\beta_h>0$.}}\label{{fig:{figure}}}", r"\end{figure}", ""]
+                 r"constants converge like $h^2$. (c) The projection's worst mode of a space with end modes on the "
+                 r"flat segment (config figures.arc\_mode), lifted to $\beta_h>0$.}"
+                 rf"\label{{fig:{figure}}}", r"\end{figure}", ""]
     return "\n".join(text)

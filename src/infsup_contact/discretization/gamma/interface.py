@@ -125,7 +125,12 @@ class Interface(abc.ABC):
 
     @abc.abstractmethod
     def cells(self, partition) -> int:
-        """Number of cells (intervals, faces) of a partition."""
+        """Number of cells (intervals, faces) of ``partition``.
+
+        Returns
+        -------
+        int
+        """
 
     @abc.abstractmethod
     def partition_key(self, partition) -> bytes:

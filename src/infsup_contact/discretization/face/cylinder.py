@@ -33,7 +33,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...errors import InputError
-from ..segment.arc import COUPLINGS
+from ..segment.arc import check_curved_options
 from .square import Square
 
 GAMMAS = ("square", "cylinder")
@@ -45,20 +45,10 @@ DEFAULT_COUPLING = "exact"
 
 
 def check_cylinder_options(gamma, radius, coupling) -> None:
-    """:class:`InputError` naming the key: ``gamma`` in :data:`GAMMAS`; with ``cylinder`` a radius
-    R > 1 (inf allowed) and a coupling in :data:`~..segment.arc.COUPLINGS` or none; without it neither."""
-    if gamma not in (None,) + GAMMAS:
-        raise InputError("gamma", ", ".join(GAMMAS), got=gamma)
-    if gamma != "cylinder":
-        for key, value in (("radius", radius), ("coupling", coupling)):
-            if value is not None:
-                raise InputError(key, "only with gamma cylinder (--gamma cylinder)", got=value)
-        return
-    if radius is None or isinstance(radius, bool) or not isinstance(radius, (int, float, np.number)) \
-            or not radius > 1:
-        raise InputError("radius", RADIUS_ALLOWED + " (required with gamma cylinder)", got=radius)
-    if coupling not in (None,) + COUPLINGS:
-        raise InputError("coupling", ", ".join(COUPLINGS), got=coupling)
+    """:class:`InputError` naming the key (:func:`~..segment.arc.check_curved_options` with
+    :data:`GAMMAS`): with ``cylinder`` a radius R > 1 (inf allowed) and a coupling in
+    :data:`~..segment.arc.COUPLINGS` or none; without it neither."""
+    check_curved_options(gamma, radius, coupling, GAMMAS, RADIUS_ALLOWED)
 
 
 @dataclass(frozen=True)

@@ -44,23 +44,28 @@ RADIUS_ALLOWED = "a number R > 1, or inf (the flat segment)"
 """R = 1 would make Ω1 a sector whose square map collapses its far side into the centre."""
 
 
-def check_arc_options(gamma, radius, coupling) -> None:
-    """:class:`InputError` naming the key: ``gamma`` in :data:`GAMMAS`; with ``arc`` a radius R > 1
-    (inf allowed) and a coupling in :data:`COUPLINGS` (None: ``exact``); without it neither."""
-    if gamma not in (None,) + GAMMAS:
-        raise InputError("gamma", ", ".join(GAMMAS), got=gamma)
-    if gamma != "arc":
+def check_curved_options(gamma, radius, coupling, gammas=GAMMAS, radius_allowed: str = RADIUS_ALLOWED) -> None:
+    """:class:`InputError` naming the key: ``gamma`` in ``gammas`` (flat, curved); with the curved one a
+    radius R > 1 (inf allowed) and a coupling in :data:`COUPLINGS` (None: ``exact``); without it neither
+    (the arc's options; the cylinder's, :mod:`..face.cylinder`, with its own names)."""
+    curved = gammas[-1]
+    if gamma not in (None,) + tuple(gammas):
+        raise InputError("gamma", ", ".join(gammas), got=gamma)
+    if gamma != curved:
         for key, value in (("radius", radius), ("coupling", coupling)):
             if value is not None:
-                raise InputError(key, "only with gamma arc (--gamma arc)", got=value)
+                raise InputError(key, f"only with gamma {curved} (--gamma {curved})", got=value)
         return
     if radius is None or isinstance(radius, bool) or not isinstance(radius, (int, float, np.number)) \
             or not radius > 1:
-        raise InputError("radius", RADIUS_ALLOWED + " (required with gamma arc)", got=radius)
-    if coupling is None:
-        coupling = "exact"
-    if coupling not in COUPLINGS:
+        raise InputError("radius", f"{radius_allowed} (required with gamma {curved})", got=radius)
+    if coupling not in (None,) + COUPLINGS:
         raise InputError("coupling", ", ".join(COUPLINGS), got=coupling)
+
+
+def check_arc_options(gamma, radius, coupling) -> None:
+    """:func:`check_curved_options` of the 2D membranes' Γ (:data:`GAMMAS`)."""
+    check_curved_options(gamma, radius, coupling)
 
 
 @dataclass(frozen=True)

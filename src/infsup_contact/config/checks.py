@@ -115,8 +115,8 @@ def check_figures(cfg) -> None:
         from ..models import MODELS
         from ..solvers.request import check_mesh_option
 
-        model = MODELS.get(cfg["face"]["model"])  # an unknown model is face.model's own refusal
-        if model is not None:
+        model = MODELS.get(cfg["face"]["model"])  # a model without a face is face.model's own refusal
+        if model is not None and dict(model.mesh_options).get("element"):
             with naming_key("figures.face_mode.element", f"not an element of the face model {model.name}"):
                 check_mesh_option(model, "element", mode["element"])
     arc = cfg["figures"].get("arc_mode")

@@ -285,27 +285,11 @@ if FACE_FIGURE_NAMES:
     # whose one kernel mode is the checkerboard. A kernel vector does not depend on the norm, so the
     # cheap L2 Gram serves; N = 4 shows the pattern (32 triangles) in well under a second.
     FACE_MODE = dict(config["figures"]["face_mode"], model=config["face"]["model"], norm="L2")
-    # HEX20 bodies (k = 2, QUAD8 faces) for the third panel of fig10_face_beta: β_h of every QUAD8
-    # space in both norms on these matching meshes, one job (study/face/hex20.py); [] for no panel
-    FACE_HEX20_N = [4, 6, 8]
-
-    rule face_hex20_beta:
-        output:
-            "results/tables/face_hex20_beta.csv",
-        input:
-            PACKAGE_SOURCES,
-        params:
-            N=" ".join(map(str, FACE_HEX20_N)),
-        threads: 1
-        resources:
-            mem_mb=1000,
-            runtime=5,
-        benchmark:
-            "results/benchmarks/rules/face_hex20_beta.tsv"
-        log:
-            "results/logs/figures/face_hex20_beta.log",
-        shell:
-            _BLAS1 + "python -m infsup_contact.study.face.hex20 --N {params.N} > {output} 2> {log}"
+    # HEX20 bodies (k = 2, QUAD8 faces) for the third panel of fig10_face_beta: the β table of the
+    # model table's beta study on HEX20 bodies (config models: an entry with elements [hex20]), where
+    # there is one; its claims are the ledger's
+    FACE_HEX20_STUDY = next((name for name, study in MODEL_STUDIES.items()
+                             if "hex20" in getattr(study, "elements", ())), None)
 
     rule face_worst_mode:
         output:
@@ -338,7 +322,7 @@ if FACE_FIGURE_NAMES:
             edge=job_path(FACE_STUDY, "edge_dropping"),
             alpha=job_path(FACE_STUDY, "alpha"),
             modes="results/tables/face_worst_mode.csv",
-            hex20=["results/tables/face_hex20_beta.csv"] if FACE_HEX20_N else [],
+            hex20=[table_path(FACE_HEX20_STUDY, "beta")] if FACE_HEX20_STUDY else [],
             style=PLOT_STYLE,
             figures="src/infsup_contact/report/figures/face.py",
         benchmark:

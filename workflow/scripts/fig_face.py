@@ -14,7 +14,7 @@ register_user_spaces(snakemake.config)  # noqa: F821
 from infsup_contact.report.figures.face import plot_face_beta, plot_face_studies  # noqa: E402
 
 inp, out = snakemake.input, snakemake.output  # noqa: F821
-hex20 = read_table(inp.hex20[0], "face_hex20") if inp.hex20 else None  # rule face_hex20_beta, where run
+hex20 = read_table(inp.hex20[0], "model_beta") if inp.hex20 else None  # the HEX20 beta study's table, where run
 plot_face_beta(read_table(inp.beta, "face_beta"), out.beta_pdf, out.beta_png, hex20=hex20)
 plot_face_studies(read_table(inp.edge, "face_edge"), read_table(inp.alpha, "face_alpha"),
                   read_table(inp.modes, "worst_mode"), out.studies_pdf, out.studies_png)

@@ -37,8 +37,11 @@ def matching_series(beta, norm: str = "H"):
 
 
 def hex20_rows(hex20):
-    """A HEX20 table (``face_hex20``: ``python -m infsup_contact.study.face.hex20``) as face_beta
-    rows: element ``hex20``, k = 2, matching meshes N1 = N2 = N."""
+    """HEX20 rows as face_beta rows: a model-table β table (``model_beta``, a beta study with element
+    ``hex20``) as it is, its HEX20 rows; a ``face_hex20`` table (``python -m infsup_contact.study.face.hex20``)
+    with element ``hex20``, k = 2, matching meshes N1 = N2 = N."""
+    if "N1" in hex20.columns:
+        return hex20[hex20.element == "hex20"]
     return hex20.assign(element="hex20", k=2, N1=hex20.N, N2=hex20.N)
 
 

@@ -1,6 +1,8 @@
 """Serendipity HEX20 bodies (``membranes3d`` with ``element="hex20"``, scikit-fem's ElementHexS2):
 dimension counts, the QUAD8 trace against scikit-fem's own evaluation, exactness on P2, the side
 operator against the reference Schur route, and against the NGSolve Q2 hexahedra (W_HEX20 ⊂ W_Q2)."""
+from types import SimpleNamespace
+
 import numpy as np
 import pytest
 
@@ -102,8 +104,8 @@ def test_other_degrees_are_refused_naming_k(k):
         MEMBRANES3D.side_operator(body(2), k)
 
 
-def test_hex20_meshes_are_structured_and_beta_only():
+def test_hex20_meshes_are_structured_and_refuse_supports_they_do_not_have():
     with pytest.raises(InputError, match="family"):
         subdomain_mesh("perturbed", 2, 1, element="hex20")
-    with pytest.raises(InputError, match="element"):
-        MEMBRANES3D.scene_side(None, body(2), 2)
+    with pytest.raises(InputError, match="element"):  # rollers on the lateral faces only: not a HEX20 scene
+        MEMBRANES3D.scene_side(SimpleNamespace(supports="side"), body(2), 2)

@@ -24,7 +24,8 @@ tetrahedral faces are general triangulations, Γ
 common refinement by polygon clipping).
 
 ``element="hex20"``: serendipity HEX20 bodies on the same structured cells, assembled by scikit-fem
-(:mod:`.hex20`; k = 2, β_h only), Γ the QUAD8 face
+(:mod:`.hex20`; k = 2; β_h and contact scenes supported on the far face or all of ∂Ω_i∖Γ, u_h
+evaluated at points), Γ the QUAD8 face
 :data:`~infsup_contact.discretization.face.serendipity.SERENDIPITY`.
 
 Boundaries: ``gamma`` (Γ), ``dir`` (the far face: z = 0 of Ω1, z = 2 of Ω2) and ``side`` (the
@@ -55,7 +56,7 @@ from dataclasses import dataclass
 import scipy.sparse as sp
 
 from .contract import Body, MaterialParam, Model, OptionalChoice
-from .membranes import field, interpolate, laplace_stiffness
+from .membranes import field as membrane_field, interpolate as membrane_interpolate, laplace_stiffness
 from .contract import SideOperator, factorized_side
 from . import hex20
 
@@ -188,11 +189,12 @@ def side_operator(body: Body, k: int, route: str = "auto", dirichlet: str = BETA
     ``body``: the mesh and its Γ (:func:`subdomain_mesh`); ``gamma``: another interface whose trace
     is taken (a narrower body passes ``Square(width=...)``); ``keep_factor``: the factorization that
     gives S also serves the solves (:func:`~.schur.gamma_factorization`; a scene's side). A HEX20
-    body (:mod:`.hex20`) is assembled by scikit-fem, u_i = 0 on all of ∂Ω_i∖Γ only."""
+    body (:mod:`.hex20`) is assembled by scikit-fem, u_i = 0 on all of ∂Ω_i∖Γ only (a scene's far face:
+    :func:`scene_side`)."""
     if hex20.is_hex20(body):
         if dirichlet != BETA_DIRICHLET or gamma is not None:
-            raise InputError("element", "hex, tet (supports other than ∂Ω_i∖Γ, a narrower Γ); hex20 serves β_h",
-                             got="hex20")
+            raise InputError("element", "hex, tet (supports other than ∂Ω_i∖Γ, a narrower Γ); hex20 bodies: "
+                             "β_h on all of ∂Ω_i∖Γ, a contact scene's far face by scene_side", got="hex20")
         return hex20.side_operator(body, k, route, keep_factor)
     if isinstance(body.interface, Cylinder):
         body.interface.curve(body.mesh, k)  # the isoparametric body: degree k is known here
@@ -208,25 +210,50 @@ def side_operator(body: Body, k: int, route: str = "auto", dirichlet: str = BETA
                         stiffness_all=K_all)
 
 
-def scene_side(scene, body: Body, k: int) -> MembraneSide:
+def scene_side(scene, body: Body, k: int):
     """The side of a contact scene: u_i prescribed on the scene's ``supports`` (an NGSolve
-    boundary regexp; the face patch test: the far face only), else on all of ∂Ω_i∖Γ. HEX20 bodies
-    serve β_h only (a scene's fields and loads are NGSolve's)."""
+    boundary regexp; the face patch test: the far face only), else on all of ∂Ω_i∖Γ. A HEX20 body
+    (:mod:`.hex20`) takes the far face alone or all of ∂Ω_i∖Γ; other supports are refused naming
+    ``element``."""
+    supports = getattr(scene, "supports", None) or BETA_DIRICHLET
     if hex20.is_hex20(body):
-        raise InputError("element", "hex, tet (contact scenes; hex20 serves beta and verdict)", got="hex20")
-    return side_operator(body, k, dirichlet=getattr(scene, "supports", None) or BETA_DIRICHLET, keep_factor=True)
+        names = set(supports.split("|")) if isinstance(supports, str) else None
+        if names not in ({FAR}, {FAR, LATERAL}):
+            raise InputError("element", f"hex, tet (the scene's supports {supports!r}; hex20 bodies take "
+                             f"{FAR!r} or {BETA_DIRICHLET!r})", got="hex20")
+        return hex20.scene_side(body, k, lateral=LATERAL in names)
+    return side_operator(body, k, dirichlet=supports, keep_factor=True)
 
 
-def load(side: MembraneSide, scene, i: int):
+def load(side, scene, i: int):
     """(F_i, u_{D,i}): the lift u_{D,i} = ``scene.far_displacement[i]`` on the far face (0 on the
     other supports), F_i = −c_i (K_i u_{D,i}) on the free dofs (no body force)."""
+    c = (scene.c1, scene.c2)[i]
+    if hex20.is_hex20_side(side):
+        return hex20.load(side, scene.far_displacement[i], c)
     fes = side.trace.fes
     gf = ngsolve.GridFunction(fes)
     gf.Set(float(scene.far_displacement[i]), definedon=fes.mesh.Boundaries(FAR))
     lift = gf.vec.FV().NumPy().copy()
     lift[np.array(fes.FreeDofs(), dtype=bool)] = 0.0  # only the supports carry the lift
-    c = (scene.c1, scene.c2)[i]
     return -c * (side.stiffness_all @ lift)[side.free], lift
+
+
+def field(side, values: np.ndarray, lift=None):
+    """u_{i,h} from its free-dof values and the lift: an NGSolve GridFunction, or on a HEX20 body a
+    :class:`~.hex20.Hex20Field` (evaluated at points)."""
+    if hex20.is_hex20_side(side):
+        return hex20.field(side, values, lift)
+    return membrane_field(side, values, lift)
+
+
+def interpolate(side, components) -> np.ndarray:
+    """The interpolant of NGSolve coefficient functions (all dofs); refused on a HEX20 body, whose
+    space is not NGSolve's (a scene compares its exact u at points there, ``exact_values``)."""
+    if hex20.is_hex20_side(side):
+        raise InputError("element", "hex, tet (the interpolant of an NGSolve coefficient function; hex20 "
+                         "bodies compare u at points)", got="hex20")
+    return membrane_interpolate(side, components)
 
 
 MEMBRANES3D = Model("membranes3d", side_operator,

@@ -144,9 +144,6 @@ class SerendipitySquare(Square):
         return phi
 
     # --- counts
-    contact = False
-    """HEX20 bodies serve β_h and verdict only (contact scenes need NGSolve fields)."""
-
     def allows(self, k: int) -> bool:
         """HEX20 bodies have k = 2 only."""
         return k == 2
@@ -183,6 +180,15 @@ class SerendipitySquare(Square):
             return max(glob, tensor_modes(*space.factors))
         modes = product_modes(*space.factors, [t.partition for t in traces])
         return glob if modes is None else max(glob, modes)
+
+    def natural_modes(self, space, partitions) -> int | None:
+        """A lower bound of dim ker Bᵀ against traces that do not vanish on ∂Γ (a contact scene with
+        natural lateral faces) on ``partitions``: for a tensor space the products orthogonal to every
+        full QUAD8 trace (:func:`product_modes` with ``vanish=False``: QUAD8 lacks the cell centres,
+        so a Q2 multiplier has modes the traces cannot see); None for other spaces (or too large)."""
+        if getattr(space, "factors", None) is None:
+            return None
+        return product_modes(*space.factors, partitions, vanish=False)
 
     def trace_nodes(self, k: int, cells: int) -> int:
         """3n² + 4n + 1 QUAD8 nodes of a side on an n × n grid, boundary included."""
@@ -221,7 +227,7 @@ PRODUCT_MODES_MAX_DIM = 2500
 """Largest dim M whose non-matching product modes :func:`product_modes` counts (one dense eigensolve)."""
 
 
-def product_modes(mx, my, partitions, rtol: float = 1e-10) -> int | None:
+def product_modes(mx, my, partitions, rtol: float = 1e-10, vanish: bool = True) -> int | None:
     """dim of the span of the products A ⊗ B ⊂ Mˣ ⊗ Mʸ orthogonal to the QUAD8 traces on every
     partition of ``partitions``: a lower bound of dim ker Bᵀ (None above :data:`PRODUCT_MODES_MAX_DIM`).
 
@@ -229,7 +235,11 @@ def product_modes(mx, my, partitions, rtol: float = 1e-10) -> int | None:
     orthogonal to it when (A ⊥ P2_0ˣ or B ⊥ P1_0ʸ) and (A ⊥ P1_0ˣ or B ⊥ P2_0ʸ): four choices per
     side; for each combination A and B are the largest subspaces meeting the chosen 1D conditions,
     and the span of all these products is the range of Σ Π_A ⊗ Π_B (orthogonal projectors in the
-    coefficients), whose rank is counted. On matching traces it is :func:`tensor_modes`."""
+    coefficients), whose rank is counted. On matching traces it is :func:`tensor_modes`.
+
+    ``vanish=False``: the traces of bodies whose lateral faces are natural (a contact scene's), which
+    do not vanish on ∂Γ: the same count with the full 1D P1, P2 (P2ˣ ⊗ P1ʸ + P1ˣ ⊗ P2ʸ is QUAD8
+    with its boundary nodes)."""
     if mx.dim * my.dim > PRODUCT_MODES_MAX_DIM:
         return None
     per_side = [(("x", 2, p.xs), ("y", 1, p.ys)) for p in partitions]
@@ -238,17 +248,17 @@ def product_modes(mx, my, partitions, rtol: float = 1e-10) -> int | None:
     total = np.zeros((mx.dim * my.dim,) * 2)
     for combo in itertools.product(*choices):
         conds = [c for pair in combo for c in pair]
-        A = _perpendicular(mx, [(d, g) for axis, d, g in conds if axis == "x"], rtol)
-        B = _perpendicular(my, [(d, g) for axis, d, g in conds if axis == "y"], rtol)
+        A = _perpendicular(mx, [(d, g) for axis, d, g in conds if axis == "x"], rtol, vanish)
+        B = _perpendicular(my, [(d, g) for axis, d, g in conds if axis == "y"], rtol, vanish)
         if A.shape[1] and B.shape[1]:
             total += np.kron(A @ A.T, B @ B.T)
     eig = np.linalg.eigvalsh(total)
     return int(np.sum(eig > rtol * max(eig.max(), 1.0)))
 
 
-def _perpendicular(factor, conditions, rtol: float) -> np.ndarray:
-    """Orthonormal coefficients of the functions of a 1D space orthogonal to P_d,0 on each grid of
-    ``conditions`` ((d, breakpoints) pairs; exact Gauss rule on the common refinement)."""
+def _perpendicular(factor, conditions, rtol: float, vanish: bool = True) -> np.ndarray:
+    """Orthonormal coefficients of the functions of a 1D space orthogonal to P_d,0 (``vanish``; else
+    P_d) on each grid of ``conditions`` ((d, breakpoints) pairs; exact Gauss rule on the common refinement)."""
     from scipy.linalg import null_space
 
     from ..gamma.quadrature import gauss_legendre
@@ -261,7 +271,7 @@ def _perpendicular(factor, conditions, rtol: float) -> np.ndarray:
     a, b = x[:-1, None], x[1:, None]
     pts, wts = (0.5 * (a + b) + 0.5 * (b - a) * t).ravel(), (0.5 * (b - a) * w).ravel()
     mu = factor.evaluate(pts) * wts[:, None]
-    G = np.hstack([mu.T @ make_space(np.asarray(g, float), d, True, True).evaluate(pts) for d, g in conditions])
+    G = np.hstack([mu.T @ make_space(np.asarray(g, float), d, True, vanish).evaluate(pts) for d, g in conditions])
     return null_space(G.T, rcond=rtol)
 
 

@@ -76,16 +76,22 @@ def face_contains_constants(spec, k: int, gamma, n: int = 6) -> bool:
 
 
 def natural_kernel_count(spec, k: int, n1: int, n2: int, gamma) -> int:
-    """The dimension count of the patch scene's kernel on uniform n1 × n1 / n2 × n2 grids, G_h =
-    the trace of Ω2: max(dim M − dim(W1 + W2), 0) with the traces of the scene, which do *not*
-    vanish on ∂Γ (natural lateral faces): dim W_i = (n_i k + 1)² (``gamma.trace_nodes``) and
-    W1 ∩ W2 ⊇ the trace space of the common coarsening, gcd(n1, n2) cells per direction,
-    ((gcd k + 1)², equality on rectangles); so the count is a lower bound of the kernel."""
+    """The count of the patch scene's kernel on uniform n1 × n1 / n2 × n2 grids, G_h = the trace of
+    Ω2: max(dim M − dim(W1 + W2), 0) with the traces of the scene, which do *not* vanish on ∂Γ
+    (natural lateral faces): dim W_i = ``gamma.trace_nodes(k, n_i)`` and W1 ∩ W2 ⊇ the trace
+    space of the common coarsening, gcd(n1, n2) cells per direction (equality on rectangles);
+    and where the face knows the structure of its traces (``gamma.natural_modes``: QUAD8, whose
+    traces lack the cell centres) the products orthogonal to both, if more. A lower bound of the kernel."""
     from math import gcd
 
-    inter = (gcd(n1, n2) * k + 1) ** 2
-    total = gamma.trace_nodes(k, n1) + gamma.trace_nodes(k, n2) - inter
-    return max(face_dimension(spec, k, n2, gamma) - total, 0)
+    total = gamma.trace_nodes(k, n1) + gamma.trace_nodes(k, n2) - gamma.trace_nodes(k, gcd(n1, n2))
+    count = max(face_dimension(spec, k, n2, gamma) - total, 0)
+    modes = getattr(gamma, "natural_modes", None)
+    if modes is None:
+        return count
+    grid = [TensorPartition(np.linspace(0.0, 1.0, n + 1), np.linspace(0.0, 1.0, n + 1)) for n in (n1, n2)]
+    structural = modes(gamma.space(spec, k, grid[1]), grid)
+    return max(count, structural or 0)
 
 
 def patch_prediction(spec, k: int, gamma, pairs) -> str:

@@ -119,6 +119,11 @@ class PressedCubes:
         lam = self.pressure
         return -lam / self.c1 * ngsolve.z, -self.d + lam / self.c2 * (2.0 - ngsolve.z)
 
+    def exact_values(self, i: int, points: np.ndarray) -> np.ndarray:
+        """u_{i+1} at ``points`` (n, 3): :meth:`exact` in numpy, what every body's u_h is compared with."""
+        lam, z = self.pressure, np.asarray(points, float)[:, 2]
+        return -lam / self.c1 * z if i == 0 else -self.d + lam / self.c2 * (2.0 - z)
+
 
 def patch_scene(c=(1.0, 1.0), delta: float = DELTA) -> PressedCubes:
     """The scene's data with material scales ``c`` and far-face displacement ``delta``."""
@@ -168,8 +173,8 @@ def solve_face_patch(case: str, k: int, n1: int, n2: int, c=(1.0, 1.0), delta: f
     lam = scene.pressure
     x = gamma.sample(gamma.common_refinement(space.breakpoints, *(s.trace.partition for s in sol.sides)), per_cell)
     lam_err = float(np.max(np.abs(sol.pressure(x) - lam)) / lam)
-    u_err = max(float(np.max(np.abs(body_values(gf, per_cell) - body_values(u, per_cell, gf.space.mesh))))
-                for gf, u in zip(sol.u, scene.exact())) / delta
+    u_err = max(float(np.max(np.abs(v - np.ravel(scene.exact_values(i, p)))))
+                for i, gf in enumerate(sol.u) for p, v in [body_samples(gf, per_cell)]) / delta
     G, _ = gamma.gram(space, "L2")
     spec = registry.space_spec(case)
     return dict(scene=scene.name, case=case, k=k, family="structured", element=element, N1=n1, N2=n2,
@@ -183,25 +188,33 @@ def solve_face_patch(case: str, k: int, n1: int, n2: int, c=(1.0, 1.0), delta: f
                 seconds=time.perf_counter() - t0)
 
 
-def body_points(mesh, per_cell: int) -> np.ndarray:
+def body_samples(f, per_cell: int) -> tuple:
+    """(points (n, 3), u_h there, flattened) at ``per_cell`` + 1 points per direction of every cell of
+    the body u_h lives on: an NGSolve GridFunction at :func:`body_points` of its mesh, a HEX20 field
+    (:class:`~infsup_contact.models.hex20.Hex20Field`) at its own cells' points (``samples``)."""
+    if hasattr(f, "samples"):
+        return f.samples(per_cell)
+    p = body_points(np.array([v.point for v in f.space.mesh.vertices]), per_cell)
+    return p, body_values(f, p)
+
+
+def body_points(vertices: np.ndarray, per_cell: int) -> np.ndarray:
     """The tensor grid (n, 3) of ``per_cell`` + 1 points per direction in every cell of the
-    structured mesh's vertex lattice (faces and edges included)."""
-    verts = np.array([v.point for v in mesh.vertices])
+    structured vertex lattice of ``vertices`` (nv, 3) (faces and edges included)."""
     t = np.linspace(0.0, 1.0, per_cell + 1)
     axes = []
     for d in range(3):
-        g = np.unique(np.round(verts[:, d], 12))
+        g = np.unique(np.round(vertices[:, d], 12))
         axes.append(np.unique((g[:-1, None] + np.outer(np.diff(g), t)).ravel()))
     return np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
 
 
-def body_values(f, per_cell: int, mesh=None) -> np.ndarray:
-    """Values of a GridFunction (or a coefficient function on ``mesh``) at :func:`body_points`:
-    point evaluation, not interpolation (NGSolve's ``Set`` of a linear function leaves its
-    higher-order coefficients at ~1e-13, not 0)."""
+def body_values(f, points: np.ndarray, mesh=None) -> np.ndarray:
+    """Values of a GridFunction (or a coefficient function on ``mesh``) at ``points`` (n, 3),
+    flattened: point evaluation, not interpolation (NGSolve's ``Set`` of a linear function leaves
+    its higher-order coefficients at ~1e-13, not 0)."""
     mesh = f.space.mesh if mesh is None else mesh
-    p = body_points(mesh, per_cell)
-    return np.asarray(f(mesh(p[:, 0], p[:, 1], p[:, 2]))).ravel()
+    return np.asarray(f(mesh(points[:, 0], points[:, 1], points[:, 2]))).ravel()
 
 
 def face_patch_rows(cases, ks, pairs, c=(1.0, 1.0), delta: float = DELTA, element: str = "hex", model=None) -> list:

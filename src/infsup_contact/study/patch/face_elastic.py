@@ -118,6 +118,13 @@ class CompressedCubes:
                                           -p / self.c1 - p * (z - 1.0) / self.c2))
         return u1, u2
 
+    def exact_values(self, i: int, points: np.ndarray) -> np.ndarray:
+        """u_{i+1} at ``points`` (n, 3), shape (n, 3): :meth:`exact` in numpy."""
+        p, nu, c = self.pressure, self.nu, (self.c1, self.c2)[i]
+        x, y, z = np.asarray(points, float).T
+        uz = -p * z / self.c1 if i == 0 else -p / self.c1 - p * (z - 1.0) / self.c2
+        return np.column_stack([nu * p * x / c, nu * p * y / c, uz])
+
 
 def patch_scene(E=(1.0, 1.0), nu: float = 0.3, delta: float = DELTA) -> CompressedCubes:
     """The scene's data with moduli ``E``, Poisson ratio ``nu`` and far-face displacement ``delta``."""

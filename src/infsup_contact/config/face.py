@@ -64,8 +64,9 @@ def _check_degrees(key: str, model, element: str, ks, k_key: str) -> None:
 
 def check_face_studies(fc, model) -> None:
     """The face studies' keys (rules/face_studies.smk) the schema cannot state: the patch
-    test's elements are the model's, its pairs non-matching; the α sweep's elements are face
-    elements with a transformed (non-identity) basis; edge dropping keeps at least 3 θ at or
+    test's elements are the model's, with contact scenes and at least one degree of
+    ``face.patch.k`` (an element runs the degrees it has: HEX20 k = 2), its pairs
+    non-matching; the α sweep's elements are face elements with a transformed (non-identity) basis; edge dropping keeps at least 3 θ at or
     below ``fit_theta_max`` (a slope fit). Each raises one ConfigError naming the key."""
     from ..discretization.face.spaces.cellwise import QUAD_ELEMENTS
     from ..discretization.face.spaces.dual_bases import transformation
@@ -78,7 +79,10 @@ def check_face_studies(fc, model) -> None:
             raise ConfigError(f"face.patch.elements[{i}]", f"the {element} bodies serve β_h only (no contact "
                               "scene, so no patch test)", got=element,
                               allowed=", ".join(e for e in options if model.gamma(element=e).contact))
-        _check_degrees(f"face.patch.elements[{i}]", model, element, fc["patch"]["k"], "face.patch.k")
+        if not any(gamma.allows(int(k)) for k in fc["patch"]["k"]):  # the others are skipped for it
+            raise ConfigError(f"face.patch.elements[{i}]", f"the {element} bodies have none of the degrees "
+                              f"face.patch.k = {list(fc['patch']['k'])}", got=element,
+                              allowed="an element with a degree of face.patch.k, or a degree it has in face.patch.k")
     for i, pair in enumerate(fc["patch"]["pairs"]):
         if pair[0] == pair[1]:
             raise ConfigError(f"face.patch.pairs[{i}]", "the patch test's pairs are non-matching: N1 != N2",

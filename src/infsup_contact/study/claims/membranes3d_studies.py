@@ -14,7 +14,8 @@ properties and the construction of the spaces (never from a case id, never from 
   ``contains_constants`` is the same on rectangles, but on triangles the boundary-modified TRI3
   dual loses 1 on the corner triangles whose three vertices lie on ∂Γ,
   :mod:`~infsup_contact.discretization.face.spaces.triangles`), and the kernel by the dimension count
-  max(dim M − dim(W1 + W2), 0) of the scene's traces, which do not vanish on ∂Γ
+  max(dim M − dim(W1 + W2), 0) of the scene's traces, which do not vanish on ∂Γ, and on QUAD8
+  faces (HEX20 bodies) by the tensor products orthogonal to both traces, if more
   (:func:`natural_kernel_count`). Predicted PASS when 1 ∈ M_h
   and the count is 0 on every pair, FAIL when 1 ∉ M_h, a finding otherwise (a kernel leaves
   λ_h to the solver's choice).

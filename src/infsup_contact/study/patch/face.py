@@ -230,7 +230,9 @@ def face_patch_table(cases, ks, pairs, elements, model: str | None = None) -> li
     """The DAG's patch table (rule face_patch, config ``face.patch``): :func:`face_patch_rows`
     for every element of ``model`` (default the scene's first), restricted to the ``cases``
     that element's face builds (``Interface.builds``: the QUAD9-element spaces pair with
-    rectangles only), every k and every non-matching pair."""
+    rectangles only, the QUAD8 ones with HEX20 bodies) and to the ``ks`` its bodies have
+    (``Interface.allows``: HEX20 k = 2 only; the config check refuses an element with none of
+    them), every non-matching pair."""
     from ..claims.membranes3d import element_interfaces
 
     name = FACE_PATCH.models[0] if model is None else model
@@ -238,5 +240,6 @@ def face_patch_table(cases, ks, pairs, elements, model: str | None = None) -> li
     rows = []
     for element in elements:
         own = [c for c in cases if gammas[element].builds(registry.space_spec(c))]
-        rows += face_patch_rows(own, ks, pairs, element=element, model=make_model(name))
+        own_ks = [k for k in ks if gammas[element].allows(int(k))]
+        rows += face_patch_rows(own, own_ks, pairs, element=element, model=make_model(name))
     return rows

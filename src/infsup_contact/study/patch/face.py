@@ -54,6 +54,35 @@ on ∂Γ, so its face space lacks the constants although the 1D ``contains_const
 module's ``predicted`` column) holds; the ledger's prediction checks 1 ∈ M_h on the space the
 face builds (``face_contains_constants``) and predicts that failure. R5.4 at k = 1 on
 tetrahedra has a kernel (1 and 2 modes on 4:5, 7:8) and still passes.
+
+**HEX20 bodies** (``element="hex20"``, k = 2 only: :mod:`infsup_contact.models.hex20`; every space
+the QUAD8 face builds, ``Interface.builds``). u is linear, so it lies in serendipity Q2 and the
+argument above holds unchanged: the test passes iff 1 ∈ M_h (``spans_constants`` on the face
+space) and K has no kernel. *Prediction* (written before the table was run): T3, Q8 and LIN0-Q8
+vanish on ∂Γ and fail; T4, T5, DUAL, DUAL-ALL, TDUAL-Q8, Q8-ALL, DISC-P1, R5.2, R5.4 hold 1 and
+pass where K has no kernel. QUAD8's consistent nodal forces of a uniform pressure are negative at
+the corners (∫N_corner = −|cell|/12, ∫N_mid = |cell|/3), but every registered cone is on the
+multiplier's coefficients (nodal values, pointwise values, dual or discontinuous coefficients),
+and the coefficients of the constant are λ·1 > 0 in each basis that holds it (nodal bases
+interpolate; the dual bases, Popp-transformed or not, are partitions of unity); the weighted gaps
+vanish since the traces coincide. So no cone is affected; what the negative corner weights change
+is the PDAS's start: the unconstrained weighted gap −δ∫μ_j is positive at the corner nodes of the
+standard QUAD8 basis (Q8, Q8-ALL), which start inactive and cost one more iteration (2, not 1).
+The kernel: the first exploratory run (R5.2, 4:5) showed 4 modes that max(dim M − dim(W1 + W2), 0)
+misses: QUAD8 traces have no cell centres, W_i = P2ˣ ⊗ P1ʸ + P1ˣ ⊗ P2ʸ on grid i, and a ⊗ b with
+a, b ∈ P2(Ω2's grid) ⊥ P1 on both grids (dim 2 per direction on n:n+1) is orthogonal to both.
+That count (:meth:`~infsup_contact.discretization.face.serendipity.SerendipitySquare.natural_modes`,
+in the ledger's prediction, :mod:`.claims.membranes3d_studies`) was then computed for every space
+before the table: 4 for R5.2 and DUAL-ALL, 1 for R5.4 on 4:5 and 7:8 (16, 16, 9 and DUAL's 4 on
+matching 4:4), 0 for the rest. A kernel leaves u_h exact and λ_h to the PDAS's minimum-norm choice.
+
+*Outcome* (N1:N2 = 4:5, 7:8 and 4:4, G_h = trace of Ω2; 36 rows, 2.5 s): as predicted. T4, T5,
+DUAL, TDUAL-Q8, Q8-ALL, DISC-P1 reproduce λ to ≤ 5e-10 and u to ≤ 2e-14 of δ (DUAL at 4:4, with
+its 4 modes, excepted: λ error 1.4); T3, Q8, LIN0-Q8 fail (λ error 1.0–1.7, u error 1–8e-2 δ).
+The kernel rows keep u to ≤ 6e-13 but not λ: R5.2 (0.45), DUAL-ALL (2.4); R5.4's modes are
+orthogonal to 1 (λ error 8e-13 on 4:4 with 9 modes) but ill-separated on 4:5 and 7:8 (7e-9, and 5e-8
+with 3 measured modes: inconclusive in the ledger). Measured
+kernels equal the count except R5.4 on 7:8 (3 ≥ 1: the count is a lower bound).
 """
 from __future__ import annotations
 

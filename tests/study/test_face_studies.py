@@ -194,6 +194,7 @@ def test_study_tables_cite_every_row_and_verdict():
 
 @pytest.mark.parametrize("mutate, key", [
     (lambda f: f["patch"].update(elements=["prism"]), "face.patch.elements[0]"),
+    (lambda f: f["patch"].update(elements=["hex", "hex20"], k=[1]), "face.patch.elements[1]"),  # HEX20: k = 2 only
     (lambda f: f["patch"].update(pairs=[[4, 4]]), "face.patch.pairs[0]"),
     (lambda f: f["alpha"].update(elements=["QUAD4"]), "face.alpha.elements[0]"),
     (lambda f: f["alpha"].update(alphas=[0.5]), "face.alpha.alphas"),

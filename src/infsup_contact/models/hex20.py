@@ -159,8 +159,8 @@ class Hex20Field:
         t = np.linspace(0.0, 1.0, per_cell + 1)
         ref = np.stack(np.meshgrid(t, t, t, indexing="ij")).reshape(3, -1)
         at = Basis(self.basis.mesh, self.basis.elem, quadrature=(ref, np.ones(ref.shape[1])))
-        points = at.global_coordinates().value.reshape(3, -1).T
-        return points, at.interpolate(self.values).value.ravel()
+        points = np.asarray(at.global_coordinates()).reshape(3, -1).T
+        return points, np.asarray(at.interpolate(self.values)).ravel()
 
 
 def field(side: Hex20Side, values: np.ndarray, lift=None) -> Hex20Field:

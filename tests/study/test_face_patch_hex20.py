@@ -133,3 +133,15 @@ def test_hostile_requests_are_refused_in_one_line():
     side = MEMBRANES3D.scene_side(face_patch.patch_scene(), body, 2)
     with pytest.raises(InputError, match="element"):  # no interpolant of NGSolve functions
         MEMBRANES3D.interpolate(side, (ngsolve.z,))
+
+
+def test_the_command_runs_every_quad8_space():
+    """``contact --case all --element hex20``: a row per space the QUAD8 face builds (the registry's
+    answer, not a list), each kernel-free row passing exactly where 1 ∈ M_h."""
+    code, out, err = run_in_process(["contact", "--model", "membranes3d", "--scene", FACE_PATCH.id, "--case", "all",
+                                     "--k", "2", "--N1", "2", "--N2", "3", "--element", "hex20"])
+    assert code == 0, err
+    lines = out.splitlines()
+    rows = [dict(zip(lines[0].split(","), line.split(","))) for line in lines[1:]]
+    assert [r["case"] for r in rows] == quad8_cases(2)
+    assert all(r["passes"] == r["predicted"] for r in rows if r["kernel_dim"] == "0")

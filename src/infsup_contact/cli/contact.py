@@ -4,8 +4,8 @@ pair, CSV rows; the scenes and the models each is defined for come from the scen
 from __future__ import annotations
 
 from ..errors import InputError, check_prestress
-from .common import (FlagUse, add_dry_run, add_model, cases, check_memory, declare_flag_uses, material, mesh_options,
-                     model_flag_uses, SPACE_HELP, write_csv)
+from .common import (FlagUse, add_dry_run, add_model, cases, check_memory, declare_flag_uses, face_cases, material,
+                     mesh_options, model_flag_uses, SPACE_HELP, write_csv)
 
 
 def add(sub) -> None:
@@ -67,6 +67,7 @@ def _check_contact(args):
     check_flat_gamma(args.mesh)
     spec = check_pair(args.model, args.scene)
     check_k(args.k)
+    args.cases = face_cases(args)  # --case all on a 3D model: also the spaces only its face builds
     for case in args.cases:
         registry.check_case(case, args.k)
     meshes.check_mesh_args(args.family, args.N1, "N1")

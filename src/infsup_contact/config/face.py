@@ -66,8 +66,9 @@ def check_face_studies(fc, model) -> None:
     """The face studies' keys (rules/face_studies.smk) the schema cannot state: the patch
     test's elements are the model's, with contact scenes and at least one degree of
     ``face.patch.k`` (an element runs the degrees it has: HEX20 k = 2), its pairs
-    non-matching; the α sweep's elements are face elements with a transformed (non-identity) basis; edge dropping keeps at least 3 θ at or
-    below ``fit_theta_max`` (a slope fit). Each raises one ConfigError naming the key."""
+    non-matching; the α sweep's elements are face elements with a transformed (non-identity)
+    basis; edge dropping keeps at least 3 θ at or below ``fit_theta_max`` (a slope fit). Each
+    raises one ConfigError naming the key."""
     from ..discretization.face.spaces.cellwise import QUAD_ELEMENTS
     from ..discretization.face.spaces.dual_bases import transformation
 

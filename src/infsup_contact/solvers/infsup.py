@@ -29,6 +29,7 @@ from ..models import DEFAULT_MODEL
 from .interface_operator import combine_terms, interface_terms
 from .kernel import kernel_check
 from .modes import worst_modes
+from . import petrov_galerkin
 from .request import NO_OPTIONS, BetaRequest, MeshOptions
 from .routes import choose_route, is_large
 from .side_cache import GramCache, SideCache
@@ -85,7 +86,11 @@ def _case_rows(r: BetaRequest, case, g_h, sides, dim_w: int, trace_norms, modes:
                grams: GramCache | None = None) -> list:
     """The rows of one case on G_h: M_h, its couplings B_i and Grams G (from the sweep's ``grams``
     where an earlier pair built them), its route, then per (c1, c2) the interface operator S and the
-    bottom of S m = β² G m for every norm (and its worst mode, appended to ``modes`` where given)."""
+    bottom of S m = β² G m for every norm (and its worst mode, appended to ``modes`` where given).
+    A Petrov–Galerkin pair (trial ≠ test space) is :mod:`.petrov_galerkin`'s."""
+    spec = registry.SPACES.get(case) if isinstance(case, str) else case
+    if isinstance(spec, SpaceSpec) and spec.petrov_galerkin:                     # trial M ≠ test N
+        return [_row(r, case, **fields) for fields in petrov_galerkin.pair_rows(r, spec, g_h, sides, dim_w, modes)]
     gamma = sides[0].trace.gamma
     space = _space(case, r.k, g_h, gamma)                                          # M_h on G_h
     tc = time.perf_counter()
@@ -112,7 +117,8 @@ def _case_rows(r: BetaRequest, case, g_h, sides, dim_w: int, trace_norms, modes:
 def _row(r, case, c1, c2, norm, spec, kernel, structural, beta_v1_zero, dim_m, dim_w, info, ndof,
          t_assemble, t_eig) -> dict:
     """One row of ``infsup-contact beta`` (its columns, in order; ``multiplier_mesh`` and
-    ``t_interface`` set by :func:`beta_table`)."""
+    ``t_interface`` set by :func:`beta_table`; a Petrov–Galerkin pair's meaning of each:
+    :mod:`.petrov_galerkin`)."""
     return dict(case=registry.case_name(case), k=r.k, family=r.family, N1=r.n1, N2=r.n2, multiplier_mesh=None,
                 c1=c1, c2=c2, norm=norm, beta=spec.beta, kernel_dim=spec.kernel_dim,
                 structural_kernel_dim=structural, kernel_detected=kernel.detected,

@@ -26,9 +26,13 @@ SPACES: dict[str, SpaceSpec] = {}
 
 
 def register(spec: SpaceSpec) -> SpaceSpec:
-    """Add a space to the registry; an id can be registered once."""
+    """Add a space to the registry; an id can be registered once, a Petrov–Galerkin pair after its
+    trial and test spaces."""
     if spec.id in SPACES and SPACES[spec.id] is not spec:
         raise InputError("space", f"an id not yet registered ({', '.join(SPACES)})", got=spec.id)
+    for role in ("trial_space", "test_space") if spec.petrov_galerkin else ():
+        if getattr(spec, role) not in SPACES:
+            raise InputError(role, f"a registered id ({', '.join(SPACES)})", got=getattr(spec, role))
     SPACES[spec.id] = spec
     return spec
 
@@ -105,6 +109,9 @@ def case_space(case: str, k: int, partition, gamma=SEGMENT) -> SegmentSpace:
     if not spec.defined_on(gamma.dim):
         raise InputError("case", f"a space defined on this Γ (dimension {gamma.dim}): {case} ({spec.paper_ref}) is "
                          f"defined on the face of a 3D model only (e.g. --model membranes3d)", got=case)
+    if spec.petrov_galerkin:  # two bases: a consumer of one would silently take the trial space's
+        raise InputError("case", f"a space with one basis for trial and test ({case} is the Petrov–Galerkin "
+                         f"pair {spec.trial_space} × {spec.test_space}: infsup-contact beta and verdict only)", got=case)
     space = gamma.space(spec, k, partition)  # the interface builds it (a face: tensor products)
     n = gamma.cells(space.breakpoints)
     if space.dim < 1:

@@ -88,6 +88,8 @@ def pair_rows(r, spec, g_h, sides, dim_w: int, modes: list | None = None) -> lis
     """The keyword arguments of ``infsup._row`` for every (c1, c2) and norm of request ``r``, for the
     pair ``spec`` on G_h = ``g_h`` (module docstring); ``modes`` receives each row's worst mode."""
     gamma = sides[0].trace.gamma
+    if registry.SPACES.get(spec.id) is spec:  # the pair's own checks first: a refusal names the pair's id
+        registry.case_space(spec.id, r.k, g_h, gamma, pair=True)
     trial, test = (registry.case_space(case, r.k, g_h, gamma) for case in (spec.trial_space, spec.test_space))
     if trial.dim != test.dim:
         raise InputError("case", f"a Petrov–Galerkin pair with dim M = dim N ({spec.id}: dim {spec.trial_space} "

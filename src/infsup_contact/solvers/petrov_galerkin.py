@@ -46,7 +46,16 @@ on matching and non-matching meshes, sqrt(γ_H) on a plateau near the symmetric 
 and LIN0-Q8 (within a factor 2 of their geometric mean), sqrt(γ_L2) decaying like h^{1/2} as every
 L² row; PGLIN-Q8 (all vertices) kernel exactly 4 on matching meshes (the corner modes of the dual
 trial space, LINDUAL-Q8's proven kernel; T5's four geometric modes on the left), on non-matching
-meshes no proven mode and a small, decaying γ_h. Outcome: see docs/models.md (HEX20 bodies).
+meshes no proven mode and a small, decaying γ_h.
+
+Outcome (N = 4, 6, 8 and 4:5, 6:7, 8:9, G_h = Ω2's trace; table in docs/models.md). PGLIN0-Q8 as
+predicted: kernel 0 everywhere (margins >= 12.5 decades), sqrt(γ_H) 1.281 / 1.263 / 1.258 matching and
+0.90 non-matching, 0.5–1.4 % below the geometric mean of β_H(LINDUAL0-Q8) and β_H(LIN0-Q8) and between
+the two in every row and both norms (not predicted); sqrt(γ_L2) falls like h^{1/2}. PGLIN-Q8: kernel 4
+on matching meshes as predicted, but also 4 on the non-matching ones, against the prediction: the
+corner products of the 1D end duals are orthogonal to every function linear on their corner cell and
+vanishing at the corner, so to both sides' hats wherever G_h's corner cell lies inside both sides'
+(G_h the finer trace); ``product_modes`` proves them (``structural_kernel_dim`` 4).
 """
 from __future__ import annotations
 

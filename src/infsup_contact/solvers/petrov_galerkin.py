@@ -97,43 +97,58 @@ def pair_rows(r, spec, g_h, sides, dim_w: int, modes: list | None = None) -> lis
     """The keyword arguments of ``infsup._row`` for every (c1, c2) and norm of request ``r``, for the
     pair ``spec`` on G_h = ``g_h`` (module docstring); ``modes`` receives each row's worst mode."""
     gamma = sides[0].trace.gamma
-    if registry.SPACES.get(spec.id) is spec:  # the pair's own checks first: a refusal names the pair's id
-        registry.case_space(spec.id, r.k, g_h, gamma, pair=True)
-    trial, test = (registry.case_space(case, r.k, g_h, gamma) for case in (spec.trial_space, spec.test_space))
-    if trial.dim != test.dim:
-        raise InputError("case", f"a Petrov–Galerkin pair with dim M = dim N ({spec.id}: dim {spec.trial_space} "
-                         f"= {trial.dim}, dim {spec.test_space} = {test.dim} on this G_h)", got=spec.id)
+    trial, test = pair_spaces(spec, r.k, g_h, gamma)
     tc = time.perf_counter()
-    terms = [np.asarray(coupling_matrix(s.trace, test, r.k) @ s.steklov_times(coupling_matrix(s.trace, trial, r.k).T))
-             for s in sides]                                                       # C_i^N X_i C_i^Mᵀ
+    terms = pair_terms(trial, test, sides, r.k)
     t_coupling = time.perf_counter() - tc
     grams = {norm: [gamma.gram(space, norm, h_route=r.h_route) for space in (trial, test)]
              for norm in dict.fromkeys(r.norms + (KERNEL_NORM,))}
     factors = {norm: [gram_factor(G) for G, _ in pair] for norm, pair in grams.items()}
-    traces = [s.trace for s in sides]
-    structural = max(gamma.proven_kernel(space, r.k, traces, dim_w) for space in (trial, test))
-    v1_zero = {norm: _gamma(terms[1], *factors[norm])[0][0] for norm in r.norms}
+    structural = max(gamma.proven_kernel(space, r.k, [side.trace for side in sides], dim_w) for space in (trial, test))
+    v1_zero = {norm: _reduced_singular(terms[1], *factors[norm])[0][0] for norm in r.norms}  # side 2 alone
+    fixed = dict(structural=structural, dim_m=trial.dim, dim_w=dim_w, ndof=sum(side.ndof for side in sides),
+                 t_assemble=t_coupling)
     out = []
     for c1, c2 in r.c_pairs:
         S = terms[0] / c1 + terms[1] / c2
-        kernel = kernel_decision(_gamma(S, *factors[KERNEL_NORM])[0], structural)
+        kernel = kernel_decision(_reduced_singular(S, *factors[KERNEL_NORM])[0], structural)
         for norm in r.norms:
             te = time.perf_counter()
-            s, vt = _gamma(S, *factors[norm], vectors=modes is not None)
+            s, vt = _reduced_singular(S, *factors[norm], vectors=modes is not None)
             spectrum = _spectrum(s, kernel.dim)
             info = [i for _, i in grams[norm]]
-            out.append(dict(c1=c1, c2=c2, norm=norm, spec=spectrum, kernel=kernel, structural=structural,
-                            beta_v1_zero=float(np.sqrt(max(v1_zero[norm], 0.0)) / np.sqrt(c2)), dim_m=trial.dim,
-                            dim_w=dim_w, info={key: max(x[key] for x in info) for key in ("n_max", "nmax_rel_error")},
-                            ndof=sum(s.ndof for s in sides), t_assemble=t_coupling, t_eig=time.perf_counter() - te))
+            out.append(dict(fixed, c1=c1, c2=c2, norm=norm, spec=spectrum, kernel=kernel,
+                            beta_v1_zero=float(np.sqrt(max(v1_zero[norm], 0.0)) / np.sqrt(c2)),
+                            info={key: max(x[key] for x in info) for key in ("n_max", "nmax_rel_error")},
+                            t_eig=time.perf_counter() - te))
             if modes is not None:
-                vector = sla.solve_triangular(factors[norm][0], vt[0], lower=True, trans="T")  # λ = L_M⁻ᵀ v
                 keys = dict(case=spec.id, multiplier_mesh=None, c1=c1, c2=c2, norm=norm)
-                modes.append(Mode(keys, spectrum.beta, vector / np.linalg.norm(vector), kernel.dim > 0, trial, gamma))
+                modes.append(_mode(keys, spectrum.beta, vt[0], factors[norm][0], kernel.dim > 0, trial, gamma))
     return out
 
 
-def _gamma(S: np.ndarray, L_m: np.ndarray, L_n: np.ndarray, vectors: bool = False) -> tuple:
+def pair_spaces(spec, k: int, g_h, gamma) -> tuple:
+    """(M, N): the trial and test spaces of ``spec`` on G_h, after the pair's own checks (a refusal
+    names the pair's id: the segment, other bodies' faces, k); :class:`InputError` if dim M ≠ dim N."""
+    if registry.SPACES.get(spec.id) is spec:
+        registry.case_space(spec.id, k, g_h, gamma, pair=True)
+    trial, test = (registry.case_space(case, k, g_h, gamma) for case in (spec.trial_space, spec.test_space))
+    if trial.dim != test.dim:
+        raise InputError("case", f"a Petrov–Galerkin pair with dim M = dim N ({spec.id}: dim {spec.trial_space} "
+                         f"= {trial.dim}, dim {spec.test_space} = {test.dim} on this G_h)", got=spec.id)
+    return trial, test
+
+
+def pair_terms(trial, test, sides, k: int) -> list:
+    """C_i^N X_i C_i^Mᵀ per side at unit material scale (dense; not symmetric unless N = M)."""
+    out = []
+    for side in sides:
+        C_m, C_n = (coupling_matrix(side.trace, space, k) for space in (trial, test))
+        out.append(np.asarray(C_n @ side.steklov_times(C_m.T)))
+    return out
+
+
+def _reduced_singular(S: np.ndarray, L_m: np.ndarray, L_n: np.ndarray, vectors: bool = False) -> tuple:
     """(singular values ascending, right singular vectors as rows in the same order or None) of
     K = L_N⁻¹ S L_M⁻ᵀ: s[0] = γ_h."""
     K = sla.solve_triangular(L_n, sla.solve_triangular(L_m, np.asarray(S, float).T, lower=True).T, lower=True)
@@ -141,6 +156,12 @@ def _gamma(S: np.ndarray, L_m: np.ndarray, L_n: np.ndarray, vectors: bool = Fals
         return np.sort(sla.svdvals(K)), None
     _, s, vt = sla.svd(K)
     return s[::-1].copy(), vt[::-1]
+
+
+def _mode(keys: dict, beta: float, v: np.ndarray, L_m: np.ndarray, in_kernel: bool, trial, gamma) -> Mode:
+    """The worst mode λ = L_M⁻ᵀ v (v the right singular vector of s_min), unit Euclidean norm, in M's basis."""
+    vector = sla.solve_triangular(L_m, v, lower=True, trans="T")
+    return Mode(keys, beta, vector / np.linalg.norm(vector), in_kernel, trial, gamma)
 
 
 def kernel_decision(s: np.ndarray, structural: int):

@@ -110,7 +110,7 @@ def case_space(case: str, k: int, partition, gamma=SEGMENT, pair: bool = False) 
     check_case(case, k)
     spec = SPACES[case]
     if not spec.defined_on(gamma.dim):
-        bodies = " and ".join(CELL_BODIES[c] for c in spec.face_cells)
+        bodies = " and ".join(CELL_BODIES.get(c, c) for c in spec.face_cells)
         raise InputError("case", f"a space defined on this Γ (dimension {gamma.dim}): {case} ({spec.paper_ref}) is "
                          f"defined on the face of a 3D model only, on {bodies} (e.g. --model membranes3d)", got=case)
     space = gamma.space(spec, k, partition)  # the interface builds it (a face: tensor products)
@@ -121,7 +121,8 @@ def case_space(case: str, k: int, partition, gamma=SEGMENT, pair: bool = False) 
                          f"on N = {n} intervals{'' if low is None else f'; it needs N >= {low}'})", got=n)
     if spec.petrov_galerkin and not pair:  # two bases: a consumer of one would silently take the trial space's
         raise InputError("case", f"a space with one basis for trial and test ({case} is the Petrov–Galerkin "
-                         f"pair {spec.trial_space} × {spec.test_space}: infsup-contact beta and verdict only)", got=case)
+                         f"pair {spec.trial_space} × {spec.test_space}: infsup-contact beta and verdict only)",
+                         got=case)
     return space
 
 

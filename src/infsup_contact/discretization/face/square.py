@@ -314,9 +314,9 @@ class Square(Interface):
             raise InputError("multiplier mesh", f"a tensor partition of Γ with at least one rectangle "
                              f"(case {spec.id}, k = {k})")
         if not self.builds(spec):
-            raise InputError("case", f"a space defined on the faces of {CELL_BODIES.get(self.cell, self.cell)} ({spec.id} is built "
-                             f"on the faces of {' and '.join(CELL_BODIES.get(c, c) for c in spec.face_cells)} only)",
-                             got=spec.id)
+            own = " and ".join(CELL_BODIES.get(c, c) for c in spec.face_cells)
+            raise InputError("case", f"a space defined on the faces of {CELL_BODIES.get(self.cell, self.cell)} "
+                             f"({spec.id} is built on the faces of {own} only)", got=spec.id)
         if spec.face_build is not None:
             return spec.face_build(k, partition)
         s, dual = int(spec.degree(k)), spec.dual

@@ -78,8 +78,7 @@ def elastic_bench(nu: float = 0.3) -> BetaBench:
 FACE_BENCH = BetaBench(
     "face_beta", MEMBRANES3D, ("H", "L2"), FACE_COLUMNS, "ratio_to_limit",
     cases=lambda k, gamma, g_h, ids: [c for c in registry.ids_built_on(k, gamma, g_h)  # beta --case all
-                                      if (ids is None or c in ids)
-                                      and not registry.SPACES[c].petrov_galerkin],  # no symmetric pencil
+                                      if ids is None or c in ids],
     kernel=lambda case, k, n, row: row["kernel_dim"], limit_factor=pardiso_or_splu,
     includes={"ours": "meshes+assembly+Γ-last LU+Schur per body+couplings+kernel from Bᵀ+interface+Gram+eigh "
                       "(+β with v1=0), every case × norm",

@@ -37,11 +37,13 @@ a pair above :data:`~infsup_contact.la.bottom.DENSE_MAX_M` is refused in one lin
 (:func:`check_pair_size`). The worst mode (``beta --worst-mode``) is the right singular vector of
 s_min, λ_h in M's basis.
 
-Prediction (written before the first run, HEX20 bodies, k = 2). With μ_j = λ_j the pairing is
-∫ μ_h λ_h = Σ λ_j² ∫φ_j > 0 (biorthogonality ∫ψ_j φ_k = δ_jk ∫φ_k), and the L² projection of the
-dual function Σ λ_j ψ_j onto Q1_0 is the hat function with coefficients M⁻¹Dλ (Fourier symbol
-between 1 and 3): if A⁻¹ saw Q1 traces only, S_PG would be coercive. The QUAD8 trace sees the
-rest of ψ_j too, so there is no proof. Predicted: PGLIN0-Q8 (∂Γ vertices dropped) invertible, kernel 0
+Prediction (written before the first run, HEX20 bodies, k = 2; the argument's wording made precise
+after it, the predictions unchanged). With μ_j = λ_j the pairing is ∫ μ_h λ_h = Σ λ_j² ∫φ_j > 0
+(biorthogonality ∫ψ_j φ_k = δ_jk ∫φ_k, D = diag ∫φ_j), and the L² projection of the dual function
+Σ λ_j ψ_j onto Q1_0 is the hat function with coefficients M⁻¹Dλ (M the Q1 mass matrix; Fourier symbol
+between 1 and 3). Were the traces Q1_0 only, S_PG = M X D, and μ = M⁻¹Dλ would give
+μᵀ S_PG λ = (Dλ)ᵀ X (Dλ) > 0: coercive. The QUAD8 trace sees the rest of ψ_j too, so there is no
+proof. Predicted: PGLIN0-Q8 (∂Γ vertices dropped) invertible, kernel 0
 on matching and non-matching meshes, sqrt(γ_H) on a plateau near the symmetric β_H of LINDUAL0-Q8
 and LIN0-Q8 (within a factor 2 of their geometric mean), sqrt(γ_L2) decaying like h^{1/2} as every
 L² row; PGLIN-Q8 (all vertices) kernel exactly 4 on matching meshes (the corner modes of the dual

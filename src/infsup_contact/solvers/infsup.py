@@ -90,7 +90,8 @@ def _case_rows(r: BetaRequest, case, g_h, sides, dim_w: int, trace_norms, modes:
     A Petrov–Galerkin pair (trial ≠ test space) is :mod:`.petrov_galerkin`'s."""
     spec = registry.SPACES.get(case) if isinstance(case, str) else case
     if isinstance(spec, SpaceSpec) and spec.petrov_galerkin:                     # trial M ≠ test N
-        return [_row(r, case, **fields) for fields in petrov_galerkin.pair_rows(r, spec, g_h, sides, dim_w, modes)]
+        return [_row(r, case, **fields) for fields in petrov_galerkin.pair_rows(r, spec, g_h, sides, dim_w, modes,
+                                                                                          grams)]
     gamma = sides[0].trace.gamma
     space = _space(case, r.k, g_h, gamma)                                          # M_h on G_h
     tc = time.perf_counter()

@@ -95,17 +95,21 @@ def check_pair_size(cases, k: int, n1: int, n2: int, multiplier_mesh: str) -> No
                              got=n2 if key == "N2" else n1 if key == "N1" else f"{n1}, {n2}")
 
 
-def pair_rows(r, spec, g_h, sides, dim_w: int, modes: list | None = None) -> list:
+def pair_rows(r, spec, g_h, sides, dim_w: int, modes: list | None = None, grams=None) -> list:
     """The keyword arguments of ``infsup._row`` for every (c1, c2) and norm of request ``r``, for the
-    pair ``spec`` on G_h = ``g_h`` (module docstring); ``modes`` receives each row's worst mode."""
+    pair ``spec`` on G_h = ``g_h`` (module docstring); ``modes`` receives each row's worst mode, ``grams``
+    (the sweep's :class:`~.side_cache.GramCache`, if any) the trial and test spaces' Gram matrices under their
+    own ids."""
     gamma = sides[0].trace.gamma
     trial, test = pair_spaces(spec, r.k, g_h, gamma)
     tc = time.perf_counter()
     terms = pair_terms(trial, test, sides, r.k)
     t_coupling = time.perf_counter() - tc
-    grams = {norm: [gamma.gram(space, norm, h_route=r.h_route) for space in (trial, test)]
-             for norm in dict.fromkeys(r.norms + (KERNEL_NORM,))}
-    factors = {norm: [gram_factor(G) for G, _ in pair] for norm, pair in grams.items()}
+    both = {norm: [gamma.gram(space, norm, h_route=r.h_route) if grams is None
+                   else grams.gram(gamma, case, r.k, g_h, space, norm, r.h_route)
+                   for case, space in zip((spec.trial_space, spec.test_space), (trial, test))]
+            for norm in dict.fromkeys(r.norms + (KERNEL_NORM,))}                 # {norm: [G_M, G_N]}
+    factors = {norm: [gram_factor(G) for G, _ in pair] for norm, pair in both.items()}
     structural = max(gamma.proven_kernel(space, r.k, [side.trace for side in sides], dim_w) for space in (trial, test))
     v1_zero = {norm: _reduced_singular(terms[1], *factors[norm])[0][0] for norm in r.norms}  # side 2 alone
     fixed = dict(structural=structural, dim_m=trial.dim, dim_w=dim_w, ndof=sum(side.ndof for side in sides),
@@ -118,7 +122,7 @@ def pair_rows(r, spec, g_h, sides, dim_w: int, modes: list | None = None) -> lis
             te = time.perf_counter()
             s, vt = _reduced_singular(S, *factors[norm], vectors=modes is not None)
             spectrum = _spectrum(s, kernel.dim)
-            info = [i for _, i in grams[norm]]
+            info = [i for _, i in both[norm]]
             out.append(dict(fixed, c1=c1, c2=c2, norm=norm, spec=spectrum, kernel=kernel,
                             beta_v1_zero=float(np.sqrt(max(v1_zero[norm], 0.0)) / np.sqrt(c2)),
                             info={key: max(x[key] for x in info) for key in ("n_max", "nmax_rel_error")},

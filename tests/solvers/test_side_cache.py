@@ -70,6 +70,43 @@ def test_cached_sweep_gives_the_rows_of_fresh_builds_bitwise():
     pd.testing.assert_frame_equal(cached[cols], fresh[cols], check_exact=True)
 
 
+def test_pairs_repeating_g_h_reuse_its_grams_bitwise_and_read_only():
+    """G_h = the trace of Ω2 repeats in N:N and N+1:N; on the tetrahedra's triangle faces the H Gram
+    (a Richardson-extrapolated series) is then computed once, and the rows equal fresh ones bit for bit."""
+    from infsup_contact.models.membranes3d import MEMBRANES3D
+
+    pairs, mesh = [(3, 3), (4, 3)], MeshOptions(element="tet")
+    kw = dict(cases=["T3", "DUAL"], norms=["H", "L2"], model=MEMBRANES3D, mesh=mesh)
+    cache = SideCache.for_sweep(MEMBRANES3D, "structured", 1, pairs, mesh)
+    cached = pd.DataFrame([r for p in pairs for r in beta_rows_all("structured", 1, *p, side_cache=cache, **kw)])
+    assert cache.grams.hits == 4  # the second pair: 2 cases × 2 norms
+    fresh = pd.DataFrame([r for p in pairs for r in beta_rows_all("structured", 1, *p, **kw)])
+    cols = [c for c in fresh.columns if not c.startswith("t_")]
+    pd.testing.assert_frame_equal(cached[cols], fresh[cols], check_exact=True)
+    G, _ = next(iter(cache.grams._grams.values()))
+    with pytest.raises(ValueError):
+        G[0, 0] = 1.0  # shared by later pairs: read-only
+
+
+def test_gram_cache_forgets_the_oldest_beyond_its_bound():
+    from infsup_contact.discretization.spaces import registry
+    from infsup_contact.solvers.side_cache import GramCache
+
+    def ask(grams, x):
+        return grams.gram(SEGMENT, "T3", 2, x, registry.case_space("T3", 2, x), "L2", "logkernel")
+
+    grams = GramCache(max_bytes=5 * 8 * 5 ** 2)  # five Grams of T3, k = 2 on 3 cells (5 × 5)
+    partitions = [np.array([0.0, 0.2 + 0.01 * i, 0.6, 1.0]) for i in range(7)]
+    for x in partitions:
+        ask(grams, x)
+    assert len(grams) == 5 and grams._bytes == grams.max_bytes  # the two oldest forgotten
+    ask(grams, partitions[-1])
+    ask(grams, partitions[0])
+    assert grams.hits == 1  # the newest was kept, the oldest was not
+    ask(grams, np.linspace(0.0, 1.0, 6))  # 9 × 9: above a quarter of the bound, not kept
+    assert len(grams) == 5
+
+
 @pytest.mark.parametrize("x1,x2,choice,expected", [
     ([0, .5, 1], [0, .25, .5, .75, 1], "omega2", [0, .25, .5, .75, 1]),
     ([0, .5, 1], [0, .25, .5, .75, 1], "omega1", [0, .5, 1]),

@@ -26,6 +26,11 @@ EPS = np.finfo(float).eps
 N1, N2 = 3, 4
 
 
+def contact_cases() -> list:
+    """The QUAD8-face spaces with one basis (a Petrov–Galerkin pair has two: no contact solve)."""
+    return [c for c in quad8_cases(2) if not SPACES[c].petrov_galerkin]
+
+
 @pytest.fixture(scope="module")
 def pair():
     return face_patch.patch_pair(2, N1, N2, element="hex20")
@@ -36,7 +41,7 @@ def rows(pair):
     """One row per QUAD8-face space, with the round-off bounds of its solve (see the test)."""
     out = []
     n_kappa_a = max(np.linalg.cond(s.stiffness.toarray()) * s.ndof for s in pair.sides)
-    for case in quad8_cases(2):
+    for case in contact_cases():
         row = face_patch.solve_face_patch(case, 2, N1, N2, element="hex20", pair=pair)
         ev = np.linalg.eigvalsh(solve_contact_on(pair, case, "omega2", time_floor=False).K)
         row["lambda_bound"] = row["dim_M"] * EPS * ev[-1] / ev[0] if row["kernel_dim"] == 0 else np.inf
@@ -52,7 +57,7 @@ def test_every_quad8_space_passes_iff_it_holds_the_constants_and_k_has_no_kernel
     (n_i free dofs of side i). A
     space holding 1 without a kernel stays inside these bounds; one lacking 1 (T3 vanishing on ∂Γ,
     the QUAD8 ones with the ∂Γ nodes dropped) misses λ by order 1."""
-    assert {r["case"] for r in rows} == set(quad8_cases(2))
+    assert {r["case"] for r in rows} == set(contact_cases())
     for r in rows:
         if r["predicted"] and r["kernel_dim"] == 0:
             assert r["lambda_max_rel_error"] <= r["lambda_bound"] < face_patch.PASS_RTOL, r
@@ -127,6 +132,10 @@ def test_hostile_requests_are_refused_in_one_line():
         code, _, err = run_in_process(["contact", "--model", "membranes3d", "--scene", FACE_PATCH.id, "--case",
                                        "T5", "--k", str(k), "--N1", "2", "--N2", "3", "--element", "hex20"])
         assert code == 2 and len(err.strip().splitlines()) == 1 and "--k" in err, err
+    pairs = [c for c in quad8_cases(2) if SPACES[c].petrov_galerkin]
+    for case in pairs:  # two bases: the contact solve refuses the pair, naming it
+        with pytest.raises(InputError, match="case"):
+            face_patch.solve_face_patch(case, 2, 2, 3, element="hex20")
     body = subdomain_mesh("structured", 2, 1, element="hex20")
     with pytest.raises(InputError, match="element"):  # supports a HEX20 side does not have
         MEMBRANES3D.scene_side(SimpleNamespace(supports="side"), body, 2)
@@ -143,5 +152,5 @@ def test_the_command_runs_every_quad8_space():
     assert code == 0, err
     lines = out.splitlines()
     rows = [dict(zip(lines[0].split(","), line.split(","))) for line in lines[1:]]
-    assert [r["case"] for r in rows] == quad8_cases(2)
+    assert [r["case"] for r in rows] == contact_cases()
     assert all(r["passes"] == r["predicted"] for r in rows if r["kernel_dim"] == "0")

@@ -24,4 +24,6 @@ CASE_STYLES = MappingProxyType({
     "TDUAL-Q8": ("orange", ">"), "TDUAL-Q9": ("bluish_green", "8"), "PWLIN-Q9": ("reddish_purple", "p"),
     "DUAL-T6": ("vermillion", "h"), "TDUAL-T6": ("bluish_green", "d"), "PWLIN-T6": ("reddish_purple", "H"),
     "Q8": ("blue", "s"), "Q8-ALL": ("sky_blue", "s"), "LIN0-Q8": ("bluish_green", "o"), "DISC-P1": ("vermillion", "v"),
+    "LINDUAL0-Q8": ("reddish_purple", "^"), "LINDUAL-Q8": ("yellow", "^"), "PGLIN0-Q8": ("black", "D"),
+    "PGLIN-Q8": ("sky_blue", "D"),
 })

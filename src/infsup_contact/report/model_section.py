@@ -32,8 +32,23 @@ def model_section_tex(name: str, entry: dict, beta: pd.DataFrame, claims: pd.Dat
         rf"Model \texttt{{{model}}} of the model table (\texttt{{config: models.{latex_id(name)}}}): $\beta_h$ "
         rf"of {len(set(beta.case))} multiplier spaces, $k \in \{{{', '.join(map(str, sorted(set(beta.k))))}\}}$, "
         rf"{len(beta)} rows. Of its {len(claims)} ledger claims, {len(checked)} carry a prediction and "
-        rf"{agree} came out as predicted.",
+        rf"{agree} came out as predicted.{_pair_note(beta)}",
         r"\begin{center}", r"\small", matching_beta_table(beta), r"\end{center}", ""])
+
+
+def _pair_note(beta: pd.DataFrame) -> str:
+    """What the entry of a Petrov–Galerkin pair is (:mod:`infsup_contact.solvers.petrov_galerkin`), where the
+    table has one; empty otherwise."""
+    from ..discretization.spaces.registry import SPACES
+
+    pairs = [SPACES[c] for c in dict.fromkeys(beta.case) if c in SPACES and SPACES[c].petrov_galerkin]
+    if not pairs:
+        return ""
+    named = ", ".join(rf"\texttt{{{latex_id(p.id)}}} (trial \texttt{{{latex_id(p.trial_space)}}}, test "
+                      rf"\texttt{{{latex_id(p.test_space)}}})" for p in pairs)
+    return (rf" For the Petrov--Galerkin pairs {named} the entry is $\sqrt{{\gamma_h}}$, "
+            r"$\gamma_h = \sigma_{\min}(L_N^{-1} B_N A^{-1} B_M^T L_M^{-T})$ with $G = L L^T$ the Gram matrices "
+            r"of trial space $M$ and test space $N$: $\beta_h$ itself when $N = M$.")
 
 
 def sections_index_tex(names) -> str:

@@ -29,9 +29,10 @@ from ..models import DEFAULT_MODEL
 from .interface_operator import combine_terms, interface_terms
 from .kernel import kernel_check
 from .modes import worst_modes
+from . import petrov_galerkin
 from .request import NO_OPTIONS, BetaRequest, MeshOptions
 from .routes import choose_route, is_large
-from .side_cache import SideCache
+from .side_cache import GramCache, SideCache
 
 
 def beta_table(request: BetaRequest, side_cache: SideCache | None = None, modes: list | None = None) -> list:
@@ -73,23 +74,31 @@ def beta_table(request: BetaRequest, side_cache: SideCache | None = None, modes:
                 continue
             found = None if modes is None else []
             by_partition[key] = ([row for case in r.cases
-                                  for row in _case_rows(r, case, g_h, sides, dim_w, trace_norms, found)], found)
+                                  for row in _case_rows(r, case, g_h, sides, dim_w, trace_norms, found,
+                                                        cache.grams)], found)
             if modes is not None:
                 modes += [replace(m, keys={**m.keys, "multiplier_mesh": multiplier_mesh}) for m in found]
             rows += [dict(row, multiplier_mesh=multiplier_mesh, t_interface=t_sides) for row in by_partition[key][0]]
     return rows
 
 
-def _case_rows(r: BetaRequest, case, g_h, sides, dim_w: int, trace_norms, modes: list | None = None) -> list:
-    """The rows of one case on G_h: M_h, its couplings B_i and Grams G, its route, then per
-    (c1, c2) the interface operator S and the bottom of S m = β² G m for every norm (and its
-    worst mode, appended to ``modes`` where given)."""
+def _case_rows(r: BetaRequest, case, g_h, sides, dim_w: int, trace_norms, modes: list | None = None,
+               grams: GramCache | None = None) -> list:
+    """The rows of one case on G_h: M_h, its couplings B_i and Grams G (from the sweep's ``grams``
+    where an earlier pair built them), its route, then per (c1, c2) the interface operator S and the
+    bottom of S m = β² G m for every norm (and its worst mode, appended to ``modes`` where given).
+    A Petrov–Galerkin pair (trial ≠ test space) is :mod:`.petrov_galerkin`'s."""
+    spec = registry.SPACES.get(case) if isinstance(case, str) else case
+    if isinstance(spec, SpaceSpec) and spec.petrov_galerkin:                     # trial M ≠ test N
+        return [_row(r, case, **fields) for fields in petrov_galerkin.pair_rows(r, spec, g_h, sides, dim_w, modes,
+                                                                                          grams)]
     gamma = sides[0].trace.gamma
     space = _space(case, r.k, g_h, gamma)                                          # M_h on G_h
     tc = time.perf_counter()
     couplings = [coupling_matrix(s.trace, space, r.k, sparse=is_large(space)) for s in sides]  # B_i
     t_coupling = time.perf_counter() - tc
-    grams = {norm: gamma.gram(space, norm, h_route=r.h_route) for norm in r.norms}      # G per norm
+    grams = GramCache() if grams is None else grams
+    grams = {norm: grams.gram(gamma, case, r.k, g_h, space, norm, r.h_route) for norm in r.norms}  # G per norm
     structural = gamma.proven_kernel(space, r.k, [s.trace for s in sides], dim_w)
     route = choose_route(space, couplings, sides, grams, structural, g_h, r.k, trace_norms, vectors=modes is not None)
     terms = interface_terms(couplings, sides)                                      # B_i X_i B_iᵀ
@@ -109,7 +118,8 @@ def _case_rows(r: BetaRequest, case, g_h, sides, dim_w: int, trace_norms, modes:
 def _row(r, case, c1, c2, norm, spec, kernel, structural, beta_v1_zero, dim_m, dim_w, info, ndof,
          t_assemble, t_eig) -> dict:
     """One row of ``infsup-contact beta`` (its columns, in order; ``multiplier_mesh`` and
-    ``t_interface`` set by :func:`beta_table`)."""
+    ``t_interface`` set by :func:`beta_table`; a Petrov–Galerkin pair's meaning of each:
+    :mod:`.petrov_galerkin`)."""
     return dict(case=registry.case_name(case), k=r.k, family=r.family, N1=r.n1, N2=r.n2, multiplier_mesh=None,
                 c1=c1, c2=c2, norm=norm, beta=spec.beta, kernel_dim=spec.kernel_dim,
                 structural_kernel_dim=structural, kernel_detected=kernel.detected,

@@ -20,6 +20,7 @@ from ..discretization.segment.norms import NORMS
 from ..errors import InputError, check_prestress
 from ..models import DEFAULT_MODEL
 from ..models.contract import Model
+from .petrov_galerkin import check_pair_size
 
 
 @dataclass(frozen=True)
@@ -102,6 +103,7 @@ class BetaRequest:
         for mm in self.multiplier_meshes:
             check_choice(mm)
             registry.check_pair_spaces(ids, self.k, self.n1, self.n2, (mm,))  # dim M_h = 0: refused here
+            check_pair_size(ids, self.k, self.n1, self.n2, mm)  # a Petrov–Galerkin pair is solved densely
 
 
 def check_mesh_option(model, name: str, value) -> None:

@@ -1,4 +1,4 @@
-"""Side operators shared by the mesh pairs of one sweep (one process, e.g. one β_h batch).
+"""Side operators and Gram matrices shared by the mesh pairs of one sweep (one process, e.g. one β_h batch).
 
 A side operator (:mod:`infsup_contact.models.contract`) depends on its own mesh and k only,
 and the mesh of Ω_i is addressed by (family, N_i, side, mesh parameters), never by the other
@@ -12,10 +12,24 @@ the β_h study's 32 pairs, 34 are distinct.
 it holds only the operators still to be reused; a pair it was not told of is built and not
 kept. The operators are deterministic functions of their key, so a cached one is the one a
 fresh build would give (the β_h rows are bitwise identical either way; tested).
+
+The Gram matrix G of a multiplier space in a norm of Γ depends on Γ, the space's definition
+(case, k) and its partition G_h only — never on the bodies. The pairs of a sweep repeat
+partitions: G_h = the trace of Ω2 is the same for N:N and N+1:N, for the matching and the
+non-matching pair of one N2, for every (c1, c2). On the faces' triangles the H Gram is a
+Richardson-extrapolated double sine series, most of a row's cost, so it is built once per
+(Γ, case, k, G_h, norm, route).
+
+:class:`GramCache` keeps each Gram (and its ``info``) read-only, so that no consumer can change
+what the next pair will be given; the computation is deterministic, so a cached Gram is
+bit for bit the one a fresh call would give (tested). It holds at most :data:`MAX_BYTES` of
+matrices and forgets the oldest first.
 """
 from __future__ import annotations
 
-from collections import Counter
+from collections import Counter, OrderedDict
+
+import numpy as np
 
 from .request import NO_OPTIONS, MeshOptions
 
@@ -32,6 +46,7 @@ class SideCache:
     def __init__(self):
         self._ops = {}
         self._uses_left = Counter()
+        self.grams = GramCache()  # the sweep's Grams (the pairs repeat G_h)
 
     @classmethod
     def for_sweep(cls, model, family: str, k: int, pairs, mesh: MeshOptions = NO_OPTIONS) -> "SideCache":
@@ -66,3 +81,46 @@ class SideCache:
 
     def __len__(self) -> int:
         return len(self._ops)
+
+
+MAX_BYTES = 64 * 2**20
+"""Bound on the cached matrices' memory (bytes): a small share of any job's memory estimate."""
+
+
+class GramCache:
+    """Grams by (Γ, case, k, partition key, norm, H route), each computed once."""
+
+    def __init__(self, max_bytes: int = MAX_BYTES):
+        self._grams = OrderedDict()
+        self._bytes = 0
+        self.max_bytes = int(max_bytes)
+        self.hits = 0
+
+    def gram(self, gamma, case, k: int, partition, space, norm: str, h_route: str) -> tuple:
+        """``gamma.gram(space, norm, h_route=h_route)``, from the cache when an equal
+        (Γ, case, k, G_h, norm, route) was asked before. ``case`` must identify the space's
+        definition (a registry id, a spec, a triple). Not cached: an unhashable Γ or case, a Gram
+        that is not a dense array or above a quarter of :attr:`max_bytes`."""
+        try:
+            key = (gamma, case, int(k), gamma.partition_key(partition), norm, h_route)
+            hash(key)
+        except TypeError:
+            return gamma.gram(space, norm, h_route=h_route)
+        hit = self._grams.get(key)
+        if hit is not None:
+            self._grams.move_to_end(key)
+            self.hits += 1
+            return hit
+        G, info = gamma.gram(space, norm, h_route=h_route)
+        if not isinstance(G, np.ndarray) or 4 * G.nbytes > self.max_bytes:
+            return G, info
+        G.setflags(write=False)  # shared by later pairs: nobody may change it
+        self._grams[key] = (G, info)
+        self._bytes += G.nbytes
+        while self._bytes > self.max_bytes:
+            _, (old, _) = self._grams.popitem(last=False)
+            self._bytes -= old.nbytes
+        return G, info
+
+    def __len__(self) -> int:
+        return len(self._grams)

@@ -25,6 +25,7 @@ import time
 import numpy as np
 import pandas as pd
 
+from ..discretization.face.square import CELL_BODIES
 from ..discretization.spaces import registry
 from ..discretization.spaces.spec import SpaceSpec
 from ..errors import InputError
@@ -162,7 +163,8 @@ def check_model_case(case: str, k: int, model, family: str = "structured", mesh:
     if case in allowed:
         return
     if not gamma.builds(spec):
-        why = (f"built on {', '.join(spec.face_cells)} face cells only" if gamma.cell is not None
+        bodies = " and ".join(CELL_BODIES.get(c, c) for c in spec.face_cells)
+        why = (f"built on the faces of {bodies} only" if gamma.cell is not None
                else "not built on a general triangulation of Γ: only Lagrange cases and their duals are")
     else:
         try:

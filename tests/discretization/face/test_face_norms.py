@@ -95,3 +95,14 @@ def test_norm2_above_the_short_krylov_gate_agrees_with_lapack():
     for A in (X @ X.T + np.diag(np.linspace(0, 1, n)), (X + X.T) - np.diag(np.linspace(-2, 1, n))):
         exact = np.max(np.abs(np.linalg.eigvalsh(A)))
         assert abs(richardson._norm2(A) / exact - 1) < 1e-8
+
+
+@pytest.mark.parametrize("aspect", [1.0, 0.37, 0.05])
+def test_in_place_weights_are_the_formula_bit_for_bit(aspect):
+    """W[m, n] = a / (π√((m/a)² + n²)) formed in place equals the formula evaluated plainly."""
+    from infsup_contact.discretization.face.norms.tensor import _weights
+
+    n = np.arange(1, 1201, dtype=float)
+    m = n[512:1024]
+    plain = aspect / (np.pi * np.sqrt((m[:, None] / aspect) ** 2 + n[None, :] ** 2))
+    assert np.array_equal(_weights(m, n ** 2, aspect), plain)

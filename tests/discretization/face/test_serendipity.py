@@ -15,7 +15,7 @@ from infsup_contact.discretization.spaces.registry import SPACES, ids_built_on, 
 from infsup_contact.models import hex20
 from infsup_contact.models.membranes3d import MEMBRANES3D
 
-QUAD8_SPACES = ["TDUAL-Q8", "Q8", "Q8-ALL", "LIN0-Q8", "DISC-P1"]
+QUAD8_SPACES = ["TDUAL-Q8", "Q8", "Q8-ALL", "LIN0-Q8", "DISC-P1", "LINDUAL0-Q8", "LINDUAL-Q8", "PGLIN0-Q8", "PGLIN-Q8"]
 
 
 def grid(n):
@@ -26,13 +26,15 @@ def predicted_kernel(case, n):
     """Kernel of Bᵀ on matching n × n meshes, k = 2: dim M − dim W, dim W = (3n − 1)(n − 1), written
     before the runs (QUAD9-type spaces: M ⊃ W, so exactly the count); T4 / T5, whose count is 0, showed
     modes in the first run, since proven from the tensor structure (the checkerboard, the four
-    corner products a ⊗ b; :func:`~infsup_contact.discretization.face.serendipity.tensor_modes`)."""
+    corner products a ⊗ b; :func:`~infsup_contact.discretization.face.serendipity.tensor_modes`). The linear
+    dual on all vertices (LINDUAL-Q8) and its Petrov–Galerkin pair PGLIN-Q8: the four corner products of the
+    1D end duals, orthogonal to every interior hat (predicted before the run, from tensor_modes)."""
     dim_w = (3 * n - 1) * (n - 1)
     count = {"T3": (2 * n - 1) ** 2, "DUAL": (2 * n - 1) ** 2, "R5.2": (2 * n + 1) ** 2,
              "DUAL-ALL": (2 * n + 1) ** 2, "R5.4": 4 * n * n, "Q8": dim_w, "TDUAL-Q8": dim_w,
              "Q8-ALL": 3 * n * n + 4 * n + 1, "DISC-P1": 3 * n * n,
-             "LIN0-Q8": (n - 1) ** 2}
-    return {"T4": 1, "T5": 4}.get(case, max(count.get(case, 0) - dim_w, 0))
+             "LIN0-Q8": (n - 1) ** 2, "LINDUAL0-Q8": (n - 1) ** 2, "PGLIN0-Q8": (n - 1) ** 2}
+    return {"T4": 1, "T5": 4, "LINDUAL-Q8": 4, "PGLIN-Q8": 4}.get(case, max(count.get(case, 0) - dim_w, 0))
 
 
 def test_the_quad8_face_builds_the_tensor_spaces_and_the_quad8_ones_only():

@@ -36,6 +36,9 @@ from ..gamma.quadrature import gauss_legendre
 CELL_SHAPES = ("quad", "trig", "quad8")
 """Boundary cells of a face: rectangles of Q_k hexahedra, their Kuhn triangles, QUAD8 rectangles of
 serendipity HEX20 bodies (:mod:`.face.serendipity`)."""
+CELL_BODIES = {"quad": "hexahedra (element hex)", "trig": "tetrahedra (element tet)",
+               "quad8": "serendipity HEX20 bodies (element hex20)"}
+"""The bodies whose traces each face cell is, for the one-line refusal of a space on other bodies."""
 
 
 @dataclass(frozen=True)
@@ -311,8 +314,9 @@ class Square(Interface):
             raise InputError("multiplier mesh", f"a tensor partition of Γ with at least one rectangle "
                              f"(case {spec.id}, k = {k})")
         if not self.builds(spec):
-            raise InputError("case", f"a space defined on faces of {self.cell} cells ({spec.id} pairs with "
-                             f"{', '.join(spec.face_cells)} faces)", got=spec.id)
+            own = " and ".join(CELL_BODIES.get(c, c) for c in spec.face_cells)
+            raise InputError("case", f"a space defined on the faces of {CELL_BODIES.get(self.cell, self.cell)} "
+                             f"({spec.id} is built on the faces of {own} only)", got=spec.id)
         if spec.face_build is not None:
             return spec.face_build(k, partition)
         s, dual = int(spec.degree(k)), spec.dual

@@ -9,6 +9,7 @@ from ..face.spaces.cellwise import DiscontinuousP1Space, cellwise_builder
 from ..face.spaces.reference_elements import reference_element
 from ..face.spaces.tri6 import triangle_builder
 from ..face.spaces.tensor import FaceSpace
+from ..segment.dual import dual_space
 from ..segment.multipliers import make_space
 from .spec import SpaceSpec
 
@@ -40,6 +41,23 @@ def _interior_q1(k, partition):  # continuous Q1 vanishing on ∂Γ: the tensor 
     return FaceSpace(*(make_space(g, 1, True, True) for g in (partition.xs, partition.ys)), partition)
 
 
+def _dual_q1(vanish: bool):
+    """The tensor product of the 1D dual bases of continuous P1 (:func:`~..segment.dual.dual_space`, k = 1) on
+    the vertices of G_h: ∫ψ_j φ_k = δ_jk ∫φ_k against the Q1 hats; ``vanish``: the ∂Γ vertices dropped, the
+    end intervals' dual functions constant (Σ ψ_j = 1 kept), as DUAL does."""
+    def build(k, partition):
+        return FaceSpace(*(dual_space(g, 1, vanish) for g in (partition.xs, partition.ys)), partition)
+    return build
+
+
+def _linear_spec(id, ref, definition, build, dimension, expected, nodal=True, pair=(None, None)):
+    """A space of degree 1 on the vertices of G_h against QUAD8 traces (HEX20 bodies, k = 2 only);
+    ``pair``: (trial id, test id) of a Petrov–Galerkin pair (its ``build`` the trial space's)."""
+    return SpaceSpec(id, ref, definition, None, lambda k: 1, min_k=2, expected=expected, dimension=dimension,
+                     nodal_basis=nodal, claim_tag=id, gamma_dims=(2,), face_build=build, face_cells=("quad8",),
+                     trial_space=pair[0], test_space=pair[1])
+
+
 _TDUAL_Q8 = "use case TDUAL-Q8 (the transformed dual basis, Popp et al. 2012, α = 1/5)"
 _TDUAL_T6 = "use case TDUAL-T6 (the transformed dual basis, Popp et al. 2012, α = 1/5)"
 
@@ -69,15 +87,31 @@ FACE_SPACES = (
                "QUAD8", "standard", lambda k, n: _interior(n) - n * n, expected="stable", cells=("quad8",)),
     _face_spec("Q8-ALL", "standard mortar on QUAD8 faces, all nodes", "continuous QUAD8 on all nodes", "QUAD8",
                "standard", lambda k, n: _quad8_nodes(n), vanish=False, expected="unstable", cells=("quad8",)),
-    # the linear multiplier on the vertices of G_h (MOOSE lm_space = LINEAR, CalculiX LINMORTAR) is
-    # T5 at k = 2 (continuous Q1, ∂Γ included); this one drops the ∂Γ vertices, as T3 / Q8 do
-    SpaceSpec("LIN0-Q8", "linear mortar on QUAD8 faces, ∂Γ vertices dropped", "continuous Q1 on the interior "
-              "vertices of G_h", None, lambda k: 1, min_k=2, expected="stable", dimension=lambda k, n: (n - 1) ** 2,
-              claim_tag="LIN0-Q8", gamma_dims=(2,), face_build=_interior_q1, face_cells=("quad8",)),
+    # the linear multiplier on the vertices of G_h: MOOSE's lm_space = LINEAR is T5 at k = 2 (continuous Q1,
+    # ∂Γ included); this one drops the ∂Γ vertices, as T3 / Q8 do
+    _linear_spec("LIN0-Q8", "linear mortar on QUAD8 faces, ∂Γ vertices dropped", "continuous Q1 on the interior "
+                 "vertices of G_h", _interior_q1, lambda k, n: (n - 1) ** 2, "stable"),
     # dim 3N² > dim W_h = 3N² − 4N + 1: at least 4N − 1 zero modes on matching meshes
     SpaceSpec("DISC-P1", "discontinuous P1 on QUAD8 faces", "discontinuous P1 on every rectangle of G_h", None,
               lambda k: 1, min_k=2, expected="unstable", dimension=lambda k, n: 3 * n * n, nodal_basis=False,
               claim_tag="DISC-P1", gamma_dims=(2,), face_build=lambda k, partition: DiscontinuousP1Space(partition),
               face_cells=("quad8",)),
+    # CalculiX LINMORTAR: the dual basis of Q1 on the vertices (the mid-nodes ignored). Without the ∂Γ
+    # vertices (constants kept) it is Wohlmuth's modified dual of Q1_0 ⊂ W_h: stable; with them the four
+    # corner products ψ_0 ⊗ ψ_0, … are orthogonal to every interior hat, hence to W_h (tensor_modes): 4 modes
+    _linear_spec("LINDUAL0-Q8", "CalculiX LINMORTAR, ∂Γ vertices dropped (Wohlmuth 2000)", "dual basis of Q1 on the "
+                 "interior vertices of G_h, constants kept", _dual_q1(True), lambda k, n: (n - 1) ** 2, "stable",
+                 nodal=False),
+    _linear_spec("LINDUAL-Q8", "CalculiX LINMORTAR", "dual basis of Q1 on all vertices of G_h", _dual_q1(False),
+                 lambda k, n: (n + 1) ** 2, "unstable", nodal=False),
+    # CalculiX PGLINMORTAR: λ_h in the linear dual space, the constraint tested with the standard Q1 hats
+    # (solvers/petrov_galerkin.py). Without the ∂Γ vertices no proof either way (a finding); with them the
+    # trial space's four corner modes are in the kernel of B_N A⁻¹ B_Mᵀ
+    _linear_spec("PGLIN0-Q8", "CalculiX PGLINMORTAR, ∂Γ vertices dropped", "λ_h in LINDUAL0-Q8, tested with "
+                 "LIN0-Q8 (Petrov–Galerkin)", _dual_q1(True), lambda k, n: (n - 1) ** 2, "unknown", nodal=False,
+                 pair=("LINDUAL0-Q8", "LIN0-Q8")),
+    _linear_spec("PGLIN-Q8", "CalculiX PGLINMORTAR", "λ_h in LINDUAL-Q8, tested with T5 (continuous Q1 on all "
+                 "vertices; Petrov–Galerkin)", _dual_q1(False), lambda k, n: (n + 1) ** 2, "unstable", nodal=False,
+                 pair=("LINDUAL-Q8", "T5")),
 )
 """The face-only entries, in registration order."""

@@ -14,6 +14,7 @@ from __future__ import annotations
 import numpy as np
 
 from ...errors import InputError
+from ..face.square import CELL_BODIES
 from ..gamma.interface import MULTIPLIER_MESHES
 from ..segment.dual import dual_space
 from ..segment.interface import SEGMENT
@@ -26,9 +27,13 @@ SPACES: dict[str, SpaceSpec] = {}
 
 
 def register(spec: SpaceSpec) -> SpaceSpec:
-    """Add a space to the registry; an id can be registered once."""
+    """Add a space to the registry; an id can be registered once, a Petrov–Galerkin pair after its
+    trial and test spaces."""
     if spec.id in SPACES and SPACES[spec.id] is not spec:
         raise InputError("space", f"an id not yet registered ({', '.join(SPACES)})", got=spec.id)
+    for role in ("trial_space", "test_space") if spec.petrov_galerkin else ():
+        if getattr(spec, role) not in SPACES:
+            raise InputError(role, f"a registered id ({', '.join(SPACES)})", got=getattr(spec, role))
     SPACES[spec.id] = spec
     return spec
 
@@ -87,12 +92,14 @@ def check_case(case: str, k: int) -> None:
         raise InputError("k", f"k >= {spec.min_k} for case {case} ({spec.paper_ref} needs k >= {spec.min_k})")
 
 
-def case_space(case: str, k: int, partition, gamma=SEGMENT) -> SegmentSpace:
+def case_space(case: str, k: int, partition, gamma=SEGMENT, pair: bool = False) -> SegmentSpace:
     """The multiplier space of a registered case for displacement degree k on G_h, a
     ``partition`` of Γ = ``gamma`` (:mod:`.gamma.interface`; for the paper's segment the sorted
     breakpoints of G_h, what ``SpaceSpec.build(k, x)`` receives; for the face
     :class:`~.face.square.Square` a tensor partition, on which the space is the tensor product of
-    the 1D builds, :meth:`~.gamma.interface.Interface.space`).
+    the 1D builds, :meth:`~.gamma.interface.Interface.space`). A Petrov–Galerkin pair (``trial_space``,
+    ``test_space``) is refused after those checks unless ``pair`` (its caller knows it has two bases):
+    then its trial space is returned.
 
     Raises
     ------
@@ -103,14 +110,19 @@ def case_space(case: str, k: int, partition, gamma=SEGMENT) -> SegmentSpace:
     check_case(case, k)
     spec = SPACES[case]
     if not spec.defined_on(gamma.dim):
+        bodies = " and ".join(CELL_BODIES.get(c, c) for c in spec.face_cells)
         raise InputError("case", f"a space defined on this Γ (dimension {gamma.dim}): {case} ({spec.paper_ref}) is "
-                         f"defined on the face of a 3D model only (e.g. --model membranes3d)", got=case)
+                         f"defined on the face of a 3D model only, on {bodies} (e.g. --model membranes3d)", got=case)
     space = gamma.space(spec, k, partition)  # the interface builds it (a face: tensor products)
     n = gamma.cells(space.breakpoints)
     if space.dim < 1:
         low = min_intervals(case, k)
         raise InputError("N", f"a multiplier mesh on which case {case} with k = {k} is not empty (dim M_h = 0 "
                          f"on N = {n} intervals{'' if low is None else f'; it needs N >= {low}'})", got=n)
+    if spec.petrov_galerkin and not pair:  # two bases: a consumer of one would silently take the trial space's
+        raise InputError("case", f"a space with one basis for trial and test ({case} is the Petrov–Galerkin "
+                         f"pair {spec.trial_space} × {spec.test_space}: infsup-contact beta and verdict only)",
+                         got=case)
     return space
 
 

@@ -81,6 +81,12 @@ class SpaceSpec:
     dual : bool
         With ``lagrange``: the space is the dual (biorthogonal) basis of that Lagrange space
         (:mod:`.segment.dual`; on triangles :class:`~.face.spaces.triangles.TriangleSpace` with ``dual=True``).
+    trial_space, test_space : str or None
+        A Petrov–Galerkin pair (both set): λ_h in the registered space ``trial_space`` M, the
+        constraint b(v, μ) tested with μ in the registered space ``test_space`` N, dim M = dim N
+        (CalculiX's PGLINMORTAR). ``build``/``face_build`` and ``dimension`` are the trial space's
+        (what sizes the pair); β_h is :mod:`infsup_contact.solvers.petrov_galerkin`'s, and a consumer
+        that needs one basis refuses the pair (``registry.case_space``). None: one space for both.
     """
 
     id: str
@@ -99,8 +105,13 @@ class SpaceSpec:
     face_cells: tuple = ("quad", "trig", "quad8")
     lagrange: tuple | None = None
     dual: bool = False
+    trial_space: str | None = None
+    test_space: str | None = None
 
     def __post_init__(self):
+        if (self.trial_space is None) != (self.test_space is None):
+            raise InputError("space", "both trial_space and test_space (a Petrov–Galerkin pair) or neither",
+                             got=self.id)
         if self.build is None and self.defined_on(1):
             raise InputError("space", f"a build(k, breakpoints) for a space of the segment (gamma_dims "
                              f"{self.gamma_dims}), or gamma_dims=(2,) for a space of the face only", got=self.id)
@@ -123,6 +134,11 @@ class SpaceSpec:
     @property
     def tag(self) -> str:
         return self.claim_tag or self.paper_ref.replace(" ", "")
+
+    @property
+    def petrov_galerkin(self) -> bool:
+        """Whether the entry is a Petrov–Galerkin pair (trial space ≠ test space)."""
+        return self.test_space is not None
 
     @property
     def stable(self) -> bool:

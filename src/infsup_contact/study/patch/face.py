@@ -60,7 +60,8 @@ the QUAD8 face builds, ``Interface.builds``). u is linear, so it lies in serendi
 argument above holds unchanged: the test passes iff 1 ∈ M_h (``spans_constants`` on the face
 space) and K has no kernel. *Prediction* (written before the table was run): T3, Q8 and LIN0-Q8
 vanish on ∂Γ and fail; T4, T5, DUAL, DUAL-ALL, TDUAL-Q8, Q8-ALL, DISC-P1, R5.2, R5.4 hold 1 and
-pass where K has no kernel. QUAD8's consistent nodal forces of a uniform pressure are negative at
+pass where K has no kernel. A Petrov–Galerkin pair (PGLIN0-Q8, PGLIN-Q8: two bases) has no
+contact solve here; it is refused naming ``case``. QUAD8's consistent nodal forces of a uniform pressure are negative at
 the corners (∫N_corner = −|cell|/12, ∫N_mid = |cell|/3), but every registered cone is on the
 multiplier's coefficients (nodal values, pointwise values, dual or discontinuous coefficients),
 and the coefficients of the constant are λ·1 > 0 in each basis that holds it (nodal bases
@@ -77,7 +78,8 @@ before the table: 4 for R5.2 and DUAL-ALL, 1 for R5.4 on 4:5 and 7:8 (16, 16, 9 
 matching 4:4), 0 for the rest. A kernel leaves u_h exact and λ_h to the PDAS's minimum-norm choice.
 
 *Outcome* (N1:N2 = 4:5, 7:8 and 4:4, G_h = trace of Ω2; 36 rows, 2.5 s): as predicted. T4, T5,
-DUAL, TDUAL-Q8, Q8-ALL, DISC-P1 reproduce λ to ≤ 5e-10 and u to ≤ 2e-14 of δ (DUAL at 4:4, with
+DUAL, TDUAL-Q8, Q8-ALL, DISC-P1 (and CalculiX's LINMORTAR duals LINDUAL0-Q8, LINDUAL-Q8, registered
+later: predicted PASS, count 0, then ≤ 1.3e-13 on the three pairs) reproduce λ to ≤ 5e-10 and u to ≤ 2e-14 of δ (DUAL at 4:4, with
 its 4 modes, excepted: λ error 1.4); T3, Q8, LIN0-Q8 fail (λ error 1.0–1.7, u error 1–8e-2 δ).
 The kernel rows keep u to ≤ 6e-13 but not λ: R5.2 (0.45), DUAL-ALL (2.4); R5.4's modes are
 orthogonal to 1 (λ error 8e-13 on 4:4 with 9 modes) but ill-separated on 4:5 and 7:8 (7e-9, and 5e-8

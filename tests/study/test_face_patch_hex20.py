@@ -154,3 +154,11 @@ def test_the_command_runs_every_quad8_space():
     rows = [dict(zip(lines[0].split(","), line.split(","))) for line in lines[1:]]
     assert [r["case"] for r in rows] == contact_cases()
     assert all(r["passes"] == r["predicted"] for r in rows if r["kernel_dim"] == "0")
+
+
+def test_the_dag_table_leaves_the_petrov_galerkin_pairs_out():
+    """A pair in ``face.cases`` (two bases: β_h only) is skipped by the patch table, not an error."""
+    from infsup_contact.study.patch.face import face_patch_table
+
+    rows = face_patch_table(["T4", "PGLIN0-Q8"], [2], [(2, 3)], ["hex20"])
+    assert [r["case"] for r in rows] == ["T4"] and rows[0]["passes"]

@@ -263,14 +263,16 @@ def face_patch_table(cases, ks, pairs, elements, model: str | None = None) -> li
     that element's face builds (``Interface.builds``: the QUAD9-element spaces pair with
     rectangles only, the QUAD8 ones with HEX20 bodies) and to the ``ks`` its bodies have
     (``Interface.allows``: HEX20 k = 2 only; the config check refuses an element with none of
-    them), every non-matching pair."""
+    them), every non-matching pair. A Petrov–Galerkin pair (two bases: a β_h question only, the
+    contact solve has one) is left out, as ``contact --case all`` leaves it out."""
     from ..claims.membranes3d import element_interfaces
 
     name = FACE_PATCH.models[0] if model is None else model
     gammas = element_interfaces(name, elements)
     rows = []
     for element in elements:
-        own = [c for c in cases if gammas[element].builds(registry.space_spec(c))]
+        own = [c for c in cases if gammas[element].builds(registry.space_spec(c))
+               and not registry.space_spec(c).petrov_galerkin]
         own_ks = [k for k in ks if gammas[element].allows(int(k))]
         rows += face_patch_rows(own, own_ks, pairs, element=element, model=make_model(name))
     return rows

@@ -117,10 +117,12 @@ def pair_rows(r, spec, g_h, sides, dim_w: int, modes: list | None = None, grams=
     out = []
     for c1, c2 in r.c_pairs:
         S = terms[0] / c1 + terms[1] / c2
-        kernel = kernel_decision(_reduced_singular(S, *factors[KERNEL_NORM])[0], structural)
+        s_kernel = _reduced_singular(S, *factors[KERNEL_NORM])
+        kernel = kernel_decision(s_kernel[0], structural)
         for norm in r.norms:
             te = time.perf_counter()
-            s, vt = _reduced_singular(S, *factors[norm], vectors=modes is not None)
+            reuse = norm == KERNEL_NORM and modes is None  # the kernel's SVD is this row's: not twice
+            s, vt = s_kernel if reuse else _reduced_singular(S, *factors[norm], vectors=modes is not None)
             spectrum = _spectrum(s, kernel.dim)
             info = [i for _, i in both[norm]]
             out.append(dict(fixed, c1=c1, c2=c2, norm=norm, spec=spectrum, kernel=kernel,

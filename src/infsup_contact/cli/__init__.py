@@ -32,7 +32,7 @@ import sys
 
 from ..errors import InputError
 from ..io import TableError
-from . import beta, bench, contact, export, rates, verdict, verdict_hook
+from . import beta, bench, contact, export, rates, reporting, verdict, verdict_hook
 from .common import EXIT_INTERRUPTED, EXIT_OUTPUT, OutputError, check_stdout, given_dests, refuse_unused, write_text
 from .verdict import VERDICT_DEFAULTS
 
@@ -85,6 +85,8 @@ def build_parser() -> argparse.ArgumentParser:
     verdict_hook.add(sub)
     export.add(sub)
     _add_provenance(sub)
+    for command in sub.choices.values():  # every subcommand: --quiet (no progress on stderr)
+        reporting.add_quiet(command)
     return parser
 
 
@@ -165,7 +167,7 @@ def _main(argv) -> int:
                        + (f" (available memory {human_bytes(avail)})" if avail is not None else "") + "\n")
             return 0
         _fit_blas_threads()
-        code = args.run(args)
+        code = reporting.run(args)  # args.run with its progress on stderr (not --quiet)
     except (InputError, TableError) as err:
         _say(f"infsup-contact: error: {_message(err, parser, args.command)}")
         return 2

@@ -26,6 +26,7 @@ from ..discretization.gamma.coupling import coupling_matrix, trace_l2_norms
 from ..discretization.segment.norms import NORMS
 from ..discretization.segment.interface import SEGMENT
 from ..models import DEFAULT_MODEL
+from .. import progress
 from .interface_operator import combine_terms, interface_terms
 from .kernel import kernel_check
 from .modes import worst_modes
@@ -55,6 +56,7 @@ def beta_table(request: BetaRequest, side_cache: SideCache | None = None, modes:
     r = request
     t0 = time.perf_counter()
     cache = SideCache() if side_cache is None else side_cache
+    progress.note("the two sides")
     sides = cache.pair(r.model, r.family, r.k, r.n1, r.n2, r.mesh)                 # Ω1, Ω2 with Γ last
     t_sides = time.perf_counter() - t0
     gamma = sides[0].trace.gamma
@@ -63,7 +65,8 @@ def beta_table(request: BetaRequest, side_cache: SideCache | None = None, modes:
     trace_norms = [trace_l2_norms(s.trace, r.k) for s in sides]
     rows, by_partition = [], {}
     with gamma.gram_session():  # spaces on one G_h may share their Grams' series
-        for multiplier_mesh in r.multiplier_meshes:
+        for multiplier_mesh in progress.steps(r.multiplier_meshes, "multiplier mesh") \
+                if len(r.multiplier_meshes) > 1 else r.multiplier_meshes:
             g_h = gamma.multiplier_partition(p1, p2, multiplier_mesh)               # G_h
             key = gamma.partition_key(g_h)
             if key in by_partition:
@@ -73,7 +76,7 @@ def beta_table(request: BetaRequest, side_cache: SideCache | None = None, modes:
                     modes += [replace(m, keys={**m.keys, "multiplier_mesh": multiplier_mesh}) for m in by_partition[key][1]]
                 continue
             found = None if modes is None else []
-            by_partition[key] = ([row for case in r.cases
+            by_partition[key] = ([row for case in progress.steps(r.cases, "space", registry.case_name)
                                   for row in _case_rows(r, case, g_h, sides, dim_w, trace_norms, found,
                                                         cache.grams)], found)
             if modes is not None:
@@ -95,17 +98,21 @@ def _case_rows(r: BetaRequest, case, g_h, sides, dim_w: int, trace_norms, modes:
     gamma = sides[0].trace.gamma
     space = _space(case, r.k, g_h, gamma)                                          # M_h on G_h
     tc = time.perf_counter()
+    progress.note("couplings B_1, B_2")
     couplings = [coupling_matrix(s.trace, space, r.k, sparse=is_large(space)) for s in sides]  # B_i
     t_coupling = time.perf_counter() - tc
     grams = GramCache() if grams is None else grams
     grams = {norm: grams.gram(gamma, case, r.k, g_h, space, norm, r.h_route) for norm in r.norms}  # G per norm
     structural = gamma.proven_kernel(space, r.k, [s.trace for s in sides], dim_w)
     route = choose_route(space, couplings, sides, grams, structural, g_h, r.k, trace_norms, vectors=modes is not None)
+    progress.note(f"interface operator ({route.name} route)")
     terms = interface_terms(couplings, sides)                                      # B_i X_i B_iᵀ
     v1_zero = route.betas_v1_zero(terms)
     rows = []
     for c1, c2 in r.c_pairs:
         S = combine_terms(terms, (c1, c2))
+        progress.note(f"eigenproblem S m = β² G m, norm {', '.join(r.norms)}"
+                      + (f", c1={c1:g} c2={c2:g}" if len(r.c_pairs) > 1 else ""))
         spectra, seconds = route.spectra(S, r.norms)  # S m = β² G m
         rows += [_row(r, case, c1, c2, norm, spectra[norm], route.kernel, structural, v1_zero[norm] / np.sqrt(c2),
                       space.dim, dim_w, grams[norm][1], sum(s.ndof for s in sides), t_coupling, seconds[norm])

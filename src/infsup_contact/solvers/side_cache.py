@@ -31,6 +31,7 @@ from collections import Counter, OrderedDict
 
 import numpy as np
 
+from .. import progress
 from .request import NO_OPTIONS, MeshOptions
 
 
@@ -70,6 +71,7 @@ class SideCache:
         op = self._ops.pop(key, None)
         if op is None:
             model, family, k, n, side, mesh = key
+            progress.note(f"side {side} of 2 (N{side}={n}): mesh, stiffness, factorization")
             # the model contract takes the options as keywords: unpacked here, and only here
             op = model.side_operator(model.subdomain_mesh(family, n, side, **mesh.kwargs()), k)
         if self._uses_left[key] > 1:  # more uses announced: keep it for them
@@ -111,6 +113,7 @@ class GramCache:
             self._grams.move_to_end(key)
             self.hits += 1
             return hit
+        progress.note(f"Gram matrix G, norm {norm}")
         G, info = gamma.gram(space, norm, h_route=h_route)
         if not isinstance(G, np.ndarray) or 4 * G.nbytes > self.max_bytes:
             return G, info

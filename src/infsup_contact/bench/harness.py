@@ -34,6 +34,13 @@ slower than this runs once, its spread being small next to its time."""
 
 
 def _log(msg: str) -> None:
+    """A benchmark's line: through the request's progress reporter where one is installed
+    (``infsup-contact bench``; ``--quiet`` silences it), else on stderr as it is."""
+    from .. import progress
+
+    if progress.active():
+        progress.note(msg.strip())
+        return
     print(f"[bench {time.strftime('%H:%M:%S')}] {msg}", file=sys.stderr, flush=True)
 
 

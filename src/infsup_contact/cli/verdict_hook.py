@@ -86,7 +86,9 @@ def check_one(path: str, criterion: dict) -> tuple[int, str]:
 def run_hook(args) -> int:
     criterion = {k: getattr(args, k) for k in ("slope_tolerance", "beta_floor", "confidence")}
     worst = 0
-    for path in args.manifests:
+    from ..progress import steps
+
+    for path in steps(args.manifests, "manifest"):
         code, line = check_one(path, criterion)
         if code == 2:
             print(line, file=sys.stderr, flush=True)

@@ -19,6 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .. import progress
 from ..errors import InputError
 from ..yaml_limits import load as yaml_load
 
@@ -126,12 +127,13 @@ def producer_rows(name: str, spec: dict, cfg: dict, workdir: Path, root: Path = 
                      f"run `{spec['install']}`")]
     out = []
     script = root / spec["export"]
-    for space in spec["spaces"]:
-        for offset in spec.get("offsets", cfg["offsets"]):  # a code's own: DOLFINx ties matching meshes only
+    for space in progress.steps(spec["spaces"], f"{name} space"):
+        for offset in progress.steps(spec.get("offsets", cfg["offsets"]), "offset"):  # a code's own: DOLFINx ties matching meshes only
             target = workdir / name / f"{space}_k{offset}"
             _empty_dir(target)
+            progress.note(f"{name} export.py, N={' '.join(map(str, cfg['N']))}")
             seconds = run_export(python, script, target, space, cfg["N"], offset)
-            for norm in cfg["norms"]:
+            for norm in progress.steps(cfg["norms"], "verdict --system, norm"):
                 row = certify(norm_copy(target / "levels.yaml", norm), cfg["criterion"])
                 row["seconds"] = row["seconds"] + (seconds if norm == cfg["norms"][0] else 0.0)
                 out.append(dict(base, version=version, space=space, offset=int(offset), norm=norm, **row))

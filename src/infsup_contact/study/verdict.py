@@ -29,6 +29,7 @@ from ..discretization.face.square import CELL_BODIES
 from ..discretization.spaces import registry
 from ..discretization.spaces.spec import SpaceSpec
 from ..errors import InputError
+from .. import progress
 from ..models import DEFAULT_MODEL
 from ..solvers.infsup import beta_rows
 from ..solvers.request import NO_OPTIONS, MeshOptions, check_norm
@@ -87,7 +88,8 @@ def verdict_rows(case_or_spec, k: int, family: str, ns, norm: str, *, tol: float
     check_criterion(tol, floor, confidence)
     check_norm(norm)
     model = DEFAULT_MODEL if model is None else model
-    rows = [r for n in ns for r in beta_rows(family, k, n + n1_offset, n, [case], multiplier_mesh,
+    level = (lambda n: f"N1={n + n1_offset} N2={n}") if n1_offset else (lambda n: f"N={n}")
+    rows = [r for n in progress.steps(ns, "level", level) for r in beta_rows(family, k, n + n1_offset, n, [case], multiplier_mesh,
                                              norms=(norm,), model=model, mesh=mesh)]
     curved = {key: getattr(mesh, key) for key in ("gamma", "radius", "coupling") if getattr(mesh, key) is not None}
     out = dict(space=case, k=k, model=model.name, element=mesh.element, **curved, family=family, norm=norm,

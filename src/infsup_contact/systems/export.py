@@ -22,6 +22,7 @@ from pathlib import Path
 import numpy as np
 import scipy.sparse as sp
 
+from .. import progress
 from ..errors import InputError
 from ..io import write_atomic, write_bytes_atomic
 from .hb_petsc import petsc_binary_bytes
@@ -52,6 +53,7 @@ def _suite_parts(case, k, n1, n2, family, multiplier_mesh, model, mesh=None):
     gamma = sides[0].trace.gamma
     g_h = gamma.multiplier_partition(*(s.trace.partition for s in sides), multiplier_mesh)
     space = registry.case_space(case, k, g_h, gamma)
+    progress.note("couplings B_1, B_2")
     blocks = []
     for sign, side in zip((-1.0, 1.0), sides):
         Bi = coupling_matrix(side.trace, space, k)
@@ -70,9 +72,10 @@ def suite_levels(case: str, k: int, ns, offset: int = 0, family: str = "structur
     from ..discretization.spaces.registry import space_spec
 
     spec, levels, described = space_spec(case), [], norm == "H"
-    parts = [_suite_parts(case, k, n + offset, n, family, multiplier_mesh, model, mesh) for n in ns]
+    parts = [_suite_parts(case, k, n + offset, n, family, multiplier_mesh, model, mesh)
+             for n in progress.steps(ns, "level", lambda n: f"N1={n + offset} N2={n}" if offset else f"N={n}")]
     described = described and all(description(spec, p[2]) is not None for p in parts)
-    for n, (A, B, space, gamma, sides) in zip(ns, parts):
+    for n, (A, B, space, gamma, sides) in progress.steps(list(zip(ns, parts)), "Gram of level", lambda p: f"N={p[0]}"):
         if not described:
             G, _ = gamma.gram(space, norm)
             levels.append((1.0 / n, A, B, np.asarray(G, float)))
@@ -222,7 +225,8 @@ def write_system(directory, levels, fmt: str, name: str, norm: str = "given", kn
     if gamma is not None:
         lines.append(f"gamma: {_flow(gamma)}")
     lines.append("levels:")
-    for i, (h, A, B, G, *described) in enumerate(levels):
+    for i, (h, A, B, G, *described) in progress.steps(list(enumerate(levels)), "writing level",
+                                                      lambda lv: f"h={lv[1][0]:g}"):
         names = {}
         for key, mat in (("A", A), ("B", B), ("G", G)):
             if mat is not None:

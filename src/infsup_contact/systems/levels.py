@@ -15,6 +15,7 @@ import time
 import numpy as np
 import scipy.sparse as sp
 
+from .. import progress
 from ..solvers.kernel import MARGIN_DECADES
 from ..criteria.stability import stability_verdict
 from .checks import check_level, check_sequence
@@ -65,8 +66,9 @@ def system_rows(manifest: Manifest, route: str = "auto", notes=sys.stderr, modes
     """One row per level: β_h, the kernel decision, the route and its residual. ``modes``: a list
     that receives each level's worst mode (:func:`level_mode`; the levels describe their multipliers)."""
     rows, shapes = [], []
-    for level in manifest.levels:
+    for level in progress.steps(manifest.levels, "level", lambda lv: f"h={lv.h:g}"):
         t0 = time.perf_counter()
+        progress.note("reading A, B, G")
         lv, mass, info = _load_level(manifest, level)
         shapes.append((lv.A.shape[0] + lv.removed, lv.B.shape[0] + lv.removed_multipliers))
         check_sequence(manifest, shapes)
@@ -74,6 +76,7 @@ def system_rows(manifest: Manifest, route: str = "auto", notes=sys.stderr, modes
         if manifest.known_kernel >= lv.B.shape[0]:
             raise SystemFileError(manifest.path, f"known_kernel = {manifest.known_kernel} >= m = {lv.B.shape[0]} "
                                   f"multipliers at levels[{level.index}]")
+        progress.note(f"spectrum of B A^-1 B^T m = β² G m (m = {lv.B.shape[0]})")
         res = level_spectrum(lv.A, lv.B, lv.G, manifest.known_kernel, route, manifest.entry_rtol,
                              vectors=modes is not None)
         if modes is not None:

@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 from . import accuracy
+from ... import progress
 from ...solvers.contact import ContactSolution, contact_pair, solve_contact, solve_contact_on
 from ...solvers.request import NO_OPTIONS, MeshOptions, check_k
 from ...errors import InputError, check_prestress
@@ -18,6 +19,7 @@ def reference_solution(scene, k: int, n_ref: int, model=None) -> ContactSolution
     """The reference of a scene without an exact solution: structured N_ref × N_ref, degree
     k + 1, the registry's reference multipliers (stable for every k); ``model`` as in
     :func:`~infsup_contact.solvers.contact.solve_contact`."""
+    progress.note(f"reference solution (N_ref={n_ref}, degree {k + 1})")
     return solve_contact(scene, REFERENCE_SPACE, k + 1, "structured", n_ref, n_ref, time_floor=False, model=model)
 
 
@@ -146,9 +148,11 @@ def contact_rows(scene_name: str, cases, k: int, family: str, n1: int, n2: int,
     sc = make_scene(scene_name, c1=c1, c2=c2, **(scene_params or {}))
     if not sc.has_exact:
         reference = reference or reference_solution(sc, k, n_ref, model)
+    progress.note("the two sides: mesh, stiffness, factorization")
     pair = contact_pair(sc, k, family, n1, n2, model=model, mesh=mesh)
     rows = []
-    for case in cases:
+    for case in progress.steps(cases, "space") if len(cases) > 1 else cases:
+        progress.note("contact solve")
         sol = solve_contact_on(pair, case, time_floor=time_floor)
         rows.append(dict(scene=scene_name, case=case, k=k, p=getattr(sc, "p", float("nan")),
                          q=getattr(sc, "q", float("nan")), family=family, N1=n1, N2=n2, c1=c1, c2=c2,

@@ -4,7 +4,7 @@ checks of a request (memory estimate included). The scene registry
 """
 from __future__ import annotations
 
-from ... import resources
+from ... import progress, resources
 from ...errors import InputError
 from . import hertz
 from ..patch import face as face_patch, face_elastic as elastic_face_patch, segment as patch
@@ -19,7 +19,7 @@ def membrane_rows(model, cases, k, family, n1, n2, c, args) -> list:
     if "n_ref" in scene_spec(args.scene).params:
         ref = reference_solution(scene_data(args.scene, c1=c[0], c2=c[1]), k, args.n_ref, model=model)
     return [contact_row(args.scene, case, k, family, n1, n2, c[0], c[1], reference=ref, scene_params=params,
-                        model=model) for case in cases]
+                        model=model) for case in progress.steps(cases, "space")]
 
 
 def membrane_check(args):
@@ -62,7 +62,7 @@ def patch_rows(model, cases, k, family, n1, n2, c, args) -> list:
 
 def hertz_rows(model, cases, k, family, n1, n2, c, args) -> list:
     """One Hertz row per case (geometry R, d as checked)."""
-    return [hertz.hertz_row(case, k, n1, n2, args.R, args.d, args.nu, c) for case in cases]
+    return [hertz.hertz_row(case, k, n1, n2, args.R, args.d, args.nu, c) for case in progress.steps(cases, "space")]
 
 
 def face_patch_rows(model, cases, k, family, n1, n2, c, args) -> list:

@@ -6,6 +6,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.linalg as sla
 
+from ... import progress
 from ...discretization.spaces import registry
 
 KERNEL_RTOL = 1e-8
@@ -17,10 +18,11 @@ def patch_rows(pair_of, solve, cases, ks, pairs) -> list:
     every k in ``ks`` and every case of ``cases`` defined for k, with ``pair = pair_of(k, n1,
     n2)`` built once per (pair, k) and shared by its cases (one factorization per body)."""
     rows = []
-    for n1, n2 in pairs:
-        for k in ks:
+    for n1, n2 in progress.steps(pairs, "mesh pair", lambda p: f"N1={p[0]} N2={p[1]}"):
+        for k in progress.steps(ks, "k") if len(ks) > 1 else ks:
+            progress.note("the two bodies: mesh, stiffness, factorization")
             pair = pair_of(k, n1, n2)
-            rows += [solve(case, k, n1, n2, pair) for case in registry.ids_valid_for(k, cases)]
+            rows += [solve(case, k, n1, n2, pair) for case in progress.steps(registry.ids_valid_for(k, cases), "space")]
     return rows
 
 

@@ -125,13 +125,15 @@ class Reporter:
         from tqdm import tqdm
 
         if self._tqdm is None:
-            self._tqdm = tqdm(total=None, file=self.stream, desc=self.title, dynamic_ncols=True, leave=False,
-                              mininterval=0, miniters=0)
+            # a terminal that reports no width (0 columns) would make tqdm drop the bar format
+            self._tqdm = tqdm(total=None, file=self.stream, desc=self.title, leave=False, mininterval=0, miniters=0,
+                              bar_format="{desc} [{elapsed}]",
+                              **({"dynamic_ncols": True} if _columns(self.stream) else {"ncols": 100}))
             self._tqdm.start_t = self._tqdm.last_print_t = time.time() - self.elapsed()  # the request's time
         index, total = self._outer
         self._tqdm.total, self._tqdm.n = total, index
-        self._tqdm.bar_format = ("{desc}: {percentage:3.0f}%|{bar:20}| {n_fmt}/{total_fmt} [{elapsed}] {postfix}"
-                                 if total else "{desc} [{elapsed}] {postfix}")
+        self._tqdm.bar_format = ("{desc}: {percentage:3.0f}%|{bar:20}| {n_fmt}/{total_fmt} [{elapsed}]{postfix}"
+                                 if total else "{desc} [{elapsed}]{postfix}")  # tqdm puts ", " before the postfix
         self._tqdm.set_postfix_str(self._where, refresh=True)
 
     def _write(self, text: str) -> None:
@@ -160,6 +162,14 @@ class Reporter:
             if self._tqdm is not None:
                 self._tqdm.close()
                 self._tqdm = None
+
+
+def _columns(stream) -> int:
+    """The terminal's width (0: unknown)."""
+    try:
+        return os.get_terminal_size(stream.fileno()).columns
+    except (AttributeError, OSError, ValueError):
+        return 0
 
 
 def _isatty(stream) -> bool:

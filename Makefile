@@ -18,10 +18,14 @@ $(STAMP): environment.lock pyproject.toml
 	@$(PYTHON) -c 'import ensurepip' 2>/dev/null || \
 	  { [ "$$(id -u)" = 0 ] && apt-get update -qq && apt-get install -y -qq python3-venv; } || \
 	  { echo "error: the Python venv module is missing: install the Debian package python3-venv"; exit 1; }
+	@echo "make env: [1/4] a fresh $(VENV) with $$($(PYTHON) --version 2>&1) (the old one removed)"
 	rm -rf $(VENV)
 	$(PYTHON) -m venv $(VENV)
-	$(BIN)/pip install --quiet --require-hashes -r environment.lock
+	@echo "make env: [2/4] $$(grep -c '^[a-zA-Z0-9]' environment.lock) pinned packages from environment.lock, hash-checked (a few minutes with an empty pip cache; pip's own progress on a terminal)"
+	$(BIN)/pip install $$([ -t 1 ] || echo --quiet) --require-hashes -r environment.lock
+	@echo "make env: [3/4] infsup-contact itself, editable (src/)"
 	$(BIN)/pip install --quiet --no-deps -e .
+	@echo "make env: [4/4] done: $(VENV) matches environment.lock ($(STAMP))"
 	touch $(STAMP)
 
 reproduce-all: $(STAMP)

@@ -21,6 +21,9 @@ import pytest
 
 
 def pytest_configure(config):
+    # progress on stderr (infsup_contact/progress.py) shows after a delay: with the default 3 s a
+    # test's stderr would depend on the machine's speed; tests/cli/test_progress.py sets it to 0
+    os.environ.setdefault("INFSUP_PROGRESS_DELAY", "3600")
     if "slurm" not in (config.getoption("markexpr", "") or "") and "SLURM_CONF" not in os.environ:
         os.environ["SLURM_CONF"] = os.devnull
 

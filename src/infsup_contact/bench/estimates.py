@@ -2,9 +2,8 @@
 
     python -m infsup_contact.bench.estimates results/benchmarks/estimates.csv [--only NAME ...]
 
-Each example (:data:`EXAMPLES`) is first validated in this process exactly as ``--dry-run``
-does (:func:`infsup_contact.cli.validate`: the same :class:`~infsup_contact.resources.Estimate`
-it prints), then run as a child process, ``infsup-contact ARGS``, with one BLAS/MKL thread;
+Each example (:data:`EXAMPLES`) is first run with ``--dry-run`` (its printed estimate read back:
+3 significant digits of memory, 2 of time), then as a child process, ``infsup-contact ARGS``, with one BLAS/MKL thread;
 ``os.wait4`` gives the child's maximum resident set size and its CPU time (user + sys). The
 time is compared with the CPU time, not the wall time: the benchmark runs on machines shared
 with other work, where the wall time of a one-thread process grows with the load and its CPU
@@ -21,6 +20,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import re
 import shlex
 import subprocess
 import sys
@@ -78,11 +78,27 @@ def _fill(words, tmp: str) -> list:
     return [w.format(tmp=tmp, python=sys.executable, cli=_cli()) for w in words]
 
 
-def estimate(args) -> "object":
-    """The :class:`~infsup_contact.resources.Estimate` ``--dry-run`` prints for ``args``."""
-    from ..cli import validate
+_BYTES = {"B": 1, "KiB": 1024, "MiB": MIB, "GiB": 1024 * MIB, "TiB": 1024 ** 4}
+_SECONDS = {"s": 1, "min": 60, "h": 3600, "days": 86400, "years": 365.25 * 86400}
+_DRY = re.compile(r"estimated ~(?P<mem>[\d.e+]+) (?P<mu>\S+) peak memory, ~(?P<t>[\d.e+]+) (?P<tu>\S+)")
 
-    return validate(list(args))[1]
+
+def parse_dry_run(line: str) -> tuple:
+    """(bytes, seconds) of ``--dry-run``'s line, "… estimated ~1.07 GiB peak memory, ~21 s …"
+    (:meth:`~infsup_contact.resources.Estimate.describe`: 3 and 2 significant digits)."""
+    m = _DRY.search(line)
+    if m is None or m["mu"] not in _BYTES or m["tu"].rstrip(" (") not in _SECONDS:
+        raise ValueError(f"not a dry-run estimate: {line.strip()!r}")
+    return float(m["mem"]) * _BYTES[m["mu"]], float(m["t"]) * _SECONDS[m["tu"]]
+
+
+def estimate(args) -> tuple:
+    """(bytes, seconds): what ``infsup-contact ARGS --dry-run`` prints, read from its output (as a
+    user reads it; the CLI sits above this package's benchmarks)."""
+    run = subprocess.run([_cli(), *args, "--dry-run"], env=_env(), capture_output=True, text=True, check=False)
+    if run.returncode != 0:
+        raise RuntimeError(f"{shlex.join(args)} --dry-run exited {run.returncode}: {run.stderr.strip()[-500:]}")
+    return parse_dry_run(run.stdout)
 
 
 def measure(argv) -> dict:
@@ -105,11 +121,11 @@ def run_example(ex: Example) -> dict:
         for words in ex.setup:
             subprocess.run(_fill(words, tmp), env=_env(), cwd=ROOT, check=True, stdout=subprocess.DEVNULL)
         args = _fill(ex.args, tmp)
-        est = estimate(args)
+        est_bytes, est_s = estimate(args)
         load_before = os.getloadavg()[0]
         got = measure([_cli(), *args])
         load_after = os.getloadavg()[0]
-    est_mib, est_s = est.bytes / MIB, est.seconds
+    est_mib = est_bytes / MIB
     command = "infsup-contact " + " ".join(ex.args).replace("{tmp}", "DIR")
     return {"example": ex.name, "command": command, "est_mib": est_mib, "rss_mib": got["rss_mib"],
             "mem_ratio": est_mib / got["rss_mib"], "est_s": est_s, "cpu_s": got["cpu_s"], "wall_s": got["wall_s"],

@@ -79,7 +79,7 @@ def estimates_table(frame) -> str:
     time is), their ratios, the wall time and the load average around the run."""
     header = ["example", "command", "estimate (MiB)", "max RSS (MiB)", "memory: estimate / measured",
               "estimate (s)", "CPU (s, user+sys)", "time: estimate / CPU", "wall (s)", "load (1 min)"]
-    rows = [[r.example, f"`{r.command}`", float(r.est_mib), float(r.rss_mib), float(r.mem_ratio), float(r.est_s),
+    rows = [[r.example, f"`{r.command}`", round(r.est_mib), round(r.rss_mib), float(r.mem_ratio), float(r.est_s),
              float(r.cpu_s), float(r.time_ratio), float(r.wall_s), f"{r.load_before:.1f} → {r.load_after:.1f}"]
             for r in frame.itertuples(index=False)]
     return markdown(header, rows)

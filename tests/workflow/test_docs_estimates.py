@@ -54,3 +54,15 @@ def test_the_benchmark_writes_what_the_generator_reads():
 
 def test_the_page_has_the_estimates_block():
     assert "<!-- generated: results/benchmarks/estimates.csv -->" in (ROOT / "docs" / "performance.md").read_text()
+
+
+def test_the_benchmark_reads_back_what_dry_run_prints():
+    # describe() rounds memory to 3 and time to 2 significant digits; the parse loses nothing more
+    from infsup_contact.bench.estimates import parse_dry_run
+    from infsup_contact.resources import Estimate
+
+    for nbytes, seconds in [(3.07e8, 3.8), (4.78e9, 84.0), (2.5e14, 4e8), (5e5, 0.4)]:
+        line = f"dry run: valid request; estimated {Estimate(nbytes, seconds).describe()} (available memory 20 GiB)"
+        got_bytes, got_seconds = parse_dry_run(line)
+        assert abs(got_bytes / nbytes - 1) < 5e-3, line
+        assert abs(got_seconds / max(seconds, 1) - 1) < 5e-2, line

@@ -103,13 +103,14 @@ def estimate(args) -> tuple:
 
 def measure(argv) -> dict:
     """Run ``argv`` as a child: max RSS (MiB), CPU seconds (user + sys), wall seconds."""
-    t0 = time.perf_counter()
-    proc = subprocess.Popen(argv, env=_env(), stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
-    _, status, usage = os.wait4(proc.pid, 0)
-    wall = time.perf_counter() - t0
-    proc.returncode = os.waitstatus_to_exitcode(status)
-    err = proc.stderr.read().decode(errors="replace")
-    proc.stderr.close()
+    with tempfile.TemporaryFile() as log:  # a file, not a pipe: a chatty child never blocks on it
+        t0 = time.perf_counter()
+        proc = subprocess.Popen(argv, env=_env(), stdout=subprocess.DEVNULL, stderr=log)
+        _, status, usage = os.wait4(proc.pid, 0)
+        wall = time.perf_counter() - t0
+        proc.returncode = os.waitstatus_to_exitcode(status)
+        log.seek(0)
+        err = log.read().decode(errors="replace")
     if proc.returncode not in (0, 1):  # 1: verdict's expectation not met, still measured
         raise RuntimeError(f"{shlex.join(argv)} exited {proc.returncode}: {err.strip()[-500:]}")
     return {"rss_mib": usage.ru_maxrss * 1024 / MIB, "cpu_s": usage.ru_utime + usage.ru_stime, "wall_s": wall}
@@ -142,6 +143,8 @@ def main(argv=None) -> int:
     p.add_argument("--only", nargs="+", metavar="NAME", help="examples whose name starts with NAME (default: all)")
     args = p.parse_args(argv)
     chosen = [ex for ex in EXAMPLES if not args.only or any(ex.name.startswith(o) for o in args.only)]
+    if not chosen:
+        p.error(f"--only {' '.join(args.only)}: no example starts so (examples: {'; '.join(e.name for e in EXAMPLES)})")
     rows = []
     for ex in chosen:
         row = run_example(ex)

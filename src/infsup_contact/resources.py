@@ -6,22 +6,13 @@ job its ``mem_mb`` from the same numbers (``workflow/rules/common.smk``).
 
 The model
 ---------
-Per membrane with N segments on Γ and degree k, the structured mesh has
-``nd = (N k)(N k − 1)`` free dofs (× 1.3 for the unstructured family, whose netgen meshes
-carry up to 1.24× the dofs). What a side costs grows like the sparse factorization:
-nested-dissection fill is O(nd log nd) in 2D, and the mesh, the stiffness and its copies are
-O(nd), so a side takes ``C · nd · log2(nd)`` bytes while it is kept (both sides are kept
-until the request ends). The dense interface operators — the Schur complement S_i and
-X_i = S_i⁻¹, (N k)² doubles each, plus the trailing blocks of the factors — and the coupling
-matrices (dim M × n_Γ, quadrature points × n_Γ) are added explicitly; so is the Gram matrix
-of the H^{-1/2}_00 norm (the log kernel holds one (s+1)² block and its quadrature per pair
-of multiplier intervals; the sine-series route ~1600 (dim M)² bytes) and the dense
-eigenproblem (a few (dim M)² doubles). The constants were measured with
-``/usr/bin/time -v`` (maximum resident set size) and ``tracemalloc`` on this package (see
-docs/refusals.md, "The memory estimate"); the estimate is an upper bound within ~10–40 % at sizes where the
-request dominates the interpreter (≥ 100k dofs).
-
-The time is rough (order of magnitude): a sparse LU is O(nd^1.5) in 2D.
+A 2D membrane (N segments on Γ, degree k) has nd = (N k)(N k − 1) free dofs (× 1.3 unstructured)
+and costs C · nd · log2(nd) bytes while kept (nested-dissection fill), plus the dense interface
+operators, couplings, the H^{-1/2}_00 Gram and the eigenproblem, explicitly; a 3D face:
+:func:`face_beta_estimate`; a foreign system: :func:`system_estimate`. Constants measured with
+``/usr/bin/time -v`` (max RSS) and ``tracemalloc`` (docs/refusals.md, "The memory estimate").
+The time is the CPU time of one thread (a sparse LU is O(nd^1.5) in 2D); both are checked
+within a factor 2 on the docs' examples (docs/performance.md, ``snakemake bench_estimates``).
 """
 from __future__ import annotations
 
@@ -123,16 +114,8 @@ SIDE_BYTES_3D = {("pardiso", 1): 260.0, ("pardiso", 2): 450.0, ("nested", 1): 15
 (:func:`face_route`) and the degree (k ≥ 2 counts as 2): the fill of a 3D sparse factorization
 is O(nd^{4/3}), and so are the dense Γ arrays, n_Γ² ~ (N k)⁴ = nd^{4/3}; at equal nd, k = 1 has
 8× the cells and so more quadrature points per Γ basis function. Everything of a β_h request but
-the process included. Peak resident memory (hexahedra, every case, ``/usr/bin/time``), with
-the C each implies:
-
-- ``pardiso``, k = 1: 0.68 GB at N = 32 (214; the 5 spaces of ``--case all``);
-- ``pardiso``, k = 2: 0.30 GB at N = 8, 1.05 GB at N = 16 (400; the 12 spaces of ``--case all``);
-  above dim M = 1,500 (k = 1 from N = 38, k = 2 from N = 19) :data:`LARGE_ROUTE_3D` instead;
-- ``nested`` (SuperLU): 0.36 GB at N = 8, 2.3 GB at N = 16, 5.3 GB at N = 20 (k = 2), 7.1 GB
-  at N = 40 (k = 1).
-
-The estimate is above each; the ``pardiso`` route adds :data:`MKL_BYTES` for the loaded library."""
+the process included; the ``pardiso`` route adds :data:`MKL_BYTES`. Above every peak resident
+memory measured (hexahedra, every case; docs/refusals.md, "The memory estimate", lists them)."""
 MKL_BYTES = 64 * MIB
 """Resident size of MKL once PARDISO is loaded (measured: 42 MB more than the package alone)."""
 SECONDS_PER_DOF2_3D = 1.3e-8
@@ -160,15 +143,10 @@ LARGE_ROUTE_3D = {1: (1530.0, 197.0, 6.06e-5, 5.28e-10), 2: (4350.0, 132.0, 1.31
 couplings, exponential-sum Grams in the reflections' parity blocks, bottom pencils; PARDISO):
 bytes a Σ nd + b m² and seconds c Σ nd + d m³ beyond the process, m = (k N₂ + 1)² (R5.2 on
 G_h = the trace of Ω2). Non-negative least squares, relative residuals, on ``beta --model
-membranes3d --case all --norm all`` (hexahedra, every space the face builds: 5 at k = 1, 12 at
-k = 2; 2 BLAS/MKL threads, quiet machine, ``/usr/bin/time``; the wall times in CHANGELOG.md):
-
-- k = 1: N = 40 1.02 GB; N = 48 1.73 GB; N = 64 4.58 GB;
-- k = 2: N = 20 1.19 GB; N = 24 1.94 GB; N = 28 3.16 GB; N = 32 4.73 GB; N = 36 7.32 GB.
-
-The sparse factors grow like nd here (nd^{4/3} only asymptotically), the Grams, the pencils' and
-the shared series' dense arrays like m², their factorizations like m³. The estimate multiplies
-the fit by :data:`LARGE_ROUTE_MARGIN`, so it lies above every measurement (by 3 % to 29 %)."""
+membranes3d --case all --norm all`` (hexahedra, k = 1, N = 40…64 and k = 2, N = 20…36; the
+peaks in docs/refusals.md, "The memory estimate"). The sparse factors grow like nd here (nd^{4/3}
+only asymptotically), the Grams, the pencils' and the shared series' dense arrays like m², their
+factorizations like m³. × :data:`LARGE_ROUTE_MARGIN`: above every measurement (by 3 % to 29 %)."""
 LARGE_ROUTE_MARGIN = 1.2
 DENSE_ROUTE_SECONDS_3D = {1: 2.2e-9, 2: 5.4e-9}
 """d of c Σ nd + d m³ seconds (c of :data:`LARGE_ROUTE_3D`) on PARDISO's dense route, where the
@@ -177,15 +155,47 @@ all``). At the gate the large route is the faster one (k = 1: the large route at
 about 1.5× the dense route at N = 32, for twice the multipliers)."""
 
 
+TRI_GRAM_SECONDS = 5e-9
+"""Seconds per n_local · T · n_max² of a triangle space's H Gram (``--element tet``, ``face.norms.
+triangles.gram_h_tri``: the sine coefficients of T triangles' n_local basis functions for all
+(m, n) ≤ n_max, over the partial sums n0, 2 n0, … n_max). Measured, CPU time, ``beta --model
+membranes3d --element tet --case all --k 2 --N1 8 --N2 8`` (T = 128; the nine Grams 14.6 of 17.5
+s): P2 4.9e-9 (n_max 768), P1 5.6e-9, P0 4.6e-9 (1024). Hexahedra: Kronecker products of 1D Grams."""
+TRI_GRAM_BYTES = 2 * 8 * 2 ** 23
+"""Its two working arrays (``triangles._BUDGET`` doubles each); measured 83 MB above the hexahedra's."""
+
+
+def tet_gram_seconds(k: int, n: int, n_spaces: int) -> float:
+    """The H Grams of ``n_spaces`` triangle spaces on Ω2's face (T = 2 N², each counted at degree k,
+    n_local = (k + 1)(k + 2)/2), at the n_max where ``gram_h_tri`` stops at its cap (an upper bound):
+    n0 = max(16, 2 (k + 1) N) doubled while ≤ N_MAX_CAP // 64."""
+    from .discretization.segment.norms import N_MAX_CAP
+
+    n0, cap = max(16, 2 * (k + 1) * n), N_MAX_CAP // 64
+    n_max = n0 * 2 ** max(int(math.floor(math.log2(cap / n0))), 0) if n0 <= cap else n0
+    return n_spaces * TRI_GRAM_SECONDS * (k + 1) * (k + 2) / 2 * 2.0 * n * n * n_max ** 2
+
+
 def _large_route_dim(k: int, n: int, components: int) -> int:
     """dim M of the largest space the face builds (R5.2: (k N + 1)² nodes, per component)."""
     return components * (k * n + 1) ** 2
 
 
-def face_beta_estimate(k: int, n1: int, n2: int, components: int = 1, process: bool = True) -> Estimate:
+def face_beta_estimate(k: int, n1: int, n2: int, components: int = 1, process: bool = True,
+                       element: str | None = None, n_spaces: int = 1, norms=("H", "L2")) -> Estimate:
     """One ``beta_rows`` call of a 3D model (a contact face): both sides kept. The dense route
     (dim M up to :data:`~.la.bottom.DENSE_MAX_M`, and every size on the ``nested`` route):
-    C nd^{4/3} per side (:data:`SIDE_BYTES_3D`); above it with PARDISO, :data:`LARGE_ROUTE_3D`."""
+    C nd^{4/3} per side (:data:`SIDE_BYTES_3D`); above it with PARDISO, :data:`LARGE_ROUTE_3D`.
+    On tetrahedra (``element`` ``tet``) with the H norm, the ``n_spaces`` triangle Grams
+    (:func:`tet_gram_seconds`, :data:`TRI_GRAM_BYTES`) come on top."""
+    est = _face_bodies_estimate(k, n1, n2, components, process)
+    if element == "tet" and "H" in norms:  # the hexahedra's Grams: Kronecker products of 1D ones
+        return Estimate(est.bytes + TRI_GRAM_BYTES, est.seconds + tet_gram_seconds(k, n2, max(n_spaces, 1)))
+    return est
+
+
+def _face_bodies_estimate(k: int, n1: int, n2: int, components: int = 1, process: bool = True) -> Estimate:
+    """:func:`face_beta_estimate` but the triangle Grams."""
     from .la.bottom import DENSE_MAX_M
 
     nds = [components * face_side_dofs(n, k) for n in (n1, n2)]
@@ -197,7 +207,7 @@ def face_beta_estimate(k: int, n1: int, n2: int, components: int = 1, process: b
         # memory never below the dense route's estimate at the gate (that one is the looser:
         # measured k = 2, 0.93 GB at N = 18 dense, 1.12 GB at N = 19 large), so it grows with N
         gate = int((math.isqrt(DENSE_MAX_M) - 1) // k)
-        floor = face_beta_estimate(k, gate, gate, components, process).bytes if gate >= 1 else 0.0
+        floor = _face_bodies_estimate(k, gate, gate, components, process).bytes if gate >= 1 else 0.0
         return Estimate(max(base + MKL_BYTES + LARGE_ROUTE_MARGIN * (a * sum(nds) + b * m * m), floor),
                         START_SECONDS + LARGE_ROUTE_MARGIN * (c * sum(nds) + d * m ** 3))
     volume = sum(SIDE_BYTES_3D[route, min(k, 2)] * nd ** (4.0 / 3.0) for nd in nds)
@@ -209,14 +219,16 @@ def face_beta_estimate(k: int, n1: int, n2: int, components: int = 1, process: b
 
 def beta_estimate(family: str, k: int, n1: int, n2: int, multiplier_mesh="omega2",
                   norms=("H", "L2"), h_route: str = "logkernel", process: bool = True,
-                  components: int = 1, dim: int = 2) -> Estimate:
+                  components: int = 1, dim: int = 2, element: str | None = None,
+                  n_spaces: int = 1) -> Estimate:
     """One ``beta_rows`` call: both sides kept, then every multiplier space in turn (the
     largest degree s ≤ k counts: a space of degree s has at most N(s + 1) functions).
     ``components``: displacement components per node (2 for the elastic model: the side
     volume is that of ``components`` × the dofs; not separately measured). ``dim`` = 3: the
-    bodies of a 3D model (:func:`face_beta_estimate`)."""
+    bodies of a 3D model (:func:`face_beta_estimate`, which also takes the ``element`` and the
+    number of spaces, ``n_spaces``)."""
     if dim == 3:
-        return face_beta_estimate(k, n1, n2, components, process)
+        return face_beta_estimate(k, n1, n2, components, process, element, n_spaces, norms)
     mms = [multiplier_mesh] if isinstance(multiplier_mesh, str) else list(multiplier_mesh)
     nds = [components * side_dofs(family, n, k) for n in (n1, n2)]
     volume = sum(_side_bytes(nd, "beta") for nd in nds)
@@ -289,28 +301,25 @@ def job_mem_mb(estimate: Estimate, margin: float = 1.25) -> int:
     return int(math.ceil(margin * estimate.bytes / 1e8)) * 100
 
 
-def available_bytes(meminfo: str = "/proc/meminfo") -> float | None:
-    """MemAvailable of /proc/meminfo in bytes (None where the file or the field is missing)."""
+def _meminfo(field: str, meminfo: str) -> float | None:
     try:
         with open(meminfo) as fh:
             for line in fh:
-                if line.startswith("MemAvailable:"):
+                if line.startswith(field + ":"):
                     return float(line.split()[1]) * 1024
     except (OSError, ValueError, IndexError):
         return None
     return None
+
+
+def available_bytes(meminfo: str = "/proc/meminfo") -> float | None:
+    """MemAvailable of /proc/meminfo in bytes (None where the file or the field is missing)."""
+    return _meminfo("MemAvailable", meminfo)
 
 
 def total_bytes(meminfo: str = "/proc/meminfo") -> float | None:
     """MemTotal of /proc/meminfo in bytes (None where unavailable)."""
-    try:
-        with open(meminfo) as fh:
-            for line in fh:
-                if line.startswith("MemTotal:"):
-                    return float(line.split()[1]) * 1024
-    except (OSError, ValueError, IndexError):
-        return None
-    return None
+    return _meminfo("MemTotal", meminfo)
 
 
 SYSTEM_MARGIN = 1.4
@@ -330,6 +339,26 @@ SYSTEM_SECONDS_3D = 3e-9
 """Seconds per n² of a 3D system (fitted to the same export)."""
 
 
+KERNEL_SVD_MAX_BYTES = 3e7
+"""``systems.engine.SVD_MAX_BYTES`` (the largest W, n_touched × m doubles, decided by a dense SVD)."""
+CERTIFICATE_COPIES = 2.0
+"""Dense m × m arrays of ``bottom_kernel``'s certificate above it (``la.bottom.at_most_below``):
+measured 2.0 × 8 m² bytes at m = 16,641 (Stokes P2-P1, N = 128), 2.1 at m = 4,225."""
+KERNEL_SECONDS_PER_M3 = 1.6e-11
+"""Seconds per m³ of that whole decision (CPU time; 72 s at m = 16,641, its dense Cholesky alone
+``dpotrf`` 7e-12 m³ at m = 8,000)."""
+
+
+def kernel_decision_cost(m: int, n_touched: int) -> tuple:
+    """(bytes, seconds) of a foreign level's kernel decision: a dense SVD of W (three copies,
+    ≤ :data:`KERNEL_SVD_MAX_BYTES`) or ``bottom_kernel``'s dense certificate, what a level with
+    thousands of multipliers costs most (Taylor–Hood N = 128: 4.4 GB, its LUs a few hundred MB)."""
+    w_bytes = 8.0 * m * n_touched
+    if w_bytes <= KERNEL_SVD_MAX_BYTES:
+        return 3 * w_bytes, KERNEL_SECONDS_PER_M3 * n_touched * m * min(m, n_touched)
+    return CERTIFICATE_COPIES * 8.0 * m * m, KERNEL_SECONDS_PER_M3 * float(m) ** 3
+
+
 def looks_3d(n: int, n_touched: int) -> bool:
     """Whether B touches a 3D body's surface (:data:`SURFACE_EXPONENT`); a foreign system does not
     declare its dimension."""
@@ -339,15 +368,15 @@ def looks_3d(n: int, n_touched: int) -> bool:
 def system_estimate(levels) -> Estimate:
     """A foreign system (``verdict --system``, ``beta --system``): one level at a time, the
     largest sets the memory. ``levels``: (n, m, n_touched, nnz of A, route) per level. Sparse
-    factors as a 2D problem's, C · n · log2 n bytes (C = 175 as for a side), the dense
-    blocks of the dense routes (X or A⁻¹ Bᵀ, S, the pencil's copies) explicitly; the
-    shift-invert route factorizes [[A, Bᵀ], [B, −δG]] and A (residuals). Calibrated on one
-    measurement only: Taylor–Hood 16..128 (scikit-fem, 130k + 16.5k dofs at 128) peaked at
-    1.02 GiB (``/usr/bin/time -v``) where the formula without :data:`SYSTEM_MARGIN` gave
-    1.02 GiB; the margin makes it an upper bound until more systems are measured. Where B touches
-    a 3D body's surface (:func:`looks_3d`) the sparse part is at least the 3D fill
-    :data:`SYSTEM_BYTES_3D` (n/2)^{4/3} per body and the time gains :data:`SYSTEM_SECONDS_3D` n²:
-    the 2D formula gave a third of the memory and of the time a 3D export took."""
+    factors as a 2D problem's, C · n · log2 n bytes (C = 175 as for a side), the dense blocks of
+    the dense routes (X or A⁻¹ Bᵀ, S, the pencil's copies) explicitly, the shift-invert route's
+    LUs of [[A, Bᵀ], [B, −δG]] and of A, all × :data:`SYSTEM_MARGIN`; before them the kernel
+    decision (:func:`kernel_decision_cost`). Where B touches a 3D body's surface
+    (:func:`looks_3d`) the sparse part is at least the 3D fill :data:`SYSTEM_BYTES_3D` (n/2)^{4/3}
+    per body and the time gains :data:`SYSTEM_SECONDS_3D` n². Measured against
+    (docs/performance.md, "The dry run's estimates, measured"): Taylor–Hood 16..128 (scikit-fem,
+    130k + 16.6k dofs at 128; 4.6 GiB, 82 s CPU, 88 % of both in the kernel decision) and a
+    membranes3d export."""
     peak, seconds = 0.0, START_SECONDS
     for n, m, nt, nnz, route in levels:
         sparse = _side_bytes(n + m, "beta") + 2 * 12.0 * nnz
@@ -361,7 +390,10 @@ def system_estimate(levels) -> Estimate:
         else:
             sparse += _side_bytes(n, "beta")
             dense = 8.0 * 20 * (n + m)
-        peak = max(peak, SYSTEM_MARGIN * (sparse + dense))
+        kernel_bytes, kernel_seconds = kernel_decision_cost(m, nt)
+        # the kernel is decided before the factorizations, its arrays freed: the larger phase counts
+        peak = max(peak, SYSTEM_MARGIN * (sparse + dense), kernel_bytes + 2 * 12.0 * nnz)
         seconds += SECONDS_PER_DOF15["beta"] * 2 * (n + m) ** 1.5 + 1e-9 * (m ** 3 if route != "shift-invert" else 0)
+        seconds += kernel_seconds
         seconds += SYSTEM_SECONDS_3D * n ** 2 if three_d else 0.0
     return Estimate(PROCESS_BYTES["beta"] + peak, seconds)

@@ -151,6 +151,11 @@ SCHEMAS = {
     # results/benchmarks/dag.csv (bench/dag.py: per rule of a run), read by the docs' generator
     "dag": Schema({"rule": "str", "jobs": "int", "wall_s_sum": "float", "wall_s_max": "float",
                    "cpu_s_sum": "float?", "max_rss_mb": "float?"}, key=("rule",), label="a DAG timing table"),
+    # results/benchmarks/estimates.csv (bench/estimates.py: --dry-run's estimate against a measured run)
+    "estimates": Schema({"example": "str", "command": "str", "est_mib": "float", "rss_mib": "float",
+                         "mem_ratio": "float", "est_s": "float", "cpu_s": "float", "wall_s": "float",
+                         "time_ratio": "float", "load_before": "float", "load_after": "float"},
+                        key=("example",), label="an estimates table"),
     # Snakemake's `benchmark:` files (bench/dag.py), tab-separated
     "rule_benchmark": Schema({"s": "float"}, optional={"max_rss": "float?", "cpu_time": "float?"},
                              label="a Snakemake benchmark file", sep="\t"),

@@ -159,3 +159,22 @@ rule bench_arc:
     shell:
         _BLAS1 + "infsup-contact bench --what arc --N {params.N} --k {params.k} --radius {params.radius}"
         " --repeats {params.repeats} --route-budget {params.budget} > {output}.tmp 2> {log} && mv {output}.tmp {output}"
+
+
+rule bench_estimates:
+    # --dry-run's time and memory estimates against measured runs of the docs' examples
+    # (bench/estimates.py: max RSS and CPU time of each request as a child process); not part of
+    # reproduce-all or `benchmarks` (minutes of CPU, a 4.7 GB Stokes run): `snakemake bench_estimates`,
+    # then `snakemake docs` for docs/performance.md's table
+    output:
+        "results/benchmarks/estimates.csv",
+    input:
+        PACKAGE_SOURCES,
+        "examples/stokes_skfem.py",
+    threads: 1
+    benchmark:
+        "results/benchmarks/rules/bench_estimates.tsv"
+    log:
+        "results/logs/bench_estimates.log",
+    shell:
+        _BLAS1 + "python -m infsup_contact.bench.estimates {output} 2> {log}"

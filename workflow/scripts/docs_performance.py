@@ -73,6 +73,18 @@ def dag_table(frame) -> str:
     return markdown(columns, frame[columns].itertuples(index=False, name=None))
 
 
+def estimates_table(frame) -> str:
+    """Per documented request: ``--dry-run``'s estimate beside the measured max RSS and CPU time
+    (user + sys: a one-thread run's time, not inflated by other work on the machine as its wall
+    time is), their ratios, the wall time and the load average around the run."""
+    header = ["example", "command", "estimate (MiB)", "max RSS (MiB)", "memory: estimate / measured",
+              "estimate (s)", "CPU (s, user+sys)", "time: estimate / CPU", "wall (s)", "load (1 min)"]
+    rows = [[r.example, f"`{r.command}`", round(r.est_mib), round(r.rss_mib), float(r.mem_ratio), float(r.est_s),
+             float(r.cpu_s), float(r.time_ratio), float(r.wall_s), f"{r.load_before:.1f} → {r.load_after:.1f}"]
+            for r in frame.itertuples(index=False)]
+    return markdown(header, rows)
+
+
 def render(source: str, root: Path) -> str:
     """The Markdown table of one source file."""
     name = Path(source).name
@@ -80,8 +92,10 @@ def render(source: str, root: Path) -> str:
         return route_table(read_table(root / source, "bench"))
     if name == "dag.csv":
         return dag_table(read_table(root / source, "dag"))
+    if name == "estimates.csv":
+        return estimates_table(read_table(root / source, "estimates"))
     raise DocsError(f"{source}: no table is generated from this file (known: "
-                    f"{', '.join(sorted(ROUTE_TABLES | {'dag.csv'}))} under results/benchmarks/)")
+                    f"{', '.join(sorted(ROUTE_TABLES | {'dag.csv', 'estimates.csv'}))} under results/benchmarks/)")
 
 
 def regenerate(page: str, root: Path) -> str:

@@ -100,7 +100,8 @@ def _check_beta(args):
         check_worst_mode(args)
     est = resources.beta_estimate(args.family, args.k, args.N1, args.N2, args.multiplier_mesh,
                                   norms(args), args.h_route,
-                                  components=args.model_obj.components, dim=args.model_obj.dim)
+                                  components=args.model_obj.components, dim=args.model_obj.dim,
+                                  element=args.mesh.element, n_spaces=len(args.cases))
     check_memory(est, *(("N1", args.N1) if args.N1 >= args.N2 else ("N2", args.N2)))
     return est
 

@@ -69,6 +69,7 @@ class Command:
 
 
 _OPERATORS = {"|", "||", "&&", ";"}
+_ALT = "\x00"
 _REDIRECTS = {">", ">>", "<", "2>", "&>"}
 
 
@@ -103,9 +104,11 @@ def commands(block: Block) -> list[Command]:
             words = line.split("  #")[0].split()
             found.append(Command(tuple(words[1:]), words[0], tuple(output)))
             continue
+        # an alternative inside an optional group, [--element hex|tet], is not a pipe
+        line = re.sub(r"\[[^\[\]]*\]", lambda m: m.group(0).replace("|", _ALT), line)
         lex = shlex.shlex(line, posix=True, punctuation_chars=True)
         lex.whitespace_split, lex.commenters = True, "#"
-        words, segment, skip = list(lex), [], False
+        words, segment, skip = [w.replace(_ALT, "|") for w in lex], [], False
         for word in words + [";"]:
             if skip:
                 skip = False
@@ -126,8 +129,10 @@ def variants(argv: tuple) -> list[list[str]]:
     text = " ".join(argv)
     if "[" not in text:
         return [list(argv)]
-    bare = re.sub(r"\[[^\[\]]*\]", " ", text)
-    while "[" in bare:
+    bare = text
+    while re.search(r"\[[^\[\]]*\]", bare):
         bare = re.sub(r"\[[^\[\]]*\]", " ", bare)
+    if "[" in bare or "]" in bare:
+        raise ValueError(f"unbalanced [ ] in {text!r}")
     full = re.sub(r"(\S+)\|\S+", r"\1", text.replace("[", " ").replace("]", " "))
     return [bare.split(), full.split()]

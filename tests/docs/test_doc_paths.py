@@ -41,7 +41,7 @@ def named_paths(text: str):
             continue
         if ":" in token or token.startswith("-") or "=" in token:
             continue
-        if "/" in token or re.search(r"\.py\b", token):
+        if "/" in token or re.search(r"\w\.py\b", token):
             yield token
 
 

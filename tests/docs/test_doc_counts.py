@@ -45,3 +45,10 @@ def test_package_states_the_architecture_caps():
     lines = re.search(r"^MAX_LINES = (\d+)", arch, re.M).group(1)
     text = " ".join((ROOT / "docs" / "package.md").read_text(encoding="utf-8").split())
     assert f"caps a folder at {modules} modules and a module at {lines} lines" in text
+
+
+def test_foreign_systems_states_the_inline_limit():
+    from infsup_contact.systems.export import INLINE_MAX
+
+    text = " ".join((ROOT / "docs" / "foreign-systems.md").read_text(encoding="utf-8").split())
+    assert f"longer than {INLINE_MAX} numbers a `.npy` file" in text

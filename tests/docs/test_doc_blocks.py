@@ -180,26 +180,26 @@ def _make(mark, cmd, where):
 
 
 # ------------------------------------------------------------------ python blocks
-@pytest.fixture(scope="module")
-def namespaces():
-    return {}
+PYTHON_PAGES = sorted({b.page for b in PYTHON})
 
 
-@pytest.mark.parametrize("block", PYTHON, ids=lambda b: b.id)
-def test_python_block(block, workdir, namespaces, monkeypatch):
-    code = compile(block.text, block.id, "exec")
-    for node in ast.walk(ast.parse(block.text)):
-        if isinstance(node, ast.Import):
-            for alias in node.names:
-                importlib.import_module(alias.name)
-        elif isinstance(node, ast.ImportFrom):
-            module = importlib.import_module(node.module)
-            for alias in node.names:
-                assert hasattr(module, alias.name), f"{block.id}: {node.module} has no {alias.name}"
-    if block.mark == "slow":
-        return
+@pytest.mark.parametrize("page", PYTHON_PAGES, ids=lambda p: p.name)
+def test_python_blocks(page, workdir, monkeypatch):
+    """A page's python blocks in order, in one namespace, like a notebook (one test per page, so
+    that xdist never splits a page's blocks between workers)."""
     monkeypatch.chdir(workdir)
-    namespace = namespaces.setdefault(block.page, {"__name__": "__docs__"})  # a page runs like a notebook
-    with contextlib.redirect_stdout(io.StringIO()):
-        exec(code, namespace)
-
+    namespace = {"__name__": "__docs__"}
+    for block in (b for b in PYTHON if b.page == page):
+        code = compile(block.text, block.id, "exec")
+        for node in ast.walk(ast.parse(block.text)):
+            if isinstance(node, ast.Import):
+                for alias in node.names:
+                    importlib.import_module(alias.name)
+            elif isinstance(node, ast.ImportFrom):
+                module = importlib.import_module(node.module)
+                for alias in node.names:
+                    assert hasattr(module, alias.name), f"{block.id}: {node.module} has no {alias.name}"
+        if block.mark == "slow":
+            continue
+        with contextlib.redirect_stdout(io.StringIO()):
+            exec(code, namespace)

@@ -203,3 +203,22 @@ def test_python_blocks(page, workdir, monkeypatch):
             continue
         with contextlib.redirect_stdout(io.StringIO()):
             exec(code, namespace)
+
+
+DOCTESTS = [b for b in all_blocks("text") if ">>> " in b.text]
+
+
+@pytest.mark.parametrize("block", DOCTESTS, ids=lambda b: b.id)
+def test_shown_refusals_are_the_api_s(block):
+    """A ``text`` block of ``>>>`` calls, each followed by the ``InputError: …`` line it shows."""
+    import infsup_contact as ic
+    from infsup_contact.errors import InputError
+
+    lines = block.text.splitlines()
+    calls = [(line[4:], lines[i + 1]) for i, line in enumerate(lines) if line.startswith(">>> ")]
+    assert calls
+    for call, shown in calls:
+        assert shown.startswith("InputError: "), f"{block.id}: {call} shows {shown!r}"
+        with pytest.raises(InputError) as err:
+            eval(call, {"ic": ic})
+        assert str(err.value) == shown[len("InputError: "):], f"{block.id}: {call}"

@@ -46,3 +46,12 @@ def test_no_docstring_cites_an_issue():
              for path in sorted((ROOT / "src").rglob("*.py")) for node, text in docstrings(path)
              if re.search(r"(?i)\bissues? #?\d+|\(#\d+\)", text)]
     assert not found, f"docstrings citing an issue number: {found}"
+
+
+@pytest.mark.parametrize("page", [ROOT / "README.md", *PAGES], ids=lambda p: p.name)
+def test_no_text_is_pasted_twice(page):
+    """A phrase repeated back to back ("exact coupling" + "exact coupling") is an edit gone wrong."""
+    text = " ".join(re.sub(r"```.*?```", " ", page.read_text(encoding="utf-8"), flags=re.S).split())
+    doubled = [m.group(1) for m in re.finditer(r"(.{16,200}?)\1", text)
+               if re.search(r"[A-Za-z]{3}", m.group(1))]
+    assert not doubled, f"{page.name}: pasted twice: {doubled}"

@@ -10,12 +10,17 @@ whole request is valid.
 
     >>> import infsup_contact as ic
     >>> ic.beta(case="T3", k=2, N1=8, N2=8, norm="H")          # doctest: +SKIP
-    >>> ic.verdict(case="R5_4", k=1, N=[4, 8, 16])              # doctest: +SKIP
-    >>> ic.certify("levels.yaml")                               # doctest: +SKIP
+    >>> ic.verdict(case="R5.4", k=1, N=[4, 8, 16])              # doctest: +SKIP
+    >>> ic.certify("levels.yaml", expect="stable")              # doctest: +SKIP
+
+A multiplier space defined in the notebook is ``space=`` a :class:`SpaceSpec` or a function
+of no arguments returning one (as ``FILE.py:FUNC`` names one in a file), checked as a file's.
 """
 from __future__ import annotations
 
 import argparse
+import sys
+import types
 
 # The CLI is the one place a request is parsed and checked; every import of the package's
 # internals the API needs is here, so a move inside the package is fixed in these lines.
@@ -27,8 +32,14 @@ from .errors import InputError
 
 __all__ = ["beta", "verdict", "certify", "InputError"]
 
-_NOT_KEYWORDS = {"help", "dry_run", "format", "output", "expect", "command"}
+_NOT_KEYWORDS = {"help", "dry_run", "format", "output", "command"}
 """Flags of the commands that are about the command line, not the result."""
+
+_NOTEBOOK = "<notebook>"
+"""The module name notebook spaces are registered under: ``space=f`` is ``<notebook>:f``."""
+_NOTEBOOK_SPACES: dict = {}
+"""id(space object) → (the object, its ``<notebook>:NAME`` reference); the object is kept so
+that its id is not reused, and passing it again is the same registered space."""
 
 
 def beta(case: str | None = None, k: int | None = None, N1: int | None = None, N2: int | None = None,
@@ -38,7 +49,7 @@ def beta(case: str | None = None, k: int | None = None, N1: int | None = None, N
     Parameters
     ----------
     case : str, optional
-        A registered space (``T3``, ``R5_4``, ``DUAL-Q9``, ...) or ``"all"`` (the default: every
+        A registered space (``T3``, ``R5.4``, ``DUAL-Q9``, ...) or ``"all"`` (the default: every
         space defined for ``k``).
     k : int
         Displacement degree, 1..4 (not with ``system``).
@@ -47,7 +58,8 @@ def beta(case: str | None = None, k: int | None = None, N1: int | None = None, N
     **options
         Any other flag of ``infsup-contact beta`` by its name: ``norm`` (``"H"``, ``"L2"``,
         ``"all"``), ``family``, ``multiplier_mesh``, ``model``, ``element``, ``h_route``, ``c1``,
-        ``c2``, ``seed``, ``alpha``, ``space`` (``"file.py:FUNC"``), ``system`` (a manifest).
+        ``c2``, ``seed``, ``alpha``, ``space`` (``"file.py:FUNC"``, a SpaceSpec or a function
+        of no arguments returning one), ``system`` (a manifest).
 
     Returns
     -------
@@ -60,6 +72,7 @@ def beta(case: str | None = None, k: int | None = None, N1: int | None = None, N
     InputError
         A bad keyword or value, with the command's one-line message.
     """
+    options["space"] = _space_ref(options.get("space"))
     return beta_frame(_request("beta", case=case, k=k, N1=N1, N2=N2, **options))
 
 
@@ -70,8 +83,9 @@ def verdict(case: str | None = None, k: int | None = None, N=None, **options):
     Parameters
     ----------
     case : str, optional
-        A registered space; exactly one of ``case``, ``space`` (``"file.py:FUNC"``) and
-        ``system`` (a manifest, see :func:`certify`).
+        A registered space; exactly one of ``case``, ``space`` (``"file.py:FUNC"``, a
+        SpaceSpec or a function of no arguments returning one) and ``system`` (a manifest, see
+        :func:`certify`).
     k : int
         Displacement degree, 1..4 (with ``case`` or ``space``).
     N : sequence of int, optional
@@ -79,20 +93,23 @@ def verdict(case: str | None = None, k: int | None = None, N=None, **options):
     **options
         Any other flag of ``infsup-contact verdict`` by its name: ``norm``, ``family``,
         ``N1_offset``, ``multiplier_mesh``, ``model``, ``element``, ``slope_tolerance``,
-        ``beta_floor``, ``confidence``.
+        ``beta_floor``, ``confidence``, ``expect`` (``"stable"`` or ``"unstable"``).
 
     Returns
     -------
     pandas.DataFrame
         One row: the command's CSV (``space``, ``k``, ..., ``verdict``, ``beta_min``,
         ``slope``, ...), lists space-separated. For a system, ``frame.attrs["levels"]`` holds
-        the per-level rows.
+        the per-level rows. ``frame.attrs["expect"]`` is the expectation (``expect=``, else a
+        manifest's ``expect:``, else None) and ``frame.attrs["met"]`` whether the verdict is
+        it (the command's exit code 0 or 1; INCONCLUSIVE never meets one; None without one).
 
     Raises
     ------
     InputError
         A bad keyword or value, with the command's one-line message.
     """
+    options["space"] = _space_ref(options.get("space"))
     given = [key for key, value in (("case", case), ("space", options.get("space")),
                                     ("system", options.get("system"))) if value is not None]
     if len(given) != 1:
@@ -100,6 +117,10 @@ def verdict(case: str | None = None, k: int | None = None, N=None, **options):
     args = _request("verdict", case=case, k=k, N=N, **options)
     row, levels = verdict_row(args)
     frame = verdict_frame(row)
+    manifest = getattr(args, "manifest", None)
+    expect = args.expect or getattr(manifest, "expect", None)
+    frame.attrs["expect"] = None if expect is None else expect.upper()
+    frame.attrs["met"] = None if expect is None else row["verdict"] == expect.upper()
     if levels is not None:
         import pandas as pd
 
@@ -107,7 +128,7 @@ def verdict(case: str | None = None, k: int | None = None, N=None, **options):
     return frame
 
 
-def certify(manifest, **criterion):
+def certify(manifest, expect: str | None = None, **criterion):
     """The verdict on a saddle-point system exported by another code, as
     ``infsup-contact verdict --system MANIFEST``.
 
@@ -115,6 +136,8 @@ def certify(manifest, **criterion):
     ----------
     manifest : str or os.PathLike
         A ``levels.yaml`` manifest of mesh levels ``{h, A, B, G}`` (docs/foreign-systems.md).
+    expect : {"stable", "unstable"}, optional
+        The expected verdict (``--expect``); without it the manifest's ``expect:``, if any.
     **criterion
         ``slope_tolerance``, ``beta_floor``, ``confidence`` (defaults: the claims ledger's).
 
@@ -122,14 +145,23 @@ def certify(manifest, **criterion):
     -------
     pandas.DataFrame
         One row (``system``, ``verdict``, ``beta_min``, ``slope``, ...);
-        ``frame.attrs["levels"]`` is the per-level table (β_h, kernel, residual per level).
+        ``frame.attrs["levels"]`` is the per-level table (β_h, kernel, residual per level);
+        ``frame.attrs["met"]``: the verdict is the expected one (None without an expectation).
 
     Raises
     ------
     InputError
         A bad argument, with the command's one-line message.
     """
-    return verdict(system=str(manifest), **criterion)
+    for key in criterion:
+        if key not in _CRITERION:
+            raise InputError(key, "one of " + ", ".join(sorted({"expect", *_CRITERION})) + " (certify's keywords: "
+                             "the other flags of verdict do not apply to a system)")
+    return verdict(system=str(manifest), expect=expect, **criterion)
+
+
+_CRITERION = ("slope_tolerance", "beta_floor", "confidence")
+"""The stability criterion's keywords (defaults: the claims ledger's)."""
 
 
 _TYPE_NAMES = {int: "an integer", float: "a number"}
@@ -181,3 +213,31 @@ def _tokens(key: str, value, action) -> list:
         if action.choices is not None and str(v) not in action.choices:
             raise InputError(key, "one of " + ", ".join(map(str, action.choices)), got=v)
     return [str(v) for v in values]
+
+
+def _space_ref(space):
+    """``space=`` as the command line's ``--space`` reference: a string as given; a
+    :class:`SpaceSpec`, or a function of no arguments returning one, defined in the notebook,
+    registered as ``<notebook>:NAME`` in a module of that name, so that the command loads and
+    checks it exactly as a ``FILE.py:FUNC`` space (:mod:`~.discretization.spaces.user_spaces`)."""
+    from .discretization.spaces.spec import SpaceSpec  # here: it loads numpy and scipy (0.3 s), not at import
+
+    if space is None or isinstance(space, str):
+        return space
+    if not (isinstance(space, SpaceSpec) or callable(space)):
+        raise InputError("space", "FILE.py:FUNC, a SpaceSpec, or a function of no arguments returning one",
+                         got=space)
+    known = _NOTEBOOK_SPACES.get(id(space))
+    if known is not None and known[0] is space:
+        return known[1]
+    module = sys.modules.setdefault(_NOTEBOOK, types.ModuleType(_NOTEBOOK))
+    stem = space.id if isinstance(space, SpaceSpec) else getattr(space, "__name__", "space")
+    stem = "space" if str(stem).startswith("<") else stem  # a lambda
+    stem = "".join(c if c.isalnum() else "_" for c in str(stem)).lstrip("0123456789") or "space"
+    name, n = stem, 1
+    while hasattr(module, name):
+        n += 1
+        name = f"{stem}_{n}"
+    setattr(module, name, (lambda: space) if isinstance(space, SpaceSpec) else space)
+    _NOTEBOOK_SPACES[id(space)] = (space, f"{_NOTEBOOK}:{name}")
+    return _NOTEBOOK_SPACES[id(space)][1]

@@ -115,8 +115,9 @@ def _run_export(args) -> None:
                     + ([f"N1{args.N1_offset:+d}"] if args.N1_offset else []))
     out = Path(args.out)
     before = {p.name for p in out.iterdir()} if out.is_dir() else set()
-    path = write_system(args.out, levels, args.format, name, norm=norm, gamma=gamma)
-    stale = sorted(before - set(_targets(args)))
+    written = []
+    path = write_system(args.out, levels, args.format, name, norm=norm, gamma=gamma, written=written)
+    stale = sorted(before - set(written))
     if stale:  # --force: what the new manifest does not name is left, and said so
         print(f"infsup-contact: note: --force: {len(stale)} file(s) not written by this export left in {out} "
               f"(not in its levels.yaml): {', '.join(stale[:5])}{' ...' if len(stale) > 5 else ''}", file=sys.stderr)

@@ -21,6 +21,7 @@ from pathlib import Path
 
 import numpy as np
 import scipy.sparse as sp
+import yaml
 
 from .. import progress
 from ..errors import InputError
@@ -214,16 +215,23 @@ def matrix_bytes(mat, fmt: str) -> bytes:
 
 
 def write_system(directory, levels, fmt: str, name: str, norm: str = "given", known_kernel: int = 0,
-                 gamma: dict | None = None) -> Path:
+                 gamma: dict | None = None, written: list | None = None) -> Path:
     """Write each level's A, B, G as ``{A,B,G}<i>.<ext>`` and ``levels.yaml`` (atomically);
     ``levels``: (h, A, B, G[, multipliers[, traces]]) coarse to fine (G None: not written;
-    ``multipliers`` a mapping and ``traces`` a list written inline, with ``gamma`` for ``norm: H``).
-    Returns the manifest's path."""
+    ``multipliers`` a mapping and ``traces`` a list, with ``gamma`` for ``norm: H``). Returns the
+    manifest's path; ``written`` (a list), if given, receives the names of the files written.
+
+    The manifest is for people too: a level without a description is one short line
+    ``- {h: …, A: …, B: …, G: …}``; a described level is a block, and each of its arrays longer
+    than :data:`INLINE_MAX` numbers is a ``.npy`` file beside the matrices
+    (``level<i>_<keys>.npy``, exact float64 / int64), which the manifest reader takes in place of
+    the inline list (:mod:`.multiplier_basis`)."""
     directory = Path(directory)
     ext = EXPORT_FORMATS[fmt]
+    written = [] if written is None else written
     lines = [f"name: {name}", f"norm: {norm}"] + ([f"known_kernel: {known_kernel}"] if known_kernel else [])
-    if gamma is not None:
-        lines.append(f"gamma: {_flow(gamma)}")
+    if gamma is not None:  # a few numbers: one line, {shape: segment, length: 1.0}
+        lines.append("gamma: " + yaml.safe_dump(gamma, default_flow_style=True, sort_keys=False).strip())
     lines.append("levels:")
     for i, (h, A, B, G, *described) in progress.steps(list(enumerate(levels)), "writing level",
                                                       lambda lv: f"h={lv[1][0]:g}"):
@@ -232,17 +240,53 @@ def write_system(directory, levels, fmt: str, name: str, norm: str = "given", kn
             if mat is not None:
                 names[key] = f"{key}{i}{ext}"
                 write_bytes_atomic(directory / names[key], matrix_bytes(mat, fmt))
-        files = "".join(f", {key}: {file}" for key, file in names.items())
+                written.append(names[key])
         mult, traces = (list(described) + [None, None])[:2]
-        lines.append(f"  - {{h: {h!r}{files}" + (f", multipliers: {_flow(mult)}" if mult else "")
-                     + (f", traces: {_flow(traces)}" if traces else "") + "}")
+        if not mult and not traces:
+            lines.append(f"  - {{h: {h!r}" + "".join(f", {key}: {file}" for key, file in names.items()) + "}")
+            continue
+        entry = {"h": h, **names}
+        for key, value in (("multipliers", mult), ("traces", traces)):
+            if value:
+                entry[key] = _side_files(directory, f"level{i}_{key}", value, written)
+        block = yaml.dump([entry], Dumper=_ManifestDumper, sort_keys=False, width=100, allow_unicode=True)
+        lines += ["  " + line for line in block.rstrip().splitlines()]
     path = directory / "levels.yaml"
     write_atomic(path, "\n".join(lines) + "\n")
+    written.append(path.name)
     return path
 
 
-def _flow(value) -> str:
-    """``value`` as one line of YAML flow style (floats as repr: they read back exactly)."""
-    import yaml
+INLINE_MAX = 12
+"""Longest array (in numbers) written inline in a manifest; a longer one is a ``.npy`` side file."""
 
-    return yaml.safe_dump(value, default_flow_style=True, width=float("inf"), sort_keys=False).strip()
+
+def _side_files(directory: Path, stem: str, value, written: list):
+    """``value`` (a description) with every numeric array longer than :data:`INLINE_MAX` numbers
+    written to ``<stem>_<key>.npy`` and replaced by that file name."""
+    if isinstance(value, dict):
+        return {k: _side_files(directory, f"{stem}_{k}", v, written) for k, v in value.items()}
+    if isinstance(value, list) and value and all(isinstance(v, dict) for v in value):
+        return [_side_files(directory, f"{stem}_{j}", v, written) for j, v in enumerate(value)]
+    if isinstance(value, list):
+        arr = np.asarray(value)
+        if arr.size > INLINE_MAX and arr.dtype.kind in "iuf":
+            name = f"{stem}.npy"
+            buf = io.BytesIO()
+            np.save(buf, arr.astype(np.int64 if arr.dtype.kind in "iu" else np.float64), allow_pickle=False)
+            write_bytes_atomic(directory / name, buf.getvalue())
+            written.append(name)
+            return name
+    return value
+
+
+class _ManifestDumper(yaml.SafeDumper):
+    """Block style, with a short list of numbers on one line (``[0.0, 0.5, 1.0]``)."""
+
+
+def _short_lists_inline(dumper, data):
+    flow = len(data) <= INLINE_MAX and all(isinstance(v, (int, float, str)) for v in data)
+    return dumper.represent_sequence("tag:yaml.org,2002:seq", data, flow_style=flow)
+
+
+_ManifestDumper.add_representer(list, _short_lists_inline)

@@ -3,7 +3,8 @@
 ========================  ======================================================
 extension                 reader
 ========================  ======================================================
-``.mtx``, ``.mtx.gz``     ``scipy.io.mmread`` (MatrixMarket coordinate or array)
+``.mtx``, ``.mtx.gz``,    ``scipy.io.mmread`` (MatrixMarket coordinate or array;
+``.mm``, ``.mm.gz``       ``.mm`` is Kratos's name for it)
 ``.npz``                  ``scipy.sparse.load_npz``; else ``numpy.load`` of an
                           archive holding exactly one array (dense)
 ``.npy``                  ``numpy.load`` (dense)
@@ -27,7 +28,8 @@ import scipy.sparse as sp
 
 from ..errors import InputError
 
-FORMATS = {".mtx": "MatrixMarket", ".mtx.gz": "MatrixMarket (gzip)", ".npz": "scipy/numpy .npz",
+FORMATS = {".mtx": "MatrixMarket", ".mtx.gz": "MatrixMarket (gzip)", ".mm": "MatrixMarket",
+           ".mm.gz": "MatrixMarket (gzip)", ".npz": "scipy/numpy .npz",
            ".npy": "numpy .npy", ".hb": "Harwell-Boeing", ".rb": "Harwell-Boeing",
            ".rua": "Harwell-Boeing", ".rsa": "Harwell-Boeing", ".petsc": "PETSc binary",
            ".bin": "PETSc binary", ".dat": "PETSc binary"}
@@ -43,10 +45,11 @@ class SystemFileError(InputError):
 
 
 def extension(path) -> str:
-    """The format-deciding extension of ``path`` (``.mtx.gz`` counts as one)."""
+    """The format-deciding extension of ``path`` (``.mtx.gz`` and ``.mm.gz`` count as one)."""
     name = Path(path).name.lower()
-    if name.endswith(".mtx.gz"):
-        return ".mtx.gz"
+    for gz in (".mtx.gz", ".mm.gz"):
+        if name.endswith(gz):
+            return gz
     return Path(name).suffix
 
 
@@ -69,7 +72,7 @@ def read_matrix(path):
     if path.stat().st_size == 0:
         raise SystemFileError(path, f"empty file (expected {FORMATS[ext]})")
     try:
-        if ext in (".mtx", ".mtx.gz"):
+        if FORMATS[ext].startswith("MatrixMarket"):
             mat = _read_mtx(path, ext)
         elif ext == ".npz":
             mat = _read_npz(path)
@@ -116,7 +119,7 @@ def _as_float_matrix(path, mat):
 def _read_mtx(path, ext):
     import scipy.io
 
-    with (gzip.open(path, "rb") if ext == ".mtx.gz" else open(path, "rb")) as fh:
+    with (gzip.open(path, "rb") if ext.endswith(".gz") else open(path, "rb")) as fh:
         head = fh.read(15)
     if not head.startswith(b"%%MatrixMarket"):
         raise SystemFileError(path, f"does not start with the MatrixMarket banner '%%MatrixMarket' "
@@ -126,7 +129,7 @@ def _read_mtx(path, ext):
     longest = MTX_SLACK + MTX_LINE_MAX * entries
     last, size = _last_byte(path, ext, longest)
     if size > longest:
-        raise SystemFileError(path, f"MatrixMarket: more than {longest} bytes{' (decompressed)' if ext == '.mtx.gz' else ''} "
+        raise SystemFileError(path, f"MatrixMarket: more than {longest} bytes{' (decompressed)' if ext.endswith('.gz') else ''} "
                               f"for the {entries} entries its header declares (at most {MTX_LINE_MAX} bytes a line)")
     if last != b"\n":
         raise SystemFileError(path, "MatrixMarket: the last line does not end with a newline (a file cut "
@@ -134,7 +137,7 @@ def _read_mtx(path, ext):
     shortest = 2 if dense else (4 if pattern else 6)  # "v\n", "i j\n", "i j v\n"
     if entries * shortest > size:
         raise SystemFileError(path, f"MatrixMarket: the header declares {entries} entries, but the "
-                              f"{size} bytes{' (decompressed)' if ext == '.mtx.gz' else ''} hold at most "
+                              f"{size} bytes{' (decompressed)' if ext.endswith('.gz') else ''} hold at most "
                               f"{size // shortest}: a file cut short")
     return scipy.io.mmread(str(path))
 
@@ -145,7 +148,7 @@ HEADER_LINE_MAX = 1 << 16
 
 def _mtx_header(path, ext):
     """(rows, cols, entries, dense, pattern) from the banner and the size line, body unread."""
-    with (gzip.open(path, "rb") if ext == ".mtx.gz" else open(path, "rb")) as fh:
+    with (gzip.open(path, "rb") if ext.endswith(".gz") else open(path, "rb")) as fh:
         banner = fh.readline(HEADER_LINE_MAX).decode("ascii", "replace").lower().split()
         while True:
             line = fh.readline(HEADER_LINE_MAX)
@@ -185,7 +188,7 @@ MTX_SLACK = 1 << 20
 def _last_byte(path, ext, stop=None):
     """(the last byte, the size) of the (decompressed) file; a .mtx.gz is streamed (constant
     memory), and only until ``stop`` bytes (its size then just exceeds ``stop``)."""
-    if ext != ".mtx.gz":
+    if not ext.endswith(".gz"):
         with open(path, "rb") as fh:
             fh.seek(-1, 2)
             return fh.read(1), fh.tell()

@@ -124,7 +124,8 @@ def is_stream(path) -> bool:
     if text.startswith(("/dev/", "/proc/self/fd/")):
         return True
     try:
-        return not stat.S_ISREG(os.stat(path).st_mode)
+        mode = os.stat(path).st_mode
+        return stat.S_ISCHR(mode) or stat.S_ISFIFO(mode) or stat.S_ISSOCK(mode) or stat.S_ISBLK(mode)
     except OSError:
         return False
 

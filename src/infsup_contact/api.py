@@ -167,7 +167,9 @@ def _actions(parser: argparse.ArgumentParser, command: str) -> dict:
 def _tokens(key: str, value, action) -> list:
     """The command-line tokens of one keyword, checked as argparse would (so that a bad value
     raises InputError here instead of argparse's exit)."""
-    values = list(value) if isinstance(value, (list, tuple, range)) or hasattr(value, "tolist") else [value]
+    if hasattr(value, "tolist"):  # numpy: a scalar (np.int64(2)) becomes its Python number, an array a list
+        value = value.tolist()
+    values = list(value) if isinstance(value, (list, tuple, range)) else [value]
     if action.nargs is None and len(values) != 1:
         raise InputError(key, "one value", got=value)
     if not values:

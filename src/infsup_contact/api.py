@@ -27,7 +27,7 @@ from .errors import InputError
 
 __all__ = ["beta", "verdict", "certify", "InputError"]
 
-_NOT_KEYWORDS = {"help", "dry_run", "format", "output", "expect", "command"}
+_NOT_KEYWORDS = {"help", "dry_run", "format", "output", "force", "expect", "command"}
 """Flags of the commands that are about the command line, not the result."""
 
 

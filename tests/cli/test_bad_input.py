@@ -648,3 +648,17 @@ def test_the_elastic3d_face_estimate_above_the_dense_gate():
     code, out, err = run_in_process(["beta", "--model", "elastic3d", "--case", "T3", "--k", "2", "--N1", "16",
                                      "--N2", "16", "--dry-run"])
     assert code == 0 and out.startswith("dry run: valid request"), (code, out, err)
+
+
+@pytest.mark.parametrize("name", ["A .npy of 1.15 GB that B does not fit", "constrained .npy of 150M dofs"])
+def test_a_large_declared_npy_is_refused_by_its_header_before_its_body(hostile, name):
+    """The refusal reads headers only: the traced peak stays far below the 1.15/1.2 GB body."""
+    import tracemalloc
+
+    tracemalloc.start()
+    try:
+        refused(["verdict", "--system", hostile[name]], "--system", HOSTILE_MANIFESTS[name])
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert peak < 100e6, f"{peak / 1e6:.0f} MB traced"

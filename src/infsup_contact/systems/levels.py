@@ -70,8 +70,9 @@ def check_declared_shapes(level) -> None:
     if shapes["A"] is None or shapes["B"] is None:
         return
     G = shapes["G"] or (shapes["B"][0], shapes["B"][0])  # no G (norm H): the described Gram, m x m
-    check_shapes(level if level.G is not None else SimpleNamespace(A=level.A, B=level.B, G=level.B),
-                 *(SimpleNamespace(shape=tuple(s)) for s in (shapes["A"], shapes["B"], G)))
+    mats = [SimpleNamespace(shape=tuple(s)) for s in (shapes["A"], shapes["B"], G)]
+    with transposed_b_hint(*mats):
+        check_shapes(level if level.G is not None else SimpleNamespace(A=level.A, B=level.B, G=level.B), *mats)
 
 
 def _load_level(manifest: Manifest, level):
@@ -250,6 +251,8 @@ def dry_check(manifest: Manifest, route: str = "auto"):
 
     sizes, shapes = [], []
     extra = 0.0
+    for level in manifest.levels:  # every level's headers before any body is read
+        check_declared_shapes(level)
     for level in manifest.levels:
         mats = [None if p is None else read_matrix(p) for p in (level.A, level.B, level.G)]
         for mat, path in zip(mats, (level.A, level.B, level.G)):

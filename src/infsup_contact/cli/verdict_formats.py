@@ -105,6 +105,8 @@ def output_path(text: str) -> str:
 
     if text == "-" or is_stream(text):  # stdout, as without --output; a device or pipe as it is
         return text
+    if Path(text).is_block_device():  # a disk: never written over
+        raise argparse.ArgumentTypeError(f"{text!r} is a block device (a disk): expected a file name to write")
     if not text or Path(text).is_dir():
         raise argparse.ArgumentTypeError(f"{text!r} is a directory or empty: expected a file name to write")
     problem = check_writable_place(Path(text).absolute().parent)
@@ -121,11 +123,11 @@ def is_stream(path) -> bool:
     from pathlib import Path
 
     text = str(Path(path).absolute())
-    if text.startswith(("/dev/", "/proc/self/fd/")):
+    if text in ("/dev/stdout", "/dev/stderr") or text.startswith(("/dev/fd/", "/proc/self/fd/")):
         return True
     try:
         mode = os.stat(path).st_mode
-        return stat.S_ISCHR(mode) or stat.S_ISFIFO(mode) or stat.S_ISSOCK(mode) or stat.S_ISBLK(mode)
+        return stat.S_ISCHR(mode) or stat.S_ISFIFO(mode) or stat.S_ISSOCK(mode)
     except OSError:
         return False
 

@@ -400,6 +400,8 @@ YAML_FAULTS = {
     "1.0e3": ("claims:\n  beta_floor: 1.0e3\n", "claims.beta_floor", "signed exponent"),
     "-1e-3": ("x: -1e-3\n", "x", "read as a string"),
     "json-duplicate": ('{"a": 1, "a": 2}', "a", "given twice"),
+    # a plain list past the limit: its size is the problem, not aliases it does not have
+    "long-list": ("x: &x 1\ny: *x\nb: [" + "0, " * 100_001 + "]\n", "b", "a list of 100,001 items"),
 }
 YAML_ACCEPTED = {
     "quoted-1e3": "a: '1e3'\n",
@@ -488,3 +490,88 @@ def test_edge_dropping_config_is_refused_not_computed_as_garbage(mutate, key, ne
     with pytest.raises(ConfigError) as err:
         check_config(cfg, SCHEMA)
     assert one_line(err.value).startswith(f"config key {key}") and needle in one_line(err.value), err.value
+
+
+# ------------------------------------------------------------------ 6. issue 50, item 8: hostile config and API values
+
+FULL_CONFIG = yaml.safe_load((ROOT / "config" / "config.yaml").read_text())
+
+
+@pytest.mark.parametrize("key", ["../../victim", "/home/user", "a/b", "..", "x y", ""])
+def test_a_producer_name_that_is_a_path_is_refused(key):
+    """A code's name is a folder of the producers' workdir, emptied before each export: a path
+    (absolute, with ``..`` or ``/``) deleted the user's files outside the project."""
+    cfg = copy.deepcopy(FULL_CONFIG)
+    codes = cfg["producers"]["codes"]
+    codes[key] = codes.pop(next(iter(codes)))
+    with pytest.raises(ConfigError) as err:
+        check_config(cfg, SCHEMA)
+    assert one_line(err.value).startswith("config key producers.codes:") and repr(key) in str(err.value)
+
+
+@pytest.mark.parametrize("space", ["../x", "/abs", "..", "a/b"])
+def test_a_producer_space_that_is_a_path_is_refused(space):
+    cfg = copy.deepcopy(FULL_CONFIG)
+    next(iter(cfg["producers"]["codes"].values()))["spaces"][0] = space
+    with pytest.raises(ConfigError) as err:
+        check_config(cfg, SCHEMA)
+    assert one_line(err.value).startswith("config key producers.codes.") and "spaces[0]" in str(err.value)
+
+
+@pytest.mark.parametrize("target", ["../victim", "../victim/sub", "kratos/../..", ".", "link/x"])
+def test_the_producers_stage_deletes_only_inside_its_workdir(tmp_path, target):
+    """Defence in depth (the config check comes first): a folder resolving outside the workdir,
+    or the workdir itself, is never deleted."""
+    from infsup_contact.study.producers import _empty_dir
+
+    workdir, victim = tmp_path / "work", tmp_path / "victim"
+    (victim / "sub").mkdir(parents=True)
+    (victim / "sub" / "file").write_text("keep me")
+    (workdir / "kratos").mkdir(parents=True)
+    (workdir / "link").symlink_to(victim)
+    with pytest.raises(InputError) as err:
+        _empty_dir(workdir / target, workdir)
+    assert err.value.key == "producers.codes" and (victim / "sub" / "file").read_text() == "keep me"
+    _empty_dir(workdir / "kratos" / "dual_k0", workdir)  # inside: accepted
+    assert (workdir / "kratos").is_dir() and not (workdir / "kratos" / "dual_k0").exists()
+
+
+def test_face_n_equal_one_at_k_one_is_refused():
+    cfg = copy.deepcopy(CI_CONFIG)
+    cfg["face"].update(k=[1], cases=["T3", "R5.2", "DUAL"], N=[1, 4, 6, 8])
+    with pytest.raises(ConfigError) as err:
+        check_config(cfg, SCHEMA)
+    text = one_line(err.value)
+    assert text.startswith("config key face.N[0]") and "T3 with k = 1" in text and "dim M_h = 0" in text
+
+
+@pytest.mark.parametrize("section, n", [("face", 64), ("face_elastic", 16)])
+def test_face_jobs_are_counted_in_the_memory_check(section, n):
+    """The face sections' β jobs have the command line's estimate (resources.beta_estimate,
+    dim 3); a local run is refused when the largest exceeds the machine's memory (here a
+    machine of 2 GB: the CI config's own largest job fits in it)."""
+    from infsup_contact.config.memory import check_job_memory, job_estimates
+
+    limit = 2e9
+    check_job_memory(CI_CONFIG, limit)
+    cfg = copy.deepcopy(CI_CONFIG)
+    cfg[section]["N"] = sorted({*cfg[section]["N"], n})
+    check_config(cfg, SCHEMA)
+    assert any(job.startswith(f"{section} beta") for _, job, _ in job_estimates(cfg))
+    with pytest.raises(ConfigError) as err:
+        check_job_memory(cfg, limit)
+    assert one_line(err.value).startswith(f"config key {section}.N:") and f"{n}x{n}" in str(err.value)
+
+
+def test_numpy_integer_scalars_are_the_integers_they_are():
+    """The API takes numpy integer scalars (k=np.int64(2), N1=np.int32(4), seed=np.int64(3)):
+    the same request, the same row (they were a TypeError)."""
+    import infsup_contact as ic
+
+    plain = ic.beta(case="T3", k=1, N1=4, N2=4, family="perturbed", seed=3, norm="L2")
+    numpy = ic.beta(case="T3", k=np.int64(1), N1=np.int32(4), N2=np.int16(4), family="perturbed",
+                    seed=np.int64(3), norm="L2")
+    assert numpy.drop(columns=[c for c in numpy if c.startswith("t_")]).equals(
+        plain.drop(columns=[c for c in plain if c.startswith("t_")]))
+    with pytest.raises(InputError):
+        ic.beta(case="T3", k=np.float64(1.5), N1=4, N2=4)

@@ -32,7 +32,7 @@ from .errors import InputError
 
 __all__ = ["beta", "verdict", "certify", "InputError"]
 
-_NOT_KEYWORDS = {"help", "dry_run", "format", "output", "command"}
+_NOT_KEYWORDS = {"help", "dry_run", "format", "output", "force", "command"}
 """Flags of the commands that are about the command line, not the result."""
 
 _NOTEBOOK = "<notebook>"
@@ -199,7 +199,9 @@ def _actions(parser: argparse.ArgumentParser, command: str) -> dict:
 def _tokens(key: str, value, action) -> list:
     """The command-line tokens of one keyword, checked as argparse would (so that a bad value
     raises InputError here instead of argparse's exit)."""
-    values = list(value) if isinstance(value, (list, tuple, range)) or hasattr(value, "tolist") else [value]
+    if hasattr(value, "tolist"):  # numpy: a scalar (np.int64(2)) becomes its Python number, an array a list
+        value = value.tolist()
+    values = list(value) if isinstance(value, (list, tuple, range)) else [value]
     if action.nargs is None and len(values) != 1:
         raise InputError(key, "one value", got=value)
     if not values:

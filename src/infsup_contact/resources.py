@@ -205,8 +205,9 @@ def _face_bodies_estimate(k: int, n1: int, n2: int, components: int = 1, process
     if route == "pardiso" and m > DENSE_MAX_M:
         a, b, c, d = LARGE_ROUTE_3D[min(k, 2)]
         # memory never below the dense route's estimate at the gate (that one is the looser:
-        # measured k = 2, 0.93 GB at N = 18 dense, 1.12 GB at N = 19 large), so it grows with N
-        gate = int((math.isqrt(DENSE_MAX_M) - 1) // k)
+        # measured k = 2, 0.93 GB at N = 18 dense, 1.12 GB at N = 19 large), so it grows with N; per
+        # component, so the gate's components (k gate + 1)^2 <= DENSE_MAX_M takes the dense route (no recursion)
+        gate = int((math.isqrt(DENSE_MAX_M // components) - 1) // k)
         floor = _face_bodies_estimate(k, gate, gate, components, process).bytes if gate >= 1 else 0.0
         return Estimate(max(base + MKL_BYTES + LARGE_ROUTE_MARGIN * (a * sum(nds) + b * m * m), floor),
                         START_SECONDS + LARGE_ROUTE_MARGIN * (c * sum(nds) + d * m ** 3))

@@ -10,7 +10,8 @@
 :class:`LimitedLoader` is a ``SafeLoader`` that checks the node tree of each document before
 anything is constructed: every mapping's keys once, and the tree as expanded through its aliases
 at most :data:`MAX_NODES` nodes (counted once per distinct node, so the check is linear in the
-file). A recursive alias is refused too. The problems are :class:`YamlLimitError`, whose
+file); a file that holds that many values without any alias is refused saying so (the size of its
+list), not blamed on aliases. A recursive alias is refused too. The problems are :class:`YamlLimitError`, whose
 ``key`` is the path of the offending key (``levels[0].h``) and ``line`` its 1-based line.
 """
 from __future__ import annotations
@@ -23,7 +24,8 @@ MAX_NODES = 100_000
 
 
 class YamlLimitError(yaml.YAMLError):
-    """A key given twice, or aliases that expand too far: ``problem``, ``key`` (a path), ``line``."""
+    """A key given twice, aliases that expand too far, or a file holding more than
+    :data:`MAX_NODES` values: ``problem``, ``key`` (a path), ``line``."""
 
     def __init__(self, problem: str, key: str = "", line: int | None = None):
         self.problem, self.key, self.line = problem, key, line
@@ -42,10 +44,12 @@ def check_nodes(root, max_nodes: int = MAX_NODES, duplicates: bool = True) -> No
     ``max_nodes`` in a composed node tree."""
     sizes: dict[int, int] = {}
     active: set[int] = set()
+    aliased: set[int] = set()  # nodes holding an alias (PyYAML composes one as the anchored node itself)
 
     def size(node, path) -> int:
         key = id(node)
         if key in sizes:
+            aliased.update(active)
             return sizes[key]
         if key in active:
             raise YamlLimitError("a recursive alias (a node that contains itself)", _path(path),
@@ -70,9 +74,15 @@ def check_nodes(root, max_nodes: int = MAX_NODES, duplicates: bool = True) -> No
                 total += size(item, [*path, i])
                 if total > max_nodes:
                     break
-        if total > max_nodes:
+        if total > max_nodes and key in aliased:
             raise YamlLimitError(f"its aliases expand to more than {max_nodes:,} values (a 'billion laughs' "
                                  "file?); write the values out, or use fewer aliases", _path(path),
+                                 node.start_mark.line + 1)
+        if total > max_nodes:  # no alias: the file itself is that large
+            what = (f"a list of {len(node.value):,} items" if isinstance(node, yaml.SequenceNode) and
+                    len(node.value) > max_nodes else "more")
+            raise YamlLimitError(f"{what}: more than the {max_nodes:,} values read from one file (a few levels or "
+                                 "settings hold far fewer); is this the right file?", _path(path),
                                  node.start_mark.line + 1)
         active.discard(key)
         sizes[key] = total

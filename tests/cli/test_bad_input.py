@@ -500,3 +500,165 @@ def test_every_subcommand_declares_its_conditional_flags():
     for command, parser in subcommands().items():
         if command != "provenance":
             assert parser.get_default("flag_uses") is not None, command  # set_defaults(flag_uses=...)
+
+
+# ------------------------------------------------------------------ issue 50, item 8: hostile inputs
+# Each one line on stderr, exit 2, before anything is computed or written (they were tracebacks,
+# files of the user replaced, or the matrices of a symlinked manifest looked for beside the link).
+
+def _variant(root, name, edit_level=None, files=None):
+    """A copy of the tiny manifest in ``root/name``: ``edit_level`` appended to level 0's
+    mapping (``", constrained: [5]"``), ``files`` {name: bytes or callable(path)} written."""
+    folder = root / name
+    manifest = _tiny_manifest(folder)
+    if edit_level:
+        text = manifest.read_text().replace("G: G0.mtx}", f"G: G0.mtx{edit_level}}}", 1)
+        manifest.write_text(text)
+    for fname, data in (files or {}).items():
+        data(folder / fname) if callable(data) else (folder / fname).write_bytes(data)
+    return manifest
+
+
+def _npy_header_only(shape, descr):
+    """An .npy file of ``shape`` whose body is a hole (a sparse file: a few kB on disk)."""
+    import numpy as np
+
+    def write(path):
+        with open(path, "wb") as fh:
+            np.lib.format.write_array_header_1_0(fh, {"descr": descr, "fortran_order": False, "shape": shape})
+            fh.truncate(fh.tell() + int(np.prod(shape)) * np.dtype(descr).itemsize)
+    return write
+
+
+@pytest.fixture(scope="module")
+def hostile(tmp_path_factory):
+    root = tmp_path_factory.mktemp("hostile")
+    out = {"good": _tiny_manifest(root / "good")}
+    (root / "link").mkdir()
+    (root / "link" / "levels.yaml").symlink_to(out["good"])
+    out["link"] = root / "link" / "levels.yaml"
+    out["loop"] = root / "loop.yaml"
+    out["loop"].symlink_to(out["loop"])
+    zero = _variant(root, "zero")
+    (zero.parent / "A0.mtx").write_text("%%MatrixMarket matrix coordinate real general\n4 4 0\n")
+    out["zero A"] = zero
+    out["constrained 10**20"] = _variant(root, "big", ", constrained: [100000000000000000000]")
+    out["constrained file 10**23"] = _variant(root, "bigfile", ", constrained: c.txt",
+                                              {"c.txt": b"100000000000000000000000\n"})
+    out["multipliers null"] = _variant(root, "mnull", ", multipliers: null")
+    out["constrained .npy of 150M dofs"] = _variant(root, "npyc", ", constrained: c.npy",
+                                                    {"c.npy": _npy_header_only((150_000_000,), "<i8")})
+    npy_a = _variant(root, "npya", files={"A0.npy": _npy_header_only((12_000, 12_000), "<f8")})
+    npy_a.write_text(npy_a.read_text().replace("A0.mtx", "A0.npy"))
+    out["A .npy of 1.15 GB that B does not fit"] = npy_a
+    out["dir"] = root
+    return out
+
+
+HOSTILE_MANIFESTS = {  # name: a needle of the one line
+    "loop": "symlink loop",
+    "zero A": "A is zero",
+    "constrained 10**20": "constrained dof 100000000000000000000 outside 0..3",
+    "constrained file 10**23": "beyond 64-bit integers",
+    "multipliers null": "levels[0].multipliers: no value (null)",
+    "constrained .npy of 150M dofs": "declares 150000000 constrained dofs",
+    "A .npy of 1.15 GB that B does not fit": "B is 2 x 4, but A (A0.npy) is 12000 x 12000",
+}
+
+
+def refused(argv, flag, needle=""):
+    """Run ``argv`` (no --dry-run): exit 2, nothing on stdout, one stderr line naming ``flag``."""
+    code, out, err = run_in_process([str(a) for a in argv])
+    assert code == 2 and out == "" and len(err.splitlines()) == 1 and "Traceback" not in err, (code, out, err)
+    assert flag in err and needle in err, err
+    return err
+
+
+@pytest.mark.parametrize("name", list(HOSTILE_MANIFESTS))
+@pytest.mark.parametrize("command", ["verdict", "beta"])
+def test_hostile_manifest_is_one_line(hostile, name, command):
+    refused([command, "--system", hostile[name]], "--system", HOSTILE_MANIFESTS[name])
+
+
+def test_a_symlinked_manifest_reads_the_matrices_beside_its_target(hostile):
+    code, out, err = run_in_process(["verdict", "--system", str(hostile["link"]), "--dry-run"])
+    assert code == 0 and out.startswith("dry run: valid request"), (code, out, err)
+
+
+TABLE_COMMANDS = {  # command → argv (a small request; never computed here: refused or --dry-run)
+    "beta": ["beta", "--k", "1", "--N1", "4", "--N2", "4"],
+    "contact": ["contact", "--scene", "manufactured", "--case", "T3", "--k", "1", "--N1", "4", "--N2", "4"],
+    "bench": ["bench", "--what", "beta", "--N", "4", "--k", "1"],
+    "verdict": ["verdict", "--case", "T3", "--k", "1"],
+}
+
+
+@pytest.mark.parametrize("command", [*TABLE_COMMANDS, "rates"])
+def test_output_never_replaces_an_existing_file_without_force(tables, tmp_path, command):
+    """Every subcommand writing a table has --output FILE; an existing file is refused (one line
+    naming --output and --force, the file untouched), with --force accepted; --force alone
+    (nothing written) is refused as unused; /proc, where no temporary file can be created, is
+    refused by the flag's type."""
+    argv = TABLE_COMMANDS.get(command, ["rates", str(tables["good"])])
+    victim = tmp_path / "precious.txt"
+    victim.write_text("keep me\n")
+    refused([*argv, "--output", victim], "--output", "--force")
+    assert victim.read_text() == "keep me\n"
+    code, out, err = run_in_process([*argv, "--output", str(victim), "--force", "--dry-run"])
+    assert code == 0 and out.startswith("dry run: valid request"), (code, out, err)
+    refused([*argv, "--force"], "--force", "used only by")
+    refused([*argv, "--output", "/proc/x.csv"], "--output", "no file can be created in /proc")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["precious.txt"]  # no temporary file left
+
+
+def test_verdict_output_force_replaces_and_rates_output_is_not_its_table(hostile, tables, tmp_path):
+    target = tmp_path / "v.json"
+    target.write_text("old\n")
+    code, out, err = run_in_process(["verdict", "--system", str(hostile["good"]), "--format", "json",
+                                     "--output", str(target), "--force"])
+    assert code == 0 and out == "" and '"verdict"' in target.read_text(), (code, out, err)
+    refused(["rates", tables["good"], "--output", tables["good"], "--force"], "--output", "other than the inputs")
+
+
+def test_export_refuses_a_place_it_cannot_write_before_computing(tmp_path):
+    base = ["export", "--case", "T3", "--k", "1", "--N", "2", "3", "4"]
+    for out in ("/proc/infsup-x", "/proc/infsup-x/sub"):
+        refused([*base, "--out", out], "--out", "no file can be created in /proc")
+
+
+def test_export_on_an_arc_names_its_radius(tmp_path):
+    """The system name joins the mesh options as text (a float radius was a TypeError)."""
+    code, out, err = run_in_process(["export", "--case", "T3", "--k", "1", "--N", "2", "3", "4", "--gamma", "arc",
+                                     "--radius", "2", "--out", str(tmp_path / "e")])
+    assert code == 0 and "arc-2-exact" in (tmp_path / "e" / "levels.yaml").read_text(), (code, out, err)
+
+
+@pytest.mark.parametrize("argv, flag, needle", [
+    (["beta", "--model", "membranes3d", "--case", "DUAL-Q9", "--k", "2", "--N1", "2", "--N2", "2", "--gamma",
+      "cylinder", "--radius", "1e300"], "--radius", "1e+08"),
+    (["export", "--model", "membranes3d", "--case", "DUAL-Q9", "--k", "2", "--N", "2", "3", "4", "--gamma",
+      "cylinder", "--radius", "1e20", "--out", "unused"], "--radius", "1e+08"),
+])
+def test_a_radius_beyond_round_off_is_refused(argv, flag, needle):
+    refused(argv, flag, needle)
+
+
+def test_the_elastic3d_face_estimate_above_the_dense_gate():
+    """The estimate of a 3-component face above the dense route's gate (a RecursionError)."""
+    code, out, err = run_in_process(["beta", "--model", "elastic3d", "--case", "T3", "--k", "2", "--N1", "16",
+                                     "--N2", "16", "--dry-run"])
+    assert code == 0 and out.startswith("dry run: valid request"), (code, out, err)
+
+
+@pytest.mark.parametrize("name", ["A .npy of 1.15 GB that B does not fit", "constrained .npy of 150M dofs"])
+def test_a_large_declared_npy_is_refused_by_its_header_before_its_body(hostile, name):
+    """The refusal reads headers only: the traced peak stays far below the 1.15/1.2 GB body."""
+    import tracemalloc
+
+    tracemalloc.start()
+    try:
+        refused(["verdict", "--system", hostile[name]], "--system", HOSTILE_MANIFESTS[name])
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert peak < 100e6, f"{peak / 1e6:.0f} MB traced"

@@ -54,10 +54,10 @@ def test_foreign_system_mode_is_the_models(tmp_path):
                                        "--out", str(out_dir), "--force"])
         assert code == 0, err
         code, _, err = run_in_process(["beta", "--system", str(out_dir / "levels.yaml"),
-                                       "--worst-mode", str(tmp_path / "system.csv")])
+                                       "--worst-mode", str(tmp_path / "system.csv"), "--force"])  # the loop's own
         assert code == 0, err
         code, _, err = run_in_process(["beta", "--case", case, "--k", str(k), "--N1", "4", "--N2", "4", "--norm", "H",
-                                       "--worst-mode", str(tmp_path / "model.csv")])
+                                       "--worst-mode", str(tmp_path / "model.csv"), "--force"])
         assert code == 0, err
         system, model = pd.read_csv(tmp_path / "system.csv"), pd.read_csv(tmp_path / "model.csv")
         assert list(system.columns) == ["system", "level", "h", "norm", "beta", "x", "mu"]

@@ -309,7 +309,8 @@ if FACE_FIGURE_NAMES:
             "results/logs/figures/face_worst_mode.log",
         shell:
             # the β row goes to the log; the modes' table is written atomically by --worst-mode
-            _BLAS1 + "python -m infsup_contact beta {params.args} --worst-mode {output} > {log} 2>&1"
+            # (--force: the rule owns its output; Snakemake removes it first, a rerun by hand does not)
+            _BLAS1 + "python -m infsup_contact beta {params.args} --worst-mode {output} --force > {log} 2>&1"
 
     rule face_figures:
         output:
@@ -356,7 +357,7 @@ if ARC_FIGURE_NAMES:
         log:
             "results/logs/figures/arc_worst_mode.log",
         shell:
-            _BLAS1 + "python -m infsup_contact beta {params.args} --worst-mode {output} > {log} 2>&1"
+            _BLAS1 + "python -m infsup_contact beta {params.args} --worst-mode {output} --force > {log} 2>&1"
 
     rule curved_figure:
         output:

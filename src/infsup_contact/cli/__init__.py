@@ -122,8 +122,12 @@ def parse(parser, argv):
 def check(args):
     """Every subcommand's validation: first the one rule for flags the request does not use
     (:func:`~.common.refuse_unused`), then its own checks; the estimate (or None)."""
+    from .verdict_formats import check_outputs
+
     refuse_unused(args)
-    return args.check(args) if hasattr(args, "check") else None
+    estimate = args.check(args) if hasattr(args, "check") else None
+    check_outputs(args)  # after the request's checks (the inputs known), before any computation
+    return estimate
 
 
 def validate(argv) -> tuple:

@@ -3,6 +3,7 @@ from __future__ import annotations
 
 from ..errors import InputError
 from .common import FlagUse, add_dry_run, check_memory, declare_flag_uses, write_csv
+from .verdict_formats import add_table_output, force_use
 
 
 def add(sub) -> None:
@@ -31,8 +32,9 @@ def add(sub) -> None:
     p.add_argument("--radius", type=float, default=None, help="arc: the radius R > 1 of Γ (default 2)")
     p.add_argument("--case", nargs="+", default=None,
                    help="elastic: the space ids to run, each where defined for k (default every registered one)")
+    add_table_output(p)
     add_dry_run(p)
-    declare_flag_uses(p, FLAG_USES)
+    declare_flag_uses(p, [*FLAG_USES, force_use()])
     p.set_defaults(run=_run_bench, check=_check_bench)
 
 
@@ -142,7 +144,7 @@ def _run_bench(args) -> None:
         from ..bench.curved import COLUMNS, curved_rows
 
         write_csv(pd.DataFrame(curved_rows(args.N, args.k, args.radius, args.repeats, args.route_budget),
-                               columns=list(COLUMNS)), float_format="%.6g")
+                               columns=list(COLUMNS)), float_format="%.6g", output=args.output)
         return
     elif args.what in PLANE_STRAIN:
         rows = bench.bench_beta(bench.bench_for(args.what, nu=args.nu), args.N, args.k, args.repeats,
@@ -150,4 +152,4 @@ def _run_bench(args) -> None:
     else:
         rows = bench.bench_contact(args.N, args.k, args.repeats, peers=tuple(peers),
                                    kkt_max_n=args.kkt_max_n, budget=args.route_budget)
-    write_csv(pd.DataFrame(rows), float_format="%.6g")
+    write_csv(pd.DataFrame(rows), float_format="%.6g", output=args.output)

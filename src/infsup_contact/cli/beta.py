@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import sys
 
-from .verdict_formats import output_path
+from .verdict_formats import add_table_output, force_use, output_path
 from .worst_mode import check_worst_mode, mode_frame, write_modes
 from .common import (FlagUse, declare_flag_uses, material_columns, mesh_options, model_flag_uses, system_flag_uses,
                      add_dry_run, add_model, cases, face_cases, check_memory, material, norms, SPACE_HELP, write_csv)
@@ -51,9 +51,10 @@ def add(sub) -> None:
                    "as mu_h = sum m_j mu_j at sample points of Γ, max |mu_h| = 1; columns case, multiplier_mesh, "
                    "c1, c2, norm, beta, x (, y on a face), mu. With --system: one mode per level, for a manifest "
                    "describing its multipliers (gamma, levels[i].multipliers)")
+    add_table_output(p)
     add_dry_run(p)
     system_uses = [u for u in system_flag_uses(p) if u.dest != "worst_mode"]  # a mode per level (worst_mode.py)
-    declare_flag_uses(p, [*system_uses, *FLAG_USES, *model_flag_uses()])
+    declare_flag_uses(p, [*system_uses, *FLAG_USES, *model_flag_uses(), force_use()])
     p.set_defaults(run=_run_beta, check=_check_beta)
 
 
@@ -132,7 +133,7 @@ def _run_beta(args) -> None:
     frame = beta_frame(args, modes)
     if modes is not None:
         write_modes(args.worst_mode, mode_frame(modes))
-    write_csv(frame, float_format="%.12g")
+    write_csv(frame, float_format="%.12g", output=args.output)
 
 
 def beta_frame(args, modes: list | None = None):

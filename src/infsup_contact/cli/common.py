@@ -187,7 +187,7 @@ def check_memory(est, key: str, value) -> None:
 
 
 SYSTEM_KEEPS = ("system", "dry_run", "expect", "slope_tolerance", "beta_floor", "confidence", "help",
-                "format", "output")
+                "format", "output", "force")
 """Flags that mean something with ``--system``; every other one is refused there."""
 
 
@@ -355,9 +355,12 @@ def write_text(text: str) -> None:
         raise OutputError(f"cannot write the result to standard output ({reason})") from None
 
 
-def write_csv(frame, float_format: str) -> None:
-    """A result table as CSV on stdout (:func:`write_text`)."""
-    write_text(frame.to_csv(index=False, float_format=float_format))
+def write_csv(frame, float_format: str, output=None) -> None:
+    """A result table as CSV on stdout (:func:`write_text`), or atomically into ``output``
+    (``--output FILE``, checked before the computation: :func:`.verdict_formats.check_outputs`)."""
+    from .verdict_formats import write_result
+
+    write_result(frame.to_csv(index=False, float_format=float_format), output)
 
 
 def material_columns(frame, args):

@@ -4,6 +4,7 @@ pair, CSV rows; the scenes and the models each is defined for come from the scen
 from __future__ import annotations
 
 from ..errors import InputError, check_prestress
+from .verdict_formats import add_table_output, force_use
 from .common import (FlagUse, add_dry_run, add_model, cases, check_memory, declare_flag_uses, face_cases, material,
                      mesh_options, model_flag_uses, SPACE_HELP, write_csv)
 
@@ -31,8 +32,9 @@ def add(sub) -> None:
                    "(default 0.05)")
     p.add_argument("--n-ref", type=int, default=64,
                    help="membranes: reference mesh N (degree k + 1), at least 2 max(N1, N2)")
+    add_table_output(p)
     add_dry_run(p)
-    declare_flag_uses(p, [*scene_flag_uses(), *model_flag_uses()])
+    declare_flag_uses(p, [*scene_flag_uses(), *model_flag_uses(), force_use()])
     p.set_defaults(run=_run_contact, check=_check_contact)
 
 
@@ -95,4 +97,4 @@ def _run_contact(args) -> None:
 
     spec = scene_spec(args.scene)
     rows = spec.rows(args.model_obj, args.cases, args.k, args.family, args.N1, args.N2, (args.c1, args.c2), args)
-    write_csv(pd.DataFrame(rows), float_format=spec.float_format)
+    write_csv(pd.DataFrame(rows), float_format=spec.float_format, output=args.output)

@@ -74,6 +74,11 @@ def _check_export(args):
         raise InputError("out", "a directory to write into (created if missing)", got=args.out)
     if out.is_dir() and not args.force:
         _refuse_nonempty(out, args)
+    from .verdict_formats import check_writable_place
+
+    problem = check_writable_place(out)  # /proc, a read-only folder: before anything is computed
+    if problem:
+        raise InputError("out", "a directory this process can create and write files in", got=f"{args.out} ({problem})")
     est = resources.beta_estimate(args.family, args.k, max(ns) + args.N1_offset, max(ns), args.multiplier_mesh,
                                   (args.norm,), components=args.model_obj.components, dim=args.model_obj.dim)
     check_memory(est, *(("N1_offset", args.N1_offset) if args.N1_offset > max(ns) else ("N", max(ns))))
@@ -111,7 +116,8 @@ def _run_export(args) -> None:
 
     levels, norm, gamma = suite_levels(args.case, args.k, args.N, args.N1_offset, args.family, args.norm,
                                        args.multiplier_mesh, model=args.model_obj, mesh=args.mesh)
-    name = "-".join([args.case, f"k{args.k}", args.model, *args.mesh.kwargs().values()]
+    name = "-".join([args.case, f"k{args.k}", args.model, *(f"{v:g}" if isinstance(v, float) else str(v)
+                                                            for v in args.mesh.kwargs().values())]
                     + ([f"N1{args.N1_offset:+d}"] if args.N1_offset else []))
     out = Path(args.out)
     before = {p.name for p in out.iterdir()} if out.is_dir() else set()

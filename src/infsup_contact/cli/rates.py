@@ -4,6 +4,7 @@ from __future__ import annotations
 from ..errors import InputError
 from ..io import TableError
 from .common import add_dry_run, declare_flag_uses, write_csv
+from .verdict_formats import add_table_output, force_use
 
 
 def add(sub) -> None:
@@ -11,8 +12,9 @@ def add(sub) -> None:
     p.add_argument("table", help="CSV written by `infsup-contact contact` or the workflow; - for standard input")
     p.add_argument("--window", type=int, default=3,
                    help="number of finest meshes in the fit (2 .. the meshes of the shortest series)")
+    add_table_output(p)
     add_dry_run(p)
-    declare_flag_uses(p, [])  # every flag of rates is used by every request
+    declare_flag_uses(p, [force_use()])  # every other flag of rates is used by every request
     p.set_defaults(run=_run_rates, check=_check_rates)
 
 
@@ -42,4 +44,4 @@ def _check_rates(args):
 def _run_rates(args) -> None:
     from ..study.contact.rates import rate_table
 
-    write_csv(rate_table(args.frame, args.window, args.name), float_format="%.6g")
+    write_csv(rate_table(args.frame, args.window, args.name), float_format="%.6g", output=args.output)

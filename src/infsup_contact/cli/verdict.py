@@ -6,7 +6,7 @@ import sys
 from ..errors import InputError
 from .common import (declare_flag_uses, model_flag_uses, system_flag_uses, add_dry_run, add_model, check_memory, mesh_options,
                      run_intervals, SPACE_HELP)
-from .verdict_formats import add_output_args, emit
+from .verdict_formats import add_output_args, emit, force_use
 
 
 VERDICT_DEFAULTS = {"slope_tolerance": 0.15, "beta_floor": 0.001, "confidence": 0.95}
@@ -61,7 +61,7 @@ def add(sub) -> None:
                        help=f"{text} (default {VERDICT_DEFAULTS[key]:g}: claims.{key} in config/config.yaml)")
     add_output_args(p)
     add_dry_run(p)
-    declare_flag_uses(p, [*system_flag_uses(p), *model_flag_uses()])
+    declare_flag_uses(p, [*system_flag_uses(p), *model_flag_uses(), force_use()])
     p.set_defaults(run=_run_verdict, check=_check_verdict)
 
 

@@ -100,33 +100,112 @@ def exit_code_table(width: int = 100) -> str:
 
 def output_path(text: str) -> str:
     """argparse ``type`` of ``--output``: refused before anything is computed when it names a
-    directory or a place that cannot be created or written."""
+    directory or a place that cannot be created or written (:func:`check_writable_place`)."""
     from pathlib import Path
 
-    path = Path(text)
-    if text == "-":  # stdout, as without --output
+    if text == "-" or is_stream(text):  # stdout, as without --output; a device or pipe as it is
         return text
-    if not text or path.is_dir():
+    if Path(text).is_block_device():  # a disk: never written over
+        raise argparse.ArgumentTypeError(f"{text!r} is a block device (a disk): expected a file name to write")
+    if not text or Path(text).is_dir():
         raise argparse.ArgumentTypeError(f"{text!r} is a directory or empty: expected a file name to write")
-    parent = path.absolute().parent
-    while not parent.exists():
-        parent = parent.parent
-    if not parent.is_dir():
-        raise argparse.ArgumentTypeError(f"{text!r}: {parent} is a file, not a directory")
-    if not os.access(parent, os.W_OK | os.X_OK):
-        raise argparse.ArgumentTypeError(f"{text!r}: the directory {parent} is not writable")
+    problem = check_writable_place(Path(text).absolute().parent)
+    if problem:
+        raise argparse.ArgumentTypeError(f"{text!r}: {problem}")
     return text
 
 
+def is_stream(path) -> bool:
+    """A device, pipe or open descriptor (``/dev/stdout``, ``/dev/fd/3``, a FIFO), written as it
+    is: nothing to replace, no temporary file beside it. ``/dev/stdout`` of a shell redirected
+    to a file resolves to that regular file, so the name decides first."""
+    import stat
+    from pathlib import Path
+
+    text = str(Path(path).absolute())
+    if text in ("/dev/stdout", "/dev/stderr") or text.startswith(("/dev/fd/", "/proc/self/fd/")):
+        return True
+    try:
+        mode = os.stat(path).st_mode
+        return stat.S_ISCHR(mode) or stat.S_ISFIFO(mode) or stat.S_ISSOCK(mode)
+    except OSError:
+        return False
+
+
+def check_writable_place(folder) -> str | None:
+    """Why a file cannot be written atomically into ``folder`` (created if missing), or None:
+    its nearest existing ancestor is a file, not writable, or a filesystem where a temporary
+    file cannot be created (``/proc``, ``/sys``: the rename of :mod:`infsup_contact.io` needs
+    one). The probe is a temporary file created and removed at once; nothing else is written."""
+    import tempfile
+    from pathlib import Path
+
+    parent = Path(folder)
+    while not parent.exists() and parent != parent.parent:
+        parent = parent.parent
+    if not parent.is_dir():
+        return f"{parent} is a file, not a directory"
+    if not os.access(parent, os.W_OK | os.X_OK):
+        return f"the directory {parent} is not writable"
+    try:
+        fd, probe = tempfile.mkstemp(dir=parent, prefix=".infsup-contact-probe.")
+    except OSError as err:
+        return f"no file can be created in {parent} ({err.strerror or err})"
+    os.close(fd)
+    os.unlink(probe)
+    return None
+
+
+FORCE_HELP = "replace an existing FILE of --output (without it an existing file is refused, nothing computed)"
+
+
 def add_output_args(p) -> None:
-    """``--format`` and ``--output`` of ``verdict``, and the exit-code table as its epilog."""
+    """``--format``, ``--output`` and ``--force`` of ``verdict``, and the exit-code table as its epilog."""
     p.add_argument("--format", default="csv", choices=FORMATS,
                    help="csv: one row (default); json: one object, the per-level rows of --system included; "
                    "junit: JUnit XML, one testcase (a failure when --expect is not met)")
     p.add_argument("--output", metavar="FILE", type=output_path, default=None,
-                   help="write the result to FILE (atomically: a temporary file renamed) instead of stdout (- : stdout)")
+                   help="write the result to FILE (atomically: a temporary file renamed) instead of stdout (- : stdout); "
+                   "an existing FILE only with --force")
+    p.add_argument("--force", action="store_true", help=FORCE_HELP)
     p.epilog = exit_code_table()
     p.formatter_class = _EpilogFormatter
+
+
+def add_table_output(p) -> None:
+    """``--output FILE`` and ``--force`` of a subcommand writing a table (CSV) on stdout."""
+    p.add_argument("--output", metavar="FILE", type=output_path, default=None,
+                   help="write the table to FILE (atomically: a temporary file renamed) instead of stdout "
+                   "(- : stdout); an existing FILE only with --force")
+    p.add_argument("--force", action="store_true", help=FORCE_HELP + "; with beta, also of --worst-mode")
+
+
+def force_use():
+    """The :class:`~.common.FlagUse` of ``--force``: used only with a file to write."""
+    from .common import FlagUse
+
+    return FlagUse("force", lambda a: _files(a) != [], "requests writing a file (--output FILE, beta's --worst-mode)",
+                   lambda a: "no file written, the result on stdout")
+
+
+def _files(args) -> list:
+    return [(dest, getattr(args, dest)) for dest in ("output", "worst_mode")
+            if getattr(args, dest, None) not in (None, "-")]
+
+
+def check_outputs(args) -> None:
+    """Before anything is computed: each file the request writes (``--output``, ``--worst-mode``)
+    is not one of its inputs, and an existing file is replaced only with ``--force`` (a device or
+    pipe, ``/dev/stdout``, is written as it is: nothing replaced; :func:`is_stream`)."""
+    from ..errors import InputError
+
+    for dest, target in _files(args):
+        if dest == "output":
+            check_not_an_input(target, args)
+        if os.path.lexists(target) and not is_stream(target) and not getattr(args, "force", False):
+            flag = "--" + dest.replace("_", "-")
+            raise InputError(dest, f"a new file, or --force to replace it ({flag} never overwrites an existing "
+                             "file without it)", got=f"{target} (exists)")
 
 
 def emit(args, row: dict, levels=None, manifest_expect=None) -> int:
@@ -156,15 +235,15 @@ def check_not_an_input(output, args) -> None:
 
     from ..errors import InputError
 
-    inputs = []
-    if args.system is not None:
+    inputs = [Path(args.table)] if getattr(args, "table", "-") != "-" else []
+    if getattr(args, "system", None) is not None and hasattr(args, "manifest"):
         inputs = [Path(args.system)] + [p for lv in args.manifest.levels for p in (lv.A, lv.B, lv.G, lv.constrained)
                                         if isinstance(p, Path)]
-    elif args.space is not None:
+    elif getattr(args, "space", None) is not None:
         inputs = [Path(args.space.rsplit(":", 1)[0])]
     target = Path(output).resolve()
     if any(p.resolve() == target for p in inputs):
-        raise InputError("output", "a file other than the inputs of the verdict (it would be overwritten)",
+        raise InputError("output", "a file other than the inputs of the request (it would be overwritten)",
                          got=str(output))
 
 
@@ -172,8 +251,6 @@ def write_result(text: str, output) -> None:
     """``text`` on stdout (``output`` None or ``-``), into a device or pipe as it is
     (``/dev/stdout``: a rename would replace the device node), else into the file ``output``
     atomically (:func:`infsup_contact.io.write_bytes_atomic`); UTF-8 whatever the locale."""
-    import stat
-
     from ..io import write_bytes_atomic
     from .common import OutputError, write_text
 
@@ -181,7 +258,7 @@ def write_result(text: str, output) -> None:
         write_text(text)
         return
     try:
-        if os.path.exists(output) and not stat.S_ISREG(os.stat(output).st_mode):
+        if is_stream(output):
             with open(output, "wb") as fh:
                 fh.write(text.encode("utf-8"))
         else:

@@ -50,7 +50,27 @@ def check_face(cfg) -> None:
                               allowed="[N1, N2] with N1 != N2 (matching meshes go under face.N)")
     _check_face_families(fc)
     _check_face_cases(cfg, fc, options)
+    _check_face_meshes(fc)
     check_face_studies(fc, model)
+
+
+def _check_face_meshes(fc) -> None:
+    """Every face mesh gets the minimum its spaces need, as the command line's rule
+    (:func:`~infsup_contact.discretization.spaces.registry.check_pair_spaces`): a case of
+    ``face.cases`` built from the segment's space (T3, DUAL, ...) with dim M_h = 0 on the
+    N2 × N2 cells of Γ (T3 with k = 1 on N = 1) is refused, naming the key, the case and k."""
+    from ..discretization.spaces.registry import SPACES, case_name, is_empty, min_intervals
+
+    meshes = [(f"face.N[{i}]", n, n) for i, n in enumerate(fc["N"])]
+    meshes += [(f"face.nonmatching[{i}]", pair, pair[1]) for i, pair in enumerate(fc["nonmatching"])]
+    segment = [c for c in fc["cases"] if c in SPACES and SPACES[c].defined_on(1)]
+    for key, value, n2 in meshes:
+        for k in fc["k"]:
+            for case in (c for c in segment if SPACES[c].valid_for(k)):
+                if is_empty(case, k, n2):
+                    raise ConfigError(key, f"case {case_name(case)} with k = {k} has dim M_h = 0 on the {n2} x {n2} "
+                                      "cells of the face: nothing to compute", got=value,
+                                      allowed=f"N >= {min_intervals(case, k)} for it (face.cases, face.k)")
 
 
 def _check_degrees(key: str, model, element: str, ks, k_key: str) -> None:

@@ -62,10 +62,33 @@ def job_estimates(cfg):
             yield "elastic.patch_pairs", f"elastic_patch k={k} {n1}x{n2}", R.beta_estimate(
                 "structured", k, n1, n2, "omega2", ("L2",), components=2)
     yield from _model_table_estimates(cfg)
+    yield from _face_estimates(cfg)
     for what in ("beta", "contact"):
         yield (f"benchmarks.{what}_N", f"bench_{what}", R.bench_estimate(
             what, bc[f"{what}_N"], bc[f"{what}_k"], bc["repeats"], bc.get("eigsh_max_N"),
             bc.get("kkt_max_N", 64)))
+
+
+def _face_estimates(cfg):
+    """The β jobs of the 3D face sections (``face``, ``face_elastic``): per element and k, each
+    matching N (up to the element's ``max_N`` or ``l2_max_N``) and non-matching pair, with the estimate the
+    command line checks (:func:`~infsup_contact.resources.beta_estimate`, ``dim = 3``)."""
+    from ..models import MODELS
+
+    for section in ("face", "face_elastic"):
+        fc = cfg.get(section)
+        if not fc or fc.get("model") not in MODELS:
+            continue
+        model = MODELS[fc["model"]]
+        for element in fc["elements"]:
+            caps = [(fc.get(cap) or {}).get(element) for cap in ("max_N", "l2_max_N")]  # l2: L² rows above max_N
+            top = None if caps[0] is None else max(c for c in caps if c is not None)
+            pairs = [(f"{section}.N", n, n) for n in fc["N"] if top is None or n <= top]
+            pairs += [(f"{section}.nonmatching", *p) for p in fc.get("nonmatching", [])]
+            for key, n1, n2 in pairs:
+                for k in fc["k"]:
+                    yield key, f"{section} beta {element} k={k} {n1}x{n2}", R.beta_estimate(
+                        "structured", k, n1, n2, components=model.components, dim=3)
 
 
 def _model_table_estimates(cfg):

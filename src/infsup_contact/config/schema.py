@@ -162,4 +162,7 @@ def schema_error(cfg, schema: dict) -> ConfigError | None:
         name = extra[0] if extra else "?"
         return ConfigError(key_path([*path, name]), f"unknown key ({name!r} was unexpected)",
                            allowed=f"the keys of {key_path(path)}: " + ", ".join(known))
+    if "propertyNames" in err.schema_path:  # a key that is not a plain name (it may become a path)
+        return ConfigError(key_path(path), f"the key {show(err.instance)} is not a plain name (a key here names "
+                           "a folder or a column, never a path)", allowed=describe({"type": "string", **sub}, schema))
     return ConfigError(key_path(path), err.message, got=err.instance, allowed=describe(sub, schema))

@@ -130,7 +130,7 @@ def producer_rows(name: str, spec: dict, cfg: dict, workdir: Path, root: Path = 
     for space in progress.steps(spec["spaces"], f"{name} space"):
         for offset in progress.steps(spec.get("offsets", cfg["offsets"]), "offset"):  # a code's own: DOLFINx ties matching meshes only
             target = workdir / name / f"{space}_k{offset}"
-            _empty_dir(target)
+            _empty_dir(target, workdir)
             progress.note(f"{name} export.py, N={' '.join(map(str, cfg['N']))}")
             seconds = run_export(python, script, target, space, cfg["N"], offset)
             for norm in progress.steps(cfg["norms"], "verdict --system, norm"):
@@ -140,13 +140,20 @@ def producer_rows(name: str, spec: dict, cfg: dict, workdir: Path, root: Path = 
     return out
 
 
-def _empty_dir(path: Path) -> None:
-    """A fresh export directory (the exporters refuse a non-empty one)."""
+def _empty_dir(path: Path, workdir: Path) -> None:
+    """A fresh export directory (the exporters refuse a non-empty one). Only a folder strictly
+    inside ``workdir`` is ever deleted: a code name or space that is a path (``/home``, ``..``;
+    the config checks refuse them first) is an :class:`InputError`, nothing deleted."""
     import shutil
 
-    if path.exists():
-        shutil.rmtree(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
+    root = Path(workdir).resolve()
+    target = Path(path).resolve()
+    if target == root or root not in target.parents or Path(path).is_symlink():
+        raise InputError("producers.codes", "a code name and spaces that are plain names (the export folder "
+                         f"must lie inside {workdir})", got=str(path))
+    if target.exists():
+        shutil.rmtree(target)
+    target.parent.mkdir(parents=True, exist_ok=True)
 
 
 def producers_table(cfg: dict, workdir: Path, root: Path = Path(".")):

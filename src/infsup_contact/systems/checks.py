@@ -311,6 +311,9 @@ def check_positive_definite(A, path, what: str = "A"):
     121,680 rows, SuperLU's LDLᵀ was most of the check)."""
     A = sp.csc_matrix(A)
     n = A.shape[0]
+    if n and not np.any(A.data):  # every entry zero: no pivot to scale a shift by
+        raise SystemFileError(path, f"{what} is zero ({n} x {n}, every entry 0): not positive definite (an empty "
+                              "export?)")
     if n >= PARDISO_CHECK_MIN and pardiso.available():
         try:  # a clean inertia certifies it at once; any doubt goes to the diagnosis below
             if pardiso.inertia(A) == (n, 0, 0):
@@ -328,8 +331,12 @@ def check_positive_definite(A, path, what: str = "A"):
     if zero:
         shift = 1e-10 * top
         x = np.random.default_rng(0).standard_normal(n)
-        shifted = spla.splu(A + shift * sp.identity(n, format="csc"), permc_spec="MMD_AT_PLUS_A",
-                            diag_pivot_thresh=0.0, options=dict(SymmetricMode=True))
+        try:
+            shifted = spla.splu(A + shift * sp.identity(n, format="csc"), permc_spec="MMD_AT_PLUS_A",
+                                diag_pivot_thresh=0.0, options=dict(SymmetricMode=True))
+        except RuntimeError:  # singular even shifted (entries of mixed magnitudes): no null vector to show
+            raise SystemFileError(path, f"{what} is singular: {max(zero, 1)} or more zero pivots of {n} (a floating "
+                                  "body: rigid motions not fixed?)") from None
         if zero < 0:  # count the pivots of A + δI at the level of δ: the null space's dimension
             zero = int(np.sum(np.abs(shifted.U.diagonal()) <= 1e4 * shift))
         for _ in range(3):  # inverse iteration: the null vector

@@ -41,8 +41,44 @@ def load_level(manifest: Manifest, level):
     return _load_level(manifest, level)[0]
 
 
+def declared_shape(path):
+    """The (rows, cols) a matrix file's header declares, its body unread (MatrixMarket, .npy), or
+    None (another format, or a header its reader will refuse with its own message)."""
+    from .readers import _mtx_header, _npy_header, extension
+
+    ext = extension(path)
+    try:
+        if ext in (".mtx", ".mtx.gz"):
+            return _mtx_header(path, ext)[:2]
+        if ext == ".npy":
+            with open(path, "rb") as fh:
+                shape = _npy_header(fh)[0]
+            return shape if len(shape) == 2 else None
+    except (OSError, ValueError, EOFError):  # SystemFileError too: read_matrix says it again
+        return None
+    return None
+
+
+def check_declared_shapes(level) -> None:
+    """A, B, G of one level against each other by their headers, before any body is read: a
+    small file (a sparse .npy of 4 kB) can declare a 12000 x 12000 A that B does not fit."""
+    from types import SimpleNamespace
+
+    from .checks import check_shapes
+
+    shapes = {key: None if p is None else declared_shape(p) for key, p in (("A", level.A), ("B", level.B),
+                                                                           ("G", level.G))}
+    if shapes["A"] is None or shapes["B"] is None:
+        return
+    G = shapes["G"] or (shapes["B"][0], shapes["B"][0])  # no G (norm H): the described Gram, m x m
+    mats = [SimpleNamespace(shape=tuple(s)) for s in (shapes["A"], shapes["B"], G)]
+    with transposed_b_hint(*mats):
+        check_shapes(level if level.G is not None else SimpleNamespace(A=level.A, B=level.B, G=level.B), *mats)
+
+
 def _load_level(manifest: Manifest, level):
     """(checked level, the L² mass of a ``norm: H`` level given as G or None, the H Gram's info)."""
+    check_declared_shapes(level)
     A, B = (read_matrix(p) for p in (level.A, level.B))
     G = None if level.G is None else read_matrix(level.G)
     A = sp.csr_matrix(A) if not sp.issparse(A) else A
@@ -181,7 +217,7 @@ def system_verdict(manifest: Manifest, *, tol: float, floor: float, confidence: 
                                tol, floor, confidence)
         out.update(verdict_L2=l2["verdict"], beta_min_L2=l2["beta_min"], slope_L2=l2["slope"])
     if any(np.isfinite(r.get("coupling_distance", np.nan)) for r in rows):
-        out["coupling_distance_max"] = float(np.nanmax([r["coupling_distance"] for r in rows]))
+        out["coupling_distance_max"] = float(np.nanmax([r.get("coupling_distance", np.nan) for r in rows]))
     if out["verdict"] == "UNSTABLE" and out["kernel_dim"] > 0:  # name the kernel nobody declared
         dims = [r["kernel_detected"] for r in rows]
         structural = [r["kernel_structural"] for r in rows]
@@ -218,6 +254,8 @@ def dry_check(manifest: Manifest, route: str = "auto"):
 
     sizes, shapes = [], []
     extra = 0.0
+    for level in manifest.levels:  # every level's headers before any body is read
+        check_declared_shapes(level)
     for level in manifest.levels:
         mats = [None if p is None else read_matrix(p) for p in (level.A, level.B, level.G)]
         for mat, path in zip(mats, (level.A, level.B, level.G)):

@@ -99,8 +99,13 @@ def load_manifest(path, min_levels: int = MIN_LEVELS) -> Manifest:
     import yaml
 
     path = Path(path)
+    try:
+        given, path = path, path.resolve(strict=True)  # a symlinked manifest: its matrices lie beside the target
+    except (OSError, RuntimeError) as err:  # missing, or a symlink loop (ELOOP; RuntimeError before Python 3.13)
+        raise SystemFileError(path, "no such manifest file" + (" (a symlink loop)" if "loop" in str(err).lower()
+                                                               or isinstance(err, RuntimeError) else "")) from None
     if not path.is_file():
-        raise SystemFileError(path, "no such manifest file")
+        raise SystemFileError(given, "no such manifest file")
     if path.stat().st_size > MANIFEST_MAX_BYTES:
         raise SystemFileError(path, f"{path.stat().st_size} bytes: a manifest lists a few levels (at most "
                               f"{MANIFEST_MAX_BYTES // 2 ** 20} MiB read); is this the manifest?")
@@ -123,7 +128,7 @@ def load_manifest(path, min_levels: int = MIN_LEVELS) -> Manifest:
     if len(levels) < min_levels:
         raise SystemFileError(path, f"'levels' has {len(levels)} entries; a verdict needs at least {min_levels} "
                               "(the slope's confidence interval needs n - 2 >= 1)")
-    name = data.get("name", path.stem)
+    name = data.get("name", given.stem)
     if isinstance(name, bool) or not isinstance(name, (str, int, float)):
         raise SystemFileError(path, f"name: expected one line of text (found a {type(name).__name__})")
     _one_line(path, "name", str(name))
@@ -208,6 +213,9 @@ def _level(path: Path, i: int, entry, norm: str = "given") -> Level:
     if "traces" in entry and "multipliers" not in entry:
         raise SystemFileError(path, f"{where}.traces: only with {where}.multipliers (the coupling is measured "
                               "against the described multipliers)")
+    for key in ("multipliers", "traces", "constrained"):  # a key written with no value: never "absent"
+        if key in entry and entry[key] is None:
+            raise SystemFileError(path, f"{where}.{key}: no value (null); give one or leave the key out")
     mult = entry.get("multipliers")
     if isinstance(mult, str):
         _one_line(path, f"{where}.multipliers", mult)
@@ -247,14 +255,26 @@ def constrained_dofs(level: Level, n: int) -> np.ndarray:
         if con.suffix == ".npy":
             from .readers import check_npy_file
 
-            check_npy_file(con)  # a header declaring more than the file holds: refused before reading
+            shape = check_npy_file(con)  # a header declaring more than the file holds: refused before reading
+            count = int(np.prod(shape, dtype=object)) if shape else 1
+            if count > n:  # more dofs than A has rows: refused before its body is read
+                raise SystemFileError(con, f"its header declares {count} constrained dofs, more than the {n} rows "
+                                      "of A (each dof once, 0-based)")
         try:
             raw = read_integer_list(con)
         except TableError as err:
             raise SystemFileError(con, f"not a list of integers ({err})") from None
+        except OverflowError:  # an index beyond int64: outside any A
+            raise SystemFileError(con, f"a constrained dof beyond 64-bit integers, outside 0..{n - 1} (A has {n} "
+                                  "rows; indices are 0-based)") from None
         where = con
     else:
-        raw, where = np.asarray(con), f"levels[{level.index}].constrained"
+        where = f"levels[{level.index}].constrained"
+        big = [c for c in con if c >= n]
+        if big:  # Python ints of any size: checked before numpy (10**20 is no int64)
+            raise SystemFileError(where, f"constrained dof {big[0]} outside 0..{n - 1} (A has {n} rows; indices "
+                                  "are 0-based)")
+        raw = np.asarray(con, dtype=np.int64)
     dofs = np.asarray(raw).ravel()
     if dofs.size and (not np.all(np.isfinite(dofs)) or np.any(dofs != np.round(dofs))):
         raise SystemFileError(where, "constrained dofs must be integers")

@@ -38,8 +38,13 @@ from .square import Square
 
 GAMMAS = ("square", "cylinder")
 """The Γ of the 3D membranes: the flat face, or the part of the cylinder of radius R."""
-RADIUS_ALLOWED = "a number R > 1, or inf (the flat face)"
-"""R = 1 would collapse Ω1's far face onto the cylinder's axis."""
+RADIUS_MAX = 1e8
+"""Largest finite R: the map's displacement (~ s²/(2R)) is computed from R-sized numbers and is
+lost to round-off for a huge R (DUAL-Q9, k = 2, N = 2: R = 1e20 and 1e300 gave β_h = 0 where the
+flat face gives 1.13875; R = 1e8 and 1e12 gave the flat face's β_h to 12 digits). Beyond 1e8 the
+face is flat to 1e-8: inf says so exactly."""
+RADIUS_ALLOWED = f"a number R in (1, {RADIUS_MAX:g}], or inf (the flat face)"
+"""R = 1 would collapse Ω1's far face onto the cylinder's axis; above :data:`RADIUS_MAX` round-off."""
 DEFAULT_COUPLING = "exact"
 """The coupling of a cylinder whose request names none."""
 
@@ -49,6 +54,8 @@ def check_cylinder_options(gamma, radius, coupling) -> None:
     :data:`GAMMAS`): with ``cylinder`` a radius R > 1 (inf allowed) and a coupling in
     :data:`~..segment.arc.COUPLINGS` or none; without it neither."""
     check_curved_options(gamma, radius, coupling, GAMMAS, RADIUS_ALLOWED)
+    if gamma == GAMMAS[-1] and math.isfinite(radius) and radius > RADIUS_MAX:
+        raise InputError("radius", f"{RADIUS_ALLOWED} (required with gamma cylinder)", got=radius)
 
 
 @dataclass(frozen=True)

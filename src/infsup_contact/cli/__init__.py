@@ -167,6 +167,8 @@ def main(argv=None) -> int:
     except OutputError as err:  # --version's line, written while parsing (before _main's own handler)
         _say(f"infsup-contact: error: {err}")
         return EXIT_OUTPUT
+    except BrokenPipeError:  # `--version | head -c1`: not an error of ours, as in _main
+        return 0
     except Exception as err:  # a bug, not "the verdict differs" (1, Python's own exit code for it)
         return report_internal_error(err)
 

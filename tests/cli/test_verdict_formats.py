@@ -320,6 +320,14 @@ def test_each_documented_exit_code_is_produced_by_its_case(systems, tmp_path, mo
         m.setattr("infsup_contact.systems.levels.system_verdict", ctrl_c)
         produced[130], out, err = verdict("--system", systems["stable"])
         assert out == "" and "interrupted" in one_line(err)
+
+    def bug(*args, **kwargs):
+        raise ZeroDivisionError("float division by zero")
+
+    with monkeypatch.context() as m:  # 70: an unexpected exception, never 1
+        m.setattr("infsup_contact.systems.levels.system_verdict", bug)
+        produced[70], out, err = verdict("--system", systems["stable"], "--expect", "stable")
+        assert out == "" and "ZeroDivisionError" in one_line(err)
     assert produced == {code: code for code, _ in EXIT_CODES}
 
 

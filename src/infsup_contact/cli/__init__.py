@@ -22,7 +22,9 @@ computation: every subcommand validates the whole request first — values, the 
 and its estimated memory against the available memory (``resources.py``) — and ``--dry-run``
 stops right there (exit 0, the estimate on stdout). ``verdict --expect`` exits with 1 when the
 verdict is not the expected one. A closed or full stdout (``>&-``, ``> /dev/full``) is exit 74
-with one line, Ctrl-C exit 130 with one line.
+with one line, Ctrl-C exit 130 with one line. Any other exception is a bug or a broken
+installation: exit 70 with one line (``cli/program.py``; ``INFSUP_TRACEBACK=1`` adds the traceback),
+never 1. ``infsup-contact --version`` prints the installed version.
 """
 from __future__ import annotations
 
@@ -34,6 +36,7 @@ from ..errors import InputError
 from ..io import TableError
 from . import beta, bench, contact, export, rates, reporting, verdict, verdict_hook
 from .common import EXIT_INTERRUPTED, EXIT_OUTPUT, OutputError, check_stdout, given_dests, refuse_unused, write_text
+from .program import package_version, report_internal_error
 from .verdict import VERDICT_DEFAULTS
 
 __all__ = ["main", "build_parser", "validate", "flag_names", "VERDICT_DEFAULTS"]
@@ -63,6 +66,17 @@ def _fit_blas_threads() -> None:
              f"{asked} (a threaded OpenBLAS waits on busy cores; INFSUP_BLAS_FIT=0 keeps {asked})")
 
 
+class _Version(argparse.Action):
+    """``--version``: looked up only when asked (``build_parser`` runs once per manifest of a hook)."""
+
+    def __init__(self, option_strings, dest=argparse.SUPPRESS, default=argparse.SUPPRESS, help=None):
+        super().__init__(option_strings, dest, nargs=0, default=default, help=help)
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        write_text(f"{parser.prog} {package_version()}\n")  # stdout, as argparse's own version action
+        parser.exit(0)
+
+
 class _Parser(argparse.ArgumentParser):
     def error(self, message):  # one line, exit 2 — argparse's own convention
         self.exit(2, f"infsup-contact: error: {message}\n")
@@ -76,6 +90,7 @@ def _add_provenance(sub) -> None:
 
 def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(prog="infsup-contact", description=__doc__.split("\n\n")[0])
+    parser.add_argument("--version", action=_Version, help="print the installed version and exit")
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
     beta.add(sub)
     contact.add(sub)
@@ -148,12 +163,20 @@ def _say(line: str) -> None:
 
 def main(argv=None) -> int:
     """Run one subcommand. Exit status: 0 done, 1 ``verdict --expect`` not met, 2 bad input,
-    74 the result could not be written (closed or full stdout), 130 interrupted (Ctrl-C)."""
+    70 an unexpected exception (one line; :mod:`.program`), 74 the result could not be written
+    (closed or full stdout), 130 interrupted (Ctrl-C)."""
     try:
         return _main(argv)
     except KeyboardInterrupt:  # Ctrl-C: one line, not a traceback from wherever it landed
         _say("infsup-contact: interrupted (Ctrl-C); no result written")
         return EXIT_INTERRUPTED
+    except OutputError as err:  # --version's line, written while parsing (before _main's own handler)
+        _say(f"infsup-contact: error: {err}")
+        return EXIT_OUTPUT
+    except BrokenPipeError:  # `--version | head -c1`: not an error of ours, as in _main
+        return 0
+    except Exception as err:  # a bug, not "the verdict differs" (1, Python's own exit code for it)
+        return report_internal_error(err)
 
 
 def _main(argv) -> int:

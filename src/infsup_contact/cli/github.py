@@ -144,7 +144,7 @@ def manifest_with_norm(path, norm: str) -> Path:
 
 def main(argv=None) -> int:
     """``python -m infsup_contact.cli.github outputs RESULT.json`` | ``with-norm LEVELS.yaml NORM``:
-    the action's two helpers; an error is one line on stderr, exit 2."""
+    the action's two helpers; an error is one line on stderr, exit 2 (70: an unexpected exception)."""
     from ..errors import InputError
 
     argv = sys.argv[1:] if argv is None else argv
@@ -158,6 +158,10 @@ def main(argv=None) -> int:
     except (InputError, OSError, ValueError, KeyError) as err:
         print(f"infsup-contact: error: {' '.join(str(err).split())}", file=sys.stderr)
         return 2
+    except Exception as err:  # a bug: 70 as the command line's (never 1, "the verdict differs")
+        from .program import report_internal_error
+
+        return report_internal_error(err)
     return 0
 
 

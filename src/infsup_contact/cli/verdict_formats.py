@@ -35,6 +35,8 @@ EXIT_CODES = (
         "the same"),
     (2, "bad input, nothing computed: a flag, the manifest, a matrix file or --output refused, or the estimated "
         "memory over the available memory; one line on stderr naming it"),
+    (70, "an unexpected exception (a bug or an incomplete installation, never exit 1): one line naming its type and "
+         "message and where to report it; INFSUP_TRACEBACK=1 adds the traceback"),
     (74, "the result cannot be written: stdout closed (>&-) or full (> /dev/full), or --output failing at the end "
          "(a full disk); one line"),
     (130, "interrupted (Ctrl-C); one line, no result written"),

@@ -5,8 +5,9 @@ Each manifest given is checked as ``verdict --system`` checks it (the same parse
 and memory gate) and its verdict compared with the manifest's ``expect:`` key, ``stable`` when
 it has none: a commit of a manifest whose verdict is UNSTABLE, INCONCLUSIVE or not the declared
 one is stopped. One line per manifest on stdout; a manifest refused is one line on stderr and
-the others are still checked. Exit code: 2 if any was refused, else 1 if any verdict differs
-from its expectation, else 0 (the codes of ``verdict``).
+the others are still checked. Exit code: 70 if checking one raised an unexpected exception
+(one line for it, the others still checked: :mod:`.program`), else 2 if any was refused, else 1
+if any verdict differs from its expectation, else 0 (the codes of ``verdict``).
 """
 from __future__ import annotations
 
@@ -15,6 +16,7 @@ import sys
 from ..errors import InputError
 from ..io import TableError
 from .common import declare_flag_uses, write_text
+from .program import report_internal_error
 from .verdict import VERDICT_DEFAULTS
 
 DEFAULT_EXPECT = "stable"
@@ -61,7 +63,8 @@ def check_hook(args):
 
 
 def check_one(path: str, criterion: dict) -> tuple[int, str]:
-    """(exit code, line) of one manifest: 0 or 1 and its verdict line; 2 and the error line."""
+    """(exit code, line) of one manifest: 0 or 1 and its verdict line; 2 and the error line
+    (70 from :func:`run_hook`, where an unexpected exception is caught)."""
     from . import build_parser, check, parse
     from ..systems.levels import system_verdict
 
@@ -89,7 +92,11 @@ def run_hook(args) -> int:
     from ..progress import steps
 
     for path in steps(args.manifests, "manifest"):
-        code, line = check_one(path, criterion)
+        try:
+            code, line = check_one(path, criterion)
+        except Exception as err:  # a bug is not "the verdict differs" (1): its own code, next manifest
+            worst = max(worst, report_internal_error(err, where=path))
+            continue
         if code == 2:
             print(line, file=sys.stderr, flush=True)
         else:

@@ -26,23 +26,44 @@ _COL_MAJOR, _LEFT, _LOWER, _NO_TRANS, _NON_UNIT = 102, 141, 122, 111, 131
 """CBLAS enumerations (cblas.h): CblasColMajor, CblasLeft, CblasLower, CblasNoTrans, CblasNonUnit."""
 
 
+FALLBACK_NOTE = ("infsup-contact: note: MKL (libmkl_rt) not loaded{why}: PARDISO and the in-place "
+                 "triangular solve are off, the scipy routes run (same results, slower on large 3D "
+                 "meshes; the mkl wheel: Linux x86_64, or INFSUP_MKL_RT=/path/to/libmkl_rt.so)")
+"""The one line :func:`mkl_rt` prints when it finds no usable library (once per process)."""
+
+
 @lru_cache(maxsize=1)
 def mkl_rt():
-    """The loaded ``mkl_rt`` (or None): $INFSUP_MKL_RT, else the environment's ``lib/``."""
+    """The loaded ``mkl_rt`` (or None): $INFSUP_MKL_RT, else the environment's ``lib/``.
+
+    None where nothing loads (no ``mkl`` wheel: it is installed on Linux x86_64 only, pyproject's
+    marker) or a library lacks the symbols used here; then every caller takes its scipy route
+    and one note on stderr says so (the results are the same; the routes differ in speed)."""
     candidates = [os.environ.get("INFSUP_MKL_RT", "")]
     for prefix in (sys.prefix, sys.base_prefix):
         candidates += sorted(glob.glob(os.path.join(prefix, "lib", "libmkl_rt.so*")))
+    failures = []
     for path in filter(None, candidates):
         try:
             lib = ctypes.CDLL(path)
-        except OSError:
+            lib.MKL_Set_Num_Threads(ctypes.c_int(threads()))
+            lib.cblas_dtrsm.restype = None
+        except (OSError, AttributeError) as err:  # not loadable, or not MKL's runtime
+            failures.append(f"{path}: {' '.join(str(err).split())}")
             continue
-        lib.MKL_Set_Num_Threads(ctypes.c_int(threads()))
-        lib.cblas_dtrsm.restype = None
         lib.cblas_dtrsm.argtypes = [ctypes.c_int] * 7 + [ctypes.c_double, ctypes.c_void_p, ctypes.c_int,
                                                          ctypes.c_void_p, ctypes.c_int]
         return lib
+    _note(FALLBACK_NOTE.format(why=f" ({failures[0]})" if failures else ""))
     return None
+
+
+def _note(line: str) -> None:
+    if sys.stderr is not None:
+        try:
+            print(line, file=sys.stderr, flush=True)
+        except OSError:
+            pass
 
 
 def available() -> bool:

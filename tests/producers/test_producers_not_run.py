@@ -96,3 +96,22 @@ def test_the_paper_counts_not_run_apart(tmp_path):
     assert macros["refVerdictBeyondThePaperCertifyingProductionCodes"] == r"\verdictfmt{NOT RUN}"
     assert macros["refOutcomeBeyondThePaperCertifyingProductionCodes"] == "INCONCLUSIVE"  # \byverdict: undecided
     assert r"\verdictfmt{NOT RUN}" in claims_table(producers)
+
+
+def test_a_config_without_predictions_has_an_empty_claims_table_the_gate_accepts(tmp_path):
+    """Predictions are optional per code: then the producers' claims table has no rows, which the
+    ledger (workflow/scripts/claims.py) and the gate (kind ``claims?``, rules/claims.smk) accept;
+    any other ledger table with no rows is still refused."""
+    from infsup_contact.io import TableError
+
+    cfg = _nothing_installed(tmp_path)
+    for spec in cfg["codes"].values():
+        spec.pop("predictions")
+    empty = producers_claims(producers_table(cfg, tmp_path / "work"), cfg)
+    assert empty.empty
+    ledger, stages = _ledger(tmp_path, [("a", "PASS", "PASS")], empty)
+    (product, sources), = stages
+    frame, summary = gate(ledger, [(product, {path: "claims?" for path in sources})])
+    assert len(frame) == 1 and "NOT RUN" not in summary
+    with pytest.raises(TableError, match="no data rows"):
+        gate(ledger, stages)

@@ -42,11 +42,12 @@ def _mtime(path) -> int:
 
 def check_stage(product, sources: dict) -> None:
     """``product`` (a file) is at least as new as each of ``sources`` (path → table kind of
-    :data:`~infsup_contact.table_schemas.SCHEMAS`), and each source exists and reads under its schema."""
+    :data:`~infsup_contact.table_schemas.SCHEMAS`; ``kind?``: the table may have no rows, as the
+    producers' claims of a config without predictions), and each source exists and reads under its schema."""
     from ...io import TableError, read_table
 
     for path, kind in sources.items():
-        read_table(path, kind)  # a missing or damaged table: TableError naming it
+        read_table(path, kind.rstrip("?"), allow_empty=kind.endswith("?"))  # missing or damaged: TableError
     if not Path(product).is_file():
         raise TableError(product, "no such file")
     for path in sources:

@@ -33,6 +33,8 @@ H_ONLY_KEYS = ("gamma",)
 H_LEVEL_KEYS = ("multipliers", "traces")
 EXPORT_TIMEOUT = 600.0
 """Seconds an exporter may take for all its levels (far above what the exporters take for N = 4..32)."""
+PAPER_REF = "beyond the paper (Certifying production codes)"
+"""The paper_ref of every producer claim."""
 
 
 def installed_version(python: str, distribution: str, probe: str | None = None) -> str | None:
@@ -213,7 +215,7 @@ def producers_claims(frame, cfg: dict):
         missing = frame[(frame.producer == name) & (frame.status == "not installed")]
         for space, pred in (spec.get("predictions") or {}).items():
             if len(missing):
-                out.append(row(f"producer-{name}-{space}", PAPER_REF, _statement(f"{name} {space}", pred, spec),
+                out.append(row(f"producer-{name}-{space}", PAPER_REF, _statement(f"{name} {space}", pred),
                                (NOT_RUN, f"not run: {missing.evidence.iloc[0]}")))
                 continue
             rows = frame[(frame.producer == name) & (frame.space == space)]
@@ -234,17 +236,14 @@ def producers_claims(frame, cfg: dict):
                     wrong.append(f"{where}: {r.verdict} kernel {kernels}")
             verdict = FAIL if wrong else INCONCLUSIVE if open_ else PASS
             evidence = "; ".join(wrong or open_ or seen)
-            statement = _statement(rows.system.iloc[0] or f"{name} {space}", pred, spec, sorted(set(rows.offset)))
+            statement = _statement(rows.system.iloc[0] or f"{name} {space}", pred, sorted(set(rows.offset)))
             out.append(row(f"producer-{name}-{space}", PAPER_REF, statement, (verdict, evidence)))
     return pd.DataFrame(out, columns=["claim_id", "paper_ref", "statement", "evidence", "verdict", "predicted"])
 
 
-PAPER_REF = "beyond the paper (Certifying production codes)"
-
-
-def _statement(system: str, pred: dict, spec: dict, offsets=None) -> str:
+def _statement(system: str, pred: dict, offsets=None) -> str:
     """A producer claim's statement: the config's prediction (verdict per norm, kernel) and why;
-    ``offsets`` those it ran on (the config's, for a producer that did not run)."""
+    ``offsets`` those it ran on (none named for a producer that did not run)."""
     kernel = f", kernel of B^T of dim {pred['kernel']} on every level" if "kernel" in pred else ""
     where = f" (offsets {list(offsets)})" if offsets is not None else ""
     return (f"{system}: verdicts " + ", ".join(f"{n} {v}" for n, v in pred["verdicts"].items()) + kernel

@@ -102,11 +102,15 @@ def test_not_installed_is_a_row_not_a_failure(tmp_path):
         table = producers_table(cfg, tmp_path / "work")
         assert len(table) == 1 and table.status.iloc[0] == "not installed"
         assert "make producers-fake" in table.evidence.iloc[0] and table.install.iloc[0] == "make producers-fake"
-        assert producers_claims(table, cfg).empty
+        claims = producers_claims(table, cfg)  # the prediction kept, the verdict NOT RUN, the command named
+        assert list(claims.claim_id) == ["producer-fake-p0"] and list(claims.verdict) == ["NOT RUN"]
+        assert claims.predicted.iloc[0] == "PASS" and "make producers-fake" in claims.evidence.iloc[0]
+        assert "h-L2 STABLE" in claims.statement.iloc[0]
         write_csv_atomic(tmp_path / "producers.csv", table)  # what the rule writes, read back as the paper rule reads it
         assert read_table(tmp_path / "producers.csv", "producers").status.iloc[0] == "not installed"
         tex = producers_tex(table, producers_claims(table, cfg), {})
         assert "not installed" in tex and r"\section{Certifying production codes}" in tex
+        assert "so none was run: fake" in tex and r"\verdictfmt{NOT RUN}" in tex
 
 
 def test_a_broken_exporter_is_named(tmp_path, monkeypatch):

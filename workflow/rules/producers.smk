@@ -2,6 +2,12 @@
 # matching and non-matching, each export certified by verdict --system in the norms of the config
 # (study/producers.py). A producer not installed is a row saying so, with its install command.
 # Only with a `producers` config section (the CI profile has none: Kratos is an optional install).
+# A producer not installed: its claims are NOT RUN (the gate lists them, unjudged). The stage reruns
+# when a code's installation changes: its interpreter and the version it reports are params (probed
+# once per snakemake process; params are a default rerun trigger), so `make producers-<code>`
+# followed by `make reproduce-all` recomputes the tables, the ledger and the paper.
+from infsup_contact.study.producers import installation
+
 PRODUCERS = config.get("producers")
 PRODUCERS_TABLES = ["results/tables/producers.csv", "results/tables/producers_claims.csv"] if PRODUCERS else []
 PRODUCERS_PAPER = ["results/paper/producers.tex"] if PRODUCERS else []
@@ -17,6 +23,7 @@ if PRODUCERS:
             src=PACKAGE_SOURCES,
         params:
             cfg=lambda wc: dict(PRODUCERS, criterion=config["claims"]),
+            installed=lambda wc: installation(PRODUCERS["codes"]),
             workdir="results/producers",
         threads: 1
         # started first: most of its wall time is the other codes' start-up, not CPU, and

@@ -16,5 +16,6 @@ table = ledger(read_table(inp.beta, "beta"), read_table(inp.rates, "rates"), rea
 import pandas as pd  # noqa: E402
 
 table = pd.concat([table] + [read_table(p, "claims") for p in inp.models]
-                  + [read_table(p, "claims") for p in inp.producers], ignore_index=True)  # rules/producers.smk
+                  + [read_table(p, "claims", allow_empty=True) for p in inp.producers],  # rules/producers.smk:
+                  ignore_index=True)  # no rows where no code has predictions (a not-installed one's are NOT RUN)
 write_claims(snakemake.output[0], table)  # noqa: F821

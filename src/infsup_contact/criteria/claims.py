@@ -23,6 +23,11 @@ comparison claims
 rate claims
     The fitted energy-error slope is at least the rate the solution's regularity allows,
     minus ``rate_tolerance`` (the regularity gives an upper bound on the error).
+not run
+    A claim whose computation needs an optional code that is not installed where the ledger
+    was built (a producer, study/producers.py) keeps its prediction and gets the verdict
+    NOT RUN, its evidence naming the install command: neither PASS nor FAIL, and not
+    INCONCLUSIVE either (nothing was computed). The gate lists such claims without judging them.
 """
 from __future__ import annotations
 
@@ -33,6 +38,8 @@ from scipy import stats
 from ..solvers.kernel import CLOSE
 
 PASS, FAIL, INCONCLUSIVE = "PASS", "FAIL", "INCONCLUSIVE"
+NOT_RUN = "NOT RUN"
+"""The verdict of a claim that was not computed: an optional code it needs is not installed."""
 FINDING = "finding"
 """``predicted`` of a row no prediction was stated for (what the tables show)."""
 BEYOND = "beyond the paper"

@@ -8,7 +8,7 @@ from __future__ import annotations
 import pandas as pd
 
 from .tables import _claims_checked, beta_default_rows, front_winner, speed_rows, speed_selection
-from .texformat import (MEASURES, VERDICTS, PaperTexError, _require, _src, fmt_fixed, fmt_int, fmt_sci,
+from .texformat import (MEASURES, NOT_RUN, VERDICTS, PaperTexError, _require, _src, fmt_fixed, fmt_int, fmt_sci,
                         latex_escape)
 from .texnames import Macro, _family, _k, _n, _scene, is_generated_name, macro_name
 
@@ -131,14 +131,18 @@ def contact_macros(contact: pd.DataFrame, primary: str) -> list[Macro]:
 
 def claims_macros(claims: pd.DataFrame) -> list[Macro]:
     claims = _claims_checked(claims)
-    beyond = claims.paper_ref.astype(str).str.startswith("beyond the paper")
-    paper = claims[(claims.predicted != "finding") & ~beyond]
-    found = claims[claims.predicted == "finding"]
-    ours = claims[(claims.predicted != "finding") & beyond]  # predicted by us, about other spaces
+    not_run = claims[claims.verdict == NOT_RUN]  # an optional code not installed: counted on their own
+    ran = claims[claims.verdict != NOT_RUN]
+    beyond = ran.paper_ref.astype(str).str.startswith("beyond the paper")
+    paper = ran[(ran.predicted != "finding") & ~beyond]
+    found = ran[ran.predicted == "finding"]
+    ours = ran[(ran.predicted != "finding") & beyond]  # predicted by us, about other spaces
     checked = paper[paper.predicted.isin(["PASS", "FAIL"])]
     out = [Macro("nClaims", fmt_int(len(paper)), "claims.csv: rows with predicted != finding, paper_ref "
-                 "not 'beyond the paper ...'"),
-           Macro("nBeyondClaims", fmt_int(len(ours)), "claims.csv: predicted rows with paper_ref 'beyond the paper (...)'"),
+                 "not 'beyond the paper ...', verdict not NOT RUN"),
+           Macro("nBeyondClaims", fmt_int(len(ours)), "claims.csv: predicted rows with paper_ref 'beyond the paper (...)', "
+                 "verdict not NOT RUN"),
+           Macro("nClaimsNotRun", fmt_int(len(not_run)), "claims.csv: rows with verdict NOT RUN (a code not installed)"),
            Macro("nBeyondAsPredicted", fmt_int((ours.verdict == ours.predicted).sum()),
                  "claims.csv: those rows with verdict == predicted"),
            Macro("nClaimsChecked", fmt_int(len(checked)), "claims.csv: rows with predicted PASS or FAIL"),
@@ -153,23 +157,38 @@ def claims_macros(claims: pd.DataFrame) -> list[Macro]:
                          f"claims.csv: findings with verdict {v}"))
     for ref, g in claims.groupby("paper_ref", sort=True):
         n_pass = int((g.verdict == "PASS").sum())
-        verdict = "PASS" if n_pass == len(g) else ("FAIL" if (g.verdict == "FAIL").any() else "INCONCLUSIVE")
+        verdict = _group_verdict(g.verdict)
         out += [Macro(macro_name("refClaims", ref), fmt_int(len(g)), f"claims.csv: rows with paper_ref '{ref}'"),
                 Macro(macro_name("refPass", ref), fmt_int(n_pass), f"claims.csv: PASS rows with paper_ref '{ref}'"),
                 Macro(macro_name("refVerdict", ref), rf"\verdictfmt{{{verdict}}}",
-                      f"claims.csv: PASS if all rows with paper_ref '{ref}' pass, else FAIL if one fails, "
-                      "else INCONCLUSIVE"),
+                      f"claims.csv: of the rows with paper_ref '{ref}' that ran: PASS if all pass, else FAIL if one "
+                      "fails, else INCONCLUSIVE; NOT RUN if none ran"),
                 # the bare word, for \byverdict: a sentence that states an outcome is chosen by it
-                Macro(macro_name("refOutcome", ref), verdict, f"claims.csv: the verdict of refVerdict for '{ref}'")]
+                Macro(macro_name("refOutcome", ref), _outcome(verdict), f"claims.csv: the verdict of refVerdict for '{ref}'"
+                      " (NOT RUN: INCONCLUSIVE, undecided)")]
     for _, r in claims.iterrows():
         out.append(Macro(macro_name("claimVerdict", r.claim_id), rf"\verdictfmt{{{r.verdict}}}",
                          _src("claims.csv", "verdict", claim_id=r.claim_id)))
-        out.append(Macro(macro_name("claimOutcome", r.claim_id), str(r.verdict),
+        out.append(Macro(macro_name("claimOutcome", r.claim_id), _outcome(str(r.verdict)),
                          _src("claims.csv", "verdict", claim_id=r.claim_id)))
         out.append(Macro(macro_name("claimEvidence", r.claim_id),
                          latex_escape(r.evidence, f"claims.csv evidence of {r.claim_id}"),
                          _src("claims.csv", "evidence", claim_id=r.claim_id)))
     return out
+
+
+def _group_verdict(verdicts: pd.Series) -> str:
+    """Of the verdicts that ran: PASS if all pass, else FAIL if one fails, else INCONCLUSIVE;
+    NOT RUN if none ran (a group of one code's claims where it is not installed)."""
+    ran = verdicts[verdicts != NOT_RUN]
+    if not len(ran):
+        return NOT_RUN
+    return "PASS" if (ran == "PASS").all() else ("FAIL" if (ran == "FAIL").any() else "INCONCLUSIVE")
+
+
+def _outcome(verdict: str) -> str:
+    """The word ``\\byverdict`` chooses by: NOT RUN decides nothing, so it is the undecided branch."""
+    return "INCONCLUSIVE" if verdict == NOT_RUN else verdict
 
 
 def series_macros(claims: pd.DataFrame) -> list[Macro]:

@@ -4,7 +4,8 @@ Per producer: its own paragraph (``examples/producers/<code>/paper.tex``: what t
 multiplier space is, what it does at Γ's ends, the fix a user can apply; written with the
 exporter, no numbers in it), then the table of its certificates (verdict, kernel dimension
 and β_h per level in each norm, matching and non-matching) and its claims' verdicts. A
-producer not installed where the paper was built is one sentence with its install command.
+producer not installed where the paper was built is one sentence with its install command
+(its claims are NOT RUN); a sentence up front names the codes that ran and those that did not.
 """
 from __future__ import annotations
 
@@ -43,6 +44,18 @@ def producer_table(rows: pd.DataFrame) -> str:
     return "\n".join(lines) + "\n"
 
 
+def which_ran(table: pd.DataFrame) -> str:
+    """One sentence: the codes that ran (with their versions) and those not installed."""
+    names = list(dict.fromkeys(table.producer))
+    missing = [n for n in names if (table[table.producer == n].status == "not installed").all()]
+    ran = [rf"{latex_id(n)} {latex_id(table[table.producer == n].version.iloc[0])}" for n in names if n not in missing]
+    if not ran:
+        return ("None of the producers was installed where this paper was built, so none was run: "
+                + ", ".join(latex_id(n) for n in missing) + ".")
+    return ("Ran where this paper was built: " + ", ".join(ran)
+            + ("; not installed, so not run: " + ", ".join(latex_id(n) for n in missing) if missing else "") + ".")
+
+
 def producers_tex(table: pd.DataFrame, claims: pd.DataFrame, paragraphs: dict) -> str:
     """The whole section; ``paragraphs``: producer name → its LaTeX paragraph (or absent)."""
     for col in NEEDED:
@@ -58,11 +71,14 @@ matching), and writes $A$, $B$ and the $L^2$ mass of its multipliers exactly as 
 assembles them (its quadrature, its Dirichlet rows, its scale factors), with a description of
 the multiplier basis on $\Gamma$ from which the certifier assembles the
 $H^{-1/2}_{00}(\Gamma)$ Gram itself (norm $H$). The $L^2$ and $h$-weighted $L^2$ rows certify
-copies with the norm changed; by Remark~3.1 a stable space is UNSTABLE in $L^2$.""", ""]
+copies with the norm changed; by Remark~3.1 a stable space is UNSTABLE in $L^2$.""", "", which_ran(table), ""]
     for name, rows in table.groupby("producer", sort=False):
         if (rows.status == "not installed").all():
+            n = int(claims.claim_id.str.startswith(f"producer-{name}-").sum())
             out += [rf"\paragraph{{{latex_id(name)}}} not installed where this paper was built "
-                    rf"(install: \texttt{{{latex_id(rows.install.iloc[0])}}}).", ""]
+                    rf"(install: \texttt{{{latex_id(rows.install.iloc[0])}}}): nothing of it was run"
+                    + (rf", and its {n} predicted claims are \verdictfmt{{NOT RUN}} in the ledger." if n else "."),
+                    ""]
             continue
         out += [rf"\paragraph{{{latex_id(name)} {latex_id(rows.version.iloc[0])}}}", paragraphs.get(name, ""), "",
                 r"\begin{table}[ht]\centering\small", producer_table(rows),

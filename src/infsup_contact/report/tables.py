@@ -7,7 +7,7 @@ import pandas as pd
 from ..study.beta.selection import primary_rows
 
 from .templates import beta_by_mesh_table
-from .texformat import (MEASURES, SPEED_COLUMNS, VERDICTS, PaperTexError, _require, case_rank,
+from .texformat import (LEDGER_VERDICTS, MEASURES, SPEED_COLUMNS, PaperTexError, _require, case_rank,
                         fmt_fixed, fmt_sci, latex_escape, latex_id)
 
 
@@ -67,7 +67,7 @@ def rates_table(rates: pd.DataFrame, primary: str) -> str:
 
 def _claims_checked(claims: pd.DataFrame) -> pd.DataFrame:
     _require(claims, ["claim_id", "paper_ref", "statement", "evidence", "verdict", "predicted"], "claims.csv")
-    bad = sorted(set(claims.verdict) - set(VERDICTS))
+    bad = sorted(set(claims.verdict) - set(LEDGER_VERDICTS))
     if bad:
         raise PaperTexError(f"claims.csv: unknown verdict(s) {bad}")
     return claims

@@ -12,9 +12,13 @@ import re
 import numpy as np
 import pandas as pd
 
+from ..criteria.claims import NOT_RUN
 from ..discretization.spaces.registry import space_ids
 
 VERDICTS = ("PASS", "FAIL", "INCONCLUSIVE")
+LEDGER_VERDICTS = VERDICTS + (NOT_RUN,)
+"""A ledger row may also be NOT RUN (an optional code not installed where it was built): it is
+typeset and counted on its own, never as one of the three computed verdicts."""
 MEASURES = {"energy_error": "Energy", "l2_error": "Ltwo", "lambda_l2_error": "LambdaLtwo",
             "lambda_hm12_error": "LambdaH"}
 SPEED_COLUMNS = ("scene", "case", "k", "N", "seconds", "energy_error", "lambda_hm12_error")

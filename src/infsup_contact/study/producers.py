@@ -8,10 +8,13 @@ offset, certifies the manifest in each requested norm (``H`` as written; ``L2``,
 copies with ``norm`` changed and the multiplier description left out) by the library call
 ``verdict --system`` makes, and returns one table row per (producer, space, offset, norm).
 A producer whose interpreter or code is missing gives one row ``status: not installed`` with
-its install command, never a failure.
+its install command, never a failure, and its predicted claims the verdict NOT RUN.
+:func:`installation` is what the workflow reruns the stage on (rules/producers.smk): each
+code's interpreter and the version it reports, so installing or upgrading a code reruns it.
 """
 from __future__ import annotations
 
+import functools
 import subprocess
 import sys
 import time
@@ -25,12 +28,14 @@ from ..yaml_limits import load as yaml_load
 
 COLUMNS = ("producer", "version", "space", "offset", "norm", "status", "verdict", "kernel_dim", "beta_levels",
            "kernel_levels", "h_levels", "slope", "slope_lo", "slope_hi", "evidence", "seconds", "install", "system")
-NOT_RUN = "-"
+NO_CELL = "-"
 """The space, norm and level cells of a row of a producer that did not run."""
 H_ONLY_KEYS = ("gamma",)
 H_LEVEL_KEYS = ("multipliers", "traces")
 EXPORT_TIMEOUT = 600.0
 """Seconds an exporter may take for all its levels (far above what the exporters take for N = 4..32)."""
+PAPER_REF = "beyond the paper (Certifying production codes)"
+"""The paper_ref of every producer claim."""
 
 
 def installed_version(python: str, distribution: str, probe: str | None = None) -> str | None:
@@ -45,6 +50,29 @@ def installed_version(python: str, distribution: str, probe: str | None = None) 
     except (OSError, subprocess.TimeoutExpired):
         return None
     return done.stdout.strip() if done.returncode == 0 and done.stdout.strip() else None
+
+
+@functools.lru_cache(maxsize=None)
+def _cached_version(python: str, distribution: str, probe: str | None) -> str | None:
+    return installed_version(python, distribution, probe)
+
+
+def installation(codes: dict, root: Path = Path(".")) -> dict:
+    """Each code's interpreter and the version it reports (``"not installed"`` where none):
+    the params of rule ``producers``, so that a change (``make producers-<code>``, an upgrade,
+    another interpreter) reruns the stage. One probe per code and process (cached): Snakemake
+    evaluates params more than once while it builds the DAG."""
+    out = {}
+    for name, spec in codes.items():
+        python = _python(spec, root)
+        version = _cached_version(python, spec["distribution"], spec.get("version"))
+        out[name] = f"{python} {version if version is not None else 'not installed'}"
+    return out
+
+
+def _python(spec: dict, root: Path) -> str:
+    """A code's interpreter: relative paths are to the repository root."""
+    return spec["python"] if Path(spec["python"]).is_absolute() else str(root / spec["python"])
 
 
 def run_export(python: str, script: Path, out: Path, space: str, ns, offset: int) -> float:
@@ -118,11 +146,11 @@ def _num(value) -> float:
 def producer_rows(name: str, spec: dict, cfg: dict, workdir: Path, root: Path = Path(".")) -> list:
     """Every row of one producer (``cfg``: the config's ``producers`` section; ``spec`` its
     entry under ``codes``): exports under ``workdir/<name>/<space>_k<offset>``."""
-    python = str(root / spec["python"]) if not Path(spec["python"]).is_absolute() else spec["python"]
+    python = _python(spec, root)
     base = dict(producer=name, install=spec["install"])
     version = installed_version(python, spec["distribution"], spec.get("version"))
     if version is None:
-        return [dict(base, version="", space=NOT_RUN, offset=0, norm=NOT_RUN, status="not installed",
+        return [dict(base, version="", space=NO_CELL, offset=0, norm=NO_CELL, status="not installed",
                      verdict="", evidence=f"{spec['distribution']} not importable by {spec['python']}: "
                      f"run `{spec['install']}`")]
     out = []
@@ -185,14 +213,20 @@ def producers_claims(frame, cfg: dict):
     dimension of the kernel of Bᵀ on every level), over every offset and norm it ran in.
     PASS when every certificate is the predicted one; FAIL when a decided certificate
     (STABLE/UNSTABLE) differs; INCONCLUSIVE when one is INCONCLUSIVE or refused. A producer
-    that is not installed gives no claim (its table row says so)."""
+    that is not installed keeps its predicted claims, each with the verdict NOT RUN and its
+    table row's evidence (the install command): the ledger says what was not checked."""
     import pandas as pd
 
-    from ..criteria.claims import FAIL, INCONCLUSIVE, PASS, row
+    from ..criteria.claims import FAIL, INCONCLUSIVE, NOT_RUN, PASS, row
 
     out = []
     for name, spec in cfg["codes"].items():
+        missing = frame[(frame.producer == name) & (frame.status == "not installed")]
         for space, pred in (spec.get("predictions") or {}).items():
+            if len(missing):
+                out.append(row(f"producer-{name}-{space}", PAPER_REF, _statement(f"{name} {space}", pred),
+                               (NOT_RUN, f"not run: {missing.evidence.iloc[0]}")))
+                continue
             rows = frame[(frame.producer == name) & (frame.space == space)]
             if rows.empty:
                 continue
@@ -211,10 +245,15 @@ def producers_claims(frame, cfg: dict):
                     wrong.append(f"{where}: {r.verdict} kernel {kernels}")
             verdict = FAIL if wrong else INCONCLUSIVE if open_ else PASS
             evidence = "; ".join(wrong or open_ or seen)
-            kernel = f", kernel of B^T of dim {pred['kernel']} on every level" if "kernel" in pred else ""
-            statement = (f"{rows.system.iloc[0] or name + ' ' + space}: verdicts "
-                         + ", ".join(f"{n} {v}" for n, v in pred["verdicts"].items()) + kernel
-                         + f" (offsets {sorted(set(rows.offset))}); {pred['why']}")
-            out.append(row(f"producer-{name}-{space}", "beyond the paper (Certifying production codes)",
-                           statement, (verdict, evidence)))
+            statement = _statement(rows.system.iloc[0] or f"{name} {space}", pred, sorted(set(rows.offset)))
+            out.append(row(f"producer-{name}-{space}", PAPER_REF, statement, (verdict, evidence)))
     return pd.DataFrame(out, columns=["claim_id", "paper_ref", "statement", "evidence", "verdict", "predicted"])
+
+
+def _statement(system: str, pred: dict, offsets=None) -> str:
+    """A producer claim's statement: the config's prediction (verdict per norm, kernel) and why;
+    ``offsets`` those it ran on (none named for a producer that did not run)."""
+    kernel = f", kernel of B^T of dim {pred['kernel']} on every level" if "kernel" in pred else ""
+    where = f" (offsets {list(offsets)})" if offsets is not None else ""
+    return (f"{system}: verdicts " + ", ".join(f"{n} {v}" for n, v in pred["verdicts"].items()) + kernel
+            + f"{where}; {pred['why']}")

@@ -15,15 +15,20 @@ What it refuses, each with one line (:class:`GateError` or :class:`~infsup_conta
 * a predicted claim whose verdict differs: a FAIL where the paper predicts PASS, an
   INCONCLUSIVE anywhere a verdict is predicted. Findings (``predicted = finding``) are listed,
   not judged: the paper says nothing about them, and FAIL is one of their results.
+
+A claim with the verdict NOT RUN (an optional producer not installed where the ledger was
+built, its evidence naming the install command) is listed by id in the summary line, not
+judged: nothing was computed for it. It does not count as checked, so a ledger of only NOT RUN
+and findings is still refused.
 """
 from __future__ import annotations
 
 import os
 from pathlib import Path
 
-from ...criteria.claims import FAIL, FINDING, INCONCLUSIVE, PASS
+from ...criteria.claims import FAIL, FINDING, INCONCLUSIVE, NOT_RUN, PASS
 
-VERDICTS = (PASS, FAIL, INCONCLUSIVE)
+VERDICTS = (PASS, FAIL, INCONCLUSIVE, NOT_RUN)
 PREDICTIONS = (PASS, FAIL, FINDING)
 
 
@@ -37,11 +42,12 @@ def _mtime(path) -> int:
 
 def check_stage(product, sources: dict) -> None:
     """``product`` (a file) is at least as new as each of ``sources`` (path → table kind of
-    :data:`~infsup_contact.table_schemas.SCHEMAS`), and each source exists and reads under its schema."""
+    :data:`~infsup_contact.table_schemas.SCHEMAS`; ``kind?``: the table may have no rows, as the
+    producers' claims of a config without predictions), and each source exists and reads under its schema."""
     from ...io import TableError, read_table
 
     for path, kind in sources.items():
-        read_table(path, kind)  # a missing or damaged table: TableError naming it
+        read_table(path, kind.rstrip("?"), allow_empty=kind.endswith("?"))  # missing or damaged: TableError
     if not Path(product).is_file():
         raise TableError(product, "no such file")
     for path in sources:
@@ -78,13 +84,19 @@ def gate(ledger, stages) -> tuple:
         if len(bad):
             raise GateError(f"{ledger}: claim {bad.claim_id.iloc[0]} has {col} {bad[col].iloc[0]!r} "
                             f"(allowed: {', '.join(allowed)})")
-    checked = frame[frame.predicted != FINDING]
+    not_run = frame[frame.verdict == NOT_RUN]
+    checked = frame[(frame.predicted != FINDING) & (frame.verdict != NOT_RUN)]
     if not len(checked):
-        raise GateError(f"{ledger}: no claim with a predicted verdict ({len(frame)} findings): nothing to verify")
+        raise GateError(f"{ledger}: no claim with a predicted verdict that ran ({len(frame)} findings or "
+                        f"{NOT_RUN}): nothing to verify")
     wrong = checked[checked.verdict != checked.predicted]
     if len(wrong):
         raise GateError(f"{len(wrong)} claim(s) differ from the paper's prediction: "
                         + ", ".join(f"{c} ({v}, predicted {p})" for c, v, p in
                                     zip(wrong.claim_id, wrong.verdict, wrong.predicted)))
-    return frame, (f"verify-claims: {len(checked)} claims as predicted, {len(frame) - len(checked)} "
-                   "findings listed")
+    findings = int((frame.predicted == FINDING).sum()) - int((not_run.predicted == FINDING).sum())
+    summary = f"verify-claims: {len(checked)} claims as predicted, {findings} findings listed"
+    if len(not_run):
+        summary += (f", {len(not_run)} {NOT_RUN} (a code not installed, its install command in the evidence): "
+                    + ", ".join(not_run.claim_id))
+    return frame, summary

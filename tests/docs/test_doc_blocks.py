@@ -77,6 +77,10 @@ def _subparser(command):
 
 
 def _synopsis(argv, where):
+    if argv[0].startswith("-"):  # a top-level flag (--version, --help): it runs, in a blink
+        code, out, err = run_in_process(list(argv[:1]))
+        assert code == 0 and out.strip(), f"{where}: infsup-contact {argv[0]}: exit {code}, {err.strip()}"
+        return None
     parser = _subparser(argv[0])
     flags = {s: a for a in parser._actions for s in a.option_strings}
     action = None

@@ -75,6 +75,23 @@ def test_export_then_verdict_system_and_case(clean_venv, tmp_path):
     assert float(system[0]["beta_min"]) == pytest.approx(float(case[0]["beta_min"]), rel=1e-4)  # %.6g printing
 
 
+def test_verdict_system_of_mm_files(clean_venv, tmp_path):
+    """Kratos writes MatrixMarket as ``.mm``: the same exported system renamed to ``.mm`` gets the
+    verdict of its ``.mtx`` files from the installed wheel (the reader's extension table ships)."""
+    out, mm = tmp_path / "exports", tmp_path / "mm"
+    ok(cli(clean_venv, "export", "--case", "R5.4", "--k", "1", "--N", "8", "16", "32", "--out", out, cwd=tmp_path))
+    mm.mkdir()
+    for path in out.iterdir():
+        name = path.stem + ".mm" if path.suffix == ".mtx" else path.name
+        text = path.read_bytes()
+        (mm / name).write_bytes(text.replace(b".mtx", b".mm") if path.name == "levels.yaml" else text)
+    assert ".mm" in (mm / "levels.yaml").read_text() and not list(mm.glob("*.mtx"))
+    got = [rows(ok(cli(clean_venv, "verdict", "--system", d / "levels.yaml", "--expect", "unstable", cwd=tmp_path)))[0]
+           for d in (out, mm)]
+    assert got[0]["verdict"] == got[1]["verdict"] == "UNSTABLE"  # Remark 5.4: one zero mode
+    assert got[0]["kernel_dim"] == got[1]["kernel_dim"] == "1"
+
+
 def test_verdict_hook(clean_venv, tmp_path):
     out = tmp_path / "exports"
     ok(cli(clean_venv, "export", "--case", "T3", "--k", "1", "--N", "8", "16", "32", "--out", out, cwd=tmp_path))

@@ -509,6 +509,18 @@ def test_a_producer_name_that_is_a_path_is_refused(key):
     assert one_line(err.value).startswith("config key producers.codes:") and repr(key) in str(err.value)
 
 
+@pytest.mark.parametrize("levels, needle", [([16, 32], "producers.codes.getfem.N"), ([16, 16, 32], "producers.codes.getfem.N"),
+                                             ([16, 32, 1024], "producers.codes.getfem.N[2]")])
+def test_a_codes_own_levels_are_checked_like_the_sections(levels, needle):
+    """``codes.<name>.N`` (GetFEM's own levels): at least 3, distinct, each in [2, 512], as the section's."""
+    check_config(copy.deepcopy(FULL_CONFIG), SCHEMA)  # the shipped levels pass (a refusal raises)
+    cfg = copy.deepcopy(FULL_CONFIG)
+    cfg["producers"]["codes"]["getfem"]["N"] = levels
+    with pytest.raises(ConfigError) as err:
+        check_config(cfg, SCHEMA)
+    assert one_line(err.value).startswith(f"config key {needle}"), err.value
+
+
 @pytest.mark.parametrize("space", ["../x", "/abs", "..", "a/b"])
 def test_a_producer_space_that_is_a_path_is_refused(space):
     cfg = copy.deepcopy(FULL_CONFIG)

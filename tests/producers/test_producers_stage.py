@@ -174,3 +174,18 @@ def test_the_section_compiles(tmp_path):
     run = subprocess.run(["latexmk", "-pdf", "-interaction=nonstopmode", "-halt-on-error", "t.tex"], cwd=tmp_path,
                          capture_output=True, text=True, timeout=120)
     assert run.returncode == 0, run.stdout[-2000:]
+
+
+def test_a_codes_own_levels_replace_the_sections(tmp_path):
+    """``codes.<name>.N`` (GetFEM's levels in config.yaml): the exporter gets that --N and the rows'
+    levels are its meshes, the L2 β_h still the closed form sqrt(h/2) on each of them."""
+    cfg = _cfg(tmp_path)
+    cfg["codes"]["fake"]["N"] = [8, 16, 32, 64]
+    table = producers_table(cfg, tmp_path / "work")
+    ok = table[(table.status == "ok") & (table.norm == "L2")]
+    assert len(ok) == 2
+    for r in ok.itertuples():
+        assert np.allclose(np.array(r.h_levels.split(), float), [1 / 8, 1 / 16, 1 / 32, 1 / 64])
+        assert np.allclose(np.array(r.beta_levels.split(), float), np.sqrt(np.array([1 / 8, 1 / 16, 1 / 32, 1 / 64]) / 2),
+                           rtol=1e-5)
+

@@ -159,8 +159,9 @@ def producer_rows(name: str, spec: dict, cfg: dict, workdir: Path, root: Path = 
         for offset in progress.steps(spec.get("offsets", cfg["offsets"]), "offset"):  # a code's own: DOLFINx ties matching meshes only
             target = workdir / name / f"{space}_k{offset}"
             _empty_dir(target, workdir)
-            progress.note(f"{name} export.py, N={' '.join(map(str, cfg['N']))}")
-            seconds = run_export(python, script, target, space, cfg["N"], offset)
+            ns = spec.get("N", cfg["N"])  # a code's own levels (GetFEM: its pre-asymptotic coarse level)
+            progress.note(f"{name} export.py, N={' '.join(map(str, ns))}")
+            seconds = run_export(python, script, target, space, ns, offset)
             for norm in progress.steps(cfg["norms"], "verdict --system, norm"):
                 row = certify(norm_copy(target / "levels.yaml", norm), cfg["criterion"])
                 row["seconds"] = row["seconds"] + (seconds if norm == cfg["norms"][0] else 0.0)

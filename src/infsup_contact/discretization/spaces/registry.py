@@ -149,9 +149,20 @@ def space_dim(case, k: int, n: int) -> int:
         _, s, continuous, vanish = case
         return make_space(np.linspace(0.0, 1.0, n + 1), s, continuous, vanish).dim
     spec = space_spec(case)
-    if _BUILT_IN.get(case) is spec:                 # the suite's own spaces: pure, built once per (k, N)
-        return _built_in_dim(case, k, n)
-    return _built_dim(spec, k, n)                   # a user's space: built (and guarded) every time
+    try:
+        hash(spec)
+    except TypeError:  # a user's entry with a list in a field: built every time
+        return _built_dim(spec, k, n)
+    return _cached_dim(spec, k, n)
+
+
+@functools.lru_cache(maxsize=4096, typed=True)
+def _cached_dim(spec: SpaceSpec, k: int, n: int) -> int:
+    """:func:`_built_dim` once per (entry, k, N): a config check asks for the same small meshes
+    of every list (the mutation test: thousands of configs). A build depends on its arguments
+    only (a user's is guarded on its first build, :func:`~.user_spaces.guarded_build`; a user
+    space loaded again is a new entry, a new key); a failing build raises, and is not cached."""
+    return _built_dim(spec, k, n)
 
 
 def _built_dim(spec: SpaceSpec, k: int, n: int) -> int:
@@ -159,15 +170,6 @@ def _built_dim(spec: SpaceSpec, k: int, n: int) -> int:
     if not spec.defined_on(1):
         return int(spec.face_space(k, n).dim)
     return int(spec.build(k, np.linspace(0.0, 1.0, n + 1)).dim)
-
-
-@functools.lru_cache(maxsize=4096, typed=True)
-def _built_in_dim(case: str, k: int, n: int) -> int:
-    """:func:`_built_dim` of a space the suite registers itself, once per (case, k, N): a config
-    check asks for the same small meshes of every list (the mutation test: thousands of
-    configs), and these builds depend on nothing but their arguments (a failing build raises,
-    and is not cached)."""
-    return _built_dim(_BUILT_IN[case], k, n)
 
 
 def is_empty(case, k: int, n: int) -> bool:
@@ -263,9 +265,6 @@ register(SpaceSpec(
 # --- spaces of the face only (the 3D models' quadratic elements) -------------------------
 for _spec in FACE_SPACES:
     register(_spec)
-
-_BUILT_IN: dict[str, SpaceSpec] = dict(SPACES)
-"""The entries registered above (not a user's, :mod:`.user_spaces`): their dimensions are cached."""
 
 
 # --- roles the study gives to particular spaces (the one place they are spelled) --------

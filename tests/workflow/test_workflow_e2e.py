@@ -91,6 +91,10 @@ def _macro(macros: Path, name: str) -> str:
     return found.group(1)
 
 
+# slow_first (tests/conftest.py): the longest call of the suite, and the first to ask for ci_run builds it
+# at the front of the run, so test_verify_claims_ci_profile (left in place, not next to it: two workers
+# would wait on one lock) finds it built instead of forming the run's tail
+@pytest.mark.slow_first
 @pytest.mark.skipif(not HAVE_TEX, reason="TeX (latexmk, pdflatex) or pdftotext missing: .ci/run installs them")
 def test_paper_numbers_follow_tables_and_config(ci_run, tmp_path):
     """`snakemake paper --profile profiles/ci` builds the PDF; its numbers come from the tables,
@@ -164,6 +168,7 @@ def _job_pids(wd: Path):
     return pids
 
 
+@pytest.mark.slow_first  # builds clean_targets early; test_two_clean_runs_are_byte_identical then finds it
 def test_killed_job_then_rerun_completes_identically(clean_targets, tmp_path):
     """SIGKILL a job mid-run, run again: same tables as an uninterrupted run (``clean_targets``)."""
     clean = clean_targets

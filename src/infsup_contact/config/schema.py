@@ -131,7 +131,18 @@ def describe(schema: dict, root: dict | None = None) -> str:
     return "see workflow/schemas/config.schema.yaml"
 
 
+_VALIDATOR: list = [None, None]
+"""The last schema and its validator: a config check (a process, a test of thousands of configs)
+validates against the same schema dict again and again; building the validator is a third of it."""
+
+
 def _validator(schema: dict):
+    if _VALIDATOR[0] is not schema:  # identity, not equality: the dict this validator holds
+        _VALIDATOR[:] = [schema, _new_validator(schema)]
+    return _VALIDATOR[1]
+
+
+def _new_validator(schema: dict):
     import jsonschema
 
     base = jsonschema.Draft202012Validator

@@ -11,6 +11,8 @@ then the dual bases, then the face-only spaces of :mod:`.face_entries`.
 """
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 
 from ...errors import InputError
@@ -143,14 +145,31 @@ def space_dim(case, k: int, n: int) -> int:
     """dim M_h of ``case`` (an id or a triple ``(label, s, continuous, vanish)``, eqs. (5.3)/(5.5))
     for degree k on N uniform intervals, built (1D, cheap): the build, not the ``dimension``
     count, is what a run uses, and a user's build is guarded (user_spaces.guarded_build)."""
-    x = np.linspace(0.0, 1.0, n + 1)
     if not isinstance(case, str):
         _, s, continuous, vanish = case
-        return make_space(x, s, continuous, vanish).dim
+        return make_space(np.linspace(0.0, 1.0, n + 1), s, continuous, vanish).dim
     spec = space_spec(case)
-    if not spec.defined_on(1):                      # a face-only space: on the n × n grid
+    try:
+        hash(spec)
+    except TypeError:  # a user's entry with a list in a field: built every time
+        return _built_dim(spec, k, n)
+    return _cached_dim(spec, k, n)
+
+
+@functools.lru_cache(maxsize=4096, typed=True)
+def _cached_dim(spec: SpaceSpec, k: int, n: int) -> int:
+    """:func:`_built_dim` once per (entry, k, N): a config check asks for the same small meshes
+    of every list (the mutation test: thousands of configs). A build depends on its arguments
+    only (a user's is guarded on its first build, :func:`~.user_spaces.guarded_build`; a user
+    space loaded again is a new entry, a new key); a failing build raises, and is not cached."""
+    return _built_dim(spec, k, n)
+
+
+def _built_dim(spec: SpaceSpec, k: int, n: int) -> int:
+    """dim M_h of ``spec`` built for degree k on N uniform intervals (face-only: the n × n grid)."""
+    if not spec.defined_on(1):
         return int(spec.face_space(k, n).dim)
-    return int(spec.build(k, x).dim)
+    return int(spec.build(k, np.linspace(0.0, 1.0, n + 1)).dim)
 
 
 def is_empty(case, k: int, n: int) -> bool:

@@ -20,9 +20,7 @@ NOT_DECLARED = {
     "qpsolvers": "bench/peers.solve_qpsolvers: a cross-check the tests call, no subcommand",
     "petsc4py": "systems/hb_petsc.read_petsc: used when importable, else its own PETSc reader",
 }
-"""Modules src/ imports that the package does not install, and why."""
-PROVIDED_BY = {"netgen-mesher": "ngsolve"}
-"""Distributions a declared dependency brings with it pinned (ngsolve requires netgen-mesher==its version)."""
+"""Modules src/ imports that a plain install does not bring, and why (each in an extra, tested below)."""
 
 
 def normalize(name: str) -> str:
@@ -51,9 +49,14 @@ def test_every_imported_module_is_a_declared_dependency():
     missing = []
     for module in sorted(imported_modules() - set(NOT_DECLARED)):
         dists = {normalize(d) for d in owners.get(module, [module])}
-        if not any(d in deps or PROVIDED_BY.get(d) in deps for d in dists):
+        if not any(d in deps for d in dists):
             missing.append(f"{module} ({', '.join(sorted(dists))})")
     assert not missing, f"src/ imports modules pyproject.toml does not declare: {missing}"
+
+
+def test_every_optional_import_is_an_extra():
+    extras = {normalize(Requirement(r).name) for reqs in PROJECT["optional-dependencies"].values() for r in reqs}
+    assert {normalize(m) for m in NOT_DECLARED} <= extras, f"not in any extra: {set(NOT_DECLARED)}"
 
 
 def test_every_dependency_has_bounds():

@@ -22,11 +22,35 @@ def displacement_space(mesh, k: int, dirichlet: str = "dir"):
     return ngsolve.H1(mesh, order=k, dirichlet=dirichlet)
 
 
+CURVED_MARGIN = 4
+"""Quadrature orders beyond the numerator's degree on a curved cell (:func:`curved_bonus_intorder`)."""
+
+
+def curved_bonus_intorder(mesh, k: int) -> int:
+    """The ``bonus_intorder`` of ∫ ∇u·∇v on ``mesh``: 0 on an undeformed mesh (the integrand is a
+    polynomial, NGSolve's default order 2k − 2 on simplices, 2k on hexahedra, is exact); on a mesh
+    curved by ``SetDeformation`` (the isoparametric arc and cylinder) NGSolve keeps that order, though the
+    integrand is the rational (adj J ∇φ)·(adj J ∇ψ) / det J: its numerator has degree 4(k − 1) on
+    triangles, 6(k − 1) on tetrahedra and 6k per direction on hexahedra, and the geometric series of
+    1 / det J about a cell's mean converges like (h/R)^n, so :data:`CURVED_MARGIN` orders more bring K
+    to round-off (measured, docs/models.md; ``tests/models/test_curved_stiffness.py``). The default order
+    put β_h of T3 on the arc R = 2, 16:17, k = 2 2.5e-3 (relative) off."""
+    if mesh.deformation is None:
+        return 0
+    k = int(k)
+    element = next(iter(mesh.Elements(ngsolve.VOL))).type
+    numerator, default = {ngsolve.ET.TRIG: (4 * (k - 1), 2 * k - 2), ngsolve.ET.TET: (6 * (k - 1), 2 * k - 2),
+                          ngsolve.ET.HEX: (6 * k, 2 * k)}.get(element, (6 * k, 2 * k))
+    return max(numerator - default, 0) + CURVED_MARGIN
+
+
 def laplace_stiffness(fes) -> sp.csr_matrix:
-    """∫ ∇u·∇v assembled by NGSolve on all dofs (c = 1)."""
+    """∫ ∇u·∇v assembled by NGSolve on all dofs (c = 1); on a curved mesh with the quadrature of
+    :func:`curved_bonus_intorder`."""
     u, v = fes.TnT()
     a = ngsolve.BilinearForm(fes)
-    a += ngsolve.grad(u) * ngsolve.grad(v) * ngsolve.dx
+    bonus = curved_bonus_intorder(fes.mesh, fes.globalorder)
+    a += ngsolve.grad(u) * ngsolve.grad(v) * ngsolve.dx(bonus_intorder=bonus)
     a.Assemble()
     mat = a.mat
     # CSR() returns views into NGSolve's memory, freed with the form: copy them

@@ -33,7 +33,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...errors import InputError
-from ..segment.arc import check_curved_options
+from ..segment.arc import MOMENT_BONUS_INTORDER, check_curved_options
 from .square import Square
 
 GAMMAS = ("square", "cylinder")
@@ -98,7 +98,7 @@ class Cylinder(Square):
             return
         mesh.UnsetDeformation()  # the map is of the box's coordinates, not of a curved mesh's
         deformation = ngsolve.GridFunction(ngsolve.VectorH1(mesh, order=int(k)))
-        deformation.Set(self.cylinder_map(), dual=True)
+        deformation.Set(self.cylinder_map(), dual=True, bonus_intorder=MOMENT_BONUS_INTORDER)
         mesh.SetDeformation(deformation)
 
     def embed(self, x):

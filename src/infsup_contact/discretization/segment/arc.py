@@ -41,6 +41,10 @@ GAMMAS = ("segment", "arc")
 COUPLINGS = ("exact", "projection")
 """How the sides are coupled on the arc (module docstring)."""
 RADIUS_ALLOWED = "a number R > 1, or inf (the flat segment)"
+MOMENT_BONUS_INTORDER = 8
+"""Orders beyond NGSolve's default with which the dual interpolation integrates the moments of Φ − id
+(not a polynomial): at the default the curved bodies' S_i sit ~6e-11 (relative; k = 2) from the
+documented interpolant's, two more orders reach round-off (docs/models.md, the arc)."""
 """R = 1 would make Ω1 a sector whose square map collapses its far side into the centre."""
 
 
@@ -101,14 +105,15 @@ class Arc(Segment):
         its deformation is the P_k interpolant of Φ − id, by NGSolve's dual (moment) interpolation, so
         that an edge's curve depends on the edge alone: the two sides of matching meshes share their
         discrete Γ exactly (the default ``Set`` projects element by element, and the sides' curves
-        then differ by ~1e-6). Nothing on a flat Γ."""
+        then differ by ~1e-6); the moments of the non-polynomial Φ integrated to round-off
+        (:data:`MOMENT_BONUS_INTORDER`). Nothing on a flat Γ."""
         import ngsolve
 
         if not self.curved:
             return
         mesh.UnsetDeformation()  # Φ is a map of the square: never of an already curved mesh
         deformation = ngsolve.GridFunction(ngsolve.VectorH1(mesh, order=int(k)))
-        deformation.Set(self.polar_map(), dual=True)
+        deformation.Set(self.polar_map(), dual=True, bonus_intorder=MOMENT_BONUS_INTORDER)
         mesh.SetDeformation(deformation)
 
     def embed(self, x):

@@ -88,11 +88,13 @@ def test_each_curved_side_is_the_reference_isoparametric_body(k):
         assert np.abs(side.schur - reference).max() <= 1e-12 * scale
 
 
-@pytest.mark.parametrize("k,n1,n2", [(1, 4, 5), (2, 4, 5), (2, 8, 9)])
-def test_arc_rows_agree_with_the_exactly_integrated_reference(k, n1, n2):
+@pytest.mark.parametrize("k,n1,n2,coupling", [(1, 4, 5, "exact"), (2, 4, 5, "exact"), (2, 8, 9, "exact"),
+                                              (2, 8, 9, "projection")])
+def test_arc_rows_agree_with_the_exactly_integrated_reference(k, n1, n2, coupling):
     """Every segment space, both norms: β_h with the library's sides and with the reference's S_i in
-    the same pencil agree to 1e-9 (the issue's acceptance: 1e-6), and so do the kernels."""
-    options = arc()
+    the same pencil (the coupling the library's: the projection's is checked below) agree to 1e-9
+    (the issue's acceptance: 1e-6), and so do the kernels."""
+    options = arc(coupling=coupling)
     library = pd.DataFrame(beta_rows("structured", k, n1, n2, model=MEMBRANES, mesh=options))
     sides = ar.reference_sides(MEMBRANES, "structured", k, n1, n2, options)
     reference = pd.DataFrame(beta_rows("structured", k, n1, n2, model=MEMBRANES, mesh=options,

@@ -33,7 +33,7 @@ def curved_bonus_intorder(mesh, k: int) -> int:
     integrand is the rational (adj J ∇φ)·(adj J ∇ψ) / det J: its numerator has degree 4(k − 1) on
     triangles, 6(k − 1) on tetrahedra and 6k per direction on hexahedra, and the geometric series of
     1 / det J about a cell's mean converges like (h/R)^n, so :data:`CURVED_MARGIN` orders more bring K
-    to round-off (measured, docs/models.md; ``tests/models/test_curved_stiffness.py``). The default order
+    to round-off (measured, docs/models.md; ``tests/discretization/segment/test_arc_reference.py``). The default order
     put β_h of T3 on the arc R = 2, 16:17, k = 2 2.5e-3 (relative) off."""
     if mesh.deformation is None:
         return 0

@@ -41,11 +41,11 @@ GAMMAS = ("segment", "arc")
 COUPLINGS = ("exact", "projection")
 """How the sides are coupled on the arc (module docstring)."""
 RADIUS_ALLOWED = "a number R > 1, or inf (the flat segment)"
+"""R = 1 would make Ω1 a sector whose square map collapses its far side into the centre."""
 MOMENT_BONUS_INTORDER = 8
 """Orders beyond NGSolve's default with which the dual interpolation integrates the moments of Φ − id
 (not a polynomial): at the default the curved bodies' S_i sit ~6e-11 (relative; k = 2) from the
 documented interpolant's, two more orders reach round-off (docs/models.md, the arc)."""
-"""R = 1 would make Ω1 a sector whose square map collapses its far side into the centre."""
 
 
 def check_curved_options(gamma, radius, coupling, gammas=GAMMAS, radius_allowed: str = RADIUS_ALLOWED) -> None:

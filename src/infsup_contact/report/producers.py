@@ -84,6 +84,18 @@ CENSUS_NEEDED = ("code", "version", "space", "offset", "norm", "verdict", "predi
                  "slope", "slope_lo", "slope_hi", "fix", "claim", "predicted_in")
 
 
+CENSUS_WIDTHS = (("l", None), ("", 1.4), ("r", None), ("", 2.3), ("", 1.3), ("", 1.3), ("", 1.2), ("", 2.3),
+                 ("l", None), ("l", None))
+"""The census table's columns: (alignment, width in cm of a ragged paragraph column or None)."""
+
+
+def _versions(census: pd.DataFrame) -> str:
+    """Each code and the version it ran as, or that it did not run."""
+    first = census.drop_duplicates("code")
+    return ", ".join(f"{latex_id(r.code)} " + ("not installed" if r.status == "not installed" else latex_id(r.version))
+                     for r in first.itertuples())
+
+
 def census_tex(census: pd.DataFrame, panels) -> str:
     """The census subsection: its longtable and, where ``panels`` (the (code, space) the figure
     draws, :func:`~infsup_contact.report.figures.census.unstable_panels`) is not empty, the mode figure."""
@@ -99,15 +111,17 @@ eigenvalue's root) with its confidence interval, what makes the space
 stable (the prediction's \texttt{fix}), the claim's verdict, and the commit since which
 \texttt{config/config.yaml} holds the prediction: predictions are committed before their first run,
 and a verdict changed afterwards is dated by its own commit. Generated: \texttt{results/tables/census.csv}.""",
-           "", r"{\scriptsize\setlength{\tabcolsep}{3pt}",
-           r"\begin{longtable}{llrlllp{1.6cm}p{2.6cm}ll}",
-           r"\caption{The census of the producers' examples (\texttt{results/tables/census.csv}).}\label{tab:census}\\",
+           "", r"{\scriptsize\setlength{\tabcolsep}{1.5pt}",
+           # ragged columns of fixed widths: the table fits the text width (a4, 2.5 cm margins)
+           r"\begin{longtable}{" + "".join(rf">{{\raggedright\arraybackslash}}p{{{w}cm}}" if w else c
+                                          for c, w in CENSUS_WIDTHS) + "}",
+           r"\caption{The census of the producers' examples (\texttt{results/tables/census.csv}); versions: "
+           + _versions(census) + r".}\label{tab:census}\\",
            r"\toprule",
-           r"code & space & $K$ & verdict & kernel$/\dim M_h$ & $\beta_h$ & slope [CI] & fix & claim & predicted in \\",
+           r"code & space & $K$ & verdict & kernel / $\dim M_h$ & $\beta_h$ & slope [CI] & fix & claim & predicted in \\",
            r"\midrule", r"\endhead", r"\bottomrule", r"\endfoot"]
     for r in census.itertuples():
-        code = latex_id(r.code) + ("" if r.version == "-" else " " + latex_id(r.version))
-        cells = [code, latex_id(r.space), str(r.offset), _verdict(r) + ("" if r.norm == "H" else f" ({latex_id(r.norm)})"),
+        cells = [latex_id(r.code), latex_id(r.space), str(r.offset), _verdict(r) + ("" if r.norm == "H" else f" ({latex_id(r.norm)})"),
                  latex_id(r.kernel_vs_dim), latex_id(_betas(r.beta_levels)), _slope(r), latex_id(r.fix),
                  latex_id(r.claim), latex_id(str(r.predicted_in).split()[0])]
         out.append(" & ".join(cells) + r" \\")

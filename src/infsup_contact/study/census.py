@@ -75,7 +75,7 @@ def _row(code: str, space: str, offset: int, group: pd.DataFrame, pred, verdicts
                 kernel_vs_dim=" ".join(f"{k}/{d}" for k, d in zip(kernels, dims)) if len(kernels) == len(dims) and dims
                 else NONE,
                 h_levels=_text(r.h_levels), beta_levels=_text(r.beta_levels), slope=_float(r.slope),
-                slope_lo=_float(r.slope_lo), slope_hi=_float(r.slope_hi), fix=_fix(pred, verdict),
+                slope_lo=_float(r.slope_lo), slope_hi=_float(r.slope_hi), fix=_fix(pred, verdict, norm),
                 claim=verdicts.get(f"producer-{code}-{space}", NONE) if pred else NONE,
                 predicted_in=predicted_in.get((code, space), NONE) if pred else NONE,
                 evidence=_text(r.evidence if ok else r.status))
@@ -94,7 +94,7 @@ def _not_run(code: str, spec: dict, cfg: dict, row, verdicts: dict, predicted_in
                             norm=norm, status="not installed", verdict=NOT_RUN, predicted=_predicted(pred, norm),
                             other_norms=NONE, kernel_levels=NONE, dim_M_levels=NONE, kernel_vs_dim=NONE,
                             h_levels=NONE, beta_levels=NONE, slope=np.nan, slope_lo=np.nan, slope_hi=np.nan,
-                            fix=_fix(pred, NOT_RUN), claim=verdicts.get(f"producer-{code}-{space}", NONE) if pred
+                            fix=_fix(pred, NOT_RUN, norm), claim=verdicts.get(f"producer-{code}-{space}", NONE) if pred
                             else NONE, predicted_in=predicted_in.get((code, space), NONE) if pred else NONE,
                             evidence=f"not installed: run `{row.install}`"))
     return out
@@ -104,12 +104,12 @@ def _predicted(pred, norm: str) -> str:
     return (pred or {}).get("verdicts", {}).get(norm, NONE)
 
 
-def _fix(pred, verdict: str) -> str:
+def _fix(pred, verdict: str, norm: str) -> str:
     """The prediction's ``fix``; where none is given, :data:`NOT_GIVEN` for a space found (or, not
-    run, predicted) UNSTABLE in the row's norm, else :data:`NONE` (nothing to fix)."""
+    run, predicted) UNSTABLE in the row's ``norm``, else :data:`NONE` (nothing to fix)."""
     if pred and pred.get("fix"):
         return " ".join(str(pred["fix"]).split())
-    unstable = verdict == "UNSTABLE" or (verdict == NOT_RUN and pred and "UNSTABLE" in pred["verdicts"].values())
+    unstable = verdict == "UNSTABLE" or (verdict == NOT_RUN and _predicted(pred, norm) == "UNSTABLE")
     return NOT_GIVEN if unstable else NONE
 
 

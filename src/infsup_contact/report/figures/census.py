@@ -41,7 +41,7 @@ def plot_census_modes(census, modes, pdf, png) -> list:
     ncols = min(NCOLS, max(1, len(panels)))
     nrows = max(1, math.ceil(len(panels) / ncols))
     with style():
-        fig, axes = plt.subplots(nrows, ncols, figsize=(2.4 * ncols, 1.9 * nrows), layout="constrained",
+        fig, axes = plt.subplots(nrows, ncols, figsize=(2.4 * ncols, 2.2 * nrows), layout="constrained",
                                  squeeze=False)
         for ax in axes.flat[len(panels):]:
             ax.set_axis_off()
@@ -71,4 +71,4 @@ def _panel(ax, code: str, space: str, census, modes) -> None:
     ax.set_xlabel(r"position on $\Gamma$", fontsize=6)
     ax.set_ylabel(r"$\mu_h$ ($\max|\mu_h|=1$)", fontsize=6)
     ax.tick_params(labelsize=5)
-    ax.legend(fontsize=4.5, frameon=False, loc="lower left")
+    ax.legend(fontsize=4.5, frameon=False, loc="upper center", bbox_to_anchor=(0.5, -0.3))  # below: off the mode

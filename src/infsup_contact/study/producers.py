@@ -207,11 +207,13 @@ def producers_modes(table, workdir: Path):
     space dropped from the config leaves no stale mode behind."""
     import pandas as pd
 
+    from ..io import read_table
+
     parts = []
     for r in table[(table.status == "ok") & (table.norm == "H")].itertuples():
         path = Path(workdir) / r.producer / f"{r.space}_k{r.offset}" / MODE_FILE
         if path.is_file():
-            parts.append(pd.read_csv(path))
+            parts.append(read_table(path, "producer_modes"))
     return pd.concat(parts, ignore_index=True) if parts else pd.DataFrame(columns=list(MODE_COLUMNS))
 
 

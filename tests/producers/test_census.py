@@ -154,3 +154,13 @@ def test_mode_figure_draws_the_unstable_spaces_only(tmp_path):
     assert plot_census_modes(stable, modes, tmp_path / "s.pdf", tmp_path / "s.png") == []
     assert r"\includegraphics" not in census_tex(stable, [])
     assert unstable_panels(census, modes.iloc[:0]) == []  # no mode written: no panel
+
+
+def test_a_stabilised_systems_class_is_carried_to_the_census_and_the_paper():
+    table, claims, cfg = _frames()
+    table["stabilisation"] = np.where((table.space == "bad") & (table.norm == "H"), "regularised", "")
+    census = census_table(table, claims, cfg)
+    assert set(census[census.space == "bad"].stabilisation) == {"regularised"}
+    assert set(census[census.space != "bad"].stabilisation) == {NONE}  # no C block, or not run
+    tex = census_tex(census, [])
+    assert tex.count("UNSTABLE; regularised") == 2  # offsets 0 and 1

@@ -74,10 +74,13 @@ def _slope(r) -> str:
 
 
 def _verdict(r) -> str:
-    """The verdict, and the prediction where it differs (or where there is none)."""
+    """The verdict, a stabilised system's class (a C block: ``stabilisation``), and the prediction
+    where it differs (or where there is none)."""
+    stab = str(getattr(r, "stabilisation", "-"))
+    out = latex_id(r.verdict) + ("" if stab in ("-", "none", "nan", "") else f"; {latex_id(stab)}")
     if r.predicted == "-":
-        return latex_id(r.verdict) + " (no prediction)"
-    return latex_id(r.verdict) + ("" if r.verdict == r.predicted else rf" (predicted {latex_id(r.predicted)})")
+        return out + " (no prediction)"
+    return out + ("" if r.verdict == r.predicted else rf" (predicted {latex_id(r.predicted)})")
 
 
 CENSUS_NEEDED = ("code", "version", "space", "offset", "norm", "verdict", "predicted", "kernel_vs_dim", "beta_levels",

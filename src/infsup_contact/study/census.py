@@ -5,9 +5,10 @@ was predicted for it (the config's ``producers.codes.<code>.predictions``): per 
 offset) the verdict in the first norm of :data:`NORM_ORDER` that ran (``H``: the inf-sup condition's
 own norm) with the others' summarised, the kernel of Bᵀ against dim M_h per level, β_h per level,
 the slope and its interval, the prediction's ``fix`` (one line: what makes the space stable), the
-claim's verdict from the ledger, and the commit since which the config holds the prediction
-(:func:`prediction_commits`). A code that is not installed has its configured spaces and offsets
-as rows with the verdict NOT RUN and its install command. Everything is read from the tables and
+claim's verdict from the ledger, the commit since which the config holds the prediction
+(:func:`prediction_commits`), and the class of a stabilised system (a manifest with a C block:
+``stabilisation``, where the producers table has it, else ``-``). A code that is not installed
+has its configured spaces and offsets as rows with the verdict NOT RUN and its install command. Everything is read from the tables and
 the config: a new producer needs no code here.
 """
 from __future__ import annotations
@@ -23,7 +24,7 @@ import pandas as pd
 
 CENSUS_COLUMNS = ("code", "version", "space", "offset", "matching", "norm", "status", "verdict", "predicted",
                   "other_norms", "kernel_levels", "dim_M_levels", "kernel_vs_dim", "h_levels", "beta_levels", "slope",
-                  "slope_lo", "slope_hi", "fix", "claim", "predicted_in", "evidence")
+                  "slope_lo", "slope_hi", "fix", "claim", "predicted_in", "evidence", "stabilisation")
 NORM_ORDER = ("H", "h-L2", "L2")
 """Which norm's verdict a census row shows: the first of these that ran (the others summarised)."""
 NONE = "-"
@@ -78,7 +79,8 @@ def _row(code: str, space: str, offset: int, group: pd.DataFrame, pred, verdicts
                 slope_lo=_float(r.slope_lo), slope_hi=_float(r.slope_hi), fix=_fix(pred, verdict, norm),
                 claim=verdicts.get(f"producer-{code}-{space}", NONE) if pred else NONE,
                 predicted_in=predicted_in.get((code, space), NONE) if pred else NONE,
-                evidence=_text(r.evidence if ok else r.status))
+                evidence=_text(r.evidence if ok else r.status),
+                stabilisation=_text(r.stabilisation) if ok and "stabilisation" in group else NONE)
 
 
 def _not_run(code: str, spec: dict, cfg: dict, row, verdicts: dict, predicted_in: dict) -> list:
@@ -96,7 +98,7 @@ def _not_run(code: str, spec: dict, cfg: dict, row, verdicts: dict, predicted_in
                             h_levels=NONE, beta_levels=NONE, slope=np.nan, slope_lo=np.nan, slope_hi=np.nan,
                             fix=_fix(pred, NOT_RUN, norm), claim=verdicts.get(f"producer-{code}-{space}", NONE) if pred
                             else NONE, predicted_in=predicted_in.get((code, space), NONE) if pred else NONE,
-                            evidence=f"not installed: run `{row.install}`"))
+                            evidence=f"not installed: run `{row.install}`", stabilisation=NONE))
     return out
 
 

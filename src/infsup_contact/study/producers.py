@@ -28,7 +28,7 @@ from ..yaml_limits import load as yaml_load
 
 COLUMNS = ("producer", "version", "space", "offset", "norm", "status", "verdict", "kernel_dim", "beta_levels",
            "kernel_levels", "h_levels", "slope", "slope_lo", "slope_hi", "evidence", "seconds", "install", "system",
-           "dim_M_levels")
+           "dim_M_levels", "stabilisation")
 MODE_COLUMNS = ("producer", "space", "offset", "level", "h", "beta", "in_kernel", "x", "mu")
 """The finest level's worst mode of each export in norm ``H`` (sampled on Γ): the census' mode plots."""
 MODE_FILE = "mode-H.csv"
@@ -136,6 +136,7 @@ def certify(manifest: Path, criterion: dict, modes: list | None = None) -> dict:
                 beta_levels=" ".join(f"{r['beta']:.6g}" for r in rows),
                 kernel_levels=" ".join(str(int(r["kernel_detected"])) for r in rows),
                 dim_M_levels=" ".join(str(int(r["m"])) for r in rows),
+                stabilisation=str(head.get("stabilisation", "")),  # a manifest with C (where certified): its class
                 h_levels=" ".join(f"{r['h']:g}" for r in rows),
                 slope=_num(head.get("slope")), slope_lo=_num(head.get("slope_lo")), slope_hi=_num(head.get("slope_hi")),
                 evidence=" ".join(str(head["evidence"]).split()), system=head["system"],
@@ -251,7 +252,8 @@ def producers_table(cfg: dict, workdir: Path, root: Path = Path(".")):
     for col in COLUMNS:
         if col not in frame:
             frame[col] = np.nan if col in ("kernel_dim", "slope", "slope_lo", "slope_hi", "seconds") else ""
-    for col in ("beta_levels", "kernel_levels", "h_levels", "evidence", "system", "verdict", "version", "dim_M_levels"):
+    for col in ("beta_levels", "kernel_levels", "h_levels", "evidence", "system", "verdict", "version", "dim_M_levels",
+                "stabilisation"):
         frame[col] = frame[col].fillna("").astype(str)
     return frame[list(COLUMNS)]
 

@@ -21,7 +21,7 @@ import yaml
 from infsup_contact.errors import InputError
 from infsup_contact.io import read_table, write_csv_atomic
 from infsup_contact.report.producers import producers_tex
-from infsup_contact.study.producers import norm_copy, producers_claims, producers_table
+from infsup_contact.study.producers import norm_copy, producers_claims, producers_modes, producers_table
 
 ROOT = Path(__file__).resolve().parents[2]
 CRITERION = {"slope_tolerance": 0.15, "beta_floor": 1e-3, "confidence": 0.95}
@@ -83,6 +83,14 @@ def test_fake_producer_rows_and_closed_forms(tmp_path):
     h = table[table.norm == "H"]  # certified once the certifier reads norm: H; until then refused, by name
     assert all(s == "ok" or s.startswith("refused: ") for s in h.status)
     assert (tmp_path / "work" / "fake" / "p0_k1" / "levels-L2.yaml").is_file()
+    assert all(r.dim_M_levels == "4 8 16" for r in ok.itertuples())  # m = N P0 multipliers, none constrained
+    modes = producers_modes(table, tmp_path / "work")  # the finest level's worst mode of each H export
+    hok = h[h.status == "ok"]
+    assert sorted(set(zip(modes.offset, modes.level))) == [(k, 2) for k in sorted(hok.offset)]
+    for r in hok.itertuples():
+        m = modes[modes.offset == r.offset]
+        assert m.beta.iloc[0] == pytest.approx(float(r.beta_levels.split()[-1]), rel=1e-5)
+        assert m.mu.abs().max() == pytest.approx(1.0) and m.x.between(0.0, 1.0).all()
 
 
 def test_claims_follow_the_certificates(tmp_path):

@@ -27,7 +27,12 @@ from ..errors import InputError
 from ..yaml_limits import load as yaml_load
 
 COLUMNS = ("producer", "version", "space", "offset", "norm", "status", "verdict", "kernel_dim", "beta_levels",
-           "kernel_levels", "h_levels", "slope", "slope_lo", "slope_hi", "evidence", "seconds", "install", "system")
+           "kernel_levels", "h_levels", "slope", "slope_lo", "slope_hi", "evidence", "seconds", "install", "system",
+           "dim_M_levels", "stabilisation")
+MODE_COLUMNS = ("producer", "space", "offset", "level", "h", "beta", "in_kernel", "x", "mu")
+"""The finest level's worst mode of each export in norm ``H`` (sampled on Γ): the census' mode plots."""
+MODE_FILE = "mode-H.csv"
+"""Where :func:`producer_rows` leaves it, in the export's folder."""
 NO_CELL = "-"
 """The space, norm and level cells of a row of a producer that did not run."""
 H_ONLY_KEYS = ("gamma",)
@@ -112,9 +117,11 @@ def norm_copy(manifest: Path, norm: str) -> Path:
     return path
 
 
-def certify(manifest: Path, criterion: dict) -> dict:
+def certify(manifest: Path, criterion: dict, modes: list | None = None) -> dict:
     """The verdict of ``verdict --system`` on ``manifest`` and its per-level β_h and kernel
-    dimensions; a manifest the certifier refuses gives ``status: refused: <its line>``."""
+    dimensions against dim M_h (``dim_M_levels``: the multipliers m certified, the constrained
+    rows removed); a manifest the certifier refuses gives ``status: refused: <its line>``.
+    ``modes``: a list that receives each level's worst mode (the levels describe their multipliers)."""
     from ..systems.levels import system_verdict
     from ..systems.manifest import load_manifest
     from ..systems.readers import SystemFileError
@@ -122,12 +129,14 @@ def certify(manifest: Path, criterion: dict) -> dict:
     t0 = time.perf_counter()
     try:
         head, rows = system_verdict(load_manifest(manifest), tol=criterion["slope_tolerance"],
-                                    floor=criterion["beta_floor"], confidence=criterion["confidence"])
+                                    floor=criterion["beta_floor"], confidence=criterion["confidence"], modes=modes)
     except (SystemFileError, InputError) as err:
         return dict(status=f"refused: {' '.join(str(err).split())}", verdict="", seconds=time.perf_counter() - t0)
     return dict(status="ok", verdict=head["verdict"], kernel_dim=int(head["kernel_dim"]),
                 beta_levels=" ".join(f"{r['beta']:.6g}" for r in rows),
                 kernel_levels=" ".join(str(int(r["kernel_detected"])) for r in rows),
+                dim_M_levels=" ".join(str(int(r["m"])) for r in rows),
+                stabilisation=str(head.get("stabilisation", "")),  # a manifest with C (where certified): its class
                 h_levels=" ".join(f"{r['h']:g}" for r in rows),
                 slope=_num(head.get("slope")), slope_lo=_num(head.get("slope_lo")), slope_hi=_num(head.get("slope_hi")),
                 evidence=" ".join(str(head["evidence"]).split()), system=head["system"],
@@ -163,10 +172,50 @@ def producer_rows(name: str, spec: dict, cfg: dict, workdir: Path, root: Path = 
             progress.note(f"{name} export.py, N={' '.join(map(str, ns))}")
             seconds = run_export(python, script, target, space, ns, offset)
             for norm in progress.steps(cfg["norms"], "verdict --system, norm"):
-                row = certify(norm_copy(target / "levels.yaml", norm), cfg["criterion"])
+                modes = [] if norm == "H" and _described(target / "levels.yaml") else None
+                row = certify(norm_copy(target / "levels.yaml", norm), cfg["criterion"], modes)
+                if modes and row["status"] == "ok":  # the finest level's, for the census' mode plots (study/census.py)
+                    _write_mode(target / MODE_FILE, modes[-1], dict(producer=name, space=space, offset=int(offset)))
                 row["seconds"] = row["seconds"] + (seconds if norm == cfg["norms"][0] else 0.0)
                 out.append(dict(base, version=version, space=space, offset=int(offset), norm=norm, **row))
     return out
+
+
+def _described(manifest: Path) -> bool:
+    """Whether every level describes its multipliers on Γ (what a mode is evaluated with)."""
+    levels = yaml_load(manifest.read_text()).get("levels") or []
+    return bool(levels) and all(isinstance(lv, dict) and lv.get("multipliers") for lv in levels)
+
+
+def _write_mode(path: Path, mode, keys: dict) -> None:
+    """One level's worst mode sampled on Γ (:func:`~infsup_contact.solvers.modes.mode_on_gamma`),
+    written atomically as :data:`MODE_COLUMNS` (a face's Γ: ``x`` the first coordinate, ``y`` the second)."""
+    import pandas as pd
+
+    from ..io import write_csv_atomic
+    from ..solvers.modes import mode_on_gamma
+
+    x, mu = mode_on_gamma(mode)
+    cols = {"x": x} if np.ndim(x) == 1 else {"x": x[:, 0], "y": x[:, 1]}
+    head = dict(keys, level=int(mode.keys["level"]), h=float(mode.keys["h"]), beta=float(mode.beta),
+                in_kernel=bool(mode.in_kernel))
+    write_csv_atomic(path, pd.DataFrame({**{k: [v] * len(mu) for k, v in head.items()}, **cols, "mu": mu}))
+
+
+def producers_modes(table, workdir: Path):
+    """The modes :func:`producer_rows` left for the table's certified ``H`` rows (:data:`MODE_COLUMNS`;
+    none where the manifest did not describe its multipliers): only the rows of this table, so a
+    space dropped from the config leaves no stale mode behind."""
+    import pandas as pd
+
+    from ..io import read_table
+
+    parts = []
+    for r in table[(table.status == "ok") & (table.norm == "H")].itertuples():
+        path = Path(workdir) / r.producer / f"{r.space}_k{r.offset}" / MODE_FILE
+        if path.is_file():
+            parts.append(read_table(path, "producer_modes"))
+    return pd.concat(parts, ignore_index=True) if parts else pd.DataFrame(columns=list(MODE_COLUMNS))
 
 
 def _empty_dir(path: Path, workdir: Path) -> None:
@@ -203,7 +252,8 @@ def producers_table(cfg: dict, workdir: Path, root: Path = Path(".")):
     for col in COLUMNS:
         if col not in frame:
             frame[col] = np.nan if col in ("kernel_dim", "slope", "slope_lo", "slope_hi", "seconds") else ""
-    for col in ("beta_levels", "kernel_levels", "h_levels", "evidence", "system", "verdict", "version"):
+    for col in ("beta_levels", "kernel_levels", "h_levels", "evidence", "system", "verdict", "version", "dim_M_levels",
+                "stabilisation"):
         frame[col] = frame[col].fillna("").astype(str)
     return frame[list(COLUMNS)]
 

@@ -196,17 +196,19 @@ def uncertain_beta(res) -> float:
 
 
 def system_verdict(manifest: Manifest, *, tol: float, floor: float, confidence: float, route: str = "auto",
-                   notes=None) -> tuple:
+                   notes=None, modes: list | None = None) -> tuple:
     """(verdict row, level rows). The criterion of ``verdict --case``
     (:func:`~infsup_contact.criteria.stability.stability_verdict`) on the kernel *beyond* the
     declared one: a kernel of Bᵀ larger than ``known_kernel`` on any level is UNSTABLE; a
     ``close`` kernel decision on any level makes the verdict INCONCLUSIVE (both by
     ``stability_verdict`` itself), the evidence saying what the user can do. η includes the
     round-off of B's entries, declared (``entry_rtol``) or estimated (:mod:`.roundoff`). Its
-    ``hints`` (:mod:`.hints`, also on ``notes``) say what mistake the numbers suggest."""
+    ``hints`` (:mod:`.hints`, also on ``notes``) say what mistake the numbers suggest. ``modes``: a
+    list that receives each level's worst mode (:func:`system_rows`; the levels describe their
+    multipliers)."""
     t0 = time.perf_counter()
     notes = sys.stderr if notes is None else notes  # the stream of now (a default would bind import time's)
-    rows = system_rows(manifest, route, notes)
+    rows = system_rows(manifest, route, notes, modes)
     immaterial = [r for r in rows if r["kernel_decision"] == "close" and r["beta_uncertain"] < floor]
     series = [dict(r, kernel_dim=r["kernel_detected"], case=manifest.name,
                    kernel_decision="clear" if r in immaterial else r["kernel_decision"]) for r in rows]

@@ -241,9 +241,7 @@ def stabilisation_verdict(rows, out: dict, *, tol: float, floor: float, confiden
     """The head's columns of C, and ``out``'s evidence extended (module docstring): ``beta_C``
     (per level), ``verdict_C``, ``beta_C_min``, ``slope_C`` (the slope test of ``verdict --case``
     on the β_C series), ``c_share``, ``c_scale_max``, ``stabilisation``."""
-    series = [dict(N2=1.0 / r["h"], beta=r["beta_C"], kernel_dim=0, smallest_nonzero=r["beta_C"],
-                   kernel_decision="clear", case=r["system"]) for r in rows]
-    vc = stability_verdict(series, tol, floor, confidence)
+    vc = uniform_verdict(rows, tol, floor, confidence)
     scale = max(r["c_scale"] for r in rows)
     betas = ", ".join(f"{r['beta_C']:.4g}" for r in rows)
     inv_h = ", ".join(f"{1 / r['h']:g}" for r in rows)
@@ -269,6 +267,28 @@ def stabilisation_verdict(rows, out: dict, *, tol: float, floor: float, confiden
     return dict(evidence=evidence, stabilisation=label, verdict_C=vc["verdict"], beta_C=[r["beta_C"] for r in rows],
                 beta_C_min=vc["beta_min"], slope_C=vc["slope"], slope_C_lo=vc["slope_lo"], slope_C_hi=vc["slope_hi"],
                 c_share_max=max(r["c_share"] for r in rows), c_scale_max=scale)
+
+
+def uniform_verdict(rows, tol: float, floor: float, confidence: float) -> dict:
+    """The slope test of ``verdict --case`` on the β_C series, one-sided: β_C bounded *below*
+    uniformly in h is STABLE when min β_C > floor and the slope interval of log β_C against
+    log h lies below +tol (a β_C that grows as h → 0, as C = α h⁻¹ M would give, is bounded
+    below); UNSTABLE when min β_C <= floor or the interval lies above +tol (β_C decays);
+    INCONCLUSIVE otherwise. ``verdict``, ``beta_min``, ``slope``, ``slope_lo``, ``slope_hi``."""
+    h = np.array([r["h"] for r in rows], float)
+    beta = np.array([r["beta_C"] for r in rows], float)
+    series = [dict(N2=1.0 / r["h"], beta=r["beta_C"], kernel_dim=0, smallest_nonzero=r["beta_C"],
+                   kernel_decision="clear", case=r["system"]) for r in rows]
+    out = stability_verdict(series, tol, floor, confidence)  # the fit, and the floor's test
+    if beta.min() <= floor:
+        verdict = "UNSTABLE"
+    elif len(h) >= 3 and np.isfinite(out["slope_hi"]) and out["slope_hi"] <= tol:
+        verdict = "STABLE"
+    elif np.isfinite(out["slope_lo"]) and out["slope_lo"] > tol:
+        verdict = "UNSTABLE"
+    else:
+        verdict = "INCONCLUSIVE"
+    return dict(out, verdict=verdict)
 
 
 def condense_bubbles(A, K_ub, K_bb, D, D_b) -> tuple:

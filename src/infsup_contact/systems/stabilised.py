@@ -24,10 +24,12 @@ Two numbers per level say how much of β_C comes from C:
 
 The verdict (:func:`stabilisation_verdict`) keeps the unstabilised verdict in ``verdict`` and
 adds ``stabilisation``: ``stable-without-C`` (the unstabilised verdict is STABLE),
-``regularised`` (C tiny, :data:`REGULARISED_MAX`, and the unstabilised pair not STABLE: the
-evidence starts "regularised: ..."), ``stabilised`` (C controls the kernel or the decay: the
+``regularised`` (C tiny, :data:`REGULARISED_MAX`, and the unstabilised pair not STABLE), ``stabilised`` (C controls the kernel or the decay: the
 slope test of ``verdict --case`` on the β_C series says "uniformly in h" or "not uniformly"),
-``none`` (C is zero). Without ``C`` none of these columns is written.
+``none`` (C is zero). The evidence starts with the label and what C does ("regularised: C ~
+eps*M ...", "stabilised: C controls a kernel of dimension 1 ... (uniformly in h)"), then the
+unstabilised evidence ("without C: ..."). Without ``C`` none of these columns is written and
+the rows are those of an unstabilised system, unchanged.
 
 **Bubble condensation.** Enrich the displacements with bubbles b (one per slave element):
 A_e = [[A, K_ub], [K_ubᵀ, K_bb]], B_e = [D, D_b]. Eliminating b from
@@ -263,7 +265,7 @@ def stabilisation_verdict(rows, out: dict, *, tol: float, floor: float, confiden
         how = {"STABLE": "uniformly in h", "UNSTABLE": "not uniformly: beta_C decays",
                "INCONCLUSIVE": "uniformity in h inconclusive"}[vc["verdict"]]
         label, words = "stabilised", f"C controls {what} ({how}); "
-    evidence = f"{out['evidence']}; {label}: {words}{c_text}"
+    evidence = f"{label}: {words}{c_text}; without C: {out['evidence']}"
     return dict(evidence=evidence, stabilisation=label, verdict_C=vc["verdict"], beta_C=[r["beta_C"] for r in rows],
                 beta_C_min=vc["beta_min"], slope_C=vc["slope"], slope_C_lo=vc["slope_lo"], slope_C_hi=vc["slope_hi"],
                 c_share_max=max(r["c_share"] for r in rows), c_scale_max=scale)

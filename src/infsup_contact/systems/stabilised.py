@@ -253,7 +253,7 @@ def stabilisation_verdict(rows, out: dict, *, tol: float, floor: float, confiden
               f"lambda_max(C,G)/lambda_max(BA^-1B^T,G) <= {scale:.2g}")
     dims = [int(r["kernel_detected"]) for r in rows]
     if out["verdict"] == "STABLE":
-        label, words = "stable-without-C", "stable without C: the unstabilised pair is STABLE, C is not needed; "
+        label, words = "stable-without-C", "the unstabilised pair is STABLE, C is not needed for stability; "
     elif scale == 0.0:
         label, words = "none", "C is zero: no stabilisation; "
     elif scale < REGULARISED_MAX:

@@ -269,3 +269,37 @@ def test_cli_prints_the_columns_of_C(tmp_path, capsys):
     assert {"stabilisation", "beta_C", "verdict_C", "slope_C"} <= set(head)
     main(["beta", "--system", str(path)])
     assert {"beta_C", "c_share", "c_scale"} <= set(capsys.readouterr().out.splitlines()[0].split(","))
+
+
+def test_C_with_a_described_H_norm_is_read_in_B_rows(tmp_path):
+    """``norm: H`` with the multipliers described: C is indexed like B as exported, and β_C is
+    that of the same system with the H Gram given (``norm: given``)."""
+    from infsup_contact.systems.export import suite_levels, write_system
+
+    levels, norm, gamma = suite_levels("R5.4", 1, [4, 8, 16], norm="H")
+    path = write_system(tmp_path, levels, "mtx", "described", norm=norm, gamma=gamma)
+    text, given = path.read_text(), []
+    for i, n in enumerate((4, 8, 16)):
+        A, B, G, M = _suite("R5.4", 1, n)
+        scipy.io.mmwrite(tmp_path / f"C{i}.mtx", sp.csr_matrix(M) / n, precision=17)
+        text = text.replace(f"    G: G{i}.mtx\n", f"    G: G{i}.mtx\n    C: C{i}.mtx\n")
+        given.append((1.0 / n, A, B, G, sp.csr_matrix(M) / n))
+    path.write_text(text)
+    described = system_rows(load_manifest(path))
+    (tmp_path / "given").mkdir()
+    plain = system_rows(load_manifest(_write(tmp_path / "given", given)))
+    for r, q in zip(described, plain):
+        assert abs(r["beta_C"] - q["beta_C"]) <= 1e-10 * q["beta_C"]
+
+
+def test_large_C_is_checked_by_its_inertia():
+    """Above the dense check's size, C + δI's LDLᵀ pivots: a negative eigenvalue is found, a
+    semidefinite C (zeros on the diagonal) passes."""
+    from infsup_contact.systems.stabilised import DENSE_PSD_MAX_M, check_semidefinite
+
+    m = DENSE_PSD_MAX_M + 1
+    d = np.where(np.arange(m) % 2 == 0, 0.0, 1.0)
+    check_semidefinite(sp.diags(d).tocsr(), "C.mtx")
+    d[7] = -1e-3
+    with pytest.raises(SystemFileError, match="C is not positive semidefinite: 1 negative pivots"):
+        check_semidefinite(sp.diags(d).tocsr(), "C.mtx")

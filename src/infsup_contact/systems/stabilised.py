@@ -107,7 +107,8 @@ def stabilised_bytes(C, route) -> float:
     """The memory β_C adds to a level (``--dry-run``): on the dense routes (``route`` None: the
     route ``auto`` picks, counted as dense) C dense, S + C and its copy in the pencil's solver,
     3 m² doubles; on shift-invert the entries of C in the KKT matrix and their fill, 3 × 12 bytes
-    per entry (a second LU of [[A, Bᵀ], [B, −(C + δG)]] is counted by the route's own estimate)."""
+    per entry (the LUs of [[A, Bᵀ], [B, −(C + δG)]] and of A are made after the unstabilised
+    route's are freed: the route's own estimate is their peak)."""
     m = C.shape[0]
     if route == "shift-invert":
         return 3 * 12.0 * sp.csr_matrix(C).nnz
@@ -148,7 +149,7 @@ def stabilised_spectrum(A, B, G, C, route: str, smax2: float) -> StabilisedSpect
     """β_C, c_share, c_scale of one checked level on ``route`` (:data:`.engine.ROUTES`, not
     ``auto``); ``smax2`` = σ_max(W)², the Jacobi scale that sets shift-invert's δ."""
     A, B = sp.csc_matrix(A), sp.csr_matrix(B)
-    if route == "shift-invert":
+    if route == "shift-invert" and B.shape[0] > 2:  # Lanczos needs k < m (m <= 2: the dense pencil)
         return _shift_invert(A, B, G, C, smax2)
     from ..la.bottom import lam_max
     from .engine import touched_dofs

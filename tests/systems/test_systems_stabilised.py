@@ -303,3 +303,25 @@ def test_large_C_is_checked_by_its_inertia():
     d[7] = -1e-3
     with pytest.raises(SystemFileError, match="C is not positive semidefinite: 1 negative pivots"):
         check_semidefinite(sp.diags(d).tocsr(), "C.mtx")
+
+
+def test_penalty_rows_of_C_follow_G_or_are_refused(tmp_path, capsys):
+    """A tgv diagonal in C alone is refused (one line); the same row marked in G too (a penalty
+    row there: the constrained-rows rule) is removed from B, G and C, and β_C is that of the
+    system without the row."""
+    A, B, G, M = _suite("R5.4", 1, 4)
+    C = (sp.csr_matrix(M) / 4).tolil()
+    C[0, 0] = 1e30
+    path = _write(tmp_path, [(0.25, A, B, G, C.tocsr())])
+    assert main(["beta", "--system", str(path)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "C0.mtx: 1 penalty rows of C" in err, err
+    G2 = sp.lil_matrix(G)
+    G2[0, 0] = 1e30
+    G2[0, 1:] = 0.0
+    G2[1:, 0] = 0.0
+    row = system_rows(load_manifest(_write(tmp_path, [(0.25, A, B, G2.tocsr(), C.tocsr())]), min_levels=1))[0]
+    keep = np.arange(1, B.shape[0])
+    C_kept = sp.csr_matrix(M)[keep][:, keep] / 4
+    ref = stabilised_spectrum(A, B[keep], G[np.ix_(keep, keep)], C_kept, "gamma-dense", 1.0)
+    assert row["removed_multipliers"] == 1 and abs(row["beta_C"] - ref.beta_C) <= 1e-10 * ref.beta_C

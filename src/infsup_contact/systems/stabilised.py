@@ -93,7 +93,23 @@ def check_stabilisation(level, C, m: int, kept=None):
     check_semidefinite(C, path)
     if kept is not None and len(kept) < m:
         C = sp.csr_matrix(C)[kept][:, kept] if sp.issparse(C) else np.asarray(C, float)[np.ix_(kept, kept)]
+    check_no_penalty(C, path)
     return sp.csr_matrix(C) if sp.issparse(C) else np.asarray(C, float)
+
+
+def check_no_penalty(C, path) -> None:
+    """Refuse penalty rows ("tgv", a diagonal >= 1e15 × the median non-zero one) left in C after
+    the constrained multipliers went: a multiplier fixed by a penalty in the (2,2) block is a
+    constrained row, which the one rule reads from G (a penalty or unit row there) and B."""
+    from .checks import _penalty_rows, _rows
+
+    diag = sp.csr_matrix(C).diagonal() if sp.issparse(C) else np.diag(np.asarray(C, float))
+    pen, med = _penalty_rows(diag)
+    if len(pen):
+        raise SystemFileError(path, f"{len(pen)} penalty rows of C (diagonal up to {np.abs(diag).max():.3g} vs median "
+                              f"{med:.3g}), rows {_rows(pen)} of those kept: multipliers fixed by a penalty in the "
+                              "(2,2) block; mark them in G as well (a penalty or unit row, the constrained-rows rule) "
+                              "or export without them")
 
 
 def check_c_shape(level, shape, m: int) -> None:

@@ -219,9 +219,9 @@ def test_routes_agree_with_C(tmp_path, scale):
 
 # ------------------------------------------------------------------ hostile C
 
-def _one_level_files(tmp_path):
-    A, B, G, M = _suite("R5.4", 1, 4)
-    levels = [(1.0 / n, *_suite("R5.4", 1, n)[:3], 1e-3 * sp.csr_matrix(_suite("R5.4", 1, n)[3])) for n in (4, 8, 16)]
+def _three_levels(tmp_path):
+    """R5.4 (k = 1, N = 4, 8, 16) with C = 1e-3 M: (manifest, levels)."""
+    levels = [(1.0 / n, A, B, G, 1e-3 * sp.csr_matrix(M)) for n in (4, 8, 16) for A, B, G, M in [_suite("R5.4", 1, n)]]
     return _write(tmp_path, levels), levels
 
 
@@ -233,7 +233,7 @@ def _one_level_files(tmp_path):
     (lambda C: sp.csr_matrix(np.where(np.eye(C.shape[0]) > 0, np.nan, 0.0)), "NaN/inf entries"),
 ])
 def test_bad_C_is_one_line_naming_the_file(tmp_path, capsys, bad, found):
-    path, levels = _one_level_files(tmp_path)
+    path, levels = _three_levels(tmp_path)
     scipy.io.mmwrite(tmp_path / "C0.mtx", sp.csr_matrix(bad(sp.csr_matrix(levels[0][4]))), precision=17)
     with pytest.raises(SystemFileError, match="C0.mtx"):
         system_rows(load_manifest(path))
@@ -244,7 +244,7 @@ def test_bad_C_is_one_line_naming_the_file(tmp_path, capsys, bad, found):
 
 
 def test_cut_C_and_C_on_some_levels_only_are_refused(tmp_path, capsys):
-    path, _ = _one_level_files(tmp_path)
+    path, _ = _three_levels(tmp_path)
     (tmp_path / "C1.mtx").write_bytes((tmp_path / "C1.mtx").read_bytes()[:-2])
     assert main(["verdict", "--system", str(path), "--dry-run"]) == 2
     assert "C1.mtx: MatrixMarket: the last line" in capsys.readouterr().err
@@ -255,7 +255,7 @@ def test_cut_C_and_C_on_some_levels_only_are_refused(tmp_path, capsys):
 
 
 def test_dry_run_counts_C(tmp_path):
-    path, _ = _one_level_files(tmp_path)
+    path, _ = _three_levels(tmp_path)
     with_c = dry_check(load_manifest(path)).bytes
     path.write_text("".join(line.split(", C:")[0] + ("}\n" if ", C:" in line else "\n")
                             for line in path.read_text().splitlines()))
@@ -263,7 +263,7 @@ def test_dry_run_counts_C(tmp_path):
 
 
 def test_cli_prints_the_columns_of_C(tmp_path, capsys):
-    path, _ = _one_level_files(tmp_path)
+    path, _ = _three_levels(tmp_path)
     main(["verdict", "--system", str(path)])
     head = capsys.readouterr().out.splitlines()[0].split(",")
     assert {"stabilisation", "beta_C", "verdict_C", "slope_C"} <= set(head)

@@ -320,7 +320,9 @@ def test_penalty_rows_of_C_follow_G_or_are_refused(tmp_path, capsys):
     G2[0, 0] = 1e30
     G2[0, 1:] = 0.0
     G2[1:, 0] = 0.0
-    row = system_rows(load_manifest(_write(tmp_path, [(0.25, A, B, G2.tocsr(), C.tocsr())]), min_levels=1))[0]
+    path = _write(tmp_path, [(0.25, A, B, G2.tocsr(), C.tocsr())])
+    assert main(["beta", "--system", str(path), "--dry-run"]) == 0  # the dry run removes the row as the run does
+    row = system_rows(load_manifest(path, min_levels=1))[0]
     keep = np.arange(1, B.shape[0])
     C_kept = sp.csr_matrix(M)[keep][:, keep] / 4
     ref = stabilised_spectrum(A, B[keep], G[np.ix_(keep, keep)], C_kept, "gamma-dense", 1.0)

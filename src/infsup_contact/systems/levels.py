@@ -298,8 +298,14 @@ def dry_check(manifest: Manifest, route: str = "auto"):
         if level.C is not None:  # checked as a run checks it; its memory beside the route's
             from .stabilised import check_stabilisation, stabilised_bytes
 
-            C = check_stabilisation(level, read_matrix(level.C), B.shape[0])
+            kept = None
+            if G is not None and level.multipliers is None:  # the multiplier rows the run keeps (checks)
+                from .checks import constrained_multipliers
+
+                kept = np.setdiff1d(np.arange(B.shape[0]), constrained_multipliers(level, B, G, manifest.tgv)[0])
+            C = check_stabilisation(level, read_matrix(level.C), B.shape[0], kept, penalty=level.multipliers is None)
             extra_c = max(extra_c, stabilised_bytes(C, r))
     est = resources.system_estimate(sizes)
     extra += extra_c
-    return resources.Estimate(est.bytes + extra, est.seconds) if extra else est
+    seconds = 2.0 * est.seconds if extra_c else est.seconds  # β_C: the route's factorization and pencil again
+    return resources.Estimate(est.bytes + extra, seconds) if extra else est

@@ -82,10 +82,12 @@ class StabilisedSpectrum:
     lam_s: float  # λ_max(S, G)
 
 
-def check_stabilisation(level, C, m: int, kept=None):
+def check_stabilisation(level, C, m: int, kept=None, penalty: bool = True):
     """C as read (``level.C``) checked: finite, m × m (m = B's rows as read), symmetric, positive
     semidefinite; returned restricted to the multiplier rows the checks kept (``kept``: the rows
-    of B as read that the checked B holds; constrained multipliers go from C as from B and G)."""
+    of B as read that the checked B holds; constrained multipliers go from C as from B and G);
+    ``penalty``: refuse penalty rows left in it (:func:`check_no_penalty`; the dry run of a level
+    that describes its multipliers does not know the rows the description removes)."""
     path = level.C
     check_finite(C, path)
     check_c_shape(level, C.shape, m)
@@ -93,7 +95,8 @@ def check_stabilisation(level, C, m: int, kept=None):
     check_semidefinite(C, path)
     if kept is not None and len(kept) < m:
         C = sp.csr_matrix(C)[kept][:, kept] if sp.issparse(C) else np.asarray(C, float)[np.ix_(kept, kept)]
-    check_no_penalty(C, path)
+    if penalty:
+        check_no_penalty(C, path)
     return sp.csr_matrix(C) if sp.issparse(C) else np.asarray(C, float)
 
 

@@ -165,7 +165,8 @@ def test_regularised_unstable_pair_with_a_tiny_mass(tmp_path):
 
 def test_stable_pair_keeps_its_verdict_and_says_C_is_not_needed(tmp_path):
     """T3 (k = 2, N = 8..32) is STABLE: with any C it is ``stable-without-C``, and β_C ≥ β_h (C is PSD)."""
-    levels = [(1.0 / n, A, B, G, 0.1 / n * sp.csr_matrix(M)) for n in (8, 16, 32) for A, B, G, M in [_suite("T3", 2, n)]]
+    levels = [(1.0 / n, A, B, G, 0.1 / n * sp.csr_matrix(M))
+              for n in (8, 16, 32) for A, B, G, M in [_suite("T3", 2, n)]]
     head, rows = system_verdict(load_manifest(_write(tmp_path, levels)), **CRITERION)
     assert head["verdict"] == "STABLE" and head["stabilisation"] == "stable-without-C"
     assert all(r["beta_C"] >= r["beta"] * (1 - 1e-12) for r in rows)

@@ -24,8 +24,9 @@ Two numbers per level say how much of β_C comes from C:
 
 The verdict (:func:`stabilisation_verdict`) keeps the unstabilised verdict in ``verdict`` and
 adds ``stabilisation``: ``stable-without-C`` (the unstabilised verdict is STABLE),
-``regularised`` (C tiny, :data:`REGULARISED_MAX`, and the unstabilised pair not STABLE), ``stabilised`` (C controls the kernel or the decay: the
-slope test of ``verdict --case`` on the β_C series says "uniformly in h" or "not uniformly"),
+``regularised`` (C tiny, :data:`REGULARISED_MAX`, and the unstabilised pair not STABLE),
+``stabilised`` (C controls the kernel or the decay: the one-sided slope test of ``verdict
+--case`` on the β_C series, :func:`uniform_verdict`, says "uniformly in h" or "not uniformly"),
 ``none`` (C is zero). The evidence starts with the label and what C does ("regularised: C ~
 eps*M ...", "stabilised: C controls a kernel of dimension 1 ... (uniformly in h)"), then the
 unstabilised evidence ("without C: ..."). Without ``C`` none of these columns is written and

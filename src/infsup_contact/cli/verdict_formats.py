@@ -327,7 +327,8 @@ def render_json(result: VerdictResult) -> str:
 
 
 PROPERTIES = ("verdict", "expect", "beta_min", "beta_max", "slope", "slope_lo", "slope_hi", "kernel_dim",
-              "known_kernel", "norm", "k", "family", "multiplier_mesh", "N_list", "h_list")
+              "known_kernel", "norm", "k", "family", "multiplier_mesh", "N_list", "h_list", "stabilisation",
+              "verdict_C", "beta_C_min", "slope_C")
 """Row fields written as ``<property>`` of the JUnit suite (those the row has)."""
 
 

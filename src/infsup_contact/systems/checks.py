@@ -88,6 +88,7 @@ class CheckedLevel:
     removed: int = 0
     removed_multipliers: int = 0
     kept_multipliers: np.ndarray | None = None  # the rows of B as read that B here holds, in order
+    C: object = None  # the stabilisation, restricted to those rows (module .stabilised)
 
 
 def check_finite(mat, path) -> None:

@@ -68,6 +68,10 @@ def check_declared_shapes(level) -> None:
 
     shapes = {key: None if p is None else declared_shape(p) for key, p in (("A", level.A), ("B", level.B),
                                                                            ("G", level.G))}
+    if level.C is not None and shapes["B"] is not None and declared_shape(level.C) is not None:
+        from .stabilised import check_c_shape
+
+        check_c_shape(level, declared_shape(level.C), shapes["B"][0])
     if shapes["A"] is None or shapes["B"] is None:
         return
     G = shapes["G"] or (shapes["B"][0], shapes["B"][0])  # no G (norm H): the described Gram, m x m
@@ -83,7 +87,7 @@ def _load_level(manifest: Manifest, level):
     G = None if level.G is None else read_matrix(level.G)
     A = sp.csr_matrix(A) if not sp.issparse(A) else A
     B = sp.csr_matrix(B) if not sp.issparse(B) else B
-    mass, info = None, None
+    mass, info, m_read = None, None, B.shape[0]
     if level.multipliers is not None:
         from .multiplier_gram import described_grams
 
@@ -95,6 +99,12 @@ def _load_level(manifest: Manifest, level):
         checked.removed_multipliers += info["removed_multipliers"]
     if manifest.norm == "h-L2":
         checked.G = checked.G * level.h
+    if level.C is not None:  # the rows the checks kept: B's as read, after the description's reordering
+        from .stabilised import check_stabilisation
+
+        kept = np.arange(B.shape[0]) if checked.kept_multipliers is None else checked.kept_multipliers
+        kept = kept if info is None else np.asarray(info["kept"])[kept]  # in the rows of B as read
+        checked.C = check_stabilisation(level, read_matrix(level.C), m_read, kept)
     return checked, mass, info
 
 
@@ -139,6 +149,12 @@ def system_rows(manifest: Manifest, route: str = "auto", notes=sys.stderr, modes
             t_read=t_read, t_factorize=res.seconds.get("factorize", np.nan),
             t_eigen=res.seconds.get("eigen", np.nan), t_kernel=res.seconds["kernel"],
             notes="; ".join(lv.notes)))
+        if lv.C is not None:  # β_C = λ_min(B A⁻¹ Bᵀ + C, G)^1/2 on the same route (module .stabilised)
+            from .stabilised import stabilised_columns, stabilised_spectrum
+
+            progress.note("spectrum of (B A^-1 B^T + C) m = β_C² G m")
+            rows[-1].update(stabilised_columns(stabilised_spectrum(lv.A, lv.B, lv.G, lv.C, res.route,
+                                                                   float(k.singular[-1]) ** 2)))
         if info is not None:  # described: B's distance to the exact coupling of described traces
             rows[-1]["coupling_distance"] = info["coupling_distance"]
         if manifest.norm == "H":  # the Gram's stated error, and the L2 row beside it where G is given
@@ -237,6 +253,10 @@ def system_verdict(manifest: Manifest, *, tol: float, floor: float, confidence: 
     close = [r for r in rows if r["kernel_decision"] == "close" and r not in immaterial]
     if out["verdict"] == "INCONCLUSIVE" and close:
         out["evidence"] += f"; levels[{close[0]['level']}]: {close[0]['kernel_advice']}"
+    if all("beta_C" in r for r in rows):  # a stabilised system: the unstabilised verdict stays in "verdict"
+        from .stabilised import stabilisation_verdict
+
+        out.update(stabilisation_verdict(rows, out, tol=tol, floor=floor, confidence=confidence))
     head = dict(system=manifest.name, norm=manifest.norm, known_kernel=manifest.known_kernel)
     head.update(out)
     head["hints"] = "; ".join(system_hints(rows, out, tol, confidence, notes))  # the verdict unchanged
@@ -255,7 +275,7 @@ def dry_check(manifest: Manifest, route: str = "auto"):
     from .engine import choose_route, touched_dofs
 
     sizes, shapes = [], []
-    extra = 0.0
+    extra = extra_c = 0.0  # the described Gram's bytes, C's (both held beside the route's blocks)
     for level in manifest.levels:  # every level's headers before any body is read
         check_declared_shapes(level)
     for level in manifest.levels:
@@ -277,5 +297,17 @@ def dry_check(manifest: Manifest, route: str = "auto"):
         nt = len(touched_dofs(sp.csr_matrix(B)))
         r = choose_route(A.shape[0], B.shape[0], nt, sp.issparse(G)) if route == "auto" else route
         sizes.append((A.shape[0], B.shape[0], nt, sp.csr_matrix(A).nnz, r))
+        if level.C is not None:  # checked as a run checks it; its memory beside the route's
+            from .stabilised import check_stabilisation, stabilised_bytes
+
+            kept = None
+            if G is not None and level.multipliers is None:  # the multiplier rows the run keeps (checks)
+                from .checks import constrained_multipliers
+
+                kept = np.setdiff1d(np.arange(B.shape[0]), constrained_multipliers(level, B, G, manifest.tgv)[0])
+            C = check_stabilisation(level, read_matrix(level.C), B.shape[0], kept, penalty=level.multipliers is None)
+            extra_c = max(extra_c, stabilised_bytes(C, r))
     est = resources.system_estimate(sizes)
-    return resources.Estimate(est.bytes + extra, est.seconds) if extra else est
+    extra += extra_c
+    seconds = 2.0 * est.seconds if extra_c else est.seconds  # β_C: the route's factorization and pencil again
+    return resources.Estimate(est.bytes + extra, seconds) if extra else est

@@ -34,6 +34,10 @@ A (n × n) SPD, B (m × n), G (m × m) the multiplier norm. Optional keys:
 per level, ``constrained``
     the 0-based dofs the producer fixed but left in A (identity or penalty rows): a list,
     or a file (``.txt``: whitespace-separated integers, ``.npy``); they are removed;
+per level, ``C``
+    the stabilisation of the (2,2) block, a file like G (m × m, symmetric positive
+    semidefinite): the system is [[A, Bᵀ], [B, −C]] and β_C² = λ_min(B A⁻¹ Bᵀ + C, G) is
+    certified beside the unstabilised β_h (:mod:`.stabilised`);
 per level, ``multipliers`` (required with ``norm: H``) and ``traces``, with the top key ``gamma``
     the description of B's rows on Γ (:mod:`.multiplier_basis`) and of the bodies' trace bases
     (:mod:`.mortar_distance`). With ``norm: H`` G is optional and the Gram is assembled from the
@@ -55,7 +59,7 @@ from .readers import SystemFileError
 
 NORMS = ("given", "L2", "h-L2", "H")
 TGV_POLICIES = ("eliminate", "refuse")
-LEVEL_KEYS = ("h", "A", "B", "G", "constrained", "multipliers", "traces")
+LEVEL_KEYS = ("h", "A", "B", "G", "constrained", "multipliers", "traces", "C")
 TOP_KEYS = ("levels", "name", "norm", "known_kernel", "tgv", "expect", "entry_rtol", "gamma")
 EXPECTS = ("stable", "unstable")
 MANIFEST_MAX_BYTES = 1 << 20
@@ -77,6 +81,7 @@ class Level:
     constrained: object = None  # None, a list of ints, or a Path
     multipliers: object = None  # with norm H: the description (a mapping) or its file (a str)
     traces: object = None  # with norm H, optional: the bodies' trace bases (mortar_distance)
+    C: Path | None = None  # the stabilisation: the (2,2) block is −C (module .stabilised)
 
 
 @dataclass(frozen=True)
@@ -147,6 +152,11 @@ def load_manifest(path, min_levels: int = MIN_LEVELS) -> Manifest:
     entry_rtol = _entry_rtol(path, data.get("entry_rtol"))
     parsed = tuple(_level(path, i, entry, norm) for i, entry in enumerate(levels))
     gamma = _gamma(path, data, norm, parsed)
+    with_c = [lv.index for lv in parsed if lv.C is not None]
+    if with_c and len(with_c) < len(parsed):  # a β_C series needs every level
+        gap = next(lv.index for lv in parsed if lv.C is None)
+        raise SystemFileError(path, f"levels[{gap}]: no key 'C' where levels[{with_c[0]}] has one: give the "
+                              "stabilisation C on every level or on none")
     hs = [lv.h for lv in parsed]
     for i in range(1, len(hs)):
         if not hs[i] < hs[i - 1]:
@@ -226,8 +236,8 @@ def _level(path: Path, i: int, entry, norm: str = "given") -> Level:
     if isinstance(h, bool) or not isinstance(h, (int, float)) or not math.isfinite(h) or h <= 0:
         raise SystemFileError(path, f"{where}.h: expected a finite number > 0 (found {h!r})")
     files = {}
-    for key in ("A", "B", "G"):
-        if key == "G" and "G" not in entry:
+    for key in ("A", "B", "G", "C"):
+        if key in ("G", "C") and key not in entry:
             files[key] = None
             continue
         if not isinstance(entry[key], str) or not entry[key]:
@@ -241,7 +251,7 @@ def _level(path: Path, i: int, entry, norm: str = "given") -> Level:
     elif con is not None:
         if not isinstance(con, list) or any(isinstance(c, bool) or not isinstance(c, int) or c < 0 for c in con):
             raise SystemFileError(path, f"{where}.constrained: expected a file or a list of integers >= 0")
-    return Level(i, float(h), files["A"], files["B"], files["G"], con, mult, entry.get("traces"))
+    return Level(i, float(h), files["A"], files["B"], files["G"], con, mult, entry.get("traces"), files["C"])
 
 
 def constrained_dofs(level: Level, n: int) -> np.ndarray:

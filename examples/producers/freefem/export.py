@@ -149,6 +149,13 @@ def membranes_level(n: int, space: str, offset: int, work: Path) -> dict:
             "multipliers": describe_multipliers(xl, np.sort(vertices), s, continuous)}
 
 
+def assemble_level(n: int, space: str, offset: int = 0) -> dict:
+    """One membranes level assembled in a temporary folder (what the tests rebuild the exact
+    coupling from: ``coords``, A's dof coordinates, and ``n1``, Ω1's number of dofs)."""
+    with tempfile.TemporaryDirectory(prefix="freefem-") as tmp:
+        return membranes_level(n, space, offset, Path(tmp))
+
+
 def describe_multipliers(xl: np.ndarray, breakpoints: np.ndarray, s: int, continuous: bool) -> dict:
     """The ``norm: H`` description: continuous P_s with all its nodes (T3's end rows are
     constrained in B and G, which the certifier sets aside), or P0 (``xl``: the cell midpoints);

@@ -151,3 +151,13 @@ def test_tgv_rows_are_the_dirichlet_dofs_and_the_certifiers_penalty_rows(export)
         assert int(rows[i]["removed_dofs"]) == int(boundary.sum())
         suite = P.suite_beta("T3", 1, n, n, norm="H")
         assert float(rows[i]["beta"]) == pytest.approx(float(suite["beta"]), rel=1e-8)
+
+
+def test_certificate_on_non_matching_meshes_is_the_suites_exact_coupling(export):
+    """Offset 1: the certifier's own distance to the exact mortar coupling (from the manifest's
+    ``traces``, B's columns at Γ's tgv ends included) is round-off, and β_h in H is that of
+    ``beta --case --N1 N+1`` (the same triangles, the same exact coupling)."""
+    for n, row in zip(NS, P.beta_rows(export("T3-k2", 1))):
+        assert float(row["coupling_distance"]) <= 1e-12
+        suite = P.suite_beta("T3", 2, n + 1, n, norm="H")
+        assert float(row["beta"]) == pytest.approx(float(suite["beta"]), rel=1e-8)

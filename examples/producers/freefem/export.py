@@ -156,6 +156,17 @@ def assemble_level(n: int, space: str, offset: int = 0) -> dict:
         return membranes_level(n, space, offset, Path(tmp))
 
 
+def traces_with_ends(coords: np.ndarray, n1: int, k: int) -> list:
+    """The contract's trace description, with B's columns at Γ's ends kept: FreeFEM's ``tgv``
+    fixes those dofs in A only, B's entries there stay (the certifier drops them with the
+    penalty rows), so the trace functions there are B's columns, not −1."""
+    out = describe_traces(coords, n1, k)
+    for trace, (lo, hi) in zip(out, ((0, n1), (n1, len(coords)))):
+        cols = lo + np.flatnonzero(np.isclose(coords[lo:hi, 1], 1.0))
+        trace["columns"] = [int(c) for c in cols[np.argsort(coords[cols, 0], kind="stable")]]
+    return out
+
+
 def describe_multipliers(xl: np.ndarray, breakpoints: np.ndarray, s: int, continuous: bool) -> dict:
     """The ``norm: H`` description: continuous P_s with all its nodes (T3's end rows are
     constrained in B and G, which the certifier sets aside), or P0 (``xl``: the cell midpoints);
@@ -183,7 +194,7 @@ def export(args) -> Path:
             else:
                 lv = membranes_level(n, args.space, args.offset, work)
                 entry = level_entry(args.out, n, lv["A"], lv["B"], lv["G"], lv["multipliers"],
-                                    describe_traces(lv["coords"], lv["n1"], SPACES[args.space][1]))
+                                    traces_with_ends(lv["coords"], lv["n1"], SPACES[args.space][1]))
             levels.append(entry)
     name = f"freefem-{version()} {args.space}: {SPACES[args.space][-1]}"
     if kind == "tutorial":

@@ -7,7 +7,7 @@ STAMP  := $(VENV)/.installed-from-lock
 # workflow rules call `python` and `infsup-contact`: they must resolve to the venv
 export PATH := $(CURDIR)/$(BIN):$(PATH)
 
-.PHONY: reproduce-all test env clean-env producers-kratos producers-dolfinx producers-getfem
+.PHONY: reproduce-all test env clean-env producers-kratos producers-dolfinx producers-getfem producers-freefem
 
 env: $(STAMP)
 
@@ -77,3 +77,15 @@ producers-getfem:
 	      --no-install-recommends python3-getfem python3-scipy python3-yaml >/dev/null; } || \
 	  { echo "error: GetFEM is installed from Debian as root: apt-get install python3-getfem python3-scipy python3-yaml"; exit 1; }
 	@/usr/bin/python3 -c 'import getfem; print("GetFEM", getfem.getfem_env("release"), "for /usr/bin/python3")'
+
+# FreeFEM from Debian (freefem++ 4.11: the binary; libfreefem++: its plugins, `load "msh3"`;
+# freefem++-doc: the shipped tutorial examples/tutorial/mortar-DN-4.edp the producer exports): needs root.
+# The exporter runs in .venv (FreeFEM is no Python package) and sets FF_LOADPATH=/usr/lib/freefem++:
+# Debian's /etc/freefem++.pref names /usr/lib/ff++/4.9/lib, which no package creates.
+FREEFEM_TUTORIAL := /usr/share/doc/freefem++/examples/tutorial/mortar-DN-4.edp
+producers-freefem:
+	@{ command -v FreeFem++ >/dev/null && [ -f /usr/lib/freefem++/msh3.so ] && [ -f $(FREEFEM_TUTORIAL) ]; } 2>/dev/null || \
+	  { [ "$$(id -u)" = 0 ] && apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq \
+	      --no-install-recommends freefem++ libfreefem++ freefem++-doc >/dev/null; } || \
+	  { echo "error: FreeFEM is installed from Debian as root: apt-get install freefem++ libfreefem++ freefem++-doc"; exit 1; }
+	@echo "FreeFEM $$(FreeFem++ 2>&1 | sed -n 's/^FreeFem++ - version \([^ ]*\).*/\1/p') (Debian freefem++ $$(dpkg-query -W -f '$${Version}' freefem++)), tutorial $(FREEFEM_TUTORIAL)"

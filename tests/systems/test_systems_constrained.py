@@ -291,3 +291,25 @@ def test_nothing_left_is_one_line(tmp_path, what):
     with pytest.raises(SystemFileError, match="is constrained .*nothing is left") as err:
         _level0(tmp_path, A, B, G, level_extra=level_extra)
     assert name in str(err.value) and "\n" not in str(err.value)
+
+
+@pytest.mark.parametrize("route", ["gamma-dense", "shift-invert"])
+def test_zero_coupling_is_a_kernel_of_every_multiplier(tmp_path, route):
+    """B = 0 with the diagonal P0 mass of equal cells, not unit rows (FreeFEM's shipped mortar tutorial, whose
+    skeleton integrals come out empty): no row is singled out from the others, so none is a
+    constraint; every multiplier is in the kernel of Bᵀ (dim M), β_h = 0, UNSTABLE — it was
+    refused as "every multiplier row constrained", then crashed on the deflated route."""
+    levels = []
+    for n in NS_STABLE:
+        A, B, _ = _suite("T4", n)
+        m = B.shape[0]
+        levels.append((1.0 / n, A, sp.csr_matrix(B.shape), np.eye(m) / m))  # P0 on m equal cells: G = I/m
+    path = write_system(tmp_path, levels, "npz", "B = 0")
+    manifest = load_manifest(path)
+    lv = load_level(manifest, manifest.levels[-1])
+    assert lv.removed_multipliers == 0 and any("kept: a kernel" in note for note in lv.notes), lv.notes
+    res = level_spectrum(lv.A, lv.B, lv.G, route=route)
+    assert res.kernel.dim == lv.B.shape[0] and res.beta == 0.0
+    head, rows = system_verdict(manifest, **CRITERION)
+    assert head["verdict"] == "UNSTABLE"
+    assert [int(r["kernel_detected"]) for r in rows] == [_suite("T4", n)[1].shape[0] for n in NS_STABLE]

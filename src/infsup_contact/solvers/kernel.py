@@ -144,6 +144,8 @@ def coupling_kernel(W: np.ndarray, proven: int = 0, entry_error: float = 0.0,
     if vectors and rows:
         _, s, vt = sla.svd(W, full_matrices=m > rows, check_finite=True)
         V = vt[::-1].T  # right singular vectors, ascending singular values
+    elif vectors:  # no trace dof touched (B = 0): every multiplier is in the kernel
+        s, V = np.zeros(0), np.eye(m)
     else:
         s, V = (sla.svdvals(W, check_finite=True) if rows else np.zeros(0)), None
     s = np.concatenate([np.zeros(m - len(s)), np.sort(s)])  # ascending, structural zeros first

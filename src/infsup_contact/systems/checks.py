@@ -228,7 +228,10 @@ def constrained_multipliers(level, B, G, tgv: str) -> tuple:
     others = np.setdiff1d(np.arange(len(gdiag)), rows)
     typical = float(np.median(gdiag[others])) if len(others) else np.nan
     g_couples = len(others) > 0 and not dec[others].all()
-    marked = rows[dec[rows] & (g_couples | (gdiag[rows] != typical))]
+    if len(others):
+        marked = rows[dec[rows] & (g_couples | (gdiag[rows] != typical))]
+    else:  # B = 0: no other row to single one out from; only the constraint idiom, a unit row, is one
+        marked = rows[dec[rows] & (gdiag[rows] == 1.0)]  # (FreeFEM's tutorial: B = 0, G a P0 mass: a kernel)
     half = rows[~dec[rows] & (gdiag[rows] == 1.0) & (typical != 1.0)]
     if len(half):  # a unit diagonal set, the row and column left: neither reading is safe
         raise SystemFileError(level.G, f"rows {_rows(half)}: B ({level.B.name}) is zero there and G's diagonal is 1 "

@@ -296,7 +296,8 @@ def _dense(A, B, G, touched, route, n_pairs):
     scale = (np.linalg.norm(S, 2) + np.abs(ev[:k]) * np.linalg.norm(Gd, 2)) * np.linalg.norm(x, axis=0)
     t2 = time.perf_counter()
     top = lam_max(S, sla.cholesky(Gd, lower=True, check_finite=False)) if k < S.shape[0] else float(ev[-1])
-    return (ev, float(np.max(res / scale)),
+    # S = 0 (B = 0): every pair exact, res = scale = 0
+    return (ev, float(np.max(np.divide(res, scale, out=np.zeros_like(res), where=scale > 0))),
             {"factorize": t1 - t0, "eigen": t2 - t1, "lam_max": time.perf_counter() - t2}, top, x)
 
 

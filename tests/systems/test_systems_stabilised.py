@@ -163,6 +163,19 @@ def test_regularised_unstable_pair_with_a_tiny_mass(tmp_path):
         assert r["c_share"] > 1 - 1e-3 and abs(r["beta_C"] ** 2 - 1e-10) <= 1e-3 * 1e-10
 
 
+@pytest.mark.parametrize("route", ["gamma-dense", "shift-invert"])
+def test_zero_coupling_with_a_tiny_mass_is_regularised(tmp_path, route):
+    """B = 0 (FreeFEM's shipped mortar tutorial, whose coupling integrals are empty) plus
+    C = 1e-10 G: there is no pencil to measure C against (B A⁻¹ Bᵀ = 0), every multiplier is in
+    the kernel, and C lifts it only to β_C = 1e-5, below the floor: ``regularised``, UNSTABLE."""
+    levels = [(1.0 / n, A, 0 * B, G, 1e-10 * sp.csr_matrix(G)) for n in (4, 8, 16) for A, B, G, _ in [_suite("R5.4", 1, n)]]
+    head, rows = system_verdict(load_manifest(_write(tmp_path, levels)), route=route, **CRITERION)
+    assert head["verdict"] == "UNSTABLE" and head["stabilisation"] == "regularised", head["evidence"]
+    assert "regularised: C lifts the kernel only" in head["evidence"]
+    for r, (_, _, B, _, _) in zip(rows, levels):
+        assert r["kernel_detected"] == B.shape[0] and abs(r["beta_C"] ** 2 - 1e-10) <= 1e-6 * 1e-10
+
+
 def test_stable_pair_keeps_its_verdict_and_says_C_is_not_needed(tmp_path):
     """T3 (k = 2, N = 8..32) is STABLE: with any C it is ``stable-without-C``, and β_C ≥ β_h (C is PSD)."""
     levels = [(1.0 / n, A, B, G, 0.1 / n * sp.csr_matrix(M))

@@ -24,7 +24,8 @@ Two numbers per level say how much of β_C comes from C:
 
 The verdict (:func:`stabilisation_verdict`) keeps the unstabilised verdict in ``verdict`` and
 adds ``stabilisation``: ``stable-without-C`` (the unstabilised verdict is STABLE),
-``regularised`` (C tiny, :data:`REGULARISED_MAX`, and the unstabilised pair not STABLE),
+``regularised`` (the unstabilised pair not STABLE and C tiny, :data:`REGULARISED_MAX`, or lifting
+the kernel only to β_C ≤ the floor on every level, as where B = 0 leaves no pencil to compare C with),
 ``stabilised`` (C controls the kernel or the decay: the one-sided slope test of ``verdict
 --case`` on the β_C series, :func:`uniform_verdict`, says "uniformly in h" or "not uniformly"),
 ``none`` (C is zero). The evidence starts with the label and what C does ("regularised: C ~
@@ -183,7 +184,8 @@ def stabilised_spectrum(A, B, G, C, route: str, smax2: float) -> StabilisedSpect
     res = np.linalg.norm(T @ x - (Gd @ x) * ev, axis=0)
     scale = (np.linalg.norm(T, 2) + np.abs(ev) * np.linalg.norm(Gd, 2)) * np.linalg.norm(x, axis=0)
     L = sla.cholesky(Gd, lower=True, check_finite=False)
-    lam_s = lam_max(S, L) if S.shape[0] > 1 else float(S[0, 0] / Gd[0, 0])
+    # B = 0 (a code whose coupling integrals are empty: FreeFEM's tutorial as Debian runs it): no pencil
+    lam_s = 0.0 if not np.any(S) else lam_max(S, L) if S.shape[0] > 1 else float(S[0, 0] / Gd[0, 0])
     lam_c = 0.0 if not np.any(Cd) else (lam_max(Cd, L) if Cd.shape[0] > 1 else float(Cd[0, 0] / Gd[0, 0]))
     return _spectrum(ev[0], x[:, 0], Cd, T, float(np.max(res / scale)), lam_c, lam_s)
 
@@ -247,7 +249,7 @@ def _shift_invert(A, B, G, C, smax2) -> StabilisedSpectrum:
     g_norm = float(spla.eigsh(Gs, k=1, which="LA", tol=1e-3, return_eigenvectors=False)[0])
     t_norm = float(np.max(np.linalg.norm(Tx, axis=0) / np.linalg.norm(x, axis=0)))
     res = np.linalg.norm(Tx - Gx * ev, axis=0) / ((t_norm + np.abs(ev) * g_norm) * np.linalg.norm(x, axis=0))
-    lam_s = _pencil_top(schur, Gs)
+    lam_s = _pencil_top(schur, Gs) if B.nnz and abs(B).max() > 0 else 0.0
     lam_c = _pencil_top(lambda y: Cs @ y, Gs) if Cs.nnz and abs(Cs).max() > 0 else 0.0
     xj = x[:, j]
     share = float(xj @ (Cs @ xj)) / float(xj @ Tx[:, j])
@@ -279,6 +281,10 @@ def stabilisation_verdict(rows, out: dict, *, tol: float, floor: float, confiden
         label, words = "none", "C is zero: no stabilisation; "
     elif scale < REGULARISED_MAX:
         label, words = "regularised", (f"C ~ eps*M with eps tiny (below {REGULARISED_MAX:g} of the pencil): it "
+                                       "regularises the solve, it does not stabilise the pair; ")
+    elif max(r["beta_C"] for r in rows) <= floor:
+        # no pencil to compare C with (B A^-1 B^T = 0) or C lifting the kernel only below the floor
+        label, words = "regularised", (f"C lifts the kernel only to beta_C <= the floor {floor:g} on every level: it "
                                        "regularises the solve, it does not stabilise the pair; ")
     else:
         what = (f"a kernel of dimension {max(dims)} (dims {dims})" if max(dims) > 0

@@ -89,7 +89,8 @@ def _load_level(manifest: Manifest, level):
 
         level, B, G, mass, info = described_grams(manifest, level, B, G)
     with transposed_b_hint(A, B, G):
-        checked = check_level(level, A, B, G, constrained_dofs(level, A.shape[0]), manifest.tgv)
+        checked = check_level(level, A, B, G, constrained_dofs(level, A.shape[0]), manifest.tgv,
+                              True if manifest.gamma is not None else None)
     if info and info.get("removed_multipliers"):  # constrained rows the description's Gram left out
         checked.notes[:0] = info["notes"]
         checked.removed_multipliers += info["removed_multipliers"]

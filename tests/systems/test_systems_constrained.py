@@ -338,7 +338,7 @@ def _dolfinx_unassembled_bcs(case, n):
 @pytest.mark.parametrize("norm", ["H", "L2"])
 @pytest.mark.parametrize("case", ["R5.2", "R5.4"])
 def test_dolfinx_dirichlet_unit_rows_touched_by_b_are_eliminated(tmp_path, case, norm):
-    """Issue 51: at N = 4 the Dirichlet unit rows are most of A's diagonal, which hid them as a
+    """A real-client rerun: at N = 4 the Dirichlet unit rows are most of A's diagonal, which hid them as a
     "Jacobi-scaled" A and kept the four B touches ("element bubbles?"): kernel 0 where R5.2 has 2
     and R5.4 1, β 19 % off. Now they are eliminated, with the manifest's gamma (norm: H) and
     without it (norm: L2, the interface told from B), and the level is the suite's own."""

@@ -1,4 +1,4 @@
-"""Descriptions that cannot be checked, and what a contact verdict advises (issue 51, item 6).
+"""Descriptions that cannot be checked, and what a contact verdict advises (a real-client rerun).
 
 A ``norm: H`` description turns B into β_h through a Gram the tool assembles itself: a wrong one
 gives a wrong β_h with exit 0. Four hostile descriptions of the suite's own exports — two rows of

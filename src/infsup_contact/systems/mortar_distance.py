@@ -80,9 +80,9 @@ CHECKED_RTOL = 1e-8
 """A body's block of B within this relative Frobenius distance of its exact coupling checks the
 description (the round-off of an exactly integrated block is ~1e-15; :data:`.multiplier_gram.MASS_RTOL`
 is the same 1e-8). Farther on every body, the distance cannot tell a wrong description from
-quadrature: a B integrated on the multiplier mesh only is 0.017–0.29 from the exact coupling on its
-other body (non-matching, per row up to 0.29: P_0 multipliers with the midpoint rule), where DOLFINx's
-P_3 described with equispaced nodes is 0.16 (0.18 per row) and one swapped pair of rows 2/√m."""
+quadrature: a B integrated on the multiplier mesh only is 0.005–0.22 from the exact coupling
+(non-matching, per row up to 0.29: P_0 multipliers with the midpoint rule), where DOLFINx's P_3
+described with equispaced nodes is 0.16 (0.18 per row) and one swapped pair of rows ~2/√m."""
 
 
 def block_distances(manifest, level, described, B, rows=None) -> list:

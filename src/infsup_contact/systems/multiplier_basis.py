@@ -13,8 +13,8 @@ routes ``beta --norm H`` uses (:mod:`.multiplier_gram`).
 Segment forms (coordinate t ∈ [0, L] along Γ)::
 
     {breakpoints: [...], degree: s, dofs: [[...], ...], coefficients: ...}   # general
-    {basis: lagrange, degree: k, breakpoints: [...], ends: keep|drop}          # continuous P_k (keep: default)
-    {basis: discontinuous, degree: k, breakpoints: [...]}                      # discontinuous P_k
+    {basis: lagrange, degree: k, breakpoints: [...], ends: keep|drop, nodes: equispaced|gll}  # continuous P_k
+    {basis: discontinuous, degree: k, breakpoints: [...], nodes: equispaced|gll}              # discontinuous P_k
     {basis: dual, degree: k, breakpoints: [...], ends: keep|drop}              # biorthogonal dual
 
 The general form is :func:`local_basis_space`'s arguments (``dofs`` = the rows of B, −1 = none;
@@ -274,14 +274,12 @@ def gll_nodes(space):
 
     from ..discretization.segment.multipliers import reference_nodes
 
-    s = space.degree
+    s, eq = space.degree, reference_nodes(space.degree)
     if s <= 2:
         return space
-    inner = np.sort(np.polynomial.legendre.Legendre.basis(s).deriv().roots().real)
-    t = np.concatenate([[0.0], (inner + 1.0) / 2.0, [1.0]])
-    eq = reference_nodes(s)
-    C = np.array([[np.prod([(eq[b] - t[c]) / (t[a] - t[c]) for c in range(s + 1) if c != a])
-                   for b in range(s + 1)] for a in range(s + 1)])
+    t = np.concatenate([[0.0], (np.sort(np.polynomial.legendre.Legendre.basis(s).deriv().roots().real) + 1) / 2, [1]])
+    C = [[np.prod([(eq[b] - t[c]) / (t[a] - t[c]) for c in range(s + 1) if c != a]) for b in range(s + 1)]
+         for a in range(s + 1)]
     return replace(space, local_coefficients=np.broadcast_to(C, (space.n_intervals, s + 1, s + 1)).copy())
 
 

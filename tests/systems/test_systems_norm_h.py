@@ -409,7 +409,8 @@ def test_a_description_too_large_for_the_memory_is_refused_before_its_gram(tmp_p
     (tmp_path / "levels.yaml").write_text(yaml.safe_dump({
         "norm": "H", "gamma": {"shape": "segment", "length": 1.0},
         "levels": [{"h": 1e-5, "A": "A.mtx", "B": "B.mtx",
-                    "multipliers": {"basis": "lagrange", "degree": 1, "ends": "drop", "breakpoints": "bp.npy"}}]}))
+                    "multipliers": {"basis": "lagrange", "degree": 1, "ends": "drop", "breakpoints": "bp.npy"},
+                    "traces": [{"basis": "lagrange", "degree": 1, "breakpoints": [0.0, 1.0], "columns": [0, 1]}]}]}))
     called = []
     monkeypatch.setattr(multiplier_gram, "gram", lambda *a: called.append(a))
     assert main(["beta", "--system", str(tmp_path / "levels.yaml")]) == 2

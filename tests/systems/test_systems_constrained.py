@@ -309,6 +309,20 @@ def test_a_decoupled_dof_on_an_interface_with_another_diagonal_is_refused(tmp_pa
     assert len(capsys.readouterr().err.strip().splitlines()) == 1
 
 
+def test_a_decoupled_dof_under_producer_zeros_of_b_is_an_identity_row(tmp_path):
+    """Kratos' Dirichlet rows (row and column zeroed, the stiffness diagonal kept) with B's column
+    holding only round-off (1e-14 max|b|: a producer zero): B does not touch it, so it is removed as
+    an identity row, not refused as an unmarked dof on the interface."""
+    A, B, G = _suite("T3")
+    dof = int(touched_dofs(B)[3])
+    Ad, Bd, _ = _a_unit_b_zeroed(A, B, dof)
+    Ad, Bd = Ad.tolil(), Bd.tolil()
+    Ad[dof, dof] = 4.0
+    Bd[2, dof] = 1e-14 * abs(B).max()
+    _, lv = _level0(tmp_path, Ad.tocsr(), Bd.tocsr(), G)
+    assert lv.removed == 1 and any("1 identity rows" in note for note in lv.notes), lv.notes
+
+
 def _dolfinx_unassembled_bcs(case, n):
     """A DOLFINx-style k = 1 level: every Dirichlet dof (∂Ω_i off Γ, Γ's end vertices included: 26
     of 50 at N = 4) a unit row of A (diagonal 1, row and column zero), B assembled without the bcs

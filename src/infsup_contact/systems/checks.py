@@ -181,7 +181,8 @@ def constrained_displacements(level, A, B, constrained, tgv: str, interface: boo
     alone = _decoupled(A) if n > 1 else np.zeros(n, bool)
     lonely = np.setdiff1d(np.flatnonzero(alone), np.concatenate(remove))
     if len(lonely):
-        touched = np.diff(sp.csc_matrix(B)[:, lonely].indptr) > 0
+        cols = abs(sp.csc_matrix(B)[:, lonely])  # a column of producer zeros (<= 1e-12 max|b|) touches nothing
+        touched = cols.max(axis=0).toarray().ravel() > TINY_COUPLING * (abs(B).max() if B.nnz else 0.0)
         interface = _interface(B, alone) if interface is None else interface
         # a Jacobi-scaled A (the *coupled* rows' diagonal 1): a unit row is not told apart; counted on
         # the coupled rows only, as a coarse mesh's Dirichlet rows are most of A (26 of 50 at N = 4)

@@ -196,3 +196,20 @@ def test_a_whole_body_kernel_may_be_declared(tmp_path):
     out, _ = system_verdict(load_manifest(path), **CRITERION, notes=io.StringIO())
     assert out["verdict"] == "UNSTABLE" and "constant pressure" in out["evidence"]
     assert "instability" not in out["evidence"]
+
+
+def test_a_permutation_the_mass_cannot_see_is_refused_by_the_traces(tmp_path):
+    """P_0 on equal cells (R5.4, k = 1): M = h I, so rows 1 and 3 swapped pass the mass check;
+    with traces, every body's block has a row √2-ish from its exact coupling (quadrature: ≤ 0.29):
+    refused, naming the key. The unswapped export passes (its distance is round-off)."""
+    levels, norm, gamma = _levels("R5.4", 1, (8,))
+    h, A, B, G, mult, traces = levels[0]
+    p = np.arange(B.shape[0])
+    p[[1, 3]] = p[[3, 1]]
+    assert np.array_equal(G[np.ix_(p, p)], G)
+    m = _write(tmp_path, "swapped", [(h, A, B[p], G, mult, traces)], norm, gamma)
+    with pytest.raises(SystemFileError, match=r"levels\[0\]\.multipliers: a row of B is 1\.\d+ .*on every body.*"
+                                              r"cannot see a permutation of equal masses"):
+        system_rows(m, notes=io.StringIO())
+    row, = system_rows(_write(tmp_path, "right", levels, norm, gamma), notes=io.StringIO())
+    assert row["description_check"] == "mass" and row["coupling_distance"] <= 1e-14

@@ -155,6 +155,20 @@ def _coupling_check(manifest, level, d, B, keep) -> str:
     return "coupling" if min(block_distances(manifest, level, d, B, keep)) <= CHECKED_RTOL else "none"
 
 
+def _rows_check(manifest, level, d, B, keep) -> None:
+    """Refuse B whose rows are, on every body, farther from the exact coupling of the described
+    traces than quadrature puts them (:data:`.mortar_distance.ROW_RTOL`): with G matching, a
+    permutation of rows of equal mass (P_0 on equal cells), which the mass cannot see."""
+    from .mortar_distance import ROW_RTOL, block_distances
+
+    worst = min(block_distances(manifest, level, d, B, keep, per_row=True))
+    if worst > ROW_RTOL:
+        raise SystemFileError(manifest.path, f"levels[{level.index}].multipliers: a row of B is {worst:.3g} (against "
+                              f"its block's largest row) from the exact coupling of the described traces on every "
+                              f"body, where quadrature error stays below {ROW_RTOL:g}: B's rows in another order than "
+                              "the description (rows:; the L2 mass cannot see a permutation of equal masses)?")
+
+
 def described_grams(manifest, level, B, G_file) -> tuple:
     """(level, B, G, L² mass from the G file or None, info) of a level describing its multipliers.
     ``norm: H``: G the described H Gram (``info`` its series' info), the G file (optional) the L²
@@ -193,6 +207,8 @@ def described_grams(manifest, level, B, G_file) -> tuple:
                                   f"{dist:.3g} relative (Frobenius; round-off is below {MASS_RTOL:g}): B's rows in "
                                   "another order than the description (rows:), another basis, or other breakpoints?")
     info = dict(info, coupling_distance=distance, described=d, kept=np.arange(d.m))  # B's rows as returned
+    if G_file is not None and level.traces is not None:  # what the mass cannot see: equal masses permuted
+        _rows_check(manifest, level, d, B, keep)
     if manifest.norm == "H":  # what checked the description: G's mass, else an exact body block of B
         info["description_check"] = "mass" if G_file is not None else _coupling_check(manifest, level, d, B, keep)
     if manifest.norm != "H":  # the checks remove the constrained rows of the file's G themselves

@@ -213,3 +213,13 @@ def test_a_permutation_the_mass_cannot_see_is_refused_by_the_traces(tmp_path):
         system_rows(m, notes=io.StringIO())
     row, = system_rows(_write(tmp_path, "right", levels, norm, gamma), notes=io.StringIO())
     assert row["description_check"] == "mass" and row["coupling_distance"] <= 1e-14
+
+
+def test_a_factor_on_b_is_not_a_wrong_row_order(tmp_path):
+    """B·(1/h) (a mortar code's E/h) with G and traces: not refused as a permutation (the row check
+    compares with the best multiple of the exact coupling); β_h carries the factor, as without traces."""
+    levels, norm, gamma = _levels("T3", 1, (8,))
+    h, A, B, G, mult, traces = levels[0]
+    row, = system_rows(_write(tmp_path, "scaled", [(h, A, B / h, G, mult, traces)], norm, gamma), notes=io.StringIO())
+    ref, = system_rows(_write(tmp_path, "ref", levels, norm, gamma), notes=io.StringIO())
+    assert abs(row["beta"] - ref["beta"] / h) <= 1e-10 * row["beta"] and row["description_check"] == "mass"

@@ -86,7 +86,7 @@ described with equispaced nodes is 0.16 (0.18 per row) and one swapped pair of r
 
 
 ROW_RTOL = 0.5
-"""Largest row distance (‖b_i − e_i‖ / max_j ‖e_j‖ on a body's block) that quadrature explains: a B
+"""Largest row distance (‖b_i − α e_i‖ / max_j ‖α e_j‖ on a body's block) that quadrature explains: a B
 integrated on the multiplier mesh only is up to 0.29 off per row (above), a row of B holding
 another multiplier's entries √2 (disjoint supports) or ≥ 1.03 (neighbours, P_1)."""
 
@@ -95,7 +95,8 @@ def block_distances(manifest, level, described, B, rows=None, per_row: bool = Fa
     """‖B_b − E_b‖_F / ‖E_b‖_F per described trace b (its columns of B only; B as read, on its
     ``rows``): the body whose trace mesh is the multiplier mesh is integrated exactly by any rule on
     the multiplier cells exact for the product's degree, so one block at round-off checks the
-    description even where the other is inexact. ``per_row``: max_i ‖b_i − e_i‖ / max_j ‖e_j‖ instead."""
+    description even where the other is inexact. ``per_row``: max_i ‖b_i − α e_i‖ / max_j ‖α e_j‖ instead,
+    α = ⟨B_b, E_b⟩ / ⟨E_b, E_b⟩ (a factor on all of B, a code's E/h, is not a wrong description)."""
     traces = _traces(manifest, level, B.shape[1])
     out = []
     for trace in traces:
@@ -104,9 +105,10 @@ def block_distances(manifest, level, described, B, rows=None, per_row: bool = Fa
         mine = sp.csr_matrix(B)[:, cols]
         if rows is not None:
             exact, mine = exact[rows], mine[rows]
-        if per_row:
-            size = np.sqrt(np.asarray(exact.multiply(exact).sum(axis=1)).ravel())
-            diff = sp.csr_matrix(mine - exact)
+        if per_row:  # against the best multiple α E_b: a factor on B (a code's E/h) is no description error
+            alpha = float(exact.multiply(mine).sum() / max(exact.multiply(exact).sum(), 1e-300))
+            size = abs(alpha) * np.sqrt(np.asarray(exact.multiply(exact).sum(axis=1)).ravel())
+            diff = sp.csr_matrix(mine - alpha * exact)
             off = np.sqrt(np.asarray(diff.multiply(diff).sum(axis=1)).ravel())
             out.append(float(off.max() / size.max()) if size.max() > 0 else float("inf"))
             continue

@@ -21,8 +21,8 @@ touched by B, diagonal not 1
 a dof coupled to nothing in A, touched refused, naming the rows and ``constrained``: an
 by B, diagonal not 1, B an interface   element bubble has no trace on Γ, so it is a fixed dof
 (the manifest's ``gamma``, or B        left unmarked, and eliminating it unmarked could change
-touching <= 1/2 of the dofs)           β_h (with diagonal 1 it is the unit row above)
-the same, B over the whole body        kept with a note (element bubbles, e.g. MINI, are
+touching <= 1/2 of the dofs), A not  β_h (with diagonal 1 it is the unit row above)
+diagonal; the same, B over the body   kept with a note (element bubbles, e.g. MINI, are
 (Stokes), or with diagonal 1 where     coupled to nothing in A); with a unit diagonal on the
 A's coupled rows have diagonal 1       coupled rows (Jacobi-scaled) a unit row is not told apart
 multiplier row: B's row zero as given  removed with a note (the boundary condition on the
@@ -185,9 +185,11 @@ def constrained_displacements(level, A, B, constrained, tgv: str, interface: boo
         touched = cols.max(axis=0).toarray().ravel() > TINY_COUPLING * (abs(B).max() if B.nnz else 0.0)
         interface = _interface(B, alone) if interface is None else interface
         # a Jacobi-scaled A (the *coupled* rows' diagonal 1): a unit row is not told apart; counted on
-        # the coupled rows only, as a coarse mesh's Dirichlet rows are most of A (26 of 50 at N = 4)
-        scaled = bool(np.any(~alone)) and np.mean(diag[~alone] == 1.0) > 0.5
-        unit = lonely[(diag[lonely] == 1.0) & touched & (interface or not scaled)]
+        # the coupled rows only, as a coarse mesh's Dirichlet rows are most of A (26 of 50 at N = 4).
+        # A diagonal A (no row coupled: a toy, a lumped operator) has no body to have fixed dofs of
+        body = bool(np.any(~alone))
+        scaled = body and np.mean(diag[~alone] == 1.0) > 0.5
+        unit = lonely[(diag[lonely] == 1.0) & touched & body & (interface or not scaled)]
         if len(unit):
             notes.append(f"{level.A.name}: {len(unit)} unit rows (diagonal exactly 1, coupled to nothing in A: "
                          "constrained dofs, v = 0) eliminated" + _dropped(B, unit))
@@ -195,7 +197,7 @@ def constrained_displacements(level, A, B, constrained, tgv: str, interface: boo
         if len(free):
             notes.append(f"{level.A.name}: {len(free)} identity rows (uncoupled dofs B does not touch) removed")
         kept = np.setdiff1d(lonely[touched], unit)
-        if len(kept) and interface:  # an element bubble has no trace on Γ: not a free dof of a body
+        if len(kept) and interface and body:  # an element bubble has no trace on Γ: not a free dof of a body
             raise SystemFileError(level.A, f"rows {_rows(kept)}: coupled to nothing in A, touched by B, diagonal "
                                   f"{diag[kept[0]]:.6g} (not 1): in a contact system (B on Γ) these are not "
                                   "element bubbles, whose trace on Γ is zero; if they are fixed (Dirichlet) dofs, "

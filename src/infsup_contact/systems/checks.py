@@ -21,8 +21,8 @@ touched by B, diagonal not 1
 a dof coupled to nothing in A, touched refused, naming the rows and ``constrained``: an
 by B, diagonal not 1, B an interface   element bubble has no trace on Γ, so it is a fixed dof
 (the manifest's ``gamma``, or B        left unmarked, and eliminating it unmarked could change
-touching <= 1/2 of the dofs), A not  β_h (with diagonal 1 it is the unit row above)
-diagonal; the same, B over the body   kept with a note (element bubbles, e.g. MINI, are
+touching <= 1/2 of the dofs), A not    β_h (with diagonal 1 it is the unit row above)
+diagonal; the same, B over the body    kept with a note (element bubbles, e.g. MINI, are
 (Stokes), or with diagonal 1 where     coupled to nothing in A); with a unit diagonal on the
 A's coupled rows have diagonal 1       coupled rows (Jacobi-scaled) a unit row is not told apart
 multiplier row: B's row zero as given  removed with a note (the boundary condition on the

@@ -260,20 +260,126 @@ def test_rows_report_what_was_removed(tmp_path):
     assert all(r["removed_multipliers"] == 2 and r["m"] == B.shape[0] - 2 for r in rows)
 
 
-def test_a_unit_diagonal_everywhere_keeps_decoupled_dofs(tmp_path):
-    """A Jacobi-scaled A (unit diagonal everywhere): a dof coupled to nothing but touched by B is
-    not told from a constrained one by its diagonal, so it is kept (a bubble), with the note."""
-    A, B, G = _suite("T3")
+def _jacobi(A, B):
+    """A scaled to a unit diagonal (and B with it): the same pencil, unit rows everywhere."""
     d = np.sqrt(A.diagonal())
-    J = sp.csr_matrix(sp.diags(1.0 / d) @ A @ sp.diags(1.0 / d))
-    Bj = sp.csr_matrix(B @ sp.diags(1.0 / d))
+    return sp.csr_matrix(sp.diags(1.0 / d) @ A @ sp.diags(1.0 / d)), sp.csr_matrix(B @ sp.diags(1.0 / d))
+
+
+def test_a_unit_diagonal_everywhere_still_eliminates_unit_rows_on_an_interface(tmp_path):
+    """A Jacobi-scaled contact A: a dof coupled to nothing but touched by B is not told from the
+    others by its diagonal, but B couples Γ only and an element bubble has no trace there: the
+    unit row is a constrained dof, eliminated, β_h that of the system without it."""
+    A, B, G = _suite("T3")
+    J, Bj = _jacobi(A, B)
     dof = int(touched_dofs(B)[3])
-    Jd = J.tolil()
-    Jd[dof, :] = 0.0
-    Jd[:, dof] = 0.0
-    Jd[dof, dof] = 1.0
-    _, lv = _level0(tmp_path, Jd.tocsr(), Bj, G)
-    assert lv.removed == 0 and any("(element bubbles?) kept" in note for note in lv.notes), lv.notes
+    Jd, _, _ = _a_unit(J, Bj, dof)
+    _, lv = _level0(tmp_path, Jd, Bj, G)
+    assert lv.removed == 1 and any("1 unit rows" in note for note in lv.notes), lv.notes
+    assert not any("bubble" in note for note in lv.notes)
+    ref = _a_reference(J, Bj, G, dof)
+    assert abs(level_spectrum(lv.A, lv.B, lv.G).beta - ref.beta) <= RTOL * ref.beta
+
+
+def test_a_unit_diagonal_everywhere_keeps_decoupled_dofs_of_a_whole_body_coupling(tmp_path):
+    """A Jacobi-scaled A whose B touches every dof (a Stokes divergence, not an interface): a
+    decoupled dof touched by B may be an element bubble (MINI's): kept, with the note."""
+    A, B, G = _suite("T3")
+    J, _ = _jacobi(A, B)
+    Bw = sp.csr_matrix(np.random.default_rng(1).standard_normal((B.shape[0], A.shape[0])))
+    Jd, _, _ = _a_unit(J, Bw, 7)
+    _, lv = _level0(tmp_path, Jd, Bw, G)
+    assert lv.removed == 0 and any("kept (element bubbles, as MINI's; fixed dofs? declare them in "
+                                   "levels[0].constrained)" in note for note in lv.notes), lv.notes
+
+
+def test_a_decoupled_dof_on_an_interface_with_another_diagonal_is_refused(tmp_path, capsys):
+    """Coupled to nothing in A, touched by a contact B, diagonal 2.5 (not the unit-row idiom): no
+    element bubble reaches Γ, and eliminating an unmarked dof could change β_h: refused in one line
+    naming the file, the row and the key to declare it with."""
+    A, B, G = _suite("T3")
+    dof = int(touched_dofs(B)[3])
+    Ad, _, _ = _a_unit(A, B, dof)
+    Ad = Ad.tolil()
+    Ad[dof, dof] = 2.5
+    with pytest.raises(SystemFileError, match=rf"A0.npz: rows {dof} \(0-based\): coupled to nothing in A, touched by "
+                                              r"B, diagonal 2.5 .*declare them in levels\[0\]\.constrained"):
+        _level0(tmp_path, Ad.tocsr(), B, G)
+    assert main(["verdict", "--system", str(tmp_path / "levels.yaml")]) == 2
+    assert len(capsys.readouterr().err.strip().splitlines()) == 1
+
+
+def test_a_decoupled_dof_under_producer_zeros_of_b_is_an_identity_row(tmp_path):
+    """Kratos' Dirichlet rows (row and column zeroed, the stiffness diagonal kept) with B's column
+    holding only round-off (1e-14 max|b|: a producer zero): B does not touch it, so it is removed as
+    an identity row, not refused as an unmarked dof on the interface."""
+    A, B, G = _suite("T3")
+    dof = int(touched_dofs(B)[3])
+    Ad, Bd, _ = _a_unit_b_zeroed(A, B, dof)
+    Ad, Bd = Ad.tolil(), Bd.tolil()
+    Ad[dof, dof] = 4.0
+    Bd[2, dof] = 1e-14 * abs(B).max()
+    _, lv = _level0(tmp_path, Ad.tocsr(), Bd.tocsr(), G)
+    assert lv.removed == 1 and any("1 identity rows" in note for note in lv.notes), lv.notes
+
+
+def _dolfinx_unassembled_bcs(case, n):
+    """A DOLFINx-style k = 1 level: every Dirichlet dof (∂Ω_i off Γ, Γ's end vertices included: 26
+    of 50 at N = 4) a unit row of A (diagonal 1, row and column zero), B assembled without the bcs
+    (its columns at Γ's four end vertices are the exact ∫ψ_i φ_end), and the norm: H description."""
+    from types import SimpleNamespace
+    from pathlib import Path
+
+    from infsup_contact.systems.export import suite_levels
+    from infsup_contact.systems.mortar_distance import _traces, exact_coupling
+    from infsup_contact.systems.multiplier_basis import Gamma, describe
+
+    (h, A, B, G, mult, traces), = suite_levels(case, 1, (n,), 0)[0]
+    fixed = 2 * (n + 1) ** 2 - A.shape[0]
+    full, nxt = [], A.shape[0]
+    for t in traces:  # each body's whole P1 trace, the end hats in new columns (the Dirichlet dofs)
+        full.append({"basis": "lagrange", "degree": 1, "breakpoints": t["breakpoints"], "sign": t["sign"],
+                     "columns": [nxt] + list(t["columns"]) + [nxt + 1]})
+        nxt += 2
+    gamma = Gamma("segment", (1.0,))
+    parsed = _traces(SimpleNamespace(path=Path("m.yaml"), gamma=gamma), SimpleNamespace(index=0, traces=full),
+                     A.shape[0] + fixed)
+    exact = exact_coupling(describe("m.yaml", 0, mult, gamma), parsed, A.shape[0] + fixed)
+    Bd = sp.hstack([B, exact[:, A.shape[0]:]], format="csr")
+    return (h, sp.block_diag([A, sp.identity(fixed)], format="csr"), Bd, G, mult), fixed
+
+
+@pytest.mark.parametrize("norm", ["H", "L2"])
+@pytest.mark.parametrize("case", ["R5.2", "R5.4"])
+def test_dolfinx_dirichlet_unit_rows_touched_by_b_are_eliminated(tmp_path, case, norm):
+    """A real-client rerun: at N = 4 the Dirichlet unit rows are most of A's diagonal, which hid them as a
+    "Jacobi-scaled" A and kept the four B touches ("element bubbles?"): kernel 0 where R5.2 has 2
+    and R5.4 1, β 19 % off. Now they are eliminated, with the manifest's gamma (norm: H) and
+    without it (norm: L2, the interface told from B), and the level is the suite's own."""
+    from infsup_contact.systems.export import suite_levels
+
+    n = 4
+    level, fixed = _dolfinx_unassembled_bcs(case, n)
+    assert fixed == 26 and np.sum(level[1].diagonal() == 1.0) == 26 and level[1].shape[0] == 50
+    assert _b_entries_on_new(level[2], level[1].shape[0] - fixed) == (8 if case == "R5.2" else 4)
+    levels, _, gamma = suite_levels(case, 1, (n,), 0)
+    if norm == "L2":
+        level, gamma = level[:4], None
+    rows = {}
+    for label, lv in (("dolfinx", level), ("suite", levels[0][:len(level)])):
+        path = write_system(tmp_path / label, [lv], "mtx", label, norm, gamma=gamma)
+        err = io.StringIO()
+        rows[label], = system_rows(load_manifest(path, min_levels=1), notes=err)
+        assert "bubble" not in err.getvalue()
+    d, s = rows["dolfinx"], rows["suite"]
+    assert d["removed_dofs"] == fixed and d["kernel_detected"] == s["kernel_detected"] >= 1
+    assert abs(d["smallest_nonzero"] - s["smallest_nonzero"]) <= RTOL * s["smallest_nonzero"]
+
+
+def _b_entries_on_new(B, first):
+    block = sp.csc_matrix(B)[:, first:]
+    block.eliminate_zeros()
+    return block.nnz
 
 
 @pytest.mark.parametrize("what", ["multipliers", "dofs"])

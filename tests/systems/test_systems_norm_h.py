@@ -211,15 +211,21 @@ def test_a_row_order_other_than_the_description_is_refused(tmp_path):
     assert abs(system_rows(m, notes=io.StringIO())[1]["beta"] - ref[1]["beta"]) <= 1e-12
 
 
-def test_without_g_the_h_verdict_stands_alone(tmp_path):
+def test_without_g_the_h_verdict_stands_alone_checked_by_the_traces(tmp_path):
+    """No G: the traces check the description (an exact body block), and the H verdict stands
+    alone; with neither G nor traces nothing checks it, and it is refused
+    (test_systems_descriptions.py has the hostile cases)."""
     levels, norm, gamma = suite_levels("DUAL", 2, (4, 8, 16), 0)
-    bare = [(h, A, B, None, mult) for h, A, B, G, mult, _ in levels]
+    bare = [(h, A, B, None, mult, traces) for h, A, B, G, mult, traces in levels]
     m = load_manifest(write_system(tmp_path, bare, "mtx", "bare", norm, gamma=gamma))
     assert all(lv.G is None for lv in m.levels) and not list(tmp_path.glob("G*"))
     rows = system_rows(m, notes=io.StringIO())
-    assert all(np.isnan(r["beta_L2"]) for r in rows)
+    assert all(np.isnan(r["beta_L2"]) and r["description_check"] == "coupling" for r in rows)
     out, _ = system_verdict(m, **CRITERION, notes=io.StringIO())
     assert out["verdict"] == "STABLE" and "verdict_L2" not in out
+    m = load_manifest(write_system(tmp_path / "none", [lv[:5] for lv in bare], "mtx", "bare", norm, gamma=gamma))
+    with pytest.raises(SystemFileError, match=r"needs G \(their L2 mass\) or traces"):
+        system_rows(m, notes=io.StringIO())
 
 
 def test_cli_export_then_verdict_system_is_stable(tmp_path, capsys):
@@ -403,7 +409,8 @@ def test_a_description_too_large_for_the_memory_is_refused_before_its_gram(tmp_p
     (tmp_path / "levels.yaml").write_text(yaml.safe_dump({
         "norm": "H", "gamma": {"shape": "segment", "length": 1.0},
         "levels": [{"h": 1e-5, "A": "A.mtx", "B": "B.mtx",
-                    "multipliers": {"basis": "lagrange", "degree": 1, "ends": "drop", "breakpoints": "bp.npy"}}]}))
+                    "multipliers": {"basis": "lagrange", "degree": 1, "ends": "drop", "breakpoints": "bp.npy"},
+                    "traces": [{"basis": "lagrange", "degree": 1, "breakpoints": [0.0, 1.0], "columns": [0, 1]}]}]}))
     called = []
     monkeypatch.setattr(multiplier_gram, "gram", lambda *a: called.append(a))
     assert main(["beta", "--system", str(tmp_path / "levels.yaml")]) == 2

@@ -13,13 +13,18 @@ constrained row                        action
 displacement dof declared              removed with B's entries over it (v = 0 there, so
 (``constrained``), a penalty row of A  b(v, μ) never sees them: dropping them is exact, however
 (|a_ii| >= 1e15 × median, "tgv"), or   the dof was marked); a note counts the dofs and the
-a unit row of A (coupled to nothing,   entries. ``tgv: refuse`` refuses the penalty rows
-a_ii exactly 1)
+a unit row of A (coupled to nothing,   entries. ``tgv: refuse`` refuses the penalty rows. A
+a_ii exactly 1)                        unit row is told by A's *coupled* rows: a coarse mesh's
+                                       Dirichlet rows are most of A (26 of 50, k = 1, N = 4)
 a dof coupled to nothing in A, not     removed (it cannot change B A⁻¹ Bᵀ)
 touched by B, diagonal not 1
-a dof coupled to nothing in A, touched kept with a note (element bubbles, e.g. MINI, are
-by B, diagonal not 1 (or A's diagonal  coupled to nothing in A); with a unit diagonal
-is 1 nearly everywhere)                everywhere a unit row is not told from the others
+a dof coupled to nothing in A, touched refused, naming the rows and ``constrained``: an
+by B, diagonal not 1, B an interface   element bubble has no trace on Γ, so it is a fixed dof
+(the manifest's ``gamma``, or B        left unmarked, and eliminating it unmarked could change
+touching <= 1/2 of the dofs), A not    β_h (with diagonal 1 it is the unit row above)
+diagonal; the same, B over the body    kept with a note (element bubbles, e.g. MINI, are
+(Stokes), or with diagonal 1 where     coupled to nothing in A); with a unit diagonal on the
+A's coupled rows have diagonal 1       coupled rows (Jacobi-scaled) a unit row is not told apart
 multiplier row: B's row zero as given  removed with a note (the boundary condition on the
 and G's row decoupled and singled out  multiplier space FE codes use to make μ vanish at Γ's
 (a unit row in a G that couples other  ends: μ_i is G-orthogonal to the rest, so removing it
@@ -156,8 +161,10 @@ def _penalty_rows(diag) -> tuple:
     return np.flatnonzero(diag >= TGV_RATIO * med), med
 
 
-def constrained_displacements(level, A, B, constrained, tgv: str) -> tuple:
-    """(dofs of A to remove, notes): the displacement rows of the module's table."""
+def constrained_displacements(level, A, B, constrained, tgv: str, interface: bool | None = None) -> tuple:
+    """(dofs of A to remove, notes): the displacement rows of the module's table. ``interface``:
+    whether B is a contact coupling on Γ (the manifest's ``gamma``), None: decided from B
+    (:func:`_interface`)."""
     n = A.shape[0]
     notes, remove = [], [np.asarray(constrained, int)]
     if len(constrained):
@@ -172,11 +179,18 @@ def constrained_displacements(level, A, B, constrained, tgv: str) -> tuple:
             raise SystemFileError(level.A, f"{where}; tgv: refuse (set tgv: eliminate, or export without them)")
         notes.append(f"{level.A.name}: {where} eliminated (v = 0 there, the penalty's limit)" + _dropped(B, pen))
         remove.append(pen)
-    lonely = np.setdiff1d(np.flatnonzero(_decoupled(A)), np.concatenate(remove)) if n > 1 else np.zeros(0, int)
+    alone = _decoupled(A) if n > 1 else np.zeros(n, bool)
+    lonely = np.setdiff1d(np.flatnonzero(alone), np.concatenate(remove))
     if len(lonely):
-        touched = np.diff(sp.csc_matrix(B)[:, lonely].indptr) > 0
-        unit_everywhere = np.mean(diag == 1.0) > 0.5  # a Jacobi-scaled A: unit rows are not told apart
-        unit = lonely[(diag[lonely] == 1.0) & touched] if not unit_everywhere else np.zeros(0, int)
+        cols = abs(sp.csc_matrix(B)[:, lonely])  # a column of producer zeros (<= 1e-12 max|b|) touches nothing
+        touched = cols.max(axis=0).toarray().ravel() > TINY_COUPLING * (abs(B).max() if B.nnz else 0.0)
+        interface = _interface(B, alone) if interface is None else interface
+        # a Jacobi-scaled A (the *coupled* rows' diagonal 1): a unit row is not told apart; counted on
+        # the coupled rows only, as a coarse mesh's Dirichlet rows are most of A (26 of 50 at N = 4).
+        # A diagonal A (no row coupled: a toy, a lumped operator) has no body to have fixed dofs of
+        body = bool(np.any(~alone))
+        scaled = body and np.mean(diag[~alone] == 1.0) > 0.5
+        unit = lonely[(diag[lonely] == 1.0) & touched & body & (interface or not scaled)]
         if len(unit):
             notes.append(f"{level.A.name}: {len(unit)} unit rows (diagonal exactly 1, coupled to nothing in A: "
                          "constrained dofs, v = 0) eliminated" + _dropped(B, unit))
@@ -184,11 +198,29 @@ def constrained_displacements(level, A, B, constrained, tgv: str) -> tuple:
         if len(free):
             notes.append(f"{level.A.name}: {len(free)} identity rows (uncoupled dofs B does not touch) removed")
         kept = np.setdiff1d(lonely[touched], unit)
+        if len(kept) and interface and body:  # an element bubble has no trace on Γ: not a free dof of a body
+            raise SystemFileError(level.A, f"rows {_rows(kept)}: coupled to nothing in A, touched by B, diagonal "
+                                  f"{diag[kept[0]]:.6g} (not 1): in a contact system (B on Γ) these are not "
+                                  "element bubbles, whose trace on Γ is zero; if they are fixed (Dirichlet) dofs, "
+                                  f"declare them in levels[{level.index}].constrained (or zero B's columns there)")
         if len(kept):
-            notes.append(f"{level.A.name}: {len(kept)} dofs coupled to nothing in A but touched by B "
-                         "(element bubbles?) kept")
+            notes.append(f"{level.A.name}: {len(kept)} dofs coupled to nothing in A but touched by B kept (element "
+                         f"bubbles, as MINI's; fixed dofs? declare them in levels[{level.index}].constrained)")
         remove += [unit, free]
     return np.unique(np.concatenate(remove)).astype(int), notes
+
+
+INTERFACE_TOUCHED = 0.5
+"""B couples an interface (contact, mortar) when it touches at most this fraction of A's dofs,
+the uncoupled dofs it does not touch (Dirichlet identity rows) not counted. A Stokes B touches
+every velocity dof; a contact B on N = 4, k = 1 membranes 10 of 28."""
+
+
+def _interface(B, alone) -> bool:
+    """Whether B couples an interface (:data:`INTERFACE_TOUCHED`) rather than a whole body."""
+    touched = np.diff(sp.csc_matrix(B).indptr) > 0
+    counted = int(np.sum(touched | ~alone))
+    return counted > 0 and touched.sum() <= INTERFACE_TOUCHED * counted
 
 
 def _dropped(B, dofs) -> str:
@@ -251,8 +283,10 @@ def constrained_multipliers(level, B, G, tgv: str) -> tuple:
     return np.unique(np.concatenate(remove)).astype(int), notes
 
 
-def check_level(level, A, B, G, constrained=np.zeros(0, int), tgv: str = "eliminate") -> CheckedLevel:
-    """Run every check on one level (module docstring); the matrices as read."""
+def check_level(level, A, B, G, constrained=np.zeros(0, int), tgv: str = "eliminate",
+                interface: bool | None = None) -> CheckedLevel:
+    """Run every check on one level (module docstring); the matrices as read. ``interface``: as in
+    :func:`constrained_displacements`."""
     for mat, path in ((A, level.A), (B, level.B), (G, level.G)):
         check_finite(mat, path)
     check_shapes(level, A, B, G)
@@ -260,7 +294,7 @@ def check_level(level, A, B, G, constrained=np.zeros(0, int), tgv: str = "elimin
     A.eliminate_zeros()
     B.eliminate_zeros()
     mult, notes = constrained_multipliers(level, B, G, tgv)
-    dofs, more = constrained_displacements(level, A, B, constrained, tgv)
+    dofs, more = constrained_displacements(level, A, B, constrained, tgv, interface)
     notes += more
     keep_m = np.setdiff1d(np.arange(B.shape[0]), mult)
     keep_n = np.setdiff1d(np.arange(A.shape[0]), dofs)

@@ -35,6 +35,11 @@ NORM_NOTES = {
 }
 
 
+UNCHECKED = ("levels[{i}].multipliers unchecked: no G, and no body's block of B is the exact coupling of the "
+             "described traces (to 1e-8): a wrong row order, breakpoints, basis or nodes cannot be told from "
+             "quadrature error, so beta_h is not certified; give G (the L2 mass of the multipliers)")
+
+
 def load_level(manifest: Manifest, level):
     """Read and check one level: a :class:`~.checks.CheckedLevel` (G scaled by h for ``h-L2``;
     for ``H`` the Gram of the described multipliers, :func:`.multiplier_gram.described_grams`)."""
@@ -93,7 +98,8 @@ def _load_level(manifest: Manifest, level):
 
         level, B, G, mass, info = described_grams(manifest, level, B, G)
     with transposed_b_hint(A, B, G):
-        checked = check_level(level, A, B, G, constrained_dofs(level, A.shape[0]), manifest.tgv)
+        checked = check_level(level, A, B, G, constrained_dofs(level, A.shape[0]), manifest.tgv,
+                              True if manifest.gamma is not None else None)
     if info and info.get("removed_multipliers"):  # constrained rows the description's Gram left out
         checked.notes[:0] = info["notes"]
         checked.removed_multipliers += info["removed_multipliers"]
@@ -157,6 +163,11 @@ def system_rows(manifest: Manifest, route: str = "auto", notes=sys.stderr, modes
                                                                    float(k.singular[-1]) ** 2)))
         if info is not None:  # described: B's distance to the exact coupling of described traces
             rows[-1]["coupling_distance"] = info["coupling_distance"]
+        if info is not None and "description_check" in info:  # norm H: what checked the description
+            rows[-1]["description_check"] = info["description_check"]
+            if info["description_check"] == "none":
+                rows[-1]["notes"] = "; ".join(filter(None, [rows[-1]["notes"], UNCHECKED.format(i=level.index)]))
+                print(f"infsup-contact: note: {UNCHECKED.format(i=level.index)}", file=notes)
         if manifest.norm == "H":  # the Gram's stated error, and the L2 row beside it where G is given
             rows[-1]["gram_rel_error"] = info["nmax_rel_error"]
             l2 = (level_spectrum(lv.A, lv.B, mass, manifest.known_kernel, route)
@@ -244,8 +255,11 @@ def system_verdict(manifest: Manifest, *, tol: float, floor: float, confidence: 
                            f"of dim {dims} over 1/h = {inv_h}"
                            + (f"; B has more rows than the dofs it touches (m - touched = {structural})"
                               if any(structural) else "")
-                           + "; slope of the eigenvalue above the kernel; declare the kernel with known_kernel "
-                           "if it is meant (e.g. a constant pressure)")
+                           + "; slope of the eigenvalue above the kernel; " + _kernel_advice(manifest, rows))
+    unchecked = [r["level"] for r in rows if r.get("description_check") == "none"]
+    if unchecked and not (out["verdict"] == "UNSTABLE" and out["kernel_dim"] > 0):  # a kernel of B^T needs no G
+        out["verdict"] = "INCONCLUSIVE"
+        out["evidence"] += "; " + UNCHECKED.format(i=", ".join(map(str, unchecked)))
     if immaterial:
         out["evidence"] += "; " + "; ".join(
             f"levels[{r['level']}]: kernel decision close, but the mode in question has beta {r['beta_uncertain']:.2g} "
@@ -264,6 +278,20 @@ def system_verdict(manifest: Manifest, *, tol: float, floor: float, confidence: 
                 max_residual=max(r["residual"] for r in rows), norm_note=NORM_NOTES[manifest.norm],
                 seconds=time.perf_counter() - t0)
     return head, rows
+
+
+def _kernel_advice(manifest: Manifest, rows) -> str:
+    """What to do about an undeclared kernel: for a contact coupling (the manifest's ``gamma``, or B
+    on an interface, :data:`~.checks.INTERFACE_TOUCHED`) the kernel is the instability itself — a
+    multiplier no displacement sees — so it is to be removed from the space, not declared; for a
+    whole-body coupling (Stokes) it may be a known one (a constant pressure)."""
+    from .checks import INTERFACE_TOUCHED
+
+    if manifest.gamma is not None or all(r["n_touched"] <= INTERFACE_TOUCHED * r["n"] for r in rows):
+        return ("for contact multipliers a kernel of B^T is the instability (multipliers no displacement "
+                "sees), not a constant to declare with known_kernel: remove it from the multiplier space (drop "
+                "the multipliers at Gamma's Dirichlet ends, as T3 does, or coarsen the multiplier mesh)")
+    return "declare the kernel with known_kernel if it is meant (e.g. a constant pressure of an enclosed flow)"
 
 
 def dry_check(manifest: Manifest, route: str = "auto"):

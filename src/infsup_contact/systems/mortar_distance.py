@@ -76,6 +76,47 @@ def exact_coupling(described, traces, n: int) -> sp.csr_matrix:
     return out
 
 
+CHECKED_RTOL = 1e-8
+"""A body's block of B within this relative Frobenius distance of its exact coupling checks the
+description (the round-off of an exactly integrated block is ~1e-15; :data:`.multiplier_gram.MASS_RTOL`
+is the same 1e-8). Farther on every body, the distance cannot tell a wrong description from
+quadrature: a B integrated on the multiplier mesh only is 0.005–0.22 from the exact coupling
+(non-matching, per row up to 0.29: P_0 multipliers with the midpoint rule), where DOLFINx's P_3
+described with equispaced nodes is 0.16 (0.18 per row) and one swapped pair of rows ~2/√m."""
+
+
+ROW_RTOL = 0.5
+"""Largest row distance (‖b_i − α e_i‖ / max_j ‖α e_j‖ on a body's block) that quadrature explains: a B
+integrated on the multiplier mesh only is up to 0.29 off per row (above), a row of B holding
+another multiplier's entries √2 (disjoint supports) or ≥ 1.03 (neighbours, P_1)."""
+
+
+def block_distances(manifest, level, described, B, rows=None, per_row: bool = False) -> list:
+    """‖B_b − E_b‖_F / ‖E_b‖_F per described trace b (its columns of B only; B as read, on its
+    ``rows``): the body whose trace mesh is the multiplier mesh is integrated exactly by any rule on
+    the multiplier cells exact for the product's degree, so one block at round-off checks the
+    description even where the other is inexact. ``per_row``: max_i ‖b_i − α e_i‖ / max_j ‖α e_j‖ instead,
+    α = ⟨B_b, E_b⟩ / ⟨E_b, E_b⟩ (a factor on all of B, a code's E/h, is not a wrong description)."""
+    traces = _traces(manifest, level, B.shape[1])
+    out = []
+    for trace in traces:
+        cols = trace[1][trace[1] >= 0]
+        exact = exact_coupling(described, [trace], B.shape[1])[:, cols]
+        mine = sp.csr_matrix(B)[:, cols]
+        if rows is not None:
+            exact, mine = exact[rows], mine[rows]
+        if per_row:  # against the best multiple α E_b: a factor on B (a code's E/h) is no description error
+            alpha = float(exact.multiply(mine).sum() / max(exact.multiply(exact).sum(), 1e-300))
+            size = abs(alpha) * np.sqrt(np.asarray(exact.multiply(exact).sum(axis=1)).ravel())
+            diff = sp.csr_matrix(mine - alpha * exact)
+            off = np.sqrt(np.asarray(diff.multiply(diff).sum(axis=1)).ravel())
+            out.append(float(off.max() / size.max()) if size.max() > 0 else float("inf"))
+            continue
+        norm = sparse_norm(exact)
+        out.append(float(sparse_norm(mine - exact) / norm) if norm > 0 else float("inf"))
+    return out
+
+
 def _interface(described):
     from ..discretization.segment.interface import SEGMENT
     from ..discretization.face.square import SQUARE

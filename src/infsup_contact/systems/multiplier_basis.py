@@ -13,8 +13,8 @@ routes ``beta --norm H`` uses (:mod:`.multiplier_gram`).
 Segment forms (coordinate t ∈ [0, L] along Γ)::
 
     {breakpoints: [...], degree: s, dofs: [[...], ...], coefficients: ...}   # general
-    {basis: lagrange, degree: k, breakpoints: [...], ends: keep|drop}          # continuous P_k (keep: default)
-    {basis: discontinuous, degree: k, breakpoints: [...]}                      # discontinuous P_k
+    {basis: lagrange, degree: k, breakpoints: [...], ends: keep|drop, nodes: equispaced|gll}  # continuous P_k
+    {basis: discontinuous, degree: k, breakpoints: [...], nodes: equispaced|gll}              # discontinuous P_k
     {basis: dual, degree: k, breakpoints: [...], ends: keep|drop}              # biorthogonal dual
 
 The general form is :func:`local_basis_space`'s arguments (``dofs`` = the rows of B, −1 = none;
@@ -42,7 +42,11 @@ MAX_DEGREE = 7
 """Largest local degree: the equispaced Lagrange shapes every route uses have positive
 Newton–Cotes weights up to 7 (a dual basis exists only there, :func:`~.dual.nodal_integrals`);
 the suite's own spaces use s ≤ 4."""
-SEGMENT_KEYS = ("basis", "degree", "breakpoints", "ends", "dofs", "coefficients", "rows")
+NODES = ("equispaced", "gll")
+"""Nodes of a ``lagrange`` / ``discontinuous`` basis: equispaced on each interval, ends included
+(t_a = a/s; the midpoint at s = 0), or Gauss–Lobatto–Legendre (the ends and the roots of P_s'):
+basix's default variant (``gll_warped``), the GLL points on an interval, so DOLFINx's P_s, s >= 3."""
+SEGMENT_KEYS = ("basis", "degree", "breakpoints", "ends", "nodes", "dofs", "coefficients", "rows")
 FACE_KEYS = ("x", "y", "rows")
 ENDS_RTOL = 1e-12
 """Relative distance to 0 and L within which the first and last breakpoints are Γ's ends (a
@@ -246,15 +250,37 @@ def _segment(where, key, value, base, length: float, face: bool):
             " or ".join(ENDS)
         raise SystemFileError(where, f"{key}.ends: {ends!r}: expected {allowed}")
     drop = ends == "drop"
+    nodes = value.get("nodes", "equispaced")
+    if nodes not in NODES or (nodes != "equispaced" and basis == "dual"):
+        raise SystemFileError(where, f"{key}.nodes: {nodes!r}: expected " + (" or ".join(NODES) if basis != "dual"
+                              else "equispaced (nodes: only with basis lagrange or discontinuous)"))
     if basis == "dual":
         space = dual_space(x, s, drop)
     else:
         space = make_space(x, s, basis == "lagrange", drop)
+        space = gll_nodes(space) if nodes == "gll" else space
     if space.dim < 1:
         raise SystemFileError(where, f"{key}: the {basis} basis of degree {s} with ends {ends} on {len(x) - 1} "
                               "interval(s) is empty")
     order = None if face else _rows(where, f"{key}.rows", value.get("rows"), base, space.dim)
     return space, (np.arange(space.dim) if order is None else order)
+
+
+def gll_nodes(space):
+    """The same space with its Lagrange basis on the GLL nodes of each interval: per interval
+    ψ_a = Σ_b ℓ_a(t_b) L_b (ℓ_a the GLL Lagrange polynomial, L_b the equispaced shape of node t_b).
+    Up to s = 2 the GLL nodes are the equispaced ones: the space itself."""
+    from dataclasses import replace
+
+    from ..discretization.segment.multipliers import reference_nodes
+
+    s, eq = space.degree, reference_nodes(space.degree)
+    if s <= 2:
+        return space
+    t = np.concatenate([[0.0], (np.sort(np.polynomial.legendre.Legendre.basis(s).deriv().roots().real) + 1) / 2, [1]])
+    C = [[np.prod([(eq[b] - t[c]) / (t[a] - t[c]) for c in range(s + 1) if c != a]) for b in range(s + 1)]
+         for a in range(s + 1)]
+    return replace(space, local_coefficients=np.broadcast_to(C, (space.n_intervals, s + 1, s + 1)).copy())
 
 
 def _nonzero(where, key, space) -> None:

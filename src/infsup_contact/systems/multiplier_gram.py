@@ -112,6 +112,11 @@ def check_description(manifest, level, B, G_file) -> tuple:
     if G_file is not None and G_file.shape != (d.m, d.m):
         raise SystemFileError(level.G, f"G is {G_file.shape[0]} x {G_file.shape[1]}; with norm: H it is the L2 mass "
                               f"of the {d.m} described multipliers ({d.m} x {d.m})")
+    if manifest.norm == "H" and G_file is None and level.traces is None:
+        raise SystemFileError(manifest.path, f"levels[{level.index}]: norm: H with the multipliers described needs G "
+                              "(their L2 mass) or traces (the bodies' trace bases on Gamma) to check the description "
+                              "against: without either a wrong row order, breakpoints, basis or nodes gives a wrong "
+                              "beta_h silently")
     if manifest.norm != "H":  # G is the file's; with L2 / h-L2 its dense copy meets the mass
         return level, G_file, (8.0 * 4 * d.m * d.m if manifest.norm in ("L2", "h-L2") else 0.0), d
     stand_in = np.broadcast_to(0.0, (d.m, d.m))  # dense like the Gram (the route), no memory
@@ -139,6 +144,29 @@ def _independent(d, M) -> None:
     if not ok:
         raise SystemFileError(d.source, f"{d.key}: the described basis functions are linearly dependent (their "
                               f"L2 mass is singular to {INDEPENDENCE_RTOL:g}): not a basis of the multipliers")
+
+
+def _coupling_check(manifest, level, d, B, keep) -> str:
+    """``coupling`` where one body's block of B is its exact coupling with the described traces
+    (:func:`.mortar_distance.block_distances` within :data:`.mortar_distance.CHECKED_RTOL`), else
+    ``none``: the description is then unchecked and the verdict INCONCLUSIVE (:mod:`.levels`)."""
+    from .mortar_distance import CHECKED_RTOL, block_distances
+
+    return "coupling" if min(block_distances(manifest, level, d, B, keep)) <= CHECKED_RTOL else "none"
+
+
+def _rows_check(manifest, level, d, B, keep) -> None:
+    """Refuse B whose rows are, on every body, farther from the exact coupling of the described
+    traces than quadrature puts them (:data:`.mortar_distance.ROW_RTOL`): with G matching, a
+    permutation of rows of equal mass (P_0 on equal cells), which the mass cannot see."""
+    from .mortar_distance import ROW_RTOL, block_distances
+
+    worst = min(block_distances(manifest, level, d, B, keep, per_row=True))
+    if worst > ROW_RTOL:
+        raise SystemFileError(manifest.path, f"levels[{level.index}].multipliers: a row of B is {worst:.3g} (against "
+                              f"its block's largest row) from the exact coupling of the described traces on every "
+                              f"body, where quadrature error stays below {ROW_RTOL:g}: B's rows in another order than "
+                              "the description (rows:; the L2 mass cannot see a permutation of equal masses)?")
 
 
 def described_grams(manifest, level, B, G_file) -> tuple:
@@ -179,6 +207,10 @@ def described_grams(manifest, level, B, G_file) -> tuple:
                                   f"{dist:.3g} relative (Frobenius; round-off is below {MASS_RTOL:g}): B's rows in "
                                   "another order than the description (rows:), another basis, or other breakpoints?")
     info = dict(info, coupling_distance=distance, described=d, kept=np.arange(d.m))  # B's rows as returned
+    if G_file is not None and level.traces is not None:  # what the mass cannot see: equal masses permuted
+        _rows_check(manifest, level, d, B, keep)
+    if manifest.norm == "H":  # what checked the description: G's mass, else an exact body block of B
+        info["description_check"] = "mass" if G_file is not None else _coupling_check(manifest, level, d, B, keep)
     if manifest.norm != "H":  # the checks remove the constrained rows of the file's G themselves
         return labelled, B, G, mass, info
     if len(keep) < d.m:

@@ -153,7 +153,8 @@ def assemble_level(n: int, space: str, offset: int = 0, intorder: int = INTORDER
     for t in traces:
         t["columns"] = t.pop("numbers")
     mult = gamma_form(mesh, Q, "gamma2", s, row)
-    mult.pop("numbers")  # the multipliers' numbers are B's rows: dofs name them directly
+    numbers = np.asarray(mult.pop("numbers"))  # the general form's dofs name B's rows directly
+    mult["dofs"] = np.where(np.asarray(mult["dofs"]) >= 0, numbers[np.asarray(mult["dofs"])], -1).tolist()
     return {"A": K[u][:, u], "B": K[lam][:, u], "G": G_full[free[2]][:, free[2]], "multipliers": mult,
             "traces": traces, "coords": np.vstack([_dof_coords(mesh, V) for V in (V1, V2)])[u],
             "n1": len(free[0])}

@@ -7,7 +7,7 @@ STAMP  := $(VENV)/.installed-from-lock
 # workflow rules call `python` and `infsup-contact`: they must resolve to the venv
 export PATH := $(CURDIR)/$(BIN):$(PATH)
 
-.PHONY: reproduce-all test env clean-env producers-kratos producers-dolfinx producers-getfem
+.PHONY: reproduce-all test env clean-env producers-kratos producers-dolfinx producers-getfem producers-ngsolve
 
 env: $(STAMP)
 
@@ -77,3 +77,10 @@ producers-getfem:
 	      --no-install-recommends python3-getfem python3-scipy python3-yaml >/dev/null; } || \
 	  { echo "error: GetFEM is installed from Debian as root: apt-get install python3-getfem python3-scipy python3-yaml"; exit 1; }
 	@/usr/bin/python3 -c 'import getfem; print("GetFEM", getfem.getfem_env("release"), "for /usr/bin/python3")'
+
+# NGSolve is a dependency of the suite itself (environment.lock): its producer runs in .venv and
+# installs nothing; this target only checks that .venv's NGSolve imports (no prerequisite: it never
+# rebuilds .venv; if the check fails, run make env).
+producers-ngsolve:
+	@$(BIN)/python -c 'import ngsolve, scipy, yaml; print("NGSolve", ngsolve.__version__, "in $(VENV)")' 2>/dev/null || \
+	  { echo "error: NGSolve does not import in $(VENV): it is one of the suite's own dependencies, run make env"; exit 1; }

@@ -7,7 +7,7 @@ STAMP  := $(VENV)/.installed-from-lock
 # workflow rules call `python` and `infsup-contact`: they must resolve to the venv
 export PATH := $(CURDIR)/$(BIN):$(PATH)
 
-.PHONY: reproduce-all test env clean-env producers-kratos producers-dolfinx producers-getfem producers-freefem
+.PHONY: reproduce-all test env clean-env producers-kratos producers-dolfinx producers-getfem producers-freefem producers-ngsolve
 
 env: $(STAMP)
 
@@ -89,3 +89,10 @@ producers-freefem:
 	      --no-install-recommends freefem++ libfreefem++ freefem++-doc >/dev/null; } || \
 	  { echo "error: FreeFEM is installed from Debian as root: apt-get install freefem++ libfreefem++ freefem++-doc"; exit 1; }
 	@echo "FreeFEM $$(FreeFem++ 2>&1 | sed -n 's/^FreeFem++ - version \([^ ]*\).*/\1/p') (Debian freefem++ $$(dpkg-query -W -f '$${Version}' freefem++)), tutorial $(FREEFEM_TUTORIAL)"
+
+# NGSolve is a dependency of the suite itself (environment.lock): its producer runs in .venv and
+# installs nothing; this target only checks that .venv's NGSolve imports (no prerequisite: it never
+# rebuilds .venv; if the check fails, run make env).
+producers-ngsolve:
+	@$(BIN)/python -c 'import ngsolve, scipy, yaml; print("NGSolve", ngsolve.__version__, "in $(VENV)")' 2>/dev/null || \
+	  { echo "error: NGSolve does not import in $(VENV): it is one of the suite's own dependencies, run make env"; exit 1; }

@@ -7,7 +7,7 @@ STAMP  := $(VENV)/.installed-from-lock
 # workflow rules call `python` and `infsup-contact`: they must resolve to the venv
 export PATH := $(CURDIR)/$(BIN):$(PATH)
 
-.PHONY: reproduce-all test env clean-env producers-kratos producers-dolfinx producers-getfem
+.PHONY: reproduce-all test env clean-env producers-kratos producers-dolfinx producers-getfem producers-calculix
 
 env: $(STAMP)
 
@@ -77,3 +77,9 @@ producers-getfem:
 	      --no-install-recommends python3-getfem python3-scipy python3-yaml >/dev/null; } || \
 	  { echo "error: GetFEM is installed from Debian as root: apt-get install python3-getfem python3-scipy python3-yaml"; exit 1; }
 	@/usr/bin/python3 -c 'import getfem; print("GetFEM", getfem.getfem_env("release"), "for /usr/bin/python3")'
+
+# CalculiX ccx 2.20 from Debian's source package, built with our dump of its mortar coupling
+# (examples/producers/calculix/install.sh: deb-src, build-dep, apt-get source, insert, make; needs
+# root, ~2 min on 2 cores). The fetched source and the binary stay in .calculix/ (git-ignored).
+producers-calculix:
+	bash examples/producers/calculix/install.sh

@@ -136,3 +136,44 @@ def test_missing_ccx_one_line_exit_2(tmp_path):
                          capture_output=True, text=True, env=env)
     assert res.returncode == 2 and res.stdout == "" and len(res.stderr.strip().splitlines()) == 1
     assert "make producers-calculix" in res.stderr
+
+
+def test_petrov_galerkin_pair_is_the_suites_PGLIN_Q8(exports):
+    """PGLINMORTAR as CalculiX solves it: trial λ in the duals (its Dd/Bd, LINMORTAR's export) and
+    constraint tested with the hats (Dpgd/Bpgd, PGLINMORTAR's); the stability constant of the pair,
+    γ_h = σ_min(L_N⁻¹ B_N A⁻¹ B_Mᵀ L_M⁻ᵀ) in L², is the suite's PGLIN-Q8 row (``beta`` = sqrt γ_h):
+    on matching meshes four singular values at CalculiX's entry accuracy (the corner modes) and
+    the next one the suite's smallest nonzero."""
+    import csv
+    import io
+
+    import scipy.linalg as sl
+
+    from helpers.cli import run_in_process
+
+    trial, test = exports["LINMORTAR"][0], exports["PGLINMORTAR"][0]
+    for i, n in enumerate(NS):
+        A, B_M, G_M = _level(trial, i)
+        _, B_N, G_N = _level(test, i)
+        S = B_N @ sla.splu(A.tocsc()).solve(B_M.T.toarray())
+        L_M, L_N = (np.linalg.cholesky(G.toarray()) for G in (G_M, G_N))
+        K = sl.solve_triangular(L_N, sl.solve_triangular(L_M, S.T, lower=True).T, lower=True)
+        s = np.linalg.svd(K, compute_uv=False)[::-1]
+        code, out, err = run_in_process(["beta", "--model", "membranes3d", "--element", "hex20", "--case", "PGLIN-Q8",
+                                         "--k", "2", "--N1", str(n), "--N2", str(n), "--norm", "L2"])
+        assert code == 0, err[-1000:]
+        row = next(csv.DictReader(io.StringIO(out)))
+        assert int(row["kernel_dim"]) == 4 and (s[:4] <= 10 * ccx_export.ENTRY_RTOL * s[-1]).all()
+        assert abs(np.sqrt(s[4]) - float(row["smallest_nonzero"])) <= 10 * ccx_export.ENTRY_RTOL * np.sqrt(s[4])
+
+
+def test_pg_trial_side_is_linmortars(tmp_path):
+    """PGLINMORTAR's trial coupling (its Dd, Bd) is LINMORTAR's, entry for entry (n = 2): the PG
+    pair's trial rows may be taken from LINMORTAR's export."""
+    (tmp_path / "lin").mkdir()
+    (tmp_path / "pg").mkdir()
+    _, lin = _run_contact(tmp_path / "lin", "LINMORTAR", 2, dump=True)
+    _, pg = _run_contact(tmp_path / "pg", "PGLINMORTAR", 2, dump=True)
+    for name in ("Dd.mtx", "Bd.mtx"):
+        a, b = (ccx_export.read_node_matrix(d / name) for d in (lin, pg))
+        assert abs(a - b).max() == 0.0

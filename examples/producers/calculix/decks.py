@@ -3,7 +3,7 @@ the multipliers' side), N × N × N serendipity bricks each (C3D20 / DC3D20), Γ
 
 Two decks per mesh: the contact deck (C3D20, ``*CONTACT PAIR, TYPE=<mortar>`` slave = Ω2's face
 z = 1, master = Ω1's), run only as far as CalculiX's mortar coupling is assembled (our dump,
-``INFSUP_CCX_DUMP``, then ``SOLVER=MATRIXSTORAGE`` stops it), and the heat deck (DC3D20, conductivity
+``INFSUP_CCX_DUMP``; ``INFSUP_CCX_DUMP_STOP`` ends the run there), and the heat deck (DC3D20, conductivity
 1, u = 0 on ∂Ω_i∖Γ): CalculiX's conduction matrix, the Laplace stiffness of the paper's membranes,
 written by ``*HEAT TRANSFER, STEADY STATE, SOLVER=MATRIXSTORAGE`` (``.con`` and ``.dof``).
 Needs numpy only.
@@ -92,15 +92,17 @@ def face_elements(m: dict, side: int) -> np.ndarray:
 
 
 def contact_deck(m: dict, mortar: str, clamped: bool) -> str:
-    """The contact deck: ``*CONTACT PAIR, TYPE=mortar``, slave Ω2's face on Γ, master Ω1's,
-    ``*STATIC, SOLVER=MATRIXSTORAGE`` (the run stops once the matrix is stored, after the coupling)."""
+    """The contact deck: ``*CONTACT PAIR, TYPE=mortar``, slave Ω2's face on Γ, master Ω1's, one
+    ``*STATIC`` step without load (the bodies touch: the coupling is assembled in its first iteration).
+    ``PRESSURE-OVERCLOSURE=HARD`` is reduced by ccx to its linear default for mortar contact (a
+    warning); the coupling does not depend on it."""
     out = _common(m, "C3D20")
     out += ["*NSET, NSET=FIX", _lines(boundary_nodes(m, clamped))]
     out += ["*SURFACE, NAME=SSLAVE, TYPE=ELEMENT"] + [f"{e}, {BOTTOM}" for e in face_elements(m, 2)]
     out += ["*SURFACE, NAME=SMASTER, TYPE=ELEMENT"] + [f"{e}, {TOP}" for e in face_elements(m, 1)]
     out += ["*SURFACE INTERACTION, NAME=SI", "*SURFACE BEHAVIOR, PRESSURE-OVERCLOSURE=HARD",
             f"*CONTACT PAIR, INTERACTION=SI, TYPE={mortar}", "SSLAVE, SMASTER",
-            "*BOUNDARY", "FIX, 1, 3", "*STEP", "*STATIC, SOLVER=MATRIXSTORAGE", "*END STEP", ""]
+            "*BOUNDARY", "FIX, 1, 3", "*STEP", "*STATIC", "*END STEP", ""]
     return "\n".join(out)
 
 

@@ -11,7 +11,8 @@ Per level (``decks.py``): Ω1 = (0,1)³ with (N + K)³ C3D20 bricks (the master)
 with N³ (the slave, the multipliers' side), Γ = (0,1)² × {1}. Two ccx runs:
 
 * the contact deck ``*CONTACT PAIR, TYPE=LINMORTAR`` (or ``PGLINMORTAR``), far faces supported:
-  our dump writes CalculiX's node-to-node coupling as bdfill assembles it in the first iteration,
+  our dump writes CalculiX's node-to-node coupling as bdfill assembles it in the first iteration
+  (and ends the run there: ``INFSUP_CCX_DUMP_STOP``),
   ``Dd`` (slave rows × slave nodes) and ``Bd`` (slave rows × master nodes, stored as −∫ψφ: the
   sign of B = [−B1 | B2]), and for PGLINMORTAR the Petrov–Galerkin pair ``Dpgd``/``Bpgd``;
 * the heat deck (DC3D20, conductivity 1, u = 0 on ∂Ω_i∖Γ, ``SOLVER=MATRIXSTORAGE``): CalculiX's
@@ -67,7 +68,7 @@ def run_ccx(workdir: Path, job: str, deck: str, dump: Path | None = None) -> Non
     env = dict(os.environ, OMP_NUM_THREADS="1", CCX_NPROC_STIFFNESS="1", CCX_NPROC_EQUATION_SOLVER="1")
     if dump is not None:
         dump.mkdir()
-        env["INFSUP_CCX_DUMP"] = str(dump)
+        env.update(INFSUP_CCX_DUMP=str(dump), INFSUP_CCX_DUMP_STOP="1")  # ccx exits after the dump
     done = subprocess.run([str(CCX), "-i", job], cwd=workdir, env=env, capture_output=True, text=True, timeout=1800)
     errors = [line.strip() for line in done.stdout.splitlines() if "*ERROR" in line]
     if done.returncode != 0 or errors:

@@ -7,7 +7,9 @@
      Bd.mtx  (slave rows, master columns), Dd.mtx (slave rows, slave columns),
      Bpgd.mtx, Dpgd.mtx (the Petrov-Galerkin pair, PGMORTAR/PGLINMORTAR only),
    islavact.txt (slave node, its state: -3 no slave, -2 no LM, -1 no gap, 0 inactive, 1 stick,
-   2 slip) and info.txt (nk, iflagdualquad). Nothing is changed in the computation. */
+   2 slip) and info.txt (nk, iflagdualquad). Nothing is changed in the computation; with
+   INFSUP_CCX_DUMP_STOP also set, ccx exits right after the dump (the solves that follow are
+   not needed for the coupling, and are most of a large run's time). */
 
 static void infsup_write_mtx(const char *dir, const char *name, ITG nk,
                              const double *val, const ITG *irow, const ITG *jq){
@@ -61,4 +63,9 @@ static void infsup_ccx_dump(ITG *nk, ITG *ntie, ITG *nslavnode, ITG *islavnode,
     fclose(f);
   }
   printf(" infsup-contact: mortar coupling written to %s\n", dir);
+  if(getenv("INFSUP_CCX_DUMP_STOP") != NULL){
+    printf(" infsup-contact: stopping after the dump (INFSUP_CCX_DUMP_STOP)\n");
+    fflush(stdout);
+    exit(0);
+  }
 }

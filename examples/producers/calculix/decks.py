@@ -91,18 +91,39 @@ def face_elements(m: dict, side: int) -> np.ndarray:
     return eids[np.isclose(z, 1.0).sum(axis=1) == 8]
 
 
-def contact_deck(m: dict, mortar: str, clamped: bool) -> str:
+def boundary_vertices(m: dict, n2: int) -> np.ndarray:
+    """Ω2's nodes at the vertices of its face on Γ that lie on ∂Γ (the slave's boundary vertices)."""
+    x, b = m["coords"], m["body"]
+    side = np.isclose(x[:, 0], 0) | np.isclose(x[:, 0], 1) | np.isclose(x[:, 1], 0) | np.isclose(x[:, 1], 1)
+    vertex = np.isclose(x[:, :2] * n2, np.rint(x[:, :2] * n2)).all(axis=1)
+    return m["ids"][(b == 2) & np.isclose(x[:, 2], 1.0) & side & vertex]
+
+
+def boundary_mpcs(m: dict, n2: int) -> list:
+    """The slave's ∂Γ vertices held by one-node MPCs (u_x + u_y = 0, with u_y = u_z = 0 as SPCs: the
+    vertex fixed). ccx 2.20 gives a slave node in an MPC no multiplier and modifies its neighbours'
+    duals (checkspcmpc.f, gendualcoeffs.f); MPCs tying it to another node are refused
+    (catsmpcslavno.f), SPCs alone leave the multiplier."""
+    nodes = boundary_vertices(m, n2)
+    eq = ["*EQUATION"] + [line for s in nodes for line in ("2", f"{s}, 1, 1., {s}, 2, 1.")]
+    return eq + ["*NSET, NSET=SLAVEBOUNDARY", _lines(nodes)]
+
+
+def contact_deck(m: dict, mortar: str, clamped: bool, mpc_boundary: int = 0) -> str:
     """The contact deck: ``*CONTACT PAIR, TYPE=mortar``, slave Ω2's face on Γ, master Ω1's, one
     ``*STATIC`` step without load (the bodies touch: the coupling is assembled in its first iteration).
     ``PRESSURE-OVERCLOSURE=HARD`` is reduced by ccx to its linear default for mortar contact (a
-    warning); the coupling does not depend on it."""
+    warning); the coupling does not depend on it. ``mpc_boundary`` = N2 (Ω2's bricks per edge): the
+    slave's ∂Γ vertices held by :func:`boundary_mpcs` (the fix); 0: not."""
     out = _common(m, "C3D20")
     out += ["*NSET, NSET=FIX", _lines(boundary_nodes(m, clamped))]
     out += ["*SURFACE, NAME=SSLAVE, TYPE=ELEMENT"] + [f"{e}, {BOTTOM}" for e in face_elements(m, 2)]
     out += ["*SURFACE, NAME=SMASTER, TYPE=ELEMENT"] + [f"{e}, {TOP}" for e in face_elements(m, 1)]
     out += ["*SURFACE INTERACTION, NAME=SI", "*SURFACE BEHAVIOR, PRESSURE-OVERCLOSURE=HARD",
             f"*CONTACT PAIR, INTERACTION=SI, TYPE={mortar}", "SSLAVE, SMASTER",
-            "*BOUNDARY", "FIX, 1, 3", "*STEP", "*STATIC", "*END STEP", ""]
+            *(boundary_mpcs(m, mpc_boundary) if mpc_boundary else []),
+            "*BOUNDARY", "FIX, 1, 3", *(["SLAVEBOUNDARY, 2, 3"] if mpc_boundary else []),
+            "*STEP", "*STATIC", "*END STEP", ""]
     return "\n".join(out)
 
 

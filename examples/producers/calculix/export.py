@@ -54,6 +54,9 @@ SPACES = {
                   "CalculiX LINMORTAR: dual basis of Q1 on every vertex of Omega2's face (LINDUAL-Q8)"),
     "PGLINMORTAR": ("PGLINMORTAR", "lagrange", "Dpgd", "Bpgd",
                     "CalculiX PGLINMORTAR, its constraint rows: tested with the Q1 hats on every vertex (T5)"),
+    "LINMORTAR-MPC": ("LINMORTAR", "dual-drop", "Dd", "Bd",
+                      "CalculiX LINMORTAR with the slave's boundary vertices held by one-node MPCs: no multiplier "
+                      "there, the neighbouring duals modified (LINDUAL0-Q8?)"),
 }
 
 
@@ -95,28 +98,35 @@ def conduction_matrix(workdir: Path, job: str):
 
 
 def dual_mass_1d(t: np.ndarray, basis: str) -> np.ndarray:
-    """The L² mass of P1 on the breakpoints ``t``: the hats (``lagrange``) or their biorthogonal
-    duals (``dual``, per interval ψ_a = 2φ_a − φ_b), exactly (products of P1 functions)."""
+    """The L² mass of P1 on the breakpoints ``t``: the hats (``lagrange``), their biorthogonal
+    duals (``dual``, per interval ψ_a = 2φ_a − φ_b) or the duals of the interior nodes with the end
+    ones added to their neighbours (``dual-drop``, Wohlmuth's modification: ψ = 1 on an end
+    interval), exactly (products of P1 functions)."""
     n = len(t)
     G = np.zeros((n, n))
-    C = np.array([[2.0, -1.0], [-1.0, 2.0]]) if basis == "dual" else np.eye(2)
+    C = np.array([[2.0, -1.0], [-1.0, 2.0]]) if basis != "lagrange" else np.eye(2)
     for e in range(n - 1):
         h = t[e + 1] - t[e]
         G[e:e + 2, e:e + 2] += C @ (h / 6.0 * np.array([[2.0, 1.0], [1.0, 2.0]])) @ C.T
-    return G
+    if basis != "dual-drop":
+        return G
+    R = np.eye(n)[1:-1]  # interior duals, each end dual added to its neighbour's
+    R[0, 0] = R[-1, -1] = 1.0
+    return R @ G @ R.T
 
 
-def multiplier_rows(m: dict, dump: Path, n2: int):
+def multiplier_rows(m: dict, dump: Path, n2: int, interior: bool = False):
     """The multiplier nodes (islavact ≥ 0) in the order i + n_x j of their vertex (x_i, y_j) on Γ,
-    checked to be exactly the (n2 + 1)² vertices of Ω2's face."""
+    checked to be exactly the (n2 + 1)² vertices of Ω2's face (``interior``: the (n2 − 1)² off ∂Γ)."""
     state = np.loadtxt(dump / "islavact.txt", dtype=np.int64, ndmin=2)
     lm = state[state[:, 1] >= 0, 0]
     xy = m["coords"][lm - 1, :2]
-    ij = np.rint(xy * n2).astype(np.int64)
-    if len(lm) != (n2 + 1) ** 2 or not np.allclose(ij / n2, xy, atol=1e-12):
-        raise CcxError(f"{len(lm)} multiplier nodes where LINMORTAR has the {(n2 + 1) ** 2} vertices of Gamma")
-    order = np.argsort(ij[:, 0] + (n2 + 1) * ij[:, 1])
-    return lm[order]
+    ij = np.rint(xy * n2).astype(np.int64) - (1 if interior else 0)
+    nx = n2 - 1 if interior else n2 + 1
+    if len(lm) != nx ** 2 or (ij < 0).any() or (ij >= nx).any():
+        raise CcxError(f"{len(lm)} multiplier nodes where {'the interior' if interior else 'all'} {nx ** 2} "
+                       "vertices of Gamma were expected")
+    return lm[np.argsort(ij[:, 0] + nx * ij[:, 1])]
 
 
 def level(out: Path, spec: tuple, n2: int, offset: int) -> dict:
@@ -125,15 +135,18 @@ def level(out: Path, spec: tuple, n2: int, offset: int) -> dict:
     m = decks.mesh(n2 + offset, n2)
     with tempfile.TemporaryDirectory(prefix="infsup-ccx-") as tmp:
         work = Path(tmp)
-        run_ccx(work, "contact", decks.contact_deck(m, mortar, clamped=False), dump=work / "dump")
+        drop = basis == "dual-drop"
+        run_ccx(work, "contact", decks.contact_deck(m, mortar, clamped=False, mpc_boundary=n2 if drop else 0),
+                dump=work / "dump")
         run_ccx(work, "heat", decks.heat_deck(m))
         A, nodes = conduction_matrix(work, "heat")
         coupling = read_node_matrix(work / "dump" / f"{slave_key}.mtx") + read_node_matrix(work / "dump" / f"{master_key}.mtx")
-        rows = multiplier_rows(m, work / "dump", n2)
+        rows = multiplier_rows(m, work / "dump", n2, interior=drop)
     B = coupling[rows - 1][:, nodes - 1]  # node ids are 1-based; A's equations are the free nodes
     t = np.linspace(0.0, 1.0, n2 + 1)
     G = np.kron(dual_mass_1d(t, basis), dual_mass_1d(t, basis))  # row i + n_x j: x fastest
-    form = {"basis": basis, "degree": 1, "ends": "keep", "breakpoints": t.tolist()}
+    form = {"basis": basis.removesuffix("-drop"), "degree": 1, "ends": "drop" if drop else "keep",
+            "breakpoints": t.tolist()}
     return level_entry(out, n2, A, sp.csr_matrix(B), sp.csr_matrix(G), {"x": form, "y": {**form, "breakpoints": t.tolist()}})
 
 

@@ -1,7 +1,8 @@
 """The CalculiX producer (examples/producers/calculix/): Debian's ccx 2.20 rebuilt with our dump of
 its mortar coupling (``make producers-calculix``), the decks of the 3D membranes on HEX20 bodies,
 and export.py. Checked against the mathematics and against the suite's own model of the same
-spaces (LINMORTAR = ``LINDUAL-Q8``, PGLINMORTAR's constraint rows = ``T5`` on QUAD8 faces): the
+spaces (LINMORTAR = ``LINDUAL-Q8``, PGLINMORTAR's constraint rows = ``T5`` on QUAD8 faces, and
+LINMORTAR with the slave's boundary vertices in one-node MPCs = ``LINDUAL0-Q8``): the
 Schur complements B A⁻¹ Bᵀ agree to CalculiX's entry accuracy (its master projection, the
 manifest's ``entry_rtol``), which no row order or dof order can hide. Skipped without the
 patched ccx; a few seconds (N ≤ 3)."""
@@ -31,7 +32,7 @@ sys.path.insert(0, str(HERE))
 import decks  # noqa: E402
 import export as ccx_export  # noqa: E402
 
-SUITE_CASE = {"LINMORTAR": "LINDUAL-Q8", "PGLINMORTAR": "T5"}
+SUITE_CASE = {"LINMORTAR": "LINDUAL-Q8", "PGLINMORTAR": "T5", "LINMORTAR-MPC": "LINDUAL0-Q8"}
 NS = (2, 3)
 
 

@@ -7,7 +7,7 @@ STAMP  := $(VENV)/.installed-from-lock
 # workflow rules call `python` and `infsup-contact`: they must resolve to the venv
 export PATH := $(CURDIR)/$(BIN):$(PATH)
 
-.PHONY: reproduce-all test env clean-env producers-kratos producers-dolfinx producers-getfem producers-freefem producers-ngsolve
+.PHONY: reproduce-all test env clean-env producers-kratos producers-dolfinx producers-getfem producers-freefem producers-ngsolve producers-calculix
 
 env: $(STAMP)
 
@@ -96,3 +96,9 @@ producers-freefem:
 producers-ngsolve:
 	@$(BIN)/python -c 'import ngsolve, scipy, yaml; print("NGSolve", ngsolve.__version__, "in $(VENV)")' 2>/dev/null || \
 	  { echo "error: NGSolve does not import in $(VENV): it is one of the suite's own dependencies, run make env"; exit 1; }
+
+# CalculiX ccx 2.20 from Debian's source package, built with our dump of its mortar coupling
+# (examples/producers/calculix/install.sh: deb-src, build-dep, apt-get source, insert, make; needs
+# root, ~2 min on 2 cores). The fetched source and the binary stay in .calculix/ (git-ignored).
+producers-calculix:
+	bash examples/producers/calculix/install.sh

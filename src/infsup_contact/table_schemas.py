@@ -68,7 +68,7 @@ SCHEMAS = {
                          "status": "str", "verdict": "str?", "kernel_dim": "int?", "beta_levels": "str?",
                          "kernel_levels": "str?", "h_levels": "str?", "slope": "float?", "slope_lo": "float?",
                          "slope_hi": "float?", "evidence": "str?", "seconds": "float?", "install": "str",
-                         "system": "str?"}, optional={"dim_M_levels": "str?", "stabilisation": "str?"}, key=("producer", "space", "offset", "norm"),
+                         "system": "str?"}, optional={"dim_M_levels": "str?", "stabilisation": "str?", "norm_as_written": "str?"}, key=("producer", "space", "offset", "norm"),
                         label="the producers table (rules/producers.smk)"),
     "producer_modes": Schema({"producer": "str", "space": "str", "offset": "int", "level": "int", "h": "float",
                               "beta": "float", "in_kernel": "bool", "x": "float", "mu": "float"},

@@ -164,3 +164,15 @@ def test_a_stabilised_systems_class_is_carried_to_the_census_and_the_paper():
     assert set(census[census.space != "bad"].stabilisation) == {NONE}  # no C block, or not run
     tex = census_tex(census, [])
     assert tex.count("UNSTABLE; regularised") == 2  # offsets 0 and 1
+
+
+def test_a_manifest_not_described_in_H_leads_with_the_next_norm():
+    """A `norm: given` manifest (FreeFEM's star-shaped skeleton) has no H^{-1/2} certificate: its
+    stage row "H" is the pencil as written, so the census leads with the next norm that ran (L2 in
+    this frame); a described manifest keeps H."""
+    table, claims, cfg = _frames()
+    table["norm_as_written"] = np.where(table.space == "good", "given", "H")
+    census = census_table(table, claims, cfg)
+    good, bad = census[census.space == "good"], census[census.space == "bad"]
+    assert set(good.norm) == {"L2"} and set(good.verdict) == {"UNSTABLE"} and set(good.other_norms) == {"H STABLE"}
+    assert set(bad.norm) == {"H"}

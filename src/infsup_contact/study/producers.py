@@ -28,7 +28,7 @@ from ..yaml_limits import load as yaml_load
 
 COLUMNS = ("producer", "version", "space", "offset", "norm", "status", "verdict", "kernel_dim", "beta_levels",
            "kernel_levels", "h_levels", "slope", "slope_lo", "slope_hi", "evidence", "seconds", "install", "system",
-           "dim_M_levels", "stabilisation")
+           "dim_M_levels", "stabilisation", "norm_as_written")
 MODE_COLUMNS = ("producer", "space", "offset", "level", "h", "beta", "in_kernel", "x", "mu")
 """The finest level's worst mode of each export in norm ``H`` (sampled on Γ): the census' mode plots."""
 MODE_FILE = "mode-H.csv"
@@ -128,7 +128,8 @@ def certify(manifest: Path, criterion: dict, modes: list | None = None) -> dict:
 
     t0 = time.perf_counter()
     try:
-        head, rows = system_verdict(load_manifest(manifest), tol=criterion["slope_tolerance"],
+        loaded = load_manifest(manifest)
+        head, rows = system_verdict(loaded, tol=criterion["slope_tolerance"],
                                     floor=criterion["beta_floor"], confidence=criterion["confidence"], modes=modes)
     except (SystemFileError, InputError) as err:
         return dict(status=f"refused: {' '.join(str(err).split())}", verdict="", seconds=time.perf_counter() - t0)
@@ -137,6 +138,8 @@ def certify(manifest: Path, criterion: dict, modes: list | None = None) -> dict:
                 kernel_levels=" ".join(str(int(r["kernel_detected"])) for r in rows),
                 dim_M_levels=" ".join(str(int(r["m"])) for r in rows),
                 stabilisation=str(head.get("stabilisation", "")),  # a manifest with C (where certified): its class
+                # the norm the manifest states: the stage's "H" row of a `norm: given` manifest is no H^-1/2 pencil
+                norm_as_written=loaded.norm,
                 h_levels=" ".join(f"{r['h']:g}" for r in rows),
                 slope=_num(head.get("slope")), slope_lo=_num(head.get("slope_lo")), slope_hi=_num(head.get("slope_hi")),
                 evidence=" ".join(str(head["evidence"]).split()), system=head["system"],
@@ -253,7 +256,7 @@ def producers_table(cfg: dict, workdir: Path, root: Path = Path(".")):
         if col not in frame:
             frame[col] = np.nan if col in ("kernel_dim", "slope", "slope_lo", "slope_hi", "seconds") else ""
     for col in ("beta_levels", "kernel_levels", "h_levels", "evidence", "system", "verdict", "version", "dim_M_levels",
-                "stabilisation"):
+                "stabilisation", "norm_as_written"):
         frame[col] = frame[col].fillna("").astype(str)
     return frame[list(COLUMNS)]
 

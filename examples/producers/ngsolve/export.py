@@ -135,8 +135,8 @@ def assemble(mesh, V1, V2, Q, intorder: int = INTORDER):
 
 
 def assemble_level(n: int, space: str, offset: int = 0, intorder: int = INTORDER) -> dict:
-    """A, B, G, the descriptions, the body dofs' coordinates (A's order) and the number of Ω1's
-    dofs (A's first block) of one level: Ω1 with n + offset segments on Γ, Ω2 with n."""
+    """A, B, G, the descriptions and the number of Ω1's dofs (A's first block) of one level: Ω1
+    with n + offset segments on Γ, Ω2 with n."""
     k, s, *_ = SPACES[space]
     mesh = two_bodies(n + offset, n)
     V1, V2, Q = spaces(mesh, space)
@@ -156,8 +156,7 @@ def assemble_level(n: int, space: str, offset: int = 0, intorder: int = INTORDER
     numbers = np.asarray(mult.pop("numbers"))  # the general form's dofs name B's rows directly
     mult["dofs"] = np.where(np.asarray(mult["dofs"]) >= 0, numbers[np.asarray(mult["dofs"])], -1).tolist()
     return {"A": K[u][:, u], "B": K[lam][:, u], "G": G_full[free[2]][:, free[2]], "multipliers": mult,
-            "traces": traces, "coords": np.vstack([_dof_coords(mesh, V) for V in (V1, V2)])[u],
-            "n1": len(free[0])}
+            "traces": traces, "n1": len(free[0])}
 
 
 def _nodes(s: int) -> np.ndarray:
@@ -203,25 +202,6 @@ def gamma_form(mesh, V, region: str, s: int, number) -> dict:
         numbers[j] = number[d]
     return {"breakpoints": breakpoints, "degree": int(s), "dofs": dofs.tolist(), "coefficients": coef.tolist(),
             "numbers": [int(c) for c in numbers]}
-
-
-def _dof_coords(mesh, V) -> np.ndarray:
-    """Coordinates of V's dofs (vertex dofs at their vertex, edge dofs at the edge's midpoint;
-    P1/P2 only), for the tests' checks."""
-    import ngsolve
-
-    out = np.full((V.ndof, 2), np.nan)
-    for e in mesh.Elements(ngsolve.VOL):
-        dofs = V.GetDofNrs(e)
-        if not any(d >= 0 for d in dofs):
-            continue
-        verts = [mesh[v].point for v in e.vertices]
-        pts = [p[:2] for p in verts]
-        edges = [np.mean([mesh[v].point[:2] for v in mesh[ed].vertices], axis=0) for ed in e.edges]
-        for d, p in zip(dofs, pts + edges):
-            if d >= 0:
-                out[d] = p
-    return out
 
 
 def ng_version() -> str:

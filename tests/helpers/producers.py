@@ -241,3 +241,22 @@ def check_refused(python, script, tmp_path, args, names) -> None:
     assert code == 2 and out == ""
     assert len(err.strip().splitlines()) == 1 and names in err, err
     assert not (tmp_path / "OUT").exists()
+
+
+def load_script(path, name: str):
+    """A producer's module (``examples/producers/<code>/export.py``) imported under its own ``name``:
+    every producer's script is called ``export``, so ``import export`` in two test modules of one
+    worker returns whichever came first. Its folder goes on ``sys.path`` for its sibling modules."""
+    import importlib.util
+    import sys
+
+    if name in sys.modules:
+        return sys.modules[name]
+    folder = str(Path(path).parent)
+    if folder not in sys.path:
+        sys.path.insert(0, folder)
+    spec = importlib.util.spec_from_file_location(name, path)
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[name] = module
+    spec.loader.exec_module(module)
+    return module

@@ -28,9 +28,8 @@ CCX = os.environ.get("INFSUP_CCX", str(P.ROOT / ".calculix" / "bin" / "ccx_infsu
 if not os.access(CCX, os.X_OK):
     pytest.skip(f"CalculiX's patched ccx is not built ({CCX}): run `make producers-calculix` (root)",
                 allow_module_level=True)
-sys.path.insert(0, str(HERE))
-import decks  # noqa: E402
-import export as ccx_export  # noqa: E402
+ccx_export = P.load_script(SCRIPT, "calculix_export")
+import decks  # noqa: E402  (its folder is on sys.path now: load_script put it there)
 
 SUITE_CASE = {"LINMORTAR": "LINDUAL-Q8", "PGLINMORTAR": "T5", "LINMORTAR-MPC": "LINDUAL0-Q8"}
 NS = (2, 3)

@@ -72,8 +72,7 @@ def test_tutorial_blocks_are_the_system_freefem_solves(tmp_path, space):
     rebuilt from the exported files: the reader's layout, 0/1-based indices and block order;
     A symmetric, C = 1e-10 × G (the tutorial's vDD), and B's rows integrate each P0 multiplier
     against the quarters' constants: per quarter ±|cell| (eps_sd = ±1), summing to 0 (the jump)."""
-    sys.path.insert(0, str(SCRIPT.parent))
-    import export as ff
+    ff = P.load_script(SCRIPT, "freefem_export")
 
     lv = ff.tutorial_level(NS[0], space, 0, tmp_path)
     A, B, C, G, M = (lv[k] for k in ("A", "B", "C", "G", "M"))

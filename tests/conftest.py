@@ -30,7 +30,16 @@ def pytest_configure(config):
 
 def pytest_collection_modifyitems(config, items):
     """Marked ``slow_first`` to the front, otherwise the collection order (a stable sort, the
-    same on every xdist worker, as xdist requires)."""
+    same on every xdist worker, as xdist requires). Marked ``machines`` (the suite's own tests
+    rerun under other OpenBLAS/MKL code paths, ~5 min of CPU) run only under ``-m machines``:
+    ``.ci/run`` runs them beside ``make test``, which stays within its 10 minutes."""
+    from helpers.markers import asked_for
+
+    if not asked_for(config.getoption("markexpr", "") or "", "machines"):
+        skip = pytest.mark.skip(reason="machines test: runs only under `pytest -m machines` (.ci/run runs it)")
+        for item in items:
+            if item.get_closest_marker("machines"):
+                item.add_marker(skip)
     items.sort(key=lambda item: item.get_closest_marker("slow_first") is None)
 
 

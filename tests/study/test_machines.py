@@ -157,6 +157,7 @@ def test_ledgers_differ_where_a_verdict_or_kernel_column_does(tmp_path):
     assert len(problems) == 1 and problems[0].startswith("results/claims.csv: damaged under f: ")
 
 
+@pytest.mark.machines
 @pytest.mark.slow_first  # a pytest run of three test files each (tests/conftest.py)
 @pytest.mark.parametrize("name", PATHS)
 def test_kernel_and_verdict_unit_tests_pass_under(name):
@@ -164,6 +165,7 @@ def test_kernel_and_verdict_unit_tests_pass_under(name):
     _pytest_under(name, UNIT_TESTS)
 
 
+@pytest.mark.machines
 @pytest.mark.slow_first
 @pytest.mark.parametrize("name", PATHS)
 def test_3d_kernel_tests_pass_under(name):
@@ -177,6 +179,7 @@ def _probe(name):
     return json.loads(run.stdout)
 
 
+@pytest.mark.machines
 @pytest.mark.parametrize("name", [p.name for p in machines.PATHS if p.vendor])
 def test_mkl_refuses_the_branches_skipped_for_the_vendor(name):
     """The vendor rule of :func:`machines.runnable` against MKL itself: where it skips a branch,
@@ -191,6 +194,7 @@ def test_mkl_refuses_the_branches_skipped_for_the_vendor(name):
         assert branch == "AUTO", f"MKL took {branch} on a {machines.cpu_vendor()} CPU: the vendor rule is too strict"
 
 
+@pytest.mark.machines
 @pytest.mark.parametrize("name", PATHS)
 def test_the_path_took_effect(runs, name):
     if runs[name] is None:

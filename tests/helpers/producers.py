@@ -260,3 +260,16 @@ def load_script(path, name: str):
     sys.modules[name] = module
     spec.loader.exec_module(module)
     return module
+
+
+def export_once(tmp_path_factory, python, script: Path, ns):
+    """``get(space, offset=0)``: the manifest of one space and offset on ``ns``, exported by
+    :func:`run_export` once per (space, offset) and reused (the producers' tests' module fixture)."""
+    done = {}
+
+    def get(space, offset=0):
+        if (space, offset) not in done:
+            done[space, offset] = run_export(python, script, tmp_path_factory.mktemp(f"{space}-{offset}"), space, ns,
+                                             offset)
+        return done[space, offset]
+    return get

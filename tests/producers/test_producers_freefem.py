@@ -29,17 +29,10 @@ TGV = 1e30
 NS = (8, 16)
 """(At N = 4, P1, 24 of 50 dofs are tgv rows: the median diagonal the certifier compares
 penalties with is then nearly a penalty itself, and A is refused as singular.)"""
-_cache = {}
-
-
 @pytest.fixture(scope="module")
 def export(tmp_path_factory):
-    def get(space, offset=0):
-        if (space, offset) not in _cache:
-            out = tmp_path_factory.mktemp(f"{space}-{offset}")
-            _cache[space, offset] = P.run_export(PYTHON, SCRIPT, out, space, NS, offset)
-        return _cache[space, offset]
-    return get
+    """The manifest of one space and offset on NS, exported once per module run."""
+    return P.export_once(tmp_path_factory, PYTHON, SCRIPT, NS)
 
 
 def _mats(manifest: Path, i: int, keys=("A", "B", "G")):

@@ -20,18 +20,10 @@ if not P.python_has(PYTHON, "getfem"):
 SPACES = {"T3-k1": 1, "T3-k2": 2, "R5.2-k1": 1, "R5.2-k2": 2, "T4-k2": 2, "R5.4-k1": 1, "R5.4-k2": 2,
           "T5-k2": 2}
 NS = (4, 8, 16)
-_cache = {}
-
-
 @pytest.fixture(scope="module")
 def export(tmp_path_factory):
     """The manifest of one space and offset on NS, exported once per module run."""
-    def get(space, offset):
-        if (space, offset) not in _cache:
-            out = tmp_path_factory.mktemp(f"{space}-{offset}")
-            _cache[space, offset] = P.run_export(PYTHON, SCRIPT, out, space, NS, offset)
-        return _cache[space, offset]
-    return get
+    return P.export_once(tmp_path_factory, PYTHON, SCRIPT, NS)
 
 
 def test_list_spaces():

@@ -29,18 +29,10 @@ CONTACT_ROUNDOFF = 4 * P.ROUNDOFF
 """Round-off of an entry of NGSolve's contact term relative to max |b|: its special elements
 integrate at points mapped through the closest-point search on either side; measured ≤ 19 ε, and
 105 ε for SurfaceL2 at N = 3 (on both bodies' blocks), so the producers' 64 ε with a factor 4."""
-_cache = {}
-
-
 @pytest.fixture(scope="module")
 def export(tmp_path_factory):
     """The manifest of one space and offset on NS, exported once per module run."""
-    def get(space, offset):
-        if (space, offset) not in _cache:
-            out = tmp_path_factory.mktemp(f"{space}-{offset}")
-            _cache[space, offset] = P.run_export(PYTHON, SCRIPT, out, space, NS, offset)
-        return _cache[space, offset]
-    return get
+    return P.export_once(tmp_path_factory, PYTHON, SCRIPT, NS)
 
 
 def test_list_spaces():

@@ -135,7 +135,10 @@ def solve_clarabel(A, B, F, tol: float = 1e-8, *, method: str = "qdldl",
 # ------------------------------------------------------------------------ qpsolvers
 def solve_qpsolvers(A, B, F, solver: str, **options) -> QpResult:
     """Any QP solver through ``qpsolvers.solve_problem`` (cross-check of the conventions)."""
-    import qpsolvers
+    try:
+        import qpsolvers
+    except ImportError as err:  # an optional peer: pyproject's extra `peers`
+        raise ImportError("solve_qpsolvers needs qpsolvers: pip install 'infsup-contact[peers]'") from err
 
     m = B.shape[0]
     prob = qpsolvers.Problem(sp.csc_matrix(A), -np.asarray(F, dtype=float),

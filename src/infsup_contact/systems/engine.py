@@ -110,6 +110,9 @@ class LevelSpectrum:
     pencil_margin : float
         log10(λ_{d+1} / (m ε λ_max)): the first eigenvalue above the kernel over the pencil's
         round-off level, in decades (the cross-check of the kernel decision).
+    schur : ndarray or None
+        S = B A⁻¹ Bᵀ as the dense routes formed it, where asked for (``keep_schur``: β_C of a
+        stabilised level adds C to it instead of factorizing A again); None on shift-invert.
     mode : ndarray or None
         The worst mode where asked for (``vectors``): the eigenvector of β_h² (the smallest
         eigenvalue above the declared kernel), or where β_h = 0 the first kernel vector of Bᵀ
@@ -128,6 +131,7 @@ class LevelSpectrum:
     entry_error_unit: float = 0.0
     pencil_margin: float = np.inf
     mode: np.ndarray | None = None
+    schur: np.ndarray | None = None
 
 
 def touched_dofs(B: sp.spmatrix) -> np.ndarray:
@@ -178,7 +182,7 @@ def scaled_coupling(A, B, G, touched, with_bound: bool = False):
 
 
 def level_spectrum(A, B, G, known_kernel: int = 0, route: str = "auto", entry_rtol=None,
-                   vectors: bool = False) -> LevelSpectrum:
+                   vectors: bool = False, keep_schur: bool = False) -> LevelSpectrum:
     """β_h and the bottom of the pencil for one level (checked matrices: :mod:`.checks`).
 
     Parameters
@@ -195,6 +199,8 @@ def level_spectrum(A, B, G, known_kernel: int = 0, route: str = "auto", entry_rt
         raised to what the data show (:func:`.roundoff.entry_roundoff`).
     vectors : bool
         Also the worst mode (``LevelSpectrum.mode``): the kernel's basis from the dense SVD too.
+    keep_schur : bool
+        Keep S = B A⁻¹ Bᵀ of the dense routes (``LevelSpectrum.schur``) for a stabilised level's β_C.
     """
     A = sp.csc_matrix(A)
     B = sp.csr_matrix(B)
@@ -222,8 +228,9 @@ def level_spectrum(A, B, G, known_kernel: int = 0, route: str = "auto", entry_rt
     if deflate:
         Z = kernel.vectors[:, :kernel.dim] / dg[:, None] if kernel.dim else None  # W v = 0 ⇔ Bᵀ (v / dg) = 0
         ev, resid, sec, top, x = _shift_invert(A, B, G, N_ABOVE, float(kernel.singular[-1]) ** 2, Z)
+        S = None
     else:
-        ev, resid, sec, top, x = _dense(A, B, G, touched, route, kernel.dim + N_BOTTOM)
+        ev, resid, sec, top, x, S = _dense(A, B, G, touched, route, kernel.dim + N_BOTTOM)
     seconds.update(sec)
     kernel, pencil_margin = pencil_cross_check(kernel, ev, top, m, zeros_computed=not deflate)
     d = kernel.dim
@@ -236,7 +243,7 @@ def level_spectrum(A, B, G, known_kernel: int = 0, route: str = "auto", entry_rt
                 else x[:, p - (len(ev) - x.shape[1])])  # x: the eigenvectors of ev's last columns
         mode = mode / np.linalg.norm(mode)
     return LevelSpectrum(beta, above, kernel, ev, route, resid, len(touched), seconds, roundoff, unit, pencil_margin,
-                         mode)
+                         mode, S if keep_schur else None)
 
 
 def _pencil_words(margin: float) -> str:
@@ -298,7 +305,7 @@ def _dense(A, B, G, touched, route, n_pairs):
     top = lam_max(S, sla.cholesky(Gd, lower=True, check_finite=False)) if k < S.shape[0] else float(ev[-1])
     # S = 0 (B = 0): every pair exact, res = scale = 0
     return (ev, float(np.max(np.divide(res, scale, out=np.zeros_like(res), where=scale > 0))),
-            {"factorize": t1 - t0, "eigen": t2 - t1, "lam_max": time.perf_counter() - t2}, top, x)
+            {"factorize": t1 - t0, "eigen": t2 - t1, "lam_max": time.perf_counter() - t2}, top, x, S)
 
 
 def kernel_projector(Z, G):

@@ -130,7 +130,7 @@ def system_rows(manifest: Manifest, route: str = "auto", notes=sys.stderr, modes
                                   f"multipliers at levels[{level.index}]")
         progress.note(f"spectrum of B A^-1 B^T m = β² G m (m = {lv.B.shape[0]})")
         res = level_spectrum(lv.A, lv.B, lv.G, manifest.known_kernel, route, manifest.entry_rtol,
-                             vectors=modes is not None)
+                             vectors=modes is not None, keep_schur=lv.C is not None)
         if modes is not None:
             modes.append(level_mode(manifest, level, lv, info, res))
         k = res.kernel
@@ -160,7 +160,7 @@ def system_rows(manifest: Manifest, route: str = "auto", notes=sys.stderr, modes
 
             progress.note("spectrum of (B A^-1 B^T + C) m = β_C² G m")
             rows[-1].update(stabilised_columns(stabilised_spectrum(lv.A, lv.B, lv.G, lv.C, res.route,
-                                                                   float(k.singular[-1]) ** 2)))
+                                                                   float(k.singular[-1]) ** 2, res.schur)))
         if info is not None:  # described: B's distance to the exact coupling of described traces
             rows[-1]["coupling_distance"] = info["coupling_distance"]
         if info is not None and "description_check" in info:  # norm H: what checked the description

@@ -166,16 +166,17 @@ def check_semidefinite(C, path) -> None:
                               "[[A, B^T], [B, -C]] with C symmetric positive semidefinite")
 
 
-def stabilised_spectrum(A, B, G, C, route: str, smax2: float) -> StabilisedSpectrum:
+def stabilised_spectrum(A, B, G, C, route: str, smax2: float, S=None) -> StabilisedSpectrum:
     """β_C, c_share, c_scale of one checked level on ``route`` (:data:`.engine.ROUTES`, not
-    ``auto``); ``smax2`` = σ_max(W)², the Jacobi scale that sets shift-invert's δ."""
+    ``auto``); ``smax2`` = σ_max(W)², the Jacobi scale that sets shift-invert's δ; ``S``: B A⁻¹ Bᵀ
+    where the unstabilised dense route formed it already (``LevelSpectrum.schur``), else formed here."""
     A, B = sp.csc_matrix(A), sp.csr_matrix(B)
     if route == "shift-invert" and B.shape[0] > 2:  # Lanczos needs k < m (m <= 2: the dense pencil)
         return _shift_invert(A, B, G, C, smax2)
     from ..la.bottom import lam_max
     from .engine import touched_dofs
 
-    S = _dense_schur(A, B, touched_dofs(B), route)
+    S = _dense_schur(A, B, touched_dofs(B), route) if S is None else S
     Cd = C.toarray() if sp.issparse(C) else np.asarray(C, float)
     Gd = G.toarray() if sp.issparse(G) else np.asarray(G, float)
     T = S + 0.5 * (Cd + Cd.T)

@@ -40,7 +40,7 @@ elastic body's ν) belongs to the model instance.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 from typing import Callable
 
 import numpy as np
@@ -49,8 +49,9 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from ..discretization.gamma.trace import GammaTrace
-from ..la import schur
+from ..la import body_parity, schur
 from ..la.schur import SteklovProduct
+from . import body_symmetry
 
 
 @dataclass(frozen=True)
@@ -180,6 +181,10 @@ class Model:
         Mesh families the model's ``mesh`` builds (None: every 2D family).
     dim : int
         Space dimension of the bodies (2, or 3 with a contact face): the memory estimate's model.
+    mirror_side : callable or None
+        ``mirror_side(side1, mesh2, k) -> SideOperator``: Ω2's side of a matching pair, reusing
+        Ω1's factorization where a mirror maps the bodies (checked; else built as
+        ``side_operator``); None: every side is factorized.
     """
 
     name: str
@@ -195,6 +200,7 @@ class Model:
     mesh_options: tuple = ()
     families: tuple | None = None
     dim: int = 2
+    mirror_side: Callable | None = None
 
     def subdomain_mesh(self, family: str, n: int, side: int, **mesh_kwargs):
         """The mesh of Ω_side the model's sides are built on (its ``mesh`` builder, else the 2D one)."""
@@ -259,6 +265,11 @@ class SideOperator(SteklovProduct):
     schur: np.ndarray
     solve: object
     steklov: np.ndarray | None = None
+    signature: np.ndarray | None = None
+    """Per free dof, what a symmetry maps as it maps points (:mod:`.body_symmetry`; None: not known)."""
+    route: str = ""
+    """How it was factorized: ``"parity 4"`` / ``"parity 2"`` (the body's symmetry parts),
+    ``"mirror"`` (side 1's, permuted), else the :func:`~.schur.gamma_factorization` route."""
 
     @property
     def ndof(self) -> int:
@@ -280,11 +291,41 @@ class SideOperator(SteklovProduct):
 
 
 def factorized_side(trace: GammaTrace, free: np.ndarray, K, route: str = "auto",
-                    keep_factor: bool = False) -> SideOperator:
+                    keep_factor: bool = False, signature: np.ndarray | None = None) -> SideOperator:
     """The SideOperator of an assembled stiffness K (free dofs, Γ last): one
-    :func:`gamma_factorization` (``keep_factor`` for a side that will solve: a contact scene's)."""
-    fac = schur.gamma_factorization(K, len(trace.gamma_dofs), route, trace.gamma.dim, keep_factor)
-    return SideOperator(trace, free, K, fac.schur, fac.solve, fac.steklov)
+    :func:`gamma_factorization` (``keep_factor`` for a side that will solve: a contact scene's).
+
+    With a ``signature`` of the free dofs (:mod:`.body_symmetry`) a body invariant under the
+    square's reflections (checked on K, Γ to Γ) is factorized in its parity parts instead
+    (:mod:`~infsup_contact.la.body_parity`: the same S and solves to round-off, a fraction of
+    the flops); any other body, or no signature, takes the general route."""
+    n_gamma = len(trace.gamma_dofs)
+    bases = body_symmetry.parity_bases(signature, K, n_gamma)
+    if bases is not None:
+        parts = body_parity.parity_parts(K, n_gamma, bases)
+        S, solve, X = parts.factorize(
+            lambda Kc, ng: schur.gamma_factorization(Kc, ng, route, trace.gamma.dim, keep_factor))
+        return SideOperator(trace, free, K, S, solve, X, signature, f"parity {len(parts.parts)}")
+    fac = schur.gamma_factorization(K, n_gamma, route, trace.gamma.dim, keep_factor)
+    return SideOperator(trace, free, K, fac.schur, fac.solve, fac.steklov, signature, fac.route)
+
+
+def extended(base: SideOperator, cls, **extra):
+    """``base`` as the subclass ``cls`` of :class:`SideOperator` with its ``extra`` fields."""
+    return cls(**{f.name: getattr(base, f.name) for f in fields(SideOperator)}, **extra)
+
+
+def mirrored_side(side1: SideOperator, trace: GammaTrace, free: np.ndarray, K, signature, route: str = "auto",
+                  keep_factor: bool = False) -> SideOperator:
+    """Body 2 of a matching pair from body 1's factorization: where a mirror maps body 2 onto
+    body 1 and K is side 1's stiffness permuted, entry by entry
+    (:func:`~.body_symmetry.mirrored_factors`), S and the solves are side 1's permuted; else
+    :func:`factorized_side`."""
+    factors = body_symmetry.mirrored_factors(side1, signature, K)
+    if factors is None:
+        return factorized_side(trace, free, K, route, keep_factor, signature)
+    S, solve, X = factors
+    return SideOperator(trace, free, K, S, solve, X, signature, "mirror")
 
 
 def schur_by_solves(side: SideOperator) -> np.ndarray:

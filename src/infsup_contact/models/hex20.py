@@ -30,7 +30,7 @@ import scipy.sparse as sp
 
 from ..discretization.face.serendipity import SERENDIPITY, NodalDofs
 from ..errors import InputError
-from .contract import Body, SideOperator, factorized_side
+from .contract import Body, SideOperator, extended, factorized_side, mirrored_side
 
 GAUSS_ORDER = 4
 """scikit-fem's ``intorder`` of the stiffness: 3 Gauss points per direction, exact to degree 5 per variable."""
@@ -98,10 +98,12 @@ class Hex20Side(SideOperator):
 
 
 def side_operator(body: Body, k: int, route: str = "auto", keep_factor: bool = False,
-                  lateral: bool = True) -> Hex20Side:
+                  lateral: bool = True, mirror_of=None) -> Hex20Side:
     """The Laplace stiffness of HEX20 on ``body`` factorized once, Γ dofs last (c = 1), u = 0 on
     the far face and, with ``lateral`` (β_h), on the lateral faces; without, those are natural and
-    the Γ dofs on ∂Γ free."""
+    the Γ dofs on ∂Γ free. The nodes are the dofs' signature (:mod:`.body_symmetry`): the body's
+    reflections factorize it in parity parts, ``mirror_of`` (side 1 of a matching pair) lends its
+    factorization through the mirror (:func:`~.contract.mirrored_side`), both checked on K."""
     check_k(k)
     basis, dofs = displacement_space(body, lateral)
     trace = body.interface.trace(dofs)
@@ -109,11 +111,13 @@ def side_operator(body: Body, k: int, route: str = "auto", keep_factor: bool = F
     is_gamma[trace.gamma_dofs] = True
     free = np.concatenate([np.flatnonzero(dofs.free & ~is_gamma), trace.gamma_dofs])
     K = stiffness(basis)
-    base = factorized_side(trace, free, K[free][:, free].tocsc(), route, keep_factor)
+    K_free = K[free][:, free].tocsc()
+    signature = np.column_stack([np.asarray(basis.doflocs, float).T, np.ones(basis.N)])[free]
+    base = (factorized_side(trace, free, K_free, route, keep_factor, signature) if mirror_of is None else
+            mirrored_side(mirror_of, trace, free, K_free, signature, route, keep_factor))
     far = np.zeros(dofs.ndof, dtype=bool)
     far[basis.get_dofs(facets=far_facets(body)).all()] = True
-    return Hex20Side(base.trace, base.free, base.stiffness, base.schur, base.solve, base.steklov,
-                     stiffness_all=K, far=far)
+    return extended(base, Hex20Side, stiffness_all=K, far=far)
 
 
 def scene_side(body: Body, k: int, lateral: bool) -> Hex20Side:

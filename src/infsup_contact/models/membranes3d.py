@@ -57,8 +57,8 @@ import scipy.sparse as sp
 
 from .contract import Body, MaterialParam, Model, OptionalChoice
 from .membranes import field as membrane_field, interpolate as membrane_interpolate, laplace_stiffness
-from .contract import SideOperator, factorized_side
-from . import hex20
+from .contract import SideOperator, extended, factorized_side, mirrored_side
+from . import body_symmetry, hex20
 
 ELEMENTS = ("hex", "tet")
 """Elements of the NGSolve bodies (the 3D elastic model's too)."""
@@ -181,7 +181,7 @@ class MembraneSide(SideOperator):
 
 
 def side_operator(body: Body, k: int, route: str = "auto", dirichlet: str = BETA_DIRICHLET, gamma=None,
-                  keep_factor: bool = False) -> MembraneSide:
+                  keep_factor: bool = False, mirror_of=None) -> MembraneSide:
     """Factorize the Laplace stiffness K_i of Q_k / P_k once, Γ dofs last (c = 1), u_i = 0 on
     ``dirichlet`` (default all of ∂Ω_i∖Γ). With natural lateral faces the Γ dofs on ∂Γ are free:
     the trace spans continuous Q_k / P_k on the partition, ∂Γ included.
@@ -190,12 +190,17 @@ def side_operator(body: Body, k: int, route: str = "auto", dirichlet: str = BETA
     is taken (a narrower body passes ``Square(width=...)``); ``keep_factor``: the factorization that
     gives S also serves the solves (:func:`~.schur.gamma_factorization`; a scene's side). A HEX20
     body (:mod:`.hex20`) is assembled by scikit-fem, u_i = 0 on all of ∂Ω_i∖Γ only (a scene's far face:
-    :func:`scene_side`)."""
+    :func:`scene_side`).
+
+    The factorization uses the body's symmetries where they are checked on K
+    (:func:`~.contract.factorized_side`: the square's reflections, parity parts); ``mirror_of``:
+    side 1 of a matching pair, whose factorization this body reuses through the mirror where it
+    maps the bodies (:func:`~.contract.mirrored_side`, checked entry by entry)."""
     if hex20.is_hex20(body):
         if dirichlet != BETA_DIRICHLET or gamma is not None:
             raise InputError("element", "hex, tet (supports other than ∂Ω_i∖Γ, a narrower Γ); hex20 bodies: "
                              "β_h on all of ∂Ω_i∖Γ, a contact scene's far face by scene_side", got="hex20")
-        return hex20.side_operator(body, k, route, keep_factor)
+        return hex20.side_operator(body, k, route, keep_factor, mirror_of=mirror_of)
     if isinstance(body.interface, Cylinder):
         body.interface.curve(body.mesh, k)  # the isoparametric body: degree k is known here
     fes = displacement_space(body.mesh, k, dirichlet)
@@ -205,9 +210,12 @@ def side_operator(body: Body, k: int, route: str = "auto", dirichlet: str = BETA
     is_gamma[trace.gamma_dofs] = True
     free = np.concatenate([np.flatnonzero(free_mask & ~is_gamma), trace.gamma_dofs])
     K_all = laplace_stiffness(fes)
-    base = factorized_side(trace, free, K_all[free][:, free].tocsc(), route, keep_factor)
-    return MembraneSide(base.trace, base.free, base.stiffness, base.schur, base.solve, base.steklov,
-                        stiffness_all=K_all)
+    K = K_all[free][:, free].tocsc()
+    signature = body_symmetry.ngsolve_signature(fes)
+    signature = None if signature is None else signature[free]
+    base = (factorized_side(trace, free, K, route, keep_factor, signature) if mirror_of is None else
+            mirrored_side(mirror_of, trace, free, K, signature, route, keep_factor))
+    return extended(base, MembraneSide, stiffness_all=K_all)
 
 
 def scene_side(scene, body: Body, k: int):
@@ -266,6 +274,7 @@ MEMBRANES3D = Model("membranes3d", side_operator,
                                                "1e-150 <= c <= 1e150", f"prestress c{i + 1} of Ω{i + 1}", side=i)
                                  for i in range(2)),
                     mesh=subdomain_mesh, families=FAMILIES_3D, dim=3,
+                    mirror_side=lambda side1, body, k: side_operator(body, k, mirror_of=side1),
                     mesh_options=(("element", MEMBRANE_ELEMENTS), ("gamma", OptionalChoice(GAMMAS)),
                                   ("radius", OptionalChoice(text=RADIUS_ALLOWED + ", with --gamma cylinder",
                                                             above=1.0)),

@@ -11,7 +11,10 @@ the β_h study's 32 pairs, 34 are distinct.
 (:meth:`SideCache.expect`) and the cache drops an operator after its last expected use, so
 it holds only the operators still to be reused; a pair it was not told of is built and not
 kept. The operators are deterministic functions of their key, so a cached one is the one a
-fresh build would give (the β_h rows are bitwise identical either way; tested).
+fresh build would give (the β_h rows are bitwise identical either way; tested). On a matching
+pair (N1 = N2) Ω2's operator is built from Ω1's where the model offers it (``Model.mirror_side``:
+the 3D bodies, whose mirror z → 2 − z maps one onto the other; K checked entry by entry, else a
+factorization of its own).
 
 The Gram matrix G of a multiplier space in a norm of Γ depends on Γ, the space's definition
 (case, k) and its partition G_h only — never on the bodies. The pairs of a sweep repeat
@@ -64,16 +67,23 @@ class SideCache:
     def pair(self, model, family: str, k: int, n1: int, n2: int, mesh: MeshOptions = NO_OPTIONS) -> list:
         """[side operator of Ω1 (N1 segments on Γ), side operator of Ω2 (N2)]. The arguments are
         a validated request's (:class:`~.request.BetaRequest`) or checked by the mesh builder."""
-        sides = [self._get(key) for key in side_keys(model, family, k, n1, n2, mesh)]
+        key1, key2 = side_keys(model, family, k, n1, n2, mesh)
+        side1 = self._get(key1)
+        sides = [side1, self._get(key2, mirror_of=side1 if n1 == n2 else None)]
         return sides[0].trace.gamma.paired(sides)  # a Γ coupled by projection ties the two
 
-    def _get(self, key):
+    def _get(self, key, mirror_of=None):
+        """The operator of ``key``, cached or built; ``mirror_of``: side 1 of a matching pair, which
+        a model with ``mirror_side`` reuses for side 2 where a mirror maps the bodies (checked)."""
         op = self._ops.pop(key, None)
         if op is None:
             model, family, k, n, side, mesh = key
             progress.note(f"side {side} of 2 (N{side}={n}): mesh, stiffness, factorization")
             # the model contract takes the options as keywords: unpacked here, and only here
-            op = model.side_operator(model.subdomain_mesh(family, n, side, **mesh.kwargs()), k)
+            body = model.subdomain_mesh(family, n, side, **mesh.kwargs())
+            mirror = getattr(model, "mirror_side", None)
+            op = (mirror(mirror_of, body, k) if mirror is not None and mirror_of is not None
+                  else model.side_operator(body, k))
         if self._uses_left[key] > 1:  # more uses announced: keep it for them
             self._uses_left[key] -= 1
             self._ops[key] = op

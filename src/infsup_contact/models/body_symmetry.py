@@ -1,0 +1,193 @@
+"""The symmetries of a 3D body, found on its dofs and checked on its stiffness.
+
+A map T of the body onto itself that maps its mesh onto itself, Γ onto Γ and the supports onto
+the supports permutes its basis: φ_j ∘ T = φ_π(j) (NGSolve's hierarchical Q_k / P_k for k ≤ 2 and
+the nodal HEX20 basis; a basis function whose sign T reverses makes π no permutation and the
+body keeps the general route). π is found numerically from a signature of each dof that T maps
+as it maps points: the centroid ∫ x φ_j / ∫ φ_j (NGSolve, four linear forms) or the node
+(scikit-fem's ``doflocs``), with the invariants ∫ φ_j and K_jj (:func:`dof_signature`,
+:func:`permutation`); a signature that matches no dof or two is no symmetry. π is then
+**checked**: every dof's image is a free dof, Γ dofs go to Γ dofs, and P K Pᵀ = K entry by entry
+to :data:`COMMUTE_RTOL` of max |K| (:func:`commutes`) — K is all the factorization sees, so S and
+the solves follow from it.
+
+Two uses (:func:`~.contract.factorized_side`, :func:`mirrored_side`):
+
+* the square's reflections x → 1 − x, y → 1 − y (:func:`involutions`): the structured hexahedra
+  (Q_k, HEX20) have both, and the body is factorized in four parity parts
+  (:mod:`infsup_contact.la.body_parity`); where one involution alone maps the body (the Kuhn
+  tetrahedra: the diagonal x ↔ y and its partner, whatever the mesh generator chose; tested) two
+  parts; where none (perturbed meshes, the unstructured tetrahedra, a narrower body), the general
+  route;
+* the mirror of the pair, body 2 → body 1 (z → 2 − z, or the point reflection about the centre of Γ
+  where the mirror reverses the tetrahedra's diagonals): on a matching pair side 2's K is side 1's
+  permuted, checked entry by entry, and so are its Schur complement and solves (:func:`mirrored_side`).
+"""
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+from scipy.spatial import cKDTree
+
+from ..discretization.gamma.symmetry import isotypic_bases
+
+ENABLED = True
+"""Whether the sides use their symmetries (False: the general route everywhere; the tests'
+reference route)."""
+MATCH_TOL = 1e-8
+"""Largest distance of a transformed signature from its match (coordinates of order 1, the
+invariants scaled to max 1); the next nearest must be farther."""
+COMMUTE_RTOL = 1e-10
+"""Largest max |P K Pᵀ − K| / max |K| of a symmetry (assembly round-off is ~1e-15; a perturbed
+mesh differs at O(1))."""
+
+
+def _reflect(*axes, flip_z: bool = False):
+    def transform(p):
+        q = np.array(p, dtype=float)
+        for a in axes:
+            q[:, a] = 1.0 - q[:, a]
+        if flip_z:
+            q[:, 2] = 2.0 - q[:, 2]
+        return q
+    return transform
+
+
+def _swap(anti: bool = False):
+    def transform(p):
+        q = np.array(p, dtype=float)
+        q[:, 0], q[:, 1] = (1.0 - p[:, 1], 1.0 - p[:, 0]) if anti else (p[:, 1], p[:, 0])
+        return q
+    return transform
+
+
+REFLECT_X, REFLECT_Y, POINT = _reflect(0), _reflect(1), _reflect(0, 1)
+SWAP, ANTISWAP = _swap(), _swap(anti=True)
+GROUPS = ((REFLECT_X, REFLECT_Y), (SWAP, ANTISWAP), (POINT,), (SWAP,), (ANTISWAP,), (REFLECT_X,), (REFLECT_Y,))
+"""Commuting involutions of the square tried in turn: the first group that maps the body is used."""
+MIRRORS = (_reflect(flip_z=True), _reflect(0, 1, flip_z=True))
+"""Maps of body 2 onto body 1 fixing Γ = (0,1)² × {1} as a set: z → 2 − z, and the point reflection."""
+
+
+def ngsolve_signature(fes) -> np.ndarray:
+    """(ndof, 4): the centroid ∫ x φ_j / ∫ φ_j and ∫ φ_j of every dof of an NGSolve space, or
+    None where some ∫ φ_j vanishes (no centroid)."""
+    import ngsolve
+
+    v = fes.TestFunction()
+    cols = []
+    for f in (ngsolve.CoefficientFunction(1.0), ngsolve.x, ngsolve.y, ngsolve.z):
+        form = ngsolve.LinearForm(fes)
+        form += f * v * ngsolve.dx
+        form.Assemble()
+        cols.append(form.vec.FV().NumPy().copy())
+    mass = cols[0]
+    if np.abs(mass).min() <= 1e-12 * np.abs(mass).max():
+        return None
+    return np.column_stack([c / mass for c in cols[1:]] + [mass])
+
+
+def _keys(signature: np.ndarray, K) -> tuple:
+    """(points (n, 3), invariants (n, m) scaled to max 1): the signature's coordinates and its
+    other columns with K's diagonal."""
+    inv = np.column_stack([signature[:, 3:], sp.csr_matrix(K).diagonal()])
+    scale = np.abs(inv).max(axis=0)
+    return signature[:, :3], inv / np.where(scale > 0, scale, 1.0)
+
+
+def _match(ref_points, ref_inv, points, inv) -> np.ndarray | None:
+    """σ with (points, inv)[i] = (ref_points, ref_inv)[σ(i)] to :data:`MATCH_TOL`, unique, a bijection."""
+    if len(points) != len(ref_points) or len(points) < 2:
+        return None
+    tree = cKDTree(np.column_stack([ref_points, ref_inv]))
+    dist, idx = tree.query(np.column_stack([points, inv]), k=2)
+    if np.any(dist[:, 0] > MATCH_TOL) or np.any(dist[:, 1] <= MATCH_TOL):
+        return None
+    sigma = idx[:, 0]
+    return sigma if np.unique(sigma).size == sigma.size else None
+
+
+def commutes(K, K_image, sigma: np.ndarray) -> bool:
+    """Whether K_image = K[σ][:, σ] entry by entry to :data:`COMMUTE_RTOL` of max |K|."""
+    K, K_image = sp.csr_matrix(K), sp.csr_matrix(K_image)
+    diff = K[sigma][:, sigma] - K_image
+    scale = np.abs(K.data).max() if K.nnz else 1.0
+    return diff.nnz == 0 or np.abs(diff.data).max() <= COMMUTE_RTOL * scale
+
+
+def _gamma_closed(sigma: np.ndarray, n_gamma: int) -> bool:
+    n = sigma.size
+    return bool(np.all(sigma[n - n_gamma:] >= n - n_gamma))
+
+
+def permutation(signature: np.ndarray, K, n_gamma: int, transform) -> np.ndarray | None:
+    """π of the free dofs (rows of ``signature`` and K, Γ the last ``n_gamma``) with
+    φ_j ∘ T = φ_π(j), checked (module text), or None."""
+    points, inv = _keys(signature, K)
+    pi = _match(points, inv, transform(points), inv)
+    if pi is None or np.any(pi[pi] != np.arange(pi.size)) or not _gamma_closed(pi, n_gamma):
+        return None
+    return pi if commutes(K, K, pi) else None
+
+
+def involutions(signature, K, n_gamma: int) -> tuple | None:
+    """The first group of :data:`GROUPS` whose every involution maps the body (checked, commuting),
+    as permutations of the free dofs; None if none (or ``signature`` is None, or :data:`ENABLED` is off)."""
+    if signature is None or not ENABLED:
+        return None
+    found = {}
+    for group in GROUPS:
+        pis = []
+        for T in group:
+            if T not in found:
+                found[T] = permutation(signature, K, n_gamma, T)
+            pis.append(found[T])
+        if all(pi is not None for pi in pis) and all(np.array_equal(a[b], b[a]) for a in pis for b in pis):
+            return tuple(pis)
+    return None
+
+
+def parity_bases(signature, K, n_gamma: int) -> tuple | None:
+    """The isotypic bases (Q_0, ...) of the body's group (:func:`involutions`), or None."""
+    pis = involutions(signature, K, n_gamma)
+    return None if pis is None else isotypic_bases(pis)
+
+
+def mirror_permutation(signature1, K1, signature2, K2, n_gamma: int) -> np.ndarray | None:
+    """σ with K2 = K1[σ][:, σ] (body 2's free dof i is body 1's σ(i) under a map of
+    :data:`MIRRORS`, Γ to Γ), checked entry by entry; None where no mirror maps the bodies."""
+    if signature1 is None or signature2 is None or not ENABLED or K1.shape != K2.shape:
+        return None
+    points1, inv1 = _keys(signature1, K1)
+    points2, inv2 = _keys(signature2, K2)
+    for M in MIRRORS:
+        sigma = _match(points1, inv1, M(points2), inv2)
+        if sigma is not None and _gamma_closed(sigma, n_gamma) and commutes(K1, K2, sigma):
+            return sigma
+    return None
+
+
+class MirroredSolve:
+    """b ↦ K2⁻¹ b = P K1⁻¹ Pᵀ b for K2 = K1[σ][:, σ] (P b = b[σ]), from body 1's solve."""
+
+    def __init__(self, solve1, sigma: np.ndarray):
+        self.solve1, self.sigma = solve1, sigma
+
+    def __call__(self, b):
+        b = np.asarray(b, dtype=float)
+        w = np.empty_like(b)
+        w[self.sigma] = b
+        return self.solve1(w)[self.sigma]
+
+
+def mirrored_factors(side1, signature2, K2) -> tuple | None:
+    """(S2, solve2, X2 or None) of body 2 from side 1's (its ``signature`` attribute, its stiffness,
+    schur, solve, steklov) through the checked mirror (:func:`mirror_permutation`), else None."""
+    n_gamma = len(side1.trace.gamma_dofs)
+    sigma = mirror_permutation(getattr(side1, "signature", None), side1.stiffness, signature2, K2, n_gamma)
+    if sigma is None:
+        return None
+    n = sigma.size
+    tau = sigma[n - n_gamma:] - (n - n_gamma)
+    X = None if side1.steklov is None else side1.steklov[np.ix_(tau, tau)]
+    return side1.schur[np.ix_(tau, tau)], MirroredSolve(side1.solve, sigma), X

@@ -104,8 +104,10 @@ def parity_parts(K, n_gamma: int, bases) -> ParityParts:
         first_row = Q.indices[Q.indptr[:-1]] if Q.shape[1] else np.zeros(0, int)
         on_gamma = first_row >= n - n_gamma
         Q = Q[:, np.concatenate([np.flatnonzero(~on_gamma), np.flatnonzero(on_gamma)])].tocsr()
-        Kc = (Q.T @ K @ Q).tocsc()
-        Kc = (0.5 * (Kc + Kc.T)).tocsc()
+        if Q.shape[1] == 0:
+            continue
+        Kc = (Q.T.tocsr() @ (K @ Q)).tocsr()
+        Kc = (0.5 * (Kc + Kc.T.tocsr())).tocsc()  # symmetric to the last bit: the solves' LU sees it whole
         Kc.sort_indices()
         parts.append(ParityPart(Kc, int(on_gamma.sum()), Q))
     return ParityParts(tuple(parts), n, int(n_gamma))

@@ -58,6 +58,22 @@ MIN_INTERIOR = 8
 """Interiors with fewer dofs are eliminated densely by :func:`gamma_schur` (module text)."""
 
 
+_FLOPS = {"on": False, "mflop": 0.0, "factorizations": 0}
+
+
+def count_flops(on: bool = True) -> None:
+    """Start (or stop) counting the factorizations' flops, from zero: PARDISO reports the MFLOP
+    its analysis plans for the numerical factorization (``iparm[18] < 0`` on entry, read after
+    phase 1), summed over the factorizations until :func:`counted_flops`. Off by default (the
+    count is a measurement's, not a result's)."""
+    _FLOPS.update(on=bool(on), mflop=0.0, factorizations=0)
+
+
+def counted_flops() -> tuple[float, int]:
+    """(GFLOP, factorizations) counted since :func:`count_flops`."""
+    return _FLOPS["mflop"] / 1e3, _FLOPS["factorizations"]
+
+
 class PardisoError(RuntimeError):
     """PARDISO returned a nonzero error code (oneMKL: -4 zero pivot, i.e. A is not SPD)."""
 
@@ -88,6 +104,7 @@ class _Handle:
         self.iparm[9] = 8    # pivot perturbation 1e-8 (not used for SPD: no pivoting)
         self.iparm[34] = 1   # zero-based ia, ja
         self.iparm[35] = schur
+        self.iparm[18] = -1 if _FLOPS["on"] else 0   # report the factorization's MFLOP (count_flops)
         self.perm = np.zeros(self.n, dtype=np.int32) if perm is None else perm
         self.alive = False
 
@@ -106,6 +123,9 @@ class _Handle:
         self.alive = self.alive or phase > 0
         if err.value:
             raise PardisoError(f"PARDISO phase {phase} returned error {err.value}")
+        if _FLOPS["on"] and phase in (11, 12, 13):
+            _FLOPS["mflop"] += float(self.iparm[18])
+            _FLOPS["factorizations"] += 1
 
     def release(self) -> None:
         if self.alive:

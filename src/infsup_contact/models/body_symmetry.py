@@ -96,23 +96,34 @@ def _keys(signature: np.ndarray, K) -> tuple:
 
 
 def _match(ref_points, ref_inv, points, inv) -> np.ndarray | None:
-    """σ with (points, inv)[i] = (ref_points, ref_inv)[σ(i)] to :data:`MATCH_TOL`, unique, a bijection."""
+    """σ with (points, inv)[i] = (ref_points, ref_inv)[σ(i)] to :data:`MATCH_TOL` (the nearest
+    reference), a bijection; else None. A wrong but close match cannot pass: the caller checks K."""
     if len(points) != len(ref_points) or len(points) < 2:
         return None
-    tree = cKDTree(np.column_stack([ref_points, ref_inv]))
-    dist, idx = tree.query(np.column_stack([points, inv]), k=2)
-    if np.any(dist[:, 0] > MATCH_TOL) or np.any(dist[:, 1] <= MATCH_TOL):
+    tree = cKDTree(np.column_stack([ref_points, ref_inv]), balanced_tree=False, compact_nodes=False)
+    dist, sigma = tree.query(np.column_stack([points, inv]), k=1, distance_upper_bound=MATCH_TOL)
+    if not np.all(np.isfinite(dist)):
         return None
-    sigma = idx[:, 0]
     return sigma if np.unique(sigma).size == sigma.size else None
 
 
 def commutes(K, K_image, sigma: np.ndarray) -> bool:
-    """Whether K_image = K[σ][:, σ] entry by entry to :data:`COMMUTE_RTOL` of max |K|."""
+    """Whether K_image = K[σ][:, σ] entry by entry to :data:`COMMUTE_RTOL` of max |K| (CSR: the
+    rows gathered, the column indices mapped by σ⁻¹; equal patterns compared value by value)."""
     K, K_image = sp.csr_matrix(K), sp.csr_matrix(K_image)
-    diff = K[sigma][:, sigma] - K_image
+    inverse = np.empty_like(sigma)
+    inverse[sigma] = np.arange(sigma.size)
+    rows = K[sigma]
+    mapped = sp.csr_matrix((rows.data, inverse[rows.indices], rows.indptr), shape=K.shape)
+    mapped.sort_indices()
+    K_image = K_image.copy() if not K_image.has_sorted_indices else K_image
+    K_image.sort_indices()
     scale = np.abs(K.data).max() if K.nnz else 1.0
-    return diff.nnz == 0 or np.abs(diff.data).max() <= COMMUTE_RTOL * scale
+    if np.array_equal(mapped.indptr, K_image.indptr) and np.array_equal(mapped.indices, K_image.indices):
+        diff = mapped.data - K_image.data
+    else:  # another pattern (explicit zeros, or no symmetry): entry by entry all the same
+        diff = (mapped - K_image).data
+    return diff.size == 0 or np.abs(diff).max() <= COMMUTE_RTOL * scale
 
 
 def _gamma_closed(sigma: np.ndarray, n_gamma: int) -> bool:
@@ -135,6 +146,7 @@ def involutions(signature, K, n_gamma: int) -> tuple | None:
     as permutations of the free dofs; None if none (or ``signature`` is None, or :data:`ENABLED` is off)."""
     if signature is None or not ENABLED:
         return None
+    K = sp.csr_matrix(K)  # once for every candidate
     found = {}
     for group in GROUPS:
         pis = []
@@ -158,6 +170,7 @@ def mirror_permutation(signature1, K1, signature2, K2, n_gamma: int) -> np.ndarr
     :data:`MIRRORS`, Γ to Γ), checked entry by entry; None where no mirror maps the bodies."""
     if signature1 is None or signature2 is None or not ENABLED or K1.shape != K2.shape:
         return None
+    K1, K2 = sp.csr_matrix(K1), sp.csr_matrix(K2)
     points1, inv1 = _keys(signature1, K1)
     points2, inv2 = _keys(signature2, K2)
     for M in MIRRORS:

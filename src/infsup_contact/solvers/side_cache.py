@@ -14,7 +14,8 @@ kept. The operators are deterministic functions of their key, so a cached one is
 fresh build would give (the β_h rows are bitwise identical either way; tested). On a matching
 pair (N1 = N2) Ω2's operator is built from Ω1's where the model offers it (``Model.mirror_side``:
 the 3D bodies, whose mirror z → 2 − z maps one onto the other; K checked entry by entry, else a
-factorization of its own).
+factorization of its own); such an operator serves its pair only, so that the rows of every pair
+are the same in a sweep and alone.
 
 The Gram matrix G of a multiplier space in a norm of Γ depends on Γ, the space's definition
 (case, k) and its partition G_h only — never on the bodies. The pairs of a sweep repeat
@@ -74,22 +75,36 @@ class SideCache:
 
     def _get(self, key, mirror_of=None):
         """The operator of ``key``, cached or built; ``mirror_of``: side 1 of a matching pair, which
-        a model with ``mirror_side`` reuses for side 2 where a mirror maps the bodies (checked)."""
+        a model with ``mirror_side`` turns into side 2 where a mirror maps the bodies (checked)."""
+        model, family, k, n, side, mesh = key
+        mirror = getattr(model, "mirror_side", None) if mirror_of is not None else None
+        if mirror is not None:
+            # always the mirror on a matching pair, never kept for another pair: each pair's rows
+            # stay a function of the pair (a cached side is the one a fresh build gives, bitwise)
+            progress.note(f"side {side} of 2 (N{side}={n}): mesh, stiffness, side 1 mirrored")
+            op = mirror(mirror_of, model.subdomain_mesh(family, n, side, **mesh.kwargs()), k)
+            self._use(key)
+            return op
         op = self._ops.pop(key, None)
         if op is None:
-            model, family, k, n, side, mesh = key
             progress.note(f"side {side} of 2 (N{side}={n}): mesh, stiffness, factorization")
             # the model contract takes the options as keywords: unpacked here, and only here
-            body = model.subdomain_mesh(family, n, side, **mesh.kwargs())
-            mirror = getattr(model, "mirror_side", None)
-            op = (mirror(mirror_of, body, k) if mirror is not None and mirror_of is not None
-                  else model.side_operator(body, k))
+            op = model.side_operator(model.subdomain_mesh(family, n, side, **mesh.kwargs()), k)
         if self._uses_left[key] > 1:  # more uses announced: keep it for them
             self._uses_left[key] -= 1
             self._ops[key] = op
         else:
             self._uses_left.pop(key, None)
         return op
+
+    def _use(self, key) -> None:
+        """Count one use of ``key`` served without the cache (the cached operator, if any, stays
+        for the uses still announced)."""
+        if self._uses_left[key] > 1:
+            self._uses_left[key] -= 1
+        else:
+            self._uses_left.pop(key, None)
+            self._ops.pop(key, None)
 
     def __len__(self) -> int:
         return len(self._ops)

@@ -81,6 +81,21 @@ def test_a_perturbed_body_keeps_the_general_route(element):
     assert body_symmetry.involutions(side.signature, side.stiffness, len(side.trace.gamma_dofs)) is None
 
 
+@pytest.mark.parametrize("element", ("hex", "tet"))
+def test_the_smallest_bodies(monkeypatch, element):
+    """N = 1 (k = 1: no free dof) keeps the general route; N = 2 (one interior dof, one on Γ, both
+    fixed by every reflection: one part) gives the general route's S, and so does its mirror."""
+    bodies = [m3.subdomain_mesh("structured", 1, s, element=element) for s in (1, 2)]
+    side1 = m3.side_operator(bodies[0], 1)
+    assert side1.ndof == 0 and side1.route == m3.side_operator(bodies[1], 1, mirror_of=side1).route == "solves"
+    bodies = [m3.subdomain_mesh("structured", 2, s, element=element) for s in (1, 2)]
+    side1 = m3.side_operator(bodies[0], 1)
+    mirrored = m3.side_operator(bodies[1], 1, mirror_of=side1)
+    reference = [_general(monkeypatch, lambda b=b: m3.side_operator(b, 1)) for b in bodies]
+    assert (side1.route, mirrored.route) == ("parity 1", "mirror")
+    assert _close(side1.schur, reference[0].schur) and _close(mirrored.schur, reference[1].schur)
+
+
 def test_the_stiffness_check_refuses_a_permutation_that_does_not_commute():
     """The same nodes (the signature matches) and one stiffness entry K_0j = K_j0 moved by 1e-6 of
     max |K| (dof 0 off the plane x = 1/2): x → 1 − x no longer commutes with K and is refused, and

@@ -144,7 +144,7 @@ def permutation(signature: np.ndarray, K, n_gamma: int, transform) -> np.ndarray
 def involutions(signature, K, n_gamma: int) -> tuple | None:
     """The first group of :data:`GROUPS` whose every involution maps the body (checked, commuting),
     as permutations of the free dofs; None if none (or ``signature`` is None, or :data:`ENABLED` is off)."""
-    if signature is None or not ENABLED:
+    if signature is None or not ENABLED or len(signature) < 2:  # nothing to split (N = 1: no free dof)
         return None
     K = sp.csr_matrix(K)  # once for every candidate
     found = {}
@@ -168,7 +168,7 @@ def parity_bases(signature, K, n_gamma: int) -> tuple | None:
 def mirror_permutation(signature1, K1, signature2, K2, n_gamma: int) -> np.ndarray | None:
     """σ with K2 = K1[σ][:, σ] (body 2's free dof i is body 1's σ(i) under a map of
     :data:`MIRRORS`, Γ to Γ), checked entry by entry; None where no mirror maps the bodies."""
-    if signature1 is None or signature2 is None or not ENABLED or K1.shape != K2.shape:
+    if signature1 is None or signature2 is None or not ENABLED or K1.shape != K2.shape or K1.shape[0] < 2:
         return None
     K1, K2 = sp.csr_matrix(K1), sp.csr_matrix(K2)
     points1, inv1 = _keys(signature1, K1)

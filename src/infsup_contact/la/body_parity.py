@@ -25,6 +25,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+import scipy.linalg as sla
 import scipy.sparse as sp
 
 
@@ -56,15 +57,17 @@ class ParityParts:
     n_gamma: int
 
     def factorize(self, factorize_one, map=map) -> tuple:
-        """(S, solve, X or None) of the body from ``factorize_one(K_c, n_gamma_c)`` of every part,
-        which returns an object with ``schur``, ``solve`` and ``steklov`` (a
-        :class:`~.schur.GammaFactorization`); ``map`` runs the independent calls (module text)."""
+        """(S, solve, X) of the body from ``factorize_one(K_c, n_gamma_c)`` of every part, which
+        returns an object with ``schur``, ``solve`` and ``steklov`` (a
+        :class:`~.schur.GammaFactorization`); ``map`` runs the independent calls (module text).
+        X = S⁻¹ = Σ_c Q_{c,Γ} S_c⁻¹ Q_{c,Γ}ᵀ from the parts' own inverses (a part's ``steklov``, else
+        potri of S_c): (1/2^g)³ of the work each, where the side would otherwise invert the whole
+        S for its products (:class:`~.schur.SteklovProduct`)."""
         facs = list(map(lambda part: factorize_one(part.stiffness, part.n_gamma), self.parts))
         gammas = [part.basis[self.n - self.n_gamma:] for part in self.parts]
         tails = [Q[:, Q.shape[1] - part.n_gamma:] for Q, part in zip(gammas, self.parts)]
         S = self._sum(tails, [f.schur for f in facs])
-        X = (self._sum(tails, [f.steklov for f in facs])
-             if all(f.steklov is not None for f in facs) else None)
+        X = self._sum(tails, [f.steklov if f.steklov is not None else spd_inverse(f.schur) for f in facs])
         return S, _PartsSolve(self.parts, [f.solve for f in facs]), X
 
     def _sum(self, tails, blocks) -> np.ndarray:
@@ -74,6 +77,19 @@ class ParityParts:
             if Q.shape[1]:
                 out += Q @ (Q @ np.asarray(M)).T  # M symmetric: (Q M)ᵀ = M Qᵀ
         return 0.5 * (out + out.T)
+
+
+def spd_inverse(S: np.ndarray) -> np.ndarray:
+    """S⁻¹ of an SPD matrix by LAPACK potrf and potri (both triangles filled)."""
+    if S.shape[0] == 0:
+        return np.zeros((0, 0))
+    c, info = sla.lapack.dpotrf(S, lower=False)
+    if info == 0:
+        c, info = sla.lapack.dpotri(c, lower=False)
+    if info != 0:
+        raise np.linalg.LinAlgError(f"potrf/potri failed (info = {info}) on a part's Schur complement")
+    X = np.triu(c)
+    return X + np.triu(X, 1).T
 
 
 class _PartsSolve:

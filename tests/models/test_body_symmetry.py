@@ -171,3 +171,11 @@ def test_beta_rows_are_the_general_routes(monkeypatch, element, k, n):
     assert len(new) == len(old) == 4
     assert (new.kernel_dim == old.kernel_dim).all()
     np.testing.assert_allclose(new.beta.to_numpy(float), old.beta.to_numpy(float), rtol=1e-9, atol=0)
+
+
+@pytest.mark.parametrize("element", ("hex", "tet"))
+def test_k3_keeps_the_general_route(element):
+    """k = 3: NGSolve's second edge function is odd about the edge's midpoint (∫ φ = 0, no centroid),
+    and a reflection may reverse its sign: no permutation is sought, the body is factorized whole."""
+    side = m3.side_operator(m3.subdomain_mesh("structured", 2, 1, element=element), 3)
+    assert side.signature is None and side.route == "solves"

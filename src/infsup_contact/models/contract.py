@@ -291,20 +291,23 @@ class SideOperator(SteklovProduct):
 
 
 def factorized_side(trace: GammaTrace, free: np.ndarray, K, route: str = "auto",
-                    keep_factor: bool = False, signature: np.ndarray | None = None) -> SideOperator:
+                    keep_factor: bool = False, signature: np.ndarray | None = None,
+                    parts_map=map) -> SideOperator:
     """The SideOperator of an assembled stiffness K (free dofs, Γ last): one
     :func:`gamma_factorization` (``keep_factor`` for a side that will solve: a contact scene's).
 
     With a ``signature`` of the free dofs (:mod:`.body_symmetry`) a body invariant under the
     square's reflections (checked on K, Γ to Γ) is factorized in its parity parts instead
     (:mod:`~infsup_contact.la.body_parity`: the same S and solves to round-off, a fraction of
-    the flops); any other body, or no signature, takes the general route."""
+    the flops); any other body, or no signature, takes the general route. ``parts_map`` runs the
+    parts' factorizations, independent calls (the built-in ``map``: one by one; a pool's ``map``:
+    side by side)."""
     n_gamma = len(trace.gamma_dofs)
     bases = body_symmetry.parity_bases(signature, K, n_gamma)
     if bases is not None:
         parts = body_parity.parity_parts(K, n_gamma, bases)
         S, solve, X = parts.factorize(
-            lambda Kc, ng: schur.gamma_factorization(Kc, ng, route, trace.gamma.dim, keep_factor))
+            lambda Kc, ng: schur.gamma_factorization(Kc, ng, route, trace.gamma.dim, keep_factor), parts_map)
         return SideOperator(trace, free, K, S, solve, X, signature, f"parity {len(parts.parts)}")
     fac = schur.gamma_factorization(K, n_gamma, route, trace.gamma.dim, keep_factor)
     return SideOperator(trace, free, K, fac.schur, fac.solve, fac.steklov, signature, fac.route)

@@ -179,3 +179,19 @@ def test_k3_keeps_the_general_route(element):
     and a reflection may reverse its sign: no permutation is sought, the body is factorized whole."""
     side = m3.side_operator(m3.subdomain_mesh("structured", 2, 1, element=element), 3)
     assert side.signature is None and side.route == "solves"
+
+
+@pytest.mark.parametrize("element", ("hex", "hex20"))
+def test_a_scene_side_keeps_its_parts_factors_for_solves(monkeypatch, element):
+    """A contact scene's side (``keep_factor``: PARDISO's interior factor kept where it loads) solves
+    with the parts' factors: the general route's solutions."""
+    from types import SimpleNamespace
+
+    from infsup_contact.la import schur
+
+    monkeypatch.setattr(schur, "SOLVES_MAX_WORK", 0)  # the large bodies' route (PARDISO, else SuperLU) at N = 3
+    body = m3.subdomain_mesh("structured", 3, 1, element=element)
+    scene = SimpleNamespace(supports=m3.FAR)
+    side = m3.scene_side(scene, body, 2)
+    reference = _general(monkeypatch, lambda: m3.scene_side(scene, body, 2))
+    assert side.route == "parity 4" and _close(side.schur, reference.schur) and _solves_agree(side, reference)

@@ -87,10 +87,10 @@ def test_the_smallest_bodies(monkeypatch, element):
     fixed by every reflection: one part) gives the general route's S, and so does its mirror."""
     bodies = [m3.subdomain_mesh("structured", 1, s, element=element) for s in (1, 2)]
     side1 = m3.side_operator(bodies[0], 1)
-    assert side1.ndof == 0 and side1.route == m3.side_operator(bodies[1], 1, mirror_of=side1).route == "solves"
+    assert side1.ndof == 0 and side1.route == m3.mirror_side(side1, bodies[1], 1).route == "solves"
     bodies = [m3.subdomain_mesh("structured", 2, s, element=element) for s in (1, 2)]
     side1 = m3.side_operator(bodies[0], 1)
-    mirrored = m3.side_operator(bodies[1], 1, mirror_of=side1)
+    mirrored = m3.mirror_side(side1, bodies[1], 1)
     reference = [_general(monkeypatch, lambda b=b: m3.side_operator(b, 1)) for b in bodies]
     assert (side1.route, mirrored.route) == ("parity 1", "mirror")
     assert _close(side1.schur, reference[0].schur) and _close(mirrored.schur, reference[1].schur)
@@ -135,7 +135,7 @@ def test_the_parts_are_independent_calls():
 def test_side_2_of_a_matching_pair_is_side_1_mirrored(monkeypatch, element, k):
     bodies = [m3.subdomain_mesh("structured", 3, s, element=element) for s in (1, 2)]
     side1 = m3.side_operator(bodies[0], k)
-    mirrored = m3.side_operator(bodies[1], k, mirror_of=side1)
+    mirrored = m3.mirror_side(side1, bodies[1], k)
     direct = _general(monkeypatch, lambda: m3.side_operator(bodies[1], k))
     assert mirrored.route == "mirror"
     assert _close(mirrored.schur, direct.schur) and _solves_agree(mirrored, direct)
@@ -146,7 +146,7 @@ def test_no_mirror_between_bodies_that_are_not_images():
     factorized on its own."""
     bodies = [m3.subdomain_mesh("perturbed", 3, s) for s in (1, 2)]
     side1 = m3.side_operator(bodies[0], 1)
-    assert m3.side_operator(bodies[1], 1, mirror_of=side1).route != "mirror"
+    assert m3.mirror_side(side1, bodies[1], 1).route != "mirror"
     other = m3.side_operator(m3.subdomain_mesh("structured", 4, 2), 1, mirror_of=m3.side_operator(
         m3.subdomain_mesh("structured", 3, 1), 1))
     assert other.route != "mirror"

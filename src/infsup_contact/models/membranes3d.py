@@ -190,17 +190,12 @@ def side_operator(body: Body, k: int, route: str = "auto", dirichlet: str = BETA
     is taken (a narrower body passes ``Square(width=...)``); ``keep_factor``: the factorization that
     gives S also serves the solves (:func:`~.schur.gamma_factorization`; a scene's side). A HEX20
     body (:mod:`.hex20`) is assembled by scikit-fem, u_i = 0 on all of ∂Ω_i∖Γ only (a scene's far face:
-    :func:`scene_side`).
-
-    The factorization uses the body's symmetries where they are checked on K
-    (:func:`~.contract.factorized_side`: the square's reflections, parity parts); ``mirror_of``:
-    side 1 of a matching pair, whose factorization this body reuses through the mirror where it
-    maps the bodies (:func:`~.contract.mirrored_side`, checked entry by entry)."""
+    :func:`scene_side`)."""
     if hex20.is_hex20(body):
         if dirichlet != BETA_DIRICHLET or gamma is not None:
             raise InputError("element", "hex, tet (supports other than ∂Ω_i∖Γ, a narrower Γ); hex20 bodies: "
                              "β_h on all of ∂Ω_i∖Γ, a contact scene's far face by scene_side", got="hex20")
-        return hex20.side_operator(body, k, route, keep_factor, mirror_of=mirror_of)
+        return hex20.side_operator(body, k, route, keep_factor)
     if isinstance(body.interface, Cylinder):
         body.interface.curve(body.mesh, k)  # the isoparametric body: degree k is known here
     fes = displacement_space(body.mesh, k, dirichlet)
@@ -216,6 +211,17 @@ def side_operator(body: Body, k: int, route: str = "auto", dirichlet: str = BETA
     base = (factorized_side(trace, free, K, route, keep_factor, signature) if mirror_of is None else
             mirrored_side(mirror_of, trace, free, K, signature, route, keep_factor))
     return extended(base, MembraneSide, stiffness_all=K_all)
+
+
+def mirror_side(side1, body: Body, k: int):
+    """Ω2's β_h side of a matching pair from Ω1's ``side1`` (``Model.mirror_side``): built as
+    :func:`side_operator` (or :func:`.hex20.side_operator`) with ``mirror_of``, so that where a mirror
+    maps the bodies (checked entry by entry on K, :func:`~.contract.mirrored_side`) Ω1's
+    factorization serves, else Ω2 is factorized on its own. Either factorization uses the body's
+    symmetries where they are checked on K (:func:`~.contract.factorized_side`: parity parts)."""
+    if hex20.is_hex20(body):
+        return hex20.side_operator(body, k, mirror_of=side1)
+    return side_operator(body, k, mirror_of=side1)
 
 
 def scene_side(scene, body: Body, k: int):
@@ -270,11 +276,11 @@ MEMBRANES3D = Model("membranes3d", side_operator,
                     "contact face Γ = (0,1)^2x{1}; structured, perturbed or unstructured (tet) meshes, "
                     "N cells per direction or maxh = 1/N (--element)",
                     scene_side=scene_side, load=load, field=field, interpolate=interpolate,
+                    mirror_side=mirror_side,
                     params=tuple(MaterialParam(f"c{i + 1}", 1.0, lambda v, key: check_prestress(key, v),
                                                "1e-150 <= c <= 1e150", f"prestress c{i + 1} of Ω{i + 1}", side=i)
                                  for i in range(2)),
                     mesh=subdomain_mesh, families=FAMILIES_3D, dim=3,
-                    mirror_side=lambda side1, body, k: side_operator(body, k, mirror_of=side1),
                     mesh_options=(("element", MEMBRANE_ELEMENTS), ("gamma", OptionalChoice(GAMMAS)),
                                   ("radius", OptionalChoice(text=RADIUS_ALLOWED + ", with --gamma cylinder",
                                                             above=1.0)),

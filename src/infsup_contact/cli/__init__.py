@@ -42,16 +42,34 @@ from .verdict import VERDICT_DEFAULTS
 __all__ = ["main", "build_parser", "validate", "flag_names", "VERDICT_DEFAULTS"]
 
 
+_THREADS_ASKED: list = []
+"""Whether the environment fixed the BLAS threads when the command started (set by :func:`_threads_default`)."""
+
+
 def _threads_default() -> None:
-    # a single-threaded BLAS is the fast choice for the small dense problems here and
-    # avoids oversubscription when jobs run in parallel (set before numpy loads BLAS)
+    # one BLAS thread until the request is validated (set before numpy loads BLAS); a count the
+    # environment fixes (Snakemake's jobs, side by side) is kept, else the request takes the idle
+    # cores once it runs (_fit_blas_threads)
+    # the variables of la.threaded.THREAD_VARIABLES, spelled here: importing la loads numpy
+    _THREADS_ASKED[:] = [any(os.environ.get(var) for var in ("MKL_NUM_THREADS", "OPENBLAS_NUM_THREADS",
+                                                            "OMP_NUM_THREADS"))]
     for var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS"):
         os.environ.setdefault(var, "1")
 
 
 def _fit_blas_threads() -> None:
-    """More than one OpenBLAS thread asked for: as many as cores are idle now (:mod:`..la.openblas`:
-    on a busy core a threaded OpenBLAS took 7-13× the one-thread time), said in one line."""
+    """No thread count in the environment: the BLAS (OpenBLAS, MKL/PARDISO) and the concurrent
+    tasks take the cores idle now (:func:`..la.threaded.decide_threads`). More than one OpenBLAS
+    thread asked for: as many as cores are idle now (:mod:`..la.openblas`: on a busy core a threaded
+    OpenBLAS took 7-13× the one-thread time), said in one line."""
+    if _THREADS_ASKED == [False]:
+        from ..la.openblas import idle_cores
+        from ..la.threaded import decide_threads, use_threads
+
+        cpus = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
+        fit = cpus > 1 and os.environ.get("INFSUP_BLAS_FIT", "1") != "0"
+        use_threads(decide_threads(None, cpus, idle_cores() if fit else None))
+        return
     try:
         asked = int(os.environ.get("OPENBLAS_NUM_THREADS", "1"))
     except ValueError:

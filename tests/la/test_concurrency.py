@@ -44,10 +44,23 @@ def _with_cli_threads(monkeypatch, environ, idle):
 
 
 def test_a_request_alone_gets_both_cores_side_by_side_one(monkeypatch):
-    assert _with_cli_threads(monkeypatch, {}, 2.0) == (2, {"numpy": 2, "scipy": 2})
+    """MKL, the threaded products and the tasks take the idle cores; OpenBLAS keeps its one thread
+    (it spins: threaded.use_threads); a count in the environment is kept (a Snakemake job's 1)."""
+    assert _with_cli_threads(monkeypatch, {}, 2.0) == (2, {"numpy": 1, "scipy": 1})
     assert _with_cli_threads(monkeypatch, {}, 0.9) == (1, {"numpy": 1, "scipy": 1})      # a busy core
     assert _with_cli_threads(monkeypatch, {"OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"}, 2.0) == \
-        (1, {"numpy": 1, "scipy": 1})                                                   # a Snakemake job's 1
+        (1, {"numpy": 1, "scipy": 1})
+    monkeypatch.setenv("INFSUP_BLAS_FIT", "0")                                          # the cores, not fitted
+    assert _with_cli_threads(monkeypatch, {}, 0.0) == (2, {"numpy": 1, "scipy": 1})
+
+
+def test_freed_memory_is_reused_unless_malloc_is_configured(monkeypatch):
+    monkeypatch.setenv("MALLOC_ARENA_MAX", "2")
+    assert threaded.reuse_freed_memory() is False
+    monkeypatch.delenv("MALLOC_ARENA_MAX")
+    for var in [v for v in threaded.os.environ if v.startswith("MALLOC_")]:
+        monkeypatch.delenv(var)
+    assert threaded.reuse_freed_memory() is True                                        # glibc (Linux)
 
 
 def test_concurrent_results_are_the_serial_ones_in_order():

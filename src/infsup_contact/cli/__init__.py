@@ -58,10 +58,13 @@ def _threads_default() -> None:
 
 
 def _fit_blas_threads() -> None:
-    """No thread count in the environment: the BLAS (OpenBLAS, MKL/PARDISO) and the concurrent
+    """No thread count in the environment: MKL/PARDISO, the threaded products and the concurrent
     tasks take the cores idle now (:func:`..la.threaded.decide_threads`). More than one OpenBLAS
     thread asked for: as many as cores are idle now (:mod:`..la.openblas`: on a busy core a threaded
     OpenBLAS took 7-13× the one-thread time), said in one line."""
+    from ..la.threaded import reuse_freed_memory
+
+    reuse_freed_memory()  # a request's large dense blocks: no page faults on each new one
     if _THREADS_ASKED == [False]:
         from ..la.openblas import idle_cores
         from ..la.threaded import decide_threads, use_threads
@@ -70,6 +73,7 @@ def _fit_blas_threads() -> None:
         fit = cpus > 1 and os.environ.get("INFSUP_BLAS_FIT", "1") != "0"
         use_threads(decide_threads(None, cpus, idle_cores() if fit else None))
         return
+    # (a fixed count: OpenBLAS too, fitted to the idle cores)
     try:
         asked = int(os.environ.get("OPENBLAS_NUM_THREADS", "1"))
     except ValueError:

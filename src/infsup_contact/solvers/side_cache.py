@@ -32,6 +32,7 @@ from collections import Counter, OrderedDict
 import numpy as np
 
 from .. import progress
+from ..la.threaded import run_concurrently
 from .request import NO_OPTIONS, MeshOptions
 
 
@@ -64,7 +65,9 @@ class SideCache:
     def pair(self, model, family: str, k: int, n1: int, n2: int, mesh: MeshOptions = NO_OPTIONS) -> list:
         """[side operator of Ω1 (N1 segments on Γ), side operator of Ω2 (N2)]. The arguments are
         a validated request's (:class:`~.request.BetaRequest`) or checked by the mesh builder."""
-        sides = [self._get(key) for key in side_keys(model, family, k, n1, n2, mesh)]
+        keys = side_keys(model, family, k, n1, n2, mesh)
+        # the two sides are independent (meshing, assembly, factorization release the GIL): side by side
+        sides = run_concurrently([lambda key=key: self._get(key) for key in keys])
         return sides[0].trace.gamma.paired(sides)  # a Γ coupled by projection ties the two
 
     def _get(self, key):

@@ -231,3 +231,59 @@ def reporting(title: str, quiet: bool = False, stream=None, bar: bool | None = N
     finally:
         _reporter = previous
         reporter.close()
+
+
+# ------------------------------------------------------------------ where the time goes
+PHASES = ("sides: mesh, assembly, factorization", "couplings", "H Grams", "L2 Grams", "kernel decision",
+          "Gram splitting", "interface terms", "β with v1 = 0", "eigensolves")
+"""The phases of a β_h request (:func:`phase`), in the order they run; the rest is ``other``."""
+OTHER = "other"
+
+_phases = None  # {phase: [wall s, CPU s]} while :func:`timing` records, else None
+
+
+@contextmanager
+def phase(name: str):
+    """Count the wall and CPU time of the code inside as ``name`` while :func:`timing` records
+    (else nothing: one global read). The CPU time is the process's (every thread: MKL's, the
+    concurrent tasks'), so only the main thread records; a phase inside another counts in its own
+    name only (the outer phase's time excludes it)."""
+    record = _phases
+    if record is None or threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    stack = _phase_stack
+    stack.append([0.0, 0.0])  # the time of the phases nested in this one
+    w0, c0 = time.perf_counter(), time.process_time()
+    try:
+        yield
+    finally:
+        wall, cpu = time.perf_counter() - w0, time.process_time() - c0
+        inner_wall, inner_cpu = stack.pop()
+        entry = record.setdefault(name, [0.0, 0.0])
+        entry[0] += wall - inner_wall
+        entry[1] += cpu - inner_cpu
+        if stack:
+            stack[-1][0] += wall
+            stack[-1][1] += cpu
+
+
+_phase_stack: list = []
+
+
+@contextmanager
+def timing():
+    """Record the :func:`phase` times of the code inside; yields the dict {phase: (wall s, CPU s)},
+    filled when the block ends, with ``other`` = the block's own time outside every phase."""
+    global _phases
+    previous, record, out = _phases, {}, {}
+    _phases = record
+    _phase_stack.clear()
+    w0, c0 = time.perf_counter(), time.process_time()
+    try:
+        yield out
+    finally:
+        wall, cpu = time.perf_counter() - w0, time.process_time() - c0
+        _phases = previous
+        out.update({name: tuple(v) for name, v in record.items()})
+        out[OTHER] = (wall - sum(v[0] for v in record.values()), cpu - sum(v[1] for v in record.values()))

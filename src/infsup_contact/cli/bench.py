@@ -32,6 +32,9 @@ def add(sub) -> None:
     p.add_argument("--radius", type=float, default=None, help="arc: the radius R > 1 of Γ (default 2)")
     p.add_argument("--case", nargs="+", default=None,
                    help="elastic: the space ids to run, each where defined for k (default every registered one)")
+    p.add_argument("--phases", default=None, metavar="FILE",
+                   help="face: also write where one end-to-end run's time goes, per phase (CPU s, wall s, "
+                        "CPU %%, share; CSV), to FILE")
     add_table_output(p)
     add_dry_run(p)
     declare_flag_uses(p, [*FLAG_USES, force_use()])
@@ -45,7 +48,7 @@ def _what(*whats):
 FLAG_USES = [FlagUse(dest, _what(what), f"--what {what}", lambda a: f"--what {a.what}")
              for dest, what in (("peers", "contact"), ("kkt_max_n", "contact"), ("eigsh_max_n", "beta"),
                                 ("dense_max_size", "beta"), ("element", "face"), ("nu", "elastic"),
-                                ("case", "elastic"), ("radius", "arc"))]
+                                ("case", "elastic"), ("radius", "arc"), ("phases", "face"))]
 """The flags of ``bench`` only one ``--what`` uses (:func:`~.common.refuse_unused`)."""
 
 
@@ -135,7 +138,13 @@ def _run_bench(args) -> None:
     peers = args.peer_list
     if args.what == "face":
         rows = bench.bench_beta(bench.bench_for("face"), args.N, args.k, args.repeats, args.route_budget,
-                                element=args.element)
+                                element=args.element, phases=[] if args.phases else None)
+        if args.phases:
+            from ..bench.phases import COLUMNS
+            from ..io import write_atomic
+
+            write_atomic(args.phases, pd.DataFrame(rows.phases, columns=list(COLUMNS)).to_csv(
+                index=False, float_format="%.4g"))
     elif args.what == "beta":
         rows = bench.bench_beta(bench.bench_for("beta", dense_max_size=args.dense_max_size,
                                                 eigsh_max_n=args.eigsh_max_n), args.N, args.k, args.repeats,

@@ -48,6 +48,8 @@ EXAMPLES = (
     Example("hex k=1 N=16", _FACE + ("--k", "1", "--N1", "16", "--N2", "16")),
     Example("hex k=2 N=8 (docs/models.md)", _FACE + ("--k", "2", "--N1", "8", "--N2", "8")),
     Example("hex k=2 N=16 (issue 50)", _FACE + ("--k", "2", "--N1", "16", "--N2", "16")),
+    Example("hex k=2 N=24, both norms", _FACE + ("--k", "2", "--N1", "24", "--N2", "24", "--norm", "all")),
+    Example("hex k=2 N=32, both norms (~4 GB)", _FACE + ("--k", "2", "--N1", "32", "--N2", "32", "--norm", "all")),
     Example("tet k=2 N=8 (docs/models.md)", _FACE + ("--element", "tet", "--k", "2", "--N1", "8", "--N2", "8")),
     Example("hex20 k=2 N=8 (docs/models.md)", _FACE + ("--element", "hex20", "--k", "2", "--N1", "8", "--N2", "8")),
     Example("Stokes P2-P1 16..128 (examples/stokes_skfem.py)", ("verdict", "--system", "{tmp}/levels.yaml"),

@@ -71,6 +71,7 @@ def test_concurrent_results_are_the_serial_ones_in_order():
     got = threaded.run_concurrently(tasks, workers=2)
     assert all(np.array_equal(a, b) for a, b in zip(got, serial))
     assert threaded.run_concurrently([], workers=2) == []
+    assert threaded.concurrent_map(lambda x: x * x, range(5)) == [0, 1, 4, 9, 16]
 
 
 def test_tasks_run_side_by_side_with_one_blas_thread_each(monkeypatch):

@@ -171,6 +171,12 @@ def run_concurrently(tasks, workers: int | None = None) -> list:
     return [f.result() for f in futures]
 
 
+def concurrent_map(fn, items) -> list:
+    """[fn(x) for x in items] by :func:`run_concurrently` (a ``map`` for callers that take one:
+    a body's parity parts, :meth:`~infsup_contact.la.body_parity.ParityParts.factorize`)."""
+    return run_concurrently([lambda x=x: fn(x) for x in items])
+
+
 def _row_blocks(n_rows: int, weights: np.ndarray | None = None, min_rows: int = MIN_ROWS) -> list[slice]:
     """At most :func:`threads` contiguous row ranges of at least ``min_rows`` rows, balanced by
     ``weights`` (cumulative work per row boundary, length n_rows + 1, e.g. a CSR indptr), else

@@ -16,6 +16,10 @@ A request done within :func:`default_delay` seconds (3; ``INFSUP_PROGRESS_DELAY`
 as tqdm's own ``delay``: a quick request's stderr stays empty; a longer one's first line (or bar)
 says where it is when the delay ends. In plain mode a step longer than :data:`HEARTBEAT` seconds is
 said again with the new time, so a slow run is told from a hung one in a log too.
+
+Where the time goes: :func:`phase` marks a phase of a β_h request (:data:`PHASES`) and
+:func:`timing` records their CPU and wall seconds (``bench --what face --phases``,
+:mod:`infsup_contact.bench.phases`); outside :func:`timing` a phase costs one global read.
 """
 from __future__ import annotations
 

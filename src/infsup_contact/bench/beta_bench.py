@@ -262,7 +262,7 @@ def _flops(setup: BetaSetup, times) -> dict:
 class Rows(list):
     """The rows of :func:`bench_beta`; ``phases``: the breakdown rows where asked (:mod:`.phases`)."""
 
-    phases: list = []
+    phases: tuple = ()
 
 
 def bench_beta(bench: BetaBench, ns, ks, repeats: int = 3, budget: float = ROUTE_BUDGET, cases=None,

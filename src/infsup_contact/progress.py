@@ -243,51 +243,56 @@ PHASES = ("sides: mesh, assembly, factorization", "couplings", "H Grams", "L2 Gr
 """The phases of a β_h request (:func:`phase`), in the order they run; the rest is ``other``."""
 OTHER = "other"
 
-_phases = None  # {phase: [wall s, CPU s]} while :func:`timing` records, else None
+_phases = None  # {phase: [wall s, CPU s, peak growth B]} while :func:`timing` records, else None
+_phase_stack: list = []
+
+
+def _clocks() -> list:
+    """[wall s, process CPU s, the process's peak resident bytes so far] now."""
+    import resource
+
+    peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024  # KiB on Linux
+    return [time.perf_counter(), time.process_time(), float(peak)]
 
 
 @contextmanager
 def phase(name: str):
     """Count the wall and CPU time of the code inside as ``name`` while :func:`timing` records
-    (else nothing: one global read). The CPU time is the process's (every thread: MKL's, the
-    concurrent tasks'), so only the main thread records; a phase inside another counts in its own
-    name only (the outer phase's time excludes it)."""
+    (else nothing: one global read), and how far it raised the process's peak resident memory.
+    The CPU time is the process's (every thread: MKL's, the concurrent tasks'), so only the main
+    thread records; a phase inside another counts in its own name only (the outer one excludes it)."""
     record = _phases
     if record is None or threading.current_thread() is not threading.main_thread():
         yield
         return
-    stack = _phase_stack
-    stack.append([0.0, 0.0])  # the time of the phases nested in this one
-    w0, c0 = time.perf_counter(), time.process_time()
+    _phase_stack.append([0.0, 0.0, 0.0])  # what the phases nested in this one took
+    start = _clocks()
     try:
         yield
     finally:
-        wall, cpu = time.perf_counter() - w0, time.process_time() - c0
-        inner_wall, inner_cpu = stack.pop()
-        entry = record.setdefault(name, [0.0, 0.0])
-        entry[0] += wall - inner_wall
-        entry[1] += cpu - inner_cpu
-        if stack:
-            stack[-1][0] += wall
-            stack[-1][1] += cpu
-
-
-_phase_stack: list = []
+        took = [b - a for a, b in zip(start, _clocks())]
+        inner = _phase_stack.pop()
+        entry = record.setdefault(name, [0.0, 0.0, 0.0])
+        for i in range(3):
+            entry[i] += took[i] - inner[i]
+            if _phase_stack:
+                _phase_stack[-1][i] += took[i]
 
 
 @contextmanager
 def timing():
-    """Record the :func:`phase` times of the code inside; yields the dict {phase: (wall s, CPU s)},
-    filled when the block ends, with ``other`` = the block's own time outside every phase."""
+    """Record the :func:`phase` measures of the code inside; yields the dict {phase: (wall s, CPU s,
+    growth of the peak resident memory in bytes)}, filled when the block ends, with ``other`` = the
+    block's own measures outside every phase."""
     global _phases
     previous, record, out = _phases, {}, {}
     _phases = record
     _phase_stack.clear()
-    w0, c0 = time.perf_counter(), time.process_time()
+    start = _clocks()
     try:
         yield out
     finally:
-        wall, cpu = time.perf_counter() - w0, time.process_time() - c0
+        took = [b - a for a, b in zip(start, _clocks())]
         _phases = previous
         out.update({name: tuple(v) for name, v in record.items()})
-        out[OTHER] = (wall - sum(v[0] for v in record.values()), cpu - sum(v[1] for v in record.values()))
+        out[OTHER] = tuple(took[i] - sum(v[i] for v in record.values()) for i in range(3))

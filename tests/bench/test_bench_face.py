@@ -83,11 +83,12 @@ def test_limit_counts_its_flops_and_every_route_its_rate(tmp_path):
     assert beta["limit_gflop"].iloc[0] >= 8 / 3 * sum(m ** 3 for m in dims) / 1e9 * (1 - 1e-3)
     table = pd.read_csv(phases)
     assert list(table.columns) == list(("what", "element", "k", "N", "phase", "cpu_s", "wall_s", "cpu_percent",
-                                        "share"))
+                                        "share", "peak_added_mib"))
     parts, total = table[table["phase"] != "total"], table[table["phase"] == "total"].iloc[0]
     assert {"sides: mesh, assembly, factorization", "H Grams", "eigensolves", "other"} <= set(parts["phase"])
     assert np.isclose(parts["cpu_s"].sum(), total["cpu_s"], rtol=1e-3) and np.isclose(parts["share"].sum(), 1.0,
                                                                                        rtol=1e-3)
+    assert (table["peak_added_mib"] >= 0).all()  # a peak never falls
 
 
 def test_limit_pencil_blocks_hold_the_whole_spectrum():

@@ -21,37 +21,33 @@ def test_phases_are_recorded_only_inside_timing_and_only_by_the_main_thread():
 
 
 class _Clock:
-    """A clock the test moves: wall and CPU seconds advance only when told."""
+    """A clock the test moves: wall and CPU seconds and the peak memory advance only when told."""
 
     def __init__(self):
-        self.wall = self.cpu = 0.0
+        self.now = [0.0, 0.0, 0.0]
 
-    def perf_counter(self):
-        return self.wall
+    def __call__(self):
+        return list(self.now)
 
-    def process_time(self):
-        return self.cpu
-
-    def advance(self, wall, cpu):
-        self.wall += wall
-        self.cpu += cpu
+    def advance(self, wall, cpu, peak=0.0):
+        self.now = [a + b for a, b in zip(self.now, (wall, cpu, peak))]
 
 
 def test_a_phase_inside_another_counts_once(monkeypatch):
     """The outer phase's time excludes the inner one's; ``other`` is the block's time outside
     every phase; the parts add up to the block."""
     clock = _Clock()
-    monkeypatch.setattr(progress, "time", clock)
+    monkeypatch.setattr(progress, "_clocks", clock)
     with progress.timing() as times:
         clock.advance(1, 1)                           # other
         with progress.phase("H Grams"):
-            clock.advance(2, 4)
+            clock.advance(2, 4, 10)
             with progress.phase("Gram splitting"):
-                clock.advance(3, 6)
+                clock.advance(3, 6, 5)
             clock.advance(1, 1)
         with progress.phase("H Grams"):               # a phase entered twice: summed
-            clock.advance(1, 2)
-    assert times == {"H Grams": (4, 7), "Gram splitting": (3, 6), progress.OTHER: (1, 1)}
+            clock.advance(1, 2, 1)
+    assert times == {"H Grams": (4, 7, 11), "Gram splitting": (3, 6, 5), progress.OTHER: (1, 1, 0)}
 
 
 def test_every_phase_named_in_the_code_is_a_known_phase():

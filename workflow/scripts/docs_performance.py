@@ -87,10 +87,13 @@ def estimates_table(frame) -> str:
 
 def phases_table(frame) -> str:
     """Per (what, element, k, N) and phase: CPU and wall seconds, CPU % (above 100: more than one
-    core busy) and the phase's share of the run's CPU, as ``bench --phases`` wrote them."""
-    header = ["what", "element", "k", "N", "phase", "CPU (s)", "wall (s)", "CPU %", "share of CPU"]
+    core busy), the phase's share of the run's CPU and how far it raised the peak resident memory,
+    as ``bench --phases`` wrote them."""
+    header = ["what", "element", "k", "N", "phase", "CPU (s)", "wall (s)", "CPU %", "share of CPU",
+              "peak memory added (MiB)"]
     rows = [[r.what, r.element if isinstance(r.element, str) else "", r.k, r.N, r.phase, float(r.cpu_s),
-             float(r.wall_s), f"{r.cpu_percent:.0f} %", f"{100 * r.share:.1f} %"] for r in frame.itertuples(index=False)]
+             float(r.wall_s), f"{r.cpu_percent:.0f} %", f"{100 * r.share:.1f} %", round(r.peak_added_mib)]
+            for r in frame.itertuples(index=False)]
     return markdown(header, rows)
 
 

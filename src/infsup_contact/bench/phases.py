@@ -13,7 +13,8 @@ from __future__ import annotations
 
 from .. import progress
 
-COLUMNS = ("what", "element", "k", "N", "phase", "cpu_s", "wall_s", "cpu_percent", "share")
+COLUMNS = ("what", "element", "k", "N", "phase", "cpu_s", "wall_s", "cpu_percent", "share", "peak_added_mib")
+MIB = 1024 ** 2
 
 
 def phase_rows(setup, run) -> list:
@@ -21,11 +22,13 @@ def phase_rows(setup, run) -> list:
     :class:`~.beta_bench.BetaSetup`), in the phases' order, ``other`` and ``total`` last."""
     with progress.timing() as times:
         run()
-    cpu = sum(c for _, c in times.values())
-    wall = sum(w for w, _ in times.values())
+    cpu = sum(t[1] for t in times.values())
+    wall = sum(t[0] for t in times.values())
     names = [p for p in progress.PHASES if p in times] + [p for p in times if p not in progress.PHASES]
     base = dict(what=setup.bench.what, element=setup.mesh_options.get("element", ""), k=setup.k, N=setup.n)
-    rows = [dict(base, phase=name, cpu_s=c, wall_s=w, cpu_percent=100.0 * c / w if w > 0 else 0.0,
-                 share=c / cpu if cpu > 0 else 0.0) for name in names for w, c in [times[name]]]
-    return rows + [dict(base, phase="total", cpu_s=cpu, wall_s=wall, cpu_percent=100.0 * cpu / wall if wall > 0
-                        else 0.0, share=1.0)]
+
+    def row(name, w, c, peak, share):
+        return dict(base, phase=name, cpu_s=c, wall_s=w, cpu_percent=100.0 * c / w if w > 0 else 0.0, share=share,
+                    peak_added_mib=peak / MIB)
+    rows = [row(name, *times[name], times[name][1] / cpu if cpu > 0 else 0.0) for name in names]
+    return rows + [row("total", wall, cpu, sum(t[2] for t in times.values()), 1.0)]

@@ -114,3 +114,17 @@ def test_face_dry_run_refuses_bad_sizes_in_one_line(flag, value, capsys):
     captured = capsys.readouterr()
     lines = [ln for ln in captured.err.splitlines() if ln.strip()]
     assert code == 2 and captured.out == "" and len(lines) == 1 and flag in lines[0], captured.err
+
+
+def test_the_large_route_fit_recovers_the_constants_it_is_given():
+    """bench.estimates.fit_large_route_3d on requests that cost exactly a Σnd + b m² bytes and
+    c Σnd + d m³ seconds beyond the process gives back (a, b, c, d)."""
+    from infsup_contact.bench.estimates import fit_large_route_3d
+
+    a, b, c, d = 3000.0, 120.0, 1e-4, 5e-10
+    points = []
+    for n in (20, 26, 32):
+        nd, m = 2 * R.face_side_dofs(n, 2), float((2 * n + 1) ** 2)
+        points.append((2, n, R.PROCESS_BYTES["beta"] + R.MKL_BYTES + a * nd + b * m * m,
+                       R.START_SECONDS + c * nd + d * m ** 3))
+    assert fit_large_route_3d(points) == pytest.approx((a, b, c, d), rel=1e-6)

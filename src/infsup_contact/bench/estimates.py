@@ -135,6 +135,30 @@ def run_example(ex: Example) -> dict:
             "time_ratio": est_s / got["cpu_s"], "load_before": load_before, "load_after": load_after}
 
 
+def fit_large_route_3d(points, components: int = 1) -> tuple:
+    """(a, b, c, d) of ``resources.LARGE_ROUTE_3D`` (before its margin) from measured requests
+    ``points`` = [(k, N, peak bytes, CPU seconds), ...] of one degree on the large route: non-negative
+    least squares on relative residuals of bytes − process − MKL = a Σnd + b m² and seconds − start =
+    c Σnd + d m³ (m = (k N + 1)²), the way the constants were fitted. At least two sizes."""
+    import numpy as np
+    from scipy.optimize import nnls
+
+    from .. import resources as R
+
+    rows_b, rows_t, rhs_b, rhs_t = [], [], [], []
+    for k, n, peak, cpu in points:
+        nd = 2 * components * R.face_side_dofs(n, k)
+        m = float(R._large_route_dim(k, n, components))
+        mem = peak - R.PROCESS_BYTES["beta"] - R.MKL_BYTES
+        rows_b.append([nd / mem, m * m / mem])
+        rhs_b.append(1.0)
+        rows_t.append([nd / (cpu - R.START_SECONDS), m ** 3 / (cpu - R.START_SECONDS)])
+        rhs_t.append(1.0)
+    (a, b), _ = nnls(np.array(rows_b), np.array(rhs_b))
+    (c, d), _ = nnls(np.array(rows_t), np.array(rhs_t))
+    return float(a), float(b), float(c), float(d)
+
+
 def main(argv=None) -> int:
     import pandas as pd
 

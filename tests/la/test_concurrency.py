@@ -134,3 +134,17 @@ def test_pardiso_schur_complements_side_by_side_are_the_serial_ones(monkeypatch)
     serial = [t() for t in tasks]
     together = threaded.run_concurrently(tasks)
     assert all(np.array_equal(a, b) for a, b in zip(together, serial))
+
+
+@pytest.mark.parametrize("estimate_gb, available_gb, reused", [(1, 8, True), (4, 8, True), (5, 8, False),
+                                                               (23, 16, False)])
+def test_freed_memory_is_kept_only_where_memory_is_plentiful(monkeypatch, estimate_gb, available_gb, reused):
+    """The command line keeps freed memory for reuse (a higher peak) only when the estimated
+    peak is at most half the available memory."""
+    from infsup_contact import cli, resources
+
+    calls = []
+    monkeypatch.setattr(threaded, "reuse_freed_memory", lambda: calls.append(1) or True)
+    monkeypatch.setattr(resources, "available_bytes", lambda *a: available_gb * 1e9)
+    cli._reuse_freed_memory(resources.Estimate(estimate_gb * 1e9, 1.0))
+    assert bool(calls) is reused

@@ -112,9 +112,12 @@ def reuse_freed_memory() -> bool:
     per large block, no trimming). A request allocates and frees dense blocks of 100 MB and more
     many times over; by default each is a fresh ``mmap`` whose pages fault in zeroed one by one,
     and the request spent 15 % of its CPU in the kernel (k = 2, N = 24: 7.1 s sys of 45.8 s,
-    689 k minor faults; with this 1.1 s, 342 k faults, peak RSS 1.78 GB against 1.68). The peak
-    is what a request's memory estimate bounds, so nothing is given back before the end. Left as
-    it is where glibc is absent or a ``MALLOC_*`` variable already says how; True if applied."""
+    689 k minor faults; with this 1.1 s, 342 k faults; N = 32: 4.9 s sys of 161 s). Transparent
+    huge pages are not the cause (``NUMPY_MADVISE_HUGEPAGE=0``: 7.5 s sys, 3.4 M faults): zeroing
+    fresh pages is. The price is a higher peak (freed blocks stay resident between reuses: peak RSS
+    1.78 GB against 1.68 at N = 24, 5.19 GB against ~4.4 at N = 32), so the command line applies it
+    only where memory is plentiful (``cli._reuse_freed_memory``). Left as it is where glibc is
+    absent or a ``MALLOC_*`` variable already says how; True if applied."""
     import ctypes
 
     if any(v.startswith("MALLOC_") for v in os.environ):

@@ -238,8 +238,8 @@ def reporting(title: str, quiet: bool = False, stream=None, bar: bool | None = N
 
 
 # ------------------------------------------------------------------ where the time goes
-PHASES = ("sides: mesh, assembly, factorization", "couplings", "H Grams", "L2 Grams", "kernel decision",
-          "Gram splitting", "interface terms", "β with v1 = 0", "eigensolves")
+PHASES = ("sides: mesh, assembly, factorization", "couplings", "H Grams", "L2 Grams",
+          "kernel decision, Grams split and factorized", "interface terms", "β with v1 = 0", "eigensolves")
 """The phases of a β_h request (:func:`phase`), in the order they run; the rest is ``other``."""
 OTHER = "other"
 

@@ -42,12 +42,12 @@ def test_a_phase_inside_another_counts_once(monkeypatch):
         clock.advance(1, 1)                           # other
         with progress.phase("H Grams"):
             clock.advance(2, 4, 10)
-            with progress.phase("Gram splitting"):
+            with progress.phase("couplings"):
                 clock.advance(3, 6, 5)
             clock.advance(1, 1)
         with progress.phase("H Grams"):               # a phase entered twice: summed
             clock.advance(1, 2, 1)
-    assert times == {"H Grams": (4, 7, 11), "Gram splitting": (3, 6, 5), progress.OTHER: (1, 1, 0)}
+    assert times == {"H Grams": (4, 7, 11), "couplings": (3, 6, 5), progress.OTHER: (1, 1, 0)}
 
 
 def test_every_phase_named_in_the_code_is_a_known_phase():

@@ -57,7 +57,8 @@ def beta_table(request: BetaRequest, side_cache: SideCache | None = None, modes:
     t0 = time.perf_counter()
     cache = SideCache() if side_cache is None else side_cache
     progress.note("the two sides")
-    sides = cache.pair(r.model, r.family, r.k, r.n1, r.n2, r.mesh)                 # Ω1, Ω2 with Γ last
+    with progress.phase("sides: mesh, assembly, factorization"):
+        sides = cache.pair(r.model, r.family, r.k, r.n1, r.n2, r.mesh)             # Ω1, Ω2 with Γ last
     t_sides = time.perf_counter() - t0
     gamma = sides[0].trace.gamma
     p1, p2 = (s.trace.partition for s in sides)
@@ -106,7 +107,9 @@ def _case_rows(r: BetaRequest, case, g_h, sides, dim_w: int, trace_norms, modes:
     grams = {norm: _timed(f"{norm} Grams", grams.gram, gamma, case, r.k, g_h, space, norm, r.h_route)
              for norm in r.norms}  # G per norm
     structural = gamma.proven_kernel(space, r.k, [s.trace for s in sides], dim_w)
-    route = choose_route(space, couplings, sides, grams, structural, g_h, r.k, trace_norms, vectors=modes is not None)
+    with progress.phase("kernel decision, Grams split and factorized"):
+        route = choose_route(space, couplings, sides, grams, structural, g_h, r.k, trace_norms,
+                             vectors=modes is not None)
     progress.note(f"interface operator ({route.name} route)")
     terms = _timed("interface terms", interface_terms, couplings, sides)            # B_i X_i B_iᵀ
     v1_zero = _timed("β with v1 = 0", route.betas_v1_zero, terms)

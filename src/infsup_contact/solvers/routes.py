@@ -18,7 +18,6 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from ..discretization.gamma.coupling import coupling_matrix, trace_l2_norms
-from .. import progress
 from ..la import bottom, reflection
 from . import spectra, symmetry
 from .kernel import KernelDecision, bottom_kernel, coupling_kernel, scaled_couplings
@@ -88,14 +87,12 @@ def choose_route(space, couplings, sides, grams: dict, structural: int, g_h, k: 
     ``vectors``: the kernel's basis on the dense route too (a worst mode, :mod:`.modes`)."""
     large = is_large(space)
     split = symmetry.split_of(space, sides[0].trace.gamma, g_h, k) if large else None
-    with progress.phase("kernel decision"):
-        kernel = space_kernel(couplings, sides, space, k, structural, grams["L2"][0] if "L2" in grams else None,
-                              iterative=large, trace_norms=trace_norms, split=split, vectors=vectors)
-    with progress.phase("Gram splitting"):  # the Grams into the reflections' blocks, their factors
-        split, parts, halves = reflection.usable(split, grams, kernel)
-        if split is not None:
-            return Route("split", kernel, spectra.SplitFactors(grams, halves), split, parts)
-        return Route("bottom" if large else "dense", kernel, {norm: gram_factor(G) for norm, (G, _) in grams.items()})
+    kernel = space_kernel(couplings, sides, space, k, structural, grams["L2"][0] if "L2" in grams else None,
+                          iterative=large, trace_norms=trace_norms, split=split, vectors=vectors)
+    split, parts, halves = reflection.usable(split, grams, kernel)
+    if split is not None:
+        return Route("split", kernel, spectra.SplitFactors(grams, halves), split, parts)
+    return Route("bottom" if large else "dense", kernel, {norm: gram_factor(G) for norm, (G, _) in grams.items()})
 
 
 def space_kernel(couplings, sides, space, k: int, structural: int, l2_gram=None,

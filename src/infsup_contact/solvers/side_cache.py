@@ -67,8 +67,7 @@ class SideCache:
         a validated request's (:class:`~.request.BetaRequest`) or checked by the mesh builder."""
         keys = side_keys(model, family, k, n1, n2, mesh)
         # the two sides are independent (meshing, assembly, factorization release the GIL): side by side
-        with progress.phase("sides: mesh, assembly, factorization"):
-            sides = run_concurrently([lambda key=key: self._get(key) for key in keys])
+        sides = run_concurrently([lambda key=key: self._get(key) for key in keys])
         return sides[0].trace.gamma.paired(sides)  # a Γ coupled by projection ties the two
 
     def _get(self, key):

@@ -83,3 +83,48 @@ def test_system_estimate_covers_the_measured_3d_export():
     est = resources.system_estimate([(n, m, nt, nnz, "gamma-dense")])
     assert est.bytes >= 4.4e9 and est.seconds >= 42
     assert not resources.looks_3d(132_098, 510) and not resources.looks_3d(n, n // 2)
+
+
+def test_face_estimate_grows_with_n_and_k_across_the_routes():
+    """The 3D bodies' estimate (both norms, every space): its memory never falls as N or k grows,
+    across the dense route's gate to the large route (dim M = (k N + 1)² > DENSE_MAX_M) and up to
+    k = 2, N = 48; its time never falls within a route (at the gate it may: the large route is the
+    faster one there, resources.DENSE_ROUTE_SECONDS_3D)."""
+    from infsup_contact.la.bottom import DENSE_MAX_M
+
+    def est(k, n):
+        return R.beta_estimate("structured", k, n, n, dim=3, element="hex", n_spaces=12)
+    for k in (1, 2):
+        series = [(n, est(k, n)) for n in range(2, 49)]
+        for (n0, a), (n1, b) in zip(series, series[1:]):
+            assert b.bytes >= a.bytes, (k, n1)
+            same_route = ((k * n0 + 1) ** 2 > DENSE_MAX_M) == ((k * n1 + 1) ** 2 > DENSE_MAX_M)
+            assert b.seconds >= a.seconds or not same_route, (k, n1)
+    assert all(est(2, n).bytes >= est(1, n).bytes for n in range(2, 49))
+
+
+@pytest.mark.parametrize("flag, value", [("--N1", "0"), ("--N2", "-3"), ("--k", "0"), ("--N1", "x")])
+def test_face_dry_run_refuses_bad_sizes_in_one_line(flag, value, capsys):
+    argv = ["beta", "--model", "membranes3d", "--case", "all", "--k", "2", "--N1", "4", "--N2", "4", "--dry-run"]
+    argv[argv.index(flag) + 1] = value
+    try:
+        code = main(argv)
+    except SystemExit as stop:  # argparse's own type errors
+        code = stop.code
+    captured = capsys.readouterr()
+    lines = [ln for ln in captured.err.splitlines() if ln.strip()]
+    assert code == 2 and captured.out == "" and len(lines) == 1 and flag in lines[0], captured.err
+
+
+def test_the_large_route_fit_recovers_the_constants_it_is_given():
+    """bench.estimates.fit_large_route_3d on requests that cost exactly a Σnd + b m² bytes and
+    c Σnd + d m³ seconds beyond the process gives back (a, b, c, d)."""
+    from infsup_contact.bench.estimates import fit_large_route_3d
+
+    a, b, c, d = 3000.0, 120.0, 1e-4, 5e-10
+    points = []
+    for n in (20, 26, 32):
+        nd, m = 2 * R.face_side_dofs(n, 2), float((2 * n + 1) ** 2)
+        points.append((2, n, R.PROCESS_BYTES["beta"] + R.MKL_BYTES + a * nd + b * m * m,
+                       R.START_SECONDS + c * nd + d * m ** 3))
+    assert fit_large_route_3d(points) == pytest.approx((a, b, c, d), rel=1e-6)

@@ -16,6 +16,10 @@ A request done within :func:`default_delay` seconds (3; ``INFSUP_PROGRESS_DELAY`
 as tqdm's own ``delay``: a quick request's stderr stays empty; a longer one's first line (or bar)
 says where it is when the delay ends. In plain mode a step longer than :data:`HEARTBEAT` seconds is
 said again with the new time, so a slow run is told from a hung one in a log too.
+
+Where the time goes: :func:`phase` marks a phase of a β_h request (:data:`PHASES`) and
+:func:`timing` records their CPU and wall seconds (``bench --what face --phases``,
+:mod:`infsup_contact.bench.phases`); outside :func:`timing` a phase costs one global read.
 """
 from __future__ import annotations
 
@@ -231,3 +235,64 @@ def reporting(title: str, quiet: bool = False, stream=None, bar: bool | None = N
     finally:
         _reporter = previous
         reporter.close()
+
+
+# ------------------------------------------------------------------ where the time goes
+PHASES = ("sides: mesh, assembly, factorization", "couplings", "H Grams", "L2 Grams",
+          "kernel decision, Grams split and factorized", "interface terms", "β with v1 = 0", "eigensolves")
+"""The phases of a β_h request (:func:`phase`), in the order they run; the rest is ``other``."""
+OTHER = "other"
+
+_phases = None  # {phase: [wall s, CPU s, peak growth B]} while :func:`timing` records, else None
+_phase_stack: list = []
+
+
+def _clocks() -> list:
+    """[wall s, process CPU s, the process's peak resident bytes so far] now."""
+    import resource
+
+    peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024  # KiB on Linux
+    return [time.perf_counter(), time.process_time(), float(peak)]
+
+
+@contextmanager
+def phase(name: str):
+    """Count the wall and CPU time of the code inside as ``name`` while :func:`timing` records
+    (else nothing: one global read), and how far it raised the process's peak resident memory.
+    The CPU time is the process's (every thread: MKL's, the concurrent tasks'), so only the main
+    thread records; a phase inside another counts in its own name only (the outer one excludes it)."""
+    record = _phases
+    if record is None or threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    _phase_stack.append([0.0, 0.0, 0.0])  # what the phases nested in this one took
+    start = _clocks()
+    try:
+        yield
+    finally:
+        took = [b - a for a, b in zip(start, _clocks())]
+        inner = _phase_stack.pop()
+        entry = record.setdefault(name, [0.0, 0.0, 0.0])
+        for i in range(3):
+            entry[i] += took[i] - inner[i]
+            if _phase_stack:
+                _phase_stack[-1][i] += took[i]
+
+
+@contextmanager
+def timing():
+    """Record the :func:`phase` measures of the code inside; yields the dict {phase: (wall s, CPU s,
+    growth of the peak resident memory in bytes)}, filled when the block ends, with ``other`` = the
+    block's own measures outside every phase."""
+    global _phases
+    previous, record, out = _phases, {}, {}
+    _phases = record
+    _phase_stack.clear()
+    start = _clocks()
+    try:
+        yield out
+    finally:
+        took = [b - a for a, b in zip(start, _clocks())]
+        _phases = previous
+        out.update({name: tuple(v) for name, v in record.items()})
+        out[OTHER] = tuple(took[i] - sum(v[i] for v in record.values()) for i in range(3))

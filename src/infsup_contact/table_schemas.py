@@ -166,6 +166,10 @@ SCHEMAS = {
                          "mem_ratio": "float", "est_s": "float", "cpu_s": "float", "wall_s": "float",
                          "time_ratio": "float", "load_before": "float", "load_after": "float"},
                         key=("example",), label="an estimates table"),
+    # results/benchmarks/face_phases.csv (bench/phases.py: a β_h request's time per phase)
+    "phases": Schema({"what": "str", "element": "str?", "k": "int", "N": "int", "phase": "str", "cpu_s": "float",
+                      "wall_s": "float", "cpu_percent": "float", "share": "float", "peak_added_mib": "float"},
+                     key=("what", "element", "k", "N", "phase"), label="a phases table"),
     # Snakemake's `benchmark:` files (bench/dag.py), tab-separated
     "rule_benchmark": Schema({"s": "float"}, optional={"max_rss": "float?", "cpu_time": "float?"},
                              label="a Snakemake benchmark file", sep="\t"),

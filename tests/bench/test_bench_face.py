@@ -63,7 +63,52 @@ def test_cli_csv_has_the_ratio_columns():
     assert (frame["element"] == "hex").all()
 
 
+def test_limit_counts_its_flops_and_every_route_its_rate(tmp_path):
+    """The limit's columns: its GFLOP (PARDISO's count + 8/3 m³ per pencil block: at least the
+    pencils' part, the same on every β row) and each route's rate = GFLOP / its median seconds;
+    --phases writes the breakdown, whose phases add up to its total."""
+    from infsup_contact.bench import face_limit
+
+    phases = tmp_path / "phases.csv"
+    code, out, err = run_in_process(["bench", "--what", "face", "--N", "2", "--k", "2", "--repeats", "1",
+                                     "--phases", str(phases)])
+    assert code in (0, None), err
+    frame = pd.read_csv(io.StringIO(out))
+    beta = frame[frame["what"] == "face_beta"]
+    assert {"limit_gflop", "gflop_per_s"} <= set(frame.columns) and beta["limit_gflop"].nunique() == 1
+    assert np.allclose(beta["gflop_per_s"], beta["limit_gflop"] / beta["seconds_median"], rtol=1e-4)
+    setup = beta_bench.BetaSetup(FACE_BENCH, 2, 2, element="hex")
+    blocks = face_limit.pencil_blocks(setup, setup.operators())
+    dims = [S.shape[0] for pairs in blocks.values() for S, _ in pairs]
+    assert beta["limit_gflop"].iloc[0] >= 8 / 3 * sum(m ** 3 for m in dims) / 1e9 * (1 - 1e-3)
+    table = pd.read_csv(phases)
+    assert list(table.columns) == list(("what", "element", "k", "N", "phase", "cpu_s", "wall_s", "cpu_percent",
+                                        "share", "peak_added_mib"))
+    parts, total = table[table["phase"] != "total"], table[table["phase"] == "total"].iloc[0]
+    assert {"sides: mesh, assembly, factorization", "H Grams", "eigensolves", "other"} <= set(parts["phase"])
+    assert np.isclose(parts["cpu_s"].sum(), total["cpu_s"], rtol=1e-3) and np.isclose(parts["share"].sum(), 1.0,
+                                                                                       rtol=1e-3)
+    assert (table["peak_added_mib"] >= 0).all()  # a peak never falls
+
+
+def test_limit_pencil_blocks_hold_the_whole_spectrum():
+    """The limit's parity blocks of each pencil: their eigenvalues together are the whole pencil's."""
+    import scipy.linalg as sla
+
+    from infsup_contact.bench import face_limit
+
+    setup = beta_bench.BetaSetup(FACE_BENCH, 2, 2, element="hex")
+    ops = setup.operators()
+    blocks = face_limit.pencil_blocks(setup, ops)
+    assert any(len(pairs) > 1 for pairs in blocks.values())                    # the reflections split some
+    for key, (S, G) in ops.items():
+        whole = sla.eigh(S, G, eigvals_only=True)
+        split = np.sort(np.concatenate([sla.eigh(s, g, eigvals_only=True) for s, g in blocks[key]]))
+        assert len(split) == len(whole) and np.allclose(split, whole, rtol=1e-8, atol=1e-10 * whole.max())
+
+
 @pytest.mark.parametrize("argv, key", [
+    (["--what", "beta", "--phases", "x.csv"], "--phases"),
     (["--what", "face", "--element", "prism"], "--element"),
     (["--what", "beta", "--element", "hex"], "--element"),
     (["--what", "face", "--peers", "osqp"], "--peers"),

@@ -116,3 +116,29 @@ def test_the_page_in_the_repository_has_a_block_per_benchmark():
     sources = [m.group("source") for m in gen.BLOCK.finditer(text)]
     assert {"results/benchmarks/beta.csv", "results/benchmarks/contact.csv"} <= set(sources)
     assert len(gen.OPEN.findall(text)) == len(sources)
+
+
+PHASES = """what,element,k,N,phase,cpu_s,wall_s,cpu_percent,share,peak_added_mib
+face_beta,hex,2,8,"sides: mesh, assembly, factorization",1.5,1,150,0.75,20
+face_beta,hex,2,8,other,0.5,0.5,100,0.25,180
+face_beta,hex,2,8,total,2,1.5,133.3,1,200
+"""
+
+
+def test_the_phases_table_has_its_columns_and_rows(tree):
+    """bench --phases' table: one Markdown row per phase with CPU, wall, CPU % and share; a
+    phases file with a column missing is refused in one line, the page untouched."""
+    root, page = tree
+    bench = root / "results" / "benchmarks"
+    (bench / "face_phases.csv").write_text(PHASES)
+    page.write_text("<!-- generated: results/benchmarks/face_phases.csv -->\n<!-- end generated -->\n")
+    assert run(page, root).returncode == 0
+    lines = page.read_text().splitlines()
+    assert lines[1].split(" | ")[4:] == ["phase", "CPU (s)", "wall (s)", "CPU %", "share of CPU",
+                                         "peak memory added (MiB) |"]
+    assert "| sides: mesh, assembly, factorization | 1.5 | 1 | 150 % | 75.0 % | 20 |" in lines[3]
+    assert len([ln for ln in lines if ln.startswith("| face_beta")]) == 3
+    (bench / "face_phases.csv").write_text("\n".join(ln.rsplit(",", 1)[0] for ln in PHASES.splitlines()) + "\n")
+    before = page.read_text()
+    res = run(page, root)
+    assert res.returncode == 2 and len(res.stderr.strip().splitlines()) == 1 and page.read_text() == before

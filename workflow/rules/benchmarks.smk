@@ -52,9 +52,11 @@ rule bench_beta:
 
 
 rule bench_face:
-    # the 3D face: β_h routes as ratios to the limit and the Schur-complement routes side by side
+    # the 3D face: β_h routes as ratios to the limit and the Schur-complement routes side by side,
+    # and where one request's time goes, per phase (--phases; docs/performance.md's breakdown)
     output:
-        "results/benchmarks/face.csv",
+        table="results/benchmarks/face.csv",
+        phases="results/benchmarks/face_phases.csv",
     input:
         PACKAGE_SOURCES,
         BENCH_SOURCES,
@@ -70,7 +72,8 @@ rule bench_face:
         "results/logs/bench_face.log",
     shell:
         _BLAS1 + "infsup-contact bench --what face --N {params.N} --k {params.k} --repeats {params.repeats}"
-        " --route-budget {params.budget} > {output}.tmp 2> {log} && mv {output}.tmp {output}"
+        " --route-budget {params.budget} --phases {output.phases} > {output.table}.tmp 2> {log}"
+        " && mv {output.table}.tmp {output.table}"
 
 
 rule bench_contact:

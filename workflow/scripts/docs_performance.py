@@ -85,6 +85,18 @@ def estimates_table(frame) -> str:
     return markdown(header, rows)
 
 
+def phases_table(frame) -> str:
+    """Per (what, element, k, N) and phase: CPU and wall seconds, CPU % (above 100: more than one
+    core busy), the phase's share of the run's CPU and how far it raised the peak resident memory,
+    as ``bench --phases`` wrote them."""
+    header = ["what", "element", "k", "N", "phase", "CPU (s)", "wall (s)", "CPU %", "share of CPU",
+              "peak memory added (MiB)"]
+    rows = [[r.what, r.element if isinstance(r.element, str) else "", r.k, r.N, r.phase, float(r.cpu_s),
+             float(r.wall_s), f"{r.cpu_percent:.0f} %", f"{100 * r.share:.1f} %", round(r.peak_added_mib)]
+            for r in frame.itertuples(index=False)]
+    return markdown(header, rows)
+
+
 def render(source: str, root: Path) -> str:
     """The Markdown table of one source file."""
     name = Path(source).name
@@ -94,8 +106,11 @@ def render(source: str, root: Path) -> str:
         return dag_table(read_table(root / source, "dag"))
     if name == "estimates.csv":
         return estimates_table(read_table(root / source, "estimates"))
+    if name == "face_phases.csv":
+        return phases_table(read_table(root / source, "phases"))
     raise DocsError(f"{source}: no table is generated from this file (known: "
-                    f"{', '.join(sorted(ROUTE_TABLES | {'dag.csv', 'estimates.csv'}))} under results/benchmarks/)")
+                    f"{', '.join(sorted(ROUTE_TABLES | {'dag.csv', 'estimates.csv', 'face_phases.csv'}))} "
+                    "under results/benchmarks/)")
 
 
 def regenerate(page: str, root: Path) -> str:

@@ -44,6 +44,7 @@ from ..solvers.interface_operator import interface_operator
 from ..solvers.request import MeshOptions
 from ..solvers.side_cache import SideCache
 from .harness import ROUTE_BUDGET, _log, _row, run_interleaved
+from .phases import phase_rows
 
 FAMILY = "structured"
 KERNEL_BETA = 1e-6
@@ -81,6 +82,10 @@ class BetaBench:
         returning {(case, norm): ascending β² values}.
     extra_rows : callable or None
         ``extra_rows(setup, repeats, budget) -> list``: rows of another measurement on the setup.
+    limit_route : callable or None
+        ``limit_route(setup, operators) -> (run, gflop)``: the model's own limit (:mod:`.face_limit`)
+        in place of ``limit_factor`` + one ``eigh`` per pencil, and its flop count (GFLOP, after a
+        run); the rows then carry ``limit_gflop`` and ``gflop_per_s``.
     """
 
     what: str
@@ -95,6 +100,7 @@ class BetaBench:
     compare_limit: bool = True
     extra_routes: Callable | None = None
     extra_rows: Callable | None = None
+    limit_route: Callable | None = None
 
 
 def splu_best_order(K):
@@ -122,9 +128,10 @@ class BetaSetup:
         self.bench, self.n, self.k, self.mesh_options = bench, n, k, mesh_options
         self.sides = SideCache().pair(bench.model, FAMILY, k, n, n, MeshOptions(**mesh_options))
         self.gamma = self.sides[0].trace.gamma
-        g_h = self.gamma.multiplier_partition(*(s.trace.partition for s in self.sides), "omega2")
+        self.g_h = g_h = self.gamma.multiplier_partition(*(s.trace.partition for s in self.sides), "omega2")
         self.cases = bench.cases(k, self.gamma, g_h, cases)
         self.spaces = {c: registry.case_space(c, k, g_h, self.gamma) for c in self.cases}
+        self.limit_gflop = None  # the limit's flops, where its route counts them
         self.ndof = sum(s.ndof for s in self.sides)
 
     def keys(self) -> list:
@@ -211,8 +218,11 @@ def compare(got: dict, ref: dict) -> tuple:
 
 def _routes(setup: BetaSetup) -> dict:
     ops = setup.operators()
-    routes = {"ours": lambda: beta_ours(setup), "ours_core": lambda: beta_ours_core(setup),
-              "limit": beta_limit(setup, ops)}
+    if setup.bench.limit_route is not None:
+        limit, setup.limit_gflop = setup.bench.limit_route(setup, ops)
+    else:
+        limit = beta_limit(setup, ops)
+    routes = {"ours": lambda: beta_ours(setup), "ours_core": lambda: beta_ours_core(setup), "limit": limit}
     return routes | (setup.bench.extra_routes(setup) if setup.bench.extra_routes else {})
 
 
@@ -234,13 +244,29 @@ def _setup_rows(setup: BetaSetup, repeats: int, budget: float) -> list:
             diff, kok = compare(got, ref)
         rows.append(_row(bench.what, name, setup.k, setup.n, times, med_ours, med_second, other=bench.second_ratio,
                          max_abs_diff=diff, kernel_ok=kok, n_problems=len(setup.keys()), ndof=setup.ndof,
-                         dim_M_max=dim_m, includes=bench.includes[name], **setup.mesh_options))  # options: columns
+                         dim_M_max=dim_m, includes=bench.includes[name], **_flops(setup, times),
+                         **setup.mesh_options))  # options: columns
         _log(f"  {name:10s} {np.median(times):9.4f} s  diff {diff:.2e}")
     return rows
 
 
+def _flops(setup: BetaSetup, times) -> dict:
+    """``limit_gflop`` and the rate of a route doing that work in its median time (none where the
+    limit does not count its flops)."""
+    if setup.limit_gflop is None:
+        return {}
+    gflop = setup.limit_gflop()
+    return {"limit_gflop": gflop, "gflop_per_s": gflop / float(np.median(times))}
+
+
+class Rows(list):
+    """The rows of :func:`bench_beta`; ``phases``: the breakdown rows where asked (:mod:`.phases`)."""
+
+    phases: tuple = ()
+
+
 def bench_beta(bench: BetaBench, ns, ks, repeats: int = 3, budget: float = ROUTE_BUDGET, cases=None,
-               **mesh_options) -> list:
+               phases: list | None = None, **mesh_options) -> list:
     """β_h routes of one model on the structured pairs, every case of the benchmark × its norms.
 
     Parameters
@@ -250,6 +276,8 @@ def bench_beta(bench: BetaBench, ns, ks, repeats: int = 3, budget: float = ROUTE
     repeats : repetitions per route (interleaved; median, min, max reported).
     budget : a route is not repeated once its accumulated time exceeds this (seconds).
     cases : the space ids to run where the benchmark's ``cases`` takes them (None: its default).
+    phases : a list that receives the breakdown rows of one ``ours`` run per setup (:mod:`.phases`),
+        also returned as the result's ``phases``; None: not measured.
     mesh_options : the model's mesh options (``element`` for the 3D bodies).
 
     Returns
@@ -265,4 +293,8 @@ def bench_beta(bench: BetaBench, ns, ks, repeats: int = 3, budget: float = ROUTE
             rows += _setup_rows(setup, repeats, budget)
             if bench.extra_rows:
                 rows += bench.extra_rows(setup, repeats, budget)
-    return [{c: r[c] for c in bench.columns} for r in rows]
+            if phases is not None:
+                phases += phase_rows(setup, lambda: beta_ours(setup))
+    out = Rows({c: r.get(c, np.nan) for c in bench.columns} for r in rows)  # a column a row lacks: empty
+    out.phases = phases or []
+    return out

@@ -10,8 +10,8 @@
 ``face`` (``bench --what face``, results/benchmarks/face.csv)
     The 3D membranes of ``MEMBRANES3D`` (hexahedra or tetrahedra, ``element``): every space built
     on the face (as ``infsup-contact beta --model membranes3d --case all``), both norms; β above
-    the kernel ours decided; the limit factorizes by MKL PARDISO (METIS order; SuperLU where
-    MKL does not load); the Schur-complement rows of :mod:`.face_schur` after each setup.
+    the kernel ours decided; the limit is the cheapest known computation of the rows and counts
+    its flops (:mod:`.face_limit`); the Schur-complement rows of :mod:`.face_schur` after each setup.
 """
 from __future__ import annotations
 
@@ -28,6 +28,7 @@ from .beta_pencil import INCLUDES as PENCIL_INCLUDES
 from .beta_pencil import pencil_routes
 from .face_schur import INCLUDES as SCHUR_INCLUDES
 from .face_schur import schur_rows
+from .face_limit import face_limit
 
 _SECONDS = ("seconds_median", "seconds_min", "seconds_max", "ratio_to_ours")
 BETA_COLUMNS = ("what", "route", "k", "N", *_SECONDS, "ratio_to_ours_core", "repeats", "max_abs_diff", "kernel_ok",
@@ -35,7 +36,7 @@ BETA_COLUMNS = ("what", "route", "k", "N", *_SECONDS, "ratio_to_ours_core", "rep
 ELASTIC_COLUMNS = ("what", "route", "k", "N", *_SECONDS, "ratio_to_limit", "repeats", "max_abs_diff", "n_problems",
                    "ndof", "includes")
 FACE_COLUMNS = ("what", "route", "element", "k", "N", *_SECONDS, "ratio_to_limit", "max_abs_diff", "repeats",
-                "n_problems", "ndof", "dim_M_max", "includes")
+                "n_problems", "ndof", "dim_M_max", "limit_gflop", "gflop_per_s", "includes")
 
 
 def structural_kernel(case, k, n, row) -> int:
@@ -84,10 +85,10 @@ FACE_BENCH = BetaBench(
                       "(+β with v1=0), every case × norm",
               "ours_core": "Γ-last LU+Schur per body+couplings+interface+Gram+eigh per (case,norm) "
                            "(assembled stiffness given)",
-              "limit": "one sparse Cholesky per body (PARDISO, else splu MMD_AT_PLUS_A) + one eigh per (case,norm) "
-                       "(interface operators, Grams given)",
+              "limit": "plain Cholesky (PARDISO) of each body's parity parts (one body on a mirrored pair) + "
+                       "one eigh per parity block of each (case,norm) (interface operators, Grams given)",
               **SCHUR_INCLUDES},
-    extra_rows=schur_rows)
+    extra_rows=schur_rows, limit_route=face_limit)
 """The 3D membranes' face benchmark (``element`` is a mesh option of ``bench_beta``)."""
 
 

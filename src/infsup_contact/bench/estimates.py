@@ -48,6 +48,8 @@ EXAMPLES = (
     Example("hex k=1 N=16", _FACE + ("--k", "1", "--N1", "16", "--N2", "16")),
     Example("hex k=2 N=8 (docs/models.md)", _FACE + ("--k", "2", "--N1", "8", "--N2", "8")),
     Example("hex k=2 N=16 (issue 50)", _FACE + ("--k", "2", "--N1", "16", "--N2", "16")),
+    Example("hex k=2 N=24, both norms", _FACE + ("--k", "2", "--N1", "24", "--N2", "24", "--norm", "all")),
+    Example("hex k=2 N=32, both norms (~4 GB)", _FACE + ("--k", "2", "--N1", "32", "--N2", "32", "--norm", "all")),
     Example("tet k=2 N=8 (docs/models.md)", _FACE + ("--element", "tet", "--k", "2", "--N1", "8", "--N2", "8")),
     Example("hex20 k=2 N=8 (docs/models.md)", _FACE + ("--element", "hex20", "--k", "2", "--N1", "8", "--N2", "8")),
     Example("Stokes P2-P1 16..128 (examples/stokes_skfem.py)", ("verdict", "--system", "{tmp}/levels.yaml"),
@@ -131,6 +133,30 @@ def run_example(ex: Example) -> dict:
     return {"example": ex.name, "command": command, "est_mib": est_mib, "rss_mib": got["rss_mib"],
             "mem_ratio": est_mib / got["rss_mib"], "est_s": est_s, "cpu_s": got["cpu_s"], "wall_s": got["wall_s"],
             "time_ratio": est_s / got["cpu_s"], "load_before": load_before, "load_after": load_after}
+
+
+def fit_large_route_3d(points, components: int = 1) -> tuple:
+    """(a, b, c, d) of ``resources.LARGE_ROUTE_3D`` (before its margin) from measured requests
+    ``points`` = [(k, N, peak bytes, CPU seconds), ...] of one degree on the large route: non-negative
+    least squares on relative residuals of bytes − process − MKL = a Σnd + b m² and seconds − start =
+    c Σnd + d m³ (m = (k N + 1)²), the way the constants were fitted. At least two sizes."""
+    import numpy as np
+    from scipy.optimize import nnls
+
+    from .. import resources as R
+
+    rows_b, rows_t, rhs_b, rhs_t = [], [], [], []
+    for k, n, peak, cpu in points:
+        nd = 2 * components * R.face_side_dofs(n, k)
+        m = float(R._large_route_dim(k, n, components))
+        mem = peak - R.PROCESS_BYTES["beta"] - R.MKL_BYTES
+        rows_b.append([nd / mem, m * m / mem])
+        rhs_b.append(1.0)
+        rows_t.append([nd / (cpu - R.START_SECONDS), m ** 3 / (cpu - R.START_SECONDS)])
+        rhs_t.append(1.0)
+    (a, b), _ = nnls(np.array(rows_b), np.array(rhs_b))
+    (c, d), _ = nnls(np.array(rows_t), np.array(rhs_t))
+    return float(a), float(b), float(c), float(d)
 
 
 def main(argv=None) -> int:

@@ -6,7 +6,9 @@ machine load hits all of them alike. ``ratio_to_ours`` = route seconds / ``ours`
 seconds; β tables add ``ratio_to_ours_core`` (/ ``ours_core``), contact tables
 ``ratio_to_limit`` (/ ``limit``: how close a route comes to the unavoidable
 factorization). All ratios are of medians.
-Run with one BLAS thread (``OPENBLAS_NUM_THREADS=1``, the CLI's default).
+The workflow's rules run one BLAS thread (``OPENBLAS_NUM_THREADS=1 MKL_NUM_THREADS=1``); with no
+thread count in the environment a run takes the idle cores (:func:`~infsup_contact.la.threaded.decide_threads`),
+and ``machine.json`` records the counts.
 
 The routes: :mod:`.beta_bench` (β_h of any model), :mod:`.contact_routes` (contact, with the peers of
 :mod:`.peers`); :mod:`.speed_accuracy` relates time to error.
@@ -137,6 +139,7 @@ def machine_info() -> dict:
                 load_average_1_5_15=load, platform=platform.platform(),
                 openblas_threads=os.environ.get("OPENBLAS_NUM_THREADS", "unset"),
                 omp_threads=os.environ.get("OMP_NUM_THREADS", "unset"),
+                mkl_threads=os.environ.get("MKL_NUM_THREADS", "unset"),
                 versions=library_versions(),
                 date=time.strftime("%Y-%m-%dT%H:%M:%S%z"))
 

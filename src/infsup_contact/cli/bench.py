@@ -3,7 +3,7 @@ from __future__ import annotations
 
 from ..errors import InputError
 from .common import FlagUse, add_dry_run, check_memory, declare_flag_uses, write_csv
-from .verdict_formats import add_table_output, force_use
+from .verdict_formats import add_table_output, force_use, is_stream, output_path
 
 
 def add(sub) -> None:
@@ -32,6 +32,9 @@ def add(sub) -> None:
     p.add_argument("--radius", type=float, default=None, help="arc: the radius R > 1 of Γ (default 2)")
     p.add_argument("--case", nargs="+", default=None,
                    help="elastic: the space ids to run, each where defined for k (default every registered one)")
+    p.add_argument("--phases", default=None, metavar="FILE", type=output_path,
+                   help="face: also write where one end-to-end run's time goes, per phase (CPU s, wall s, "
+                        "CPU %%, share; CSV), to FILE")
     add_table_output(p)
     add_dry_run(p)
     declare_flag_uses(p, [*FLAG_USES, force_use()])
@@ -45,7 +48,7 @@ def _what(*whats):
 FLAG_USES = [FlagUse(dest, _what(what), f"--what {what}", lambda a: f"--what {a.what}")
              for dest, what in (("peers", "contact"), ("kkt_max_n", "contact"), ("eigsh_max_n", "beta"),
                                 ("dense_max_size", "beta"), ("element", "face"), ("nu", "elastic"),
-                                ("case", "elastic"), ("radius", "arc"))]
+                                ("case", "elastic"), ("radius", "arc"), ("phases", "face"))]
 """The flags of ``bench`` only one ``--what`` uses (:func:`~.common.refuse_unused`)."""
 
 
@@ -63,6 +66,8 @@ def _check_bench(args):
     from ..discretization.spaces.registry import check_pair_spaces, ids_valid_for
 
     TARGET_CHECKS.get(args.what, lambda _: None)(args)  # a target's own flags
+    if args.phases is not None and (args.phases == "-" or is_stream(args.phases)):
+        raise InputError("phases", "a file name to write (the table goes to stdout or --output)", got=args.phases)
     for k in args.k:  # every registered space defined for k: a superset of what the routes run
         for n in args.N:
             check_pair_spaces(ids_valid_for(k), k, n, n, key="N")
@@ -135,7 +140,13 @@ def _run_bench(args) -> None:
     peers = args.peer_list
     if args.what == "face":
         rows = bench.bench_beta(bench.bench_for("face"), args.N, args.k, args.repeats, args.route_budget,
-                                element=args.element)
+                                element=args.element, phases=[] if args.phases else None)
+        if args.phases:
+            from ..bench.phases import COLUMNS
+            from ..io import write_atomic
+
+            write_atomic(args.phases, pd.DataFrame(rows.phases, columns=list(COLUMNS)).to_csv(
+                index=False, float_format="%.4g"))
     elif args.what == "beta":
         rows = bench.bench_beta(bench.bench_for("beta", dense_max_size=args.dense_max_size,
                                                 eigsh_max_n=args.eigsh_max_n), args.N, args.k, args.repeats,

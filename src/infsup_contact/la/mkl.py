@@ -8,7 +8,9 @@ own OpenBLAS; MKL serves where scipy's wrappers cannot: PARDISO's Schur compleme
 a sub-block of a matrix in place (scipy's f2py wrappers copy every non-contiguous slice, about
 half of a 4,225² inverse standard form, :func:`~infsup_contact.la.bottom.inverse_standard_form`).
 Every caller keeps a scipy route for a machine without it (:func:`available`). Threads: as
-:func:`~infsup_contact.la.threaded.threads` (MKL_NUM_THREADS, else OPENBLAS_NUM_THREADS, else 1).
+:func:`~infsup_contact.la.threaded.threads` (MKL_NUM_THREADS, else OPENBLAS_NUM_THREADS, else 1) when
+MKL loads; later :func:`~infsup_contact.la.threaded.use_threads` (the request's count) and
+:func:`~infsup_contact.la.threaded.run_concurrently` (one thread per task, ``MKL_Set_Num_Threads_Local``).
 """
 from __future__ import annotations
 
@@ -20,6 +22,7 @@ from functools import lru_cache
 
 import numpy as np
 
+from . import threaded
 from .threaded import threads
 
 _COL_MAJOR, _LEFT, _LOWER, _NO_TRANS, _NON_UNIT = 102, 141, 122, 111, 131
@@ -53,6 +56,9 @@ def mkl_rt():
             continue
         lib.cblas_dtrsm.argtypes = [ctypes.c_int] * 7 + [ctypes.c_double, ctypes.c_void_p, ctypes.c_int,
                                                          ctypes.c_void_p, ctypes.c_int]
+        # later decisions reach MKL too: a request's thread count, one thread per concurrent task
+        threaded.GLOBAL_THREADS_HOOKS.append(lambda n: lib.MKL_Set_Num_Threads(ctypes.c_int(n)))
+        threaded.LOCAL_THREADS_HOOKS.append(lambda n: lib.MKL_Set_Num_Threads_Local(ctypes.c_int(n)))
         return lib
     _note(FALLBACK_NOTE.format(why=f" ({failures[0]})" if failures else ""))
     return None

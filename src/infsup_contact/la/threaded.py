@@ -16,14 +16,22 @@ never transposes a large operand: X Aᵀ is formed row block by row block from s
 
 The number of threads is the BLAS's (MKL_NUM_THREADS, else OPENBLAS_NUM_THREADS, else 1, as
 :mod:`infsup_contact.la.pardiso` reads it): a run asked to use one core uses one.
+
+Here too the decisions on threads for a whole request (:func:`decide_threads`: what the
+environment asks, else every idle core; :func:`use_threads`) and the helper that runs independent
+non-BLAS work side by side (:func:`run_concurrently`: the two sides, a body's parity parts) with
+the BLAS of each task on one thread, so that tasks × threads never exceed the cores.
 """
 from __future__ import annotations
 
 import os
-from concurrent.futures import ThreadPoolExecutor
+import threading
+from concurrent.futures import ThreadPoolExecutor, wait
 
 import numpy as np
 import scipy.sparse as sp
+
+from .openblas import fitted_threads, set_threads, threads_now
 
 MIN_ROWS = 256
 """Fewest result rows of a sparse product per thread worth a thread (below it one call does all)."""
@@ -35,13 +43,141 @@ transposed, a pass that stays in cache at this width (one thread: R S_P Rᵀ at 
 B X Bᵀ at n_Γ = 3,969 take about half the time of BLOCK = 256)."""
 
 
+THREAD_VARIABLES = ("MKL_NUM_THREADS", "OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS")
+"""The variables that fix the BLAS threads, in the order they are read (:func:`asked_threads`)."""
+
+_worker = threading.local()
+"""``inside`` is True in a thread of :func:`run_concurrently`: its BLAS has one thread."""
+LOCAL_THREADS_HOOKS: list = []
+"""Callables ``hook(n)`` setting the calling thread's own BLAS thread count (0: the process's
+again); :mod:`.mkl` registers ``MKL_Set_Num_Threads_Local`` once it loads MKL."""
+GLOBAL_THREADS_HOOKS: list = []
+"""Callables ``hook(n)`` setting a loaded library's process-wide thread count (:mod:`.mkl`'s)."""
+
+
 def threads() -> int:
-    """Threads for the products here: MKL_NUM_THREADS, else OPENBLAS_NUM_THREADS, else 1."""
+    """Threads for the products here: MKL_NUM_THREADS, else OPENBLAS_NUM_THREADS, else 1 (1 inside
+    a :func:`run_concurrently` task: the tasks hold the cores)."""
+    if getattr(_worker, "inside", False):
+        return 1
     value = os.environ.get("MKL_NUM_THREADS") or os.environ.get("OPENBLAS_NUM_THREADS") or "1"
     try:
         return max(int(value), 1)
     except ValueError:
         return 1
+
+
+def asked_threads(environ=None) -> int | None:
+    """The thread count the environment fixes: the first of :data:`THREAD_VARIABLES` that is set
+    (an unreadable value counts as 1, as :func:`threads` reads it); None where none is set (nobody
+    chose: :func:`decide_threads` takes the idle cores)."""
+    environ = os.environ if environ is None else environ
+    for var in THREAD_VARIABLES:
+        value = environ.get(var)
+        if value:
+            try:
+                return max(int(value), 1)
+            except ValueError:
+                return 1
+    return None
+
+
+def decide_threads(asked: int | None, cpus: int, idle: float | None) -> int:
+    """Threads of one request (:func:`use_threads`): the count asked for, else ``cpus``, fitted
+    to the idle cores either way (:func:`~.openblas.fitted_threads`: a core counts when 3/4 idle;
+    processes side by side, e.g. Snakemake's jobs, each fix their own count and so never sum to
+    more than the machine; a request alone on an idle machine gets every core)."""
+    return fitted_threads(max(cpus, 1) if asked is None else asked, idle)
+
+
+def use_threads(n: int) -> None:
+    """Give a request ``n`` threads: MKL (PARDISO, its BLAS), the products here and
+    :func:`run_concurrently`'s tasks (MKL_NUM_THREADS, which :func:`threads` and MKL read; MKL
+    itself if already loaded). OpenBLAS keeps the count it started with (one, the CLI's default):
+    its threads wait for work by spinning, and a second OpenBLAS thread on a core another process
+    takes made the same request 11× slower (N = 8, k = 2, ``--case all``, load 8 on 2 cores: 86.7 s
+    against 7.6 s wall), where MKL's second thread and two tasks cost nothing (8.3 s)."""
+    n = max(int(n), 1)
+    os.environ["MKL_NUM_THREADS"] = str(n)
+    for hook in GLOBAL_THREADS_HOOKS:
+        hook(n)
+
+
+M_TRIM_THRESHOLD, M_MMAP_MAX = -1, -4
+"""glibc's ``mallopt`` parameters (malloc.h)."""
+
+
+def reuse_freed_memory() -> bool:
+    """Keep freed memory in the process for the next allocation (glibc ``mallopt``: no ``mmap``
+    per large block, no trimming). A request allocates and frees dense blocks of 100 MB and more
+    many times over; by default each is a fresh ``mmap`` whose pages fault in zeroed one by one,
+    and the request spent 15 % of its CPU in the kernel (k = 2, N = 24: 7.1 s sys of 45.8 s,
+    689 k minor faults; with this 1.1 s, 342 k faults; N = 32: 4.9 s sys of 161 s). Transparent
+    huge pages are not the cause (``NUMPY_MADVISE_HUGEPAGE=0``: 7.5 s sys, 3.4 M faults): zeroing
+    fresh pages is. The price is a higher peak (freed blocks stay resident between reuses: peak RSS
+    1.78 GB against 1.68 at N = 24, 5.19 GB against ~4.4 at N = 32), so the command line applies it
+    only where memory is plentiful (``cli._reuse_freed_memory``). Left as it is where glibc is
+    absent or a ``MALLOC_*`` variable already says how; True if applied."""
+    import ctypes
+
+    if any(v.startswith("MALLOC_") for v in os.environ):
+        return False
+    try:
+        libc = ctypes.CDLL(None)
+        mallopt = libc.mallopt
+    except (OSError, AttributeError):
+        return False
+    return bool(mallopt(M_MMAP_MAX, 0)) and bool(mallopt(M_TRIM_THRESHOLD, 2 ** 31 - 1))
+
+
+def run_concurrently(tasks, workers: int | None = None) -> list:
+    """[task() for task in tasks], the tasks (callables without arguments, independent of each
+    other) run side by side on ``workers`` threads (default :func:`threads`, at most one per task).
+
+    For work that releases the GIL and is not BLAS: PARDISO's factorizations (ctypes releases the
+    GIL), NGSolve's assembly, numpy's and scipy's kernels. No oversubscription: inside the tasks the
+    BLAS runs one thread per task (OpenBLAS set to 1 for the duration, MKL per thread, the products
+    of this module serial), so tasks × BLAS threads ≤ the threads asked for. One worker, one task,
+    or a call from inside a task (nested): the tasks run in turn in the calling thread. The results
+    come in the tasks' order; every task runs to its end, then the first failure (in the tasks'
+    order) is raised."""
+    tasks = list(tasks)
+    n = min(len(tasks), threads() if workers is None else max(int(workers), 1))
+    if n <= 1 or getattr(_worker, "inside", False):
+        return [task() for task in tasks]
+    before = threads_now()
+
+    def inside(task):
+        def run():
+            _worker.inside = True
+            for hook in LOCAL_THREADS_HOOKS:
+                hook(1)
+            try:
+                return task()
+            finally:
+                for hook in LOCAL_THREADS_HOOKS:
+                    hook(0)
+                _worker.inside = False
+        return run
+
+    set_threads(1)
+    try:
+        with ThreadPoolExecutor(n, thread_name_prefix="infsup-concurrent") as pool:
+            futures = [pool.submit(inside(t)) for t in tasks]
+            wait(futures)
+    finally:
+        if before:
+            set_threads(max(before.values()))
+    for f in futures:  # the first failure in the tasks' order, after all ran
+        if f.exception() is not None:
+            raise f.exception()
+    return [f.result() for f in futures]
+
+
+def concurrent_map(fn, items) -> list:
+    """[fn(x) for x in items] by :func:`run_concurrently` (a ``map`` for callers that take one:
+    a body's parity parts, :meth:`~infsup_contact.la.body_parity.ParityParts.factorize`)."""
+    return run_concurrently([lambda x=x: fn(x) for x in items])
 
 
 def _row_blocks(n_rows: int, weights: np.ndarray | None = None, min_rows: int = MIN_ROWS) -> list[slice]:

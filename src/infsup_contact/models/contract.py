@@ -51,6 +51,7 @@ import scipy.sparse.linalg as spla
 from ..discretization.gamma.trace import GammaTrace
 from ..la import body_parity, schur
 from ..la.schur import SteklovProduct
+from ..la.threaded import concurrent_map
 from . import body_symmetry
 
 
@@ -292,7 +293,7 @@ class SideOperator(SteklovProduct):
 
 def factorized_side(trace: GammaTrace, free: np.ndarray, K, route: str = "auto",
                     keep_factor: bool = False, signature: np.ndarray | None = None,
-                    parts_map=map) -> SideOperator:
+                    parts_map=concurrent_map) -> SideOperator:
     """The SideOperator of an assembled stiffness K (free dofs, Γ last): one
     :func:`gamma_factorization` (``keep_factor`` for a side that will solve: a contact scene's).
 
@@ -300,8 +301,9 @@ def factorized_side(trace: GammaTrace, free: np.ndarray, K, route: str = "auto",
     square's reflections (checked on K, Γ to Γ) is factorized in its parity parts instead
     (:mod:`~infsup_contact.la.body_parity`: the same S and solves to round-off, a fraction of
     the flops); any other body, or no signature, takes the general route. ``parts_map`` runs the
-    parts' factorizations, independent calls (the built-in ``map``: one by one; a pool's ``map``:
-    side by side)."""
+    parts' factorizations, independent calls (default :func:`~infsup_contact.la.threaded.concurrent_map`:
+    side by side on the request's threads, one BLAS thread each, in turn inside another task; the
+    built-in ``map``: one by one)."""
     n_gamma = len(trace.gamma_dofs)
     bases = body_symmetry.parity_bases(signature, K, n_gamma)
     if bases is not None:

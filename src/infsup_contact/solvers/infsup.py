@@ -57,7 +57,8 @@ def beta_table(request: BetaRequest, side_cache: SideCache | None = None, modes:
     t0 = time.perf_counter()
     cache = SideCache() if side_cache is None else side_cache
     progress.note("the two sides")
-    sides = cache.pair(r.model, r.family, r.k, r.n1, r.n2, r.mesh)                 # Ω1, Ω2 with Γ last
+    with progress.phase("sides: mesh, assembly, factorization"):
+        sides = cache.pair(r.model, r.family, r.k, r.n1, r.n2, r.mesh)             # Ω1, Ω2 with Γ last
     t_sides = time.perf_counter() - t0
     gamma = sides[0].trace.gamma
     p1, p2 = (s.trace.partition for s in sides)
@@ -99,27 +100,37 @@ def _case_rows(r: BetaRequest, case, g_h, sides, dim_w: int, trace_norms, modes:
     space = _space(case, r.k, g_h, gamma)                                          # M_h on G_h
     tc = time.perf_counter()
     progress.note("couplings B_1, B_2")
-    couplings = [coupling_matrix(s.trace, space, r.k, sparse=is_large(space)) for s in sides]  # B_i
+    with progress.phase("couplings"):
+        couplings = [coupling_matrix(s.trace, space, r.k, sparse=is_large(space)) for s in sides]  # B_i
     t_coupling = time.perf_counter() - tc
     grams = GramCache() if grams is None else grams
-    grams = {norm: grams.gram(gamma, case, r.k, g_h, space, norm, r.h_route) for norm in r.norms}  # G per norm
+    grams = {norm: _timed(f"{norm} Grams", grams.gram, gamma, case, r.k, g_h, space, norm, r.h_route)
+             for norm in r.norms}  # G per norm
     structural = gamma.proven_kernel(space, r.k, [s.trace for s in sides], dim_w)
-    route = choose_route(space, couplings, sides, grams, structural, g_h, r.k, trace_norms, vectors=modes is not None)
+    with progress.phase("kernel decision, Grams split and factorized"):
+        route = choose_route(space, couplings, sides, grams, structural, g_h, r.k, trace_norms,
+                             vectors=modes is not None)
     progress.note(f"interface operator ({route.name} route)")
-    terms = interface_terms(couplings, sides)                                      # B_i X_i B_iᵀ
-    v1_zero = route.betas_v1_zero(terms)
+    terms = _timed("interface terms", interface_terms, couplings, sides)            # B_i X_i B_iᵀ
+    v1_zero = _timed("β with v1 = 0", route.betas_v1_zero, terms)
     rows = []
     for c1, c2 in r.c_pairs:
         S = combine_terms(terms, (c1, c2))
         progress.note(f"eigenproblem S m = β² G m, norm {', '.join(r.norms)}"
                       + (f", c1={c1:g} c2={c2:g}" if len(r.c_pairs) > 1 else ""))
-        spectra, seconds = route.spectra(S, r.norms)  # S m = β² G m
+        spectra, seconds = _timed("eigensolves", route.spectra, S, r.norms)  # S m = β² G m
         rows += [_row(r, case, c1, c2, norm, spectra[norm], route.kernel, structural, v1_zero[norm] / np.sqrt(c2),
                       space.dim, dim_w, grams[norm][1], sum(s.ndof for s in sides), t_coupling, seconds[norm])
                  for norm in r.norms]
         if modes is not None:
             modes += worst_modes(route, S, rows[-len(r.norms):], space, gamma)
     return rows
+
+
+def _timed(name: str, fn, *args):
+    """fn(*args), its time counted as the phase ``name`` (:func:`~infsup_contact.progress.phase`)."""
+    with progress.phase(name):
+        return fn(*args)
 
 
 def _row(r, case, c1, c2, norm, spec, kernel, structural, beta_v1_zero, dim_m, dim_w, info, ndof,

@@ -36,6 +36,7 @@ from collections import Counter, OrderedDict
 import numpy as np
 
 from .. import progress
+from ..la.threaded import run_concurrently
 from .request import NO_OPTIONS, MeshOptions
 
 
@@ -69,8 +70,14 @@ class SideCache:
         """[side operator of Ω1 (N1 segments on Γ), side operator of Ω2 (N2)]. The arguments are
         a validated request's (:class:`~.request.BetaRequest`) or checked by the mesh builder."""
         key1, key2 = side_keys(model, family, k, n1, n2, mesh)
-        side1 = self._get(key1)
-        sides = [side1, self._get(key2, mirror_of=side1 if n1 == n2 else None)]
+        if n1 == n2 and getattr(model, "mirror_side", None) is not None:
+            # a matching pair: side 2 is side 1 mirrored (checked), so side 1 first; its parity
+            # parts take the cores (factorized_side's parts_map)
+            side1 = self._get(key1)
+            sides = [side1, self._get(key2, mirror_of=side1)]
+        else:
+            # two independent sides (meshing, assembly, factorization release the GIL): side by side
+            sides = run_concurrently([lambda key=key: self._get(key) for key in (key1, key2)])
         return sides[0].trace.gamma.paired(sides)  # a Γ coupled by projection ties the two
 
     def _get(self, key, mirror_of=None):

@@ -38,7 +38,7 @@ import scipy.sparse.linalg as spla
 from ..discretization.gamma.coupling import coupling_matrix
 from ..discretization.spaces import registry
 from ..errors import InputError
-from ..models.contract import Model, factorized_side
+from ..models.contract import Model, factorized_side, mirrored_side
 from ..solvers.infsup import beta_rows
 from ..solvers.interface_operator import interface_operator
 from ..solvers.request import MeshOptions
@@ -164,7 +164,9 @@ def beta_ours_core(setup: BetaSetup) -> dict:
     are first returned to their state right after the build (a fresh run has no cached basis)."""
     for s in setup.sides:
         s.forget_cached()
-    sides = [factorized_side(s.trace, s.free, s.stiffness) for s in setup.sides]
+    s1, s2 = setup.sides  # as ours: the bodies' parity parts, side 2 side 1's mirror where checked
+    side1 = factorized_side(s1.trace, s1.free, s1.stiffness, signature=getattr(s1, "signature", None))
+    sides = [side1, mirrored_side(side1, s2.trace, s2.free, s2.stiffness, getattr(s2, "signature", None))]
     out = {}
     with setup.gamma.gram_session():  # as ours: spaces sharing a piece space share its series
         for c in setup.cases:

@@ -26,12 +26,9 @@ import scipy.linalg as sla
 from ..la import pardiso
 from ..solvers.symmetry import split_of
 
-try:  # the bodies' parity parts, where the package has them
-    from ..la.body_parity import parity_parts as _parity_parts
-    from ..models.body_symmetry import mirror_permutation as _mirror
-    from ..models.body_symmetry import parity_bases as _parity_bases
-except ImportError:  # pragma: no cover - without them the limit factorizes each body whole
-    _parity_parts = _parity_bases = _mirror = None
+from ..la.body_parity import parity_parts as _parity_parts
+from ..models.body_symmetry import mirror_permutation as _mirror
+from ..models.body_symmetry import parity_bases as _parity_bases
 
 EIGH_FLOPS_PER_M3 = 8.0 / 3.0
 """Flops of a dense generalized ``eigh`` of size m, eigenvalues only, per m³ (module text)."""
@@ -42,7 +39,7 @@ def parity_parts(side) -> list:
     has the square's reflections (a ``signature`` and the parity modules), else [K]."""
     K, n_gamma = side.stiffness, len(side.trace.gamma_dofs)
     signature = getattr(side, "signature", None)
-    if _parity_bases is not None and signature is not None:
+    if signature is not None:
         bases = _parity_bases(signature, K, n_gamma)
         if bases is not None:
             return [part.stiffness for part in _parity_parts(K, n_gamma, bases).parts]
@@ -53,9 +50,8 @@ def floor_matrices(sides) -> list:
     """The matrices of both bodies' floor: side 2's none where it is side 1's mirror image."""
     out = parity_parts(sides[0])
     s1, s2 = sides
-    mirrored = (_mirror is not None and _mirror(getattr(s1, "signature", None), s1.stiffness,
-                                                getattr(s2, "signature", None), s2.stiffness,
-                                                len(s1.trace.gamma_dofs)) is not None)
+    mirrored = _mirror(getattr(s1, "signature", None), s1.stiffness, getattr(s2, "signature", None),
+                       s2.stiffness, len(s1.trace.gamma_dofs)) is not None
     return out if mirrored else out + parity_parts(s2)
 
 

@@ -30,7 +30,8 @@ LAYERS = [
     {"discretization.face"},                         # the face of the 3D models
     {"discretization.spaces"},                       # the registry of multiplier spaces
     {"models"},                                      # physics: the bodies and their operators
-    {"solvers"},                                     # β_h (eq. 4.5), the contact solvers
+    {"solvers"},                                     # β_h (eq. 4.5)
+    {"contact"},                                     # the contact problem (4.1): PDAS, KKT, reduced QP
     {"criteria"},                                    # the rules that turn β_h series into verdicts
     {"resources"},                                   # memory and time estimates of a run
     {"systems"},                                     # foreign systems read and certified

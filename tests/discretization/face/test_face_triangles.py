@@ -18,7 +18,7 @@ from infsup_contact.errors import InputError
 from infsup_contact.models import make_model
 from infsup_contact.solvers.side_cache import SideCache
 from infsup_contact.solvers.infsup import beta_rows
-from infsup_contact.solvers.contact import contact_qp
+from infsup_contact.contact.contact import contact_qp
 from infsup_contact.solvers.request import MeshOptions
 
 FAMILIES = [(1, True, True), (2, True, True), (1, True, False), (3, True, False), (0, False, False),

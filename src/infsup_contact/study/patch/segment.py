@@ -51,7 +51,7 @@ from ...discretization.segment import meshes
 from ...discretization.spaces import registry
 from ...models import make_model
 from ...models.plane_strain import check_modulus, check_nu
-from ...solvers.contact import contact_pair, solve_contact_on
+from ...contact.contact import contact_pair, solve_contact_on
 from ..contact.blocks import SIDE, PressedBlocks, block_mesh
 from ..contact.registry import PATCH
 from . import table

@@ -2,8 +2,8 @@
 declared through the section templates (:mod:`.templates`, :mod:`.sections`).
 
 Pure functions from the elastic tables (results/tables/elastic_*.csv, the elastic claims and
-results/benchmarks/elastic_beta.csv) to LaTeX text; ``workflow/scripts/elastic_paper.py``
-reads and writes. Macro names start with ``elastic`` (letters only, :func:`macro_name`), so
+results/benchmarks/elastic_beta.csv) to LaTeX text; ``workflow/scripts/model_paper.py``
+reads and writes (plans/elastic.py). Macro names start with ``elastic`` (letters only, :func:`macro_name`), so
 they stay apart from the main paper's generated namespace.
 """
 from __future__ import annotations

@@ -171,6 +171,3 @@ SCHEMAS = {
                              label="a Snakemake benchmark file", sep="\t"),
 }
 """The declared tables (:func:`read_table`): one :class:`Schema` per kind."""
-
-TABLE_COLUMNS = {kind: tuple(s.columns) for kind, s in SCHEMAS.items()}
-"""Required columns per table kind (derived from :data:`SCHEMAS`)."""

@@ -19,7 +19,6 @@ from .templates import (Group, at, beta_cell, blank, body_lines, case_keys, case
 from .texformat import case_order, fmt_fixed, fmt_int, fmt_sci, latex_id
 from .texnames import Macro, _k, macro_name
 
-ELASTIC_FILES = ("elastic_macros.tex", "elastic_beta_table.tex", "elastic_patch_table.tex", "elastic_hertz_table.tex")
 FAMILIES = ("structured", "perturbed", "unstructured")
 """The mesh families of the β_h table, in its row order."""
 PATCH_ERRORS = ("lambda_max_rel_error", "lambda_end_rel_error", "lambda_middle_rel_error", "u_max_rel_error")

@@ -94,9 +94,9 @@ def test_beta_limit_and_core_routes_agree_with_ours():
 @pytest.mark.parametrize("route", ["solves", "nested"])
 def test_reduced_qp_equals_solve_contact(route):
     """The QP-level route (only A, B, F) = the mesh-level route, for both factorizations."""
-    from infsup_contact.solvers.contact import solve_contact
+    from infsup_contact.contact.contact import solve_contact
     from infsup_contact.bench.peers import contact_qp
-    from infsup_contact.solvers.reduced_qp import solve_reduced_qp
+    from infsup_contact.contact.reduced_qp import solve_reduced_qp
     from infsup_contact.study.contact.scenes import membranes
 
     sc, sides, Bs, F = contact_routes._contact_problem(6, 2)
@@ -127,7 +127,7 @@ def test_speed_accuracy_table_from_contact_rows():
 
 def test_split_timing_parts_are_ordered_and_a_shared_pair_solves_as_a_fresh_one():
     from infsup_contact.bench.speed_accuracy import time_contact_solves
-    from infsup_contact.solvers.contact import contact_pair, solve_contact, solve_contact_on
+    from infsup_contact.contact.contact import contact_pair, solve_contact, solve_contact_on
     from infsup_contact.study.contact.scenes import membranes
 
     t = time_contact_solves(["T3", "R5.4"], 2, 4, repeats=3)

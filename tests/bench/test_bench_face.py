@@ -11,7 +11,7 @@ from infsup_contact.bench import beta_bench, face_schur
 from infsup_contact.bench.beta_models import FACE_BENCH, FACE_COLUMNS
 from infsup_contact.discretization.gamma.coupling import coupling_matrix
 from infsup_contact.solvers.infsup import saddle_point_beta
-from infsup_contact.solvers.contact import contact_qp
+from infsup_contact.contact.contact import contact_qp
 
 from helpers.cli import run_in_process
 from infsup_contact.discretization.spaces import registry

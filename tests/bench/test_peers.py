@@ -4,7 +4,7 @@ import pytest
 
 from infsup_contact import bench
 from infsup_contact.bench import contact_routes, peers
-from infsup_contact.solvers.contact import solve_contact
+from infsup_contact.contact.contact import solve_contact
 from infsup_contact.study.contact.scenes import membranes
 
 

@@ -18,7 +18,7 @@ EXTERNAL = {"PetscBinaryIO.py", "actions/runner", "actions/checkout@v4", "infsup
 
 _SKIP_DIRS = {".git", ".venv", "results", ".snakemake", "build", "__pycache__", "node_modules"}
 _PLACEHOLDER = re.compile(r"[{}<>…]|\b(NAME|DIR|FILE|RULE|GROUP|SPACE)\b")
-_OUTPUT_ROOTS = ("results/", "/", ".snakemake/", ".venv/", "~")
+_OUTPUT_ROOTS = ("results/", "/", ".snakemake/", ".venv/", "~", ".calculix/")
 
 
 @lru_cache(maxsize=1)

@@ -20,9 +20,9 @@ from infsup_contact.models import MODELS
 from infsup_contact.models.elastic import (ELASTIC, check_nu, elastic_model, elastic_space, elastic_stiffness,
                                            interpolate, lame, side_operator)
 from infsup_contact.solvers.interface_operator import interface_operator
-from infsup_contact.solvers.contact import contact_qp
+from infsup_contact.contact.contact import contact_qp
 from infsup_contact.solvers.infsup import beta_rows, saddle_point_beta
-from infsup_contact.solvers.pdas import solve_pdas
+from infsup_contact.contact.pdas import solve_pdas
 from infsup_contact.study.patch.segment import PASS_RTOL
 
 

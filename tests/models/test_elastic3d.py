@@ -18,7 +18,7 @@ from infsup_contact.models.elastic3d import (ELASTIC3D, elastic_stiffness, side_
                                              vector_space)
 from infsup_contact.models.plane_strain import lame
 from infsup_contact.models.contract import Body, schur_by_solves
-from infsup_contact.solvers.contact import solve_contact_on
+from infsup_contact.contact.contact import solve_contact_on
 from infsup_contact.solvers.infsup import beta_rows_all
 from infsup_contact.study.patch import face_elastic as efp
 from infsup_contact.study.patch.face import PASS_RTOL

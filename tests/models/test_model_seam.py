@@ -85,7 +85,7 @@ def test_every_other_pair_is_refused_in_one_line(model, scene):
 def test_a_manufactured_gap_is_not_an_initial_gap():
     """A manufactured scene's ``gap`` is its exact g = u2 − u1, not data: the Γ solve adds only
     a scene's ``initial_gap`` (the Hertz curvature), so the membranes' pairs carry none."""
-    from infsup_contact.solvers.contact import contact_pair
+    from infsup_contact.contact.contact import contact_pair
     from infsup_contact.study.contact.hertz import hertz_scene
     from infsup_contact.study.contact.scenes import manufactured
 
@@ -97,7 +97,7 @@ def test_lambda_values_of_a_saved_reference(tmp_path):
     """A reference written by save_reference (space and λ only) is evaluated like a solution."""
     import numpy as np
 
-    from infsup_contact.solvers.contact import lambda_values, solve_contact
+    from infsup_contact.contact.contact import lambda_values, solve_contact
     from infsup_contact.study.contact.rows import load_reference, save_reference
     from infsup_contact.study.contact.scenes import membranes
 

@@ -1,4 +1,4 @@
-"""The elastic face stage of the DAG (config ``face_elastic``, rules/face_elastic.smk): its config
+"""The elastic face stage of the DAG (config ``face_elastic``, rules/models.smk with plans/face_elastic.py): its config
 checks, the claim builder (study/face_elastic_claims.py: predictions from structure, verdicts from
 the table) and the generated subsection (report/face_elastic.py), on fabricated tables — the
 numbers themselves are computed by the DAG, and the elastic model is tested in test_elastic3d.py."""

@@ -12,7 +12,7 @@ from infsup_contact.discretization.spaces import registry
 from infsup_contact.discretization.face.square import SQUARE
 from infsup_contact.discretization.face.tensor_grid import TensorPartition
 from infsup_contact.errors import InputError
-from infsup_contact.solvers.contact import gamma_values, solve_contact_on
+from infsup_contact.contact.contact import gamma_values, solve_contact_on
 from infsup_contact.study.patch import face as face_patch
 from infsup_contact.study.contact.registry import FACE_PATCH
 

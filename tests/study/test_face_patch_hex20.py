@@ -15,7 +15,7 @@ from infsup_contact.discretization.spaces.registry import SPACES
 from infsup_contact.errors import InputError
 from infsup_contact.models import hex20
 from infsup_contact.models.membranes3d import MEMBRANES3D, subdomain_mesh
-from infsup_contact.solvers.contact import solve_contact_on
+from infsup_contact.contact.contact import solve_contact_on
 from infsup_contact.study.claims.membranes3d_studies import natural_kernel_count
 from infsup_contact.study.contact.registry import FACE_PATCH
 from infsup_contact.study.face.hex20 import quad8_cases

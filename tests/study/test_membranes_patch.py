@@ -9,7 +9,7 @@ from infsup_contact.discretization.gamma.constants import spans_constants
 from infsup_contact.discretization.spaces import registry
 from infsup_contact.errors import InputError
 from infsup_contact.models import MODELS
-from infsup_contact.solvers.contact import solve_contact_on
+from infsup_contact.contact.contact import solve_contact_on
 from infsup_contact.study.contact.blocks import block_mesh
 from infsup_contact.study.patch import membranes as patch
 

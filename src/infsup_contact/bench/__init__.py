@@ -4,7 +4,7 @@
 limit) with what differs per model in ``beta_models`` (the membranes' pencil routes in
 ``beta_pencil``, the face's Schur routes in ``face_schur``), ``contact_routes`` (ours against the
 floor, the limit and the peers of ``peers``), ``speed_accuracy`` (time against error, the Pareto
-front), ``estimates`` (``--dry-run``'s estimates against measured runs). Top of the house: imports ``study``, ``solvers`` and below.
+front), ``estimates`` (``--dry-run``'s estimates against measured runs). Top of the house: imports ``study``, ``contact``, ``solvers`` and below.
 """
 from .beta_bench import bench_beta
 from .beta_models import bench_for

@@ -3,15 +3,15 @@
 ``ours_end_to_end`` gets the same assembled (A, B, F) — exactly what the peers get:
 
 ``ours``
-    :func:`infsup_contact.solvers.reduced_qp.solve_reduced_qp`: the unknowns B touches (Γ) read off B, one
+    :func:`infsup_contact.contact.reduced_qp.solve_reduced_qp`: the unknowns B touches (Γ) read off B, one
     factorization per block of A with Γ last, interface operator, PDAS on the Γ-reduced
     LCP, recovery of u.
 ``ours_end_to_end``
-    End to end (:func:`infsup_contact.solvers.contact.solve_contact`): meshes, NGSolve assembly, loads,
+    End to end (:func:`infsup_contact.contact.contact.solve_contact`): meshes, NGSolve assembly, loads,
     and the same linear algebra built side by side.
 ``floor``
     One sparse direct solve of the linear saddle-point system with the contact set
-    known (:func:`infsup_contact.solvers.contact.linear_saddle_solve`: symmetric quasi-definite, SuperLU
+    known (:func:`infsup_contact.contact.contact.linear_saddle_solve`: symmetric quasi-definite, SuperLU
     in minimum-degree order without pivoting); its u and λ are compared too.
 ``limit``
     One best-order (``MMD_AT_PLUS_A``) sparse LU of each side's stiffness and one solve
@@ -24,7 +24,7 @@
     (the QP is positively homogeneous in F: u and λ are scaled back), otherwise their
     absolute tolerance floors make the needed tolerances depend on the mesh size.
 ``kkt_sparse``
-    PDAS on the full sparse KKT system (:func:`infsup_contact.solvers.pdas.solve_kkt_sparse`), N ≤ ``kkt_max_n``.
+    PDAS on the full sparse KKT system (:func:`infsup_contact.contact.kkt.solve_kkt_sparse`), N ≤ ``kkt_max_n``.
 """
 from __future__ import annotations
 
@@ -52,7 +52,7 @@ CONTACT_COLUMNS = ("what", "route", "k", "N", "seconds_median", "seconds_min", "
 
 def _contact_problem(n: int, k: int, case: str = REFERENCE_SPACE):
     """Membranes scene on the structured N×N pair: sides, couplings, loads (c = 1), as
-    :func:`infsup_contact.solvers.contact.solve_contact` builds them."""
+    :func:`infsup_contact.contact.contact.solve_contact` builds them."""
     from ..models.membranes import MEMBRANES
     from ..study.contact.scenes import membranes
 
@@ -128,9 +128,9 @@ def bench_contact(ns, ks, repeats: int = 3, case: str = REFERENCE_SPACE, peers=(
     the tolerance search: tol, rel. diff u, rel. diff λ, iterations, seconds, status).
     """
     from . import peers as peer_mod
-    from ..solvers.kkt import solve_kkt_sparse
-    from ..solvers.contact import linear_saddle_solve, solve_contact
-    from ..solvers.reduced_qp import solve_reduced_qp
+    from ..contact.kkt import solve_kkt_sparse
+    from ..contact.contact import linear_saddle_solve, solve_contact
+    from ..contact.reduced_qp import solve_reduced_qp
     from ..study.contact.scenes import membranes
 
     peer_options = {"clarabel": {"method": "faer"}} if peer_options is None else peer_options

@@ -7,7 +7,7 @@ The contact problem is the convex QP
 with A = diag(c1 K1, c2 K2) the stiffness on the free dofs of both membranes, F the
 loads and B = [−B1, B2] the weighted gaps (B_i embedded on the Γ dofs, which are the
 last block of each side). Its KKT conditions are exactly (4.1) in the convention of
-:mod:`infsup_contact.solvers.pdas`:
+:mod:`infsup_contact.contact.pdas`:
 
     A u = F + Bᵀ λ,   λ ≥ 0,   B u ≥ 0,   λ∘(B u) = 0,
 
@@ -32,7 +32,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.sparse as sp
 
-from ..solvers.contact import contact_qp  # the assembled QP all peers get
+from ..contact.contact import contact_qp  # the assembled QP all peers get
 
 TOLERANCES = tuple(10.0 ** -e for e in range(3, 16))
 """Tolerances tried, loosest first, when tuning a peer to reproduce our solution."""

@@ -31,12 +31,12 @@ def pareto_front(times, errors) -> np.ndarray:
 def time_contact_solves(cases, k: int, n: int, repeats: int = 3, scene: str = MANUFACTURED.id,
                         family: str = "structured", scene_params: dict | None = None, c=(1.0, 1.0),
                         budget: float = np.inf) -> dict:
-    """Wall time of a whole contact solve (:func:`~infsup_contact.solvers.contact.solve_contact`,
+    """Wall time of a whole contact solve (:func:`~infsup_contact.contact.contact.solve_contact`,
     no floor timing) for each case on the matching pair N1 = N2 = ``n``, timed in two parts.
 
     A solve is the build of the pair (meshes, side factorizations, loads:
-    :func:`~infsup_contact.solvers.contact.contact_pair`), which no multiplier space changes,
-    and the case's own part on it (:func:`~infsup_contact.solvers.contact.solve_contact_on`:
+    :func:`~infsup_contact.contact.contact.contact_pair`), which no multiplier space changes,
+    and the case's own part on it (:func:`~infsup_contact.contact.contact.solve_contact_on`:
     space, couplings, interface operator, PDAS, recovery). The build is timed once for all
     cases; each case's part starts from the state a fresh build leaves (nothing an earlier
     case cached on the sides, :meth:`~infsup_contact.models.contract.SideOperator.forget_cached`).
@@ -49,7 +49,7 @@ def time_contact_solves(cases, k: int, n: int, repeats: int = 3, scene: str = MA
         Seconds of build + case part: median(build) + median(part), likewise min and max;
         ``runs``: how often the case's part ran.
     """
-    from ..solvers.contact import contact_pair, solve_contact_on
+    from ..contact.contact import contact_pair, solve_contact_on
     from ..study.contact.scenes import scene as make_scene
 
     sc = make_scene(scene, c1=c[0], c2=c[1], **(scene_params or {}))

@@ -56,7 +56,7 @@ def scene_flag_uses() -> list:
 def _check_contact(args):
     from ..discretization.segment import meshes
     from ..discretization.spaces import registry
-    from ..solvers.contact import check_flat_gamma
+    from ..contact.contact import check_flat_gamma
     from ..solvers.request import check_k
     from ..study.contact.registry import check_pair
     from ..study.contact.scenes import _exponent

@@ -1,4 +1,4 @@
-"""Cross-key checks of the config's ``face`` section (the 3D contact face stage, rules/face.smk).
+"""Cross-key checks of the config's ``face`` section (the 3D contact face stage, rules/models.smk with plans/face.py).
 
 What the schema cannot state: the model is a registered one with a 3D face, each element is
 one of its ``element`` mesh options, each case id is a registered space the face can build for
@@ -83,7 +83,7 @@ def _check_degrees(key: str, model, element: str, ks, k_key: str) -> None:
 
 
 def check_face_studies(fc, model) -> None:
-    """The face studies' keys (rules/face_studies.smk) the schema cannot state: the patch
+    """The face studies' keys (rules/models.smk with plans/face.py) the schema cannot state: the patch
     test's elements are the model's, with contact scenes and at least one degree of
     ``face.patch.k`` (an element runs the degrees it has: HEX20 k = 2), its pairs
     non-matching; the α sweep's elements are face elements with a transformed (non-identity)

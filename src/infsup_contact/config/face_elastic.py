@@ -1,5 +1,5 @@
 """Cross-key checks of the config's ``face_elastic`` section (the 3D elastic bodies on the
-contact face, rules/face_elastic.smk).
+contact face, rules/models.smk with plans/face_elastic.py).
 
 What the schema cannot state: the model is a registered 3D model whose stiffness takes the
 Poisson ratio ``nu`` (a model parameter, :attr:`~infsup_contact.models.contract.Model.params`),

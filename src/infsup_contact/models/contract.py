@@ -1,7 +1,7 @@
 """The model seam: what a physical model must give the Γ-reduced engine.
 
 β_h (:mod:`infsup_contact.solvers.infsup`), the contact solver
-(:mod:`infsup_contact.solvers.contact`), the ledger and the paper take a :class:`Model` and
+(:mod:`infsup_contact.contact.contact`), the ledger and the paper take a :class:`Model` and
 never ask which one it is. A model is one function, ``side_operator(mesh, k)``, applied to
 each mesh of a pair; the :class:`~infsup_contact.models.contract.SideOperator` it returns carries
 
@@ -19,7 +19,7 @@ each mesh of a pair; the :class:`~infsup_contact.models.contract.SideOperator` i
   which the contact solver recovers u_h = A_i⁻¹ (F_i ∓ B_iᵀ λ_h).
 
 Contact asks a model four more things, so that one Γ solve
-(:func:`~infsup_contact.solvers.contact.solve_on_gamma`) serves every model and scene:
+(:func:`~infsup_contact.contact.contact.solve_on_gamma`) serves every model and scene:
 
 * ``scene_side(scene, mesh, k)`` — the side of a contact scene (a scene may put its own
   supports on ∂Ω_i∖Γ, such as the elastic patch test's rollers);

@@ -2,8 +2,8 @@
 declared through the section templates (:mod:`.templates`, :mod:`.sections`).
 
 Pure functions from the elastic tables (results/tables/elastic_*.csv, the elastic claims and
-results/benchmarks/elastic_beta.csv) to LaTeX text; ``workflow/scripts/elastic_paper.py``
-reads and writes. Macro names start with ``elastic`` (letters only, :func:`macro_name`), so
+results/benchmarks/elastic_beta.csv) to LaTeX text; ``workflow/scripts/model_paper.py``
+reads and writes (plans/elastic.py). Macro names start with ``elastic`` (letters only, :func:`macro_name`), so
 they stay apart from the main paper's generated namespace.
 """
 from __future__ import annotations
@@ -19,7 +19,6 @@ from .templates import (Group, at, beta_cell, blank, body_lines, case_keys, case
 from .texformat import case_order, fmt_fixed, fmt_int, fmt_sci, latex_id
 from .texnames import Macro, _k, macro_name
 
-ELASTIC_FILES = ("elastic_macros.tex", "elastic_beta_table.tex", "elastic_patch_table.tex", "elastic_hertz_table.tex")
 FAMILIES = ("structured", "perturbed", "unstructured")
 """The mesh families of the β_h table, in its row order."""
 PATCH_ERRORS = ("lambda_max_rel_error", "lambda_end_rel_error", "lambda_middle_rel_error", "u_max_rel_error")

@@ -5,7 +5,7 @@ edge dropping), each declared through the section templates (:mod:`.templates`, 
 Pure functions from ``results/tables/face_beta.csv``, ``results/tables/face_claims.csv``,
 ``results/face/{patch,alpha,edge_dropping}.csv`` and the studies' claims
 (``results/tables/face_study_claims.csv``, :mod:`infsup_contact.study.claims.membranes3d_studies`)
-to LaTeX text; ``workflow/scripts/face_paper.py`` reads and writes. Macro names start with
+to LaTeX text; ``workflow/scripts/model_paper.py`` reads and writes (plans/face.py). Macro names start with
 ``face`` (letters only, :func:`~infsup_contact.report.texnames.macro_name`), apart from the
 main paper's generated namespace. Every number of the section is one of these macros or a
 cell of a table, each computed from the tables here; each outcome macro (``\\faceOutcome…``)
@@ -24,13 +24,11 @@ from .templates import (Group, at, beta_cell, case_blocks, case_table, error_cel
 from .texformat import PaperTexError, fmt_fixed, fmt_int, fmt_sci, latex_id
 from .texnames import Macro, macro_name
 
-FACE_FILES = ("face_macros.tex", "face_beta_table.tex")
 KINDS = (("kernel", "face-kernel-"), ("nonmatching", "face-nonmatching-kernel-"), ("ltwo", "face-Rem3.1-"),
          ("bounded", "face-"))
 """Claim kinds by id prefix (study/claims/membranes3d.py), the first matching prefix wins."""
 
 
-STUDY_FILES = ("face_patch_table.tex", "face_alpha_table.tex", "face_edge_table.tex")
 _COLUMNS = {"patch": ("element", "case", "k", "N1", "N2", "lambda_max_rel_error", "u_max_rel_error", "kernel_dim"),
             "alpha": ("element", "alpha", "N", "norm", "min_weight", "accepted", "beta"),
             "edge": ("case", "k", "N", "theta", "beta_H", "beta_H_resolved", "cond_D", "cond_D_kappa", "cond_S",

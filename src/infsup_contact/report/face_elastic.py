@@ -3,8 +3,8 @@ subsection (its text, counts and table) that paper/face.tex reads with ``\\Input
 (a config without ``face_elastic`` has no such subsection).
 
 A pure function of ``results/tables/face_elastic_beta.csv``, ``results/face/elastic_patch.csv``
-and ``results/tables/face_elastic_claims.csv`` (study/face_elastic_claims.py);
-``workflow/scripts/face_elastic_paper.py`` reads and writes. Every number is computed here
+and ``results/tables/face_elastic_claims.csv`` (study/claims/elastic3d.py);
+``workflow/scripts/model_paper.py`` reads and writes (plans/face_elastic.py). Every number is computed here
 from those tables; the text states the predictions as the claims module makes them.
 """
 from __future__ import annotations

@@ -7,5 +7,5 @@ model, the elastic pair, the rows a figure shows), ``face/`` (the face studies o
 and their tables), ``machines/`` (the checks under every BLAS code path and their ledgers),
 ``claims/`` (the ledger's criterion and every claim), ``patch/`` (the patch tests), ``verdict``
 (one space's stability verdict by the ledger's criterion, ``infsup-contact verdict``) and
-``producers`` (other codes' systems certified). Imports ``solvers`` and the stages below it.
+``producers`` (other codes' systems certified). Imports ``solvers``, ``contact`` and the stages below them.
 """

@@ -23,7 +23,7 @@ from pathlib import Path
 import numpy as np
 import scipy.sparse as sp
 
-from .readers import HEADER_LINE_MAX, SystemFileError, check_read_memory
+from .file_checks import HEADER_LINE_MAX, SystemFileError, check_read_memory
 
 MAT_FILE_CLASSID = 1211216
 """PETSc's class id of a matrix in a binary file."""

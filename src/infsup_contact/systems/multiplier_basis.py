@@ -360,7 +360,8 @@ def _checked(where, key, arr, integer):
 def _read_numbers(where, key, path: Path, integer: bool) -> np.ndarray:
     """Numbers of a ``.npy`` file (its header checked against its size and the memory first) or
     of a ``.txt`` file (whitespace- or comma-separated, ``#`` comments; ends with a newline)."""
-    from .readers import check_npy_file, check_read_memory
+    from .file_checks import check_read_memory
+    from .readers import check_npy_file
 
     if not path.is_file():
         raise SystemFileError(where, f"{key}: no such file {path}")

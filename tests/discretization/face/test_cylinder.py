@@ -14,7 +14,7 @@ from infsup_contact.discretization.gamma.coupling import coupling_matrix
 from infsup_contact.discretization.spaces import registry
 from infsup_contact.errors import InputError
 from infsup_contact.models.membranes3d import MEMBRANES3D, subdomain_mesh
-from infsup_contact.solvers.contact import check_flat_gamma
+from infsup_contact.contact.contact import check_flat_gamma
 from infsup_contact.solvers.infsup import beta_rows
 from infsup_contact.solvers.request import MeshOptions
 from infsup_contact.solvers.side_cache import SideCache

@@ -15,7 +15,7 @@ from infsup_contact.discretization.segment.interface import SEGMENT
 from infsup_contact.models import make_model
 from infsup_contact.solvers.side_cache import SideCache
 from infsup_contact.solvers.infsup import beta_rows, saddle_point_beta
-from infsup_contact.solvers.contact import contact_qp
+from infsup_contact.contact.contact import contact_qp
 from infsup_contact.solvers.request import MeshOptions
 
 MODEL = make_model("membranes3d")

@@ -1,6 +1,6 @@
 """Whether 1 ∈ M_h, computed on the space a solver uses (its own G_h and construction).
 
-What a patch test of a uniform pressure asks of M_h (study/patch.py, study/face_patch.py).
+What a patch test of a uniform pressure asks of M_h (study/patch/: segment.py, face.py).
 ``SpaceSpec.contains_constants(k)`` answers it for the segment's space on a uniform partition
 (and for a face-only space on its n × n grid); on a face the construction can differ from the
 1D one in a way the segment cannot show: the TRI3 dual with Wohlmuth's boundary modification

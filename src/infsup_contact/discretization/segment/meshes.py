@@ -29,7 +29,6 @@ from ..gamma.interface import MULTIPLIER_MESHES  # noqa: F401  (the choices of G
 from .interface import SEGMENT
 
 FAMILIES = ("structured", "perturbed", "unstructured")
-SIDES = (1, 2)
 GAMMA, DIRICHLET = SEGMENT.boundary, "dir"
 SYMMETRY_X, SYMMETRY_Y = "side_x0", "side_y0"
 """Boundary names of the lateral faces x = 0 and y = 0 of the 3D elastic bodies' meshes

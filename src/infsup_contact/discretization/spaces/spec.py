@@ -150,7 +150,7 @@ class SpaceSpec:
     def contains_constants(self, k: int, n: int = 6) -> bool:
         """Whether 1 ∈ M_h for displacement degree k: :func:`~..gamma.constants.spans_constants`
         of the space built on N = ``n`` uniform intervals (a face-only space: on the n × n grid of
-        the face). What a patch test of a uniform pressure asks of M_h (study/patch.py)."""
+        the face). What a patch test of a uniform pressure asks of M_h (study/patch/)."""
         if not self.defined_on(1):
             return spans_constants(self.face_space(k, n))
         return spans_constants(self.build(k, np.linspace(0.0, 1.0, n + 1)))

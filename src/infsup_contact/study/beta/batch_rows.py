@@ -2,7 +2,7 @@
 
 The membranes' batches (``workflow/scripts/beta_job.py``: every pair of one (family, k) ×
 seed × case × multiplier mesh × c pair × norm, rows tagged with their series) and the elastic
-ones (:mod:`infsup_contact.study.beta.elastic`, ``workflow/scripts/elastic_beta_job.py``) both
+ones (:mod:`infsup_contact.study.beta.elastic`, ``workflow/scripts/model_job.py``) both
 call :func:`beta_batch_rows`; the model is named (``models.make_model``) or passed, never
 imported here. The pairs of a batch share one side cache, so a side common to several pairs
 ((16, 16), (17, 16), (24, 16): Ω2's) is factorized once.

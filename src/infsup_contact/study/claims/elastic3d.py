@@ -46,7 +46,7 @@ from ...criteria.claims import COLUMNS, FAIL, FINDING, INCONCLUSIVE, PASS, close
 from .membranes3d import matching_kernel
 from .membranes3d_studies import face_contains_constants, patch_prediction, patch_verdict
 
-REF = "beyond the paper (issue 28: the 3D elastic bodies on the contact face)"
+REF = "beyond the paper (the 3D elastic bodies on the contact face: docs/models.md, 3D bodies with a contact face)"
 PREDICTED_SLOPE = 0.5
 """β_H ≍ (1 − 2ν)^{1/2} on a fixed mesh (module docstring)."""
 

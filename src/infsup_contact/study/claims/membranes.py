@@ -55,7 +55,7 @@ def sign_check(k: int = 2, n: int = 32, c=(1.0, 3.0), case: str = SIGN_CHECK_SPA
     """
     import ngsolve
 
-    from ...solvers.contact import lambda_values, solve_contact
+    from ...contact.contact import lambda_values, solve_contact
     from ..contact.scenes import membranes
 
     sol = solve_contact(membranes(c1=c[0], c2=c[1]), case, k, "structured", n, n, time_floor=False)

@@ -50,7 +50,7 @@ from ...discretization.face.tensor_grid import TensorPartition
 from ...criteria.claims import FAIL, FINDING, INCONCLUSIVE, PASS, bounded_claim, close_decisions, close_text, finest, kernel_claim, \
     row, slope_verdict
 
-REF = "beyond the paper (issue 28: the 3D contact face)"
+REF = "beyond the paper (the 3D contact face: docs/models.md, 3D bodies with a contact face)"
 
 
 def face_dimension(spec, k: int, n: int, gamma=SQUARE) -> int:

@@ -8,7 +8,7 @@ import ngsolve
 import numpy as np
 import scipy.fft
 
-from ...solvers.contact import ContactSolution, gamma_values, lambda_values
+from ...contact.contact import ContactSolution, gamma_values, lambda_values
 from ...discretization.segment.norms import sine_coefficients
 from .profiles import gamma_sample_points
 

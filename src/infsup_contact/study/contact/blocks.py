@@ -6,7 +6,7 @@ the Hertz scene (:mod:`.hertz`).
 top (``dir``); the lateral sides ``side`` (x = 0, 1) are either on rollers (u_x = 0: the patch
 test) or traction free (Hertz). The model (:mod:`infsup_contact.models.contract`) turns the
 data into Dirichlet lifts u_{D,i} and loads F_i = −A_i u_{D,i}; the shared Γ solve
-(:func:`~infsup_contact.solvers.contact.solve_on_gamma`) adds the weighted initial gap
+(:func:`~infsup_contact.contact.contact.solve_on_gamma`) adds the weighted initial gap
 G_j = ∫_Γ μ_j g0 and solves g = G + g_F + K λ, λ ≥ 0, g ≥ 0, λ∘g = 0.
 """
 from __future__ import annotations

@@ -38,7 +38,7 @@ import numpy as np
 from ...discretization.spaces import registry
 from ...models import make_model
 from ...models.plane_strain import check_modulus, check_nu, lame
-from ...solvers.contact import contact_pair, solve_contact_on
+from ...contact.contact import contact_pair, solve_contact_on
 from .accuracy import _element_quadrature
 from .blocks import PressedBlocks
 from .registry import HERTZ

@@ -18,7 +18,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from ...solvers.contact import ContactSolution, gamma_values, lambda_values, solve_contact
+from ...contact.contact import ContactSolution, gamma_values, lambda_values, solve_contact
 from ...solvers.request import NO_OPTIONS, MeshOptions
 from .scenes import membranes
 

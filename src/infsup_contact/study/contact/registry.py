@@ -159,13 +159,6 @@ def check_pair(model: str, scene: str) -> SceneSpec:
     return spec
 
 
-def scene_model(scene: str, **params):
-    """The default model of ``scene`` (its first), with the model's ``params`` (elastic: nu)."""
-    from ...models import make_model
-
-    return make_model(scene_spec(scene).models[0], **params)
-
-
 def data_scene_ids() -> list:
     """The scenes the contact stage runs from their data (the allowed ``kind`` of a config scene)."""
     return [s.id for s in _SCENES.values() if s.data is not None]

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 from . import accuracy
 from ... import progress
-from ...solvers.contact import ContactSolution, contact_pair, solve_contact, solve_contact_on
+from ...contact.contact import ContactSolution, contact_pair, solve_contact, solve_contact_on
 from ...solvers.request import NO_OPTIONS, MeshOptions, check_k
 from ...errors import InputError, check_prestress
 from ...discretization.spaces.registry import REFERENCE_SPACE, check_case, space_spec
@@ -18,7 +18,7 @@ def cone_kind(case: str, k: int) -> str:
 def reference_solution(scene, k: int, n_ref: int, model=None) -> ContactSolution:
     """The reference of a scene without an exact solution: structured N_ref × N_ref, degree
     k + 1, the registry's reference multipliers (stable for every k); ``model`` as in
-    :func:`~infsup_contact.solvers.contact.solve_contact`."""
+    :func:`~infsup_contact.contact.contact.solve_contact`."""
     progress.note(f"reference solution (N_ref={n_ref}, degree {k + 1})")
     return solve_contact(scene, REFERENCE_SPACE, k + 1, "structured", n_ref, n_ref, time_floor=False, model=model)
 
@@ -139,7 +139,7 @@ def contact_rows(scene_name: str, cases, k: int, family: str, n1: int, n2: int,
                  n_ref: int = 64, time_floor: bool = True, scene_params: dict | None = None,
                  model=None, mesh: MeshOptions = NO_OPTIONS) -> list[dict]:
     """:func:`contact_row` for several multiplier cases on one mesh pair, which is meshed,
-    factorized and loaded once (:func:`~infsup_contact.solvers.contact.contact_pair`)."""
+    factorized and loaded once (:func:`~infsup_contact.contact.contact.contact_pair`)."""
     check_k(k)
     for case in cases:
         check_case(case, k)

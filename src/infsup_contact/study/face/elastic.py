@@ -1,5 +1,5 @@
 """The tables of the 3D elastic bodies on the contact face (config ``face_elastic``;
-rules/face_elastic.smk): β_h per Poisson ratio and the elastic face patch test.
+rules/models.smk with plans/face_elastic.py): β_h per Poisson ratio and the elastic face patch test.
 
 Pure functions of the config section returning DataFrames; the job scripts only read and write.
 

@@ -120,8 +120,6 @@ MKL's code branches (``default``: no ``MKL_CBWR``, MKL dispatches as on any mach
 that dispatch with deterministic reductions). Each path sets one library's switch and leaves the
 other library at its own choice."""
 PATH_NAMES = tuple(p.name for p in PATHS)
-CORE_TYPES = tuple(p.setting for p in PATHS if p.library == "openblas")
-"""The OpenBLAS core types among :data:`PATHS`."""
 
 
 def machine_path(name: str) -> MachinePath:

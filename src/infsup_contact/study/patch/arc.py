@@ -34,7 +34,7 @@ from ...discretization.segment.arc import Arc, check_arc_options
 from ...errors import InputError, check_prestress
 from ...models import make_model
 from ...models.contract import Body
-from ...solvers.contact import contact_pair, solve_contact_on
+from ...contact.contact import contact_pair, solve_contact_on
 from ..contact.blocks import PressedBlocks, block_mesh
 from . import table
 

@@ -32,7 +32,7 @@ non-matching traces — iff 1 ∈ M_h, computed on the face space itself
 the six-tetrahedra faces, whose two corner triangles have no vertex off ∂Γ) (the face space
 is the tensor product of the 1D one, :mod:`~infsup_contact.discretization.face.spaces.tensor`, and
 1 ⊗ 1 = 1). T3 (Q_k vanishing on ∂Γ) fails. A kernel of K (λ_h not unique) leaves u_h unique;
-the PDAS's representative (minimum norm, :mod:`infsup_contact.solvers.pdas`) need not be the
+the PDAS's representative (minimum norm, :mod:`infsup_contact.contact.pdas`) need not be the
 constant, so a space with a kernel may reproduce u but not λ: ``kernel_dim`` and ``nonunique``
 are reported with each row. With natural lateral faces the traces do not vanish on ∂Γ, so
 the spaces' kernel on clamped traces (R5.2's boundary modes) has no counterpart here.
@@ -99,7 +99,7 @@ from ...discretization.spaces import registry
 from ...discretization.segment.meshes import DIRICHLET
 from ...errors import InputError
 from ...models import make_model
-from ...solvers.contact import contact_pair, solve_contact_on
+from ...contact.contact import contact_pair, solve_contact_on
 from ...solvers.request import MeshOptions
 from ..contact.registry import FACE_PATCH
 from . import table

@@ -62,7 +62,7 @@ from ...discretization.segment.meshes import DIRICHLET, SYMMETRY_X, SYMMETRY_Y
 from ...errors import InputError
 from ...models import make_model
 from ...models.plane_strain import check_modulus, check_nu
-from ...solvers.contact import contact_pair
+from ...contact.contact import contact_pair
 from ...solvers.request import MeshOptions
 from .face import DELTA, solve_face_patch
 from ..contact.registry import ELASTIC_FACE_PATCH

@@ -47,7 +47,7 @@ from ...discretization.segment import meshes
 from ...discretization.spaces import registry
 from ...errors import InputError, check_prestress
 from ...models import make_model
-from ...solvers.contact import contact_pair, solve_contact_on
+from ...contact.contact import contact_pair, solve_contact_on
 from ..contact.blocks import PressedBlocks
 from . import table
 

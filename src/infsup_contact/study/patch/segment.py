@@ -51,8 +51,8 @@ from ...discretization.segment import meshes
 from ...discretization.spaces import registry
 from ...models import make_model
 from ...models.plane_strain import check_modulus, check_nu
-from ...solvers.contact import contact_pair, solve_contact_on
-from ..contact.blocks import SIDE, PressedBlocks, block_mesh
+from ...contact.contact import contact_pair, solve_contact_on
+from ..contact.blocks import SIDE, PressedBlocks
 from ..contact.registry import PATCH
 from . import table
 
@@ -68,11 +68,6 @@ PASS_RTOL = 1e-10
 
 DELTA = 1e-2
 """Default downward displacement of Ω2's top in the patch test."""
-
-
-def patch_mesh(n: int, side: int) -> ngsolve.Mesh:
-    """The structured N×N block of Ω_side (:func:`~.blocks.block_mesh`)."""
-    return block_mesh(n, side)
 
 
 def patch_scene(E=(1.0, 1.0), delta: float = DELTA) -> PressedBlocks:

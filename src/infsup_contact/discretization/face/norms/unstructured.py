@@ -17,7 +17,8 @@ coefficients come from the closed-form Fourier transform of a polynomial on a tr
       F_ab = −i/|κ|² [ Σ_edges (κ·ν_E) ∫_E ξ^a η^b e^{iκ·ξ} ds − a κ1 F_{a−1,b} − b κ2 F_{a,b−1} ],
 
   whose edge integrals are the moments ∫_0^1 t^j e^{iωt} dt
-  (:func:`~.face.norms.triangles.moments`, exact for every ω, a series for small |ω|);
+  (:func:`~.face.norms.triangles.moments`, the structured triangles' own: exact for every ω, a
+  series for small |ω|);
 * below |κ| = :data:`SMALL` the recursion would cancel, and the integrand is smooth: a Duffy
   rule of degree :data:`SMALL_DEGREE` (error ~ |κ|^{d+1}/(d+1)! ≪ ε) replaces it.
 
@@ -32,7 +33,7 @@ import numpy as np
 from ....errors import InputError
 from .tensor import extrapolated
 from ..quadrature import duffy_rule, triangles_rule
-from .triangles import TAIL_EXPONENTS, tail_key
+from .triangles import TAIL_EXPONENTS, moments, tail_key
 from ..spaces.triangles import lagrange_barycentric
 from ...segment.norms import N_MAX_CAP, gram_by_norm
 
@@ -60,33 +61,6 @@ def monomial_coefficients(s: int) -> np.ndarray:
     return np.linalg.solve(V, L)
 
 
-#: |ω| below which :func:`_moments` sums the series (the recursion amplifies errors by j/|ω|).
-_SERIES_BELOW, _SERIES_TERMS = 2.0, 32
-
-
-def _moments(omega: np.ndarray, e: np.ndarray, jmax: int) -> list:
-    """[M_j(ω) = ∫_0^1 t^j e^{iωt} dt for j = 0..jmax] given e = e^{iω}: the recursion
-    M_j = (e − j M_{j−1})/(iω) where |ω| ≥ 2, the series Σ_k (iω)^k / (k! (j + k + 1)) on the
-    few entries below (32 terms: 2^32/32! < 1e-25), as :func:`~.face.norms.triangles.moments`."""
-    small = np.abs(omega) < _SERIES_BELOW
-    r = -1j / np.where(small, 1.0, omega)
-    out, prev = [], (e - 1.0) * r
-    out.append(prev)
-    for j in range(1, jmax + 1):
-        prev = (e - j * prev) * r
-        out.append(prev)
-    if small.any():
-        z = 1j * omega[small]
-        term = np.ones_like(z)
-        acc = np.zeros((jmax + 1, z.size), dtype=complex)
-        for k in range(_SERIES_TERMS):
-            acc += term[None, :] / (np.arange(jmax + 1)[:, None] + k + 1.0)
-            term = term * z / (k + 1.0)
-        for j in range(jmax + 1):
-            out[j][small] = acc[j]
-    return out
-
-
 def reference_transforms(k1: np.ndarray, k2: np.ndarray, s: int, e1=None, e2=None) -> np.ndarray:
     """F_ab(κ) = ∫_T̂ ξ^a η^b e^{i(κ1 ξ + κ2 η)}, shape (n_mono, *κ.shape), module docstring;
     ``e1``, ``e2``: e^{iκ1}, e^{iκ2} if already known."""
@@ -97,8 +71,8 @@ def reference_transforms(k1: np.ndarray, k2: np.ndarray, s: int, e1=None, e2=Non
     kk = k1 ** 2 + k2 ** 2
     small = kk < SMALL ** 2
     scale = -1j / np.where(small, 1.0, kk)  # the recursion where |κ| ≥ SMALL
-    M1, M2 = _moments(k1, e1, s), _moments(k2, e2, s)
-    M12 = _moments(k2 - k1, e2 * np.conj(e1), s)
+    M1, M2 = moments(k1, s, e1), moments(k2, s, e2)
+    M12 = moments(k2 - k1, s, e2 * np.conj(e1))
     F = {}
     out = np.empty((len(mono),) + k1.shape, dtype=complex)
     for i, (a, b) in enumerate(mono):

@@ -29,8 +29,8 @@ from .pdas import PdasResult, solve_pdas
 from ..discretization.gamma.coupling import coupling_matrix
 from ..models import DEFAULT_MODEL
 from ..models.contract import B_SIGN
-from .interface_operator import interface_operator
-from .request import NO_OPTIONS, MeshOptions
+from ..solvers.interface_operator import interface_operator
+from ..solvers.request import NO_OPTIONS, MeshOptions
 
 FLAT_GAMMAS = (None, "segment", "square")
 """The Γ options of the flat interfaces (unset, the segment, the face), the only ones of the contact scenes."""

@@ -22,7 +22,7 @@ choice of solution when λ is not unique):
     Primal–dual active set (PDAS) = semismooth Newton on the NCP function
     λ − max(0, λ − c g) (Hintermüller, Ito & Kunisch, SIAM J. Optim. 13 (2002)) on the
     small dense Γ-reduced problem, with a documented treatment of singular K.
-:func:`~infsup_contact.solvers.kkt.solve_kkt_sparse`
+:func:`~infsup_contact.contact.kkt.solve_kkt_sparse`
     The same PDAS iteration, each step solving the full sparse saddle-point system
     [[A, −B_𝒜ᵀ], [B_𝒜, 0]] — used to cross-check the Γ-reduced route.
 

@@ -13,8 +13,8 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from scipy.optimize import minimize
 
-from infsup_contact.solvers.kkt import solve_kkt_sparse
-from infsup_contact.solvers.pdas import PdasDidNotConverge, PdasResult, solve_pdas
+from infsup_contact.contact.kkt import solve_kkt_sparse
+from infsup_contact.contact.pdas import PdasDidNotConverge, PdasResult, solve_pdas
 from infsup_contact.errors import InputError
 
 TOL = 1e-10

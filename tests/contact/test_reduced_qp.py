@@ -3,11 +3,11 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
-from infsup_contact.solvers.kkt import solve_kkt_sparse
-from infsup_contact.solvers.contact import linear_saddle_solve
+from infsup_contact.contact.kkt import solve_kkt_sparse
+from infsup_contact.contact.contact import linear_saddle_solve
 from infsup_contact.errors import InputError
 from infsup_contact.la.schur import gamma_factorization
-from infsup_contact.solvers.reduced_qp import solve_reduced_qp, touched_columns
+from infsup_contact.contact.reduced_qp import solve_reduced_qp, touched_columns
 
 from test_pdas import assert_qp_kkt, lap2d, random_problem, thin_obstacle
 

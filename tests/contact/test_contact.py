@@ -3,9 +3,9 @@ import numpy as np
 import pytest
 
 from infsup_contact.study.claims.membranes import sign_check
-from infsup_contact.solvers.kkt import solve_kkt_sparse
+from infsup_contact.contact.kkt import solve_kkt_sparse
 from infsup_contact.models.membranes import load_vector
-from infsup_contact.solvers.contact import contact_qp, solve_contact
+from infsup_contact.contact.contact import contact_qp, solve_contact
 from infsup_contact.study.contact.scenes import manufactured, membranes
 from infsup_contact.study.contact.rows import contact_row
 
@@ -110,7 +110,7 @@ def test_errors_against_a_reference_vanish_on_itself_and_do_not_depend_on_call_o
 def test_cases_sharing_one_pair_solve_as_if_alone():
     """A pair built once and solved with several spaces gives each case the solution it
     gets from a pair of its own (nothing a case does leaks into the shared sides)."""
-    from infsup_contact.solvers.contact import contact_pair, solve_contact_on
+    from infsup_contact.contact.contact import contact_pair, solve_contact_on
     sc = membranes(c1=1.0, c2=2.0)
     pair = contact_pair(sc, 2, "perturbed", 6, 5)
     for case in ("R5.2", "T4", "T3"):

@@ -5,15 +5,15 @@ The discrete contact problem (4.1) is the convex QP
     minimize ½ uᵀ A u − Fᵀ u   subject to   B u ≥ 0,
 
 with KKT conditions A u = F + Bᵀ λ, λ ≥ 0, B u ≥ 0, λ∘(B u) = 0 (the convention of
-:mod:`infsup_contact.solvers.pdas` and :mod:`infsup_contact.bench.peers`). This module takes exactly the
+:mod:`infsup_contact.contact.pdas` and :mod:`infsup_contact.bench.peers`). This module takes exactly the
 data a general QP solver gets — (A, B, F), nothing about meshes or sides — and uses only one
 structural fact: B touches few unknowns (the Γ dofs, read off B's sparsity). With those
 unknowns Γ ordered last, one factorization of A gives X = (A⁻¹)_ΓΓ
 (:func:`~infsup_contact.la.schur.gamma_factorization`), the LCP g = g0 + K λ with K = B_Γ X B_Γᵀ and
-g0 = B A⁻¹ F is solved by :func:`~infsup_contact.solvers.pdas.solve_pdas` on the small dense multiplier space, and
+g0 = B A⁻¹ F is solved by :func:`~infsup_contact.contact.pdas.solve_pdas` on the small dense multiplier space, and
 u = A⁻¹(F + Bᵀ λ) is recovered with the same factorization.
 
-Compared with :func:`infsup_contact.solvers.contact.solve_contact`, which builds the same operators side by
+Compared with :func:`infsup_contact.contact.contact.solve_contact`, which builds the same operators side by
 side from the meshes, this is the route timed against the peers in the benchmarks (same
 input, same answer).
 """
@@ -77,7 +77,7 @@ def solve_reduced_qp(A, B, F, *, route: str = "auto", **pdas_options) -> Reduced
     route : str
         Factorization route of :func:`~infsup_contact.la.schur.gamma_factorization`.
     **pdas_options
-        Passed to :func:`~infsup_contact.solvers.pdas.solve_pdas` (``max_iter``, ``tol``, ``kernel_rtol``).
+        Passed to :func:`~infsup_contact.contact.pdas.solve_pdas` (``max_iter``, ``tol``, ``kernel_rtol``).
 
     Returns
     -------
@@ -88,7 +88,7 @@ def solve_reduced_qp(A, B, F, *, route: str = "auto", **pdas_options) -> Reduced
     InputError
         Inconsistent shapes or bad options.
     PdasDidNotConverge
-        As :func:`~infsup_contact.solvers.pdas.solve_pdas`.
+        As :func:`~infsup_contact.contact.pdas.solve_pdas`.
     """
     A, B, F = _check_kkt(A, B, F)
     gamma = touched_columns(B)

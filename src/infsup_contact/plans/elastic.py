@@ -1,4 +1,4 @@
-"""The plane-strain elastic bodies on the paper's geometry (config section ``elastic``).
+"""The plane-strain elastic bodies on the paper's geometry (model-table study ``elastic``).
 
 Jobs: β_h of every (family, k) next to the membranes on the same meshes, the ν → 1/2 sweep of
 each k (:mod:`infsup_contact.study.beta.elastic`), the Hertz scene's discretization study per k and its modeling
@@ -24,14 +24,15 @@ def _drop_seconds(rows) -> pd.DataFrame:
 
 
 class ElasticStudy:
-    """The elastic study of the config section ``name`` (module docstring)."""
+    """The elastic study ``name`` of the model table: its entry's scenes and the spaces it runs
+    (``infsup.cases``; module docstring)."""
 
     tex_source = "paper/elastic.tex"
     in_paper = True
     model_section = False
 
-    def __init__(self, name: str, config: dict):
-        self.name, self.cfg, self.cases = name, config[name], list(config["infsup"]["cases"])
+    def __init__(self, name: str, scenes: dict, cases: list):
+        self.name, self.cfg, self.cases = name, scenes, list(cases)
 
     def _mem_mb(self, family: str, k: int) -> int:
         """The β estimate of the largest pair, two displacement components per node (+25 %)."""

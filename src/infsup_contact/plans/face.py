@@ -1,4 +1,4 @@
-"""The membranes in 3D with a 2D contact face Γ = (0,1)²×{1} (config section ``face``).
+"""The membranes in 3D with a 2D contact face Γ = (0,1)²×{1} (model-table study ``face``).
 
 Jobs: β_h of every (element, k) on its mesh pairs in both norms, the L²(Γ)-only rows of the finer
 matching meshes where an element has them (``face.l2_max_N``), the 3D contact patch test, the
@@ -15,18 +15,18 @@ from ..config.face import face_pairs, l2_only_sizes
 from .protocol import Inputs, Job, Table, claims_path, job_path, table_path
 
 STUDIES = ("patch", "alpha", "edge_dropping")
-"""The face studies: sub-sections of ``face`` and jobs of their own."""
+"""The face studies: sub-mappings of the entry and jobs of their own."""
 
 
 class FaceStudy:
-    """The face study of the config section ``name`` (module docstring)."""
+    """The face study ``name`` of the model table, from its entry's scenes (module docstring)."""
 
     tex_source = "paper/face.tex"
     in_paper = True
     model_section = False
 
-    def __init__(self, name: str, config: dict):
-        self.name, self.cfg = name, config[name]
+    def __init__(self, name: str, scenes: dict):
+        self.name, self.cfg = name, scenes
 
     def _mem_mb(self, element: str, k: int, l2_only: bool) -> int:
         fc = self.cfg

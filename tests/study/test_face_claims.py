@@ -1,4 +1,4 @@
-"""The face stage's claims (study/face_claims.py), macros (report/face.py) and config checks
+"""The face stage's claims (study/face_claims.py), macros (report/sections/face.py) and config checks
 (config/face.py) on synthetic tables: verdicts follow the data by the ledger's criteria, the
 predictions follow registry properties (not ids), a bad ``face:`` key is named."""
 from __future__ import annotations
@@ -110,7 +110,7 @@ def test_predictions_come_from_properties_not_ids():
 
 
 def test_face_macros_count_the_claims():
-    from infsup_contact.report.face import check_face_tex, face_paper_files
+    from infsup_contact.report.sections.face import check_face_tex, face_paper_files
 
     beta = pd.concat([_rows("T3", 1), _rows("R5.2", 1), _rows("T3", 1, element="tet")], ignore_index=True)
     claims = face_claims(beta, CLAIMS_CFG, {"hex": SQUARE, "tet": SQUARE_TRIG})
@@ -168,8 +168,8 @@ def test_face_section_renders_under_any_verdict(verdict):
     """paper/face.tex states outcomes only through \\byverdict on its generated outcome macros:
     it renders (every macro expanded, every branch resolved) whatever the ledger says."""
     from infsup_contact.report.consistency import render
-    from infsup_contact.report.face import face_macros
-    from infsup_contact.report.face import study_files
+    from infsup_contact.report.sections.face import face_macros
+    from infsup_contact.report.sections.face import study_files
 
     from helpers.face_tables import small_face_tables
 

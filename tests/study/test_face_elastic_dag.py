@@ -1,6 +1,6 @@
 """The elastic face stage of the DAG (config ``face_elastic``, rules/face_elastic.smk): its config
 checks, the claim builder (study/face_elastic_claims.py: predictions from structure, verdicts from
-the table) and the generated subsection (report/face_elastic.py), on fabricated tables — the
+the table) and the generated subsection (report/sections/face_elastic.py), on fabricated tables — the
 numbers themselves are computed by the DAG, and the elastic model is tested in test_elastic3d.py."""
 from __future__ import annotations
 
@@ -123,7 +123,7 @@ def test_patch_claims_predict_pass_iff_the_space_spans_constants():
 
 
 def test_subsection_renders_the_table():
-    from infsup_contact.report.face_elastic import face_elastic_tex
+    from infsup_contact.report.sections.face_elastic import face_elastic_tex
 
     frames = [_rows("T3"), _rows("R5.2"), _rows("DUAL")]
     beta = pd.concat([f[0] for f in frames], ignore_index=True)

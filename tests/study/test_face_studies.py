@@ -1,6 +1,6 @@
 """The face studies in the DAG: the model job script (rule model_job) of the face study
 on tiny inputs, the claims of study/face_study_claims.py (predictions from properties; verdicts
-that flip when the data flips) and the three paper tables (report/face.py)."""
+that flip when the data flips) and the three paper tables (report/sections/face.py)."""
 import copy
 import math
 import subprocess
@@ -179,7 +179,7 @@ def test_edge_predictions_follow_degree_and_stability():
 # ------------------------------------------------------------------ paper and config
 
 def test_study_tables_cite_every_row_and_verdict():
-    from infsup_contact.report.face import face_paper_files
+    from infsup_contact.report.sections.face import face_paper_files
 
     t = small_face_tables()
     files = face_paper_files(**t)

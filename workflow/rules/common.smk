@@ -37,7 +37,7 @@ _PKG = Path("src/infsup_contact")
 PRESENTATION_ONLY = ("report", "bench")
 PACKAGE_SOURCES = sorted(str(p) for p in _PKG.rglob("*.py") if p.relative_to(_PKG).parts[0] not in PRESENTATION_ONLY)
 PACKAGE_SOURCES += USER_SPACE_FILES  # a user's space is code the results depend on
-REPORT_SOURCES = sorted(str(p) for p in (_PKG / "report").glob("*.py"))
+REPORT_SOURCES = sorted(str(p) for p in (_PKG / "report").rglob("*.py"))  # sections/, figures/ included
 BENCH_SOURCES = sorted(str(p) for p in (_PKG / "bench").glob("*.py"))
 
 def beta_pairs():

@@ -4,7 +4,7 @@ Jobs: β_h of every (family, k) next to the membranes on the same meshes, the ν
 each k (:mod:`infsup_contact.study.beta.elastic`), the Hertz scene's discretization study per k and its modeling
 study (:mod:`infsup_contact.study.contact.hertz`) and the contact patch test (:mod:`infsup_contact.study.patch.segment`); the spaces
 are the ``infsup.cases`` (one list for the membranes' and this study). Claims:
-:mod:`infsup_contact.study.claims.elastic`; paper: :mod:`infsup_contact.report.elastic` against ``paper/elastic.tex``.
+:mod:`infsup_contact.study.claims.elastic`; paper: :mod:`infsup_contact.report.sections.elastic` against ``paper/elastic.tex``.
 """
 from __future__ import annotations
 
@@ -116,12 +116,12 @@ class ElasticStudy:
                        "speed": ("results/benchmarks/elastic_beta.csv", "bench")})
 
     def paper_files(self, frames: dict, params: dict) -> dict:
-        from ..report.elastic import elastic_paper_files
+        from ..report.sections.elastic import elastic_paper_files
 
         return elastic_paper_files(frames["beta"], frames["sweep"], frames["patch"], frames["hertz"], frames["claims"],
                                    frames["speed"], nu_slope_cases=params["nu_slope_cases"])
 
     def check_tex(self, tex: str, files: dict) -> None:
-        from ..report.elastic import check_elastic_tex
+        from ..report.sections.elastic import check_elastic_tex
 
         check_elastic_tex(tex, files)

@@ -4,7 +4,7 @@ Jobs: β_h of every (element, k) on its mesh pairs in both norms, the L²(Γ)-on
 matching meshes where an element has them (``face.l2_max_N``), the 3D contact patch test, the
 α sweep of the transformed duals and edge dropping (:mod:`infsup_contact.study.face.tables`).
 Claims: :mod:`infsup_contact.study.claims.membranes3d` and its studies' claims; paper:
-:mod:`infsup_contact.report.face` against ``paper/face.tex``.
+:mod:`infsup_contact.report.sections.face` against ``paper/face.tex``.
 """
 from __future__ import annotations
 
@@ -98,7 +98,7 @@ class FaceStudy:
         return Inputs({**self.claim_inputs().files, "claims": (claims_path(self.name), "claims")})
 
     def paper_files(self, frames: dict, params: dict) -> dict:
-        from ..report.face import face_paper_files
+        from ..report.sections.face import face_paper_files
         from ..study.claims.membranes3d_studies import STUDY_CLAIM_PREFIXES
 
         claims = frames["claims"]
@@ -107,6 +107,6 @@ class FaceStudy:
                                 claims[of_studies])
 
     def check_tex(self, tex: str, files: dict) -> None:
-        from ..report.face import check_face_tex
+        from ..report.sections.face import check_face_tex
 
         check_face_tex(tex, files)

@@ -5,7 +5,7 @@ Jobs: β_H of every element (every k; the table's ν on every mesh pair and the 
 (:func:`~infsup_contact.study.face.elastic.patch_frame`). Claims:
 :mod:`infsup_contact.study.claims.elastic3d`, whose kernel comparison reads the membranes' face
 table when the model table has a face study; paper: the generated subsection ``face_elastic.tex``
-of the face section (:mod:`infsup_contact.report.face_elastic`), read by ``paper/face.tex``.
+of the face section (:mod:`infsup_contact.report.sections.face_elastic`), read by ``paper/face.tex``.
 """
 from __future__ import annotations
 
@@ -60,7 +60,7 @@ class FaceElasticStudy:
         return Inputs({"beta": files["beta"], "patch": files["patch"], "claims": (claims_path(self.name), "claims")})
 
     def paper_files(self, frames: dict, params: dict) -> dict:
-        from ..report.face_elastic import face_elastic_tex
+        from ..report.sections.face_elastic import face_elastic_tex
 
         return {"face_elastic.tex": face_elastic_tex(frames["beta"], frames["patch"], frames["claims"], self.cfg)}
 

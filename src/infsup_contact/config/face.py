@@ -89,7 +89,7 @@ def _check_degrees(key: str, model, element: str, ks, k_key: str) -> None:
 
 
 def check_face_studies(fc, model, at: str) -> None:
-    """The face studies' keys (rules/face_studies.smk) the schema cannot state: the patch
+    """The face studies' keys (jobs of the face study, plans/face.py) the schema cannot state: the patch
     test's elements are the model's, with contact scenes and at least one degree of
     ``face.patch.k`` (an element runs the degrees it has: HEX20 k = 2), its pairs
     non-matching; the α sweep's elements are face elements with a transformed (non-identity)

@@ -226,12 +226,12 @@ N_LISTS = {
     ("infsup", "nonmatching_families", "sqrt2"): "schema",  # round(√2·1) = 1: no pair; N2 >= 2
     ("contact", "N"): "empty",
     ("contact", "scenes", "membranes", "N"): "empty",
-    ("elastic", "N"): "empty",
-    ("elastic", "nonmatching"): "empty",
-    ("elastic", "patch_pairs"): "empty",
-    ("elastic", "bench_N"): "empty",
-    ("elastic", "hertz", "N"): "empty",
-    ("elastic", "hertz", "modeling_N"): "accepted",  # T3 with k = 2: dim = 2·1 − 1 = 1
+    ("models", "elastic", "N"): "empty",
+    ("models", "elastic", "nonmatching"): "empty",
+    ("models", "elastic", "patch_pairs"): "empty",
+    ("models", "elastic", "bench_N"): "empty",
+    ("models", "elastic", "hertz", "N"): "empty",
+    ("models", "elastic", "hertz", "modeling_N"): "accepted",  # T3 with k = 2: dim = 2·1 − 1 = 1
     ("benchmarks", "beta_N"): "empty",
     ("benchmarks", "contact_N"): "empty",
     ("claims", "rem55_N"): "empty",

@@ -1,4 +1,4 @@
-"""The section templates (report/sections/templates.py, report/sections/blocks.py) and the section tables declared
+"""The section templates (report/sections/templates.py, blocks.py) and the section tables declared
 through them (report/sections/elastic.py, face.py, face_elastic.py, model_section.py): every row of a generated
 tabular has the tabular's column count, blocks and rows come in the paper's order, the cells
 say what the rows hold, and the claim counts add up under any ledger."""
@@ -9,8 +9,9 @@ import pandas as pd
 import pytest
 
 from infsup_contact.report.sections.blocks import claim_count_macros, n_as_predicted, outcome, predicted, verdict_macros
-from infsup_contact.report.sections.templates import (NORM_TITLES, Group, at, beta_by_mesh_table, beta_cell, case_blocks,
-                                             case_table, kernel_cell, pairs_tex, tabular, verdict_cell)
+from infsup_contact.report.sections.templates import (NORM_TITLES, Group, at, beta_by_mesh_table, beta_cell,
+                                                      case_blocks, case_table, kernel_cell, pairs_tex, tabular,
+                                                      verdict_cell)
 from infsup_contact.report.texformat import case_order, fmt_fixed
 from infsup_contact.report.texnames import macro_name
 

@@ -194,7 +194,8 @@ def test_study_tables_cite_every_row_and_verdict():
 
 @pytest.mark.parametrize("mutate, key", [
     (lambda f: f["patch"].update(elements=["prism"]), "models.face.patch.elements[0]"),
-    (lambda f: f["patch"].update(elements=["hex", "hex20"], k=[1]), "models.face.patch.elements[1]"),  # HEX20: k = 2 only
+    # HEX20: k = 2 only
+    (lambda f: f["patch"].update(elements=["hex", "hex20"], k=[1]), "models.face.patch.elements[1]"),
     (lambda f: f["patch"].update(pairs=[[4, 4]]), "models.face.patch.pairs[0]"),
     (lambda f: f["alpha"].update(elements=["QUAD4"]), "models.face.alpha.elements[0]"),
     (lambda f: f["alpha"].update(alphas=[0.5]), "models.face.alpha.alphas"),

@@ -4,7 +4,8 @@ Jobs: β_h of every (family, k) next to the membranes on the same meshes, the ν
 each k (:mod:`infsup_contact.study.beta.elastic`), the Hertz scene's discretization study per k and its modeling
 study (:mod:`infsup_contact.study.contact.hertz`) and the contact patch test (:mod:`infsup_contact.study.patch.segment`); the spaces
 are the ``infsup.cases`` (one list for the membranes' and this study). Claims:
-:mod:`infsup_contact.study.claims.elastic`; paper: :mod:`infsup_contact.report.sections.elastic` against ``paper/elastic.tex``.
+:mod:`infsup_contact.study.claims.elastic`; paper: :mod:`infsup_contact.report.sections.elastic` against
+``paper/elastic.tex``.
 """
 from __future__ import annotations
 

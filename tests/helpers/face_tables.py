@@ -1,4 +1,4 @@
-"""Small synthetic face tables (study/face_claims.py, report/face.py) for the tests: rows of
+"""Small synthetic face tables (study/face_claims.py, report/sections/face.py) for the tests: rows of
 the face β table whose kernel is the dimension count (or as told) and whose β follows a given
 law of N; shared by tests/study/test_face_claims.py and the paper build of tests/report/test_paper.py."""
 from __future__ import annotations

@@ -288,7 +288,7 @@ def test_elastic_section_uses_only_generated_macros_and_has_no_typed_results():
 
     from helpers.elastic_tables import small_elastic_tables
 
-    from infsup_contact.report.elastic import check_elastic_tex, elastic_paper_files
+    from infsup_contact.report.sections.elastic import check_elastic_tex, elastic_paper_files
 
     t = small_elastic_tables()
     claims = t["claims"]

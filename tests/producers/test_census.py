@@ -1,4 +1,4 @@
-"""The census (study/census.py, report/figures/census.py, report/producers.py census_tex) on
+"""The census (study/census.py, report/figures/census.py, report/sections/producers.py census_tex) on
 synthetic producers tables: no code is run. Each row of the census is one (code, space, offset)
 of the producers table, its verdict the H row's; a code not installed has its configured spaces
 and offsets as NOT RUN rows with the install command; the fix is the prediction's; the date of a
@@ -15,7 +15,7 @@ import yaml
 
 from infsup_contact.io import read_table, write_csv_atomic
 from infsup_contact.report.figures.census import plot_census_modes, unstable_panels
-from infsup_contact.report.producers import census_tex
+from infsup_contact.report.sections.producers import census_tex
 from infsup_contact.study.census import (CENSUS_COLUMNS, NONE, NOT_GIVEN, UNCOMMITTED, census_table, matching,
                                          prediction_commits)
 from infsup_contact.study.producers import COLUMNS, MODE_COLUMNS

@@ -1,4 +1,4 @@
-"""The producers stage (rules/producers.smk, study/producers.py, report/producers.py) on a fake
+"""The producers stage (rules/producers.smk, study/producers.py, report/sections/producers.py) on a fake
 producer: a tiny script obeying the exporter contract, so the stage is tested without Kratos.
 
 The fake system has a closed form: A = 2 I on n = N + 2 dofs, B = h [I_N | 0] (m = N P0
@@ -20,7 +20,7 @@ import yaml
 
 from infsup_contact.errors import InputError
 from infsup_contact.io import read_table, write_csv_atomic
-from infsup_contact.report.producers import producers_tex
+from infsup_contact.report.sections.producers import producers_tex
 from infsup_contact.study.producers import norm_copy, producers_claims, producers_modes, producers_table
 
 ROOT = Path(__file__).resolve().parents[2]

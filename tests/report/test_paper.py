@@ -406,7 +406,7 @@ def test_pdf_builds_and_shows_generated_numbers(tables, tmp_path):
     # the elastic section (paper/elastic.tex) and its generated files, from small real tables
     from helpers.elastic_tables import small_elastic_tables
 
-    from infsup_contact.report.elastic import elastic_paper_files
+    from infsup_contact.report.sections.elastic import elastic_paper_files
 
     for name, text in elastic_paper_files(**small_elastic_tables()).items():
         (gen / name).write_text(text)
@@ -415,7 +415,7 @@ def test_pdf_builds_and_shows_generated_numbers(tables, tmp_path):
     # the face section (paper/face.tex) and its generated files, from small synthetic tables
     from helpers.face_tables import small_face_tables
 
-    from infsup_contact.report.face import face_paper_files
+    from infsup_contact.report.sections.face import face_paper_files
 
     for name, text in face_paper_files(**small_face_tables()).items():
         (gen / name).write_text(text)

@@ -1,5 +1,5 @@
-"""The section templates (report/templates.py, report/sections.py) and the section tables declared
-through them (report/elastic.py, face.py, face_elastic.py, model_section.py): every row of a generated
+"""The section templates (report/sections/templates.py, blocks.py) and the section tables declared
+through them (report/sections/elastic.py, face.py, face_elastic.py, model_section.py): every row of a generated
 tabular has the tabular's column count, blocks and rows come in the paper's order, the cells
 say what the rows hold, and the claim counts add up under any ledger."""
 import re
@@ -8,9 +8,10 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from infsup_contact.report.sections import claim_count_macros, n_as_predicted, outcome, predicted, verdict_macros
-from infsup_contact.report.templates import (NORM_TITLES, Group, at, beta_by_mesh_table, beta_cell, case_blocks,
-                                             case_table, kernel_cell, pairs_tex, tabular, verdict_cell)
+from infsup_contact.report.sections.blocks import claim_count_macros, n_as_predicted, outcome, predicted, verdict_macros
+from infsup_contact.report.sections.templates import (NORM_TITLES, Group, at, beta_by_mesh_table, beta_cell,
+                                                      case_blocks, case_table, kernel_cell, pairs_tex, tabular,
+                                                      verdict_cell)
 from infsup_contact.report.texformat import case_order, fmt_fixed
 from infsup_contact.report.texnames import macro_name
 
@@ -55,7 +56,7 @@ def _face_elastic_beta(cases=("T3", "R5.2"), nus=(0.3, 0.49, 0.499, 0.4999), exp
 def _elastic_files(which: str) -> dict:
     from helpers.elastic_tables import small_elastic_tables
 
-    from infsup_contact.report.elastic import elastic_paper_files
+    from infsup_contact.report.sections.elastic import elastic_paper_files
 
     t = dict(small_elastic_tables())
     if which == "matching, no modeling":
@@ -67,7 +68,7 @@ def _elastic_files(which: str) -> dict:
 def _face_files(which: str) -> dict:
     from helpers.face_tables import small_face_tables
 
-    from infsup_contact.report.face import face_paper_files
+    from infsup_contact.report.sections.face import face_paper_files
 
     t = small_face_tables()
     if which == "matching, no studies":
@@ -76,7 +77,7 @@ def _face_files(which: str) -> dict:
 
 
 def _face_elastic_table(which: str) -> dict:
-    from infsup_contact.report.face_elastic import face_elastic_table
+    from infsup_contact.report.sections.face_elastic import face_elastic_table
 
     nus = (0.3, 0.49, 0.499, 0.4999) if which == "sweep" else (0.3,)
     return {"face_elastic table": face_elastic_table(_face_elastic_beta(nus=nus), 0.49, 0.3, 4)}
@@ -85,7 +86,7 @@ def _face_elastic_table(which: str) -> dict:
 def _model_section(which: str) -> dict:
     from helpers.face_tables import small_face_tables
 
-    from infsup_contact.report.model_section import model_section_tex
+    from infsup_contact.report.sections.model_section import model_section_tex
 
     t = small_face_tables()
     beta = t["beta"].assign(model="orthotropic")
@@ -110,7 +111,7 @@ def test_face_elastic_slope_of_a_square_root_law_is_one_half():
     """β_H = (1 − 2ν)^{1/2}: the fitted slope of log β_H against log(1 − 2ν) is 1/2 up to
     round-off (the cell's 3 decimals), each ν cell is β_H there, a space with a kernel shows 0
     and no slope."""
-    from infsup_contact.report.face_elastic import face_elastic_table
+    from infsup_contact.report.sections.face_elastic import face_elastic_table
 
     text = face_elastic_table(_face_elastic_beta(), 0.49, 0.3, 4)
     rows = {line.split(" & ")[2]: line.removesuffix(r" \\").split(" & ") for line in text.splitlines()

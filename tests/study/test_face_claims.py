@@ -1,4 +1,4 @@
-"""The face stage's claims (study/face_claims.py), macros (report/face.py) and config checks
+"""The face stage's claims (study/face_claims.py), macros (report/sections/face.py) and config checks
 (config/face.py) on synthetic tables: verdicts follow the data by the ledger's criteria, the
 predictions follow registry properties (not ids), a bad ``face:`` key is named."""
 from __future__ import annotations
@@ -110,7 +110,7 @@ def test_predictions_come_from_properties_not_ids():
 
 
 def test_face_macros_count_the_claims():
-    from infsup_contact.report.face import check_face_tex, face_paper_files
+    from infsup_contact.report.sections.face import check_face_tex, face_paper_files
 
     beta = pd.concat([_rows("T3", 1), _rows("R5.2", 1), _rows("T3", 1, element="tet")], ignore_index=True)
     claims = face_claims(beta, CLAIMS_CFG, {"hex": SQUARE, "tet": SQUARE_TRIG})
@@ -134,36 +134,31 @@ def _ci():
 
 
 @pytest.mark.parametrize("mutate, key", [
-    (lambda f: f.update(cases=["T3", "NOPE"]), "face.cases[1]"),
-    (lambda f: f.update(elements=["hex", "prism"]), "face.elements[1]"),
-    (lambda f: f.update(nonmatching=[[5, 5]]), "face.nonmatching[0]"),
-    (lambda f: f.update(model="membranes"), "face.model"),
-    (lambda f: f.update(norms=["H", "H1"]), "face.norms"),
-    (lambda f: f.update(max_N={"prism": 8}), "face.max_N.prism"),
-    (lambda f: f.update(max_N={"hex": 4}), "face.max_N.hex"),
-    (lambda f: f.update(l2_max_N={"hex": 12}), "face.l2_max_N.hex"),                 # no max_N to exceed
-    (lambda f: f.update(max_N={"hex": 8}, l2_max_N={"hex": 6}), "face.l2_max_N.hex"),  # below max_N
-    (lambda f: f.update(max_N={"hex": 8}, l2_max_N={"hex": 10}, norms=["H"]), "face.l2_max_N.hex"),
+    (lambda f: f.update(cases=["T3", "NOPE"]), "models.face.cases[1]"),
+    (lambda f: f.update(elements=["hex", "prism"]), "models.face.elements[1]"),
+    (lambda f: f.update(nonmatching=[[5, 5]]), "models.face.nonmatching[0]"),
+    (lambda f: f.update(model="membranes"), "models.face.model"),
+    (lambda f: f.update(norms=["H", "H1"]), "models.face.norms"),
+    (lambda f: f.update(max_N={"prism": 8}), "models.face.max_N.prism"),
+    (lambda f: f.update(max_N={"hex": 4}), "models.face.max_N.hex"),
+    (lambda f: f.update(l2_max_N={"hex": 12}), "models.face.l2_max_N.hex"),                 # no max_N to exceed
+    (lambda f: f.update(max_N={"hex": 8}, l2_max_N={"hex": 6}), "models.face.l2_max_N.hex"),  # below max_N
+    (lambda f: f.update(max_N={"hex": 8}, l2_max_N={"hex": 10}, norms=["H"]), "models.face.l2_max_N.hex"),
 ])
 def test_bad_face_key_is_named(mutate, key):
     from infsup_contact.config.checks import ConfigError, check_config
 
     cfg = copy.deepcopy(_ci())
-    mutate(cfg["face"])
+    mutate(cfg["models"]["face"])
     with pytest.raises(ConfigError) as err:
         check_config(cfg, ROOT / "workflow" / "schemas" / "config.schema.yaml")
     assert f"config key {key}" in str(err.value)
 
 
-def test_config_without_face_section_is_valid():
+def test_config_without_face_study_is_valid():
     from infsup_contact.config.checks import check_config
 
-    from infsup_contact.config.schema import ConfigError
-
     cfg = _ci()
-    del cfg["face"]
-    with pytest.raises(ConfigError, match="models.face"):  # its model-table entry reads it: one line
-        check_config(cfg, ROOT / "workflow" / "schemas" / "config.schema.yaml")
     del cfg["models"]["face"]
     check_config(cfg, ROOT / "workflow" / "schemas" / "config.schema.yaml")
 
@@ -173,8 +168,8 @@ def test_face_section_renders_under_any_verdict(verdict):
     """paper/face.tex states outcomes only through \\byverdict on its generated outcome macros:
     it renders (every macro expanded, every branch resolved) whatever the ledger says."""
     from infsup_contact.report.consistency import render
-    from infsup_contact.report.face import face_macros
-    from infsup_contact.report.face import study_files
+    from infsup_contact.report.sections.face import face_macros
+    from infsup_contact.report.sections.face import study_files
 
     from helpers.face_tables import small_face_tables
 
@@ -238,8 +233,9 @@ def test_face_case_no_configured_element_carries_is_refused(patch, refused):
     from infsup_contact.config.checks import ConfigError, check_config
 
     cfg = copy.deepcopy(_ci())
-    cfg["face"]["cases"] = [*cfg["face"]["cases"], "PWLIN-T6"]
-    cfg["face"]["patch"]["elements"] = patch
+    face = cfg["models"]["face"]
+    face["cases"] = [*face["cases"], "PWLIN-T6"]
+    face["patch"]["elements"] = patch
     schema = ROOT / "workflow" / "schemas" / "config.schema.yaml"
     if not refused:
         check_config(cfg, schema)
@@ -247,5 +243,5 @@ def test_face_case_no_configured_element_carries_is_refused(patch, refused):
     with pytest.raises(ConfigError) as err:
         check_config(cfg, schema)
     line = str(err.value)
-    assert line.startswith(f"config key face.cases[{len(cfg['face']['cases']) - 1}]: PWLIN-T6 is built by the face "
+    assert line.startswith(f"config key models.face.cases[{len(face['cases']) - 1}]: PWLIN-T6 is built by the face "
                            "of none of the elements hex") and "allowed T3, R5.2" in line and "PWLIN-Q9" in line, line

@@ -1,6 +1,6 @@
 """The elastic face stage of the DAG (config ``face_elastic``, rules/models.smk with plans/face_elastic.py): its config
 checks, the claim builder (study/face_elastic_claims.py: predictions from structure, verdicts from
-the table) and the generated subsection (report/face_elastic.py), on fabricated tables — the
+the table) and the generated subsection (report/sections/face_elastic.py), on fabricated tables — the
 numbers themselves are computed by the DAG, and the elastic model is tested in test_elastic3d.py."""
 from __future__ import annotations
 
@@ -123,7 +123,7 @@ def test_patch_claims_predict_pass_iff_the_space_spans_constants():
 
 
 def test_subsection_renders_the_table():
-    from infsup_contact.report.face_elastic import face_elastic_tex
+    from infsup_contact.report.sections.face_elastic import face_elastic_tex
 
     frames = [_rows("T3"), _rows("R5.2"), _rows("DUAL")]
     beta = pd.concat([f[0] for f in frames], ignore_index=True)
@@ -143,39 +143,35 @@ def _ci():
 
 
 @pytest.mark.parametrize("mutate, key", [
-    (lambda f: f.update(model="membranes3d"), "face_elastic.model"),
-    (lambda f: f.update(elements=["hex", "prism"]), "face_elastic.elements[1]"),
-    (lambda f: f["patch"].update(elements=["prism"]), "face_elastic.patch.elements[0]"),
-    (lambda f: f.update(nu=0.5), "face_elastic.nu"),
-    (lambda f: f["nu_sweep"].update(nu=[0.3, 0.49, 0.5]), "face_elastic.nu_sweep.nu[2]"),
-    (lambda f: f["nu_sweep"].update(fit_nu_min=0.4999), "face_elastic.nu_sweep.fit_nu_min"),
-    (lambda f: f["nu_sweep"].update(N=[5]), "face_elastic.nu_sweep.N[0]"),
-    (lambda f: f.update(nonmatching=[[5, 5]]), "face_elastic.nonmatching[0]"),
-    (lambda f: f["patch"].update(pairs=[[4, 4]]), "face_elastic.patch.pairs[0]"),
-    (lambda f: f.update(cases=["T3", "NOPE"]), "face_elastic.cases[1]"),
-    (lambda f: f.update(k=[1], cases=["T4"]), "face_elastic.cases[0]"),
-    (lambda f: f["nu_sweep"].update(slope_tolerance=0), "face_elastic.nu_sweep.slope_tolerance"),
-    (lambda f: f.update(surprise=1), "face_elastic"),
+    (lambda f: f.update(model="membranes3d"), "models.face_elastic.model"),
+    (lambda f: f.update(elements=["hex", "prism"]), "models.face_elastic.elements[1]"),
+    (lambda f: f["patch"].update(elements=["prism"]), "models.face_elastic.patch.elements[0]"),
+    (lambda f: f.update(nu=0.5), "models.face_elastic.nu"),
+    (lambda f: f["nu_sweep"].update(nu=[0.3, 0.49, 0.5]), "models.face_elastic.nu_sweep.nu[2]"),
+    (lambda f: f["nu_sweep"].update(fit_nu_min=0.4999), "models.face_elastic.nu_sweep.fit_nu_min"),
+    (lambda f: f["nu_sweep"].update(N=[5]), "models.face_elastic.nu_sweep.N[0]"),
+    (lambda f: f.update(nonmatching=[[5, 5]]), "models.face_elastic.nonmatching[0]"),
+    (lambda f: f["patch"].update(pairs=[[4, 4]]), "models.face_elastic.patch.pairs[0]"),
+    (lambda f: f.update(cases=["T3", "NOPE"]), "models.face_elastic.cases[1]"),
+    (lambda f: f.update(k=[1], cases=["T4"]), "models.face_elastic.cases[0]"),
+    (lambda f: f["nu_sweep"].update(slope_tolerance=0), "models.face_elastic.nu_sweep.slope_tolerance"),
+    (lambda f: f.update(surprise=1), "models.face_elastic"),
 ])
 def test_bad_face_elastic_key_is_named(mutate, key):
     from infsup_contact.config.checks import ConfigError, check_config
 
     cfg = copy.deepcopy(_ci())
-    mutate(cfg["face_elastic"])
+    mutate(cfg["models"]["face_elastic"])
     with pytest.raises(ConfigError) as err:
         check_config(cfg, ROOT / "workflow" / "schemas" / "config.schema.yaml")
     assert f"config key {key}" in str(err.value)
 
 
 @pytest.mark.parametrize("name", ["ci.yaml", "config.yaml"])
-def test_shipped_configs_pass_and_the_section_is_optional(name):
+def test_shipped_configs_pass_and_the_study_is_optional(name):
     from infsup_contact.config.checks import check_config
-    from infsup_contact.config.schema import ConfigError
 
     cfg = yaml.safe_load((ROOT / "config" / name).read_text())
     check_config(cfg, ROOT / "workflow" / "schemas" / "config.schema.yaml")
-    del cfg["face_elastic"]
-    with pytest.raises(ConfigError, match="models.face_elastic"):  # its model-table entry reads it
-        check_config(cfg, ROOT / "workflow" / "schemas" / "config.schema.yaml")
     del cfg["models"]["face_elastic"]
     check_config(cfg, ROOT / "workflow" / "schemas" / "config.schema.yaml")

@@ -1,6 +1,6 @@
 """The face studies in the DAG: the model job script (rule model_job) of the face study
 on tiny inputs, the claims of study/face_study_claims.py (predictions from properties; verdicts
-that flip when the data flips) and the three paper tables (report/face.py)."""
+that flip when the data flips) and the three paper tables (report/sections/face.py)."""
 import copy
 import math
 import subprocess
@@ -27,7 +27,7 @@ ENV = {"PYTHONPATH": str(ROOT / "src"), "OPENBLAS_NUM_THREADS": "1", "PATH": str
 JOB = """
 import runpy, sys, types
 snakemake = types.SimpleNamespace(output=[sys.out], log=[sys.log], threads=1,
-                                  config={"spaces": [], "models": {"face": {"study": "face"}}, "face": sys.fc},
+                                  config={"spaces": [], "models": {"face": {"study": "face", **sys.fc}}},
                                   wildcards=types.SimpleNamespace(model="face", job=sys.study))
 runpy.run_path("workflow/scripts/model_job.py", init_globals={"snakemake": snakemake})
 """
@@ -179,7 +179,7 @@ def test_edge_predictions_follow_degree_and_stability():
 # ------------------------------------------------------------------ paper and config
 
 def test_study_tables_cite_every_row_and_verdict():
-    from infsup_contact.report.face import face_paper_files
+    from infsup_contact.report.sections.face import face_paper_files
 
     t = small_face_tables()
     files = face_paper_files(**t)
@@ -193,20 +193,21 @@ def test_study_tables_cite_every_row_and_verdict():
 
 
 @pytest.mark.parametrize("mutate, key", [
-    (lambda f: f["patch"].update(elements=["prism"]), "face.patch.elements[0]"),
-    (lambda f: f["patch"].update(elements=["hex", "hex20"], k=[1]), "face.patch.elements[1]"),  # HEX20: k = 2 only
-    (lambda f: f["patch"].update(pairs=[[4, 4]]), "face.patch.pairs[0]"),
-    (lambda f: f["alpha"].update(elements=["QUAD4"]), "face.alpha.elements[0]"),
-    (lambda f: f["alpha"].update(alphas=[0.5]), "face.alpha.alphas"),
-    (lambda f: f["edge_dropping"].update(theta=[0.0, 0.5, 1.0]), "face.edge_dropping.theta"),
-    (lambda f: f["edge_dropping"].update(fit_theta_max=0.012), "face.edge_dropping.fit_theta_max"),
-    (lambda f: f.pop("patch"), "face"),
+    (lambda f: f["patch"].update(elements=["prism"]), "models.face.patch.elements[0]"),
+    # HEX20: k = 2 only
+    (lambda f: f["patch"].update(elements=["hex", "hex20"], k=[1]), "models.face.patch.elements[1]"),
+    (lambda f: f["patch"].update(pairs=[[4, 4]]), "models.face.patch.pairs[0]"),
+    (lambda f: f["alpha"].update(elements=["QUAD4"]), "models.face.alpha.elements[0]"),
+    (lambda f: f["alpha"].update(alphas=[0.5]), "models.face.alpha.alphas"),
+    (lambda f: f["edge_dropping"].update(theta=[0.0, 0.5, 1.0]), "models.face.edge_dropping.theta"),
+    (lambda f: f["edge_dropping"].update(fit_theta_max=0.012), "models.face.edge_dropping.fit_theta_max"),
+    (lambda f: f.pop("patch"), "models.face"),
 ])
 def test_bad_study_key_is_named(mutate, key):
     from infsup_contact.config.checks import ConfigError, check_config
 
     cfg = copy.deepcopy(yaml.safe_load((ROOT / "config" / "ci.yaml").read_text()))
-    mutate(cfg["face"])
+    mutate(cfg["models"]["face"])
     with pytest.raises(ConfigError) as err:
         check_config(cfg, ROOT / "workflow" / "schemas" / "config.schema.yaml")
     assert f"config key {key}" in str(err.value)
@@ -217,6 +218,6 @@ def test_theta_window_of_the_helper_matches_the_configs():
     """The synthetic tables use the configs' fit window and its θ (the claims' data), and full cover."""
     window = sorted(t for t in THETAS if t <= FIT_THETA_MAX)
     for name in ("config.yaml", "ci.yaml"):
-        ed = yaml.safe_load((ROOT / "config" / name).read_text())["face"]["edge_dropping"]
+        ed = yaml.safe_load((ROOT / "config" / name).read_text())["models"]["face"]["edge_dropping"]
         assert ed["fit_theta_max"] == FIT_THETA_MAX and 1.0 in ed["theta"]
         assert sorted(t for t in ed["theta"] if t <= FIT_THETA_MAX) == window

@@ -7,7 +7,7 @@ from snakemake.utils import validate
 
 from infsup_contact import resources
 from infsup_contact.config.checks import ConfigError, check_config, speed_accuracy_scene
-from infsup_contact.plans import claims_path, job_path, model_table, study_of, table_path
+from infsup_contact.plans import claims_path, job_path, model_table, scenes_of, study_of, table_path
 from infsup_contact.config.strict_yaml import check_config_files
 from infsup_contact.config.memory import check_job_memory, memory_notes
 from infsup_contact.discretization.gamma.mesh_series import seeds, series_of_pairs
@@ -37,7 +37,7 @@ _PKG = Path("src/infsup_contact")
 PRESENTATION_ONLY = ("report", "bench")
 PACKAGE_SOURCES = sorted(str(p) for p in _PKG.rglob("*.py") if p.relative_to(_PKG).parts[0] not in PRESENTATION_ONLY)
 PACKAGE_SOURCES += USER_SPACE_FILES  # a user's space is code the results depend on
-REPORT_SOURCES = sorted(str(p) for p in (_PKG / "report").glob("*.py"))
+REPORT_SOURCES = sorted(str(p) for p in (_PKG / "report").rglob("*.py"))  # sections/, figures/ included
 BENCH_SOURCES = sorted(str(p) for p in (_PKG / "bench").glob("*.py"))
 
 def beta_pairs():

@@ -253,7 +253,7 @@ rule elastic_hertz_profiles:
     input:
         PACKAGE_SOURCES,
     params:
-        ec=lambda wc: config["elastic"],
+        ec=lambda wc: scenes_of(config, "elastic"),  # the model table's elastic study (config key models.elastic)
         fig=lambda wc: config["figures"]["elastic_profiles"],
     threads: 1
     benchmark:
@@ -284,7 +284,7 @@ if FACE_FIGURE_NAMES:
     # The worst mode of panel (d), config figures.face_mode (the tetrahedra's P_0 at k = 2 on the Kuhn triangles of Γ),
     # whose one kernel mode is the checkerboard. A kernel vector does not depend on the norm, so the
     # cheap L2 Gram serves; N = 4 shows the pattern (32 triangles) in well under a second.
-    FACE_MODE = dict(config["figures"]["face_mode"], model=config["face"]["model"], norm="L2")
+    FACE_MODE = dict(config["figures"]["face_mode"], model=scenes_of(config, FACE_STUDY)["model"], norm="L2")
     # HEX20 bodies (k = 2, QUAD8 faces) for the third panel of fig10_face_beta: the β table of the
     # model table's beta study on HEX20 bodies (config models: an entry with elements [hex20]), where
     # there is one; its claims are the ledger's

@@ -1,4 +1,4 @@
-"""results/paper/producers.tex: the section "Certifying production codes" (report/producers.py)."""
+"""results/paper/producers.tex: the section "Certifying production codes" (report/sections/producers.py)."""
 import sys
 from pathlib import Path
 
@@ -9,7 +9,7 @@ log_to(snakemake.log[0])  # noqa: F821
 
 from infsup_contact.io import write_atomic  # noqa: E402
 from infsup_contact.report.figures.census import unstable_panels  # noqa: E402
-from infsup_contact.report.producers import producers_tex  # noqa: E402
+from infsup_contact.report.sections.producers import producers_tex  # noqa: E402
 
 inp = snakemake.input  # noqa: F821
 table = read_table(inp.table, "producers")

@@ -24,6 +24,7 @@ import re
 
 from ..discretization.spaces.user_spaces import config_case_ids
 from .meshes import check_space_meshes, config_intervals, scene_meshes
+from .models import check_models, check_moved_sections, check_required_studies, scenes_of, study_entries
 from .schema import (ConfigError, check_finite, describe, key_path, load_schema,  # noqa: F401
                             naming_key, schema_error, show)
 from ..errors import InputError
@@ -110,12 +111,12 @@ def check_figures(cfg) -> None:
             with naming_key(key, f"{case} needs k >= {spec.min_k} ({spec.paper_ref}), the figure has k = {k}",
                             got=case, allowed=f"spaces defined for k = {k}"):
                 check_case(case, k)
-    mode = cfg["figures"].get("face_mode")
-    if mode and cfg.get("face"):
+    mode, face = cfg["figures"].get("face_mode"), scenes_of(cfg, "face")
+    if mode and face:
         from ..models import MODELS
         from ..solvers.request import check_mesh_option
 
-        model = MODELS.get(cfg["face"]["model"])  # a model without a face is face.model's own refusal
+        model = MODELS.get(face["model"])  # a model without a face is the face study's own refusal
         if model is not None and dict(model.mesh_options).get("element"):
             with naming_key("figures.face_mode.element", f"not an element of the face model {model.name}"):
                 check_mesh_option(model, "element", mode["element"])
@@ -222,27 +223,28 @@ def check_speed_accuracy_scene(cfg) -> None:
 
 
 def check_elastic_nonmatching(cfg) -> None:
-    """An elastic non-matching pair (β_h table, patch test) has N1 ≠ N2."""
-    for key in ("nonmatching", "patch_pairs"):
-        for i, pair in enumerate(cfg["elastic"][key]):
-            if pair[0] == pair[1]:
-                raise ConfigError(f"elastic.{key}[{i}]", "a non-matching pair needs N1 != N2", got=pair,
-                                  allowed="[N1, N2] with N1 != N2 (matching meshes go under elastic.N)")
+    """An elastic study's non-matching pair (β_h table, patch test) has N1 ≠ N2."""
+    for at, ec in study_entries(cfg, "elastic"):
+        for key in ("nonmatching", "patch_pairs"):
+            for i, pair in enumerate(ec[key]):
+                if pair[0] == pair[1]:
+                    raise ConfigError(f"{at}.{key}[{i}]", "a non-matching pair needs N1 != N2", got=pair,
+                                      allowed=f"[N1, N2] with N1 != N2 (matching meshes go under {at}.N)")
 
 
 def check_hertz_reference(cfg) -> None:
-    """elastic.hertz.N_ref >= REFERENCE_MARGIN × the largest elastic.hertz.N (as the membranes)."""
-    hz = cfg["elastic"]["hertz"]
-    need = REFERENCE_MARGIN * max(hz["N"])
-    if hz["N_ref"] < need:
-        raise ConfigError("elastic.hertz.N_ref", f"the Hertz reference must be {REFERENCE_MARGIN}x finer than the "
-                          f"finest mesh it measures (N up to {max(hz['N'])})", got=hz["N_ref"],
-                          allowed=f"N_ref >= {need}")
+    """An elastic study's hertz.N_ref >= REFERENCE_MARGIN × its largest hertz.N (as the membranes)."""
+    for at, ec in study_entries(cfg, "elastic"):
+        hz = ec["hertz"]
+        need = REFERENCE_MARGIN * max(hz["N"])
+        if hz["N_ref"] < need:
+            raise ConfigError(f"{at}.hertz.N_ref", f"the Hertz reference must be {REFERENCE_MARGIN}x finer than "
+                              f"the finest mesh it measures (N up to {max(hz['N'])})", got=hz["N_ref"],
+                              allowed=f"N_ref >= {need}")
 
 
 from .face import check_face  # noqa: E402 (the face section's checks: config/face.py)
 from .face_elastic import check_face_elastic  # noqa: E402 (config/face_elastic.py)
-from .models import check_models  # noqa: E402 (the model table: config/models.py)
 
 CROSS_KEY_RULES = {
     # rule: the keys it relates (the error names the first; a change to any of them can trip it)
@@ -255,16 +257,20 @@ CROSS_KEY_RULES = {
     check_membranes_parameters: ("contact.scenes",),
     check_primary_scene: ("contact.primary_scene", "contact.scenes"),
     check_speed_accuracy_scene: ("benchmarks.speed_accuracy_scene", "contact.scenes", "contact.primary_scene"),
-    check_elastic_nonmatching: ("elastic.nonmatching", "elastic.patch_pairs"),
-    check_hertz_reference: ("elastic.hertz.N_ref", "elastic.hertz.N"),
-    check_face: ("face.model", "face.elements", "face.nonmatching", "face.nonmatching_families", "face.cases",
-                 "face.max_N", "face.l2_max_N", "face.norms", "spaces"),
-    check_face_elastic: ("face_elastic.model", "face_elastic.elements", "face_elastic.nu", "face_elastic.nu_sweep",
-                         "face_elastic.nonmatching", "face_elastic.cases", "face_elastic.patch", "spaces"),
-    check_models: ("models", "elastic", "face", "face_elastic", "spaces"),
+    check_required_studies: ("models",),  # first of the table's rules: the others read its elastic entry
+    check_models: ("models", "spaces"),
+    check_elastic_nonmatching: ("models.elastic.nonmatching", "models.elastic.patch_pairs"),
+    check_hertz_reference: ("models.elastic.hertz.N_ref", "models.elastic.hertz.N"),
+    check_face: ("models.face.model", "models.face.elements", "models.face.nonmatching",
+                 "models.face.nonmatching_families", "models.face.cases", "models.face.max_N",
+                 "models.face.l2_max_N", "models.face.norms", "spaces"),
+    check_face_elastic: ("models.face_elastic.model", "models.face_elastic.elements", "models.face_elastic.nu",
+                         "models.face_elastic.nu_sweep", "models.face_elastic.nonmatching",
+                         "models.face_elastic.cases", "models.face_elastic.patch", "spaces"),
     check_space_meshes: ("infsup.N", "infsup.nonmatching", "infsup.nonmatching_families", "contact.N",
-                         "contact.scenes", "elastic.N", "elastic.nonmatching", "elastic.patch_pairs",
-                         "elastic.bench_N", "elastic.hertz.N", "elastic.hertz.modeling_N", "benchmarks.beta_N",
+                         "contact.scenes", "models.elastic.N", "models.elastic.nonmatching",
+                         "models.elastic.patch_pairs", "models.elastic.bench_N", "models.elastic.hertz.N",
+                         "models.elastic.hertz.modeling_N", "benchmarks.beta_N",
                          "benchmarks.contact_N", "claims.rem55_N", "infsup.cases", "contact.cases",
                          "figures.contact_solutions", "figures.dual", "figures.elastic_profiles"),
 }
@@ -316,6 +322,7 @@ def check_config(cfg, schema) -> tuple[list, list]:
     if not isinstance(cfg, dict):
         raise ConfigError("(top level)", "the config file must be a mapping of keys", got=type(cfg).__name__,
                           allowed=describe(schema))
+    check_moved_sections(cfg)
     files = load_spaces(cfg)
     check_finite(cfg)
     err = schema_error(cfg, schema)

@@ -41,26 +41,7 @@ def job_estimates(cfg):
                     yield key, f"contact_job {s} {f} k={k} N={n}", est
     for n in cfg["claims"]["rem55_N"]:
         yield "claims.rem55_N", f"claims_extra N={n}", R.beta_estimate("structured", 3, n, n, norms=("H",))
-    ec = cfg["elastic"]  # one job per (family, k): its largest pair; membranes alongside (smaller)
-    for n1, n2 in [(n, n) for n in ec["N"]] + [tuple(p) for p in ec["nonmatching"]]:
-        key = "elastic.N" if n1 == n2 else "elastic.nonmatching"
-        for f in ec["families"]:
-            for k in sorted(set(ec["k"]) | set(ec["nu_sweep_k"])):
-                yield key, f"elastic_beta_job {f} k={k} {n1}x{n2}", R.beta_estimate(
-                    f, k, n1, n2, "omega2", ("H",), components=2)
-    hz = ec["hertz"]
-    for key, n, k in [("elastic.hertz.N_ref", hz["N_ref"], k + 1) for k in hz["k"]] + \
-            [("elastic.hertz.modeling_N", hz["modeling_N"], 2)]:
-        yield key, f"elastic_hertz k={k} N={n}", R.beta_estimate("structured", k, n, n, "omega2", ("L2",),
-                                                                 components=2)
-    for n in ec["bench_N"]:
-        for k in ec["bench_k"]:
-            yield "elastic.bench_N", f"elastic_bench k={k} N={n}", R.beta_estimate(
-                "structured", k, n, n, "omega2", ("H",), components=2)
-    for n1, n2 in ec["patch_pairs"]:
-        for k in ec["patch_k"]:
-            yield "elastic.patch_pairs", f"elastic_patch k={k} {n1}x{n2}", R.beta_estimate(
-                "structured", k, n1, n2, "omega2", ("L2",), components=2)
+    yield from _elastic_estimates(cfg)
     yield from _model_table_estimates(cfg)
     yield from _face_estimates(cfg)
     for what in ("beta", "contact"):
@@ -69,25 +50,53 @@ def job_estimates(cfg):
             bc.get("kkt_max_N", 64)))
 
 
+def _elastic_estimates(cfg):
+    """The jobs of the model table's ``elastic`` studies: one β job per (family, k), its largest pair
+    (membranes alongside, smaller), the Hertz references, the benchmark and the patch test."""
+    from .models import study_entries
+
+    for at, ec in study_entries(cfg, "elastic"):
+        for n1, n2 in [(n, n) for n in ec["N"]] + [tuple(p) for p in ec["nonmatching"]]:
+            key = f"{at}.N" if n1 == n2 else f"{at}.nonmatching"
+            for f in ec["families"]:
+                for k in sorted(set(ec["k"]) | set(ec["nu_sweep_k"])):
+                    yield key, f"elastic_beta_job {f} k={k} {n1}x{n2}", R.beta_estimate(
+                        f, k, n1, n2, "omega2", ("H",), components=2)
+        hz = ec["hertz"]
+        for key, n, k in [(f"{at}.hertz.N_ref", hz["N_ref"], k + 1) for k in hz["k"]] + \
+                [(f"{at}.hertz.modeling_N", hz["modeling_N"], 2)]:
+            yield key, f"elastic_hertz k={k} N={n}", R.beta_estimate("structured", k, n, n, "omega2", ("L2",),
+                                                                     components=2)
+        for n in ec["bench_N"]:
+            for k in ec["bench_k"]:
+                yield f"{at}.bench_N", f"elastic_bench k={k} N={n}", R.beta_estimate(
+                    "structured", k, n, n, "omega2", ("H",), components=2)
+        for n1, n2 in ec["patch_pairs"]:
+            for k in ec["patch_k"]:
+                yield f"{at}.patch_pairs", f"elastic_patch k={k} {n1}x{n2}", R.beta_estimate(
+                    "structured", k, n1, n2, "omega2", ("L2",), components=2)
+
+
 def _face_estimates(cfg):
-    """The β jobs of the 3D face sections (``face``, ``face_elastic``): per element and k, each
+    """The β jobs of the model table's 3D face studies (``face``, ``face_elastic``): per element and k, each
     matching N (up to the element's ``max_N`` or ``l2_max_N``) and non-matching pair, with the estimate the
     command line checks (:func:`~infsup_contact.resources.beta_estimate`, ``dim = 3``)."""
     from ..models import MODELS
+    from .models import study_entries
 
-    for section in ("face", "face_elastic"):
-        fc = cfg.get(section)
-        if not fc or fc.get("model") not in MODELS:
+    for at, fc in study_entries(cfg, "face") + study_entries(cfg, "face_elastic"):
+        if fc.get("model") not in MODELS:
             continue
+        name = at.rpartition(".")[2]
         model = MODELS[fc["model"]]
         for element in fc["elements"]:
             caps = [(fc.get(cap) or {}).get(element) for cap in ("max_N", "l2_max_N")]  # l2: L² rows above max_N
             top = None if caps[0] is None else max(c for c in caps if c is not None)
-            pairs = [(f"{section}.N", n, n) for n in fc["N"] if top is None or n <= top]
-            pairs += [(f"{section}.nonmatching", *p) for p in fc.get("nonmatching", [])]
+            pairs = [(f"{at}.N", n, n) for n in fc["N"] if top is None or n <= top]
+            pairs += [(f"{at}.nonmatching", *p) for p in fc.get("nonmatching", [])]
             for key, n1, n2 in pairs:
                 for k in fc["k"]:
-                    yield key, f"{section} beta {element} k={k} {n1}x{n2}", R.beta_estimate(
+                    yield key, f"{name} beta {element} k={k} {n1}x{n2}", R.beta_estimate(
                         "structured", k, n1, n2, components=model.components, dim=3)
 
 
@@ -97,7 +106,7 @@ def _model_table_estimates(cfg):
 
     for name, entry in (cfg.get("models") or {}).items():
         if entry.get("study") != "beta":
-            continue  # the built-in studies' jobs are counted under their sections above
+            continue  # the other studies' jobs are counted above
         model = model_named(entry["model"])
         for n1, n2 in [(n, n) for n in entry["N"]] + [tuple(p) for p in entry.get("nonmatching", [])]:
             key = f"models.{name}.N" if n1 == n2 else f"models.{name}.nonmatching"

@@ -4,6 +4,7 @@ multiplier on each of them (:func:`check_space_meshes`, a rule of
 :data:`~infsup_contact.config.checks.CROSS_KEY_RULES`)."""
 from __future__ import annotations
 
+from .models import study_entries
 from .schema import ConfigError
 from ..errors import InputError
 
@@ -33,7 +34,7 @@ def mesh_uses(cfg, with_cases: bool = True):
             return {}
         return {k: ids_valid_for(k, ids if ids is not None else list(cfg["infsup"]["cases"])) for k in ks}
 
-    ic, cc, ec, bc = cfg["infsup"], cfg["contact"], cfg["elastic"], cfg["benchmarks"]
+    ic, cc, bc = cfg["infsup"], cfg["contact"], cfg["benchmarks"]
     inf, mm = by_k(ic["cases"]), ic["multiplier_meshes"]
     for i, n in enumerate(ic["N"]):
         yield f"infsup.N[{i}]", n, n, n, inf, mm
@@ -47,16 +48,17 @@ def mesh_uses(cfg, with_cases: bool = True):
         key = f"contact.scenes.{name}.N" if "N" in cc["scenes"][name] else "contact.N"
         for i, n in enumerate(ns):
             yield f"{key}[{i}]", n, n, n, con, ("omega2",)
-    for key, ks in (("N", {*ec["k"], *ec["nu_sweep_k"]}), ("nonmatching", ec["k"]), ("patch_pairs", ec["patch_k"]),
-                    ("bench_N", ec["bench_k"])):
-        for i, item in enumerate(ec[key]):
-            n1, n2 = item if isinstance(item, list) else (item, item)
-            yield f"elastic.{key}[{i}]", item, n1, n2, every(ks), ("omega2",)
-    hz = ec["hertz"]
-    for i, n in enumerate(hz["N"]):
-        yield f"elastic.hertz.N[{i}]", n, n, n, every(hz["k"]), ("omega2",)
-    yield ("elastic.hertz.modeling_N", hz["modeling_N"], hz["modeling_N"], hz["modeling_N"],
-           {2: [REFERENCE_SPACE]} if with_cases else {}, ("omega2",))
+    for at, ec in study_entries(cfg, "elastic"):
+        for key, ks in (("N", {*ec["k"], *ec["nu_sweep_k"]}), ("nonmatching", ec["k"]),
+                        ("patch_pairs", ec["patch_k"]), ("bench_N", ec["bench_k"])):
+            for i, item in enumerate(ec[key]):
+                n1, n2 = item if isinstance(item, list) else (item, item)
+                yield f"{at}.{key}[{i}]", item, n1, n2, every(ks), ("omega2",)
+        hz = ec["hertz"]
+        for i, n in enumerate(hz["N"]):
+            yield f"{at}.hertz.N[{i}]", n, n, n, every(hz["k"]), ("omega2",)
+        yield (f"{at}.hertz.modeling_N", hz["modeling_N"], hz["modeling_N"], hz["modeling_N"],
+               {2: [REFERENCE_SPACE]} if with_cases else {}, ("omega2",))
     for key, ks, ids in (("beta_N", bc["beta_k"], PAPER_CASES), ("contact_N", bc["contact_k"], [REFERENCE_SPACE])):
         for i, n in enumerate(bc[key]):
             yield f"benchmarks.{key}[{i}]", n, n, n, every(ks, ids), ("omega2",)

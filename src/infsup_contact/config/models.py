@@ -1,7 +1,10 @@
-"""Cross-key checks of the config's model table (key ``models``; :mod:`infsup_contact.plans`).
+"""The config's model table (key ``models``; :mod:`infsup_contact.plans`): reading it, and the
+cross-key checks the schema cannot state.
 
-What the schema cannot state: a built-in study (``elastic``, ``face``, ``face_elastic``) is the
-entry of the config section of its name, and that section exists; a ``beta`` study names a model
+Every study carries its scenes in its entry (:func:`scenes`). The studies the paper's sections and
+figures read by name (``elastic``, ``face``, ``face_elastic``: :data:`NAMED`) are entries of that
+name, and the table has an ``elastic`` one; a config that still has their old top-level sections is
+told where they moved (:func:`check_moved_sections`). A ``beta`` study names a model
 (registered, or ``FILE.py:NAME`` imported here once, so a wrong file stops the run before any job)
 and its scenes ``k``, ``N`` and ``cases``; each element is one of the model's ``element`` options
 (none for a model without them); each case is a registered space defined for some k and built by
@@ -14,45 +17,79 @@ from __future__ import annotations
 from ..errors import InputError
 from .schema import ConfigError, naming_key
 
-BUILT_IN = ("elastic", "face", "face_elastic")
-"""Studies whose scenes are the config section of the entry's name."""
+NAMED = ("elastic", "face", "face_elastic")
+"""Studies whose files the paper's sections and figures read by the study's name
+(``results/paper/<name>/``, ``results/tables/<name>_*.csv``): their entry has that name."""
+REQUIRED = ("elastic",)
+"""Studies the table must have: the paper's elastic section, fig9 and the elastic benchmark read it."""
 RESERVED = ("beta", "contact", "mesh_quality", "claims", "producers", "references", "rates")
 """Names the other stages' tables use (``results/tables/<name>/`` or ``<name>_*.csv``)."""
 BETA_KEYS = ("model", "k", "N", "cases")
 """What a ``beta`` study's entry must state."""
 
 
+def model_table(config: dict) -> dict:
+    """``{name: entry}`` of the config's model table (key ``models``) in its order."""
+    return dict(config.get("models") or {})
+
+
+def scenes(entry: dict) -> dict:
+    """A model-table entry's scenes: the entry without its ``study`` (what its jobs' provenance hashes)."""
+    return {key: value for key, value in entry.items() if key != "study"}
+
+
+def study_entries(config: dict, study: str) -> list:
+    """``[(key, scenes)]`` of every entry running ``study``, ``key`` = ``models.<name>`` (what errors name)."""
+    return [(f"models.{name}", scenes(e)) for name, e in model_table(config).items() if e.get("study") == study]
+
+
+def scenes_of(config: dict, study: str) -> dict | None:
+    """The scenes of the table's first entry running ``study`` (None: it has none), for the stages
+    outside the table that draw or time that model (the elastic benchmark, the face figures)."""
+    entries = study_entries(config, study)
+    return entries[0][1] if entries else None
+
+
+def check_moved_sections(cfg) -> None:
+    """A config written before the wings joined the model table: its top-level section
+    ``elastic``, ``face`` or ``face_elastic`` is refused, naming where its keys now live (unchanged,
+    under the entry of that name with ``study: <name>``). Run before the schema, whose message
+    (an unknown top-level key) would not say where it went."""
+    for name in NAMED:
+        if isinstance(cfg, dict) and name in cfg:
+            raise ConfigError(name, f"the top-level section moved into the model table: its keys go, unchanged, "
+                              f"under models.{name} beside `study: {name}`", got=f"<a top-level `{name}:` section>",
+                              allowed=f"models: {{{name}: {{study: {name}, <the keys of the old section>}}}} "
+                              "(config/config.yaml has one)")
+
+
+def check_required_studies(cfg) -> None:
+    """The model table has the studies of :data:`REQUIRED` (the workflow's other stages read them)."""
+    table = model_table(cfg)
+    for study in REQUIRED:
+        if not any(e["study"] == study for e in table.values()):
+            raise ConfigError("models", f"no {study} study (the paper's {study} section, its figure and benchmark "
+                              "read it)", got=sorted(table), allowed=f"a model table with the entry "
+                              f"{study}: {{study: {study}, ...}} (config/config.yaml has one)")
+
+
 def check_models(cfg) -> None:
-    """Check ``cfg["models"]`` (absent: the built-in sections present are the table)."""
-    table = cfg.get("models")
-    if table is None:
-        return
+    """Check ``cfg["models"]``: names, the named studies, each ``beta``/``arc``/``cylinder`` entry."""
+    table = model_table(cfg)
     for name, entry in table.items():
         key = f"models.{name}"
         if name in RESERVED:
             raise ConfigError(key, "a name the other stages' tables use", got=name,
                               allowed=f"any other name (not {', '.join(RESERVED)})")
         study = entry["study"]
-        if study in BUILT_IN:
-            _check_built_in(cfg, key, name, entry)
-        elif study in ("arc", "cylinder"):
+        if study in NAMED and name != study:
+            raise ConfigError(f"{key}.study", f"the paper and its figures read the {study} study's files by "
+                              f"the name {study!r}: its entry must have that name", got=name,
+                              allowed=f"models: {{{study}: {{study: {study}, ...}}}}")
+        if study in ("arc", "cylinder"):
             _check_arc(key, entry, 1 if study == "arc" else 2)
-        else:
+        elif study == "beta":
             _check_beta(key, entry)
-
-
-def _check_built_in(cfg, key: str, name: str, entry: dict) -> None:
-    if name != entry["study"]:
-        raise ConfigError(f"{key}.study", f"the study {entry['study']} reads the config section "
-                          f"{entry['study']!r}: its entry must have that name", got=name,
-                          allowed=f"models: {{{entry['study']}: {{study: {entry['study']}}}}}")
-    if cfg.get(name) is None:
-        raise ConfigError(key, f"the study reads the config section {name!r}, which the config lacks",
-                          got=name, allowed=f"a `{name}:` section (config/config.yaml has one) or no such entry")
-    extra = sorted(set(entry) - {"study"})
-    if extra:
-        raise ConfigError(f"{key}.{extra[0]}", f"the {name} study's scenes live in the section {name!r}",
-                          got=entry[extra[0]], allowed="only `study` in a built-in study's entry")
 
 
 def _check_beta(key: str, entry: dict) -> None:

@@ -7,7 +7,7 @@ optionally the ``patch`` test (its ``k``, ``pairs`` refined by a common factor, 
 Jobs: one per k, every radius × coupling × pair, plus the paper's own flat rows
 (:func:`infsup_contact.study.beta.arc.arc_rows`); the patch test (:mod:`infsup_contact.study.patch.arc`).
 Claims: :mod:`infsup_contact.study.claims.arc`.
-Paper: one generated subsection (:func:`infsup_contact.report.model_section.arc_section_tex`).
+Paper: one generated subsection (:func:`infsup_contact.report.sections.model_section.arc_section_tex`).
 """
 from __future__ import annotations
 
@@ -102,7 +102,7 @@ class ArcStudy:
         return Inputs({**self.claim_inputs().files, "claims": (claims_path(self.name), "claims")})
 
     def paper_files(self, frames: dict, params: dict) -> dict:
-        from ..report.model_section import arc_section_tex
+        from ..report.sections.model_section import arc_section_tex
         from ..study.beta.arc import arc_verdicts
 
         c = params["claims"]

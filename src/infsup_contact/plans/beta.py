@@ -95,7 +95,7 @@ class BetaStudy:
                        "claims": (claims_path(self.name), "claims")})
 
     def paper_files(self, frames: dict, params: dict) -> dict:
-        from ..report.model_section import model_section_tex
+        from ..report.sections.model_section import model_section_tex
 
         return {f"{self.name}.tex": model_section_tex(self.name, self.cfg, frames["beta"], frames["claims"])}
 

@@ -1,10 +1,11 @@
-"""The plane-strain elastic bodies on the paper's geometry (config section ``elastic``).
+"""The plane-strain elastic bodies on the paper's geometry (model-table study ``elastic``).
 
 Jobs: β_h of every (family, k) next to the membranes on the same meshes, the ν → 1/2 sweep of
 each k (:mod:`infsup_contact.study.beta.elastic`), the Hertz scene's discretization study per k and its modeling
 study (:mod:`infsup_contact.study.contact.hertz`) and the contact patch test (:mod:`infsup_contact.study.patch.segment`); the spaces
 are the ``infsup.cases`` (one list for the membranes' and this study). Claims:
-:mod:`infsup_contact.study.claims.elastic`; paper: :mod:`infsup_contact.report.elastic` against ``paper/elastic.tex``.
+:mod:`infsup_contact.study.claims.elastic`; paper: :mod:`infsup_contact.report.sections.elastic` against
+``paper/elastic.tex``.
 """
 from __future__ import annotations
 
@@ -24,14 +25,15 @@ def _drop_seconds(rows) -> pd.DataFrame:
 
 
 class ElasticStudy:
-    """The elastic study of the config section ``name`` (module docstring)."""
+    """The elastic study ``name`` of the model table: its entry's scenes and the spaces it runs
+    (``infsup.cases``; module docstring)."""
 
     tex_source = "paper/elastic.tex"
     in_paper = True
     model_section = False
 
-    def __init__(self, name: str, config: dict):
-        self.name, self.cfg, self.cases = name, config[name], list(config["infsup"]["cases"])
+    def __init__(self, name: str, scenes: dict, cases: list):
+        self.name, self.cfg, self.cases = name, scenes, list(cases)
 
     def _mem_mb(self, family: str, k: int) -> int:
         """The β estimate of the largest pair, two displacement components per node (+25 %)."""
@@ -115,12 +117,12 @@ class ElasticStudy:
                        "speed": ("results/benchmarks/elastic_beta.csv", "bench")})
 
     def paper_files(self, frames: dict, params: dict) -> dict:
-        from ..report.elastic import elastic_paper_files
+        from ..report.sections.elastic import elastic_paper_files
 
         return elastic_paper_files(frames["beta"], frames["sweep"], frames["patch"], frames["hertz"], frames["claims"],
                                    frames["speed"], nu_slope_cases=params["nu_slope_cases"])
 
     def check_tex(self, tex: str, files: dict) -> None:
-        from ..report.elastic import check_elastic_tex
+        from ..report.sections.elastic import check_elastic_tex
 
         check_elastic_tex(tex, files)

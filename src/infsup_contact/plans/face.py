@@ -1,10 +1,10 @@
-"""The membranes in 3D with a 2D contact face Γ = (0,1)²×{1} (config section ``face``).
+"""The membranes in 3D with a 2D contact face Γ = (0,1)²×{1} (model-table study ``face``).
 
 Jobs: β_h of every (element, k) on its mesh pairs in both norms, the L²(Γ)-only rows of the finer
 matching meshes where an element has them (``face.l2_max_N``), the 3D contact patch test, the
 α sweep of the transformed duals and edge dropping (:mod:`infsup_contact.study.face.tables`).
 Claims: :mod:`infsup_contact.study.claims.membranes3d` and its studies' claims; paper:
-:mod:`infsup_contact.report.face` against ``paper/face.tex``.
+:mod:`infsup_contact.report.sections.face` against ``paper/face.tex``.
 """
 from __future__ import annotations
 
@@ -15,18 +15,18 @@ from ..config.face import face_pairs, l2_only_sizes
 from .protocol import Inputs, Job, Table, claims_path, job_path, table_path
 
 STUDIES = ("patch", "alpha", "edge_dropping")
-"""The face studies: sub-sections of ``face`` and jobs of their own."""
+"""The face studies: sub-mappings of the entry and jobs of their own."""
 
 
 class FaceStudy:
-    """The face study of the config section ``name`` (module docstring)."""
+    """The face study ``name`` of the model table, from its entry's scenes (module docstring)."""
 
     tex_source = "paper/face.tex"
     in_paper = True
     model_section = False
 
-    def __init__(self, name: str, config: dict):
-        self.name, self.cfg = name, config[name]
+    def __init__(self, name: str, scenes: dict):
+        self.name, self.cfg = name, scenes
 
     def _mem_mb(self, element: str, k: int, l2_only: bool) -> int:
         fc = self.cfg
@@ -98,7 +98,7 @@ class FaceStudy:
         return Inputs({**self.claim_inputs().files, "claims": (claims_path(self.name), "claims")})
 
     def paper_files(self, frames: dict, params: dict) -> dict:
-        from ..report.face import face_paper_files
+        from ..report.sections.face import face_paper_files
         from ..study.claims.membranes3d_studies import STUDY_CLAIM_PREFIXES
 
         claims = frames["claims"]
@@ -107,6 +107,6 @@ class FaceStudy:
                                 claims[of_studies])
 
     def check_tex(self, tex: str, files: dict) -> None:
-        from ..report.face import check_face_tex
+        from ..report.sections.face import check_face_tex
 
         check_face_tex(tex, files)

@@ -1,11 +1,11 @@
-"""The linear-elastic bodies on the 3D contact face (config section ``face_elastic``).
+"""The linear-elastic bodies on the 3D contact face (model-table study ``face_elastic``).
 
 Jobs: β_H of every element (every k; the table's ν on every mesh pair and the ν → 1/2 sweep,
 :func:`infsup_contact.study.face.elastic.beta_frame`) and the elastic face patch test
 (:func:`~infsup_contact.study.face.elastic.patch_frame`). Claims:
 :mod:`infsup_contact.study.claims.elastic3d`, whose kernel comparison reads the membranes' face
 table when the model table has a face study; paper: the generated subsection ``face_elastic.tex``
-of the face section (:mod:`infsup_contact.report.face_elastic`), read by ``paper/face.tex``.
+of the face section (:mod:`infsup_contact.report.sections.face_elastic`), read by ``paper/face.tex``.
 """
 from __future__ import annotations
 
@@ -15,13 +15,13 @@ from .protocol import Inputs, Job, Table, claims_path, job_path, table_path
 
 
 class FaceElasticStudy:
-    """The elastic face study of the config section ``name`` (module docstring)."""
+    """The elastic face study ``name`` of the model table, from its entry's scenes (module docstring)."""
 
     tex_source = None
     model_section = False  # its subsection is read by the face section (paper/face.tex), not listed
 
-    def __init__(self, name: str, config: dict, membranes: str | None = None):
-        self.name, self.cfg, self.membranes = name, config[name], membranes
+    def __init__(self, name: str, scenes: dict, membranes: str | None = None):
+        self.name, self.cfg, self.membranes = name, scenes, membranes
         self.in_paper = membranes is not None  # a subsection of the face section: only with one
 
     def jobs(self) -> dict:
@@ -60,7 +60,7 @@ class FaceElasticStudy:
         return Inputs({"beta": files["beta"], "patch": files["patch"], "claims": (claims_path(self.name), "claims")})
 
     def paper_files(self, frames: dict, params: dict) -> dict:
-        from ..report.face_elastic import face_elastic_tex
+        from ..report.sections.face_elastic import face_elastic_tex
 
         return {"face_elastic.tex": face_elastic_tex(frames["beta"], frames["patch"], frames["claims"], self.cfg)}
 

@@ -16,7 +16,7 @@ object, never the model, what to do. A study object answers four questions:
   files of :meth:`ModelStudy.paper_inputs`, checked against its paper source if it has one.
 
 Everything model-specific stays in the study's own module (:mod:`.elastic`, :mod:`.face`,
-:mod:`.face_elastic`, :mod:`.beta`); the stages are shared.
+:mod:`.face_elastic`, :mod:`.beta`, :mod:`.arc`), each reading its scenes from its entry; the stages are shared.
 """
 from __future__ import annotations
 
@@ -83,7 +83,7 @@ class ModelStudy(Protocol):
     """A study of one model over the config's scenes of it (module docstring)."""
 
     name: str
-    """The study's name: the ``{model}`` wildcard, its config section and its tables' prefix."""
+    """The study's name: the ``{model}`` wildcard, its entry in the model table and its tables' prefix."""
     tex_source: str | None
     """The hand-written paper section its generated files are checked against (or None)."""
     in_paper: bool

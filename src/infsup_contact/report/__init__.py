@@ -1,10 +1,13 @@
 """Report: what turns tables into figures and the paper — shared figure style, the paper's macros and tables.
 
-``style`` (one colour and marker per space, from the registry), ``texnames`` / ``texformat``
-(macro names, number formatting, escaping), ``macros`` and ``tables`` (generated LaTeX),
-``paper`` (the generated files and the check of ``paper.tex``); the sections kept in their own
-sources: one template per kind of their tables (``templates``) and of their macro blocks
-(``sections``), and per section its declarations (``elastic``, ``face``, ``face_elastic``).
+By concept: here the paper's own numbers and text — ``style`` / ``case_styles`` (one colour and
+marker per space, from the registry), ``texnames`` / ``texformat`` (macro names, number formatting,
+escaping), ``macros`` and ``tables`` (the paper's generated LaTeX), ``paper`` (the generated files and
+the check of ``paper.tex``), ``consistency`` (text that stays true whatever the verdict);
+``sections/`` the sections each study of the model table (and the producers) generates: one template
+per kind of their tables (``templates``) and of their macro blocks (``blocks``), and per section its
+declarations (``elastic``, ``face``, ``face_elastic``, ``model_section`` for the table's other studies,
+``producers``); ``figures/`` the figures drawn by the package.
 Reads tables only; imports ``discretization`` (the registry) and nothing that computes.
 """
 from .macros import all_macros, macros_tex, speed_macros

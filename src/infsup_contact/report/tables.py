@@ -6,7 +6,7 @@ import pandas as pd
 
 from ..study.beta.selection import primary_rows
 
-from .templates import beta_by_mesh_table
+from .sections.templates import beta_by_mesh_table
 from .texformat import (LEDGER_VERDICTS, MEASURES, SPEED_COLUMNS, PaperTexError, _require, case_rank,
                         fmt_fixed, fmt_sci, latex_escape, latex_id)
 

@@ -23,19 +23,20 @@ def cylinder_rows(radii=RADII, pairs=PAIRS, k: int = 1, cases=None, couplings=CO
     """β_h rows (module docstring) of ``cases`` (None: every face space of k on hexahedra) at each
     radius, coupling and pair (N1, N2), both norms; a bad argument raises
     :class:`~infsup_contact.errors.InputError` naming its key (the request's checks)."""
-    from ...models.membranes3d import MEMBRANES3D
+    from ...models import model_of_dim
     from ...solvers.infsup import beta_rows
     from ...solvers.request import MeshOptions
     from ...solvers.side_cache import SideCache
 
+    membranes3d = model_of_dim(3)  # the registry's 3D membranes, asked for (not imported by module)
     rows = []
     for radius in radii:
         for coupling in couplings:
             mesh = MeshOptions(element="hex", gamma="cylinder", radius=float(radius), coupling=coupling)
-            cache = SideCache.for_sweep(MEMBRANES3D, "structured", k, pairs, mesh)  # Ω2 at N shared by N:N, N+1:N
+            cache = SideCache.for_sweep(membranes3d, "structured", k, pairs, mesh)  # Ω2 at N shared by N:N, N+1:N
             for n1, n2 in pairs:
-                found = beta_rows("structured", k, n1, n2, cases, norms=tuple(norms), model=MEMBRANES3D,
+                found = beta_rows("structured", k, n1, n2, cases, norms=tuple(norms), model=membranes3d,
                                   side_cache=cache, mesh=mesh)
-                rows += [dict(r, model=MEMBRANES3D.name, element="hex", gamma="cylinder", radius=float(radius),
+                rows += [dict(r, model=membranes3d.name, element="hex", gamma="cylinder", radius=float(radius),
                               coupling=coupling) for r in found]
     return rows

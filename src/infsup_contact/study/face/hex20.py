@@ -38,11 +38,12 @@ def hex20_table(ns=NS, norms=("H", "L2"), cases=None, criterion=None) -> list[di
     """Rows of :data:`COLUMNS` for N in ``ns`` (at least three distinct N >= 2: the verdict's
     slope), every QUAD8 space (or ``cases``), both norms; ``seconds`` = wall time of the N's
     β request (both sides factorized once, every space and norm)."""
-    from ...models.membranes3d import MEMBRANES3D
+    from ...models import model_of_dim
     from ...solvers.infsup import beta_rows_all
     from ...solvers.request import MeshOptions
     from ...solvers.side_cache import SideCache
 
+    membranes3d = model_of_dim(3)  # the registry's 3D membranes, asked for (not imported by module)
     ns = sorted({int(n) for n in ns})
     if len(ns) < 3 or ns[0] < 2:
         raise InputError("N", "at least three distinct integers >= 2", got=ns)
@@ -51,7 +52,7 @@ def hex20_table(ns=NS, norms=("H", "L2"), cases=None, criterion=None) -> list[di
     cache, rows = SideCache(), []
     for n in ns:
         t0 = time.perf_counter()
-        found = beta_rows_all("structured", 2, n, n, cases, norms=tuple(norms), model=MEMBRANES3D,
+        found = beta_rows_all("structured", 2, n, n, cases, norms=tuple(norms), model=membranes3d,
                               side_cache=cache, mesh=MeshOptions(element="hex20"))
         seconds = time.perf_counter() - t0
         rows += [dict(r, N=n, seconds=seconds) for r in found]

@@ -9,9 +9,9 @@ from __future__ import annotations
 
 import pandas as pd
 
-from .sections import n_as_predicted, predicted
+from .blocks import n_as_predicted, predicted
 from .templates import beta_by_mesh_table
-from .texformat import PaperTexError, case_order, fmt_sci, latex_escape, latex_id
+from ..texformat import PaperTexError, case_order, fmt_sci, latex_escape, latex_id
 
 def matching_beta_table(beta: pd.DataFrame) -> str:
     """Tabular of β_h on matching meshes: rows (norm, element, k, case), columns N
@@ -39,7 +39,7 @@ def model_section_tex(name: str, entry: dict, beta: pd.DataFrame, claims: pd.Dat
 def _pair_note(beta: pd.DataFrame) -> str:
     """What the entry of a Petrov–Galerkin pair is (:mod:`infsup_contact.solvers.petrov_galerkin`), where the
     table has one; empty otherwise."""
-    from ..discretization.spaces.registry import SPACES
+    from ...discretization.spaces.registry import SPACES
 
     pairs = [SPACES[c] for c in dict.fromkeys(beta.case) if c in SPACES and SPACES[c].petrov_galerkin]
     if not pairs:

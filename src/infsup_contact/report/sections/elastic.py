@@ -13,11 +13,11 @@ from typing import Callable
 import numpy as np
 import pandas as pd
 
-from .sections import check_section_tex, claim_count_macros, section_macros_tex
+from .blocks import check_section_tex, claim_count_macros, section_macros_tex
 from .templates import (Group, at, beta_cell, blank, body_lines, case_keys, case_table, error_cells,
                         head_lines, multicolumn, tabular)
-from .texformat import case_order, fmt_fixed, fmt_int, fmt_sci, latex_id
-from .texnames import Macro, _k, macro_name
+from ..texformat import case_order, fmt_fixed, fmt_int, fmt_sci, latex_id
+from ..texnames import Macro, _k, macro_name
 
 FAMILIES = ("structured", "perturbed", "unstructured")
 """The mesh families of the β_h table, in its row order."""
@@ -38,7 +38,7 @@ def elastic_macros(beta, sweep, patch, hertz, claims, speed, nu_slope_cases=None
     against log(1 − 2ν) gets a macro (config key figures.nu_slope_cases; None: every case of
     the sweep without a kernel). The patch errors are those of the spaces whose M_h contains the
     constants (``SpaceSpec.contains_constants``, registry): the others fail by design."""
-    from ..discretization.spaces.registry import SPACES
+    from ...discretization.spaces.registry import SPACES
 
     out = claim_count_macros(claims, _name, "elastic_claims.csv")
     h = beta[(beta.norm == "H")]
@@ -94,7 +94,7 @@ def elastic_macros(beta, sweep, patch, hertz, claims, speed, nu_slope_cases=None
 
 def elastic_macros_tex(macros: list[Macro]) -> str:
     """The section's macro file (:func:`~.sections.section_macros_tex`)."""
-    return section_macros_tex(macros, "elastic", "infsup_contact.report.elastic (rule elastic_paper)")
+    return section_macros_tex(macros, "elastic", "infsup_contact.report.sections.elastic (rule elastic_paper)")
 
 
 def elastic_beta_table(beta: pd.DataFrame, sweep: pd.DataFrame) -> str:

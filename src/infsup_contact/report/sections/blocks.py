@@ -9,8 +9,8 @@ from typing import Callable
 
 import pandas as pd
 
-from .texformat import VERDICTS, PaperTexError, fmt_int
-from .texnames import Macro
+from ..texformat import VERDICTS, PaperTexError, fmt_int
+from ..texnames import Macro
 
 
 def predicted(claims: pd.DataFrame) -> pd.DataFrame:

@@ -15,14 +15,14 @@ from __future__ import annotations
 
 import pandas as pd
 
-from ..criteria.claims import slope_interval
-from ..study.claims.membranes3d_studies import edge_claim_id, patch_claim_id
-from .sections import (check_section_tex, claim_count_macros, n_as_predicted, outcome, section_macros_tex,
+from ...criteria.claims import slope_interval
+from ...study.claims.membranes3d_studies import edge_claim_id, patch_claim_id
+from .blocks import (check_section_tex, claim_count_macros, n_as_predicted, outcome, section_macros_tex,
                        verdict_macros)
 from .templates import (Group, at, beta_cell, case_blocks, case_table, error_cells, ids_tex, ints_tex, kernel_cell,
                         pair_tex, pairs_tex, verdict_cell)
-from .texformat import PaperTexError, fmt_fixed, fmt_int, fmt_sci, latex_id
-from .texnames import Macro, macro_name
+from ..texformat import PaperTexError, fmt_fixed, fmt_int, fmt_sci, latex_id
+from ..texnames import Macro, macro_name
 
 KINDS = (("kernel", "face-kernel-"), ("nonmatching", "face-nonmatching-kernel-"), ("ltwo", "face-Rem3.1-"),
          ("bounded", "face-"))
@@ -85,7 +85,7 @@ def face_macros(beta: pd.DataFrame, claims: pd.DataFrame) -> list[Macro]:
 
 def face_macros_tex(macros: list[Macro]) -> str:
     """The section's macro file (:func:`~.sections.section_macros_tex`)."""
-    return section_macros_tex(macros, "face", "infsup_contact.report.face (rule face_paper)")
+    return section_macros_tex(macros, "face", "infsup_contact.report.sections.face (rule face_paper)")
 
 
 def face_beta_table(beta: pd.DataFrame) -> str:

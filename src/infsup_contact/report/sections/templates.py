@@ -19,7 +19,7 @@ from typing import Callable, Sequence
 import numpy as np
 import pandas as pd
 
-from .texformat import case_order, fmt_fixed, fmt_sci, latex_id
+from ..texformat import case_order, fmt_fixed, fmt_sci, latex_id
 
 VERDICT_SHORT = {"PASS": "P", "FAIL": "F", "INCONCLUSIVE": "I"}
 """A verdict's letter in a table cell."""

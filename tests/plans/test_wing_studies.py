@@ -1,0 +1,68 @@
+"""The elastic, face and face_elastic studies are model-table studies like the others: each reads its
+scenes from its entry of ``models`` (no config section of its name), and a config written with the
+old top-level sections is refused in one line naming the section and where its keys went."""
+import copy
+from pathlib import Path
+
+import pytest
+import yaml
+
+from infsup_contact.config.checks import ConfigError, check_config
+from infsup_contact.plans import model_table, scenes, scenes_of, study_of
+
+ROOT = Path(__file__).resolve().parents[2]
+SCHEMA = ROOT / "workflow" / "schemas" / "config.schema.yaml"
+WINGS = ("elastic", "face", "face_elastic")
+
+pytestmark = pytest.mark.usefixtures("registry_as_found")  # tests/conftest.py
+
+
+def _ci():
+    return yaml.safe_load((ROOT / "config" / "ci.yaml").read_text())
+
+
+@pytest.mark.parametrize("name", WINGS)
+def test_an_old_top_level_section_is_one_line_naming_where_it_moved(name):
+    cfg = _ci()
+    cfg[name] = scenes(cfg["models"].pop(name))  # the layout before the model table held the scenes
+    with pytest.raises(ConfigError) as err:
+        check_config(cfg, SCHEMA)
+    text = str(err.value)
+    assert err.value.key == name and "\n" not in text and f"models.{name}" in text and f"study: {name}" in text
+
+
+@pytest.mark.parametrize("name", WINGS)
+def test_a_wing_study_reads_its_entry_and_nothing_named_after_it(name):
+    """Its scenes are the entry without ``study``; a change in the entry is a change of its jobs."""
+    cfg = _ci()
+    check_config(copy.deepcopy(cfg), SCHEMA)
+    assert name not in cfg and cfg["models"][name]["study"] == name
+    study = study_of(cfg, name)
+    assert study.cfg == scenes(cfg["models"][name]) == scenes_of(cfg, name) and "study" not in study.cfg
+    jobs = study.jobs()
+    assert jobs and all(job.provenance is study.cfg or job.provenance in study.cfg.values() for job in jobs.values())
+    if name != "face_elastic":  # its jobs are per element, every k in one
+        cfg["models"][name]["k"] = [1]
+        beta = [j for j in study_of(cfg, name).jobs() if j.startswith("beta_")]
+        assert beta and all(j.endswith("_k1") for j in beta)
+
+
+def test_the_table_is_the_models_key_only():
+    """Without ``models`` there is no table (the section fallback is gone), and the schema asks for it."""
+    cfg = _ci()
+    assert list(model_table(cfg)) == list(cfg["models"]) and model_table({}) == {}
+    del cfg["models"]
+    with pytest.raises(ConfigError) as err:
+        check_config(cfg, SCHEMA)
+    assert err.value.key == "models"
+
+
+def test_the_elastic_study_is_required_and_the_paper_names_are_kept():
+    cfg = _ci()
+    del cfg["models"]["elastic"]
+    with pytest.raises(ConfigError, match="config key models: no elastic study"):
+        check_config(copy.deepcopy(cfg), SCHEMA)
+    cfg = _ci()
+    cfg["models"]["membranes_face"] = cfg["models"].pop("face")
+    with pytest.raises(ConfigError, match=r"config key models\.membranes_face\.study"):
+        check_config(cfg, SCHEMA)

@@ -14,7 +14,7 @@ from the tolerance, and the error actually reached is measured on a dense sample
 With every w_j > 0 and a relative error ≤ ε in each weight, a Gram matrix Σ w(m, n) c cᵀ built
 from the sum differs from the exact one by at most ε times itself in the Loewner order, so every
 eigenvalue of a pencil with it moves by at most the factor 1 ± ε (:mod:`.face.norms.tensor` uses it
-above :data:`~.face.norms.tensor.EXP_SUM_MIN_DIM`).
+at every size; its direct double sum stays the reference route of the tests).
 """
 from __future__ import annotations
 

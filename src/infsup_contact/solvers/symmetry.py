@@ -34,13 +34,18 @@ def reflection_split(space, points: np.ndarray) -> ReflectionSplit | None:
     return None if pis is None else ReflectionSplit(pis, isotypic_bases(pis))
 
 
-def split_of(space, gamma, g_h, k: int) -> ReflectionSplit | None:
+def split_of(space, gamma, g_h, k: int, face_only: bool = False) -> ReflectionSplit | None:
     """The reflections' split of ``space`` (:func:`reflection_split`, checked at the Gauss
-    points of G_h), or None (no such symmetry, a Γ without a quadrature, or an empty component)."""
+    points of G_h), or None (no such symmetry, a Γ without a quadrature, or an empty component).
+    ``face_only``: None on a one-dimensional Γ too (the dense route splits the face's pencils
+    only: the segment's are small, and its rows keep their digits)."""
     quadrature = getattr(gamma, "quadrature", None)
     if quadrature is None:
         return None
-    split = reflection_split(space, quadrature(g_h, 2 * k)[0])
+    points = quadrature(g_h, 2 * k)[0]
+    if face_only and not (np.ndim(points) == 2 and np.shape(points)[1] == 2):
+        return None
+    split = reflection_split(space, points)
     return split if split is not None and min(split.sizes) >= 1 else None
 
 

@@ -28,6 +28,7 @@ def _reference_route(monkeypatch):
     split_of = symmetry.split_of
     monkeypatch.setattr(symmetry, "split_of",
                         lambda *a, face_only=False, **kw: None if face_only else split_of(*a, **kw))
+    monkeypatch.setattr(symmetry, "split_dense_kernel", lambda *a, **kw: None)
 
 
 @pytest.mark.parametrize("k,n1,n2,cases,element", [
@@ -58,6 +59,8 @@ def test_rows_equal_the_route_before(monkeypatch, k, n1, n2, cases, element):
             assert a[key] == pytest.approx(b[key], rel=RTOL, abs=1e-14), key
         assert a["nmax_rel_error"] == pytest.approx(b["nmax_rel_error"], rel=1e-6)
         assert a["gap_over_roundoff"] == pytest.approx(b["gap_over_roundoff"], rel=1e-6)
+        assert a["kernel_margin_decades"] == pytest.approx(b["kernel_margin_decades"], rel=1e-9)
+        assert (a["kernel_detected"], a["kernel_check"]) == (b["kernel_detected"], b["kernel_check"])
 
 
 def test_a_pencil_that_is_not_invariant_is_solved_whole():
@@ -80,3 +83,33 @@ def test_a_pencil_that_is_not_invariant_is_solved_whole():
     S_bad[0, 1] += 1e-6 * np.abs(S).max()
     S_bad[1, 0] = S_bad[0, 1]
     assert spectra.dense_split_spectra(split, S_bad, factors) is None
+
+
+@pytest.mark.parametrize("case,k,n1,n2", [("R5.4", 1, 4, 4), ("T3", 2, 3, 4), ("R5.2", 2, 4, 4)])
+def test_the_components_kernel_is_the_whole_svds(case, k, n1, n2):
+    """split_dense_kernel: the same dimension, error level and margin as coupling_kernel on the
+    whole W where it decides (it must, on these symmetric faces: the kernel is the proven one),
+    and no decision where modes beyond the proof would be counted (proven understated)."""
+    from infsup_contact.discretization.gamma.coupling import coupling_matrix, trace_l2_norms
+    from infsup_contact.solvers.kernel import coupling_kernel, scaled_couplings
+    from infsup_contact.solvers.side_cache import SideCache
+
+    sides = SideCache().pair(MODELS["membranes3d"], "structured", k, n1, n2, MeshOptions())
+    gamma = sides[0].trace.gamma
+    g_h = gamma.multiplier_partition(*(s.trace.partition for s in sides), "omega2")
+    from infsup_contact.solvers.infsup import _space
+    space = _space(case, k, g_h, gamma)
+    rows = [trace_l2_norms(s.trace, k) for s in sides]
+    cols = np.sqrt(np.diag(gamma.gram(space, "L2")[0]))
+    W = scaled_couplings([coupling_matrix(s.trace, space, k) for s in sides], rows, cols)
+    structural = gamma.proven_kernel(space, k, [s.trace for s in sides],
+                                     gamma.trace_sum_dimension(k, *(s.trace.partition for s in sides)))
+    split = symmetry.split_of(space, gamma, g_h, k)
+    whole = coupling_kernel(W, structural)
+    blocked = symmetry.split_dense_kernel(W, split, structural)
+    assert blocked is not None
+    assert (blocked.dim, blocked.decision) == (whole.dim, whole.decision)
+    assert blocked.tol == pytest.approx(whole.tol, rel=1e-12)
+    assert blocked.margin_decades == pytest.approx(whole.margin_decades, rel=1e-9)
+    if whole.dim:
+        assert symmetry.split_dense_kernel(W, split, 0) is None

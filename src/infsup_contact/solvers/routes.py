@@ -95,7 +95,7 @@ def choose_route(space, couplings, sides, grams: dict, structural: int, g_h, k: 
     gamma = sides[0].trace.gamma
     split = symmetry.split_of(space, gamma, g_h, k, face_only=not large)
     kernel = space_kernel(couplings, sides, space, k, structural, grams["L2"][0] if "L2" in grams else None,
-                          iterative=large, trace_norms=trace_norms, split=split if large else None, vectors=vectors)
+                          iterative=large, trace_norms=trace_norms, split=split, vectors=vectors)
     split, parts, halves = reflection.usable(split, grams, kernel if large else None)
     if split is not None:  # the dense route keeps its name: its pencils in blocks, whole spectra
         return Route("split" if large else "dense", kernel, spectra.SplitFactors(grams, halves), split, parts)
@@ -126,7 +126,10 @@ def space_kernel(couplings, sides, space, k: int, structural: int, l2_gram=None,
     longer = scaled_couplings([coupling_matrix(s.trace, space, k, extra_degree=extra, sparse=iterative)
                                for s in sides], rows, cols)
     if not iterative:
-        decision = coupling_kernel(W, structural, entry_error=np.linalg.norm(W - longer), vectors=vectors)
+        error = np.linalg.norm(W - longer)
+        decision = (symmetry.split_dense_kernel(W, split, structural, error)
+                    if split is not None and not vectors else None)  # the components' SVDs where they decide
+        decision = decision or coupling_kernel(W, structural, entry_error=error, vectors=vectors)
         return decision if decision.vectors is None else replace(decision, vectors=decision.vectors / cols[:, None])
     W, error = sp.csr_matrix(W), spla.norm(sp.csr_matrix(W - longer))
     decision = symmetry.split_bottom_kernel(W, split, structural, error) if split is not None else None

@@ -104,3 +104,16 @@ def test_other_bases_are_refused():
     Q[:, :2] = Q[:, :2] @ np.array([[0.6, -0.8], [0.8, 0.6]])
     assert parity.in_bases([sp.csr_matrix(Q), *parity.bases[1:]]) is None
     assert all(np.array_equal(a, b) for a, b in zip(parity.in_bases(parity.bases), parity.blocks))
+
+
+@pytest.mark.parametrize("case,k,n", [("R5.2", 2, 4), ("T3", 1, 6), ("DUAL", 2, 5)])
+def test_the_l2_blocks_are_the_split_of_the_l2_gram(case, k, n):
+    """The L² Gram's parity blocks (tensor.l2_parity, Kronecker products of the 1D blocks) equal the
+    split of G_x ⊗ G_y to round-off."""
+    space = _space(case, k, n)
+    G, info = SQUARE.gram(space, "L2")
+    split = reflection_split(space, SQUARE.quadrature(space.breakpoints, 2 * k)[0])
+    given = info["parity"].in_bases(split.bases)
+    *resplit, distance = split.blocks(G)
+    for a, b in zip(given, resplit):
+        assert np.abs(a - b).max() <= 1e-14 * np.abs(G).max()

@@ -236,5 +236,23 @@ def extrapolated(partial, p: float, n0: int, n_cap: int, rtol: float, ops=None) 
 
 def gram(space, norm: str, **kwargs) -> tuple[np.ndarray, dict]:
     """Gram matrix of a tensor face space (its ``factors``) for ``norm`` ∈ {"H", "L2"} (``kwargs``
-    go to :func:`gram_h_face`); spaces without factors: :mod:`.face.norms.cellwise`."""
-    return gram_by_norm(norm, lambda: gram_l2_face(space), lambda **kw: gram_h_face(space, **kw), **kwargs)
+    go to :func:`gram_h_face`); spaces without factors: :mod:`.face.norms.cellwise`. The L² Gram
+    of a space with both factors symmetric carries its parity blocks too (:func:`l2_parity`)."""
+    G, info = gram_by_norm(norm, lambda: gram_l2_face(space), lambda **kw: gram_h_face(space, **kw), **kwargs)
+    if norm == "L2":
+        parity = l2_parity(space)
+        info = info if parity is None else dict(info, parity=parity)
+    return G, info
+
+
+def l2_parity(space):
+    """The L² Gram G_x ⊗ G_y in the four parity blocks of the axis reflections,
+    (Q^x_pᵀ G_x Q^x_p) ⊗ (Q^y_qᵀ G_y Q^y_q) (a :class:`~infsup_contact.la.face_parity.ParityGram`,
+    for the pencils' split without splitting G), or None (a factor not symmetric)."""
+    parities = parity_bases.tensor_parities(space)
+    if parities is None:
+        return None
+    gx, gy = (gram_l2(f) for f in space.factors)
+    blocks = [np.kron(np.asarray(parities[0][c & 1].T @ gx @ parities[0][c & 1]),
+                      np.asarray(parities[1][c >> 1].T @ gy @ parities[1][c >> 1])) for c in range(4)]
+    return face_parity.ParityGram(face_parity.tensor_bases(parities), [0.5 * (B + B.T) for B in blocks])

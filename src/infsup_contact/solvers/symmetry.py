@@ -126,7 +126,7 @@ def split_dense_kernel(W: np.ndarray, split: ReflectionSplit, proven: int = 0,
     off2 = sum(float(np.linalg.norm(blocks[a].T @ blocks[b])) ** 2
                for b in range(len(blocks)) for a in range(b) if blocks[a].shape[1] and blocks[b].shape[1])
     cross = float(np.sqrt(2.0 * off2))  # ‖O‖_F: each off-diagonal block counted twice
-    s = [sla_svdvals(B) for B in blocks if B.shape[1]]
+    s = [sla.svdvals(B, check_finite=True) for B in blocks if B.shape[1]]  # LAPACK, as coupling_kernel
     s = np.sort(np.concatenate([np.zeros(m - sum(len(v) for v in s))] + s))
     s_max = float(s[-1])
     tol = error_level(rows, m, s_max, entry_error)
@@ -138,8 +138,3 @@ def split_dense_kernel(W: np.ndarray, split: ReflectionSplit, proven: int = 0,
     if not (below and above):
         return None
     return decide(s, proven, tol, numerical, s_max)
-
-
-def sla_svdvals(B: np.ndarray) -> np.ndarray:
-    """The singular values of B (LAPACK, as :func:`~.kernel.coupling_kernel`)."""
-    return sla.svdvals(B, check_finite=True)

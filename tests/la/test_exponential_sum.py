@@ -56,21 +56,23 @@ def test_separable_gram_equals_the_direct_sum_in_loewner_order(monkeypatch, case
     Loewner order, i.e. the generalized eigenvalues of (G_sep − G, G) are that small."""
     space = _space(case, k, nx, ny)
     n = 96
-    direct = face_norms.partial_gram(space, n, aspect)
-    monkeypatch.setattr(face_norms, "EXP_SUM_MIN_DIM", 0)
+    direct = face_norms.partial_gram(space, n, aspect, direct=True)
     separable = face_norms.partial_gram(space, n, aspect)
     assert np.array_equal(separable, separable.T)
     ev = sla.eigh(separable - direct, direct, eigvals_only=True)
     assert np.max(np.abs(ev)) < 1e-12
 
 
-def test_the_gate_keeps_the_small_grams_direct(monkeypatch):
-    """Below EXP_SUM_MIN_DIM nothing changes: the routes differ, so the gate must decide."""
+def test_the_reference_route_is_the_direct_sum(monkeypatch):
+    """``direct=True`` is another computation (the flag must reach the sum): the two differ in
+    their last digits, and the default route is the exponential sum at every size."""
     space = _space("R5.2", 2, 4, 4)
-    assert space.dim <= face_norms.EXP_SUM_MIN_DIM
-    direct = face_norms.partial_gram(space, 64)
-    monkeypatch.setattr(face_norms, "EXP_SUM_MIN_DIM", 0)
-    assert not np.array_equal(face_norms.partial_gram(space, 64), direct)
+    direct = face_norms.partial_gram(space, 64, direct=True)
+    separable = face_norms.partial_gram(space, 64)
+    assert not np.array_equal(separable, direct)
+    monkeypatch.setattr(face_norms, "_separable_sum", lambda *a: (_ for _ in ()).throw(RuntimeError("taken")))
+    with pytest.raises(RuntimeError, match="taken"):
+        face_norms.partial_gram(space, 64)
 
 
 @pytest.mark.parametrize("n,aspect", [(96, 1.0), (1536, 1.0), (1536, 0.45)])
@@ -78,8 +80,7 @@ def test_the_taylor_block_keeps_the_loewner_bound_at_large_n(monkeypatch, n, asp
     """The small rates taken as one Taylor block (TAYLOR_BELOW, TAYLOR_DEGREE): still within
     ±1e-12 of the direct sum in the Loewner order, at n_max where most terms are in the block."""
     space = _space("DUAL-ALL", 1, 5, 4)
-    direct = face_norms.partial_gram(space, n, aspect)
-    monkeypatch.setattr(face_norms, "EXP_SUM_MIN_DIM", 0)
+    direct = face_norms.partial_gram(space, n, aspect, direct=True)
     separable = face_norms.partial_gram(space, n, aspect)
     ev = sla.eigh(separable - direct, direct, eigvals_only=True)
     assert np.max(np.abs(ev)) < 1e-12

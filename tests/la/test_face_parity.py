@@ -37,10 +37,9 @@ def test_even_functions_have_odd_sine_indices_only(case, k):
 
 @pytest.mark.parametrize("case,k,n", [("T3", 2, 7), ("R5.2", 2, 6), ("R5.4", 2, 6), ("DUAL", 2, 6), ("R5.2", 1, 9)])
 def test_tensor_blocks_equal_the_whole_series(monkeypatch, case, k, n):
-    """gram_h_face on the parity blocks (the route of dim > EXP_SUM_MIN_DIM, forced here) is
-    the whole-matrix exponential-sum route to round-off, with the same n_max."""
+    """gram_h_face on the parity blocks (the route of every size) is the whole-matrix
+    exponential-sum route to round-off, with the same n_max."""
     space = _space(case, k, np.linspace(0.0, 1.0, n + 1))
-    monkeypatch.setattr(fn, "EXP_SUM_MIN_DIM", 0)
     G_blocks, info_blocks = fn.gram_h_face(space)
     monkeypatch.setattr(fpb, "tensor_parities", lambda s: None)
     G_whole, info_whole = fn.gram_h_face(space)
@@ -53,8 +52,6 @@ def test_tensor_blocks_equal_the_whole_series(monkeypatch, case, k, n):
 def test_cellwise_blocks_equal_the_whole_series(monkeypatch, case):
     """The cellwise spaces: R̃_c S_P,c R̃_cᵀ per block, assembled, against R S_P Rᵀ."""
     space = _space(case, 2, np.linspace(0.0, 1.0, 7))
-    monkeypatch.setattr(fc, "EXP_SUM_MIN_DIM", 0)
-    monkeypatch.setattr(fn, "EXP_SUM_MIN_DIM", 0)
     R, P = fc.projection(space)
     assert fc._parity_route(space, R, P) is not None
     G_blocks, info_blocks = fc.gram_h_cellwise(space)

@@ -80,3 +80,41 @@ def _cache(sides):
     cache = SideCache()
     cache.pair = lambda *a, **k: sides
     return cache
+
+
+def test_block_steps_by_lanczos_are_the_dense_ones():
+    """BlockOps above BLOCK_DENSE_MAX: Lanczos with L⁻¹ shared by the steps gives the largest
+    |eigenvalue| of L⁻¹ E L⁻ᵀ to its tolerance (1e-8 relative; asserted at 1e-7) against the
+    whole standard form's eigenvalues, block by block, the max over the blocks."""
+    from infsup_contact.la import richardson
+
+    rng = np.random.default_rng(3)
+    grams, es = [], [[], []]
+    for n in (40, 150, 200):
+        X = rng.standard_normal((n, n))
+        grams.append(X @ X.T + n * np.eye(n))
+        for e in es:
+            Y = rng.standard_normal((n, n)) * 1e-4
+            e.append(Y + Y.T)
+    got = richardson.BlockOps.rel_norms(es, grams)
+    for e, g in zip(es, got):
+        want = max(richardson._standard_form_norm(E, np.linalg.cholesky(R)) for E, R in zip(e, grams))
+        assert g == pytest.approx(want, rel=1e-7)
+
+
+def test_a_series_capped_at_its_first_extrapolation_states_that_step():
+    """The first level with an extrapolation is measured only where the loop ends there (the cap):
+    its stated error is then the size of that extrapolation in R's metric, as before."""
+    from infsup_contact.la import richardson
+
+    A = np.diag([1.0, 2.0, 3.0])
+    B = np.array([[1.0, 0.2, 0.0], [0.2, 1.0, 0.1], [0.0, 0.1, 1.0]])
+
+    def partial(n):
+        return A + B / n ** 2 + B * B / n ** 3
+
+    R, info = richardson.extrapolate(partial, 2.0, 8, 16, 1e-12)
+    assert info["n_max"] == 16 and info["capped"]
+    S8, S16 = partial(8), partial(16)
+    T = S16 + (S16 - S8) / 3.0
+    assert info["nmax_rel_error"] == pytest.approx(richardson.relative_step(T - S16, T), rel=1e-12)

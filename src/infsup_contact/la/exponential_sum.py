@@ -14,11 +14,12 @@ from the tolerance, and the error actually reached is measured on a dense sample
 With every w_j > 0 and a relative error ≤ ε in each weight, a Gram matrix Σ w(m, n) c cᵀ built
 from the sum differs from the exact one by at most ε times itself in the Loewner order, so every
 eigenvalue of a pencil with it moves by at most the factor 1 ± ε (:mod:`.face.norms.tensor` uses it
-above :data:`~.face.norms.tensor.EXP_SUM_MIN_DIM`).
+at every size; its direct double sum stays the reference route of the tests).
 """
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 
@@ -58,6 +59,10 @@ class ExponentialSum:
 def inverse_sqrt(x_min: float, x_max: float, rtol: float = 1e-13) -> ExponentialSum:
     """The exponential sum of 1/√x on [x_min, x_max] to relative accuracy ``rtol`` (module docstring).
 
+    Remembered per (x_min, x_max, rtol, :data:`STEP`, :data:`SAMPLES`) (:data:`CACHED` sums, read-only arrays): the face series
+    asks for the same few ranges at every level and block of every space on one G_h, and
+    measuring the reached error (:data:`SAMPLES` × r exponentials) cost as much as the product.
+
     Raises
     ------
     InputError
@@ -67,11 +72,22 @@ def inverse_sqrt(x_min: float, x_max: float, rtol: float = 1e-13) -> Exponential
         raise InputError("x_min/x_max", "0 < x_min <= x_max < inf", got=(x_min, x_max))
     if not 1e-15 <= rtol < 1:
         raise InputError("rtol", "a float in [1e-15, 1)", got=rtol)
+    return _inverse_sqrt(float(x_min), float(x_max), float(rtol), STEP, SAMPLES)
+
+
+CACHED = 64
+"""Exponential sums :func:`inverse_sqrt` keeps (a few hundred terms each)."""
+
+
+@lru_cache(maxsize=CACHED)
+def _inverse_sqrt(x_min: float, x_max: float, rtol: float, step: float, samples: int) -> ExponentialSum:
     s_lo = 2.0 * np.log(rtol * np.sqrt(np.pi) / (2.0 * np.sqrt(x_max)))   # tail below: ≤ rtol
     s_hi = np.log(np.log(1.0 / rtol) / x_min)                              # tail above: ≤ rtol
-    s = np.arange(s_lo, s_hi + STEP, STEP)
-    rates, weights = np.exp(s), STEP * np.exp(s / 2.0) / np.sqrt(np.pi)
-    x = np.geomspace(x_min, x_max, SAMPLES)
+    s = np.arange(s_lo, s_hi + step, step)
+    rates, weights = np.exp(s), step * np.exp(s / 2.0) / np.sqrt(np.pi)
+    x = np.geomspace(x_min, x_max, samples)
     approx = np.exp(-np.multiply.outer(x, rates)) @ weights
     err = float(np.max(np.abs(approx * np.sqrt(x) - 1.0)))
-    return ExponentialSum(rates, weights, float(x_min), float(x_max), err)
+    rates.setflags(write=False)
+    weights.setflags(write=False)
+    return ExponentialSum(rates, weights, x_min, x_max, err)

@@ -91,3 +91,41 @@ def assemble(bases, blocks) -> np.ndarray:
         index.append(idx)
         sign.append(w)
     return signed_gather_sum([np.asarray(B, dtype=float) for B in blocks], index, sign)
+
+
+SIGNED_PERMUTATION_RTOL = 1e-12
+"""Largest | |entry| − 1 | of Q_cᵀ Q'_c for which two orthonormal bases of one component count
+as the same columns up to order and sign (:meth:`ParityGram.in_bases`)."""
+
+
+class ParityGram:
+    """A Gram matrix in the four parity blocks it was summed in: G = Σ_c Q_c G_c Q_cᵀ
+    (``bases`` Q_c with orthonormal columns, at most one nonzero per row; ``blocks`` G_c).
+    Carried in the Gram's ``info["parity"]`` so that the pencils (:func:`~.reflection.usable`)
+    take the blocks as summed instead of splitting the assembled G again."""
+
+    def __init__(self, bases, blocks):
+        self.bases = tuple(sp.csr_matrix(Q) for Q in bases)
+        self.blocks = tuple(np.asarray(B, dtype=float) for B in blocks)
+
+    def in_bases(self, bases) -> list | None:
+        """[Q'_cᵀ G Q'_c] for the bases Q'_c of the same components (another order of the
+        columns, other signs: the reflections' split, :class:`~.reflection.ReflectionSplit`),
+        each a signed gather of the G_c whose component holds it; None where a Q'_c is not such
+        a signed permutation of one Q_c (the caller splits G itself)."""
+        out = []
+        for Qs in bases:
+            Qs = sp.csc_matrix(Qs)
+            hits = [c for c, Q in enumerate(self.bases) if (Q.T @ Qs).count_nonzero()]
+            if len(hits) != 1 or self.bases[hits[0]].shape[1] != Qs.shape[1]:
+                return None
+            c = hits[0]
+            P = sp.csc_matrix(self.bases[c].T @ Qs)
+            P.eliminate_zeros()
+            if np.any(np.diff(P.indptr) != 1) or np.any(np.abs(np.abs(P.data) - 1.0) > SIGNED_PERMUTATION_RTOL):
+                return None
+            idx, sign = P.indices, np.sign(P.data)  # column j of Q' is sign[j] times column idx[j] of Q_c
+            if len(np.unique(idx)) != len(idx):
+                return None
+            out.append(self.blocks[c][np.ix_(idx, idx)] * np.multiply.outer(sign, sign))
+        return out

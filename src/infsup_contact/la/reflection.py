@@ -104,17 +104,22 @@ class ReflectionSplit:
 
 def usable(split: ReflectionSplit | None, grams: dict, kernel):
     """(split, kernel parts, {norm: blocks of G}) where every Gram matrix is invariant under
-    ``split`` and the kernel splits, else (None, None, None). Each interface operator S is checked where it
-    is split (:func:`split_pencils`; :func:`~infsup_contact.solvers.spectra.split_spectra` solves it unsplit where it is not)."""
+    ``split`` and the kernel splits (``kernel`` None: no kernel to deflate, parts None), else (None, None, None). Each interface operator S is checked where it
+    is split (:func:`split_pencils`; :func:`~infsup_contact.solvers.spectra.split_spectra` solves it unsplit where it is not).
+    A Gram summed in the same components (``info["parity"]``, :class:`~.face_parity.ParityGram`)
+    gives its blocks as summed (exactly block diagonal: no distance to check); else G is split."""
     if split is None:
         return None, None, None
     halves = {}
-    for norm, (G, _) in grams.items():
-        *halves[norm], distance = split.blocks(G)
-        if distance > INVARIANCE_RTOL:
-            return None, None, None
-    parts = split.components(kernel.vectors) if kernel.dim else None
-    if kernel.dim and parts is None:
+    for norm, (G, info) in grams.items():
+        summed = info.get("parity") if isinstance(info, dict) else None
+        halves[norm] = summed.in_bases(split.bases) if summed is not None else None
+        if halves[norm] is None:
+            *halves[norm], distance = split.blocks(G)
+            if distance > INVARIANCE_RTOL:
+                return None, None, None
+    parts = split.components(kernel.vectors) if kernel is not None and kernel.dim else None
+    if kernel is not None and kernel.dim and parts is None:
         return None, None, None
     return split, parts, halves
 

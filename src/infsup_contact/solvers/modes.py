@@ -79,7 +79,7 @@ def mode_vector(route, S: np.ndarray, norm: str) -> tuple:
         if kernel.vectors is None:
             raise ValueError("a kernel mode needs the kernel's vectors: choose the route with vectors=True")
         return _unit(kernel.vectors[:, 0]), True
-    factors = route.factors.whole if route.name == "split" else route.factors
+    factors = getattr(route.factors, "whole", route.factors)  # a split route's: G's own factors
     L = factors[norm]
     if route.iterative:
         return _unit(bottom.bottom_pencil(S, L, 1, vectors=True).vectors[:, 0]), False

@@ -62,6 +62,12 @@ class Route:
     def spectra(self, S: np.ndarray, norms) -> tuple:
         """({norm: :class:`~.spectra.Spectrum`}, {norm: seconds}) of S m = β² G m. Dense: each
         norm's eigenproblem timed alone; otherwise the norms share work and each gets an equal share."""
+        if not self.iterative and self.split is not None:  # the dense pencils in blocks
+            te = time.perf_counter()
+            out = spectra.dense_split_spectra(self.split, S, self.factors.split, self.kernel)
+            if out is not None:
+                return out, dict.fromkeys(norms, (time.perf_counter() - te) / len(norms))
+            return Route(self.name, self.kernel, self.factors.whole).spectra(S, norms)
         if not self.iterative:
             out, seconds = {}, {}
             for norm in norms:
@@ -86,12 +92,13 @@ def choose_route(space, couplings, sides, grams: dict, structural: int, g_h, k: 
     ``structural`` the proven kernel dimension, ``trace_norms`` the sides' :func:`~.coupling.trace_l2_norms`;
     ``vectors``: the kernel's basis on the dense route too (a worst mode, :mod:`.modes`)."""
     large = is_large(space)
-    split = symmetry.split_of(space, sides[0].trace.gamma, g_h, k) if large else None
+    gamma = sides[0].trace.gamma
+    split = symmetry.split_of(space, gamma, g_h, k, face_only=not large)
     kernel = space_kernel(couplings, sides, space, k, structural, grams["L2"][0] if "L2" in grams else None,
                           iterative=large, trace_norms=trace_norms, split=split, vectors=vectors)
-    split, parts, halves = reflection.usable(split, grams, kernel)
-    if split is not None:
-        return Route("split", kernel, spectra.SplitFactors(grams, halves), split, parts)
+    split, parts, halves = reflection.usable(split, grams, kernel if large else None)
+    if split is not None:  # the dense route keeps its name: its pencils in blocks, whole spectra
+        return Route("split" if large else "dense", kernel, spectra.SplitFactors(grams, halves), split, parts)
     return Route("bottom" if large else "dense", kernel, {norm: gram_factor(G) for norm, (G, _) in grams.items()})
 
 
@@ -119,7 +126,10 @@ def space_kernel(couplings, sides, space, k: int, structural: int, l2_gram=None,
     longer = scaled_couplings([coupling_matrix(s.trace, space, k, extra_degree=extra, sparse=iterative)
                                for s in sides], rows, cols)
     if not iterative:
-        decision = coupling_kernel(W, structural, entry_error=np.linalg.norm(W - longer), vectors=vectors)
+        error = np.linalg.norm(W - longer)
+        decision = (symmetry.split_dense_kernel(W, split, structural, error)
+                    if split is not None and not vectors else None)  # the components' SVDs where they decide
+        decision = decision or coupling_kernel(W, structural, entry_error=error, vectors=vectors)
         return decision if decision.vectors is None else replace(decision, vectors=decision.vectors / cols[:, None])
     W, error = sp.csr_matrix(W), spla.norm(sp.csr_matrix(W - longer))
     decision = symmetry.split_bottom_kernel(W, split, structural, error) if split is not None else None

@@ -10,6 +10,7 @@ is decided on the split's components (:func:`split_bottom_kernel`, the certifica
 from __future__ import annotations
 
 import numpy as np
+import scipy.linalg as sla
 import scipy.sparse as sp
 
 from ..discretization.gamma.symmetry import axis_reflections, induced_permutation, isotypic_bases, reflect
@@ -34,13 +35,18 @@ def reflection_split(space, points: np.ndarray) -> ReflectionSplit | None:
     return None if pis is None else ReflectionSplit(pis, isotypic_bases(pis))
 
 
-def split_of(space, gamma, g_h, k: int) -> ReflectionSplit | None:
+def split_of(space, gamma, g_h, k: int, face_only: bool = False) -> ReflectionSplit | None:
     """The reflections' split of ``space`` (:func:`reflection_split`, checked at the Gauss
-    points of G_h), or None (no such symmetry, a Γ without a quadrature, or an empty component)."""
+    points of G_h), or None (no such symmetry, a Γ without a quadrature, or an empty component).
+    ``face_only``: None on a one-dimensional Γ too (the dense route splits the face's pencils
+    only: the segment's are small, and its rows keep their digits)."""
     quadrature = getattr(gamma, "quadrature", None)
     if quadrature is None:
         return None
-    split = reflection_split(space, quadrature(g_h, 2 * k)[0])
+    points = quadrature(g_h, 2 * k)[0]
+    if face_only and not (np.ndim(points) == 2 and np.shape(points)[1] == 2):
+        return None
+    split = reflection_split(space, points)
     return split if split is not None and min(split.sizes) >= 1 else None
 
 
@@ -88,3 +94,47 @@ def split_bottom_kernel(W, split: ReflectionSplit, proven: int = 0, entry_error:
         return None
     s = np.concatenate([np.sort(np.concatenate(counted)), [above, smax]])
     return decide(s, proven, tol, d, smax, np.hstack(vectors))
+
+
+def split_dense_kernel(W: np.ndarray, split: ReflectionSplit, proven: int = 0,
+                       entry_error: float = 0.0) -> KernelDecision | None:
+    """:func:`~.kernel.coupling_kernel` of a dense W (trace dofs × multipliers) from the singular
+    values of its components' columns W Q_c (about (1/c)² of the whole SVD's flops), or None (the
+    caller's dense SVD decides).
+
+    With the traces' reflections W is equivariant, so in Q = [Q_0, Q_1, ...] the computed WᵀW
+    is D + O, D = diag((W Q_c)ᵀ (W Q_c)) and O the round-off across components (‖O‖₂ <= ‖O‖_F,
+    computed). The blocks' count d is taken only where it is provably W's count (η the unsplit
+    :func:`~.kernel.error_level` of σ_max, the same from either):
+
+    * at least d values <= η: the counted right vectors v_j of the blocks, x_j = Q_c v_j, are
+      orthonormal with ‖W x_j‖ = σ_j, so by Cauchy interlacing W has d singular values <= ‖W X‖₂
+      <= ‖W X‖_F = (Σ_j σ_j²)^{1/2}; required <= η (the cross terms cancel nothing here: the
+      bound holds whatever O is);
+    * at most d: Weyl on D + O, σ_{d+1}(W)² >= σ'_{d+1}² − ‖O‖₂; required > η².
+
+    And only where d is exactly the proven count: the margin is then log10(σ_{d+1}/η), a value
+    above round-off, which the blocks give to its relative ‖O‖/σ_{d+1}²; where modes beyond the
+    proof would be counted the margin rests on a round-off singular value, and the whole SVD
+    reports it as before (None)."""
+    W = np.asarray(W, float)
+    rows, m = W.shape
+    proven = int(max(proven, m - rows, 0))
+    if rows == 0 or m == 0:
+        return None
+    blocks = [np.asarray((Q.T @ W.T).T) for Q in split.bases]
+    off2 = sum(float(np.linalg.norm(blocks[a].T @ blocks[b])) ** 2
+               for b in range(len(blocks)) for a in range(b) if blocks[a].shape[1] and blocks[b].shape[1])
+    cross = float(np.sqrt(2.0 * off2))  # ‖O‖_F: each off-diagonal block counted twice
+    s = [sla.svdvals(B, check_finite=True) for B in blocks if B.shape[1]]  # LAPACK, as coupling_kernel
+    s = np.sort(np.concatenate([np.zeros(m - sum(len(v) for v in s))] + s))
+    s_max = float(s[-1])
+    tol = error_level(rows, m, s_max, entry_error)
+    numerical = int(np.sum(s <= tol))
+    if numerical != proven:
+        return None
+    below = float(np.sqrt(np.sum(s[:numerical] ** 2))) <= tol
+    above = s[numerical] ** 2 - cross > tol ** 2 if numerical < m else True
+    if not (below and above):
+        return None
+    return decide(s, proven, tol, numerical, s_max)

@@ -103,7 +103,7 @@ def test_the_raised_start_gives_the_same_gram_when_the_last_levels_agree():
 
     f = make_space(np.linspace(0, 1, 21), 1, False, False)      # dim 40² = 1600 > 1500, p = 2
     space = FaceSpace(f, f, TensorPartition(np.linspace(0, 1, 21), np.linspace(0, 1, 21)))
-    assert space.dim > fn.EXP_SUM_MIN_DIM and fn.start_level(80, 2.0, space.dim) == 4 * 80
+    assert space.dim > fn.LONG_SERIES_MIN_DIM and fn.start_level(80, 2.0, space.dim) == 4 * 80
     assert fn.start_level(80, 4.0, space.dim) == 80 and fn.start_level(80, 2.0, 1500) == 80
     G_raised, info = fn.gram_h_face(space, rtol=1e-5)
     G_from_n0, info0 = fn.gram_h_face(space, rtol=1e-5, n_start=80)

@@ -74,8 +74,9 @@ def test_large_route_agrees_with_the_solve_route(setup, monkeypatch):
 
 def test_below_the_gate_the_terms_are_the_solve_routes_bit_for_bit(setup):
     sides, spaces, k = setup
-    for space in spaces:
-        assert space.dim <= interface_operator.SPARSE_PRODUCT_MIN_DIM
+    below = [space for space in spaces if space.dim <= interface_operator.SPARSE_PRODUCT_MIN_DIM]
+    assert below
+    for space in below:
         Bs = [coupling_matrix(s.trace, space, k) for s in sides[:2]]
         for T, B, side in zip(interface_operator.interface_terms(Bs, sides[:2]), Bs, sides[:2]):
             assert np.array_equal(T, _solve_route(B, side))

@@ -40,7 +40,7 @@ from ...gamma.coupling import weighted_values
 from ....la import face_parity
 from . import parity_bases
 from ...gamma.symmetry import axis_reflections, isotypic_bases
-from .tensor import EXP_SUM_MIN_DIM, default_cap, extrapolated, partial_gram, partial_gram_blocks, start_level
+from .tensor import default_cap, extrapolated, partial_gram, partial_gram_blocks, start_level
 from ..spaces.tensor import FaceSpace
 from ...segment.multipliers import make_space
 from ...segment.norms import gram_by_norm, gram_l2
@@ -70,17 +70,17 @@ def shared_piece_sums():
         _shared = outer
 
 
-def piece_partial_gram(P: FaceSpace, n: int, parities=None):
+def piece_partial_gram(P: FaceSpace, n: int, parities=None, direct: bool = False):
     """S_P(n) of :func:`~.face.norms.tensor.partial_gram` (with ``parities``: its four parity blocks,
     :func:`~.face.norms.tensor.partial_gram_blocks`), from the shared sums when a
     :func:`shared_piece_sums` block is open."""
     def compute():
-        return partial_gram(P, n) if parities is None else partial_gram_blocks(P, n, parities)
+        return partial_gram(P, n, direct=direct) if parities is None else partial_gram_blocks(P, n, parities)
 
     if _shared is None:
         return compute()
     key = (np.asarray(P.breakpoints.xs, float).tobytes(), np.asarray(P.breakpoints.ys, float).tobytes(),
-           P.degree, P.dim, parities is None)
+           P.degree, P.dim, parities is None, direct)
     if _shared.get("key") != key:
         _shared.clear()
         _shared.update(key=key, sums={})
@@ -169,10 +169,12 @@ def gram_l2_cellwise(space) -> np.ndarray:
 
 
 def gram_h_cellwise(space, rtol: float = 1e-6, n_start: int | None = None, n_cap: int | None = None,
-                    exponent: float | None = None) -> tuple[np.ndarray, dict]:
+                    exponent: float | None = None, reference: bool = False) -> tuple[np.ndarray, dict]:
     """The H^{1/2}_00(Γ)' Gram matrix (module docstring); arguments as :func:`~.face.norms.tensor.gram_h_face`
-    (n0 default max(16, 2 (s + 1) N), N the pieces per direction, raised on the exponential-sum
-    route as there, :func:`~.face.norms.tensor.start_level`)."""
+    (n0 default max(16, 2 (s + 1) N), N the pieces per direction, raised for a long series as
+    there, :func:`~.face.norms.tensor.start_level`). In the parity blocks where the space has
+    them (:func:`_parity_route`, the blocks in ``info["parity"]``); ``reference``: the whole
+    matrix by the direct sums, on the same levels."""
     if not rtol > 0:
         raise InputError("rtol", "a positive float", got=rtol)
     R, P = projection(space)
@@ -182,25 +184,22 @@ def gram_h_cellwise(space, rtol: float = 1e-6, n_start: int | None = None, n_cap
           else int(n_start))
     n_cap = default_cap(P.dim) if n_cap is None else n_cap
 
-    blocked = _parity_route(space, R, P)
+    blocked = None if reference else _parity_route(space, R, P)
     if blocked is not None:  # the four parity blocks of the axis reflections (:mod:`infsup_contact.la.face_parity`)
         parities, Rs, bases = blocked
         G, info = extrapolated(lambda n: face_parity.sandwiched(Rs, piece_partial_gram(P, n, parities)),
                                p, n0, n_cap, rtol, ops=BlockOps)
-        return face_parity.assemble(bases, G), info
+        return face_parity.assemble(bases, G), dict(info, parity=face_parity.ParityGram(bases, G))
 
     def partial(n):  # S_P is exactly symmetric; the sandwich only to round-off
-        return symmetric_part(symmetric_sandwich(R, piece_partial_gram(P, n)))
+        return symmetric_part(symmetric_sandwich(R, piece_partial_gram(P, n, direct=reference)))
 
     return extrapolated(partial, p, n0, n_cap, rtol)
 
 
 def _parity_route(space, R, P):
-    """(P's 1D parities, [R̃_c], the multiplier basis's components Q_c) where the series is summed
-    on the exponential-sum route (dim P above :data:`~.face.norms.tensor.EXP_SUM_MIN_DIM`) and both
-    bases are symmetric under both axis reflections with R intertwining them, else None."""
-    if P.dim <= EXP_SUM_MIN_DIM:
-        return None
+    """(P's 1D parities, [R̃_c], the multiplier basis's components Q_c) where both bases are
+    symmetric under both axis reflections with R intertwining them, else None."""
     parities = parity_bases.tensor_parities(P)
     if parities is None:
         return None

@@ -31,11 +31,12 @@ from ....la.richardson import BlockOps, _norm2, extrapolate
 
 #: Rows of the weight matrix W[m, n] = 1/(π√(m² + n²)) handled at once (memory ~ chunk · n_max).
 _CHUNK = 512
-EXP_SUM_MIN_DIM = 1500
-"""dim M above which :func:`partial_gram` takes the weight as an exponential sum
-(:mod:`infsup_contact.la.exponential_sum`): n_max · r (dim M^x² + dim M^y²) + r (dim M)² operations with r ≈ 260
-terms instead of n_max² dim M^y² + n_max (dim M)²; the same as :data:`~infsup_contact.la.bottom.DENSE_MAX_M`, so
-the default DAG's Grams (all below it) stay the direct sums, bit for bit."""
+LONG_SERIES_MIN_DIM = 1500
+"""dim above which the series' levels are those of a long series (:func:`start_level`,
+:func:`default_cap`): chosen when the exponential sum (:mod:`infsup_contact.la.exponential_sum`)
+was the route above this size only, where a level costs about the same at every n; kept so that
+every space keeps its Richardson levels, hence its n_max and its stated error, now that the
+exponential sum is the route at every size (:func:`partial_gram`)."""
 EXP_SUM_START = 4
 """Factor of the first level on the exponential-sum route for a slow tail (:func:`start_level`):
 there a level costs about the same at every n (its product has dim² · r terms, n-independent),
@@ -57,7 +58,7 @@ def gram_l2_face(space) -> np.ndarray:
     return np.kron(gram_l2(sx), gram_l2(sy))
 
 
-def partial_gram(space, n_max: int, aspect: float = 1.0) -> np.ndarray:
+def partial_gram(space, n_max: int, aspect: float = 1.0, direct: bool = False) -> np.ndarray:
     """S(n_max) = Σ_{m,n ≤ n_max} c_mn c_mnᵀ / (π√(m² + n²)), c_mn = c^x_m ⊗ c^y_n.
 
     ``aspect`` = a ≠ 1: the space lives on the rectangle (0, a) × (0, 1), given by its pull-back
@@ -66,15 +67,19 @@ def partial_gram(space, n_max: int, aspect: float = 1.0) -> np.ndarray:
     the coefficient of μ is √a μ̃_mn, so the weight is a / (π√((m/a)² + n²)).
 
     With A[(a, a'), m] = c^x_{a,m} c^x_{a',m} and B[(b, b'), n] = c^y_{b,n} c^y_{b',n},
-    S[(a, b), (a', b')] = (A W Bᵀ)[(a, a'), (b, b')]: n_max² · (dim M^y)² + n_max · (dim M^x dim M^y)²
-    operations, the weight matrix W handled in row blocks."""
+    S[(a, b), (a', b')] = (A W Bᵀ)[(a, a'), (b, b')]. The route of every size: W as an exponential
+    sum (:func:`_separable_sum`, n_max · r (dim M^x² + dim M^y²) + r (dim M)² operations, r ≈ 90
+    columns after the Taylor block), within a relative :data:`EXP_SUM_RTOL` of the direct sum in
+    the Loewner order. ``direct``: the reference route, W formed in row blocks and summed
+    (n_max² · (dim M^y)² + n_max · (dim M^x dim M^y)² operations; the route below dim 1,500
+    before, kept for the tests that compare the two)."""
     sx, sy = space.factors
     n = np.arange(1, n_max + 1, dtype=float)
     cx, cy = sine_coefficients(sx, n), sine_coefficients(sy, n)
     dx, dy = cx.shape[0], cy.shape[0]
     A = (cx[:, None, :] * cx[None, :, :]).reshape(dx * dx, n_max)
     B = (cy[:, None, :] * cy[None, :, :]).reshape(dy * dy, n_max)
-    if dx * dy > EXP_SUM_MIN_DIM:
+    if not direct:
         flat = _separable_sum(A, B, n, n, aspect)
     else:
         flat = np.zeros((dx * dx, dy * dy))
@@ -129,20 +134,20 @@ def _separable_sum(A: np.ndarray, B: np.ndarray, m: np.ndarray, n: np.ndarray, a
 
 def default_cap(dim: int) -> int:
     """Largest n_max of a face series summed in ``dim`` dimensions: :data:`~.segment.norms.N_MAX_CAP` on the
-    exponential-sum route (above :data:`EXP_SUM_MIN_DIM`), where a level costs about the same at
+    long series (above :data:`LONG_SERIES_MIN_DIM`), where a level costs about the same at
     every n (at k = 2, N = 32, R5.2, DUAL-ALL and TDUAL-Q9 stopped at the former cap 8,192 with a
     stated error of 1.5e-5 to 3.2e-5; one level more, 12,288, states 6e-8 to 9e-8); an eighth of
     it on the direct sums, whose levels cost n_max²."""
-    return N_MAX_CAP if dim > EXP_SUM_MIN_DIM else N_MAX_CAP // 8
+    return N_MAX_CAP if dim > LONG_SERIES_MIN_DIM else N_MAX_CAP // 8
 
 
 def start_level(n0: int, p: float, dim: int) -> int:
     """The first n of the Richardson levels: n0, or :data:`EXP_SUM_START` n0 for a slow tail
     (p = 2) on the exponential-sum route (``dim`` = the dimension :func:`partial_gram` sums in,
-    above :data:`EXP_SUM_MIN_DIM`). The result is that of the levels from n0 whenever those
+    above :data:`LONG_SERIES_MIN_DIM`). The result is that of the levels from n0 whenever those
     would have stopped at n_max ≥ 16 · EXP_SUM_START · n0 (the two-stage extrapolation, its
     step and the step's look-ahead use the last five levels only)."""
-    return EXP_SUM_START * n0 if p <= 2.0 and dim > EXP_SUM_MIN_DIM else n0
+    return EXP_SUM_START * n0 if p <= 2.0 and dim > LONG_SERIES_MIN_DIM else n0
 
 
 def smooth_tail(space) -> bool:
@@ -158,13 +163,16 @@ def tail_exponent(space, n_max: int) -> float:
 
 
 def gram_h_face(space, rtol: float = 1e-6, n_start: int | None = None, n_cap: int | None = None,
-                exponent: float | None = None, aspect: float = 1.0) -> tuple[np.ndarray, dict]:
+                exponent: float | None = None, aspect: float = 1.0, reference: bool = False) -> tuple[np.ndarray, dict]:
     """Gram matrix of the M = H^{1/2}_00(Γ)' norm on the square (module docstring).
 
     Partial sums S(n) at n = n0, 2n0, 4n0, ... are extrapolated,
     R(n) = S(2n) + (S(2n) − S(n)) / (2^p − 1) and once more for n^{−(p+1)}, until the stated
     error is ≤ rtol: the last step in R's own metric with a one-level look-ahead, a bound on the
     relative change of every eigenvalue of a pencil with the Gram (:func:`~.richardson.extrapolate`).
+    Each S(n) is the exponential-sum product (:func:`partial_gram`), in the four parity blocks of
+    the axis reflections where both factors are symmetric (:func:`partial_gram_blocks`; the
+    blocks go on in ``info["parity"]``, :class:`~infsup_contact.la.face_parity.ParityGram`).
 
     Parameters
     ----------
@@ -182,12 +190,16 @@ def gram_h_face(space, rtol: float = 1e-6, n_start: int | None = None, n_cap: in
     aspect : float
         Width a of the rectangle (0, a) × (0, 1) the pulled-back ``space`` stands for
         (:func:`partial_gram`); 1 for the square.
+    reference : bool
+        The reference route: the whole matrix by the direct sums (``partial_gram(direct=True)``),
+        on the same levels (the tests compare the two).
 
     Returns
     -------
     G : ndarray (dim, dim)
     info : dict
-        ``n_max``, ``nmax_rel_error``, ``capped``, ``n_start``, ``tail_exponent``.
+        ``n_max``, ``nmax_rel_error``, ``capped``, ``n_start``, ``tail_exponent``; ``parity`` (the
+        blocks) where they were summed in blocks.
     """
     if not rtol > 0:
         raise InputError("rtol", "a positive float", got=rtol)
@@ -198,12 +210,13 @@ def gram_h_face(space, rtol: float = 1e-6, n_start: int | None = None, n_cap: in
     if not aspect > 0:
         raise InputError("aspect", "a positive float", got=aspect)
     n_cap = default_cap(space.dim) if n_cap is None else n_cap
-    parities = parity_bases.tensor_parities(space) if aspect == 1.0 and space.dim > EXP_SUM_MIN_DIM else None
+    parities = parity_bases.tensor_parities(space) if aspect == 1.0 and not reference else None
     if parities is None:
-        return extrapolated(lambda n: partial_gram(space, n, aspect), p, n0, n_cap, rtol)
+        return extrapolated(lambda n: partial_gram(space, n, aspect, direct=reference), p, n0, n_cap, rtol)
     blocks, info = extrapolated(lambda n: partial_gram_blocks(space, n, parities), p, n0, n_cap, rtol,
                                 ops=BlockOps)
-    return face_parity.assemble(face_parity.tensor_bases(parities), blocks), info
+    bases = face_parity.tensor_bases(parities)
+    return face_parity.assemble(bases, blocks), dict(info, parity=face_parity.ParityGram(bases, blocks))
 
 
 def partial_gram_blocks(space, n_max: int, parities) -> list:
@@ -223,5 +236,23 @@ def extrapolated(partial, p: float, n0: int, n_cap: int, rtol: float, ops=None) 
 
 def gram(space, norm: str, **kwargs) -> tuple[np.ndarray, dict]:
     """Gram matrix of a tensor face space (its ``factors``) for ``norm`` ∈ {"H", "L2"} (``kwargs``
-    go to :func:`gram_h_face`); spaces without factors: :mod:`.face.norms.cellwise`."""
-    return gram_by_norm(norm, lambda: gram_l2_face(space), lambda **kw: gram_h_face(space, **kw), **kwargs)
+    go to :func:`gram_h_face`); spaces without factors: :mod:`.face.norms.cellwise`. The L² Gram
+    of a space with both factors symmetric carries its parity blocks too (:func:`l2_parity`)."""
+    G, info = gram_by_norm(norm, lambda: gram_l2_face(space), lambda **kw: gram_h_face(space, **kw), **kwargs)
+    if norm == "L2":
+        parity = l2_parity(space)
+        info = info if parity is None else dict(info, parity=parity)
+    return G, info
+
+
+def l2_parity(space):
+    """The L² Gram G_x ⊗ G_y in the four parity blocks of the axis reflections,
+    (Q^x_pᵀ G_x Q^x_p) ⊗ (Q^y_qᵀ G_y Q^y_q) (a :class:`~infsup_contact.la.face_parity.ParityGram`,
+    for the pencils' split without splitting G), or None (a factor not symmetric)."""
+    parities = parity_bases.tensor_parities(space)
+    if parities is None:
+        return None
+    gx, gy = (gram_l2(f) for f in space.factors)
+    blocks = [np.kron(np.asarray(parities[0][c & 1].T @ gx @ parities[0][c & 1]),
+                      np.asarray(parities[1][c >> 1].T @ gy @ parities[1][c >> 1])) for c in range(4)]
+    return face_parity.ParityGram(face_parity.tensor_bases(parities), [0.5 * (B + B.T) for B in blocks])

@@ -1,0 +1,115 @@
+"""The face's dense pencils in the reflections' blocks (solvers/spectra.py dense_split_spectra,
+solvers/routes.py) with the Gram summed in blocks (face/norms/tensor.py, cellwise.py): the β rows
+of the route before (the direct Gram sums, whole pencils) to round-off.
+
+Tolerance: the Gram moves by at most 1e-11 in its own metric (tests/discretization/face/
+test_gram_routes.py), so every eigenvalue by that factor; the block eigensolves differ from the
+whole one by the round-off of a backward-stable solver, m ε λ_max absolute, which at these
+pencils' conditioning (λ_max / λ_min ≲ 1e3) is below 1e-10 relative."""
+import functools
+
+import numpy as np
+import pytest
+
+from infsup_contact.discretization.face.norms import cellwise as fc
+from infsup_contact.discretization.face.norms import tensor as fn
+from infsup_contact.models import MODELS
+from infsup_contact.solvers import spectra, symmetry
+from infsup_contact.solvers.infsup import beta_table
+from infsup_contact.solvers.request import BetaRequest, MeshOptions
+
+RTOL = 1e-9
+
+
+def _reference_route(monkeypatch):
+    """The route before: direct Gram sums (whole matrices), the dense pencils whole."""
+    monkeypatch.setattr(fn, "gram_h_face", functools.partial(fn.gram_h_face, reference=True))
+    monkeypatch.setattr(fc, "gram_h_cellwise", functools.partial(fc.gram_h_cellwise, reference=True))
+    split_of = symmetry.split_of
+    monkeypatch.setattr(symmetry, "split_of",
+                        lambda *a, face_only=False, **kw: None if face_only else split_of(*a, **kw))
+    monkeypatch.setattr(symmetry, "split_dense_kernel", lambda *a, **kw: None)
+
+
+@pytest.mark.parametrize("k,n1,n2,cases,element", [
+    (2, 4, 4, ("T3", "R5.2", "DUAL-Q9"), "hex"),
+    (1, 5, 6, ("R5.4", "T3"), "hex"),
+    (2, 3, 3, ("TDUAL-Q8",), "hex20"),
+    (1, 3, 3, ("T3", "R5.2"), "tet"),       # Kuhn triangles: the point reflection, two components
+])
+def test_rows_equal_the_route_before(monkeypatch, k, n1, n2, cases, element):
+    request = BetaRequest("structured", k, n1, n2, cases, ("omega2",), ((1.0, 1.0), (1.0, 4.0)), ("H", "L2"),
+                          model=MODELS["membranes3d"], mesh=MeshOptions(element=element))
+    calls = []
+    dense_split = spectra.dense_split_spectra
+    monkeypatch.setattr(spectra, "dense_split_spectra", lambda *a, **kw: calls.append(1) or dense_split(*a, **kw))
+    new = beta_table(request)
+    assert calls, "the dense pencils were not solved in blocks"
+    with monkeypatch.context() as m:
+        _reference_route(m)
+        calls.clear()
+        old = beta_table(request)
+        assert not calls
+    assert len(new) == len(old)
+    for a, b in zip(new, old):
+        assert (a["case"], a["norm"], a["c2"]) == (b["case"], b["norm"], b["c2"])
+        for key in ("kernel_dim", "n_max", "kernel_decision", "dim_M"):
+            assert a[key] == b[key], key
+        for key in ("beta", "smallest_nonzero", "beta_v1_zero"):
+            assert a[key] == pytest.approx(b[key], rel=RTOL, abs=1e-14), key
+        assert a["nmax_rel_error"] == pytest.approx(b["nmax_rel_error"], rel=1e-6)
+        assert a["gap_over_roundoff"] == pytest.approx(b["gap_over_roundoff"], rel=1e-6)
+        assert a["kernel_margin_decades"] == pytest.approx(b["kernel_margin_decades"], rel=1e-9)
+        assert (a["kernel_detected"], a["kernel_check"]) == (b["kernel_detected"], b["kernel_check"])
+
+
+def test_a_pencil_that_is_not_invariant_is_solved_whole():
+    """An S with a block across components above INVARIANCE_RTOL: no split (None)."""
+    from infsup_contact.discretization.face.square import SQUARE
+    from infsup_contact.discretization.face.tensor_grid import TensorPartition
+    from infsup_contact.discretization.spaces import registry
+
+    xs = np.linspace(0.0, 1.0, 5)
+    space = registry.case_space("R5.2", 2, TensorPartition(xs, xs), SQUARE)
+    split = symmetry.reflection_split(space, SQUARE.quadrature(space.breakpoints, 4)[0])
+    G = SQUARE.gram(space, "L2")[0]
+    factors = {"L2": tuple(spectra.gram_factor(B) for B in split.blocks(G)[:-1])}
+    S = G @ G
+    whole = spectra.spectrum(S, G)
+    blocked = spectra.dense_split_spectra(split, S, factors)["L2"]
+    assert blocked.beta == pytest.approx(whole.beta, rel=1e-12)
+    np.testing.assert_allclose(blocked.bottom, whole.bottom, rtol=1e-12)
+    S_bad = S.copy()
+    S_bad[0, 1] += 1e-6 * np.abs(S).max()
+    S_bad[1, 0] = S_bad[0, 1]
+    assert spectra.dense_split_spectra(split, S_bad, factors) is None
+
+
+@pytest.mark.parametrize("case,k,n1,n2", [("R5.4", 1, 4, 4), ("T3", 2, 3, 4), ("R5.2", 2, 4, 4)])
+def test_the_components_kernel_is_the_whole_svds(case, k, n1, n2):
+    """split_dense_kernel: the same dimension, error level and margin as coupling_kernel on the
+    whole W where it decides (it must, on these symmetric faces: the kernel is the proven one),
+    and no decision where modes beyond the proof would be counted (proven understated)."""
+    from infsup_contact.discretization.gamma.coupling import coupling_matrix, trace_l2_norms
+    from infsup_contact.solvers.kernel import coupling_kernel, scaled_couplings
+    from infsup_contact.solvers.side_cache import SideCache
+
+    sides = SideCache().pair(MODELS["membranes3d"], "structured", k, n1, n2, MeshOptions())
+    gamma = sides[0].trace.gamma
+    g_h = gamma.multiplier_partition(*(s.trace.partition for s in sides), "omega2")
+    from infsup_contact.solvers.infsup import _space
+    space = _space(case, k, g_h, gamma)
+    rows = [trace_l2_norms(s.trace, k) for s in sides]
+    cols = np.sqrt(np.diag(gamma.gram(space, "L2")[0]))
+    W = scaled_couplings([coupling_matrix(s.trace, space, k) for s in sides], rows, cols)
+    structural = gamma.proven_kernel(space, k, [s.trace for s in sides],
+                                     gamma.trace_sum_dimension(k, *(s.trace.partition for s in sides)))
+    split = symmetry.split_of(space, gamma, g_h, k)
+    whole = coupling_kernel(W, structural)
+    blocked = symmetry.split_dense_kernel(W, split, structural)
+    assert blocked is not None
+    assert (blocked.dim, blocked.decision) == (whole.dim, whole.decision)
+    assert blocked.tol == pytest.approx(whole.tol, rel=1e-12)
+    assert blocked.margin_decades == pytest.approx(whole.margin_decades, rel=1e-9)
+    if whole.dim:
+        assert symmetry.split_dense_kernel(W, split, 0) is None

@@ -330,6 +330,10 @@ def elementwise(f, *arrays: np.ndarray) -> np.ndarray:
     return out
 
 
+GATHER_CHUNK = 1 << 20
+"""Entries per pass of :func:`signed_gather_sum` (a few MB of temporaries instead of m² per block)."""
+
+
 def signed_gather_sum(blocks, index, sign) -> np.ndarray:
     """G[i, j] = Σ_c D_c[index_c[i], index_c[j]] (sign_c[i] sign_c[j]) for dense symmetric D_c
     (``blocks``), integer maps ``index`` and weights ``sign`` (0 where row i has no entry in
@@ -339,14 +343,20 @@ def signed_gather_sum(blocks, index, sign) -> np.ndarray:
     result is exactly symmetric."""
     m = len(index[0])
     out = np.empty((m, m))
+    chunk = max(1, GATHER_CHUNK // max(m, 1))  # rows per pass: the temporaries stay small (cache, memory)
 
     def block(rows):
         def task():
-            acc = None
-            for D, idx, w in zip(blocks, index, sign):
-                part = D[np.ix_(idx[rows], idx)] * (w[rows, None] * w[None, :])
-                acc = part if acc is None else np.add(acc, part, out=acc)
-            out[rows] = acc
+            for start in range(rows.start, rows.stop, chunk):
+                r = slice(start, min(start + chunk, rows.stop))
+                acc = out[r]
+                for c, (D, idx, w) in enumerate(zip(blocks, index, sign)):
+                    part = D[idx[r]][:, idx]
+                    part *= w[r, None] * w[None, :]  # the product first: G stays exactly symmetric
+                    if c == 0:
+                        acc[...] = part
+                    else:
+                        acc += part
         return task
 
     _run(block(r) for r in _row_blocks(m))

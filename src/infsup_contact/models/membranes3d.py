@@ -5,7 +5,7 @@ The paper's model problem (Section 3) one dimension up: the side operator is the
 stiffness of continuous Q_k (hexahedra) or P_k (tetrahedra) with the Γ dofs last and its Γ
 Schur complement (:func:`~infsup_contact.models.contract.factorized_side`; the nested-dissection
 ordering is graph based, so it serves 3D meshes as it is). Γ is the face
-:class:`~infsup_contact.discretization.face.square.Square`: the traces are tensor grids, the
+:class:`~infsup_contact.discretization.face.shapes.square.Square`: the traces are tensor grids, the
 multiplier spaces tensor products (:mod:`infsup_contact.discretization.face.spaces.tensor`) on
 hexahedra and P_s on the triangles of G_h on tetrahedra
 (:mod:`infsup_contact.discretization.face.spaces.triangles`).
@@ -15,18 +15,18 @@ N × N × N cells of each body (N = cells per direction on Γ) from
 ``ngsolve.meshes.MakeStructured3DMesh``: ``element="hex"`` gives hexahedra,
 ``element="tet"`` the six-tetrahedra (Kuhn) split of every cube, whose faces on Γ are the
 rectangles cut by the diagonal from (x_i, y_j) to (x_{i+1}, y_{j+1}) — on both bodies, so the
-trace is a tensor grid of triangles (:data:`~infsup_contact.discretization.face.square.SQUARE_TRIG`).
+trace is a tensor grid of triangles (:data:`~infsup_contact.discretization.face.shapes.square.SQUARE_TRIG`).
 The ``unstructured`` family (Netgen tetrahedra, maxh = 1/N, each body meshed on its own) and
 the ``perturbed`` one (structured, vertices moved; on hexahedra only off Γ and in z, so the
 face stays a tensor grid) are built in :mod:`infsup_contact.discretization.face.meshes`; their
 tetrahedral faces are general triangulations, Γ
-:data:`~infsup_contact.discretization.face.triangulated_square.TRIANGULATED` (non-matching traces,
+:data:`~infsup_contact.discretization.face.shapes.triangulated_square.TRIANGULATED` (non-matching traces,
 common refinement by polygon clipping).
 
 ``element="hex20"``: serendipity HEX20 bodies on the same structured cells, assembled by scikit-fem
 (:mod:`.hex20`; k = 2; β_h and contact scenes supported on the far face or all of ∂Ω_i∖Γ, u_h
 evaluated at points), Γ the QUAD8 face
-:data:`~infsup_contact.discretization.face.serendipity.SERENDIPITY`.
+:data:`~infsup_contact.discretization.face.shapes.serendipity.SERENDIPITY`.
 
 Boundaries: ``gamma`` (Γ), ``dir`` (the far face: z = 0 of Ω1, z = 2 of Ω2) and ``side`` (the
 four lateral faces). β_h clamps both (:data:`BETA_DIRICHLET`, the paper's u_i = 0 on ∂Ω_i∖Γ);
@@ -46,10 +46,10 @@ from ngsolve import meshes as ngmeshes
 
 from ..discretization.segment.meshes import DIRICHLET
 from ..discretization.face import meshes as meshes3d
-from ..discretization.face.cylinder import GAMMAS, RADIUS_ALLOWED, Cylinder, cylinder_of
-from ..discretization.face.square import SQUARE, SQUARE_TRIG
+from ..discretization.face.shapes.cylinder import GAMMAS, RADIUS_ALLOWED, Cylinder, cylinder_of
+from ..discretization.face.shapes.square import SQUARE, SQUARE_TRIG
 from ..discretization.segment.arc import COUPLINGS
-from ..discretization.face.triangulated_square import TRIANGULATED
+from ..discretization.face.shapes.triangulated_square import TRIANGULATED
 from ..errors import InputError, check_prestress
 from dataclasses import dataclass
 
@@ -91,7 +91,7 @@ def subdomain_mesh(family: str, n: int, side: int, *, element: str = "hex", widt
     ``Square(width=width)``.
 
     ``gamma``, ``radius``, ``coupling``: Γ the cylinder of radius R
-    (:mod:`~infsup_contact.discretization.face.cylinder`): the box is built as here and curved by
+    (:mod:`~infsup_contact.discretization.face.shapes.cylinder`): the box is built as here and curved by
     :func:`side_operator`, where the body's degree is known; hexahedra (both couplings) and
     structured tetrahedra (``exact``), width 1.
 
@@ -102,7 +102,7 @@ def subdomain_mesh(family: str, n: int, side: int, *, element: str = "hex", widt
         unstructured family: :data:`UNSTRUCTURED_ELEMENTS`; ``hex20``: structured, width 1), N < 1,
         a width outside (0, 1] (or
         other than 1 for the unstructured and perturbed families), α or seed out of range, a
-        cylinder's options (:func:`~infsup_contact.discretization.face.cylinder.check_cylinder_options`)
+        cylinder's options (:func:`~infsup_contact.discretization.face.shapes.cylinder.check_cylinder_options`)
         or a body it does not curve.
     """
     if gamma is not None or radius is not None or coupling is not None:
@@ -144,7 +144,7 @@ def subdomain_mesh(family: str, n: int, side: int, *, element: str = "hex", widt
 
 def _on_cylinder(body: Body, family: str, element: str, width: float, gamma, radius, coupling) -> Body:
     """``body`` with its Γ the cylinder of the options (flat: as built); refused where its face is
-    no tensor grid of :class:`~infsup_contact.discretization.face.square.Square` (HEX20's QUAD8
+    no tensor grid of :class:`~infsup_contact.discretization.face.shapes.square.Square` (HEX20's QUAD8
     face, the triangulated faces of the perturbed and unstructured tetrahedra) or narrower."""
     if gamma == "cylinder":
         if element == "hex20":

@@ -25,7 +25,7 @@ import time
 import numpy as np
 import pandas as pd
 
-from ..discretization.face.square import CELL_BODIES
+from ..discretization.face.shapes.square import CELL_BODIES
 from ..discretization.spaces import registry
 from ..discretization.spaces.spec import SpaceSpec
 from ..errors import InputError

@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 from infsup_contact.cli import main as cli_main
-from infsup_contact.discretization.face.cylinder import Cylinder
-from infsup_contact.discretization.face.cylinder_projection import ProjectedCylinder, face_curve
+from infsup_contact.discretization.face.shapes.cylinder import Cylinder
+from infsup_contact.discretization.face.shapes.cylinder_projection import ProjectedCylinder, face_curve
 from infsup_contact.discretization.gamma.coupling import coupling_matrix
 from infsup_contact.discretization.spaces import registry
 from infsup_contact.errors import InputError

@@ -15,8 +15,8 @@ opaque: obtained from the interface, handed back to it); a side's trace carries 
 
 Implementations: the paper's segment (:class:`~.segment.interface.Segment`, partitions = sorted
 breakpoints, what users' ``build(k, x)`` receive); the face (0, 1)² × {1} with tensor partitions
-(:class:`~.face.square.Square`; QUAD8 traces: :class:`~.face.serendipity.SerendipitySquare`) and
-with general triangulations (:class:`~.face.triangulated_square.TriangulatedSquare`, clipped).
+(:class:`~.face.shapes.square.Square`; QUAD8 traces: :class:`~.face.shapes.serendipity.SerendipitySquare`) and
+with general triangulations (:class:`~.face.shapes.triangulated_square.TriangulatedSquare`, clipped).
 """
 from __future__ import annotations
 
@@ -315,7 +315,7 @@ class Interface(abc.ABC):
     def proven_kernel(self, space, k: int, traces, dim_w: int) -> int:
         """The part of dim ker Bᵀ on ``space`` that a count proves (the kernel rule never loses it
         to round-off): max(dim M − dim(W1 + W2), 0), ``dim_w`` = :meth:`trace_sum_dimension`.
-        An interface may add local counts (:class:`~.face.triangulated_square.TriangulatedSquare`:
+        An interface may add local counts (:class:`~.face.shapes.triangulated_square.TriangulatedSquare`:
         the corners of Γ).
 
         Parameters
@@ -346,7 +346,7 @@ class Interface(abc.ABC):
         """The multiplier space of a registry entry on a partition of this interface.
 
         The default (the segment's): ``spec.build(k, partition)`` on the sorted breakpoints. A
-        face builds its tensor products from the same 1D ``build`` (:class:`~.face.square.Square`).
+        face builds its tensor products from the same 1D ``build`` (:class:`~.face.shapes.square.Square`).
 
         Parameters
         ----------

@@ -51,7 +51,7 @@ documented interpolant's, two more orders reach round-off (docs/models.md, the a
 def check_curved_options(gamma, radius, coupling, gammas=GAMMAS, radius_allowed: str = RADIUS_ALLOWED) -> None:
     """:class:`InputError` naming the key: ``gamma`` in ``gammas`` (flat, curved); with the curved one a
     radius R > 1 (inf allowed) and a coupling in :data:`COUPLINGS` (None: ``exact``); without it neither
-    (the arc's options; the cylinder's, :mod:`..face.cylinder`, with its own names)."""
+    (the arc's options; the cylinder's, :mod:`..face.shapes.cylinder`, with its own names)."""
     curved = gammas[-1]
     if gamma not in (None,) + tuple(gammas):
         raise InputError("gamma", ", ".join(gammas), got=gamma)

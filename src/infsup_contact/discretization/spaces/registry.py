@@ -16,7 +16,7 @@ import functools
 import numpy as np
 
 from ...errors import InputError
-from ..face.square import CELL_BODIES
+from ..face.shapes.square import CELL_BODIES
 from ..gamma.interface import MULTIPLIER_MESHES
 from ..segment.dual import dual_space
 from ..segment.interface import SEGMENT
@@ -98,7 +98,7 @@ def case_space(case: str, k: int, partition, gamma=SEGMENT, pair: bool = False) 
     """The multiplier space of a registered case for displacement degree k on G_h, a
     ``partition`` of Γ = ``gamma`` (:mod:`.gamma.interface`; for the paper's segment the sorted
     breakpoints of G_h, what ``SpaceSpec.build(k, x)`` receives; for the face
-    :class:`~.face.square.Square` a tensor partition, on which the space is the tensor product of
+    :class:`~.face.shapes.square.Square` a tensor partition, on which the space is the tensor product of
     the 1D builds, :meth:`~.gamma.interface.Interface.space`). A Petrov–Galerkin pair (``trial_space``,
     ``test_space``) is refused after those checks unless ``pair`` (its caller knows it has two bases):
     then its trial space is returned.

@@ -42,7 +42,7 @@ def arc_rows(radii, series: dict, k: int, cases=None, couplings=COUPLINGS, famil
         :data:`PAPER`, curvature 0: what R = ∞ must reproduce.
     element : str or None
         None: the 2D membranes, Γ the arc; an element of the 3D membranes (``hex``, ``tet``): Γ the
-        part of the cylinder (:mod:`infsup_contact.discretization.face.cylinder`), the flat face the reference.
+        part of the cylinder (:mod:`infsup_contact.discretization.face.shapes.cylinder`), the flat face the reference.
 
     Returns
     -------

@@ -1,4 +1,4 @@
-"""β_h of the face spaces on the cylinder (:mod:`infsup_contact.discretization.face.cylinder`).
+"""β_h of the face spaces on the cylinder (:mod:`infsup_contact.discretization.face.shapes.cylinder`).
 
 The 3D membranes on hexahedra, Γ the part of the cylinder of radius R (R = inf: the flat face, the
 reference), coupled ``exact`` (both traces mapped to the cylinder) or by ``projection`` (the

@@ -24,11 +24,11 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from ...errors import InputError
-from ..segment.interface import SEGMENT
-from ..segment.projection import EXTRA_POINTS, curve_nodes, fit_curve, preimages, project
+from ....errors import InputError
+from ...segment.interface import SEGMENT
+from ...segment.projection import EXTRA_POINTS, curve_nodes, fit_curve, preimages, project
 from .cylinder import Cylinder
-from .tensor_grid import merge_breakpoints
+from ..partitions.tensor_grid import merge_breakpoints
 
 TOL = 1e-12
 """Breakpoints closer than this are one (as :meth:`~.square.Square.common_refinement` merges them)."""

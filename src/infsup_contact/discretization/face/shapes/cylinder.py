@@ -32,8 +32,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ...errors import InputError
-from ..segment.arc import MOMENT_BONUS_INTORDER, check_curved_options
+from ....errors import InputError
+from ...segment.arc import MOMENT_BONUS_INTORDER, check_curved_options
 from .square import Square
 
 GAMMAS = ("square", "cylinder")

@@ -1,0 +1,1 @@
+"""discretization.face.partitions.tensor_grid."""

@@ -1,0 +1,1 @@
+"""discretization.face.shapes.square."""

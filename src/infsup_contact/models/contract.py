@@ -200,7 +200,7 @@ class Model:
         """The mesh of Ω_side the model's sides are built on (its ``mesh`` builder, else the 2D one)."""
         if self.mesh is None:
             from ..discretization.segment import meshes
-            from ..discretization.segment.arc import arc_of
+            from ..discretization.spaces.gammas import arc_of
 
             arc = arc_of(*(mesh_kwargs.pop(key, None) for key in ("gamma", "radius", "coupling")))
             mesh = meshes.subdomain_mesh(family, n, side, **mesh_kwargs)
@@ -211,7 +211,7 @@ class Model:
         """The Γ of the model's meshes with these options (an element's face; the paper's segment
         for the 2D meshes), asked of its coarsest mesh: a property of the request, not of N."""
         if self.mesh is None:
-            from ..discretization.segment.arc import arc_of
+            from ..discretization.spaces.gammas import arc_of
             from ..discretization.segment.interface import SEGMENT
 
             return arc_of(*(mesh_kwargs.get(key) for key in ("gamma", "radius", "coupling"))) or SEGMENT

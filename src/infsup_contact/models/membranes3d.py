@@ -46,7 +46,8 @@ from ngsolve import meshes as ngmeshes
 
 from ..discretization.segment.meshes import DIRICHLET
 from ..discretization.face import meshes as meshes3d
-from ..discretization.face.shapes.cylinder import GAMMAS, RADIUS_ALLOWED, Cylinder, cylinder_of
+from ..discretization.face.shapes.cylinder import GAMMAS, RADIUS_ALLOWED, Cylinder
+from ..discretization.spaces.gammas import cylinder_of
 from ..discretization.face.shapes.square import SQUARE, SQUARE_TRIG
 from ..discretization.segment.arc import COUPLINGS
 from ..discretization.face.shapes.triangulated_square import TRIANGULATED

@@ -15,7 +15,8 @@ import pytest
 from helpers.cli import run_in_process
 
 from infsup_contact.discretization.gamma.coupling import coupling_matrix
-from infsup_contact.discretization.segment.arc import Arc, arc_of
+from infsup_contact.discretization.segment.arc import Arc
+from infsup_contact.discretization.spaces.gammas import arc_of
 from infsup_contact.discretization.segment.projection import project, side_curve
 from infsup_contact.discretization.spaces import registry
 from infsup_contact.errors import InputError

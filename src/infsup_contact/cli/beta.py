@@ -150,6 +150,6 @@ def beta_frame(args, modes: list | None = None):
 
     rows = beta_table(args.request, modes=modes)
     frame = pd.DataFrame(rows)
-    for i, (name, value) in enumerate(args.mesh.kwargs().items()):  # e.g. element, after family
+    for i, (name, value) in enumerate(args.mesh.columns(args.model_obj).items()):  # e.g. element, after family
         frame.insert(frame.columns.get_loc("family") + 1 + i, name, value)
     return material_columns(frame, args)

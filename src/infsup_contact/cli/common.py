@@ -34,17 +34,15 @@ def face_cases(args) -> list:
     """``--case all`` on a 3D model: the paper's spaces and the duals (:func:`cases`), then every
     other registered space the model's face builds for k (the quadratic face elements' on
     hexahedra or tetrahedra; those refused by construction, e.g. DUAL-Q8, left out), on the
-    partition of the model's coarsest mesh (one cell per direction; ``args.mesh`` set) of
-    the Γ its mesh builder names for the request (no body is factorized)."""
+    uniform partition of one cell per direction of the request's Γ (``Model.gamma``, resolved
+    without a mesh; ``args.mesh`` set)."""
     from ..discretization.spaces.registry import ids_built_on
 
     base = list(args.cases)
     if args.case not in (None, "all") or args.space is not None or args.model_obj.dim != 3:
         return base
-    model = args.model_obj
-    body = model.subdomain_mesh(args.family, 1, 1, **args.mesh.kwargs())  # the model contract
-    gamma = body.interface
-    partition = gamma.partition_of(body.mesh)
+    gamma = args.model_obj.gamma(args.family, **args.mesh.kwargs())
+    partition = gamma.uniform_partition(1)
     g_h = gamma.multiplier_partition(partition, partition)
     return base + [c for c in ids_built_on(args.k, gamma, g_h) if c not in base]
 
@@ -123,7 +121,7 @@ def mesh_options(args):
     does not build (``Model.families``) is refused (a mesh flag the model does not take was
     refused before, :func:`refuse_unused`)."""
     from ..models.contract import OptionalChoice
-    from ..solvers.request import MeshOptions, check_mesh_option
+    from ..solvers.request import check_mesh_option, mesh_of
 
     model = args.model_obj
     if model.families is not None and getattr(args, "family", None) not in model.families:
@@ -143,7 +141,7 @@ def mesh_options(args):
                 out[name] = own[name].values[0]
             continue
         out[name] = own[name][0] if given is None else given
-    return MeshOptions(**out)
+    return mesh_of(model, getattr(args, "family", "structured"), **out)  # Γ resolved once, here, without a mesh
 
 
 def material(args):

@@ -65,8 +65,8 @@ def _check_contact(args):
         raise InputError("case", "one of --case ID|all or --space FILE.py:FUNC")
     args.cases = cases(args)
     material(args)
+    check_flat_gamma(args)  # the flags, before Γ is resolved: a curved Γ is refused as such
     args.mesh = mesh_options(args)  # a mesh flag of another model is refused; the scene's rows read them
-    check_flat_gamma(args.mesh)
     spec = check_pair(args.model, args.scene)
     check_k(args.k)
     # --case all on a 3D model: also the spaces only its face builds, but no Petrov–Galerkin pair (two

@@ -22,7 +22,7 @@ from infsup_contact.discretization.spaces import registry
 from infsup_contact.errors import InputError
 from infsup_contact.models import MODELS
 from infsup_contact.solvers.infsup import beta_rows
-from infsup_contact.solvers.request import MeshOptions
+from infsup_contact.solvers.request import MeshOptions, mesh_of
 from infsup_contact.solvers.side_cache import SideCache
 
 MEMBRANES = MODELS["membranes"]
@@ -30,7 +30,7 @@ COLUMNS = ["case", "norm", "beta", "kernel_dim", "structural_kernel_dim", "small
 
 
 def arc_options(radius, coupling="exact"):
-    return MeshOptions(gamma="arc", radius=float(radius), coupling=coupling)
+    return mesh_of(MODELS["membranes"], gamma="arc", radius=float(radius), coupling=coupling)
 
 
 def rows(k, n1, n2, mesh=MeshOptions(), cases=None):

@@ -298,18 +298,8 @@ class Interface(abc.ABC):
 
     @abc.abstractmethod
     def multiplier_cells(self, n1: int, n2: int, choice: str = "omega2") -> int:
-        """Cells of G_h when the traces of Ω1 and Ω2 are uniform with ``n1`` and ``n2`` cells
-        (the registry's emptiness checks and the sizing model).
-
-        Parameters
-        ----------
-        n1, n2 : int
-        choice : {"omega2", "omega1", "union"}
-
-        Returns
-        -------
-        int
-        """
+        """Cells of G_h (an int) when the traces of Ω1 and Ω2 are uniform with ``n1`` and ``n2``
+        cells, ``choice`` one of omega2, omega1, union (the emptiness checks, the sizing model)."""
 
     # --- derived, shared by every implementation ----------------------------------------------
     def proven_kernel(self, space, k: int, traces, dim_w: int) -> int:
@@ -335,6 +325,15 @@ class Interface(abc.ABC):
     def builds(self, spec) -> bool:
         """Whether this interface has a space of the registry entry ``spec``; default: every one."""
         return True
+
+    def uniform_partition(self, n: int):
+        """The trace partition of uniform bodies with ``n`` cells per direction, built without a mesh."""
+        raise NotImplementedError(f"{type(self).__name__} has no uniform partition")
+
+    def check_builds(self, spec) -> None:
+        """:class:`InputError` naming ``case`` unless :meth:`builds` (a shape may say why in its words)."""
+        if not self.builds(spec):
+            raise InputError("case", f"a space this Γ builds ({spec.id} is not one)", got=spec.id)
 
     contact = True  # whether contact scenes (the patch test among them) run on this Γ's bodies
 

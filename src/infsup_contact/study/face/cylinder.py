@@ -25,13 +25,13 @@ def cylinder_rows(radii=RADII, pairs=PAIRS, k: int = 1, cases=None, couplings=CO
     :class:`~infsup_contact.errors.InputError` naming its key (the request's checks)."""
     from ...models.membranes3d import MEMBRANES3D
     from ...solvers.infsup import beta_rows
-    from ...solvers.request import MeshOptions
+    from ...solvers.request import mesh_of
     from ...solvers.side_cache import SideCache
 
     rows = []
     for radius in radii:
         for coupling in couplings:
-            mesh = MeshOptions(element="hex", gamma="cylinder", radius=float(radius), coupling=coupling)
+            mesh = mesh_of(MEMBRANES3D, element="hex", gamma="cylinder", radius=float(radius), coupling=coupling)
             cache = SideCache.for_sweep(MEMBRANES3D, "structured", k, pairs, mesh)  # Ω2 at N shared by N:N, N+1:N
             for n1, n2 in pairs:
                 found = beta_rows("structured", k, n1, n2, cases, norms=tuple(norms), model=MEMBRANES3D,

@@ -117,6 +117,10 @@ class Square(Interface):
         """x and y breakpoints of the Γ boundary elements (a tensor grid, checked)."""
         return self._partition_of_elements(self._gamma_elements(mesh))
 
+    def uniform_partition(self, n: int) -> TensorPartition:
+        """The n × n tensor grid of the face (a structured trace)."""
+        return TensorPartition(np.linspace(0.0, self.width, int(n) + 1), np.linspace(0.0, 1.0, int(n) + 1))
+
     def common_refinement(self, *partitions, tol: float = 1e-12) -> TensorPartition:
         """Union of the x breakpoints and of the y breakpoints, merging within ``tol`` (for
         triangles the tensor grid under them: :meth:`coupling_quadrature` cuts its cells)."""
@@ -300,6 +304,12 @@ class Square(Interface):
         """Whether ``spec`` is defined on this face's cells (``spec.face_cells``)."""
         return self.cell in spec.face_cells
 
+    def check_builds(self, spec) -> None:
+        if not self.builds(spec):
+            own = " and ".join(CELL_BODIES.get(c, c) for c in spec.face_cells)
+            raise InputError("case", f"a space defined on the faces of {CELL_BODIES.get(self.cell, self.cell)} "
+                             f"({spec.id} is built on the faces of {own} only)", got=spec.id)
+
     def space(self, spec, k: int, partition):
         """The tensor product of ``spec``'s 1D space on xs and on ys (:class:`.face.spaces.tensor.FaceSpace`),
         or the entry's own face space where it has one (``spec.face_build``: the cellwise element
@@ -313,10 +323,7 @@ class Square(Interface):
         if not isinstance(partition, TensorPartition) or partition.cells < 1:
             raise InputError("multiplier mesh", f"a tensor partition of Γ with at least one rectangle "
                              f"(case {spec.id}, k = {k})")
-        if not self.builds(spec):
-            own = " and ".join(CELL_BODIES.get(c, c) for c in spec.face_cells)
-            raise InputError("case", f"a space defined on the faces of {CELL_BODIES.get(self.cell, self.cell)} "
-                             f"({spec.id} is built on the faces of {own} only)", got=spec.id)
+        self.check_builds(spec)
         if spec.face_build is not None:
             return spec.face_build(k, partition)
         s, dual = int(spec.degree(k)), spec.dual

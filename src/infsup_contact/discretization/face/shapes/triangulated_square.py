@@ -86,6 +86,12 @@ class TriangulatedSquare(Interface):
         """The triangles of the Γ boundary elements of ``mesh`` (they must tile (0, 1)²)."""
         return self._partition([v for _, v in self._gamma_elements(mesh)])
 
+    def uniform_partition(self, n: int) -> Triangulation:
+        """The Kuhn triangles of the n × n grid (each cell cut by its diagonal (x_i, y_j)–(x_i+1, y_j+1))."""
+        x = np.linspace(0.0, 1.0, int(n) + 1)
+        cells = [(x[i], x[i + 1], x[j], x[j + 1]) for i in range(int(n)) for j in range(int(n))]
+        return self._partition([tri for a, b, c, d in cells for tri in (((a, c), (b, c), (b, d)), ((a, c), (b, d), (a, d)))])
+
     def common_refinement(self, *partitions, tol: float = 1e-12) -> Triangulation:
         """The overlay of the triangulations (shapely), fanned; one partition is returned as it is."""
         key = tuple(p.key for p in partitions)
@@ -192,6 +198,11 @@ class TriangulatedSquare(Interface):
         of degree 1 or 2 (checked when built)."""
         return spec.lagrange is not None and "trig" in spec.face_cells
 
+    def check_builds(self, spec) -> None:
+        if not self.builds(spec):
+            raise InputError("case", f"a Lagrange case or its dual on a general triangulation of Γ "
+                             f"({spec.id} has no space on triangles)", got=spec.id)
+
     def space(self, spec, k: int, partition):
         """P_s on the triangles of G_h (:class:`~.face.spaces.unstructured.MeshTriangleSpace`,
         s = ``spec.degree(k)``, continuity and ∂Γ condition from ``spec.lagrange``, dual basis for
@@ -200,9 +211,7 @@ class TriangulatedSquare(Interface):
 
         if not isinstance(partition, Triangulation):
             raise InputError("multiplier mesh", f"a triangulation of Γ (case {spec.id}, k = {k})")
-        if not self.builds(spec):
-            raise InputError("case", f"a Lagrange case or its dual on a general triangulation of Γ "
-                             f"({spec.id} has no space on triangles)", got=spec.id)
+        self.check_builds(spec)
         continuous, vanish = spec.lagrange
         return mesh_space(partition, int(spec.degree(k)), continuous, vanish, spec.dual)
 

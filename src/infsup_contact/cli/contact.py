@@ -5,8 +5,8 @@ from __future__ import annotations
 
 from ..errors import InputError, check_prestress
 from .verdict_formats import add_table_output, force_use
-from .common import (FlagUse, add_dry_run, add_model, cases, check_memory, declare_flag_uses, face_cases, material,
-                     mesh_options, model_flag_uses, SPACE_HELP, write_csv)
+from .common import FlagUse, add_dry_run, add_model, check_memory, declare_flag_uses, model_flag_uses, SPACE_HELP, write_csv
+from .request import cases, face_cases, material, mesh_options
 
 
 def add(sub) -> None:

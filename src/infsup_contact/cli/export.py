@@ -5,8 +5,8 @@ import sys
 from pathlib import Path
 
 from ..errors import InputError
-from .common import (add_dry_run, add_model, check_memory, declare_flag_uses, material, mesh_options, model_flag_uses,
-                     write_text)
+from .common import add_dry_run, add_model, check_memory, declare_flag_uses, model_flag_uses, write_text
+from .request import material, mesh_options
 
 
 def add(sub) -> None:

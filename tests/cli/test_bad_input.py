@@ -363,6 +363,11 @@ def flag_named(line: str, flag: str, label: str) -> bool:
     return re.search(rf"(?<![\w-]){re.escape(flag)}\b", line) is not None
 
 
+REQUIRED_WITH = {"--gamma": ("--radius",)}
+"""Flags whose values need another flag: ``--gamma arc`` (or ``cylinder``) alone is refused at the
+edge, where Γ is resolved, naming the radius it needs."""
+
+
 def test_every_cli_flag_mutated(tables, capsys):
     t0 = time.perf_counter()
     tried, refused, accepted, failures = 0, 0, 0, []
@@ -386,7 +391,8 @@ def test_every_cli_flag_mutated(tables, capsys):
         refused += 1
         if code != 2 or len(lines) != 1 or out or "Traceback" in err:
             failures.append(f"{' '.join(argv)}: exit {code}, stdout {out[:80]!r}, stderr {err!r}")
-        elif not lines[0].startswith("infsup-contact: error:") or not flag_named(lines[0], flag, label):
+        elif not lines[0].startswith("infsup-contact: error:") or not any(
+                flag_named(lines[0], f, label) for f in (flag, *REQUIRED_WITH.get(flag, ()))):
             failures.append(f"{' '.join(argv)}: does not name {flag}: {lines[0]}")
     every_flag = {(c, max(a.option_strings, key=len) if a.option_strings else a.dest)
                   for c, p in subcommands().items() for a in p._actions if not isinstance(a, argparse._HelpAction)}

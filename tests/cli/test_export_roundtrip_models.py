@@ -22,8 +22,8 @@ import scipy.sparse.linalg as spla
 
 from infsup_contact.cli import main
 from infsup_contact.discretization.spaces.registry import SPACES, ids_built_on, ids_valid_for
-from infsup_contact.discretization.face.square import SQUARE, SQUARE_TRIG
-from infsup_contact.discretization.face.tensor_grid import TensorPartition
+from infsup_contact.discretization.face.shapes.square import SQUARE, SQUARE_TRIG
+from infsup_contact.discretization.face.partitions.tensor_grid import TensorPartition
 from infsup_contact.models import MODELS
 from infsup_contact.solvers.infsup import beta_rows
 from infsup_contact.solvers.request import MeshOptions

@@ -336,7 +336,7 @@ def reference_sides(model, family: str, k: int, n1: int, n2: int, mesh_options, 
     out = []
     for side, n, which in zip(sides, (n1, n2), (1, 2)):
         square = model.subdomain_mesh(family, n, which, **mesh_options.kwargs()).mesh
-        body = Body(*library_square(square), mesh_options.radius, k)
+        body = Body(*library_square(square), mesh_options.gamma.radius, k)
         out.append(replace(side, schur=reference_schur(side, body, points), steklov=None))
     return out
 

@@ -6,7 +6,7 @@ from __future__ import annotations
 import pandas as pd
 
 from infsup_contact.discretization.spaces.registry import SPACES
-from infsup_contact.discretization.face.square import SQUARE, SQUARE_TRIG
+from infsup_contact.discretization.face.shapes.square import SQUARE, SQUARE_TRIG
 from infsup_contact.study.claims.membranes3d import face_claims, matching_kernel, planar_kernel
 
 CLAIMS_CFG = {"slope_tolerance": 0.15, "beta_floor": 1e-3, "confidence": 0.95, "fit_window": 5}

@@ -7,8 +7,8 @@ from infsup_contact.discretization.face.norms import tensor as face_norms
 from infsup_contact.discretization.spaces import registry
 from infsup_contact.la import exponential_sum
 from infsup_contact.la.exponential_sum import inverse_sqrt
-from infsup_contact.discretization.face.square import SQUARE
-from infsup_contact.discretization.face.tensor_grid import TensorPartition
+from infsup_contact.discretization.face.shapes.square import SQUARE
+from infsup_contact.discretization.face.partitions.tensor_grid import TensorPartition
 from infsup_contact.errors import InputError
 
 

@@ -11,8 +11,8 @@ from infsup_contact.discretization.face.norms import parity_bases as fpb
 from infsup_contact.la import face_parity as fp
 from infsup_contact.discretization.spaces import registry
 from infsup_contact.discretization.segment.norms import sine_coefficients
-from infsup_contact.discretization.face.square import SQUARE
-from infsup_contact.discretization.face.tensor_grid import TensorPartition
+from infsup_contact.discretization.face.shapes.square import SQUARE
+from infsup_contact.discretization.face.partitions.tensor_grid import TensorPartition
 
 
 def _space(case, k, xs):

@@ -7,8 +7,8 @@ import pytest
 import scipy.linalg as sla
 
 from infsup_contact.discretization.spaces import registry
-from infsup_contact.discretization.face.square import SQUARE, SQUARE_TRIG
-from infsup_contact.discretization.face.tensor_grid import TensorPartition
+from infsup_contact.discretization.face.shapes.square import SQUARE, SQUARE_TRIG
+from infsup_contact.discretization.face.partitions.tensor_grid import TensorPartition
 from infsup_contact.la import bottom, reflection
 from infsup_contact.solvers import infsup, spectra, symmetry
 from infsup_contact.solvers.kernel import KernelDecision

@@ -6,7 +6,7 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from infsup_contact.discretization.face.serendipity import SERENDIPITY
+from infsup_contact.discretization.face.shapes.serendipity import SERENDIPITY
 from infsup_contact.errors import InputError
 from infsup_contact.models import hex20
 from infsup_contact.models.contract import schur_by_solves

@@ -11,7 +11,7 @@ from infsup_contact.solvers import modes as modes_mod
 from infsup_contact.solvers.infsup import beta_table
 from infsup_contact.solvers.interface_operator import combine_terms, interface_terms
 from infsup_contact.solvers.modes import mode_on_gamma, normalized
-from infsup_contact.solvers.request import BetaRequest, MeshOptions
+from infsup_contact.solvers.request import BetaRequest, MeshOptions, mesh_of
 from infsup_contact.solvers.side_cache import SideCache
 
 EPS = np.finfo(float).eps
@@ -149,7 +149,7 @@ CYLINDER = dict(gamma="cylinder", radius=2.0, coupling="exact")
 def test_every_model_gives_the_eigenvector(model, options, case, k, n):
     """Segment and face models, scalar and vector bodies, flat and curved Γ: the mode's Rayleigh
     quotient is β_h², and its samples cover Γ (a segment: x; a face: x and y) with max |μ_h| = 1."""
-    mesh = MeshOptions(**options)
+    mesh = mesh_of(MODELS[model], **options)
     request = BetaRequest("structured", k, n, n, (case,), ("omega2",), ((1.0, 1.0),), ("H", "L2"),
                           model=MODELS[model], mesh=mesh)
     rows, found = worst(request)

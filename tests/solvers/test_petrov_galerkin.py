@@ -9,8 +9,8 @@ import pandas as pd
 import pytest
 
 from helpers.cli import run_in_process
-from infsup_contact.discretization.face.serendipity import SERENDIPITY
-from infsup_contact.discretization.face.tensor_grid import TensorPartition
+from infsup_contact.discretization.face.shapes.serendipity import SERENDIPITY
+from infsup_contact.discretization.face.partitions.tensor_grid import TensorPartition
 from infsup_contact.discretization.gamma.quadrature import gauss_legendre
 from infsup_contact.discretization.spaces import registry
 from infsup_contact.discretization.spaces.registry import SPACES

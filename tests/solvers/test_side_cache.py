@@ -22,6 +22,10 @@ class _Counting:
         self.builds += 1
         return MEMBRANES.side_operator(mesh, k)
 
+    def gamma(self, family="structured", **options):
+        """The request's Γ (the model contract): the membranes'."""
+        return MEMBRANES.gamma(family, **options)
+
     def subdomain_mesh(self, family, n, side, **mesh_kwargs):
         return MEMBRANES.subdomain_mesh(family, n, side, **mesh_kwargs)
 

@@ -9,8 +9,8 @@ from infsup_contact.discretization.face.spaces.clipped import ClippedFace, clip_
 from infsup_contact.discretization.face.norms.tensor import partial_gram
 from infsup_contact.discretization.segment.norms import sine_coefficients
 from infsup_contact.discretization.gamma.quadrature import gauss_legendre_01
-from infsup_contact.discretization.face.square import SQUARE
-from infsup_contact.discretization.face.tensor_grid import TensorPartition
+from infsup_contact.discretization.face.shapes.square import SQUARE
+from infsup_contact.discretization.face.partitions.tensor_grid import TensorPartition
 from infsup_contact.errors import InputError
 from infsup_contact.solvers.spectra import spectrum
 from infsup_contact.study.face.edge_dropping import (edge_row, geometry, interface_operator,
@@ -214,7 +214,7 @@ def test_ngsolve_route_equals_tensor_route(k):
 def test_narrow_side_mesh():
     """Ω2 = (0, L) × (0, 1) × (1, 2) from MakeStructured3DMesh: its Γ trace is the uniform
     grid of (0, L) × (0, 1) with (N2 k − 1)² dofs and Square(width = L) checks its extent."""
-    from infsup_contact.discretization.face.square import Square
+    from infsup_contact.discretization.face.shapes.square import Square
     from infsup_contact.models.membranes3d import subdomain_mesh
 
     n, n2, theta, k = 2, 3, 0.4, 2

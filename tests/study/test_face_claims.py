@@ -14,7 +14,7 @@ import yaml
 
 from infsup_contact.discretization.spaces.registry import SPACES
 from infsup_contact.errors import InputError
-from infsup_contact.discretization.face.square import SQUARE, SQUARE_TRIG
+from infsup_contact.discretization.face.shapes.square import SQUARE, SQUARE_TRIG
 from infsup_contact.criteria.claims import FAIL, INCONCLUSIVE, PASS
 from infsup_contact.study.claims.membranes3d import (face_claims, face_dimension, face_predictions, kernel_formula,
                                               planar_kernel, tensor_kernel_bound)
@@ -203,7 +203,7 @@ def test_quadrilateral_element_spaces_are_not_built_on_triangles():
     quad_only = [s for s in SPACES.values() if s.face_cells == ("quad",)]
     assert quad_only and all(SQUARE.builds(s) and not SQUARE_TRIG.builds(s) for s in quad_only)
     x = __import__("numpy").linspace(0.0, 1.0, 3)
-    from infsup_contact.discretization.face.tensor_grid import TensorPartition
+    from infsup_contact.discretization.face.partitions.tensor_grid import TensorPartition
 
     with pytest.raises(InputError, match="faces"):
         SQUARE_TRIG.space(quad_only[0], 2, TensorPartition(x, x))

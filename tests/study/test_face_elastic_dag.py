@@ -13,7 +13,7 @@ import pytest
 import yaml
 
 from infsup_contact.discretization.spaces.registry import SPACES
-from infsup_contact.discretization.face.square import SQUARE
+from infsup_contact.discretization.face.shapes.square import SQUARE
 from infsup_contact.criteria.claims import FAIL, INCONCLUSIVE, PASS
 from infsup_contact.study.claims.membranes3d import matching_kernel
 from infsup_contact.study.face.elastic import nu_pairs

@@ -9,8 +9,8 @@ import pytest
 from helpers.cli import run_in_process
 
 from infsup_contact.discretization.spaces import registry
-from infsup_contact.discretization.face.square import SQUARE
-from infsup_contact.discretization.face.tensor_grid import TensorPartition
+from infsup_contact.discretization.face.shapes.square import SQUARE
+from infsup_contact.discretization.face.partitions.tensor_grid import TensorPartition
 from infsup_contact.errors import InputError
 from infsup_contact.contact.contact import gamma_values, solve_contact_on
 from infsup_contact.study.patch import face as face_patch

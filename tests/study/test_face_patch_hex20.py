@@ -10,7 +10,7 @@ import pytest
 
 from helpers.cli import run_in_process
 
-from infsup_contact.discretization.face.serendipity import SERENDIPITY
+from infsup_contact.discretization.face.shapes.serendipity import SERENDIPITY
 from infsup_contact.discretization.spaces.registry import SPACES
 from infsup_contact.errors import InputError
 from infsup_contact.models import hex20

@@ -15,8 +15,8 @@ import yaml
 from infsup_contact.config.checks import ConfigError, check_config
 from infsup_contact.config.face import face_pairs, family_pairs
 from infsup_contact.discretization.spaces.registry import SPACES
-from infsup_contact.discretization.face.square import SQUARE
-from infsup_contact.discretization.face.tensor_grid import TensorPartition
+from infsup_contact.discretization.face.shapes.square import SQUARE
+from infsup_contact.discretization.face.partitions.tensor_grid import TensorPartition
 from infsup_contact.study.face.families import family_kernels, family_pair
 from helpers.cli import run_in_process
 

@@ -17,7 +17,7 @@ from helpers.face_tables import (CLAIMS_CFG, FIT_THETA_MAX, THETAS, alpha_rows, 
 
 from infsup_contact.discretization.face.spaces.dual_bases import ZERO_WEIGHT_RTOL, weight_fractions
 from infsup_contact.discretization.spaces.registry import SPACES, ids_valid_for
-from infsup_contact.discretization.face.square import SQUARE, SQUARE_TRIG
+from infsup_contact.discretization.face.shapes.square import SQUARE, SQUARE_TRIG
 from infsup_contact.io import read_table
 from infsup_contact.study.claims import membranes3d_studies as fsc
 

@@ -25,7 +25,7 @@ from ..discretization.gamma.coupling import coupling_matrix
 from ..discretization.spaces import registry
 from ..models.membranes import MEMBRANES, displacement_space, laplace_stiffness
 from ..solvers.infsup import beta_table
-from ..solvers.request import BetaRequest, MeshOptions
+from ..solvers.request import BetaRequest, MeshOptions, mesh_of
 from ..solvers.side_cache import SideCache
 from .beta_bench import splu_best_order
 from .harness import _log, _stats, run_interleaved
@@ -35,7 +35,7 @@ COLUMNS = ("what", "route", "radius", "k", "N1", "N2", "seconds_median", "second
 
 
 def _options(radius: float, coupling: str | None) -> MeshOptions:
-    return MeshOptions() if coupling is None else MeshOptions(gamma="arc", radius=float(radius), coupling=coupling)
+    return MeshOptions() if coupling is None else mesh_of(MEMBRANES, gamma="arc", radius=float(radius), coupling=coupling)
 
 
 def _betas(k, n1, n2, cases, mesh):

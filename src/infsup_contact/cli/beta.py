@@ -5,8 +5,9 @@ import sys
 
 from .verdict_formats import add_table_output, force_use, output_path
 from .worst_mode import check_worst_mode, mode_frame, write_modes
-from .common import (FlagUse, declare_flag_uses, material_columns, mesh_options, model_flag_uses, system_flag_uses,
-                     add_dry_run, add_model, cases, face_cases, check_memory, material, norms, SPACE_HELP, write_csv)
+from .common import (FlagUse, declare_flag_uses, material_columns, model_flag_uses, system_flag_uses,
+                     add_dry_run, add_model, check_memory, SPACE_HELP, write_csv)
+from .request import cases, face_cases, material, mesh_options, norms, request
 
 
 def add(sub) -> None:
@@ -107,22 +108,6 @@ def _check_beta(args):
     return est
 
 
-def request(args):
-    """The :class:`~infsup_contact.solvers.request.BetaRequest` of the command line, validated once
-    (the perturbed family's seed and α with it); the engine runs it unchecked."""
-    from ..discretization.segment.meshes import check_perturbation
-    from dataclasses import replace
-
-    from ..solvers.request import BetaRequest
-
-    perturbed = dict(seed=args.seed, alpha=args.alpha) if args.family == "perturbed" else {}
-    out = BetaRequest(args.family, args.k, args.N1, args.N2, tuple(args.cases), (args.multiplier_mesh,),
-                      ((args.c1, args.c2),), norms(args), args.h_route, args.model_obj,
-                      replace(args.mesh, **perturbed))
-    check_perturbation(args.alpha, args.seed)
-    return out
-
-
 def _run_beta(args) -> None:
     if args.system is not None:
         from ..systems.levels import NORM_NOTES
@@ -150,6 +135,6 @@ def beta_frame(args, modes: list | None = None):
 
     rows = beta_table(args.request, modes=modes)
     frame = pd.DataFrame(rows)
-    for i, (name, value) in enumerate(args.mesh.kwargs().items()):  # e.g. element, after family
+    for i, (name, value) in enumerate(args.mesh.columns(args.model_obj).items()):  # e.g. element, after family
         frame.insert(frame.columns.get_loc("family") + 1 + i, name, value)
     return material_columns(frame, args)

@@ -5,8 +5,8 @@ from __future__ import annotations
 
 from ..errors import InputError, check_prestress
 from .verdict_formats import add_table_output, force_use
-from .common import (FlagUse, add_dry_run, add_model, cases, check_memory, declare_flag_uses, face_cases, material,
-                     mesh_options, model_flag_uses, SPACE_HELP, write_csv)
+from .common import FlagUse, add_dry_run, add_model, check_memory, declare_flag_uses, model_flag_uses, SPACE_HELP, write_csv
+from .request import cases, face_cases, material, mesh_options
 
 
 def add(sub) -> None:
@@ -65,8 +65,8 @@ def _check_contact(args):
         raise InputError("case", "one of --case ID|all or --space FILE.py:FUNC")
     args.cases = cases(args)
     material(args)
+    check_flat_gamma(args)  # the flags, before Γ is resolved: a curved Γ is refused as such
     args.mesh = mesh_options(args)  # a mesh flag of another model is refused; the scene's rows read them
-    check_flat_gamma(args.mesh)
     spec = check_pair(args.model, args.scene)
     check_k(args.k)
     # --case all on a 3D model: also the spaces only its face builds, but no Petrov–Galerkin pair (two

@@ -5,8 +5,8 @@ import sys
 from pathlib import Path
 
 from ..errors import InputError
-from .common import (add_dry_run, add_model, check_memory, declare_flag_uses, material, mesh_options, model_flag_uses,
-                     write_text)
+from .common import add_dry_run, add_model, check_memory, declare_flag_uses, model_flag_uses, write_text
+from .request import material, mesh_options
 
 
 def add(sub) -> None:
@@ -117,7 +117,7 @@ def _run_export(args) -> None:
     levels, norm, gamma = suite_levels(args.case, args.k, args.N, args.N1_offset, args.family, args.norm,
                                        args.multiplier_mesh, model=args.model_obj, mesh=args.mesh)
     name = "-".join([args.case, f"k{args.k}", args.model, *(f"{v:g}" if isinstance(v, float) else str(v)
-                                                            for v in args.mesh.kwargs().values())]
+                                                            for v in args.mesh.columns(args.model_obj).values())]
                     + ([f"N1{args.N1_offset:+d}"] if args.N1_offset else []))
     out = Path(args.out)
     before = {p.name for p in out.iterdir()} if out.is_dir() else set()

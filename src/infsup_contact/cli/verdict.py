@@ -4,8 +4,9 @@ from __future__ import annotations
 import sys
 
 from ..errors import InputError
-from .common import (declare_flag_uses, model_flag_uses, system_flag_uses, add_dry_run, add_model, check_memory, mesh_options,
-                     run_intervals, SPACE_HELP)
+from .common import (declare_flag_uses, model_flag_uses, system_flag_uses, add_dry_run, add_model, check_memory,
+                     SPACE_HELP)
+from .request import mesh_options, run_intervals
 from .verdict_formats import add_output_args, emit, force_use
 
 

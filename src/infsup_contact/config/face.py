@@ -238,8 +238,8 @@ def check_face_case_ids(cfg, at: str, cases, ks_config, faces, need_builder: boo
     least one face must (the error names the elements and the ids their faces build)."""
     from ..discretization.spaces.user_spaces import config_case_ids
     from ..discretization.spaces.registry import SPACES
-    from ..discretization.face.square import SQUARE
-    from ..discretization.face.tensor_grid import TensorPartition
+    from ..discretization.face.shapes.square import SQUARE
+    from ..discretization.face.partitions.tensor_grid import TensorPartition
 
     ids = config_case_ids(cfg, gamma_dim=SQUARE.dim)
     names = list(faces) if isinstance(faces, dict) else None

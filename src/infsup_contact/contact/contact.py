@@ -225,12 +225,16 @@ class ContactPair:
 
 def check_flat_gamma(mesh: MeshOptions) -> None:
     """:class:`InputError` naming the key unless ``mesh`` leaves Γ flat: contact scenes are built
-    on the segment and the face only (β_h and the verdicts take the arc and the cylinder)."""
-    if mesh.gamma not in FLAT_GAMMAS:
+    on the segment and the face only (β_h and the verdicts take the arc and the cylinder). ``mesh``:
+    the command line's flags, or a request's options whose ``gamma`` is the resolved Γ."""
+    gamma = mesh.gamma
+    if gamma is not None and not isinstance(gamma, str):  # a resolved Γ: the curved shapes have a radius
+        gamma = type(gamma).__name__.lower() if hasattr(gamma, "radius") else None
+    if gamma not in FLAT_GAMMAS:
         raise InputError("gamma", f"{', '.join(FLAT_GAMMAS[1:])} (contact scenes on the arc and the cylinder are "
-                         "not built: beta and verdict take --gamma arc, cylinder)", got=mesh.gamma)
+                         "not built: beta and verdict take --gamma arc, cylinder)", got=gamma)
     for key in ("radius", "coupling"):
-        if getattr(mesh, key) is not None:
+        if getattr(mesh, key, None) is not None:
             raise InputError(key, "unset (contact scenes: a flat Γ; beta and verdict take --gamma arc, cylinder)",
                              got=getattr(mesh, key))
 
@@ -246,8 +250,7 @@ def contact_pair(scene, k: int, family: str, n1: int, n2: int, model=None,
     build = getattr(scene, "mesh_pair", None)
     kw = mesh.kwargs()
     check_flat_gamma(mesh)
-    for key in ("gamma", "radius", "coupling"):
-        kw.pop(key, None)
+    kw.pop("gamma", None)  # flat: the builders' own Γ
     if build is not None:
         mesh_pair = build(family, n1, n2, **kw)
     elif model.mesh is not None:

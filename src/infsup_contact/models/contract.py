@@ -180,6 +180,14 @@ class Model:
         cache key): what the command line offers for this model only.
     families : tuple of str or None
         Mesh families the model's ``mesh`` builds (None: every 2D family).
+    interface : callable or None
+        ``interface(family, **mesh_kwargs) -> Interface``: the Γ of the model's bodies for the
+        request's options (its element's face, curved by ``gamma``/``radius``/``coupling``), checked
+        and resolved without a mesh (:mod:`~infsup_contact.discretization.spaces.gammas`); None:
+        the 2D membranes' Γ, the paper's segment or the arc (:meth:`gamma`).
+    curving : tuple of str
+        The Γ table's (flat, curved) shape names its ``gamma`` option chooses between
+        (``("segment", "arc")``); () for a model without the option.
     dim : int
         Space dimension of the bodies (2, or 3 with a contact face): the memory estimate's model.
     mirror_side : callable or None
@@ -202,27 +210,46 @@ class Model:
     families: tuple | None = None
     dim: int = 2
     mirror_side: Callable | None = None
+    interface: Callable | None = None
+    curving: tuple = ()
 
     def subdomain_mesh(self, family: str, n: int, side: int, **mesh_kwargs):
-        """The mesh of Ω_side the model's sides are built on (its ``mesh`` builder, else the 2D one)."""
+        """The mesh of Ω_side the model's sides are built on (its ``mesh`` builder, else the 2D one),
+        on the request's Γ (``gamma``, an Interface resolved by :meth:`gamma`; None: the flat one)."""
         if self.mesh is None:
             from ..discretization.segment import meshes
-            from ..discretization.segment.arc import arc_of
 
-            arc = arc_of(*(mesh_kwargs.pop(key, None) for key in ("gamma", "radius", "coupling")))
+            gamma = mesh_kwargs.pop("gamma", None)
             mesh = meshes.subdomain_mesh(family, n, side, **mesh_kwargs)
-            return mesh if arc is None else Body(mesh, arc)  # the square's mesh, curved with the side
+            flat = gamma is None or gamma == self.gamma(family)
+            return mesh if flat else Body(mesh, gamma)  # the square's mesh, curved with the side
         return self.mesh(family, n, side, **mesh_kwargs)
 
-    def gamma(self, **mesh_kwargs):
-        """The Γ of the model's meshes with these options (an element's face; the paper's segment
-        for the 2D meshes), asked of its coarsest mesh: a property of the request, not of N."""
-        if self.mesh is None:
-            from ..discretization.segment.arc import arc_of
-            from ..discretization.segment.interface import SEGMENT
+    def gamma(self, family: str = "structured", **mesh_kwargs):
+        """The Γ of the model's meshes with these options (an element's face; the paper's segment or
+        the arc for the 2D meshes): a property of the request, not of N, resolved without a mesh
+        (``interface``; the checks of the Γ table, :mod:`~infsup_contact.discretization.spaces.gammas`).
+        An Interface given as ``gamma`` is the request's, resolved before."""
+        given = mesh_kwargs.get("gamma")
+        if given is not None and not isinstance(given, str):
+            return given
+        if self.interface is not None:
+            return self.interface(family, **mesh_kwargs)
+        if self.mesh is not None:  # a model that declares no interface: asked of its coarsest body
+            return self.mesh(family, 1, 1, **mesh_kwargs).interface
+        from ..discretization.spaces.gammas import curved_of, gamma_of
 
-            return arc_of(*(mesh_kwargs.get(key) for key in ("gamma", "radius", "coupling"))) or SEGMENT
-        return self.mesh("structured", 1, 1, **mesh_kwargs).interface
+        curving = self.curving or ("segment", "arc")
+        return curved_of(gamma_of(curving[0]), curving, *(mesh_kwargs.get(key) for key in ("gamma", "radius", "coupling")))
+
+    def gamma_columns(self, gamma) -> dict:
+        """The table columns of a request's Γ (``gamma`` an Interface, or None where the request
+        names none): the curved shape's name, radius and coupling; the flat one's name."""
+        if gamma is None or not self.curving:
+            return {}
+        if not hasattr(gamma, "radius"):
+            return {"gamma": self.curving[0]}
+        return {"gamma": self.curving[1], "radius": gamma.radius, "coupling": gamma.coupling}
 
     def param_names(self) -> list:
         """The names of the model's material parameters (its flags without ``--``)."""

@@ -57,7 +57,7 @@ from ..discretization.segment.meshes import SYMMETRY_X, SYMMETRY_Y
 from ..errors import InputError
 from .contract import Model
 from .elastic import PARAMS
-from .membranes3d import ELEMENTS, FAMILIES_3D, FAR, LATERAL
+from .membranes3d import ELEMENTS, FAMILIES_3D, FAR, LATERAL, face_gamma
 from .membranes3d import subdomain_mesh as cube_mesh
 from .plane_strain import check_nu, lame
 from .contract import Body, SideOperator, factorized_side
@@ -212,7 +212,7 @@ def elastic3d_model(nu: float = 0.3) -> Model:
                  f"nu = {nu:g}, frictionless contact on the face Γ = (0,1)^2x{{1}} (--element)",
                  scene_side=partial(scene_side, nu=nu), load=load, field=field, interpolate=interpolate,
                  params=PARAMS, components=3, mesh=subdomain_mesh, mesh_options=(("element", ELEMENTS),),
-                 families=FAMILIES_3D, dim=3)
+                 families=FAMILIES_3D, dim=3, interface=face_gamma)
 
 
 ELASTIC3D = elastic3d_model(0.3)

@@ -3,7 +3,7 @@
 NGSolve has no serendipity hexahedra; scikit-fem's ``ElementHexS2`` is the 20-node serendipity Q2
 element (nodal values at the 8 vertices and the 12 edge midpoints; per cell P2 plus the ten
 monomials of degree ≤ 2 in each variable up to x²yz, xy²z, xyz² — no face or cell centres). Its
-trace on a face is QUAD8, so Γ is :data:`~infsup_contact.discretization.face.serendipity.SERENDIPITY`.
+trace on a face is QUAD8, so Γ is :data:`~infsup_contact.discretization.face.shapes.serendipity.SERENDIPITY`.
 
 Meshes: the structured N × N × N cells of each body (:func:`subdomain_mesh`, ``MeshHex.init_tensor``),
 Ω1 = (0,1)³ and Ω2 = (0,1)²×(1,2) as in :mod:`.membranes3d`. The side operator (:func:`side_operator`):
@@ -28,7 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from ..discretization.face.serendipity import SERENDIPITY, NodalDofs
+from ..discretization.face.shapes.serendipity import SERENDIPITY, NodalDofs
 from ..errors import InputError
 from .contract import Body, SideOperator, extended, factorized_side, mirrored_side
 

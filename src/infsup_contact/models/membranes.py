@@ -156,6 +156,7 @@ MEMBRANES = Model("membranes", side_operator,
                   params=tuple(MaterialParam(f"c{i + 1}", 1.0, lambda v, key: check_prestress(key, v),
                                              "1e-150 <= c <= 1e150", f"prestress c{i + 1} of Ω{i + 1}", side=i)
                                for i in range(2)),
+                  curving=("segment", "arc"),
                   mesh_options=(("gamma", OptionalChoice(GAMMAS)),
                                 ("radius", OptionalChoice(text=RADIUS_ALLOWED + ", with --gamma arc", above=1.0)),
                                 ("coupling", OptionalChoice(COUPLINGS, filled_when=("gamma", "arc")))))

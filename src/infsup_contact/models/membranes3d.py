@@ -5,7 +5,7 @@ The paper's model problem (Section 3) one dimension up: the side operator is the
 stiffness of continuous Q_k (hexahedra) or P_k (tetrahedra) with the Γ dofs last and its Γ
 Schur complement (:func:`~infsup_contact.models.contract.factorized_side`; the nested-dissection
 ordering is graph based, so it serves 3D meshes as it is). Γ is the face
-:class:`~infsup_contact.discretization.face.square.Square`: the traces are tensor grids, the
+:class:`~infsup_contact.discretization.face.shapes.square.Square`: the traces are tensor grids, the
 multiplier spaces tensor products (:mod:`infsup_contact.discretization.face.spaces.tensor`) on
 hexahedra and P_s on the triangles of G_h on tetrahedra
 (:mod:`infsup_contact.discretization.face.spaces.triangles`).
@@ -15,18 +15,18 @@ N × N × N cells of each body (N = cells per direction on Γ) from
 ``ngsolve.meshes.MakeStructured3DMesh``: ``element="hex"`` gives hexahedra,
 ``element="tet"`` the six-tetrahedra (Kuhn) split of every cube, whose faces on Γ are the
 rectangles cut by the diagonal from (x_i, y_j) to (x_{i+1}, y_{j+1}) — on both bodies, so the
-trace is a tensor grid of triangles (:data:`~infsup_contact.discretization.face.square.SQUARE_TRIG`).
+trace is a tensor grid of triangles (:data:`~infsup_contact.discretization.face.shapes.square.SQUARE_TRIG`).
 The ``unstructured`` family (Netgen tetrahedra, maxh = 1/N, each body meshed on its own) and
 the ``perturbed`` one (structured, vertices moved; on hexahedra only off Γ and in z, so the
 face stays a tensor grid) are built in :mod:`infsup_contact.discretization.face.meshes`; their
 tetrahedral faces are general triangulations, Γ
-:data:`~infsup_contact.discretization.face.triangulated_square.TRIANGULATED` (non-matching traces,
+:data:`~infsup_contact.discretization.face.shapes.triangulated_square.TRIANGULATED` (non-matching traces,
 common refinement by polygon clipping).
 
 ``element="hex20"``: serendipity HEX20 bodies on the same structured cells, assembled by scikit-fem
 (:mod:`.hex20`; k = 2; β_h and contact scenes supported on the far face or all of ∂Ω_i∖Γ, u_h
 evaluated at points), Γ the QUAD8 face
-:data:`~infsup_contact.discretization.face.serendipity.SERENDIPITY`.
+:data:`~infsup_contact.discretization.face.shapes.serendipity.SERENDIPITY`.
 
 Boundaries: ``gamma`` (Γ), ``dir`` (the far face: z = 0 of Ω1, z = 2 of Ω2) and ``side`` (the
 four lateral faces). β_h clamps both (:data:`BETA_DIRICHLET`, the paper's u_i = 0 on ∂Ω_i∖Γ);
@@ -46,10 +46,12 @@ from ngsolve import meshes as ngmeshes
 
 from ..discretization.segment.meshes import DIRICHLET
 from ..discretization.face import meshes as meshes3d
-from ..discretization.face.cylinder import GAMMAS, RADIUS_ALLOWED, Cylinder, cylinder_of
-from ..discretization.face.square import SQUARE, SQUARE_TRIG
+from ..discretization.face.shapes.cylinder import GAMMAS, RADIUS_ALLOWED, Cylinder
+from ..discretization.spaces.gammas import cylinder_of
+from ..discretization.face.shapes.square import SQUARE, SQUARE_TRIG
 from ..discretization.segment.arc import COUPLINGS
-from ..discretization.face.triangulated_square import TRIANGULATED
+from ..discretization.face.shapes.serendipity import SERENDIPITY
+from ..discretization.face.shapes.triangulated_square import TRIANGULATED
 from ..errors import InputError, check_prestress
 from dataclasses import dataclass
 
@@ -76,8 +78,7 @@ BETA_DIRICHLET = f"{FAR}|{LATERAL}"
 
 
 def subdomain_mesh(family: str, n: int, side: int, *, element: str = "hex", width: float = 1.0,
-                   alpha: float = 0.2, seed: int = 0, gamma: str | None = None, radius: float | None = None,
-                   coupling: str | None = None) -> Body:
+                   alpha: float = 0.2, seed: int = 0, gamma=None) -> Body:
     """The mesh of Ω_side of a family: Γ named ``gamma``, the far face :data:`FAR`, the
     lateral faces :data:`LATERAL`. ``structured``: N × N × N cells; ``unstructured`` (tetrahedra,
     maxh = 1/N) and ``perturbed`` (the structured mesh, vertices moved by U(−αh, αh) per free
@@ -90,10 +91,10 @@ def subdomain_mesh(family: str, n: int, side: int, *, element: str = "hex", widt
     partially (:mod:`infsup_contact.study.face.edge_dropping`); its Γ is then
     ``Square(width=width)``.
 
-    ``gamma``, ``radius``, ``coupling``: Γ the cylinder of radius R
-    (:mod:`~infsup_contact.discretization.face.cylinder`): the box is built as here and curved by
-    :func:`side_operator`, where the body's degree is known; hexahedra (both couplings) and
-    structured tetrahedra (``exact``), width 1.
+    ``gamma``: the request's Γ (:func:`face_gamma`, resolved and checked without a mesh); a
+    :class:`~infsup_contact.discretization.face.shapes.cylinder.Cylinder`: the box is built as here
+    and curved by :func:`side_operator`, where the body's degree is known; None or the flat face:
+    the body's own face.
 
     Raises
     ------
@@ -102,29 +103,18 @@ def subdomain_mesh(family: str, n: int, side: int, *, element: str = "hex", widt
         unstructured family: :data:`UNSTRUCTURED_ELEMENTS`; ``hex20``: structured, width 1), N < 1,
         a width outside (0, 1] (or
         other than 1 for the unstructured and perturbed families), α or seed out of range, a
-        cylinder's options (:func:`~infsup_contact.discretization.face.cylinder.check_cylinder_options`)
+        cylinder's options (:func:`~infsup_contact.discretization.face.shapes.cylinder.check_cylinder_options`)
         or a body it does not curve.
     """
-    if gamma is not None or radius is not None or coupling is not None:
+    if gamma is not None:
         body = subdomain_mesh(family, n, side, element=element, width=width, alpha=alpha, seed=seed)
-        return _on_cylinder(body, family, element, width, gamma, radius, coupling)
-    if family not in FAMILIES_3D:
-        raise InputError("family", f"{', '.join(FAMILIES_3D)} (the 3D model's meshes)", got=family)
-    if element not in MEMBRANE_ELEMENTS:
-        raise InputError("element", ", ".join(MEMBRANE_ELEMENTS), got=element)
+        return body if gamma == body.interface else Body(body.mesh, gamma)
     if not isinstance(n, (int, np.integer)) or n < 1:
         raise InputError("N", "an integer >= 1", got=n)
+    check_body(family, element, width)
     if element == "hex20":
-        if family != "structured" or width != 1.0:
-            raise InputError("family" if family != "structured" else "width",
-                             "structured, width 1 (the HEX20 bodies)", got=family if family != "structured" else width)
         return hex20.subdomain_mesh(int(n), side)
-    if not 0.0 < width <= 1.0 or (family != "structured" and width != 1.0):
-        raise InputError("width", "a width 0 < width <= 1 of the body in x (1 for the unstructured and "
-                         "perturbed families)", got=width)
     if family == "unstructured":
-        if element not in UNSTRUCTURED_ELEMENTS:
-            raise InputError("element", f"{', '.join(UNSTRUCTURED_ELEMENTS)} (the unstructured family)", got=element)
         return Body(meshes3d.unstructured_box(int(n), side), interface_of(family, element))
     mapping = None if width == 1.0 else (lambda x, y, z: (width * x, y, z))
     ngmesh = ngmeshes.MakeStructured3DMesh(hexes=element == "hex", nx=int(n), mapping=mapping).ngmesh
@@ -142,20 +132,44 @@ def subdomain_mesh(family: str, n: int, side: int, *, element: str = "hex", widt
     return Body(mesh, interface_of(family, element))
 
 
-def _on_cylinder(body: Body, family: str, element: str, width: float, gamma, radius, coupling) -> Body:
-    """``body`` with its Γ the cylinder of the options (flat: as built); refused where its face is
-    no tensor grid of :class:`~infsup_contact.discretization.face.square.Square` (HEX20's QUAD8
-    face, the triangulated faces of the perturbed and unstructured tetrahedra) or narrower."""
+def check_body(family: str, element: str, width: float = 1.0) -> None:
+    """:class:`InputError` naming the key unless the bodies of ``family`` with ``element`` cells and
+    ``width`` exist (:func:`subdomain_mesh`'s refusals, without a mesh)."""
+    if family not in FAMILIES_3D:
+        raise InputError("family", f"{', '.join(FAMILIES_3D)} (the 3D model's meshes)", got=family)
+    if element not in MEMBRANE_ELEMENTS:
+        raise InputError("element", ", ".join(MEMBRANE_ELEMENTS), got=element)
+    if element == "hex20":
+        if family != "structured" or width != 1.0:
+            raise InputError("family" if family != "structured" else "width",
+                             "structured, width 1 (the HEX20 bodies)", got=family if family != "structured" else width)
+        return
+    if not 0.0 < width <= 1.0 or (family != "structured" and width != 1.0):
+        raise InputError("width", "a width 0 < width <= 1 of the body in x (1 for the unstructured and "
+                         "perturbed families)", got=width)
+    if family == "unstructured" and element not in UNSTRUCTURED_ELEMENTS:
+        raise InputError("element", f"{', '.join(UNSTRUCTURED_ELEMENTS)} (the unstructured family)", got=element)
+
+
+def face_gamma(family: str = "structured", element: str = "hex", width: float = 1.0, gamma=None, radius=None,
+               coupling=None, **_) -> object:
+    """Γ of the bodies of a request, without a mesh (the model's ``interface``): the face of its
+    cells (:func:`interface_of`; HEX20's QUAD8 face), or the cylinder of the options
+    (:func:`~infsup_contact.discretization.spaces.gammas.cylinder_of`), refused where the face is no
+    tensor grid of :class:`~infsup_contact.discretization.face.shapes.square.Square` (HEX20's QUAD8
+    face, the triangulated faces of the perturbed and unstructured tetrahedra) or narrower; the
+    bodies checked first (:func:`check_body`)."""
+    check_body(family, element, width)
+    flat = SERENDIPITY if element == "hex20" else interface_of(family, element)
     if gamma == "cylinder":
         if element == "hex20":
             raise InputError("element", "hex, tet (the bodies curved to the cylinder)", got=element)
-        if body.interface not in (SQUARE, SQUARE_TRIG):
+        if flat not in (SQUARE, SQUARE_TRIG):
             raise InputError("family", "structured, or perturbed with element hex (the faces curved to the "
                              "cylinder)", got=f"{family} with element {element}")
         if width != 1.0:
             raise InputError("width", "1 (the cylinder's bodies)", got=width)
-    cylinder = cylinder_of(body.interface, gamma, radius, coupling)
-    return body if cylinder is None else Body(body.mesh, cylinder)
+    return cylinder_of(flat, gamma, radius, coupling) or flat
 
 
 def interface_of(family: str, element: str):
@@ -281,6 +295,7 @@ MEMBRANES3D = Model("membranes3d", side_operator,
                                                "1e-150 <= c <= 1e150", f"prestress c{i + 1} of Ω{i + 1}", side=i)
                                  for i in range(2)),
                     mesh=subdomain_mesh, families=FAMILIES_3D, dim=3,
+                    interface=face_gamma, curving=("square", "cylinder"),
                     mesh_options=(("element", MEMBRANE_ELEMENTS), ("gamma", OptionalChoice(GAMMAS)),
                                   ("radius", OptionalChoice(text=RADIUS_ALLOWED + ", with --gamma cylinder",
                                                             above=1.0)),

@@ -118,7 +118,7 @@ class ArcStudy:
 
 class CylinderStudy(ArcStudy):
     """The same study one dimension up: the 3D membranes on hexahedra, Γ the part of the cylinder of
-    radius R (:mod:`infsup_contact.discretization.face.cylinder`); no patch test (contact scenes are
+    radius R (:mod:`infsup_contact.discretization.face.shapes.cylinder`); no patch test (contact scenes are
     not built on a curved face)."""
 
     element = "hex"

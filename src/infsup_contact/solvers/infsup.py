@@ -24,7 +24,6 @@ from ..discretization.spaces import registry
 from ..discretization.spaces.spec import SpaceSpec
 from ..discretization.gamma.coupling import coupling_matrix, trace_l2_norms
 from ..discretization.segment.norms import NORMS
-from ..discretization.segment.interface import SEGMENT
 from ..models import DEFAULT_MODEL
 from .. import progress
 from .interface_operator import combine_terms, interface_terms
@@ -148,13 +147,13 @@ def _row(r, case, c1, c2, norm, spec, kernel, structural, beta_v1_zero, dim_m, d
                 t_interface=None, t_eig=t_eig)
 
 
-def _space(case, k, partition, gamma=SEGMENT):
-    """A named case on G_h = ``partition`` of ``gamma``, an unregistered
+def _space(case, k, partition, gamma):
+    """A named case on G_h = ``partition`` of ``gamma`` (checked on Γ by the request, once), an unregistered
     :class:`~infsup_contact.discretization.spaces.spec.SpaceSpec` (a study's variant, e.g. the α
     sweep of study/face/alpha.py), or a general triple ``(label, s, continuous, vanish)``
     (eqs. 5.3, 5.5; spaces of the segment)."""
     if isinstance(case, str):
-        return registry.case_space(case, k, partition, gamma)
+        return registry.space_on(registry.SPACES[case], k, partition, gamma)
     if isinstance(case, SpaceSpec):
         return gamma.space(case, k, partition)
     _, s, continuous, vanish = case

@@ -8,7 +8,7 @@ parameters travel as a :class:`MeshOptions`, not as keywords.
 """
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -35,23 +35,38 @@ class MeshOptions:
         The perturbed family's seed and amplitude α / h; None: the builder's default.
     width : float or None
         A 3D body's extent in x (a narrower Ω2, :mod:`infsup_contact.study.face.edge_dropping`).
-    gamma, radius, coupling : str, float, str or None
-        A curved Γ (``arc`` of the 2D membranes, :mod:`infsup_contact.discretization.segment.arc`),
-        its radius R (inf: flat) and how the sides are coupled on it (``exact``, ``projection``);
-        None: the flat Γ.
+    gamma : Interface or None
+        The request's Γ where it names one (``--gamma``: the arc of the 2D membranes, the
+        cylinder of the 3D ones, with their radius and coupling; resolved and checked by the Γ
+        table, :mod:`infsup_contact.discretization.spaces.gammas`, through ``Model.gamma``): the
+        model's mesh builder meshes it; None: the model's flat Γ.
     """
 
     element: str | None = None
     seed: int | None = None
     alpha: float | None = None
     width: float | None = None
-    gamma: str | None = None
-    radius: float | None = None
-    coupling: str | None = None
+    gamma: object = None
 
     def kwargs(self) -> dict:
         """The builder's keywords: the options that are set."""
-        return {key: value for key, value in asdict(self).items() if value is not None}
+        return {key: getattr(self, key) for key in self.__dataclass_fields__ if getattr(self, key) is not None}
+
+    def columns(self, model) -> dict:
+        """The table's columns of the options that are set (after ``family``): the builder's, then
+        the Γ's parameters (``Model.gamma_columns``: gamma, radius, coupling)."""
+        out = {key: value for key, value in self.kwargs().items() if key != "gamma"}
+        return {**out, **model.gamma_columns(self.gamma)}
+
+
+def mesh_of(model, family: str = "structured", **options) -> MeshOptions:
+    """The :class:`MeshOptions` of ``model``'s mesh options as the command line names them, the
+    curving ones (``gamma``, ``radius``, ``coupling``) resolved to the request's Γ by ``Model.gamma``
+    (the Γ table's checks, no mesh): the Γ's parameters, not mesh options."""
+    curving = {key: options.pop(key) for key in ("gamma", "radius", "coupling") if options.get(key) is not None}
+    if curving:
+        options["gamma"] = model.gamma(family, **options, **curving)
+    return MeshOptions(**options)
 
 
 NO_OPTIONS = MeshOptions()
@@ -65,7 +80,8 @@ class BetaRequest:
     Building it validates it (:meth:`__post_init__`); ``cases`` None means every registered
     space defined for k. A case is a registry id, an unregistered
     :class:`~infsup_contact.discretization.spaces.registry.SpaceSpec` or a general triple
-    ``(label, s, continuous, vanish)`` (those two are the caller's, not checked here).
+    ``(label, s, continuous, vanish)`` (those two are the caller's, not checked here). The
+    registered ids are checked once, on the request's Γ (:attr:`gamma`, resolved without a mesh).
     """
 
     family: str
@@ -85,14 +101,14 @@ class BetaRequest:
         cases = registry.ids_valid_for(self.k) if self.cases is None else list(self.cases)
         object.__setattr__(self, "cases", tuple(cases))
         ids = [c for c in cases if isinstance(c, str)]
-        for c in ids:
-            registry.check_case(c, self.k)
         if not isinstance(self.mesh, MeshOptions):  # a caller's slip, not input: say what it should be
             raise TypeError(f"BetaRequest.mesh must be a MeshOptions, not {type(self.mesh).__name__}")
         declared = dict(getattr(self.model, "mesh_options", ()))
         for name, value in self.mesh.kwargs().items():
-            if name in declared:  # the options the model's builder declares (seed, α: the family's)
+            if name in declared and name != "gamma":  # the builder's options (seed, α: the family's); Γ resolved
                 check_mesh_option(self.model, name, value)
+        for c in ids:
+            registry.check_on_gamma(c, self.k, self.gamma)
         meshes.check_mesh_args(self.family, self.n1, "N1")
         meshes.check_mesh_args(self.family, self.n2, "N2")
         for c1, c2 in self.c_pairs:
@@ -104,6 +120,13 @@ class BetaRequest:
             check_choice(mm)
             registry.check_pair_spaces(ids, self.k, self.n1, self.n2, (mm,))  # dim M_h = 0: refused here
             check_pair_size(ids, self.k, self.n1, self.n2, mm)  # a Petrov–Galerkin pair is solved densely
+
+
+    @property
+    def gamma(self):
+        """The request's Γ: the one its mesh options name, else the model's for its family and
+        options (``Model.gamma``: no mesh is built)."""
+        return self.model.gamma(self.family, **self.mesh.kwargs())
 
 
 def check_mesh_option(model, name: str, value) -> None:

@@ -25,7 +25,7 @@ import time
 import numpy as np
 import pandas as pd
 
-from ..discretization.face.square import CELL_BODIES
+from ..discretization.face.shapes.square import CELL_BODIES
 from ..discretization.spaces import registry
 from ..discretization.spaces.spec import SpaceSpec
 from ..errors import InputError
@@ -91,7 +91,7 @@ def verdict_rows(case_or_spec, k: int, family: str, ns, norm: str, *, tol: float
     level = (lambda n: f"N1={n + n1_offset} N2={n}") if n1_offset else (lambda n: f"N={n}")
     rows = [r for n in progress.steps(ns, "level", level) for r in beta_rows(family, k, n + n1_offset, n, [case], multiplier_mesh,
                                              norms=(norm,), model=model, mesh=mesh)]
-    curved = {key: getattr(mesh, key) for key in ("gamma", "radius", "coupling") if getattr(mesh, key) is not None}
+    curved = model.gamma_columns(mesh.gamma)
     out = dict(space=case, k=k, model=model.name, element=mesh.element, **curved, family=family, norm=norm,
                multiplier_mesh=multiplier_mesh, N1_offset=n1_offset,
                **stability_verdict(rows, tol, floor, confidence), N_list=ns)
@@ -137,9 +137,11 @@ def model_case_ids(model, k: int, family: str = "structured", mesh: MeshOptions 
 
 
 def _coarsest_multiplier_mesh(model, k, family, mesh: MeshOptions):
-    """(Γ, G_h) of ``model`` on its coarsest matching mesh pair (one cell per direction)."""
-    trace = model.side_operator(model.subdomain_mesh(family, 1, 1, **mesh.kwargs()), k).trace  # the model contract
-    return trace.gamma, trace.gamma.multiplier_partition(trace.partition, trace.partition)
+    """(Γ, G_h) of ``model`` on its coarsest matching mesh pair (one cell per direction), without a
+    mesh: the request's Γ (``Model.gamma``) and its uniform partition."""
+    gamma = model.gamma(family, **mesh.kwargs())
+    partition = gamma.uniform_partition(1)
+    return gamma, gamma.multiplier_partition(partition, partition)
 
 
 def check_model_case(case: str, k: int, model, family: str = "structured", mesh: MeshOptions = NO_OPTIONS) -> None:
@@ -151,7 +153,7 @@ def check_model_case(case: str, k: int, model, family: str = "structured", mesh:
     if not spec.valid_for(k):
         ks = [j for j in range(registry.K_RANGE[0], registry.K_RANGE[1] + 1) if spec.valid_for(j)]
         raise InputError("k", f"k in {ks[0]}..{ks[-1]} for case {case} ({spec.paper_ref})", got=k)
-    where = " ".join([f"--model {model.name}", *(f"--{key} {value}" for key, value in mesh.kwargs().items()),
+    where = " ".join([f"--model {model.name}", *(f"--{key} {value}" for key, value in mesh.columns(model).items()),
                       *([f"--family {family}"] if family != "structured" else [])])
     if not spec.defined_on(model.dim - 1):
         why = (f"defined on the face of a 3D model only: --model {', '.join(_models(3))}" if model.dim == 2

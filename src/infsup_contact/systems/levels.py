@@ -181,7 +181,7 @@ def level_mode(manifest: Manifest, level, lv, info: dict, res):
     """The worst mode of one level (``res.mode``, in the rows of B the checks kept) as a
     :class:`~infsup_contact.solvers.modes.Mode` of the described basis: row r of B as read holds
     basis function j with ``rows[j] = r``; a multiplier the producer constrained is 0."""
-    from ..discretization.face.square import SQUARE
+    from ..discretization.face.shapes.square import SQUARE
     from ..discretization.segment.interface import SEGMENT
     from ..solvers.modes import Mode
 

@@ -119,7 +119,7 @@ def block_distances(manifest, level, described, B, rows=None, per_row: bool = Fa
 
 def _interface(described):
     from ..discretization.segment.interface import SEGMENT
-    from ..discretization.face.square import SQUARE
+    from ..discretization.face.shapes.square import SQUARE
 
     return SEGMENT if described.gamma.shape == "segment" else SQUARE
 

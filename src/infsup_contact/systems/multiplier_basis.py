@@ -153,7 +153,7 @@ def _read_yaml(path: Path):
 
 def _face(where, key, value, base, gamma):
     from ..discretization.face.spaces.tensor import FaceSpace
-    from ..discretization.face.tensor_grid import TensorPartition
+    from ..discretization.face.partitions.tensor_grid import TensorPartition
 
     _keys(where, key, value, FACE_KEYS, "a rectangle's multipliers")
     factors = []

@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 
 from infsup_contact.discretization.spaces.registry import SPACES
-from infsup_contact.discretization.face.square import SQUARE, SQUARE_TRIG
-from infsup_contact.discretization.face.tensor_grid import TensorPartition
+from infsup_contact.discretization.face.shapes.square import SQUARE, SQUARE_TRIG
+from infsup_contact.discretization.face.partitions.tensor_grid import TensorPartition
 from infsup_contact.models import MODELS
 from infsup_contact.discretization.gamma.coupling import coupling_matrix
 from infsup_contact.solvers import infsup

@@ -2,21 +2,22 @@
 isoparametric bodies' geometric convergence, the product structure of the discrete surfaces, the
 projection coupling against the exact one, kernel counts, and one-line refusals."""
 import math
+from types import SimpleNamespace
 
 import ngsolve
 import numpy as np
 import pytest
 
 from infsup_contact.cli import main as cli_main
-from infsup_contact.discretization.face.cylinder import Cylinder
-from infsup_contact.discretization.face.cylinder_projection import ProjectedCylinder, face_curve
+from infsup_contact.discretization.face.shapes.cylinder import Cylinder
+from infsup_contact.discretization.face.shapes.cylinder_projection import ProjectedCylinder, face_curve
 from infsup_contact.discretization.gamma.coupling import coupling_matrix
 from infsup_contact.discretization.spaces import registry
 from infsup_contact.errors import InputError
 from infsup_contact.models.membranes3d import MEMBRANES3D, subdomain_mesh
 from infsup_contact.contact.contact import check_flat_gamma
 from infsup_contact.solvers.infsup import beta_rows
-from infsup_contact.solvers.request import MeshOptions
+from infsup_contact.solvers.request import MeshOptions, mesh_of
 from infsup_contact.solvers.side_cache import SideCache
 
 ROUNDOFF = 1e-12
@@ -24,8 +25,13 @@ ROUNDOFF = 1e-12
 FLAT = MeshOptions(element="hex")
 
 
+def Flags(gamma=None, radius=None, coupling=None):
+    """The contact command's curving flags as parsed."""
+    return SimpleNamespace(gamma=gamma, radius=radius, coupling=coupling)
+
+
 def cylinder(radius, coupling="exact", element="hex"):
-    return MeshOptions(element=element, gamma="cylinder", radius=float(radius), coupling=coupling)
+    return mesh_of(MEMBRANES3D, element=element, gamma="cylinder", radius=float(radius), coupling=coupling)
 
 
 def rows(k, n1, n2, mesh, cases=None):
@@ -63,7 +69,7 @@ def test_projection_on_the_flat_face_is_the_identity():
 
 # ------------------------------------------------------------------ the curved bodies
 def curved_body(n, side, k, radius=2.0):
-    body = subdomain_mesh("structured", n, side, element="hex", gamma="cylinder", radius=radius)
+    body = subdomain_mesh("structured", n, side, element="hex", gamma=MEMBRANES3D.gamma(gamma="cylinder", radius=radius))
     MEMBRANES3D.side_operator(body, k)  # curves the mesh at the body's degree
     return body
 
@@ -185,14 +191,14 @@ def test_the_exact_coupling_is_the_flat_faces_in_parameters():
 ])
 def test_bad_cylinder_options_are_refused_naming_the_key(options, key):
     with pytest.raises(InputError) as e:
-        subdomain_mesh("structured", 2, 1, **{"element": "hex", **options})
+        MEMBRANES3D.gamma("structured", **{"element": "hex", **options})  # resolved without a mesh
     assert e.value.key == key
 
 
 @pytest.mark.parametrize("family, element", [("unstructured", "tet"), ("perturbed", "tet")])
 def test_faces_that_are_no_tensor_grid_are_refused(family, element):
     with pytest.raises(InputError) as e:
-        subdomain_mesh(family, 2, 1, element=element, gamma="cylinder", radius=2.0)
+        MEMBRANES3D.gamma(family, element=element, gamma="cylinder", radius=2.0)
     assert e.value.key == "family"
 
 
@@ -212,11 +218,14 @@ def test_the_command_line_refuses_in_one_line(capsys, argv, key):
     assert code != 0 and "\n" not in err and "Traceback" not in err and key in err, err
 
 
-@pytest.mark.parametrize("mesh, key", [(MeshOptions(gamma="cylinder", radius=2.0), "gamma"),
-                                       (MeshOptions(gamma="arc", radius=2.0, coupling="exact"), "gamma"),
-                                       (MeshOptions(radius=2.0), "radius")])
+@pytest.mark.parametrize("mesh, key", [(Flags(gamma="cylinder", radius=2.0), "gamma"),
+                                       (Flags(gamma="arc", radius=2.0, coupling="exact"), "gamma"),
+                                       (Flags(radius=2.0), "radius"),
+                                       (cylinder(2.0), "gamma")])
 def test_contact_scenes_refuse_a_curved_gamma(mesh, key):
+    """The command line's flags, and a request's resolved Γ."""
     with pytest.raises(InputError) as e:
         check_flat_gamma(mesh)
     assert e.value.key == key
-    check_flat_gamma(MeshOptions(gamma="square"))  # the flat face is the contact scenes' own
+    check_flat_gamma(Flags(gamma="square"))  # the flat face is the contact scenes' own
+    check_flat_gamma(mesh_of(MEMBRANES3D, gamma="square"))

@@ -9,8 +9,8 @@ import pytest
 from helpers.cli import run_in_process
 from infsup_contact.discretization.spaces.registry import SPACES, ids_built_on, ids_valid_for
 from infsup_contact.discretization.segment.interface import SEGMENT
-from infsup_contact.discretization.face.square import SQUARE, SQUARE_TRIG
-from infsup_contact.discretization.face.tensor_grid import TensorPartition
+from infsup_contact.discretization.face.shapes.square import SQUARE, SQUARE_TRIG
+from infsup_contact.discretization.face.partitions.tensor_grid import TensorPartition
 
 GRID = TensorPartition(np.linspace(0, 1, 3), np.linspace(0, 1, 3))
 

@@ -13,8 +13,8 @@ from infsup_contact.discretization.face.norms.tensor import gram_l2_face
 from infsup_contact.discretization.segment.multipliers import make_space
 from infsup_contact.discretization.segment.norms import gram_l2
 from infsup_contact.discretization.segment.interface import SEGMENT
-from infsup_contact.discretization.face.square import SQUARE
-from infsup_contact.discretization.face.tensor_grid import TensorPartition
+from infsup_contact.discretization.face.shapes.square import SQUARE
+from infsup_contact.discretization.face.partitions.tensor_grid import TensorPartition
 from infsup_contact.errors import InputError
 
 GRID = TensorPartition(np.array([0.0, 0.2, 0.45, 0.7, 1.0]), np.array([0.0, 0.35, 0.6, 1.0]))

@@ -14,8 +14,8 @@ from infsup_contact.discretization.face.spaces.dual_bases import weights
 from infsup_contact.discretization.face.spaces.tensor import FaceSpace
 from infsup_contact.discretization.segment.multipliers import make_space
 from infsup_contact.discretization.segment.interface import SEGMENT
-from infsup_contact.discretization.face.square import SQUARE
-from infsup_contact.discretization.face.tensor_grid import TensorPartition
+from infsup_contact.discretization.face.shapes.square import SQUARE
+from infsup_contact.discretization.face.partitions.tensor_grid import TensorPartition
 from infsup_contact.errors import InputError
 from infsup_contact.models import make_model
 from infsup_contact.solvers.side_cache import SideCache

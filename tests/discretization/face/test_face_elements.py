@@ -14,7 +14,7 @@ from infsup_contact.discretization.face.spaces.dual_bases import (
 from infsup_contact.discretization.face.spaces.reference_elements import (
     ELEMENT_NAMES, cell_quadrature, pwlin_shapes, pwlin_subelements, reference_element)
 from infsup_contact.discretization.face.spaces.cellwise import CellwiseFaceSpace
-from infsup_contact.discretization.face.tensor_grid import TensorPartition
+from infsup_contact.discretization.face.partitions.tensor_grid import TensorPartition
 from infsup_contact.errors import InputError
 
 # the spaces by definition (not read from the module): which ξ^a η^b, a, b <= 2, they contain

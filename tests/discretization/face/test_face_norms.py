@@ -7,8 +7,8 @@ import pytest
 from infsup_contact.discretization.face.norms import tensor as face_norms
 from infsup_contact.la.richardson import relative_step
 from infsup_contact.discretization.spaces.registry import case_space, space_spec
-from infsup_contact.discretization.face.square import SQUARE
-from infsup_contact.discretization.face.tensor_grid import TensorPartition
+from infsup_contact.discretization.face.shapes.square import SQUARE
+from infsup_contact.discretization.face.partitions.tensor_grid import TensorPartition
 
 CASES = [("T3", 1), ("T3", 2), ("R5.2", 1), ("R5.2", 2), ("T4", 2), ("R5.4", 1), ("R5.4", 2), ("T5", 2),
          ("DUAL", 2), ("DUAL-ALL", 1)]

@@ -14,8 +14,8 @@ from infsup_contact.discretization.face.spaces.reference_elements import (cell_q
                                                          reference_element)
 from infsup_contact.discretization.face.spaces.tri6 import halved, tri6_space
 from infsup_contact.discretization.segment.interface import SEGMENT
-from infsup_contact.discretization.face.square import SQUARE, SQUARE_TRIG
-from infsup_contact.discretization.face.tensor_grid import TensorPartition
+from infsup_contact.discretization.face.shapes.square import SQUARE, SQUARE_TRIG
+from infsup_contact.discretization.face.partitions.tensor_grid import TensorPartition
 from infsup_contact.errors import InputError
 from infsup_contact.solvers.request import MeshOptions
 

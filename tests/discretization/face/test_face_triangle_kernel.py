@@ -13,7 +13,7 @@ from infsup_contact.discretization.face.kernel_bounds import (COMPONENTS, class_
                                                                  permutations, symmetric_kernel_bound, trace_space,
                                                                  uniform)
 from infsup_contact.discretization.spaces.registry import SPACES, case_space
-from infsup_contact.discretization.face.square import SQUARE, SQUARE_TRIG
+from infsup_contact.discretization.face.shapes.square import SQUARE, SQUARE_TRIG
 from infsup_contact.errors import InputError
 from infsup_contact.models import make_model
 from infsup_contact.solvers.side_cache import SideCache

@@ -9,8 +9,8 @@ from infsup_contact.discretization.face.norms import triangles as ftn
 from infsup_contact.discretization.face.symmetry import reflection, transposition
 from infsup_contact.discretization.face.spaces.triangles import TriangleSpace
 from infsup_contact.discretization.spaces.registry import case_space
-from infsup_contact.discretization.face.square import SQUARE_TRIG
-from infsup_contact.discretization.face.tensor_grid import TensorPartition
+from infsup_contact.discretization.face.shapes.square import SQUARE_TRIG
+from infsup_contact.discretization.face.partitions.tensor_grid import TensorPartition
 
 FAMILIES = [  # (s, continuous, vanish, dual)
     (0, False, False, False), (1, False, False, False), (2, False, False, False),

@@ -8,12 +8,12 @@ import pytest
 
 from infsup_contact.discretization.face.norms import triangles as ftn
 from infsup_contact.discretization.gamma.coupling import coupling_matrix
-from infsup_contact.discretization.face.quadrature import triangles_rule
+from infsup_contact.discretization.face.partitions.quadrature import triangles_rule
 from infsup_contact.discretization.face.spaces.tensor import FaceSpace
 from infsup_contact.discretization.face.spaces.triangles import TriangleSpace
 from infsup_contact.discretization.spaces.registry import SPACES, case_space, ids_valid_for
-from infsup_contact.discretization.face.square import SQUARE, SQUARE_TRIG
-from infsup_contact.discretization.face.tensor_grid import TensorPartition
+from infsup_contact.discretization.face.shapes.square import SQUARE, SQUARE_TRIG
+from infsup_contact.discretization.face.partitions.tensor_grid import TensorPartition
 from infsup_contact.errors import InputError
 from infsup_contact.models import make_model
 from infsup_contact.solvers.side_cache import SideCache
@@ -221,7 +221,7 @@ def test_p0_coupling_by_triangle_triangle_intersections():
     """B[T, j] = ∫_T w_j for P_0 on the triangles T of G_h (k = 2, non-matching 3 / 2): against
     Σ_τ ∫_{T∩τ} w_j over the trace's triangles τ, T∩τ clipped by T's three edges (a different
     decomposition from the rectangles-cut-by-diagonals of the coupling)."""
-    from infsup_contact.discretization.face.quadrature import _clip
+    from infsup_contact.discretization.face.partitions.quadrature import _clip
 
     k = 2
     sides = SideCache().pair(MODEL, "structured", k, 3, 2, MeshOptions(element="tet"))

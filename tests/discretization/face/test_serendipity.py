@@ -1,7 +1,7 @@
 """The QUAD8 face of HEX20 bodies (:class:`SerendipitySquare`): the spaces it builds, its dimension
 counts against numerical ranks, and ``beta --element hex20 --case all`` against kernels predicted
 from the dimension argument (and, for the tensor spaces below the count, the serendipity structure
-W = P2_0 ⊗ P1_0 + P1_0 ⊗ P2_0, :func:`~infsup_contact.discretization.face.serendipity.tensor_modes`)."""
+W = P2_0 ⊗ P1_0 + P1_0 ⊗ P2_0, :func:`~infsup_contact.discretization.face.shapes.serendipity.tensor_modes`)."""
 import io
 
 import numpy as np
@@ -9,8 +9,8 @@ import pandas as pd
 import pytest
 
 from helpers.cli import run_in_process
-from infsup_contact.discretization.face.serendipity import SERENDIPITY, interior_dimension, product_modes, tensor_modes
-from infsup_contact.discretization.face.tensor_grid import TensorPartition
+from infsup_contact.discretization.face.shapes.serendipity import SERENDIPITY, interior_dimension, product_modes, tensor_modes
+from infsup_contact.discretization.face.partitions.tensor_grid import TensorPartition
 from infsup_contact.discretization.spaces.registry import SPACES, ids_built_on, ids_valid_for
 from infsup_contact.models import hex20
 from infsup_contact.models.membranes3d import MEMBRANES3D
@@ -26,7 +26,7 @@ def predicted_kernel(case, n):
     """Kernel of Bᵀ on matching n × n meshes, k = 2: dim M − dim W, dim W = (3n − 1)(n − 1), written
     before the runs (QUAD9-type spaces: M ⊃ W, so exactly the count); T4 / T5, whose count is 0, showed
     modes in the first run, since proven from the tensor structure (the checkerboard, the four
-    corner products a ⊗ b; :func:`~infsup_contact.discretization.face.serendipity.tensor_modes`). The linear
+    corner products a ⊗ b; :func:`~infsup_contact.discretization.face.shapes.serendipity.tensor_modes`). The linear
     dual on all vertices (LINDUAL-Q8) and its Petrov–Galerkin pair PGLIN-Q8: the four corner products of the
     1D end duals, orthogonal to every interior hat (predicted before the run, from tensor_modes)."""
     dim_w = (3 * n - 1) * (n - 1)

@@ -6,8 +6,8 @@ import ngsolve
 import pytest
 
 from infsup_contact.discretization.gamma.interface import Interface
-from infsup_contact.discretization.face.square import SQUARE, SQUARE_TRIG, Square
-from infsup_contact.discretization.face.tensor_grid import TensorPartition
+from infsup_contact.discretization.face.shapes.square import SQUARE, SQUARE_TRIG, Square
+from infsup_contact.discretization.face.partitions.tensor_grid import TensorPartition
 from infsup_contact.errors import InputError
 from infsup_contact.models.membranes3d import displacement_space, subdomain_mesh
 
@@ -114,7 +114,7 @@ def test_coupling_rule_of_triangles_cuts_the_refinement_by_the_trace_diagonals(d
     """On G_h ∪ trace, each rectangle cut by the diagonal of its trace cell: exact for a function
     with a kink on every trace diagonal, |diagonal coordinate| (∬ |u − v| = 1/3 per cell), times
     a polynomial of each variable."""
-    from infsup_contact.discretization.face.quadrature import split_rule
+    from infsup_contact.discretization.face.partitions.quadrature import split_rule
 
     trace, gh = grid(3), grid(4, 5)
     x, w = split_rule(SQUARE_TRIG.common_refinement(trace, gh), trace, 2 * degree)

@@ -17,10 +17,10 @@ from infsup_contact.discretization.face.norms import unstructured as tf
 from infsup_contact.discretization.face.spaces.triangles import TriangleSpace
 from infsup_contact.discretization.face.spaces.unstructured import MeshTriangleSpace, mesh_space
 from infsup_contact.discretization.spaces.registry import SPACES, case_space
-from infsup_contact.discretization.face.square import SQUARE_TRIG
-from infsup_contact.discretization.face.tensor_grid import TensorPartition
-from infsup_contact.discretization.face.triangulated_square import TRIANGULATED
-from infsup_contact.discretization.face.triangulation import Triangulation, barycentric, locate, overlay
+from infsup_contact.discretization.face.shapes.square import SQUARE_TRIG
+from infsup_contact.discretization.face.partitions.tensor_grid import TensorPartition
+from infsup_contact.discretization.face.shapes.triangulated_square import TRIANGULATED
+from infsup_contact.discretization.face.partitions.triangulation import Triangulation, barycentric, locate, overlay
 from infsup_contact.errors import InputError
 from infsup_contact.models import make_model
 from infsup_contact.models import membranes3d
@@ -108,7 +108,7 @@ def test_general_spaces_are_the_structured_ones(s, continuous, vanish, dual):
     grid = TensorPartition(np.array([0.0, 0.3, 0.5, 1.0]), np.array([0.0, 0.2, 0.7, 1.0]))
     old = TriangleSpace(grid, s, continuous, vanish, dual)
     tri = Triangulation(old.triangles().reshape(-1, 2), np.arange(3 * len(old.triangles())).reshape(-1, 3))
-    from infsup_contact.discretization.face.triangulation import from_elements
+    from infsup_contact.discretization.face.partitions.triangulation import from_elements
 
     new = mesh_space(from_elements(old.triangles()), s, continuous, vanish, dual)
     assert tri.cells == new.breakpoints.cells and new.dim == old.dim

@@ -7,8 +7,8 @@ import pytest
 
 from infsup_contact.discretization.spaces import registry
 from infsup_contact.discretization.gamma.constants import interior_samples, spans_constants
-from infsup_contact.discretization.face.square import SQUARE, SQUARE_TRIG
-from infsup_contact.discretization.face.tensor_grid import TensorPartition
+from infsup_contact.discretization.face.shapes.square import SQUARE, SQUARE_TRIG
+from infsup_contact.discretization.face.partitions.tensor_grid import TensorPartition
 from infsup_contact.study.patch import face as face_patch
 
 

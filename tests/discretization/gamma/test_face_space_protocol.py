@@ -10,8 +10,8 @@ from dataclasses import dataclass
 import numpy as np
 import pytest
 
-from infsup_contact.discretization.face.square import SQUARE, SQUARE_TRIG
-from infsup_contact.discretization.face.tensor_grid import TensorPartition
+from infsup_contact.discretization.face.shapes.square import SQUARE, SQUARE_TRIG
+from infsup_contact.discretization.face.partitions.tensor_grid import TensorPartition
 from infsup_contact.discretization.gamma.constants import spans_constants
 from infsup_contact.discretization.gamma.protocol import MultiplierSpace, SpaceDefaults
 from infsup_contact.discretization.segment.interface import SEGMENT

@@ -15,13 +15,14 @@ import pytest
 from helpers.cli import run_in_process
 
 from infsup_contact.discretization.gamma.coupling import coupling_matrix
-from infsup_contact.discretization.segment.arc import Arc, arc_of
+from infsup_contact.discretization.segment.arc import Arc
+from infsup_contact.discretization.spaces.gammas import arc_of
 from infsup_contact.discretization.segment.projection import project, side_curve
 from infsup_contact.discretization.spaces import registry
 from infsup_contact.errors import InputError
 from infsup_contact.models import MODELS
 from infsup_contact.solvers.infsup import beta_rows
-from infsup_contact.solvers.request import MeshOptions
+from infsup_contact.solvers.request import MeshOptions, mesh_of
 from infsup_contact.solvers.side_cache import SideCache
 
 MEMBRANES = MODELS["membranes"]
@@ -29,7 +30,7 @@ COLUMNS = ["case", "norm", "beta", "kernel_dim", "structural_kernel_dim", "small
 
 
 def arc_options(radius, coupling="exact"):
-    return MeshOptions(gamma="arc", radius=float(radius), coupling=coupling)
+    return mesh_of(MODELS["membranes"], gamma="arc", radius=float(radius), coupling=coupling)
 
 
 def rows(k, n1, n2, mesh=MeshOptions(), cases=None):

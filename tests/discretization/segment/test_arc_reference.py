@@ -16,14 +16,14 @@ from infsup_contact.discretization.gamma.coupling import coupling_matrix
 from infsup_contact.discretization.spaces import registry
 from infsup_contact.models import MODELS
 from infsup_contact.solvers.infsup import beta_rows
-from infsup_contact.solvers.request import MeshOptions
+from infsup_contact.solvers.request import MeshOptions, mesh_of
 from infsup_contact.solvers.side_cache import SideCache
 
 MEMBRANES, MEMBRANES3D = MODELS["membranes"], MODELS["membranes3d"]
 
 
 def arc(radius=2.0, coupling="exact"):
-    return MeshOptions(gamma="arc", radius=float(radius), coupling=coupling)
+    return mesh_of(MEMBRANES, gamma="arc", radius=float(radius), coupling=coupling)
 
 
 def curved_space(model, n, k, **options):
@@ -39,8 +39,8 @@ def stiffness_with_margin(fes, margin, monkeypatch):
 
 @pytest.mark.parametrize("model,k,options", [
     (MEMBRANES, 2, arc().kwargs()), (MEMBRANES, 3, arc().kwargs()),
-    (MEMBRANES3D, 1, dict(element="hex", gamma="cylinder", radius=2.0)),
-    (MEMBRANES3D, 2, dict(element="tet", gamma="cylinder", radius=2.0))])
+    (MEMBRANES3D, 1, mesh_of(MEMBRANES3D, element="hex", gamma="cylinder", radius=2.0).kwargs()),
+    (MEMBRANES3D, 2, mesh_of(MEMBRANES3D, element="tet", gamma="cylinder", radius=2.0).kwargs())])
 def test_curved_stiffness_is_converged_in_its_quadrature(model, k, options, monkeypatch):
     """The integrand on a curved cell is rational, no rule is exact: the Gauss error falls
     geometrically with the order, so K at the library's order, 4 and 8 orders more agree to round-off

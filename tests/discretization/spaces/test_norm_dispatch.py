@@ -15,9 +15,9 @@ from infsup_contact.discretization.face.spaces.triangles import TriangleSpace
 from infsup_contact.discretization.face.spaces.unstructured import mesh_space
 from infsup_contact.discretization.segment.multipliers import make_space
 from infsup_contact.discretization.spaces.registry import case_space
-from infsup_contact.discretization.face.square import SQUARE
-from infsup_contact.discretization.face.tensor_grid import TensorPartition
-from infsup_contact.discretization.face.triangulation import from_elements
+from infsup_contact.discretization.face.shapes.square import SQUARE
+from infsup_contact.discretization.face.partitions.tensor_grid import TensorPartition
+from infsup_contact.discretization.face.partitions.triangulation import from_elements
 from infsup_contact.errors import InputError
 
 GRID = TensorPartition(np.array([0.0, 0.3, 0.55, 1.0]), np.array([0.0, 0.45, 1.0]))

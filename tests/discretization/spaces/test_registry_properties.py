@@ -30,9 +30,9 @@ import pytest
 
 from infsup_contact.discretization.spaces.registry import SPACES
 from infsup_contact.discretization.segment.interface import SEGMENT
-from infsup_contact.discretization.face.serendipity import face_of, tensor_modes
-from infsup_contact.discretization.face.square import CELL_SHAPES
-from infsup_contact.discretization.face.tensor_grid import TensorPartition
+from infsup_contact.discretization.face.shapes.serendipity import face_of, tensor_modes
+from infsup_contact.discretization.face.shapes.square import CELL_SHAPES
+from infsup_contact.discretization.face.partitions.tensor_grid import TensorPartition
 from infsup_contact.errors import InputError
 
 SEGMENT_N = (2, 3, 5)

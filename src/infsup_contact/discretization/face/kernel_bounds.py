@@ -49,10 +49,10 @@ import math
 import numpy as np
 
 from ..gamma.coupling import weighted_values
-from .quadrature import split_triangles, triangles_rule
+from .partitions.quadrature import split_triangles, triangles_rule
 from .symmetry import reflection, transposition
 from .spaces.triangles import TriangleSpace
-from .tensor_grid import TensorPartition
+from .partitions.tensor_grid import TensorPartition
 
 #: The isotypic components (χ(T), χ(R)) of G = {id, T, R, TR}; χ(TR) = χ(T) χ(R).
 COMPONENTS = ((1, 1), (1, -1), (-1, 1), (-1, -1))
@@ -143,7 +143,7 @@ def layer_modes(space, k: int, n1: int, n2: int, width_cells: int = 2) -> dict:
 
     The multipliers supported there (all their sample values farther in are zero) are coupled
     exactly with every function of W1 and W2 (Duffy rule on the overlay of both traces and
-    G_h, :func:`~.face.quadrature.split_triangles`, restricted to the layer); the nullity of that
+    G_h, :func:`~.face.partitions.quadrature.split_triangles`, restricted to the layer); the nullity of that
     matrix on the span of :func:`component_basis` is the count of c. The width is capped at
     (n2 − 1) // 2 cells, so that the layer never is the whole face (whose nullity would be the
     kernel itself, not a count): no layer for n2 <= 2."""

@@ -14,9 +14,9 @@ perturbed
     ``|shift|_∞ ≤ αh``): the box's planes, Γ's among them, are kept. Tetrahedra: the Γ vertices
     move in the plane too (their shifts drawn from a stream of (seed, N) only, so N1 = N2 gives
     matching perturbed faces; the other vertices' from (seed, N, side)); the trace is then a
-    general triangulation (:class:`~.face.triangulated_square.TriangulatedSquare`). Hexahedra: the Γ
+    general triangulation (:class:`~.face.shapes.triangulated_square.TriangulatedSquare`). Hexahedra: the Γ
     vertices do not move (only off-Γ vertices do), so the face stays a tensor grid and its
-    interface :class:`~.face.square.Square`; only the bodies' interiors are perturbed, and only in z
+    interface :class:`~.face.shapes.square.Square`; only the bodies' interiors are perturbed, and only in z
     (the direction normal to Γ): NGSolve's hexahedra with vertices moved in two directions at
     once do not keep the box's volume (measured: 1.0022 for N = 3), those moved in one do.
 

@@ -15,8 +15,8 @@ opaque: obtained from the interface, handed back to it); a side's trace carries 
 
 Implementations: the paper's segment (:class:`~.segment.interface.Segment`, partitions = sorted
 breakpoints, what users' ``build(k, x)`` receive); the face (0, 1)² × {1} with tensor partitions
-(:class:`~.face.square.Square`; QUAD8 traces: :class:`~.face.serendipity.SerendipitySquare`) and
-with general triangulations (:class:`~.face.triangulated_square.TriangulatedSquare`, clipped).
+(:class:`~.face.shapes.square.Square`; QUAD8 traces: :class:`~.face.shapes.serendipity.SerendipitySquare`) and
+with general triangulations (:class:`~.face.shapes.triangulated_square.TriangulatedSquare`, clipped).
 """
 from __future__ import annotations
 
@@ -298,24 +298,14 @@ class Interface(abc.ABC):
 
     @abc.abstractmethod
     def multiplier_cells(self, n1: int, n2: int, choice: str = "omega2") -> int:
-        """Cells of G_h when the traces of Ω1 and Ω2 are uniform with ``n1`` and ``n2`` cells
-        (the registry's emptiness checks and the sizing model).
-
-        Parameters
-        ----------
-        n1, n2 : int
-        choice : {"omega2", "omega1", "union"}
-
-        Returns
-        -------
-        int
-        """
+        """Cells of G_h (an int) when the traces of Ω1 and Ω2 are uniform with ``n1`` and ``n2``
+        cells, ``choice`` one of omega2, omega1, union (the emptiness checks, the sizing model)."""
 
     # --- derived, shared by every implementation ----------------------------------------------
     def proven_kernel(self, space, k: int, traces, dim_w: int) -> int:
         """The part of dim ker Bᵀ on ``space`` that a count proves (the kernel rule never loses it
         to round-off): max(dim M − dim(W1 + W2), 0), ``dim_w`` = :meth:`trace_sum_dimension`.
-        An interface may add local counts (:class:`~.face.triangulated_square.TriangulatedSquare`:
+        An interface may add local counts (:class:`~.face.shapes.triangulated_square.TriangulatedSquare`:
         the corners of Γ).
 
         Parameters
@@ -336,6 +326,15 @@ class Interface(abc.ABC):
         """Whether this interface has a space of the registry entry ``spec``; default: every one."""
         return True
 
+    def uniform_partition(self, n: int):
+        """The trace partition of uniform bodies with ``n`` cells per direction, built without a mesh."""
+        raise NotImplementedError(f"{type(self).__name__} has no uniform partition")
+
+    def check_builds(self, spec) -> None:
+        """:class:`InputError` naming ``case`` unless :meth:`builds` (a shape may say why in its words)."""
+        if not self.builds(spec):
+            raise InputError("case", f"a space this Γ builds ({spec.id} is not one)", got=spec.id)
+
     contact = True  # whether contact scenes (the patch test among them) run on this Γ's bodies
 
     def allows(self, k: int) -> bool:
@@ -346,7 +345,7 @@ class Interface(abc.ABC):
         """The multiplier space of a registry entry on a partition of this interface.
 
         The default (the segment's): ``spec.build(k, partition)`` on the sorted breakpoints. A
-        face builds its tensor products from the same 1D ``build`` (:class:`~.face.square.Square`).
+        face builds its tensor products from the same 1D ``build`` (:class:`~.face.shapes.square.Square`).
 
         Parameters
         ----------

@@ -29,7 +29,8 @@ R = ∞ builds the paper's meshes unchanged; ``exact`` then is the paper's β_h,
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from typing import Callable
 
 import numpy as np
 
@@ -51,7 +52,7 @@ documented interpolant's, two more orders reach round-off (docs/models.md, the a
 def check_curved_options(gamma, radius, coupling, gammas=GAMMAS, radius_allowed: str = RADIUS_ALLOWED) -> None:
     """:class:`InputError` naming the key: ``gamma`` in ``gammas`` (flat, curved); with the curved one a
     radius R > 1 (inf allowed) and a coupling in :data:`COUPLINGS` (None: ``exact``); without it neither
-    (the arc's options; the cylinder's, :mod:`..face.cylinder`, with its own names)."""
+    (the arc's options; the cylinder's, :mod:`..face.shapes.cylinder`, with its own names)."""
     curved = gammas[-1]
     if gamma not in (None,) + tuple(gammas):
         raise InputError("gamma", ", ".join(gammas), got=gamma)
@@ -82,10 +83,16 @@ class Arc(Segment):
         R > 1, or inf (the paper's segment).
     coupling : str
         One of :data:`COUPLINGS`.
+    pairing : callable or None
+        ``pairing(arc, sides) -> sides`` ties the two sides' traces for ``projection``
+        (:func:`.projection.project_pair`): given by the Γ table
+        (:mod:`infsup_contact.discretization.spaces.gammas`), which pairs the shape with its
+        projection, so that this module does not import the projection's.
     """
 
     radius: float = math.inf
     coupling: str = "exact"
+    pairing: Callable | None = field(default=None, compare=False, repr=False)
 
     @property
     def curved(self) -> bool:
@@ -126,16 +133,11 @@ class Arc(Segment):
 
     def paired(self, sides: list) -> list:
         """With ``projection`` on a curved arc, the sides' traces tied to each other
-        (:func:`.projection.project_pair`); else as built."""
+        (:attr:`pairing`, :func:`.projection.project_pair`); else as built."""
         if self.coupling != "projection":
             return sides
-        from .projection import project_pair
+        if self.pairing is None:  # a caller's slip: the Γ table builds a projected arc with its pairing
+            raise TypeError("an Arc coupled by projection is built by the Γ table (spaces.gammas.gamma_of), "
+                            "which gives it its pairing")
+        return self.pairing(self, sides)
 
-        return project_pair(self, sides)
-
-
-def arc_of(gamma=None, radius=None, coupling=None):
-    """The Γ of the mesh options: None for the paper's segment (no option given, or ``segment``),
-    else the checked :class:`Arc`."""
-    check_arc_options(gamma, radius, coupling)
-    return None if gamma != "arc" else Arc(radius=float(radius), coupling=coupling or "exact")

@@ -47,6 +47,10 @@ class Segment(Interface):
                     xs.add(mesh[v].point[0])
         return np.array(sorted(xs))
 
+    def uniform_partition(self, n: int) -> np.ndarray:
+        """The breakpoints of N uniform segments."""
+        return np.linspace(0.0, 1.0, int(n) + 1)
+
     def common_refinement(self, *partitions, tol: float = 1e-12) -> np.ndarray:
         """Sorted union of the breakpoints, merging points closer than ``tol``."""
         x = np.unique(np.concatenate(partitions))

@@ -203,6 +203,7 @@ def project_pair(arc: Arc, sides: list) -> list:
     curves, rules = tuple(side_curve(s.trace, k) for s in sides), {}
     out = []
     for i, s in enumerate(sides):
-        view = ProjectedArc(arc.boundary, arc.y, arc.radius, arc.coupling, curves, i, rules)
+        view = ProjectedArc(boundary=arc.boundary, y=arc.y, radius=arc.radius, coupling=arc.coupling,
+                            curves=curves, side=i, rules=rules)
         out.append(replace(s, trace=replace(s.trace, gamma=view, basis_cache={}, sparse_cache={})))
     return out

@@ -16,7 +16,7 @@ import functools
 import numpy as np
 
 from ...errors import InputError
-from ..face.square import CELL_BODIES
+from ..face.shapes.square import CELL_BODIES
 from ..gamma.interface import MULTIPLIER_MESHES
 from ..segment.dual import dual_space
 from ..segment.interface import SEGMENT
@@ -98,7 +98,7 @@ def case_space(case: str, k: int, partition, gamma=SEGMENT, pair: bool = False) 
     """The multiplier space of a registered case for displacement degree k on G_h, a
     ``partition`` of Γ = ``gamma`` (:mod:`.gamma.interface`; for the paper's segment the sorted
     breakpoints of G_h, what ``SpaceSpec.build(k, x)`` receives; for the face
-    :class:`~.face.square.Square` a tensor partition, on which the space is the tensor product of
+    :class:`~.face.shapes.square.Square` a tensor partition, on which the space is the tensor product of
     the 1D builds, :meth:`~.gamma.interface.Interface.space`). A Petrov–Galerkin pair (``trial_space``,
     ``test_space``) is refused after those checks unless ``pair`` (its caller knows it has two bases):
     then its trial space is returned.
@@ -109,12 +109,27 @@ def case_space(case: str, k: int, partition, gamma=SEGMENT, pair: bool = False) 
         For a partition with no interval or a space of dimension 0 on it (nothing to compute:
         the eigenproblems and solves would fail deep inside numpy), naming the case, N and k.
     """
+    return space_on(check_on_gamma(case, k, gamma), k, partition, gamma, pair)
+
+
+def check_on_gamma(case: str, k: int, gamma) -> SpaceSpec:
+    """The entry of ``case``, checked once, before any mesh: registered, valid for degree k,
+    defined on Γ's dimension and built on its cells (:meth:`~.gamma.interface.Interface.builds`);
+    else one :class:`InputError` naming ``case`` (or ``k``)."""
     check_case(case, k)
     spec = SPACES[case]
     if not spec.defined_on(gamma.dim):
         bodies = " and ".join(CELL_BODIES.get(c, c) for c in spec.face_cells)
         raise InputError("case", f"a space defined on this Γ (dimension {gamma.dim}): {case} ({spec.paper_ref}) is "
                          f"defined on the face of a 3D model only, on {bodies} (e.g. --model membranes3d)", got=case)
+    gamma.check_builds(spec)
+    return spec
+
+
+def space_on(spec: SpaceSpec, k: int, partition, gamma=SEGMENT, pair: bool = False):
+    """The multiplier space of a checked entry (:func:`check_on_gamma`) on G_h = ``partition`` of
+    ``gamma`` (:func:`case_space`'s construction and its refusals of an empty space or a pair)."""
+    case = spec.id
     space = gamma.space(spec, k, partition)  # the interface builds it (a face: tensor products)
     n = gamma.cells(space.breakpoints)
     if space.dim < 1:

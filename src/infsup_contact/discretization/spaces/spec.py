@@ -68,16 +68,16 @@ class SpaceSpec:
         that is not a tensor product of ``build`` (:mod:`.face.spaces.cellwise`); ``dimension(k, N)`` is
         then dim M_h on an N × N grid.
     face_cells : tuple of str
-        The face cells (``quad``, ``trig``: :data:`~.face.square.CELL_SHAPES`) whose traces the space
+        The face cells (``quad``, ``trig``: :data:`~.face.shapes.square.CELL_SHAPES`) whose traces the space
         is defined against: the quadratic quadrilateral elements' multipliers pair with QUAD9
         traces (hexahedra) only, the TRI6 ones with P2 triangle traces (tetrahedra) only; ``quad8``:
-        the QUAD8 traces of serendipity HEX20 bodies (:mod:`.face.serendipity`), which every tensor
+        the QUAD8 traces of serendipity HEX20 bodies (:mod:`.face.shapes.serendipity`), which every tensor
         product space (the default) and the QUAD8 element spaces build on.
     lagrange : tuple or None
         ``(continuous, vanish)`` when ``build`` is the Lagrange space M^r_s / M^r_{0,s} of degree
         s = ``degree(k)`` (:func:`~.segment.multipliers.make_space`): the description an interface
         reads to build the analogue on other cells (P_s on triangles,
-        :meth:`~.face.square.Square.space`); None for other bases.
+        :meth:`~.face.shapes.square.Square.space`); None for other bases.
     dual : bool
         With ``lagrange``: the space is the dual (biorthogonal) basis of that Lagrange space
         (:mod:`.segment.dual`; on triangles :class:`~.face.spaces.triangles.TriangleSpace` with ``dual=True``).
@@ -123,9 +123,9 @@ class SpaceSpec:
     def face_space(self, k: int, n: int):
         """The space on the uniform n × n grid of the face: the square's build on the first face
         cell shape the entry is defined on (``face_cells``: rectangles, else triangles)."""
-        from ..face.serendipity import face_of
-        from ..face.square import CELL_SHAPES
-        from ..face.tensor_grid import TensorPartition
+        from ..face.shapes.serendipity import face_of
+        from ..face.shapes.square import CELL_SHAPES
+        from ..face.partitions.tensor_grid import TensorPartition
 
         x = np.linspace(0.0, 1.0, n + 1)
         cell = next(c for c in CELL_SHAPES if c in self.face_cells)
@@ -161,8 +161,8 @@ class SpaceSpec:
         if self.dimension is None:
             return None
         if not self.defined_on(1):
-            from ..face.serendipity import face_of  # the face builds on the segment's spaces: imported late
-            from ..face.square import CELL_SHAPES
+            from ..face.shapes.serendipity import face_of  # the face builds on the segment's spaces: imported late
+            from ..face.shapes.square import CELL_SHAPES
 
             face = face_of(next(c for c in CELL_SHAPES if c in self.face_cells))
             return max(self.dimension(k, n) - face.trace_dimension(k, n), 0)

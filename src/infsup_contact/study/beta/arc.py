@@ -14,7 +14,8 @@ import pandas as pd
 
 from ...criteria.stability import stability_verdict
 from ...discretization.segment.arc import COUPLINGS
-from ...solvers.request import MeshOptions
+from ...models import MODELS
+from ...solvers.request import MeshOptions, mesh_of
 from .batch_rows import beta_batch_rows
 
 PAPER = "paper"
@@ -42,7 +43,7 @@ def arc_rows(radii, series: dict, k: int, cases=None, couplings=COUPLINGS, famil
         :data:`PAPER`, curvature 0: what R = ∞ must reproduce.
     element : str or None
         None: the 2D membranes, Γ the arc; an element of the 3D membranes (``hex``, ``tet``): Γ the
-        part of the cylinder (:mod:`infsup_contact.discretization.face.cylinder`), the flat face the reference.
+        part of the cylinder (:mod:`infsup_contact.discretization.face.shapes.cylinder`), the flat face the reference.
 
     Returns
     -------
@@ -53,7 +54,7 @@ def arc_rows(radii, series: dict, k: int, cases=None, couplings=COUPLINGS, famil
     pairs = sorted({tuple(p) for ps in series.values() for p in ps})
     by_pair = {p: [s for s, ps in series.items() if p in {tuple(q) for q in ps}] for p in pairs}
     model, gamma = ("membranes", "arc") if element is None else ("membranes3d", "cylinder")
-    runs = [(curvature(r), c, MeshOptions(element=element, gamma=gamma, radius=float(r), coupling=c))
+    runs = [(curvature(r), c, mesh_of(MODELS[model], family, element=element, gamma=gamma, radius=float(r), coupling=c))
             for r in radii for c in couplings]
     if paper:
         runs.append((0.0, PAPER, MeshOptions(element=element)))

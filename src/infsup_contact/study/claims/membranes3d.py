@@ -45,8 +45,8 @@ import pandas as pd
 from ...discretization.spaces.registry import SPACES
 from ...errors import InputError
 from ...discretization.face.kernel_bounds import symmetric_kernel_bound
-from ...discretization.face.square import SQUARE, SQUARE_TRIG, Square
-from ...discretization.face.tensor_grid import TensorPartition
+from ...discretization.face.shapes.square import SQUARE, SQUARE_TRIG, Square
+from ...discretization.face.partitions.tensor_grid import TensorPartition
 from ...criteria.claims import FAIL, FINDING, INCONCLUSIVE, PASS, bounded_claim, close_decisions, close_text, finest, kernel_claim, \
     row, slope_verdict
 
@@ -92,7 +92,7 @@ def _uniform(n: int) -> TensorPartition:
 
 def checkerboard(spec, k: int, gamma=SQUARE) -> bool:
     """Whether ``gamma`` proves the checkerboard mode of ``spec`` at degree k on matching meshes
-    (:meth:`~infsup_contact.discretization.face.square.Square.checkerboard_modes`: P_0 multipliers
+    (:meth:`~infsup_contact.discretization.face.shapes.square.Square.checkerboard_modes`: P_0 multipliers
     against P_2 traces on the same triangles; independent of N)."""
     modes = getattr(gamma, "checkerboard_modes", None)
     if modes is None or not gamma.builds(spec):

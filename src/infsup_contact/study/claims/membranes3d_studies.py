@@ -42,7 +42,7 @@ import pandas as pd
 from ...discretization.gamma.constants import spans_constants
 from ...discretization.face.spaces.dual_bases import weights
 from ...discretization.spaces.registry import SPACES
-from ...discretization.face.tensor_grid import TensorPartition
+from ...discretization.face.partitions.tensor_grid import TensorPartition
 from ...criteria.claims import COLUMNS, FAIL, FINDING, INCONCLUSIVE, PASS, row, slope_verdict
 from .membranes3d import REF, face_dimension
 

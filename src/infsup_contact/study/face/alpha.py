@@ -33,7 +33,7 @@ from ...discretization.face.spaces.cellwise import cellwise_builder
 from ...discretization.face.spaces.dual_bases import alpha_sweep, transformation
 from ...discretization.face.spaces.reference_elements import reference_element
 from ...discretization.face.spaces.tri6 import triangle_builder
-from ...discretization.face.tensor_grid import TensorPartition
+from ...discretization.face.partitions.tensor_grid import TensorPartition
 from ...discretization.spaces.spec import SpaceSpec
 from ...errors import InputError
 
@@ -45,7 +45,7 @@ TRI_ALPHAS = (0.05, 0.1, 0.15, 0.2, 0.25, 0.3, 1.0 / 3.0, 0.4, 0.45)
 SWEEP_ELEMENTS = ("QUAD8", "QUAD9", "TRI6")
 FACE_CELL = {"quad": "quad", "tri": "trig"}
 """Reference cell of an element (:attr:`~.face_elements.ReferenceElement.cell`) → face cell shape
-(:data:`~infsup_contact.discretization.face.square.CELL_SHAPES`)."""
+(:data:`~infsup_contact.discretization.face.shapes.square.CELL_SHAPES`)."""
 
 
 def transformed_dual_spec(element: str, alpha: float) -> SpaceSpec:

@@ -67,8 +67,8 @@ from ...discretization.face.spaces.tensor import FaceSpace
 from ...discretization.segment.multipliers import SegmentSpace, make_space
 from ...discretization.segment.norms import gram_l2
 from ...discretization.gamma.quadrature import gauss_legendre_01
-from ...discretization.face.square import SQUARE, Square
-from ...discretization.face.tensor_grid import TensorPartition
+from ...discretization.face.shapes.square import SQUARE, Square
+from ...discretization.face.partitions.tensor_grid import TensorPartition
 from ...errors import InputError
 from ...models import model_of_dim
 from ...solvers.interface_operator import combine_terms, interface_terms
@@ -130,7 +130,7 @@ def couplings(face: ClippedFace, partition: TensorPartition, values, degree: int
     """∫_Γ μ_j φ_d of the clipped face multipliers μ_j against functions φ_d given by
     ``values`` (points (n, 2) ↦ (n, dim)), piecewise polynomial of degree ≤ ``degree`` − s on the
     rectangles of ``partition`` (a side's trace): the tensor Gauss rule of
-    :meth:`Square.quadrature <infsup_contact.discretization.face.square.Square.quadrature>` per
+    :meth:`Square.quadrature <infsup_contact.discretization.face.shapes.square.Square.quadrature>` per
     rectangle of the common refinement of ``partition`` and G_h, clipped at x = L (exact)."""
     L = face.L
     xs = _merged(partition.xs, np.asarray(face.space.sx.breakpoints) * L, upper=L)

@@ -1,7 +1,7 @@
 """The multiplier spaces on QUAD8 faces: serendipity HEX20 bodies (k = 2) on matching meshes.
 
 One row per (space, N, norm): dim M_h, dim W_h = (3N − 1)(N − 1), the measured kernel of Bᵀ, the
-proven one (:meth:`~infsup_contact.discretization.face.serendipity.SerendipitySquare.proven_kernel`:
+proven one (:meth:`~infsup_contact.discretization.face.shapes.serendipity.SerendipitySquare.proven_kernel`:
 the dimension count, and for tensor spaces the serendipity structure W = P2_0 ⊗ P1_0 + P1_0 ⊗ P2_0),
 β_h, and the stability verdict of the space's series in that norm
 (:func:`~infsup_contact.criteria.stability.stability_verdict`, the criterion of ``infsup-contact verdict``).
@@ -26,8 +26,8 @@ def quad8_cases(k: int = 2) -> list:
     """The registered ids the QUAD8 face builds for k (the paper's tensor spaces, the duals, the QUAD8 ones)."""
     import numpy as np
 
-    from ...discretization.face.serendipity import SERENDIPITY
-    from ...discretization.face.tensor_grid import TensorPartition
+    from ...discretization.face.shapes.serendipity import SERENDIPITY
+    from ...discretization.face.partitions.tensor_grid import TensorPartition
     from ...discretization.spaces.registry import ids_built_on
 
     x = np.linspace(0.0, 1.0, 3)

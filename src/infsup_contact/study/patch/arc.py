@@ -31,6 +31,7 @@ import numpy as np
 
 from ...discretization.gamma.constants import spans_constants
 from ...discretization.segment.arc import Arc, check_arc_options
+from ...discretization.spaces.gammas import arc_of
 from ...errors import InputError, check_prestress
 from ...models import make_model
 from ...models.contract import Body
@@ -58,7 +59,7 @@ def patch_scene(radius: float, coupling: str = "exact", c=(1.0, 1.0), delta: flo
     if not (np.isfinite(delta) and 0.0 < delta < 1.0):
         raise InputError("delta", "0 < delta < 1", got=delta)
     c1, c2 = (check_prestress(key, v) for key, v in (("c1", c[0]), ("c2", c[1])))
-    return ArcBlocks(SCENE, c1, c2, float(delta), ("dir",), arc=Arc(radius=float(radius), coupling=coupling))
+    return ArcBlocks(SCENE, c1, c2, float(delta), ("dir",), arc=arc_of("arc", radius, coupling))
 
 
 def exact_pressure(radius: float, delta: float, c) -> float:

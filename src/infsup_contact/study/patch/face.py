@@ -72,7 +72,7 @@ standard QUAD8 basis (Q8, Q8-ALL), which start inactive and cost one more iterat
 The kernel: the first exploratory run (R5.2, 4:5) showed 4 modes that max(dim M − dim(W1 + W2), 0)
 misses: QUAD8 traces have no cell centres, W_i = P2ˣ ⊗ P1ʸ + P1ˣ ⊗ P2ʸ on grid i, and a ⊗ b with
 a, b ∈ P2(Ω2's grid) ⊥ P1 on both grids (dim 2 per direction on n:n+1) is orthogonal to both.
-That count (:meth:`~infsup_contact.discretization.face.serendipity.SerendipitySquare.natural_modes`,
+That count (:meth:`~infsup_contact.discretization.face.shapes.serendipity.SerendipitySquare.natural_modes`,
 in the ledger's prediction, :mod:`.claims.membranes3d_studies`) was then computed for every space
 before the table: 4 for R5.2 and DUAL-ALL, 1 for R5.4 on 4:5 and 7:8 (16, 16, 9 and DUAL's 4 on
 matching 4:4), 0 for the rest. A kernel leaves u_h exact and λ_h to the PDAS's minimum-norm choice.

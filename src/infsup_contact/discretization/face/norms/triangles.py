@@ -1,6 +1,6 @@
 """Gram matrices of the triangle multiplier spaces (:mod:`.face.spaces.triangles`) on Γ = (0, 1)².
 
-L²(Γ): exact, by the collapsed (Duffy) Gauss rule of :mod:`.face.quadrature` on the triangles of
+L²(Γ): exact, by the collapsed (Duffy) Gauss rule of :mod:`.face.partitions.quadrature` on the triangles of
 G_h, exact for the total degree 2s of a product of two P_s functions.
 
 M = H^{1/2}_00(Γ)': the double sine series of :mod:`.face.norms.tensor`,
@@ -30,7 +30,7 @@ from scipy import sparse
 
 from ....errors import InputError
 from .tensor import extrapolated
-from ..quadrature import triangles_rule
+from ..partitions.quadrature import triangles_rule
 from ..symmetry import ReflectedGram, reflection, transposition
 from ..spaces.triangles import lagrange_barycentric
 from ...segment.norms import N_MAX_CAP, gram_by_norm

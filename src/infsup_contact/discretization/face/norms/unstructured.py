@@ -1,6 +1,6 @@
 """Gram matrices of P_s spaces on general triangulations of Γ = (0, 1)².
 
-L²(Γ): exact, the Duffy rule of :mod:`.face.quadrature` on the triangles of G_h (degree 2s).
+L²(Γ): exact, the Duffy rule of :mod:`.face.partitions.quadrature` on the triangles of G_h (degree 2s).
 
 M = H^{1/2}_00(Γ)': the double sine series of :mod:`.face.norms.tensor`,
 ‖μ‖²_M = Σ_{m,n≥1} μ_mn² / (π√(m² + n²)), μ_mn = 2 ∬ μ sin(mπx) sin(nπy), truncated to
@@ -32,7 +32,7 @@ import numpy as np
 
 from ....errors import InputError
 from .tensor import extrapolated
-from ..quadrature import duffy_rule, triangles_rule
+from ..partitions.quadrature import duffy_rule, triangles_rule
 from .triangles import TAIL_EXPONENTS, moments, tail_key
 from ..spaces.triangles import lagrange_barycentric
 from ...segment.norms import N_MAX_CAP, gram_by_norm

@@ -1,7 +1,7 @@
 """Multiplier spaces on a tensor grid of rectangles of the face (0, 1)².
 
 :class:`CellwiseFaceSpace` puts one reference quadrilateral (QUAD4, QUAD8 or QUAD9 of
-:mod:`.face.spaces.reference_elements`) on every rectangle of a :class:`~.face.tensor_grid.TensorPartition` and numbers
+:mod:`.face.spaces.reference_elements`) on every rectangle of a :class:`~.face.partitions.tensor_grid.TensorPartition` and numbers
 the nodes globally: a node shared by neighbouring rectangles is one dof. The bases:
 
 * ``standard`` — the continuous nodal basis N;
@@ -171,7 +171,7 @@ class CellwiseFaceSpace(SpaceDefaults):
         degree ≤ :attr:`piece_degree` per variable: the cells, or for ``pwlin`` on QUAD4/QUAD9
         the cells halved in both directions (the four QUAD4 pieces); None for ``pwlin`` on
         QUAD8 (triangular pieces: no exact tensor route, :mod:`.face.norms.cellwise` refuses it)."""
-        from ..tensor_grid import TensorPartition
+        from ..partitions.tensor_grid import TensorPartition
 
         if self.basis != "pwlin":
             return self.breakpoints

@@ -27,7 +27,7 @@ from ..norms.tensor import gram_h_face
 from .tensor import FaceSpace
 from ...segment.multipliers import local_basis_space, local_shapes, reference_nodes
 from ...segment.norms import gram_l2
-from ..tensor_grid import TensorPartition
+from ..partitions.tensor_grid import TensorPartition
 
 CLIP_TOL = 1e-12
 """Cells starting within this of the cut L count as beyond it (:func:`clip_1d`, unit face)."""

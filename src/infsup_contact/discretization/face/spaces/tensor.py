@@ -1,9 +1,9 @@
 """Multiplier spaces on the face Γ = (0, 1)²: tensor products of two 1D spaces.
 
-On a tensor partition G_h = {[x_i, x_{i+1}] × [y_j, y_{j+1}]} (:class:`~.face.tensor_grid.TensorPartition`)
+On a tensor partition G_h = {[x_i, x_{i+1}] × [y_j, y_{j+1}]} (:class:`~.face.partitions.tensor_grid.TensorPartition`)
 the face analogues of the paper's spaces (eqs. (5.3), (5.5)) are M_h = M^x ⊗ M^y with M^x, M^y
 the segment's 1D space of the same case on the x and y breakpoints
-(:meth:`~.face.square.Square.space` asks the registry's 1D ``build`` for each factor):
+(:meth:`~.face.shapes.square.Square.space` asks the registry's 1D ``build`` for each factor):
 
 * T3   — Q_k continuous vanishing on ∂Γ, M^1_{0,k} ⊗ M^1_{0,k};
 * R5.2 — Q_k continuous, M^1_k ⊗ M^1_k;

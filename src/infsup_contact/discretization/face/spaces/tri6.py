@@ -39,7 +39,7 @@ TRI6_BASES = ("dual", "transformed_dual", "pwlin")
 
 def halved(partition):
     """The tensor partition with the midpoint of every interval added in x and in y."""
-    from ..tensor_grid import TensorPartition
+    from ..partitions.tensor_grid import TensorPartition
 
     return TensorPartition(*(np.sort(np.concatenate([g, 0.5 * (g[:-1] + g[1:])]))
                              for g in (np.asarray(partition.xs, float), np.asarray(partition.ys, float))))

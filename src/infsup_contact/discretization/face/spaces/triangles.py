@@ -2,7 +2,7 @@
 
 The trace on Γ of the six-tetrahedra (Kuhn) split of a structured grid is P_k on the triangles
 that the diagonal from (x_i, y_j) to (x_{i+1}, y_{j+1}) cuts every rectangle of the grid into
-(:mod:`.face.quadrature`, ``Square(cell="trig")``). The analogues of the paper's spaces
+(:mod:`.face.partitions.quadrature`, ``Square(cell="trig")``). The analogues of the paper's spaces
 (eqs. (5.3), (5.5)) on such a triangulated partition G_h are the Lagrange spaces
 
 * M^1_{0,s}: continuous P_s vanishing on ∂Γ (T3 with s = k),
@@ -118,7 +118,7 @@ class TriangleSpace(SpaceDefaults):
     @property
     def degree(self) -> int:
         """Total degree s: a coupling with a P_k trace is a polynomial of total degree k + s on
-        every piece of :func:`~.face.quadrature.split_triangles`."""
+        every piece of :func:`~.face.partitions.quadrature.split_triangles`."""
         return int(self.s)
 
     @property

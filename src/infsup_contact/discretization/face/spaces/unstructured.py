@@ -1,10 +1,10 @@
 """P_s multiplier spaces on a general triangulation G_h of the face.
 
 The spaces of :mod:`.face.spaces.triangles` (the paper's M^1_{0,s}, M^1_s, M^0_s, eqs. (5.3), (5.5),
-and the dual bases TRI3 / TRI6) on any :class:`~.face.triangulation.Triangulation`, not only on the
+and the dual bases TRI3 / TRI6) on any :class:`~.face.partitions.triangulation.Triangulation`, not only on the
 structured Kuhn triangles: the same barycentric Lagrange basis
 φ_α = Π_v Π_{a<α_v} (s λ_v − a)/(a + 1) per triangle (:func:`~.face.spaces.triangles.lagrange_barycentric`),
-glued by node coordinates for the continuous spaces (:func:`~.face.triangulation.lattice`), nodes
+glued by node coordinates for the continuous spaces (:func:`~.face.partitions.triangulation.lattice`), nodes
 on ∂Γ removed for ``vanish``; the dual basis ψ = Â N per triangle with the boundary modification
 of :class:`~.face.spaces.triangles.TriangleSpace` (its ``_dual_matrix``: dead local nodes' dual
 functions shared among the nearest live ones). The reference dual coefficients are symmetric
@@ -26,13 +26,13 @@ import scipy.sparse as sp
 from ....errors import InputError
 from ...gamma.protocol import SpaceDefaults
 from .triangles import DUAL_ELEMENTS, TriangleSpace, lagrange_barycentric, local_lattice
-from ..triangulation import Triangulation, lattice, locate, on_boundary
+from ..partitions.triangulation import Triangulation, lattice, locate, on_boundary
 
 
 @dataclass(frozen=True, eq=False)
 class MeshTriangleSpace(SpaceDefaults):
     """P_s (continuous or not, optionally vanishing on ∂Γ, optionally its dual basis) on the
-    triangles of a :class:`~.face.triangulation.Triangulation` ``breakpoints`` (G_h).
+    triangles of a :class:`~.face.partitions.triangulation.Triangulation` ``breakpoints`` (G_h).
 
     Attributes
     ----------

@@ -1,11 +1,11 @@
 """Γ = (0, 1)² × {1} traced by any tetrahedral mesh: partitions are general triangulations.
 
 :class:`TriangulatedSquare` is the third implementation of :class:`~.gamma.interface.Interface`, a
-sibling of :class:`~.face.square.Square` (whose partitions are tensor grids): the face of
+sibling of :class:`~.face.shapes.square.Square` (whose partitions are tensor grids): the face of
 unstructured (Netgen) and perturbed tetrahedral meshes, Ω1 and Ω2 meshed
 independently, so their traces do not match. Its partition is a
-:class:`~.face.triangulation.Triangulation`; the common refinement is the polygon overlay of two
-triangulations (shapely, :func:`~.face.triangulation.overlay`), fanned into triangles, on which a
+:class:`~.face.partitions.triangulation.Triangulation`; the common refinement is the polygon overlay of two
+triangulations (shapely, :func:`~.face.partitions.triangulation.overlay`), fanned into triangles, on which a
 P_k trace times a P_s multiplier is a polynomial of total degree k + s: the Duffy rule there is
 exact (:meth:`quadrature`). The multiplier spaces of the registry's Lagrange cases
 (``SpaceSpec.lagrange``, duals ``SpaceSpec.dual`` of degree 1 or 2) are P_s on the triangles of
@@ -15,7 +15,7 @@ located in its boundary element and the element's ``CalcShape`` evaluated there.
 
 Dimension counts: dim W_i (continuous P_k on trace i vanishing on ∂Γ) is the number of P_k
 lattice nodes off ∂Γ (exact); dim(W1 ∩ W2) is bounded below by the nodes whose triangles are
-triangles of both traces (:func:`~.face.triangulation.matched_interior_nodes`; exact for equal
+triangles of both traces (:func:`~.face.partitions.triangulation.matched_interior_nodes`; exact for equal
 traces, 0 for generic non-matching ones), so :meth:`trace_sum_dimension` is an upper bound of
 dim(W1 + W2) and the global count max(dim M − dim(W1 + W2), 0) a lower bound of the kernel;
 :meth:`proven_kernel` adds the modes at the corners of Γ that it misses. The counts that
@@ -28,13 +28,13 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ...errors import InputError
-from ..gamma.interface import Interface, check_choice
-from ..gamma.trace import GammaTrace
+from ....errors import InputError
+from ...gamma.interface import Interface, check_choice
+from ...gamma.trace import GammaTrace
 from .square import SQUARE_TRIG
-from .triangulation import (CORNERS, Triangulation, contains, corner_triangles, from_elements, interior_nodes,
+from ..partitions.triangulation import (CORNERS, Triangulation, contains, corner_triangles, from_elements, interior_nodes,
                             locate, matched_interior_nodes, on_boundary, overlay)
-from .quadrature import triangles_rule
+from ..partitions.quadrature import triangles_rule
 
 #: Common refinements a face keeps (by the keys of their inputs).
 _REFINEMENT_CACHE = 8
@@ -42,7 +42,7 @@ _REFINEMENT_CACHE = 8
 
 @dataclass(frozen=True)
 class TriangulatedSquare(Interface):
-    """Γ = (0, 1)² × {z} whose partitions are :class:`~.face.triangulation.Triangulation` s.
+    """Γ = (0, 1)² × {z} whose partitions are :class:`~.face.partitions.triangulation.Triangulation` s.
 
     Attributes
     ----------
@@ -86,6 +86,12 @@ class TriangulatedSquare(Interface):
         """The triangles of the Γ boundary elements of ``mesh`` (they must tile (0, 1)²)."""
         return self._partition([v for _, v in self._gamma_elements(mesh)])
 
+    def uniform_partition(self, n: int) -> Triangulation:
+        """The Kuhn triangles of the n × n grid (each cell cut by its diagonal (x_i, y_j)–(x_i+1, y_j+1))."""
+        x = np.linspace(0.0, 1.0, int(n) + 1)
+        cells = [(x[i], x[i + 1], x[j], x[j + 1]) for i in range(int(n)) for j in range(int(n))]
+        return self._partition([tri for a, b, c, d in cells for tri in (((a, c), (b, c), (b, d)), ((a, c), (b, d), (a, d)))])
+
     def common_refinement(self, *partitions, tol: float = 1e-12) -> Triangulation:
         """The overlay of the triangulations (shapely), fanned; one partition is returned as it is."""
         key = tuple(p.key for p in partitions)
@@ -117,8 +123,8 @@ class TriangulatedSquare(Interface):
 
     def sample(self, partition, per_cell: int, upper: float | None = None) -> np.ndarray:
         """The P_{per_cell} lattice points of every triangle, duplicates removed, shape (n, 2)."""
-        from .spaces.triangles import local_lattice
-        from .triangulation import glue
+        from ..spaces.triangles import local_lattice
+        from ..partitions.triangulation import glue
 
         alpha = local_lattice(max(int(per_cell), 1)).astype(float) / max(int(per_cell), 1)
         pts = np.einsum("la,tac->tlc", alpha, partition.corners).reshape(-1, 2)
@@ -182,8 +188,8 @@ class TriangulatedSquare(Interface):
 
     def gram(self, space, norm: str, h_route: str = "logkernel", **kwargs) -> tuple:
         """:func:`~.face.norms.unstructured.gram`: L² exact, H by the extrapolated double sine series
-        with exact coefficients (the only route here, as on :class:`~.face.square.Square`)."""
-        from .norms.unstructured import gram
+        with exact coefficients (the only route here, as on :class:`~.face.shapes.square.Square`)."""
+        from ..norms.unstructured import gram
 
         return gram(space, norm, **kwargs)
 
@@ -192,17 +198,20 @@ class TriangulatedSquare(Interface):
         of degree 1 or 2 (checked when built)."""
         return spec.lagrange is not None and "trig" in spec.face_cells
 
+    def check_builds(self, spec) -> None:
+        if not self.builds(spec):
+            raise InputError("case", f"a Lagrange case or its dual on a general triangulation of Γ "
+                             f"({spec.id} has no space on triangles)", got=spec.id)
+
     def space(self, spec, k: int, partition):
         """P_s on the triangles of G_h (:class:`~.face.spaces.unstructured.MeshTriangleSpace`,
         s = ``spec.degree(k)``, continuity and ∂Γ condition from ``spec.lagrange``, dual basis for
         ``spec.dual``)."""
-        from .spaces.unstructured import mesh_space
+        from ..spaces.unstructured import mesh_space
 
         if not isinstance(partition, Triangulation):
             raise InputError("multiplier mesh", f"a triangulation of Γ (case {spec.id}, k = {k})")
-        if not self.builds(spec):
-            raise InputError("case", f"a Lagrange case or its dual on a general triangulation of Γ "
-                             f"({spec.id} has no space on triangles)", got=spec.id)
+        self.check_builds(spec)
         continuous, vanish = spec.lagrange
         return mesh_space(partition, int(spec.degree(k)), continuous, vanish, spec.dual)
 
@@ -228,12 +237,12 @@ class TriangulatedSquare(Interface):
         the multipliers supported in S (dim M_S) are orthogonal to both traces but for at most
         U = dim(W1|_S + W2|_S) of them; U is bounded by the free trace dofs on the trace cells
         meeting S, and where S lies in a corner triangle of a trace
-        (:func:`~.face.triangulation.corner_triangles`) by k(k − 1)/2, the dimension of
+        (:func:`~.face.partitions.triangulation.corner_triangles`) by k(k − 1)/2, the dimension of
         (x − c_x)(y − c_y) P_{k−2}, in which every trace function vanishing on both sides through
         c lies (one space for both sides when both contain S). Σ_c max(dim M_S − U, 0) is a lower
         bound of dim ker Bᵀ (the M_S of different corners are independent)."""
         glob = max(space.dim - dim_w, 0)
-        from .spaces.unstructured import MeshTriangleSpace
+        from ..spaces.unstructured import MeshTriangleSpace
 
         if not isinstance(space, MeshTriangleSpace):
             return glob

@@ -7,7 +7,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..gamma.constants import axis_samples
+from ...gamma.constants import axis_samples
 
 
 @dataclass(frozen=True, eq=False)

@@ -2,7 +2,7 @@
 
 A :class:`Triangulation` is a vertex array and a triangle array: the trace on Γ of any
 tetrahedral mesh (Netgen's unstructured meshes, perturbed structured ones), not only the
-structured Kuhn split of :mod:`.face.square`. The coupling ∫_Γ v_i μ of a trace on one triangulation
+structured Kuhn split of :mod:`.face.shapes.square`. The coupling ∫_Γ v_i μ of a trace on one triangulation
 and a multiplier on another is polynomial on every piece of their *common refinement*, the
 overlay whose cells are the nonempty intersections T1 ∩ T2 of a triangle of each (convex
 polygons). The intersections are computed with shapely (GEOS; ``STRtree`` for the candidate
@@ -12,7 +12,7 @@ containing it) for the point location of the quadrature points (:func:`locate`).
 
 Lagrange lattices (:func:`lattice`): the P_s nodes Σ_v α_v X_v / s (|α| = s) of every triangle,
 glued by coordinates, give the continuous numbering of the P_s spaces
-(:mod:`.face.spaces.unstructured`) and the trace counts of :class:`~.face.triangulated_square.TriangulatedSquare`.
+(:mod:`.face.spaces.unstructured`) and the trace counts of :class:`~.face.shapes.triangulated_square.TriangulatedSquare`.
 """
 from __future__ import annotations
 
@@ -21,8 +21,8 @@ from functools import cached_property
 
 import numpy as np
 
-from ...errors import InputError
-from .spaces.triangles import local_lattice
+from ....errors import InputError
+from ..spaces.triangles import local_lattice
 
 #: Relative area below which an intersection polygon is a touching, not a cell.
 AREA_TOL = 1e-12

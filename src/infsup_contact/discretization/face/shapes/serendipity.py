@@ -20,11 +20,11 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from ...errors import InputError
-from ..gamma.trace import GammaTrace
-from .spaces.reference_elements import reference_element
+from ....errors import InputError
+from ...gamma.trace import GammaTrace
+from ..spaces.reference_elements import reference_element
 from .square import Square
-from .tensor_grid import TensorPartition, coarsening_cells, merge_breakpoints
+from ..partitions.tensor_grid import TensorPartition, coarsening_cells, merge_breakpoints
 
 QUAD8 = reference_element("QUAD8")
 
@@ -261,8 +261,8 @@ def _perpendicular(factor, conditions, rtol: float, vanish: bool = True) -> np.n
     P_d) on each grid of ``conditions`` ((d, breakpoints) pairs; exact Gauss rule on the common refinement)."""
     from scipy.linalg import null_space
 
-    from ..gamma.quadrature import gauss_legendre
-    from ..segment.multipliers import make_space
+    from ...gamma.quadrature import gauss_legendre
+    from ...segment.multipliers import make_space
 
     if not conditions:
         return np.eye(factor.dim)
@@ -277,8 +277,8 @@ def _perpendicular(factor, conditions, rtol: float, vanish: bool = True) -> np.n
 
 def _orthogonal_dims(factor, rtol: float) -> tuple:
     """(dim M ∩ P1_0^⊥, dim M ∩ P2_0^⊥) of a 1D space on its breakpoints (exact Gauss rule per interval)."""
-    from ..gamma.quadrature import gauss_legendre
-    from ..segment.multipliers import make_space
+    from ...gamma.quadrature import gauss_legendre
+    from ...segment.multipliers import make_space
 
     x = np.asarray(factor.breakpoints, float)
     t, w = gauss_legendre(factor.degree // 2 + 3)

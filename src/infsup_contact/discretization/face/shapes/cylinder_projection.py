@@ -24,11 +24,11 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from ...errors import InputError
-from ..segment.interface import SEGMENT
-from ..segment.projection import EXTRA_POINTS, curve_nodes, fit_curve, preimages, project
+from ....errors import InputError
+from ...segment.interface import SEGMENT
+from ...segment.projection import EXTRA_POINTS, curve_nodes, fit_curve, preimages, project
 from .cylinder import Cylinder
-from .tensor_grid import merge_breakpoints
+from ..partitions.tensor_grid import merge_breakpoints
 
 TOL = 1e-12
 """Breakpoints closer than this are one (as :meth:`~.square.Square.common_refinement` merges them)."""
@@ -118,7 +118,8 @@ def project_pair(cylinder: Cylinder, sides: list) -> list:
     partitions = tuple(s.trace.partition for s in sides)
     out = []
     for i, s in enumerate(sides):
-        view = ProjectedCylinder(cylinder.boundary, cylinder.z, cylinder.cell, cylinder.width, cylinder.radius,
-                                 cylinder.coupling, curves, partitions, i)
+        view = ProjectedCylinder(boundary=cylinder.boundary, z=cylinder.z, cell=cylinder.cell, width=cylinder.width,
+                                 radius=cylinder.radius, coupling=cylinder.coupling, curves=curves,
+                                 partitions=partitions, side=i)
         out.append(replace(s, trace=replace(s.trace, gamma=view, basis_cache={}, sparse_cache={})))
     return out

@@ -14,7 +14,7 @@ The trace of a tetrahedral mesh from the same structured grid (every rectangle c
 triangles by its diagonal from (x_i, y_j) to (x_{i+1}, y_{j+1})) has the same tensor partition;
 ``Square(cell="trig")`` is its interface (the trace basis is then P_k on triangles, not Q_k;
 its couplings are integrated on the rectangles cut by the diagonals of the trace and of G_h,
-:mod:`.face.quadrature`). There the registry's Lagrange cases (``SpaceSpec.lagrange``) are
+:mod:`.face.partitions.quadrature`). There the registry's Lagrange cases (``SpaceSpec.lagrange``) are
 P_s on the triangles of G_h (:mod:`.face.spaces.triangles`, Grams in :mod:`.face.norms.triangles`),
 the duals TRI3 / TRI6 (s ≤ 2); other spaces stay tensor products.
 """
@@ -26,16 +26,16 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from ...errors import InputError
-from ..gamma.interface import Interface, check_choice
-from ..gamma.trace import GammaTrace
-from .quadrature import split_rule
-from .tensor_grid import TensorPartition, coarsening_cells, merge_breakpoints
-from ..gamma.quadrature import gauss_legendre
+from ....errors import InputError
+from ...gamma.interface import Interface, check_choice
+from ...gamma.trace import GammaTrace
+from ..partitions.quadrature import split_rule
+from ..partitions.tensor_grid import TensorPartition, coarsening_cells, merge_breakpoints
+from ...gamma.quadrature import gauss_legendre
 
 CELL_SHAPES = ("quad", "trig", "quad8")
 """Boundary cells of a face: rectangles of Q_k hexahedra, their Kuhn triangles, QUAD8 rectangles of
-serendipity HEX20 bodies (:mod:`.face.serendipity`)."""
+serendipity HEX20 bodies (:mod:`.face.shapes.serendipity`)."""
 CELL_BODIES = {"quad": "hexahedra (element hex)", "trig": "tetrahedra (element tet)",
                "quad8": "serendipity HEX20 bodies (element hex20)"}
 """The bodies whose traces each face cell is, for the one-line refusal of a space on other bodies."""
@@ -54,7 +54,7 @@ class Square(Interface):
     cell : {"quad", "trig", "quad8"}
         Shape of the boundary elements on Γ: rectangles of a hexahedral mesh, or each
         rectangle cut in two triangles (a tetrahedral mesh); ``quad8``: the QUAD8 rectangles of
-        serendipity HEX20 bodies, whose trace is :class:`~.face.serendipity.SerendipitySquare`'s.
+        serendipity HEX20 bodies, whose trace is :class:`~.face.shapes.serendipity.SerendipitySquare`'s.
     width : float
         Γ's extent in x (1: the unit face). A narrower face (0, width) × (0, 1) is the trace
         of a narrower body (:mod:`infsup_contact.study.face.edge_dropping`); the trace
@@ -116,6 +116,10 @@ class Square(Interface):
     def partition_of(self, mesh) -> TensorPartition:
         """x and y breakpoints of the Γ boundary elements (a tensor grid, checked)."""
         return self._partition_of_elements(self._gamma_elements(mesh))
+
+    def uniform_partition(self, n: int) -> TensorPartition:
+        """The n × n tensor grid of the face (a structured trace)."""
+        return TensorPartition(np.linspace(0.0, self.width, int(n) + 1), np.linspace(0.0, 1.0, int(n) + 1))
 
     def common_refinement(self, *partitions, tol: float = 1e-12) -> TensorPartition:
         """Union of the x breakpoints and of the y breakpoints, merging within ``tol`` (for
@@ -264,7 +268,7 @@ class Square(Interface):
     def coupling_quadrature(self, trace: GammaTrace, space, degree: int) -> tuple:
         """Quadrature ``degree`` on the common refinement of the trace and G_h; for triangles
         every rectangle is cut by the diagonal of the trace cell containing it
-        (:func:`~.face.quadrature.split_rule`), exact for the P_k × Q_s products. A space that is
+        (:func:`~.face.partitions.quadrature.split_rule`), exact for the P_k × Q_s products. A space that is
         polynomial only on a finer tensor partition (its ``pieces``: 4C pwlin) is integrated on those."""
         pieces = space.pieces
         if pieces is None:
@@ -280,10 +284,10 @@ class Square(Interface):
         series (the only route on the square: ``h_route`` "logkernel", the command line's
         default, and "series" both name it; ``n_max`` > 0 in ``info`` says it is a series).
         A non-tensor space: :mod:`.face.norms.cellwise` (same norms, same series)."""
-        from .norms.cellwise import gram_cellwise
-        from .norms.tensor import gram
-        from .norms.triangles import gram as gram_triangles
-        from .spaces.triangles import TriangleSpace
+        from ..norms.cellwise import gram_cellwise
+        from ..norms.tensor import gram
+        from ..norms.triangles import gram as gram_triangles
+        from ..spaces.triangles import TriangleSpace
 
         if isinstance(space, TriangleSpace):
             return gram_triangles(space, norm, **kwargs)
@@ -292,13 +296,19 @@ class Square(Interface):
     def gram_session(self):
         """Spaces on one G_h that share a piece space reuse its series
         (:func:`~.face.norms.cellwise.shared_piece_sums`)."""
-        from .norms.cellwise import shared_piece_sums
+        from ..norms.cellwise import shared_piece_sums
 
         return shared_piece_sums()
 
     def builds(self, spec) -> bool:
         """Whether ``spec`` is defined on this face's cells (``spec.face_cells``)."""
         return self.cell in spec.face_cells
+
+    def check_builds(self, spec) -> None:
+        if not self.builds(spec):
+            own = " and ".join(CELL_BODIES.get(c, c) for c in spec.face_cells)
+            raise InputError("case", f"a space defined on the faces of {CELL_BODIES.get(self.cell, self.cell)} "
+                             f"({spec.id} is built on the faces of {own} only)", got=spec.id)
 
     def space(self, spec, k: int, partition):
         """The tensor product of ``spec``'s 1D space on xs and on ys (:class:`.face.spaces.tensor.FaceSpace`),
@@ -307,16 +317,13 @@ class Square(Interface):
         (``spec.lagrange``) is P_s on the triangles of G_h instead
         (:class:`.face.spaces.triangles.TriangleSpace`, s = ``spec.degree(k)``; a dual basis
         (``spec.dual``) for s ∈ {1, 2} only, TRI3 / TRI6: the tensor dual above)."""
-        from .spaces.tensor import FaceSpace
-        from .spaces.triangles import DUAL_ELEMENTS, TriangleSpace
+        from ..spaces.tensor import FaceSpace
+        from ..spaces.triangles import DUAL_ELEMENTS, TriangleSpace
 
         if not isinstance(partition, TensorPartition) or partition.cells < 1:
             raise InputError("multiplier mesh", f"a tensor partition of Γ with at least one rectangle "
                              f"(case {spec.id}, k = {k})")
-        if not self.builds(spec):
-            own = " and ".join(CELL_BODIES.get(c, c) for c in spec.face_cells)
-            raise InputError("case", f"a space defined on the faces of {CELL_BODIES.get(self.cell, self.cell)} "
-                             f"({spec.id} is built on the faces of {own} only)", got=spec.id)
+        self.check_builds(spec)
         if spec.face_build is not None:
             return spec.face_build(k, partition)
         s, dual = int(spec.degree(k)), spec.dual

@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..gamma.quadrature import gauss_legendre_01
+from ...gamma.quadrature import gauss_legendre_01
 
 
 def duffy_rule(degree: int) -> tuple:

@@ -28,12 +28,13 @@ R = ∞ builds the flat meshes unchanged; ``exact`` then gives the flat face's �
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from typing import Callable
 
 import numpy as np
 
-from ...errors import InputError
-from ..segment.arc import MOMENT_BONUS_INTORDER, check_curved_options
+from ....errors import InputError
+from ...segment.arc import MOMENT_BONUS_INTORDER, check_curved_options
 from .square import Square
 
 GAMMAS = ("square", "cylinder")
@@ -72,6 +73,10 @@ class Cylinder(Square):
 
     radius: float = math.inf
     coupling: str = DEFAULT_COUPLING
+    pairing: Callable | None = field(default=None, compare=False, repr=False)
+    """``pairing(cylinder, sides) -> sides`` for ``projection`` (:func:`.cylinder_projection.project_pair`),
+    given by the Γ table (:mod:`infsup_contact.discretization.spaces.gammas`), so that this module
+    does not import its subclass's."""
 
     @property
     def curved(self) -> bool:
@@ -114,20 +119,8 @@ class Cylinder(Square):
         (:func:`.cylinder_projection.project_pair`); else as built."""
         if self.coupling != "projection":
             return sides
-        from .cylinder_projection import project_pair
+        if self.pairing is None:  # a caller's slip: the Γ table builds a projected cylinder with its pairing
+            raise TypeError("a Cylinder coupled by projection is built by the Γ table (spaces.gammas.gamma_of), "
+                            "which gives it its pairing")
+        return self.pairing(self, sides)
 
-        return project_pair(self, sides)
-
-
-def cylinder_of(face: Square, gamma=None, radius=None, coupling=None):
-    """The Γ of the mesh options on a body whose flat face is ``face``: None for the flat face (no
-    option given, or ``square``), else the checked :class:`Cylinder` of its cells. Projection
-    is on tensor-product surfaces only: refused on tetrahedra, whose triangles' master images
-    are curved in the slave's parameters."""
-    check_cylinder_options(gamma, radius, coupling)
-    if gamma != "cylinder":
-        return None
-    coupling = DEFAULT_COUPLING if coupling is None else coupling
-    if coupling == "projection" and face.cell != "quad":
-        raise InputError("coupling", "exact on tetrahedra (projection: element hex)", got=coupling)
-    return Cylinder(face.boundary, face.z, face.cell, face.width, float(radius), coupling)

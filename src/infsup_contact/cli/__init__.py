@@ -178,6 +178,9 @@ def check(args):
     return estimate
 
 
+verdict_hook.use_program(build_parser=build_parser, parse=parse, check=check, message=_message)
+
+
 def validate(argv) -> tuple:
     """Parse and validate a command line without computing: ``(args, estimate)``; raises
     InputError/TableError (bad values) or SystemExit(2) (argparse: unknown flag, wrong type)."""

@@ -3,7 +3,8 @@ from __future__ import annotations
 
 from ..errors import InputError
 from .common import FlagUse, add_dry_run, check_memory, declare_flag_uses, write_csv
-from .verdict_formats import add_table_output, force_use, is_stream, output_path
+from .common import is_stream
+from .verdict_formats import add_table_output, force_use, output_path
 
 
 def add(sub) -> None:

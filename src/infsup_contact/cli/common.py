@@ -3,6 +3,7 @@ model and its material flags, the norms, --dry-run and the memory check."""
 from __future__ import annotations
 
 import argparse
+import os
 from dataclasses import dataclass
 from typing import Callable
 
@@ -251,11 +252,46 @@ def write_text(text: str) -> None:
         raise OutputError(f"cannot write the result to standard output ({reason})") from None
 
 
+def is_stream(path) -> bool:
+    """A device, pipe or open descriptor (``/dev/stdout``, ``/dev/fd/3``, a FIFO), written as it
+    is: nothing to replace, no temporary file beside it. ``/dev/stdout`` of a shell redirected
+    to a file resolves to that regular file, so the name decides first."""
+    import stat
+    from pathlib import Path
+
+    text = str(Path(path).absolute())
+    if text in ("/dev/stdout", "/dev/stderr") or text.startswith(("/dev/fd/", "/proc/self/fd/")):
+        return True
+    try:
+        mode = os.stat(path).st_mode
+        return stat.S_ISCHR(mode) or stat.S_ISFIFO(mode) or stat.S_ISSOCK(mode)
+    except OSError:
+        return False
+
+
+
+def write_result(text: str, output) -> None:
+    """``text`` on stdout (``output`` None or ``-``), into a device or pipe as it is
+    (``/dev/stdout``: a rename would replace the device node), else into the file ``output``
+    atomically (:func:`infsup_contact.io.write_bytes_atomic`); UTF-8 whatever the locale."""
+    from ..io import write_bytes_atomic
+
+    if output in (None, "-"):
+        write_text(text)
+        return
+    try:
+        if is_stream(output):
+            with open(output, "wb") as fh:
+                fh.write(text.encode("utf-8"))
+        else:
+            write_bytes_atomic(output, text.encode("utf-8"))
+    except OSError as err:
+        raise OutputError(f"cannot write the result to {output} ({err.strerror or err})") from None
+
+
 def write_csv(frame, float_format: str, output=None) -> None:
     """A result table as CSV on stdout (:func:`write_text`), or atomically into ``output``
     (``--output FILE``, checked before the computation: :func:`.verdict_formats.check_outputs`)."""
-    from .verdict_formats import write_result
-
     write_result(frame.to_csv(index=False, float_format=float_format), output)
 
 

@@ -23,6 +23,8 @@ import os
 import re
 from dataclasses import dataclass, field
 
+from .common import is_stream, write_result
+
 FORMATS = ("csv", "json", "junit")
 CLASSNAME = "infsup-contact"
 SCHEMA = "infsup-contact-verdict/1"
@@ -115,23 +117,6 @@ def output_path(text: str) -> str:
     if problem:
         raise argparse.ArgumentTypeError(f"{text!r}: {problem}")
     return text
-
-
-def is_stream(path) -> bool:
-    """A device, pipe or open descriptor (``/dev/stdout``, ``/dev/fd/3``, a FIFO), written as it
-    is: nothing to replace, no temporary file beside it. ``/dev/stdout`` of a shell redirected
-    to a file resolves to that regular file, so the name decides first."""
-    import stat
-    from pathlib import Path
-
-    text = str(Path(path).absolute())
-    if text in ("/dev/stdout", "/dev/stderr") or text.startswith(("/dev/fd/", "/proc/self/fd/")):
-        return True
-    try:
-        mode = os.stat(path).st_mode
-        return stat.S_ISCHR(mode) or stat.S_ISFIFO(mode) or stat.S_ISSOCK(mode)
-    except OSError:
-        return False
 
 
 def check_writable_place(folder) -> str | None:
@@ -247,26 +232,6 @@ def check_not_an_input(output, args) -> None:
     if any(p.resolve() == target for p in inputs):
         raise InputError("output", "a file other than the inputs of the request (it would be overwritten)",
                          got=str(output))
-
-
-def write_result(text: str, output) -> None:
-    """``text`` on stdout (``output`` None or ``-``), into a device or pipe as it is
-    (``/dev/stdout``: a rename would replace the device node), else into the file ``output``
-    atomically (:func:`infsup_contact.io.write_bytes_atomic`); UTF-8 whatever the locale."""
-    from ..io import write_bytes_atomic
-    from .common import OutputError, write_text
-
-    if output in (None, "-"):
-        write_text(text)
-        return
-    try:
-        if is_stream(output):
-            with open(output, "wb") as fh:
-                fh.write(text.encode("utf-8"))
-        else:
-            write_bytes_atomic(output, text.encode("utf-8"))
-    except OSError as err:
-        raise OutputError(f"cannot write the result to {output} ({err.strerror or err})") from None
 
 
 def render(result: VerdictResult, fmt: str) -> str:

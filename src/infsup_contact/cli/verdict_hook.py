@@ -19,6 +19,17 @@ from .common import declare_flag_uses, write_text
 from .program import report_internal_error
 from .verdict import VERDICT_DEFAULTS
 
+_PROGRAM = {}
+"""The command-line program the hook runs ``verdict`` through: ``build_parser``, ``parse``,
+``check``, ``message`` (:func:`use_program`, called by the package that registers the hook: the
+hook does not import its own package, which imports it)."""
+
+
+def use_program(**functions) -> None:
+    """Give the hook the program's ``build_parser``, ``parse``, ``check`` and ``message``."""
+    _PROGRAM.update(functions)
+
+
 DEFAULT_EXPECT = "stable"
 """A manifest without ``expect:`` is expected STABLE (a hook that passed UNSTABLE would gate nothing)."""
 
@@ -48,9 +59,9 @@ def check_hook(args):
     check_criterion(args.slope_tolerance, args.beta_floor, args.confidence)
     if not args.dry_run:
         return None  # a real run checks each manifest itself and goes on after a refused one
-    from . import build_parser, check, parse
-
     from ..systems.readers import SystemFileError
+
+    build_parser, check, parse = _PROGRAM["build_parser"], _PROGRAM["check"], _PROGRAM["parse"]
 
     estimates = []
     for path in args.manifests:
@@ -65,8 +76,9 @@ def check_hook(args):
 def check_one(path: str, criterion: dict) -> tuple[int, str]:
     """(exit code, line) of one manifest: 0 or 1 and its verdict line; 2 and the error line
     (70 from :func:`run_hook`, where an unexpected exception is caught)."""
-    from . import build_parser, check, parse
     from ..systems.levels import system_verdict
+
+    build_parser, check, parse = _PROGRAM["build_parser"], _PROGRAM["check"], _PROGRAM["parse"]
 
     argv = ["verdict", f"--system={path}", *(f"--{k.replace('_', '-')}={v!r}" for k, v in criterion.items())]
     parser = build_parser()
@@ -76,9 +88,7 @@ def check_one(path: str, criterion: dict) -> tuple[int, str]:
         row, _ = system_verdict(args.manifest, tol=args.slope_tolerance, floor=args.beta_floor,
                                 confidence=args.confidence, notes=sys.stderr)
     except (InputError, TableError) as err:
-        from . import _message
-
-        return 2, f"infsup-contact: error: {_message(err, parser, 'verdict')}"
+        return 2, f"infsup-contact: error: {_PROGRAM['message'](err, parser, 'verdict')}"
     expect = args.manifest.expect or DEFAULT_EXPECT
     ok = row["verdict"] == expect.upper()
     line = (f"{path}: {row['verdict']} ({'as expected' if ok else 'expected ' + expect.upper()}); "

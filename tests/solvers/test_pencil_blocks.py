@@ -65,8 +65,8 @@ def test_rows_equal_the_route_before(monkeypatch, k, n1, n2, cases, element):
 
 def test_a_pencil_that_is_not_invariant_is_solved_whole():
     """An S with a block across components above INVARIANCE_RTOL: no split (None)."""
-    from infsup_contact.discretization.face.square import SQUARE
-    from infsup_contact.discretization.face.tensor_grid import TensorPartition
+    from infsup_contact.discretization.face.shapes.square import SQUARE
+    from infsup_contact.discretization.face.partitions.tensor_grid import TensorPartition
     from infsup_contact.discretization.spaces import registry
 
     xs = np.linspace(0.0, 1.0, 5)
@@ -113,3 +113,34 @@ def test_the_components_kernel_is_the_whole_svds(case, k, n1, n2):
     assert blocked.margin_decades == pytest.approx(whole.margin_decades, rel=1e-9)
     if whole.dim:
         assert symmetry.split_dense_kernel(W, split, 0) is None
+    # with vectors (the large route's fallback when a block's certificate is too close to round-off):
+    # the same decision, and an orthonormal basis of the same kernel as the whole SVD's
+    with_vectors = symmetry.split_dense_kernel(W, split, structural, vectors=True)
+    assert (with_vectors.dim, with_vectors.margin_decades) == (blocked.dim, blocked.margin_decades)
+    V = with_vectors.vectors
+    assert V.shape == (W.shape[1], whole.dim)
+    np.testing.assert_allclose(V.T @ V, np.eye(whole.dim), atol=1e-12)
+    assert np.linalg.norm(W @ V) <= max(whole.tol, 1e-300) * max(whole.dim, 1)
+    if whole.dim:  # the same subspace: the projector onto the whole SVD's kernel fixes V
+        Vw = coupling_kernel(W, structural, vectors=True).vectors
+        np.testing.assert_allclose(Vw @ (Vw.T @ V), V, atol=1e-10)
+
+
+def test_the_large_route_takes_the_blocks_svds_where_a_certificate_fails(monkeypatch):
+    """R5.4 on a symmetric face (kernel from ∂Γ's lines): with every block's certificate refused
+    (as at k = 2, N = 48, where σ_{d+1}² comes within the floor of round-off), the large route
+    decides on the blocks' dense SVDs, not the whole W's, and the row is the dense route's."""
+    from infsup_contact.solvers import kernel as kernel_mod
+    from infsup_contact.solvers import routes
+
+    request = BetaRequest("structured", 1, 4, 4, ("R5.4",), ("omega2",), ((1.0, 1.0),), ("H",),
+                          model=MODELS["membranes3d"], mesh=MeshOptions(element="hex"))
+    dense = beta_table(request)
+    monkeypatch.setattr(routes, "is_large", lambda space: True)
+    monkeypatch.setattr(symmetry, "certified_bottom", lambda *a, **kw: None)
+    whole = []
+    monkeypatch.setattr(routes, "bottom_kernel", lambda *a, **kw: whole.append(1) or kernel_mod.bottom_kernel(*a, **kw))
+    large = beta_table(request)
+    assert not whole, "the whole W's SVD decided"
+    assert large[0]["kernel_dim"] == dense[0]["kernel_dim"] > 0
+    assert large[0]["beta"] == pytest.approx(dense[0]["beta"], abs=1e-12)

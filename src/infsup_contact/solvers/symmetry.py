@@ -97,7 +97,7 @@ def split_bottom_kernel(W, split: ReflectionSplit, proven: int = 0, entry_error:
 
 
 def split_dense_kernel(W: np.ndarray, split: ReflectionSplit, proven: int = 0,
-                       entry_error: float = 0.0) -> KernelDecision | None:
+                       entry_error: float = 0.0, vectors: bool = False) -> KernelDecision | None:
     """:func:`~.kernel.coupling_kernel` of a dense W (trace dofs × multipliers) from the singular
     values of its components' columns W Q_c (about (1/c)² of the whole SVD's flops), or None (the
     caller's dense SVD decides).
@@ -116,7 +116,8 @@ def split_dense_kernel(W: np.ndarray, split: ReflectionSplit, proven: int = 0,
     And only where d is exactly the proven count: the margin is then log10(σ_{d+1}/η), a value
     above round-off, which the blocks give to its relative ‖O‖/σ_{d+1}²; where modes beyond the
     proof would be counted the margin rests on a round-off singular value, and the whole SVD
-    reports it as before (None)."""
+    reports it as before (None). ``vectors``: also the kernel's basis, the blocks' right singular
+    vectors below η mapped by Q_c (orthonormal: the Q_c are)."""
     W = np.asarray(W, float)
     rows, m = W.shape
     proven = int(max(proven, m - rows, 0))
@@ -126,7 +127,13 @@ def split_dense_kernel(W: np.ndarray, split: ReflectionSplit, proven: int = 0,
     off2 = sum(float(np.linalg.norm(blocks[a].T @ blocks[b])) ** 2
                for b in range(len(blocks)) for a in range(b) if blocks[a].shape[1] and blocks[b].shape[1])
     cross = float(np.sqrt(2.0 * off2))  # ‖O‖_F: each off-diagonal block counted twice
-    s = [sla.svdvals(B, check_finite=True) for B in blocks if B.shape[1]]  # LAPACK, as coupling_kernel
+    live = [(B, Q) for B, Q in zip(blocks, split.bases) if B.shape[1]]
+    if vectors:  # each block's SVD with its right vectors, ascending (structural zeros first)
+        svds = [sla.svd(B, full_matrices=B.shape[1] > B.shape[0], check_finite=True)[1:] for B, _ in live]
+        per_block = [np.concatenate([np.zeros(B.shape[1] - len(sb)), np.sort(sb)]) for (B, _), (sb, _) in zip(live, svds)]
+        s = per_block
+    else:
+        s = [sla.svdvals(B, check_finite=True) for B, _ in live]  # LAPACK, as coupling_kernel
     s = np.sort(np.concatenate([np.zeros(m - sum(len(v) for v in s))] + s))
     s_max = float(s[-1])
     tol = error_level(rows, m, s_max, entry_error)
@@ -137,4 +144,11 @@ def split_dense_kernel(W: np.ndarray, split: ReflectionSplit, proven: int = 0,
     above = s[numerical] ** 2 - cross > tol ** 2 if numerical < m else True
     if not (below and above):
         return None
-    return decide(s, proven, tol, numerical, s_max)
+    if not vectors:
+        return decide(s, proven, tol, numerical, s_max)
+    basis = []
+    for (B, Q), (sb, vt), asc in zip(live, svds, per_block):
+        d_b = int(np.sum(asc <= tol))
+        if d_b:
+            basis.append(np.asarray(Q @ vt[::-1][:d_b].T))  # rows of vt descending: the smallest last
+    return decide(s, proven, tol, numerical, s_max, np.hstack(basis) if basis else np.zeros((m, 0)))

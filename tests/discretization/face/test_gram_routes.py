@@ -15,8 +15,8 @@ import scipy.linalg as sla
 
 from infsup_contact.discretization.face.norms import cellwise as fc
 from infsup_contact.discretization.face.norms import tensor as fn
-from infsup_contact.discretization.face.square import SQUARE
-from infsup_contact.discretization.face.tensor_grid import TensorPartition
+from infsup_contact.discretization.face.shapes.square import SQUARE
+from infsup_contact.discretization.face.partitions.tensor_grid import TensorPartition
 from infsup_contact.discretization.segment.multipliers import make_space
 from infsup_contact.discretization.face.spaces.tensor import FaceSpace
 from infsup_contact.discretization.spaces import registry

@@ -298,8 +298,14 @@ class Interface(abc.ABC):
 
     @abc.abstractmethod
     def multiplier_cells(self, n1: int, n2: int, choice: str = "omega2") -> int:
-        """Cells of G_h (an int) when the traces of Ω1 and Ω2 are uniform with ``n1`` and ``n2``
-        cells, ``choice`` one of omega2, omega1, union (the emptiness checks, the sizing model)."""
+        """Cells of G_h when the traces of Ω1 and Ω2 are uniform with ``n1`` and ``n2`` cells,
+        ``choice`` one of omega2, omega1, union (the emptiness checks, the sizing model).
+
+        Returns
+        -------
+        int
+            the number of cells of the multiplier partition G_h.
+        """
 
     # --- derived, shared by every implementation ----------------------------------------------
     def proven_kernel(self, space, k: int, traces, dim_w: int) -> int:

@@ -182,16 +182,19 @@ def test_k3_keeps_the_general_route(element):
 
 
 @pytest.mark.parametrize("element", ("hex", "hex20"))
-def test_a_scene_side_keeps_its_parts_factors_for_solves(monkeypatch, element):
-    """A contact scene's side (``keep_factor``: PARDISO's interior factor kept where it loads) solves
-    with the parts' factors: the general route's solutions."""
+def test_a_scene_side_keeps_the_general_route(monkeypatch, element):
+    """A contact scene's side (``keep_factor``) is factorized whole even where the body is symmetric:
+    the ledger's patch tests print round-off quantities, which must not move with a β_h speed-up;
+    its S is the general route's, bit for bit."""
     from types import SimpleNamespace
 
     from infsup_contact.la import schur
 
     monkeypatch.setattr(schur, "SOLVES_MAX_WORK", 0)  # the large bodies' route (PARDISO, else SuperLU) at N = 3
     body = m3.subdomain_mesh("structured", 3, 1, element=element)
+    assert m3.side_operator(body, 2).route == "parity 4"  # the β_h side of the same body: its parts
     scene = SimpleNamespace(supports=m3.FAR)
     side = m3.scene_side(scene, body, 2)
     reference = _general(monkeypatch, lambda: m3.scene_side(scene, body, 2))
-    assert side.route == "parity 4" and _close(side.schur, reference.schur) and _solves_agree(side, reference)
+    assert side.route == reference.route != "parity 4"
+    assert np.array_equal(side.schur, reference.schur) and _solves_agree(side, reference)

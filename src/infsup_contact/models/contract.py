@@ -330,9 +330,12 @@ def factorized_side(trace: GammaTrace, free: np.ndarray, K, route: str = "auto",
     the flops); any other body, or no signature, takes the general route. ``parts_map`` runs the
     parts' factorizations, independent calls (default :func:`~infsup_contact.la.threaded.concurrent_map`:
     side by side on the request's threads, one BLAS thread each, in turn inside another task; the
-    built-in ``map``: one by one)."""
+    built-in ``map``: one by one). A side that will solve (``keep_factor``: a contact scene's)
+    keeps the general route: its solves agree with the parity route's to round-off only, and the
+    ledger's patch tests print round-off quantities (R5.4's λ error on tetrahedra sits within 2× of
+    its 1e-8 threshold), which must not move with the route of a β_h speed-up."""
     n_gamma = len(trace.gamma_dofs)
-    bases = body_symmetry.parity_bases(signature, K, n_gamma)
+    bases = None if keep_factor else body_symmetry.parity_bases(signature, K, n_gamma)
     if bases is not None:
         parts = body_parity.parity_parts(K, n_gamma, bases)
         S, solve, X = parts.factorize(

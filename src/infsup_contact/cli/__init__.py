@@ -230,7 +230,8 @@ def _main(argv) -> int:
                        + (f" (available memory {human_bytes(avail)})" if avail is not None else "") + "\n")
             return 0
         _fit_blas_threads()
-        _reuse_freed_memory(estimate)
+        if argv is None:  # the process is this command line: in-process callers (tests, notebooks) keep glibc's malloc
+            _reuse_freed_memory(estimate)
         code = reporting.run(args)  # args.run with its progress on stderr (not --quiet)
     except (InputError, TableError) as err:
         _say(f"infsup-contact: error: {_message(err, parser, args.command)}")

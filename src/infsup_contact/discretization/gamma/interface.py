@@ -5,9 +5,8 @@ dimension, the partitions G_h (the trace of Ω1, of Ω2, their common refinement
 multiplier partition chosen from them), the trace dofs of a side, quadrature on a partition,
 the values of a side's trace basis at points of Γ, the Gram matrices of its norms (L² and the
 exact H^{-1/2}_00) and the dimension counts the kernel proof, the registry and the sizing model
-use. Multiplier spaces are built on it: ``registry.case_space(case, k, partition, gamma)``
-builds a registered space on a partition of ``gamma`` (the registry imports this module, never
-the other way round).
+use. Multiplier spaces are built on it: ``registry.case_space(case, k, partition, gamma)`` builds
+a registered space on a partition of ``gamma`` (the registry imports this module, not the reverse).
 
 Coupling, β_h, contact and the scenes ask the interface and never take a partition apart (it is
 opaque: obtained from the interface, handed back to it); a side's trace carries its interface
@@ -298,13 +297,11 @@ class Interface(abc.ABC):
 
     @abc.abstractmethod
     def multiplier_cells(self, n1: int, n2: int, choice: str = "omega2") -> int:
-        """Cells of G_h when the traces of Ω1 and Ω2 are uniform with ``n1`` and ``n2`` cells,
-        ``choice`` one of omega2, omega1, union (the emptiness checks, the sizing model).
+        """Cells of G_h for uniform traces of ``n1``, ``n2`` cells, ``choice`` omega2, omega1 or union.
 
         Returns
         -------
         int
-            the number of cells of the multiplier partition G_h.
         """
 
     # --- derived, shared by every implementation ----------------------------------------------

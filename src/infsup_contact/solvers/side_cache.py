@@ -36,7 +36,6 @@ from collections import Counter, OrderedDict
 import numpy as np
 
 from .. import progress
-from ..la.threaded import run_concurrently
 from .request import NO_OPTIONS, MeshOptions
 
 
@@ -70,14 +69,12 @@ class SideCache:
         """[side operator of Ω1 (N1 segments on Γ), side operator of Ω2 (N2)]. The arguments are
         a validated request's (:class:`~.request.BetaRequest`) or checked by the mesh builder."""
         key1, key2 = side_keys(model, family, k, n1, n2, mesh)
-        if n1 == n2 and getattr(model, "mirror_side", None) is not None:
-            # a matching pair: side 2 is side 1 mirrored (checked), so side 1 first; its parity
-            # parts take the cores (factorized_side's parts_map)
-            side1 = self._get(key1)
-            sides = [side1, self._get(key2, mirror_of=side1)]
-        else:
-            # two independent sides (meshing, assembly, factorization release the GIL): side by side
-            sides = run_concurrently([lambda key=key: self._get(key) for key in (key1, key2)])
+        # one side after the other: building two sides side by side in threads aborted the process
+        # (NGSolve's meshing and assembly are not thread-safe); the parallel work is inside a side
+        # (a body's parity parts, PARDISO's threads)
+        side1 = self._get(key1)
+        mirror = n1 == n2 and getattr(model, "mirror_side", None) is not None
+        sides = [side1, self._get(key2, mirror_of=side1 if mirror else None)]
         return sides[0].trace.gamma.paired(sides)  # a Γ coupled by projection ties the two
 
     def _get(self, key, mirror_of=None):

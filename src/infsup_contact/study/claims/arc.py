@@ -26,6 +26,7 @@ import pandas as pd
 from ...criteria.claims import FAIL, FINDING, PASS, kernel_claim, row
 from ...criteria.stability import INCONCLUSIVE as UNDECIDED
 from ..beta.arc import PAPER, arc_verdicts, radius_of
+from .tolerance import within
 
 REF = "beyond the paper (the curved segment)"
 ROW_KEY = ["series", "case", "k", "N1", "N2", "multiplier_mesh", "c1", "c2", "norm"]
@@ -49,7 +50,7 @@ def _bitwise(joined: pd.DataFrame):
 def _round_off(joined: pd.DataFrame):
     gap = np.abs(joined.beta - joined.beta_paper).max() / joined.beta_paper.max()
     kernels = (joined.kernel_dim == joined.kernel_dim_paper).all()
-    text = f"{len(joined)} rows: kernels {'equal' if kernels else 'DIFFER'}, max |Δβ|/max β = {gap:.2e}"
+    text = f"{len(joined)} rows: kernels {'equal' if kernels else 'DIFFER'}, {within('max |Δβ|/max β', gap, FLAT_PROJECTION_TOLERANCE)}"
     return (PASS if len(joined) and kernels and gap <= FLAT_PROJECTION_TOLERANCE else FAIL), text
 
 

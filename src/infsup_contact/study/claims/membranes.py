@@ -11,14 +11,15 @@ import pandas as pd
 from ...discretization.spaces.registry import PAPER_CASES, SIGN_CHECK_SPACE, SPACES
 from ...criteria.claims import (BEYOND, COLUMNS, FAIL, INCONCLUSIVE, PASS, bounded_claim, finest, kernel_at_least, kernel_claim,
                        ns_text, predicted_kernel, row, seeds_text, slope_verdict)
+from .tolerance import LOWER, within
 
 
 def sufficiency_claim(beta: pd.DataFrame, atol: float = 1e-6):
     """(5.10) is sufficient: β_h >= β_h restricted to v = (0, v2), on every row (up to the
     round-off floor of a β that is 0: sqrt of 1e-16 relative eigenvalue noise)."""
-    gap = beta.beta - beta.beta_v1_zero
+    gap = beta.beta - beta.beta_v1_zero  # 0 up to round-off where the two are equal: stated against -atol
     return (PASS if (gap >= -atol).all() else FAIL), (
-        f"{len(beta)} rows; min β_h − β_h(v1 = 0) = {gap.min():.3g}")
+        f"{len(beta)} rows; {within('min β_h − β_h(v1 = 0)', gap.min(skipna=False), -atol, LOWER)}")
 
 
 def nonmatching_claim(beta: pd.DataFrame, finer: bool, families=None, rtol: float = 1e-8, series=None):

@@ -45,6 +45,7 @@ from ...discretization.spaces.registry import SPACES
 from ...discretization.face.partitions.tensor_grid import TensorPartition
 from ...criteria.claims import COLUMNS, FAIL, FINDING, INCONCLUSIVE, PASS, row, slope_verdict
 from .membranes3d import REF, face_dimension
+from .tolerance import within
 
 STUDY_CLAIM_PREFIXES = ("face-patch-", "face-alpha-", "face-edge-")
 """Every claim id this module writes starts with one of these (and no claim of the face's β table
@@ -106,13 +107,15 @@ def patch_prediction(spec, k: int, gamma, pairs) -> str:
 
 def patch_verdict(rc: pd.DataFrame):
     """λ_h = λ and u_h = u to :data:`PATCH_RTOL` on every pair of a patch table (any model's)."""
-    err = np.maximum(rc.lambda_max_rel_error.to_numpy(float), rc.u_max_rel_error.to_numpy(float))
-    err = np.where(np.isfinite(err), err, np.inf)
+    lam, u = (np.where(np.isfinite(e), e, np.inf) for e in (rc.lambda_max_rel_error.to_numpy(float),
+                                                            rc.u_max_rel_error.to_numpy(float)))
+    err = np.maximum(lam, u)
     verdict = PASS if np.all(err <= PATCH_RTOL) else FAIL if np.any(err >= PATCH_FAIL_RTOL) else INCONCLUSIVE
     pairs = " ".join(f"{a}:{b}" for a, b in zip(rc.N1, rc.N2))
-    return verdict, (f"max |λ_h − λ|/λ = {rc.lambda_max_rel_error.max():.3g}, max |u_h − u|/δ = "
-                     f"{rc.u_max_rel_error.max():.3g} on {pairs} (pass <= {PATCH_RTOL:g}, fail >= "
-                     f"{PATCH_FAIL_RTOL:g}); kernel dims {sorted(set(rc.kernel_dim.astype(int).tolist()))}")
+    # round-off when passing: stated against the tolerance, printed only where not (.tolerance)
+    return verdict, (f"on {pairs}: {within('max |λ_h − λ|/λ', lam.max(), PATCH_RTOL)}; "
+                     f"{within('max |u_h − u|/δ', u.max(), PATCH_RTOL)} (fail >= {PATCH_FAIL_RTOL:g}); "
+                     f"kernel dims {sorted(set(rc.kernel_dim.astype(int).tolist()))}")
 
 
 def patch_claims(patch: pd.DataFrame, interfaces: dict) -> list:
@@ -237,7 +240,7 @@ def edge_claims(edge: pd.DataFrame, cfg: dict, fit_theta_max: float) -> list:
             rel = np.abs(both.beta_L2_kappa.to_numpy(float) / both.beta_L2.to_numpy(float) - 1.0)
             worst = float(np.max(rel)) if np.all(np.isfinite(rel)) else np.inf
             v = PASS if worst <= INVARIANCE_RTOL else FAIL if worst > INVARIANCE_FAIL_RTOL else INCONCLUSIVE
-            text = f"max |β_κ/β − 1| = {worst:.3g} over {len(both)} of {len(rc)} θ (both resolved)"
+            text = f"{within('max |β_κ/β − 1|', worst, INVARIANCE_RTOL)} over {len(both)} of {len(rc)} θ (both resolved)"
         else:
             v, text = INCONCLUSIVE, "no θ where both routes are resolved"
         out.append(row(edge_claim_id("kappa-beta", case, k, n), REF,

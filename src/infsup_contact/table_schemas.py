@@ -175,3 +175,119 @@ SCHEMAS = {
                              label="a Snakemake benchmark file", sep="\t"),
 }
 """The declared tables (:func:`read_table`): one :class:`Schema` per kind."""
+
+
+# ------------------------------------------------------------------ round-off columns
+# What two results trees may differ in and still agree (workflow/scripts/compare_results.py):
+# columns whose numbers are round-off-level by what they measure. Their digits follow the route
+# that computed them (a body factorized in parity blocks, another H-Gram route) and the machine
+# (OpenBLAS and MKL pick code paths by CPU), while every β_h, kernel and verdict stays the same.
+# Every other column is compared as text, character by character.
+
+_EPS = 2.220446049250313e-16
+
+
+class RoundOff:
+    """A round-off-level column: two values a, b agree when |a − b| <= ``atol`` + ``rtol`` ·
+    max(|a|, |b|) + the row's own term (``per_row``: ``"sqrt_eta"`` or ``"cond"``, below).
+
+    ``where`` (column, value): the rule holds on the rows where that column has that value
+    (``"> 0"``: a positive number; ``"True"``/``"False"``: a flag) in both trees; elsewhere the
+    column is compared as text. ``reason`` says what the column measures and why its digits are
+    round-off; :meth:`describe` is the tolerance as the compare script prints it."""
+
+    def __init__(self, reason: str, rtol: float = 0.0, atol: float = 0.0, where: tuple | None = None,
+                 per_row: str | None = None):
+        self.reason, self.rtol, self.atol, self.where, self.per_row = reason, rtol, atol, where, per_row
+
+    def applies(self, row_a: dict, row_b: dict) -> bool:
+        """Whether the rule holds on this pair of rows (``where`` true in both)."""
+        if self.where is None:
+            return True
+        column, value = self.where
+        return all(_holds(r.get(column, ""), value) for r in (row_a, row_b))
+
+    def tolerance(self, a: float, b: float, row_a: dict, row_b: dict) -> float:
+        """The allowed |a − b| on this pair of rows."""
+        size = max(abs(a), abs(b))
+        tol = self.atol + self.rtol * size
+        if self.per_row == "sqrt_eta":
+            tol += _sqrt_eta_term(size, row_a, row_b)
+        elif self.per_row == "cond":
+            tol += _EPS * size * size
+        return tol
+
+    def describe(self) -> str:
+        parts = [f"{self.atol:g}" if self.atol else "", f"{self.rtol:g}·|x|" if self.rtol else "",
+                 {"sqrt_eta": "min(sqrt(η), 10 η/|x|)", "cond": "ε·x²", None: ""}[self.per_row]]
+        text = " + ".join(p for p in parts if p) or "0"
+        return text + (f" where {self.where[0]} {self.where[1]}" if self.where else "")
+
+
+def _holds(cell: str, value: str) -> bool:
+    if value == "> 0":
+        try:
+            return float(cell) > 0
+        except ValueError:
+            return False
+    return cell == value
+
+
+def _sqrt_eta_term(size: float, row_a: dict, row_b: dict) -> float:
+    """A square root of a pencil eigenvalue s = sqrt(λ) whose λ is known to η = n ε λ_max: η from the
+    row itself, s²/gap_over_roundoff (gap = λ/η); s is then known to η/(2s) where s >> sqrt(η), to
+    sqrt(η) where not (a factor 10 on the first: the Gram routes' own relative differences)."""
+    etas = []
+    for r in (row_a, row_b):
+        try:
+            s, gap = float(r["smallest_nonzero"]), float(r["gap_over_roundoff"])
+        except (KeyError, ValueError):
+            continue
+        if gap > 0 and gap != float("inf"):
+            etas.append(s * s / gap)
+    if not etas:
+        return 0.0
+    eta = max(etas)
+    return min(eta ** 0.5, 10 * eta / size) if size > 0 else eta ** 0.5
+
+
+_GRAM_BOUND = RoundOff(
+    "the H Gram's stated bound on the relative error of every pencil eigenvalue (la/richardson.py): "
+    "the difference of two partial sums, whose own digits follow the route's round-off; it is checked "
+    "against the Gram's rtol (1e-6), and one decimal of it is what it states", rtol=1e-4, atol=1e-12)
+_COND = RoundOff(
+    "a condition number κ from the extreme eigenvalues: the smallest carries an absolute error ~ ε λ_max, "
+    "so κ a relative one ~ ε κ (beyond 1/ε: singular to working precision, any value)", rtol=1e-9, per_row="cond")
+_PATCH = RoundOff(
+    "a patch test's error where the row passes: round-off below the table's pass bound (1e-10 on the "
+    "segment, 1e-8 on the face), which the row's passes flag certifies", atol=1e-8, where=("passes", "True"))
+
+
+def _unresolved(norm: str) -> RoundOff:
+    return RoundOff(f"β of the edge table where beta_{norm}_resolved is False: β² below the pencil's round-off "
+                    "level (study/face/edge_dropping.py), its digits are noise", atol=float("inf"),
+                    where=(f"beta_{norm}_resolved", "False"))
+
+
+ROUNDOFF_COLUMNS = {
+    "nmax_rel_error": _GRAM_BOUND,
+    "h_rel_error": _GRAM_BOUND,                    # the edge table's name for it
+    "gap_over_roundoff": RoundOff(
+        "λ_{d+1}/η: the first pencil eigenvalue above the kernel in units of the pencil's round-off level "
+        "η = n ε λ_max; an eigenvalue is known to about η, i.e. to about 1 in these units, and λ_max to "
+        "its relative round-off; it is read in decades (kernel_margin_decades)", rtol=1e-8, atol=1.0),
+    "smallest_nonzero": RoundOff(
+        "where kernel_dim > 0: β above the kernel, the square root of a pencil eigenvalue known to "
+        "η = smallest_nonzero²/gap_over_roundoff (a round-off value where gap_over_roundoff < 1); where "
+        "kernel_dim = 0 it is β and compared as text", rtol=1e-10, where=("kernel_dim", "> 0"), per_row="sqrt_eta"),
+    "beta_v1_zero": RoundOff(
+        "β_h with v1 = 0 ((5.10)): 0 where the restricted pencil has a kernel, where the computed value "
+        "is the square root of an eigenvalue's round-off (η <= 1e-14 here: up to 1e-7); elsewhere a β, "
+        "to 1e-10 relative", rtol=1e-10, atol=1e-7),
+    **{f"cond_{m}{s}": _COND for m in "DSG" for s in ("", "_kappa", "_unit")},
+    **{c: _PATCH for c in ("lambda_max_rel_error", "lambda_end_rel_error", "lambda_middle_rel_error",
+                            "u_max_rel_error")},
+    "beta_H": _unresolved("H"), "beta_L2": _unresolved("L2"), "beta_L2_kappa": _unresolved("L2_kappa"),
+}
+"""Columns compared to a stated error instead of as text (workflow/scripts/compare_results.py), by
+name: the same name is the same quantity in every table that has it."""

@@ -161,6 +161,8 @@ def build(declared: Declared, command: str, values: dict, given) -> argparse.Nam
     args = argparse.Namespace(command=command)
     for dest, action in by_dest.items():
         default = action.default
+        if default is argparse.SUPPRESS:  # --help: no attribute, as argparse
+            continue
         if isinstance(default, str) and action.type is not None:  # argparse converts a string default too
             default = action.type(default)
         setattr(args, dest, default)

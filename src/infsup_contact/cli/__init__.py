@@ -25,6 +25,12 @@ verdict is not the expected one. A closed or full stdout (``>&-``, ``> /dev/full
 with one line, Ctrl-C exit 130 with one line. Any other exception is a bug or a broken
 installation: exit 70 with one line (``cli/program.py``; ``INFSUP_TRACEBACK=1`` adds the traceback),
 never 1. ``infsup-contact --version`` prints the installed version.
+
+One request builder for the command line and the Python API: argparse parses ``argv``
+(:func:`parse`), and the flags typed, with their parsed values, go to the builder
+(:func:`~.request.build`) the API's keywords go to (:func:`request_of`); :func:`check` then
+validates the request. The flags are declared once, on the subcommands' parsers, which keep
+their declarations for the builder (:func:`options`).
 """
 from __future__ import annotations
 

@@ -1,7 +1,11 @@
-"""The request of a subcommand, built from its parsed flags: the multiplier spaces (--case |
+"""The request of a subcommand. First the namespace from typed values (:func:`build`): the flags
+as each subcommand declares them once (:class:`Declared`), their defaults, each value checked
+and converted as the command line converts its text (:func:`typed`); the command line's parsed
+flags (``cli.parse``) and the Python API's keywords (``cli.request_of``) both come this way,
+and no command line is parsed for the API. Then its parts: the multiplier spaces (--case |
 --space), the model and its material flags, the mesh options with the request's Γ resolved once
 (:func:`mesh_options`), the norms; ``beta``'s :class:`~infsup_contact.solvers.request.BetaRequest`
-(:func:`request`). The flags themselves are declared in :mod:`.common`."""
+(:func:`request`). The shared flags themselves are declared in :mod:`.common`."""
 from __future__ import annotations
 
 import argparse

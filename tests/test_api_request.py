@@ -108,6 +108,9 @@ def test_a_keyword_is_checked_as_its_flag_is():
     with pytest.raises(InputError) as err:
         request_of("contact", {"case": "T3", "k": 1, "N1": 4, "N2": 4})  # argparse's required=True
     assert err.value.key == "scene"
+    with pytest.raises(InputError) as err:  # a type raising argparse's error: one line too
+        request_of("beta", {"case": "T3", "k": 1, "N1": 4, "N2": 4, "worst_mode": str(ROOT)})
+    assert err.value.key == "worst_mode" and "is a directory" in str(err.value) and "\n" not in str(err.value)
 
 
 # ---------------------------------------------------------------- space= an object

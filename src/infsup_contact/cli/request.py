@@ -221,8 +221,9 @@ def _one(key: str, action, value):
         except (TypeError, ValueError):
             raise InputError(key, _TYPE_NAMES.get(action.type, getattr(action.type, "__name__", "a value")),
                              got=value) from None
-        except argparse.ArgumentTypeError as err:
-            raise InputError(key, str(err), got=value) from None
+        except argparse.ArgumentTypeError as err:  # "<why>: expected <what>" (output_path) → one InputError line
+            why, sep, what = str(err).partition(": expected ")
+            raise InputError(key, f"{what} ({why})" if sep else str(err), got=value) from None
     if action.choices is not None and out not in action.choices:
         raise InputError(key, "one of " + ", ".join(map(str, action.choices)), got=value)
     return out

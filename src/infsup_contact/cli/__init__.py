@@ -161,6 +161,9 @@ class _Exclusive:
         self._dests.append(action.dest)
         return action
 
+    def __getattr__(self, name):  # the rest of argparse's group, as it is
+        return getattr(self._group, name)
+
 
 def _add_provenance(sub) -> None:
     p = sub.add_parser("provenance", help="versions, git commit, platform, date (JSON)")

@@ -1,12 +1,14 @@
 """The Python API for notebooks: :func:`beta`, :func:`verdict` and :func:`certify`.
 
 Each function is the command of the same name, called with keywords instead of flags: the
-keywords are the flags' names (``N1``, ``multiplier_mesh``, ``h_route``, ...), the request goes
-through the command line's own parser and checks (:func:`infsup_contact.cli.check`), and the
-result is the table the command writes, as a :class:`pandas.DataFrame` with the same rows and
-columns. Bad arguments raise :class:`~infsup_contact.errors.InputError` with the command's
-one-line message, the offending key spelled as the keyword; nothing is computed before the
-whole request is valid.
+keywords are the flags' names (``N1``, ``multiplier_mesh``, ``h_route``, ...). The keywords go
+straight to the request builder the command line's parsed flags go to
+(:func:`infsup_contact.cli.request_of`: the flags' declared defaults, types, choices and nargs,
+then the command's own checks); no command line is written or parsed. The result is the table
+the command writes, as a :class:`pandas.DataFrame` with the same rows and columns. Bad
+arguments raise :class:`~infsup_contact.errors.InputError` with the command's one-line
+message, the offending key spelled as the keyword; nothing is computed before the whole
+request is valid.
 
     >>> import infsup_contact as ic
     >>> ic.beta(case="T3", k=2, N1=8, N2=8, norm="H")          # doctest: +SKIP
@@ -14,17 +16,15 @@ whole request is valid.
     >>> ic.certify("levels.yaml", expect="stable")              # doctest: +SKIP
 
 A multiplier space defined in the notebook is ``space=`` a :class:`SpaceSpec` or a function
-of no arguments returning one (as ``FILE.py:FUNC`` names one in a file), checked as a file's.
+of no arguments returning one (as ``FILE.py:FUNC`` names one in a file): the object itself goes
+into the request and is checked as a file's
+(:func:`~infsup_contact.discretization.spaces.user_spaces.load_user_space`).
 """
 from __future__ import annotations
 
-import argparse
-import sys
-import types
-
-# The CLI is the one place a request is parsed and checked; every import of the package's
+# The CLI declares the flags and builds and checks a request; every import of the package's
 # internals the API needs is here, so a move inside the package is fixed in these lines.
-from .cli import build_parser, check, parse
+from .cli import build_parser, options, request_of
 from .cli.beta import beta_frame
 from .cli.verdict import verdict_row
 from .cli.verdict_formats import verdict_frame
@@ -34,13 +34,6 @@ __all__ = ["beta", "verdict", "certify", "InputError"]
 
 _NOT_KEYWORDS = {"help", "dry_run", "format", "output", "force", "command"}
 """Flags of the commands that are about the command line, not the result."""
-
-_NOTEBOOK = "<notebook>"
-"""The module name notebook spaces are registered under: ``space=f`` is ``<notebook>:f``."""
-_NOTEBOOK_SPACES: dict = {}
-"""id(space object) → (the object, its ``<notebook>:NAME`` reference); the object is kept so
-that its id is not reused, and passing it again is the same registered space."""
-
 
 def beta(case: str | None = None, k: int | None = None, N1: int | None = None, N2: int | None = None,
          **options):
@@ -72,7 +65,6 @@ def beta(case: str | None = None, k: int | None = None, N1: int | None = None, N
     InputError
         A bad keyword or value, with the command's one-line message.
     """
-    options["space"] = _space_ref(options.get("space"))
     return beta_frame(_request("beta", case=case, k=k, N1=N1, N2=N2, **options))
 
 
@@ -109,7 +101,6 @@ def verdict(case: str | None = None, k: int | None = None, N=None, **options):
     InputError
         A bad keyword or value, with the command's one-line message.
     """
-    options["space"] = _space_ref(options.get("space"))
     given = [key for key, value in (("case", case), ("space", options.get("space")),
                                     ("system", options.get("system"))) if value is not None]
     if len(given) != 1:
@@ -164,82 +155,17 @@ _CRITERION = ("slope_tolerance", "beta_floor", "confidence")
 """The stability criterion's keywords (defaults: the claims ledger's)."""
 
 
-_TYPE_NAMES = {int: "an integer", float: "a number"}
-
-
-def _request(command: str, **keywords) -> argparse.Namespace:
-    """The validated request of ``command`` for the keywords given (None: the flag's default)."""
+def _request(command: str, **keywords):
+    """The validated request of ``command`` for the keywords given (None: the flag's default; a
+    switch False: not given), built from the typed values (:func:`infsup_contact.cli.request_of`)."""
     parser = build_parser()
-    actions = _actions(parser, command)
-    argv = [command]
+    allowed = set(options(command, parser)) - _NOT_KEYWORDS
+    values = {}
     for key, value in keywords.items():
         if value is None:
             continue
-        action = actions.get(key)
-        if action is None or key in _NOT_KEYWORDS:
-            raise InputError(key, "one of " + ", ".join(sorted(set(actions) - _NOT_KEYWORDS)))
-        flag = max(action.option_strings, key=len)
-        if action.nargs == 0:  # a switch: True sets it
-            if not isinstance(value, bool):
-                raise InputError(key, "True or False", got=value)
-            argv += [flag] if value else []
-            continue
-        argv += [flag, *_tokens(key, value, action)]
-    args = parse(parser, argv)
-    check(args)
-    return args
-
-
-def _actions(parser: argparse.ArgumentParser, command: str) -> dict:
-    """dest → argparse action of the options of ``command``."""
-    sub = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction)).choices[command]
-    return {a.dest: a for a in sub._actions if a.option_strings}
-
-
-def _tokens(key: str, value, action) -> list:
-    """The command-line tokens of one keyword, checked as argparse would (so that a bad value
-    raises InputError here instead of argparse's exit)."""
-    if hasattr(value, "tolist"):  # numpy: a scalar (np.int64(2)) becomes its Python number, an array a list
-        value = value.tolist()
-    values = list(value) if isinstance(value, (list, tuple, range)) else [value]
-    if action.nargs is None and len(values) != 1:
-        raise InputError(key, "one value", got=value)
-    if not values:
-        raise InputError(key, "at least one value", got=value)
-    for v in values:
-        if action.type is not None:
-            try:
-                action.type(str(v))
-            except (TypeError, ValueError):
-                raise InputError(key, _TYPE_NAMES.get(action.type, action.type.__name__), got=v) from None
-        if action.choices is not None and str(v) not in action.choices:
-            raise InputError(key, "one of " + ", ".join(map(str, action.choices)), got=v)
-    return [str(v) for v in values]
-
-
-def _space_ref(space):
-    """``space=`` as the command line's ``--space`` reference: a string as given; a
-    :class:`SpaceSpec`, or a function of no arguments returning one, defined in the notebook,
-    registered as ``<notebook>:NAME`` in a module of that name, so that the command loads and
-    checks it exactly as a ``FILE.py:FUNC`` space (:mod:`~.discretization.spaces.user_spaces`)."""
-    from .discretization.spaces.spec import SpaceSpec  # here: it loads numpy and scipy (0.3 s), not at import
-
-    if space is None or isinstance(space, str):
-        return space
-    if not (isinstance(space, SpaceSpec) or callable(space)):
-        raise InputError("space", "FILE.py:FUNC, a SpaceSpec, or a function of no arguments returning one",
-                         got=space)
-    known = _NOTEBOOK_SPACES.get(id(space))
-    if known is not None and known[0] is space:
-        return known[1]
-    module = sys.modules.setdefault(_NOTEBOOK, types.ModuleType(_NOTEBOOK))
-    stem = space.id if isinstance(space, SpaceSpec) else getattr(space, "__name__", "space")
-    stem = "space" if str(stem).startswith("<") else stem  # a lambda
-    stem = "".join(c if c.isalnum() else "_" for c in str(stem)).lstrip("0123456789") or "space"
-    name, n = stem, 1
-    while hasattr(module, name):
-        n += 1
-        name = f"{stem}_{n}"
-    setattr(module, name, (lambda: space) if isinstance(space, SpaceSpec) else space)
-    _NOTEBOOK_SPACES[id(space)] = (space, f"{_NOTEBOOK}:{name}")
-    return _NOTEBOOK_SPACES[id(space)][1]
+        if key not in allowed:
+            raise InputError(key, "one of " + ", ".join(sorted(allowed)))
+        if value is not False or options(command, parser)[key].nargs != 0:  # a switch False: its default
+            values[key] = value
+    return request_of(command, values, parser=parser)

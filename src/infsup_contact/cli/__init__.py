@@ -25,6 +25,12 @@ verdict is not the expected one. A closed or full stdout (``>&-``, ``> /dev/full
 with one line, Ctrl-C exit 130 with one line. Any other exception is a bug or a broken
 installation: exit 70 with one line (``cli/program.py``; ``INFSUP_TRACEBACK=1`` adds the traceback),
 never 1. ``infsup-contact --version`` prints the installed version.
+
+One request builder for the command line and the Python API: argparse parses ``argv``
+(:func:`parse`), and the flags typed, with their parsed values, go to the builder
+(:func:`~.request.build`) the API's keywords go to (:func:`request_of`); :func:`check` then
+validates the request. The flags are declared once, on the subcommands' parsers, which keep
+their declarations for the builder (:func:`options`).
 """
 from __future__ import annotations
 
@@ -36,10 +42,11 @@ from ..errors import InputError
 from ..io import TableError
 from . import beta, bench, contact, export, rates, reporting, verdict, verdict_hook
 from .common import EXIT_INTERRUPTED, EXIT_OUTPUT, OutputError, check_stdout, given_dests, refuse_unused, write_text
+from .request import Declared, build
 from .program import package_version, report_internal_error
 from .verdict import VERDICT_DEFAULTS
 
-__all__ = ["main", "build_parser", "validate", "flag_names", "VERDICT_DEFAULTS"]
+__all__ = ["main", "build_parser", "validate", "flag_names", "options", "request_of", "VERDICT_DEFAULTS"]
 
 
 _THREADS_ASKED: list = []
@@ -111,8 +118,51 @@ class _Version(argparse.Action):
 
 
 class _Parser(argparse.ArgumentParser):
+    """The program's parser: one-line errors, and each subcommand's declarations kept where
+    the request builder reads them (:class:`~.request.Declared`: its options, defaults,
+    exclusive groups), so that the Python API builds a request without parsing a command line."""
+
+    def __init__(self, *args, **kwargs):
+        self.declared = Declared()  # before argparse's own --help is added
+        self.commands: dict = {}
+        super().__init__(*args, **kwargs)
+
     def error(self, message):  # one line, exit 2 — argparse's own convention
         self.exit(2, f"infsup-contact: error: {message}\n")
+
+    def add_argument(self, *args, **kwargs):
+        action = super().add_argument(*args, **kwargs)
+        self.declared.options.append(action)
+        return action
+
+    def add_mutually_exclusive_group(self, **kwargs):
+        return _Exclusive(self, super().add_mutually_exclusive_group(**kwargs), kwargs.get("required", False))
+
+    def set_defaults(self, **kwargs):
+        super().set_defaults(**kwargs)
+        self.declared.defaults.update(kwargs)
+
+    def add_subparsers(self, **kwargs):
+        sub = super().add_subparsers(**kwargs)
+        self.commands = sub.choices  # name → subcommand parser, filled as they are added
+        return sub
+
+
+class _Exclusive:
+    """A mutually exclusive group of :class:`_Parser` whose options are declared to the builder too."""
+
+    def __init__(self, parser: _Parser, group, required: bool):
+        self._parser, self._group, self._dests = parser, group, []
+        parser.declared.exclusive.append((self._dests, required))
+
+    def add_argument(self, *args, **kwargs):
+        action = self._group.add_argument(*args, **kwargs)
+        self._parser.declared.options.append(action)
+        self._dests.append(action.dest)
+        return action
+
+    def __getattr__(self, name):  # the rest of argparse's group, as it is
+        return getattr(self._group, name)
 
 
 def _add_provenance(sub) -> None:
@@ -141,9 +191,29 @@ def build_parser() -> argparse.ArgumentParser:
 def flag_names(parser: argparse.ArgumentParser, command: str) -> dict:
     """dest → the flag as typed (``n_ref`` → ``--n-ref``) for the options of ``command``, and
     dest → dest for its positionals (``verdict-hook``'s ``manifests``)."""
-    sub = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction)).choices[command]
-    return {a.dest: max(a.option_strings, key=len) if a.option_strings else a.dest for a in sub._actions
-            if a.option_strings or a.dest != argparse.SUPPRESS}
+    return {a.dest: max(a.option_strings, key=len) if a.option_strings else a.dest
+            for a in parser.commands[command].declared.options if a.dest != argparse.SUPPRESS}
+
+
+def options(command: str, parser: argparse.ArgumentParser | None = None) -> dict:
+    """dest → the declared option (an argparse action: ``type``, ``default``, ``choices``,
+    ``nargs``, ``option_strings``) of ``command``'s flags, as declared once for both the
+    command line and the Python API."""
+    parser = parser or build_parser()
+    return {a.dest: a for a in parser.commands[command].declared.options if a.option_strings}
+
+
+def request_of(command: str, values: dict, given=None, parser: argparse.ArgumentParser | None = None):
+    """The validated request of ``command`` from typed values: ``values`` dest → value (the
+    flags given; the others take their declared defaults) and ``given`` the dests the caller
+    gave (default: those of ``values``), checked by the builder (:func:`~.request.build`:
+    types, choices, nargs) then by :func:`check` (the flags the request does not use, the
+    command's own checks, the outputs). No command line is parsed: the Python API's path.
+    Returns the namespace the command runs; ``.estimate`` is its memory estimate (or None)."""
+    parser = parser or build_parser()
+    args = build(parser.commands[command].declared, command, values, set(values) if given is None else given)
+    args.estimate = check(args)
+    return args
 
 
 def _message(err: Exception, parser, command: str) -> str:
@@ -161,10 +231,16 @@ def _message(err: Exception, parser, command: str) -> str:
 
 
 def parse(parser, argv):
-    """``parser.parse_args(argv)`` with ``args.given``, the flags typed (:func:`~.common.given_dests`)."""
-    args = parser.parse_args(argv)
-    args.given = given_dests(parser, argv)
-    return args
+    """The request of a command line, unchecked: argparse parses ``argv`` (an unknown flag, a bad
+    type or choice: one line, exit 2), then the flags typed (:func:`~.common.given_dests`) and
+    their parsed values go through the same builder as the Python API's keywords
+    (:func:`~.request.build`); :func:`check` validates it."""
+    parsed = parser.parse_args(argv)
+    given = given_dests(parser, argv)
+    declared = parser.commands[parsed.command].declared
+    dests = {a.dest for a in declared.options}
+    return build(declared, parsed.command, {d: v for d, v in vars(parsed).items() if d in given and d in dests},
+                 given)
 
 
 def check(args):

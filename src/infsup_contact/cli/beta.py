@@ -6,7 +6,7 @@ import sys
 from .verdict_formats import add_table_output, force_use, output_path
 from .worst_mode import check_worst_mode, mode_frame, write_modes
 from .common import (FlagUse, declare_flag_uses, material_columns, model_flag_uses, system_flag_uses,
-                     add_dry_run, add_model, check_memory, SPACE_HELP, write_csv)
+                     add_dry_run, add_model, check_memory, SPACE_HELP, space_value, write_csv)
 from .request import cases, face_cases, material, mesh_options, norms, request
 
 
@@ -28,7 +28,7 @@ def add(sub) -> None:
                         "paper's list and the duals; on a 3D model also every space its face elements "
                         "build for k (k = 2: DUAL-Q9, TDUAL-Q8, PWLIN-Q9, ... on hexahedra, TDUAL-T6, "
                         "PWLIN-T6 on tetrahedra; DUAL-Q8 and DUAL-T6, refused by construction, by name)")
-    p.add_argument("--space", metavar="FILE.py:FUNC", help=SPACE_HELP)
+    p.add_argument("--space", metavar="FILE.py:FUNC", type=space_value, help=SPACE_HELP)
     p.add_argument("--system", metavar="LEVELS.yaml", default=None,
                    help="a saddle-point system exported by another code (a manifest of mesh levels "
                    "{h, A, B, G}): one row per level; instead of --case/--k/--N1/--N2")

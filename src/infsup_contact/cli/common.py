@@ -14,6 +14,33 @@ SPACE_HELP = ("a user-defined multiplier space: a file or module and a function 
               "SpaceSpec (see examples/macro_p0.py); instead of --case")
 
 
+def space_value(value):
+    """The ``type`` of ``--space``: the command line's text as it is (``FILE.py:FUNC``, loaded and
+    checked with the request: :func:`~infsup_contact.discretization.spaces.user_spaces.load_user_space`);
+    from the Python API also a SpaceSpec or a function of no arguments returning one, the object
+    itself (``takes_objects``: the request builder hands it over unconverted), checked there alike."""
+    if isinstance(value, str) or callable(value):
+        return value
+    from ..discretization.spaces.spec import SpaceSpec  # here: it loads numpy (a string never gets here)
+    from ..discretization.spaces.user_spaces import SPACE_ALLOWED
+
+    if isinstance(value, SpaceSpec):
+        return value
+    raise InputError("space", SPACE_ALLOWED, got=value)
+
+
+space_value.takes_objects = True
+
+
+def space_file(args):
+    """The file or module a request's ``--space`` names (``FILE.py:FUNC`` → FILE.py), or None: no
+    space, or an object given by the Python API (no file to protect from an output)."""
+    from pathlib import Path
+
+    space = getattr(args, "space", None)
+    return Path(space.rsplit(":", 1)[0]) if isinstance(space, str) else None
+
+
 def _material_params() -> dict:
     """Flag name → [(model name, MaterialParam)] over every registered model."""
     from ..models import MODELS
@@ -147,9 +174,9 @@ def declare_flag_uses(p, uses) -> None:
     """Declare a subcommand's conditional flags (those among its options) for
     :func:`refuse_unused`; its option defaults are kept too (a flag differing from its default
     counts as given where the command line is not at hand)."""
-    dests = {a.dest for a in p._actions if a.option_strings}
+    dests = {a.dest for a in p.declared.options if a.option_strings}
     p.set_defaults(flag_uses=[u for u in uses if u.dest in dests],
-                   option_defaults={a.dest: a.default for a in p._actions if a.option_strings})
+                   option_defaults={a.dest: a.default for a in p.declared.options if a.option_strings})
 
 
 def refuse_unused(args) -> None:
@@ -170,7 +197,7 @@ def system_flag_uses(p) -> list:
     fix the spaces, meshes and norm (its 'norm' key says what G is)."""
     return [FlagUse(a.dest, lambda args: args.system is None, "requests without --system (the manifest's "
                     "matrices fix the spaces, meshes and norm)", lambda args: f"--system {args.system}")
-            for a in p._actions if a.option_strings and a.dest not in SYSTEM_KEEPS]
+            for a in p.declared.options if a.option_strings and a.dest not in SYSTEM_KEEPS]
 
 
 def model_flag_uses() -> list:

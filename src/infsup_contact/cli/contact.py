@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from ..errors import InputError, check_prestress
 from .verdict_formats import add_table_output, force_use
-from .common import FlagUse, add_dry_run, add_model, check_memory, declare_flag_uses, model_flag_uses, SPACE_HELP, write_csv
+from .common import FlagUse, add_dry_run, add_model, check_memory, declare_flag_uses, model_flag_uses, SPACE_HELP, space_value, write_csv
 from .request import cases, face_cases, material, mesh_options
 
 
@@ -18,7 +18,7 @@ def add(sub) -> None:
     p.add_argument("--scene", required=True, choices=scene_ids(),
                    help=f"a registered scene, defined for the models of these --model/--scene pairs: {allowed_pairs()}")
     p.add_argument("--case", choices=[*space_ids(None), "all"], help="a registered space, or all")
-    p.add_argument("--space", metavar="FILE.py:FUNC", help=SPACE_HELP)
+    p.add_argument("--space", metavar="FILE.py:FUNC", type=space_value, help=SPACE_HELP)
     p.add_argument("--k", type=int, required=True, help="displacement degree, 1..4")
     p.add_argument("--family", default="structured", choices=FAMILIES)
     p.add_argument("--N1", type=int, required=True)

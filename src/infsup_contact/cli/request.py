@@ -1,8 +1,15 @@
-"""The request of a subcommand, built from its parsed flags: the multiplier spaces (--case |
+"""The request of a subcommand. First the namespace from typed values (:func:`build`): the flags
+as each subcommand declares them once (:class:`Declared`), their defaults, each value checked
+and converted as the command line converts its text (:func:`typed`); the command line's parsed
+flags (``cli.parse``) and the Python API's keywords (``cli.request_of``) both come this way,
+and no command line is parsed for the API. Then its parts: the multiplier spaces (--case |
 --space), the model and its material flags, the mesh options with the request's Γ resolved once
 (:func:`mesh_options`), the norms; ``beta``'s :class:`~infsup_contact.solvers.request.BetaRequest`
-(:func:`request`). The flags themselves are declared in :mod:`.common`."""
+(:func:`request`). The shared flags themselves are declared in :mod:`.common`."""
 from __future__ import annotations
+
+import argparse
+from dataclasses import dataclass, field
 
 from ..errors import InputError
 from .common import _material_params, _mesh_options  # noqa: F401 (the flags' owners, declared there)
@@ -123,4 +130,100 @@ def request(args):
                       ((args.c1, args.c2),), norms(args), args.h_route, args.model_obj,
                       replace(args.mesh, **perturbed))
     check_perturbation(args.alpha, args.seed)
+    return out
+
+
+# ---------------------------------------------------------------- the request from typed values
+@dataclass
+class Declared:
+    """What a subcommand declares, once, for both the command line and the Python API: its
+    options (argparse actions: dest, type, default, choices, nargs, option strings), the
+    defaults it sets (``run``, ``check``, ``flag_uses``, ...) and its exclusive groups
+    (``([dest, ...], required)``). Filled as the subcommand's parser is declared (``cli._Parser``)."""
+
+    options: list = field(default_factory=list)
+    defaults: dict = field(default_factory=dict)
+    exclusive: list = field(default_factory=list)
+
+
+_TYPE_NAMES = {int: "an integer", float: "a number"}
+
+
+def build(declared: Declared, command: str, values: dict, given) -> argparse.Namespace:
+    """The request of ``command``: its declared defaults, then ``values`` (dest → value) each
+    checked and converted as the command line converts its text (:func:`typed`), the required
+    flags and exclusive groups checked, ``given`` (the dests the caller gave, for
+    :func:`~.common.refuse_unused`) kept as ``args.given``. The namespace is the one argparse
+    would make from the same flags; the command's checks come after (``cli.check``).
+
+    Raises
+    ------
+    InputError
+        A key that is not one of the command's options, or a bad value, naming the key.
+    """
+    by_dest = {a.dest: a for a in declared.options if a.dest != argparse.SUPPRESS}
+    args = argparse.Namespace(command=command)
+    for dest, action in by_dest.items():
+        default = action.default
+        if default is argparse.SUPPRESS:  # --help: no attribute, as argparse
+            continue
+        if isinstance(default, str) and action.type is not None:  # argparse converts a string default too
+            default = action.type(default)
+        setattr(args, dest, default)
+    for key, value in declared.defaults.items():
+        setattr(args, key, value)
+    for key, value in values.items():
+        if key not in by_dest:
+            raise InputError(key, "one of " + ", ".join(sorted(by_dest)))
+        setattr(args, key, typed(key, by_dest[key], value))
+    given = set(given)
+    for dests, required in declared.exclusive:
+        chosen = [d for d in dests if d in given]
+        if len(chosen) > 1 or (required and not chosen):
+            raise InputError(chosen[-1] if chosen else dests[0], f"exactly one of {', '.join(dests)}",
+                             got=chosen or None)
+    for dest, action in by_dest.items():
+        if action.required and dest not in given:
+            raise InputError(dest, "a value (required)")
+    args.given = given
+    return args
+
+
+def typed(key: str, action, value):
+    """``value`` of the option ``action`` as the command line makes it from its text: a number
+    given as its text to the declared ``type`` (``np.int64(2)`` → 2, ``"2"`` → 2, 2.5 refused by
+    ``int``), then the declared ``choices`` and ``nargs``; a switch takes True or False. A type
+    marked ``takes_objects`` (``--space``) receives any other object as it is."""
+    if action.nargs == 0:  # a switch
+        if not isinstance(value, bool):
+            raise InputError(key, "True or False", got=value)
+        return action.const if value else action.default
+    if hasattr(value, "tolist"):  # numpy: a scalar (np.int64(2)) becomes its Python number, an array a list
+        value = value.tolist()
+    many = action.nargs in ("+", "*") or isinstance(action.nargs, int)
+    if not many:
+        if isinstance(value, (list, tuple, range)):
+            raise InputError(key, "one value", got=value)
+        return _one(key, action, value)
+    values = list(value) if isinstance(value, (list, tuple, range)) else [value]
+    if not values and action.nargs != "*":
+        raise InputError(key, "at least one value", got=value)
+    return [_one(key, action, v) for v in values]
+
+
+def _one(key: str, action, value):
+    if not isinstance(value, str) and getattr(action.type, "takes_objects", False):
+        out = action.type(value)
+    else:
+        text = str(value)
+        try:
+            out = text if action.type is None else action.type(text)
+        except (TypeError, ValueError):
+            raise InputError(key, _TYPE_NAMES.get(action.type, getattr(action.type, "__name__", "a value")),
+                             got=value) from None
+        except argparse.ArgumentTypeError as err:  # "<why>: expected <what>" (output_path) → one InputError line
+            why, sep, what = str(err).partition(": expected ")
+            raise InputError(key, f"{what} ({why})" if sep else str(err), got=value) from None
+    if action.choices is not None and out not in action.choices:
+        raise InputError(key, "one of " + ", ".join(map(str, action.choices)), got=value)
     return out

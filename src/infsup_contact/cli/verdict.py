@@ -5,7 +5,7 @@ import sys
 
 from ..errors import InputError
 from .common import (declare_flag_uses, model_flag_uses, system_flag_uses, add_dry_run, add_model, check_memory,
-                     SPACE_HELP)
+                     SPACE_HELP, space_value)
 from .request import mesh_options, run_intervals
 from .verdict_formats import add_output_args, emit, force_use
 
@@ -37,7 +37,7 @@ def add(sub) -> None:
                        help="a registered space: one of the segment's, or on a 3D model one its face "
                        "elements build (k >= 2: DUAL-Q9, TDUAL-Q8, ... with --element hex; TDUAL-T6, "
                        "PWLIN-T6 with --element tet)")
-    which.add_argument("--space", metavar="FILE.py:FUNC", help=SPACE_HELP)
+    which.add_argument("--space", metavar="FILE.py:FUNC", type=space_value, help=SPACE_HELP)
     which.add_argument("--system", metavar="LEVELS.yaml",
                        help="a saddle-point system exported by another code: a manifest of mesh levels "
                        "{h, A, B, G} (docs/foreign-systems.md); --k, --family, "

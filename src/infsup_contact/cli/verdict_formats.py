@@ -23,7 +23,7 @@ import os
 import re
 from dataclasses import dataclass, field
 
-from .common import is_stream, write_result
+from .common import is_stream, space_file, write_result
 
 FORMATS = ("csv", "json", "junit")
 CLASSNAME = "infsup-contact"
@@ -204,7 +204,8 @@ def emit(args, row: dict, levels=None, manifest_expect=None) -> int:
 
     expect = args.expect or manifest_expect
     form = "system" if args.system is not None else "space" if args.space is not None else "case"
-    source = args.system if form == "system" else args.space.rsplit(":", 1)[0] if form == "space" else None
+    source = args.system if form == "system" else space_file(args) if form == "space" else None
+    source = None if source is None else str(source)
     result = VerdictResult(form, row, None if expect is None else expect.upper(),
                            {k: getattr(args, k) for k in ("slope_tolerance", "beta_floor", "confidence")},
                            levels, source)
@@ -226,8 +227,8 @@ def check_not_an_input(output, args) -> None:
     if getattr(args, "system", None) is not None and hasattr(args, "manifest"):
         inputs = [Path(args.system)] + [p for lv in args.manifest.levels for p in (lv.A, lv.B, lv.G, lv.constrained)
                                         if isinstance(p, Path)]
-    elif getattr(args, "space", None) is not None:
-        inputs = [Path(args.space.rsplit(":", 1)[0])]
+    elif space_file(args) is not None:
+        inputs = [space_file(args)]
     target = Path(output).resolve()
     if any(p.resolve() == target for p in inputs):
         raise InputError("output", "a file other than the inputs of the request (it would be overwritten)",

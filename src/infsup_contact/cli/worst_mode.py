@@ -12,6 +12,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..errors import InputError
+from .common import space_file
 
 DESCRIPTION_NEEDED = ("a manifest whose levels describe their multipliers on Γ (the top key gamma and "
                       "levels[i].multipliers: `infsup-contact export --norm H` writes them)")
@@ -32,8 +33,8 @@ def check_worst_mode(args) -> None:
         if bare:
             raise InputError("worst_mode", DESCRIPTION_NEEDED, got=f"{args.system} (levels[{bare[0]}] has no "
                              "multipliers)")
-    if args.space is not None:
-        inputs.append(Path(args.space.rsplit(":", 1)[0]))
+    if space_file(args) is not None:
+        inputs.append(space_file(args))
     if any(p.resolve() == target for p in inputs):
         raise InputError("worst_mode", "a file other than the inputs of the request (it would be overwritten)",
                          got=str(args.worst_mode))

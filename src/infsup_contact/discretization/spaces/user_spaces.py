@@ -1,4 +1,5 @@
-"""Users' multiplier spaces: ``FILE.py:FUNC`` or ``module:FUNC`` → a checked registry entry.
+"""Users' multiplier spaces: ``FILE.py:FUNC`` or ``module:FUNC`` (the command line), or the
+:class:`SpaceSpec` or function itself (the Python API's ``space=``) → a checked registry entry.
 
 A user space is a function of no arguments returning a
 :class:`~infsup_contact.discretization.spaces.spec.SpaceSpec` whose ``build(k, breakpoints)``
@@ -46,9 +47,14 @@ from ..segment.multipliers import SegmentSpace
 from .registry import SPACES, register
 from .spec import K_RANGE, SpaceSpec
 
-_LOADED: dict[str, SpaceSpec] = {}
-_CHECKED: dict[str, set] = {}
-"""Per reference, the interval counts N its space was fully checked on."""
+_LOADED: dict = {}
+"""Reference key (:func:`_key`) → the registered SpaceSpec."""
+_CHECKED: dict = {}
+"""Per reference key, the interval counts N its space was fully checked on."""
+_LABELS: dict = {}
+"""Per reference key, the reference as messages name it."""
+_OBJECTS: dict = {}
+"""Per object key, the object given (kept, so that its id stays its own)."""
 CHECK_PARTITION = np.array([0.0, 0.13, 0.3, 0.52, 0.71, 1.0])
 """The non-uniform partition (N = 5) every user space is checked on."""
 ID_PATTERN = re.compile(r"[A-Za-z][A-Za-z0-9.-]{0,31}")
@@ -102,10 +108,13 @@ def _import(where: str, ref: str):
     return run_user(ref, f"the import of {where}", importlib.import_module, where)
 
 
+SPACE_ALLOWED = "FILE.py:FUNC, module:FUNC, a SpaceSpec, or a function of no arguments returning one"
+"""What a space reference may be: a file's or module's function by name (the command line), or
+the SpaceSpec or function itself (the Python API, ``space=``)."""
+
+
 def _function(ref: str):
     """The callable named by ``path/to/file.py:func`` or ``package.module:func``."""
-    if not isinstance(ref, str):
-        raise InputError("space", "FILE.py:FUNC or module:FUNC (a string)", got=ref)
     where, sep, name = ref.rpartition(":")
     if not sep or not where or not name.isidentifier():
         raise InputError("space", "FILE.py:FUNC or module:FUNC", got=ref)
@@ -113,6 +122,12 @@ def _function(ref: str):
     func = getattr(module, name, None)
     if not callable(func):
         raise InputError("space", f"a function {name} in {where}", got=ref)
+    return _of_no_arguments(func, name, ref)
+
+
+def _of_no_arguments(func, name: str, ref):
+    """``func`` itself, refused (one line) when it needs arguments: the build function named
+    instead of the one returning the SpaceSpec."""
     try:
         params = inspect.signature(func).parameters.values()
     except (TypeError, ValueError):  # a builtin without a signature: calling it will tell
@@ -124,6 +139,21 @@ def _function(ref: str):
                          f"({', '.join(required)}): is it the build function? Name the function that "
                          "returns the SpaceSpec (e.g. FILE.py:space)", got=ref)
     return func
+
+
+def _source(ref) -> tuple:
+    """``(label, name, function of no arguments)`` of a space reference: a ``FILE.py:FUNC`` or
+    ``module:FUNC`` string, a :class:`SpaceSpec` (its own function), or such a function given
+    itself (labelled ``module:NAME``, as a string would name it)."""
+    if isinstance(ref, str):
+        return ref, ref.rpartition(":")[2], _function(ref)
+    if isinstance(ref, SpaceSpec):
+        return f"SpaceSpec {ref.id!r}", "the SpaceSpec", lambda: ref
+    if callable(ref):
+        name = getattr(ref, "__qualname__", None) or type(ref).__name__
+        label = f"{getattr(ref, '__module__', None) or '?'}:{name}"
+        return label, name, _of_no_arguments(ref, name, label)
+    raise InputError("space", SPACE_ALLOWED, got=ref)
 
 
 def check_fields(spec, ref: str) -> None:
@@ -218,29 +248,41 @@ def check_space(spec: SpaceSpec, ref: str = "", intervals=()) -> None:
                                  f"N = {n})")
 
 
-def load_user_space(ref: str, intervals=()) -> SpaceSpec:
-    """Load, check and register the space of ``ref`` (``FILE.py:FUNC`` or ``module:FUNC``).
+def load_user_space(ref, intervals=()) -> SpaceSpec:
+    """Load, check and register the space of ``ref``: ``FILE.py:FUNC`` or ``module:FUNC``, or
+    (the Python API) a :class:`SpaceSpec` or a function of no arguments returning one, checked
+    exactly as the function a string names.
 
     ``intervals``: the numbers of intervals of the multiplier meshes the run will use; the
     space is checked on each (loading again with new ones checks those). Loading the same
-    reference again returns the same entry. Its ledger claims are tagged with its id unless it
-    sets ``claim_tag``. Its registered ``build`` is :func:`guarded_build`.
+    reference (the same string, the same object) again returns the same entry. Its ledger
+    claims are tagged with its id unless it sets ``claim_tag``. Its registered ``build`` is
+    :func:`guarded_build`.
     """
     intervals = {int(n) for n in intervals}
-    if ref in _LOADED:
-        todo = intervals - _CHECKED[ref]
+    key = _key(ref)
+    if key in _LOADED:
+        todo = intervals - _CHECKED[key]
         if todo:
-            check_space(_LOADED[ref], ref, todo)
-            _CHECKED[ref] |= todo
-        return _LOADED[ref]
-    func = _function(ref)
-    spec = run_user(ref, f"{ref.rpartition(':')[2]}()", func)
-    check_fields(spec, ref)
-    check_space(spec, ref, intervals)
-    spec = dataclasses.replace(spec, build=guarded_build(spec, ref), claim_tag=spec.claim_tag or spec.id)
-    _LOADED[ref] = register(spec)
-    _CHECKED[ref] = set(intervals)
+            check_space(_LOADED[key], _LABELS[key], todo)
+            _CHECKED[key] |= todo
+        return _LOADED[key]
+    label, name, func = _source(ref)
+    spec = run_user(label, f"{name}()", func)
+    check_fields(spec, label)
+    check_space(spec, label, intervals)
+    spec = dataclasses.replace(spec, build=guarded_build(spec, label), claim_tag=spec.claim_tag or spec.id)
+    _LOADED[key] = register(spec)
+    _CHECKED[key], _LABELS[key] = set(intervals), label
+    if not isinstance(ref, str):
+        _OBJECTS[key] = ref  # kept alive: its id is not reused while the entry is
     return spec
+
+
+def _key(ref):
+    """The registry key of a reference: the string, or the object's identity (a SpaceSpec may
+    hold unhashable values; the same object again is the same entry)."""
+    return ref if isinstance(ref, str) else ("object", id(ref))
 
 
 def load_user_spaces(refs, intervals=()) -> list:
@@ -251,9 +293,10 @@ def load_user_spaces(refs, intervals=()) -> list:
 def forget_since(before) -> None:
     """Unregister every user space loaded since the registry held the ids ``before`` (a test,
     or a long-lived process such as a notebook, restores the registry it started with)."""
-    for ref, spec in list(_LOADED.items()):
+    for key, spec in list(_LOADED.items()):
         if spec.id not in before:
-            del _LOADED[ref]
+            for table in (_LOADED, _CHECKED, _LABELS, _OBJECTS):
+                table.pop(key, None)
     for case in set(SPACES) - set(before):
         del SPACES[case]
 

@@ -329,9 +329,11 @@ class Interface(abc.ABC):
         """Whether this interface has a space of the registry entry ``spec``; default: every one."""
         return True
 
+    @abc.abstractmethod
     def uniform_partition(self, n: int):
-        """The trace partition of uniform bodies with ``n`` cells per direction, built without a mesh."""
-        raise NotImplementedError(f"{type(self).__name__} has no uniform partition")
+        """The trace partition of uniform bodies with ``n`` cells per direction, built without a
+        mesh: what the request checks its spaces on before any body exists (``--case all`` on a
+        3D model, ``verdict``), so every shape provides it (the Γ table's rows, :mod:`~..spaces.gammas`)."""
 
     def check_builds(self, spec) -> None:
         """:class:`InputError` naming ``case`` unless :meth:`builds` (a shape may say why in its words)."""

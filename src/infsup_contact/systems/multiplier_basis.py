@@ -36,6 +36,9 @@ from ..errors import InputError
 from .readers import SystemFileError
 
 GAMMA_SHAPES = ("segment", "rectangle")
+PULL_BACKS = {"segment": "segment", "rectangle": "square"}
+"""The shape of the Γ table (:mod:`~infsup_contact.discretization.spaces.gammas`) of each manifest
+``gamma.shape``'s pull-back: the unit interval or square the described space lives on."""
 BASES = ("lagrange", "discontinuous", "dual")
 ENDS = ("keep", "drop")
 MAX_DEGREE = 7
@@ -62,6 +65,15 @@ class Gamma:
 
     shape: str
     size: tuple
+
+    @property
+    def interface(self):
+        """The :class:`~infsup_contact.discretization.gamma.interface.Interface` of Γ's pull-back
+        (:data:`PULL_BACKS`), from the Γ table: what its quadrature, Gram and modes are computed
+        on, scaled to ``size`` by the caller. The manifest names Γ; nothing is assumed."""
+        from ..discretization.spaces.gammas import gamma_of
+
+        return gamma_of(PULL_BACKS[self.shape])
 
 
 @dataclass(frozen=True)

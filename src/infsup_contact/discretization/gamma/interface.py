@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import abc
 import contextlib
+import math
 
 import numpy as np
 
@@ -333,7 +334,13 @@ class Interface(abc.ABC):
     def uniform_partition(self, n: int):
         """The trace partition of uniform bodies with ``n`` cells per direction, built without a
         mesh: what the request checks its spaces on before any body exists (``--case all`` on a
-        3D model, ``verdict``), so every shape provides it (the Γ table's rows, :mod:`~..spaces.gammas`)."""
+        3D model, ``verdict``), so every shape provides it (the Γ table's rows, :mod:`~..spaces.gammas`).
+
+        Returns
+        -------
+        partition
+            What :meth:`partition_of` returns for the mesh of such a body.
+        """
 
     def check_builds(self, spec) -> None:
         """:class:`InputError` naming ``case`` unless :meth:`builds` (a shape may say why in its words)."""
@@ -394,6 +401,15 @@ class Interface(abc.ABC):
     def paired(self, sides: list) -> list:
         """The sides of a pair as the coupling sees them (a projection ties each to the other): as built."""
         return sides
+
+
+def intervals_per_direction(n1: int, n2: int, choice: str = "omega2") -> int:
+    """Intervals per direction of G_h for uniform traces of ``n1`` and ``n2`` cells per direction:
+    N2 (``omega2``), N1 (``omega1``), or N1 + N2 − gcd(N1, N2) for their ``union`` (i/N1 = j/N2
+    exactly at the multiples of 1/gcd). The same on every shape of the Γ table (the segment's
+    cells; a face's per direction, :meth:`Interface.multiplier_cells` counts its cells): what a
+    request's N means before any Γ is built."""
+    return {"omega2": n2, "omega1": n1}.get(choice, n1 + n2 - math.gcd(n1, n2))
 
 
 def check_choice(choice: str) -> None:

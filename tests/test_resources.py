@@ -129,19 +129,3 @@ def test_the_large_route_fit_recovers_the_constants_it_is_given():
                        R.START_SECONDS + c * nd + d * m ** 3))
     assert fit_large_route_3d(points) == pytest.approx((a, b, c, d), rel=1e-6)
 
-
-def test_trace_nodes_count_what_every_gamma_shape_counts():
-    """The estimates' Γ nodes, (n k + 1)^dim in arithmetic, are every Lagrange shape's of the Γ
-    table, and bound the serendipity face's (QUAD8: no cell-centre nodes)."""
-    from infsup_contact.discretization.spaces.gammas import GAMMA_SHAPES
-
-    params = {"arc": dict(radius=2.0), "cylinder": dict(radius=3.0)}
-    for name, row in GAMMA_SHAPES.items():
-        gamma = row(**params.get(name, {}))
-        for k in (2,) if name == "serendipity" else (1, 2, 3):  # QUAD8 bodies are quadratic
-            for n in (1, 2, 5):
-                counted = gamma.trace_nodes(k, n)
-                if name == "serendipity":
-                    assert counted < R.trace_nodes(k, n, gamma.dim)
-                else:
-                    assert counted == R.trace_nodes(k, n, gamma.dim), (name, k, n)

@@ -86,22 +86,13 @@ def _side_bytes(nd: float, what: str) -> float:
     return SIDE_BYTES_PER_DOF_LOG[what] * nd * math.log2(max(nd, 2.0))
 
 
-def trace_nodes(k: int, n: int, gamma_dim: int) -> int:
-    """Γ nodes of a side of degree k with ``n`` cells per direction on a Γ of dimension
-    ``gamma_dim``, its boundary included: (n k + 1)^gamma_dim, what ``Interface.trace_nodes``
-    counts on every Lagrange shape (the segment and the arc: n k + 1; a face of hexahedra or
-    tetrahedra: (n k + 1)²; a QUAD8 face has fewer), in arithmetic (this module imports no Interface)."""
-    return (int(n) * int(k) + 1) ** int(gamma_dim)
-
-
 def _dense_bytes(k: int, ns, n_mult: float, s: int, norms, h_route: str, gamma_dim: int) -> float:
-    """Dense Γ work of one multiplier space: interface operators, couplings, Gram, eigh, on a Γ of
-    dimension ``gamma_dim`` (the 2D models': 1; a 3D face has its own model, :func:`face_beta_estimate`)."""
+    """Dense Γ work of one multiplier space: interface operators, couplings, Gram, eigh (Γ of dim ``gamma_dim``)."""
     m = n_mult * (s + 1)                        # dim M: at most (s + 1) per interval
     n_quad = sum(ns) * (k + s + 2) / 2          # quadrature points on the common refinement
     total = 0.0
     for n in ns:
-        g = float(trace_nodes(k, n, gamma_dim))  # Γ dofs of side i
+        g = float((n * k + 1) ** gamma_dim)  # Γ dofs of side i: Interface.trace_nodes of a Lagrange Γ
         total += 8 * (4 * g * g + g * (m + n_quad) + n_quad * m)
     total += 8 * 10 * m * m                     # B X Bᵀ, its copies, eigh of two pencils
     if "H" in norms:
@@ -110,10 +101,6 @@ def _dense_bytes(k: int, ns, n_mult: float, s: int, norms, h_route: str, gamma_d
         else:                                   # log kernel: per pair of intervals
             total += (600 + 110 * (s + 1) ** 2) * n_mult * (n_mult + 1) / 2
     return total
-
-
-GAMMA_DIM_2D = 1
-"""Dimension of the Γ of a 2D model's bodies (the segment, the arc): the contact estimates' (2D only)."""
 
 
 def _multiplier_intervals(multiplier_mesh: str, n1: int, n2: int) -> float:
@@ -254,15 +241,15 @@ def contact_estimate(family: str, k: int, n1: int, n2: int, n_ref: int | None = 
                      n_cases: int = 1, process: bool = True) -> Estimate:
     """One contact solve per case on (N1, N2); with ``n_ref`` (a scene measured against a
     reference solve) first the reference (degree k + 1, structured N_ref × N_ref, kept for
-    the whole request). The 2D models' scenes: Γ of dimension 1."""
+    the whole request)."""
     nds = [side_dofs(family, n, k) for n in (n1, n2)]
     total = sum(_side_bytes(nd, "contact") for nd in nds) + CONTACT_EXTRA_BYTES
-    total += _dense_bytes(k, (n1, n2), n2, k, ("H",), "logkernel", GAMMA_DIM_2D)
+    total += _dense_bytes(k, (n1, n2), n2, k, ("H",), "logkernel", 1)  # a 2D scene: Γ a curve
     seconds = START_SECONDS + SECONDS_PER_DOF15["contact"] * sum(nd ** 1.5 for nd in nds) * max(n_cases, 1)
     if n_ref is not None:
         nd_ref = side_dofs("structured", n_ref, k + 1)
         total += 2 * _side_bytes(nd_ref, "reference") + _dense_bytes(k + 1, (n_ref, n_ref), n_ref, k + 1,
-                                                                    ("H",), "logkernel", GAMMA_DIM_2D)
+                                                                    ("H",), "logkernel", 1)
         seconds += SECONDS_PER_DOF15["contact"] * 2 * nd_ref ** 1.5
     return Estimate((PROCESS_BYTES["contact"] if process else 0) + total, seconds)
 

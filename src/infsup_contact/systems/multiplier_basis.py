@@ -35,10 +35,7 @@ import numpy as np
 from ..errors import InputError
 from .readers import SystemFileError
 
-GAMMA_SHAPES = ("segment", "rectangle")
-PULL_BACKS = {"segment": "segment", "rectangle": "square"}
-"""The shape of the Γ table (:mod:`~infsup_contact.discretization.spaces.gammas`) of each manifest
-``gamma.shape``'s pull-back: the unit interval or square the described space lives on."""
+GAMMA_SHAPES = {"segment": "segment", "rectangle": "square"}  # gamma.shape → its pull-back's shape in the Γ table
 BASES = ("lagrange", "discontinuous", "dual")
 ENDS = ("keep", "drop")
 MAX_DEGREE = 7
@@ -60,20 +57,16 @@ DESCRIPTION_MAX_BYTES = 64 << 20
 
 @dataclass(frozen=True)
 class Gamma:
-    """Γ as the manifest's ``gamma`` describes it: ``segment`` of ``size`` (L,) or ``rectangle``
-    of ``size`` (a, b)."""
+    """Γ as the manifest's ``gamma`` describes it: ``segment`` of ``size`` (L,) or ``rectangle`` of ``size`` (a, b)."""
 
     shape: str
     size: tuple
 
     @property
     def interface(self):
-        """The :class:`~infsup_contact.discretization.gamma.interface.Interface` of Γ's pull-back
-        (:data:`PULL_BACKS`), from the Γ table: what its quadrature, Gram and modes are computed
-        on, scaled to ``size`` by the caller. The manifest names Γ; nothing is assumed."""
-        from ..discretization.spaces.gammas import gamma_of
-
-        return gamma_of(PULL_BACKS[self.shape])
+        """The Interface of Γ's pull-back (:data:`GAMMA_SHAPES`): the manifest names Γ, nothing is assumed."""
+        from ..discretization.spaces.gammas import gamma_of  # the Γ table: imported when asked
+        return gamma_of(GAMMA_SHAPES[self.shape])
 
 
 @dataclass(frozen=True)

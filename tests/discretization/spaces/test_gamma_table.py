@@ -59,3 +59,13 @@ def test_a_shape_without_uniform_partition_is_refused():
     Partial = type("Partial", (Interface,), members)
     with pytest.raises(TypeError, match="uniform_partition"):
         Partial()
+
+
+def test_every_entry_counts_on_a_gamma_of_the_table_it_is_built_on():
+    """An entry's dimension count (its structural kernel) is made on a Γ of the table, of a
+    dimension it is defined on and whose cells build it: no segment assumed."""
+    shapes = [gamma for _, gamma in SHAPES]
+    for spec in registry.SPACES.values():
+        gamma = spec.count_gamma()
+        assert any(gamma is s for s in shapes) or type(gamma) in {type(s) for s in shapes}, spec.id
+        assert spec.defined_on(gamma.dim) and gamma.builds(spec), spec.id

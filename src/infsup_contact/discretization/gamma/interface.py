@@ -21,15 +21,12 @@ from __future__ import annotations
 
 import abc
 import contextlib
-import math
 
 import numpy as np
 
 from ...errors import InputError
+from .multiplier_meshes import MULTIPLIER_MESHES, check_choice, intervals_per_direction  # noqa: F401 (G_h's choices)
 from .trace import GammaTrace
-
-MULTIPLIER_MESHES = ("omega2", "omega1", "union")
-"""The choices of G_h: the trace partition of Ω2 (the paper's default), of Ω1, or their union."""
 
 
 class Interface(abc.ABC):
@@ -332,14 +329,12 @@ class Interface(abc.ABC):
 
     @abc.abstractmethod
     def uniform_partition(self, n: int):
-        """The trace partition of uniform bodies with ``n`` cells per direction, built without a
-        mesh: what the request checks its spaces on before any body exists (``--case all`` on a
-        3D model, ``verdict``), so every shape provides it (the Γ table's rows, :mod:`~..spaces.gammas`).
+        """The trace partition of uniform bodies with ``n`` cells per direction, without a mesh: what
+        a request checks its spaces on before any body exists (``--case all`` on a 3D model, ``verdict``).
 
         Returns
         -------
-        partition
-            What :meth:`partition_of` returns for the mesh of such a body.
+        What :meth:`partition_of` returns for such a body's mesh.
         """
 
     def check_builds(self, spec) -> None:
@@ -402,17 +397,3 @@ class Interface(abc.ABC):
         """The sides of a pair as the coupling sees them (a projection ties each to the other): as built."""
         return sides
 
-
-def intervals_per_direction(n1: int, n2: int, choice: str = "omega2") -> int:
-    """Intervals per direction of G_h for uniform traces of ``n1`` and ``n2`` cells per direction:
-    N2 (``omega2``), N1 (``omega1``), or N1 + N2 − gcd(N1, N2) for their ``union`` (i/N1 = j/N2
-    exactly at the multiples of 1/gcd). The same on every shape of the Γ table (the segment's
-    cells; a face's per direction, :meth:`Interface.multiplier_cells` counts its cells): what a
-    request's N means before any Γ is built."""
-    return {"omega2": n2, "omega1": n1}.get(choice, n1 + n2 - math.gcd(n1, n2))
-
-
-def check_choice(choice: str) -> None:
-    """:class:`InputError` unless ``choice`` names a G_h (:data:`MULTIPLIER_MESHES`)."""
-    if choice not in MULTIPLIER_MESHES:
-        raise InputError("multiplier_mesh", ", ".join(MULTIPLIER_MESHES), got=choice)

@@ -6,7 +6,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..gamma.interface import Interface, check_choice, intervals_per_direction
+from ..gamma.interface import Interface
+from ..gamma.multiplier_meshes import check_choice, intervals_per_direction
 from ..gamma.trace import GammaTrace
 from ..gamma.quadrature import gauss_legendre
 

@@ -17,9 +17,8 @@ import numpy as np
 
 from ...errors import InputError
 from ..face.shapes.square import CELL_BODIES
-from ..gamma.interface import MULTIPLIER_MESHES, intervals_per_direction
+from ..gamma.multiplier_meshes import MULTIPLIER_MESHES, intervals_per_direction
 from ..segment.dual import dual_space
-from ..segment.interface import SEGMENT
 from ..segment.multipliers import SegmentSpace, make_space
 from .face_entries import FACE_SPACES
 from .spec import SpaceSpec

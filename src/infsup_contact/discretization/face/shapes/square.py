@@ -26,7 +26,8 @@ import numpy as np
 import scipy.sparse as sp
 
 from ....errors import InputError
-from ...gamma.interface import Interface, check_choice, intervals_per_direction
+from ...gamma.interface import Interface
+from ...gamma.multiplier_meshes import check_choice, intervals_per_direction
 from ...gamma.trace import GammaTrace
 from ..partitions.quadrature import split_rule
 from ..partitions.tensor_grid import TensorPartition, coarsening_cells, merge_breakpoints

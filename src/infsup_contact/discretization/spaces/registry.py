@@ -237,11 +237,6 @@ def check_pair_spaces(cases, k: int, n1: int, n2: int, multiplier_meshes=("omega
             check_nonempty(case, k, n, name, where)
 
 
-def paper_dimension(case: str, k: int, n_intervals: int) -> int:
-    """dim M_h from the registry's count (the paper's: Rem 5.2, Rem 5.4, Thm 5), N intervals."""
-    return space_spec(case).dimension(k, n_intervals)
-
-
 def structural_kernel_dim(case: str, k: int, n_intervals: int) -> int:
     """max(dim M − dim W, 0) on matching meshes: 2 for R5.2, 1 for R5.4, 0 otherwise."""
     return space_spec(case).structural_kernel(k, n_intervals)

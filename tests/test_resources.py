@@ -128,4 +128,3 @@ def test_the_large_route_fit_recovers_the_constants_it_is_given():
         points.append((2, n, R.PROCESS_BYTES["beta"] + R.MKL_BYTES + a * nd + b * m * m,
                        R.START_SECONDS + c * nd + d * m ** 3))
     assert fit_large_route_3d(points) == pytest.approx((a, b, c, d), rel=1e-6)
-

@@ -26,6 +26,7 @@ from infsup_contact.discretization.spaces import registry
 from infsup_contact.discretization.spaces.registry import SPACES
 from infsup_contact.discretization.spaces.user_spaces import load_user_space
 from infsup_contact.errors import InputError
+from infsup_contact.discretization.segment.interface import SEGMENT
 
 ROOT = Path(__file__).resolve().parents[1]
 SCHEMA = ROOT / "workflow" / "schemas" / "config.schema.yaml"
@@ -165,7 +166,7 @@ def test_empty_space_is_refused_before_any_computation(case, k, n, capsys, monke
     text = one_line(err.value)
     assert f"case {case}" in text and f"k = {k}" in text and f"N = {n}" in text
     with pytest.raises(InputError):  # the backstop every consumer of the registry goes through
-        registry.case_space(case, k, np.linspace(0.0, 1.0, n + 1))
+        registry.case_space(case, k, np.linspace(0.0, 1.0, n + 1), SEGMENT)
     argvs = {
         "beta": ["beta", "--case", case, "--k", str(k), "--N1", str(n), "--N2", str(n)],
         "verdict": ["verdict", "--case", case, "--k", str(k), "--N", str(n), "8", "16"],
@@ -198,7 +199,7 @@ def test_empty_multiplier_mesh_of_a_pair(argv, refused, capsys):
 
 def test_multiplier_mesh_with_no_interval():
     with pytest.raises(InputError) as err:
-        registry.case_space("T3", 2, np.array([0.0]))
+        registry.case_space("T3", 2, np.array([0.0]), SEGMENT)
     assert "at least one interval" in one_line(err.value) and "case T3" in str(err.value)
 
 
@@ -376,7 +377,7 @@ def test_every_later_build_is_guarded(tmp_path):
                                                   f"lambda k: k, {dim})\n")
     spec = load_user_space(f"{path}:space")
     with pytest.raises(InputError) as err:
-        registry.case_space(spec.id, 1, np.linspace(0.0, 1.0, 8))
+        registry.case_space(spec.id, 1, np.linspace(0.0, 1.0, 8), SEGMENT)
     assert needle in one_line(err.value)
 
 

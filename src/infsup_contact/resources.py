@@ -19,8 +19,6 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from .discretization.segment.interface import SEGMENT
-
 MIB = 1024 ** 2
 
 PROCESS_BYTES = {"beta": 200 * MIB, "contact": 230 * MIB, "bench": 220 * MIB}
@@ -88,13 +86,13 @@ def _side_bytes(nd: float, what: str) -> float:
     return SIDE_BYTES_PER_DOF_LOG[what] * nd * math.log2(max(nd, 2.0))
 
 
-def _dense_bytes(k: int, ns, n_mult: float, s: int, norms, h_route: str) -> float:
-    """Dense Γ work of one multiplier space: interface operators, couplings, Gram, eigh."""
+def _dense_bytes(k: int, ns, n_mult: float, s: int, norms, h_route: str, gamma_dim: int) -> float:
+    """Dense Γ work of one multiplier space: interface operators, couplings, Gram, eigh (Γ of dim ``gamma_dim``)."""
     m = n_mult * (s + 1)                        # dim M: at most (s + 1) per interval
     n_quad = sum(ns) * (k + s + 2) / 2          # quadrature points on the common refinement
     total = 0.0
     for n in ns:
-        g = float(SEGMENT.trace_nodes(k, n))  # Γ dofs of side i
+        g = float((n * k + 1) ** gamma_dim)  # Γ dofs of side i: Interface.trace_nodes of a Lagrange Γ
         total += 8 * (4 * g * g + g * (m + n_quad) + n_quad * m)
     total += 8 * 10 * m * m                     # B X Bᵀ, its copies, eigh of two pencils
     if "H" in norms:
@@ -233,7 +231,7 @@ def beta_estimate(family: str, k: int, n1: int, n2: int, multiplier_mesh="omega2
     mms = [multiplier_mesh] if isinstance(multiplier_mesh, str) else list(multiplier_mesh)
     nds = [components * side_dofs(family, n, k) for n in (n1, n2)]
     volume = sum(_side_bytes(nd, "beta") for nd in nds)
-    dense = max(_dense_bytes(k, (n1, n2), _multiplier_intervals(mm, n1, n2), k, norms, h_route)
+    dense = max(_dense_bytes(k, (n1, n2), _multiplier_intervals(mm, n1, n2), k, norms, h_route, dim - 1)
                 for mm in mms)
     seconds = START_SECONDS + SECONDS_PER_DOF15["beta"] * sum(nd ** 1.5 for nd in nds) * len(mms)
     return Estimate((PROCESS_BYTES["beta"] if process else 0) + volume + dense, seconds)
@@ -246,12 +244,12 @@ def contact_estimate(family: str, k: int, n1: int, n2: int, n_ref: int | None = 
     the whole request)."""
     nds = [side_dofs(family, n, k) for n in (n1, n2)]
     total = sum(_side_bytes(nd, "contact") for nd in nds) + CONTACT_EXTRA_BYTES
-    total += _dense_bytes(k, (n1, n2), n2, k, ("H",), "logkernel")
+    total += _dense_bytes(k, (n1, n2), n2, k, ("H",), "logkernel", 1)  # a 2D scene: Γ a curve
     seconds = START_SECONDS + SECONDS_PER_DOF15["contact"] * sum(nd ** 1.5 for nd in nds) * max(n_cases, 1)
     if n_ref is not None:
         nd_ref = side_dofs("structured", n_ref, k + 1)
         total += 2 * _side_bytes(nd_ref, "reference") + _dense_bytes(k + 1, (n_ref, n_ref), n_ref, k + 1,
-                                                                    ("H",), "logkernel")
+                                                                    ("H",), "logkernel", 1)
         seconds += SECONDS_PER_DOF15["contact"] * 2 * nd_ref ** 1.5
     return Estimate((PROCESS_BYTES["contact"] if process else 0) + total, seconds)
 

@@ -13,6 +13,7 @@ from infsup_contact.models.membranes import side_operator
 from infsup_contact.discretization.segment.meshes import mesh_pair, multiplier_breakpoints
 from infsup_contact.discretization.spaces.registry import case_space
 from infsup_contact.discretization.segment.norms import gram
+from infsup_contact.discretization.segment.interface import SEGMENT
 
 EPS = np.finfo(float).eps
 
@@ -35,7 +36,7 @@ def test_schur_from_factors_equals_solve_route(family, n, k):
 def _full_problem(family, n1, n2, k, case, mm="omega2", c=(1.0, 1.0)):
     m1, m2 = mesh_pair(family, n1, n2)
     sides = [side_operator(m, k) for m in (m1, m2)]
-    space = case_space(case, k, multiplier_breakpoints(m1, m2, mm))
+    space = case_space(case, k, multiplier_breakpoints(m1, m2, mm), SEGMENT)
     Bs = [coupling_matrix(s.trace, space, k) for s in sides]
     return sides, space, Bs, c
 

@@ -24,6 +24,7 @@ from infsup_contact.contact.contact import contact_qp
 from infsup_contact.solvers.infsup import beta_rows, saddle_point_beta
 from infsup_contact.contact.pdas import solve_pdas
 from infsup_contact.study.patch.segment import PASS_RTOL
+from infsup_contact.discretization.segment.interface import SEGMENT
 
 
 def test_registered():
@@ -83,7 +84,7 @@ def test_pressure_pushes_the_bodies_apart():
     k = 2
     m1, m2 = meshes.mesh_pair("structured", 4, 4)
     sides = [side_operator(m, k) for m in (m1, m2)]
-    space = registry.case_space("T5", k, meshes.multiplier_breakpoints(m1, m2))
+    space = registry.case_space("T5", k, meshes.multiplier_breakpoints(m1, m2), SEGMENT)
     lam = np.linalg.lstsq(space.evaluate(np.linspace(0.05, 0.95, 40)), np.ones(40), rcond=None)[0]
     assert np.allclose(space.evaluate(np.array([0.3, 0.7])) @ lam, 1.0)
     Bs = [coupling_matrix(s.trace, space, k) for s in sides]
@@ -106,7 +107,7 @@ def test_beta_schur_route_equals_full_saddle_point_pencil(case, k, n1, n2):
         row = beta_rows("structured", k, n1, n2, [case], norms=("H",), model=model)[0]
         m1, m2 = meshes.mesh_pair("structured", n1, n2)
         sides = [model.side_operator(m, k) for m in (m1, m2)]
-        space = registry.case_space(case, k, meshes.multiplier_breakpoints(m1, m2))
+        space = registry.case_space(case, k, meshes.multiplier_breakpoints(m1, m2), SEGMENT)
         Bs = [coupling_matrix(s.trace, space, k) for s in sides]
         A, B, _ = contact_qp(sides, Bs, [np.zeros(s.ndof) for s in sides])
         G, _ = gram(space, "H")
@@ -120,7 +121,7 @@ def test_contact_schur_route_equals_sparse_saddle_point_solve():
     k, n1, n2, E = 2, 4, 3, (1.0, 3.0)
     m1, m2 = meshes.mesh_pair("structured", n1, n2)
     sides = [side_operator(m, k) for m in (m1, m2)]
-    space = registry.case_space("T3", k, meshes.multiplier_breakpoints(m1, m2))
+    space = registry.case_space("T3", k, meshes.multiplier_breakpoints(m1, m2), SEGMENT)
     Bs = [coupling_matrix(s.trace, space, k) for s in sides]
     F = []
     for s, fy in zip(sides, (1.0, -1.0)):

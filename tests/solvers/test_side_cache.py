@@ -97,7 +97,7 @@ def test_gram_cache_forgets_the_oldest_beyond_its_bound():
     from infsup_contact.solvers.side_cache import GramCache
 
     def ask(grams, x):
-        return grams.gram(SEGMENT, "T3", 2, x, registry.case_space("T3", 2, x), "L2", "logkernel")
+        return grams.gram(SEGMENT, "T3", 2, x, registry.case_space("T3", 2, x, SEGMENT), "L2", "logkernel")
 
     grams = GramCache(max_bytes=5 * 8 * 5 ** 2)  # five Grams of T3, k = 2 on 3 cells (5 × 5)
     partitions = [np.array([0.0, 0.2 + 0.01 * i, 0.6, 1.0]) for i in range(7)]

@@ -239,7 +239,7 @@ class Model:
             return self.mesh(family, 1, 1, **mesh_kwargs).interface
         from ..discretization.spaces.gammas import curved_of, gamma_of
 
-        curving = self.curving or ("segment", "arc")
+        curving = self.curving or (PAPER_GAMMA, "arc")
         return curved_of(gamma_of(curving[0]), curving, *(mesh_kwargs.get(key) for key in ("gamma", "radius", "coupling")))
 
     def gamma_columns(self, gamma) -> dict:
@@ -262,6 +262,11 @@ class Model:
             return self.side_operator(mesh, k)
         return self.scene_side(scene, mesh, k)
 
+
+PAPER_GAMMA = "segment"
+"""The Γ table's shape (:mod:`~infsup_contact.discretization.spaces.gammas`) of the paper's 2D
+meshes: the Γ of a bare mesh (one given without its :class:`Body`), and the flat Γ of a 2D model
+that names no ``curving``."""
 
 B_SIGN = (-1.0, 1.0)
 """Sign of B_iᵀ λ in A_i u_i = F_i + sign_i B_iᵀ λ (Ω1, Ω2): b(v, μ) = ∫_Γ (v_2 − v_1)·n μ."""

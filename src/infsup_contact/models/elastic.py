@@ -31,9 +31,9 @@ import numpy as np
 import ngsolve
 import scipy.sparse as sp
 
-from ..discretization.segment.interface import SEGMENT
 from ..discretization.segment.meshes import DIRICHLET
-from .contract import MaterialParam, Model
+from ..discretization.spaces.gammas import gamma_of
+from .contract import PAPER_GAMMA, Body, MaterialParam, Model
 from .plane_strain import E_RANGE, NU_RANGE, check_modulus, check_nu, lame  # noqa: F401 (the model's material law)
 from .contract import SideOperator, factorized_side
 
@@ -88,21 +88,22 @@ def elastic_stiffness(space: ElasticSpace, nu: float) -> sp.csr_matrix:
     return sp.csr_matrix((data, cols, rows), shape=(mat.height, mat.width))
 
 
-def gamma_dofs_both(space: ElasticSpace) -> tuple:
-    """(tangential, normal) free Γ dofs in product-space numbering, each sorted by dof."""
-    tx = SEGMENT.trace(space.fx).gamma_dofs
-    ty = SEGMENT.trace(space.fy).gamma_dofs + space.offset_y
+def gamma_dofs_both(space: ElasticSpace, gamma) -> tuple:
+    """(tangential, normal) free Γ dofs in product-space numbering, each sorted by dof, on the
+    interface ``gamma`` (:class:`~infsup_contact.discretization.gamma.interface.Interface`)."""
+    tx = gamma.trace(space.fx).gamma_dofs
+    ty = gamma.trace(space.fy).gamma_dofs + space.offset_y
     return tx, ty
 
 
-def free_order(space: ElasticSpace) -> tuple:
+def free_order(space: ElasticSpace, gamma) -> tuple:
     """Free product-space dofs ordered [interior, Γ tangential, Γ normal], and the normal
-    component's :class:`GammaTrace` (its dofs numbered in ``space.fy``, as the coupling
-    matrices B_i see them)."""
-    trace = SEGMENT.trace(space.fy)
+    component's :class:`GammaTrace` on ``gamma`` (its dofs numbered in ``space.fy``, as the
+    coupling matrices B_i see them)."""
+    trace = gamma.trace(space.fy)
     free_mask = np.concatenate([np.array(space.fx.FreeDofs(), dtype=bool),
                                 np.array(space.fy.FreeDofs(), dtype=bool)])
-    tx, ty = gamma_dofs_both(space)
+    tx, ty = gamma_dofs_both(space, gamma)
     on_gamma = np.zeros(len(free_mask), dtype=bool)
     on_gamma[tx] = on_gamma[ty] = True
     free = np.concatenate([np.flatnonzero(free_mask & ~on_gamma), tx, ty])
@@ -143,10 +144,12 @@ def side_operator(mesh, k: int, nu: float = 0.3, x_dirichlet: str = "dir", y_dir
                   route: str = "auto") -> ElasticSide:
     """One elastic body factorized once (E = 1), Γ dofs of both components last, the normal
     ones at the very end; its Γ Schur complement is that of the normal dofs (see the module
-    docstring), ``route`` as in :func:`~infsup_contact.la.schur.gamma_factorization`."""
+    docstring), ``route`` as in :func:`~infsup_contact.la.schur.gamma_factorization`. ``mesh``: a
+    :class:`~.contract.Body` (its mesh and Γ), or a bare mesh of the paper's (Γ: :data:`PAPER_GAMMA`)."""
     nu = check_nu(nu)
+    mesh, gamma = (mesh.mesh, mesh.interface) if isinstance(mesh, Body) else (mesh, gamma_of(PAPER_GAMMA))
     space = elastic_space(mesh, k, x_dirichlet, y_dirichlet)
-    free, trace, n_t = free_order(space)
+    free, trace, n_t = free_order(space, gamma)
     K_all = elastic_stiffness(space, nu)
     base = factorized_side(trace, free, K_all[free][:, free].tocsc(), route)
     return ElasticSide(base.trace, base.free, base.stiffness, base.schur, base.solve, base.steklov,

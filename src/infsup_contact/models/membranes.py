@@ -10,9 +10,9 @@ import numpy as np
 import ngsolve
 import scipy.sparse as sp
 
-from ..discretization.segment.interface import SEGMENT
+from ..discretization.spaces.gammas import gamma_of
 from ..errors import check_prestress
-from .contract import OUTWARD_NORMAL_Y, Body, MaterialParam, Model, OptionalChoice
+from .contract import OUTWARD_NORMAL_Y, PAPER_GAMMA, Body, MaterialParam, Model, OptionalChoice
 from ..discretization.segment.arc import COUPLINGS, GAMMAS, RADIUS_ALLOWED
 from .contract import SideOperator, factorized_side
 
@@ -62,11 +62,13 @@ def side_operator(mesh, k: int, route: str = "auto", dirichlet: str = "dir") -> 
     """Factorize K_i once and extract its Γ Schur complement (c = 1); ``route`` as in
     :func:`gamma_factorization`, u_i = 0 on ``dirichlet``. ``mesh``: a body of the paper's, or a
     :class:`~.contract.Body` whose Γ is an :class:`~infsup_contact.discretization.segment.arc.Arc`
-    (the mesh of its square, curved here at the body's degree k)."""
-    gamma = SEGMENT
+    (the mesh of its square, curved here at the body's degree k); a bare mesh: the paper's, whose Γ
+    is the Γ table's :data:`~.contract.PAPER_GAMMA`."""
     if isinstance(mesh, Body):
         mesh, gamma = mesh.mesh, mesh.interface
         gamma.curve(mesh, k)
+    else:
+        gamma = gamma_of(PAPER_GAMMA)
     fes = displacement_space(mesh, k, dirichlet)
     trace = gamma.trace(fes)
     free_mask = np.array(fes.FreeDofs(), dtype=bool)

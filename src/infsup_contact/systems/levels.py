@@ -181,8 +181,6 @@ def level_mode(manifest: Manifest, level, lv, info: dict, res):
     """The worst mode of one level (``res.mode``, in the rows of B the checks kept) as a
     :class:`~infsup_contact.solvers.modes.Mode` of the described basis: row r of B as read holds
     basis function j with ``rows[j] = r``; a multiplier the producer constrained is 0."""
-    from ..discretization.face.shapes.square import SQUARE
-    from ..discretization.segment.interface import SEGMENT
     from ..solvers.modes import Mode
 
     described = info["described"]
@@ -190,7 +188,7 @@ def level_mode(manifest: Manifest, level, lv, info: dict, res):
     kept = info["kept"] if lv.kept_multipliers is None else info["kept"][lv.kept_multipliers]
     rows[kept] = res.mode
     keys = dict(system=manifest.name, level=level.index, h=level.h, norm=manifest.norm)
-    gamma = SEGMENT if described.gamma.shape == "segment" else SQUARE
+    gamma = described.gamma.interface  # the manifest's Γ, pulled back
     size = described.gamma.size if len(described.gamma.size) == 2 else described.gamma.size * 2
     return Mode(keys, res.beta, rows[described.rows], res.kernel.detected > 0, described.space, gamma, size)
 

@@ -61,7 +61,7 @@ def exact_coupling(described, traces, n: int) -> sp.csr_matrix:
     """B_exact (m × n, rows in B's order) of the described multipliers against ``traces``."""
     from ..discretization.gamma.coupling import weighted_values
 
-    gamma = _interface(described)
+    gamma = described.gamma.interface  # the manifest's Γ, pulled back
     scale = float(np.prod(described.gamma.size))
     rows = described.rows  # row of B of each multiplier function
     out = sp.csr_matrix((described.m, n))
@@ -115,13 +115,6 @@ def block_distances(manifest, level, described, B, rows=None, per_row: bool = Fa
         norm = sparse_norm(exact)
         out.append(float(sparse_norm(mine - exact) / norm) if norm > 0 else float("inf"))
     return out
-
-
-def _interface(described):
-    from ..discretization.segment.interface import SEGMENT
-    from ..discretization.face.shapes.square import SQUARE
-
-    return SEGMENT if described.gamma.shape == "segment" else SQUARE
 
 
 def coupling_distance(manifest, level, described, B, rows=None) -> float:

@@ -35,7 +35,7 @@ import numpy as np
 from ..errors import InputError
 from .readers import SystemFileError
 
-GAMMA_SHAPES = ("segment", "rectangle")
+GAMMA_SHAPES = {"segment": "segment", "rectangle": "square"}  # gamma.shape → its pull-back's shape in the Γ table
 BASES = ("lagrange", "discontinuous", "dual")
 ENDS = ("keep", "drop")
 MAX_DEGREE = 7
@@ -57,11 +57,16 @@ DESCRIPTION_MAX_BYTES = 64 << 20
 
 @dataclass(frozen=True)
 class Gamma:
-    """Γ as the manifest's ``gamma`` describes it: ``segment`` of ``size`` (L,) or ``rectangle``
-    of ``size`` (a, b)."""
+    """Γ as the manifest's ``gamma`` describes it: ``segment`` of ``size`` (L,) or ``rectangle`` of ``size`` (a, b)."""
 
     shape: str
     size: tuple
+
+    @property
+    def interface(self):
+        """The Interface of Γ's pull-back (:data:`GAMMA_SHAPES`): the manifest names Γ, nothing is assumed."""
+        from ..discretization.spaces.gammas import gamma_of  # the Γ table: imported when asked
+        return gamma_of(GAMMA_SHAPES[self.shape])
 
 
 @dataclass(frozen=True)

@@ -48,11 +48,10 @@ holds the Grams, the pencils and the series' arrays: 132 to 197)."""
 def gram(described, norm: str) -> tuple:
     """(G, info): the Gram of ``norm`` ∈ {"H", "L2"} in the order of B's rows, scaled to Γ."""
     from ..discretization.face.norms.tensor import gram_h_face, gram_l2_face
-    from ..discretization.segment.interface import SEGMENT
 
     space, size = described.space, described.gamma.size
     if described.gamma.shape == "segment":
-        G, info = SEGMENT.gram(space, norm)
+        G, info = described.gamma.interface.gram(space, norm)
         scale = size[0] ** 2 if norm == "H" else size[0]
     elif norm == "H":
         a, b = size

@@ -40,7 +40,7 @@ def test_newton_cotes_weights_positive(k):
 def test_biorthogonal_on_nonuniform_partitions(k, case, trace_case):
     """∫ ψ_i φ_j = δ_ij ∫ φ_j against the nodal basis of W_h (zero at the ends for DUAL)."""
     x = nonuniform(7)
-    psi, phi = case_space(case, k, x), case_space(trace_case, k, x)
+    psi, phi = case_space(case, k, x, SEGMENT), case_space(trace_case, k, x, SEGMENT)
     M, integrals = mixed_mass(psi, phi, x, 2 * k)
     assert psi.dim == phi.dim
     assert np.all(integrals > 0)
@@ -52,7 +52,7 @@ def test_biorthogonal_on_nonuniform_partitions(k, case, trace_case):
 def test_partition_of_unity_and_dimension(k, case):
     """Σ_j ψ_j = 1 (the constants are reproduced, also next to Γ's ends) and dim as counted."""
     x = nonuniform(5, seed=8)
-    psi = case_space(case, k, x)
+    psi = case_space(case, k, x, SEGMENT)
     t = np.linspace(0.001, 0.999, 301)
     np.testing.assert_allclose(psi.evaluate(t).sum(axis=1), 1.0, atol=1e-12)
     assert psi.dim == SPACES[case].dimension(k, 5)
@@ -86,7 +86,7 @@ def test_coupling_with_own_trace_is_nodal(k):
     m1, m2 = mesh_pair("structured", 6, 6)
     side = side_operator(m2, k)
     x = multiplier_breakpoints(m1, m2)
-    dual, nodal = case_space("DUAL", k, x), case_space("T3", k, x)
+    dual, nodal = case_space("DUAL", k, x, SEGMENT), case_space("T3", k, x, SEGMENT)
     B = coupling_matrix(side.trace, dual, k)
     rows, cols, vals = SEGMENT.trace_values(side.trace, nodal.nodes())
     V = np.zeros((nodal.dim, B.shape[1]))
@@ -99,7 +99,7 @@ def test_coupling_with_own_trace_is_nodal(k):
 @pytest.mark.parametrize("k", [1, 2])
 def test_gram_routes_agree_for_dual(k):
     """Log kernel and sine series give the same H^{-1/2}_00 Gram for a non-Lagrange basis."""
-    space = case_space("DUAL", k, nonuniform(6, seed=4))
+    space = case_space("DUAL", k, nonuniform(6, seed=4), SEGMENT)
     G1, _ = gram(space, "H")
     G2, _ = gram_h(space, rtol=1e-9)
     np.testing.assert_allclose(G1, G2, rtol=0, atol=1e-8 * np.abs(G1).max())

@@ -11,6 +11,7 @@ from infsup_contact.errors import InputError
 from infsup_contact.discretization.segment.logkernel import gram_h_logkernel, log_kernel
 from infsup_contact.discretization.segment.multipliers import local_shapes, make_space
 from infsup_contact.discretization.spaces.registry import PAPER_CASES, SPACES, case_space
+from infsup_contact.discretization.segment.interface import SEGMENT
 
 NONUNIFORM = np.array([0.0, 0.07, 0.21, 0.5, 0.56, 0.83, 1.0])
 GRADED = np.array([0.0, 1e-3, 1e-2, 0.1, 0.3, 1.0])
@@ -98,11 +99,11 @@ SERIES_SPACES = {
     "P0 disc nonuniform": lambda: make_space(NONUNIFORM, 0, False, False),
     "P1 disc nonuniform": lambda: make_space(NONUNIFORM, 1, False, False),
     "P2 disc graded": lambda: make_space(GRADED, 2, False, False),
-    "P1 cont (R5.2 k=1)": lambda: case_space("R5.2", 1, NONUNIFORM),
-    "P2 cont (R5.2 k=2)": lambda: case_space("R5.2", 2, np.linspace(0, 1, 4)),
-    "T3 k=1 nonuniform": lambda: case_space("T3", 1, NONUNIFORM),
-    "T3 k=2 nonuniform": lambda: case_space("T3", 2, NONUNIFORM),
-    "T3 k=3 uniform": lambda: case_space("T3", 3, np.linspace(0, 1, 4)),
+    "P1 cont (R5.2 k=1)": lambda: case_space("R5.2", 1, NONUNIFORM, SEGMENT),
+    "P2 cont (R5.2 k=2)": lambda: case_space("R5.2", 2, np.linspace(0, 1, 4), SEGMENT),
+    "T3 k=1 nonuniform": lambda: case_space("T3", 1, NONUNIFORM, SEGMENT),
+    "T3 k=2 nonuniform": lambda: case_space("T3", 2, NONUNIFORM, SEGMENT),
+    "T3 k=3 uniform": lambda: case_space("T3", 3, np.linspace(0, 1, 4), SEGMENT),
     "P3 disc one interval": lambda: make_space([0.0, 1.0], 3, False, False),
 }
 
@@ -127,7 +128,7 @@ CASE_GRID = [(c, k, n) for c in PAPER_CASES for k in (1, 2, 3) for n in (3, 4, 7
 def test_symmetric_positive_definite(case, k, n):
     rng = np.random.default_rng(n)
     for bp in (np.linspace(0, 1, n + 1), np.r_[0.0, np.sort(rng.uniform(0.05, 0.95, n - 1)), 1.0]):
-        space = case_space(case, k, bp)
+        space = case_space(case, k, bp, SEGMENT)
         g = gram_h_logkernel(space)
         assert g.shape == (space.dim, space.dim)
         assert np.array_equal(g, g.T)
@@ -139,7 +140,7 @@ def test_symmetric_positive_definite(case, k, n):
     make_space(np.linspace(0, 1, 8), 0, False, False),
     make_space(NONUNIFORM, 1, False, False),
     make_space(GRADED, 3, False, False),
-    case_space("T3", 2, np.linspace(0, 1, 33)),
+    case_space("T3", 2, np.linspace(0, 1, 33), SEGMENT),
     make_space(np.r_[0.0, np.sort(np.random.default_rng(1).random(40)), 1.0], 2, True, False),
 ], ids=["P0x7", "P1 nonuniform", "P3 graded", "T3 k=2 N=32", "P2 cont random N=41"])
 def test_quadrature_converged(space):
@@ -174,7 +175,7 @@ def test_empty_space():
     # the Gram matrix of an empty space is empty; the registry refuses to build one for a case
     assert gram_h_logkernel(make_space([0.0, 1.0], 1, True, True)).shape == (0, 0)
     with pytest.raises(InputError, match="T3"):
-        case_space("T3", 1, [0.0, 1.0])
+        case_space("T3", 1, [0.0, 1.0], SEGMENT)
 
 
 @pytest.mark.parametrize("kwargs", [{"quad_scale": 0}, {"quad_scale": 1.5}, {"quad_scale": True}])
@@ -196,7 +197,7 @@ def test_subspace_gram_is_a_submatrix():
     that one space's integrals are not handed to the other wrongly)."""
     bp = np.r_[0.0, np.sort(np.random.default_rng(3).uniform(0.02, 0.98, 9)), 1.0]
     for k in (1, 2, 3):
-        full, inner = case_space("R5.2", k, bp), case_space("T3", k, bp)
+        full, inner = case_space("R5.2", k, bp, SEGMENT), case_space("T3", k, bp, SEGMENT)
         g_full, g_inner = gram_h_logkernel(full), gram_h_logkernel(inner)
         x_full, x_inner = full.nodes(), inner.nodes()
         keep = [int(np.argmin(np.abs(x_full - x))) for x in x_inner]

@@ -14,6 +14,7 @@ from infsup_contact.errors import InputError
 from infsup_contact.discretization.segment.multipliers import make_space
 from infsup_contact.discretization.spaces.registry import PAPER_CASES, SPACES, case_space
 from infsup_contact.discretization.segment.norms import gram, gram_h, gram_l2, sine_coefficients
+from infsup_contact.discretization.segment.interface import SEGMENT
 
 UNIFORM7 = np.linspace(0.0, 1.0, 8)
 NONUNIFORM5 = np.array([0.0, 0.07, 0.3, 0.35, 0.8, 1.0])
@@ -80,7 +81,7 @@ def test_gram_l2_constant_p0():
 
 
 def test_gram_l2_matches_dense_quadrature():
-    space = case_space("T3", 3, NONUNIFORM5)
+    space = case_space("T3", 3, NONUNIFORM5, SEGMENT)
     x, w = _composite_gauss(space, per_unit=10)
     V = space.evaluate(x)
     np.testing.assert_allclose(gram_l2(space), (V * w[:, None]).T @ V, atol=1e-14)
@@ -99,7 +100,7 @@ def test_sine_coefficients_of_one():
 @pytest.mark.parametrize("case,k", [("R5.2", 2), ("R5.4", 2), ("T3", 3)])
 def test_sine_coefficients_match_qawo(case, k):
     """Per basis function and interval against scipy's QAWO (weight='sin') rule."""
-    space = case_space(case, k, NONUNIFORM5)
+    space = case_space(case, k, NONUNIFORM5, SEGMENT)
     n = np.array([1, 2, 5, 40, 333, 4001])
     phi = sine_coefficients(space, n)
     rng = np.random.default_rng(1)
@@ -169,7 +170,7 @@ def test_gram_h_matches_independent_series(s, continuous, vanish, breakpoints):
 def test_gram_matrices_symmetric_positive_definite(case, k, breakpoints):
     if k < SPACES[case].min_k:
         pytest.skip(f"{case} needs k >= {SPACES[case].min_k}")
-    space = case_space(case, k, breakpoints)
+    space = case_space(case, k, breakpoints, SEGMENT)
     for norm in ("H", "L2"):
         G, info = gram(space, norm)
         assert G.shape == (space.dim, space.dim)
@@ -200,7 +201,7 @@ def test_cap_is_reported_honestly():
 
 
 def test_gram_dispatch_and_errors():
-    space = case_space("T3", 2, UNIFORM7)
+    space = case_space("T3", 2, UNIFORM7, SEGMENT)
     np.testing.assert_array_equal(gram(space, "L2")[0], gram_l2(space))
     np.testing.assert_array_equal(gram(space, "H", h_route="series")[0], gram_h(space)[0])
     # the two H routes are independent (log kernel vs truncated sine series) and agree

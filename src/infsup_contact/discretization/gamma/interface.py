@@ -25,10 +25,8 @@ import contextlib
 import numpy as np
 
 from ...errors import InputError
+from .multiplier_meshes import MULTIPLIER_MESHES, check_choice, intervals_per_direction  # noqa: F401 (G_h's choices)
 from .trace import GammaTrace
-
-MULTIPLIER_MESHES = ("omega2", "omega1", "union")
-"""The choices of G_h: the trace partition of Ω2 (the paper's default), of Ω1, or their union."""
 
 
 class Interface(abc.ABC):
@@ -329,9 +327,15 @@ class Interface(abc.ABC):
         """Whether this interface has a space of the registry entry ``spec``; default: every one."""
         return True
 
+    @abc.abstractmethod
     def uniform_partition(self, n: int):
-        """The trace partition of uniform bodies with ``n`` cells per direction, built without a mesh."""
-        raise NotImplementedError(f"{type(self).__name__} has no uniform partition")
+        """The trace partition of uniform bodies with ``n`` cells per direction, without a mesh: what
+        a request checks its spaces on before any body exists (``--case all`` on a 3D model, ``verdict``).
+
+        Returns
+        -------
+        What :meth:`partition_of` returns for such a body's mesh.
+        """
 
     def check_builds(self, spec) -> None:
         """:class:`InputError` naming ``case`` unless :meth:`builds` (a shape may say why in its words)."""
@@ -393,8 +397,3 @@ class Interface(abc.ABC):
         """The sides of a pair as the coupling sees them (a projection ties each to the other): as built."""
         return sides
 
-
-def check_choice(choice: str) -> None:
-    """:class:`InputError` unless ``choice`` names a G_h (:data:`MULTIPLIER_MESHES`)."""
-    if choice not in MULTIPLIER_MESHES:
-        raise InputError("multiplier_mesh", ", ".join(MULTIPLIER_MESHES), got=choice)

@@ -2,12 +2,12 @@
 :class:`~.gamma.interface.Interface`, whose partitions are sorted arrays of breakpoints."""
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
 
-from ..gamma.interface import Interface, check_choice
+from ..gamma.interface import Interface
+from ..gamma.multiplier_meshes import check_choice, intervals_per_direction
 from ..gamma.trace import GammaTrace
 from ..gamma.quadrature import gauss_legendre
 
@@ -171,9 +171,8 @@ class Segment(Interface):
         return cells * k + 1
 
     def multiplier_cells(self, n1: int, n2: int, choice: str = "omega2") -> int:
-        """N2 (``omega2``), N1 (``omega1``), or N1 + N2 − gcd(N1, N2) for their ``union``
-        (i/N1 = j/N2 exactly at the multiples of 1/gcd)."""
-        return {"omega2": n2, "omega1": n1}.get(choice, n1 + n2 - math.gcd(n1, n2))
+        """The intervals of G_h (:func:`~..gamma.interface.intervals_per_direction`)."""
+        return intervals_per_direction(n1, n2, choice)
 
 
 SEGMENT = Segment()

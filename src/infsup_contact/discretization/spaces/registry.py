@@ -17,9 +17,8 @@ import numpy as np
 
 from ...errors import InputError
 from ..face.shapes.square import CELL_BODIES
-from ..gamma.interface import MULTIPLIER_MESHES
+from ..gamma.multiplier_meshes import MULTIPLIER_MESHES, intervals_per_direction
 from ..segment.dual import dual_space
-from ..segment.interface import SEGMENT
 from ..segment.multipliers import SegmentSpace, make_space
 from .face_entries import FACE_SPACES
 from .spec import SpaceSpec
@@ -94,7 +93,7 @@ def check_case(case: str, k: int) -> None:
         raise InputError("k", f"k >= {spec.min_k} for case {case} ({spec.paper_ref} needs k >= {spec.min_k})")
 
 
-def case_space(case: str, k: int, partition, gamma=SEGMENT, pair: bool = False) -> SegmentSpace:
+def case_space(case: str, k: int, partition, gamma, pair: bool = False) -> SegmentSpace:
     """The multiplier space of a registered case for displacement degree k on G_h, a
     ``partition`` of Γ = ``gamma`` (:mod:`.gamma.interface`; for the paper's segment the sorted
     breakpoints of G_h, what ``SpaceSpec.build(k, x)`` receives; for the face
@@ -126,7 +125,7 @@ def check_on_gamma(case: str, k: int, gamma) -> SpaceSpec:
     return spec
 
 
-def space_on(spec: SpaceSpec, k: int, partition, gamma=SEGMENT, pair: bool = False):
+def space_on(spec: SpaceSpec, k: int, partition, gamma, pair: bool = False):
     """The multiplier space of a checked entry (:func:`check_on_gamma`) on G_h = ``partition`` of
     ``gamma`` (:func:`case_space`'s construction and its refusals of an empty space or a pair)."""
     case = spec.id
@@ -207,10 +206,11 @@ MULTIPLIER_CHOICES = MULTIPLIER_MESHES
 
 
 def multiplier_intervals(n1: int, n2: int, choice: str = "omega2") -> int:
-    """Intervals of G_h when the traces on Γ have N1 and N2 equal segments
-    (:meth:`~.gamma.interface.Interface.multiplier_cells` of the paper's segment). The perturbed
-    family's union has at least as many intervals; every space here grows with N."""
-    return SEGMENT.multiplier_cells(n1, n2, choice)
+    """Intervals per direction of G_h when the traces on Γ have N1 and N2 equal cells per
+    direction, on every Γ (:func:`~.gamma.interface.intervals_per_direction`; the checks count
+    a space's dimension on that many intervals per direction). The perturbed family's union has
+    at least as many intervals; every space here grows with N."""
+    return intervals_per_direction(n1, n2, choice)
 
 
 def check_nonempty(case, k: int, n: int, key: str = "N", where: str = "") -> None:
@@ -235,11 +235,6 @@ def check_pair_spaces(cases, k: int, n1: int, n2: int, multiplier_meshes=("omega
         where = "" if n1 == n2 else f" of the {choice} multiplier mesh, N1 = {n1}, N2 = {n2}"
         for case in cases:
             check_nonempty(case, k, n, name, where)
-
-
-def paper_dimension(case: str, k: int, n_intervals: int) -> int:
-    """dim M_h from the registry's count (the paper's: Rem 5.2, Rem 5.4, Thm 5), N intervals."""
-    return space_spec(case).dimension(k, n_intervals)
 
 
 def structural_kernel_dim(case: str, k: int, n_intervals: int) -> int:

@@ -15,7 +15,6 @@ import numpy as np
 
 from ...errors import InputError
 from ..gamma.constants import spans_constants
-from ..segment.interface import SEGMENT
 from ..segment.multipliers import SegmentSpace
 
 K_RANGE = (1, 4)
@@ -156,17 +155,24 @@ class SpaceSpec:
         return spans_constants(self.build(k, np.linspace(0.0, 1.0, n + 1)))
 
     def structural_kernel(self, k: int, n: int) -> int | None:
-        """max(dim M − dim W, 0) on matching meshes with N intervals (W = the trace space),
-        None without a dimension count; a face-only space: on the n × n grid of the face."""
+        """max(dim M − dim W, 0) on matching meshes with N intervals (W = the trace space on
+        :meth:`count_gamma`, where ``dimension`` counts), None without a dimension count."""
         if self.dimension is None:
             return None
-        if not self.defined_on(1):
-            from ..face.shapes.serendipity import face_of  # the face builds on the segment's spaces: imported late
-            from ..face.shapes.square import CELL_SHAPES
+        return max(self.dimension(k, n) - self.count_gamma().trace_dimension(k, n), 0)
 
-            face = face_of(next(c for c in CELL_SHAPES if c in self.face_cells))
-            return max(self.dimension(k, n) - face.trace_dimension(k, n), 0)
-        return max(self.dimension(k, n) - SEGMENT.trace_dimension(k, n), 0)
+    def count_gamma(self):
+        """The Γ of the Γ table on which ``dimension`` counts: the segment for a space of the
+        segment (its counts are per interval, Rem 5.2, Rem 5.4, Thm 5), for a space of the face
+        only the n × n grid's face of its cells (QUAD9, QUAD8 or TRI6)."""
+        from ..face.shapes.square import CELL_SHAPES  # the shapes build on the segment's spaces: imported late
+        from .gammas import gamma_of
+
+        if self.defined_on(1):
+            return gamma_of("segment")
+        from ..face.shapes.serendipity import face_of
+
+        return face_of(next(c for c in CELL_SHAPES if c in self.face_cells))
 
     def cone(self, k: int) -> str:
         """``pointwise`` (λ_h ≥ 0 everywhere), ``nodal`` (at the Lagrange nodes) or

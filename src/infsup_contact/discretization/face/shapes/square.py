@@ -20,14 +20,14 @@ the duals TRI3 / TRI6 (s ≤ 2); other spaces stay tensor products.
 """
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse as sp
 
 from ....errors import InputError
-from ...gamma.interface import Interface, check_choice
+from ...gamma.interface import Interface
+from ...gamma.multiplier_meshes import check_choice, intervals_per_direction
 from ...gamma.trace import GammaTrace
 from ..partitions.quadrature import split_rule
 from ..partitions.tensor_grid import TensorPartition, coarsening_cells, merge_breakpoints
@@ -381,9 +381,8 @@ class Square(Interface):
         return (cells * k + 1) ** 2
 
     def multiplier_cells(self, n1: int, n2: int, choice: str = "omega2") -> int:
-        """Rectangles of G_h for n1 × n1 and n2 × n2 traces: the segment's count squared."""
-        per = {"omega2": n2, "omega1": n1}.get(choice, n1 + n2 - math.gcd(n1, n2))
-        return per * per
+        """Rectangles of G_h for n1 × n1 and n2 × n2 traces: the intervals per direction squared."""
+        return intervals_per_direction(n1, n2, choice) ** 2
 
 
 SQUARE = Square()

@@ -165,3 +165,10 @@ def test_a_wrong_space_object_is_one_line_naming_space(space, says, command):
             ic.verdict(space=space, k=1, N=[4, 8, 16])
     assert err.value.key == "space" and says in str(err.value) and "\n" not in str(err.value)
     assert set(registry.SPACES) == before  # nothing registered
+
+
+def test_the_package_exports_the_error_its_api_raises():
+    """``except ic.InputError`` catches a bad keyword: the package's name is the error the API raises."""
+    assert ic.InputError is InputError
+    with pytest.raises(ic.InputError, match="N1"):
+        ic.beta(case="T3", k=2, N1=0, N2=4, norm="H")

@@ -6,5 +6,6 @@ interpolations for contact problems*, Rend. Lincei Mat. Appl. 12 (2001) 167–18
 __version__ = "0.1.0"
 
 from .api import beta, certify, verdict  # noqa: E402  (the notebook API: docs/api.md)
+from .errors import InputError  # noqa: E402  (what a bad keyword raises: `except ic.InputError`)
 
-__all__ = ["beta", "verdict", "certify", "__version__"]
+__all__ = ["beta", "verdict", "certify", "InputError", "__version__"]

@@ -95,3 +95,22 @@ def test_assemble_inverts_the_blocks():
         for b, Qb in enumerate(T):
             if a != b:
                 assert np.abs(Qa.T @ G @ Qb).max() <= 1e-13 * np.abs(G).max()
+
+
+@pytest.mark.parametrize("case", ["R5.2", "DUAL-Q9"])
+def test_deferred_assembly_gives_the_same_gram_when_read(case):
+    """Inside deferred_assembly a Gram summed in parity blocks comes as its ParityGram, not
+    assembled; read densely (np.asarray, dense) it is bit for bit the eager route's G, read-only,
+    assembled once; outside, the eager G."""
+    space = _space(case, 2, np.linspace(0.0, 1.0, 6))
+    G_eager, info_eager = SQUARE.gram(space, "H")
+    assert isinstance(G_eager, np.ndarray) and isinstance(info_eager["parity"], fp.ParityGram)
+    with fp.deferred_assembly():
+        G_lazy, info_lazy = SQUARE.gram(space, "H")
+    assert isinstance(G_lazy, fp.ParityGram) and G_lazy is info_lazy["parity"]
+    assert "dense" not in G_lazy.__dict__  # nothing assembled yet
+    assert G_lazy.shape == G_eager.shape and G_lazy.nbytes == sum(B.nbytes for B in G_lazy.blocks)
+    dense = np.asarray(G_lazy)
+    assert np.array_equal(dense, G_eager) and not dense.flags.writeable
+    assert fp.dense(G_lazy) is dense and fp.dense(G_eager) is G_eager
+    assert info_lazy["n_max"] == info_eager["n_max"]

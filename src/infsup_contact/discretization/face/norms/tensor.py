@@ -215,8 +215,8 @@ def gram_h_face(space, rtol: float = 1e-6, n_start: int | None = None, n_cap: in
         return extrapolated(lambda n: partial_gram(space, n, aspect, direct=reference), p, n0, n_cap, rtol)
     blocks, info = extrapolated(lambda n: partial_gram_blocks(space, n, parities), p, n0, n_cap, rtol,
                                 ops=BlockOps)
-    bases = face_parity.tensor_bases(parities)
-    return face_parity.assemble(bases, blocks), dict(info, parity=face_parity.ParityGram(bases, blocks))
+    G, parity = face_parity.gram_of(face_parity.tensor_bases(parities), blocks)  # G deferred in a β_h request
+    return G, dict(info, parity=parity)
 
 
 def partial_gram_blocks(space, n_max: int, parities) -> list:

@@ -149,8 +149,9 @@ def test_the_large_route_takes_the_blocks_svds_where_a_certificate_fails(monkeyp
 
 @pytest.mark.parametrize("case,k,n", [("R5.4", 2, 6), ("R5.2", 2, 6), ("T3", 2, 6)])
 def test_the_components_kernel_side_by_side_is_the_serial_one(monkeypatch, case, k, n):
-    """split_bottom_kernel decides on the components side by side (two workers): the decision,
-    its values and kernel vectors bit for bit those of the components one after the other."""
+    """split_bottom_kernel and split_dense_kernel decide on the components side by side (two
+    workers): the decision, its values and kernel vectors bit for bit those of the components one
+    after the other."""
     import dataclasses
 
     from infsup_contact.discretization.gamma.coupling import coupling_matrix, trace_l2_norms
@@ -174,12 +175,16 @@ def test_the_components_kernel_side_by_side_is_the_serial_one(monkeypatch, case,
     def side_by_side(fn, items):
         calls.append(1)
         return threaded.run_concurrently([lambda x=x: fn(x) for x in items], workers=2)
-    monkeypatch.setattr(symmetry, "concurrent_map", side_by_side)
-    together = symmetry.split_bottom_kernel(W, split, structural)
-    monkeypatch.setattr(symmetry, "concurrent_map", lambda fn, items: [fn(x) for x in items])
-    serial = symmetry.split_bottom_kernel(W, split, structural)
-    assert calls and serial is not None and together is not None
-    for f in dataclasses.fields(serial):
-        a, b = getattr(together, f.name), getattr(serial, f.name)
-        assert np.array_equal(a, b) if isinstance(a, np.ndarray) else a == b, f.name
-    assert serial.dim == structural
+    routes = [lambda: symmetry.split_bottom_kernel(W, split, structural),                  # the large route's
+              lambda: symmetry.split_dense_kernel(W.toarray(), split, structural),           # the dense route's
+              lambda: symmetry.split_dense_kernel(W.toarray(), split, structural, vectors=True)]
+    for route in routes:
+        monkeypatch.setattr(symmetry, "concurrent_map", side_by_side)
+        together = route()
+        monkeypatch.setattr(symmetry, "concurrent_map", lambda fn, items: [fn(x) for x in items])
+        serial = route()
+        assert calls and serial is not None and together is not None
+        for f in dataclasses.fields(serial):
+            a, b = getattr(together, f.name), getattr(serial, f.name)
+            assert np.array_equal(a, b) if isinstance(a, np.ndarray) else a == b, f.name
+        assert serial.dim == structural

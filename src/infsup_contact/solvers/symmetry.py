@@ -135,12 +135,14 @@ def split_dense_kernel(W: np.ndarray, split: ReflectionSplit, proven: int = 0,
                for b in range(len(blocks)) for a in range(b) if blocks[a].shape[1] and blocks[b].shape[1])
     cross = float(np.sqrt(2.0 * off2))  # ‖O‖_F: each off-diagonal block counted twice
     live = [(B, Q) for B, Q in zip(blocks, split.bases) if B.shape[1]]
+    # the blocks' SVDs side by side (LAPACK, GIL-free, one BLAS thread each: the same bits)
     if vectors:  # each block's SVD with its right vectors, ascending (structural zeros first)
-        svds = [sla.svd(B, full_matrices=B.shape[1] > B.shape[0], check_finite=True)[1:] for B, _ in live]
+        svds = concurrent_map(lambda BQ: sla.svd(BQ[0], full_matrices=BQ[0].shape[1] > BQ[0].shape[0],
+                                                 check_finite=True)[1:], live)
         per_block = [np.concatenate([np.zeros(B.shape[1] - len(sb)), np.sort(sb)]) for (B, _), (sb, _) in zip(live, svds)]
         s = per_block
     else:
-        s = [sla.svdvals(B, check_finite=True) for B, _ in live]  # LAPACK, as coupling_kernel
+        s = concurrent_map(lambda BQ: sla.svdvals(BQ[0], check_finite=True), live)  # LAPACK, as coupling_kernel
     s = np.sort(np.concatenate([np.zeros(m - sum(len(v) for v in s))] + s))
     s_max = float(s[-1])
     tol = error_level(rows, m, s_max, entry_error)

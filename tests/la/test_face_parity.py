@@ -114,3 +114,19 @@ def test_deferred_assembly_gives_the_same_gram_when_read(case):
     assert np.array_equal(dense, G_eager) and not dense.flags.writeable
     assert fp.dense(G_lazy) is dense and fp.dense(G_eager) is G_eager
     assert info_lazy["n_max"] == info_eager["n_max"]
+
+
+@pytest.mark.parametrize("case", ["R5.2", "T3"])
+def test_the_deferred_l2_gram_is_the_kron_and_its_diagonal_needs_no_matrix(monkeypatch, case):
+    """Inside deferred_assembly a tensor space's L² Gram comes in its parity blocks; its diagonal
+    (the kernel decision's scaling) is bit for bit that of G_x ⊗ G_y without forming it, its
+    dense matrix bit for bit the eager one, its blocks the eager route's parity blocks."""
+    space = _space(case, 2, np.linspace(0.0, 1.0, 6))
+    G_eager, info_eager = SQUARE.gram(space, "L2")
+    with fp.deferred_assembly():
+        G_lazy, info_lazy = SQUARE.gram(space, "L2")
+    assert isinstance(G_lazy, fn.KronParityGram) and info_lazy["parity"] is G_lazy
+    assert {k: v for k, v in info_lazy.items() if k != "parity"} == {k: v for k, v in info_eager.items() if k != "parity"}
+    assert np.array_equal(fp.diagonal(G_lazy), np.diag(G_eager)) and "dense" not in G_lazy.__dict__
+    assert all(np.array_equal(a, b) for a, b in zip(G_lazy.blocks, info_eager["parity"].blocks))
+    assert np.array_equal(np.asarray(G_lazy), G_eager) and np.array_equal(fp.diagonal(G_eager), np.diag(G_eager))

@@ -127,9 +127,20 @@ def gram_of(bases, blocks) -> tuple:
     return (parity if _DEFERRED.get() else assemble(parity.bases, parity.blocks)), parity
 
 
+def deferring() -> bool:
+    """Whether a Gram summed in parity blocks is returned unassembled (:func:`deferred_assembly`)."""
+    return _DEFERRED.get()
+
+
 def dense(G) -> np.ndarray:
     """The dense matrix of a Gram: G itself, or a :class:`ParityGram`'s assembled matrix."""
     return G.dense if isinstance(G, ParityGram) else G
+
+
+def diagonal(G) -> np.ndarray:
+    """The diagonal of a Gram: ``np.diag`` of a dense one; a :class:`ParityGram`'s own
+    (:meth:`ParityGram.diagonal`: without assembling it where it knows how)."""
+    return G.diagonal() if isinstance(G, ParityGram) else np.diag(G)
 
 
 class ParityGram:
@@ -162,6 +173,10 @@ class ParityGram:
         G = assemble(self.bases, self.blocks)
         G.setflags(write=False)
         return G
+
+    def diagonal(self) -> np.ndarray:
+        """The diagonal of G (of the assembled matrix: its entries, bit for bit)."""
+        return np.diag(self.dense)
 
     def __array__(self, dtype=None, copy=None):
         return self.dense if dtype is None else self.dense.astype(dtype, copy=False)

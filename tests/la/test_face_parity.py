@@ -95,3 +95,38 @@ def test_assemble_inverts_the_blocks():
         for b, Qb in enumerate(T):
             if a != b:
                 assert np.abs(Qa.T @ G @ Qb).max() <= 1e-13 * np.abs(G).max()
+
+
+@pytest.mark.parametrize("case", ["R5.2", "DUAL-Q9"])
+def test_deferred_assembly_gives_the_same_gram_when_read(case):
+    """Inside deferred_assembly a Gram summed in parity blocks comes as its ParityGram, not
+    assembled; read densely (np.asarray, dense) it is bit for bit the eager route's G, read-only,
+    assembled once; outside, the eager G."""
+    space = _space(case, 2, np.linspace(0.0, 1.0, 6))
+    G_eager, info_eager = SQUARE.gram(space, "H")
+    assert isinstance(G_eager, np.ndarray) and isinstance(info_eager["parity"], fp.ParityGram)
+    with fp.deferred_assembly():
+        G_lazy, info_lazy = SQUARE.gram(space, "H")
+    assert isinstance(G_lazy, fp.ParityGram) and G_lazy is info_lazy["parity"]
+    assert "dense" not in G_lazy.__dict__  # nothing assembled yet
+    assert G_lazy.shape == G_eager.shape and G_lazy.nbytes == sum(B.nbytes for B in G_lazy.blocks)
+    dense = np.asarray(G_lazy)
+    assert np.array_equal(dense, G_eager) and not dense.flags.writeable
+    assert fp.dense(G_lazy) is dense and fp.dense(G_eager) is G_eager
+    assert info_lazy["n_max"] == info_eager["n_max"]
+
+
+@pytest.mark.parametrize("case", ["R5.2", "T3"])
+def test_the_deferred_l2_gram_is_the_kron_and_its_diagonal_needs_no_matrix(monkeypatch, case):
+    """Inside deferred_assembly a tensor space's L² Gram comes in its parity blocks; its diagonal
+    (the kernel decision's scaling) is bit for bit that of G_x ⊗ G_y without forming it, its
+    dense matrix bit for bit the eager one, its blocks the eager route's parity blocks."""
+    space = _space(case, 2, np.linspace(0.0, 1.0, 6))
+    G_eager, info_eager = SQUARE.gram(space, "L2")
+    with fp.deferred_assembly():
+        G_lazy, info_lazy = SQUARE.gram(space, "L2")
+    assert isinstance(G_lazy, fn.KronParityGram) and info_lazy["parity"] is G_lazy
+    assert {k: v for k, v in info_lazy.items() if k != "parity"} == {k: v for k, v in info_eager.items() if k != "parity"}
+    assert np.array_equal(fp.diagonal(G_lazy), np.diag(G_eager)) and "dense" not in G_lazy.__dict__
+    assert all(np.array_equal(a, b) for a, b in zip(G_lazy.blocks, info_eager["parity"].blocks))
+    assert np.array_equal(np.asarray(G_lazy), G_eager) and np.array_equal(fp.diagonal(G_eager), np.diag(G_eager))

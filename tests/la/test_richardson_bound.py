@@ -118,3 +118,28 @@ def test_a_series_capped_at_its_first_extrapolation_states_that_step():
     S8, S16 = partial(8), partial(16)
     T = S16 + (S16 - S8) / 3.0
     assert info["nmax_rel_error"] == pytest.approx(richardson.relative_step(T - S16, T), rel=1e-12)
+
+
+def test_block_steps_side_by_side_are_the_serial_ones(monkeypatch):
+    """BlockOps.rel_norms measures the blocks side by side (two workers): bit for bit the steps
+    measured one block after the other (dense and Lanczos blocks)."""
+    from infsup_contact.la import richardson, threaded
+
+    rng = np.random.default_rng(5)
+    grams, es = [], [[], []]
+    for n in (60, 150, 210, 0):
+        X = rng.standard_normal((n, n))
+        grams.append(X @ X.T + n * np.eye(n))
+        for e in es:
+            Y = rng.standard_normal((n, n)) * 1e-4
+            e.append(Y + Y.T)
+    calls = []
+
+    def side_by_side(fn, items):
+        calls.append(1)
+        return threaded.run_concurrently([lambda x=x: fn(x) for x in items], workers=2)
+    monkeypatch.setattr(richardson, "concurrent_map", side_by_side)
+    together = richardson.BlockOps.rel_norms(es, grams)
+    monkeypatch.setattr(richardson, "concurrent_map", lambda fn, items: [fn(x) for x in items])
+    serial = richardson.BlockOps.rel_norms(es, grams)
+    assert calls and together == serial and all(np.isfinite(serial))

@@ -198,3 +198,19 @@ def test_a_scene_side_keeps_the_general_route(monkeypatch, element):
     reference = _general(monkeypatch, lambda: m3.scene_side(scene, body, 2))
     assert side.route == reference.route != "parity 4"
     assert np.array_equal(side.schur, reference.schur) and _solves_agree(side, reference)
+
+
+def test_a_beta_side_drops_k_on_every_dof_and_its_load_is_the_scene_sides():
+    """A β_h side (no solves) keeps no stiffness on every dof; given a scene's lift anyway, its
+    load is assembled again: the scene side's load (same K, same lift)."""
+    from types import SimpleNamespace
+
+    body = m3.subdomain_mesh("structured", 2, 1)
+    beta_side = m3.side_operator(body, 1)
+    scene_side = m3.side_operator(body, 1, keep_factor=True)
+    assert beta_side.stiffness_all is None and scene_side.stiffness_all is not None
+    scene = SimpleNamespace(c1=2.0, c2=1.0, far_displacement=(0.1, -0.2))
+    F_beta, lift_beta = m3.load(beta_side, scene, 0)
+    F_scene, lift_scene = m3.load(scene_side, scene, 0)
+    assert np.array_equal(lift_beta, lift_scene) and np.abs(lift_scene).max() > 0
+    assert np.array_equal(F_beta, F_scene) and np.abs(F_scene).max() > 0

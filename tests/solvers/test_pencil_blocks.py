@@ -144,3 +144,47 @@ def test_the_large_route_takes_the_blocks_svds_where_a_certificate_fails(monkeyp
     assert not whole, "the whole W's SVD decided"
     assert large[0]["kernel_dim"] == dense[0]["kernel_dim"] > 0
     assert large[0]["beta"] == pytest.approx(dense[0]["beta"], abs=1e-12)
+
+
+
+@pytest.mark.parametrize("case,k,n", [("R5.4", 2, 6), ("R5.2", 2, 6), ("T3", 2, 6)])
+def test_the_components_kernel_side_by_side_is_the_serial_one(monkeypatch, case, k, n):
+    """split_bottom_kernel and split_dense_kernel decide on the components side by side (two
+    workers): the decision, its values and kernel vectors bit for bit those of the components one
+    after the other."""
+    import dataclasses
+
+    from infsup_contact.discretization.gamma.coupling import coupling_matrix, trace_l2_norms
+    from infsup_contact.la import threaded
+    from infsup_contact.solvers.kernel import scaled_couplings
+    from infsup_contact.solvers.infsup import _space
+    from infsup_contact.solvers.side_cache import SideCache
+
+    sides = SideCache().pair(MODELS["membranes3d"], "structured", k, n, n, MeshOptions())
+    gamma = sides[0].trace.gamma
+    g_h = gamma.multiplier_partition(*(s.trace.partition for s in sides), "omega2")
+    space = _space(case, k, g_h, gamma)
+    cols = np.sqrt(np.diag(gamma.gram(space, "L2")[0]))
+    W = scaled_couplings([coupling_matrix(s.trace, space, k, sparse=True) for s in sides],
+                         [trace_l2_norms(s.trace, k) for s in sides], cols)
+    structural = gamma.proven_kernel(space, k, [s.trace for s in sides],
+                                     gamma.trace_sum_dimension(k, *(s.trace.partition for s in sides)))
+    split = symmetry.split_of(space, gamma, g_h, k)
+    calls = []
+
+    def side_by_side(fn, items):
+        calls.append(1)
+        return threaded.run_concurrently([lambda x=x: fn(x) for x in items], workers=2)
+    routes = [lambda: symmetry.split_bottom_kernel(W, split, structural),                  # the large route's
+              lambda: symmetry.split_dense_kernel(W.toarray(), split, structural),           # the dense route's
+              lambda: symmetry.split_dense_kernel(W.toarray(), split, structural, vectors=True)]
+    for route in routes:
+        monkeypatch.setattr(symmetry, "concurrent_map", side_by_side)
+        together = route()
+        monkeypatch.setattr(symmetry, "concurrent_map", lambda fn, items: [fn(x) for x in items])
+        serial = route()
+        assert calls and serial is not None and together is not None
+        for f in dataclasses.fields(serial):
+            a, b = getattr(together, f.name), getattr(serial, f.name)
+            assert np.array_equal(a, b) if isinstance(a, np.ndarray) else a == b, f.name
+        assert serial.dim == structural

@@ -123,3 +123,33 @@ def test_partition_choice(x1, x2, choice, expected):
 def test_partition_choice_names_the_allowed_values():
     with pytest.raises(InputError, match="multiplier_mesh.*omega2, omega1, union"):
         SEGMENT.multiplier_partition(np.array([0, 1.0]), np.array([0, 1.0]), "both")
+
+
+def test_the_sweeps_face_grams_stay_in_their_parity_blocks_and_rows_are_unchanged(monkeypatch):
+    """A β_h request takes its face Grams in parity blocks (GramCache under deferred_assembly):
+    the pencils read the blocks and the kernel's scaling the L² diagonal, so no dense G is formed
+    on the split route, and every row is the one of the eager route (G formed at once, every
+    consumer reading it)."""
+    from infsup_contact.la import face_parity
+    from infsup_contact.models.membranes3d import MEMBRANES3D
+    from infsup_contact.solvers.infsup import beta_table
+    from infsup_contact.solvers.request import BetaRequest
+
+    def request():
+        return BetaRequest(family="structured", k=2, n1=3, n2=3, cases=("R5.2", "DUAL-Q9"), model=MEMBRANES3D)
+
+    from infsup_contact.discretization.face.norms import tensor
+
+    assembled = []
+    real = face_parity.assemble
+    monkeypatch.setattr(face_parity, "assemble", lambda *a: assembled.append(1) or real(*a))
+    kron = tensor.KronParityGram.dense.func
+    monkeypatch.setattr(tensor.KronParityGram, "dense", property(lambda g: assembled.append(2) or kron(g)))
+    lazy = pd.DataFrame(beta_table(request()))
+    assert not assembled  # neither space's H Gram was assembled, nor R5.2's L² Gram formed
+    monkeypatch.setattr(face_parity, "deferred_assembly", __import__("contextlib").nullcontext)
+    monkeypatch.setattr("infsup_contact.solvers.side_cache.deferred_assembly", __import__("contextlib").nullcontext)
+    eager = pd.DataFrame(beta_table(request()))
+    assert assembled  # the eager route assembles them
+    cols = [c for c in lazy.columns if not c.startswith("t_")]
+    pd.testing.assert_frame_equal(lazy[cols], eager[cols], check_exact=True)

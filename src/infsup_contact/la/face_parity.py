@@ -18,11 +18,17 @@ the spectral norms that stop them (:class:`~.richardson.BlockOps`) cost about a 
 space's sandwich R S_P Rᵀ becomes R̃_c S_P,c R̃_cᵀ with R̃_c = Q_cᵀ R T_c (Q_c the multiplier
 basis's own components under the same two reflections: R intertwines them, so the blocks
 between different components vanish; checked, :func:`intertwined`). The Gram matrix is
-assembled once at the end, G = Σ_c Q_c G_c Q_cᵀ (:func:`assemble`). The coefficients the split
+assembled once at the end, G = Σ_c Q_c G_c Q_cᵀ (:func:`assemble`), or, inside
+:func:`deferred_assembly` (a β_h request, whose pencils take the blocks), only where a consumer
+reads it (:class:`ParityGram`: :func:`numpy.asarray` of it assembles it then, once). The coefficients the split
 drops (an even function's at even m) are zero mathematically, round-off numerically: G agrees
 with the unsplit series to round-off (tests/la/test_face_parity.py).
 """
 from __future__ import annotations
+
+import contextlib
+import contextvars
+from functools import cached_property
 
 import numpy as np
 import scipy.sparse as sp
@@ -98,15 +104,82 @@ SIGNED_PERMUTATION_RTOL = 1e-12
 as the same columns up to order and sign (:meth:`ParityGram.in_bases`)."""
 
 
+_DEFERRED = contextvars.ContextVar("face_parity_deferred", default=False)
+
+
+@contextlib.contextmanager
+def deferred_assembly():
+    """Inside: a Gram summed in parity blocks (:func:`gram_of`) is returned as its
+    :class:`ParityGram`, assembled only where a consumer reads the dense G (``np.asarray(G)``,
+    :func:`dense`); a β_h request's pencils take the blocks and never do (5 of 89 CPU-s at k = 2,
+    N = 32 went into assembling 12 full Grams nobody read)."""
+    token = _DEFERRED.set(True)
+    try:
+        yield
+    finally:
+        _DEFERRED.reset(token)
+
+
+def gram_of(bases, blocks) -> tuple:
+    """(G, :class:`ParityGram`) of a Gram summed in the parity blocks ``blocks`` of ``bases``: G
+    assembled (:func:`assemble`), or inside :func:`deferred_assembly` the ParityGram itself."""
+    parity = ParityGram(bases, blocks)
+    return (parity if _DEFERRED.get() else assemble(parity.bases, parity.blocks)), parity
+
+
+def deferring() -> bool:
+    """Whether a Gram summed in parity blocks is returned unassembled (:func:`deferred_assembly`)."""
+    return _DEFERRED.get()
+
+
+def dense(G) -> np.ndarray:
+    """The dense matrix of a Gram: G itself, or a :class:`ParityGram`'s assembled matrix."""
+    return G.dense if isinstance(G, ParityGram) else G
+
+
+def diagonal(G) -> np.ndarray:
+    """The diagonal of a Gram: ``np.diag`` of a dense one; a :class:`ParityGram`'s own
+    (:meth:`ParityGram.diagonal`: without assembling it where it knows how)."""
+    return G.diagonal() if isinstance(G, ParityGram) else np.diag(G)
+
+
 class ParityGram:
     """A Gram matrix in the four parity blocks it was summed in: G = Σ_c Q_c G_c Q_cᵀ
     (``bases`` Q_c with orthonormal columns, at most one nonzero per row; ``blocks`` G_c).
     Carried in the Gram's ``info["parity"]`` so that the pencils (:func:`~.reflection.usable`)
-    take the blocks as summed instead of splitting the assembled G again."""
+    take the blocks as summed instead of splitting the assembled G again; inside
+    :func:`deferred_assembly` also in place of G, which it assembles on first use (:attr:`dense`,
+    ``np.asarray``: the same matrix as :func:`assemble`, read-only: it is shared)."""
+
+    ndim = 2
+    dtype = np.dtype(float)
 
     def __init__(self, bases, blocks):
         self.bases = tuple(sp.csr_matrix(Q) for Q in bases)
         self.blocks = tuple(np.asarray(B, dtype=float) for B in blocks)
+
+    @property
+    def shape(self) -> tuple:
+        return (self.bases[0].shape[0],) * 2
+
+    @property
+    def nbytes(self) -> int:
+        """The blocks' bytes (about a quarter of the dense G's; constant, for a cache's count)."""
+        return sum(B.nbytes for B in self.blocks)
+
+    @cached_property
+    def dense(self) -> np.ndarray:
+        """G = Σ_c Q_c G_c Q_cᵀ (:func:`assemble`), once."""
+        G = assemble(self.bases, self.blocks)
+        G.setflags(write=False)
+        return G
+
+    def diagonal(self) -> np.ndarray:
+        """The diagonal of G (of the assembled matrix: its entries, bit for bit)."""
+        return np.diag(self.dense)
+
+    def __array__(self, dtype=None, copy=None):
+        return self.dense if dtype is None else self.dense.astype(dtype, copy=False)
 
     def in_bases(self, bases) -> list | None:
         """[Q'_cᵀ G Q'_c] for the bases Q'_c of the same components (another order of the

@@ -9,7 +9,7 @@ import scipy.sparse.linalg as spla
 from scipy.linalg import lapack
 
 from ..errors import InputError
-from .threaded import elementwise
+from .threaded import concurrent_map, elementwise
 
 
 def extrapolate(partial, p: float, n0: int, n_cap: int, rtol: float, ops=None) -> tuple[np.ndarray, dict]:
@@ -148,8 +148,10 @@ class BlockOps:
 
     @staticmethod
     def rel_norms(es, grams):
-        # G = Q diag(blocks) Qᵀ with Q orthogonal: the Loewner order holds block by block
-        per_block = [relative_steps([e[b] for e in es], R, BLOCK_DENSE_MAX) for b, R in enumerate(grams) if len(R)]
+        # G = Q diag(blocks) Qᵀ with Q orthogonal: the Loewner order holds block by block; the
+        # blocks side by side (LAPACK and Lanczos, GIL-free, one BLAS thread each: the same bits)
+        per_block = concurrent_map(lambda b: relative_steps([e[b] for e in es], grams[b], BLOCK_DENSE_MAX),
+                                   [b for b, R in enumerate(grams) if len(R)])
         return [max((v[j] for v in per_block), default=0.0) for j in range(len(es))]
 
 

@@ -189,7 +189,8 @@ def displacement_space(mesh, k: int, dirichlet: str = BETA_DIRICHLET):
 @dataclass(frozen=True)
 class MembraneSide(SideOperator):
     """A :class:`SideOperator` plus K_i on every dof (``stiffness_all``): the loads of a
-    scene's Dirichlet lift, F_i = −c_i K_i u_{D,i}."""
+    scene's Dirichlet lift, F_i = −c_i K_i u_{D,i} (None on a β_h side, which never solves:
+    :func:`load` assembles it where such a side is given a scene)."""
 
     stiffness_all: sp.csr_matrix | None = None
 
@@ -224,7 +225,9 @@ def side_operator(body: Body, k: int, route: str = "auto", dirichlet: str = BETA
     signature = None if signature is None else signature[free]
     base = (factorized_side(trace, free, K, route, keep_factor, signature) if mirror_of is None else
             mirrored_side(mirror_of, trace, free, K, signature, route, keep_factor))
-    return extended(base, MembraneSide, stiffness_all=K_all)
+    # K on every dof serves the loads of a scene's lift (a side that solves); a β_h side drops it
+    # (190 MB a side at k = 2, N = 32) and :func:`load` would assemble it again
+    return extended(base, MembraneSide, stiffness_all=K_all if keep_factor else None)
 
 
 def mirror_side(side1, body: Body, k: int):
@@ -264,7 +267,8 @@ def load(side, scene, i: int):
     gf.Set(float(scene.far_displacement[i]), definedon=fes.mesh.Boundaries(FAR))
     lift = gf.vec.FV().NumPy().copy()
     lift[np.array(fes.FreeDofs(), dtype=bool)] = 0.0  # only the supports carry the lift
-    return -c * (side.stiffness_all @ lift)[side.free], lift
+    K_all = side.stiffness_all if side.stiffness_all is not None else laplace_stiffness(fes)
+    return -c * (K_all @ lift)[side.free], lift
 
 
 def field(side, values: np.ndarray, lift=None):

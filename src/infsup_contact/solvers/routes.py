@@ -18,7 +18,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from ..discretization.gamma.coupling import coupling_matrix, trace_l2_norms
-from ..la import bottom, reflection
+from ..la import bottom, face_parity, reflection
 from . import spectra, symmetry
 from .kernel import KernelDecision, bottom_kernel, coupling_kernel, scaled_couplings
 from .spectra import gram_factor
@@ -120,7 +120,7 @@ def space_kernel(couplings, sides, space, k: int, structural: int, l2_gram=None,
     dense decision returns the kernel's basis too (the iterative one always does), in multiplier coordinates."""
     G = sides[0].trace.gamma.gram(space, "L2")[0] if l2_gram is None else l2_gram
     rows = [trace_l2_norms(s.trace, k) for s in sides] if trace_norms is None else trace_norms
-    cols = np.sqrt(np.diag(G))
+    cols = np.sqrt(face_parity.diagonal(G))  # a Gram kept in parity blocks: without assembling it
     W = scaled_couplings(couplings, rows, cols)
     extra = LONGER_RULE_LARGE if iterative else LONGER_RULE
     longer = scaled_couplings([coupling_matrix(s.trace, space, k, extra_degree=extra, sparse=iterative)

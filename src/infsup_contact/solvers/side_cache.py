@@ -36,6 +36,7 @@ from collections import Counter, OrderedDict
 import numpy as np
 
 from .. import progress
+from ..la.face_parity import ParityGram, deferred_assembly
 from .request import NO_OPTIONS, MeshOptions
 
 
@@ -131,7 +132,9 @@ class GramCache:
         """``gamma.gram(space, norm, h_route=h_route)``, from the cache when an equal
         (Γ, case, k, G_h, norm, route) was asked before. ``case`` must identify the space's
         definition (a registry id, a spec, a triple). Not cached: an unhashable Γ or case, a Gram
-        that is not a dense array or above a quarter of :attr:`max_bytes`."""
+        that is not a dense array or above a quarter of :attr:`max_bytes`. A Gram summed in
+        parity blocks comes as its :class:`~infsup_contact.la.face_parity.ParityGram`, assembled
+        where a consumer reads it densely (:func:`~infsup_contact.la.face_parity.deferred_assembly`)."""
         try:
             key = (gamma, case, int(k), gamma.partition_key(partition), norm, h_route)
             hash(key)
@@ -143,10 +146,12 @@ class GramCache:
             self.hits += 1
             return hit
         progress.note(f"Gram matrix G, norm {norm}")
-        G, info = gamma.gram(space, norm, h_route=h_route)
-        if not isinstance(G, np.ndarray) or 4 * G.nbytes > self.max_bytes:
+        with deferred_assembly():  # a Gram summed in parity blocks stays in them until read densely
+            G, info = gamma.gram(space, norm, h_route=h_route)
+        if not isinstance(G, (np.ndarray, ParityGram)) or 4 * G.nbytes > self.max_bytes:
             return G, info
-        G.setflags(write=False)  # shared by later pairs: nobody may change it
+        for held in (G.blocks if isinstance(G, ParityGram) else (G,)):
+            held.setflags(write=False)  # shared by later pairs: nobody may change it
         self._grams[key] = (G, info)
         self._bytes += G.nbytes
         while self._bytes > self.max_bytes:

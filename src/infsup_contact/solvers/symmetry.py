@@ -16,6 +16,7 @@ import scipy.sparse as sp
 from ..discretization.gamma.symmetry import axis_reflections, induced_permutation, isotypic_bases, reflect
 from ..la import bottom
 from ..la.reflection import ReflectionSplit
+from ..la.threaded import concurrent_map
 from .kernel import BLOCK_EXTRA, KernelDecision, certified_bottom, certify_floor, decide, error_level
 
 
@@ -77,15 +78,21 @@ def split_bottom_kernel(W, split: ReflectionSplit, proven: int = 0, entry_error:
     smax = max(smaxes)
     tol = error_level(rows, m, smax, entry_error)
     floor = max(certify_floor(rows, m, smax), 2.0 * cross)  # the whole W's certificate at τ − ‖O‖
-    counted, vectors, above = [], [], np.inf
-    for B, g, s_b, Q in zip(blocks, grams, smaxes, bases):
-        mb = B.shape[1]
-        if mb < 2:
-            return None
+    if min(B.shape[1] for B in blocks) < 2:
+        return None
+
+    def certified(b):
+        mb = blocks[b].shape[1]
         hint = int(np.ceil(proven * mb / m))  # a block size only: each half holds about its share
-        res = certified_bottom(B, g, min(hint + BLOCK_EXTRA, mb - 1), tol, s_b, floor)
-        if res is None:
-            return None
+        return certified_bottom(blocks[b], grams[b], min(hint + BLOCK_EXTRA, mb - 1), tol, smaxes[b], floor)
+
+    # the blocks side by side (LAPACK and sparse products: GIL-free, one BLAS thread each; each
+    # block's steps are the same operations whatever runs beside them, so the same bits)
+    results = concurrent_map(certified, range(len(blocks)))
+    if any(res is None for res in results):
+        return None
+    counted, vectors, above = [], [], np.inf
+    for res, Q in zip(results, bases):
         counted.append(res.values[:res.count])
         vectors.append(np.asarray(Q @ res.vectors[:, :res.count]))
         above = min(above, float(res.above))
@@ -128,12 +135,14 @@ def split_dense_kernel(W: np.ndarray, split: ReflectionSplit, proven: int = 0,
                for b in range(len(blocks)) for a in range(b) if blocks[a].shape[1] and blocks[b].shape[1])
     cross = float(np.sqrt(2.0 * off2))  # ‖O‖_F: each off-diagonal block counted twice
     live = [(B, Q) for B, Q in zip(blocks, split.bases) if B.shape[1]]
+    # the blocks' SVDs side by side (LAPACK, GIL-free, one BLAS thread each: the same bits)
     if vectors:  # each block's SVD with its right vectors, ascending (structural zeros first)
-        svds = [sla.svd(B, full_matrices=B.shape[1] > B.shape[0], check_finite=True)[1:] for B, _ in live]
+        svds = concurrent_map(lambda BQ: sla.svd(BQ[0], full_matrices=BQ[0].shape[1] > BQ[0].shape[0],
+                                                 check_finite=True)[1:], live)
         per_block = [np.concatenate([np.zeros(B.shape[1] - len(sb)), np.sort(sb)]) for (B, _), (sb, _) in zip(live, svds)]
         s = per_block
     else:
-        s = [sla.svdvals(B, check_finite=True) for B, _ in live]  # LAPACK, as coupling_kernel
+        s = concurrent_map(lambda BQ: sla.svdvals(BQ[0], check_finite=True), live)  # LAPACK, as coupling_kernel
     s = np.sort(np.concatenate([np.zeros(m - sum(len(v) for v in s))] + s))
     s_max = float(s[-1])
     tol = error_level(rows, m, s_max, entry_error)

@@ -189,7 +189,8 @@ def gram_h_cellwise(space, rtol: float = 1e-6, n_start: int | None = None, n_cap
         parities, Rs, bases = blocked
         G, info = extrapolated(lambda n: face_parity.sandwiched(Rs, piece_partial_gram(P, n, parities)),
                                p, n0, n_cap, rtol, ops=BlockOps)
-        return face_parity.assemble(bases, G), dict(info, parity=face_parity.ParityGram(bases, G))
+        G, parity = face_parity.gram_of(bases, G)  # G deferred in a β_h request
+        return G, dict(info, parity=parity)
 
     def partial(n):  # S_P is exactly symmetric; the sandwich only to round-off
         return symmetric_part(symmetric_sandwich(R, piece_partial_gram(P, n, direct=reference)))

@@ -19,6 +19,8 @@ a nonzero value on ∂Γ (1D coefficients ~ 1/m), p = 4 for continuous spaces va
 """
 from __future__ import annotations
 
+from functools import cached_property
+
 import numpy as np
 
 from ....errors import InputError
@@ -215,8 +217,8 @@ def gram_h_face(space, rtol: float = 1e-6, n_start: int | None = None, n_cap: in
         return extrapolated(lambda n: partial_gram(space, n, aspect, direct=reference), p, n0, n_cap, rtol)
     blocks, info = extrapolated(lambda n: partial_gram_blocks(space, n, parities), p, n0, n_cap, rtol,
                                 ops=BlockOps)
-    bases = face_parity.tensor_bases(parities)
-    return face_parity.assemble(bases, blocks), dict(info, parity=face_parity.ParityGram(bases, blocks))
+    G, parity = face_parity.gram_of(face_parity.tensor_bases(parities), blocks)  # G deferred in a β_h request
+    return G, dict(info, parity=parity)
 
 
 def partial_gram_blocks(space, n_max: int, parities) -> list:
@@ -238,11 +240,33 @@ def gram(space, norm: str, **kwargs) -> tuple[np.ndarray, dict]:
     """Gram matrix of a tensor face space (its ``factors``) for ``norm`` ∈ {"H", "L2"} (``kwargs``
     go to :func:`gram_h_face`); spaces without factors: :mod:`.face.norms.cellwise`. The L² Gram
     of a space with both factors symmetric carries its parity blocks too (:func:`l2_parity`)."""
-    G, info = gram_by_norm(norm, lambda: gram_l2_face(space), lambda **kw: gram_h_face(space, **kw), **kwargs)
-    if norm == "L2":
-        parity = l2_parity(space)
-        info = info if parity is None else dict(info, parity=parity)
-    return G, info
+    parity = l2_parity(space) if norm == "L2" else None
+    deferred = parity is not None and face_parity.deferring()  # a β_h request: G_x ⊗ G_y where read
+    G, info = gram_by_norm(norm, lambda: KronParityGram(space, parity) if deferred else gram_l2_face(space),
+                           lambda **kw: gram_h_face(space, **kw), **kwargs)
+    return G, (info if parity is None else dict(info, parity=G if deferred else parity))
+
+
+class KronParityGram(face_parity.ParityGram):
+    """The L² Gram G_x ⊗ G_y of a tensor space in its parity blocks (:func:`l2_parity`), its dense
+    matrix the Kronecker product made on first read (bit for bit :func:`gram_l2_face`), its
+    diagonal that of the factors (each entry the same one product): inside
+    :func:`~infsup_contact.la.face_parity.deferred_assembly` the kernel decision's scaling reads
+    the diagonal only, the pencils the blocks (a β_h request at k = 2, N = 48 never forms the
+    708 MB of each space's G)."""
+
+    def __init__(self, space, parity):
+        super().__init__(parity.bases, parity.blocks)
+        self._factors = tuple(gram_l2(f) for f in space.factors)
+
+    @cached_property
+    def dense(self) -> np.ndarray:
+        G = np.kron(*self._factors)
+        G.setflags(write=False)
+        return G
+
+    def diagonal(self) -> np.ndarray:
+        return np.kron(*(np.diag(g) for g in self._factors))
 
 
 def l2_parity(space):

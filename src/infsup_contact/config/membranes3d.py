@@ -1,4 +1,4 @@
-"""Cross-key checks of the model table's ``face`` studies (the 3D membranes on the contact face).
+"""Cross-key checks of the model table's ``membranes3d`` studies (the 3D membranes on the contact face).
 
 What the schema cannot state: the model is a registered one with a 3D face, each element is
 one of its ``element`` mesh options, each case id is a registered space the face can build for
@@ -6,7 +6,7 @@ some k of ``face.k`` (built on the 2 × 2 grid of Γ: a face-only space added to
 later passes by config alone), a non-matching pair has N1 ≠ N2, and the face studies' keys
 (:func:`check_face_studies`). Each raises one
 :class:`~infsup_contact.config.schema.ConfigError` naming the key under the study's entry
-(``face.k`` below: ``models.face.k`` for the entry ``face``).
+(``face.k`` below: ``models.membranes3d.k`` for the entry ``membranes3d``).
 
 Non-matching families (``face.nonmatching_families``: family → element → N1 list):
 the rules of the 2D study's families (:data:`~infsup_contact.discretization.gamma.mesh_series.FAMILY_RULES`:
@@ -22,11 +22,11 @@ import numpy as np
 from .schema import ConfigError, naming_key
 
 
-def check_face(cfg) -> None:
-    """Check every ``face`` study of the model table (none: nothing to check)."""
+def check_membranes3d(cfg) -> None:
+    """Check every ``membranes3d`` study of the model table (none: nothing to check)."""
     from .models import study_entries
 
-    for at, fc in study_entries(cfg, "face"):
+    for at, fc in study_entries(cfg, "membranes3d"):
         _check_face(cfg, fc, at)
 
 
@@ -89,7 +89,7 @@ def _check_degrees(key: str, model, element: str, ks, k_key: str) -> None:
 
 
 def check_face_studies(fc, model, at: str) -> None:
-    """The face studies' keys (jobs of the face study, plans/face.py) the schema cannot state: the patch
+    """The face studies' keys (jobs of the face study, plans/membranes3d.py) the schema cannot state: the patch
     test's elements are the model's, with contact scenes and at least one degree of
     ``face.patch.k`` (an element runs the degrees it has: HEX20 k = 2), its pairs
     non-matching; the α sweep's elements are face elements with a transformed (non-identity)

@@ -78,13 +78,13 @@ def _elastic_estimates(cfg):
 
 
 def _face_estimates(cfg):
-    """The β jobs of the model table's 3D face studies (``face``, ``face_elastic``): per element and k, each
+    """The β jobs of the model table's 3D face studies (``membranes3d``, ``elastic3d``): per element and k, each
     matching N (up to the element's ``max_N`` or ``l2_max_N``) and non-matching pair, with the estimate the
     command line checks (:func:`~infsup_contact.resources.beta_estimate`, ``dim = 3``)."""
     from ..models import MODELS
     from .models import study_entries
 
-    for at, fc in study_entries(cfg, "face") + study_entries(cfg, "face_elastic"):
+    for at, fc in study_entries(cfg, "membranes3d") + study_entries(cfg, "elastic3d"):
         if fc.get("model") not in MODELS:
             continue
         name = at.rpartition(".")[2]

@@ -2,9 +2,9 @@
 cross-key checks the schema cannot state.
 
 Every study carries its scenes in its entry (:func:`scenes`). The studies the paper's sections and
-figures read by name (``elastic``, ``face``, ``face_elastic``: :data:`NAMED`) are entries of that
-name, and the table has an ``elastic`` one; a config that still has their old top-level sections is
-told where they moved (:func:`check_moved_sections`). A ``beta`` study names a model
+figures read by name (``elastic``, ``membranes3d``, ``elastic3d``: :data:`NAMED`, each named by its
+model) are entries of that name, and the table has an ``elastic`` one; a config that still has their
+old top-level sections or old study names is told where they moved (:func:`check_moved_sections`). A ``beta`` study names a model
 (registered, or ``FILE.py:NAME`` imported here once, so a wrong file stops the run before any job)
 and its scenes ``k``, ``N`` and ``cases``; each element is one of the model's ``element`` options
 (none for a model without them); each case is a registered space defined for some k and built by
@@ -17,9 +17,11 @@ from __future__ import annotations
 from ..errors import InputError
 from .schema import ConfigError, naming_key
 
-NAMED = ("elastic", "face", "face_elastic")
+NAMED = ("elastic", "membranes3d", "elastic3d")
 """Studies whose files the paper's sections and figures read by the study's name
 (``results/paper/<name>/``, ``results/tables/<name>_*.csv``): their entry has that name."""
+RENAMED = {"face": "membranes3d", "face_elastic": "elastic3d"}
+"""The studies' old names (``study:`` values and top-level sections) → their model's name."""
 REQUIRED = ("elastic",)
 """Studies the table must have: the paper's elastic section, fig9 and the elastic benchmark read it."""
 RESERVED = ("beta", "contact", "mesh_quality", "claims", "producers", "references", "rates")
@@ -51,16 +53,28 @@ def scenes_of(config: dict, study: str) -> dict | None:
 
 
 def check_moved_sections(cfg) -> None:
-    """A config written before the wings joined the model table: its top-level section
-    ``elastic``, ``face`` or ``face_elastic`` is refused, naming where its keys now live (unchanged,
-    under the entry of that name with ``study: <name>``). Run before the schema, whose message
-    (an unknown top-level key) would not say where it went."""
-    for name in NAMED:
-        if isinstance(cfg, dict) and name in cfg:
-            raise ConfigError(name, f"the top-level section moved into the model table: its keys go, unchanged, "
-                              f"under models.{name} beside `study: {name}`", got=f"<a top-level `{name}:` section>",
-                              allowed=f"models: {{{name}: {{study: {name}, <the keys of the old section>}}}} "
+    """A config written before the wings joined the model table, or before each took its model's
+    name: a top-level section ``elastic``, ``face`` or ``face_elastic`` is refused, naming where its
+    keys now live (unchanged, under the entry of the model's name, :data:`RENAMED`); so is an entry
+    whose ``study`` is an old name. Run before the schema, whose message (an unknown top-level key,
+    a value not in an enum) would not say where it went."""
+    if not isinstance(cfg, dict):
+        return
+    for old in ("elastic", *RENAMED):
+        if old in cfg:
+            new = RENAMED.get(old, old)
+            raise ConfigError(old, f"the top-level section moved into the model table: its keys go, unchanged, "
+                              f"under models.{new} beside `study: {new}`", got=f"<a top-level `{old}:` section>",
+                              allowed=f"models: {{{new}: {{study: {new}, <the keys of the old section>}}}} "
                               "(config/config.yaml has one)")
+    table = cfg.get("models")
+    for name, entry in (table.items() if isinstance(table, dict) else ()):
+        study = entry.get("study") if isinstance(entry, dict) else None
+        if isinstance(study, str) and study in RENAMED:
+            new = RENAMED[study]
+            raise ConfigError(f"models.{name}.study", f"the study {study!r} is named by its model now: "
+                              f"{new!r} (its keys unchanged, the entry named {new})", got=study,
+                              allowed=f"models: {{{new}: {{study: {new}, ...}}}}")
 
 
 def check_required_studies(cfg) -> None:

@@ -11,14 +11,14 @@ from __future__ import annotations
 import pandas as pd
 
 from .. import resources
-from ..config.face import face_pairs, l2_only_sizes
+from ..config.membranes3d import face_pairs, l2_only_sizes
 from .protocol import Inputs, Job, Table, claims_path, job_path, table_path
 
 STUDIES = ("patch", "alpha", "edge_dropping")
 """The face studies: sub-mappings of the entry and jobs of their own."""
 
 
-class FaceStudy:
+class Membranes3dStudy:
     """The face study ``name`` of the model table, from its entry's scenes (module docstring)."""
 
     tex_source = "paper/face.tex"

@@ -15,8 +15,8 @@ object, never the model, what to do. A study object answers four questions:
 * :meth:`ModelStudy.paper_files` — its generated LaTeX (``results/paper/s/*.tex``) from the
   files of :meth:`ModelStudy.paper_inputs`, checked against its paper source if it has one.
 
-Everything model-specific stays in the study's own module (:mod:`.elastic`, :mod:`.face`,
-:mod:`.face_elastic`, :mod:`.beta`, :mod:`.arc`), each reading its scenes from its entry; the stages are shared.
+Everything model-specific stays in the study's own module (:mod:`.elastic`, :mod:`.membranes3d`,
+:mod:`.elastic3d`, :mod:`.beta`, :mod:`.arc`), each reading its scenes from its entry; the stages are shared.
 """
 from __future__ import annotations
 

@@ -5,7 +5,7 @@ edge dropping), each declared through the section templates (:mod:`.templates`, 
 Pure functions from ``results/tables/face_beta.csv``, ``results/tables/face_claims.csv``,
 ``results/face/{patch,alpha,edge_dropping}.csv`` and the studies' claims
 (``results/tables/face_study_claims.csv``, :mod:`infsup_contact.study.claims.membranes3d_studies`)
-to LaTeX text; ``workflow/scripts/model_paper.py`` reads and writes (plans/face.py). Macro names start with
+to LaTeX text; ``workflow/scripts/model_paper.py`` reads and writes (plans/membranes3d.py). Macro names start with
 ``face`` (letters only, :func:`~infsup_contact.report.texnames.macro_name`), apart from the
 main paper's generated namespace. Every number of the section is one of these macros or a
 cell of a table, each computed from the tables here; each outcome macro (``\\faceOutcome…``)

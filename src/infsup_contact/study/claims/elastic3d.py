@@ -31,7 +31,7 @@ the config — never from a case id and never from the measured tables. The reas
   Predicted PASS where 1 ∈ M_h (:func:`.membranes3d_studies.face_contains_constants`, computed by
   :func:`~infsup_contact.discretization.gamma.constants.spans_constants` on the built face space) and the
   kernel count is 0; without the constants only the lower bound holds (slope ≤ 1/2): a finding.
-* **Patch test** (``face-elastic-patch-<tag>-k<k>-<element>``, :mod:`..patch.face_elastic`): the
+* **Patch test** (``face-elastic-patch-<tag>-k<k>-<element>``, :mod:`..patch.elastic3d`): the
   uniform compression is reproduced to round-off iff 1 ∈ M_h (spans_constants of the built space)
   and the scene's natural-trace kernel count is 0 (:func:`.membranes3d_studies.patch_prediction`,
   the membranes' face patch rule: the exact solution is linear, its z traces coincide).

@@ -1,5 +1,5 @@
 """The tables of the 3D elastic bodies on the contact face (config ``face_elastic``;
-rules/models.smk with plans/face_elastic.py): β_h per Poisson ratio and the elastic face patch test.
+rules/models.smk with plans/elastic3d.py): β_h per Poisson ratio and the elastic face patch test.
 
 Pure functions of the config section returning DataFrames; the job scripts only read and write.
 
@@ -9,7 +9,7 @@ Pure functions of the config section returning DataFrames; the job scripts only 
   every ν of ``face_elastic.nu_sweep`` on its matching meshes (the ν → 1/2 sweep of
   :mod:`.claims.elastic3d`). Each (ν, pair) is computed once, through the one β batch path
   of every model (:func:`~.beta_batches.beta_batch_rows`, the model built with ``nu``).
-* :func:`patch_frame`: the elastic face patch test (:mod:`.patch.face_elastic`) on the pairs of
+* :func:`patch_frame`: the elastic face patch test (:mod:`.patch.elastic3d`) on the pairs of
   ``face_elastic.patch`` at ν = ``face_elastic.nu``, E1 = E2 = 1.
 """
 from __future__ import annotations
@@ -65,7 +65,7 @@ def patch_frame(fe: dict) -> pd.DataFrame:
     """The elastic face patch test (:func:`~.elastic_face_patch.elastic_face_patch_rows`) for
     every element of ``face_elastic.patch``, the cases its face builds, every k and pair."""
     from ...models import make_model
-    from ..patch.face_elastic import elastic_face_patch_rows
+    from ..patch.elastic3d import elastic_face_patch_rows
     from ..claims.membranes3d import element_interfaces
 
     pc = fe["patch"]

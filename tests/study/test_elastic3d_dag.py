@@ -143,25 +143,25 @@ def _ci():
 
 
 @pytest.mark.parametrize("mutate, key", [
-    (lambda f: f.update(model="membranes3d"), "models.elastic3d.model"),
-    (lambda f: f.update(elements=["hex", "prism"]), "models.elastic3d.elements[1]"),
-    (lambda f: f["patch"].update(elements=["prism"]), "models.elastic3d.patch.elements[0]"),
-    (lambda f: f.update(nu=0.5), "models.elastic3d.nu"),
-    (lambda f: f["nu_sweep"].update(nu=[0.3, 0.49, 0.5]), "models.elastic3d.nu_sweep.nu[2]"),
-    (lambda f: f["nu_sweep"].update(fit_nu_min=0.4999), "models.elastic3d.nu_sweep.fit_nu_min"),
-    (lambda f: f["nu_sweep"].update(N=[5]), "models.elastic3d.nu_sweep.N[0]"),
-    (lambda f: f.update(nonmatching=[[5, 5]]), "models.elastic3d.nonmatching[0]"),
-    (lambda f: f["patch"].update(pairs=[[4, 4]]), "models.elastic3d.patch.pairs[0]"),
-    (lambda f: f.update(cases=["T3", "NOPE"]), "models.elastic3d.cases[1]"),
-    (lambda f: f.update(k=[1], cases=["T4"]), "models.elastic3d.cases[0]"),
-    (lambda f: f["nu_sweep"].update(slope_tolerance=0), "models.elastic3d.nu_sweep.slope_tolerance"),
-    (lambda f: f.update(surprise=1), "models.elastic3d"),
+    (lambda f: f.update(model="membranes3d"), "studies.elastic3d.model"),
+    (lambda f: f.update(elements=["hex", "prism"]), "studies.elastic3d.elements[1]"),
+    (lambda f: f["patch"].update(elements=["prism"]), "studies.elastic3d.patch.elements[0]"),
+    (lambda f: f.update(nu=0.5), "studies.elastic3d.nu"),
+    (lambda f: f["nu_sweep"].update(nu=[0.3, 0.49, 0.5]), "studies.elastic3d.nu_sweep.nu[2]"),
+    (lambda f: f["nu_sweep"].update(fit_nu_min=0.4999), "studies.elastic3d.nu_sweep.fit_nu_min"),
+    (lambda f: f["nu_sweep"].update(N=[5]), "studies.elastic3d.nu_sweep.N[0]"),
+    (lambda f: f.update(nonmatching=[[5, 5]]), "studies.elastic3d.nonmatching[0]"),
+    (lambda f: f["patch"].update(pairs=[[4, 4]]), "studies.elastic3d.patch.pairs[0]"),
+    (lambda f: f.update(cases=["T3", "NOPE"]), "studies.elastic3d.cases[1]"),
+    (lambda f: f.update(k=[1], cases=["T4"]), "studies.elastic3d.cases[0]"),
+    (lambda f: f["nu_sweep"].update(slope_tolerance=0), "studies.elastic3d.nu_sweep.slope_tolerance"),
+    (lambda f: f.update(surprise=1), "studies.elastic3d"),
 ])
 def test_bad_elastic3d_key_is_named(mutate, key):
     from infsup_contact.config.checks import ConfigError, check_config
 
     cfg = copy.deepcopy(_ci())
-    mutate(cfg["models"]["elastic3d"])
+    mutate(cfg["studies"]["elastic3d"])
     with pytest.raises(ConfigError) as err:
         check_config(cfg, ROOT / "workflow" / "schemas" / "config.schema.yaml")
     assert f"config key {key}" in str(err.value)
@@ -173,5 +173,5 @@ def test_shipped_configs_pass_and_the_study_is_optional(name):
 
     cfg = yaml.safe_load((ROOT / "config" / name).read_text())
     check_config(cfg, ROOT / "workflow" / "schemas" / "config.schema.yaml")
-    del cfg["models"]["elastic3d"]
+    del cfg["studies"]["elastic3d"]
     check_config(cfg, ROOT / "workflow" / "schemas" / "config.schema.yaml")

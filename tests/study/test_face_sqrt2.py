@@ -39,7 +39,7 @@ def test_sqrt2_pairs_follow_the_rule_and_share_no_interior_line():
 
 
 def test_the_config_runs_one_sqrt2_pair_per_element():
-    fc = CONFIG["models"]["membranes3d"]
+    fc = CONFIG["studies"]["membranes3d"]
     check_config(copy.deepcopy(CONFIG), SCHEMA)
     for element in fc["elements"]:
         fam = family_pairs(fc, element)
@@ -48,13 +48,13 @@ def test_the_config_runs_one_sqrt2_pair_per_element():
 
 
 @pytest.mark.parametrize("families,key", [
-    ({"cube": {"hex": [5]}}, "models.membranes3d.nonmatching_families.cube"),
-    ({"sqrt2": {"prism": [5]}}, "models.membranes3d.nonmatching_families.sqrt2.prism"),
-    ({"sqrt2": {"hex": [1]}}, "models.membranes3d.nonmatching_families.sqrt2.hex[0]"),
+    ({"cube": {"hex": [5]}}, "studies.membranes3d.nonmatching_families.cube"),
+    ({"sqrt2": {"prism": [5]}}, "studies.membranes3d.nonmatching_families.sqrt2.prism"),
+    ({"sqrt2": {"hex": [1]}}, "studies.membranes3d.nonmatching_families.sqrt2.hex[0]"),
 ])
 def test_bad_families_are_refused_naming_the_key(families, key):
     cfg = copy.deepcopy(CONFIG)
-    cfg["models"]["membranes3d"]["nonmatching_families"] = families
+    cfg["studies"]["membranes3d"]["nonmatching_families"] = families
     with pytest.raises(ConfigError) as err:
         check_config(cfg, SCHEMA)
     assert err.value.key == key and "\n" not in str(err.value)

@@ -105,7 +105,7 @@ def reference_mem_mb(wildcards):
 # the face benchmark (rules/benchmarks.smk), with benchmarks.face_N
 FACE_BENCH = ["results/benchmarks/face.csv"] if config["benchmarks"].get("face_N") else []
 
-# The model table (config key `models`; src/infsup_contact/plans/): each study by name, the {model}
+# The model table (config key `studies`; src/infsup_contact/plans/): each study by name, the {model}
 # wildcard of rules/models.smk (jobs, joined tables), claims.smk (model_claims) and paper.smk (model_paper).
 MODEL_TABLE = model_table(config)
 MODEL_STUDIES = {name: study_of(config, name) for name in MODEL_TABLE}

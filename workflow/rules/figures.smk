@@ -253,7 +253,7 @@ rule elastic_hertz_profiles:
     input:
         PACKAGE_SOURCES,
     params:
-        ec=lambda wc: scenes_of(config, "elastic"),  # the model table's elastic study (config key models.elastic)
+        ec=lambda wc: scenes_of(config, "elastic"),  # the model table's elastic study (config key studies.elastic)
         fig=lambda wc: config["figures"]["elastic_profiles"],
     threads: 1
     benchmark:

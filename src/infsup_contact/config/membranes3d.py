@@ -6,7 +6,7 @@ some k of ``face.k`` (built on the 2 × 2 grid of Γ: a face-only space added to
 later passes by config alone), a non-matching pair has N1 ≠ N2, and the face studies' keys
 (:func:`check_face_studies`). Each raises one
 :class:`~infsup_contact.config.schema.ConfigError` naming the key under the study's entry
-(``face.k`` below: ``models.membranes3d.k`` for the entry ``membranes3d``).
+(``face.k`` below: ``studies.membranes3d.k`` for the entry ``membranes3d``).
 
 Non-matching families (``face.nonmatching_families``: family → element → N1 list):
 the rules of the 2D study's families (:data:`~infsup_contact.discretization.gamma.mesh_series.FAMILY_RULES`:
@@ -31,7 +31,7 @@ def check_membranes3d(cfg) -> None:
 
 
 def _check_face(cfg, fc: dict, at: str) -> None:
-    """Check one face study's scenes ``fc``, its errors naming the keys under ``at`` (``models.<name>``)."""
+    """Check one face study's scenes ``fc``, its errors naming the keys under ``at`` (``studies.<name>``)."""
     from ..models import MODELS
 
     model = MODELS.get(fc["model"])

@@ -104,12 +104,12 @@ def _model_table_estimates(cfg):
     """The β jobs of the model table's ``beta`` studies (one per element and k: its largest pair)."""
     from ..models.user_models import model_named
 
-    for name, entry in (cfg.get("models") or {}).items():
+    for name, entry in (cfg.get("studies") or {}).items():
         if entry.get("study") != "beta":
             continue  # the other studies' jobs are counted above
         model = model_named(entry["model"])
         for n1, n2 in [(n, n) for n in entry["N"]] + [tuple(p) for p in entry.get("nonmatching", [])]:
-            key = f"models.{name}.N" if n1 == n2 else f"models.{name}.nonmatching"
+            key = f"studies.{name}.N" if n1 == n2 else f"studies.{name}.nonmatching"
             for k in entry["k"]:
                 yield key, f"model_job {name} k={k} {n1}x{n2}", R.beta_estimate(
                     "structured", k, n1, n2, "omega2", tuple(entry.get("norms", ("H", "L2"))),

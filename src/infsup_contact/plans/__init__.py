@@ -1,6 +1,6 @@
 """The model table: each model study's jobs, tables, claims and paper files (:mod:`.protocol`).
 
-The config key ``models`` lists the studies by name with the study each runs (:data:`STUDIES`);
+The config key ``studies`` lists the studies by name with the study each runs (:data:`STUDIES`);
 :func:`model_table` reads it and :func:`study_of` builds one. The workflow's stages take the
 study's name as their ``{model}`` wildcard and ask this package everything else.
 """

@@ -1,7 +1,7 @@
 """What a model study is to the workflow: its jobs, its tables, its claims and its paper files.
 
-The model is an axis of the data. The config's model table (key ``models``; :mod:`.table`) names
-each study; one rule per stage takes the study's name as its ``{model}`` wildcard
+The model is an axis of the data. The config's model table (key ``studies``;
+:mod:`infsup_contact.config.models`) names each study; one rule per stage takes the study's name as its ``{model}`` wildcard
 (``workflow/rules/models.smk``: jobs and tables; ``claims.smk``; ``paper.smk``) and asks the study
 object, never the model, what to do. A study object answers four questions:
 

@@ -31,7 +31,7 @@ def check_membranes3d(cfg) -> None:
 
 
 def _check_face(cfg, fc: dict, at: str) -> None:
-    """Check one face study's scenes ``fc``, its errors naming the keys under ``at`` (``studies.<name>``)."""
+    """Check one membranes3d study's scenes ``fc``, its errors naming the keys under ``at`` (``studies.<name>``)."""
     from ..models import MODELS
 
     model = MODELS.get(fc["model"])
@@ -89,9 +89,9 @@ def _check_degrees(key: str, model, element: str, ks, k_key: str) -> None:
 
 
 def check_face_studies(fc, model, at: str) -> None:
-    """The face studies' keys (jobs of the face study, plans/membranes3d.py) the schema cannot state: the patch
-    test's elements are the model's, with contact scenes and at least one degree of
-    ``face.patch.k`` (an element runs the degrees it has: HEX20 k = 2), its pairs
+    """The face studies' keys (jobs of the membranes3d study, plans/membranes3d.py) the schema
+    cannot state: the patch test's elements are the model's, with contact scenes and at least one
+    degree of ``face.patch.k`` (an element runs the degrees it has: HEX20 k = 2), its pairs
     non-matching; the α sweep's elements are face elements with a transformed (non-identity)
     basis; edge dropping keeps at least 3 θ at or below ``fit_theta_max`` (a slope fit). Each
     raises one ConfigError naming the key."""

@@ -4,9 +4,9 @@ cross-key checks the schema cannot state.
 Every study carries its scenes in its entry (:func:`scenes`). The studies the paper's sections and
 figures read by name (``elastic``, ``membranes3d``, ``elastic3d``: :data:`NAMED`, each named by its
 model) are entries of that name, and the table has an ``elastic`` one; a config that still has their
-old top-level sections or old study names is told where they moved (:func:`check_moved_sections`). A ``beta`` study names a model
-(registered, or ``FILE.py:NAME`` imported here once, so a wrong file stops the run before any job)
-and its scenes ``k``, ``N`` and ``cases``; each element is one of the model's ``element`` options
+old top-level sections, old study names or the old table key ``models`` is told where they moved
+(:func:`check_moved_sections`). A ``beta`` study names a model (registered, or ``FILE.py:NAME``
+imported here once, so a wrong file stops the run before any job) and its scenes ``k``, ``N`` and ``cases``; each element is one of the model's ``element`` options
 (none for a model without them); each case is a registered space defined for some k and built by
 the model's Γ; a study's name does not shadow a folder the other stages write under
 ``results/tables/`` (:data:`RESERVED`). Each raises one

@@ -15,7 +15,7 @@ from .protocol import Inputs, Job, Table, claims_path, job_path, table_path
 
 
 class Elastic3dStudy:
-    """The elastic face study ``name`` of the model table, from its entry's scenes (module docstring)."""
+    """The elastic3d study ``name`` of the model table, from its entry's scenes (module docstring)."""
 
     tex_source = None
     model_section = False  # its subsection is read by the face section (paper/face.tex), not listed

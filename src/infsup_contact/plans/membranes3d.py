@@ -1,4 +1,4 @@
-"""The membranes in 3D with a 2D contact face Γ = (0,1)²×{1} (model-table study ``face``).
+"""The membranes in 3D with a 2D contact face Γ = (0,1)²×{1} (model-table study ``membranes3d``).
 
 Jobs: β_h of every (element, k) on its mesh pairs in both norms, the L²(Γ)-only rows of the finer
 matching meshes where an element has them (``face.l2_max_N``), the 3D contact patch test, the
@@ -19,7 +19,8 @@ STUDIES = ("patch", "alpha", "edge_dropping")
 
 
 class Membranes3dStudy:
-    """The face study ``name`` of the model table, from its entry's scenes (module docstring)."""
+    """The membranes3d study ``name`` of the model table (the 3D membranes on the face), from its
+    entry's scenes (module docstring)."""
 
     tex_source = "paper/face.tex"
     in_paper = True

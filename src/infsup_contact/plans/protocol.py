@@ -1,9 +1,9 @@
 """What a model study is to the workflow: its jobs, its tables, its claims and its paper files.
 
 The model is an axis of the data. The config's model table (key ``studies``;
-:mod:`infsup_contact.config.models`) names each study; one rule per stage takes the study's name as its ``{model}`` wildcard
-(``workflow/rules/models.smk``: jobs and tables; ``claims.smk``; ``paper.smk``) and asks the study
-object, never the model, what to do. A study object answers four questions:
+:mod:`infsup_contact.config.models`) names each study; one rule per stage takes the study's name
+as its ``{model}`` wildcard (``workflow/rules/models.smk``: jobs and tables; ``claims.smk``;
+``paper.smk``) and asks the study object, never the model, what to do. A study object answers four questions:
 
 * :meth:`ModelStudy.jobs` — the tables computed in one process each, by name: the job ``j``
   of the study ``s`` writes ``results/tables/s/j.csv`` (:func:`job_path`);

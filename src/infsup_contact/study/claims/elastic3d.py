@@ -1,5 +1,5 @@
-"""Ledger claims of the 3D elastic bodies on the contact face (config ``face_elastic``;
-``results/tables/face_elastic_beta.csv`` and ``results/face/elastic_patch.csv``), appended to
+"""Ledger claims of the 3D elastic bodies on the contact face (config ``studies.elastic3d``;
+``results/tables/elastic3d_beta.csv`` and ``results/tables/elastic3d/patch.csv``), appended to
 ``results/claims.csv`` like :mod:`.membranes3d`.
 
 Same verdicts as the paper's ledger (:mod:`infsup_contact.criteria.claims`): PASS / FAIL /
@@ -16,7 +16,7 @@ the config — never from a case id and never from the measured tables. The reas
   the same element, k, case and pair) and on matching meshes the dimension count
   max(dim M − dim W, 0) (:func:`.membranes3d.matching_kernel`). Predicted PASS.
 * **Bounded** (``face-elastic-bounded-<tag>-k<k>-<element>``): spaces marked stable in the
-  registry have β_H > ``claims.beta_floor`` on every mesh at ν = ``face_elastic.nu``, no kernel
+  registry have β_H > ``claims.beta_floor`` on every mesh at ν = ``elastic3d.nu``, no kernel
   and every kernel decision clear. Predicted PASS (a(·,·) of elasticity at fixed ν is equivalent
   to the membranes' Dirichlet form on each component by Korn's inequality, so the membranes'
   stability carries over).
@@ -139,13 +139,13 @@ def face_elastic_claims(beta: pd.DataFrame, patch: pd.DataFrame | None, cfg: dic
     Parameters
     ----------
     beta
-        ``face_elastic_beta.csv`` (β table columns plus ``model``, ``element``, ``nu``).
+        ``elastic3d_beta.csv`` (β table columns plus ``model``, ``element``, ``nu``).
     patch
         ``results/face/elastic_patch.csv`` or ``None``.
     cfg
         The ``claims`` config (``beta_floor``).
     fe
-        The ``face_elastic`` config (``nu``, ``nu_sweep``).
+        The ``elastic3d`` entry's scenes (``nu``, ``nu_sweep``).
     interfaces
         element → its face interface (:func:`.membranes3d.element_interfaces`).
     membranes

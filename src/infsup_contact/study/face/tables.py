@@ -1,5 +1,5 @@
-"""The face studies' tables from the config's ``face`` section (rules/models.smk with plans/membranes3d.py): one
-pure function per study, each reading its own sub-section (``face.patch``, ``face.alpha``,
+"""The face studies' tables of the model table's ``membranes3d`` study (rules/models.smk with
+plans/membranes3d.py): one pure function per study, each reading its own sub-section (``face.patch``, ``face.alpha``,
 ``face.edge_dropping``) and the face's shared keys (model, cases, norms), returning a DataFrame.
 :data:`FACE_STUDIES` maps the sub-section's key to its function, so the job script names none."""
 from __future__ import annotations

@@ -12,7 +12,7 @@ the config — never from a case id and never from the measured tables. The reas
   (Σ_i B_i X_i B_iᵀ, G) with X_i = S_i⁻¹ SPD, so the kernel is ker B_1ᵀ ∩ ker B_2ᵀ: it depends
   on the couplings only, which see the z traces of vector Q_k / P_k clamped on ∂Ω_i∖Γ — the
   scalar trace spaces of the 3D membranes on the same meshes. Hence on every mesh pair and every ν
-  the kernel equals the membranes' (``face.model``'s, compared wherever the face stage computed
+  the kernel equals the membranes' (``membranes3d.model``'s, compared wherever the face stage computed
   the same element, k, case and pair) and on matching meshes the dimension count
   max(dim M − dim W, 0) (:func:`.membranes3d.matching_kernel`). Predicted PASS.
 * **Bounded** (``face-elastic-bounded-<tag>-k<k>-<element>``): spaces marked stable in the
@@ -64,7 +64,8 @@ def nu_prediction(spec, k: int, n: int, gamma) -> str:
 
 
 def _membrane_kernels(membranes: pd.DataFrame | None, element: str, k: int, case: str) -> dict:
-    """(N1, N2) → (kernel_dim, structural_kernel_dim) of ``face.model`` (H rows, G_h = trace of Ω2)."""
+    """(N1, N2) → (kernel_dim, structural_kernel_dim) of ``membranes3d.model`` (H rows, G_h = trace
+    of Ω2)."""
     if membranes is None or not len(membranes):
         return {}
     m = membranes[(membranes.element == element) & (membranes.k == k) & (membranes.case == case)
@@ -149,7 +150,7 @@ def face_elastic_claims(beta: pd.DataFrame, patch: pd.DataFrame | None, cfg: dic
     interfaces
         element → its face interface (:func:`.membranes3d.element_interfaces`).
     membranes
-        ``face_beta.csv`` of ``face.model`` (the kernel comparison), or ``None``.
+        ``face_beta.csv`` of ``membranes3d.model`` (the kernel comparison), or ``None``.
     """
     sweep, base_nu = fe["nu_sweep"], float(fe["nu"])
     out = []

@@ -42,9 +42,15 @@ def scenes(entry: dict) -> dict:
     return {key: value for key, value in entry.items() if key != "study"}
 
 
+def study_names(config: dict, study: str) -> list:
+    """The names of the entries running ``study``, in the table's order."""
+    return [name for name, e in model_table(config).items() if e.get("study") == study]
+
+
 def study_entries(config: dict, study: str) -> list:
     """``[(key, scenes)]`` of every entry running ``study``, ``key`` = ``studies.<name>`` (what errors name)."""
-    return [(f"{TABLE_KEY}.{name}", scenes(e)) for name, e in model_table(config).items() if e.get("study") == study]
+    table = model_table(config)
+    return [(f"{TABLE_KEY}.{name}", scenes(table[name])) for name in study_names(config, study)]
 
 
 def scenes_of(config: dict, study: str) -> dict | None:

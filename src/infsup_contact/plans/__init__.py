@@ -6,7 +6,7 @@ study's name as their ``{model}`` wildcard and ask this package everything else.
 """
 from __future__ import annotations
 
-from ..config.models import model_table, scenes, scenes_of
+from ..config.models import model_table, scenes, scenes_of, study_names
 from .arc import ArcStudy, CylinderStudy
 from .beta import BetaStudy
 from .elastic import ElasticStudy
@@ -22,7 +22,7 @@ def _elastic(name: str, entry: dict, config: dict) -> ElasticStudy:
 
 def _elastic3d(name: str, entry: dict, config: dict) -> Elastic3dStudy:
     """Its kernel claims compare with a membranes3d study's table, when the table has one."""
-    membranes = next((n for n, e in model_table(config).items() if e["study"] == "membranes3d"), None)
+    membranes = next(iter(study_names(config, "membranes3d")), None)
     return Elastic3dStudy(name, scenes(entry), membranes)
 
 

@@ -142,7 +142,7 @@ def face_elastic_claims(beta: pd.DataFrame, patch: pd.DataFrame | None, cfg: dic
     beta
         ``elastic3d_beta.csv`` (β table columns plus ``model``, ``element``, ``nu``).
     patch
-        ``results/face/elastic_patch.csv`` or ``None``.
+        ``results/tables/elastic3d/patch.csv`` or ``None``.
     cfg
         The ``claims`` config (``beta_floor``).
     fe

@@ -2,7 +2,7 @@
 
 A new model is this file plus one entry of the config's model table (docs/models.md)::
 
-    models:
+    studies:
       orthotropic: {study: beta, model: examples/orthotropic_membranes.py:MODEL, k: [1, 2],
                     N: [8, 12, 16], cases: [T3, R5.2, T4, R5.4, T5], norms: [H, L2]}
 

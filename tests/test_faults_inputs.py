@@ -227,12 +227,12 @@ N_LISTS = {
     ("infsup", "nonmatching_families", "sqrt2"): "schema",  # round(√2·1) = 1: no pair; N2 >= 2
     ("contact", "N"): "empty",
     ("contact", "scenes", "membranes", "N"): "empty",
-    ("models", "elastic", "N"): "empty",
-    ("models", "elastic", "nonmatching"): "empty",
-    ("models", "elastic", "patch_pairs"): "empty",
-    ("models", "elastic", "bench_N"): "empty",
-    ("models", "elastic", "hertz", "N"): "empty",
-    ("models", "elastic", "hertz", "modeling_N"): "accepted",  # T3 with k = 2: dim = 2·1 − 1 = 1
+    ("studies", "elastic", "N"): "empty",
+    ("studies", "elastic", "nonmatching"): "empty",
+    ("studies", "elastic", "patch_pairs"): "empty",
+    ("studies", "elastic", "bench_N"): "empty",
+    ("studies", "elastic", "hertz", "N"): "empty",
+    ("studies", "elastic", "hertz", "modeling_N"): "accepted",  # T3 with k = 2: dim = 2·1 − 1 = 1
     ("benchmarks", "beta_N"): "empty",
     ("benchmarks", "contact_N"): "empty",
     ("claims", "rem55_N"): "empty",
@@ -478,16 +478,16 @@ def test_user_space_empty_on_small_n(tmp_path, capsys):
 
 # ------------------------------------------------------------------ issue 39, item 5: edge dropping in the config
 @pytest.mark.parametrize("mutate, key, needle", [
-    (lambda ed, fc: ed.update(theta=[1.0, 0.05, 0.03, 0.02, 0.015, 1e-12]), "models.face.edge_dropping.theta[5]",
+    (lambda ed, fc: ed.update(theta=[1.0, 0.05, 0.03, 0.02, 0.015, 1e-12]), "studies.membranes3d.edge_dropping.theta[5]",
      "allowed 4e-09 <= θ <= 1"),
-    (lambda ed, fc: fc.update(cases=["T3", "T4", "T5", "DUAL"]), "models.face.edge_dropping.k[0]",
-     "k = 1 has no edge case among models.face.cases"),
+    (lambda ed, fc: fc.update(cases=["T3", "T4", "T5", "DUAL"]), "studies.membranes3d.edge_dropping.k[0]",
+     "k = 1 has no edge case among studies.membranes3d.cases"),
 ])
 def test_edge_dropping_config_is_refused_not_computed_as_garbage(mutate, key, needle):
     """θ below what the geometry resolves computed θ = 0 and turned the decay claims into FAIL;
     a k without an edge case among face.cases computed nothing. Both refused, naming the key."""
     cfg = copy.deepcopy(CI_CONFIG)
-    mutate(cfg["models"]["face"]["edge_dropping"], cfg["models"]["face"])
+    mutate(cfg["studies"]["membranes3d"]["edge_dropping"], cfg["studies"]["membranes3d"])
     with pytest.raises(ConfigError) as err:
         check_config(cfg, SCHEMA)
     assert one_line(err.value).startswith(f"config key {key}") and needle in one_line(err.value), err.value
@@ -551,14 +551,14 @@ def test_the_producers_stage_deletes_only_inside_its_workdir(tmp_path, target):
 
 def test_face_n_equal_one_at_k_one_is_refused():
     cfg = copy.deepcopy(CI_CONFIG)
-    cfg["models"]["face"].update(k=[1], cases=["T3", "R5.2", "DUAL"], N=[1, 4, 6, 8])
+    cfg["studies"]["membranes3d"].update(k=[1], cases=["T3", "R5.2", "DUAL"], N=[1, 4, 6, 8])
     with pytest.raises(ConfigError) as err:
         check_config(cfg, SCHEMA)
     text = one_line(err.value)
-    assert text.startswith("config key models.face.N[0]") and "T3 with k = 1" in text and "dim M_h = 0" in text
+    assert text.startswith("config key studies.membranes3d.N[0]") and "T3 with k = 1" in text and "dim M_h = 0" in text
 
 
-@pytest.mark.parametrize("section, n", [("face", 64), ("face_elastic", 16)])
+@pytest.mark.parametrize("section, n", [("membranes3d", 64), ("elastic3d", 16)])
 def test_face_jobs_are_counted_in_the_memory_check(section, n):
     """The face studies' β jobs have the command line's estimate (resources.beta_estimate,
     dim 3); a local run is refused when the largest exceeds the machine's memory (here a
@@ -568,12 +568,12 @@ def test_face_jobs_are_counted_in_the_memory_check(section, n):
     limit = 2e9
     check_job_memory(CI_CONFIG, limit)
     cfg = copy.deepcopy(CI_CONFIG)
-    cfg["models"][section]["N"] = sorted({*cfg["models"][section]["N"], n})
+    cfg["studies"][section]["N"] = sorted({*cfg["studies"][section]["N"], n})
     check_config(cfg, SCHEMA)
     assert any(job.startswith(f"{section} beta") for _, job, _ in job_estimates(cfg))
     with pytest.raises(ConfigError) as err:
         check_job_memory(cfg, limit)
-    assert one_line(err.value).startswith(f"config key models.{section}.N:") and f"{n}x{n}" in str(err.value)
+    assert one_line(err.value).startswith(f"config key studies.{section}.N:") and f"{n}x{n}" in str(err.value)
 
 
 def test_numpy_integer_scalars_are_the_integers_they_are():

@@ -111,7 +111,7 @@ SCHEMAS = {
                              "p_max_rel_error": "float?", "half_width_rel_error": "float?"},
                             optional={"R": "float", "nu": "float", "E1": "float", "E2": "float"},
                             key=("study", "case", "k", "N", "R", "d", "nu", "E1", "E2")),
-    # the 3D contact face (rules/models.smk, plans/face.py: study/beta/batch_rows.py with models/membranes3d.py)
+    # the 3D contact face (rules/models.smk, plans/membranes3d.py: study/beta/batch_rows.py with models/membranes3d.py)
     "face_beta": Schema({**_BETA, "model": "str", "element": "str"},
                         key=("model", "element", "family", "case", "k", "N1", "N2", "multiplier_mesh", "c1", "c2",
                              "norm")),
@@ -130,15 +130,15 @@ SCHEMAS = {
                          "kernel_dim": "int", "lambda_max_rel_error": "float", "lambda_interior_rel_error": "float?",
                          "u_max_rel_error": "float", "holds_constants": "bool"},
                         key=("curvature", "coupling", "case", "k", "N1", "N2")),
-    # the 3D elastic bodies on the face (rules/models.smk, plans/face_elastic.py: study/face/elastic.py): β_h per ν
-    "face_elastic_beta": Schema({**_BETA, "model": "str", "element": "str", "nu": "float"},
-                                key=("model", "element", "family", "case", "k", "N1", "N2", "multiplier_mesh", "c1",
-                                     "c2", "nu", "norm")),
-    "face_elastic_patch": Schema({"element": "str", "case": "str", "k": "int", "N1": "int", "N2": "int",
-                                  "E1": "float", "E2": "float", "nu": "float", "lambda_max_rel_error": "float",
-                                  "u_max_rel_error": "float", "kernel_dim": "int", "passes": "bool"},
-                                 key=("element", "case", "k", "N1", "N2", "E1", "E2", "nu")),
-    # the face studies (rules/models.smk, plans/face.py: study/patch/face.py, study/face/alpha.py, edge_dropping.py);
+    # the 3D elastic bodies on the face (rules/models.smk, plans/elastic3d.py: study/face/elastic3d.py): β_h per ν
+    "elastic3d_beta": Schema({**_BETA, "model": "str", "element": "str", "nu": "float"},
+                             key=("model", "element", "family", "case", "k", "N1", "N2", "multiplier_mesh", "c1",
+                                  "c2", "nu", "norm")),
+    "elastic3d_patch": Schema({"element": "str", "case": "str", "k": "int", "N1": "int", "N2": "int",
+                               "E1": "float", "E2": "float", "nu": "float", "lambda_max_rel_error": "float",
+                               "u_max_rel_error": "float", "kernel_dim": "int", "passes": "bool"},
+                              key=("element", "case", "k", "N1", "N2", "E1", "E2", "nu")),
+    # the face studies (rules/models.smk, plans/membranes3d.py: study/patch/face.py, study/face/alpha.py, edge_dropping.py);
     # condition numbers may be inf (singular to working precision): extra columns, not declared
     "face_patch": Schema({"element": "str", "case": "str", "k": "int", "N1": "int", "N2": "int",
                           "lambda_max_rel_error": "float", "u_max_rel_error": "float", "kernel_dim": "int",

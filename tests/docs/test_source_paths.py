@@ -5,7 +5,7 @@ Snakefiles and the config files. A path is a word with a ``/`` ending in ``.py``
 ``../scripts/model_job.py``), or any ``*.smk`` word: a rule file is often named bare.
 
 A path is found when it is the repository path of a file, or the tail of one
-(``rules/models.smk``, ``plans/face.py``), or, written with ``./`` or ``../``, a file
+(``rules/models.smk``, ``plans/membranes3d.py``), or, written with ``./`` or ``../``, a file
 relative to the naming file's folder. Placeholders (``DIR/``, ``path/to/``, a ``{wildcard}``,
 ``<name>``, a glob) and outputs (``results/``) are not paths of the repository.
 """
@@ -98,7 +98,7 @@ def test_the_scanner_finds_and_misses(tmp_path):
     assert list(named_paths("DIR/levels.yaml results/x/y.py path/to/file.py {model}/a.py la.py")) == []
     rules = ROOT / "workflow" / "rules" / "models.smk"
     assert exists("../scripts/model_job.py", rules) and not exists("../scripts/no_such_job.py", rules)
-    assert exists("rules/models.smk", rules) and exists("plans/face.py", rules)
+    assert exists("rules/models.smk", rules) and exists("plans/membranes3d.py", rules)
     assert not exists("rules/face_studies.smk", rules)
     source = '"""Doc (rules/gone.smk)."""\nX = "rules/data.smk"  # rules/comment.smk\n'
     assert sorted(t for _, text in python_prose(source) for t in named_paths(text)) == [

@@ -44,14 +44,14 @@ FIT_THETA_MAX = 0.05
 
 def patch_rows(case, k, element="hex", err=lambda passes: 1e-13 if passes else 1.0, passes=True,
                pairs=((4, 5), (7, 8))) -> pd.DataFrame:
-    """Rows of results/face/patch.csv for one (case, k, element): errors ``err(passes)``."""
+    """Rows of results/tables/membranes3d/patch.csv for one (case, k, element): errors ``err(passes)``."""
     return pd.DataFrame([dict(scene="face-patch", case=case, k=k, family="structured", element=element, N1=a, N2=b,
                               lambda_max_rel_error=err(passes), u_max_rel_error=err(passes) / 10, kernel_dim=0,
                               passes=passes) for a, b in pairs])
 
 
 def alpha_rows(element="QUAD8", alphas=(0.1, 0.125, 0.2, 0.3), n=4) -> pd.DataFrame:
-    """Rows of results/face/alpha.csv: the weights from face_dual (two evaluations of the same
+    """Rows of results/tables/membranes3d/alpha.csv: the weights from face_dual (two evaluations of the same
     numbers here), accepted where positive, β_h = 1 there."""
     from infsup_contact.discretization.face.spaces.dual_bases import weight_fractions
 
@@ -66,7 +66,7 @@ def alpha_rows(element="QUAD8", alphas=(0.1, 0.125, 0.2, 0.3), n=4) -> pd.DataFr
 
 
 def edge_rows(case, k, beta_h=lambda t: t / 2, cond=lambda t: 10.0, n=4, kappa_rel=0.0) -> pd.DataFrame:
-    """Rows of results/face/edge_dropping.csv for one (case, k): β_H = beta_h(θ), β_L2 = β_H / 10
+    """Rows of results/tables/membranes3d/edge_dropping.csv for one (case, k): β_H = beta_h(θ), β_L2 = β_H / 10
     (its κ-scaled route off by ``kappa_rel``), every cond_*_kappa = cond(θ), unscaled 1/θ²."""
     out = []
     for t in THETAS:

@@ -129,7 +129,7 @@ def _membrane_rows():
 
 def _elastic_rows():
     from infsup_contact.discretization.spaces import registry
-    from infsup_contact.study.patch import face_elastic as elastic_face_patch
+    from infsup_contact.study.patch import elastic3d as elastic_face_patch
 
     return elastic_face_patch.elastic_face_patch_rows(registry.space_ids(), [1], [(2, 3)])
 

@@ -20,7 +20,7 @@ from infsup_contact.models.plane_strain import lame
 from infsup_contact.models.contract import Body, schur_by_solves
 from infsup_contact.contact.contact import solve_contact_on
 from infsup_contact.solvers.infsup import beta_rows_all
-from infsup_contact.study.patch import face_elastic as efp
+from infsup_contact.study.patch import elastic3d as efp
 from infsup_contact.study.patch.face import PASS_RTOL
 from infsup_contact.study.contact.registry import ELASTIC_FACE_PATCH
 from infsup_contact.solvers.request import MeshOptions

@@ -21,7 +21,7 @@ CLAIMS = {"slope_tolerance": 0.15, "beta_floor": 1e-3, "confidence": 0.95, "fit_
 
 @pytest.fixture(scope="module")
 def run():
-    config = {"models": {"arc": ENTRY}, "claims": CLAIMS}
+    config = {"studies": {"arc": ENTRY}, "claims": CLAIMS}
     check_models(config)
     study = study_of(config, "arc")
     beta = pd.concat([job.run() for job in study.jobs().values()], ignore_index=True)
@@ -64,17 +64,17 @@ def test_curvature_names_a_radius_both_ways():
 
 
 @pytest.mark.parametrize("change, key", [
-    ({"radii": None}, "models.arc.radii"),
-    ({"model": "membranes"}, "models.arc.model"),
-    ({"series": {"short": [[4, 4], [6, 6]]}}, "models.arc.series.short"),
-    ({"series": {"dup": [[4, 4], [4, 4], [6, 6]]}}, "models.arc.series.dup"),
-    ({"cases": ["T3", "Q8"]}, "models.arc.cases[1]"),
-    ({"cases": ["NOPE"]}, "models.arc.cases[0]"),
+    ({"radii": None}, "studies.arc.radii"),
+    ({"model": "membranes"}, "studies.arc.model"),
+    ({"series": {"short": [[4, 4], [6, 6]]}}, "studies.arc.series.short"),
+    ({"series": {"dup": [[4, 4], [4, 4], [6, 6]]}}, "studies.arc.series.dup"),
+    ({"cases": ["T3", "Q8"]}, "studies.arc.cases[1]"),
+    ({"cases": ["NOPE"]}, "studies.arc.cases[0]"),
 ])
 def test_a_bad_entry_is_one_line_naming_its_key(change, key):
     entry = {k: v for k, v in dict(ENTRY, **change).items() if v is not None}
     with pytest.raises(ConfigError) as err:
-        check_models({"models": {"arc": entry}})
+        check_models({"studies": {"arc": entry}})
     text = str(err.value)
     assert key in text and "\n" not in text
 
@@ -87,7 +87,7 @@ CYLINDER = {"study": "cylinder", "k": [1], "radii": [2], "couplings": ["exact", 
 def test_the_cylinder_study_runs_and_its_predictions_hold():
     """The same study on the 3D membranes (hexahedra, Γ a part of the cylinder): the flat face is
     reproduced bit for bit, the exact coupling keeps every kernel, no verdict flips."""
-    config = {"models": {"cyl": CYLINDER}, "claims": CLAIMS}
+    config = {"studies": {"cyl": CYLINDER}, "claims": CLAIMS}
     check_models(config)
     study = study_of(config, "cyl")
     beta = pd.concat([job.run() for job in study.jobs().values()], ignore_index=True)
@@ -98,9 +98,9 @@ def test_the_cylinder_study_runs_and_its_predictions_hold():
     assert r"\subsection{The curved face \texttt{cyl}}" in tex
 
 
-@pytest.mark.parametrize("change, key", [({"patch": {"k": [1], "pairs": [[3, 2], [6, 4]], "c": [1, 1]}}, "models.cyl.patch"),
-                                         ({"cases": ["T3", "Q8"]}, "models.cyl.cases[1]")])
+@pytest.mark.parametrize("change, key", [({"patch": {"k": [1], "pairs": [[3, 2], [6, 4]], "c": [1, 1]}}, "studies.cyl.patch"),
+                                         ({"cases": ["T3", "Q8"]}, "studies.cyl.cases[1]")])
 def test_a_bad_cylinder_entry_is_one_line_naming_its_key(change, key):
     with pytest.raises(ConfigError) as err:
-        check_models({"models": {"cyl": dict(CYLINDER, **change)}})
+        check_models({"studies": {"cyl": dict(CYLINDER, **change)}})
     assert key in str(err.value) and "\n" not in str(err.value)

@@ -38,10 +38,10 @@ def tables(request):
     cwd = os.getcwd()
     os.chdir(ROOT)  # the entry names the model file relative to the workflow, as a config does
     try:
-        config = {"models": {"orthotropic": ENTRY, "reference": dict(ENTRY, model="membranes")}}
+        config = {"studies": {"orthotropic": ENTRY, "reference": dict(ENTRY, model="membranes")}}
         check_models(config)
         out = {}
-        for name in config["models"]:
+        for name in config["studies"]:
             study = study_of(config, name)
             out[name] = pd.concat([job.run() for job in study.jobs().values()], ignore_index=True)
         out["claims"] = study_of(config, "orthotropic").claims({"beta": out["orthotropic"]}, CLAIMS)
@@ -75,19 +75,19 @@ def test_the_claims_come_out_as_predicted(tables):
 
 
 @pytest.mark.parametrize("entry, key", [
-    ({"model": "examples/no_such_file.py:MODEL"}, "models.toy.model"),
-    ({"model": "examples/orthotropic_membranes.py:STIFFNESS_Y"}, "models.toy.model"),
-    ({"model": "membranes", "elements": ["hex"]}, "models.toy.elements[0]"),
-    ({"model": "membranes3d"}, "models.toy.elements"),
-    ({"model": "membranes", "cases": ["T3", "NOPE"]}, "models.toy.cases[1]"),
-    ({"model": "membranes", "nonmatching": [[5, 5]]}, "models.toy.nonmatching[0]"),
+    ({"model": "examples/no_such_file.py:MODEL"}, "studies.toy.model"),
+    ({"model": "examples/orthotropic_membranes.py:STIFFNESS_Y"}, "studies.toy.model"),
+    ({"model": "membranes", "elements": ["hex"]}, "studies.toy.elements[0]"),
+    ({"model": "membranes3d"}, "studies.toy.elements"),
+    ({"model": "membranes", "cases": ["T3", "NOPE"]}, "studies.toy.cases[1]"),
+    ({"model": "membranes", "nonmatching": [[5, 5]]}, "studies.toy.nonmatching[0]"),
 ])
 def test_a_bad_entry_is_one_line_naming_its_key(entry, key):
     cwd = os.getcwd()
     os.chdir(ROOT)
     try:
         with pytest.raises(ConfigError) as err:
-            check_models({"models": {"toy": dict(ENTRY, **entry)}})
+            check_models({"studies": {"toy": dict(ENTRY, **entry)}})
     finally:
         os.chdir(cwd)
     text = str(err.value)
@@ -95,10 +95,10 @@ def test_a_bad_entry_is_one_line_naming_its_key(entry, key):
 
 
 def test_reserved_and_built_in_names_are_refused():
-    with pytest.raises(ConfigError, match="models.contact"):
-        check_models({"models": {"contact": ENTRY}})
-    with pytest.raises(ConfigError, match="models.my_elastic.study"):  # the paper reads it by its name
-        check_models({"models": {"my_elastic": {"study": "elastic"}}})
+    with pytest.raises(ConfigError, match="studies.contact"):
+        check_models({"studies": {"contact": ENTRY}})
+    with pytest.raises(ConfigError, match="studies.my_elastic.study"):  # the paper reads it by its name
+        check_models({"studies": {"my_elastic": {"study": "elastic"}}})
 
 
 def test_the_workflow_runs_a_new_model_from_its_entry(tmp_path):
@@ -109,7 +109,7 @@ def test_the_workflow_runs_a_new_model_from_its_entry(tmp_path):
                                                            **({"ignore": shutil.ignore_patterns("__pycache__")}
                                                               if src.is_dir() else {}))
     config = yaml.safe_load((ROOT / "config" / "ci.yaml").read_text())
-    config["models"]["orthotropic"] = ENTRY
+    config["studies"]["orthotropic"] = ENTRY
     (tmp_path / "config" / "new_model.yaml").write_text(yaml.safe_dump(config, sort_keys=False))
     bin_dir = Path(sys.executable).parent
     env = dict(os.environ, OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1", PATH=f"{bin_dir}:{os.environ['PATH']}")
@@ -129,7 +129,7 @@ def test_an_entry_too_large_for_this_machine_is_refused_before_any_job():
     from infsup_contact.config.memory import check_job_memory
 
     config = yaml.safe_load((ROOT / "config" / "ci.yaml").read_text())
-    config["models"]["huge"] = dict(ENTRY, model="membranes3d", elements=["hex"], k=[4], N=[8, 16, 200])
+    config["studies"]["huge"] = dict(ENTRY, model="membranes3d", elements=["hex"], k=[4], N=[8, 16, 200])
     with pytest.raises(ConfigError) as err:
         check_job_memory(config, 24e9)
-    assert "models.huge.N" in str(err.value) and "model_job huge k=4 200x200" in str(err.value)
+    assert "studies.huge.N" in str(err.value) and "model_job huge k=4 200x200" in str(err.value)

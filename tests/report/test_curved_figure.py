@@ -14,7 +14,7 @@ ENTRY = {"study": "arc", "k": [1], "radii": [2], "couplings": ["exact"],
 
 
 def test_the_curved_figure_is_drawn_from_the_study_tables(tmp_path):
-    study = study_of({"models": {"arc": ENTRY}}, "arc")
+    study = study_of({"studies": {"arc": ENTRY}}, "arc")
     jobs = study.jobs()
     beta = pd.concat([jobs[j].run() for j in jobs if j != PATCH], ignore_index=True)
     patch = jobs[PATCH].run()

@@ -1,5 +1,5 @@
 """The section templates (report/sections/templates.py, blocks.py) and the section tables declared
-through them (report/sections/elastic.py, face.py, face_elastic.py, model_section.py): every row of a generated
+through them (report/sections/elastic.py, face.py, elastic3d.py, model_section.py): every row of a generated
 tabular has the tabular's column count, blocks and rows come in the paper's order, the cells
 say what the rows hold, and the claim counts add up under any ledger."""
 import re
@@ -40,7 +40,7 @@ def _rows_that_misfit(text: str) -> list[str]:
 
 # ----------------------------------------------------------------------------- small section inputs
 
-def _face_elastic_beta(cases=("T3", "R5.2"), nus=(0.3, 0.49, 0.499, 0.4999), exponent=0.5) -> pd.DataFrame:
+def _elastic3d_beta(cases=("T3", "R5.2"), nus=(0.3, 0.49, 0.499, 0.4999), exponent=0.5) -> pd.DataFrame:
     """Elastic face rows: N = 4, 6 at ν = 0.3 and N = 4 at every ν; β_H = (1 − 2ν)^exponent, a
     kernel of dimension 3 (count 3) for R5.2."""
     out = []
@@ -76,11 +76,11 @@ def _face_files(which: str) -> dict:
     return face_paper_files(**t)
 
 
-def _face_elastic_table(which: str) -> dict:
-    from infsup_contact.report.sections.face_elastic import face_elastic_table
+def _elastic3d_table(which: str) -> dict:
+    from infsup_contact.report.sections.elastic3d import elastic3d_table
 
     nus = (0.3, 0.49, 0.499, 0.4999) if which == "sweep" else (0.3,)
-    return {"face_elastic table": face_elastic_table(_face_elastic_beta(nus=nus), 0.49, 0.3, 4)}
+    return {"elastic3d table": elastic3d_table(_elastic3d_beta(nus=nus), 0.49, 0.3, 4)}
 
 
 def _model_section(which: str) -> dict:
@@ -96,7 +96,7 @@ def _model_section(which: str) -> dict:
 
 @pytest.mark.parametrize("files, which", [(_elastic_files, "as run"), (_elastic_files, "matching, no modeling"),
                                           (_face_files, "as run"), (_face_files, "matching, no studies"),
-                                          (_face_elastic_table, "sweep"), (_face_elastic_table, "no other nu"),
+                                          (_elastic3d_table, "sweep"), (_elastic3d_table, "no other nu"),
                                           (_model_section, "both norms"), (_model_section, "H only")])
 def test_every_row_fills_its_tabular(files, which):
     """A row with more or fewer cells than the tabular's columns is a LaTeX error or a shifted
@@ -107,13 +107,13 @@ def test_every_row_fills_its_tabular(files, which):
         assert _rows_that_misfit(text) == [], name
 
 
-def test_face_elastic_slope_of_a_square_root_law_is_one_half():
+def test_elastic3d_slope_of_a_square_root_law_is_one_half():
     """β_H = (1 − 2ν)^{1/2}: the fitted slope of log β_H against log(1 − 2ν) is 1/2 up to
     round-off (the cell's 3 decimals), each ν cell is β_H there, a space with a kernel shows 0
     and no slope."""
-    from infsup_contact.report.sections.face_elastic import face_elastic_table
+    from infsup_contact.report.sections.elastic3d import elastic3d_table
 
-    text = face_elastic_table(_face_elastic_beta(), 0.49, 0.3, 4)
+    text = elastic3d_table(_elastic3d_beta(), 0.49, 0.3, 4)
     rows = {line.split(" & ")[2]: line.removesuffix(r" \\").split(" & ") for line in text.splitlines()
             if line.startswith("hex & ")}
     assert rows["T3"][-1] == "0.500"

@@ -2,7 +2,7 @@
 that the command line, the request and the config share."""
 import pytest
 
-from infsup_contact.config.face import check_element
+from infsup_contact.config.membranes3d import check_element
 from infsup_contact.config.schema import ConfigError
 from infsup_contact.errors import InputError
 from infsup_contact.models import MODELS

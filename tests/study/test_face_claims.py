@@ -1,5 +1,5 @@
 """The face stage's claims (study/face_claims.py), macros (report/sections/face.py) and config checks
-(config/face.py) on synthetic tables: verdicts follow the data by the ledger's criteria, the
+(config/membranes3d.py) on synthetic tables: verdicts follow the data by the ledger's criteria, the
 predictions follow registry properties (not ids), a bad ``face:`` key is named."""
 from __future__ import annotations
 
@@ -134,22 +134,22 @@ def _ci():
 
 
 @pytest.mark.parametrize("mutate, key", [
-    (lambda f: f.update(cases=["T3", "NOPE"]), "models.face.cases[1]"),
-    (lambda f: f.update(elements=["hex", "prism"]), "models.face.elements[1]"),
-    (lambda f: f.update(nonmatching=[[5, 5]]), "models.face.nonmatching[0]"),
-    (lambda f: f.update(model="membranes"), "models.face.model"),
-    (lambda f: f.update(norms=["H", "H1"]), "models.face.norms"),
-    (lambda f: f.update(max_N={"prism": 8}), "models.face.max_N.prism"),
-    (lambda f: f.update(max_N={"hex": 4}), "models.face.max_N.hex"),
-    (lambda f: f.update(l2_max_N={"hex": 12}), "models.face.l2_max_N.hex"),                 # no max_N to exceed
-    (lambda f: f.update(max_N={"hex": 8}, l2_max_N={"hex": 6}), "models.face.l2_max_N.hex"),  # below max_N
-    (lambda f: f.update(max_N={"hex": 8}, l2_max_N={"hex": 10}, norms=["H"]), "models.face.l2_max_N.hex"),
+    (lambda f: f.update(cases=["T3", "NOPE"]), "studies.membranes3d.cases[1]"),
+    (lambda f: f.update(elements=["hex", "prism"]), "studies.membranes3d.elements[1]"),
+    (lambda f: f.update(nonmatching=[[5, 5]]), "studies.membranes3d.nonmatching[0]"),
+    (lambda f: f.update(model="membranes"), "studies.membranes3d.model"),
+    (lambda f: f.update(norms=["H", "H1"]), "studies.membranes3d.norms"),
+    (lambda f: f.update(max_N={"prism": 8}), "studies.membranes3d.max_N.prism"),
+    (lambda f: f.update(max_N={"hex": 4}), "studies.membranes3d.max_N.hex"),
+    (lambda f: f.update(l2_max_N={"hex": 12}), "studies.membranes3d.l2_max_N.hex"),                 # no max_N to exceed
+    (lambda f: f.update(max_N={"hex": 8}, l2_max_N={"hex": 6}), "studies.membranes3d.l2_max_N.hex"),  # below max_N
+    (lambda f: f.update(max_N={"hex": 8}, l2_max_N={"hex": 10}, norms=["H"]), "studies.membranes3d.l2_max_N.hex"),
 ])
 def test_bad_face_key_is_named(mutate, key):
     from infsup_contact.config.checks import ConfigError, check_config
 
     cfg = copy.deepcopy(_ci())
-    mutate(cfg["models"]["face"])
+    mutate(cfg["studies"]["membranes3d"])
     with pytest.raises(ConfigError) as err:
         check_config(cfg, ROOT / "workflow" / "schemas" / "config.schema.yaml")
     assert f"config key {key}" in str(err.value)
@@ -159,7 +159,7 @@ def test_config_without_face_study_is_valid():
     from infsup_contact.config.checks import check_config
 
     cfg = _ci()
-    del cfg["models"]["face"]
+    del cfg["studies"]["membranes3d"]
     check_config(cfg, ROOT / "workflow" / "schemas" / "config.schema.yaml")
 
 
@@ -181,7 +181,7 @@ def test_face_section_renders_under_any_verdict(verdict):
 
 
 def test_max_n_trims_the_pairs_of_its_element_only():
-    from infsup_contact.config.face import face_pairs
+    from infsup_contact.config.membranes3d import face_pairs
 
     fc = {"N": [4, 5, 6, 8, 12], "nonmatching": [[4, 5], [8, 9]], "max_N": {"tet": 6}}
     assert face_pairs(fc, "tet") == [(4, 4), (5, 5), (6, 6), (4, 5)]
@@ -189,7 +189,7 @@ def test_max_n_trims_the_pairs_of_its_element_only():
 
 
 def test_l2_max_n_adds_the_matching_meshes_above_max_n_of_its_element_only():
-    from infsup_contact.config.face import face_pairs, l2_only_sizes
+    from infsup_contact.config.membranes3d import face_pairs, l2_only_sizes
 
     fc = {"N": [4, 5, 6, 7, 8, 10, 12], "nonmatching": [[4, 5], [8, 9]], "max_N": {"tet": 6},
           "l2_max_N": {"tet": 10}}
@@ -233,7 +233,7 @@ def test_face_case_no_configured_element_carries_is_refused(patch, refused):
     from infsup_contact.config.checks import ConfigError, check_config
 
     cfg = copy.deepcopy(_ci())
-    face = cfg["models"]["face"]
+    face = cfg["studies"]["membranes3d"]
     face["cases"] = [*face["cases"], "PWLIN-T6"]
     face["patch"]["elements"] = patch
     schema = ROOT / "workflow" / "schemas" / "config.schema.yaml"
@@ -243,5 +243,5 @@ def test_face_case_no_configured_element_carries_is_refused(patch, refused):
     with pytest.raises(ConfigError) as err:
         check_config(cfg, schema)
     line = str(err.value)
-    assert line.startswith(f"config key models.face.cases[{len(face['cases']) - 1}]: PWLIN-T6 is built by the face "
+    assert line.startswith(f"config key studies.membranes3d.cases[{len(face['cases']) - 1}]: PWLIN-T6 is built by the face "
                            "of none of the elements hex") and "allowed T3, R5.2" in line and "PWLIN-Q9" in line, line

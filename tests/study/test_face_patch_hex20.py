@@ -20,7 +20,7 @@ from infsup_contact.study.claims.membranes3d_studies import natural_kernel_count
 from infsup_contact.study.contact.registry import FACE_PATCH
 from infsup_contact.study.face.hex20 import quad8_cases
 from infsup_contact.study.patch import face as face_patch
-from infsup_contact.study.patch import face_elastic
+from infsup_contact.study.patch import elastic3d
 
 EPS = np.finfo(float).eps
 N1, N2 = 3, 4
@@ -100,7 +100,7 @@ def test_standard_quad8_multipliers_start_with_open_corners(pair):
 
 
 @pytest.mark.parametrize("scene", [face_patch.patch_scene((1.0, 3.0), 0.02),
-                                   face_elastic.patch_scene((2.0, 1.0), 0.3, 0.02)])
+                                   elastic3d.patch_scene((2.0, 1.0), 0.3, 0.02)])
 def test_numpy_exact_solution_is_the_ngsolve_one(scene):
     """On NGSolve bodies, ``exact_values`` equals ``exact()`` at points of each body to the round-off
     of evaluating the same affine formula twice (a few ε of the largest value)."""

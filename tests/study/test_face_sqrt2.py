@@ -13,7 +13,7 @@ import pytest
 import yaml
 
 from infsup_contact.config.checks import ConfigError, check_config
-from infsup_contact.config.face import face_pairs, family_pairs
+from infsup_contact.config.membranes3d import face_pairs, family_pairs
 from infsup_contact.discretization.spaces.registry import SPACES
 from infsup_contact.discretization.face.shapes.square import SQUARE
 from infsup_contact.discretization.face.partitions.tensor_grid import TensorPartition
@@ -39,7 +39,7 @@ def test_sqrt2_pairs_follow_the_rule_and_share_no_interior_line():
 
 
 def test_the_config_runs_one_sqrt2_pair_per_element():
-    fc = CONFIG["models"]["face"]
+    fc = CONFIG["studies"]["membranes3d"]
     check_config(copy.deepcopy(CONFIG), SCHEMA)
     for element in fc["elements"]:
         fam = family_pairs(fc, element)
@@ -48,13 +48,13 @@ def test_the_config_runs_one_sqrt2_pair_per_element():
 
 
 @pytest.mark.parametrize("families,key", [
-    ({"cube": {"hex": [5]}}, "models.face.nonmatching_families.cube"),
-    ({"sqrt2": {"prism": [5]}}, "models.face.nonmatching_families.sqrt2.prism"),
-    ({"sqrt2": {"hex": [1]}}, "models.face.nonmatching_families.sqrt2.hex[0]"),
+    ({"cube": {"hex": [5]}}, "studies.membranes3d.nonmatching_families.cube"),
+    ({"sqrt2": {"prism": [5]}}, "studies.membranes3d.nonmatching_families.sqrt2.prism"),
+    ({"sqrt2": {"hex": [1]}}, "studies.membranes3d.nonmatching_families.sqrt2.hex[0]"),
 ])
 def test_bad_families_are_refused_naming_the_key(families, key):
     cfg = copy.deepcopy(CONFIG)
-    cfg["models"]["face"]["nonmatching_families"] = families
+    cfg["studies"]["membranes3d"]["nonmatching_families"] = families
     with pytest.raises(ConfigError) as err:
         check_config(cfg, SCHEMA)
     assert err.value.key == key and "\n" not in str(err.value)

@@ -27,8 +27,8 @@ ENV = {"PYTHONPATH": str(ROOT / "src"), "OPENBLAS_NUM_THREADS": "1", "PATH": str
 JOB = """
 import runpy, sys, types
 snakemake = types.SimpleNamespace(output=[sys.out], log=[sys.log], threads=1,
-                                  config={"spaces": [], "models": {"face": {"study": "face", **sys.fc}}},
-                                  wildcards=types.SimpleNamespace(model="face", job=sys.study))
+                                  config={"spaces": [], "studies": {"membranes3d": {"study": "membranes3d", **sys.fc}}},
+                                  wildcards=types.SimpleNamespace(model="membranes3d", job=sys.study))
 runpy.run_path("workflow/scripts/model_job.py", init_globals={"snakemake": snakemake})
 """
 TINY = {"model": "membranes3d", "cases": ["T3", "R5.2", "T4", "T5"], "norms": ["L2"],
@@ -193,21 +193,21 @@ def test_study_tables_cite_every_row_and_verdict():
 
 
 @pytest.mark.parametrize("mutate, key", [
-    (lambda f: f["patch"].update(elements=["prism"]), "models.face.patch.elements[0]"),
+    (lambda f: f["patch"].update(elements=["prism"]), "studies.membranes3d.patch.elements[0]"),
     # HEX20: k = 2 only
-    (lambda f: f["patch"].update(elements=["hex", "hex20"], k=[1]), "models.face.patch.elements[1]"),
-    (lambda f: f["patch"].update(pairs=[[4, 4]]), "models.face.patch.pairs[0]"),
-    (lambda f: f["alpha"].update(elements=["QUAD4"]), "models.face.alpha.elements[0]"),
-    (lambda f: f["alpha"].update(alphas=[0.5]), "models.face.alpha.alphas"),
-    (lambda f: f["edge_dropping"].update(theta=[0.0, 0.5, 1.0]), "models.face.edge_dropping.theta"),
-    (lambda f: f["edge_dropping"].update(fit_theta_max=0.012), "models.face.edge_dropping.fit_theta_max"),
-    (lambda f: f.pop("patch"), "models.face"),
+    (lambda f: f["patch"].update(elements=["hex", "hex20"], k=[1]), "studies.membranes3d.patch.elements[1]"),
+    (lambda f: f["patch"].update(pairs=[[4, 4]]), "studies.membranes3d.patch.pairs[0]"),
+    (lambda f: f["alpha"].update(elements=["QUAD4"]), "studies.membranes3d.alpha.elements[0]"),
+    (lambda f: f["alpha"].update(alphas=[0.5]), "studies.membranes3d.alpha.alphas"),
+    (lambda f: f["edge_dropping"].update(theta=[0.0, 0.5, 1.0]), "studies.membranes3d.edge_dropping.theta"),
+    (lambda f: f["edge_dropping"].update(fit_theta_max=0.012), "studies.membranes3d.edge_dropping.fit_theta_max"),
+    (lambda f: f.pop("patch"), "studies.membranes3d"),
 ])
 def test_bad_study_key_is_named(mutate, key):
     from infsup_contact.config.checks import ConfigError, check_config
 
     cfg = copy.deepcopy(yaml.safe_load((ROOT / "config" / "ci.yaml").read_text()))
-    mutate(cfg["models"]["face"])
+    mutate(cfg["studies"]["membranes3d"])
     with pytest.raises(ConfigError) as err:
         check_config(cfg, ROOT / "workflow" / "schemas" / "config.schema.yaml")
     assert f"config key {key}" in str(err.value)
@@ -218,6 +218,6 @@ def test_theta_window_of_the_helper_matches_the_configs():
     """The synthetic tables use the configs' fit window and its θ (the claims' data), and full cover."""
     window = sorted(t for t in THETAS if t <= FIT_THETA_MAX)
     for name in ("config.yaml", "ci.yaml"):
-        ed = yaml.safe_load((ROOT / "config" / name).read_text())["models"]["face"]["edge_dropping"]
+        ed = yaml.safe_load((ROOT / "config" / name).read_text())["studies"]["membranes3d"]["edge_dropping"]
         assert ed["fit_theta_max"] == FIT_THETA_MAX and 1.0 in ed["theta"]
         assert sorted(t for t in ed["theta"] if t <= FIT_THETA_MAX) == window

@@ -148,9 +148,9 @@ def test_ledgers_differ_where_a_verdict_or_kernel_column_does(tmp_path):
                and p.endswith("kernel_dim 3 under c, 2 under a") for p in problems), problems
     _, problems = ledgers.ledger_differences({"a": same["a"], "d": _ledger(tmp_path / "d", verdict="FAIL")})
     assert problems == ["results/claims.csv row 1 (claim_id b): verdict FAIL under d, PASS under a"]
-    dropped = _ledger(tmp_path / "e", drop="results/tables/face/patch.csv")
+    dropped = _ledger(tmp_path / "e", drop="results/tables/membranes3d/patch.csv")
     _, problems = ledgers.ledger_differences({"a": same["a"], "e": dropped})
-    assert len(problems) == 1 and problems[0].startswith("results/tables/face/patch.csv: missing under e")
+    assert len(problems) == 1 and problems[0].startswith("results/tables/membranes3d/patch.csv: missing under e")
     cut = _ledger(tmp_path / "f")
     (cut / "results/claims.csv").write_text((cut / "results/claims.csv").read_text()[:-3])  # a cut-off write
     _, problems = ledgers.ledger_differences({"a": same["a"], "f": cut})

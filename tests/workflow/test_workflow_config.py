@@ -297,8 +297,8 @@ def test_default_profile_provides_cores(workdir):
 
 # what the ledger is made of on config/ci.yaml (workflow/rules/claims.smk: GATE_STAGES), oldest first
 GATE_FILES = ["results/tables/contact.csv",
-              *(f"results/tables/{t}.csv" for t in ("beta", "rates", "claims_extra", "elastic_claims", "face_claims",
-                                                   "face_elastic_claims")),
+              *(f"results/tables/{t}.csv" for t in ("beta", "rates", "claims_extra", "elastic_claims", "membranes3d_claims",
+                                                   "elastic3d_claims")),
               "results/claims.csv",
               "results/benchmarks/rules/verify_claims.tsv"]  # an earlier gate's benchmark file
 

@@ -129,7 +129,7 @@ rule elastic_bench:
         PACKAGE_SOURCES,
         BENCH_SOURCES,
     params:
-        ec=lambda wc: scenes_of(config, "elastic"),  # the model table's elastic study (config key models.elastic)
+        ec=lambda wc: scenes_of(config, "elastic"),  # the model table's elastic study (config key studies.elastic)
         cases=lambda wc: list(config["infsup"]["cases"]),
     threads: 1
     benchmark:

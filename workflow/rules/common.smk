@@ -105,11 +105,11 @@ def reference_mem_mb(wildcards):
 # the face benchmark (rules/benchmarks.smk), with benchmarks.face_N
 FACE_BENCH = ["results/benchmarks/face.csv"] if config["benchmarks"].get("face_N") else []
 
-# The model table (config key `models`; src/infsup_contact/plans/): each study by name, the {model}
+# The model table (config key `studies`; src/infsup_contact/plans/): each study by name, the {model}
 # wildcard of rules/models.smk (jobs, joined tables), claims.smk (model_claims) and paper.smk (model_paper).
 MODEL_TABLE = model_table(config)
 MODEL_STUDIES = {name: study_of(config, name) for name in MODEL_TABLE}
-# longest first: "face_elastic_beta" is {model}=face_elastic, {table}=beta, never face + elastic_beta
+# longest first: "elastic3d_beta" is {model}=elastic3d, {table}=beta, never a study "elastic3d_x" + "beta"
 MODEL_NAMES_RE = "|".join(sorted(MODEL_STUDIES, key=len, reverse=True)) or "(?!)"
 MODEL_TABLE_NAMES_RE = "|".join(sorted({t for s in MODEL_STUDIES.values() for t in s.tables()}, key=len,
                                        reverse=True)) or "(?!)"

@@ -15,7 +15,7 @@ FIGURE_NAMES = [
 ]
 # The face section's figures (paper/face.tex), where the model table has the face study: both
 # drawn by one rule (rule face_figures: one job, one Python start), the worst mode by one small job.
-FACE_STUDY = "face"
+FACE_STUDY = "membranes3d"
 FACE_FIGURE_NAMES = (["fig10_face_beta", "fig11_face_studies"]
                      if FACE_STUDY in MODEL_STUDIES and config["figures"].get("face_mode") else [])
 FIGURE_NAMES += FACE_FIGURE_NAMES
@@ -253,7 +253,7 @@ rule elastic_hertz_profiles:
     input:
         PACKAGE_SOURCES,
     params:
-        ec=lambda wc: scenes_of(config, "elastic"),  # the model table's elastic study (config key models.elastic)
+        ec=lambda wc: scenes_of(config, "elastic"),  # the model table's elastic study (config key studies.elastic)
         fig=lambda wc: config["figures"]["elastic_profiles"],
     threads: 1
     benchmark:

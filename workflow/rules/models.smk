@@ -1,4 +1,4 @@
-# Model stage: every study of the model table (config key `models`; src/infsup_contact/plans/),
+# Model stage: every study of the model table (config key `studies`; src/infsup_contact/plans/),
 # the study's name as the {model} wildcard. A study's jobs each write results/tables/{model}/{job}.csv
 # (one process per table: β of one element or family and k, a sweep, a patch test, ...), and its
 # joined tables results/tables/{model}_{table}.csv concatenate some of them in order. Its claims

@@ -79,7 +79,7 @@ rule paper_pdf:
         figures=PAPER_FIGURES,
         elastic_tex="paper/elastic.tex",  # the elastic section (model table: elastic)
         elastic_figure=["results/figures/fig9_elastic.pdf"] if "elastic" in MODEL_STUDIES else [],
-        face_tex="paper/face.tex",  # the face section (model table: face; its elastic subsection: face_elastic)
+        face_tex="paper/face.tex",  # the face section (model table: membranes3d; its elastic subsection: elastic3d)
         models=MODEL_PAPER,  # each study's generated files (rule model_paper), \input by name
         model_sections="results/paper/model_sections.tex",  # the generated model subsections (rule model_sections)
         producers=PRODUCERS_PAPER,  # "Certifying production codes" (rules/producers.smk), \InputIfFileExists in paper.tex

@@ -111,7 +111,7 @@ def check_figures(cfg) -> None:
             with naming_key(key, f"{case} needs k >= {spec.min_k} ({spec.paper_ref}), the figure has k = {k}",
                             got=case, allowed=f"spaces defined for k = {k}"):
                 check_case(case, k)
-    mode, face = cfg["figures"].get("face_mode"), scenes_of(cfg, "face")
+    mode, face = cfg["figures"].get("face_mode"), scenes_of(cfg, "membranes3d")
     if mode and face:
         from ..models import MODELS
         from ..solvers.request import check_mesh_option
@@ -243,8 +243,8 @@ def check_hertz_reference(cfg) -> None:
                               allowed=f"N_ref >= {need}")
 
 
-from .face import check_face  # noqa: E402 (the face section's checks: config/face.py)
-from .face_elastic import check_face_elastic  # noqa: E402 (config/face_elastic.py)
+from .elastic3d import check_elastic3d  # noqa: E402 (config/elastic3d.py)
+from .membranes3d import check_membranes3d  # noqa: E402 (config/membranes3d.py)
 
 CROSS_KEY_RULES = {
     # rule: the keys it relates (the error names the first; a change to any of them can trip it)
@@ -257,20 +257,21 @@ CROSS_KEY_RULES = {
     check_membranes_parameters: ("contact.scenes",),
     check_primary_scene: ("contact.primary_scene", "contact.scenes"),
     check_speed_accuracy_scene: ("benchmarks.speed_accuracy_scene", "contact.scenes", "contact.primary_scene"),
-    check_required_studies: ("models",),  # first of the table's rules: the others read its elastic entry
-    check_models: ("models", "spaces"),
-    check_elastic_nonmatching: ("models.elastic.nonmatching", "models.elastic.patch_pairs"),
-    check_hertz_reference: ("models.elastic.hertz.N_ref", "models.elastic.hertz.N"),
-    check_face: ("models.face.model", "models.face.elements", "models.face.nonmatching",
-                 "models.face.nonmatching_families", "models.face.cases", "models.face.max_N",
-                 "models.face.l2_max_N", "models.face.norms", "spaces"),
-    check_face_elastic: ("models.face_elastic.model", "models.face_elastic.elements", "models.face_elastic.nu",
-                         "models.face_elastic.nu_sweep", "models.face_elastic.nonmatching",
-                         "models.face_elastic.cases", "models.face_elastic.patch", "spaces"),
+    check_required_studies: ("studies",),  # first of the table's rules: the others read its elastic entry
+    check_models: ("studies", "spaces"),
+    check_elastic_nonmatching: ("studies.elastic.nonmatching", "studies.elastic.patch_pairs"),
+    check_hertz_reference: ("studies.elastic.hertz.N_ref", "studies.elastic.hertz.N"),
+    check_membranes3d: ("studies.membranes3d.model", "studies.membranes3d.elements",
+                        "studies.membranes3d.nonmatching", "studies.membranes3d.nonmatching_families",
+                        "studies.membranes3d.cases", "studies.membranes3d.max_N", "studies.membranes3d.l2_max_N",
+                        "studies.membranes3d.norms", "spaces"),
+    check_elastic3d: ("studies.elastic3d.model", "studies.elastic3d.elements", "studies.elastic3d.nu",
+                     "studies.elastic3d.nu_sweep", "studies.elastic3d.nonmatching",
+                     "studies.elastic3d.cases", "studies.elastic3d.patch", "spaces"),
     check_space_meshes: ("infsup.N", "infsup.nonmatching", "infsup.nonmatching_families", "contact.N",
-                         "contact.scenes", "models.elastic.N", "models.elastic.nonmatching",
-                         "models.elastic.patch_pairs", "models.elastic.bench_N", "models.elastic.hertz.N",
-                         "models.elastic.hertz.modeling_N", "benchmarks.beta_N",
+                         "contact.scenes", "studies.elastic.N", "studies.elastic.nonmatching",
+                         "studies.elastic.patch_pairs", "studies.elastic.bench_N", "studies.elastic.hertz.N",
+                         "studies.elastic.hertz.modeling_N", "benchmarks.beta_N",
                          "benchmarks.contact_N", "claims.rem55_N", "infsup.cases", "contact.cases",
                          "figures.contact_solutions", "figures.dual", "figures.elastic_profiles"),
 }

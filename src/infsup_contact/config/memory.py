@@ -78,13 +78,13 @@ def _elastic_estimates(cfg):
 
 
 def _face_estimates(cfg):
-    """The β jobs of the model table's 3D face studies (``face``, ``face_elastic``): per element and k, each
+    """The β jobs of the model table's 3D face studies (``membranes3d``, ``elastic3d``): per element and k, each
     matching N (up to the element's ``max_N`` or ``l2_max_N``) and non-matching pair, with the estimate the
     command line checks (:func:`~infsup_contact.resources.beta_estimate`, ``dim = 3``)."""
     from ..models import MODELS
     from .models import study_entries
 
-    for at, fc in study_entries(cfg, "face") + study_entries(cfg, "face_elastic"):
+    for at, fc in study_entries(cfg, "membranes3d") + study_entries(cfg, "elastic3d"):
         if fc.get("model") not in MODELS:
             continue
         name = at.rpartition(".")[2]
@@ -104,12 +104,12 @@ def _model_table_estimates(cfg):
     """The β jobs of the model table's ``beta`` studies (one per element and k: its largest pair)."""
     from ..models.user_models import model_named
 
-    for name, entry in (cfg.get("models") or {}).items():
+    for name, entry in (cfg.get("studies") or {}).items():
         if entry.get("study") != "beta":
             continue  # the other studies' jobs are counted above
         model = model_named(entry["model"])
         for n1, n2 in [(n, n) for n in entry["N"]] + [tuple(p) for p in entry.get("nonmatching", [])]:
-            key = f"models.{name}.N" if n1 == n2 else f"models.{name}.nonmatching"
+            key = f"studies.{name}.N" if n1 == n2 else f"studies.{name}.nonmatching"
             for k in entry["k"]:
                 yield key, f"model_job {name} k={k} {n1}x{n2}", R.beta_estimate(
                     "structured", k, n1, n2, "omega2", tuple(entry.get("norms", ("H", "L2"))),

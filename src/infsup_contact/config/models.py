@@ -1,12 +1,12 @@
-"""The config's model table (key ``models``; :mod:`infsup_contact.plans`): reading it, and the
+"""The config's model table (key ``studies``; :mod:`infsup_contact.plans`): reading it, and the
 cross-key checks the schema cannot state.
 
 Every study carries its scenes in its entry (:func:`scenes`). The studies the paper's sections and
-figures read by name (``elastic``, ``face``, ``face_elastic``: :data:`NAMED`) are entries of that
-name, and the table has an ``elastic`` one; a config that still has their old top-level sections is
-told where they moved (:func:`check_moved_sections`). A ``beta`` study names a model
-(registered, or ``FILE.py:NAME`` imported here once, so a wrong file stops the run before any job)
-and its scenes ``k``, ``N`` and ``cases``; each element is one of the model's ``element`` options
+figures read by name (``elastic``, ``membranes3d``, ``elastic3d``: :data:`NAMED`, each named by its
+model) are entries of that name, and the table has an ``elastic`` one; a config that still has their
+old top-level sections, old study names or the old table key ``models`` is told where they moved
+(:func:`check_moved_sections`). A ``beta`` study names a model (registered, or ``FILE.py:NAME``
+imported here once, so a wrong file stops the run before any job) and its scenes ``k``, ``N`` and ``cases``; each element is one of the model's ``element`` options
 (none for a model without them); each case is a registered space defined for some k and built by
 the model's Γ; a study's name does not shadow a folder the other stages write under
 ``results/tables/`` (:data:`RESERVED`). Each raises one
@@ -17,9 +17,13 @@ from __future__ import annotations
 from ..errors import InputError
 from .schema import ConfigError, naming_key
 
-NAMED = ("elastic", "face", "face_elastic")
+NAMED = ("elastic", "membranes3d", "elastic3d")
 """Studies whose files the paper's sections and figures read by the study's name
 (``results/paper/<name>/``, ``results/tables/<name>_*.csv``): their entry has that name."""
+TABLE_KEY, OLD_TABLE_KEY = "studies", "models"
+"""The model table's config key, and the one it had (refused, naming the new)."""
+RENAMED = {"face": "membranes3d", "face_elastic": "elastic3d"}
+"""The studies' old names (``study:`` values and top-level sections) → their model's name."""
 REQUIRED = ("elastic",)
 """Studies the table must have: the paper's elastic section, fig9 and the elastic benchmark read it."""
 RESERVED = ("beta", "contact", "mesh_quality", "claims", "producers", "references", "rates")
@@ -29,8 +33,8 @@ BETA_KEYS = ("model", "k", "N", "cases")
 
 
 def model_table(config: dict) -> dict:
-    """``{name: entry}`` of the config's model table (key ``models``) in its order."""
-    return dict(config.get("models") or {})
+    """``{name: entry}`` of the config's model table (key :data:`TABLE_KEY`) in its order."""
+    return dict(config.get(TABLE_KEY) or {})
 
 
 def scenes(entry: dict) -> dict:
@@ -38,9 +42,15 @@ def scenes(entry: dict) -> dict:
     return {key: value for key, value in entry.items() if key != "study"}
 
 
+def study_names(config: dict, study: str) -> list:
+    """The names of the entries running ``study``, in the table's order."""
+    return [name for name, e in model_table(config).items() if e.get("study") == study]
+
+
 def study_entries(config: dict, study: str) -> list:
-    """``[(key, scenes)]`` of every entry running ``study``, ``key`` = ``models.<name>`` (what errors name)."""
-    return [(f"models.{name}", scenes(e)) for name, e in model_table(config).items() if e.get("study") == study]
+    """``[(key, scenes)]`` of every entry running ``study``, ``key`` = ``studies.<name>`` (what errors name)."""
+    table = model_table(config)
+    return [(f"{TABLE_KEY}.{name}", scenes(table[name])) for name in study_names(config, study)]
 
 
 def scenes_of(config: dict, study: str) -> dict | None:
@@ -51,16 +61,34 @@ def scenes_of(config: dict, study: str) -> dict | None:
 
 
 def check_moved_sections(cfg) -> None:
-    """A config written before the wings joined the model table: its top-level section
-    ``elastic``, ``face`` or ``face_elastic`` is refused, naming where its keys now live (unchanged,
-    under the entry of that name with ``study: <name>``). Run before the schema, whose message
-    (an unknown top-level key) would not say where it went."""
-    for name in NAMED:
-        if isinstance(cfg, dict) and name in cfg:
-            raise ConfigError(name, f"the top-level section moved into the model table: its keys go, unchanged, "
-                              f"under models.{name} beside `study: {name}`", got=f"<a top-level `{name}:` section>",
-                              allowed=f"models: {{{name}: {{study: {name}, <the keys of the old section>}}}} "
+    """A config written before the wings joined the model table, or before each took its model's
+    name: the table under its old key ``models`` is refused, naming ``studies`` (its entries are
+    studies: some name a model, ``arc``, ``cylinder``, ``hex20`` a Γ shape or an element); a
+    top-level section ``elastic``, ``face`` or ``face_elastic`` is refused, naming where its keys
+    now live (unchanged, under the entry of the model's name, :data:`RENAMED`); so is an entry whose
+    ``study`` is an old name. Run before the schema, whose message (an unknown top-level key, a
+    value not in an enum) would not say where it went."""
+    if not isinstance(cfg, dict):
+        return
+    if OLD_TABLE_KEY in cfg:
+        raise ConfigError(OLD_TABLE_KEY, f"the model table is the key {TABLE_KEY!r} now (its entries unchanged: "
+                          "each a study, named by its model or by its Γ shape)", got=f"<a `{OLD_TABLE_KEY}:` section>",
+                          allowed=f"{TABLE_KEY}: {{<name>: {{study: ..., ...}}}} (config/config.yaml has one)")
+    for old in ("elastic", *RENAMED):
+        if old in cfg:
+            new = RENAMED.get(old, old)
+            raise ConfigError(old, f"the top-level section moved into the model table: its keys go, unchanged, "
+                              f"under {TABLE_KEY}.{new} beside `study: {new}`", got=f"<a top-level `{old}:` section>",
+                              allowed=f"{TABLE_KEY}: {{{new}: {{study: {new}, <the keys of the old section>}}}} "
                               "(config/config.yaml has one)")
+    table = cfg.get(TABLE_KEY)
+    for name, entry in (table.items() if isinstance(table, dict) else ()):
+        study = entry.get("study") if isinstance(entry, dict) else None
+        if isinstance(study, str) and study in RENAMED:
+            new = RENAMED[study]
+            raise ConfigError(f"{TABLE_KEY}.{name}.study", f"the study {study!r} is named by its model now: "
+                              f"{new!r} (its keys unchanged, the entry named {new})", got=study,
+                              allowed=f"{TABLE_KEY}: {{{new}: {{study: {new}, ...}}}}")
 
 
 def check_required_studies(cfg) -> None:
@@ -68,16 +96,16 @@ def check_required_studies(cfg) -> None:
     table = model_table(cfg)
     for study in REQUIRED:
         if not any(e["study"] == study for e in table.values()):
-            raise ConfigError("models", f"no {study} study (the paper's {study} section, its figure and benchmark "
+            raise ConfigError(TABLE_KEY, f"no {study} study (the paper's {study} section, its figure and benchmark "
                               "read it)", got=sorted(table), allowed=f"a model table with the entry "
                               f"{study}: {{study: {study}, ...}} (config/config.yaml has one)")
 
 
 def check_models(cfg) -> None:
-    """Check ``cfg["models"]``: names, the named studies, each ``beta``/``arc``/``cylinder`` entry."""
+    """Check ``cfg["studies"]``: names, the named studies, each ``beta``/``arc``/``cylinder`` entry."""
     table = model_table(cfg)
     for name, entry in table.items():
-        key = f"models.{name}"
+        key = f"{TABLE_KEY}.{name}"
         if name in RESERVED:
             raise ConfigError(key, "a name the other stages' tables use", got=name,
                               allowed=f"any other name (not {', '.join(RESERVED)})")
@@ -85,7 +113,7 @@ def check_models(cfg) -> None:
         if study in NAMED and name != study:
             raise ConfigError(f"{key}.study", f"the paper and its figures read the {study} study's files by "
                               f"the name {study!r}: its entry must have that name", got=name,
-                              allowed=f"models: {{{study}: {{study: {study}, ...}}}}")
+                              allowed=f"{TABLE_KEY}: {{{study}: {{study: {study}, ...}}}}")
         if study in ("arc", "cylinder"):
             _check_arc(key, entry, 1 if study == "arc" else 2)
         elif study == "beta":

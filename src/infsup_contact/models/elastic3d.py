@@ -28,7 +28,7 @@ z trace vanishes on ∂Γ and W_h, the structural kernel count dim M − dim W a
 H^{-1/2}_00(Γ) norm are those of the membranes. A contact scene gives its ``supports``: one
 NGSolve boundary regexp per component (x, y, z). The lateral faces x = 0 and y = 0 carry their
 own names (:data:`SYMMETRY_X`, :data:`SYMMETRY_Y`: symmetry planes u_x = 0, u_y = 0 of the
-elastic face patch test, :mod:`infsup_contact.study.patch.face_elastic`); the other two keep
+elastic face patch test, :mod:`infsup_contact.study.patch.elastic3d`); the other two keep
 ``side``.
 
 **Loads** (contract): a scene's far-face displacement ``far_displacement[i]`` is u_z on Ω_i's

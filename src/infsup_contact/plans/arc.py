@@ -1,6 +1,6 @@
 """The curved segment: β_h of every registered space on the arc of radius R, both couplings.
 
-The entry (config ``models.<name>`` with ``study: arc``, :mod:`infsup_contact.config.models`) carries
+The entry (config ``studies.<name>`` with ``study: arc``, :mod:`infsup_contact.config.models`) carries
 its scenes: degrees ``k``, ``radii`` (finite R > 1; R = ∞ always runs too), the ``couplings``, the
 mesh ``series`` (name → [N1, N2] pairs, each at least 3: a verdict fits a slope), the ``cases`` and
 optionally the ``patch`` test (its ``k``, ``pairs`` refined by a common factor, prestresses ``c``).

@@ -1,6 +1,6 @@
 """β_h of any model: the study a new model gets from a model file and one model-table entry.
 
-The entry (config ``models.<name>``, :mod:`infsup_contact.config.models`) names the model (a
+The entry (config ``studies.<name>``, :mod:`infsup_contact.config.models`) names the model (a
 registered name or ``FILE.py:NAME``, :mod:`infsup_contact.models.user_models`) and its scenes:
 degrees ``k``, matching meshes ``N``, non-matching pairs ``nonmatching``, the model's ``elements``
 (its mesh option, where it has one), the ``cases`` and the ``norms``. Jobs: one per (element, k),

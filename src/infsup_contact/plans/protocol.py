@@ -1,9 +1,9 @@
 """What a model study is to the workflow: its jobs, its tables, its claims and its paper files.
 
-The model is an axis of the data. The config's model table (key ``models``; :mod:`.table`) names
-each study; one rule per stage takes the study's name as its ``{model}`` wildcard
-(``workflow/rules/models.smk``: jobs and tables; ``claims.smk``; ``paper.smk``) and asks the study
-object, never the model, what to do. A study object answers four questions:
+The model is an axis of the data. The config's model table (key ``studies``;
+:mod:`infsup_contact.config.models`) names each study; one rule per stage takes the study's name
+as its ``{model}`` wildcard (``workflow/rules/models.smk``: jobs and tables; ``claims.smk``;
+``paper.smk``) and asks the study object, never the model, what to do. A study object answers four questions:
 
 * :meth:`ModelStudy.jobs` — the tables computed in one process each, by name: the job ``j``
   of the study ``s`` writes ``results/tables/s/j.csv`` (:func:`job_path`);
@@ -15,8 +15,8 @@ object, never the model, what to do. A study object answers four questions:
 * :meth:`ModelStudy.paper_files` — its generated LaTeX (``results/paper/s/*.tex``) from the
   files of :meth:`ModelStudy.paper_inputs`, checked against its paper source if it has one.
 
-Everything model-specific stays in the study's own module (:mod:`.elastic`, :mod:`.face`,
-:mod:`.face_elastic`, :mod:`.beta`, :mod:`.arc`), each reading its scenes from its entry; the stages are shared.
+Everything model-specific stays in the study's own module (:mod:`.elastic`, :mod:`.membranes3d`,
+:mod:`.elastic3d`, :mod:`.beta`, :mod:`.arc`), each reading its scenes from its entry; the stages are shared.
 """
 from __future__ import annotations
 

@@ -6,7 +6,7 @@ escaping), ``macros`` and ``tables`` (the paper's generated LaTeX), ``paper`` (t
 the check of ``paper.tex``), ``consistency`` (text that stays true whatever the verdict);
 ``sections/`` the sections each study of the model table (and the producers) generates: one template
 per kind of their tables (``templates``) and of their macro blocks (``blocks``), and per section its
-declarations (``elastic``, ``face``, ``face_elastic``, ``model_section`` for the table's other studies,
+declarations (``elastic``, ``face`` (membranes3d), ``elastic3d``, ``model_section`` for the table's other studies,
 ``producers``); ``figures/`` the figures drawn by the package.
 Reads tables only; imports ``discretization`` (the registry) and nothing that computes.
 """

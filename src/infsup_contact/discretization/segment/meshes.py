@@ -33,7 +33,7 @@ GAMMA, DIRICHLET = SEGMENT.boundary, "dir"
 SYMMETRY_X, SYMMETRY_Y = "side_x0", "side_y0"
 """Boundary names of the lateral faces x = 0 and y = 0 of the 3D elastic bodies' meshes
 (:mod:`infsup_contact.models.elastic3d`): the symmetry planes of the elastic face patch test
-(:mod:`infsup_contact.study.patch.face_elastic`), named here so that the scene need not import
+(:mod:`infsup_contact.study.patch.elastic3d`), named here so that the scene need not import
 the model."""
 
 

@@ -2,10 +2,11 @@
 face and the three study tables (the 3D patch test, the α sweep of the transformed dual bases,
 edge dropping), each declared through the section templates (:mod:`.templates`, :mod:`.sections`).
 
-Pure functions from ``results/tables/face_beta.csv``, ``results/tables/face_claims.csv``,
-``results/face/{patch,alpha,edge_dropping}.csv`` and the studies' claims
-(``results/tables/face_study_claims.csv``, :mod:`infsup_contact.study.claims.membranes3d_studies`)
-to LaTeX text; ``workflow/scripts/model_paper.py`` reads and writes (plans/face.py). Macro names start with
+Pure functions from the membranes3d study's tables (``results/tables/membranes3d_beta.csv``,
+``results/tables/membranes3d/{patch,alpha,edge_dropping}.csv``) and its claims
+(``results/tables/membranes3d_claims.csv``: :mod:`infsup_contact.study.claims.membranes3d` and
+:mod:`~infsup_contact.study.claims.membranes3d_studies`) to LaTeX text;
+``workflow/scripts/model_paper.py`` reads and writes (plans/membranes3d.py). Macro names start with
 ``face`` (letters only, :func:`~infsup_contact.report.texnames.macro_name`), apart from the
 main paper's generated namespace. Every number of the section is one of these macros or a
 cell of a table, each computed from the tables here; each outcome macro (``\\faceOutcome…``)

@@ -1,5 +1,5 @@
-"""Ledger claims of the 3D elastic bodies on the contact face (config ``face_elastic``;
-``results/tables/face_elastic_beta.csv`` and ``results/face/elastic_patch.csv``), appended to
+"""Ledger claims of the 3D elastic bodies on the contact face (config ``studies.elastic3d``;
+``results/tables/elastic3d_beta.csv`` and ``results/tables/elastic3d/patch.csv``), appended to
 ``results/claims.csv`` like :mod:`.membranes3d`.
 
 Same verdicts as the paper's ledger (:mod:`infsup_contact.criteria.claims`): PASS / FAIL /
@@ -12,11 +12,11 @@ the config — never from a case id and never from the measured tables. The reas
   (Σ_i B_i X_i B_iᵀ, G) with X_i = S_i⁻¹ SPD, so the kernel is ker B_1ᵀ ∩ ker B_2ᵀ: it depends
   on the couplings only, which see the z traces of vector Q_k / P_k clamped on ∂Ω_i∖Γ — the
   scalar trace spaces of the 3D membranes on the same meshes. Hence on every mesh pair and every ν
-  the kernel equals the membranes' (``face.model``'s, compared wherever the face stage computed
+  the kernel equals the membranes' (``membranes3d.model``'s, compared wherever the face stage computed
   the same element, k, case and pair) and on matching meshes the dimension count
   max(dim M − dim W, 0) (:func:`.membranes3d.matching_kernel`). Predicted PASS.
 * **Bounded** (``face-elastic-bounded-<tag>-k<k>-<element>``): spaces marked stable in the
-  registry have β_H > ``claims.beta_floor`` on every mesh at ν = ``face_elastic.nu``, no kernel
+  registry have β_H > ``claims.beta_floor`` on every mesh at ν = ``elastic3d.nu``, no kernel
   and every kernel decision clear. Predicted PASS (a(·,·) of elasticity at fixed ν is equivalent
   to the membranes' Dirichlet form on each component by Korn's inequality, so the membranes'
   stability carries over).
@@ -31,7 +31,7 @@ the config — never from a case id and never from the measured tables. The reas
   Predicted PASS where 1 ∈ M_h (:func:`.membranes3d_studies.face_contains_constants`, computed by
   :func:`~infsup_contact.discretization.gamma.constants.spans_constants` on the built face space) and the
   kernel count is 0; without the constants only the lower bound holds (slope ≤ 1/2): a finding.
-* **Patch test** (``face-elastic-patch-<tag>-k<k>-<element>``, :mod:`..patch.face_elastic`): the
+* **Patch test** (``face-elastic-patch-<tag>-k<k>-<element>``, :mod:`..patch.elastic3d`): the
   uniform compression is reproduced to round-off iff 1 ∈ M_h (spans_constants of the built space)
   and the scene's natural-trace kernel count is 0 (:func:`.membranes3d_studies.patch_prediction`,
   the membranes' face patch rule: the exact solution is linear, its z traces coincide).
@@ -64,7 +64,8 @@ def nu_prediction(spec, k: int, n: int, gamma) -> str:
 
 
 def _membrane_kernels(membranes: pd.DataFrame | None, element: str, k: int, case: str) -> dict:
-    """(N1, N2) → (kernel_dim, structural_kernel_dim) of ``face.model`` (H rows, G_h = trace of Ω2)."""
+    """(N1, N2) → (kernel_dim, structural_kernel_dim) of ``membranes3d.model`` (H rows, G_h = trace
+    of Ω2)."""
     if membranes is None or not len(membranes):
         return {}
     m = membranes[(membranes.element == element) & (membranes.k == k) & (membranes.case == case)
@@ -139,17 +140,17 @@ def face_elastic_claims(beta: pd.DataFrame, patch: pd.DataFrame | None, cfg: dic
     Parameters
     ----------
     beta
-        ``face_elastic_beta.csv`` (β table columns plus ``model``, ``element``, ``nu``).
+        ``elastic3d_beta.csv`` (β table columns plus ``model``, ``element``, ``nu``).
     patch
-        ``results/face/elastic_patch.csv`` or ``None``.
+        ``results/tables/elastic3d/patch.csv`` or ``None``.
     cfg
         The ``claims`` config (``beta_floor``).
     fe
-        The ``face_elastic`` config (``nu``, ``nu_sweep``).
+        The ``elastic3d`` entry's scenes (``nu``, ``nu_sweep``).
     interfaces
         element → its face interface (:func:`.membranes3d.element_interfaces`).
     membranes
-        ``face_beta.csv`` of ``face.model`` (the kernel comparison), or ``None``.
+        ``face_beta.csv`` of ``membranes3d.model`` (the kernel comparison), or ``None``.
     """
     sweep, base_nu = fe["nu_sweep"], float(fe["nu"])
     out = []

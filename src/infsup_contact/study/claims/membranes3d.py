@@ -191,7 +191,7 @@ def _nonmatching_check(rows: pd.DataFrame, spec, k: int, gamma):
 
 
 def face_claims(beta: pd.DataFrame, cfg: dict, interfaces: dict) -> pd.DataFrame:
-    """The face claims of a face β table (``results/tables/face_beta.csv``).
+    """The face claims of a face β table (``results/tables/membranes3d_beta.csv``).
 
     Parameters
     ----------

@@ -1,6 +1,7 @@
 """Ledger claims of the face's three studies: the 3D patch test, the
-α sweep of the transformed dual bases and edge dropping (``results/face/{patch,alpha,edge_dropping}.csv``,
-rules/models.smk with plans/face.py), appended to ``results/claims.csv`` like :mod:`.membranes3d`.
+α sweep of the transformed dual bases and edge dropping
+(``results/tables/membranes3d/{patch,alpha,edge_dropping}.csv``, rules/models.smk with
+plans/membranes3d.py), appended to ``results/claims.csv`` like :mod:`.membranes3d`.
 
 Same verdicts as the paper's ledger (:mod:`infsup_contact.criteria.claims`): PASS / FAIL /
 INCONCLUSIVE, slope claims by the Student-t interval inside s0 ± τ, and a decision too close to

@@ -7,7 +7,7 @@ from __future__ import annotations
 from ... import progress, resources
 from ...errors import InputError
 from . import hertz
-from ..patch import face as face_patch, face_elastic as elastic_face_patch, segment as patch
+from ..patch import face as face_patch, elastic3d as elastic_face_patch, segment as patch
 from .rows import contact_row, reference_solution
 from .registry import REFERENCE_MARGIN, scene_data, scene_spec
 

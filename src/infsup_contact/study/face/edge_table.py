@@ -29,7 +29,7 @@ def edge_plan(ks, ns, thetas, cases=None, n2_factor: int = 2, norms=NORMS, h_cap
               explicit: bool = False) -> list:
     """Check a whole request before anything is computed and return ``[(k, cases of k)]``.
 
-    ``cases``: a filter of :func:`edge_cases` (the config's ``face.cases``), or with ``explicit``
+    ``cases``: a filter of :func:`edge_cases` (the config's ``membranes3d.cases``), or with ``explicit``
     the spaces to run for every k (``--case``: any space with a 1D factor defined for k). Each
     bad value raises one :class:`InputError` naming its key (``k``, ``N``, ``theta``, ``case``,
     ``n2_factor``, ``norm``, ``h_cap``) and the allowed values; a k without a space to run is
@@ -78,7 +78,7 @@ def edge_table(ks=(1,), ns=(4, 8), thetas=THETAS, cases=None, n2_factor: int = 2
     """Rows of :func:`edge_row` for every k, N (N2 = ``n2_factor`` N: a primary side fine enough
     that B2 has full row rank for the continuous spaces of Ω1's face), θ and case (θ before the
     case: the side operators of one θ serve every space); the cases are :func:`edge_cases` of
-    each k, those among ``cases`` when given (e.g. the config's ``face.cases``). The whole
+    each k, those among ``cases`` when given (e.g. the config's ``membranes3d.cases``). The whole
     request is checked first (:func:`edge_plan`)."""
     plan = edge_plan(ks, ns, thetas, cases, n2_factor, norms, h_cap)
     return [edge_row(c, k, n, n2_factor * n, th, norms, h_cap=h_cap)

@@ -4,7 +4,7 @@ The 2D study's families (:mod:`~infsup_contact.discretization.gamma.mesh_series`
 of the two traces with N; ``sqrt2`` (round(√2 n)) makes the two grids share no interior line when
 gcd(N1, N2) = 1 (5:7, 7:10), so the common coarsening of the traces is the single cell and
 dim(W1 ∩ W2) = 0 on rectangles (:meth:`~infsup_contact.discretization.face.shapes.square.Square.trace_sum_dimension`).
-On the face Ω2 is the finer side, N2 = round(√2 N1) (:mod:`infsup_contact.config.face`).
+On the face Ω2 is the finer side, N2 = round(√2 N1) (:mod:`infsup_contact.config.membranes3d`).
 
 For every space, k and element on such a pair this compares three numbers
 (:mod:`.claims.membranes3d`' reasoning):

@@ -1,6 +1,6 @@
-"""The face studies' tables from the config's ``face`` section (rules/models.smk with plans/face.py): one
-pure function per study, each reading its own sub-section (``face.patch``, ``face.alpha``,
-``face.edge_dropping``) and the face's shared keys (model, cases, norms), returning a DataFrame.
+"""The face studies' tables of the model table's ``membranes3d`` study (rules/models.smk with
+plans/membranes3d.py): one pure function per study, each reading its own sub-section
+(``membranes3d.patch``, ``membranes3d.alpha``, ``membranes3d.edge_dropping``) and the face's shared keys (model, cases, norms), returning a DataFrame.
 :data:`FACE_STUDIES` maps the sub-section's key to its function, so the job script names none."""
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ import pandas as pd
 
 def patch_frame(fc: dict) -> pd.DataFrame:
     """The 3D contact patch test (:func:`.face_patch.face_patch_table`): every case of
-    ``face.cases`` the element's face builds, each k and non-matching pair of ``face.patch``."""
+    ``membranes3d.cases`` the element's face builds, each k and non-matching pair of ``membranes3d.patch``."""
     from ..patch.face import face_patch_table
 
     sc = fc["patch"]
@@ -18,7 +18,7 @@ def patch_frame(fc: dict) -> pd.DataFrame:
 
 
 def alpha_frame(fc: dict) -> pd.DataFrame:
-    """The α sweep of the transformed dual bases (:func:`.face_alpha.sweep`) in ``face.norms``."""
+    """The α sweep of the transformed dual bases (:func:`.face_alpha.sweep`) in ``membranes3d.norms``."""
     from .alpha import sweep
 
     sc = fc["alpha"]
@@ -27,7 +27,7 @@ def alpha_frame(fc: dict) -> pd.DataFrame:
 
 
 def edge_frame(fc: dict) -> pd.DataFrame:
-    """Edge dropping (:func:`.edge_table.edge_table`) for the edge cases among ``face.cases``,
+    """Edge dropping (:func:`.edge_table.edge_table`) for the edge cases among ``membranes3d.cases``,
     its columns plus the claims' fit window ``fit_theta_max``."""
     from .edge_table import COLUMNS, edge_table
 

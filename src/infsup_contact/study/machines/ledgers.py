@@ -12,10 +12,11 @@ from ...io import TableError, read_table_text
 LEDGER_TABLES = {"results/claims.csv": "claims", "results/tables/beta.csv": "beta",
                  "results/tables/contact.csv": "contact", "results/tables/elastic_beta.csv": "elastic_beta",
                  "results/tables/elastic_nu_sweep.csv": "elastic_beta",
-                 "results/tables/elastic_patch.csv": "elastic_patch", "results/tables/face_beta.csv": "face_beta",
-                 "results/tables/face_elastic_beta.csv": "face_elastic_beta",
-                 "results/tables/face/alpha.csv": "face_alpha", "results/tables/face/patch.csv": "face_patch",
-                 "results/tables/face_elastic/patch.csv": "face_elastic_patch"}
+                 "results/tables/elastic_patch.csv": "elastic_patch", "results/tables/membranes3d_beta.csv": "face_beta",
+                 "results/tables/elastic3d_beta.csv": "elastic3d_beta",
+                 "results/tables/membranes3d/alpha.csv": "face_alpha",
+                 "results/tables/membranes3d/patch.csv": "face_patch",
+                 "results/tables/elastic3d/patch.csv": "elastic3d_patch"}
 """The CI profile's tables ``verify-machines`` compares across paths (relative to the workflow),
 each with the schema it is read under: the ledger and every table of the segment's, the elastic
 and the face stages that carries a kernel column."""

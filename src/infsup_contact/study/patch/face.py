@@ -179,7 +179,7 @@ def solve_face_patch(case: str, k: int, n1: int, n2: int, c=(1.0, 1.0), delta: f
     ``scene``: another uniform-pressure scene on the face, with this scene's ``name``, ``d``,
     ``pressure`` and ``exact()`` (one NGSolve coefficient function per body, scalar or vector
     as the model's u_h), solved on ``pair`` (built from it); default :func:`patch_scene` of
-    ``pair.c`` and ``delta`` (the elastic one: :mod:`.face_elastic`).
+    ``pair.c`` and ``delta`` (the elastic one: :mod:`.elastic3d`).
 
     Returns
     -------

@@ -1,4 +1,4 @@
-"""Cross-key checks of the model table's ``face_elastic`` studies (the 3D elastic bodies on the
+"""Cross-key checks of the model table's ``elastic3d`` studies (the 3D elastic bodies on the
 contact face).
 
 What the schema cannot state: the model is a registered 3D model whose stiffness takes the
@@ -12,22 +12,22 @@ naming the key.
 """
 from __future__ import annotations
 
-from .face import check_element
+from .membranes3d import check_element
 from .schema import ConfigError, naming_key
 
 MIN_FIT_POINTS = 3
 """A slope fit of the ν sweep needs this many ν >= fit_nu_min."""
 
 
-def check_face_elastic(cfg) -> None:
-    """Check every ``face_elastic`` study of the model table (none: nothing to check)."""
+def check_elastic3d(cfg) -> None:
+    """Check every ``elastic3d`` study of the model table (none: nothing to check)."""
     from .models import study_entries
 
-    for at, fe in study_entries(cfg, "face_elastic"):
-        _check_face_elastic(cfg, fe, at)
+    for at, fe in study_entries(cfg, "elastic3d"):
+        _check_elastic3d(cfg, fe, at)
 
 
-def _check_face_elastic(cfg, fe: dict, at: str) -> None:
+def _check_elastic3d(cfg, fe: dict, at: str) -> None:
     """Check one elastic face study's scenes ``fe``, its errors naming the keys under ``at``."""
     from ..models import MODELS
 
@@ -75,7 +75,7 @@ def _check_nus(fe, at: str) -> None:
 
 
 def _check_cases(cfg, fe, model, at: str) -> None:
-    from .face import check_face_case_ids
+    from .membranes3d import check_face_case_ids
     from ..study.claims.membranes3d import element_interfaces
 
     faces = element_interfaces(model, sorted(set(fe["elements"]) | set(fe["patch"]["elements"])))

@@ -1,18 +1,18 @@
-"""Cross-key checks of the model table's ``face`` studies (the 3D membranes on the contact face).
+"""Cross-key checks of the model table's ``membranes3d`` studies (the 3D membranes on the contact face).
 
 What the schema cannot state: the model is a registered one with a 3D face, each element is
 one of its ``element`` mesh options, each case id is a registered space the face can build for
-some k of ``face.k`` (built on the 2 × 2 grid of Γ: a face-only space added to the registry
+some k of ``membranes3d.k`` (built on the 2 × 2 grid of Γ: a face-only space added to the registry
 later passes by config alone), a non-matching pair has N1 ≠ N2, and the face studies' keys
 (:func:`check_face_studies`). Each raises one
 :class:`~infsup_contact.config.schema.ConfigError` naming the key under the study's entry
-(``face.k`` below: ``models.face.k`` for the entry ``face``).
+(``membranes3d.k`` below: ``studies.membranes3d.k`` for the entry ``membranes3d``).
 
-Non-matching families (``face.nonmatching_families``: family → element → N1 list):
+Non-matching families (``membranes3d.nonmatching_families``: family → element → N1 list):
 the rules of the 2D study's families (:data:`~infsup_contact.discretization.gamma.mesh_series.FAMILY_RULES`:
 ``sqrt2`` n → round(√2 n), ``plus1`` n → n + 1) give the *finer* side from the coarser one, and on
-the face Ω2 is the finer side as in ``face.nonmatching`` (G_h = the trace of Ω2): N2 = rule(N1),
-e.g. sqrt2 5:7, 7:10, 10:14. They are listed per element and explicitly, so ``face.max_N`` does not
+the face Ω2 is the finer side as in ``membranes3d.nonmatching`` (G_h = the trace of Ω2): N2 = rule(N1),
+e.g. sqrt2 5:7, 7:10, 10:14. They are listed per element and explicitly, so ``membranes3d.max_N`` does not
 cap them (one √2 pair per element keeps the DAG cheap).
 """
 from __future__ import annotations
@@ -22,16 +22,16 @@ import numpy as np
 from .schema import ConfigError, naming_key
 
 
-def check_face(cfg) -> None:
-    """Check every ``face`` study of the model table (none: nothing to check)."""
+def check_membranes3d(cfg) -> None:
+    """Check every ``membranes3d`` study of the model table (none: nothing to check)."""
     from .models import study_entries
 
-    for at, fc in study_entries(cfg, "face"):
+    for at, fc in study_entries(cfg, "membranes3d"):
         _check_face(cfg, fc, at)
 
 
 def _check_face(cfg, fc: dict, at: str) -> None:
-    """Check one face study's scenes ``fc``, its errors naming the keys under ``at`` (``models.<name>``)."""
+    """Check one membranes3d study's scenes ``fc``, its errors naming the keys under ``at`` (``studies.<name>``)."""
     from ..models import MODELS
 
     model = MODELS.get(fc["model"])
@@ -63,7 +63,7 @@ def _check_face(cfg, fc: dict, at: str) -> None:
 def _check_face_meshes(fc, at: str) -> None:
     """Every face mesh gets the minimum its spaces need, as the command line's rule
     (:func:`~infsup_contact.discretization.spaces.registry.check_pair_spaces`): a case of
-    ``face.cases`` built from the segment's space (T3, DUAL, ...) with dim M_h = 0 on the
+    ``membranes3d.cases`` built from the segment's space (T3, DUAL, ...) with dim M_h = 0 on the
     N2 × N2 cells of Γ (T3 with k = 1 on N = 1) is refused, naming the key, the case and k."""
     from ..discretization.spaces.registry import SPACES, case_name, is_empty, min_intervals
 
@@ -89,9 +89,9 @@ def _check_degrees(key: str, model, element: str, ks, k_key: str) -> None:
 
 
 def check_face_studies(fc, model, at: str) -> None:
-    """The face studies' keys (jobs of the face study, plans/face.py) the schema cannot state: the patch
-    test's elements are the model's, with contact scenes and at least one degree of
-    ``face.patch.k`` (an element runs the degrees it has: HEX20 k = 2), its pairs
+    """The face studies' keys (jobs of the membranes3d study, plans/membranes3d.py) the schema
+    cannot state: the patch test's elements are the model's, with contact scenes and at least one
+    degree of ``membranes3d.patch.k`` (an element runs the degrees it has: HEX20 k = 2), its pairs
     non-matching; the α sweep's elements are face elements with a transformed (non-identity)
     basis; edge dropping keeps at least 3 θ at or below ``fit_theta_max`` (a slope fit). Each
     raises one ConfigError naming the key."""
@@ -139,7 +139,7 @@ def check_element(key: str, model, element) -> None:
 
 def _check_edge_dropping(fc, ed, at: str) -> None:
     """Each θ is one the geometry resolves at the largest N (a narrower cut column was dropped
-    whole: θ = 1e-12 computed θ = 0), and each k has an edge case among ``face.cases`` (a k
+    whole: θ = 1e-12 computed θ = 0), and each k has an edge case among ``membranes3d.cases`` (a k
     without one computed nothing)."""
     from ..discretization.face.spaces.clipped import SLIVER_MIN, min_covered_fraction
     from ..discretization.spaces.registry import edge_cases
@@ -176,7 +176,7 @@ def _check_face_families(fc, at: str) -> None:
 
 
 def family_pairs(fc, element: str) -> list:
-    """(N1, N2 = rule(N1)) of every ``face.nonmatching_families`` entry of ``element`` (module
+    """(N1, N2 = rule(N1)) of every ``membranes3d.nonmatching_families`` entry of ``element`` (module
     docstring: Ω2 the finer side), in the config's order."""
     from ..discretization.gamma.mesh_series import FAMILY_RULES
 
@@ -186,7 +186,7 @@ def family_pairs(fc, element: str) -> list:
 
 
 def _check_l2_max_n(fc, at: str) -> None:
-    """``face.l2_max_N``: an element with a ``face.max_N``, not below it, and L2 among the norms."""
+    """``membranes3d.l2_max_N``: an element with a ``membranes3d.max_N``, not below it, and L2 among the norms."""
     caps = fc.get("max_N") or {}
     for element, top in (fc.get("l2_max_N") or {}).items():
         key = f"{at}.l2_max_N.{element}"
@@ -200,8 +200,8 @@ def _check_l2_max_n(fc, at: str) -> None:
 
 
 def l2_only_sizes(fc, element: str) -> list:
-    """The matching N of ``face.N`` above the element's ``face.max_N`` and up to its
-    ``face.l2_max_N``: they get L²(Γ) rows only. The L² Gram is exact (a mass matrix); what
+    """The matching N of ``membranes3d.N`` above the element's ``membranes3d.max_N`` and up to its
+    ``membranes3d.l2_max_N``: they get L²(Γ) rows only. The L² Gram is exact (a mass matrix); what
     ``max_N`` caps is the H^{-1/2}_00 Gram of the triangles (a double series per triangle), so the
     L² slope of Remark 3.1 gets finer meshes than the H rows can afford."""
     top, l2_top = (fc.get("max_N") or {}).get(element), (fc.get("l2_max_N") or {}).get(element)
@@ -212,7 +212,7 @@ def l2_only_sizes(fc, element: str) -> list:
 
 def face_pairs(fc, element: str) -> list:
     """The mesh pairs of one element: every matching N and non-matching pair of the config,
-    up to the element's ``face.max_N`` where it has one, then the element's family pairs
+    up to the element's ``membranes3d.max_N`` where it has one, then the element's family pairs
     (:func:`family_pairs`, not capped)."""
     top = (fc.get("max_N") or {}).get(element, max(max(fc["N"]), *(max(p) for p in fc["nonmatching"])))
     pairs = [(n, n) for n in fc["N"]] + [tuple(p) for p in fc["nonmatching"]]
@@ -221,8 +221,8 @@ def face_pairs(fc, element: str) -> list:
 
 
 def _check_face_cases(cfg, fc, options, at: str) -> None:
-    """Each face case is built by the face of one of the configured elements (``face.elements``
-    or ``face.patch.elements``): a space no configured element carries (PWLIN-T6 with hexahedra
+    """Each face case is built by the face of one of the configured elements (``membranes3d.elements``
+    or ``membranes3d.patch.elements``): a space no configured element carries (PWLIN-T6 with hexahedra
     only) was accepted and silently never computed."""
     from ..study.claims.membranes3d import element_interfaces
 

@@ -1,6 +1,6 @@
-"""The elastic face stage of the DAG (config ``face_elastic``, rules/models.smk with plans/face_elastic.py): its config
+"""The elastic face stage of the DAG (config ``models.elastic3d``, rules/models.smk with plans/elastic3d.py): its config
 checks, the claim builder (study/face_elastic_claims.py: predictions from structure, verdicts from
-the table) and the generated subsection (report/sections/face_elastic.py), on fabricated tables — the
+the table) and the generated subsection (report/sections/elastic3d.py), on fabricated tables — the
 numbers themselves are computed by the DAG, and the elastic model is tested in test_elastic3d.py."""
 from __future__ import annotations
 
@@ -16,7 +16,7 @@ from infsup_contact.discretization.spaces.registry import SPACES
 from infsup_contact.discretization.face.shapes.square import SQUARE
 from infsup_contact.criteria.claims import FAIL, INCONCLUSIVE, PASS
 from infsup_contact.study.claims.membranes3d import matching_kernel
-from infsup_contact.study.face.elastic import nu_pairs
+from infsup_contact.study.face.elastic3d import nu_pairs
 from infsup_contact.study.claims.elastic3d import FINDING, claim_id, face_elastic_claims, nu_slope
 from infsup_contact.study.claims.membranes3d_studies import face_contains_constants
 
@@ -123,13 +123,13 @@ def test_patch_claims_predict_pass_iff_the_space_spans_constants():
 
 
 def test_subsection_renders_the_table():
-    from infsup_contact.report.sections.face_elastic import face_elastic_tex
+    from infsup_contact.report.sections.elastic3d import elastic3d_tex
 
     frames = [_rows("T3"), _rows("R5.2"), _rows("DUAL")]
     beta = pd.concat([f[0] for f in frames], ignore_index=True)
     claims = _claims(frames).reset_index()
-    tex = face_elastic_tex(beta, None, claims, FE)
-    assert r"\label{tab:face-elastic}" in tex and tex.count(r"hex & 2 &") == 3
+    tex = elastic3d_tex(beta, None, claims, FE)
+    assert r"\label{tab:elastic3d}" in tex and tex.count(r"hex & 2 &") == 3
     assert "48 (48)" in tex  # R5.2, k = 2, N = 6: 4Nk on matching meshes
 
 
@@ -143,25 +143,25 @@ def _ci():
 
 
 @pytest.mark.parametrize("mutate, key", [
-    (lambda f: f.update(model="membranes3d"), "models.face_elastic.model"),
-    (lambda f: f.update(elements=["hex", "prism"]), "models.face_elastic.elements[1]"),
-    (lambda f: f["patch"].update(elements=["prism"]), "models.face_elastic.patch.elements[0]"),
-    (lambda f: f.update(nu=0.5), "models.face_elastic.nu"),
-    (lambda f: f["nu_sweep"].update(nu=[0.3, 0.49, 0.5]), "models.face_elastic.nu_sweep.nu[2]"),
-    (lambda f: f["nu_sweep"].update(fit_nu_min=0.4999), "models.face_elastic.nu_sweep.fit_nu_min"),
-    (lambda f: f["nu_sweep"].update(N=[5]), "models.face_elastic.nu_sweep.N[0]"),
-    (lambda f: f.update(nonmatching=[[5, 5]]), "models.face_elastic.nonmatching[0]"),
-    (lambda f: f["patch"].update(pairs=[[4, 4]]), "models.face_elastic.patch.pairs[0]"),
-    (lambda f: f.update(cases=["T3", "NOPE"]), "models.face_elastic.cases[1]"),
-    (lambda f: f.update(k=[1], cases=["T4"]), "models.face_elastic.cases[0]"),
-    (lambda f: f["nu_sweep"].update(slope_tolerance=0), "models.face_elastic.nu_sweep.slope_tolerance"),
-    (lambda f: f.update(surprise=1), "models.face_elastic"),
+    (lambda f: f.update(model="membranes3d"), "studies.elastic3d.model"),
+    (lambda f: f.update(elements=["hex", "prism"]), "studies.elastic3d.elements[1]"),
+    (lambda f: f["patch"].update(elements=["prism"]), "studies.elastic3d.patch.elements[0]"),
+    (lambda f: f.update(nu=0.5), "studies.elastic3d.nu"),
+    (lambda f: f["nu_sweep"].update(nu=[0.3, 0.49, 0.5]), "studies.elastic3d.nu_sweep.nu[2]"),
+    (lambda f: f["nu_sweep"].update(fit_nu_min=0.4999), "studies.elastic3d.nu_sweep.fit_nu_min"),
+    (lambda f: f["nu_sweep"].update(N=[5]), "studies.elastic3d.nu_sweep.N[0]"),
+    (lambda f: f.update(nonmatching=[[5, 5]]), "studies.elastic3d.nonmatching[0]"),
+    (lambda f: f["patch"].update(pairs=[[4, 4]]), "studies.elastic3d.patch.pairs[0]"),
+    (lambda f: f.update(cases=["T3", "NOPE"]), "studies.elastic3d.cases[1]"),
+    (lambda f: f.update(k=[1], cases=["T4"]), "studies.elastic3d.cases[0]"),
+    (lambda f: f["nu_sweep"].update(slope_tolerance=0), "studies.elastic3d.nu_sweep.slope_tolerance"),
+    (lambda f: f.update(surprise=1), "studies.elastic3d"),
 ])
-def test_bad_face_elastic_key_is_named(mutate, key):
+def test_bad_elastic3d_key_is_named(mutate, key):
     from infsup_contact.config.checks import ConfigError, check_config
 
     cfg = copy.deepcopy(_ci())
-    mutate(cfg["models"]["face_elastic"])
+    mutate(cfg["studies"]["elastic3d"])
     with pytest.raises(ConfigError) as err:
         check_config(cfg, ROOT / "workflow" / "schemas" / "config.schema.yaml")
     assert f"config key {key}" in str(err.value)
@@ -173,5 +173,5 @@ def test_shipped_configs_pass_and_the_study_is_optional(name):
 
     cfg = yaml.safe_load((ROOT / "config" / name).read_text())
     check_config(cfg, ROOT / "workflow" / "schemas" / "config.schema.yaml")
-    del cfg["models"]["face_elastic"]
+    del cfg["studies"]["elastic3d"]
     check_config(cfg, ROOT / "workflow" / "schemas" / "config.schema.yaml")

@@ -1,4 +1,4 @@
-"""The membranes in 3D with a 2D contact face Γ = (0,1)²×{1} (model-table study ``face``).
+"""The membranes in 3D with a 2D contact face Γ = (0,1)²×{1} (model-table study ``membranes3d``).
 
 Jobs: β_h of every (element, k) on its mesh pairs in both norms, the L²(Γ)-only rows of the finer
 matching meshes where an element has them (``face.l2_max_N``), the 3D contact patch test, the
@@ -11,15 +11,16 @@ from __future__ import annotations
 import pandas as pd
 
 from .. import resources
-from ..config.face import face_pairs, l2_only_sizes
+from ..config.membranes3d import face_pairs, l2_only_sizes
 from .protocol import Inputs, Job, Table, claims_path, job_path, table_path
 
 STUDIES = ("patch", "alpha", "edge_dropping")
 """The face studies: sub-mappings of the entry and jobs of their own."""
 
 
-class FaceStudy:
-    """The face study ``name`` of the model table, from its entry's scenes (module docstring)."""
+class Membranes3dStudy:
+    """The membranes3d study ``name`` of the model table (the 3D membranes on the face), from its
+    entry's scenes (module docstring)."""
 
     tex_source = "paper/face.tex"
     in_paper = True

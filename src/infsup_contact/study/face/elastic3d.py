@@ -1,16 +1,16 @@
-"""The tables of the 3D elastic bodies on the contact face (config ``face_elastic``;
-rules/models.smk with plans/face_elastic.py): β_h per Poisson ratio and the elastic face patch test.
+"""The tables of the 3D elastic bodies on the contact face (config ``studies.elastic3d``;
+rules/models.smk with plans/elastic3d.py): β_h per Poisson ratio and the elastic face patch test.
 
 Pure functions of the config section returning DataFrames; the job scripts only read and write.
 
-* :func:`beta_frame`: β_h in the H^{-1/2}_00(Γ) norm (G_h = trace of Ω2) of ``face_elastic.model``
+* :func:`beta_frame`: β_h in the H^{-1/2}_00(Γ) norm (G_h = trace of Ω2) of ``elastic3d.model``
   (:mod:`infsup_contact.models.elastic3d`) for one element, every k, every case the element's
-  face builds: at ν = ``face_elastic.nu`` on every matching N and non-matching pair, and at
-  every ν of ``face_elastic.nu_sweep`` on its matching meshes (the ν → 1/2 sweep of
+  face builds: at ν = ``elastic3d.nu`` on every matching N and non-matching pair, and at
+  every ν of ``elastic3d.nu_sweep`` on its matching meshes (the ν → 1/2 sweep of
   :mod:`.claims.elastic3d`). Each (ν, pair) is computed once, through the one β batch path
   of every model (:func:`~.beta_batches.beta_batch_rows`, the model built with ``nu``).
-* :func:`patch_frame`: the elastic face patch test (:mod:`.patch.face_elastic`) on the pairs of
-  ``face_elastic.patch`` at ν = ``face_elastic.nu``, E1 = E2 = 1.
+* :func:`patch_frame`: the elastic face patch test (:mod:`.patch.elastic3d`) on the pairs of
+  ``elastic3d.patch`` at ν = ``elastic3d.nu``, E1 = E2 = 1.
 """
 from __future__ import annotations
 
@@ -31,7 +31,7 @@ def nu_pairs(fe: dict) -> list:
 
 
 def face_cases(fe: dict, k: int, gamma) -> list:
-    """The cases of ``face_elastic.cases`` defined for k and built by the face ``gamma``."""
+    """The cases of ``elastic3d.cases`` defined for k and built by the face ``gamma``."""
     from ...discretization.spaces.registry import SPACES, ids_valid_for
 
     return [c for c in ids_valid_for(k, fe["cases"]) if gamma.builds(SPACES[c])]
@@ -63,9 +63,9 @@ def beta_frame(fe: dict, element: str) -> pd.DataFrame:
 
 def patch_frame(fe: dict) -> pd.DataFrame:
     """The elastic face patch test (:func:`~.elastic_face_patch.elastic_face_patch_rows`) for
-    every element of ``face_elastic.patch``, the cases its face builds, every k and pair."""
+    every element of ``elastic3d.patch``, the cases its face builds, every k and pair."""
     from ...models import make_model
-    from ..patch.face_elastic import elastic_face_patch_rows
+    from ..patch.elastic3d import elastic_face_patch_rows
     from ..claims.membranes3d import element_interfaces
 
     pc = fe["patch"]

@@ -1,11 +1,11 @@
-"""The linear-elastic bodies on the 3D contact face (model-table study ``face_elastic``).
+"""The linear-elastic bodies on the 3D contact face (model-table study ``elastic3d``).
 
 Jobs: β_H of every element (every k; the table's ν on every mesh pair and the ν → 1/2 sweep,
-:func:`infsup_contact.study.face.elastic.beta_frame`) and the elastic face patch test
-(:func:`~infsup_contact.study.face.elastic.patch_frame`). Claims:
+:func:`infsup_contact.study.face.elastic3d.beta_frame`) and the elastic face patch test
+(:func:`~infsup_contact.study.face.elastic3d.patch_frame`). Claims:
 :mod:`infsup_contact.study.claims.elastic3d`, whose kernel comparison reads the membranes' face
-table when the model table has a face study; paper: the generated subsection ``face_elastic.tex``
-of the face section (:mod:`infsup_contact.report.sections.face_elastic`), read by ``paper/face.tex``.
+table when the model table has a membranes3d study; paper: the generated subsection ``elastic3d.tex``
+of the face section (:mod:`infsup_contact.report.sections.elastic3d`), read by ``paper/face.tex``.
 """
 from __future__ import annotations
 
@@ -14,8 +14,8 @@ import pandas as pd
 from .protocol import Inputs, Job, Table, claims_path, job_path, table_path
 
 
-class FaceElasticStudy:
-    """The elastic face study ``name`` of the model table, from its entry's scenes (module docstring)."""
+class Elastic3dStudy:
+    """The elastic3d study ``name`` of the model table, from its entry's scenes (module docstring)."""
 
     tex_source = None
     model_section = False  # its subsection is read by the face section (paper/face.tex), not listed
@@ -25,7 +25,7 @@ class FaceElasticStudy:
         self.in_paper = membranes is not None  # a subsection of the face section: only with one
 
     def jobs(self) -> dict:
-        from ..study.face.elastic import beta_frame, patch_frame
+        from ..study.face.elastic3d import beta_frame, patch_frame
 
         fe = self.cfg
         jobs = {f"beta_{e}": Job(lambda e=e: beta_frame(fe, e), fe, lambda: 1500,
@@ -37,11 +37,11 @@ class FaceElasticStudy:
         return jobs
 
     def tables(self) -> dict:
-        return {"beta": Table("face_elastic_beta", tuple(f"beta_{e}" for e in self.cfg["elements"]))}
+        return {"beta": Table("elastic3d_beta", tuple(f"beta_{e}" for e in self.cfg["elements"]))}
 
     def claim_inputs(self) -> Inputs:
-        files = {"beta": (table_path(self.name, "beta"), "face_elastic_beta"),
-                 "patch": (job_path(self.name, "patch"), "face_elastic_patch")}
+        files = {"beta": (table_path(self.name, "beta"), "elastic3d_beta"),
+                 "patch": (job_path(self.name, "patch"), "elastic3d_patch")}
         if self.membranes:  # the kernel comparison, when the membranes' face table is computed
             files["membranes"] = (table_path(self.membranes, "beta"), "face_beta")
         return Inputs(files)
@@ -60,9 +60,9 @@ class FaceElasticStudy:
         return Inputs({"beta": files["beta"], "patch": files["patch"], "claims": (claims_path(self.name), "claims")})
 
     def paper_files(self, frames: dict, params: dict) -> dict:
-        from ..report.sections.face_elastic import face_elastic_tex
+        from ..report.sections.elastic3d import elastic3d_tex
 
-        return {"face_elastic.tex": face_elastic_tex(frames["beta"], frames["patch"], frames["claims"], self.cfg)}
+        return {"elastic3d.tex": elastic3d_tex(frames["beta"], frames["patch"], frames["claims"], self.cfg)}
 
     def check_tex(self, tex: str, files: dict) -> None:
         """No hand-written source: the subsection is generated whole."""

@@ -136,21 +136,22 @@ def face_side_dofs(n: int, k: int) -> float:
     return max((nk - 1.0) ** 2 * nk, 1.0)
 
 
-LARGE_ROUTE_3D = {1: (1530.0, 197.0, 6.06e-5, 5.28e-10), 2: (4350.0, 132.0, 1.31e-4, 6.49e-10)}
+LARGE_ROUTE_3D = {1: (1530.0, 197.0, 6.06e-5, 5.28e-10), 2: (4257.0, 75.8, 8.08e-5, 5.79e-10)}
 """(a, b, c, d) of the large route (dim M above :data:`~.la.bottom.DENSE_MAX_M`: sparse
 couplings, exponential-sum Grams in the reflections' parity blocks, bottom pencils; PARDISO):
 bytes a Σ nd + b m² and seconds c Σ nd + d m³ beyond the process, m = (k N₂ + 1)² (R5.2 on
 G_h = the trace of Ω2). Non-negative least squares, relative residuals, on ``beta --model
-membranes3d --case all --norm all`` (hexahedra, k = 1, N = 40…64 and k = 2, N = 20…36; the
-peaks in docs/refusals.md, "The memory estimate"). The sparse factors grow like nd here (nd^{4/3}
+membranes3d --case all --norm all`` (hexahedra; k = 1, N = 40…64; k = 2 refitted with
+:func:`~.bench.estimates.fit_large_route_3d` after the parity factorization and the Grams kept in
+blocks, N = 20…36 and 48; the peaks and CPU times in docs/refusals.md, "The memory estimate"). The sparse factors grow like nd here (nd^{4/3}
 only asymptotically), the Grams, the pencils' and the shared series' dense arrays like m², their
 factorizations like m³. × :data:`LARGE_ROUTE_MARGIN`: above every measurement (by 3 % to 29 %)."""
 LARGE_ROUTE_MARGIN = 1.2
-DENSE_ROUTE_SECONDS_3D = {1: 2.2e-9, 2: 5.4e-9}
+DENSE_ROUTE_SECONDS_3D = {1: 2.2e-9, 2: 1.0e-9}
 """d of c Σ nd + d m³ seconds (c of :data:`LARGE_ROUTE_3D`) on PARDISO's dense route, where the
-dense SVDs and pencils cost more per m³ (fitted at k = 1, N = 32 and k = 2, N = 16, ``--case
-all``). At the gate the large route is the faster one (k = 1: the large route at N = 40 takes
-about 1.5× the dense route at N = 32, for twice the multipliers)."""
+dense SVDs and pencils cost more per m³ (fitted at k = 1, N = 32, ``--case all``; k = 2 on
+N = 8…18 after the pencils went into parity blocks: 1.2–1.3× the CPU time measured). At the gate the large route is the faster one (k = 1: the
+large route at N = 40 takes about 1.5× the dense route at N = 32, for twice the multipliers)."""
 
 
 TRI_GRAM_SECONDS = 5e-9

@@ -24,7 +24,7 @@ def test_routes_agree_on_beta(n):
     assert [r["route"] for r in beta] == ["ours", "ours_core", "limit"]
     for r in beta:
         assert r["max_abs_diff"] <= 1e-8, r
-        assert r["n_problems"] == 2 * len(registry.ids_valid_for(1))     # k = 1: no quadratic face elements
+        assert r["n_problems"] == 2 * len(registry.common_ids(1))     # k = 1: no quadratic face elements
 
 
 def test_schur_routes_give_one_schur_complement():

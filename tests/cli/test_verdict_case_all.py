@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from infsup_contact.cli import main
-from infsup_contact.discretization.spaces.registry import SPACES, ids_built_on, ids_valid_for
+from infsup_contact.discretization.spaces.registry import common_ids, ids_built_on, SPACES
 from infsup_contact.discretization.face.shapes.square import SQUARE, SQUARE_TRIG
 from infsup_contact.discretization.face.partitions.tensor_grid import TensorPartition
 from infsup_contact.models import MODELS
@@ -54,7 +54,7 @@ def test_acceptance_face_only_space_on_hexahedra(capsys):
 
 
 def _expected_ids(model, element, k):
-    segment = set(ids_valid_for(k))
+    segment = set(common_ids(k))
     return segment if model.dim == 2 else segment | _face_only(element, k)
 
 

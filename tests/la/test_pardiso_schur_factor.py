@@ -124,14 +124,14 @@ def _membrane_rows():
     from infsup_contact.discretization.spaces import registry
     from infsup_contact.study.patch import face as face_patch
 
-    return face_patch.face_patch_rows(registry.space_ids(), [2], [(3, 4)])
+    return face_patch.face_patch_rows(registry.common_ids(), [2], [(3, 4)])
 
 
 def _elastic_rows():
     from infsup_contact.discretization.spaces import registry
     from infsup_contact.study.patch import elastic3d as elastic_face_patch
 
-    return elastic_face_patch.elastic_face_patch_rows(registry.space_ids(), [1], [(2, 3)])
+    return elastic_face_patch.elastic_face_patch_rows(registry.common_ids(), [1], [(2, 3)])
 
 
 @pytest.mark.parametrize("patch_rows", [_membrane_rows, _elastic_rows], ids=["membranes3d", "elastic3d"])

@@ -111,7 +111,7 @@ def matching_rows():
     out = {}
     for name in ("elastic3d", "membranes3d"):
         for k in (1, 2):
-            out[name, k] = beta_rows_all("structured", k, 3, 3, registry.ids_valid_for(k), norms=("H", "L2"),
+            out[name, k] = beta_rows_all("structured", k, 3, 3, registry.common_ids(k), norms=("H", "L2"),
                                          model=MODELS[name], mesh=MeshOptions(element="hex"))
     return out
 
@@ -136,7 +136,7 @@ def test_elastic_and_membranes_share_kernels_and_both_are_stable_for_t3(matching
         assert el.keys() == mem.keys()
         for key in el:
             assert el[key]["kernel_dim"] == mem[key]["kernel_dim"], key
-        t3 = [c for c in registry.ids_valid_for(k) if not registry.space_spec(c).contains_constants(k)]
+        t3 = [c for c in registry.common_ids(k) if not registry.space_spec(c).contains_constants(k)]
         for case in t3:
             for norm in ("H", "L2"):
                 assert el[case, norm]["beta"] > 0 and mem[case, norm]["beta"] > 0
@@ -145,16 +145,16 @@ def test_elastic_and_membranes_share_kernels_and_both_are_stable_for_t3(matching
 def test_non_matching_kernels_equal_the_membranes():
     """On a non-matching pair (tetrahedra 2:3) both models see the same couplings: equal kernels."""
     kw = dict(norms=("L2",), mesh=MeshOptions(element="tet"))
-    el = beta_rows_all("structured", 1, 2, 3, registry.ids_valid_for(1), model=ELASTIC3D, **kw)
-    mem = beta_rows_all("structured", 1, 2, 3, registry.ids_valid_for(1), model=MODELS["membranes3d"], **kw)
+    el = beta_rows_all("structured", 1, 2, 3, registry.common_ids(1), model=ELASTIC3D, **kw)
+    mem = beta_rows_all("structured", 1, 2, 3, registry.common_ids(1), model=MODELS["membranes3d"], **kw)
     assert [(r["case"], r["kernel_dim"]) for r in el] == [(r["case"], r["kernel_dim"]) for r in mem]
 
 
 # ------------------------------------------------------------------ the elastic face patch test
 @pytest.mark.parametrize("element, k", [("hex", 1), ("hex", 2), ("tet", 2)])
 def test_patch_passes_iff_the_space_contains_the_constants(element, k):
-    rows = efp.elastic_face_patch_rows(registry.space_ids(), [k], [(3, 4)], element=element)
-    assert {r["case"] for r in rows} == set(registry.ids_valid_for(k))
+    rows = efp.elastic_face_patch_rows(registry.common_ids(), [k], [(3, 4)], element=element)
+    assert {r["case"] for r in rows} == set(registry.common_ids(k))
     for r in rows:
         assert r["scene"] == ELASTIC_FACE_PATCH.id and r["kernel_dim"] == 0
         assert r["passes"] == r["predicted"] == registry.space_spec(r["case"]).contains_constants(k), r
@@ -204,7 +204,7 @@ def test_cli_beta_and_verdict():
                                      "--N2", "3", "--element", "tet", "--nu", "0.49", "--norm", "L2"])
     assert code == 0, err
     rows = _csv(out)
-    assert {r["case"] for r in rows} == set(registry.ids_valid_for(1))
+    assert {r["case"] for r in rows} == set(registry.common_ids(1))
     assert all(r["model"] == "elastic3d" and r["element"] == "tet" and float(r["nu"]) == 0.49 for r in rows)
     code, out, err = run_in_process(["verdict", "--model", "elastic3d", "--case", "T3", "--k", "1",
                                      "--N", "2", "3", "4"])

@@ -20,11 +20,11 @@ from infsup_contact.study.contact.registry import FACE_PATCH
 @pytest.fixture(scope="module", params=[1, 2])
 def hex_rows(request):
     """Every registered space valid for k on the non-matching hexahedral pair 3:4."""
-    return face_patch.face_patch_rows(registry.space_ids(), [request.param], [(3, 4)])
+    return face_patch.face_patch_rows(registry.common_ids(), [request.param], [(3, 4)])
 
 
 def test_passes_iff_the_space_contains_the_constants(hex_rows):
-    assert {r["case"] for r in hex_rows} == set(registry.ids_valid_for(hex_rows[0]["k"]))
+    assert {r["case"] for r in hex_rows} == set(registry.common_ids(hex_rows[0]["k"]))
     for r in hex_rows:
         spec = registry.space_spec(r["case"])
         assert r["passes"] == spec.contains_constants(r["k"]), r
@@ -36,7 +36,7 @@ def test_passes_iff_the_space_contains_the_constants(hex_rows):
 
 
 def test_non_matching_tetrahedra_agree_with_the_prediction():
-    rows = face_patch.face_patch_rows(registry.space_ids(), [2], [(3, 4)], element="tet")
+    rows = face_patch.face_patch_rows(registry.common_ids(), [2], [(3, 4)], element="tet")
     assert rows and all(r["passes"] == r["predicted"] for r in rows), rows
 
 
@@ -85,7 +85,7 @@ def test_nodal_face_bases_are_nodal_at_their_nodes():
     part = TensorPartition(np.linspace(0, 1, 4), np.array([0.0, 0.2, 0.7, 1.0]))
     checked = 0
     for k in (1, 2):
-        for case in registry.ids_valid_for(k):
+        for case in registry.common_ids(k):
             spec = registry.space_spec(case)
             if not spec.nodal_basis:
                 continue
@@ -106,7 +106,7 @@ def test_cli_prints_the_rows_and_refuses_a_bad_delta():
     lines = out.splitlines()
     cols = lines[0].split(",")
     rows = [dict(zip(cols, line.split(","))) for line in lines[1:]]
-    assert len(rows) == len(registry.ids_valid_for(1))
+    assert len(rows) == len(registry.common_ids(1))
     assert all(r["passes"] == r["predicted"] for r in rows)
     with pytest.raises(InputError, match="delta"):
         face_patch.patch_scene(delta=-1.0)

@@ -16,7 +16,7 @@ from helpers.face_tables import (CLAIMS_CFG, FIT_THETA_MAX, THETAS, alpha_rows, 
                           small_face_tables)
 
 from infsup_contact.discretization.face.spaces.dual_bases import ZERO_WEIGHT_RTOL, weight_fractions
-from infsup_contact.discretization.spaces.registry import SPACES, ids_valid_for
+from infsup_contact.discretization.spaces.registry import common_ids, ids_valid_for, SPACES
 from infsup_contact.discretization.face.shapes.square import SQUARE, SQUARE_TRIG
 from infsup_contact.io import read_table
 from infsup_contact.study.claims import membranes3d_studies as fsc
@@ -89,7 +89,7 @@ def test_face_constants_agree_with_the_registry_on_rectangles():
     """Two routes: the face build's least-squares check against the registry's 1D one, on
     tensor products (1 ∈ M ⊗ M iff 1 ∈ M)."""
     for k in (1, 2):
-        for case in ids_valid_for(k):
+        for case in common_ids(k):
             assert fsc.face_contains_constants(SPACES[case], k, SQUARE) == SPACES[case].contains_constants(k), case
 
 

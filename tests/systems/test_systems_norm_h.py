@@ -14,7 +14,7 @@ import pytest
 import scipy.sparse as sp
 
 from infsup_contact.cli import main
-from infsup_contact.discretization.spaces.registry import ids_valid_for, space_ids, space_spec
+from infsup_contact.discretization.spaces.registry import common_ids, space_spec
 from infsup_contact.models import make_model
 from infsup_contact.solvers.infsup import beta_rows
 from infsup_contact.systems.export import segment_form, suite_levels, write_system
@@ -28,9 +28,9 @@ from infsup_contact.solvers.request import MeshOptions
 NS = (4, 8)
 RTOL = 1e-8
 CRITERION = dict(tol=0.15, floor=1e-3, confidence=0.95)
-SEGMENT_CASES = [(case, k) for k in (1, 2) for case in ids_valid_for(k)]
+SEGMENT_CASES = [(case, k) for k in (1, 2) for case in common_ids(k)]
 FACE_MODEL = make_model("membranes3d")
-FACE_CASES = [(case, k) for k in (1, 2) for case in ids_valid_for(k)]  # the tensor ones: every segment id
+FACE_CASES = [(case, k) for k in (1, 2) for case in common_ids(k)]  # the tensor ones: every segment id
 
 
 def _general(levels):
@@ -76,7 +76,7 @@ def test_described_segment_reproduces_beta_case(tmp_path, case, k, offset, gener
 
 
 def test_every_registered_segment_space_is_covered():
-    assert {c for c, _ in SEGMENT_CASES} == set(space_ids())
+    assert {c for c, _ in SEGMENT_CASES} == set(common_ids())
     for case, k in SEGMENT_CASES:  # the helper form where the registry says what the space is
         spec = space_spec(case)
         form = segment_form(spec, spec.build(k, np.linspace(0.0, 1.0, 5)))

@@ -68,7 +68,7 @@ def elastic_bench(nu: float = 0.3) -> BetaBench:
     """The plane-strain bodies' benchmark at Poisson ratio ν."""
     return BetaBench(
         "elastic_beta", elastic_model(nu), ("H",), ELASTIC_COLUMNS, "ratio_to_limit",
-        cases=lambda k, gamma, g_h, ids: registry.ids_valid_for(k, ids),
+        cases=lambda k, gamma, g_h, ids: registry.common_ids(k) if ids is None else registry.ids_valid_for(k, ids),
         kernel=lambda case, k, n, row: 0, limit_factor=splu_best_order,
         includes={"ours": "meshes, assembly, factorization + Schur per body, couplings, interface operator, Gram, "
                           "eigh (+ β with v1 = 0), every case",

@@ -69,7 +69,7 @@ def curved_rows(ns, ks, radius: float = 2.0, repeats: int = 3, budget: float = 1
     """The rows of the module docstring for every N of ``ns`` (the pair N : N + 1) and k of ``ks``."""
     rows = []
     for k in ks:
-        cases = registry.ids_valid_for(k)
+        cases = registry.common_ids(k)
         for n in ns:
             n1, n2 = n, n + 1
             routes = {"limit": _limit(k, max(n1, n2), radius)}

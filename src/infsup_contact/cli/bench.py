@@ -64,14 +64,14 @@ def _check_bench(args):
                 raise InputError(key, allowed, got=v)
         if len(set(values)) < len(values):
             raise InputError(key, f"{allowed}, each once", got=" ".join(map(str, values)))
-    from ..discretization.spaces.registry import check_pair_spaces, ids_valid_for
+    from ..discretization.spaces.registry import check_pair_spaces, common_ids
 
     TARGET_CHECKS.get(args.what, lambda _: None)(args)  # a target's own flags
     if args.phases is not None and (args.phases == "-" or is_stream(args.phases)):
         raise InputError("phases", "a file name to write (the table goes to stdout or --output)", got=args.phases)
     for k in args.k:  # every registered space defined for k: a superset of what the routes run
         for n in args.N:
-            check_pair_spaces(ids_valid_for(k), k, n, n, key="N")
+            check_pair_spaces(common_ids(k), k, n, n, key="N")
     if args.repeats < 1:
         raise InputError("repeats", "an integer >= 1", got=args.repeats)
     from ..bench.harness import ROUTE_BUDGET

@@ -18,7 +18,7 @@ from .common import _material_params, _mesh_options  # noqa: F401 (the flags' ow
 def cases(args) -> list:
     """Case ids of a request: --space (loaded, checked, registered), else --case (all: every
     registered space defined for k)."""
-    from ..discretization.spaces.registry import ids_valid_for
+    from ..discretization.spaces.registry import common_ids
     from ..discretization.spaces.user_spaces import load_user_space
     from ..solvers.request import check_k
 
@@ -28,7 +28,7 @@ def cases(args) -> list:
         return [load_user_space(args.space, run_intervals(args)).id]
     if args.case in (None, "all"):
         check_k(args.k)
-        return ids_valid_for(args.k)
+        return common_ids(args.k)
     return [args.case]
 
 

@@ -63,7 +63,7 @@ def check_cases(cfg) -> None:
     request's rule, :func:`~infsup_contact.discretization.spaces.registry.check_case`)."""
     from ..discretization.spaces.registry import SPACES, check_case
 
-    ids = config_case_ids(cfg)
+    ids = config_case_ids(cfg, gamma_dim=1)  # the 2D stages: Γ a curve
     for stage in ("infsup", "contact"):
         cases = cfg[stage]["cases"]
         for case, ks in cases.items():
@@ -101,7 +101,7 @@ def check_figures(cfg) -> None:
     under contact.scenes or a scene kind."""
     from ..discretization.spaces.registry import SPACES, check_case
 
-    ids = config_case_ids(cfg)
+    ids = config_case_ids(cfg, gamma_dim=1)  # the 2D stages: Γ a curve
     for key, case, k in figure_cases(cfg):
         if case not in ids:
             raise ConfigError(key, f"{case!r} is not a registered space", got=case,

@@ -48,7 +48,7 @@ class ArcStudy:
         from ..study.beta.arc import arc_rows
 
         radii = [float(r) for r in self.cfg["radii"]] + [math.inf]  # R = ∞: the reference of every claim
-        cases = ids_valid_for(k, self.cfg["cases"], gamma_dim=1 if self.element is None else 2)
+        cases = ids_valid_for(k, self.cfg["cases"])
         return arc_rows(radii, self.series(), k, cases, tuple(self.cfg["couplings"]), paper=True, element=self.element)
 
     def _mem_mb(self, k: int) -> int:

@@ -13,7 +13,7 @@ import numpy as np
 import pandas as pd
 
 from ..criteria.claims import NOT_RUN
-from ..discretization.spaces.registry import space_ids
+from ..discretization.spaces.registry import common_ids
 
 VERDICTS = ("PASS", "FAIL", "INCONCLUSIVE")
 LEDGER_VERDICTS = VERDICTS + (NOT_RUN,)
@@ -154,7 +154,7 @@ def _plain(v) -> str:
 
 def case_rank(case) -> int:
     """Position of a case in the registry (the paper's order first); unknown ids last."""
-    ids = space_ids()
+    ids = common_ids()
     return ids.index(case) if case in ids else len(ids)
 
 

@@ -98,7 +98,7 @@ class BetaRequest:
 
     def __post_init__(self):
         check_k(self.k)
-        cases = registry.ids_valid_for(self.k) if self.cases is None else list(self.cases)
+        cases = registry.common_ids(self.k) if self.cases is None else list(self.cases)
         object.__setattr__(self, "cases", tuple(cases))
         ids = [c for c in cases if isinstance(c, str)]
         if not isinstance(self.mesh, MeshOptions):  # a caller's slip, not input: say what it should be

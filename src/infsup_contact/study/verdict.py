@@ -132,7 +132,7 @@ def model_case_ids(model, k: int, family: str = "structured", mesh: MeshOptions 
     model's coarsest mesh (one cell per direction; a 2D model: no mesh, the segment builds
     every space of its dimension)."""
     if model.dim == 2:
-        return registry.ids_valid_for(k, gamma_dim=model.dim - 1)
+        return registry.ids_valid_for(k, registry.space_ids(model.dim - 1))
     return registry.ids_built_on(k, *_coarsest_multiplier_mesh(model, k, family, mesh))
 
 

@@ -10,7 +10,7 @@ import pytest
 from helpers.cli import run_in_process
 from infsup_contact.discretization.gamma.coupling import coupling_matrix
 from infsup_contact.discretization.segment.multipliers import make_space
-from infsup_contact.discretization.spaces.registry import SPACES, case_space, ids_valid_for
+from infsup_contact.discretization.spaces.registry import case_space, common_ids, SPACES
 from infsup_contact.discretization.segment.interface import SEGMENT
 from infsup_contact.models import make_model
 from infsup_contact.solvers.side_cache import SideCache
@@ -51,7 +51,7 @@ def test_kernel_is_the_dimension_count(k, n1, n2):
     frame = rows_of(k, n1, n2)
     sides = SideCache().pair(MODEL, "structured", k, n1, n2, MeshOptions(element="hex"))
     parts = [s.trace.partition for s in sides]
-    assert set(frame.case) == set(ids_valid_for(k))
+    assert set(frame.case) == set(common_ids(k))
     for case, rows in frame.groupby("case"):
         row = rows.iloc[0]
         assert (rows.kernel_decision == "clear").all()

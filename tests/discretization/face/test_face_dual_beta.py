@@ -115,10 +115,10 @@ def test_an_empty_face_space_is_refused_before_any_computation():
 
 def test_face_spaces_stay_off_the_segment():
     """The 2D listings are the segment's; a face id on the segment is refused in one line."""
-    assert all(registry.SPACES[c].defined_on(1) for c in registry.space_ids())
-    assert set(registry.PAPER_CASES) <= set(registry.space_ids())
-    assert not set(FACE_IDS) & set(registry.ids_valid_for(2))
-    assert set(BUILDABLE) <= set(registry.ids_valid_for(2, gamma_dim=2))
+    assert all(registry.SPACES[c].defined_on(1) for c in registry.common_ids())
+    assert set(registry.PAPER_CASES) <= set(registry.common_ids())
+    assert not set(FACE_IDS) & set(registry.common_ids(2))
+    assert set(BUILDABLE) <= set(registry.ids_valid_for(2, registry.space_ids(2)))
     for case in FACE_IDS:
         with pytest.raises(InputError, match="face of a 3D model") as err:
             registry.case_space(case, 2, np.linspace(0, 1, 4), SEGMENT)

@@ -11,7 +11,7 @@ from infsup_contact.discretization.gamma.coupling import coupling_matrix
 from infsup_contact.discretization.face.partitions.quadrature import triangles_rule
 from infsup_contact.discretization.face.spaces.tensor import FaceSpace
 from infsup_contact.discretization.face.spaces.triangles import TriangleSpace
-from infsup_contact.discretization.spaces.registry import SPACES, case_space, ids_valid_for
+from infsup_contact.discretization.spaces.registry import case_space, common_ids, SPACES
 from infsup_contact.discretization.face.shapes.square import SQUARE, SQUARE_TRIG
 from infsup_contact.discretization.face.partitions.tensor_grid import TensorPartition
 from infsup_contact.errors import InputError
@@ -113,7 +113,7 @@ def test_tail_exponents_are_the_measured_ones(s, continuous, vanish, dual):
 
 def test_registry_builds_triangles_on_tetrahedral_traces_only():
     grid = TensorPartition(np.linspace(0, 1, 4), np.linspace(0, 1, 4))
-    for case in ids_valid_for(2):
+    for case in common_ids(2):
         spec = SPACES[case]
         hexes, tets = case_space(case, 2, grid, SQUARE), case_space(case, 2, grid, SQUARE_TRIG)
         assert isinstance(hexes, FaceSpace)
@@ -164,7 +164,7 @@ def test_beta_agrees_with_the_saddle_point_pencil_on_triangles():
     from infsup_contact.solvers.infsup import saddle_point_beta
 
     k, n1, n2 = 2, 2, 3
-    case = next(c for c in ids_valid_for(k) if SPACES[c].lagrange == (True, True) and SPACES[c].degree(k) == k)
+    case = next(c for c in common_ids(k) if SPACES[c].lagrange == (True, True) and SPACES[c].degree(k) == k)
     sides = SideCache().pair(MODEL, "structured", k, n1, n2, MeshOptions(element="tet"))
     gamma = sides[0].trace.gamma
     space = case_space(case, k, sides[1].trace.partition, gamma)
@@ -206,7 +206,7 @@ def test_couplings_on_non_matching_pairs_sum_to_the_trace_integrals(k, n1, n2):
     triangles (Square.quadrature of the trace partition, no multiplier involved)."""
     sides = SideCache().pair(MODEL, "structured", k, n1, n2, MeshOptions(element="tet"))
     gamma = sides[0].trace.gamma
-    for case in ids_valid_for(k):
+    for case in common_ids(k):
         spec = SPACES[case]
         if spec.lagrange is None or spec.lagrange[1] or spec.dual:
             continue

@@ -11,7 +11,7 @@ import pytest
 from helpers.cli import run_in_process
 from infsup_contact.discretization.face.shapes.serendipity import SERENDIPITY, interior_dimension, product_modes, tensor_modes
 from infsup_contact.discretization.face.partitions.tensor_grid import TensorPartition
-from infsup_contact.discretization.spaces.registry import SPACES, ids_built_on, ids_valid_for
+from infsup_contact.discretization.spaces.registry import common_ids, ids_built_on, SPACES
 from infsup_contact.models import hex20
 from infsup_contact.models.membranes3d import MEMBRANES3D
 
@@ -39,7 +39,7 @@ def predicted_kernel(case, n):
 
 def test_the_quad8_face_builds_the_tensor_spaces_and_the_quad8_ones_only():
     built = ids_built_on(2, SERENDIPITY, grid(2))
-    assert built == ids_valid_for(2) + QUAD8_SPACES
+    assert built == common_ids(2) + QUAD8_SPACES
     assert "DUAL-Q8" not in built and "DUAL-Q9" not in built               # refused / a QUAD9 space
     assert "Q8" not in ids_built_on(2, MEMBRANES3D.subdomain_mesh("structured", 1, 1).interface, grid(2))
 
@@ -69,7 +69,7 @@ def test_beta_case_all_on_hex20_kernels_are_the_predicted_counts():
                                      "--k", "2", "--N1", str(n), "--N2", str(n)])
     assert code == 0, err
     frame = pd.read_csv(io.StringIO(out))
-    assert list(dict.fromkeys(frame.case)) == ids_valid_for(2) + QUAD8_SPACES
+    assert list(dict.fromkeys(frame.case)) == common_ids(2) + QUAD8_SPACES
     assert (frame.dim_W == (3 * n - 1) * (n - 1)).all()
     for case, rows in frame.groupby("case"):
         assert (rows.kernel_dim == predicted_kernel(case, n)).all(), case
@@ -89,7 +89,7 @@ def test_hex20_refuses_other_degrees_in_one_line(k):
 @pytest.mark.parametrize("n", [3, 4])
 def test_product_modes_on_matching_grids_are_the_closed_form(n):
     """Two routes to the same number: the rank of Σ Π_A ⊗ Π_B and the formula from the 1D ranks."""
-    for case in ids_valid_for(2):
+    for case in common_ids(2):
         space = SERENDIPITY.space(SPACES[case], 2, grid(n))
         assert product_modes(*space.factors, [grid(n)] * 2) == tensor_modes(*space.factors), case
 

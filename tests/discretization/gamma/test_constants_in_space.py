@@ -14,7 +14,7 @@ from infsup_contact.study.patch import face as face_patch
 
 @pytest.mark.parametrize("k", [1, 2, 3])
 def test_segment_spaces_agree_with_the_registry_rule(k):
-    for case in registry.ids_valid_for(k):
+    for case in registry.common_ids(k):
         spec = registry.space_spec(case)
         if not spec.defined_on(1):
             continue

@@ -10,7 +10,7 @@ import pytest
 import scipy.sparse as sp
 
 from infsup_contact.discretization.gamma.coupling import coupling_matrix
-from infsup_contact.discretization.spaces.registry import case_space, ids_valid_for
+from infsup_contact.discretization.spaces.registry import case_space, ids_valid_for, space_ids
 from infsup_contact.errors import InputError
 from infsup_contact.models import make_model
 from infsup_contact.solvers import interface_operator
@@ -28,7 +28,7 @@ def setup(request):
     gamma = sides[0].trace.gamma
     part = gamma.multiplier_partition(sides[0].trace.partition, sides[1].trace.partition, "union")
     spaces = []
-    for case in ids_valid_for(k, gamma_dim=gamma.dim):
+    for case in ids_valid_for(k, space_ids(gamma.dim)):
         try:
             spaces.append(case_space(case, k, part, gamma))
         except InputError:

@@ -189,6 +189,6 @@ def test_acceptance_line_prints_every_registered_segment_space():
                                      "--k", "2", "--N1", "16", "--N2", "17"])
     assert code == 0, err
     table = pd.read_csv(io.StringIO(out))
-    assert set(table.case) == set(registry.ids_valid_for(2)) and len(table) == 2 * len(set(table.case))
+    assert set(table.case) == set(registry.common_ids(2)) and len(table) == 2 * len(set(table.case))
     assert (table.gamma == "arc").all() and (table.radius == 2.0).all() and (table.coupling == "exact").all()
     assert np.isfinite(table.beta).all() and (table.beta >= 0).all()

@@ -92,12 +92,12 @@ def test_elastic_stage_runs_the_configs_spaces(name):
     of the segment (the 2D DAG's; the face spaces of the 3D models are not its) and their user
     space, so the elastic stage runs what it ran when it took every registered space (the
     tables stay as they were)."""
-    from infsup_contact.discretization.spaces.registry import space_ids
+    from infsup_contact.discretization.spaces.registry import common_ids
     from infsup_contact.discretization.spaces.user_spaces import load_user_space
 
     cfg = yaml.safe_load((ROOT / "config" / name).read_text())
     users = [load_user_space(ref).id for ref in cfg["spaces"]]
-    builtin = [c for c in space_ids() if c not in users]
+    builtin = [c for c in common_ids() if c not in users]
     assert list(cfg["infsup"]["cases"]) == [*builtin, *users]
 
 

@@ -50,7 +50,7 @@ def test_case_all_resolves_on_the_uniform_partition(label, gamma):
     direction, include every space of its dimension defined for k whose cells it has."""
     p = gamma.uniform_partition(1)
     built = registry.ids_built_on(1, gamma, gamma.multiplier_partition(p, p))
-    assert set(registry.PAPER_CASES) & set(registry.ids_valid_for(1)) <= set(built)
+    assert set(registry.PAPER_CASES) & set(registry.common_ids(1)) <= set(built)
 
 
 def test_a_shape_without_uniform_partition_is_refused():
@@ -69,3 +69,20 @@ def test_every_entry_counts_on_a_gamma_of_the_table_it_is_built_on():
         gamma = spec.count_gamma()
         assert any(gamma is s for s in shapes) or type(gamma) in {type(s) for s in shapes}, spec.id
         assert spec.defined_on(gamma.dim) and gamma.builds(spec), spec.id
+
+
+def test_no_list_of_spaces_assumes_the_segment():
+    """The registry's lists take Γ's dimension from the caller (no default of 1): ``space_ids``
+    and ``config_case_ids`` require it, ``ids_valid_for`` filters the ids it is given, and
+    ``common_ids`` is what every Γ builds: the ids defined on curves and surfaces alike."""
+    import inspect
+
+    from infsup_contact.discretization.spaces.user_spaces import config_case_ids
+
+    for fn, name in ((registry.space_ids, "gamma_dim"), (config_case_ids, "gamma_dim"), (registry.ids_valid_for, "ids")):
+        assert inspect.signature(fn).parameters[name].default is inspect.Parameter.empty, fn.__name__
+    common = registry.common_ids()
+    assert common == [c for c in registry.space_ids(1) if c in registry.space_ids(2)]
+    assert set(registry.PAPER_CASES) <= set(common)
+    for k in range(1, 5):
+        assert registry.common_ids(k) == [c for c in common if registry.SPACES[c].valid_for(k)]

@@ -46,16 +46,28 @@ def space_spec(case: str) -> SpaceSpec:
     return SPACES[case]
 
 
-def space_ids(gamma_dim: int | None = 1) -> tuple:
-    """The registered ids defined on an interface of dimension ``gamma_dim`` (default 1, the
-    segment of the 2D models and of every config; None: all, e.g. the command line's choices)."""
+GAMMA_DIMS = (1, 2)
+"""The dimensions Γ takes: a curve between 2D bodies, a surface between 3D bodies."""
+
+
+def space_ids(gamma_dim: int | None) -> tuple:
+    """The registered ids defined on an interface of dimension ``gamma_dim`` (the request's
+    ``Γ.dim``; None: all, e.g. the command line's choices), in registry order."""
     return tuple(c for c, spec in SPACES.items() if gamma_dim is None or spec.defined_on(gamma_dim))
 
 
-def ids_valid_for(k: int, ids=None, gamma_dim: int | None = 1) -> list:
-    """The registered ids (or ``ids``) defined for displacement degree k (and, without ``ids``,
-    on an interface of dimension ``gamma_dim``, :func:`space_ids`)."""
-    return [c for c in (space_ids(gamma_dim) if ids is None else ids) if SPACES[c].valid_for(k)]
+def ids_valid_for(k: int, ids) -> list:
+    """The ids of ``ids`` defined for displacement degree k (``ids``: a config's list, or
+    :func:`space_ids` of the request's Γ)."""
+    return [c for c in ids if SPACES[c].valid_for(k)]
+
+
+def common_ids(k: int | None = None) -> list:
+    """The registered ids every Γ builds (defined on curves and surfaces alike: the paper's list
+    and the duals), valid for degree k (None: any), in registry order: a request's default
+    cases, to which a 3D request's ``--case all`` adds its face's own (``cli.request.face_cases``)."""
+    common = [c for c, spec in SPACES.items() if all(spec.defined_on(d) for d in GAMMA_DIMS)]
+    return common if k is None else ids_valid_for(k, common)
 
 
 def ids_built_on(k: int, gamma, partition) -> list:
@@ -64,7 +76,7 @@ def ids_built_on(k: int, gamma, partition) -> list:
     refused there (an entry that refuses its construction, e.g. a dual basis with a weight
     ≤ 0 such as DUAL-Q8, raises :class:`InputError` "case" naming its remedy; it is left out)."""
     out = []
-    for case in ids_valid_for(k, gamma_dim=gamma.dim):
+    for case in ids_valid_for(k, space_ids(gamma.dim)):
         if not gamma.builds(SPACES[case]):
             continue
         try:
@@ -83,7 +95,7 @@ def edge_cases(k: int) -> list:
     vanish at the ends (a space vanishing on ∂(Ω1's face) does not vanish on the edge x = L of
     Γ: not the natural analogue)."""
     x = np.linspace(0.0, 1.0, 5)
-    return [c for c in ids_valid_for(k) if not space_spec(c).build(k, x).vanish_at_ends]
+    return [c for c in common_ids(k) if not space_spec(c).build(k, x).vanish_at_ends]
 
 
 def check_case(case: str, k: int) -> None:

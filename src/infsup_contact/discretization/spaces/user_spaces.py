@@ -301,7 +301,7 @@ def forget_since(before) -> None:
         del SPACES[case]
 
 
-def config_case_ids(cfg, gamma_dim: int = 1) -> list:
+def config_case_ids(cfg, gamma_dim: int) -> list:
     """The ids a config may use on an interface of dimension ``gamma_dim`` (1: the segment of
     the 2D stages; 2: the face stage): the built-in spaces and the user spaces of its own
     ``spaces`` key (not those another config registered earlier in the same process)."""

@@ -45,7 +45,7 @@ def membranes_rows(family: str, k: int, pairs, E=(1.0, 1.0), cases=None, norms=(
                    mesh: MeshOptions = NO_OPTIONS) -> pd.DataFrame:
     """The membranes' β_h rows (c = E) on every pair, G_h = trace of Ω2: they do not depend on
     ν, so a ν sweep computes them once."""
-    cases = registry.ids_valid_for(k) if cases is None else list(cases)
+    cases = registry.common_ids(k) if cases is None else list(cases)
     return beta_batch_rows(MEMBRANES, family, k, pairs, cases, ("omega2",), (tuple(E),), norms, mesh=mesh)
 
 
@@ -56,7 +56,7 @@ def elastic_beta_rows(family: str, k: int, pairs, nu: float = 0.3, E=(1.0, 1.0),
     every case valid for k (default) and norm; G_h = trace of Ω2 (the paper's choice). Both
     come from the β_h batches' study path (:func:`~infsup_contact.study.beta.batch_rows.beta_batch_rows`).
     ``membranes``: the membranes' rows of :func:`membranes_rows` where already computed."""
-    cases = registry.ids_valid_for(k) if cases is None else list(cases)
+    cases = registry.common_ids(k) if cases is None else list(cases)
     if membranes is None:
         membranes = membranes_rows(family, k, pairs, E, cases, norms, mesh)
     el = beta_batch_rows(ELASTIC, family, k, pairs, cases, ("omega2",), (tuple(E),), norms,

@@ -56,7 +56,7 @@ def edge_plan(ks, ns, thetas, cases=None, n2_factor: int = 2, norms=NORMS, h_cap
         if not isinstance(k, (int, np.integer)) or isinstance(k, bool) or k not in range(1, 5):
             raise InputError("k", f"a degree with an edge case: {', '.join(map(str, with_cases))}", got=k)
         if explicit:
-            allowed = registry.ids_valid_for(k)
+            allowed = registry.common_ids(k)
             for c in cases:
                 if c not in allowed:
                     raise InputError("case", f"a registered space with a 1D factor defined for k = {k}: "

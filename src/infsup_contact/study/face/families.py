@@ -32,7 +32,7 @@ import sys
 
 import numpy as np
 
-from ...discretization.spaces.registry import SPACES, ids_valid_for
+from ...discretization.spaces.registry import SPACES, ids_valid_for, space_ids
 from ...discretization.gamma.mesh_series import FAMILY_RULES
 from ...errors import InputError
 from ...criteria.claims import FAIL, PASS
@@ -101,8 +101,8 @@ def family_kernels(pairs, ks=(1, 2), cases=None, elements=None, model: str | Non
     for element in elements:
         gamma = faces[element]
         for k in (k for k in ks if gamma.allows(k)):  # HEX20 bodies: k = 2 only
-            ids = [c for c in ids_valid_for(k, cases, gamma_dim=2) if gamma.builds(SPACES[c])
-                   and SPACES[c].dimension is not None]
+            offered = space_ids(gamma.dim) if cases is None else cases
+            ids = [c for c in ids_valid_for(k, offered) if gamma.builds(SPACES[c]) and SPACES[c].dimension is not None]
             for n1, n2 in pairs:
                 built = []
                 for c in ids:

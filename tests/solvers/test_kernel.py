@@ -14,7 +14,7 @@ from infsup_contact.solvers.infsup import _space, beta_rows
 from infsup_contact.solvers.routes import space_kernel
 from infsup_contact.solvers.spectra import spectrum
 from infsup_contact.solvers.kernel import (CLOSE, GAP_DECADES, MARGIN_DECADES, coupling_kernel, kernel_from_gap,
-                                           scaled_couplings)
+                                           right_singular, scaled_couplings)
 from infsup_contact.criteria import stability as verdict
 from infsup_contact.criteria import claims
 
@@ -30,6 +30,21 @@ def _with_singular_values(s, rows, seed=0):
 
 
 # ------------------------------------------------------------------ the rule on plain matrices
+
+@pytest.mark.parametrize("rows,m", [(1283, 700), (1282, 700), (2000, 300), (600, 300), (300, 600), (40, 1)])
+def test_right_singular_is_the_whole_svds_bit_for_bit(rows, m):
+    """right_singular: s and Vᵀ of scipy's dgesdd on W, bit for bit, on both sides of dgesdd's
+    threshold ⌊11 m / 6⌋ (1283 × 700 goes through R alone, 1282 × 700 through W), wide and
+    one-column W, with W's memory reused (Fortran order) or not. The rows are mostly zero, as a
+    coupling's are (only the trace dofs under a multiplier's support)."""
+    rng = np.random.default_rng(rows + m)
+    W = rng.standard_normal((rows, m)) * (rng.random((rows, 1)) < 0.3)
+    _, s, vt = sla.svd(W, full_matrices=m > rows)
+    for got in (right_singular(W), right_singular(W.copy(order="F"), overwrite=True)):
+        assert np.array_equal(got[0], s) and np.array_equal(got[1], vt)
+    with_vectors = coupling_kernel(W, vectors=True)  # the decision's values and basis are the SVD's
+    assert np.array_equal(with_vectors.singular[-len(s):], np.sort(s))
+
 
 def test_exact_zero_singular_values_are_counted_with_a_wide_margin():
     W = _with_singular_values(np.r_[0.0, 0.0, np.linspace(1e-3, 2.0, 20)], 40)

@@ -188,3 +188,15 @@ def test_the_components_kernel_side_by_side_is_the_serial_one(monkeypatch, case,
             a, b = getattr(together, f.name), getattr(serial, f.name)
             assert np.array_equal(a, b) if isinstance(a, np.ndarray) else a == b, f.name
         assert serial.dim == structural
+
+
+def test_the_cross_norm_is_the_dense_products():
+    """split_dense_kernel's ‖O‖_F from sparse products: on blocks whose cross products are not
+    round-off (random columns, mostly zero rows, an empty block) the value of the dense
+    formula (2 Σ_{a<b} ‖B_aᵀ B_b‖_F²)^{1/2}."""
+    rng = np.random.default_rng(3)
+    blocks = [rng.standard_normal((300, m)) * (rng.random((300, 1)) < 0.2) for m in (40, 37, 0, 29)]
+    dense = np.sqrt(2.0 * sum(np.linalg.norm(blocks[a].T @ blocks[b]) ** 2
+                              for b in range(4) for a in range(b)))
+    assert dense > 1.0
+    assert symmetry._cross_norm(blocks) == pytest.approx(dense, rel=1e-12)

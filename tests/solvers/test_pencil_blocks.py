@@ -10,6 +10,7 @@ import functools
 
 import numpy as np
 import pytest
+import scipy.sparse as sp
 
 from infsup_contact.discretization.face.norms import cellwise as fc
 from infsup_contact.discretization.face.norms import tensor as fn
@@ -199,4 +200,34 @@ def test_the_cross_norm_is_the_dense_products():
     dense = np.sqrt(2.0 * sum(np.linalg.norm(blocks[a].T @ blocks[b]) ** 2
                               for b in range(4) for a in range(b)))
     assert dense > 1.0
-    assert symmetry._cross_norm(blocks) == pytest.approx(dense, rel=1e-12)
+    assert symmetry._cross_norm([sp.csc_matrix(B) for B in blocks]) == pytest.approx(dense, rel=1e-12)
+
+
+def test_the_components_kernel_takes_a_sparse_coupling(monkeypatch):
+    """split_dense_kernel of the sparse W (the large route's fallback) is, field by field and bit
+    for bit, that of W made dense: the blocks W Q_c hold the same sums of W's nonzeros either way."""
+    import dataclasses
+
+    from infsup_contact.discretization.gamma.coupling import coupling_matrix, trace_l2_norms
+    from infsup_contact.solvers.kernel import scaled_couplings
+    from infsup_contact.solvers.infsup import _space
+    from infsup_contact.solvers.side_cache import SideCache
+
+    k, n = 2, 6
+    sides = SideCache().pair(MODELS["membranes3d"], "structured", k, n, n, MeshOptions())
+    gamma = sides[0].trace.gamma
+    g_h = gamma.multiplier_partition(*(s.trace.partition for s in sides), "omega2")
+    space = _space("R5.4", k, g_h, gamma)
+    cols = np.sqrt(np.diag(gamma.gram(space, "L2")[0]))
+    W = scaled_couplings([coupling_matrix(s.trace, space, k, sparse=True) for s in sides],
+                         [trace_l2_norms(s.trace, k) for s in sides], cols)
+    structural = gamma.proven_kernel(space, k, [s.trace for s in sides],
+                                     gamma.trace_sum_dimension(k, *(s.trace.partition for s in sides)))
+    split = symmetry.split_of(space, gamma, g_h, k)
+    for vectors in (False, True):
+        a = symmetry.split_dense_kernel(W, split, structural, vectors=vectors)
+        b = symmetry.split_dense_kernel(W.toarray(), split, structural, vectors=vectors)
+        assert a is not None and a.dim == structural > 0
+        for f in dataclasses.fields(a):
+            x, y = getattr(a, f.name), getattr(b, f.name)
+            assert np.array_equal(x, y) if isinstance(x, np.ndarray) else x == y, f.name

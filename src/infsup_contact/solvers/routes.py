@@ -135,7 +135,7 @@ def space_kernel(couplings, sides, space, k: int, structural: int, l2_gram=None,
     decision = symmetry.split_bottom_kernel(W, split, structural, error) if split is not None else None
     if decision is None and split is not None:  # a certificate too close to round-off: the blocks'
         # dense SVDs (about (1/c)² of the whole one's flops and memory) before the whole W's
-        decision = symmetry.split_dense_kernel(W.toarray(), split, structural, error, vectors=True)
+        decision = symmetry.split_dense_kernel(W, split, structural, error, vectors=True)
     decision = bottom_kernel(W, structural, entry_error=error) if decision is None else decision
     return replace(decision, vectors=decision.vectors / cols[:, None])  # W v = 0 ⇔ Bᵀ (v / cols) = 0
 

@@ -104,20 +104,18 @@ def split_bottom_kernel(W, split: ReflectionSplit, proven: int = 0, entry_error:
 
 
 def _cross_norm(blocks) -> float:
-    """‖O‖_F of :func:`split_dense_kernel`: O's blocks (W Q_a)ᵀ (W Q_b), a < b, each counted twice.
-    A coupling touches only the trace dofs under its multiplier's support, so each W Q_c is almost
-    all zeros and the products are sparse ones (the dense products cost 6 rows (m/4)² flops, as
-    much as the blocks' SVDs at R5.4, k = 2, N = 24). O is itself round-off, bounded against
-    σ_{d+1}²: a different order of its sums does not matter."""
-    sparse = [sp.csc_matrix(B) for B in blocks]
-    off2 = sum(sp.linalg.norm((sparse[a].T @ sparse[b]).tocsr()) ** 2
-               for b in range(len(sparse)) for a in range(b) if sparse[a].shape[1] and sparse[b].shape[1])
+    """‖O‖_F of :func:`split_dense_kernel`: O's blocks (W Q_a)ᵀ (W Q_b), a < b, each counted twice,
+    from the sparse W Q_c (a coupling touches only the trace dofs under its multiplier's support:
+    the dense products cost 6 rows (m/4)² flops, as much as the blocks' SVDs at R5.4, k = 2,
+    N = 24). O is itself round-off, bounded against σ_{d+1}²: another order of its sums does not matter."""
+    off2 = sum(sp.linalg.norm((blocks[a].T @ blocks[b]).tocsr()) ** 2
+               for b in range(len(blocks)) for a in range(b) if blocks[a].shape[1] and blocks[b].shape[1])
     return float(np.sqrt(2.0 * off2))
 
 
 def split_dense_kernel(W: np.ndarray, split: ReflectionSplit, proven: int = 0,
                        entry_error: float = 0.0, vectors: bool = False) -> KernelDecision | None:
-    """:func:`~.kernel.coupling_kernel` of a dense W (trace dofs × multipliers) from the singular
+    """:func:`~.kernel.coupling_kernel` of W (trace dofs × multipliers, dense or sparse) from the singular
     values of its components' columns W Q_c (about (1/c)² of the whole SVD's flops), or None (the
     caller's dense SVD decides).
 
@@ -137,13 +135,15 @@ def split_dense_kernel(W: np.ndarray, split: ReflectionSplit, proven: int = 0,
     proof would be counted the margin rests on a round-off singular value, and the whole SVD
     reports it as before (None). ``vectors``: also the kernel's basis, the blocks' right singular
     vectors below η mapped by Q_c (orthonormal: the Q_c are)."""
-    W = np.asarray(W, float)
+    W = sp.csr_matrix(W, dtype=float)
     rows, m = W.shape
     proven = int(max(proven, m - rows, 0))
     if rows == 0 or m == 0:
         return None
-    blocks = [np.asarray((Q.T @ W.T).T) for Q in split.bases]  # Fortran-ordered: QR in place
-    cross = _cross_norm(blocks)
+    sparse = [(W @ Q).tocsc() for Q in split.bases]  # the products of W's nonzeros, in W's order
+    cross = _cross_norm(sparse)
+    blocks = [B.toarray(order="F") for B in sparse]  # Fortran-ordered: their QR in place
+    del sparse
     live = [(B, Q) for B, Q in zip(blocks, split.bases) if B.shape[1]]
     # the blocks' SVDs side by side (LAPACK, GIL-free, one BLAS thread each: the same bits)
     if vectors:  # each block's SVD with its right vectors, ascending (structural zeros first)

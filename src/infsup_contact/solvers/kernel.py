@@ -162,8 +162,8 @@ def right_singular(W: np.ndarray, overwrite: bool = False) -> tuple[np.ndarray, 
     LAPACK's dgesdd decomposes a W with rows >= ⌊11 m / 6⌋ (its MNTHR) through W = Q R: dgeqrf,
     then R alone (dgebrd, dbdsdc, dormbr), then U = Q U_R. The kernel needs only s and Vᵀ, which
     the same calls on R give with the same bits (tests/solvers/test_kernel.py), without forming Q
-    and U: 4 rows m² of the 6 rows m² + O(m³) flops (a block of R5.4 at k = 2, N = 48: 18,818 ×
-    2,304) and two rows × m arrays fewer. Other shapes take dgesdd on W itself. ``overwrite``: W's
+    and U: 2 rows m² + O(m³) flops instead of 6 rows m² + O(m³) (a block of R5.4 at k = 2, N = 48:
+    18,818 × 2,304), and two rows × m arrays fewer. Other shapes take dgesdd on W itself. ``overwrite``: W's
     memory may hold the QR factors (a caller's temporary, Fortran-ordered to be used in place)."""
     W = np.asarray(W, float)
     rows, m = W.shape

@@ -143,7 +143,7 @@ def split_dense_kernel(W: np.ndarray, split: ReflectionSplit, proven: int = 0,
     sparse = [(W @ Q).tocsc() for Q in split.bases]  # the products of W's nonzeros, in W's order
     cross = _cross_norm(sparse)
     blocks = [B.toarray(order="F") for B in sparse]  # Fortran-ordered: their QR in place
-    del sparse  # freed before the SVDs (k = 2, N = 48: 4 × 347 MB dense blocks)
+    del sparse  # not needed past the cross term: freed before the SVDs
     live = [(B, Q) for B, Q in zip(blocks, split.bases) if B.shape[1]]
     # the blocks' SVDs side by side (LAPACK, GIL-free, one BLAS thread each: the same bits)
     if vectors:  # each block's SVD with its right vectors, ascending (structural zeros first)

@@ -131,7 +131,7 @@ class GramCache:
     def gram(self, gamma, case, k: int, partition, space, norm: str, h_route: str) -> tuple:
         """``gamma.gram(space, norm, h_route=h_route)``, from the cache when an equal
         (Γ, case, k, G_h, norm, route) was asked before. ``case`` must identify the space's
-        definition (a registry id, a spec, a triple). Not cached: an unhashable Γ or case, a Gram
+        definition (its registry entry or an unregistered spec, a triple). Not cached: an unhashable Γ or case, a Gram
         that is not a dense array or above a quarter of :attr:`max_bytes`. A Gram summed in
         parity blocks comes as its :class:`~infsup_contact.la.face_parity.ParityGram`, assembled
         where a consumer reads it densely (:func:`~infsup_contact.la.face_parity.deferred_assembly`)."""

@@ -344,9 +344,10 @@ def factorized_side(trace: GammaTrace, free: np.ndarray, K, route: str = "auto",
     if bases is not None:
         parts = body_parity.parity_parts(K, n_gamma, bases)
         S, solve, X = parts.factorize(
-            lambda Kc, ng: schur.gamma_factorization(Kc, ng, route, trace.gamma.dim, keep_factor), parts_map)
+            lambda Kc, ng: schur.gamma_factorization(Kc, ng, route, gamma_dim=trace.gamma.dim,
+                                                     keep_factor=keep_factor), parts_map)
         return SideOperator(trace, free, K, S, solve, X, signature, f"parity {len(parts.parts)}")
-    fac = schur.gamma_factorization(K, n_gamma, route, trace.gamma.dim, keep_factor)
+    fac = schur.gamma_factorization(K, n_gamma, route, gamma_dim=trace.gamma.dim, keep_factor=keep_factor)
     return SideOperator(trace, free, K, fac.schur, fac.solve, fac.steklov, signature, fac.route)
 
 

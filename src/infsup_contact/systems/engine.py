@@ -287,7 +287,9 @@ def _dense(A, B, G, touched, route, n_pairs):
     if route == "gamma-dense":
         rest = np.setdiff1d(np.arange(A.shape[0]), touched)
         order = np.concatenate([rest, touched])
-        fac = gamma_factorization(A[order][:, order], len(touched))
+        # Γ not told: a foreign system's touched unknowns keep the SuperLU routes (its rows as before;
+        # the manifest's optional gamma describes multipliers, and PARDISO's gain was measured on our faces)
+        fac = gamma_factorization(A[order][:, order], len(touched), gamma_dim=None)
         Bg = B[:, touched].toarray()
         t1 = time.perf_counter()
         S = Bg @ fac.steklov_times(Bg.T)

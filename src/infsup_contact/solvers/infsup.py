@@ -57,7 +57,7 @@ def beta_table(request: BetaRequest, side_cache: SideCache | None = None, modes:
     cache = SideCache() if side_cache is None else side_cache
     progress.note("the two sides")
     with progress.phase("sides: mesh, assembly, factorization"):
-        sides = cache.pair(r.model, r.family, r.k, r.n1, r.n2, r.mesh)             # Ω1, Ω2 with Γ last
+        sides = cache.pair(r.model, r.family, r.k, r.n1, r.n2, r.mesh, checked=True)  # Ω1, Ω2 with Γ last
     t_sides = time.perf_counter() - t0
     gamma = sides[0].trace.gamma
     p1, p2 = (s.trace.partition for s in sides)

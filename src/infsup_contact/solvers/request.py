@@ -123,7 +123,9 @@ class BetaRequest:
             check_choice(mm)
             registry.check_pair_spaces(entries, self.k, self.n1, self.n2, (mm,))  # dim M_h = 0: refused here
             check_pair_size(entries, self.k, self.n1, self.n2, mm)  # a Petrov–Galerkin pair is solved densely
-
+        if self.family == "perturbed":  # the mesh builder trusts the request (SideCache.pair, checked)
+            meshes.check_perturbation(meshes.ALPHA_MAX if self.mesh.alpha is None else self.mesh.alpha,
+                                      0 if self.mesh.seed is None else self.mesh.seed)
 
     @property
     def gamma(self):

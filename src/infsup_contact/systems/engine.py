@@ -287,9 +287,7 @@ def _dense(A, B, G, touched, route, n_pairs):
     if route == "gamma-dense":
         rest = np.setdiff1d(np.arange(A.shape[0]), touched)
         order = np.concatenate([rest, touched])
-        # Γ not told: a foreign system's touched unknowns keep the SuperLU routes (its rows as before;
-        # the manifest's optional gamma describes multipliers, and PARDISO's gain was measured on our faces)
-        fac = gamma_factorization(A[order][:, order], len(touched), gamma_dim=None)
+        fac = gamma_factorization(A[order][:, order], len(touched), gamma_dim=None)  # Γ not told: SuperLU, as before
         Bg = B[:, touched].toarray()
         t1 = time.perf_counter()
         S = Bg @ fac.steklov_times(Bg.T)

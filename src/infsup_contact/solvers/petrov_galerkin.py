@@ -82,10 +82,9 @@ def check_pair_size(cases, k: int, n1: int, n2: int, multiplier_mesh: str) -> No
     """:class:`InputError` (naming the N that sets G_h) for a Petrov–Galerkin pair among ``cases``
     (registry entries, checked on the request's Γ) whose dim M on the multiplier mesh exceeds
     :data:`~infsup_contact.la.bottom.DENSE_MAX_M` (solved by a dense SVD only)."""
-    n = registry.multiplier_intervals(n1, n2, multiplier_mesh)
-    for spec in cases:
-        if not spec.petrov_galerkin or spec.dimension is None:
-            continue
+    pairs = [spec for spec in cases if spec.petrov_galerkin and spec.dimension is not None]
+    n = registry.multiplier_intervals(n1, n2, multiplier_mesh) if pairs else None  # G_h's cells: for a pair only
+    for spec in pairs:
         dim = spec.dimension(k, n)
         if dim > DENSE_MAX_M:
             key = {"omega2": "N2", "omega1": "N1"}.get(multiplier_mesh, "N1, N2")

@@ -11,7 +11,6 @@ import pytest
 
 import infsup_contact as ic
 from infsup_contact.cli import build_parser, options, request_of
-from infsup_contact.cli.common import given_dests
 from infsup_contact.cli.request import build
 from infsup_contact.discretization.spaces import registry
 from infsup_contact.discretization.spaces.user_spaces import forget_since
@@ -71,7 +70,7 @@ def test_the_builder_makes_argparses_namespace(argv):
     """The same flags as typed values: the namespace argparse makes from their text, the flags given kept."""
     parser = build_parser()
     parsed = parser.parse_args(argv)
-    given = given_dests(parser, argv)
+    given = parsed.given  # noted by the actions argparse called: the flags typed
     declared = parser.commands[argv[0]].declared
     values = {d: getattr(parsed, d) for d in given if d in options(argv[0], parser)}
     built = build(declared, argv[0], values, given)
@@ -172,3 +171,48 @@ def test_the_package_exports_the_error_its_api_raises():
     assert ic.InputError is InputError
     with pytest.raises(ic.InputError, match="N1"):
         ic.beta(case="T3", k=2, N1=0, N2=4, norm="H")
+
+
+def _typed_by_a_second_parse(parser, argv) -> set:
+    """The reference route: ``argv`` parsed again with every default suppressed (what the
+    command line did before its actions noted their dests): the dests present were typed."""
+    parsers, todo = [], [parser]
+    while todo:
+        p = todo.pop()
+        parsers.append(p)
+        todo += [q for a in p._actions if isinstance(a, argparse._SubParsersAction) for q in a.choices.values()]
+    saved = [(p, dict(p._defaults), [(a, a.default) for a in p._actions]) for p in parsers]
+    try:
+        for p in parsers:
+            p._defaults.clear()
+            for a in p._actions:
+                if not isinstance(a, argparse._SubParsersAction):
+                    a.default = argparse.SUPPRESS
+        return set(vars(parser.parse_args(argv))) - {"given"}  # the set the actions noted: not a flag
+    finally:
+        for p, defaults, actions in saved:
+            p._defaults.update(defaults)
+            for a, default in actions:
+                a.default = default
+
+
+@pytest.mark.parametrize("argv", [
+    ["beta", "--case", "T3", "--k", "2", "--N1=4", "--N2", "4", "--quiet"],
+    ["beta", "--family", "perturbed", "--seed", "0", "--alpha", "0.2", "--k", "1", "--N1", "5", "--N2", "4"],
+    ["verdict", "--case", "T3", "--k", "1", "--N", "2", "4", "8", "--N1-off", "1", "--dry-run"],
+    ["verdict-hook", "a.yaml", "b.yaml"],
+    ["rates", "x.csv"],
+])
+def test_argv_is_parsed_once_and_the_flags_typed_are_those_a_second_parse_finds(argv, monkeypatch):
+    """The flags typed (a default value typed counts, an abbreviation too) are noted as argparse
+    calls their actions: the same set as the reference route's, from one parse of argv."""
+    from infsup_contact import cli
+
+    parser = build_parser()
+    calls = []
+    real = parser.parse_args
+    monkeypatch.setattr(parser, "parse_args", lambda a: calls.append(a) or real(a))
+    args = cli.parse(parser, argv)
+    assert len(calls) == 1
+    monkeypatch.undo()
+    assert args.given == _typed_by_a_second_parse(build_parser(), argv)

@@ -62,3 +62,23 @@ def test_the_fallback_route_gives_the_schur_complement_of_pardiso(monkeypatch, t
     assert (with_mkl.route, without.route) == ("pardiso", "nested")
     scale = np.abs(with_mkl.schur).max()
     assert np.abs(without.schur - with_mkl.schur).max() <= 1e-12 * scale
+
+
+def test_the_route_is_told_gammas_dimension_never_assumes_it(monkeypatch):
+    """``gamma_dim`` has no default (no caller's Γ is taken for the segment); PARDISO is a face's
+    route only: a curve and a Γ not told (a foreign system) take the same SuperLU route, bit for
+    bit; a dimension that is neither is refused naming the key."""
+    import numpy as np
+
+    from infsup_contact.errors import InputError
+    from infsup_contact.la import schur
+
+    A, n_gamma = _laplacian(24), 24
+    with pytest.raises(TypeError):
+        schur.gamma_factorization(A, n_gamma)
+    with pytest.raises(InputError, match="gamma_dim"):
+        schur.gamma_factorization(A, n_gamma, gamma_dim=3)
+    monkeypatch.setattr(schur, "SOLVES_MAX_WORK", 0)  # the large-problem branch on a small A
+    curve, untold = (schur.gamma_factorization(A, n_gamma, gamma_dim=d) for d in (1, None))
+    assert curve.route == untold.route == "nested"
+    assert np.array_equal(curve.schur, untold.schur)

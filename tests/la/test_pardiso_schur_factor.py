@@ -149,9 +149,9 @@ def test_the_face_patch_contact_solution_is_unchanged(monkeypatch, patch_rows):
     kept = []
 
     def rows(keep):
-        def forced(A, n_gamma, route="auto", gamma_dim=1, keep_factor=False):
+        def forced(A, n_gamma, route="auto", *, gamma_dim, keep_factor=False):
             kept.append(keep_factor and keep)
-            return real(A, n_gamma, "pardiso", gamma_dim, keep_factor and keep)
+            return real(A, n_gamma, "pardiso", gamma_dim=gamma_dim, keep_factor=keep_factor and keep)
         monkeypatch.setattr(schur, "gamma_factorization", forced)
         return patch_rows()
 

@@ -14,6 +14,7 @@ from infsup_contact.la.richardson import extrapolate, lookahead_bound, relative_
 from infsup_contact.models import MODELS
 from infsup_contact.solvers.interface_operator import combine_terms, interface_terms
 from infsup_contact.solvers.side_cache import SideCache
+from infsup_contact.discretization.spaces import registry
 from infsup_contact.solvers import infsup
 from infsup_contact.solvers.request import MeshOptions
 
@@ -65,7 +66,7 @@ def test_stated_h_error_bounds_beta_against_a_series_carried_further(face_sides,
     assert 0 < row["nmax_rel_error"] <= 1e-6
     gamma = face_sides[0].trace.gamma
     partition = gamma.multiplier_partition(*(s.trace.partition for s in face_sides), "omega2")
-    space = infsup._space(case, 2, partition, gamma)
+    space = registry.case_space(case, 2, partition, gamma)
     S = combine_terms(interface_terms([coupling_matrix(s.trace, space, 2) for s in face_sides], face_sides),
                       (1.0, 1.0))
     G, info = gram_h_face(space, rtol=1e-10, n_cap=2 ** 16)

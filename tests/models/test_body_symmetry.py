@@ -123,7 +123,7 @@ def test_the_parts_are_independent_calls():
                                      body_symmetry.parity_bases(side.signature, side.stiffness, n_gamma))
     from infsup_contact.la import schur
 
-    one = lambda Kc, ng: schur.gamma_factorization(Kc, ng, "nested")  # noqa: E731
+    one = lambda Kc, ng: schur.gamma_factorization(Kc, ng, "nested", gamma_dim=2)  # noqa: E731
     serial = parts.factorize(one)[0]
     with ThreadPoolExecutor(2) as pool:
         threaded = parts.factorize(one, map=pool.map)[0]

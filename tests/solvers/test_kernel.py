@@ -10,7 +10,8 @@ from infsup_contact.discretization.segment.norms import gram
 from infsup_contact.models.membranes import MEMBRANES
 from infsup_contact.solvers.interface_operator import combine_terms, interface_terms
 from infsup_contact.solvers.side_cache import SideCache
-from infsup_contact.solvers.infsup import _space, beta_rows
+from infsup_contact.discretization.spaces.registry import case_space
+from infsup_contact.solvers.infsup import beta_rows
 from infsup_contact.solvers.routes import space_kernel
 from infsup_contact.solvers.spectra import spectrum
 from infsup_contact.solvers.kernel import (CLOSE, GAP_DECADES, MARGIN_DECADES, coupling_kernel, kernel_from_gap,
@@ -93,7 +94,7 @@ def _kernel_pieces(case, k, n1, n2, mm="omega2", family="structured"):
     sides = _sides(family, k, n1, n2)
     gamma = sides[0].trace.gamma
     x1, x2 = (s.trace.partition for s in sides)
-    space = _space(case, k, gamma.multiplier_partition(x1, x2, mm), gamma)
+    space = case_space(case, k, gamma.multiplier_partition(x1, x2, mm), gamma)
     couplings = [coupling_matrix(s.trace, space, k) for s in sides]
     structural = max(space.dim - gamma.trace_sum_dimension(k, x1, x2), 0)
     return sides, space, couplings, structural

@@ -14,6 +14,7 @@ import scipy.sparse as sp
 
 from infsup_contact.discretization.face.norms import cellwise as fc
 from infsup_contact.discretization.face.norms import tensor as fn
+from infsup_contact.discretization.spaces import registry
 from infsup_contact.models import MODELS
 from infsup_contact.solvers import spectra, symmetry
 from infsup_contact.solvers.infsup import beta_table
@@ -68,7 +69,6 @@ def test_a_pencil_that_is_not_invariant_is_solved_whole():
     """An S with a block across components above INVARIANCE_RTOL: no split (None)."""
     from infsup_contact.discretization.face.shapes.square import SQUARE
     from infsup_contact.discretization.face.partitions.tensor_grid import TensorPartition
-    from infsup_contact.discretization.spaces import registry
 
     xs = np.linspace(0.0, 1.0, 5)
     space = registry.case_space("R5.2", 2, TensorPartition(xs, xs), SQUARE)
@@ -98,8 +98,7 @@ def test_the_components_kernel_is_the_whole_svds(case, k, n1, n2):
     sides = SideCache().pair(MODELS["membranes3d"], "structured", k, n1, n2, MeshOptions())
     gamma = sides[0].trace.gamma
     g_h = gamma.multiplier_partition(*(s.trace.partition for s in sides), "omega2")
-    from infsup_contact.solvers.infsup import _space
-    space = _space(case, k, g_h, gamma)
+    space = registry.case_space(case, k, g_h, gamma)
     rows = [trace_l2_norms(s.trace, k) for s in sides]
     cols = np.sqrt(np.diag(gamma.gram(space, "L2")[0]))
     W = scaled_couplings([coupling_matrix(s.trace, space, k) for s in sides], rows, cols)
@@ -158,13 +157,12 @@ def test_the_components_kernel_side_by_side_is_the_serial_one(monkeypatch, case,
     from infsup_contact.discretization.gamma.coupling import coupling_matrix, trace_l2_norms
     from infsup_contact.la import threaded
     from infsup_contact.solvers.kernel import scaled_couplings
-    from infsup_contact.solvers.infsup import _space
     from infsup_contact.solvers.side_cache import SideCache
 
     sides = SideCache().pair(MODELS["membranes3d"], "structured", k, n, n, MeshOptions())
     gamma = sides[0].trace.gamma
     g_h = gamma.multiplier_partition(*(s.trace.partition for s in sides), "omega2")
-    space = _space(case, k, g_h, gamma)
+    space = registry.case_space(case, k, g_h, gamma)
     cols = np.sqrt(np.diag(gamma.gram(space, "L2")[0]))
     W = scaled_couplings([coupling_matrix(s.trace, space, k, sparse=True) for s in sides],
                          [trace_l2_norms(s.trace, k) for s in sides], cols)

@@ -67,3 +67,18 @@ def test_the_config_refuses_an_element_by_the_request_s_rule_naming_its_key():
     assert f"allowed {request_err.value.allowed})" in text and "got 'prism'" in text
     for element in dict(FACE_MODEL.mesh_options)["element"]:
         check_element("face.elements[0]", FACE_MODEL, element)
+
+
+@pytest.mark.parametrize("alpha, seed", [(0.5, 1), (0.1, -1), (float("nan"), None), (None, 2.5)])
+def test_a_perturbed_request_refuses_what_its_mesh_builder_would(alpha, seed):
+    """The mesh builder trusts a validated request (``SideCache.pair(..., checked=True)``), so the
+    request refuses the perturbed family's seed and α itself: the builder's own error, key and words."""
+    from infsup_contact.discretization.segment import meshes
+
+    given = {key: v for key, v in (("alpha", alpha), ("seed", seed)) if v is not None}
+    with pytest.raises(InputError) as builder:
+        meshes.subdomain_mesh("perturbed", 2, 1, **given)
+    with pytest.raises(InputError) as request:
+        BetaRequest("perturbed", 1, 2, 2, ("T3",), mesh=MeshOptions(**given))
+    assert (request.value.key, request.value.allowed, request.value.got) == (
+        builder.value.key, builder.value.allowed, builder.value.got)

@@ -29,7 +29,8 @@ def schur_routes(setup) -> dict:
     n_gamma = max(len(s.trace.gamma_dofs) for s in setup.sides)
     names = [r for r in SCHUR_ROUTES if (r != "solves" or n_gamma <= SOLVES_MAX_GAMMA)
              and (r != "pardiso" or pardiso.available())]
-    return {r: (lambda r=r: [gamma_factorization(s.stiffness, len(s.trace.gamma_dofs), r).schur
+    return {r: (lambda r=r: [gamma_factorization(s.stiffness, len(s.trace.gamma_dofs), r,
+                                                 gamma_dim=s.trace.gamma.dim).schur
                              for s in setup.sides]) for r in names}
 
 

@@ -35,13 +35,14 @@ their declarations for the builder (:func:`options`).
 from __future__ import annotations
 
 import argparse
+import functools
 import os
 import sys
 
 from ..errors import InputError
 from ..io import TableError
 from . import beta, bench, contact, export, rates, reporting, verdict, verdict_hook
-from .common import EXIT_INTERRUPTED, EXIT_OUTPUT, OutputError, check_stdout, given_dests, refuse_unused, write_text
+from .common import EXIT_INTERRUPTED, EXIT_OUTPUT, OutputError, check_stdout, refuse_unused, write_text
 from .request import Declared, build
 from .program import package_version, report_internal_error
 from .verdict import VERDICT_DEFAULTS
@@ -185,7 +186,30 @@ def build_parser() -> argparse.ArgumentParser:
     _add_provenance(sub)
     for command in sub.choices.values():  # every subcommand: --quiet (no progress on stderr)
         reporting.add_quiet(command)
+    todo = [parser]
+    while todo:  # every action of every (sub)parser notes its dest when argparse calls it
+        for action in todo.pop()._actions:
+            action.__class__ = _noting(type(action))
+            if isinstance(action, argparse._SubParsersAction):
+                todo.extend(action.choices.values())
     return parser
+
+
+@functools.cache
+def _noting(kind: type) -> type:
+    """``kind`` whose call (argparse's, for a flag typed on the command line only; abbreviated or
+    ``--flag=value`` too) adds its dest to the namespace's ``given``: the flags typed, whatever
+    their values, learned as argv is parsed, once (a subcommand's set is carried up with its
+    namespace: merged, not replaced)."""
+
+    class Noting(kind):
+        def __call__(self, parser, namespace, values, option_string=None):
+            before = set(getattr(namespace, "given", ()))
+            super().__call__(parser, namespace, values, option_string)
+            namespace.given = before | set(getattr(namespace, "given", ())) | {self.dest}
+
+    Noting.__name__ = Noting.__qualname__ = kind.__name__
+    return Noting
 
 
 def flag_names(parser: argparse.ArgumentParser, command: str) -> dict:
@@ -231,12 +255,12 @@ def _message(err: Exception, parser, command: str) -> str:
 
 
 def parse(parser, argv):
-    """The request of a command line, unchecked: argparse parses ``argv`` (an unknown flag, a bad
-    type or choice: one line, exit 2), then the flags typed (:func:`~.common.given_dests`) and
-    their parsed values go through the same builder as the Python API's keywords
-    (:func:`~.request.build`); :func:`check` validates it."""
+    """The request of a command line, unchecked: argparse parses ``argv`` once (an unknown flag, a
+    bad type or choice: one line, exit 2), its actions noting the flags typed (:func:`_noting`:
+    ``parsed.given``), then those flags' parsed values go through the same builder as the Python
+    API's keywords (:func:`~.request.build`); :func:`check` validates it."""
     parsed = parser.parse_args(argv)
-    given = given_dests(parser, argv)
+    given = parsed.given
     declared = parser.commands[parsed.command].declared
     dests = {a.dest for a in declared.options}
     return build(declared, parsed.command, {d: v for d, v in vars(parsed).items() if d in given and d in dests},

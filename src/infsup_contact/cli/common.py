@@ -2,7 +2,6 @@
 model and its material flags, the norms, --dry-run and the memory check."""
 from __future__ import annotations
 
-import argparse
 import os
 from dataclasses import dataclass
 from typing import Callable
@@ -144,32 +143,6 @@ class FlagUse:
     request: Callable
 
 
-def given_dests(parser, argv) -> set:
-    """The dests of the options typed on the command line ``argv`` (abbreviated or as
-    ``--flag=value`` too), whatever their values: ``argv`` parsed again with every default
-    suppressed (restored after), so a flag given with its default value counts as given."""
-    parsers, todo = [], [parser]
-    while todo:
-        p = todo.pop()
-        parsers.append(p)
-        for a in p._actions:
-            if isinstance(a, argparse._SubParsersAction):
-                todo.extend(a.choices.values())
-    saved = [(p, dict(p._defaults), [(a, a.default) for a in p._actions]) for p in parsers]
-    try:
-        for p in parsers:
-            p._defaults.clear()
-            for a in p._actions:
-                if not isinstance(a, argparse._SubParsersAction):
-                    a.default = argparse.SUPPRESS
-        return set(vars(parser.parse_args(argv)))
-    finally:
-        for p, defaults, actions in saved:
-            p._defaults.update(defaults)
-            for a, default in actions:
-                a.default = default
-
-
 def declare_flag_uses(p, uses) -> None:
     """Declare a subcommand's conditional flags (those among its options) for
     :func:`refuse_unused`; its option defaults are kept too (a flag differing from its default
@@ -181,7 +154,7 @@ def declare_flag_uses(p, uses) -> None:
 
 def refuse_unused(args) -> None:
     """:class:`InputError` naming the first flag given that this request does not use (module
-    comment above): ``args.given`` (:func:`given_dests`), else the flags whose value differs
+    comment above): ``args.given`` (the flags typed, noted as argv was parsed: ``cli._noting``), else the flags whose value differs
     from the default."""
     given = getattr(args, "given", None)
     if given is None:

@@ -129,7 +129,8 @@ def request(args):
     out = BetaRequest(args.family, args.k, args.N1, args.N2, tuple(args.cases), (args.multiplier_mesh,),
                       ((args.c1, args.c2),), norms(args), args.h_route, args.model_obj,
                       replace(args.mesh, **perturbed))
-    check_perturbation(args.alpha, args.seed)
+    if args.family != "perturbed":  # the perturbed family's: checked by the request itself
+        check_perturbation(args.alpha, args.seed)
     return out
 
 

@@ -117,7 +117,7 @@ class _Part:
         on_gamma = np.isin(idx, gamma)
         self.idx = np.concatenate([idx[~on_gamma], idx[on_gamma]])   # Γ last
         self.ng = int(on_gamma.sum())
-        fac = gamma_factorization(A[self.idx][:, self.idx], self.ng, route)
+        fac = gamma_factorization(A[self.idx][:, self.idx], self.ng, route, gamma_dim=None)  # a QP: no Γ told
         self.solve, self.route = fac.solve, fac.route
         self.B = B[:, self.idx[len(self.idx) - self.ng:]].toarray()   # B on Γ of this block
         self.K = self.B @ fac.steklov_times(self.B.T)

@@ -107,6 +107,9 @@ SOLVES_MAX_WORK = 2.0e5
 
 GAMMA_ROUTES = ("auto", "solves", "nested", "pardiso")
 
+GAMMA_DIMS = (1, 2, None)
+"""What a caller says of Γ's dimension: a curve, a face, or not told (a foreign system's unknowns)."""
+
 
 class _LazyPardisoSolve:
     """b ↦ A⁻¹ b with a PARDISO factorization made on the first call: the ``"pardiso"``
@@ -145,9 +148,14 @@ class GammaFactorization(SteklovProduct):
 
 
 
-def gamma_factorization(A, n_gamma: int, route: str = "auto", gamma_dim: int = 1,
+def gamma_factorization(A, n_gamma: int, route: str = "auto", *, gamma_dim: int | None,
                         keep_factor: bool = False) -> GammaFactorization:
     """Factorize the SPD matrix A once and get its Γ Schur complement (Γ = last n_gamma).
+
+    ``gamma_dim``: the dimension of the Γ the last n_gamma unknowns live on, from the caller's Γ
+    (``trace.gamma.dim`` of a side; 1 a curve, 2 a face), or None where the caller is not told
+    one (a foreign system's or a general QP's unknowns that B touches): no default, so that no
+    caller's Γ is taken for the segment. It only steers ``"auto"``.
 
     ``route``:
 
@@ -165,18 +173,20 @@ def gamma_factorization(A, n_gamma: int, route: str = "auto", gamma_dim: int = 1
         once more, on first use.
     ``"auto"``
         ``"solves"`` while n · n_Γ ≤ :data:`SOLVES_MAX_WORK`; above it ``"pardiso"`` on a face
-        (``gamma_dim`` = 2) where MKL loads, else ``"nested"``. Measured on the structured
+        (``gamma_dim`` = 2) where MKL loads, else (a curve, or Γ not told) ``"nested"``. Measured on the structured
         meshes, one body, k = 2: on a face with n_Γ = 529 (N = 12) PARDISO is about 3× faster
         than nested and 10× faster than solves; on the segment both factorizations take the
         same time at N = 128, so the segment keeps SuperLU and its results bit for bit.
     """
     if route not in GAMMA_ROUTES:
         raise InputError("route", ", ".join(GAMMA_ROUTES), got=route)
+    if gamma_dim not in GAMMA_DIMS:
+        raise InputError("gamma_dim", "1, 2 or None (Γ not told)", got=gamma_dim)
     A = sp.csc_matrix(A)
     n = A.shape[0]
     if route == "auto":
         route = ("solves" if n * n_gamma <= SOLVES_MAX_WORK else
-                 "pardiso" if gamma_dim >= 2 and pardiso.available() else "nested")
+                 "pardiso" if gamma_dim == 2 and pardiso.available() else "nested")
     if route == "pardiso" and keep_factor:
         factor = pardiso.SchurFactor(A, n_gamma)
         return GammaFactorization(factor.solve, factor.schur, None, route)

@@ -213,14 +213,16 @@ class Model:
     interface: Callable | None = None
     curving: tuple = ()
 
-    def subdomain_mesh(self, family: str, n: int, side: int, **mesh_kwargs):
+    def subdomain_mesh(self, family: str, n: int, side: int, *, checked: bool = False, **mesh_kwargs):
         """The mesh of Ω_side the model's sides are built on (its ``mesh`` builder, else the 2D one),
-        on the request's Γ (``gamma``, an Interface resolved by :meth:`gamma`; None: the flat one)."""
+        on the request's Γ (``gamma``, an Interface resolved by :meth:`gamma`; None: the flat one).
+        ``checked``: the arguments are a validated request's, not checked again by the 2D builder
+        (a model's own builder keeps its checks)."""
         if self.mesh is None:
             from ..discretization.segment import meshes
 
             gamma = mesh_kwargs.pop("gamma", None)
-            mesh = meshes.subdomain_mesh(family, n, side, **mesh_kwargs)
+            mesh = meshes.subdomain_mesh(family, n, side, checked=checked, **mesh_kwargs)
             flat = gamma is None or gamma == self.gamma(family)
             return mesh if flat else Body(mesh, gamma)  # the square's mesh, curved with the side
         return self.mesh(family, n, side, **mesh_kwargs)
@@ -344,9 +346,10 @@ def factorized_side(trace: GammaTrace, free: np.ndarray, K, route: str = "auto",
     if bases is not None:
         parts = body_parity.parity_parts(K, n_gamma, bases)
         S, solve, X = parts.factorize(
-            lambda Kc, ng: schur.gamma_factorization(Kc, ng, route, trace.gamma.dim, keep_factor), parts_map)
+            lambda Kc, ng: schur.gamma_factorization(Kc, ng, route, gamma_dim=trace.gamma.dim,
+                                                     keep_factor=keep_factor), parts_map)
         return SideOperator(trace, free, K, S, solve, X, signature, f"parity {len(parts.parts)}")
-    fac = schur.gamma_factorization(K, n_gamma, route, trace.gamma.dim, keep_factor)
+    fac = schur.gamma_factorization(K, n_gamma, route, gamma_dim=trace.gamma.dim, keep_factor=keep_factor)
     return SideOperator(trace, free, K, fac.schur, fac.solve, fac.steklov, signature, fac.route)
 
 

@@ -57,7 +57,7 @@ def beta_table(request: BetaRequest, side_cache: SideCache | None = None, modes:
     cache = SideCache() if side_cache is None else side_cache
     progress.note("the two sides")
     with progress.phase("sides: mesh, assembly, factorization"):
-        sides = cache.pair(r.model, r.family, r.k, r.n1, r.n2, r.mesh)             # Ω1, Ω2 with Γ last
+        sides = cache.pair(r.model, r.family, r.k, r.n1, r.n2, r.mesh, checked=True)  # Ω1, Ω2 with Γ last
     t_sides = time.perf_counter() - t0
     gamma = sides[0].trace.gamma
     p1, p2 = (s.trace.partition for s in sides)
@@ -91,9 +91,8 @@ def _case_rows(r: BetaRequest, case, g_h, sides, dim_w: int, trace_norms, modes:
     where an earlier pair built them), its route, then per (c1, c2) the interface operator S and the
     bottom of S m = β² G m for every norm (and its worst mode, appended to ``modes`` where given).
     A Petrov–Galerkin pair (trial ≠ test space) is :mod:`.petrov_galerkin`'s."""
-    spec = registry.SPACES.get(case) if isinstance(case, str) else case
-    if isinstance(spec, SpaceSpec) and spec.petrov_galerkin:                     # trial M ≠ test N
-        return [_row(r, case, **fields) for fields in petrov_galerkin.pair_rows(r, spec, g_h, sides, dim_w, modes,
+    if isinstance(case, SpaceSpec) and case.petrov_galerkin:                     # trial M ≠ test N
+        return [_row(r, case, **fields) for fields in petrov_galerkin.pair_rows(r, case, g_h, sides, dim_w, modes,
                                                                                           grams)]
     gamma = sides[0].trace.gamma
     space = _space(case, r.k, g_h, gamma)                                          # M_h on G_h
@@ -159,12 +158,13 @@ def _row(r, case, c1, c2, norm, spec, kernel, structural, beta_v1_zero, dim_m, d
 
 
 def _space(case, k, partition, gamma):
-    """A named case on G_h = ``partition`` of ``gamma`` (checked on Γ by the request, once), an unregistered
-    :class:`~infsup_contact.discretization.spaces.spec.SpaceSpec` (a study's variant, e.g. the α
-    sweep of study/face/alpha.py), or a general triple ``(label, s, continuous, vanish)``
+    """A request's case on G_h = ``partition`` of ``gamma``: a registry entry (its id resolved and
+    checked on Γ by the request, once; built with the registry's refusals of an empty space), an
+    unregistered :class:`~infsup_contact.discretization.spaces.spec.SpaceSpec` (a study's variant,
+    e.g. the α sweep of study/face/alpha.py), or a general triple ``(label, s, continuous, vanish)``
     (eqs. 5.3, 5.5; spaces of the segment)."""
-    if isinstance(case, str):
-        return registry.space_on(registry.SPACES[case], k, partition, gamma)
+    if isinstance(case, SpaceSpec) and registry.SPACES.get(case.id) is case:
+        return registry.space_on(case, k, partition, gamma)
     if isinstance(case, SpaceSpec):
         return gamma.space(case, k, partition)
     _, s, continuous, vanish = case

@@ -79,19 +79,17 @@ KERNEL_NORM = "L2"
 
 
 def check_pair_size(cases, k: int, n1: int, n2: int, multiplier_mesh: str) -> None:
-    """:class:`InputError` (naming the N that sets G_h) for a registered Petrov–Galerkin pair among
-    ``cases`` whose dim M on the multiplier mesh exceeds :data:`~infsup_contact.la.bottom.DENSE_MAX_M`
-    (solved by a dense SVD only)."""
-    n = registry.multiplier_intervals(n1, n2, multiplier_mesh)
-    for case in cases:
-        spec = registry.SPACES.get(case) if isinstance(case, str) else None
-        if spec is None or not spec.petrov_galerkin or spec.dimension is None:
-            continue
+    """:class:`InputError` (naming the N that sets G_h) for a Petrov–Galerkin pair among ``cases``
+    (registry entries, checked on the request's Γ) whose dim M on the multiplier mesh exceeds
+    :data:`~infsup_contact.la.bottom.DENSE_MAX_M` (solved by a dense SVD only)."""
+    pairs = [spec for spec in cases if spec.petrov_galerkin and spec.dimension is not None]
+    n = registry.multiplier_intervals(n1, n2, multiplier_mesh) if pairs else None  # G_h's cells: for a pair only
+    for spec in pairs:
         dim = spec.dimension(k, n)
         if dim > DENSE_MAX_M:
             key = {"omega2": "N2", "omega1": "N1"}.get(multiplier_mesh, "N1, N2")
             raise InputError(key, f"a multiplier mesh with dim M <= {DENSE_MAX_M} for the Petrov–Galerkin pair "
-                             f"{case} (a dense SVD; dim M = {dim} on {n} x {n} cells of G_h = {multiplier_mesh})",
+                             f"{spec.id} (a dense SVD; dim M = {dim} on {n} x {n} cells of G_h = {multiplier_mesh})",
                              got=n2 if key == "N2" else n1 if key == "N1" else f"{n1}, {n2}")
 
 
@@ -99,15 +97,16 @@ def pair_rows(r, spec, g_h, sides, dim_w: int, modes: list | None = None, grams=
     """The keyword arguments of ``infsup._row`` for every (c1, c2) and norm of request ``r``, for the
     pair ``spec`` on G_h = ``g_h`` (module docstring); ``modes`` receives each row's worst mode, ``grams``
     (the sweep's :class:`~.side_cache.GramCache`, if any) the trial and test spaces' Gram matrices under their
-    own ids."""
+    own registry entries."""
     gamma = sides[0].trace.gamma
     trial, test = pair_spaces(spec, r.k, g_h, gamma)
     tc = time.perf_counter()
     terms = pair_terms(trial, test, sides, r.k)
     t_coupling = time.perf_counter() - tc
+    entries = [registry.SPACES[role] for role in (spec.trial_space, spec.test_space)]  # the Grams' keys
     both = {norm: [gamma.gram(space, norm, h_route=r.h_route) if grams is None
-                   else grams.gram(gamma, case, r.k, g_h, space, norm, r.h_route)
-                   for case, space in zip((spec.trial_space, spec.test_space), (trial, test))]
+                   else grams.gram(gamma, entry, r.k, g_h, space, norm, r.h_route)
+                   for entry, space in zip(entries, (trial, test))]
             for norm in dict.fromkeys(r.norms + (KERNEL_NORM,))}                 # {norm: [G_M, G_N]}
     factors = {norm: [gram_factor(G) for G, _ in pair] for norm, pair in both.items()}
     structural = max(gamma.proven_kernel(space, r.k, [side.trace for side in sides], dim_w) for space in (trial, test))
@@ -136,10 +135,11 @@ def pair_rows(r, spec, g_h, sides, dim_w: int, modes: list | None = None, grams=
 
 
 def pair_spaces(spec, k: int, g_h, gamma) -> tuple:
-    """(M, N): the trial and test spaces of ``spec`` on G_h, after the pair's own checks (a refusal
-    names the pair's id: the segment, other bodies' faces, k); :class:`InputError` if dim M ≠ dim N."""
-    if registry.SPACES.get(spec.id) is spec:
-        registry.case_space(spec.id, k, g_h, gamma, pair=True)
+    """(M, N): the trial and test spaces of ``spec`` on G_h, the pair checked on Γ by the request
+    (a refusal names the pair's id: the segment, other bodies' faces, k), each space on its own;
+    :class:`InputError` if dim M ≠ dim N."""
+    if registry.SPACES.get(spec.id) is spec:  # checked on Γ by the request: built with the pair's refusals
+        registry.space_on(spec, k, g_h, gamma, pair=True)
     trial, test = (registry.case_space(case, k, g_h, gamma) for case in (spec.trial_space, spec.test_space))
     if trial.dim != test.dim:
         raise InputError("case", f"a Petrov–Galerkin pair with dim M = dim N ({spec.id}: dim {spec.trial_space} "

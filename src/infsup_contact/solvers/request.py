@@ -81,7 +81,9 @@ class BetaRequest:
     space defined for k. A case is a registry id, an unregistered
     :class:`~infsup_contact.discretization.spaces.registry.SpaceSpec` or a general triple
     ``(label, s, continuous, vanish)`` (those two are the caller's, not checked here). The
-    registered ids are checked once, on the request's Γ (:attr:`gamma`, resolved without a mesh).
+    registered ids are resolved once, here, to their entries checked on the request's Γ
+    (:attr:`gamma`, resolved without a mesh): the built request's ``cases`` hold those
+    :class:`SpaceSpec` s (their ``id`` the rows' name), and the engine never looks an id up again.
     """
 
     family: str
@@ -99,16 +101,17 @@ class BetaRequest:
     def __post_init__(self):
         check_k(self.k)
         cases = registry.common_ids(self.k) if self.cases is None else list(self.cases)
-        object.__setattr__(self, "cases", tuple(cases))
-        ids = [c for c in cases if isinstance(c, str)]
         if not isinstance(self.mesh, MeshOptions):  # a caller's slip, not input: say what it should be
             raise TypeError(f"BetaRequest.mesh must be a MeshOptions, not {type(self.mesh).__name__}")
         declared = dict(getattr(self.model, "mesh_options", ()))
         for name, value in self.mesh.kwargs().items():
             if name in declared and name != "gamma":  # the builder's options (seed, α: the family's); Γ resolved
                 check_mesh_option(self.model, name, value)
-        for c in ids:
-            registry.check_on_gamma(c, self.k, self.gamma)
+        ids = {i: c for i, c in enumerate(cases) if isinstance(c, str)}
+        gamma = self.gamma if ids else None
+        entries = {i: registry.check_on_gamma(c, self.k, gamma) for i, c in ids.items()}
+        object.__setattr__(self, "cases", tuple(entries.get(i, c) for i, c in enumerate(cases)))  # resolved once
+        entries = list(entries.values())  # the registered ones, checked here (the caller's own are not)
         meshes.check_mesh_args(self.family, self.n1, "N1")
         meshes.check_mesh_args(self.family, self.n2, "N2")
         for c1, c2 in self.c_pairs:
@@ -118,9 +121,11 @@ class BetaRequest:
             check_norm(nm)
         for mm in self.multiplier_meshes:
             check_choice(mm)
-            registry.check_pair_spaces(ids, self.k, self.n1, self.n2, (mm,))  # dim M_h = 0: refused here
-            check_pair_size(ids, self.k, self.n1, self.n2, mm)  # a Petrov–Galerkin pair is solved densely
-
+            registry.check_pair_spaces(entries, self.k, self.n1, self.n2, (mm,))  # dim M_h = 0: refused here
+            check_pair_size(entries, self.k, self.n1, self.n2, mm)  # a Petrov–Galerkin pair is solved densely
+        if self.family == "perturbed":  # the mesh builder trusts the request (SideCache.pair, checked)
+            meshes.check_perturbation(meshes.ALPHA_MAX if self.mesh.alpha is None else self.mesh.alpha,
+                                      0 if self.mesh.seed is None else self.mesh.seed)
 
     @property
     def gamma(self):

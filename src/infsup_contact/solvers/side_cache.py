@@ -66,35 +66,39 @@ class SideCache:
         for n1, n2 in pairs:
             self._uses_left.update(side_keys(model, family, k, n1, n2, mesh))
 
-    def pair(self, model, family: str, k: int, n1: int, n2: int, mesh: MeshOptions = NO_OPTIONS) -> list:
+    def pair(self, model, family: str, k: int, n1: int, n2: int, mesh: MeshOptions = NO_OPTIONS,
+             checked: bool = False) -> list:
         """[side operator of Ω1 (N1 segments on Γ), side operator of Ω2 (N2)]. The arguments are
-        a validated request's (:class:`~.request.BetaRequest`) or checked by the mesh builder."""
+        a validated request's (:class:`~.request.BetaRequest`; ``checked``: the mesh builder does
+        not check them again) or checked by the mesh builder."""
         key1, key2 = side_keys(model, family, k, n1, n2, mesh)
         # one side after the other: building two sides side by side in threads aborted the process
         # (NGSolve's meshing and assembly are not thread-safe); the parallel work is inside a side
         # (a body's parity parts, PARDISO's threads)
-        side1 = self._get(key1)
+        side1 = self._get(key1, checked=checked)
         mirror = n1 == n2 and getattr(model, "mirror_side", None) is not None
-        sides = [side1, self._get(key2, mirror_of=side1 if mirror else None)]
+        sides = [side1, self._get(key2, mirror_of=side1 if mirror else None, checked=checked)]
         return sides[0].trace.gamma.paired(sides)  # a Γ coupled by projection ties the two
 
-    def _get(self, key, mirror_of=None):
+    def _get(self, key, mirror_of=None, checked: bool = False):
         """The operator of ``key``, cached or built; ``mirror_of``: side 1 of a matching pair, which
-        a model with ``mirror_side`` turns into side 2 where a mirror maps the bodies (checked)."""
+        a model with ``mirror_side`` turns into side 2 where a mirror maps the bodies (checked);
+        ``checked``: the request checked the mesh arguments (:meth:`pair`)."""
         model, family, k, n, side, mesh = key
+        kwargs = dict(mesh.kwargs(), checked=True) if checked else mesh.kwargs()
         mirror = getattr(model, "mirror_side", None) if mirror_of is not None else None
         if mirror is not None:
             # always the mirror on a matching pair, never kept for another pair: each pair's rows
             # stay a function of the pair (a cached side is the one a fresh build gives, bitwise)
             progress.note(f"side {side} of 2 (N{side}={n}): mesh, stiffness, side 1 mirrored")
-            op = mirror(mirror_of, model.subdomain_mesh(family, n, side, **mesh.kwargs()), k)
+            op = mirror(mirror_of, model.subdomain_mesh(family, n, side, **kwargs), k)
             self._use(key)
             return op
         op = self._ops.pop(key, None)
         if op is None:
             progress.note(f"side {side} of 2 (N{side}={n}): mesh, stiffness, factorization")
             # the model contract takes the options as keywords: unpacked here, and only here
-            op = model.side_operator(model.subdomain_mesh(family, n, side, **mesh.kwargs()), k)
+            op = model.side_operator(model.subdomain_mesh(family, n, side, **kwargs), k)
         if self._uses_left[key] > 1:  # more uses announced: keep it for them
             self._uses_left[key] -= 1
             self._ops[key] = op
@@ -131,7 +135,7 @@ class GramCache:
     def gram(self, gamma, case, k: int, partition, space, norm: str, h_route: str) -> tuple:
         """``gamma.gram(space, norm, h_route=h_route)``, from the cache when an equal
         (Γ, case, k, G_h, norm, route) was asked before. ``case`` must identify the space's
-        definition (a registry id, a spec, a triple). Not cached: an unhashable Γ or case, a Gram
+        definition (its registry entry or an unregistered spec, a triple). Not cached: an unhashable Γ or case, a Gram
         that is not a dense array or above a quarter of :attr:`max_bytes`. A Gram summed in
         parity blocks comes as its :class:`~infsup_contact.la.face_parity.ParityGram`, assembled
         where a consumer reads it densely (:func:`~infsup_contact.la.face_parity.deferred_assembly`)."""

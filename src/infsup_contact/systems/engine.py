@@ -287,7 +287,7 @@ def _dense(A, B, G, touched, route, n_pairs):
     if route == "gamma-dense":
         rest = np.setdiff1d(np.arange(A.shape[0]), touched)
         order = np.concatenate([rest, touched])
-        fac = gamma_factorization(A[order][:, order], len(touched))
+        fac = gamma_factorization(A[order][:, order], len(touched), gamma_dim=None)  # Γ not told: SuperLU, as before
         Bg = B[:, touched].toarray()
         t1 = time.perf_counter()
         S = Bg @ fac.steklov_times(Bg.T)

@@ -205,7 +205,7 @@ def _dense_schur(A, B, touched, route) -> np.ndarray:
     if route == "gamma-dense":
         rest = np.setdiff1d(np.arange(A.shape[0]), touched)
         order = np.concatenate([rest, touched])
-        fac = gamma_factorization(A[order][:, order], len(touched))
+        fac = gamma_factorization(A[order][:, order], len(touched), gamma_dim=None)  # as .engine._dense
         Bg = B[:, touched].toarray()
         S = Bg @ fac.steklov_times(Bg.T)
     else:

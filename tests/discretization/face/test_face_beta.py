@@ -190,7 +190,7 @@ def test_auto_route_takes_pardiso_on_a_face_and_superlu_on_the_segment():
     for side, expected in ((face, "pardiso"), (segment, "nested")):
         n_gamma = len(side.trace.gamma_dofs)
         assert side.ndof * n_gamma > SOLVES_MAX_WORK
-        fac = gamma_factorization(side.stiffness, n_gamma, "auto", side.trace.gamma.dim)
+        fac = gamma_factorization(side.stiffness, n_gamma, "auto", gamma_dim=side.trace.gamma.dim)
         assert fac.route == expected
 
 

@@ -210,17 +210,22 @@ def unstructured_mesh(n: int, side: int) -> ngsolve.Mesh:
     return ngsolve.Mesh(ngmesh)
 
 
-def subdomain_mesh(family: str, n: int, side: int, *, alpha: float = 0.2, seed: int = 0) -> ngsolve.Mesh:
+def subdomain_mesh(family: str, n: int, side: int, *, alpha: float = 0.2, seed: int = 0,
+                   checked: bool = False) -> ngsolve.Mesh:
     """The mesh of Ω_side (side = 1 or 2) of a family with N segments on Γ, checked
-    (:func:`check_mesh`: positive orientation, element areas summing to |Ω_side| = 1)."""
-    check_mesh_args(family, n)
+    (:func:`check_mesh`: positive orientation, element areas summing to |Ω_side| = 1).
+    ``checked``: the family, N, seed and α were checked by a request (a validated
+    :class:`~infsup_contact.solvers.request.BetaRequest`) and are not checked again."""
+    if not checked:
+        check_mesh_args(family, n)
     about = f"family {family}, N = {n}, side {side}"
     if family == "unstructured":
         mesh = unstructured_mesh(n, side)
     else:
         points, triangles = structured_arrays(n, side)
         if family == "perturbed":
-            check_perturbation(alpha, seed)
+            if not checked:
+                check_perturbation(alpha, seed)
             points = perturb(points, n, side, alpha, seed)
             about += f", seed {seed}, alpha {alpha:g}"
         mesh = mesh_from_arrays(points, triangles, boundary_segments(points, side))

@@ -168,13 +168,13 @@ def case_name(case) -> str:
 
 
 def space_dim(case, k: int, n: int) -> int:
-    """dim M_h of ``case`` (an id or a triple ``(label, s, continuous, vanish)``, eqs. (5.3)/(5.5))
-    for degree k on N uniform intervals, built (1D, cheap): the build, not the ``dimension``
-    count, is what a run uses, and a user's build is guarded (user_spaces.guarded_build)."""
-    if not isinstance(case, str):
+    """dim M_h of ``case`` (an id, its entry, or a triple ``(label, s, continuous, vanish)``,
+    eqs. (5.3)/(5.5)) for degree k on N uniform intervals, built (1D, cheap): the build, not the
+    ``dimension`` count, is what a run uses, and a user's build is guarded (user_spaces.guarded_build)."""
+    if not isinstance(case, (str, SpaceSpec)):
         _, s, continuous, vanish = case
         return make_space(np.linspace(0.0, 1.0, n + 1), s, continuous, vanish).dim
-    spec = space_spec(case)
+    spec = case if isinstance(case, SpaceSpec) else space_spec(case)
     try:
         hash(spec)
     except TypeError:  # a user's entry with a list in a field: built every time

@@ -208,14 +208,13 @@ def test_the_components_kernel_takes_a_sparse_coupling(monkeypatch):
 
     from infsup_contact.discretization.gamma.coupling import coupling_matrix, trace_l2_norms
     from infsup_contact.solvers.kernel import scaled_couplings
-    from infsup_contact.solvers.infsup import _space
     from infsup_contact.solvers.side_cache import SideCache
 
     k, n = 2, 6
     sides = SideCache().pair(MODELS["membranes3d"], "structured", k, n, n, MeshOptions())
     gamma = sides[0].trace.gamma
     g_h = gamma.multiplier_partition(*(s.trace.partition for s in sides), "omega2")
-    space = _space("R5.4", k, g_h, gamma)
+    space = registry.case_space("R5.4", k, g_h, gamma)
     cols = np.sqrt(np.diag(gamma.gram(space, "L2")[0]))
     W = scaled_couplings([coupling_matrix(s.trace, space, k, sparse=True) for s in sides],
                          [trace_l2_norms(s.trace, k) for s in sides], cols)

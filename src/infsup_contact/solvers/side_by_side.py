@@ -21,14 +21,15 @@ m about dim(W1 + W2)), and two spaces run at once only where both working sets f
 N = 36, 2 × 1.6 GB, two at a time; N = 48, 2 × 5.2 GB against about 14 GB free after the sides,
 one at a time: the peak stays the serial one). Where the request's progress is timed by phase
 (:func:`~infsup_contact.progress.timing`, the benchmark's breakdown), the concurrent spaces'
-phases count as one, :data:`PHASE`.
+phases count as one, :data:`PHASE`. Where the command line keeps freed memory within a stage
+only, each space's end is a stage's end (:func:`~infsup_contact.la.threaded.release_freed_memory`).
 """
 from __future__ import annotations
 
 import os
 
 from .. import progress
-from ..la.threaded import run_concurrently, threads
+from ..la.threaded import release_freed_memory, run_concurrently, threads
 
 DENSE_COPIES = 8.0
 """Dense m × m float64 matrices one space holds at its peak (measured at k = 2 on the face,
@@ -73,11 +74,18 @@ def rows_by_case(cases, rows_of, dim: int, label=str) -> list:
     each on one BLAS thread; else one after the other. ``dim``: about the spaces' dimension
     (their working set, :func:`working_set`); ``label``: a case's name in the progress."""
     cases = list(cases)
+    release_freed_memory()  # the sides' factorizations are done: what they freed goes back
+
+    def released(case):
+        out = rows_of(case)
+        release_freed_memory()
+        return out
+
     workers = space_workers(dim, len(cases) - 1)
     if workers < 2:
-        return [rows_of(case) for case in progress.steps(cases, "space", label)]
-    first = [rows_of(case) for case in progress.steps(cases[:1], "space", label)]
+        return [released(case) for case in progress.steps(cases, "space", label)]
+    first = [released(case) for case in progress.steps(cases[:1], "space", label)]
     progress.note(f"{len(cases) - 1} spaces, {workers} at a time")
     with progress.phase(PHASE):
-        rest = run_concurrently([lambda case=case: rows_of(case) for case in cases[1:]], workers=workers)
+        rest = run_concurrently([lambda case=case: released(case) for case in cases[1:]], workers=workers)
     return first + rest

@@ -239,8 +239,10 @@ def reporting(title: str, quiet: bool = False, stream=None, bar: bool | None = N
 
 # ------------------------------------------------------------------ where the time goes
 PHASES = ("sides: mesh, assembly, factorization", "couplings", "H Grams", "L2 Grams",
-          "kernel decision, Grams split and factorized", "interface terms", "β with v1 = 0", "eigensolves")
-"""The phases of a β_h request (:func:`phase`), in the order they run; the rest is ``other``."""
+          "kernel decision, Grams split and factorized", "interface terms", "β with v1 = 0", "eigensolves",
+          "spaces side by side")
+"""The phases of a β_h request (:func:`phase`), in the order they run; the rest is ``other``. The
+spaces that run two at a time (:mod:`infsup_contact.solvers.side_by_side`) count as the last one."""
 OTHER = "other"
 
 _phases = None  # {phase: [wall s, CPU s, peak growth B]} while :func:`timing` records, else None

@@ -136,15 +136,30 @@ def test_pardiso_schur_complements_side_by_side_are_the_serial_ones(monkeypatch)
     assert all(np.array_equal(a, b) for a, b in zip(together, serial))
 
 
-@pytest.mark.parametrize("estimate_gb, available_gb, reused", [(1, 8, True), (4, 8, True), (5, 8, False),
-                                                               (23, 16, False)])
-def test_freed_memory_is_kept_only_where_memory_is_plentiful(monkeypatch, estimate_gb, available_gb, reused):
-    """The command line keeps freed memory for reuse (a higher peak) only when the estimated
-    peak is at most half the available memory."""
+@pytest.mark.parametrize("estimate_gb, available_gb, bounded", [(1, 8, False), (4, 8, False), (5, 8, True),
+                                                                (23, 16, True)])
+def test_freed_memory_is_kept_for_the_whole_request_only_where_memory_is_plentiful(monkeypatch, estimate_gb,
+                                                                                   available_gb, bounded):
+    """The command line keeps freed memory for reuse (a higher peak) for the whole request when the
+    estimated peak is at most half the available memory, else within a stage only (bounded)."""
     from infsup_contact import cli, resources
 
     calls = []
-    monkeypatch.setattr(threaded, "reuse_freed_memory", lambda: calls.append(1) or True)
+    monkeypatch.setattr(threaded, "reuse_freed_memory", lambda bounded=False: calls.append(bounded) or True)
     monkeypatch.setattr(resources, "available_bytes", lambda *a: available_gb * 1e9)
     cli._reuse_freed_memory(resources.Estimate(estimate_gb * 1e9, 1.0))
-    assert bool(calls) is reused
+    assert calls == [bounded]
+
+
+def test_bounded_reuse_gives_freed_memory_back_at_a_stages_end(monkeypatch):
+    for var in [v for v in threaded.os.environ if v.startswith("MALLOC_")]:
+        monkeypatch.delenv(var)
+    monkeypatch.setattr(threaded, "_BOUNDED_REUSE", [False])
+    released = []
+    libc = type("Libc", (), {"malloc_trim": staticmethod(released.append), "mallopt": staticmethod(lambda p, v: 1)})
+    monkeypatch.setattr("ctypes.CDLL", lambda name: libc())      # glibc's calls recorded, not made
+    threaded.release_freed_memory()
+    assert released == []                                         # glibc's default or unbounded reuse: nothing
+    assert threaded.reuse_freed_memory(bounded=True) is True
+    threaded.release_freed_memory()
+    assert released == [0]

@@ -29,7 +29,7 @@ from .. import progress
 from .interface_operator import combine_terms, interface_terms
 from .kernel import kernel_check
 from .modes import worst_modes
-from . import petrov_galerkin
+from . import petrov_galerkin, side_by_side
 from .request import NO_OPTIONS, BetaRequest, MeshOptions
 from .routes import choose_route, is_large
 from .side_cache import GramCache, SideCache
@@ -75,14 +75,24 @@ def beta_table(request: BetaRequest, side_cache: SideCache | None = None, modes:
                 if modes is not None:
                     modes += [replace(m, keys={**m.keys, "multiplier_mesh": multiplier_mesh}) for m in by_partition[key][1]]
                 continue
-            found = None if modes is None else []
-            by_partition[key] = ([row for case in progress.steps(r.cases, "space", registry.case_name)
-                                  for row in _case_rows(r, case, g_h, sides, dim_w, trace_norms, found,
-                                                        cache.grams)], found)
+            per_case = side_by_side.rows_by_case(  # two spaces at a time where the cores and memory allow
+                r.cases, lambda case: _case_rows_and_modes(r, case, g_h, sides, dim_w, trace_norms,
+                                                           modes is not None, cache.grams),
+                dim_w, registry.case_name)
+            found = None if modes is None else [m for _, case_modes in per_case for m in case_modes]
+            by_partition[key] = ([row for case_rows, _ in per_case for row in case_rows], found)
             if modes is not None:
                 modes += [replace(m, keys={**m.keys, "multiplier_mesh": multiplier_mesh}) for m in found]
             rows += [dict(row, multiplier_mesh=multiplier_mesh, t_interface=t_sides) for row in by_partition[key][0]]
     return rows
+
+
+def _case_rows_and_modes(r: BetaRequest, case, g_h, sides, dim_w: int, trace_norms, vectors: bool,
+                         grams: GramCache) -> tuple:
+    """(:func:`_case_rows` of one case, its worst modes: a list of its own, empty without
+    ``vectors``), so that cases run side by side (:mod:`.side_by_side`) never append to one list."""
+    found = [] if vectors else None
+    return _case_rows(r, case, g_h, sides, dim_w, trace_norms, found, grams), found or []
 
 
 def _case_rows(r: BetaRequest, case, g_h, sides, dim_w: int, trace_norms, modes: list | None = None,

@@ -27,10 +27,14 @@ Richardson-extrapolated double sine series, most of a row's cost, so it is built
 :class:`GramCache` keeps each Gram (and its ``info``) read-only, so that no consumer can change
 what the next pair will be given; the computation is deterministic, so a cached Gram is
 bit for bit the one a fresh call would give (tested). It holds at most :data:`MAX_BYTES` of
-matrices and forgets the oldest first.
+matrices and forgets the oldest first. Spaces run side by side (:mod:`.side_by_side`) ask it
+from two threads: one Gram is computed at a time (a lock), so an equal key is computed once and
+the series the spaces of one G_h share (``gamma.gram_session``, a module's state) is never
+written by two threads at once.
 """
 from __future__ import annotations
 
+import threading
 from collections import Counter, OrderedDict
 
 import numpy as np
@@ -131,6 +135,7 @@ class GramCache:
         self._bytes = 0
         self.max_bytes = int(max_bytes)
         self.hits = 0
+        self._lock = threading.RLock()  # one Gram at a time: spaces side by side share the series
 
     def gram(self, gamma, case, k: int, partition, space, norm: str, h_route: str) -> tuple:
         """``gamma.gram(space, norm, h_route=h_route)``, from the cache when an equal
@@ -138,7 +143,12 @@ class GramCache:
         definition (its registry entry or an unregistered spec, a triple). Not cached: an unhashable Γ or case, a Gram
         that is not a dense array or above a quarter of :attr:`max_bytes`. A Gram summed in
         parity blocks comes as its :class:`~infsup_contact.la.face_parity.ParityGram`, assembled
-        where a consumer reads it densely (:func:`~infsup_contact.la.face_parity.deferred_assembly`)."""
+        where a consumer reads it densely (:func:`~infsup_contact.la.face_parity.deferred_assembly`).
+        Safe from several threads: one Gram is computed at a time."""
+        with self._lock:
+            return self._gram(gamma, case, k, partition, space, norm, h_route)
+
+    def _gram(self, gamma, case, k: int, partition, space, norm: str, h_route: str) -> tuple:
         try:
             key = (gamma, case, int(k), gamma.partition_key(partition), norm, h_route)
             hash(key)

@@ -5,6 +5,7 @@ it carries its interface (``trace.gamma``, :mod:`.gamma.interface`), which evalu
 """
 from __future__ import annotations
 
+import threading
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -12,6 +13,10 @@ import scipy.sparse as sp
 
 BASIS_CACHE_SIZE = 4
 """Point sets whose trace basis values a trace keeps (:meth:`GammaTrace.cached_basis`)."""
+_BASIS_LOCK = threading.RLock()
+"""Held while a trace's basis values are looked up or computed: multiplier spaces run side by side
+(:mod:`infsup_contact.solvers.side_by_side`) ask for the same point sets, which are computed once,
+and NGSolve's shape functions are evaluated by one thread at a time."""
 
 
 @dataclass(frozen=True)
@@ -58,13 +63,14 @@ class GammaTrace:
         sets): every multiplier space of one degree on one G_h asks for the same quadrature points,
         and NGSolve evaluates one point at a time (:meth:`Interface.trace_basis`)."""
         key = _points_key(x)
-        phi = self.basis_cache.get(key)
-        if phi is None:
-            phi = compute(x)
-            phi.flags.writeable = False
-            if len(self.basis_cache) >= BASIS_CACHE_SIZE:
-                self.forget_basis()
-            self.basis_cache[key] = phi
+        with _BASIS_LOCK:
+            phi = self.basis_cache.get(key)
+            if phi is None:
+                phi = compute(x)
+                phi.flags.writeable = False
+                if len(self.basis_cache) >= BASIS_CACHE_SIZE:
+                    self.forget_basis()
+                self.basis_cache[key] = phi
         return phi
 
     def cached_sparse_basis(self, x: np.ndarray):
@@ -73,20 +79,22 @@ class GammaTrace:
         ``csr_matrix`` of the dense slices (sorted indices, no stored zeros). An interface with a
         ``sparse_trace_basis`` (the face) makes it without the dense values."""
         key = _points_key(x)
-        phi = self.sparse_cache.get(key)
-        if phi is None:
-            phi = self.gamma.sparse_trace_basis(self, x)
+        with _BASIS_LOCK:
+            phi = self.sparse_cache.get(key)
             if phi is None:
-                phi = sp.csr_matrix(self.gamma.trace_basis(self, x))
-            if len(self.sparse_cache) >= BASIS_CACHE_SIZE:
-                self.sparse_cache.clear()
-            self.sparse_cache[key] = phi
+                phi = self.gamma.sparse_trace_basis(self, x)
+                if phi is None:
+                    phi = sp.csr_matrix(self.gamma.trace_basis(self, x))
+                if len(self.sparse_cache) >= BASIS_CACHE_SIZE:
+                    self.sparse_cache.clear()
+                self.sparse_cache[key] = phi
         return phi
 
     def forget_basis(self) -> None:
         """Drop the kept basis values, dense and sparse (a benchmark's fresh state)."""
-        self.basis_cache.clear()
-        self.sparse_cache.clear()
+        with _BASIS_LOCK:
+            self.basis_cache.clear()
+            self.sparse_cache.clear()
 
 
 def _points_key(x: np.ndarray) -> bytes:

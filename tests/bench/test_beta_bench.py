@@ -89,3 +89,29 @@ def test_the_given_cases_are_the_ones_run_where_defined(what, options):
     """``cases`` narrows every model's default list; T4 (discontinuous P_(k-2)) needs k >= 2."""
     setup = BetaSetup(bench_for(what), 2, 1, cases=["T3", "T4"], **options)
     assert setup.cases == ["T3"] and set(setup.spaces) == {"T3"}
+
+
+def test_row_values_give_back_the_rows_bottom():
+    """row_values of a row with a kernel: bottom() reads its kernel values and its first β above
+    (smallest_nonzero); without a kernel, its β."""
+    from infsup_contact.bench.beta_bench import bottom, row_values
+
+    kern, beta = bottom(row_values({"kernel_dim": 3, "beta": 1e-9, "smallest_nonzero": 0.25}), 3)
+    assert len(kern) == 3 and np.all(kern == 1e-9) and beta == 0.25
+    assert bottom(row_values({"kernel_dim": 0, "beta": 0.5, "smallest_nonzero": np.nan}), 0)[1] == 0.5
+
+
+def test_the_face_core_route_is_ours_engine(monkeypatch):
+    """The face's ours_core runs ours' engine (beta_rows) on the given sides, never meshing: its
+    bottoms are those of ours' rows, value for value, on a hex pair."""
+    from infsup_contact.bench import beta_bench
+    from infsup_contact.bench.beta_models import FACE_BENCH
+    from infsup_contact.models import contract
+
+    assert FACE_BENCH.core_route is beta_bench.beta_ours_engine
+    setup = beta_bench.BetaSetup(FACE_BENCH, 2, 2, element="hex")
+    ours = beta_bench.beta_ours(setup)
+    monkeypatch.setattr(contract.Model, "subdomain_mesh", lambda *a, **k: pytest.fail("ours_core meshed"))
+    got = beta_bench.beta_ours_engine(setup)
+    assert set(got) == set(ours) == set(setup.keys())
+    assert all(np.array_equal(got[key], beta_bench.row_values(ours[key]), equal_nan=True) for key in got)

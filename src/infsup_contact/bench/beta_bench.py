@@ -12,7 +12,9 @@ every route answers all of them. What each time includes (also in the ``includes
 ``ours_core``
     Given the assembled stiffness matrices (Γ dofs last) and the multiplier spaces: the Γ-last
     factorization + Schur complement per body, couplings, interface operator, Gram matrix and
-    one dense ``eigh`` per (case, norm) — exactly what β_h = λ_min(B A⁻¹ Bᵀ, G)^{1/2} needs.
+    one dense ``eigh`` per (case, norm) — exactly what β_h = λ_min(B A⁻¹ Bᵀ, G)^{1/2} needs. A
+    model whose ``ours`` solves in blocks times its own engine here instead (``core_route``: the
+    face's :func:`beta_ours_engine`), so that ``ours_core`` is ours without mesh and assembly.
 ``limit``
     The floor of any route, given the assembled stiffness and the (precomputed) interface
     operators and Gram matrices: one sparse factorization of each body's stiffness by the
@@ -86,6 +88,9 @@ class BetaBench:
         ``limit_route(setup, operators) -> (run, gflop)``: the model's own limit (:mod:`.face_limit`)
         in place of ``limit_factor`` + one ``eigh`` per pencil, and its flop count (GFLOP, after a
         run); the rows then carry ``limit_gflop`` and ``gflop_per_s``.
+    core_route : callable or None
+        ``core_route(setup) -> {(case, norm): β² values}``: the model's ``ours_core`` in place of
+        :func:`beta_ours_core` (the face's: :func:`beta_ours_engine`, ours' own route).
     """
 
     what: str
@@ -101,6 +106,7 @@ class BetaBench:
     extra_routes: Callable | None = None
     extra_rows: Callable | None = None
     limit_route: Callable | None = None
+    core_route: Callable | None = None
 
 
 def splu_best_order(K):
@@ -159,14 +165,52 @@ def beta_ours(setup: BetaSetup) -> dict:
     return {(r["case"], r["norm"]): r for r in rows}
 
 
-def beta_ours_core(setup: BetaSetup) -> dict:
-    """{(case, norm): eigenvalues β²}: factorization, couplings, interface, Gram, eigh. The sides
-    are first returned to their state right after the build (a fresh run has no cached basis)."""
+def _factorized_sides(setup: BetaSetup) -> list:
+    """The setup's two bodies factorized from their assembled stiffness, as ours factorizes them
+    (the parity parts, side 2 side 1's mirror where checked), after returning the sides to their
+    state right after the build (a fresh run has no cached basis)."""
     for s in setup.sides:
         s.forget_cached()
-    s1, s2 = setup.sides  # as ours: the bodies' parity parts, side 2 side 1's mirror where checked
+    s1, s2 = setup.sides
     side1 = factorized_side(s1.trace, s1.free, s1.stiffness, signature=getattr(s1, "signature", None))
-    sides = [side1, mirrored_side(side1, s2.trace, s2.free, s2.stiffness, getattr(s2, "signature", None))]
+    return [side1, mirrored_side(side1, s2.trace, s2.free, s2.stiffness, getattr(s2, "signature", None))]
+
+
+class _GivenSides(SideCache):
+    """A side cache that serves one given pair (the engine run from assembled stiffness)."""
+
+    def __init__(self, sides: list):
+        super().__init__()
+        self._given = sides
+
+    def pair(self, *args, **kwargs) -> list:
+        return self._given[0].trace.gamma.paired(list(self._given))
+
+
+def row_values(row: dict) -> np.ndarray:
+    """A β row's bottom as ascending β² values: its kernel values (``beta``, ``kernel_dim`` times)
+    then the first above (``smallest_nonzero``), or ``beta`` alone without a kernel: what
+    :func:`compare` reads of a route, told by the row ours' engine wrote."""
+    if row["kernel_dim"] == 0:
+        return np.array([row["beta"] ** 2])
+    return np.array([row["beta"] ** 2] * row["kernel_dim"] + [row["smallest_nonzero"] ** 2])
+
+
+def beta_ours_engine(setup: BetaSetup) -> dict:
+    """{(case, norm): β² values (:func:`row_values`)}: ours' own route (the engine,
+    :func:`~infsup_contact.solvers.infsup.beta_rows`) from the assembled stiffness: the bodies'
+    factorization, couplings, Grams, the kernel decision, the interface operator, the pencils in
+    their blocks and β with v1 = 0; no mesh, no assembly."""
+    rows = beta_rows(FAMILY, setup.k, setup.n, setup.n, setup.cases, norms=setup.bench.norms,
+                     model=setup.bench.model, mesh=MeshOptions(**setup.mesh_options),
+                     side_cache=_GivenSides(_factorized_sides(setup)))
+    return {(r["case"], r["norm"]): row_values(r) for r in rows}
+
+
+def beta_ours_core(setup: BetaSetup) -> dict:
+    """{(case, norm): eigenvalues β²}: factorization, couplings, interface, Gram, eigh
+    (:func:`_factorized_sides`: as ours factorizes the bodies)."""
+    sides = _factorized_sides(setup)
     out = {}
     with setup.gamma.gram_session():  # as ours: spaces sharing a piece space share its series
         for c in setup.cases:
@@ -226,7 +270,8 @@ def _routes(setup: BetaSetup) -> dict:
         limit, setup.limit_gflop = setup.bench.limit_route(setup, ops)
     else:
         limit = beta_limit(setup, ops)
-    routes = {"ours": lambda: beta_ours(setup), "ours_core": lambda: beta_ours_core(setup), "limit": limit}
+    core = setup.bench.core_route or beta_ours_core
+    routes = {"ours": lambda: beta_ours(setup), "ours_core": lambda: core(setup), "limit": limit}
     return routes | (setup.bench.extra_routes(setup) if setup.bench.extra_routes else {})
 
 

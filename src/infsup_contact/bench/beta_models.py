@@ -23,7 +23,7 @@ from ..la import pardiso
 from ..models.elastic import elastic_model
 from ..models.membranes import MEMBRANES
 from ..models.membranes3d import MEMBRANES3D
-from .beta_bench import BetaBench, splu_best_order
+from .beta_bench import BetaBench, beta_ours_engine, splu_best_order
 from .beta_pencil import INCLUDES as PENCIL_INCLUDES
 from .beta_pencil import pencil_routes
 from .face_schur import INCLUDES as SCHUR_INCLUDES
@@ -83,12 +83,12 @@ FACE_BENCH = BetaBench(
     kernel=lambda case, k, n, row: row["kernel_dim"], limit_factor=pardiso_or_splu,
     includes={"ours": "meshes+assembly+Γ-last LU+Schur per body+couplings+kernel from Bᵀ+interface+Gram+eigh "
                       "(+β with v1=0), every case × norm",
-              "ours_core": "Γ-last LU+Schur per body+couplings+interface+Gram+eigh per (case,norm) "
-                           "(assembled stiffness given)",
+              "ours_core": "ours' engine from the assembled stiffness: Γ-last LU+Schur per body (parity parts)+"
+                           "couplings+Grams+kernel decision+interface+pencils in blocks (+β with v1=0)",
               "limit": "plain Cholesky (PARDISO) of each body's parity parts (one body on a mirrored pair) + "
                        "one eigh per parity block of each (case,norm) (interface operators, Grams given)",
               **SCHUR_INCLUDES},
-    extra_rows=schur_rows, limit_route=face_limit)
+    extra_rows=schur_rows, limit_route=face_limit, core_route=beta_ours_engine)
 """The 3D membranes' face benchmark (``element`` is a mesh option of ``bench_beta``)."""
 
 

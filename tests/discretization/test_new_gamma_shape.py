@@ -18,7 +18,7 @@ import pytest
 from infsup_contact.discretization.spaces import gammas
 from infsup_contact.models import MODELS
 from infsup_contact.solvers.infsup import beta_table
-from infsup_contact.solvers.request import BetaRequest, mesh_of
+from infsup_contact.solvers.request import BetaRequest, resolve_gamma
 
 FILES = {
     # 1. the Interface: the segment at another height (the trace, partitions, spaces and norms are x's)
@@ -87,7 +87,7 @@ def test_a_new_gamma_shape_is_three_files(lifted):
     assert sorted(p.name for p in where.iterdir() if p.suffix == ".py") == sorted(FILES)
     assert "lifted" in gammas.GAMMA_SHAPES and "lifted" not in MODELS
     request = BetaRequest("structured", 2, 5, 4, ("T3", "R5.4"), norms=("H", "L2"), model=model,
-                          mesh=mesh_of(model, gamma="lifted"))
+                          gamma=resolve_gamma(model, gamma="lifted"))
     assert request.gamma.y == 3.0  # resolved from the table, no mesh built
     new = beta_table(request)
     old = beta_table(BetaRequest("structured", 2, 5, 4, ("T3", "R5.4"), norms=("H", "L2")))

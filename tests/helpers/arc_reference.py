@@ -325,18 +325,18 @@ def projection_coupling(slave: Curve, master: Curve, mu, g_h) -> tuple:
 
 # --- β_h from the reference sides -----------------------------------------------------------------
 
-def reference_sides(model, family: str, k: int, n1: int, n2: int, mesh_options, points: int = 14) -> list:
+def reference_sides(model, family: str, k: int, n1: int, n2: int, gamma, points: int = 14) -> list:
     """The library's pair on the arc with each side's S_i replaced by the reference's (its trace,
     couplings and Grams are the library's: the pencil is the same, only the bodies' S_i differ)."""
     from dataclasses import replace
 
     from infsup_contact.solvers.side_cache import SideCache
 
-    sides = SideCache().pair(model, family, k, n1, n2, mesh_options)
+    sides = SideCache().pair(model, family, k, n1, n2, gamma=gamma)
     out = []
     for side, n, which in zip(sides, (n1, n2), (1, 2)):
-        square = model.subdomain_mesh(family, n, which, **mesh_options.kwargs()).mesh
-        body = Body(*library_square(square), mesh_options.gamma.radius, k)
+        square = model.subdomain_mesh(family, n, which, gamma=gamma).mesh
+        body = Body(*library_square(square), gamma.radius, k)
         out.append(replace(side, schur=reference_schur(side, body, points), steklov=None))
     return out
 

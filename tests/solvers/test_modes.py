@@ -11,7 +11,7 @@ from infsup_contact.solvers import modes as modes_mod
 from infsup_contact.solvers.infsup import beta_table
 from infsup_contact.solvers.interface_operator import combine_terms, interface_terms
 from infsup_contact.solvers.modes import mode_on_gamma, normalized
-from infsup_contact.solvers.request import BetaRequest, MeshOptions, mesh_of
+from infsup_contact.solvers.request import BetaRequest, MeshOptions, options_of
 from infsup_contact.solvers.side_cache import SideCache
 
 EPS = np.finfo(float).eps
@@ -28,7 +28,8 @@ def worst(request):
 
 def pencil(request, mode):
     """S and G of the mode's row, rebuilt from the sides, the couplings and the Gram (no eigensolver)."""
-    sides = SideCache().pair(request.model, request.family, request.k, request.n1, request.n2, request.mesh)
+    sides = SideCache().pair(request.model, request.family, request.k, request.n1, request.n2, request.mesh,
+                             request.gamma)
     couplings = [coupling_matrix(s.trace, mode.space, request.k) for s in sides]
     S = combine_terms(interface_terms(couplings, sides), (mode.keys["c1"], mode.keys["c2"]))
     G = sides[0].trace.gamma.gram(mode.space, mode.keys["norm"])[0]
@@ -149,9 +150,9 @@ CYLINDER = dict(gamma="cylinder", radius=2.0, coupling="exact")
 def test_every_model_gives_the_eigenvector(model, options, case, k, n):
     """Segment and face models, scalar and vector bodies, flat and curved Γ: the mode's Rayleigh
     quotient is β_h², and its samples cover Γ (a segment: x; a face: x and y) with max |μ_h| = 1."""
-    mesh = mesh_of(MODELS[model], **options)
+    mesh, gamma = options_of(MODELS[model], **options)
     request = BetaRequest("structured", k, n, n, (case,), ("omega2",), ((1.0, 1.0),), ("H", "L2"),
-                          model=MODELS[model], mesh=mesh)
+                          model=MODELS[model], mesh=mesh, gamma=gamma)
     rows, found = worst(request)
     for mode in found:
         gap, bound = rayleigh_gap(request, mode)

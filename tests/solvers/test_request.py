@@ -7,7 +7,8 @@ from infsup_contact.config.schema import ConfigError
 from infsup_contact.errors import InputError
 from infsup_contact.models import MODELS
 from infsup_contact.models.membranes import MEMBRANES
-from infsup_contact.solvers.request import NO_OPTIONS, BetaRequest, MeshOptions, check_mesh_option
+from infsup_contact.solvers.request import (NO_OPTIONS, BetaRequest, MeshOptions, check_mesh_option, options_of,
+                                            resolve_gamma)
 from infsup_contact.solvers.side_cache import SideCache, side_keys
 
 FACE_MODEL = MODELS["membranes3d"]
@@ -33,7 +34,7 @@ def test_options_equal_as_values_are_one_key():
     """An option left unset and one set to None are the builder's default alike: one key."""
     assert side_keys(MEMBRANES, "perturbed", 2, 5, 4, MeshOptions(seed=None)) == side_keys(
         MEMBRANES, "perturbed", 2, 5, 4, NO_OPTIONS)
-    assert side_keys(MEMBRANES, "perturbed", 2, 5, 4, MeshOptions(seed=1, alpha=0.2))[1][-1] == MeshOptions(
+    assert side_keys(MEMBRANES, "perturbed", 2, 5, 4, MeshOptions(seed=1, alpha=0.2))[1][-2] == MeshOptions(
         alpha=0.2, seed=1)
 
 
@@ -82,3 +83,29 @@ def test_a_perturbed_request_refuses_what_its_mesh_builder_would(alpha, seed):
         BetaRequest("perturbed", 1, 2, 2, ("T3",), mesh=MeshOptions(**given))
     assert (request.value.key, request.value.allowed, request.value.got) == (
         builder.value.key, builder.value.allowed, builder.value.got)
+
+
+def test_mesh_options_are_the_builder_s_own_and_gamma_is_the_request_s():
+    """Γ is a value of the request, not a mesh option: MeshOptions has no gamma, radius or
+    coupling; the command line's Γ keys resolve to the request's own ``gamma`` (no mesh built)."""
+    assert not {"gamma", "radius", "coupling"} & set(MeshOptions.__dataclass_fields__)
+    mesh, gamma = options_of(MEMBRANES, gamma="arc", radius=2.0, coupling="projection")
+    assert mesh == NO_OPTIONS and (gamma.radius, gamma.coupling) == (2.0, "projection")
+    request = BetaRequest("structured", 1, 3, 2, ("T3",), mesh=mesh, gamma=gamma)
+    assert request.gamma is gamma and request.interface is gamma
+    flat = BetaRequest("structured", 1, 3, 2, ("T3",))
+    assert flat.gamma is None and flat.interface == MEMBRANES.gamma()  # the model's flat Γ
+    assert options_of(MEMBRANES) == (NO_OPTIONS, None)
+    with pytest.raises(TypeError, match="gamma"):  # an unresolved name is a caller's slip
+        BetaRequest("structured", 1, 3, 2, ("T3",), gamma="arc")
+
+
+def test_a_sweep_over_two_gammas_shares_no_side():
+    """The request's Γ is part of the side cache's key: two radii (or a radius and the flat Γ)
+    never hand out each other's side, though the mesh options are equal."""
+    arcs = [resolve_gamma(MEMBRANES, gamma="arc", radius=r, coupling="exact") for r in (2.0, 4.0)]
+    keys = [side_keys(MEMBRANES, "structured", 1, 3, 2, NO_OPTIONS, g) for g in (None, *arcs)]
+    for side in (0, 1):
+        assert len({k[side] for k in keys}) == 3
+    sides = [SideCache().pair(MEMBRANES, "structured", 1, 3, 2, gamma=g)[1] for g in (None, *arcs)]
+    assert [s.trace.gamma for s in sides] == [MEMBRANES.gamma(), *arcs]  # each side built on its own Γ

@@ -25,7 +25,7 @@ from ..discretization.gamma.coupling import coupling_matrix
 from ..discretization.spaces import registry
 from ..models.membranes import MEMBRANES, displacement_space, laplace_stiffness
 from ..solvers.infsup import beta_table
-from ..solvers.request import BetaRequest, MeshOptions, mesh_of
+from ..solvers.request import BetaRequest, resolve_gamma
 from ..solvers.side_cache import SideCache
 from .beta_bench import splu_best_order
 from .harness import _log, _stats, run_interleaved
@@ -34,16 +34,17 @@ COLUMNS = ("what", "route", "radius", "k", "N1", "N2", "seconds_median", "second
            "ratio_to_limit", "ratio_to_exact", "repeats", "n_problems", "max_abs_diff_to_flat")
 
 
-def _options(radius: float, coupling: str | None) -> MeshOptions:
-    return MeshOptions() if coupling is None else mesh_of(MEMBRANES, gamma="arc", radius=float(radius), coupling=coupling)
+def _gamma(radius: float, coupling: str | None):
+    """The request's Γ: the arc of ``radius`` with ``coupling``; None (coupling None): the flat segment."""
+    return None if coupling is None else resolve_gamma(MEMBRANES, gamma="arc", radius=float(radius), coupling=coupling)
 
 
-def _betas(k, n1, n2, cases, mesh):
-    return beta_table(BetaRequest("structured", k, n1, n2, tuple(cases), norms=("H",), mesh=mesh))
+def _betas(k, n1, n2, cases, gamma):
+    return beta_table(BetaRequest("structured", k, n1, n2, tuple(cases), norms=("H",), gamma=gamma))
 
 
-def _couplings(k, n1, n2, cases, mesh):
-    sides = SideCache().pair(MEMBRANES, "structured", k, n1, n2, mesh)
+def _couplings(k, n1, n2, cases, gamma):
+    sides = SideCache().pair(MEMBRANES, "structured", k, n1, n2, gamma=gamma)
     gamma = sides[0].trace.gamma
     g_h = gamma.multiplier_partition(*(s.trace.partition for s in sides), "omega2")
     spaces = [registry.case_space(c, k, g_h, gamma) for c in cases]
@@ -56,7 +57,7 @@ def _couplings(k, n1, n2, cases, mesh):
 
 
 def _limit(k, n, radius):
-    body = MEMBRANES.subdomain_mesh("structured", n, 2, **_options(radius, "exact").kwargs())
+    body = MEMBRANES.subdomain_mesh("structured", n, 2, gamma=_gamma(radius, "exact"))
     body.interface.curve(body.mesh, k)
     fes = displacement_space(body.mesh, k)
     K = laplace_stiffness(fes)
@@ -73,12 +74,12 @@ def curved_rows(ns, ks, radius: float = 2.0, repeats: int = 3, budget: float = 1
         for n in ns:
             n1, n2 = n, n + 1
             routes = {"limit": _limit(k, max(n1, n2), radius)}
-            routes.update({name: (lambda c=coupling: _betas(k, n1, n2, cases, _options(radius, c)))
+            routes.update({name: (lambda c=coupling: _betas(k, n1, n2, cases, _gamma(radius, c)))
                            for name, coupling in (("flat", None), ("exact", "exact"), ("projection", "projection"))})
-            routes.update({f"couplings_{c}": _couplings(k, n1, n2, cases, _options(radius, c))
+            routes.update({f"couplings_{c}": _couplings(k, n1, n2, cases, _gamma(radius, c))
                            for c in ("exact", "projection")})
             _log(f"arc k={k} N={n1}:{n2} R={radius:g}: {', '.join(routes)}")
-            _betas(k, min(n1, 4), min(n1, 4) + 1, cases, _options(radius, "projection"))  # one-time start-up: untimed
+            _betas(k, min(n1, 4), min(n1, 4) + 1, cases, _gamma(radius, "projection"))  # one-time start-up: untimed
             out = run_interleaved(routes, repeats, budget)
             flat = np.array([r["beta"] for r in out["flat"][0]])
             limit = _stats(out["limit"][1])[0]

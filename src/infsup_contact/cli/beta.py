@@ -95,7 +95,7 @@ def _check_beta(args):
 
     args.cases = cases(args)
     material(args)
-    args.mesh = mesh_options(args)
+    args.mesh, args.gamma_obj = mesh_options(args)
     args.cases = face_cases(args)
     args.request = request(args)
     if args.worst_mode is not None:
@@ -135,6 +135,6 @@ def beta_frame(args, modes: list | None = None):
 
     rows = beta_table(args.request, modes=modes)
     frame = pd.DataFrame(rows)
-    for i, (name, value) in enumerate(args.mesh.columns(args.model_obj).items()):  # e.g. element, after family
+    for i, (name, value) in enumerate(args.mesh.columns(args.model_obj, args.gamma_obj).items()):  # e.g. element, after family
         frame.insert(frame.columns.get_loc("family") + 1 + i, name, value)
     return material_columns(frame, args)

@@ -66,7 +66,7 @@ def _check_contact(args):
     args.cases = cases(args)
     material(args)
     check_flat_gamma(args)  # the flags, before Γ is resolved: a curved Γ is refused as such
-    args.mesh = mesh_options(args)  # a mesh flag of another model is refused; the scene's rows read them
+    args.mesh, args.gamma_obj = mesh_options(args)  # a mesh flag of another model is refused; the scene's rows read them
     spec = check_pair(args.model, args.scene)
     check_k(args.k)
     # --case all on a 3D model: also the spaces only its face builds, but no Petrov–Galerkin pair (two

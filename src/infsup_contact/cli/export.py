@@ -52,7 +52,7 @@ def _check_export(args):
     from ..study.verdict import check_model_case, check_n1_offset
 
     material(args)
-    args.mesh = mesh_options(args)
+    args.mesh, args.gamma_obj = mesh_options(args)
     for prm in args.model_obj.params:  # the sides' scales c_i (E_i of the elastic bodies)
         if prm.side is not None and getattr(args, prm.name) != 1.0:
             raise InputError(prm.name, "1 (an export is at unit material scale)", got=getattr(args, prm.name))
@@ -66,7 +66,7 @@ def _check_export(args):
     check_n1_offset(ns, args.N1_offset)
     for n in ns:
         meshes.check_mesh_args(args.family, n + args.N1_offset, "N1_offset")
-    check_model_case(args.case, args.k, args.model_obj, args.family, args.mesh)
+    check_model_case(args.case, args.k, args.model_obj, args.family, args.mesh, args.gamma_obj)
     for n in ns:  # an empty space on a small N: refused here, before any file is written
         registry.check_pair_spaces([args.case], args.k, n + args.N1_offset, n, (args.multiplier_mesh,), key="N")
     out = Path(args.out)
@@ -115,9 +115,10 @@ def _run_export(args) -> None:
     from ..systems.export import suite_levels, write_system
 
     levels, norm, gamma = suite_levels(args.case, args.k, args.N, args.N1_offset, args.family, args.norm,
-                                       args.multiplier_mesh, model=args.model_obj, mesh=args.mesh)
+                                       args.multiplier_mesh, model=args.model_obj, mesh=args.mesh,
+                                       gamma=args.gamma_obj)
     name = "-".join([args.case, f"k{args.k}", args.model, *(f"{v:g}" if isinstance(v, float) else str(v)
-                                                            for v in args.mesh.columns(args.model_obj).values())]
+                                                            for v in args.mesh.columns(args.model_obj, args.gamma_obj).values())]
                     + ([f"N1{args.N1_offset:+d}"] if args.N1_offset else []))
     out = Path(args.out)
     before = {p.name for p in out.iterdir()} if out.is_dir() else set()

@@ -36,14 +36,14 @@ def face_cases(args) -> list:
     """``--case all`` on a 3D model: the paper's spaces and the duals (:func:`cases`), then every
     other registered space the model's face builds for k (the quadratic face elements' on
     hexahedra or tetrahedra; those refused by construction, e.g. DUAL-Q8, left out), on the
-    uniform partition of one cell per direction of the request's Γ (``Model.gamma``, resolved
-    without a mesh; ``args.mesh`` set)."""
+    uniform partition of one cell per direction of the request's Γ (``args.gamma_obj``, else the
+    model's flat one, ``Model.gamma``: resolved without a mesh; ``args.mesh`` set)."""
     from ..discretization.spaces.registry import ids_built_on
 
     base = list(args.cases)
     if args.case not in (None, "all") or args.space is not None or args.model_obj.dim != 3:
         return base
-    gamma = args.model_obj.gamma(args.family, **args.mesh.kwargs())
+    gamma = args.gamma_obj if args.gamma_obj is not None else args.model_obj.gamma(args.family, **args.mesh.kwargs())
     partition = gamma.uniform_partition(1)
     g_h = gamma.multiplier_partition(partition, partition)
     return base + [c for c in ids_built_on(args.k, gamma, g_h) if c not in base]
@@ -63,14 +63,15 @@ def run_intervals(args, limit: int = 1024) -> set:
     return {multiplier_intervals(a, b, choice) for a, b in ok}
 
 
-def mesh_options(args):
-    """The :class:`~infsup_contact.solvers.request.MeshOptions` of a request for its model
-    (``args.model_obj``), defaults filled in, each flag checked by the request's own rule
+def mesh_options(args) -> tuple:
+    """(:class:`~infsup_contact.solvers.request.MeshOptions`, Γ) of a request for its model
+    (``args.model_obj``): the mesh builder's options and the request's Γ (``--gamma``, ``--radius``,
+    ``--coupling`` resolved once, here, without a mesh; None: the model's flat Γ), defaults filled in, each flag checked by the request's own rule
     (:func:`~infsup_contact.solvers.request.check_mesh_option`); a family the model's mesh builder
     does not build (``Model.families``) is refused (a mesh flag the model does not take was
     refused before, :func:`refuse_unused`)."""
     from ..models.contract import OptionalChoice
-    from ..solvers.request import check_mesh_option, mesh_of
+    from ..solvers.request import check_mesh_option, options_of
 
     model = args.model_obj
     if model.families is not None and getattr(args, "family", None) not in model.families:
@@ -90,7 +91,7 @@ def mesh_options(args):
                 out[name] = own[name].values[0]
             continue
         out[name] = own[name][0] if given is None else given
-    return mesh_of(model, getattr(args, "family", "structured"), **out)  # Γ resolved once, here, without a mesh
+    return options_of(model, getattr(args, "family", "structured"), **out)  # Γ resolved once, here, without a mesh
 
 
 def material(args):
@@ -128,7 +129,7 @@ def request(args):
     perturbed = dict(seed=args.seed, alpha=args.alpha) if args.family == "perturbed" else {}
     out = BetaRequest(args.family, args.k, args.N1, args.N2, tuple(args.cases), (args.multiplier_mesh,),
                       ((args.c1, args.c2),), norms(args), args.h_route, args.model_obj,
-                      replace(args.mesh, **perturbed))
+                      replace(args.mesh, **perturbed), args.gamma_obj)
     if args.family != "perturbed":  # the perturbed family's: checked by the request itself
         check_perturbation(args.alpha, args.seed)
     return out

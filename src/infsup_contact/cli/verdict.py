@@ -94,14 +94,14 @@ def _check_verdict(args):
     from ..models import make_model
 
     args.model_obj = make_model(args.model)
-    args.mesh = mesh_options(args)
+    args.mesh, args.gamma_obj = mesh_options(args)
     meshes.check_mesh_args(args.family, 1)
     ns = check_mesh_sizes(args.N)
     check_n1_offset(ns, args.N1_offset)
     for n in ns:
         meshes.check_mesh_args(args.family, n + args.N1_offset, "N1_offset")
     if args.space is None:  # a face-only id on a 2D model, a face space of the other element: one line
-        check_model_case(case, args.k, args.model_obj, args.family, args.mesh)
+        check_model_case(case, args.k, args.model_obj, args.family, args.mesh, args.gamma_obj)
     for n in ns:  # an empty space on a small N is refused here, before any β_h
         registry.check_pair_spaces([case], args.k, n + args.N1_offset, n, (args.multiplier_mesh,), key="N")
     check_criterion(args.slope_tolerance, args.beta_floor, args.confidence)
@@ -134,5 +134,5 @@ def verdict_row(args) -> tuple:
     out = verdict_rows(args.space_or_case, args.k, args.family, args.N, args.norm,
                        tol=args.slope_tolerance, floor=args.beta_floor, confidence=args.confidence,
                        multiplier_mesh=args.multiplier_mesh, model=args.model_obj, n1_offset=args.N1_offset,
-                       mesh=args.mesh)
+                       mesh=args.mesh, gamma=args.gamma_obj)
     return out, None

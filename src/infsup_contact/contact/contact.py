@@ -223,34 +223,36 @@ class ContactPair:
     gap_degree: int = 0
 
 
-def check_flat_gamma(mesh: MeshOptions) -> None:
-    """:class:`InputError` naming the key unless ``mesh`` leaves Γ flat: contact scenes are built
-    on the segment and the face only (β_h and the verdicts take the arc and the cylinder). ``mesh``:
-    the command line's flags, or a request's options whose ``gamma`` is the resolved Γ."""
-    gamma = mesh.gamma
-    if gamma is not None and not isinstance(gamma, str):  # a resolved Γ: the curved shapes have a radius
+def check_flat_gamma(flags=None, gamma=None) -> None:
+    """:class:`InputError` naming the key unless Γ is flat: contact scenes are built on the segment
+    and the face only (β_h and the verdicts take the arc and the cylinder). ``flags``: the command
+    line's (``gamma``, ``radius``, ``coupling``, before Γ is resolved); ``gamma``: a request's
+    resolved Γ (an Interface; None: the model's flat one)."""
+    if gamma is not None:  # a resolved Γ: the curved shapes have a radius
         gamma = type(gamma).__name__.lower() if hasattr(gamma, "radius") else None
+    else:
+        gamma = getattr(flags, "gamma", None)
     if gamma not in FLAT_GAMMAS:
         raise InputError("gamma", f"{', '.join(FLAT_GAMMAS[1:])} (contact scenes on the arc and the cylinder are "
                          "not built: beta and verdict take --gamma arc, cylinder)", got=gamma)
     for key in ("radius", "coupling"):
-        if getattr(mesh, key, None) is not None:
+        if getattr(flags, key, None) is not None:
             raise InputError(key, "unset (contact scenes: a flat Γ; beta and verdict take --gamma arc, cylinder)",
-                             got=getattr(mesh, key))
+                             got=getattr(flags, key))
 
 
 def contact_pair(scene, k: int, family: str, n1: int, n2: int, model=None,
-                 mesh: MeshOptions = NO_OPTIONS) -> ContactPair:
+                 mesh: MeshOptions = NO_OPTIONS, gamma=None) -> ContactPair:
     """Mesh, factorize and load both sides of ``scene`` with ``model`` (default: the registry's,
     the paper's membranes; see :class:`ContactPair`); the scene's ``mesh_pair`` where it has
     one (structured blocks of the elastic scenes), else the model's mesh builder where it has
     one (``Model.mesh``: the 3D bodies, ``mesh`` options such as ``element``), else the family's.
-    The builders take the options as keywords (the model contract)."""
+    The builders take the options as keywords (the model contract); ``gamma``, the request's Γ,
+    must be flat (None; :func:`check_flat_gamma`)."""
     model = DEFAULT_MODEL if model is None else model
     build = getattr(scene, "mesh_pair", None)
     kw = mesh.kwargs()
-    check_flat_gamma(mesh)
-    kw.pop("gamma", None)  # flat: the builders' own Γ
+    check_flat_gamma(gamma=gamma)  # flat: the builders' own Γ
     if build is not None:
         mesh_pair = build(family, n1, n2, **kw)
     elif model.mesh is not None:

@@ -213,19 +213,20 @@ class Model:
     interface: Callable | None = None
     curving: tuple = ()
 
-    def subdomain_mesh(self, family: str, n: int, side: int, *, checked: bool = False, **mesh_kwargs):
+    def subdomain_mesh(self, family: str, n: int, side: int, *, checked: bool = False, gamma=None,
+                       **mesh_kwargs):
         """The mesh of Ω_side the model's sides are built on (its ``mesh`` builder, else the 2D one),
-        on the request's Γ (``gamma``, an Interface resolved by :meth:`gamma`; None: the flat one).
+        from the builder's own options ``mesh_kwargs``, on the request's Γ ``gamma`` (its own
+        argument: an Interface resolved by :meth:`gamma`; None: the flat one).
         ``checked``: the arguments are a validated request's, not checked again by the 2D builder
         (a model's own builder keeps its checks)."""
         if self.mesh is None:
             from ..discretization.segment import meshes
 
-            gamma = mesh_kwargs.pop("gamma", None)
             mesh = meshes.subdomain_mesh(family, n, side, checked=checked, **mesh_kwargs)
             flat = gamma is None or gamma == self.gamma(family)
             return mesh if flat else Body(mesh, gamma)  # the square's mesh, curved with the side
-        return self.mesh(family, n, side, **mesh_kwargs)
+        return self.mesh(family, n, side, **mesh_kwargs, **({} if gamma is None else {"gamma": gamma}))
 
     def gamma(self, family: str = "structured", **mesh_kwargs):
         """The Γ of the model's meshes with these options (an element's face; the paper's segment or

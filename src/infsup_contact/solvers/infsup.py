@@ -57,7 +57,7 @@ def beta_table(request: BetaRequest, side_cache: SideCache | None = None, modes:
     cache = SideCache() if side_cache is None else side_cache
     progress.note("the two sides")
     with progress.phase("sides: mesh, assembly, factorization"):
-        sides = cache.pair(r.model, r.family, r.k, r.n1, r.n2, r.mesh, checked=True)  # Ω1, Ω2 with Γ last
+        sides = cache.pair(r.model, r.family, r.k, r.n1, r.n2, r.mesh, r.gamma, checked=True)  # Ω1, Ω2 with Γ last
     t_sides = time.perf_counter() - t0
     gamma = sides[0].trace.gamma
     p1, p2 = (s.trace.partition for s in sides)
@@ -183,7 +183,7 @@ def _space(case, k, partition, gamma):
 
 def beta_rows(family, k, n1, n2, cases=None, multiplier_mesh="omega2",
               c1=1.0, c2=1.0, norms=NORMS, h_route="logkernel", model=DEFAULT_MODEL, side_cache=None,
-              mesh: MeshOptions = NO_OPTIONS):
+              mesh: MeshOptions = NO_OPTIONS, gamma=None):
     """β_h for several cases and norms on one mesh pair: :func:`beta_rows_all` with one
     multiplier mesh and one (c1, c2).
 
@@ -193,17 +193,19 @@ def beta_rows(family, k, n1, n2, cases=None, multiplier_mesh="omega2",
         One row per (case, norm) with the columns of ``infsup-contact beta``.
     """
     return beta_rows_all(family, k, n1, n2, cases, (multiplier_mesh,), ((c1, c2),), norms,
-                         h_route=h_route, model=model, side_cache=side_cache, mesh=mesh)
+                         h_route=h_route, model=model, side_cache=side_cache, mesh=mesh,
+                         gamma=gamma)
 
 
 def beta_rows_all(family, k, n1, n2, cases=None, multiplier_meshes=("omega2",), c_pairs=((1.0, 1.0),),
                   norms=NORMS, h_route="logkernel", model=DEFAULT_MODEL, side_cache=None,
-                  mesh: MeshOptions = NO_OPTIONS):
+                  mesh: MeshOptions = NO_OPTIONS, gamma=None):
     """:func:`beta_table` of the :class:`~.request.BetaRequest` these arguments make (validated
     here, once: a bad one raises :class:`~infsup_contact.errors.InputError` naming its key);
-    ``mesh``: the mesh parameters beyond (family, N), e.g. ``MeshOptions(element="hex")``."""
+    ``mesh``: the mesh parameters beyond (family, N), e.g. ``MeshOptions(element="hex")``;
+    ``gamma``: the request's Γ (:func:`~.request.resolve_gamma`; None: the model's flat one)."""
     request = BetaRequest(family, k, n1, n2, None if cases is None else tuple(cases), tuple(multiplier_meshes),
-                          tuple(tuple(c) for c in c_pairs), tuple(norms), h_route, model, mesh)
+                          tuple(tuple(c) for c in c_pairs), tuple(norms), h_route, model, mesh, gamma)
     return beta_table(request, side_cache)
 
 

@@ -4,7 +4,8 @@ The command line (:mod:`infsup_contact.cli.beta`) and the Python callers
 (:func:`~.infsup.beta_rows`, :func:`~.infsup.beta_rows_all`) build a :class:`BetaRequest`;
 building it checks every key (one :class:`~infsup_contact.errors.InputError` naming the first
 offending one) and :func:`~.infsup.beta_table` runs it without checking again. The mesh
-parameters travel as a :class:`MeshOptions`, not as keywords.
+parameters travel as a :class:`MeshOptions`, not as keywords; Γ travels as the request's own
+field (``gamma``, resolved once at the edge by :func:`resolve_gamma`).
 """
 from __future__ import annotations
 
@@ -25,7 +26,10 @@ from .petrov_galerkin import check_pair_size
 
 @dataclass(frozen=True)
 class MeshOptions:
-    """The mesh parameters of a request beyond (family, N): what a model's mesh builder takes.
+    """The mesh parameters of a request beyond (family, N): the model's mesh builder's own.
+
+    Γ is not one of them: a request carries its Γ itself (:attr:`BetaRequest.gamma`, resolved by
+    :func:`resolve_gamma`) and the builder receives it as its own argument (``Model.subdomain_mesh``).
 
     Attributes
     ----------
@@ -35,38 +39,41 @@ class MeshOptions:
         The perturbed family's seed and amplitude α / h; None: the builder's default.
     width : float or None
         A 3D body's extent in x (a narrower Ω2, :mod:`infsup_contact.study.face.edge_dropping`).
-    gamma : Interface or None
-        The request's Γ where it names one (``--gamma``: the arc of the 2D membranes, the
-        cylinder of the 3D ones, with their radius and coupling; resolved and checked by the Γ
-        table, :mod:`infsup_contact.discretization.spaces.gammas`, through ``Model.gamma``): the
-        model's mesh builder meshes it; None: the model's flat Γ.
     """
 
     element: str | None = None
     seed: int | None = None
     alpha: float | None = None
     width: float | None = None
-    gamma: object = None
 
     def kwargs(self) -> dict:
         """The builder's keywords: the options that are set."""
         return {key: getattr(self, key) for key in self.__dataclass_fields__ if getattr(self, key) is not None}
 
-    def columns(self, model) -> dict:
+    def columns(self, model, gamma=None) -> dict:
         """The table's columns of the options that are set (after ``family``): the builder's, then
-        the Γ's parameters (``Model.gamma_columns``: gamma, radius, coupling)."""
-        out = {key: value for key, value in self.kwargs().items() if key != "gamma"}
-        return {**out, **model.gamma_columns(self.gamma)}
+        those of the request's Γ ``gamma`` (``Model.gamma_columns``: gamma, radius, coupling)."""
+        return {**self.kwargs(), **model.gamma_columns(gamma)}
 
 
-def mesh_of(model, family: str = "structured", **options) -> MeshOptions:
-    """The :class:`MeshOptions` of ``model``'s mesh options as the command line names them, the
-    curving ones (``gamma``, ``radius``, ``coupling``) resolved to the request's Γ by ``Model.gamma``
-    (the Γ table's checks, no mesh): the Γ's parameters, not mesh options."""
-    curving = {key: options.pop(key) for key in ("gamma", "radius", "coupling") if options.get(key) is not None}
-    if curving:
-        options["gamma"] = model.gamma(family, **options, **curving)
-    return MeshOptions(**options)
+CURVING = ("gamma", "radius", "coupling")
+"""The command line's Γ keys (``--gamma``, ``--radius``, ``--coupling``): the request's Γ, not mesh options."""
+
+
+def resolve_gamma(model, family: str = "structured", **options):
+    """The request's Γ named by ``options``' Γ keys (:data:`CURVING`), resolved and checked by
+    ``Model.gamma`` (the Γ table's checks, no mesh) with the mesh options beside them (a 3D
+    model's element chooses the face); None where no Γ key is set: the model's flat Γ."""
+    if all(options.get(key) is None for key in CURVING):
+        return None
+    return model.gamma(family, **{key: value for key, value in options.items() if value is not None})
+
+
+def options_of(model, family: str = "structured", **options) -> tuple:
+    """(:class:`MeshOptions`, Γ) of ``model``'s options as the command line names them: the mesh
+    builder's own, and the request's Γ (:func:`resolve_gamma`; None: the model's flat Γ)."""
+    mesh = MeshOptions(**{key: value for key, value in options.items() if key not in CURVING})
+    return mesh, resolve_gamma(model, family, **options)
 
 
 NO_OPTIONS = MeshOptions()
@@ -82,8 +89,11 @@ class BetaRequest:
     :class:`~infsup_contact.discretization.spaces.registry.SpaceSpec` or a general triple
     ``(label, s, continuous, vanish)`` (those two are the caller's, not checked here). The
     registered ids are resolved once, here, to their entries checked on the request's Γ
-    (:attr:`gamma`, resolved without a mesh): the built request's ``cases`` hold those
+    (:attr:`interface`, resolved without a mesh): the built request's ``cases`` hold those
     :class:`SpaceSpec` s (their ``id`` the rows' name), and the engine never looks an id up again.
+    ``gamma`` is the request's Γ where it names one (``--gamma``: the arc, the cylinder; an
+    Interface resolved once, at the edge, by :func:`resolve_gamma`), None for the model's flat Γ;
+    ``mesh`` holds the mesh builder's own parameters only.
     """
 
     family: str
@@ -97,18 +107,21 @@ class BetaRequest:
     h_route: str = "logkernel"
     model: Model = DEFAULT_MODEL
     mesh: MeshOptions = NO_OPTIONS
+    gamma: object = None
 
     def __post_init__(self):
         check_k(self.k)
         cases = registry.common_ids(self.k) if self.cases is None else list(self.cases)
         if not isinstance(self.mesh, MeshOptions):  # a caller's slip, not input: say what it should be
             raise TypeError(f"BetaRequest.mesh must be a MeshOptions, not {type(self.mesh).__name__}")
+        if isinstance(self.gamma, str):  # a caller's slip: Γ is resolved at the edge (resolve_gamma)
+            raise TypeError("BetaRequest.gamma must be a resolved Interface (resolve_gamma) or None, not a str")
         declared = dict(getattr(self.model, "mesh_options", ()))
         for name, value in self.mesh.kwargs().items():
-            if name in declared and name != "gamma":  # the builder's options (seed, α: the family's); Γ resolved
+            if name in declared:  # the builder's options (seed, α: the family's)
                 check_mesh_option(self.model, name, value)
         ids = {i: c for i, c in enumerate(cases) if isinstance(c, str)}
-        gamma = self.gamma if ids else None
+        gamma = self.interface if ids else None
         entries = {i: registry.check_on_gamma(c, self.k, gamma) for i, c in ids.items()}
         object.__setattr__(self, "cases", tuple(entries.get(i, c) for i, c in enumerate(cases)))  # resolved once
         entries = list(entries.values())  # the registered ones, checked here (the caller's own are not)
@@ -128,10 +141,10 @@ class BetaRequest:
                                       0 if self.mesh.seed is None else self.mesh.seed)
 
     @property
-    def gamma(self):
-        """The request's Γ: the one its mesh options name, else the model's for its family and
-        options (``Model.gamma``: no mesh is built)."""
-        return self.model.gamma(self.family, **self.mesh.kwargs())
+    def interface(self):
+        """The request's Γ resolved: its own (:attr:`gamma`), else the model's flat one for its
+        family and mesh options (``Model.gamma``: no mesh is built)."""
+        return self.gamma if self.gamma is not None else self.model.gamma(self.family, **self.mesh.kwargs())
 
 
 def check_mesh_option(model, name: str, value) -> None:

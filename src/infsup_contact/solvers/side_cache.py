@@ -3,7 +3,8 @@
 A side operator (:mod:`infsup_contact.models.contract`) depends on its own mesh and k only,
 and the mesh of Ω_i is addressed by (family, N_i, side, mesh parameters), never by the other
 side's N (:func:`~infsup_contact.discretization.segment.meshes.subdomain_mesh`); the mesh
-parameters are a frozen :class:`~.request.MeshOptions`. So the pairs
+parameters are a frozen :class:`~.request.MeshOptions` and the request's Γ (None: the model's flat
+one) is part of the address too, so that a sweep over two Γs never shares a side. So the pairs
 (16, 16), (17, 16) and (24, 16) of one sweep share the operator of Ω2: of the 64 sides of
 the β_h study's 32 pairs, 34 are distinct.
 
@@ -44,14 +45,15 @@ from ..la.face_parity import ParityGram, deferred_assembly
 from .request import NO_OPTIONS, MeshOptions
 
 
-def side_keys(model, family: str, k: int, n1: int, n2: int, mesh: MeshOptions = NO_OPTIONS) -> list:
+def side_keys(model, family: str, k: int, n1: int, n2: int, mesh: MeshOptions = NO_OPTIONS, gamma=None) -> list:
     """The cache keys of the two sides of the pair (N1, N2): Ω1 with N1, Ω2 with N2; ``mesh`` (frozen,
-    hashable) is part of each key as it is."""
-    return [(model, family, int(k), int(n), side, mesh) for n, side in ((n1, 1), (n2, 2))]
+    hashable) and the request's Γ ``gamma`` (an Interface, frozen; None: the flat one) are part of
+    each key as they are."""
+    return [(model, family, int(k), int(n), side, mesh, gamma) for n, side in ((n1, 1), (n2, 2))]
 
 
 class SideCache:
-    """Side operators by (model, family, k, N, side, mesh options), each built once."""
+    """Side operators by (model, family, k, N, side, mesh options, Γ), each built once."""
 
     def __init__(self):
         self._ops = {}
@@ -59,23 +61,25 @@ class SideCache:
         self.grams = GramCache()  # the sweep's Grams (the pairs repeat G_h)
 
     @classmethod
-    def for_sweep(cls, model, family: str, k: int, pairs, mesh: MeshOptions = NO_OPTIONS) -> "SideCache":
+    def for_sweep(cls, model, family: str, k: int, pairs, mesh: MeshOptions = NO_OPTIONS,
+                  gamma=None) -> "SideCache":
         """A cache told to expect the pairs of one sweep (:meth:`expect`)."""
         cache = cls()
-        cache.expect(model, family, k, pairs, mesh)
+        cache.expect(model, family, k, pairs, mesh, gamma)
         return cache
 
-    def expect(self, model, family: str, k: int, pairs, mesh: MeshOptions = NO_OPTIONS) -> None:
-        """Announce that :meth:`pair` will be asked for each (N1, N2) in ``pairs``."""
+    def expect(self, model, family: str, k: int, pairs, mesh: MeshOptions = NO_OPTIONS, gamma=None) -> None:
+        """Announce that :meth:`pair` will be asked for each (N1, N2) in ``pairs`` (on Γ ``gamma``)."""
         for n1, n2 in pairs:
-            self._uses_left.update(side_keys(model, family, k, n1, n2, mesh))
+            self._uses_left.update(side_keys(model, family, k, n1, n2, mesh, gamma))
 
     def pair(self, model, family: str, k: int, n1: int, n2: int, mesh: MeshOptions = NO_OPTIONS,
-             checked: bool = False) -> list:
-        """[side operator of Ω1 (N1 segments on Γ), side operator of Ω2 (N2)]. The arguments are
-        a validated request's (:class:`~.request.BetaRequest`; ``checked``: the mesh builder does
-        not check them again) or checked by the mesh builder."""
-        key1, key2 = side_keys(model, family, k, n1, n2, mesh)
+             gamma=None, checked: bool = False) -> list:
+        """[side operator of Ω1 (N1 segments on Γ), side operator of Ω2 (N2)], on the request's Γ
+        ``gamma`` (None: the model's flat one). The arguments are a validated request's
+        (:class:`~.request.BetaRequest`; ``checked``: the mesh builder does not check them again)
+        or checked by the mesh builder."""
+        key1, key2 = side_keys(model, family, k, n1, n2, mesh, gamma)
         # one side after the other: building two sides side by side in threads aborted the process
         # (NGSolve's meshing and assembly are not thread-safe); the parallel work is inside a side
         # (a body's parity parts, PARDISO's threads)
@@ -88,8 +92,10 @@ class SideCache:
         """The operator of ``key``, cached or built; ``mirror_of``: side 1 of a matching pair, which
         a model with ``mirror_side`` turns into side 2 where a mirror maps the bodies (checked);
         ``checked``: the request checked the mesh arguments (:meth:`pair`)."""
-        model, family, k, n, side, mesh = key
+        model, family, k, n, side, mesh, gamma = key
         kwargs = dict(mesh.kwargs(), checked=True) if checked else mesh.kwargs()
+        if gamma is not None:  # the request's Γ, the builder's own argument (Model.subdomain_mesh)
+            kwargs["gamma"] = gamma
         mirror = getattr(model, "mirror_side", None) if mirror_of is not None else None
         if mirror is not None:
             # always the mirror on a matching pair, never kept for another pair: each pair's rows

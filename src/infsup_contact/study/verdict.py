@@ -39,7 +39,7 @@ from ..criteria.stability import MIN_MESHES, stability_verdict
 
 def verdict_rows(case_or_spec, k: int, family: str, ns, norm: str, *, tol: float, floor: float,
                  confidence: float, multiplier_mesh: str = "omega2", model=None, n1_offset: int = 0,
-                 mesh: MeshOptions = NO_OPTIONS) -> dict:
+                 mesh: MeshOptions = NO_OPTIONS, gamma=None) -> dict:
     """β_h on the mesh pairs N1 = N + ``n1_offset``, N2 = N for each N in ``ns`` (matching
     meshes by default), and its stability verdict.
 
@@ -67,6 +67,9 @@ def verdict_rows(case_or_spec, k: int, family: str, ns, norm: str, *, tol: float
     mesh : MeshOptions
         The mesh parameters (``seed``, ``alpha`` of the perturbed family; the 3D model's
         ``element``); default: the builder's.
+    gamma : Interface or None
+        The request's Γ (``--gamma``: the arc, the cylinder; resolved by
+        :func:`~infsup_contact.solvers.request.resolve_gamma`); None: the model's flat Γ.
 
     Returns
     -------
@@ -90,8 +93,8 @@ def verdict_rows(case_or_spec, k: int, family: str, ns, norm: str, *, tol: float
     model = DEFAULT_MODEL if model is None else model
     level = (lambda n: f"N1={n + n1_offset} N2={n}") if n1_offset else (lambda n: f"N={n}")
     rows = [r for n in progress.steps(ns, "level", level) for r in beta_rows(family, k, n + n1_offset, n, [case], multiplier_mesh,
-                                             norms=(norm,), model=model, mesh=mesh)]
-    curved = model.gamma_columns(mesh.gamma)
+                                             norms=(norm,), model=model, mesh=mesh, gamma=gamma)]
+    curved = model.gamma_columns(gamma)
     out = dict(space=case, k=k, model=model.name, element=mesh.element, **curved, family=family, norm=norm,
                multiplier_mesh=multiplier_mesh, N1_offset=n1_offset,
                **stability_verdict(rows, tol, floor, confidence), N_list=ns)
@@ -124,7 +127,7 @@ def check_n1_offset(ns, offset) -> int:
     return int(offset)
 
 
-def model_case_ids(model, k: int, family: str = "structured", mesh: MeshOptions = NO_OPTIONS) -> list:
+def model_case_ids(model, k: int, family: str = "structured", mesh: MeshOptions = NO_OPTIONS, gamma=None) -> list:
     """The registered ids ``model`` builds for degree k: on a 2D model the segment's spaces
     defined for k; on a 3D model also the face-only ones its element's face cells carry
     (QUAD8/QUAD9 spaces on hexahedra, TRI6 spaces on tetrahedra), those refused by
@@ -133,18 +136,19 @@ def model_case_ids(model, k: int, family: str = "structured", mesh: MeshOptions 
     every space of its dimension)."""
     if model.dim == 2:
         return registry.ids_valid_for(k, registry.space_ids(model.dim - 1))
-    return registry.ids_built_on(k, *_coarsest_multiplier_mesh(model, k, family, mesh))
+    return registry.ids_built_on(k, *_coarsest_multiplier_mesh(model, k, family, mesh, gamma))
 
 
-def _coarsest_multiplier_mesh(model, k, family, mesh: MeshOptions):
+def _coarsest_multiplier_mesh(model, k, family, mesh: MeshOptions, gamma=None):
     """(Γ, G_h) of ``model`` on its coarsest matching mesh pair (one cell per direction), without a
-    mesh: the request's Γ (``Model.gamma``) and its uniform partition."""
-    gamma = model.gamma(family, **mesh.kwargs())
+    mesh: the request's Γ ``gamma``, else the model's flat one (``Model.gamma``), and its uniform partition."""
+    gamma = model.gamma(family, **mesh.kwargs()) if gamma is None else gamma
     partition = gamma.uniform_partition(1)
     return gamma, gamma.multiplier_partition(partition, partition)
 
 
-def check_model_case(case: str, k: int, model, family: str = "structured", mesh: MeshOptions = NO_OPTIONS) -> None:
+def check_model_case(case: str, k: int, model, family: str = "structured", mesh: MeshOptions = NO_OPTIONS,
+                     gamma=None) -> None:
     """:class:`InputError` unless ``model`` (with its mesh options, e.g. ``element``) builds the
     registered space ``case`` for degree k (:func:`model_case_ids`): one line naming the key
     (``case`` or ``k``) and the values allowed for this model, element and k. The id and k are
@@ -153,16 +157,16 @@ def check_model_case(case: str, k: int, model, family: str = "structured", mesh:
     if not spec.valid_for(k):
         ks = [j for j in range(registry.K_RANGE[0], registry.K_RANGE[1] + 1) if spec.valid_for(j)]
         raise InputError("k", f"k in {ks[0]}..{ks[-1]} for case {case} ({spec.paper_ref})", got=k)
-    where = " ".join([f"--model {model.name}", *(f"--{key} {value}" for key, value in mesh.columns(model).items()),
+    where = " ".join([f"--model {model.name}", *(f"--{key} {value}" for key, value in mesh.columns(model, gamma).items()),
                       *([f"--family {family}"] if family != "structured" else [])])
     if not spec.defined_on(model.dim - 1):
         why = (f"defined on the face of a 3D model only: --model {', '.join(_models(3))}" if model.dim == 2
                else "defined on the segment Γ of the 2D models only")
-        allowed = model_case_ids(model, k, family, mesh)
+        allowed = model_case_ids(model, k, family, mesh, gamma)
         raise InputError("case", f"a space of {where} with k = {k}: {', '.join(allowed)} ({case} is {why})", got=case)
     if model.dim == 2:
         return
-    gamma, g_h = _coarsest_multiplier_mesh(model, k, family, mesh)
+    gamma, g_h = _coarsest_multiplier_mesh(model, k, family, mesh, gamma)
     allowed = registry.ids_built_on(k, gamma, g_h)
     if case in allowed:
         return

@@ -32,16 +32,17 @@ EXPORT_FORMATS = {"mtx": ".mtx", "npz": ".npz", "petsc": ".petsc"}
 
 
 def suite_system(case: str, k: int, n1: int, n2: int, family: str = "structured", norm: str = "H",
-                 multiplier_mesh: str = "omega2", model=None, mesh=None):
+                 multiplier_mesh: str = "omega2", model=None, mesh=None, gamma=None):
     """(A, B, G) of ``case`` on the pair (N1, N2) of ``model`` (default: membranes) with the mesh
     options ``mesh`` (a :class:`~infsup_contact.solvers.request.MeshOptions`; None: the builder's
-    defaults)."""
-    A, B, space, gamma, _ = _suite_parts(case, k, n1, n2, family, multiplier_mesh, model, mesh)
+    defaults) on the request's Γ ``gamma`` (:func:`~infsup_contact.solvers.request.resolve_gamma`;
+    None: the model's flat one)."""
+    A, B, space, gamma, _ = _suite_parts(case, k, n1, n2, family, multiplier_mesh, model, mesh, gamma)
     G, _ = gamma.gram(space, norm)
     return A, B, np.asarray(G, float)
 
 
-def _suite_parts(case, k, n1, n2, family, multiplier_mesh, model, mesh=None):
+def _suite_parts(case, k, n1, n2, family, multiplier_mesh, model, mesh=None, gamma=None):
     """(A, B, the multiplier space, Γ, the two side operators) of ``case`` on the pair (N1, N2)."""
     from ..discretization.spaces import registry
     from ..discretization.gamma.coupling import coupling_matrix
@@ -50,7 +51,7 @@ def _suite_parts(case, k, n1, n2, family, multiplier_mesh, model, mesh=None):
     from ..solvers.side_cache import SideCache
 
     sides = SideCache().pair(MEMBRANES if model is None else model, family, k, n1, n2,
-                             NO_OPTIONS if mesh is None else mesh)
+                             NO_OPTIONS if mesh is None else mesh, gamma)
     gamma = sides[0].trace.gamma
     g_h = gamma.multiplier_partition(*(s.trace.partition for s in sides), multiplier_mesh)
     space = registry.case_space(case, k, g_h, gamma)
@@ -66,14 +67,14 @@ def _suite_parts(case, k, n1, n2, family, multiplier_mesh, model, mesh=None):
 
 
 def suite_levels(case: str, k: int, ns, offset: int = 0, family: str = "structured", norm: str = "H",
-                 multiplier_mesh: str = "omega2", model=None, mesh=None) -> tuple:
+                 multiplier_mesh: str = "omega2", model=None, mesh=None, gamma=None) -> tuple:
     """(levels, manifest norm, gamma) of ``case`` on N1 = N + offset, N2 = N for N in ``ns``, as
     :func:`write_system` takes them (module docstring: ``norm: H`` with the description where the
-    space has one; ``mesh`` as in :func:`suite_system`)."""
+    space has one; ``mesh``, ``gamma`` as in :func:`suite_system`)."""
     from ..discretization.spaces.registry import space_spec
 
     spec, levels, described = space_spec(case), [], norm == "H"
-    parts = [_suite_parts(case, k, n + offset, n, family, multiplier_mesh, model, mesh)
+    parts = [_suite_parts(case, k, n + offset, n, family, multiplier_mesh, model, mesh, gamma)
              for n in progress.steps(ns, "level", lambda n: f"N1={n + offset} N2={n}" if offset else f"N={n}")]
     described = described and all(description(spec, p[2]) is not None for p in parts)
     for n, (A, B, space, gamma, sides) in progress.steps(list(zip(ns, parts)), "Gram of level", lambda p: f"N={p[0]}"):

@@ -17,7 +17,7 @@ from infsup_contact.errors import InputError
 from infsup_contact.models.membranes3d import MEMBRANES3D, subdomain_mesh
 from infsup_contact.contact.contact import check_flat_gamma
 from infsup_contact.solvers.infsup import beta_rows
-from infsup_contact.solvers.request import MeshOptions, mesh_of
+from infsup_contact.solvers.request import MeshOptions, options_of
 from infsup_contact.solvers.side_cache import SideCache
 
 ROUNDOFF = 1e-12
@@ -31,11 +31,14 @@ def Flags(gamma=None, radius=None, coupling=None):
 
 
 def cylinder(radius, coupling="exact", element="hex"):
-    return mesh_of(MEMBRANES3D, element=element, gamma="cylinder", radius=float(radius), coupling=coupling)
+    """(mesh options, Γ) of a request on the cylinder: Γ the request's own, not a mesh option."""
+    return options_of(MEMBRANES3D, element=element, gamma="cylinder", radius=float(radius), coupling=coupling)
 
 
-def rows(k, n1, n2, mesh, cases=None):
-    return beta_rows("structured", k, n1, n2, cases, model=MEMBRANES3D, mesh=mesh)
+def rows(k, n1, n2, where, cases=None):
+    """``where``: the flat face's mesh options, or (mesh options, Γ) of :func:`cylinder`."""
+    mesh, gamma = where if isinstance(where, tuple) else (where, None)
+    return beta_rows("structured", k, n1, n2, cases, model=MEMBRANES3D, mesh=mesh, gamma=gamma)
 
 
 def slope(ns, errors) -> float:
@@ -56,7 +59,7 @@ def test_exact_coupling_at_radius_inf_is_the_flat_face_bit_for_bit(k, n1, n2, el
 
 def test_projection_on_the_flat_face_is_the_identity():
     """Flat curves, normals e_z: P(x) = x, so β_h and the kernels are the flat face's to round-off."""
-    sides = SideCache().pair(MEMBRANES3D, "structured", 2, 3, 4, cylinder(math.inf, "projection"))
+    sides = SideCache().pair(MEMBRANES3D, "structured", 2, 3, 4, *cylinder(math.inf, "projection"))
     g = sides[0].trace.gamma
     space = registry.case_space("T3", 2, sides[1].trace.partition, g)
     x, x_master, w = g.coupling_points(sides[0].trace, space, 4)  # Ω1 is the master of G_h = Ω2's trace
@@ -129,7 +132,7 @@ def test_projection_on_matching_meshes_is_exact_up_to_the_geometric_error(k):
     for n in ns:
         B = {}
         for coupling in ("exact", "projection"):
-            sides = SideCache().pair(MEMBRANES3D, "structured", k, n, n, cylinder(2.0, coupling))
+            sides = SideCache().pair(MEMBRANES3D, "structured", k, n, n, *cylinder(2.0, coupling))
             g = sides[0].trace.gamma
             space = registry.case_space("T3", k, sides[1].trace.partition, g)
             B[coupling] = [coupling_matrix(s.trace, space, k) for s in sides]
@@ -164,7 +167,7 @@ def test_nonmatching_projection_gives_a_finite_beta_near_the_exact_couplings(rad
 def test_the_exact_coupling_is_the_flat_faces_in_parameters():
     """(arc length, y) parametrize the cylinder isometrically: the exact coupling's points and
     weights are the flat face's, the curvature enters through the bodies' Schur complements only."""
-    sides = SideCache().pair(MEMBRANES3D, "structured", 1, 3, 4, cylinder(2.0))
+    sides = SideCache().pair(MEMBRANES3D, "structured", 1, 3, 4, *cylinder(2.0))
     g = sides[0].trace.gamma
     assert type(g) is Cylinder
     space = registry.case_space("T3", 1, sides[1].trace.partition, g)
@@ -225,7 +228,7 @@ def test_the_command_line_refuses_in_one_line(capsys, argv, key):
 def test_contact_scenes_refuse_a_curved_gamma(mesh, key):
     """The command line's flags, and a request's resolved Γ."""
     with pytest.raises(InputError) as e:
-        check_flat_gamma(mesh)
+        check_flat_gamma(gamma=mesh[1]) if isinstance(mesh, tuple) else check_flat_gamma(mesh)
     assert e.value.key == key
     check_flat_gamma(Flags(gamma="square"))  # the flat face is the contact scenes' own
-    check_flat_gamma(mesh_of(MEMBRANES3D, gamma="square"))
+    check_flat_gamma(gamma=options_of(MEMBRANES3D, gamma="square")[1])

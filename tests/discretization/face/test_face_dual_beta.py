@@ -104,13 +104,13 @@ def test_dual_q8_is_refused_with_its_weights_and_the_remedy():
 def test_an_empty_face_space_is_refused_before_any_computation():
     """TDUAL-Q8 on one cell: QUAD8 has no node inside (0, 1)², dim M_h = 0 = the count."""
     from infsup_contact.models import MODELS
-    from infsup_contact.solvers.request import BetaRequest, mesh_of
+    from infsup_contact.solvers.request import BetaRequest, MeshOptions
 
     assert registry.SPACES["TDUAL-Q8"].dimension(2, 1) == 0
     model = MODELS["membranes3d"]  # the request's Γ is the face (the 2D model's segment refuses the id)
     with pytest.raises(InputError, match="dim M_h = 0"):
         BetaRequest("structured", 2, 1, 1, ("TDUAL-Q8",), norms=("H",), model=model,
-                    mesh=mesh_of(model, element="hex"))
+                    mesh=MeshOptions(element="hex"))
 
 
 def test_face_spaces_stay_off_the_segment():

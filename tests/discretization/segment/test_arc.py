@@ -22,7 +22,7 @@ from infsup_contact.discretization.spaces import registry
 from infsup_contact.errors import InputError
 from infsup_contact.models import MODELS
 from infsup_contact.solvers.infsup import beta_rows
-from infsup_contact.solvers.request import MeshOptions, mesh_of
+from infsup_contact.solvers.request import resolve_gamma
 from infsup_contact.solvers.side_cache import SideCache
 
 MEMBRANES = MODELS["membranes"]
@@ -30,11 +30,12 @@ COLUMNS = ["case", "norm", "beta", "kernel_dim", "structural_kernel_dim", "small
 
 
 def arc_options(radius, coupling="exact"):
-    return mesh_of(MODELS["membranes"], gamma="arc", radius=float(radius), coupling=coupling)
+    """The request's Γ: the arc (an Interface, not a mesh option)."""
+    return resolve_gamma(MODELS["membranes"], gamma="arc", radius=float(radius), coupling=coupling)
 
 
-def rows(k, n1, n2, mesh=MeshOptions(), cases=None):
-    return pd.DataFrame(beta_rows("structured", k, n1, n2, cases=cases, model=MEMBRANES, mesh=mesh))[COLUMNS]
+def rows(k, n1, n2, gamma=None, cases=None):
+    return pd.DataFrame(beta_rows("structured", k, n1, n2, cases=cases, model=MEMBRANES, gamma=gamma))[COLUMNS]
 
 
 @pytest.mark.parametrize("k,n1,n2", [(1, 5, 4), (2, 6, 6), (2, 7, 5)])
@@ -69,7 +70,7 @@ def test_beta_tends_to_the_flat_one_like_one_over_r():
 
 
 def curved_mesh(n, side, k, radius=2.0):
-    body = MEMBRANES.subdomain_mesh("structured", n, side, **arc_options(radius).kwargs())
+    body = MEMBRANES.subdomain_mesh("structured", n, side, gamma=arc_options(radius))
     body.interface.curve(body.mesh, k)
     return body
 
@@ -102,7 +103,7 @@ def test_discrete_gamma_has_its_vertices_on_the_arc_and_length_tending_to_one(k)
 
 
 def pair(k, n1, n2, coupling, radius=2.0):
-    return SideCache().pair(MEMBRANES, "structured", k, n1, n2, arc_options(radius, coupling))
+    return SideCache().pair(MEMBRANES, "structured", k, n1, n2, gamma=arc_options(radius, coupling))
 
 
 def space_of(sides, case, k, choice="omega2"):

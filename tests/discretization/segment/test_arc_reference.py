@@ -16,14 +16,15 @@ from infsup_contact.discretization.gamma.coupling import coupling_matrix
 from infsup_contact.discretization.spaces import registry
 from infsup_contact.models import MODELS
 from infsup_contact.solvers.infsup import beta_rows
-from infsup_contact.solvers.request import MeshOptions, mesh_of
+from infsup_contact.solvers.request import resolve_gamma
 from infsup_contact.solvers.side_cache import SideCache
 
 MEMBRANES, MEMBRANES3D = MODELS["membranes"], MODELS["membranes3d"]
 
 
 def arc(radius=2.0, coupling="exact"):
-    return mesh_of(MEMBRANES, gamma="arc", radius=float(radius), coupling=coupling)
+    """The request's Γ: the arc (an Interface, not a mesh option)."""
+    return resolve_gamma(MEMBRANES, gamma="arc", radius=float(radius), coupling=coupling)
 
 
 def curved_space(model, n, k, **options):
@@ -38,9 +39,9 @@ def stiffness_with_margin(fes, margin, monkeypatch):
 
 
 @pytest.mark.parametrize("model,k,options", [
-    (MEMBRANES, 2, arc().kwargs()), (MEMBRANES, 3, arc().kwargs()),
-    (MEMBRANES3D, 1, mesh_of(MEMBRANES3D, element="hex", gamma="cylinder", radius=2.0).kwargs()),
-    (MEMBRANES3D, 2, mesh_of(MEMBRANES3D, element="tet", gamma="cylinder", radius=2.0).kwargs())])
+    (MEMBRANES, 2, dict(gamma=arc())), (MEMBRANES, 3, dict(gamma=arc())),
+    (MEMBRANES3D, 1, dict(element="hex", gamma=resolve_gamma(MEMBRANES3D, element="hex", gamma="cylinder", radius=2.0))),
+    (MEMBRANES3D, 2, dict(element="tet", gamma=resolve_gamma(MEMBRANES3D, element="tet", gamma="cylinder", radius=2.0)))])
 def test_curved_stiffness_is_converged_in_its_quadrature(model, k, options, monkeypatch):
     """The integrand on a curved cell is rational, no rule is exact: the Gauss error falls
     geometrically with the order, so K at the library's order, 4 and 8 orders more agree to round-off
@@ -66,7 +67,7 @@ def test_arc_beta_is_unchanged_by_finer_quadrature(monkeypatch):
             if default:
                 m.setattr(membranes, "curved_bonus_intorder", lambda mesh, k: 0)
             return pd.DataFrame(beta_rows("structured", 2, 8, 9, cases=["T3", "R5.2", "T5"], model=MEMBRANES,
-                                          mesh=arc())).beta.to_numpy()
+                                          gamma=arc())).beta.to_numpy()
     beta = betas()
     for more in (4, 8):
         assert np.abs(betas(membranes.CURVED_MARGIN + more) - beta).max() <= 1e-9 * beta.max()
@@ -78,9 +79,9 @@ def test_each_curved_side_is_the_reference_isoparametric_body(k):
     """S_i of both sides equals the reference's (its own element maps, nodes and quadrature; the
     documented interpolant of Φ) to 1e-12 relative: the same discrete problem, each to round-off. The
     reference's own quadrature is converged (8 and 14 Gauss points per direction agree)."""
-    sides = SideCache().pair(MEMBRANES, "structured", k, 4, 5, arc())
+    sides = SideCache().pair(MEMBRANES, "structured", k, 4, 5, gamma=arc())
     for side, n, which in zip(sides, (4, 5), (1, 2)):
-        square = MEMBRANES.subdomain_mesh("structured", n, which, **arc().kwargs()).mesh
+        square = MEMBRANES.subdomain_mesh("structured", n, which, gamma=arc()).mesh
         body = ar.Body(*ar.library_square(square), 2.0, k)
         reference = ar.reference_schur(side, body)
         scale = np.abs(reference).max()
@@ -94,10 +95,10 @@ def test_arc_rows_agree_with_the_exactly_integrated_reference(k, n1, n2, couplin
     """Every segment space, both norms: β_h with the library's sides and with the reference's S_i in
     the same pencil (the coupling the library's: the projection's is checked below) agree to 1e-9
     (the issue's acceptance: 1e-6), and so do the kernels."""
-    options = arc(coupling=coupling)
-    library = pd.DataFrame(beta_rows("structured", k, n1, n2, model=MEMBRANES, mesh=options))
-    sides = ar.reference_sides(MEMBRANES, "structured", k, n1, n2, options)
-    reference = pd.DataFrame(beta_rows("structured", k, n1, n2, model=MEMBRANES, mesh=options,
+    gamma = arc(coupling=coupling)
+    library = pd.DataFrame(beta_rows("structured", k, n1, n2, model=MEMBRANES, gamma=gamma))
+    sides = ar.reference_sides(MEMBRANES, "structured", k, n1, n2, gamma)
+    reference = pd.DataFrame(beta_rows("structured", k, n1, n2, model=MEMBRANES, gamma=gamma,
                                        side_cache=ar.reference_cache(sides)))
     assert (library.kernel_dim == reference.kernel_dim).all()
     assert np.abs(library.beta - reference.beta).max() <= 1e-9
@@ -110,9 +111,9 @@ def test_projection_coupling_is_the_adaptively_integrated_mortar_integral(k, n1,
     independently — the reference's curves and averaged normals, the projection a bracketed root,
     adaptive Gauss–Kronrod on the pieces — entrywise to 1e-12 of max |B| (the library's rule is
     documented accurate to 1e-13)."""
-    options = arc(1.5, "projection")
-    sides = SideCache().pair(MEMBRANES, "structured", k, n1, n2, options)
-    bodies = [ar.Body(*ar.library_square(MEMBRANES.subdomain_mesh("structured", n, w, **options.kwargs()).mesh),
+    arc_15 = arc(1.5, "projection")
+    sides = SideCache().pair(MEMBRANES, "structured", k, n1, n2, gamma=arc_15)
+    bodies = [ar.Body(*ar.library_square(MEMBRANES.subdomain_mesh("structured", n, w, gamma=arc_15).mesh),
                       1.5, k) for n, w in ((n1, 1), (n2, 2))]
     curves = [ar.Curve(b) for b in bodies]
     gamma = sides[0].trace.gamma

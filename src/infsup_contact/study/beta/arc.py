@@ -15,7 +15,7 @@ import pandas as pd
 from ...criteria.stability import stability_verdict
 from ...discretization.segment.arc import COUPLINGS
 from ...models import MODELS
-from ...solvers.request import MeshOptions, mesh_of
+from ...solvers.request import MeshOptions, resolve_gamma
 from .batch_rows import beta_batch_rows
 
 PAPER = "paper"
@@ -54,13 +54,14 @@ def arc_rows(radii, series: dict, k: int, cases=None, couplings=COUPLINGS, famil
     pairs = sorted({tuple(p) for ps in series.values() for p in ps})
     by_pair = {p: [s for s, ps in series.items() if p in {tuple(q) for q in ps}] for p in pairs}
     model, gamma = ("membranes", "arc") if element is None else ("membranes3d", "cylinder")
-    runs = [(curvature(r), c, mesh_of(MODELS[model], family, element=element, gamma=gamma, radius=float(r), coupling=c))
+    mesh = MeshOptions(element=element)
+    runs = [(curvature(r), c, resolve_gamma(MODELS[model], family, element=element, gamma=gamma, radius=float(r), coupling=c))
             for r in radii for c in couplings]
     if paper:
-        runs.append((0.0, PAPER, MeshOptions(element=element)))
+        runs.append((0.0, PAPER, None))
     frames = []
-    for kappa, coupling, mesh in runs:
-        frame = beta_batch_rows(model, family, k, pairs, cases, norms=norms, series=by_pair, mesh=mesh)
+    for kappa, coupling, curved in runs:
+        frame = beta_batch_rows(model, family, k, pairs, cases, norms=norms, series=by_pair, mesh=mesh, gamma=curved)
         frame = frame.drop(columns=[c for c in frame.columns if c.startswith("t_")])  # timings: benchmark tree
         frame.insert(0, "coupling", coupling)
         frame.insert(0, "curvature", kappa)

@@ -32,7 +32,8 @@ def as_model(model, **params) -> Model:
 
 def beta_batch_rows(model, family: str, k: int, pairs, cases=None, multiplier_meshes=("omega2",),
                     c_pairs=((1.0, 1.0),), norms=NORMS, *, seeds=None, series=None, model_params=None,
-                    side_cache: SideCache | None = None, mesh: MeshOptions = NO_OPTIONS) -> pd.DataFrame:
+                    side_cache: SideCache | None = None, mesh: MeshOptions = NO_OPTIONS,
+                    gamma=None) -> pd.DataFrame:
     """β_h rows of ``model`` on every (N1, N2) of ``pairs``, one frame.
 
     Parameters
@@ -53,6 +54,9 @@ def beta_batch_rows(model, family: str, k: int, pairs, cases=None, multiplier_me
         Side operators already built (default: a cache for this batch).
     mesh
         Mesh parameters of every pair (e.g. ``MeshOptions(alpha=0.2)`` of the perturbed family).
+    gamma
+        The Γ of every pair (:func:`~infsup_contact.solvers.request.resolve_gamma`: the arc, the
+        cylinder); None: the model's flat Γ.
 
     Rows in the order pair, seed, series, then :func:`beta_rows_all`'s (multiplier mesh,
     case, c pair, norm).
@@ -62,13 +66,13 @@ def beta_batch_rows(model, family: str, k: int, pairs, cases=None, multiplier_me
         s: mesh if s is None else replace(mesh, seed=int(s)) for s in seeds}
     sides = SideCache() if side_cache is None else side_cache
     for options in variants.values():
-        sides.expect(model, family, k, pairs, options)
+        sides.expect(model, family, k, pairs, options, gamma)
     frames = []
     for n1, n2 in pairs:
         for seed, options in variants.items():
             rows = pd.DataFrame(beta_rows_all(family, k, n1, n2, cases, tuple(multiplier_meshes),
                                               [tuple(c) for c in c_pairs], norms, model=model,
-                                              side_cache=sides, mesh=options))
+                                              side_cache=sides, mesh=options, gamma=gamma))
             if seeds is not None:
                 rows["seed"] = np.nan if seed is None else seed
             for name in ([None] if series is None else series[(n1, n2)]):

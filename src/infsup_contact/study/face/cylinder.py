@@ -25,18 +25,19 @@ def cylinder_rows(radii=RADII, pairs=PAIRS, k: int = 1, cases=None, couplings=CO
     :class:`~infsup_contact.errors.InputError` naming its key (the request's checks)."""
     from ...models import model_of_dim
     from ...solvers.infsup import beta_rows
-    from ...solvers.request import mesh_of
+    from ...solvers.request import MeshOptions, resolve_gamma
     from ...solvers.side_cache import SideCache
 
     membranes3d = model_of_dim(3)  # the registry's 3D membranes, asked for (not imported by module)
     rows = []
     for radius in radii:
         for coupling in couplings:
-            mesh = mesh_of(membranes3d, element="hex", gamma="cylinder", radius=float(radius), coupling=coupling)
-            cache = SideCache.for_sweep(membranes3d, "structured", k, pairs, mesh)  # Ω2 at N shared by N:N, N+1:N
+            mesh = MeshOptions(element="hex")
+            gamma = resolve_gamma(membranes3d, element="hex", gamma="cylinder", radius=float(radius), coupling=coupling)
+            cache = SideCache.for_sweep(membranes3d, "structured", k, pairs, mesh, gamma)  # Ω2 at N shared by N:N, N+1:N
             for n1, n2 in pairs:
                 found = beta_rows("structured", k, n1, n2, cases, norms=tuple(norms), model=membranes3d,
-                                  side_cache=cache, mesh=mesh)
+                                  side_cache=cache, mesh=mesh, gamma=gamma)
                 rows += [dict(r, model=membranes3d.name, element="hex", gamma="cylinder", radius=float(radius),
                               coupling=coupling) for r in found]
     return rows

@@ -35,8 +35,9 @@ def test_face_patch_evidence_does_not_depend_on_the_round_off_of_a_pass():
     assert a.loc[hold, "evidence"] == b.loc[hold, "evidence"] and a.loc[hold, "verdict"] == "PASS"
     assert "e-09" not in a.loc[hold, "evidence"] and "e-10" not in b.loc[hold, "evidence"]
     assert "= 1," in a.loc[lack, "evidence"]                            # the failing error is printed
-    inconclusive = _face_patch_claims(1e-7).loc[hold]
-    assert inconclusive.verdict == "INCONCLUSIVE" and "1e-07" in inconclusive.evidence
+    between = 10 * fsc.PATCH_RTOL                                        # above round-off, below failure
+    inconclusive = _face_patch_claims(between).loc[hold]
+    assert inconclusive.verdict == "INCONCLUSIVE" and f"{between:.3g}" in inconclusive.evidence
 
 
 @pytest.mark.parametrize("rel_a, rel_b", [(2.46e-10, 5.77e-10), (0.0, 7.02e-08)])

@@ -51,10 +51,13 @@ from .tolerance import within
 STUDY_CLAIM_PREFIXES = ("face-patch-", "face-alpha-", "face-edge-")
 """Every claim id this module writes starts with one of these (and no claim of the face's β table
 does): the face's claims table holds both kinds, and the paper counts them apart."""
-PATCH_RTOL = 1e-8
-"""λ_h = λ and u_h = u to this relative accuracy: the patch test is passed (round-off)."""
+PATCH_RTOL = 1e-7
+"""λ_h = λ and u_h = u to this relative accuracy: the patch test is passed (round-off). A decade
+above the round-off of the least-conditioned row: R5.4, k = 1, tetrahedra, 7:8, whose K has a
+mode at 5.8e-9 λ_max (below the kernel cutoff), gives max |λ_h − λ|/λ = 6.3e-9 … 1.3e-8 as
+OpenBLAS's code path (SkylakeX, Sandybridge, Haswell, Zen) changes; 1e-8 sat inside that spread."""
 PATCH_FAIL_RTOL = 1e-5
-"""An error above this (three decades above :data:`PATCH_RTOL`) is a failure; between: INCONCLUSIVE."""
+"""An error above this (two decades above :data:`PATCH_RTOL`) is a failure; between: INCONCLUSIVE."""
 WEIGHT_ATOL = 1e-12
 """A weight fraction within this of 0 is not positive (the construction's own tolerance)."""
 INVARIANCE_RTOL, INVARIANCE_FAIL_RTOL = 1e-6, 1e-3

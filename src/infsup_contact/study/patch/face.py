@@ -109,8 +109,10 @@ SCENE = FACE_PATCH.id
 """This scene's registry id (:mod:`..scene_registry` declares it and its models)."""
 DELTA = 1e-2
 """Default downward displacement δ of Ω2's far face."""
-PASS_RTOL = 1e-8
-"""λ_h = λ and u_h = u to this relative accuracy count as passing."""
+PASS_RTOL = 1e-7
+"""λ_h = λ and u_h = u to this relative accuracy count as passing (the ledger's ``PATCH_RTOL``,
+:mod:`infsup_contact.study.claims.membranes3d_studies`: a decade above the round-off spread of the
+least-conditioned row across BLAS code paths)."""
 
 
 @dataclass(frozen=True)

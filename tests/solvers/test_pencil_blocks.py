@@ -152,23 +152,9 @@ def test_the_components_kernel_side_by_side_is_the_serial_one(monkeypatch, case,
     """split_bottom_kernel and split_dense_kernel decide on the components side by side (two
     workers): the decision, its values and kernel vectors bit for bit those of the components one
     after the other."""
-    import dataclasses
-
-    from infsup_contact.discretization.gamma.coupling import coupling_matrix, trace_l2_norms
     from infsup_contact.la import threaded
-    from infsup_contact.solvers.kernel import scaled_couplings
-    from infsup_contact.solvers.side_cache import SideCache
 
-    sides = SideCache().pair(MODELS["membranes3d"], "structured", k, n, n, MeshOptions())
-    gamma = sides[0].trace.gamma
-    g_h = gamma.multiplier_partition(*(s.trace.partition for s in sides), "omega2")
-    space = registry.case_space(case, k, g_h, gamma)
-    cols = np.sqrt(np.diag(gamma.gram(space, "L2")[0]))
-    W = scaled_couplings([coupling_matrix(s.trace, space, k, sparse=True) for s in sides],
-                         [trace_l2_norms(s.trace, k) for s in sides], cols)
-    structural = gamma.proven_kernel(space, k, [s.trace for s in sides],
-                                     gamma.trace_sum_dimension(k, *(s.trace.partition for s in sides)))
-    split = symmetry.split_of(space, gamma, g_h, k)
+    W, split, structural = _kernel_problem(case, k, n)
     calls = []
 
     def side_by_side(fn, items):
@@ -183,9 +169,7 @@ def test_the_components_kernel_side_by_side_is_the_serial_one(monkeypatch, case,
         monkeypatch.setattr(symmetry, "concurrent_map", lambda fn, items: [fn(x) for x in items])
         serial = route()
         assert calls and serial is not None and together is not None
-        for f in dataclasses.fields(serial):
-            a, b = getattr(together, f.name), getattr(serial, f.name)
-            assert np.array_equal(a, b) if isinstance(a, np.ndarray) else a == b, f.name
+        _assert_same_fields(together, serial)
         assert serial.dim == structural
 
 
@@ -201,30 +185,40 @@ def test_the_cross_norm_is_the_dense_products():
     assert symmetry._cross_norm([sp.csc_matrix(B) for B in blocks]) == pytest.approx(dense, rel=1e-12)
 
 
-def test_the_components_kernel_takes_a_sparse_coupling(monkeypatch):
+def test_the_components_kernel_takes_a_sparse_coupling():
     """split_dense_kernel of the sparse W (the large route's fallback) is, field by field and bit
     for bit, that of W made dense: the blocks W Q_c hold the same sums of W's nonzeros either way."""
-    import dataclasses
+    W, split, structural = _kernel_problem("R5.4", 2, 6)
+    for vectors in (False, True):
+        a = symmetry.split_dense_kernel(W, split, structural, vectors=vectors)
+        b = symmetry.split_dense_kernel(W.toarray(), split, structural, vectors=vectors)
+        assert a is not None and a.dim == structural > 0
+        _assert_same_fields(a, b)
 
+
+def _kernel_problem(case: str, k: int, n: int) -> tuple:
+    """(W: the scaled sparse couplings, the space's reflection split, the structural kernel) of a
+    case on the hex pair n:n, what the components' kernel decision receives."""
     from infsup_contact.discretization.gamma.coupling import coupling_matrix, trace_l2_norms
     from infsup_contact.solvers.kernel import scaled_couplings
     from infsup_contact.solvers.side_cache import SideCache
 
-    k, n = 2, 6
     sides = SideCache().pair(MODELS["membranes3d"], "structured", k, n, n, MeshOptions())
     gamma = sides[0].trace.gamma
     g_h = gamma.multiplier_partition(*(s.trace.partition for s in sides), "omega2")
-    space = registry.case_space("R5.4", k, g_h, gamma)
+    space = registry.case_space(case, k, g_h, gamma)
     cols = np.sqrt(np.diag(gamma.gram(space, "L2")[0]))
     W = scaled_couplings([coupling_matrix(s.trace, space, k, sparse=True) for s in sides],
                          [trace_l2_norms(s.trace, k) for s in sides], cols)
     structural = gamma.proven_kernel(space, k, [s.trace for s in sides],
                                      gamma.trace_sum_dimension(k, *(s.trace.partition for s in sides)))
-    split = symmetry.split_of(space, gamma, g_h, k)
-    for vectors in (False, True):
-        a = symmetry.split_dense_kernel(W, split, structural, vectors=vectors)
-        b = symmetry.split_dense_kernel(W.toarray(), split, structural, vectors=vectors)
-        assert a is not None and a.dim == structural > 0
-        for f in dataclasses.fields(a):
-            x, y = getattr(a, f.name), getattr(b, f.name)
-            assert np.array_equal(x, y) if isinstance(x, np.ndarray) else x == y, f.name
+    return W, symmetry.split_of(space, gamma, g_h, k), structural
+
+
+def _assert_same_fields(a, b) -> None:
+    """Two kernel decisions equal field by field, arrays bit for bit."""
+    import dataclasses
+
+    for f in dataclasses.fields(a):
+        x, y = getattr(a, f.name), getattr(b, f.name)
+        assert np.array_equal(x, y) if isinstance(x, np.ndarray) else x == y, f.name

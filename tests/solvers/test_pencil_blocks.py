@@ -222,3 +222,37 @@ def _assert_same_fields(a, b) -> None:
     for f in dataclasses.fields(a):
         x, y = getattr(a, f.name), getattr(b, f.name)
         assert np.array_equal(x, y) if isinstance(x, np.ndarray) else x == y, f.name
+
+
+@pytest.mark.parametrize("k,n,cases,element,blocked", [
+    (2, 10, ("T3", "R5.4", "DUAL-Q9"), "hex", True),   # four components on both sides
+    (2, 12, ("TDUAL-Q8", "T3"), "hex20", True),
+    # the Kuhn tetrahedra's body parts (a 3D involution) are not the face's point reflection:
+    # C = Qᵀ B P is not block diagonal, the bound refuses and the terms are computed whole
+    (2, 10, ("T3",), "tet", False),
+])
+def test_interface_terms_in_parity_blocks_give_the_rows_of_the_whole_terms(monkeypatch, k, n, cases, element,
+                                                                            blocked):
+    """B_i X_i B_iᵀ from the bodies' parity blocks (la/parity_sandwich.py) against the whole
+    sandwich split afterwards: the same rows to the eigensolvers' round-off (module text)."""
+    from infsup_contact.la import parity_sandwich
+    from infsup_contact.solvers import interface_operator
+
+    request = BetaRequest("structured", k, n, n, cases, ("omega2",), ((1.0, 1.0), (1.0, 4.0)), ("H", "L2"),
+                          model=MODELS["membranes3d"], mesh=MeshOptions(element=element))
+    taken = []
+    sandwich = parity_sandwich.parity_sandwich
+    monkeypatch.setattr(interface_operator, "parity_sandwich",
+                        lambda *a: taken.append(sandwich(*a)) or taken[-1])
+    new = beta_table(request)
+    assert taken and all((t is not None) == blocked for t in taken), "the blocks were not taken (refused) as stated"
+    assert all(t.distance < 1e-13 for t in taken if t is not None)
+    monkeypatch.setattr(interface_operator, "_parity_terms", lambda *a: None)
+    old = beta_table(request)
+    assert len(new) == len(old)
+    for a, b in zip(new, old):
+        for key in ("kernel_dim", "n_max", "kernel_decision", "dim_M", "case", "norm", "c2"):
+            assert a[key] == b[key], key
+        for key in ("beta", "smallest_nonzero", "beta_v1_zero"):
+            assert a[key] == pytest.approx(b[key], rel=RTOL, abs=1e-14), key
+        assert a["gap_over_roundoff"] == pytest.approx(b["gap_over_roundoff"], rel=1e-6)

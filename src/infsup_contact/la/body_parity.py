@@ -57,18 +57,21 @@ class ParityParts:
     n_gamma: int
 
     def factorize(self, factorize_one, map=map) -> tuple:
-        """(S, solve, X) of the body from ``factorize_one(K_c, n_gamma_c)`` of every part, which
-        returns an object with ``schur``, ``solve`` and ``steklov`` (a
+        """(S, solve, X, X's blocks) of the body from ``factorize_one(K_c, n_gamma_c)`` of every
+        part, which returns an object with ``schur``, ``solve`` and ``steklov`` (a
         :class:`~.schur.GammaFactorization`); ``map`` runs the independent calls (module text).
         X = S⁻¹ = Σ_c Q_{c,Γ} S_c⁻¹ Q_{c,Γ}ᵀ from the parts' own inverses (a part's ``steklov``, else
         potri of S_c): (1/2^g)³ of the work each, where the side would otherwise invert the whole
-        S for its products (:class:`~.schur.SteklovProduct`)."""
+        S for its products (:class:`~.schur.SteklovProduct`). X's blocks: ((Q_{c,Γ}, S_c⁻¹), ...),
+        each S_c⁻¹ exactly symmetric, for the sandwiches in parity blocks (:mod:`.parity_sandwich`)."""
         facs = list(map(lambda part: factorize_one(part.stiffness, part.n_gamma), self.parts))
         gammas = [part.basis[self.n - self.n_gamma:] for part in self.parts]
-        tails = [Q[:, Q.shape[1] - part.n_gamma:] for Q, part in zip(gammas, self.parts)]
+        tails = [Q[:, Q.shape[1] - part.n_gamma:].tocsr() for Q, part in zip(gammas, self.parts)]
         S = self._sum(tails, [f.schur for f in facs])
-        X = self._sum(tails, [f.steklov if f.steklov is not None else spd_inverse(f.schur) for f in facs])
-        return S, _PartsSolve(self.parts, [f.solve for f in facs]), X
+        inverses = [f.steklov if f.steklov is not None else spd_inverse(f.schur) for f in facs]
+        X = self._sum(tails, inverses)
+        blocks = tuple((P, _exactly_symmetric(Xc)) for P, Xc in zip(tails, inverses))
+        return S, _PartsSolve(self.parts, [f.solve for f in facs]), X, blocks
 
     def _sum(self, tails, blocks) -> np.ndarray:
         """Σ_c Q_{c,Γ} M_c Q_{c,Γ}ᵀ (dense n_Γ × n_Γ), symmetrized."""
@@ -77,6 +80,12 @@ class ParityParts:
             if Q.shape[1]:
                 out += Q @ (Q @ np.asarray(M)).T  # M symmetric: (Q M)ᵀ = M Qᵀ
         return 0.5 * (out + out.T)
+
+
+def _exactly_symmetric(X) -> np.ndarray:
+    """½ (X + Xᵀ) of a square dense X (a no-op on the bits of an exactly symmetric one)."""
+    X = np.asarray(X, dtype=float)
+    return 0.5 * (X + X.T)
 
 
 def spd_inverse(S: np.ndarray) -> np.ndarray:

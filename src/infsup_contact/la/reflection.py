@@ -38,10 +38,8 @@ import scipy.sparse as sp
 
 from .threaded import sparse_times_dense, symmetric_part, times_transpose
 from . import bottom
+from .parity_sandwich import INVARIANCE_RTOL, ParityOperator
 
-INVARIANCE_RTOL = 1e-11
-"""Largest (Σ_{a<b} ‖Q_aᵀ M Q_b‖_F²)^{1/2} / ‖M‖_F (the blocks the split drops) for which S
-and G count as reflection invariant."""
 SPLIT_GAP = 1e-6
 """A kernel vector's part in a component must have norm > 1 − SPLIT_GAP or < SPLIT_GAP (the
 cosines of the principal angles between the kernel and the component): else no split."""
@@ -74,7 +72,13 @@ class ReflectionSplit:
 
         Row combinations Q_aᵀ M (sparse × dense: whole rows, threaded), then (Q_aᵀ M) Q_b by
         :func:`~infsup_contact.la.threaded.times_transpose` (small transposed blocks): fancy
-        column gathers M[:, j] of a C-ordered 4,225² matrix were a strided pass each."""
+        column gathers M[:, j] of a C-ordered 4,225² matrix were a strided pass each. An operator
+        already kept in these components (:class:`~.parity_sandwich.ParityOperator`) gives its
+        blocks and its bound on what they drop."""
+        if isinstance(M, ParityOperator):
+            if tuple(Q.shape for Q in M.bases) != tuple(Q.shape for Q in self.bases):
+                raise ValueError("a ParityOperator of another split")
+            return (*M.blocks, M.distance)
         QT = [Q.T.tocsr() for Q in self.bases]
         M = np.ascontiguousarray(M, dtype=float)
         T = [sparse_times_dense(Q, M) for Q in QT]

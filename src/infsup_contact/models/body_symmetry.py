@@ -194,8 +194,10 @@ class MirroredSolve:
 
 
 def mirrored_factors(side1, signature2, K2) -> tuple | None:
-    """(S2, solve2, X2 or None) of body 2 from side 1's (its ``signature`` attribute, its stiffness,
-    schur, solve, steklov) through the checked mirror (:func:`mirror_permutation`), else None."""
+    """(S2, solve2, X2 or None, X2's parity blocks or None) of body 2 from side 1's (its
+    ``signature`` attribute, its stiffness, schur, solve, steklov, steklov_parts) through the
+    checked mirror (:func:`mirror_permutation`), else None. X2 = X1[τ][:, τ], so its blocks are
+    side 1's with the rows of each P_c permuted (the X_c themselves shared)."""
     n_gamma = len(side1.trace.gamma_dofs)
     sigma = mirror_permutation(getattr(side1, "signature", None), side1.stiffness, signature2, K2, n_gamma)
     if sigma is None:
@@ -203,4 +205,6 @@ def mirrored_factors(side1, signature2, K2) -> tuple | None:
     n = sigma.size
     tau = sigma[n - n_gamma:] - (n - n_gamma)
     X = None if side1.steklov is None else side1.steklov[np.ix_(tau, tau)]
-    return side1.schur[np.ix_(tau, tau)], MirroredSolve(side1.solve, sigma), X
+    parts1 = getattr(side1, "steklov_parts", None)
+    parts = None if parts1 is None else tuple((P[tau], Xc) for P, Xc in parts1)
+    return side1.schur[np.ix_(tau, tau)], MirroredSolve(side1.solve, sigma), X, parts

@@ -306,6 +306,11 @@ class SideOperator(SteklovProduct):
     route: str = ""
     """How it was factorized: ``"parity 4"`` / ``"parity 2"`` (the body's symmetry parts),
     ``"mirror"`` (side 1's, permuted), else the :func:`~.schur.gamma_factorization` route."""
+    steklov_parts: tuple | None = None
+    """X = ``steklov`` in the body's parity blocks, ((P_c, X_c), ...) with X = Σ_c P_c X_c P_cᵀ
+    (P_c sparse, n_Γ × n_c, orthonormal columns): a side factorized in parity parts (or mirrored
+    from one); None otherwise. The sandwiches B X Bᵀ of a split space take them
+    (:mod:`~infsup_contact.la.parity_sandwich`)."""
 
     @property
     def ndof(self) -> int:
@@ -346,10 +351,10 @@ def factorized_side(trace: GammaTrace, free: np.ndarray, K, route: str = "auto",
     bases = None if keep_factor else body_symmetry.parity_bases(signature, K, n_gamma)
     if bases is not None:
         parts = body_parity.parity_parts(K, n_gamma, bases)
-        S, solve, X = parts.factorize(
+        S, solve, X, blocks = parts.factorize(
             lambda Kc, ng: schur.gamma_factorization(Kc, ng, route, gamma_dim=trace.gamma.dim,
                                                      keep_factor=keep_factor), parts_map)
-        return SideOperator(trace, free, K, S, solve, X, signature, f"parity {len(parts.parts)}")
+        return SideOperator(trace, free, K, S, solve, X, signature, f"parity {len(parts.parts)}", blocks)
     fac = schur.gamma_factorization(K, n_gamma, route, gamma_dim=trace.gamma.dim, keep_factor=keep_factor)
     return SideOperator(trace, free, K, fac.schur, fac.solve, fac.steklov, signature, fac.route)
 
@@ -368,8 +373,8 @@ def mirrored_side(side1: SideOperator, trace: GammaTrace, free: np.ndarray, K, s
     factors = body_symmetry.mirrored_factors(side1, signature, K)
     if factors is None:
         return factorized_side(trace, free, K, route, keep_factor, signature)
-    S, solve, X = factors
-    return SideOperator(trace, free, K, S, solve, X, signature, "mirror")
+    S, solve, X, blocks = factors
+    return SideOperator(trace, free, K, S, solve, X, signature, "mirror", blocks)
 
 
 def schur_by_solves(side: SideOperator) -> np.ndarray:

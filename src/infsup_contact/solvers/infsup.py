@@ -119,7 +119,9 @@ def _case_rows(r: BetaRequest, case, g_h, sides, dim_w: int, trace_norms, modes:
         route = choose_route(space, couplings, sides, grams, structural, g_h, r.k, trace_norms,
                              vectors=modes is not None)
     progress.note(f"interface operator ({route.name} route)")
-    terms = _timed("interface terms", interface_terms, couplings, sides)            # B_i X_i B_iᵀ
+    # B_i X_i B_iᵀ, in the blocks of the space's reflections where the sides know X in theirs
+    # (a worst mode is a vector of the whole space: its S is whole)
+    terms = _timed("interface terms", interface_terms, couplings, sides, route.split if modes is None else None)
     v1_zero = _timed("β with v1 = 0", route.betas_v1_zero, terms)
     rows = []
     for c1, c2 in r.c_pairs:

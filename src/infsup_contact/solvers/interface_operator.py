@@ -11,6 +11,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
+from ..la.parity_sandwich import ParityOperator, combine, parity_sandwich
 from ..la.threaded import symmetric_part
 
 
@@ -24,12 +25,20 @@ potri once, 0.1); below 300 (every segment space of the default DAG, up to N = 6
 face's at N = 6) both are milliseconds and the rows keep their bits."""
 
 
-def interface_terms(couplings, sides) -> list:
+def interface_terms(couplings, sides, split=None) -> list:
     """The terms B_i X_i B_iᵀ of the interface operator at unit material scale, one per side.
 
     Above :data:`SPARSE_PRODUCT_MIN_DIM` by a side's ``steklov_sandwich`` where it has one (the
     same matrix to round-off: X from potri instead of the triangular solves), else
-    ``B (X Bᵀ)`` by its ``steklov_times``."""
+    ``B (X Bᵀ)`` by its ``steklov_times``. ``split``: the space's reflections
+    (:class:`~infsup_contact.la.reflection.ReflectionSplit`, its route's); where every side
+    knows X in its parity blocks (``steklov_parts``) the terms are computed in the split's
+    components only (:func:`~infsup_contact.la.parity_sandwich.parity_sandwich`:
+    :class:`~infsup_contact.la.parity_sandwich.ParityOperator` terms, their dropped part bounded),
+    else, or where a bound is too large, whole."""
+    blocked = _parity_terms(couplings, sides, split)
+    if blocked is not None:
+        return blocked
     out = []
     for B, side in zip(couplings, sides):
         large = B.shape[0] > SPARSE_PRODUCT_MIN_DIM
@@ -42,9 +51,28 @@ def interface_terms(couplings, sides) -> list:
     return out
 
 
+def _parity_terms(couplings, sides, split) -> list | None:
+    """The terms in the components of ``split`` (:func:`interface_terms`), or None."""
+    if split is None or couplings[0].shape[0] <= SPARSE_PRODUCT_MIN_DIM:
+        return None
+    parts = [getattr(side, "steklov_parts", None) for side in sides]
+    if any(p is None for p in parts):
+        return None
+    out = []
+    for B, p in zip(couplings, parts):
+        term = parity_sandwich(B, p, split.bases)
+        if term is None:
+            return None
+        out.append(term)
+    return out
+
+
 def combine_terms(terms, c) -> np.ndarray:
     """Σ_i T_i / c_i, symmetrized: the interface operator for the material scales c (the
-    symmetrisation over the threads, :func:`~infsup_contact.la.threaded.symmetric_part`)."""
+    symmetrisation over the threads, :func:`~infsup_contact.la.threaded.symmetric_part`);
+    terms in parity blocks stay in them (:func:`~infsup_contact.la.parity_sandwich.combine`)."""
+    if isinstance(terms[0], ParityOperator):
+        return combine(terms, c)
     out = 0.0
     for T, ci in zip(terms, c):
         out = out + T / ci

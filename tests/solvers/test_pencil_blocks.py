@@ -256,3 +256,60 @@ def test_interface_terms_in_parity_blocks_give_the_rows_of_the_whole_terms(monke
         for key in ("beta", "smallest_nonzero", "beta_v1_zero"):
             assert a[key] == pytest.approx(b[key], rel=RTOL, abs=1e-14), key
         assert a["gap_over_roundoff"] == pytest.approx(b["gap_over_roundoff"], rel=1e-6)
+
+
+def _trace_rows(case, k, n):
+    """(W, split, structural) of :func:`_kernel_problem` and the row components of the sides'
+    parity parts on Γ (or None)."""
+    from infsup_contact.solvers import routes
+    from infsup_contact.solvers.side_cache import SideCache
+
+    sides = SideCache().pair(MODELS["membranes3d"], "structured", k, n, n, MeshOptions())
+    return (*_kernel_problem(case, k, n), routes._trace_components(sides))
+
+
+@pytest.mark.parametrize("case,k,n", [("R5.4", 2, 6), ("T3", 2, 6), ("R5.2", 1, 8)])
+def test_the_kernel_on_the_trace_components_rows_is_the_whole_blocks(case, k, n):
+    """split_dense_kernel on the rows of the matching trace component (the bodies' parity parts on Γ)
+    decides as on the whole blocks W Q_c: the same count, decision and margin to round-off; the
+    kept rows' singular values interlace the block's (σ_i(A) <= σ_i([A; O])) and the dropped
+    energy is the block's rest."""
+    W, split, structural, rows = _trace_rows(case, k, n)
+    assert rows is not None and sum(R.shape[1] for R in rows) == W.shape[0]
+    for vectors in (False, True):
+        whole = symmetry.split_dense_kernel(W, split, structural, vectors=vectors)
+        reduced = symmetry.split_dense_kernel(W, split, structural, vectors=vectors, row_bases=rows)
+        assert whole is not None and reduced is not None
+        assert (reduced.dim, reduced.decision, reduced.numerical) == (whole.dim, whole.decision, whole.numerical)
+        assert reduced.margin_decades == pytest.approx(whole.margin_decades, rel=1e-9)
+    blocks = [(W @ Q).tocsc() for Q in split.bases]
+    kept, dropped = symmetry.row_components(blocks, rows)
+    for A, B in zip(kept, blocks):
+        assert A.shape[0] < B.shape[0] and A.shape[1] == B.shape[1]
+        sa = np.sort(np.linalg.svd(A.toarray(), compute_uv=False))[::-1]
+        sb = np.sort(np.linalg.svd(B.toarray(), compute_uv=False))[::-1]
+        assert np.all(sa <= sb[:len(sa)] * (1 + 1e-12) + 1e-14 * sb[0])
+    total = sum(sp.linalg.norm(B) ** 2 for B in blocks)
+    assert 0.0 <= dropped <= 1e-24 * total
+
+
+def test_rows_of_another_group_are_kept_whole():
+    """The Kuhn tetrahedra's body parts are not the face's point reflection: their trace components
+    do not hold W Q_c, and row_components keeps every row (the blocks unchanged, nothing dropped)."""
+    from infsup_contact.discretization.gamma.coupling import coupling_matrix, trace_l2_norms
+    from infsup_contact.solvers.kernel import scaled_couplings
+    from infsup_contact.solvers import routes
+    from infsup_contact.solvers.side_cache import SideCache
+
+    sides = SideCache().pair(MODELS["membranes3d"], "structured", 2, 4, 4, MeshOptions(element="tet"))
+    gamma = sides[0].trace.gamma
+    g_h = gamma.multiplier_partition(*(s.trace.partition for s in sides), "omega2")
+    space = registry.case_space("T3", 2, g_h, gamma)
+    W = scaled_couplings([coupling_matrix(s.trace, space, 2, sparse=True) for s in sides],
+                         [trace_l2_norms(s.trace, 2) for s in sides], np.ones(space.dim))
+    split = symmetry.split_of(space, gamma, g_h, 2)
+    rows = routes._trace_components(sides)
+    assert split is not None and rows is not None
+    blocks = [(W @ Q).tocsc() for Q in split.bases]
+    kept, dropped = symmetry.row_components(blocks, rows)
+    assert kept is blocks and dropped == 0.0

@@ -127,7 +127,7 @@ def space_kernel(couplings, sides, space, k: int, structural: int, l2_gram=None,
                                for s in sides], rows, cols)
     if not iterative:
         error = np.linalg.norm(W - longer)
-        decision = (symmetry.split_dense_kernel(W, split, structural, error)
+        decision = (symmetry.split_dense_kernel(W, split, structural, error, row_bases=_trace_components(sides))
                     if split is not None and not vectors else None)  # the components' SVDs where they decide
         decision = decision or coupling_kernel(W, structural, entry_error=error, vectors=vectors)
         return decision if decision.vectors is None else replace(decision, vectors=decision.vectors / cols[:, None])
@@ -135,9 +135,20 @@ def space_kernel(couplings, sides, space, k: int, structural: int, l2_gram=None,
     decision = symmetry.split_bottom_kernel(W, split, structural, error) if split is not None else None
     if decision is None and split is not None:  # a certificate too close to round-off: the blocks'
         # dense SVDs (about (1/c)² of the whole one's flops and memory) before the whole W's
-        decision = symmetry.split_dense_kernel(W, split, structural, error, vectors=True)
+        decision = symmetry.split_dense_kernel(W, split, structural, error, vectors=True,
+                                               row_bases=_trace_components(sides))
     decision = bottom_kernel(W, structural, entry_error=error) if decision is None else decision
     return replace(decision, vectors=decision.vectors / cols[:, None])  # W v = 0 ⇔ Bᵀ (v / cols) = 0
+
+
+def _trace_components(sides) -> tuple | None:
+    """The components of W's rows (the sides' trace dofs, side 1's first): blockdiag(P_1c, P_2c)
+    of the sides' parity parts on Γ (``steklov_parts``), or None where a side has none or their
+    counts differ (:func:`~.symmetry.split_dense_kernel` then keeps every row)."""
+    parts = [getattr(side, "steklov_parts", None) for side in sides]
+    if any(p is None for p in parts) or len({len(p) for p in parts}) != 1:
+        return None
+    return tuple(sp.block_diag([p[c][0] for p in parts], format="csr") for c in range(len(parts[0])))
 
 
 LONGER_RULE = 6

@@ -114,7 +114,7 @@ def _cross_norm(blocks) -> float:
 
 
 def split_dense_kernel(W: np.ndarray, split: ReflectionSplit, proven: int = 0,
-                       entry_error: float = 0.0, vectors: bool = False) -> KernelDecision | None:
+                       entry_error: float = 0.0, vectors: bool = False, row_bases=None) -> KernelDecision | None:
     """:func:`~.kernel.coupling_kernel` of W (trace dofs × multipliers, dense or sparse) from the singular
     values of its components' columns W Q_c (about (1/c)² of the whole SVD's flops), or None (the
     caller's dense SVD decides).
@@ -134,7 +134,14 @@ def split_dense_kernel(W: np.ndarray, split: ReflectionSplit, proven: int = 0,
     above round-off, which the blocks give to its relative ‖O‖/σ_{d+1}²; where modes beyond the
     proof would be counted the margin rests on a round-off singular value, and the whole SVD
     reports it as before (None). ``vectors``: also the kernel's basis, the blocks' right singular
-    vectors below η mapped by Q_c (orthonormal: the Q_c are)."""
+    vectors below η mapped by Q_c (orthonormal: the Q_c are).
+
+    ``row_bases``: the trace dofs' components (R_0, ...: orthonormal, complete; the bodies'
+    parity parts on Γ, :func:`row_components`), which the equivariant W Q_c keeps to one of them
+    but round-off: each block is then R_{σ(c)}ᵀ W Q_c (about 1/2^g of the rows, as many fewer QR
+    flops), and the rows dropped, O_c, enter the first bound (‖W X‖_F² <= Σ_j σ_j² + Σ_c ‖O_c‖_F²,
+    computed) — not the second: (W Q_c)ᵀ (W Q_c) = A_cᵀ A_c + O_cᵀ O_c ⪰ A_cᵀ A_c, so the kept
+    rows' σ_{d+1} is a lower bound of the whole block's."""
     W = sp.csr_matrix(W, dtype=float)
     rows, m = W.shape
     proven = int(max(proven, m - rows, 0))
@@ -142,6 +149,7 @@ def split_dense_kernel(W: np.ndarray, split: ReflectionSplit, proven: int = 0,
         return None
     sparse = [(W @ Q).tocsc() for Q in split.bases]  # the products of W's nonzeros, in W's order
     cross = _cross_norm(sparse)
+    sparse, dropped_rows = row_components(sparse, row_bases)
     blocks = [B.toarray(order="F") for B in sparse]  # Fortran-ordered: their QR in place
     del sparse  # not needed past the cross term: freed before the SVDs
     live = [(B, Q) for B, Q in zip(blocks, split.bases) if B.shape[1]]
@@ -158,7 +166,7 @@ def split_dense_kernel(W: np.ndarray, split: ReflectionSplit, proven: int = 0,
     numerical = int(np.sum(s <= tol))
     if numerical != proven:
         return None
-    below = float(np.sqrt(np.sum(s[:numerical] ** 2))) <= tol
+    below = float(np.sqrt(np.sum(s[:numerical] ** 2) + dropped_rows)) <= tol
     above = s[numerical] ** 2 - cross > tol ** 2 if numerical < m else True
     if not (below and above):
         return None
@@ -170,3 +178,36 @@ def split_dense_kernel(W: np.ndarray, split: ReflectionSplit, proven: int = 0,
         if d_b:
             basis.append(np.asarray(Q @ vt[::-1][:d_b].T))  # rows of vt descending: the smallest last
     return decide(s, proven, tol, numerical, s_max, np.hstack(basis) if basis else np.zeros((m, 0)))
+
+
+def row_components(blocks, row_bases) -> tuple:
+    """([R_{σ(c)}ᵀ B_c, ...], Σ_c Σ_{d ≠ σ(c)} ‖R_dᵀ B_c‖_F²) for the column blocks B_c = W Q_c and
+    the row components ``row_bases`` (σ(c) the component holding most of B_c: a bijection between
+    the non-empty blocks, else the blocks unchanged, 0.0); ``row_bases`` None: the same."""
+    if row_bases is None:
+        return blocks, 0.0
+    RT = [sp.csr_matrix(R.T) for R in row_bases]
+    kept, dropped, total, taken = [], 0.0, 0.0, set()
+    for B in blocks:
+        if B.shape[1] == 0:
+            kept.append(sp.csc_matrix((0, 0)))
+            continue
+        parts = [(Rt @ B).tocsc() for Rt in RT]
+        norms = [sp.linalg.norm(T) ** 2 if T.nnz else 0.0 for T in parts]
+        best = int(np.argmax(norms))
+        if best in taken:
+            return blocks, 0.0
+        taken.add(best)
+        kept.append(parts[best])
+        dropped += float(sum(v for d, v in enumerate(norms) if d != best))  # not a difference: no cancellation
+        total += float(sum(norms))
+    if dropped > ROWS_SPLIT_RTOL * total:  # the rows do not split (another group: the tetrahedra's)
+        return blocks, 0.0
+    return kept, dropped
+
+
+ROWS_SPLIT_RTOL = 1e-20
+"""Largest share of ‖W Q_c‖_F² outside the kept row components for which :func:`row_components`
+reduces the rows (round-off is about ε² ≈ 5e-32 of it; a body group that is not the face's leaves
+a share of order one)."""
+

@@ -60,6 +60,16 @@ def run_cli(capsys, *argv) -> tuple[int, str]:
 BEYOND = [0.2 + 1e-9, 0.25, 0.3, 0.45, 0.5, -0.01, float("nan"), float("inf")]
 
 
+def test_the_builders_defaults_are_none_and_pass():
+    """A request that leaves α and the seed to the mesh builder (None) is checked with them:
+    nothing to refuse; a wrong seed or α beside a None is still refused, naming its key."""
+    meshes.check_perturbation(None, None)
+    for alpha, seed, key in ((None, -1, "seed"), (None, True, "seed"), (0.3, None, "alpha"), ("x", None, "alpha")):
+        with pytest.raises(InputError) as err:
+            meshes.check_perturbation(alpha, seed)
+        assert err.value.key == key
+
+
 @pytest.mark.parametrize("alpha", BEYOND)
 def test_alpha_beyond_the_bound_is_refused(alpha, capsys):
     with pytest.raises(InputError) as err:

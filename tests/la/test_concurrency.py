@@ -154,7 +154,7 @@ def test_freed_memory_is_kept_for_the_whole_request_only_where_memory_is_plentif
 def test_bounded_reuse_gives_freed_memory_back_at_a_stages_end(monkeypatch):
     for var in [v for v in threaded.os.environ if v.startswith("MALLOC_")]:
         monkeypatch.delenv(var)
-    monkeypatch.setattr(threaded, "_BOUNDED_REUSE", [False])
+    monkeypatch.setattr(threaded, "_bounded_reuse", False)
     released = []
     libc = type("Libc", (), {"malloc_trim": staticmethod(released.append), "mallopt": staticmethod(lambda p, v: 1)})
     monkeypatch.setattr("ctypes.CDLL", lambda name: libc())      # glibc's calls recorded, not made

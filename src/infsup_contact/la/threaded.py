@@ -107,7 +107,7 @@ M_TRIM_THRESHOLD, M_MMAP_MAX, M_ARENA_MAX = -1, -4, -8
 """glibc's ``mallopt`` parameters (malloc.h)."""
 
 
-_BOUNDED_REUSE = [False]
+_bounded_reuse = False
 """Whether :func:`release_freed_memory` gives the kept free memory back (:func:`reuse_freed_memory`
 with ``bounded``)."""
 
@@ -147,14 +147,15 @@ def reuse_freed_memory(bounded: bool = False) -> bool:
         return False
     applied = (bool(mallopt(M_MMAP_MAX, 0)) and bool(mallopt(M_TRIM_THRESHOLD, 2 ** 31 - 1))
                and bool(mallopt(M_ARENA_MAX, 1)))
-    _BOUNDED_REUSE[0] = applied and bounded
+    global _bounded_reuse
+    _bounded_reuse = applied and bounded
     return applied
 
 
 def release_freed_memory() -> None:
     """Where :func:`reuse_freed_memory` was applied ``bounded``: give the free memory the process
     keeps back to the system (glibc ``malloc_trim``; live blocks stay where they are). Else nothing."""
-    if _BOUNDED_REUSE[0]:
+    if _bounded_reuse:
         import ctypes
 
         ctypes.CDLL(None).malloc_trim(0)

@@ -137,8 +137,7 @@ class BetaRequest:
             registry.check_pair_spaces(entries, self.k, self.n1, self.n2, (mm,))  # dim M_h = 0: refused here
             check_pair_size(entries, self.k, self.n1, self.n2, mm)  # a Petrov–Galerkin pair is solved densely
         if self.family == "perturbed":  # the mesh builder trusts the request (SideCache.pair, checked)
-            meshes.check_perturbation(meshes.ALPHA_MAX if self.mesh.alpha is None else self.mesh.alpha,
-                                      0 if self.mesh.seed is None else self.mesh.seed)
+            meshes.check_perturbation(self.mesh.alpha, self.mesh.seed)  # None: the builder's default
 
     @property
     def interface(self):

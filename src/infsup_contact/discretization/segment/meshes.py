@@ -84,11 +84,11 @@ def perturbation_bounds(alpha: float) -> tuple[float, float]:
 
 def check_perturbation(alpha, seed) -> None:
     """:class:`InputError` unless 0 <= α <= :data:`ALPHA_MAX` (finite) and the seed is an
-    integer >= 0 (numpy)."""
-    if isinstance(alpha, bool) or not isinstance(alpha, (int, float, np.integer, np.floating)) \
-            or not ALPHA_RANGE[0] <= alpha <= ALPHA_RANGE[1]:
+    integer >= 0 (numpy); None stands for the mesh builder's default (valid by construction)."""
+    if alpha is not None and (isinstance(alpha, bool) or not isinstance(alpha, (int, float, np.integer, np.floating))
+                              or not ALPHA_RANGE[0] <= alpha <= ALPHA_RANGE[1]):
         raise InputError("alpha", ALPHA_ALLOWED, got=alpha)
-    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
+    if seed is not None and (isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0):
         raise InputError("seed", "an integer >= 0 (a numpy seed)", got=seed)
 
 

@@ -31,7 +31,7 @@ import pytest
 PACKAGE = Path(__file__).resolve().parents[1] / "src" / "infsup_contact"
 
 LAYERS = [
-    {"errors", "yaml_limits", "io", "table_schemas", "provenance", "command_line", "progress"},  # no physics: errors, limits, table I/O
+    {"errors", "yaml_limits", "io", "table_schemas", "provenance", "command_line", "progress", "memory"},  # no physics: errors, limits, table I/O
     {"la"},                                          # linear-algebra back ends
     {"discretization.gamma", "discretization"},      # what every Γ shares (today: one hall)
     {"discretization.segment"},                      # the paper's segment

@@ -19,6 +19,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from .memory import available_bytes, total_bytes  # noqa: F401  (the readings, here for the estimates' callers)
+
 MIB = 1024 ** 2
 
 PROCESS_BYTES = {"beta": 200 * MIB, "contact": 230 * MIB, "bench": 220 * MIB}
@@ -299,27 +301,6 @@ def bench_estimate(what: str, ns, ks, repeats: int = 3, eigsh_max_n=None, kkt_ma
 def job_mem_mb(estimate: Estimate, margin: float = 1.25) -> int:
     """``mem_mb`` of a workflow job: the estimate with a margin, rounded up to 100 MB."""
     return int(math.ceil(margin * estimate.bytes / 1e8)) * 100
-
-
-def _meminfo(field: str, meminfo: str) -> float | None:
-    try:
-        with open(meminfo) as fh:
-            for line in fh:
-                if line.startswith(field + ":"):
-                    return float(line.split()[1]) * 1024
-    except (OSError, ValueError, IndexError):
-        return None
-    return None
-
-
-def available_bytes(meminfo: str = "/proc/meminfo") -> float | None:
-    """MemAvailable of /proc/meminfo in bytes (None where the file or the field is missing)."""
-    return _meminfo("MemAvailable", meminfo)
-
-
-def total_bytes(meminfo: str = "/proc/meminfo") -> float | None:
-    """MemTotal of /proc/meminfo in bytes (None where unavailable)."""
-    return _meminfo("MemTotal", meminfo)
 
 
 SYSTEM_MARGIN = 1.4

@@ -17,8 +17,8 @@ operands: the rows are those of one space at a time (tested bit for bit at one B
 
 Memory bounds it: a space holds a few dense m × m matrices at its peak (:data:`DENSE_COPIES`,
 m about dim(W1 + W2)), and two spaces run at once only where both working sets fit in
-:data:`MEMORY_SHARE` of the memory free when the spaces start (k = 2 on the face, 24 GB:
-N = 36, 2 × 1.6 GB, two at a time; N = 48, 2 × 5.2 GB against about 14 GB free after the sides,
+:data:`MEMORY_SHARE` of the memory available when the spaces start (k = 2 on the face, 24 GB:
+N = 36, 2 × 1.6 GB, two at a time; N = 48, 2 × 5.7 GB against about 17 GB available after the sides,
 one at a time: the peak stays the serial one). Where the request's progress is timed by phase
 (:func:`~infsup_contact.progress.timing`, the benchmark's breakdown), the concurrent spaces'
 phases count as one, :data:`PHASE`. Where the command line keeps freed memory within a stage
@@ -26,16 +26,15 @@ only, each space's end is a stage's end (:func:`~infsup_contact.la.threaded.rele
 """
 from __future__ import annotations
 
-import os
-
 from .. import progress
+from ..memory import available_bytes
 from ..la.threaded import release_freed_memory, run_concurrently, threads
 
 DENSE_COPIES = 8.0
 """Dense m × m float64 matrices one space holds at its peak (measured at k = 2 on the face,
 N = 32 and 36: the interface terms raised the resident memory by 7–8 m² doubles)."""
 MEMORY_SHARE = 0.5
-"""Share of the free memory two spaces' working sets may take together."""
+"""Share of the available memory two spaces' working sets may take together."""
 PHASE = "spaces side by side"
 """The phase (:func:`~infsup_contact.progress.phase`) the concurrent spaces count in."""
 
@@ -49,23 +48,14 @@ def space_workers(dim: int, n_spaces: int, available: float | None = None) -> in
     """How many spaces run at once: two where the request has two threads or more
     (:func:`~infsup_contact.la.threaded.threads`), there are two spaces to run and two working
     sets of dimension ``dim`` fit in :data:`MEMORY_SHARE` of ``available`` bytes (default: the
-    memory free now, :func:`free_memory`); else one."""
+    memory available now, :func:`~infsup_contact.memory.available_bytes`); else one."""
     if threads() < 2 or n_spaces < 2:
         return 1
     if available is None:
-        available = free_memory()
+        available = available_bytes()
     if available is None or 2 * working_set(dim) > MEMORY_SHARE * available:
         return 1
     return 2
-
-
-def free_memory() -> float | None:
-    """Bytes of memory free now (the pages no process holds and no cache keeps: less than
-    MemAvailable, on the safe side), None where the system does not say."""
-    try:
-        return float(os.sysconf("SC_AVPHYS_PAGES")) * os.sysconf("SC_PAGE_SIZE")
-    except (ValueError, OSError, AttributeError):
-        return None
 
 
 def rows_by_case(cases, rows_of, dim: int, label=str) -> list:

@@ -214,3 +214,41 @@ def test_a_beta_side_drops_k_on_every_dof_and_its_load_is_the_scene_sides():
     F_scene, lift_scene = m3.load(scene_side, scene, 0)
     assert np.array_equal(lift_beta, lift_scene) and np.abs(lift_scene).max() > 0
     assert np.array_equal(F_beta, F_scene) and np.abs(F_scene).max() > 0
+
+
+def _commutes_whole(K, K_image, sigma) -> bool:
+    """The straightforward check: max |K[σ][:, σ] − K_image| ≤ COMMUTE_RTOL max |K|, whole and dense."""
+    K = sp.csr_matrix(K)
+    diff = np.abs((K[sigma][:, sigma] - sp.csr_matrix(K_image)).toarray()).max()
+    return bool(diff <= body_symmetry.COMMUTE_RTOL * np.abs(K.data).max())
+
+
+@pytest.mark.parametrize("element, k", (("hex", 2), ("tet", 2), ("hex20", 2)))
+def test_the_blockwise_check_is_the_whole_one(monkeypatch, element, k):
+    """:func:`~infsup_contact.models.body_symmetry.commutes` row block by row block (blocks of a few
+    rows here, so that every kind of block boundary is crossed), on CSC matrices through their
+    transposes: the same verdict as the whole dense check, on symmetries that hold, a stiffness
+    entry moved, a pattern changed and a permutation that is no symmetry."""
+    monkeypatch.setattr(body_symmetry, "BLOCK_ENTRIES", 97)
+    side = m3.side_operator(m3.subdomain_mesh("structured", 3, 1, element=element), k)
+    K, n_gamma = side.stiffness, len(side.trace.gamma_dofs)
+    points, inv = body_symmetry._keys(side.signature, K)
+    candidates = [body_symmetry._match(points, inv, T(points), inv) for T in (
+        body_symmetry.REFLECT_X, body_symmetry.REFLECT_Y, body_symmetry.SWAP, body_symmetry.ANTISWAP)]
+    candidates = [pi for pi in candidates if pi is not None]
+    candidates.append(np.random.default_rng(2).permutation(K.shape[0]))
+    moved = K.tolil()
+    j = int(sp.csr_matrix(K)[0].indices[-1])
+    moved[0, j] += 1e-6 * np.abs(K.data).max()
+    moved[j, 0] = moved[0, j]
+    coo = K.tocoo()  # an explicit zero off the pattern: another pattern, the same K
+    zero = sp.csc_matrix((np.append(coo.data, 0.0), (np.append(coo.row, 0), np.append(coo.col, K.shape[0] - 1))),
+                         shape=K.shape)
+    assert zero.nnz == K.nnz + 1
+    verdicts = []
+    for image in (K, moved.tocsc(), moved.tocsr(), zero):
+        for pi in candidates:
+            verdict = body_symmetry.commutes(K if image.format == "csc" else K.tocsr(), image, pi)
+            assert verdict == _commutes_whole(K, image, pi)
+            verdicts.append(verdict)
+    assert any(verdicts) and not all(verdicts)

@@ -252,3 +252,34 @@ def test_the_blockwise_check_is_the_whole_one(monkeypatch, element, k):
             assert verdict == _commutes_whole(K, image, pi)
             verdicts.append(verdict)
     assert any(verdicts) and not all(verdicts)
+
+
+@pytest.mark.parametrize("element, k", (("hex", 2), ("tet", 2), ("hex20", 2)))
+def test_the_orbit_route_of_the_parts_sum_is_the_sparse_products(monkeypatch, element, k):
+    """Σ_c Q_{c,Γ} M_c Q_{c,Γ}ᵀ by :func:`~infsup_contact.la.body_parity.orbit_sandwich_sum` (entries
+    gathered row block by row block) against scipy's sparse products
+    (:func:`~infsup_contact.la.body_parity.sandwich_sum`): bit for bit, on a body's parts with
+    symmetric blocks holding a −0 (the products' added zeros turn it into +0) and a block of
+    rows smaller than n_Γ; a Q with two entries in a row takes the sparse products."""
+    side = m3.side_operator(m3.subdomain_mesh("structured", 3, 1, element=element), k)
+    n_gamma = len(side.trace.gamma_dofs)
+    parts = body_parity.parity_parts(side.stiffness, n_gamma,
+                                     body_symmetry.parity_bases(side.signature, side.stiffness, n_gamma))
+    tails = [p.basis[parts.n - n_gamma:][:, p.basis.shape[1] - p.n_gamma:].tocsr() for p in parts.parts]
+    rng = np.random.default_rng(3)
+    blocks = []
+    for Q in tails:
+        M = rng.standard_normal((Q.shape[1], Q.shape[1]))
+        M = M + M.T
+        M[0, 0] = -0.0
+        blocks.append(M)
+    reference = body_parity.sandwich_sum(tails, blocks, n_gamma)
+    monkeypatch.setattr(body_parity, "ROWS", 7)  # blocks and tiles of 7 rows, the last one shorter
+    assert np.array_equal(parts._sum(tails, blocks).view(np.int64), reference.view(np.int64))
+    assert np.array_equal(body_parity.orbit_sandwich_sum(tails, blocks, n_gamma).view(np.int64),
+                          reference.view(np.int64))
+    mixed = [Q.tolil() for Q in tails]
+    mixed[0][0, 1] = 0.5  # two entries in row 0: no orbit route
+    mixed = [Q.tocsr() for Q in mixed]
+    assert np.array_equal(parts._sum(mixed, blocks).view(np.int64),
+                          body_parity.sandwich_sum(mixed, blocks, n_gamma).view(np.int64))

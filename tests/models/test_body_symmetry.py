@@ -283,3 +283,21 @@ def test_the_orbit_route_of_the_parts_sum_is_the_sparse_products(monkeypatch, el
     mixed = [Q.tocsr() for Q in mixed]
     assert np.array_equal(parts._sum(mixed, blocks).view(np.int64),
                           body_parity.sandwich_sum(mixed, blocks, n_gamma).view(np.int64))
+
+
+@pytest.mark.parametrize("element, k", (("hex", 2), ("tet", 2), ("hex20", 2)))
+def test_the_blockwise_congruence_is_scipys_product(monkeypatch, element, k):
+    """K_c = Q_cᵀ K Q_c by :func:`~infsup_contact.la.body_parity.congruence` (row blocks of 5 here)
+    against scipy's whole ``Q.T.tocsr() @ (K @ Q)``: the same arrays, stored entries in the same
+    order, bit for bit, for every part of a body."""
+    monkeypatch.setattr(body_parity, "CONGRUENCE_ROWS", 5)
+    side = m3.side_operator(m3.subdomain_mesh("structured", 3, 1, element=element), k)
+    n_gamma = len(side.trace.gamma_dofs)
+    K = sp.csr_matrix(side.stiffness)
+    for Q in body_symmetry.parity_bases(side.signature, side.stiffness, n_gamma):
+        Q = Q.tocsr()
+        whole, blocked = (Q.T.tocsr() @ (K @ Q)).tocsr(), body_parity.congruence(K, Q)
+        assert Q.shape[1] > 5 and blocked.format == "csr"
+        for field in ("indptr", "indices", "data"):
+            a, b = getattr(whole, field), getattr(blocked, field)
+            assert a.dtype == b.dtype and np.array_equal(a.view(np.uint8), b.view(np.uint8))

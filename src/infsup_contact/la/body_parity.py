@@ -164,6 +164,30 @@ class _PartsSolve:
         return out
 
 
+CONGRUENCE_ROWS = 4096
+"""Rows of Q_cᵀ K Q_c per block of :func:`congruence` (at most four orbits' worth of K's rows each:
+the block's K Q_c, a few tens of MB, instead of one the size of K for every part)."""
+
+
+def congruence(K: sp.csr_matrix, Q: sp.csr_matrix) -> sp.csr_matrix:
+    """Qᵀ (K Q), CSR, as scipy's ``Q.T.tocsr() @ (K @ Q)`` gives it, to the order of its stored
+    entries (the reference route; tested), row block by row block: the rows A of Qᵀ need the rows
+    I of K Q where they hold entries (I sorted), and the product adds row by row, each row of
+    K[I] Q is that row of K Q and the entries of a row of Qᵀ keep their order, so every block is
+    those rows of the whole product."""
+    Qt = Q.T.tocsr()
+    blocks = []
+    for a in range(0, Qt.shape[0], CONGRUENCE_ROWS):
+        rows = Qt[a:a + CONGRUENCE_ROWS]
+        support = np.unique(rows.indices)
+        local = sp.csr_matrix((rows.data, np.searchsorted(support, rows.indices).astype(rows.indices.dtype),
+                               rows.indptr), shape=(rows.shape[0], support.size))
+        blocks.append((local @ (K[support] @ Q)).tocsr())
+    if not blocks:
+        return sp.csr_matrix((0, Q.shape[1]))
+    return sp.vstack(blocks, format="csr")
+
+
 def parity_parts(K, n_gamma: int, bases) -> ParityParts:
     """The isotypic parts of the Γ-last SPD ``K`` in the ``bases`` (Q_0, ...) of its group
     (:func:`~infsup_contact.discretization.gamma.symmetry.isotypic_bases` of involutions of its
@@ -179,7 +203,7 @@ def parity_parts(K, n_gamma: int, bases) -> ParityParts:
         Q = Q[:, np.concatenate([np.flatnonzero(~on_gamma), np.flatnonzero(on_gamma)])].tocsr()
         if Q.shape[1] == 0:
             continue
-        Kc = (Q.T.tocsr() @ (K @ Q)).tocsr()
+        Kc = congruence(K, Q)
         Kc = (0.5 * (Kc + Kc.T.tocsr())).tocsc()  # symmetric to the last bit: the solves' LU sees it whole
         Kc.sort_indices()
         parts.append(ParityPart(Kc, int(on_gamma.sum()), Q))

@@ -133,7 +133,8 @@ def commutes(K, K_image, sigma: np.ndarray) -> bool:
     """Whether K_image = K[σ][:, σ] entry by entry to :data:`COMMUTE_RTOL` of max |K| (CSR, or two
     CSC matrices by their transposes, :func:`by_rows`; row block by row block of K_image: K's rows
     σ gathered, their column indices mapped by σ⁻¹ and sorted, equal patterns compared value by
-    value, other patterns, explicit zeros or no symmetry, as the difference of the two blocks)."""
+    value, other patterns, explicit zeros or no symmetry, as the difference of the two blocks; the
+    first block that differs decides)."""
     K, K_image = by_rows(K, K_image)
     n = sigma.size
     inverse = np.empty(n, dtype=K.indices.dtype)
@@ -141,7 +142,7 @@ def commutes(K, K_image, sigma: np.ndarray) -> bool:
     image = K_image if K_image.has_sorted_indices else K_image.sorted_indices()
     scale = np.abs(K.data).max() if K.nnz else 1.0
     step = max(1, int(BLOCK_ENTRIES * n // max(K.nnz, 1)))
-    worst = 0.0
+    tolerance = COMMUTE_RTOL * scale
     for a in range(0, n, step):
         b = min(a + step, n)
         rows = K[sigma[a:b]]
@@ -153,9 +154,9 @@ def commutes(K, K_image, sigma: np.ndarray) -> bool:
             diff = block.data - image.data[lo:hi]
         else:
             diff = (block - sp.csr_matrix((image.data[lo:hi], image.indices[lo:hi], indptr), shape=block.shape)).data
-        if diff.size:
-            worst = np.maximum(worst, np.abs(diff).max())  # a NaN stays a NaN: no match
-    return bool(worst <= COMMUTE_RTOL * scale)
+        if diff.size and not np.abs(diff).max() <= tolerance:  # a NaN is no match either
+            return False  # the first block off K decides
+    return True
 
 
 def _gamma_closed(sigma: np.ndarray, n_gamma: int) -> bool:
@@ -208,8 +209,9 @@ def mirror_permutation(signature1, K1, signature2, K2, n_gamma: int) -> np.ndarr
     K1, K2 = by_rows(K1, K2)
     points1, inv1 = _keys(signature1, K1)
     points2, inv2 = _keys(signature2, K2)
+    tree = _reference_tree(points1, inv1)  # body 1's, whichever mirror is tried
     for M in MIRRORS:
-        sigma = _match(points1, inv1, M(points2), inv2)
+        sigma = _match(points1, inv1, M(points2), inv2, tree)
         if sigma is not None and _gamma_closed(sigma, n_gamma) and commutes(K1, K2, sigma):
             return sigma
     return None

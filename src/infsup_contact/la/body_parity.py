@@ -102,7 +102,7 @@ def orbit_sandwich_sum(tails, blocks, n_gamma: int) -> np.ndarray:
     """:func:`sandwich_sum` bit for bit where each row r of each Q_c holds one entry q_r at
     column j_r at most (else q_r = 0, j_r = 0) and every M_c is finite: the sparse products add
     each product to a zero, so (Q_c (Q_c M_c)ᵀ)_{rs} = 0 + q_r (0 + q_s M_c[j_s, j_r]), formed
-    here row block by row block from M_cᵀ's entries, and the symmetrization tile by tile — no
+    here row block by row block from M_cᵀ's entries, and symmetrized in place tile by tile — no
     n_Γ × n_c or n_Γ × n_Γ temporary and no strided pass over a whole transposed matrix."""
     out = np.zeros((n_gamma, n_gamma))
     for Q, M in zip(tails, blocks):
@@ -121,13 +121,15 @@ def orbit_sandwich_sum(tails, blocks, n_gamma: int) -> np.ndarray:
             term *= q[r, None]
             term += 0.0
             out[r] += term
-    half = np.empty_like(out)
-    for a in range(0, n_gamma, ROWS):
+    for a in range(0, n_gamma, ROWS):  # ½ (out + outᵀ) in place, a tile and its mirror at a time
         r = slice(a, min(a + ROWS, n_gamma))
-        for b in range(0, n_gamma, ROWS):
+        for b in range(a, n_gamma, ROWS):
             c = slice(b, min(b + ROWS, n_gamma))
-            np.multiply(0.5, out[r, c] + out[c, r].T, out=half[r, c])
-    return half
+            upper = out[r, c].copy()
+            np.multiply(0.5, upper + out[c, r].T, out=out[r, c])
+            if b != a:
+                np.multiply(0.5, out[c, r] + upper.T, out=out[c, r])
+    return out
 
 
 def _exactly_symmetric(X) -> np.ndarray:

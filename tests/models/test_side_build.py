@@ -12,7 +12,6 @@ import scipy.sparse as sp
 
 from infsup_contact.la import body_parity
 from infsup_contact.models import body_symmetry, membranes3d as m3
-from infsup_contact.models.contract import free_block
 from infsup_contact.models.membranes import laplace_stiffness
 
 
@@ -110,31 +109,13 @@ def test_the_blockwise_congruence_is_scipys_product(monkeypatch, element, k):
 
 @pytest.mark.parametrize("element, k", (("hex", 1), ("hex", 2), ("tet", 2)))
 def test_k_on_the_free_dofs_is_the_whole_ks_restriction(element, k):
-    """``laplace_stiffness(fes, free)`` (read from NGSolve's arrays) and
-    :func:`~infsup_contact.models.contract.free_block` against the whole K's
-    ``K[free][:, free].tocsc()`` (free dofs in an order of their own, a Dirichlet dof among them),
-    and a β_h side's stiffness against a scene side's (which keeps the whole K): the same arrays."""
+    """``laplace_stiffness(fes, free)`` (read from NGSolve's arrays) against the whole K's
+    ``K[free][:, free].tocsc()``, and a β_h side's stiffness against a scene side's (which keeps
+    the whole K and restricts it): the same arrays."""
     body = m3.subdomain_mesh("structured", 3, 1, element=element)
     fes = m3.displacement_space(body.mesh, k)
     free = np.concatenate([np.flatnonzero(np.array(fes.FreeDofs(), dtype=bool))[::-1], [0]])
-    K = laplace_stiffness(fes)
-    reference = K[free][:, free].tocsc()
-    assert _same_arrays(laplace_stiffness(fes, free), reference) and _same_arrays(free_block(K, free), reference)
+    assert _same_arrays(laplace_stiffness(fes, free), laplace_stiffness(fes)[free][:, free].tocsc())
     beta, scene = m3.side_operator(body, k), m3.side_operator(body, k, keep_factor=True)
     assert beta.stiffness_all is None and np.array_equal(beta.free, scene.free)
     assert _same_arrays(beta.stiffness, scene.stiffness)
-
-
-def test_the_free_block_of_unsorted_rows_with_duplicates():
-    """:func:`~infsup_contact.models.contract.free_block` of a CSR K whose rows hold columns out of
-    order and twice: the same arrays as ``K[free][:, free].tocsc()`` (the HEX20 stiffness comes
-    from scikit-fem's assembly, whatever its order)."""
-    rng = np.random.default_rng(4)
-    n = 40
-    rows, cols = rng.integers(0, n, 400), rng.integers(0, n, 400)
-    indptr = np.searchsorted(np.sort(rows), np.arange(n + 1)).astype(np.int32)
-    K = sp.csr_matrix((rng.standard_normal(400), cols[np.argsort(rows, kind="stable")].astype(np.int32), indptr),
-                      shape=(n, n))
-    assert not K.has_sorted_indices
-    free = rng.permutation(n)[:30]
-    assert _same_arrays(free_block(K, free), K[free][:, free].tocsc())

@@ -331,13 +331,6 @@ class SideOperator(SteklovProduct):
 
 
 
-def free_block(K, free: np.ndarray) -> sp.csc_matrix:
-    """K[free][:, free].tocsc() of a CSR ``K``, bit for bit and in the same order of stored entries
-    (tested), as K[free].tocsc()[:, free]: the rows gathered, turned to columns (each column's rows
-    come out in order) and whole columns gathered, where the column selection of CSR rows scatters."""
-    return sp.csr_matrix(K)[free].tocsc()[:, free]
-
-
 def factorized_side(trace: GammaTrace, free: np.ndarray, K, route: str = "auto",
                     keep_factor: bool = False, signature: np.ndarray | None = None,
                     parts_map=concurrent_map) -> SideOperator:

@@ -30,7 +30,7 @@ import scipy.sparse as sp
 
 from ..discretization.face.shapes.serendipity import SERENDIPITY, NodalDofs
 from ..errors import InputError
-from .contract import Body, SideOperator, extended, factorized_side, free_block, mirrored_side
+from .contract import Body, SideOperator, extended, factorized_side, mirrored_side
 
 GAUSS_ORDER = 4
 """scikit-fem's ``intorder`` of the stiffness: 3 Gauss points per direction, exact to degree 5 per variable."""
@@ -111,7 +111,7 @@ def side_operator(body: Body, k: int, route: str = "auto", keep_factor: bool = F
     is_gamma[trace.gamma_dofs] = True
     free = np.concatenate([np.flatnonzero(dofs.free & ~is_gamma), trace.gamma_dofs])
     K = stiffness(basis)
-    K_free = free_block(K, free)
+    K_free = K[free][:, free].tocsc()
     signature = np.column_stack([np.asarray(basis.doflocs, float).T, np.ones(basis.N)])[free]
     base = (factorized_side(trace, free, K_free, route, keep_factor, signature) if mirror_of is None else
             mirrored_side(mirror_of, trace, free, K_free, signature, route, keep_factor))

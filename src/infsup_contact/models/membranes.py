@@ -14,7 +14,7 @@ from ..discretization.spaces.gammas import gamma_of
 from ..errors import check_prestress
 from .contract import OUTWARD_NORMAL_Y, PAPER_GAMMA, Body, MaterialParam, Model, OptionalChoice
 from ..discretization.segment.arc import COUPLINGS, GAMMAS, RADIUS_ALLOWED
-from .contract import SideOperator, factorized_side, free_block
+from .contract import SideOperator, factorized_side
 
 
 def displacement_space(mesh, k: int, dirichlet: str = "dir"):
@@ -47,7 +47,7 @@ def curved_bonus_intorder(mesh, k: int) -> int:
 def laplace_stiffness(fes, free: np.ndarray | None = None) -> sp.spmatrix:
     """∫ ∇u·∇v assembled by NGSolve on all dofs (c = 1, CSR); on a curved mesh with the quadrature
     of :func:`curved_bonus_intorder`. ``free``: K restricted to those dofs, rows and columns in
-    that order (:func:`~.contract.free_block`: ``K[free][:, free].tocsc()``, bit for bit), read from
+    that order (CSC, as ``K[free][:, free].tocsc()`` of the whole one, bit for bit), read from
     NGSolve's arrays without a copy of the whole K (at k = 2, N = 32 a copy of 200 MB in fresh
     pages: half a second a side)."""
     u, v = fes.TnT()
@@ -60,7 +60,7 @@ def laplace_stiffness(fes, free: np.ndarray | None = None) -> sp.spmatrix:
         # views into NGSolve's memory, alive with the form ``a`` until this returns: the row and
         # column selections copy what they keep
         data, cols, rows = mat.CSR()
-        return free_block(sp.csr_matrix((data, cols, rows), shape=(mat.height, mat.width)), free)
+        return sp.csr_matrix((data, cols, rows), shape=(mat.height, mat.width))[free][:, free].tocsc()
     # CSR() returns views into NGSolve's memory, freed with the form: copy them
     data, cols, rows = (np.array(arr, copy=True) for arr in mat.CSR())
     return sp.csr_matrix((data, cols, rows), shape=(mat.height, mat.width))

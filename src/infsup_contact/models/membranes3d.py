@@ -59,7 +59,7 @@ import scipy.sparse as sp
 
 from .contract import Body, MaterialParam, Model, OptionalChoice
 from .membranes import field as membrane_field, interpolate as membrane_interpolate, laplace_stiffness
-from .contract import SideOperator, extended, factorized_side, free_block, mirrored_side
+from .contract import SideOperator, extended, factorized_side, mirrored_side
 from . import body_symmetry, hex20
 
 ELEMENTS = ("hex", "tet")
@@ -222,7 +222,7 @@ def side_operator(body: Body, k: int, route: str = "auto", dirichlet: str = BETA
     # K on every dof serves the loads of a scene's lift (a side that solves); a β_h side never
     # holds it (190 MB a side at k = 2, N = 32: :func:`load` would assemble it again)
     K_all = laplace_stiffness(fes) if keep_factor else None
-    K = free_block(K_all, free) if keep_factor else laplace_stiffness(fes, free)
+    K = K_all[free][:, free].tocsc() if keep_factor else laplace_stiffness(fes, free)
     signature = body_symmetry.ngsolve_signature(fes)
     signature = None if signature is None else signature[free]
     base = (factorized_side(trace, free, K, route, keep_factor, signature) if mirror_of is None else

@@ -113,7 +113,7 @@ def _match(ref_points, ref_inv, points, inv, tree: cKDTree | None = None) -> np.
     return sigma if np.unique(sigma).size == sigma.size else None
 
 
-def by_rows(*matrices) -> tuple:
+def _by_rows(*matrices) -> tuple:
     """The matrices as CSR for a row-by-row check: CSC ones (every one) as the CSR of their
     transposes, the same arrays without a conversion — what the checks read is the same for Kᵀ
     (its diagonal; P Kᵀ Pᵀ = (P K Pᵀ)ᵀ, so K_image = K[σ][:, σ] entry by entry iff the same holds
@@ -126,16 +126,16 @@ def by_rows(*matrices) -> tuple:
 BLOCK_ENTRIES = 2 ** 18
 """Stored entries of K per row block of :func:`commutes`: its temporaries (a few MB) are reused
 from block to block, where whole-matrix ones (~30 bytes an entry, 0.5 GB at k = 2, N = 32) were
-fresh pages of memory each time (page faults: a third of the time of a side's build)."""
+fresh memory each time (the pair's build spent about a third of its CPU time in the kernel)."""
 
 
 def commutes(K, K_image, sigma: np.ndarray) -> bool:
     """Whether K_image = K[σ][:, σ] entry by entry to :data:`COMMUTE_RTOL` of max |K| (CSR, or two
-    CSC matrices by their transposes, :func:`by_rows`; row block by row block of K_image: K's rows
+    CSC matrices by their transposes, :func:`_by_rows`; row block by row block of K_image: K's rows
     σ gathered, their column indices mapped by σ⁻¹ and sorted, equal patterns compared value by
     value, other patterns, explicit zeros or no symmetry, as the difference of the two blocks; the
     first block that differs decides)."""
-    K, K_image = by_rows(K, K_image)
+    K, K_image = _by_rows(K, K_image)
     n = sigma.size
     inverse = np.empty(n, dtype=K.indices.dtype)
     inverse[sigma] = np.arange(n, dtype=inverse.dtype)
@@ -180,7 +180,7 @@ def involutions(signature, K, n_gamma: int) -> tuple | None:
     as permutations of the free dofs; None if none (or ``signature`` is None, or :data:`ENABLED` is off)."""
     if signature is None or not ENABLED or len(signature) < 2:  # nothing to split (N = 1: no free dof)
         return None
-    K, = by_rows(K)  # once for every candidate
+    K, = _by_rows(K)  # once for every candidate
     points, inv = _keys(signature, K)
     keys = (points, inv, _reference_tree(points, inv))  # the body's own, whatever T is tried
     found = {}
@@ -206,7 +206,7 @@ def mirror_permutation(signature1, K1, signature2, K2, n_gamma: int) -> np.ndarr
     :data:`MIRRORS`, Γ to Γ), checked entry by entry; None where no mirror maps the bodies."""
     if signature1 is None or signature2 is None or not ENABLED or K1.shape != K2.shape or K1.shape[0] < 2:
         return None
-    K1, K2 = by_rows(K1, K2)
+    K1, K2 = _by_rows(K1, K2)
     points1, inv1 = _keys(signature1, K1)
     points2, inv2 = _keys(signature2, K2)
     tree = _reference_tree(points1, inv1)  # body 1's, whichever mirror is tried

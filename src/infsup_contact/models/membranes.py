@@ -48,8 +48,7 @@ def laplace_stiffness(fes, free: np.ndarray | None = None) -> sp.spmatrix:
     """∫ ∇u·∇v assembled by NGSolve on all dofs (c = 1, CSR); on a curved mesh with the quadrature
     of :func:`curved_bonus_intorder`. ``free``: K restricted to those dofs, rows and columns in
     that order (CSC, as ``K[free][:, free].tocsc()`` of the whole one, bit for bit), read from
-    NGSolve's arrays without a copy of the whole K (at k = 2, N = 32 a copy of 200 MB in fresh
-    pages: half a second a side)."""
+    NGSolve's arrays without a copy of the whole K (200 MB at k = 2, N = 32)."""
     u, v = fes.TnT()
     a = ngsolve.BilinearForm(fes)
     bonus = curved_bonus_intorder(fes.mesh, fes.globalorder)

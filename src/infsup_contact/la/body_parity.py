@@ -74,12 +74,62 @@ class ParityParts:
         return S, _PartsSolve(self.parts, [f.solve for f in facs]), X, blocks
 
     def _sum(self, tails, blocks) -> np.ndarray:
-        """Σ_c Q_{c,Γ} M_c Q_{c,Γ}ᵀ (dense n_Γ × n_Γ), symmetrized."""
-        out = np.zeros((self.n_gamma, self.n_gamma))
-        for Q, M in zip(tails, blocks):
-            if Q.shape[1]:
-                out += Q @ (Q @ np.asarray(M)).T  # M symmetric: (Q M)ᵀ = M Qᵀ
-        return 0.5 * (out + out.T)
+        """Σ_c Q_{c,Γ} M_c Q_{c,Γ}ᵀ (dense n_Γ × n_Γ), symmetrized: :func:`orbit_sandwich_sum`
+        where every row of every Q_{c,Γ} holds one entry at most (a dof lies in one orbit), else
+        :func:`sandwich_sum` (the same bits)."""
+        if all(np.diff(Q.indptr).max(initial=0) <= 1 for Q in tails) and all(
+                np.isfinite(M).all() for Q, M in zip(tails, blocks) if Q.shape[1]):
+            return orbit_sandwich_sum(tails, blocks, self.n_gamma)
+        return sandwich_sum(tails, blocks, self.n_gamma)
+
+
+def sandwich_sum(tails, blocks, n_gamma: int) -> np.ndarray:
+    """½ (A + Aᵀ), A = Σ_c Q_c (Q_c M_c)ᵀ (M_c symmetric: Q_c M_c Q_cᵀ) by scipy's sparse × dense
+    products: the reference route of :func:`orbit_sandwich_sum`."""
+    out = np.zeros((n_gamma, n_gamma))
+    for Q, M in zip(tails, blocks):
+        if Q.shape[1]:
+            out += Q @ (Q @ np.asarray(M)).T
+    return 0.5 * (out + out.T)
+
+
+ROWS = 128
+"""Rows of the result per block of :func:`orbit_sandwich_sum` (a block of n_Γ ≤ 10⁴ columns stays
+within a few MB)."""
+
+
+def orbit_sandwich_sum(tails, blocks, n_gamma: int) -> np.ndarray:
+    """:func:`sandwich_sum` bit for bit where each row r of each Q_c holds one entry q_r at
+    column j_r at most (else q_r = 0, j_r = 0) and every M_c is finite: the sparse products add
+    each product to a zero, so (Q_c (Q_c M_c)ᵀ)_{rs} = 0 + q_r (0 + q_s M_c[j_s, j_r]), formed
+    here row block by row block from M_cᵀ's entries, and symmetrized in place tile by tile — no
+    n_Γ × n_c or n_Γ × n_Γ temporary and no strided pass over a whole transposed matrix."""
+    out = np.zeros((n_gamma, n_gamma))
+    for Q, M in zip(tails, blocks):
+        if not Q.shape[1]:
+            continue
+        Mt = np.ascontiguousarray(np.asarray(M, dtype=float).T)
+        has = np.diff(Q.indptr) > 0
+        q = np.zeros(n_gamma)
+        j = np.zeros(n_gamma, dtype=np.intp)
+        q[has], j[has] = Q.data[Q.indptr[:-1][has]], Q.indices[Q.indptr[:-1][has]]
+        for a in range(0, n_gamma, ROWS):
+            r = slice(a, min(a + ROWS, n_gamma))
+            term = np.take(Mt[j[r]], j, axis=1)  # (r, s) ↦ M_c[j_s, j_r]
+            term *= q
+            term += 0.0
+            term *= q[r, None]
+            term += 0.0
+            out[r] += term
+    for a in range(0, n_gamma, ROWS):  # ½ (out + outᵀ) in place, a tile and its mirror at a time
+        r = slice(a, min(a + ROWS, n_gamma))
+        for b in range(a, n_gamma, ROWS):
+            c = slice(b, min(b + ROWS, n_gamma))
+            upper = out[r, c].copy()
+            np.multiply(0.5, upper + out[c, r].T, out=out[r, c])
+            if b != a:
+                np.multiply(0.5, out[c, r] + upper.T, out=out[c, r])
+    return out
 
 
 def _exactly_symmetric(X) -> np.ndarray:
@@ -116,6 +166,30 @@ class _PartsSolve:
         return out
 
 
+CONGRUENCE_ROWS = 4096
+"""Rows of Q_cᵀ K Q_c per block of :func:`congruence` (at most four orbits' worth of K's rows each:
+the block's K Q_c, a few tens of MB, instead of one the size of K for every part)."""
+
+
+def congruence(K: sp.csr_matrix, Q: sp.csr_matrix) -> sp.csr_matrix:
+    """Qᵀ (K Q), CSR, as scipy's ``Q.T.tocsr() @ (K @ Q)`` gives it, to the order of its stored
+    entries (the reference route; tested), row block by row block: the rows A of Qᵀ need the rows
+    I of K Q where they hold entries (I sorted), and the product adds row by row, each row of
+    K[I] Q is that row of K Q and the entries of a row of Qᵀ keep their order, so every block is
+    those rows of the whole product."""
+    Qt = Q.T.tocsr()
+    blocks = []
+    for a in range(0, Qt.shape[0], CONGRUENCE_ROWS):
+        rows = Qt[a:a + CONGRUENCE_ROWS]
+        support = np.unique(rows.indices)
+        local = sp.csr_matrix((rows.data, np.searchsorted(support, rows.indices).astype(rows.indices.dtype),
+                               rows.indptr), shape=(rows.shape[0], support.size))
+        blocks.append((local @ (K[support] @ Q)).tocsr())
+    if not blocks:
+        return sp.csr_matrix((0, Q.shape[1]))
+    return sp.vstack(blocks, format="csr")
+
+
 def parity_parts(K, n_gamma: int, bases) -> ParityParts:
     """The isotypic parts of the Γ-last SPD ``K`` in the ``bases`` (Q_0, ...) of its group
     (:func:`~infsup_contact.discretization.gamma.symmetry.isotypic_bases` of involutions of its
@@ -131,7 +205,7 @@ def parity_parts(K, n_gamma: int, bases) -> ParityParts:
         Q = Q[:, np.concatenate([np.flatnonzero(~on_gamma), np.flatnonzero(on_gamma)])].tocsr()
         if Q.shape[1] == 0:
             continue
-        Kc = (Q.T.tocsr() @ (K @ Q)).tocsr()
+        Kc = congruence(K, Q)
         Kc = (0.5 * (Kc + Kc.T.tocsr())).tocsc()  # symmetric to the last bit: the solves' LU sees it whole
         Kc.sort_indices()
         parts.append(ParityPart(Kc, int(on_gamma.sum()), Q))

@@ -90,40 +90,73 @@ def ngsolve_signature(fes) -> np.ndarray:
 def _keys(signature: np.ndarray, K) -> tuple:
     """(points (n, 3), invariants (n, m) scaled to max 1): the signature's coordinates and its
     other columns with K's diagonal."""
-    inv = np.column_stack([signature[:, 3:], sp.csr_matrix(K).diagonal()])
+    inv = np.column_stack([signature[:, 3:], K.diagonal()])
     scale = np.abs(inv).max(axis=0)
     return signature[:, :3], inv / np.where(scale > 0, scale, 1.0)
 
 
-def _match(ref_points, ref_inv, points, inv) -> np.ndarray | None:
+def _reference_tree(ref_points, ref_inv) -> cKDTree:
+    """The search tree of the reference keys (:func:`_match`; one body's, shared by its candidates)."""
+    return cKDTree(np.column_stack([ref_points, ref_inv]), balanced_tree=False, compact_nodes=False)
+
+
+def _match(ref_points, ref_inv, points, inv, tree: cKDTree | None = None) -> np.ndarray | None:
     """σ with (points, inv)[i] = (ref_points, ref_inv)[σ(i)] to :data:`MATCH_TOL` (the nearest
-    reference), a bijection; else None. A wrong but close match cannot pass: the caller checks K."""
+    reference), a bijection; else None. A wrong but close match cannot pass: the caller checks K.
+    ``tree``: the reference's :func:`_reference_tree`, where the caller already has it."""
     if len(points) != len(ref_points) or len(points) < 2:
         return None
-    tree = cKDTree(np.column_stack([ref_points, ref_inv]), balanced_tree=False, compact_nodes=False)
+    tree = _reference_tree(ref_points, ref_inv) if tree is None else tree
     dist, sigma = tree.query(np.column_stack([points, inv]), k=1, distance_upper_bound=MATCH_TOL)
     if not np.all(np.isfinite(dist)):
         return None
     return sigma if np.unique(sigma).size == sigma.size else None
 
 
+def _by_rows(*matrices) -> tuple:
+    """The matrices as CSR for a row-by-row check: CSC ones (every one) as the CSR of their
+    transposes, the same arrays without a conversion — what the checks read is the same for Kᵀ
+    (its diagonal; P Kᵀ Pᵀ = (P K Pᵀ)ᵀ, so K_image = K[σ][:, σ] entry by entry iff the same holds
+    for the transposes) — else converted to CSR."""
+    if all(sp.issparse(M) and M.format == "csc" for M in matrices):
+        return tuple(M.T for M in matrices)
+    return tuple(sp.csr_matrix(M) for M in matrices)
+
+
+BLOCK_ENTRIES = 2 ** 18
+"""Stored entries of K per row block of :func:`commutes`: its temporaries (a few MB) are reused
+from block to block, where whole-matrix ones (~30 bytes an entry, 0.5 GB at k = 2, N = 32) were
+fresh memory each time (the pair's build spent about a third of its CPU time in the kernel)."""
+
+
 def commutes(K, K_image, sigma: np.ndarray) -> bool:
-    """Whether K_image = K[σ][:, σ] entry by entry to :data:`COMMUTE_RTOL` of max |K| (CSR: the
-    rows gathered, the column indices mapped by σ⁻¹; equal patterns compared value by value)."""
-    K, K_image = sp.csr_matrix(K), sp.csr_matrix(K_image)
-    inverse = np.empty_like(sigma)
-    inverse[sigma] = np.arange(sigma.size)
-    rows = K[sigma]
-    mapped = sp.csr_matrix((rows.data, inverse[rows.indices], rows.indptr), shape=K.shape)
-    mapped.sort_indices()
-    K_image = K_image.copy() if not K_image.has_sorted_indices else K_image
-    K_image.sort_indices()
+    """Whether K_image = K[σ][:, σ] entry by entry to :data:`COMMUTE_RTOL` of max |K| (CSR, or two
+    CSC matrices by their transposes, :func:`_by_rows`; row block by row block of K_image: K's rows
+    σ gathered, their column indices mapped by σ⁻¹ and sorted, equal patterns compared value by
+    value, other patterns, explicit zeros or no symmetry, as the difference of the two blocks; the
+    first block that differs decides)."""
+    K, K_image = _by_rows(K, K_image)
+    n = sigma.size
+    inverse = np.empty(n, dtype=K.indices.dtype)
+    inverse[sigma] = np.arange(n, dtype=inverse.dtype)
+    image = K_image if K_image.has_sorted_indices else K_image.sorted_indices()
     scale = np.abs(K.data).max() if K.nnz else 1.0
-    if np.array_equal(mapped.indptr, K_image.indptr) and np.array_equal(mapped.indices, K_image.indices):
-        diff = mapped.data - K_image.data
-    else:  # another pattern (explicit zeros, or no symmetry): entry by entry all the same
-        diff = (mapped - K_image).data
-    return diff.size == 0 or np.abs(diff).max() <= COMMUTE_RTOL * scale
+    step = max(1, int(BLOCK_ENTRIES * n // max(K.nnz, 1)))
+    tolerance = COMMUTE_RTOL * scale
+    for a in range(0, n, step):
+        b = min(a + step, n)
+        rows = K[sigma[a:b]]
+        block = sp.csr_matrix((rows.data, inverse[rows.indices], rows.indptr), shape=(b - a, K.shape[1]))
+        block.sort_indices()
+        lo, hi = image.indptr[a], image.indptr[b]
+        indptr = image.indptr[a:b + 1] - lo
+        if np.array_equal(block.indptr, indptr) and np.array_equal(block.indices, image.indices[lo:hi]):
+            diff = block.data - image.data[lo:hi]
+        else:
+            diff = (block - sp.csr_matrix((image.data[lo:hi], image.indices[lo:hi], indptr), shape=block.shape)).data
+        if diff.size and not np.abs(diff).max() <= tolerance:  # a NaN is no match either
+            return False  # the first block off K decides
+    return True
 
 
 def _gamma_closed(sigma: np.ndarray, n_gamma: int) -> bool:
@@ -131,11 +164,12 @@ def _gamma_closed(sigma: np.ndarray, n_gamma: int) -> bool:
     return bool(np.all(sigma[n - n_gamma:] >= n - n_gamma))
 
 
-def permutation(signature: np.ndarray, K, n_gamma: int, transform) -> np.ndarray | None:
+def permutation(signature: np.ndarray, K, n_gamma: int, transform, keys: tuple | None = None) -> np.ndarray | None:
     """π of the free dofs (rows of ``signature`` and K, Γ the last ``n_gamma``) with
-    φ_j ∘ T = φ_π(j), checked (module text), or None."""
-    points, inv = _keys(signature, K)
-    pi = _match(points, inv, transform(points), inv)
+    φ_j ∘ T = φ_π(j), checked (module text), or None. ``keys``: the body's (points, invariants,
+    search tree) where the caller tries several T (:func:`involutions`)."""
+    points, inv, tree = keys if keys is not None else (*_keys(signature, K), None)
+    pi = _match(points, inv, transform(points), inv, tree)
     if pi is None or np.any(pi[pi] != np.arange(pi.size)) or not _gamma_closed(pi, n_gamma):
         return None
     return pi if commutes(K, K, pi) else None
@@ -146,13 +180,15 @@ def involutions(signature, K, n_gamma: int) -> tuple | None:
     as permutations of the free dofs; None if none (or ``signature`` is None, or :data:`ENABLED` is off)."""
     if signature is None or not ENABLED or len(signature) < 2:  # nothing to split (N = 1: no free dof)
         return None
-    K = sp.csr_matrix(K)  # once for every candidate
+    K, = _by_rows(K)  # once for every candidate
+    points, inv = _keys(signature, K)
+    keys = (points, inv, _reference_tree(points, inv))  # the body's own, whatever T is tried
     found = {}
     for group in GROUPS:
         pis = []
         for T in group:
             if T not in found:
-                found[T] = permutation(signature, K, n_gamma, T)
+                found[T] = permutation(signature, K, n_gamma, T, keys)
             pis.append(found[T])
         if all(pi is not None for pi in pis) and all(np.array_equal(a[b], b[a]) for a in pis for b in pis):
             return tuple(pis)
@@ -170,11 +206,12 @@ def mirror_permutation(signature1, K1, signature2, K2, n_gamma: int) -> np.ndarr
     :data:`MIRRORS`, Γ to Γ), checked entry by entry; None where no mirror maps the bodies."""
     if signature1 is None or signature2 is None or not ENABLED or K1.shape != K2.shape or K1.shape[0] < 2:
         return None
-    K1, K2 = sp.csr_matrix(K1), sp.csr_matrix(K2)
+    K1, K2 = _by_rows(K1, K2)
     points1, inv1 = _keys(signature1, K1)
     points2, inv2 = _keys(signature2, K2)
+    tree = _reference_tree(points1, inv1)  # body 1's, whichever mirror is tried
     for M in MIRRORS:
-        sigma = _match(points1, inv1, M(points2), inv2)
+        sigma = _match(points1, inv1, M(points2), inv2, tree)
         if sigma is not None and _gamma_closed(sigma, n_gamma) and commutes(K1, K2, sigma):
             return sigma
     return None

@@ -219,15 +219,15 @@ def side_operator(body: Body, k: int, route: str = "auto", dirichlet: str = BETA
     is_gamma = np.zeros(fes.ndof, dtype=bool)
     is_gamma[trace.gamma_dofs] = True
     free = np.concatenate([np.flatnonzero(free_mask & ~is_gamma), trace.gamma_dofs])
-    K_all = laplace_stiffness(fes)
-    K = K_all[free][:, free].tocsc()
+    # K on every dof serves the loads of a scene's lift (a side that solves); a β_h side never
+    # holds it (190 MB a side at k = 2, N = 32: :func:`load` would assemble it again)
+    K_all = laplace_stiffness(fes) if keep_factor else None
+    K = K_all[free][:, free].tocsc() if keep_factor else laplace_stiffness(fes, free)
     signature = body_symmetry.ngsolve_signature(fes)
     signature = None if signature is None else signature[free]
     base = (factorized_side(trace, free, K, route, keep_factor, signature) if mirror_of is None else
             mirrored_side(mirror_of, trace, free, K, signature, route, keep_factor))
-    # K on every dof serves the loads of a scene's lift (a side that solves); a β_h side drops it
-    # (190 MB a side at k = 2, N = 32) and :func:`load` would assemble it again
-    return extended(base, MembraneSide, stiffness_all=K_all if keep_factor else None)
+    return extended(base, MembraneSide, stiffness_all=K_all)
 
 
 def mirror_side(side1, body: Body, k: int):

@@ -1,0 +1,121 @@
+"""The side build's cheaper routes (issue 52: the 3D side build's overhead) against the
+straightforward ones, bit for bit: the symmetry check row block by row block, K_c = Q_cᵀ K Q_c
+block by block, the parts' sum by its orbits, and K on the free dofs read from NGSolve's arrays.
+Each compares the verdict or the arrays themselves (dtype, order of the stored entries, bits), on
+every element whose side takes the route; the new route is run in blocks smaller than the body
+so that block boundaries are crossed."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+
+from infsup_contact.la import body_parity
+from infsup_contact.models import body_symmetry, membranes3d as m3
+from infsup_contact.models.membranes import laplace_stiffness
+
+
+def _same_arrays(a, b) -> bool:
+    """Two sparse matrices with the same format, shape and stored arrays, bit for bit."""
+    return a.format == b.format and a.shape == b.shape and all(
+        getattr(a, f).dtype == getattr(b, f).dtype and np.array_equal(getattr(a, f).view(np.uint8),
+                                                                       getattr(b, f).view(np.uint8))
+        for f in ("indptr", "indices", "data"))
+
+
+def _commutes_whole(K, K_image, sigma) -> bool:
+    """The straightforward check: max |K[σ][:, σ] − K_image| ≤ COMMUTE_RTOL max |K|, whole and dense."""
+    K = sp.csr_matrix(K)
+    diff = np.abs((K[sigma][:, sigma] - sp.csr_matrix(K_image)).toarray()).max()
+    return bool(diff <= body_symmetry.COMMUTE_RTOL * np.abs(K.data).max())
+
+
+@pytest.mark.parametrize("element, k", (("hex", 2), ("tet", 2), ("hex20", 2)))
+def test_the_blockwise_check_is_the_whole_one(monkeypatch, element, k):
+    """:func:`~infsup_contact.models.body_symmetry.commutes` row block by row block (blocks of a few
+    rows here, so that every kind of block boundary is crossed), on CSC matrices through their
+    transposes: the same verdict as the whole dense check, on symmetries that hold, a stiffness
+    entry moved, a pattern changed and a permutation that is no symmetry."""
+    monkeypatch.setattr(body_symmetry, "BLOCK_ENTRIES", 97)
+    side = m3.side_operator(m3.subdomain_mesh("structured", 3, 1, element=element), k)
+    K = side.stiffness
+    points, inv = body_symmetry._keys(side.signature, K)
+    candidates = [body_symmetry._match(points, inv, T(points), inv) for T in (
+        body_symmetry.REFLECT_X, body_symmetry.REFLECT_Y, body_symmetry.SWAP, body_symmetry.ANTISWAP)]
+    candidates = [pi for pi in candidates if pi is not None]
+    candidates.append(np.random.default_rng(2).permutation(K.shape[0]))
+    moved = K.tolil()
+    j = int(sp.csr_matrix(K)[0].indices[-1])
+    moved[0, j] += 1e-6 * np.abs(K.data).max()
+    moved[j, 0] = moved[0, j]
+    coo = K.tocoo()  # an explicit zero off the pattern: another pattern, the same K
+    zero = sp.csc_matrix((np.append(coo.data, 0.0), (np.append(coo.row, 0), np.append(coo.col, K.shape[0] - 1))),
+                         shape=K.shape)
+    assert zero.nnz == K.nnz + 1
+    verdicts = []
+    for image in (K, moved.tocsc(), moved.tocsr(), zero):
+        for pi in candidates:
+            verdict = body_symmetry.commutes(K if image.format == "csc" else K.tocsr(), image, pi)
+            assert verdict == _commutes_whole(K, image, pi)
+            verdicts.append(verdict)
+    assert any(verdicts) and not all(verdicts)
+
+
+@pytest.mark.parametrize("element, k", (("hex", 2), ("tet", 2), ("hex20", 2)))
+def test_the_orbit_route_of_the_parts_sum_is_the_sparse_products(monkeypatch, element, k):
+    """Σ_c Q_{c,Γ} M_c Q_{c,Γ}ᵀ by :func:`~infsup_contact.la.body_parity.orbit_sandwich_sum` (entries
+    gathered row block by row block) against scipy's sparse products
+    (:func:`~infsup_contact.la.body_parity.sandwich_sum`): bit for bit, on a body's parts with
+    symmetric blocks holding a −0 (the products' added zeros turn it into +0) and a block of
+    rows smaller than n_Γ; a Q with two entries in a row takes the sparse products."""
+    side = m3.side_operator(m3.subdomain_mesh("structured", 3, 1, element=element), k)
+    n_gamma = len(side.trace.gamma_dofs)
+    parts = body_parity.parity_parts(side.stiffness, n_gamma,
+                                     body_symmetry.parity_bases(side.signature, side.stiffness, n_gamma))
+    tails = [p.basis[parts.n - n_gamma:][:, p.basis.shape[1] - p.n_gamma:].tocsr() for p in parts.parts]
+    rng = np.random.default_rng(3)
+    blocks = []
+    for Q in tails:
+        M = rng.standard_normal((Q.shape[1], Q.shape[1]))
+        M = M + M.T
+        M[0, 0] = -0.0
+        blocks.append(M)
+    reference = body_parity.sandwich_sum(tails, blocks, n_gamma)
+    monkeypatch.setattr(body_parity, "ROWS", 7)  # blocks and tiles of 7 rows, the last one shorter
+    assert np.array_equal(parts._sum(tails, blocks).view(np.int64), reference.view(np.int64))
+    assert np.array_equal(body_parity.orbit_sandwich_sum(tails, blocks, n_gamma).view(np.int64),
+                          reference.view(np.int64))
+    mixed = [Q.tolil() for Q in tails]
+    mixed[0][0, 1] = 0.5  # two entries in row 0: no orbit route
+    mixed = [Q.tocsr() for Q in mixed]
+    assert np.array_equal(parts._sum(mixed, blocks).view(np.int64),
+                          body_parity.sandwich_sum(mixed, blocks, n_gamma).view(np.int64))
+
+
+@pytest.mark.parametrize("element, k", (("hex", 2), ("tet", 2), ("hex20", 2)))
+def test_the_blockwise_congruence_is_scipys_product(monkeypatch, element, k):
+    """K_c = Q_cᵀ K Q_c by :func:`~infsup_contact.la.body_parity.congruence` (row blocks of 5 here)
+    against scipy's whole ``Q.T.tocsr() @ (K @ Q)``: the same arrays, stored entries in the same
+    order, bit for bit, for every part of a body."""
+    monkeypatch.setattr(body_parity, "CONGRUENCE_ROWS", 5)
+    side = m3.side_operator(m3.subdomain_mesh("structured", 3, 1, element=element), k)
+    n_gamma = len(side.trace.gamma_dofs)
+    K = sp.csr_matrix(side.stiffness)
+    for Q in body_symmetry.parity_bases(side.signature, side.stiffness, n_gamma):
+        Q = Q.tocsr()
+        assert Q.shape[1] > 5
+        assert _same_arrays(body_parity.congruence(K, Q), (Q.T.tocsr() @ (K @ Q)).tocsr())
+
+
+@pytest.mark.parametrize("element, k", (("hex", 1), ("hex", 2), ("tet", 2)))
+def test_k_on_the_free_dofs_is_the_whole_ks_restriction(element, k):
+    """``laplace_stiffness(fes, free)`` (read from NGSolve's arrays) against the whole K's
+    ``K[free][:, free].tocsc()``, and a β_h side's stiffness against a scene side's (which keeps
+    the whole K and restricts it): the same arrays."""
+    body = m3.subdomain_mesh("structured", 3, 1, element=element)
+    fes = m3.displacement_space(body.mesh, k)
+    free = np.concatenate([np.flatnonzero(np.array(fes.FreeDofs(), dtype=bool))[::-1], [0]])
+    assert _same_arrays(laplace_stiffness(fes, free), laplace_stiffness(fes)[free][:, free].tocsc())
+    beta, scene = m3.side_operator(body, k), m3.side_operator(body, k, keep_factor=True)
+    assert beta.stiffness_all is None and np.array_equal(beta.free, scene.free)
+    assert _same_arrays(beta.stiffness, scene.stiffness)

@@ -149,3 +149,23 @@ def test_sparse_couplings_and_their_scaling_are_the_dense_ones_bit_for_bit(setup
             cols = np.linspace(0.5, 2.0, space.dim)
             W = scaled_couplings(sparse, rows, cols)
             assert sp.issparse(W) and np.array_equal(W.toarray(), scaled_couplings(dense, rows, cols))
+
+
+@pytest.mark.parametrize("element,k,n", [("hex", 1, 4), ("hex", 2, 3), ("tet", 2, 3), ("hex20", 2, 3)])
+def test_face_trace_norms_from_the_sparse_basis_are_the_dense_sums(element, k, n):
+    """trace_l2_norms on the face (from the sparse trace basis) against the dense values' sums
+    w @ Φ²: the same sums in another order, to round-off; on Q1 hexahedra also an exact integral:
+    the trace dofs are the tensor hats of Γ's N − 1 inner nodes per direction (u = 0 on the lateral
+    faces), whose 1D squares integrate to 2h/3, so Σ_d ‖φ_d‖² = (2 (N − 1) h / 3)²."""
+    from infsup_contact.solvers.request import MeshOptions
+    from infsup_contact.solvers.side_cache import SideCache
+    from infsup_contact.models import MODELS
+
+    side = SideCache().pair(MODELS["membranes3d"], "structured", k, n, n, MeshOptions(element=element))[0]
+    trace = side.trace
+    x, w = trace.gamma.quadrature(trace.partition, 2 * k)
+    dense = np.sqrt(w @ trace.gamma.trace_basis(trace, x) ** 2)
+    sparse = coupling.trace_l2_norms(trace, k)
+    np.testing.assert_allclose(sparse, dense, rtol=1e-14, atol=0)
+    if element == "hex" and k == 1:
+        assert np.sum(sparse ** 2) == pytest.approx((2.0 * (n - 1) / (3.0 * n)) ** 2, rel=1e-13)

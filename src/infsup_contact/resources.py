@@ -138,16 +138,18 @@ def face_side_dofs(n: int, k: int) -> float:
     return max((nk - 1.0) ** 2 * nk, 1.0)
 
 
-LARGE_ROUTE_3D = {1: (1530.0, 197.0, 6.06e-5, 5.28e-10), 2: (4257.0, 75.8, 8.08e-5, 5.79e-10)}
+LARGE_ROUTE_3D = {1: (1530.0, 197.0, 6.06e-5, 5.28e-10), 2: (3026.0, 81.3, 4.56e-5, 3.00e-10)}
 """(a, b, c, d) of the large route (dim M above :data:`~.la.bottom.DENSE_MAX_M`: sparse
 couplings, exponential-sum Grams in the reflections' parity blocks, bottom pencils; PARDISO):
 bytes a Σ nd + b m² and seconds c Σ nd + d m³ beyond the process, m = (k N₂ + 1)² (R5.2 on
 G_h = the trace of Ω2). Non-negative least squares, relative residuals, on ``beta --model
 membranes3d --case all --norm all`` (hexahedra; k = 1, N = 40…64; k = 2 refitted with
-:func:`~.bench.estimates.fit_large_route_3d` after the parity factorization and the Grams kept in
-blocks, N = 20…36 and 48; the peaks and CPU times in docs/refusals.md, "The memory estimate"). The sparse factors grow like nd here (nd^{4/3}
+:func:`~.bench.estimates.fit_large_route_3d` after the interface terms and the kernel decision's
+rows went into the parity components, N = 20…36 and 48; the peaks and CPU times in
+docs/refusals.md, "The memory estimate"). The sparse factors grow like nd here (nd^{4/3}
 only asymptotically), the Grams, the pencils' and the shared series' dense arrays like m², their
-factorizations like m³. × :data:`LARGE_ROUTE_MARGIN`: above every measurement (by 3 % to 29 %)."""
+factorizations like m³. × :data:`LARGE_ROUTE_MARGIN`: above every measurement (by 15 % to 25 %; at N = 20
+the dense route's floor, 81 %)."""
 LARGE_ROUTE_MARGIN = 1.2
 DENSE_ROUTE_SECONDS_3D = {1: 2.2e-9, 2: 1.0e-9}
 """d of c Σ nd + d m³ seconds (c of :data:`LARGE_ROUTE_3D`) on PARDISO's dense route, where the

@@ -150,7 +150,21 @@ docs/refusals.md, "The memory estimate"). The sparse factors grow like nd here (
 only asymptotically), the Grams, the pencils' and the shared series' dense arrays like m², their
 factorizations like m³. × :data:`LARGE_ROUTE_MARGIN`: above every measurement (by 15 % to 25 %; at N = 20
 the dense route's floor, 81 %)."""
+LARGE_ROUTE_3D_VECTOR = {2: (4856.0, 124.9, 3.72e-5, 4.22e-10)}
+"""The same constants for the 3D elastic bodies (three components a node, ``components`` = 3),
+where they are measured: their bodies are factorized whole, not in parity parts, and hold more per
+dof. Fitted on ``beta --model elastic3d --case all --k 2 --norm all`` at N = 12, 16, 20, 24
+(2026-12-06; peaks 1.08, 2.44, 5.99, 9.25 GB, CPU 8.3, 23.1, 70.4, 188 s): the membranes' fit put
+N = 16 at 0.80 of its peak. Elsewhere :data:`LARGE_ROUTE_3D`."""
 LARGE_ROUTE_MARGIN = 1.2
+
+
+def _large_route_constants(k: int, components: int) -> tuple:
+    """(a, b, c, d) of the large route for degree ``k`` and ``components`` a node."""
+    if components > 1 and min(k, 2) in LARGE_ROUTE_3D_VECTOR:
+        return LARGE_ROUTE_3D_VECTOR[min(k, 2)]
+    return LARGE_ROUTE_3D[min(k, 2)]
+
 DENSE_ROUTE_SECONDS_3D = {1: 2.2e-9, 2: 1.0e-9}
 """d of c Σ nd + d m³ seconds (c of :data:`LARGE_ROUTE_3D`) on PARDISO's dense route, where the
 dense SVDs and pencils cost more per m³ (fitted at k = 1, N = 32, ``--case all``; k = 2 on
@@ -206,7 +220,7 @@ def _face_bodies_estimate(k: int, n1: int, n2: int, components: int = 1, process
     base = PROCESS_BYTES["beta"] if process else 0
     m = float(_large_route_dim(k, n2, components))
     if route == "pardiso" and m > DENSE_MAX_M:
-        a, b, c, d = LARGE_ROUTE_3D[min(k, 2)]
+        a, b, c, d = _large_route_constants(k, components)
         # memory never below the dense route's estimate at the gate (that one is the looser:
         # measured k = 2, 0.93 GB at N = 18 dense, 1.12 GB at N = 19 large), so it grows with N; per
         # component, so the gate's components (k gate + 1)^2 <= DENSE_MAX_M takes the dense route (no recursion)
@@ -217,7 +231,7 @@ def _face_bodies_estimate(k: int, n1: int, n2: int, components: int = 1, process
     volume = sum(SIDE_BYTES_3D[route, min(k, 2)] * nd ** (4.0 / 3.0) for nd in nds)
     if route == "nested":
         return Estimate(base + volume, START_SECONDS + SECONDS_PER_DOF2_3D * sum(nd ** 2 for nd in nds))
-    c, d = LARGE_ROUTE_3D[min(k, 2)][2], DENSE_ROUTE_SECONDS_3D[min(k, 2)]
+    c, d = _large_route_constants(k, components)[2], DENSE_ROUTE_SECONDS_3D[min(k, 2)]
     return Estimate(base + MKL_BYTES + volume, START_SECONDS + LARGE_ROUTE_MARGIN * (c * sum(nds) + d * m ** 3))
 
 

@@ -141,15 +141,15 @@ def _off_energy(C, sigma, inverses) -> float:
     return total
 
 
-def _matching(C) -> list | None:
-    """σ: for each multiplier component a, the body part c with the largest ‖C_ac‖_F (None for
-    an empty component, or a row of zeros); None unless a bijection between the components that
-    carry anything."""
-    sigma = []
-    for row in C:
-        norms = [sp.linalg.norm(Cac) if Cac.nnz else 0.0 for Cac in row]
-        sigma.append(int(np.argmax(norms)) if row and max(norms) > 0.0 else None)
+def strongest_components(norms) -> list | None:
+    """σ(a) = argmax_c ``norms[a][c]`` for each row a (None for a row of zeros or an empty one),
+    or None unless σ is one-to-one on the rows that carry anything: which component of an
+    equivariant map's target holds each component of its source (the rest is round-off)."""
+    sigma = [int(np.argmax(row)) if len(row) and max(row) > 0.0 else None for row in norms]
     taken = [c for c in sigma if c is not None]
     return sigma if len(taken) == len(set(taken)) else None
 
 
+def _matching(C) -> list | None:
+    """:func:`strongest_components` of the blocks C_ac by their Frobenius norms."""
+    return strongest_components([[sp.linalg.norm(Cac) if Cac.nnz else 0.0 for Cac in row] for row in C])

@@ -15,6 +15,7 @@ import scipy.sparse as sp
 
 from ..discretization.gamma.symmetry import axis_reflections, induced_permutation, isotypic_bases, reflect
 from ..la import bottom
+from ..la.parity_sandwich import strongest_components
 from ..la.reflection import ReflectionSplit
 from ..la.threaded import concurrent_map
 from .kernel import BLOCK_EXTRA, KernelDecision, certified_bottom, certify_floor, decide, error_level, right_singular
@@ -187,20 +188,15 @@ def row_components(blocks, row_bases) -> tuple:
     if row_bases is None:
         return blocks, 0.0
     RT = [sp.csr_matrix(R.T) for R in row_bases]
-    kept, dropped, total, taken = [], 0.0, 0.0, set()
-    for B in blocks:
-        if B.shape[1] == 0:
-            kept.append(sp.csc_matrix((0, 0)))
-            continue
-        parts = [(Rt @ B).tocsc() for Rt in RT]
-        norms = [sp.linalg.norm(T) ** 2 if T.nnz else 0.0 for T in parts]
-        best = int(np.argmax(norms))
-        if best in taken:
-            return blocks, 0.0
-        taken.add(best)
-        kept.append(parts[best])
-        dropped += float(sum(v for d, v in enumerate(norms) if d != best))  # not a difference: no cancellation
-        total += float(sum(norms))
+    parts = [[(Rt @ B).tocsc() for Rt in RT] if B.shape[1] else [] for B in blocks]
+    energy = [[sp.linalg.norm(T) ** 2 if T.nnz else 0.0 for T in row] for row in parts]
+    sigma = strongest_components(energy)
+    if sigma is None:
+        return blocks, 0.0
+    kept = [row[s] if s is not None else B for row, s, B in zip(parts, sigma, blocks)]  # B: empty or zero
+    # the rest summed as such, not as a difference: no cancellation
+    dropped = float(sum(v for row, s in zip(energy, sigma) for d, v in enumerate(row) if d != s))
+    total = float(sum(map(sum, energy)))
     if dropped > ROWS_SPLIT_RTOL * total:  # the rows do not split (another group: the tetrahedra's)
         return blocks, 0.0
     return kept, dropped

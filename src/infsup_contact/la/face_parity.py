@@ -45,20 +45,29 @@ def tensor_bases(parities) -> list:
     return [sp.kron(qx[c & 1], qy[c >> 1], format="csr") for c in range(4)]
 
 
-def parity_blocks(coeffs, index, separable_sum) -> list:
+def parity_blocks(coeffs, index, weights_on) -> list:
     """[S_c(n_max)], c = 0..3: the four parity blocks of the double sine series (module text) from
     the factors' coefficients in the parity bases, ``coeffs[axis][p]`` = (Q_p)ᵀ c (dim_p × len(index[p])),
-    and the sine indices ``index`` = (odd m, even m); each block by ``separable_sum(A, B, m, n)``
-    (the exponential-sum product over the index sets m of x and n of y)."""
-    blocks = []
-    for c in range(4):
-        p, q = c & 1, c >> 1
-        cx, cy = coeffs[0][p], coeffs[1][q]
-        A = (cx[:, None, :] * cx[None, :, :]).reshape(cx.shape[0] ** 2, -1)
-        B = (cy[:, None, :] * cy[None, :, :]).reshape(cy.shape[0] ** 2, -1)
-        flat = separable_sum(A, B, index[p], index[q])  # it reuses A's columns where B equals A
-        blocks.append(symmetric_pairs(flat, cx.shape[0], cy.shape[0]))
-    return blocks
+    and the sine indices ``index`` = (odd m, even m). The weights 1/(π√(m² + n²)) come as one
+    separable sum for the four blocks, ``weights_on(x_lo, x_hi)`` on the range of all of them
+    (``columns(M, squares)`` = M E, ``scaled(L)`` = L D, :class:`~infsup_contact.discretization.face.norms.tensor.SeparableWeights`):
+    so each parity's products c ⊗ c and their columns are made once per direction, not once
+    per block (the y direction's are the x direction's where the two factors are the same), and
+    block c = p + 2q is scaled(columns_x[p]) · columns_y[q]ᵀ."""
+    squares = [np.asarray(idx, dtype=float) ** 2 for idx in index]
+    ends = [(s[0], s[-1]) for s in squares]
+    weights = weights_on(min(a[0] + b[0] for a in ends for b in ends), max(a[1] + b[1] for a in ends for b in ends))
+
+    def columns(cs):  # per parity: (c ⊗ c) E, the products dropped once their columns are made
+        return [weights.columns((c[:, None, :] * c[None, :, :]).reshape(c.shape[0] ** 2, -1), x)
+                for c, x in zip(cs, squares)]
+
+    left = columns(coeffs[0])
+    same = all(np.array_equal(a, b) for a, b in zip(coeffs[0], coeffs[1]))
+    right = left if same else columns(coeffs[1])
+    scaled = [weights.scaled(L) for L in left]
+    return [symmetric_pairs(scaled[c & 1] @ right[c >> 1].T, coeffs[0][c & 1].shape[0], coeffs[1][c >> 1].shape[0])
+            for c in range(4)]
 
 
 def intertwined(R: sp.csr_matrix, Qs, Ts) -> list | None:

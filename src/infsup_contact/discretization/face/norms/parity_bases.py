@@ -35,12 +35,12 @@ def tensor_parities(space) -> tuple | None:
     return out
 
 
-def partial_gram_blocks(space, n_max: int, parities, separable_sum) -> list:
+def partial_gram_blocks(space, n_max: int, parities, weights_on) -> list:
     """[S_c(n_max)], c = 0..3: the blocks T_cᵀ S(n_max) T_c of :func:`~.face_norms.partial_gram`
-    (module text), each by ``separable_sum(A, B, m, n)`` (the exponential-sum product
-    :func:`~.face_norms._separable_sum` over the index sets m of x and n of y)."""
+    (module text), the weights by ``weights_on(x_lo, x_hi)`` (the exponential sum on that range,
+    :class:`~.face_norms.SeparableWeights`), one for the four blocks."""
     n = np.arange(1, n_max + 1, dtype=float)
     index = (n[0::2], n[1::2])                      # odd m for even functions, even m for odd ones
     coeffs = [[(Q.T @ sine_coefficients(f, idx))  # (dim_p, len(idx)) per parity p
                for Q, idx in zip(q, index)] for f, q in zip(space.factors, parities)]
-    return face_parity.parity_blocks(coeffs, index, separable_sum)
+    return face_parity.parity_blocks(coeffs, index, weights_on)

@@ -103,35 +103,51 @@ def _weights(m: np.ndarray, n2: np.ndarray, aspect: float) -> np.ndarray:
 
 
 def _separable_sum(A: np.ndarray, B: np.ndarray, m: np.ndarray, n: np.ndarray, aspect: float) -> np.ndarray:
-    """A W Bᵀ for W[m, n] = a / (π√((m/a)² + n²)) (A's columns at the indices ``m``, B's at ``n``) written as Σ_j w_j e^{−a_j (m/a)²} e^{−a_j n²}
-    (:func:`~infsup_contact.la.exponential_sum.inverse_sqrt`, relative accuracy :data:`EXP_SUM_RTOL`):
-    (A E_x) diag(a w / π) (B E_y)ᵀ, never forming W (B E_y is A E_x itself when the two
-    directions are the same: one product of dim² · n_max · r fewer).
-
-    Most terms have a_j x_max ≤ :data:`TAYLOR_BELOW` (x = (m/a)² + n² ≤ x_max): there
-    e^{−b_j (t + u)}, b_j = a_j x_max, t = (m/a)²/x_max, u = n²/x_max ∈ [0, 1], is its double
-    Taylor polynomial of degree :data:`TAYLOR_DEGREE` per variable to round-off, so those terms
-    together are T_x C T_yᵀ with T[m, q] = t_m^q and one (p + 1)² matrix
-    C = Σ_j w_j v_j v_jᵀ, v_j[q] = (−b_j)^q / q!: about 200 of the ~270 columns become 18."""
+    """A W Bᵀ for W[m, n] = a / (π√((m/a)² + n²)) (A's columns at the indices ``m``, B's at ``n``),
+    W as the exponential sum of :class:`SeparableWeights` on the range of (m/a)² + n²:
+    (A E_x) D (B E_y)ᵀ, never forming W (B E_y is A E_x itself when the two directions are the
+    same: one product of dim² · n_max · r fewer)."""
     x_lo, x_hi = (m[0] / aspect) ** 2 + n[0] ** 2, (m[-1] / aspect) ** 2 + n[-1] ** 2
-    x_max = max(x_lo, x_hi)
-    expo = inverse_sqrt(min(x_lo, x_hi), x_max, EXP_SUM_RTOL)
-    weights = aspect * expo.weights / np.pi
-    taylor = expo.rates * x_max <= TAYLOR_BELOW
-    q = np.arange(TAYLOR_DEGREE + 1)
-    v = (-(expo.rates[taylor] * x_max)[:, None]) ** q / np.cumprod(np.maximum(q, 1))
-    C = (v * weights[taylor, None]).T @ v
-
-    def columns(M, squares):            # [M e^{−a_j x}, M T] for one direction (x = squares)
-        return np.hstack([M @ np.exp(-np.multiply.outer(squares, expo.rates[~taylor])),
-                          M @ (squares / x_max)[:, None] ** q])
-
-    left = columns(A, (m / aspect) ** 2)
+    weights = SeparableWeights(x_lo, x_hi, aspect)
+    left = weights.columns(A, (m / aspect) ** 2)
     same = aspect == 1.0 and np.array_equal(m, n) and (B is A or np.array_equal(A, B))
-    right = left if same else columns(B, n ** 2)
-    k = int(np.count_nonzero(~taylor))
-    scaled = np.hstack([left[:, :k] * weights[~taylor], left[:, k:] @ C])
-    return scaled @ right.T
+    right = left if same else weights.columns(B, n ** 2)
+    return weights.scaled(left) @ right.T
+
+
+class SeparableWeights:
+    """W[m, n] = a / (π√(x)), x = (m/a)² + n² in [x_lo, x_hi] (either order), written as
+    Σ_j w_j e^{−a_j (m/a)²} e^{−a_j n²} (:func:`~infsup_contact.la.exponential_sum.inverse_sqrt`,
+    relative accuracy :data:`EXP_SUM_RTOL`): W = E_x D E_yᵀ, so M_x W M_yᵀ =
+    :meth:`scaled` (:meth:`columns` (M_x)) · :meth:`columns` (M_y)ᵀ. One instance serves every
+    product whose x lies in its range (the four parity blocks of a level,
+    :func:`~infsup_contact.la.face_parity.parity_blocks`: each direction's columns once).
+
+    Most terms have a_j x_max ≤ :data:`TAYLOR_BELOW`: there e^{−b_j (t + u)}, b_j = a_j x_max,
+    t = (m/a)²/x_max, u = n²/x_max ∈ [0, 1], is its double Taylor polynomial of degree
+    :data:`TAYLOR_DEGREE` per variable to round-off, so those terms together are T_x C T_yᵀ with
+    T[m, q] = t_m^q and one (p + 1)² matrix C = Σ_j w_j v_j v_jᵀ, v_j[q] = (−b_j)^q / q!: about
+    200 of the ~270 columns become 18."""
+
+    def __init__(self, x_lo: float, x_hi: float, aspect: float = 1.0):
+        self.x_max = max(x_lo, x_hi)
+        expo = inverse_sqrt(min(x_lo, x_hi), self.x_max, EXP_SUM_RTOL)
+        weights = aspect * expo.weights / np.pi
+        taylor = expo.rates * self.x_max <= TAYLOR_BELOW
+        self.q = np.arange(TAYLOR_DEGREE + 1)
+        v = (-(expo.rates[taylor] * self.x_max)[:, None]) ** self.q / np.cumprod(np.maximum(self.q, 1))
+        self.C = (v * weights[taylor, None]).T @ v
+        self.rates, self.weights = expo.rates[~taylor], weights[~taylor]
+
+    def columns(self, M: np.ndarray, squares: np.ndarray) -> np.ndarray:
+        """[M e^{−a_j x}, M T] for one direction (x = ``squares``, M's columns at them)."""
+        return np.hstack([M @ np.exp(-np.multiply.outer(squares, self.rates)),
+                          M @ (squares / self.x_max)[:, None] ** self.q])
+
+    def scaled(self, left: np.ndarray) -> np.ndarray:
+        """:meth:`columns` times the weights: [L_e diag(w_j), L_T C]."""
+        k = len(self.rates)
+        return np.hstack([left[:, :k] * self.weights, left[:, k:] @ self.C])
 
 
 def default_cap(dim: int) -> int:
@@ -224,8 +240,7 @@ def gram_h_face(space, rtol: float = 1e-6, n_start: int | None = None, n_cap: in
 def partial_gram_blocks(space, n_max: int, parities) -> list:
     """:func:`partial_gram` (exponential-sum route) in the four parity blocks of the axis
     reflections (:func:`.parity_bases.partial_gram_blocks`)."""
-    return parity_bases.partial_gram_blocks(space, n_max, parities,
-                                           lambda A, B, m, n: _separable_sum(A, B, m, n, 1.0))
+    return parity_bases.partial_gram_blocks(space, n_max, parities, SeparableWeights)
 
 
 def extrapolated(partial, p: float, n0: int, n_cap: int, rtol: float, ops=None) -> tuple[np.ndarray, dict]:

@@ -130,3 +130,21 @@ def test_the_deferred_l2_gram_is_the_kron_and_its_diagonal_needs_no_matrix(monke
     assert np.array_equal(fp.diagonal(G_lazy), np.diag(G_eager)) and "dense" not in G_lazy.__dict__
     assert all(np.array_equal(a, b) for a, b in zip(G_lazy.blocks, info_eager["parity"].blocks))
     assert np.array_equal(np.asarray(G_lazy), G_eager) and np.array_equal(fp.diagonal(G_eager), np.diag(G_eager))
+
+
+@pytest.mark.parametrize("case,k,n", [("R5.2", 2, 6), ("T5", 2, 7)])
+def test_a_levels_blocks_side_by_side_are_the_blocks_one_after_the_other(monkeypatch, case, k, n):
+    """parity_blocks runs its parities' columns and its four block products as concurrent tasks
+    (one BLAS thread each): on two threads the blocks are those of one thread bit for bit, and
+    each block is its own exponential sum's T_cᵀ S T_c of the unsplit series to round-off."""
+    space = _space(case, k, np.linspace(0.0, 1.0, n + 1))
+    parities = fpb.tensor_parities(space)
+    monkeypatch.setenv("MKL_NUM_THREADS", "1")
+    serial = fn.partial_gram_blocks(space, 96, parities)
+    monkeypatch.setenv("MKL_NUM_THREADS", "2")
+    side_by_side = fn.partial_gram_blocks(space, 96, parities)
+    assert all(np.array_equal(a, b) for a, b in zip(serial, side_by_side))
+    whole = fn.partial_gram(space, 96)
+    scale = np.abs(whole).max()
+    for T, block in zip(fp.tensor_bases(parities), serial):
+        assert np.abs(np.asarray(T.T @ whole @ T) - block).max() <= 1e-13 * scale

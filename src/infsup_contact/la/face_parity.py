@@ -33,7 +33,7 @@ from functools import cached_property
 import numpy as np
 import scipy.sparse as sp
 
-from .threaded import signed_gather_sum, symmetric_pairs, symmetric_part, symmetric_sandwich
+from .threaded import concurrent_map, signed_gather_sum, symmetric_pairs, symmetric_part, symmetric_sandwich
 
 INTERTWINE_RTOL = 1e-10
 """Largest ‖Q_aᵀ R T_b‖_F / ‖R‖_F (a ≠ b) for which R counts as intertwining the reflections."""
@@ -59,15 +59,16 @@ def parity_blocks(coeffs, index, weights_on) -> list:
     weights = weights_on(min(a[0] + b[0] for a in ends for b in ends), max(a[1] + b[1] for a in ends for b in ends))
 
     def columns(cs):  # per parity: (c ⊗ c) E, the products dropped once their columns are made
-        return [weights.columns((c[:, None, :] * c[None, :, :]).reshape(c.shape[0] ** 2, -1), x)
-                for c, x in zip(cs, squares)]
+        return concurrent_map(lambda cx: weights.columns((cx[0][:, None, :] * cx[0][None, :, :]).reshape(
+            cx[0].shape[0] ** 2, -1), cx[1]), list(zip(cs, squares)))
 
+    # the parities' columns, then the blocks, side by side (GIL-free products, one BLAS thread each)
     left = columns(coeffs[0])
     same = all(np.array_equal(a, b) for a, b in zip(coeffs[0], coeffs[1]))
     right = left if same else columns(coeffs[1])
-    scaled = [weights.scaled(L) for L in left]
-    return [symmetric_pairs(scaled[c & 1] @ right[c >> 1].T, coeffs[0][c & 1].shape[0], coeffs[1][c >> 1].shape[0])
-            for c in range(4)]
+    scaled = concurrent_map(weights.scaled, left)
+    return concurrent_map(lambda c: symmetric_pairs(scaled[c & 1] @ right[c >> 1].T, coeffs[0][c & 1].shape[0],
+                                                    coeffs[1][c >> 1].shape[0]), range(4))
 
 
 def intertwined(R: sp.csr_matrix, Qs, Ts) -> list | None:

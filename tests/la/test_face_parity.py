@@ -148,3 +148,30 @@ def test_a_levels_blocks_side_by_side_are_the_blocks_one_after_the_other(monkeyp
     scale = np.abs(whole).max()
     for T, block in zip(fp.tensor_bases(parities), serial):
         assert np.abs(np.asarray(T.T @ whole @ T) - block).max() <= 1e-13 * scale
+
+
+@pytest.mark.parametrize("case", ["DUAL-Q9", "TDUAL-Q8", "PWLIN-Q9", "DUAL-Q9-ALL"])
+def test_the_deferred_cellwise_l2_gram_is_its_blocks_and_the_dense_one_when_read(case):
+    """Inside deferred_assembly a cellwise space's L² Gram comes in the parity blocks of the
+    axis reflections, summed from the sparse G: assembled, the blocks give the dense Gram to
+    round-off; read, it is the dense Gram bit for bit, its diagonal the same entries."""
+    space = _space(case, 2, np.linspace(0.0, 1.0, 6))
+    dense, _ = fc.gram_cellwise(space, "L2")
+    with fp.deferred_assembly():
+        G, info = fc.gram_cellwise(space, "L2")
+    assert isinstance(G, fc.SparseParityGram) and info["parity"] is G
+    assert sum(Q.shape[1] for Q in G.bases) == space.dim
+    assembled = fp.assemble(G.bases, G.blocks)
+    assert np.abs(assembled - dense).max() <= 1e-14 * np.abs(dense).max()
+    assert np.array_equal(G.diagonal(), np.diag(dense))
+    assert np.array_equal(np.asarray(G), dense)
+
+
+def test_a_cellwise_l2_gram_without_the_reflections_stays_dense(monkeypatch):
+    """Where the basis is not mapped onto itself by both reflections the L² Gram stays the dense
+    matrix inside deferred_assembly too."""
+    space = _space("DUAL-Q9", 2, np.linspace(0.0, 1.0, 6))
+    monkeypatch.setattr(fc, "axis_reflections", lambda *a: None)
+    with fp.deferred_assembly():
+        G, info = fc.gram_cellwise(space, "L2")
+    assert isinstance(G, np.ndarray) and "parity" not in info

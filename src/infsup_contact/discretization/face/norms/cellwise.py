@@ -30,6 +30,7 @@ pieces are not axis-aligned rectangles (4C ``pwlin`` on QUAD8) is refused.
 from __future__ import annotations
 
 import contextlib
+from functools import cached_property
 
 import numpy as np
 import scipy.sparse as sp
@@ -162,10 +163,58 @@ def projection(space) -> tuple[sp.csr_matrix, FaceSpace]:
 
 def gram_l2_cellwise(space) -> np.ndarray:
     """Exact L²(Γ) Gram ∫ μ_i μ_j by the per-piece Gauss rule of degree 2s per variable."""
+    G = _l2_sparse(space).toarray()
+    return 0.5 * (G + G.T)
+
+
+def _l2_sparse(space) -> sp.csr_matrix:
+    """The L² Gram of :func:`gram_l2_cellwise`, sparse and not yet symmetrised."""
     P = piece_space(space)
     x, w = piece_rule(P.breakpoints, space.piece_degree + 1)
-    G = (weighted_values(space, x, w).T @ _at(space, x)).toarray()
-    return 0.5 * (G + G.T)
+    return (weighted_values(space, x, w).T @ _at(space, x)).tocsr()
+
+
+class SparseParityGram(face_parity.ParityGram):
+    """The L² Gram of a cellwise space in the parity blocks of the axis reflections
+    (:func:`l2_parity`), Q_cᵀ G Q_c from the sparse G (local supports: about 25 nonzeros a row
+    at s = 2), its dense matrix made on first read (bit for bit :func:`gram_l2_cellwise`), its
+    diagonal the sparse G's (the same entries): inside
+    :func:`~infsup_contact.la.face_parity.deferred_assembly` a β_h request never forms the dense
+    G (708 MB at k = 2, N = 48) nor splits it again."""
+
+    def __init__(self, bases, blocks, sparse):
+        super().__init__(bases, blocks)
+        self._sparse = sparse
+
+    @cached_property
+    def dense(self) -> np.ndarray:
+        G = self._sparse.toarray()
+        G = 0.5 * (G + G.T)
+        G.setflags(write=False)
+        return G
+
+    def diagonal(self) -> np.ndarray:
+        return self._sparse.diagonal()
+
+
+def l2_parity(space):
+    """The L² Gram of a cellwise space as a :class:`SparseParityGram` in the components of the
+    axis reflections (the H Gram's bases, :func:`_parity_route`), or None: the basis not mapped
+    onto itself, an empty component, or G not block diagonal in them (a cross block above
+    :data:`~infsup_contact.la.face_parity.INTERTWINE_RTOL` of G, Frobenius)."""
+    P = piece_space(space)
+    pis = axis_reflections(space, piece_rule(P.breakpoints, space.piece_degree + 1)[0])
+    if pis is None:
+        return None
+    bases = isotypic_bases(pis)
+    if min(Q.shape[1] for Q in bases) < 1:
+        return None
+    G = _l2_sparse(space)
+    sym = (0.5 * (G + G.T)).tocsr()
+    blocks = face_parity.intertwined(sym, bases, bases)
+    if blocks is None:
+        return None
+    return SparseParityGram(bases, [symmetric_part(B.toarray()) for B in blocks], G)
 
 
 def gram_h_cellwise(space, rtol: float = 1e-6, n_start: int | None = None, n_cap: int | None = None,
@@ -213,5 +262,10 @@ def _parity_route(space, R, P):
 
 
 def gram_cellwise(space, norm: str, **kwargs) -> tuple[np.ndarray, dict]:
-    """Gram matrix for ``norm`` ∈ {"H", "L2"} of a non-tensor face space."""
-    return gram_by_norm(norm, lambda: gram_l2_cellwise(space), lambda **kw: gram_h_cellwise(space, **kw), **kwargs)
+    """Gram matrix for ``norm`` ∈ {"H", "L2"} of a non-tensor face space; the L² Gram inside
+    :func:`~infsup_contact.la.face_parity.deferred_assembly` in its parity blocks where it has
+    them (:func:`l2_parity`, also in ``info["parity"]``)."""
+    parity = l2_parity(space) if norm == "L2" and face_parity.deferring() else None
+    G, info = gram_by_norm(norm, lambda: gram_l2_cellwise(space) if parity is None else parity,
+                           lambda **kw: gram_h_cellwise(space, **kw), **kwargs)
+    return G, (info if parity is None else dict(info, parity=parity))

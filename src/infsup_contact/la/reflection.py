@@ -36,7 +36,7 @@ import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
 
-from .threaded import sparse_times_dense, symmetric_part, times_transpose
+from .threaded import concurrent_map, sparse_times_dense, symmetric_part, times_transpose
 from . import bottom
 from .parity_sandwich import INVARIANCE_RTOL, ParityOperator
 
@@ -139,7 +139,8 @@ def split_pencils(split: ReflectionSplit, S: np.ndarray, factors: dict, kernel_p
     if distance > INVARIANCE_RTOL:
         return None
     parts = [None if kernel_parts is None or not Z.shape[1] else Z for Z in (kernel_parts or [None] * len(halves))]
-    shared = [bottom.definite_factor(h) if Z is None and h.shape[0] >= 3 else None for h, Z in zip(halves, parts)]
+    shared = concurrent_map(lambda hZ: bottom.definite_factor(hZ[0]) if hZ[1] is None and hZ[0].shape[0] >= 3 else None,
+                            list(zip(halves, parts)))  # side by side: LAPACK potrf, one BLAS thread each
     out = {}
     for norm, Ls in factors.items():
         values, top = [], 0.0

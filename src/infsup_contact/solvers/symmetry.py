@@ -70,12 +70,18 @@ def split_bottom_kernel(W, split: ReflectionSplit, proven: int = 0, entry_error:
     rows, m = W.shape
     proven = int(max(proven, m - rows, 0))
     bases = split.bases
-    blocks = [sp.csr_matrix(W @ Q) for Q in bases]
-    grams = [sp.csr_matrix(B.T @ B) for B in blocks]
-    off = [float(sp.linalg.norm(blocks[a].T @ blocks[b])) for b in range(len(blocks)) for a in range(b)]
+
+    def prepared(Q):  # a component's W Q_c, its Gram and σ_max (sparse products and Lanczos)
+        B = sp.csr_matrix(W @ Q)
+        g = sp.csr_matrix(B.T @ B)
+        return B, g, (bottom.largest_singular(B, g) if B.shape[1] else 0.0)
+
+    # the components side by side, then their cross products (GIL-free: the same bits)
+    blocks, grams, smaxes = map(list, zip(*concurrent_map(prepared, bases)))
+    pairs = [(a, b) for b in range(len(blocks)) for a in range(b)]
+    off = concurrent_map(lambda ab: float(sp.linalg.norm(blocks[ab[0]].T @ blocks[ab[1]])), pairs)
     # ‖O‖₂ of the off-diagonal part O of WᵀW in Q: ‖C‖₂ <= ‖C‖_F for two blocks, ‖O‖_F beyond
     cross = off[0] if len(off) == 1 else float(np.sqrt(2.0 * np.sum(np.square(off))))
-    smaxes = [bottom.largest_singular(B, g) if B.shape[1] else 0.0 for B, g in zip(blocks, grams)]
     smax = max(smaxes)
     tol = error_level(rows, m, smax, entry_error)
     floor = max(certify_floor(rows, m, smax), 2.0 * cross)  # the whole W's certificate at τ − ‖O‖

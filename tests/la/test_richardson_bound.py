@@ -85,7 +85,7 @@ def _cache(sides):
 
 def test_block_steps_by_lanczos_are_the_dense_ones():
     """BlockOps above BLOCK_DENSE_MAX: Lanczos with L⁻¹ shared by the steps gives the largest
-    |eigenvalue| of L⁻¹ E L⁻ᵀ to its tolerance (1e-8 relative; asserted at 1e-7) against the
+    |eigenvalue| of L⁻¹ E L⁻ᵀ to about the square of its residual tolerance (asserted at 1e-7) against the
     whole standard form's eigenvalues, block by block, the max over the blocks."""
     from infsup_contact.la import richardson
 

@@ -191,3 +191,16 @@ def test_an_interface_operator_that_is_not_invariant_is_solved_unsplit():
     S[0, 2] += 1e-8 * np.abs(S).max()
     S[2, 0] = S[0, 2]
     assert spectra.split_spectra(split, S, factors) is None
+
+
+@pytest.mark.parametrize("n", [1, 7, 130])
+def test_symmetric_permutation_is_the_fancy_index(n):
+    """symmetric_permutation(A, p) copies the entries of A[np.ix_(p, p)], bit for bit, for a
+    permutation p and for a selection with repeats (and keeps the dtype)."""
+    from infsup_contact.la.reflection import symmetric_permutation
+
+    rng = np.random.default_rng(n)
+    A = rng.standard_normal((n, n))
+    for p in (rng.permutation(n), rng.integers(0, n, size=max(n // 2, 1))):
+        got = symmetric_permutation(A, p)
+        assert got.dtype == A.dtype and np.array_equal(got, A[np.ix_(p, p)])

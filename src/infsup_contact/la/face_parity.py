@@ -33,6 +33,7 @@ from functools import cached_property
 import numpy as np
 import scipy.sparse as sp
 
+from .reflection import symmetric_permutation
 from .threaded import concurrent_map, signed_gather_sum, symmetric_pairs, symmetric_part, symmetric_sandwich
 
 INTERTWINE_RTOL = 1e-10
@@ -210,5 +211,5 @@ class ParityGram:
             idx, sign = P.indices, np.sign(P.data)  # column j of Q' is sign[j] times column idx[j] of Q_c
             if len(np.unique(idx)) != len(idx):
                 return None
-            out.append(self.blocks[c][np.ix_(idx, idx)] * np.multiply.outer(sign, sign))
+            out.append(symmetric_permutation(self.blocks[c], idx) * np.multiply.outer(sign, sign))
         return out

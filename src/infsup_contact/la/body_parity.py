@@ -28,6 +28,8 @@ import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
 
+from .threaded import concurrent_map
+
 
 @dataclass(frozen=True)
 class ParityPart:
@@ -68,7 +70,7 @@ class ParityParts:
         gammas = [part.basis[self.n - self.n_gamma:] for part in self.parts]
         tails = [Q[:, Q.shape[1] - part.n_gamma:].tocsr() for Q, part in zip(gammas, self.parts)]
         S = self._sum(tails, [f.schur for f in facs])
-        inverses = [f.steklov if f.steklov is not None else spd_inverse(f.schur) for f in facs]
+        inverses = concurrent_map(lambda f: f.steklov if f.steklov is not None else spd_inverse(f.schur), facs)
         X = self._sum(tails, inverses)
         blocks = tuple((P, _exactly_symmetric(Xc)) for P, Xc in zip(tails, inverses))
         return S, _PartsSolve(self.parts, [f.solve for f in facs]), X, blocks
@@ -197,16 +199,19 @@ def parity_parts(K, n_gamma: int, bases) -> ParityParts:
     Each part's columns are ordered interior first (an orbit never mixes the two), K_c symmetrized."""
     K = sp.csr_matrix(K)
     n = K.shape[0]
-    parts = []
-    for Q in bases:
+
+    def part(Q):
         Q = Q.tocsc()
         first_row = Q.indices[Q.indptr[:-1]] if Q.shape[1] else np.zeros(0, int)
         on_gamma = first_row >= n - n_gamma
         Q = Q[:, np.concatenate([np.flatnonzero(~on_gamma), np.flatnonzero(on_gamma)])].tocsr()
         if Q.shape[1] == 0:
-            continue
+            return None
         Kc = congruence(K, Q)
         Kc = (0.5 * (Kc + Kc.T.tocsr())).tocsc()  # symmetric to the last bit: the solves' LU sees it whole
         Kc.sort_indices()
-        parts.append(ParityPart(Kc, int(on_gamma.sum()), Q))
+        return ParityPart(Kc, int(on_gamma.sum()), Q)
+
+    # the parts side by side (sparse products, GIL-free: each part the same operations, the same bits)
+    parts = [p for p in concurrent_map(part, list(bases)) if p is not None]
     return ParityParts(tuple(parts), n, int(n_gamma))

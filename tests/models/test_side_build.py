@@ -119,3 +119,24 @@ def test_k_on_the_free_dofs_is_the_whole_ks_restriction(element, k):
     beta, scene = m3.side_operator(body, k), m3.side_operator(body, k, keep_factor=True)
     assert beta.stiffness_all is None and np.array_equal(beta.free, scene.free)
     assert _same_arrays(beta.stiffness, scene.stiffness)
+
+
+def test_the_stiffness_on_the_task_manager_is_the_serial_one(monkeypatch):
+    """laplace_stiffness assembles on NGSolve's task manager where the request has two threads:
+    the same matrix, bit for bit, as the serial assembly (structure and values)."""
+    import numpy as np
+
+    from infsup_contact.models import membranes, membranes3d
+
+    body = membranes3d.subdomain_mesh("structured", 6, 1)
+    fes = membranes3d.displacement_space(body.mesh, 2, membranes3d.BETA_DIRICHLET)
+    monkeypatch.setenv("MKL_NUM_THREADS", "1")
+    serial = membranes.laplace_stiffness(fes)
+    monkeypatch.setenv("MKL_NUM_THREADS", "2")
+    calls = []
+    monkeypatch.setattr(membranes.ngsolve, "TaskManager", (lambda tm: lambda *a, **k: calls.append(1) or tm(*a, **k))(
+        membranes.ngsolve.TaskManager))
+    tasks = membranes.laplace_stiffness(fes)
+    assert calls
+    for name in ("indptr", "indices", "data"):
+        assert np.array_equal(getattr(serial, name), getattr(tasks, name))

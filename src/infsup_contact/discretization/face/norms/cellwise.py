@@ -202,12 +202,8 @@ def l2_parity(space):
     axis reflections (the H Gram's bases, :func:`_parity_route`), or None: the basis not mapped
     onto itself, an empty component, or G not block diagonal in them (a cross block above
     :data:`~infsup_contact.la.face_parity.INTERTWINE_RTOL` of G, Frobenius)."""
-    P = piece_space(space)
-    pis = axis_reflections(space, piece_rule(P.breakpoints, space.piece_degree + 1)[0])
-    if pis is None:
-        return None
-    bases = isotypic_bases(pis)
-    if min(Q.shape[1] for Q in bases) < 1:
+    bases = _reflection_bases(space, piece_space(space))
+    if bases is None:
         return None
     G = _l2_sparse(space)
     sym = (0.5 * (G + G.T)).tocsr()
@@ -253,12 +249,21 @@ def _parity_route(space, R, P):
     parities = parity_bases.tensor_parities(P)
     if parities is None:
         return None
+    bases = _reflection_bases(space, P)
+    if bases is None:
+        return None
+    Rs = face_parity.intertwined(R, bases, face_parity.tensor_bases(parities))
+    return None if Rs is None else (parities, Rs, bases)
+
+
+def _reflection_bases(space, P):
+    """The multiplier basis's components Q_c under the two axis reflections (checked at P's
+    Gauss points), or None: the basis not mapped onto itself, or an empty component."""
     pis = axis_reflections(space, piece_rule(P.breakpoints, space.piece_degree + 1)[0])
     if pis is None:
         return None
     bases = isotypic_bases(pis)
-    Rs = face_parity.intertwined(R, bases, face_parity.tensor_bases(parities))
-    return None if Rs is None or min(Q.shape[1] for Q in bases) < 1 else (parities, Rs, bases)
+    return None if min(Q.shape[1] for Q in bases) < 1 else bases
 
 
 def gram_cellwise(space, norm: str, **kwargs) -> tuple[np.ndarray, dict]:

@@ -124,6 +124,35 @@ def test_split_pencils_equal_the_unsplit_route(dims):
     assert halves.gap == pytest.approx(plain.gap, rel=1e-2)
 
 
+@pytest.mark.parametrize("dims", [(0, 0, 0, 0), (2, 0, 1, 0)])
+def test_split_pencils_side_by_side_are_the_pencils_one_after_the_other(monkeypatch, dims):
+    """split_pencils solves every (norm, block) pencil as a concurrent task (one BLAS thread each):
+    on two threads its values and λ_max are those of one thread bit for bit, with and without a
+    deflated kernel, for two norms."""
+    space, part = _space("R5.2", 2, 6)
+    split = symmetry.reflection_split(space, SQUARE.quadrature(part, 4)[0])
+    els, m = _elements(split), space.dim
+    rng = np.random.default_rng(5)
+    cols = [sum(_character(c, b) * w[e] for b, e in enumerate(els))
+            for c, dc in enumerate(dims) for w in rng.standard_normal((dc, m))]
+    A = _invariant_spd(split, 2)
+    if cols:
+        Q = sla.qr(np.column_stack(cols), mode="economic")[0]
+        Pp = np.eye(m) - Q @ Q.T
+        A = 0.5 * (Pp @ A @ Pp + (Pp @ A @ Pp).T)
+    parts = split.components(np.column_stack(cols)) if cols else None
+    factors = {nm: tuple(spectra.gram_factor(b) for b in split.blocks(_invariant_spd(split, seed, shift=0.2))[:-1])
+               for nm, seed in (("H", 3), ("L2", 4))}
+    monkeypatch.setenv("MKL_NUM_THREADS", "1")
+    serial = reflection.split_pencils(split, A, factors, parts, 6)
+    monkeypatch.setenv("MKL_NUM_THREADS", "2")
+    side_by_side = reflection.split_pencils(split, A, factors, parts, 6)
+    assert serial.keys() == side_by_side.keys() == factors.keys()
+    for nm in factors:
+        (v1, t1), (v2, t2) = serial[nm], side_by_side[nm]
+        assert np.array_equal(v1, v2) and t1 == t2 and len(v1) == 6 and np.all(v1 > 0)
+
+
 def test_a_kernel_that_is_not_the_sum_of_its_parts_is_refused():
     space, part = _space("R5.2", 2, 4)
     split = symmetry.reflection_split(space, SQUARE.quadrature(part, 4)[0])

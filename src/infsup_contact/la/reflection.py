@@ -141,23 +141,28 @@ def split_pencils(split: ReflectionSplit, S: np.ndarray, factors: dict, kernel_p
     parts = [None if kernel_parts is None or not Z.shape[1] else Z for Z in (kernel_parts or [None] * len(halves))]
     shared = concurrent_map(lambda hZ: bottom.definite_factor(hZ[0]) if hZ[1] is None and hZ[0].shape[0] >= 3 else None,
                             list(zip(halves, parts)))  # side by side: LAPACK potrf, one BLAS thread each
+
+    def solve(task):  # one block's pencil of one norm: (values above its kernel, its λ_max), or None
+        norm, b = task
+        Sb, Lb, Zb = halves[b], factors[norm][b], parts[b]
+        free = Sb.shape[0] - (0 if Zb is None else Zb.shape[1])
+        if free < 1:
+            return None
+        if free == 1 or Sb.shape[0] < 3:  # too small for Lanczos: the dense pencil
+            ev = sla.eigh(Sb, Lb @ Lb.T, eigvals_only=True)
+            return ev[(0 if Zb is None else Zb.shape[1]):], float(ev[-1])
+        res = bottom.bottom_pencil(Sb, Lb, n_values, Zb, s_factor=shared[b])
+        return res.values, res.lam_max
+
+    # every (norm, block) side by side: the Lanczos products (symv, OpenBLAS's one thread) and the
+    # factorizations, one BLAS thread each (each pencil the same operations: the same bits)
+    tasks = [(norm, b) for norm, Ls in factors.items() for b in range(min(len(halves), len(Ls)))]
+    solved = dict(zip(tasks, concurrent_map(solve, tasks)))
     out = {}
-    for norm, Ls in factors.items():
-        values, top = [], 0.0
-        for b, (Sb, Lb) in enumerate(zip(halves, Ls)):
-            Zb = parts[b]
-            free = Sb.shape[0] - (0 if Zb is None else Zb.shape[1])
-            if free < 1:
-                continue
-            if free == 1 or Sb.shape[0] < 3:  # too small for Lanczos: the dense pencil
-                ev = sla.eigh(Sb, Lb @ Lb.T, eigvals_only=True)
-                values.append(ev[(0 if Zb is None else Zb.shape[1]):])
-                top = max(top, float(ev[-1]))
-                continue
-            res = bottom.bottom_pencil(Sb, Lb, n_values, Zb, s_factor=shared[b])
-            values.append(res.values)
-            top = max(top, res.lam_max)
-        out[norm] = (np.sort(np.concatenate(values))[:max(n_values, 1)], top)
+    for norm in factors:
+        done = [r for (n, _), r in solved.items() if n == norm and r is not None]
+        values = np.sort(np.concatenate([v for v, _ in done]))
+        out[norm] = (values[:max(n_values, 1)], max([0.0] + [t for _, t in done]))
     return out
 
 

@@ -22,7 +22,7 @@ from ..discretization.segment import multipliers
 
 from ..discretization.spaces import registry
 from ..discretization.spaces.spec import SpaceSpec
-from ..discretization.gamma.coupling import coupling_matrix, trace_l2_norms
+from ..discretization.gamma.coupling import coupling_matrices, trace_l2_norms
 from ..discretization.segment.norms import NORMS
 from ..models import DEFAULT_MODEL
 from .. import progress
@@ -109,7 +109,7 @@ def _case_rows(r: BetaRequest, case, g_h, sides, dim_w: int, trace_norms, modes:
     tc = time.perf_counter()
     progress.note("couplings B_1, B_2")
     with progress.phase("couplings"):
-        couplings = [coupling_matrix(s.trace, space, r.k, sparse=is_large(space)) for s in sides]  # B_i
+        couplings = coupling_matrices([s.trace for s in sides], space, r.k, sparse=is_large(space))  # B_i
     t_coupling = time.perf_counter() - tc
     grams = GramCache() if grams is None else grams
     grams = {norm: _timed(f"{norm} Grams", grams.gram, gamma, case, r.k, g_h, space, norm, r.h_route)

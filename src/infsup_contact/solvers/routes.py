@@ -17,7 +17,7 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from ..discretization.gamma.coupling import coupling_matrix, trace_l2_norms
+from ..discretization.gamma.coupling import coupling_matrices, trace_l2_norms
 from ..la import bottom, face_parity, reflection
 from . import spectra, symmetry
 from .kernel import KernelDecision, bottom_kernel, coupling_kernel, scaled_couplings
@@ -123,8 +123,8 @@ def space_kernel(couplings, sides, space, k: int, structural: int, l2_gram=None,
     cols = np.sqrt(face_parity.diagonal(G))  # a Gram kept in parity blocks: without assembling it
     W = scaled_couplings(couplings, rows, cols)
     extra = LONGER_RULE_LARGE if iterative else LONGER_RULE
-    longer = scaled_couplings([coupling_matrix(s.trace, space, k, extra_degree=extra, sparse=iterative)
-                               for s in sides], rows, cols)
+    longer = scaled_couplings(coupling_matrices([s.trace for s in sides], space, k, extra_degree=extra,
+                                                sparse=iterative), rows, cols)
     if not iterative:
         error = np.linalg.norm(W - longer)
         decision = (symmetry.split_dense_kernel(W, split, structural, error, row_bases=_trace_components(sides))

@@ -86,3 +86,33 @@ def test_a_sweep_sparsifies_each_point_set_once_and_forget_drops_both(setup, mon
     assert np.array_equal(side.trace.cached_sparse_basis(x).toarray(), side.trace.gamma.trace_basis(side.trace, x))
     side.forget_cached()
     assert not side.trace.basis_cache and not side.trace.sparse_cache
+
+
+@pytest.mark.parametrize("model, kw, n, k", [("membranes3d", {"element": "hex"}, 3, 2),
+                                             ("membranes3d", {"element": "tet"}, 2, 1), ("membranes", {}, 4, 2)])
+def test_both_sides_couplings_share_the_multiplier_values_bit_for_bit(model, kw, n, k, monkeypatch):
+    """coupling_matrices on a matching pair evaluates μ once per chunk for both sides and gives
+    each side's coupling_matrix bit for bit (dense, sparse, a longer rule); a non-matching pair's
+    rules differ and each side keeps its own values."""
+    m = make_model(model)
+    calls = []
+    real = coupling.weighted_values
+    monkeypatch.setattr(coupling, "weighted_values", lambda *a: calls.append(1) or real(*a))
+    for sizes, shared in (((n, n), True), ((n, n + 1), False)):
+        sides = [m.side_operator(m.subdomain_mesh("structured", sizes[i], i + 1, **kw), k) for i in range(2)]
+        gamma = sides[0].trace.gamma
+        part = gamma.multiplier_partition(*(s.trace.partition for s in sides))
+        for case in ids_valid_for(k, space_ids(gamma.dim))[:4]:
+            space = case_space(case, k, part, gamma)
+            for extra, sparse in ((0, False), (2, True), (6, False)):
+                calls.clear()
+                both = coupling.coupling_matrices([s.trace for s in sides], space, k, extra, sparse)
+                n_both = len(calls)
+                calls.clear()
+                alone = [coupling_matrix(s.trace, space, k, extra, sparse) for s in sides]
+                assert n_both == (len(calls) // 2 if shared else len(calls)) and n_both >= 1
+                for a, b in zip(both, alone):
+                    if sparse:
+                        assert a.format == b.format == "csr"
+                        a, b = a.toarray(), b.toarray()
+                    assert a.dtype == b.dtype and np.array_equal(a, b) and np.array_equal(np.signbit(a), np.signbit(b))

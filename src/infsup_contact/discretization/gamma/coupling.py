@@ -24,23 +24,57 @@ def coupling_matrix(trace: GammaTrace, space: MultiplierSpace, k: int, extra_deg
     to round-off, which is how the kernel decision measures the round-off of the entries.
     ``sparse``: the same entries, bit for bit, as a CSR matrix (the large route: a face's B at
     dim M ≈ 4,000 is 130 MB dense and 99.8 % zeros)."""
-    # μ and the trace at their own points: the same ones unless Γ couples the sides by projection
-    x, x_trace, w = trace.gamma.coupling_points(trace, space, k + space.degree + extra_degree)
-    phi = trace.cached_sparse_basis(x_trace)  # CSR, made once per point set for a sweep of spaces
-    out = sp.csr_matrix((space.dim, phi.shape[1])) if sparse else np.zeros((space.dim, phi.shape[1]))
-    # each point sees (k + 1)^d trace and (s + 1)^d multiplier functions: a sparse product
-    # costs O(n_q) where the dense one costs n_q · dim M · n_Γ (a face at N = 32: 1e11 flops)
-    for rows in _chunks(len(w), space.dim):
-        part = weighted_values(space, x[rows], w[rows]).T @ phi[rows]
-        if sparse:  # 0 + a = a and a + b as below: the dense route's sums, entry by entry
-            out = out + part
-            continue
-        part = part.tocoo()
-        # = out += part.toarray() bit for bit: the product stores no zeros and out holds no −0.0,
-        # so the entries it skips would add +0.0 to them (and a single product, over the points
-        # of a chunk in ascending order per entry, is the same whatever built the CSR of μ)
-        out[part.row, part.col] += part.data
-    return out.tocsr() if sparse else out
+    return coupling_matrices([trace], space, k, extra_degree, sparse)[0]
+
+
+def coupling_matrices(traces: list, space: MultiplierSpace, k: int, extra_degree: int = 0,
+                      sparse: bool = False) -> list:
+    """[:func:`coupling_matrix` of each trace], bit for bit, the multiplier's values made once for
+    the traces whose coupling rule has the same points and weights (the sides of a matching pair:
+    half the values of μ, a third of a face's couplings at k = 2)."""
+    rules = [trace.gamma.coupling_points(trace, space, k + space.degree + extra_degree) for trace in traces]
+    out = [None] * len(traces)
+    for group in _same_rules(rules):
+        x, _, w = rules[group[0]]
+        # μ and the trace at their own points: the same ones unless Γ couples the sides by projection
+        phis = [traces[i].cached_sparse_basis(rules[i][1]) for i in group]  # CSR, once per point set
+        acc = [sp.csr_matrix((space.dim, phi.shape[1])) if sparse else np.zeros((space.dim, phi.shape[1]))
+               for phi in phis]
+        # each point sees (k + 1)^d trace and (s + 1)^d multiplier functions: a sparse product
+        # costs O(n_q) where the dense one costs n_q · dim M · n_Γ (a face at N = 32: 1e11 flops)
+        for rows in _chunks(len(w), space.dim):
+            mu_t = weighted_values(space, x[rows], w[rows]).T
+            for j, phi in enumerate(phis):
+                acc[j] = _add(acc[j], mu_t @ phi[rows], sparse)
+        for i, a in zip(group, acc):
+            out[i] = a.tocsr() if sparse else a
+    return out
+
+
+def _add(out, part, sparse: bool):
+    """out + part: sparse, 0 + a = a and a + b as the dense route's sums, entry by entry."""
+    if sparse:
+        return out + part
+    part = part.tocoo()
+    # = out += part.toarray() bit for bit: the product stores no zeros and out holds no −0.0,
+    # so the entries it skips would add +0.0 to them (and a single product, over the points
+    # of a chunk in ascending order per entry, is the same whatever built the CSR of μ)
+    out[part.row, part.col] += part.data
+    return out
+
+
+def _same_rules(rules: list) -> list:
+    """Groups of indices of ``rules`` (x_μ, x_trace, w) with equal x_μ and w, in first-seen order."""
+    groups = []
+    for i, (x, _, w) in enumerate(rules):
+        for g in groups:
+            x0, _, w0 = rules[g[0]]
+            if x.shape == x0.shape and w.shape == w0.shape and np.array_equal(x, x0) and np.array_equal(w, w0):
+                g.append(i)
+                break
+        else:
+            groups.append([i])
+    return groups
 
 
 def weighted_values(space, x: np.ndarray, w: np.ndarray) -> sp.csr_matrix:

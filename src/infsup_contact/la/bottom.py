@@ -33,11 +33,11 @@ from dataclasses import dataclass
 
 import numpy as np
 import scipy.linalg as sla
-from scipy.linalg import blas, lapack
+from scipy.linalg import blas
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from . import mkl
+from . import mkl, openblas
 
 DENSE_MAX_M = 1500
 """Largest dim M decided and solved densely (SVD of W, dense pencil); above it, this module.
@@ -177,7 +177,7 @@ def at_most_below(C: np.ndarray, tau: float, Z: np.ndarray, omega: float) -> boo
     M[np.diag_indices_from(M)] -= tau
     if Z.shape[1]:
         M = blas.dsyrk(omega, np.asfortranarray(Z), beta=1.0, c=M, trans=0, lower=1, overwrite_c=1)
-    _, info = lapack.dpotrf(M, lower=1, clean=0, overwrite_a=1)
+    _, info = openblas.potrf(M, clean=False, overwrite=True)
     return info == 0
 
 
@@ -226,7 +226,7 @@ def lam_max(S: np.ndarray, L: np.ndarray) -> float:
 def definite_factor(S: np.ndarray) -> np.ndarray | None:
     """Lower Cholesky factor of S (LAPACK potrf, the upper triangle zeroed), or None where S is
     not numerically positive definite (potrf meets a non-positive pivot)."""
-    R, info = lapack.dpotrf(S, lower=1, clean=1)
+    R, info = openblas.potrf(S)  # without the GIL: the blocks' factors side by side
     return None if info else R
 
 
@@ -252,7 +252,7 @@ def inverse_standard_form(R: np.ndarray, L: np.ndarray) -> np.ndarray:
         for j in range(0, m, SOLVE_BLOCK):
             e = min(j + SOLVE_BLOCK, m)
             K[j:, j:e] = sla.solve_triangular(R[j:, j:], L[j:, j:e], lower=True, check_finite=False)
-    C, info = lapack.dlauum(K, lower=1, overwrite_c=1)
+    C, info = openblas.lauum(K, overwrite=True)
     if info:
         raise np.linalg.LinAlgError(f"lauum failed (info {info})")
     return C
@@ -290,7 +290,7 @@ def bottom_pencil(S: np.ndarray, L: np.ndarray, n_values: int, Z: np.ndarray | N
             Sp += 2.0 * top * GZ @ sla.solve(LtZ.T @ LtZ, GZ.T, assume_a="pos", check_finite=False)
         # a floor keeps the factorization defined where S is singular (no Z given): λ ≈ 0 there anyway
         Sp[np.diag_indices(m)] += 1e-14 * top * np.einsum("ij,ij->i", L, L)
-        R = sla.cholesky(Sp, lower=True, overwrite_a=True, check_finite=False)
+        R = openblas.cholesky_lower(Sp, overwrite=True)
         del Sp
     inverse = inverse_standard_form(R, L)
     del R

@@ -107,3 +107,141 @@ def fit_to_idle_cores(asked: int) -> tuple[int, float | None]:
     if n < asked:
         set_threads(n)
     return n, idle
+
+
+# --- scipy's LAPACK without the GIL
+# scipy.linalg's LAPACK wrappers (f2py) hold the GIL for the whole call: two threads calling
+# potrf or gesdd run one after the other (k = 2 face sizes, order 1,500, one OpenBLAS thread: potrf
+# 1.10×, gesdd 0.99× the speed of one thread on two threads; numpy's matmul 1.64×). The same
+# routines of the same library called through ctypes release it, so the tasks of
+# :func:`~.threaded.run_concurrently` overlap; the same routine with the same arguments and
+# workspace gives the same bits (tests/la/test_nogil_lapack.py). Where scipy's OpenBLAS or one of
+# the routines is not found (another scipy build), scipy.linalg's own calls serve.
+
+_INT = ctypes.c_int
+"""scipy's OpenBLAS takes 32-bit LAPACK integers (numpy's copy is the ILP64 one)."""
+
+
+def _np():
+    """numpy, scipy.linalg and its lapack, imported on first use: this module is read before them
+    (the thread counts are set before OpenBLAS loads)."""
+    import numpy
+    import scipy.linalg
+    from scipy.linalg import lapack
+
+    return numpy, scipy.linalg, lapack
+
+
+@lru_cache(maxsize=None)
+def _lapack(name: str):
+    """scipy's OpenBLAS routine ``scipy_<name>_`` (ctypes), or None."""
+    for copy, lib, _ in loaded():
+        fn = getattr(lib, f"scipy_{name}_", None) if copy == "scipy" else None
+        if fn is not None:
+            fn.restype = None
+            return fn
+    return None
+
+
+def _ref(value: int):
+    return ctypes.byref(_INT(int(value)))
+
+
+def _ptr(a):
+    return ctypes.c_void_p(a.ctypes.data)
+
+
+def _fortran(A, overwrite: bool):
+    """A as a Fortran-ordered float64 array: A itself where ``overwrite`` and it already is one
+    (as f2py's ``overwrite_a``), else a copy."""
+    np = _np()[0]
+    return np.asfortranarray(A, dtype=float) if overwrite else np.array(A, dtype=float, order="F")
+
+
+def potrf(A, clean: bool = True, overwrite: bool = False) -> tuple:
+    """(L, info): ``scipy.linalg.lapack.dpotrf(A, lower=1, clean=clean, overwrite_a=overwrite)``,
+    bit for bit, without the GIL (module text)."""
+    lapack = _np()[2]
+    fn = _lapack("dpotrf")
+    if fn is None:
+        return lapack.dpotrf(A, lower=1, clean=int(clean), overwrite_a=int(overwrite))
+    a = _fortran(A, overwrite)
+    n, info = a.shape[0], _INT(0)
+    if n:
+        fn(ctypes.c_char_p(b"L"), _ref(n), _ptr(a), _ref(n), ctypes.byref(info), ctypes.c_size_t(1))
+    if clean:  # f2py's clean: the strict upper triangle zeroed (column by column: contiguous)
+        for j in range(1, n):
+            a[:j, j] = 0.0
+    return a, int(info.value)
+
+
+def cholesky_lower(A, overwrite: bool = False):
+    """``scipy.linalg.cholesky(A, lower=True, overwrite_a=overwrite, check_finite=False)``, bit for
+    bit, without the GIL; LinAlgError where A is not positive definite."""
+    np = _np()[0]
+    L, info = potrf(A, True, overwrite)
+    if info > 0:
+        raise np.linalg.LinAlgError(f"{info}-th leading minor of the array is not positive definite")
+    return L
+
+
+def lauum(K, overwrite: bool = False) -> tuple:
+    """(C, info): ``scipy.linalg.lapack.dlauum(K, lower=1, overwrite_c=overwrite)``, bit for bit,
+    without the GIL: Kᵀ K of a lower triangular K in C's lower triangle."""
+    lapack = _np()[2]
+    fn = _lapack("dlauum")
+    if fn is None:
+        return lapack.dlauum(K, lower=1, overwrite_c=int(overwrite))
+    c = _fortran(K, overwrite)
+    n, info = c.shape[0], _INT(0)
+    if n:
+        fn(ctypes.c_char_p(b"L"), _ref(n), _ptr(c), _ref(n), ctypes.byref(info), ctypes.c_size_t(1))
+    return c, int(info.value)
+
+
+def qr_r(W, overwrite: bool = False):
+    """``np.triu(scipy.linalg.qr(W, mode="r", overwrite_a=overwrite)[0][:n])`` (W m × n, m >= n,
+    finite), bit for bit, without the GIL: dgeqrf with the workspace it asks for, as scipy's."""
+    np, sla, _ = _np()
+    fn = _lapack("dgeqrf")
+    m, n = np.shape(W)
+    if fn is None or m < n or n == 0:
+        return np.triu(sla.qr(W, mode="r", overwrite_a=overwrite, check_finite=True)[0][:n])
+    a = _fortran(np.asarray_chkfinite(W), overwrite)
+    tau, work, info = np.empty(n), np.empty(1), _INT(0)
+    fn(_ref(m), _ref(n), _ptr(a), _ref(m), _ptr(tau), _ptr(work), _ref(-1), ctypes.byref(info))
+    lwork = int(np.int_(work[0].real))  # scipy's safecall: the query's value, truncated
+    work = np.empty(max(lwork, 1))
+    fn(_ref(m), _ref(n), _ptr(a), _ref(m), _ptr(tau), _ptr(work), _ref(lwork), ctypes.byref(info))
+    if info.value < 0:
+        raise ValueError(f"illegal value in {-info.value}th argument of internal geqrf")
+    return np.triu(a[:n])
+
+
+def gesdd(A, compute_uv: bool, overwrite: bool = False) -> tuple:
+    """(s, Vᵀ) of ``scipy.linalg.svd(A, full_matrices=False, compute_uv=True, overwrite_a=overwrite,
+    check_finite=False)``, or (s, None) of ``svdvals`` where not ``compute_uv``, bit for bit, without
+    the GIL: dgesdd with scipy's workspace (its ``dgesdd_lwork``)."""
+    np, sla, lapack = _np()
+    fn = _lapack("dgesdd")
+    m, n = np.shape(A)
+    k = min(m, n)
+    if fn is None or k == 0:
+        if compute_uv:
+            return tuple(sla.svd(A, full_matrices=False, overwrite_a=overwrite, check_finite=False)[1:])
+        return sla.svd(A, compute_uv=False, overwrite_a=overwrite, check_finite=False), None
+    a = _fortran(A, overwrite)
+    work, info = lapack.dgesdd_lwork(m, n, compute_uv=int(compute_uv), full_matrices=int(not compute_uv))
+    if info:
+        raise ValueError(f"Internal work array size computation failed: {info}")
+    lwork = int(work.real)
+    s, iwork, work, info = np.empty(k), np.empty(8 * k, dtype=np.int32), np.empty(max(lwork, 1)), _INT(0)
+    u, vt = (np.empty((m, k), order="F"), np.empty((k, n), order="F")) if compute_uv else (np.empty(1), np.empty(1))
+    ldu, ldvt = (m, k) if compute_uv else (1, 1)
+    fn(ctypes.c_char_p(b"S" if compute_uv else b"N"), _ref(m), _ref(n), _ptr(a), _ref(m), _ptr(s), _ptr(u),
+       _ref(ldu), _ptr(vt), _ref(ldvt), _ptr(work), _ref(lwork), _ptr(iwork), ctypes.byref(info), ctypes.c_size_t(1))
+    if info.value > 0:
+        raise np.linalg.LinAlgError("SVD did not converge")
+    if info.value < 0:
+        raise ValueError(f"illegal value in {-info.value}th argument of internal gesdd")
+    return (s, vt) if compute_uv else (s, None)

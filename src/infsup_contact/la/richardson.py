@@ -6,9 +6,10 @@ from __future__ import annotations
 import numpy as np
 import scipy.linalg as sla
 import scipy.sparse.linalg as spla
-from scipy.linalg import blas, lapack
+from scipy.linalg import blas
 
 from ..errors import InputError
+from . import openblas
 from .threaded import concurrent_map, elementwise
 
 
@@ -184,7 +185,7 @@ def relative_steps(Es: list, R: np.ndarray, dense_max: int | None = None) -> lis
     """:func:`relative_step` of each of ``Es`` against one R, its Cholesky factor made once (for
     every E: the standard forms up to ``dense_max``, default :data:`RELATIVE_DENSE_MAX`, Lanczos
     above)."""
-    L, info = lapack.dpotrf(np.asarray(R, float), lower=1, clean=1)
+    L, info = openblas.potrf(np.asarray(R, float))  # without the GIL: the blocks side by side
     if info:
         return [float(np.inf)] * len(Es)
     dense_max = RELATIVE_DENSE_MAX if dense_max is None else dense_max

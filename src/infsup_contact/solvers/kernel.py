@@ -52,7 +52,7 @@ import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
 
-from ..la import bottom
+from ..la import bottom, openblas
 
 MARGIN_DECADES = 1.0
 """A kernel decision whose margin from η is smaller than this many decades is ``close``."""
@@ -147,7 +147,7 @@ def coupling_kernel(W: np.ndarray, proven: int = 0, entry_error: float = 0.0,
     elif vectors:  # no trace dof touched (B = 0): every multiplier is in the kernel
         s, V = np.zeros(0), np.eye(m)
     else:
-        s, V = (sla.svdvals(W, check_finite=True) if rows else np.zeros(0)), None
+        s, V = (openblas.gesdd(np.asarray_chkfinite(W, dtype=float), False)[0] if rows else np.zeros(0)), None
     s = np.concatenate([np.zeros(m - len(s)), np.sort(s)])  # ascending, structural zeros first
     s_max = float(s[-1])
     tol = error_level(rows, m, s_max, entry_error)
@@ -167,10 +167,13 @@ def right_singular(W: np.ndarray, overwrite: bool = False) -> tuple[np.ndarray, 
     memory may hold the QR factors (a caller's temporary, Fortran-ordered to be used in place)."""
     W = np.asarray(W, float)
     rows, m = W.shape
-    if m == 0 or rows < (m * 11) // 6:
+    if m == 0 or m > rows:
         return tuple(sla.svd(W, full_matrices=m > rows, check_finite=True)[1:])
-    R = np.triu(sla.qr(W, mode="r", overwrite_a=overwrite, check_finite=True)[0][:m])
-    return tuple(sla.svd(R, full_matrices=False, overwrite_a=True, check_finite=False)[1:])
+    # scipy's own LAPACK routines through ctypes (la/openblas.py): the same bits, without the GIL,
+    # so the reflections' blocks side by side (symmetry.split_dense_kernel) run on both cores
+    if rows < (m * 11) // 6:
+        return openblas.gesdd(np.asarray_chkfinite(W), True)
+    return openblas.gesdd(openblas.qr_r(W, overwrite=overwrite), True, overwrite=True)
 
 
 def decide(s, proven, tol, numerical, s_max, vectors=None) -> KernelDecision:

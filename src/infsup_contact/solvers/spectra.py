@@ -16,7 +16,7 @@ from functools import cached_property
 import numpy as np
 from scipy.linalg import lapack
 
-from ..la import bottom, reflection
+from ..la import bottom, openblas, reflection
 from ..la.threaded import concurrent_map
 from .interface_operator import combine_terms
 from .kernel import KernelDecision, gap_over_roundoff, kernel_from_gap
@@ -54,7 +54,7 @@ def gram_factor(G: np.ndarray) -> np.ndarray:
     """Lower Cholesky factor of the Gram matrix G (LAPACK potrf, zeros above the diagonal: the
     large route's deflation and inverse use L whole), for :func:`spectrum`: one
     factorization serves every interface operator S paired with G (each (c1, c2), v1 = 0)."""
-    L, info = lapack.dpotrf(np.asarray(G, float), lower=1, clean=1)
+    L, info = openblas.potrf(np.asarray(G, float))  # without the GIL: blocks side by side
     if info:
         raise np.linalg.LinAlgError(f"the Gram matrix is not positive definite (potrf info {info})")
     return L

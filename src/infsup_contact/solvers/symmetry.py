@@ -10,11 +10,10 @@ is decided on the split's components (:func:`split_bottom_kernel`, the certifica
 from __future__ import annotations
 
 import numpy as np
-import scipy.linalg as sla
 import scipy.sparse as sp
 
 from ..discretization.gamma.symmetry import axis_reflections, induced_permutation, isotypic_bases, reflect
-from ..la import bottom
+from ..la import bottom, openblas
 from ..la.parity_sandwich import strongest_components
 from ..la.reflection import ReflectionSplit
 from ..la.threaded import concurrent_map
@@ -166,7 +165,7 @@ def split_dense_kernel(W: np.ndarray, split: ReflectionSplit, proven: int = 0,
         per_block = [np.concatenate([np.zeros(B.shape[1] - len(sb)), np.sort(sb)]) for (B, _), (sb, _) in zip(live, svds)]
         s = per_block
     else:
-        s = concurrent_map(lambda BQ: sla.svdvals(BQ[0], check_finite=True), live)  # LAPACK, as coupling_kernel
+        s = concurrent_map(lambda BQ: openblas.gesdd(np.asarray_chkfinite(BQ[0]), False)[0], live)  # as coupling_kernel
     s = np.sort(np.concatenate([np.zeros(m - sum(len(v) for v in s))] + s))
     s_max = float(s[-1])
     tol = error_level(rows, m, s_max, entry_error)

@@ -12,7 +12,7 @@ from infsup_contact.discretization.segment.dual import dual_space
 from infsup_contact.discretization.face.spaces.dual_bases import (
     SWEEP_ALPHAS, alpha_sweep, dual_coefficients, dual_shapes, mass_matrix, transformation, weights)
 from infsup_contact.discretization.face.spaces.reference_elements import (
-    ELEMENT_NAMES, cell_quadrature, pwlin_shapes, pwlin_subelements, reference_element)
+    ELEMENT_NAMES, cell_quadrature, monomials, pwlin_shapes, pwlin_subelements, reference_element)
 from infsup_contact.discretization.face.spaces.cellwise import CellwiseFaceSpace
 from infsup_contact.discretization.face.partitions.tensor_grid import TensorPartition
 from infsup_contact.errors import InputError
@@ -300,3 +300,17 @@ def test_continuous_bases_are_continuous_across_cells(name, basis):
     for y in GRID.ys[1:-1]:
         below, above = np.column_stack([t, np.full(20, y - eps)]), np.column_stack([t, np.full(20, y + eps)])
         assert np.allclose(S.evaluate(below), S.evaluate(above), atol=1e-7)
+
+
+@pytest.mark.parametrize("name", ELEMENT_NAMES)
+def test_monomials_are_each_power_product_bit_for_bit(name):
+    """monomials makes each distinct power of a coordinate once and gathers it: every column is
+    ξ^a η^b of the direct elementwise powers, bit for bit (edges, the corners, random points)."""
+    el = reference_element(name)
+    rng = np.random.default_rng(7)
+    pts = np.vstack([rng.uniform(-1.0, 1.0, (500, 2)), el.nodes, [[0.0, -0.0], [1e-300, -1e100]]])
+    got = monomials(el.exponents, pts)
+    assert got.shape == (len(pts), len(el.exponents))
+    for j, (a, b) in enumerate(el.exponents):
+        want = pts[:, 0] ** np.full(len(pts), a) * pts[:, 1] ** np.full(len(pts), b)
+        assert np.array_equal(got[:, j], want, equal_nan=True)

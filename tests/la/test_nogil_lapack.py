@@ -1,0 +1,75 @@
+"""scipy's LAPACK called through ctypes (la/openblas.py: potrf, lauum, geqrf, gesdd) gives what
+scipy.linalg's wrappers give, bit for bit (the same routine of the same library, the same
+workspace), in C or Fortran order, overwritten in place or not; the calls release the GIL, so
+two threads give each their own result unchanged."""
+from concurrent.futures import ThreadPoolExecutor
+
+import numpy as np
+import pytest
+import scipy.linalg as sla
+from scipy.linalg import lapack
+
+from infsup_contact.la import openblas
+
+
+def _spd(n, seed=0):
+    A = np.random.default_rng(seed).standard_normal((n, n))
+    return A @ A.T + n * np.eye(n)
+
+
+def test_the_routines_are_found_in_scipys_openblas():
+    assert all(openblas._lapack(name) is not None for name in ("dpotrf", "dlauum", "dgeqrf", "dgesdd"))
+
+
+@pytest.mark.parametrize("n", [1, 7, 130, 600])
+@pytest.mark.parametrize("order", ["C", "F"])
+def test_potrf_cholesky_and_lauum_are_scipys_bit_for_bit(n, order):
+    S = np.array(_spd(n, n), order=order)
+    for clean in (True, False):
+        L, info = openblas.potrf(S, clean=clean)
+        L0, info0 = lapack.dpotrf(S, lower=1, clean=int(clean))
+        assert info == info0 == 0 and np.array_equal(L, L0) and L.flags.f_contiguous
+    assert np.array_equal(openblas.cholesky_lower(S), sla.cholesky(S, lower=True, check_finite=False))
+    K = np.tril(np.random.default_rng(n).standard_normal((n, n)))
+    C, info = openblas.lauum(np.array(K, order=order))
+    assert info == 0 and np.array_equal(C, lapack.dlauum(K, lower=1)[0])
+    F = np.asfortranarray(S.copy())
+    L, _ = openblas.potrf(F, overwrite=True)
+    assert L is F and np.array_equal(L, lapack.dpotrf(S, lower=1, clean=1)[0])  # in place, as overwrite_a
+    assert np.array_equal(S, _spd(n, n))  # the input untouched without overwrite
+
+
+def test_a_matrix_that_is_not_positive_definite_is_reported_as_scipy_does():
+    S = _spd(50)
+    S[10, 10] = -1.0
+    assert openblas.potrf(S)[1] == lapack.dpotrf(S, lower=1, clean=1)[1] == 11
+    with pytest.raises(np.linalg.LinAlgError):
+        openblas.cholesky_lower(S)
+
+
+@pytest.mark.parametrize("shape", [(40, 40), (300, 120), (700, 200), (90, 150), (1, 1), (5, 0)])
+@pytest.mark.parametrize("order", ["C", "F"])
+def test_gesdd_and_the_qr_r_are_scipys_bit_for_bit(shape, order):
+    W = np.array(np.random.default_rng(sum(shape)).standard_normal(shape), order=order)
+    s, vt = openblas.gesdd(W, compute_uv=True)
+    _, s0, vt0 = sla.svd(W, full_matrices=False, check_finite=False)
+    assert np.array_equal(s, s0) and np.array_equal(vt, vt0)
+    s, none = openblas.gesdd(W, compute_uv=False)
+    assert none is None and np.array_equal(s, sla.svdvals(W, check_finite=True))
+    if shape[0] >= shape[1]:
+        R0 = np.triu(sla.qr(W, mode="r", check_finite=True)[0][:shape[1]])
+        assert np.array_equal(openblas.qr_r(W), R0)
+        F = np.asfortranarray(W.copy())
+        assert np.array_equal(openblas.qr_r(F, overwrite=True), R0)
+
+
+def test_two_threads_give_each_call_its_own_result():
+    mats = [_spd(400, seed) for seed in range(4)]
+    alone = [openblas.gesdd(M, compute_uv=True) for M in mats] + [openblas.potrf(M)[0] for M in mats]
+    with ThreadPoolExecutor(2) as pool:
+        both = list(pool.map(lambda M: openblas.gesdd(M, compute_uv=True), mats))
+        both += list(pool.map(lambda M: openblas.potrf(M)[0], mats))
+    for a, b in zip(alone, both):
+        a, b = (a, b) if isinstance(a, np.ndarray) else (np.concatenate([a[0], a[1].ravel()]),
+                                                          np.concatenate([b[0], b[1].ravel()]))
+        assert np.array_equal(a, b)

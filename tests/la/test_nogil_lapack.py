@@ -73,3 +73,31 @@ def test_two_threads_give_each_call_its_own_result():
         a, b = (a, b) if isinstance(a, np.ndarray) else (np.concatenate([a[0], a[1].ravel()]),
                                                           np.concatenate([b[0], b[1].ravel()]))
         assert np.array_equal(a, b)
+
+
+@pytest.mark.parametrize("n", [1, 9, 250])
+@pytest.mark.parametrize("order", ["C", "F"])
+def test_the_lanczos_steps_level_2_calls_are_scipys_bit_for_bit(n, order):
+    from scipy.linalg import blas
+
+    rng = np.random.default_rng(n)
+    S = np.array(_spd(n, n), order=order)
+    L = np.array(np.linalg.cholesky(S), order=order)
+    x = rng.standard_normal(n)
+    X = rng.standard_normal((n, 3))
+    for lower in (True, False):
+        A = L if lower else np.array(L.T, order=order)
+        assert np.array_equal(openblas.symv(S, x, lower), blas.dsymv(1.0, S, x, lower=int(lower)))
+        for trans in (0, 1):
+            assert np.array_equal(openblas.trsv(A, x, lower, trans), blas.dtrsv(A, x, lower=int(lower), trans=trans))
+            for b in (x, X):
+                want = sla.solve_triangular(A, b, lower=lower, trans=trans, check_finite=False)
+                got = openblas.solve_triangular(A, b, lower, trans)
+                assert got.shape == want.shape and np.array_equal(got, want)
+    assert np.array_equal(x, np.random.default_rng(n).standard_normal(n))  # the inputs untouched
+    A = np.array(L, order=order)
+    A[n // 2, n // 2] = 0.0
+    with pytest.raises(np.linalg.LinAlgError):
+        sla.solve_triangular(A, x, lower=True, check_finite=False)
+    with pytest.raises(np.linalg.LinAlgError):
+        openblas.solve_triangular(A, x, True)

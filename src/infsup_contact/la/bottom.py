@@ -206,9 +206,9 @@ def _standard_form(S: np.ndarray, L: np.ndarray) -> spla.LinearOperator:
     # symv takes Fortran order: a C-ordered S is passed as Sᵀ (no copy), whose upper triangle it is
     A, lower = (S.T, 0) if S.flags.c_contiguous and not S.flags.f_contiguous else (np.asfortranarray(S), 1)
 
-    def mv(x):
-        y = sla.solve_triangular(L, np.ravel(x), lower=True, trans="T", check_finite=False)
-        return sla.solve_triangular(L, blas.dsymv(1.0, A, y, lower=lower), lower=True, check_finite=False)
+    def mv(x):  # scipy's routines without the GIL (la/openblas.py): pencils side by side overlap
+        y = openblas.solve_triangular(L, np.ravel(x), True, 1)
+        return openblas.solve_triangular(L, openblas.symv(A, y, bool(lower)), True)
 
     return spla.LinearOperator((m, m), matvec=mv, dtype=float)
 
@@ -296,7 +296,7 @@ def bottom_pencil(S: np.ndarray, L: np.ndarray, n_values: int, Z: np.ndarray | N
     del R
 
     def mv(x):
-        return blas.dsymv(1.0, inverse, np.ravel(x), lower=1)
+        return openblas.symv(inverse, np.ravel(x), True)
 
     k = min(n_values, m - 1)
     op = spla.LinearOperator((m, m), matvec=mv, dtype=float)

@@ -245,3 +245,66 @@ def gesdd(A, compute_uv: bool, overwrite: bool = False) -> tuple:
     if info.value < 0:
         raise ValueError(f"illegal value in {-info.value}th argument of internal gesdd")
     return (s, vt) if compute_uv else (s, None)
+
+
+# the Lanczos steps' level-2 calls (a few ms each at a face block's order; ctypes adds microseconds)
+_CHARS = {False: b"U", True: b"L"}
+_TRANS = {0: b"N", 1: b"T"}
+
+
+def _column_major(A):
+    """A's data in Fortran order: A itself where it is one (f2py's rule for an ``intent(in)`` array)."""
+    return A if A.flags.f_contiguous and A.dtype == float else _np()[0].asfortranarray(A, dtype=float)
+
+
+def symv(A, x, lower: bool):
+    """``scipy.linalg.blas.dsymv(1.0, A, x, lower=lower)``, bit for bit, without the GIL."""
+    np, _, _ = _np()
+    fn = _lapack("dsymv")
+    if fn is None:
+        from scipy.linalg import blas
+
+        return blas.dsymv(1.0, A, x, lower=int(lower))
+    a, x = _column_major(A), np.ascontiguousarray(x, dtype=float)
+    n, y = a.shape[0], np.zeros(a.shape[0])
+    fn(ctypes.c_char_p(_CHARS[lower]), _ref(n), ctypes.byref(ctypes.c_double(1.0)), _ptr(a), _ref(n), _ptr(x),
+       _ref(1), ctypes.byref(ctypes.c_double(0.0)), _ptr(y), _ref(1), ctypes.c_size_t(1))
+    return y
+
+
+def trsv(L, x, lower: bool, trans: int):
+    """``scipy.linalg.blas.dtrsv(L, x, lower=lower, trans=trans)``, bit for bit, without the GIL."""
+    np, _, _ = _np()
+    fn = _lapack("dtrsv")
+    if fn is None:
+        from scipy.linalg import blas
+
+        return blas.dtrsv(L, x, lower=int(lower), trans=int(trans))
+    a, x = _column_major(L), np.array(x, dtype=float)
+    fn(ctypes.c_char_p(_CHARS[lower]), ctypes.c_char_p(_TRANS[int(trans)]), ctypes.c_char_p(b"N"), _ref(a.shape[0]),
+       _ptr(a), _ref(a.shape[0]), _ptr(x), _ref(1), ctypes.c_size_t(1), ctypes.c_size_t(1), ctypes.c_size_t(1))
+    return x
+
+
+def solve_triangular(L, b, lower: bool, trans: int = 0):
+    """``scipy.linalg.solve_triangular(L, b, lower=lower, trans=trans, check_finite=False)`` (b a
+    vector or a matrix, real), bit for bit, without the GIL: LAPACK trtrs on L, or on Lᵀ with the
+    other triangle and transposition where L is C-ordered, as scipy."""
+    np, sla, _ = _np()
+    fn = _lapack("dtrtrs")
+    b = np.asarray(b)
+    if fn is None or b.size == 0 or L.dtype != float or b.dtype != float:
+        return sla.solve_triangular(L, b, lower=lower, trans=trans, check_finite=False)
+    a = L if L.flags.f_contiguous else L.T
+    lower, trans = (lower, int(trans)) if L.flags.f_contiguous else (not lower, 1 - int(trans))
+    a = _column_major(a)
+    x = np.array(b, dtype=float, order="F")
+    n, nrhs, info = a.shape[0], (1 if x.ndim == 1 else x.shape[1]), _INT(0)
+    fn(ctypes.c_char_p(_CHARS[bool(lower)]), ctypes.c_char_p(_TRANS[trans]), ctypes.c_char_p(b"N"), _ref(n),
+       _ref(nrhs), _ptr(a), _ref(n), _ptr(x), _ref(n), ctypes.byref(info), ctypes.c_size_t(1), ctypes.c_size_t(1),
+       ctypes.c_size_t(1))
+    if info.value > 0:
+        raise np.linalg.LinAlgError(f"singular matrix: resolution failed at diagonal {info.value - 1}")
+    if info.value < 0:
+        raise ValueError(f"illegal value in {-info.value}-th argument of internal trtrs")
+    return x

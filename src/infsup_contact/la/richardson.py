@@ -200,8 +200,8 @@ def _lanczos_norm(E: np.ndarray, L: np.ndarray) -> float:
     and one product, O(n²)). The solves need no L⁻¹: at order 2,352 (a block of k = 2, N = 48)
     a step took 2.6 ms against 4.1 ms with L⁻¹ formed (dtrtri, 0.19 s more per block and level),
     and less at every order from 300 (one thread, OpenBLAS)."""
-    def apply(x):
-        return blas.dtrsv(L, E @ blas.dtrsv(L, x, lower=1, trans=1), lower=1)
+    def apply(x):  # scipy's dtrsv without the GIL (la/openblas.py): the blocks' steps overlap
+        return openblas.trsv(L, E @ openblas.trsv(L, x, True, 1), True, 0)
 
     n = len(L)
     op = spla.LinearOperator((n, n), matvec=apply, dtype=float)

@@ -101,3 +101,16 @@ def test_the_lanczos_steps_level_2_calls_are_scipys_bit_for_bit(n, order):
         sla.solve_triangular(A, x, lower=True, check_finite=False)
     with pytest.raises(np.linalg.LinAlgError):
         openblas.solve_triangular(A, x, True)
+
+
+@pytest.mark.parametrize("n", [1, 60, 300])
+def test_cho_factor_and_cho_solve_are_scipys_bit_for_bit(n):
+    S = _spd(n, 2 * n)
+    c0, _ = sla.cho_factor(S.copy(), lower=True, check_finite=False)
+    c = openblas.cholesky_lower(S.copy(), clean=False)
+    assert np.array_equal(c, c0)
+    rng = np.random.default_rng(n)
+    for b in (rng.standard_normal(n), rng.standard_normal((n, 4)), np.asfortranarray(rng.standard_normal((n, 2)))):
+        want = sla.cho_solve((c0, True), b, check_finite=False)
+        got = openblas.potrs(c, b)
+        assert got.shape == want.shape and np.array_equal(got, want)

@@ -126,19 +126,19 @@ def bottom_singular(W, p: int, eta: float, smax: float | None = None,
     smax = largest_singular(W, gram) if smax is None else smax
     C = gram.toarray()
     C[np.diag_indices(m)] += SHIFT * smax ** 2
-    F = sla.cho_factor(C, lower=True, overwrite_a=True, check_finite=False)
+    F = openblas.cholesky_lower(C, overwrite=True, clean=False)  # cho_factor's, without the GIL
     while (res := _subspace_iteration(W, F, p, eta, smax)) is None and p < m - 1:
         p = min(2 * p, m - 1)
     return res
 
 
 def _subspace_iteration(W, F, p: int, eta: float, smax: float) -> BottomSingular | None:
-    """Step 1 and 2 of :func:`bottom_singular` with block p and F = Cholesky of WᵀW + δI."""
+    """Step 1 and 2 of :func:`bottom_singular` with block p and F = the lower Cholesky factor of WᵀW + δI."""
     m = W.shape[1]
     Q = sla.qr(np.random.default_rng(SEED).standard_normal((m, p)), mode="economic")[0]
     counts, previous, it = [], None, 0
     for it in range(1, MAX_ITER + 1):
-        Q = sla.qr(sla.cho_solve(F, Q, check_finite=False), mode="economic")[0]
+        Q = sla.qr(openblas.potrs(F, Q), mode="economic")[0]
         R = sla.qr(np.asarray(W @ Q), mode="r")[0][:p]
         _, s, vt = sla.svd(R)  # the singular values of W Q without its left vectors
         s, Q = s[::-1].copy(), Q @ vt[::-1].T  # ascending
@@ -156,7 +156,7 @@ def _subspace_iteration(W, F, p: int, eta: float, smax: float) -> BottomSingular
     if d:  # refinement: (WᵀW + δI)⁻¹ amplifies the round-off of the solve by σ_max²/σ_{p+1}²
         # along the range of Wᵀ; one corrected step Z − (WᵀW + δI)⁻¹ Wᵀ W Z removes it
         Z = Q[:, :d]
-        Z = sla.qr(Z - sla.cho_solve(F, np.asarray(W.T @ (W @ Z)), check_finite=False), mode="economic")[0]
+        Z = sla.qr(Z - openblas.potrs(F, np.asarray(W.T @ (W @ Z))), mode="economic")[0]
         _, sz, vt = sla.svd(sla.qr(np.asarray(W @ Z), mode="r")[0][:d])
         s = np.concatenate([sz[::-1], s[d:]])
         Q = np.hstack([Z @ vt[::-1].T, Q[:, d:]])

@@ -175,14 +175,32 @@ def potrf(A, clean: bool = True, overwrite: bool = False) -> tuple:
     return a, int(info.value)
 
 
-def cholesky_lower(A, overwrite: bool = False):
+def cholesky_lower(A, overwrite: bool = False, clean: bool = True):
     """``scipy.linalg.cholesky(A, lower=True, overwrite_a=overwrite, check_finite=False)``, bit for
-    bit, without the GIL; LinAlgError where A is not positive definite."""
+    bit, without the GIL; LinAlgError where A is not positive definite. ``clean`` False:
+    ``cho_factor``'s factor (the strict upper triangle as it was)."""
     np = _np()[0]
-    L, info = potrf(A, True, overwrite)
+    L, info = potrf(A, clean, overwrite)
     if info > 0:
         raise np.linalg.LinAlgError(f"{info}-th leading minor of the array is not positive definite")
     return L
+
+
+def potrs(c, b):
+    """``scipy.linalg.cho_solve((c, True), b, check_finite=False)`` (c a lower factor, b a vector or
+    a matrix), bit for bit, without the GIL."""
+    np, sla, _ = _np()
+    fn = _lapack("dpotrs")
+    b = np.asarray(b)
+    if fn is None or b.size == 0 or b.dtype != float:
+        return sla.cho_solve((c, True), b, check_finite=False)
+    a, x = _column_major(c), np.array(b, dtype=float, order="F")
+    n, nrhs, info = a.shape[0], (1 if x.ndim == 1 else x.shape[1]), _INT(0)
+    fn(ctypes.c_char_p(b"L"), _ref(n), _ref(nrhs), _ptr(a), _ref(n), _ptr(x), _ref(n), ctypes.byref(info),
+       ctypes.c_size_t(1))
+    if info.value != 0:
+        raise ValueError(f"illegal value in {-info.value}th argument of internal potrs")
+    return x
 
 
 def lauum(K, overwrite: bool = False) -> tuple:

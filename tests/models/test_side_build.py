@@ -140,3 +140,18 @@ def test_the_stiffness_on_the_task_manager_is_the_serial_one(monkeypatch):
     assert calls
     for name in ("indptr", "indices", "data"):
         assert np.array_equal(getattr(serial, name), getattr(tasks, name))
+
+
+def test_the_sums_and_the_mirrored_copies_side_by_side_are_the_serial_ones(monkeypatch):
+    """A body's S and X (the parts' sums) and side 2's mirrored S2, X2 are made as two concurrent
+    tasks where the request has two threads: the same arrays, bit for bit, as one after the other."""
+    bodies = [m3.subdomain_mesh("structured", 4, s) for s in (1, 2)]
+    out = {}
+    for threads in ("1", "2"):
+        monkeypatch.setenv("MKL_NUM_THREADS", threads)
+        side1 = m3.side_operator(bodies[0], 2)
+        side2 = m3.mirror_side(side1, bodies[1], 2)
+        out[threads] = [side1.schur, side1.steklov, side2.schur, side2.steklov]
+    assert side2.route == "mirror" and all(a is not None for a in out["2"])
+    for a, b in zip(out["1"], out["2"]):
+        assert a.shape == b.shape and np.array_equal(a, b)

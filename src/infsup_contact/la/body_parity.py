@@ -69,9 +69,9 @@ class ParityParts:
         facs = list(map(lambda part: factorize_one(part.stiffness, part.n_gamma), self.parts))
         gammas = [part.basis[self.n - self.n_gamma:] for part in self.parts]
         tails = [Q[:, Q.shape[1] - part.n_gamma:].tocsr() for Q, part in zip(gammas, self.parts)]
-        S = self._sum(tails, [f.schur for f in facs])
         inverses = concurrent_map(lambda f: f.steklov if f.steklov is not None else spd_inverse(f.schur), facs)
-        X = self._sum(tails, inverses)
+        # S and X side by side (numpy's gathers and products, GIL-free: the same bits)
+        S, X = concurrent_map(lambda Ms: self._sum(tails, Ms), [[f.schur for f in facs], inverses])
         blocks = tuple((P, _exactly_symmetric(Xc)) for P, Xc in zip(tails, inverses))
         return S, _PartsSolve(self.parts, [f.solve for f in facs]), X, blocks
 

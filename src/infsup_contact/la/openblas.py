@@ -1,4 +1,5 @@
-"""OpenBLAS's thread count fitted to the cores that are idle when a request starts.
+"""scipy's and numpy's OpenBLAS: its thread count fitted to the cores that are idle when a request
+starts, and scipy's LAPACK called without the GIL (the second half of this module).
 
 numpy and scipy each load their own OpenBLAS (``scipy_openblas``), whose threads wait for work
 by spinning. When another process holds a core, a multi-threaded call waits for a thread that is

@@ -150,7 +150,7 @@ class BlockOps:
     @staticmethod
     def rel_norms(es, grams):
         # G = Q diag(blocks) Qᵀ with Q orthogonal: the Loewner order holds block by block; the
-        # blocks side by side (LAPACK and Lanczos, GIL-free, one BLAS thread each: the same bits)
+        # blocks side by side (potrf and the Lanczos steps by la/openblas.py, GIL-free, one BLAS thread each: the same bits)
         per_block = concurrent_map(lambda b: relative_steps([e[b] for e in es], grams[b], BLOCK_DENSE_MAX),
                                    [b for b, R in enumerate(grams) if len(R)])
         return [max((v[j] for v in per_block), default=0.0) for j in range(len(es))]

@@ -166,7 +166,9 @@ def run_concurrently(tasks, workers: int | None = None) -> list:
     other) run side by side on ``workers`` threads (default :func:`threads`, at most one per task).
 
     For work that releases the GIL and is not BLAS: PARDISO's factorizations (ctypes releases the
-    GIL), NGSolve's assembly, numpy's and scipy's kernels. No oversubscription: inside the tasks the
+    GIL), NGSolve's assembly, numpy's kernels and scipy's sparse products. scipy.linalg's LAPACK and
+    BLAS wrappers hold the GIL for the whole call (tasks of them run one after the other): the
+    tasks call them through :mod:`.openblas` (the same routines by ctypes). No oversubscription: inside the tasks the
     BLAS runs one thread per task (OpenBLAS set to 1 for the duration, MKL per thread, the products
     of this module serial), so tasks × BLAS threads ≤ the threads asked for. One worker, one task,
     or a call from inside a task (nested): the tasks run in turn in the calling thread. The results

@@ -31,6 +31,7 @@ from scipy.spatial import cKDTree
 
 from ..discretization.gamma.symmetry import isotypic_bases
 from ..la.reflection import symmetric_permutation
+from ..la.threaded import concurrent_map
 
 ENABLED = True
 """Whether the sides use their symmetries (False: the general route everywhere; the tests'
@@ -242,7 +243,8 @@ def mirrored_factors(side1, signature2, K2) -> tuple | None:
         return None
     n = sigma.size
     tau = sigma[n - n_gamma:] - (n - n_gamma)
-    X = None if side1.steklov is None else symmetric_permutation(side1.steklov, tau)
+    # S2 and X2 side by side (np.take, GIL-free: the same copies)
+    S, X = concurrent_map(lambda A: None if A is None else symmetric_permutation(A, tau), [side1.schur, side1.steklov])
     parts1 = getattr(side1, "steklov_parts", None)
     parts = None if parts1 is None else tuple((P[tau], Xc) for P, Xc in parts1)
-    return symmetric_permutation(side1.schur, tau), MirroredSolve(side1.solve, sigma), X, parts
+    return S, MirroredSolve(side1.solve, sigma), X, parts

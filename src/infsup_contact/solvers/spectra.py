@@ -214,7 +214,7 @@ class SplitFactors:
 
     def __init__(self, grams: dict, halves: dict):
         self._grams = grams
-        # every block of every norm side by side (LAPACK potrf, GIL-free, one BLAS thread each:
+        # every block of every norm side by side (LAPACK potrf by la/openblas.py, GIL-free, one BLAS thread each:
         # the same bits; k = 2, N = 48: 8 factorizations of order ~2,350 a space)
         keys = [(norm, b) for norm, hs in halves.items() for b in range(len(hs))]
         factors = dict(zip(keys, concurrent_map(lambda key: gram_factor(halves[key[0]][key[1]]), keys)))

@@ -92,7 +92,7 @@ def split_bottom_kernel(W, split: ReflectionSplit, proven: int = 0, entry_error:
         hint = int(np.ceil(proven * mb / m))  # a block size only: each half holds about its share
         return certified_bottom(blocks[b], grams[b], min(hint + BLOCK_EXTRA, mb - 1), tol, smaxes[b], floor)
 
-    # the blocks side by side (LAPACK and sparse products: GIL-free, one BLAS thread each; each
+    # the blocks side by side (LAPACK by la/openblas.py and sparse products: GIL-free, one BLAS thread each; each
     # block's steps are the same operations whatever runs beside them, so the same bits)
     results = concurrent_map(certified, range(len(blocks)))
     if any(res is None for res in results):
@@ -159,7 +159,7 @@ def split_dense_kernel(W: np.ndarray, split: ReflectionSplit, proven: int = 0,
     blocks = [B.toarray(order="F") for B in sparse]  # Fortran-ordered: their QR in place
     del sparse  # not needed past the cross term: freed before the SVDs
     live = [(B, Q) for B, Q in zip(blocks, split.bases) if B.shape[1]]
-    # the blocks' SVDs side by side (LAPACK, GIL-free, one BLAS thread each: the same bits)
+    # the blocks' SVDs side by side (LAPACK by la/openblas.py, GIL-free, one BLAS thread each: the same bits)
     if vectors:  # each block's SVD with its right vectors, ascending (structural zeros first)
         svds = concurrent_map(lambda BQ: right_singular(BQ[0], overwrite=True), live)
         per_block = [np.concatenate([np.zeros(B.shape[1] - len(sb)), np.sort(sb)]) for (B, _), (sb, _) in zip(live, svds)]

@@ -18,7 +18,9 @@ def _spd(n, seed=0):
 
 
 def test_the_routines_are_found_in_scipys_openblas():
-    assert all(openblas._lapack(name) is not None for name in ("dpotrf", "dlauum", "dgeqrf", "dgesdd"))
+    assert openblas._agrees()
+    names = ("dpotrf", "dpotrs", "dlauum", "dgeqrf", "dgesdd", "dsymv", "dtrsv", "dtrtrs")
+    assert all(openblas._lapack(name) is not None for name in names)
 
 
 @pytest.mark.parametrize("n", [1, 7, 130, 600])
@@ -114,3 +116,15 @@ def test_cho_factor_and_cho_solve_are_scipys_bit_for_bit(n):
         want = sla.cho_solve((c0, True), b, check_finite=False)
         got = openblas.potrs(c, b)
         assert got.shape == want.shape and np.array_equal(got, want)
+
+
+def test_without_scipys_openblas_the_calls_are_scipy_linalgs(monkeypatch):
+    """Where the routines are not found (another scipy build) every call falls back to
+    scipy.linalg's own, with the same results."""
+    monkeypatch.setattr(openblas, "_lapack", lambda name: None)
+    S, W = _spd(30), np.random.default_rng(3).standard_normal((50, 20))
+    assert np.array_equal(openblas.potrf(S)[0], lapack.dpotrf(S, lower=1, clean=1)[0])
+    assert np.array_equal(openblas.gesdd(W, True)[1], sla.svd(W, full_matrices=False)[2])
+    assert np.array_equal(openblas.qr_r(W), np.triu(sla.qr(W, mode="r")[0][:20]))
+    assert np.array_equal(openblas.potrs(openblas.cholesky_lower(S, clean=False), W[:30]),
+                          sla.cho_solve(sla.cho_factor(S, lower=True), W[:30]))

@@ -135,13 +135,35 @@ def _np():
 
 @lru_cache(maxsize=None)
 def _lapack(name: str):
-    """scipy's OpenBLAS routine ``scipy_<name>_`` (ctypes), or None."""
+    """scipy's OpenBLAS routine ``scipy_<name>_`` (ctypes), or None: not found, or the library
+    does not pass :func:`_agrees` (another integer width or calling convention)."""
+    fn = _symbol(name)
+    return fn if fn is not None and _agrees() else None
+
+
+def _symbol(name: str):
     for copy, lib, _ in loaded():
         fn = getattr(lib, f"scipy_{name}_", None) if copy == "scipy" else None
         if fn is not None:
             fn.restype = None
             return fn
     return None
+
+
+@lru_cache(maxsize=1)
+def _agrees() -> bool:
+    """Whether scipy's dpotrf called through ctypes factors a 3 × 3 matrix as scipy.linalg does
+    (the LP64 interface this module assumes; an ILP64 copy names its symbols with a suffix and is
+    not found)."""
+    np, _, lapack = _np()
+    fn = _symbol("dpotrf")
+    if fn is None:
+        return False
+    S = np.array([[4.0, 1.0, 0.5], [1.0, 3.0, 0.25], [0.5, 0.25, 2.0]], order="F")
+    info = _INT(0)
+    fn(ctypes.c_char_p(b"L"), _ref(3), _ptr(S), _ref(3), ctypes.byref(info), ctypes.c_size_t(1))
+    want, info0 = lapack.dpotrf(np.array([[4.0, 1.0, 0.5], [1.0, 3.0, 0.25], [0.5, 0.25, 2.0]]), lower=1, clean=0)
+    return info.value == info0 == 0 and bool(np.array_equal(np.tril(S), np.tril(want)))
 
 
 def _ref(value: int):

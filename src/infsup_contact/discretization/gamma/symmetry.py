@@ -8,6 +8,10 @@ pencils and kernel decisions (:mod:`infsup_contact.la.reflection`).
 """
 from __future__ import annotations
 
+import hashlib
+import threading
+import weakref
+
 import numpy as np
 import scipy.sparse as sp
 
@@ -19,13 +23,15 @@ MATCH_RTOL = 1e-10
 
 def reflect(axis: int | None = None):
     """The map x → 1 − x of coordinate ``axis`` of points (n, d), or of every coordinate (None:
-    the point reflection of the face, the reflection of the segment)."""
+    the point reflection of the face, the reflection of the segment); its ``key`` names it for
+    :func:`induced_permutation`'s cache."""
     def transform(x):
         if axis is None:
             return 1.0 - x
         y = np.array(x, dtype=float)
         y[:, axis] = 1.0 - y[:, axis]
         return y
+    transform.key = ("reflect", axis)
     return transform
 
 
@@ -41,7 +47,41 @@ def induced_permutation(space, x: np.ndarray, transform) -> np.ndarray | None:
 
     π(j) is the function whose values at x are nearest to those of μ_j ∘ T among the functions
     whose supports meet its image (sparse overlaps); accepted only if π is an involution and
-    the values agree to :data:`MATCH_RTOL`."""
+    the values agree to :data:`MATCH_RTOL`. Kept per space for a transform with a ``key``
+    (:func:`reflect`'s) and the same points (read-only): a request's route, Grams and kernel
+    decision ask for the same reflections (k = 2, N = 24: 82 calls, 49 distinct)."""
+    key = getattr(transform, "key", None)
+    if key is None:
+        return _induced_permutation(space, x, transform)
+    x = np.ascontiguousarray(x, dtype=float)
+    key = (key, x.shape, hashlib.blake2b(x.tobytes(), digest_size=16).digest())
+    with _CACHE_LOCK:
+        kept = _cache_of(space)
+        if key in kept:
+            return kept[key]
+    pi = _induced_permutation(space, x, transform)
+    if pi is not None:
+        pi.flags.writeable = False
+    with _CACHE_LOCK:
+        _cache_of(space)[key] = pi
+    return pi
+
+
+_CACHE: dict = {}
+"""id(space) → (a weak reference to it, {key: π}), an entry dropped with its space."""
+_CACHE_LOCK = threading.Lock()
+
+
+def _cache_of(space) -> dict:
+    entry = _CACHE.get(id(space))
+    if entry is None or entry[0]() is not space:
+        entry = (weakref.ref(space), {})
+        _CACHE[id(space)] = entry
+        weakref.finalize(space, _CACHE.pop, id(space), None)
+    return entry[1]
+
+
+def _induced_permutation(space, x: np.ndarray, transform) -> np.ndarray | None:
     ones = np.ones(len(x))
     A, B = weighted_values(space, x, ones), weighted_values(space, transform(x), ones)
     overlap = (B.T @ A).tocsr()

@@ -224,6 +224,7 @@ class Square(Interface):
         order = np.argsort(cell, kind="stable")  # the points of every cell, ascending
         bounds = np.searchsorted(cell[order], np.arange(cell.max(initial=-1) + 2))
         tol = 1e-10
+        found = []  # (points, Γ-dof positions, kept, element, reference coordinates) per element taking points
         for (cx, cy), elems in by_cell.items():
             c = cx * ny + cy
             pts = order[bounds[c]:bounds[c + 1]] if c + 1 < len(bounds) else order[:0]
@@ -237,11 +238,11 @@ class Square(Interface):
                 if not inside.any():
                     continue
                 todo &= ~inside
-                fe = trace.fes.GetFE(el)
                 pos = position[dn]
-                keep = pos >= 0
-                shapes = np.array([np.asarray(fe.CalcShape(a, b, 0.0)) for a, b in ref[inside]])
-                yield pts[inside], pos[keep], shapes[:, keep]
+                found.append((pts[inside], pos, pos >= 0, el, ref[inside]))
+        values = _shape_values(trace.fes, [(el, ref, len(pos)) for _, pos, _, el, ref in found])
+        for (pts, pos, keep, _, _), shapes in zip(found, values):
+            yield pts, pos[keep], shapes[:, keep]
 
     def trace_basis(self, trace: GammaTrace, x: np.ndarray) -> np.ndarray:
         """Dense values of the Γ-dof basis at the points x (n, 2), cached on the trace
@@ -389,3 +390,32 @@ SQUARE = Square()
 """Γ = (0, 1)² × {1} of the hexahedral meshes."""
 SQUARE_TRIG = Square(cell="trig")
 """The same face, traced by tetrahedral meshes (rectangles cut in two triangles)."""
+
+
+def _shape_values(fes, items: list) -> list:
+    """[NGSolve's ``CalcShape`` of element ``el`` at each row of ``ref`` (points, its ndof)] for
+    the (el, ref, number of its dofs) of ``items``, each distinct point evaluated once per kind of
+    element (type, number of dofs, order of its vertex numbers).
+
+    An element's shape functions depend on its type, order and the order of its global vertex
+    numbers only (NGSolve orients the edge and face functions by comparing them), so elements of
+    one kind share them: on a structured Γ the reference points of the cells repeat (to the bit,
+    about one in eight at k = 2), and CalcShape per point was most of the trace basis' time. The
+    values are those of each element's own calls, bit for bit (tests/discretization/face/
+    test_trace_shapes.py)."""
+    groups = {}
+    for i, (el, ref, n_dofs) in enumerate(items):
+        key = (str(el.type), n_dofs, tuple(np.argsort([v.nr for v in el.vertices], kind="stable")))
+        groups.setdefault(key, []).append(i)
+    out = [None] * len(items)
+    for members in groups.values():
+        refs = np.vstack([items[i][1] for i in members])
+        unique, inverse = np.unique(refs, axis=0, return_inverse=True)
+        fe = fes.GetFE(items[members[0]][0])
+        values = np.array([np.asarray(fe.CalcShape(a, b, 0.0)) for a, b in unique]).reshape(len(unique), -1)
+        start = 0
+        for i in members:
+            n = len(items[i][1])
+            out[i] = values[np.ravel(inverse)[start:start + n]]
+            start += n
+    return out

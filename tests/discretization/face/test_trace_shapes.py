@@ -1,5 +1,5 @@
 """The face's trace basis evaluates NGSolve's CalcShape once per distinct reference point and kind
-of element (type, dofs, order of its vertex numbers; square._shape_values): its values are those
+of element (type, dofs, order of its vertex numbers; trace_shapes.shape_values): its values are those
 of every element's own CalcShape calls, bit for bit, on hexahedra and tetrahedra of several
 degrees, matching and not, at the couplings' and the norms' points."""
 import numpy as np
@@ -51,19 +51,19 @@ def test_the_trace_basis_is_each_elements_own_calcshape_bit_for_bit(element, k, 
 
 def test_elements_of_other_vertex_orders_keep_their_own_shapes():
     """On an unstructured triangulation the elements' vertex numbers come in several orders, and
-    at degree 3 the edge functions' signs follow them: _shape_values keeps each order apart (the
+    at degree 3 the edge functions' signs follow them: shape_values keeps each order apart (the
     same reference points on every element), each element's values its own CalcShape's."""
     import ngsolve
     from netgen.geom2d import unit_square
 
-    from infsup_contact.discretization.face.shapes.square import _shape_values
+    from infsup_contact.discretization.face.shapes.trace_shapes import shape_values
 
     mesh = ngsolve.Mesh(unit_square.GenerateMesh(maxh=0.3))
     fes = ngsolve.H1(mesh, order=3)
     ref = np.random.default_rng(1).dirichlet(np.ones(3), size=6)[:, :2]
     elements = list(mesh.Elements(ngsolve.VOL))
     items = [(el, ref, len(fes.GetDofNrs(el))) for el in elements]
-    got = _shape_values(fes, items)
+    got = shape_values(fes, items)
     own = [np.array([np.asarray(fes.GetFE(el).CalcShape(a, b, 0.0)) for a, b in ref]) for el in elements]
     assert all(np.array_equal(g, o) for g, o in zip(got, own))
     assert len({tuple(np.argsort([v.nr for v in el.vertices])) for el in elements}) > 1

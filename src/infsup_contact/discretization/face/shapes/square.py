@@ -31,6 +31,7 @@ from ...gamma.multiplier_meshes import check_choice, intervals_per_direction
 from ...gamma.trace import GammaTrace
 from ..partitions.quadrature import split_rule
 from ..partitions.tensor_grid import TensorPartition, coarsening_cells, merge_breakpoints
+from .trace_shapes import shape_values
 from ...gamma.quadrature import gauss_legendre
 
 CELL_SHAPES = ("quad", "trig", "quad8")
@@ -240,7 +241,7 @@ class Square(Interface):
                 todo &= ~inside
                 pos = position[dn]
                 found.append((pts[inside], pos, pos >= 0, el, ref[inside]))
-        values = _shape_values(trace.fes, [(el, ref, len(pos)) for _, pos, _, el, ref in found])
+        values = shape_values(trace.fes, [(el, ref, len(pos)) for _, pos, _, el, ref in found])
         for (pts, pos, keep, _, _), shapes in zip(found, values):
             yield pts, pos[keep], shapes[:, keep]
 
@@ -390,32 +391,3 @@ SQUARE = Square()
 """Γ = (0, 1)² × {1} of the hexahedral meshes."""
 SQUARE_TRIG = Square(cell="trig")
 """The same face, traced by tetrahedral meshes (rectangles cut in two triangles)."""
-
-
-def _shape_values(fes, items: list) -> list:
-    """[NGSolve's ``CalcShape`` of element ``el`` at each row of ``ref`` (points, its ndof)] for
-    the (el, ref, number of its dofs) of ``items``, each distinct point evaluated once per kind of
-    element (type, number of dofs, order of its vertex numbers).
-
-    An element's shape functions depend on its type, order and the order of its global vertex
-    numbers only (NGSolve orients the edge and face functions by comparing them), so elements of
-    one kind share them: on a structured Γ the reference points of the cells repeat (to the bit,
-    about one in eight at k = 2), and CalcShape per point was most of the trace basis' time. The
-    values are those of each element's own calls, bit for bit (tests/discretization/face/
-    test_trace_shapes.py)."""
-    groups = {}
-    for i, (el, ref, n_dofs) in enumerate(items):
-        key = (str(el.type), n_dofs, tuple(np.argsort([v.nr for v in el.vertices], kind="stable")))
-        groups.setdefault(key, []).append(i)
-    out = [None] * len(items)
-    for members in groups.values():
-        refs = np.vstack([items[i][1] for i in members])
-        unique, inverse = np.unique(refs, axis=0, return_inverse=True)
-        fe = fes.GetFE(items[members[0]][0])
-        values = np.array([np.asarray(fe.CalcShape(a, b, 0.0)) for a, b in unique]).reshape(len(unique), -1)
-        start = 0
-        for i in members:
-            n = len(items[i][1])
-            out[i] = values[np.ravel(inverse)[start:start + n]]
-            start += n
-    return out

@@ -1,4 +1,4 @@
-"""scipy's LAPACK called through ctypes (la/openblas.py: potrf, lauum, geqrf, gesdd) gives what
+"""scipy's LAPACK called through ctypes (la/openblas.py: potrf, lauum, geqrf, orgqr, gesdd) gives what
 scipy.linalg's wrappers give, bit for bit (the same routine of the same library, the same
 workspace), in C or Fortran order, overwritten in place or not; the calls release the GIL, so
 two threads give each their own result unchanged."""
@@ -19,7 +19,7 @@ def _spd(n, seed=0):
 
 def test_the_routines_are_found_in_scipys_openblas():
     assert openblas._agrees()
-    names = ("dpotrf", "dpotrs", "dlauum", "dgeqrf", "dgesdd", "dsymv", "dtrsv", "dtrtrs")
+    names = ("dpotrf", "dpotrs", "dlauum", "dgeqrf", "dorgqr", "dgesdd", "dsymv", "dtrsv", "dtrtrs")
     assert all(openblas._lapack(name) is not None for name in names)
 
 
@@ -63,6 +63,32 @@ def test_gesdd_and_the_qr_r_are_scipys_bit_for_bit(shape, order):
         assert np.array_equal(openblas.qr_r(W), R0)
         F = np.asfortranarray(W.copy())
         assert np.array_equal(openblas.qr_r(F, overwrite=True), R0)
+
+
+@pytest.mark.parametrize("shape", [(40, 40), (300, 120), (700, 200), (90, 150), (1, 1), (5, 0), (2000, 40)])
+@pytest.mark.parametrize("order", ["C", "F"])
+def test_the_full_gesdd_and_the_orthonormal_qr_factor_are_scipys_bit_for_bit(shape, order):
+    W = np.array(np.random.default_rng(3 * sum(shape)).standard_normal(shape), order=order)
+    s, vt = openblas.gesdd(W, compute_uv=True, full=True)
+    _, s0, vt0 = sla.svd(W, check_finite=False)  # full_matrices: Vᵀ square
+    assert vt.shape == vt0.shape == (shape[1], shape[1])
+    assert np.array_equal(s, s0) and np.array_equal(vt, vt0)
+    Q0 = sla.qr(W, mode="economic")[0]
+    Q = openblas.qr_q(W)
+    assert Q.shape == Q0.shape and np.array_equal(Q, Q0)
+    assert np.array_equal(W, np.random.default_rng(3 * sum(shape)).standard_normal(shape))  # W untouched
+    if shape[0] >= shape[1] > 0:
+        assert np.allclose(Q.T @ Q, np.eye(shape[1]), atol=1e-13)
+        F = np.asfortranarray(W.copy())
+        assert np.array_equal(openblas.qr_q(F, overwrite=True), Q0)
+
+
+def test_a_non_finite_matrix_is_refused_by_the_qr_as_by_scipys():
+    W = np.ones((6, 3))
+    W[2, 1] = np.nan
+    for qr in (openblas.qr_q, openblas.qr_r, lambda A: sla.qr(A, mode="economic")):
+        with pytest.raises(ValueError):
+            qr(W)
 
 
 def test_two_threads_give_each_call_its_own_result():

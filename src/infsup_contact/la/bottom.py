@@ -135,12 +135,14 @@ def bottom_singular(W, p: int, eta: float, smax: float | None = None,
 def _subspace_iteration(W, F, p: int, eta: float, smax: float) -> BottomSingular | None:
     """Step 1 and 2 of :func:`bottom_singular` with block p and F = the lower Cholesky factor of WᵀW + δI."""
     m = W.shape[1]
-    Q = sla.qr(np.random.default_rng(SEED).standard_normal((m, p)), mode="economic")[0]
+    # QR and SVD through la.openblas (scipy's routines, bit for bit, without the GIL): the blocks
+    # of one space and the spaces beside it iterate side by side
+    Q = openblas.qr_q(np.random.default_rng(SEED).standard_normal((m, p)), overwrite=True)
     counts, previous, it = [], None, 0
     for it in range(1, MAX_ITER + 1):
-        Q = sla.qr(openblas.potrs(F, Q), mode="economic")[0]
-        R = sla.qr(np.asarray(W @ Q), mode="r")[0][:p]
-        _, s, vt = sla.svd(R)  # the singular values of W Q without its left vectors
+        Q = openblas.qr_q(openblas.potrs(F, Q), overwrite=True)
+        R = openblas.qr_r(np.asarray(W @ Q), overwrite=True)
+        s, vt = openblas.gesdd(R, True, overwrite=True, full=True)  # the singular values of W Q, no left vectors
         s, Q = s[::-1].copy(), Q @ vt[::-1].T  # ascending
         counts.append(int(np.sum(s <= eta)))
         if counts[-1] > p - GUARD:
@@ -156,8 +158,8 @@ def _subspace_iteration(W, F, p: int, eta: float, smax: float) -> BottomSingular
     if d:  # refinement: (WᵀW + δI)⁻¹ amplifies the round-off of the solve by σ_max²/σ_{p+1}²
         # along the range of Wᵀ; one corrected step Z − (WᵀW + δI)⁻¹ Wᵀ W Z removes it
         Z = Q[:, :d]
-        Z = sla.qr(Z - openblas.potrs(F, np.asarray(W.T @ (W @ Z))), mode="economic")[0]
-        _, sz, vt = sla.svd(sla.qr(np.asarray(W @ Z), mode="r")[0][:d])
+        Z = openblas.qr_q(Z - openblas.potrs(F, np.asarray(W.T @ (W @ Z))), overwrite=True)
+        sz, vt = openblas.gesdd(openblas.qr_r(np.asarray(W @ Z), overwrite=True), True, overwrite=True, full=True)
         s = np.concatenate([sz[::-1], s[d:]])
         Q = np.hstack([Z @ vt[::-1].T, Q[:, d:]])
     above = float(s[d])

@@ -240,15 +240,15 @@ def lauum(K, overwrite: bool = False) -> tuple:
     return c, int(info.value)
 
 
-def qr_r(W, overwrite: bool = False):
-    """``np.triu(scipy.linalg.qr(W, mode="r", overwrite_a=overwrite)[0][:n])`` (W m × n, m >= n,
-    finite), bit for bit, without the GIL: dgeqrf with the workspace it asks for, as scipy's."""
-    np, sla, _ = _np()
+def _geqrf(W, overwrite: bool):
+    """(a, tau): dgeqrf of W (m × n, m >= n > 0) in a's storage, with the workspace it asks for, as
+    scipy's ``safecall``; None where the symbol is absent."""
+    np = _np()[0]
     fn = _lapack("dgeqrf")
-    m, n = np.shape(W)
-    if fn is None or m < n or n == 0:
-        return np.triu(sla.qr(W, mode="r", overwrite_a=overwrite, check_finite=True)[0][:n])
+    if fn is None:
+        return None
     a = _fortran(np.asarray_chkfinite(W), overwrite)
+    m, n = a.shape
     tau, work, info = np.empty(n), np.empty(1), _INT(0)
     fn(_ref(m), _ref(n), _ptr(a), _ref(m), _ptr(tau), _ptr(work), _ref(-1), ctypes.byref(info))
     lwork = int(np.int_(work[0].real))  # scipy's safecall: the query's value, truncated
@@ -256,30 +256,66 @@ def qr_r(W, overwrite: bool = False):
     fn(_ref(m), _ref(n), _ptr(a), _ref(m), _ptr(tau), _ptr(work), _ref(lwork), ctypes.byref(info))
     if info.value < 0:
         raise ValueError(f"illegal value in {-info.value}th argument of internal geqrf")
-    return np.triu(a[:n])
+    return a, tau
 
 
-def gesdd(A, compute_uv: bool, overwrite: bool = False) -> tuple:
-    """(s, Vᵀ) of ``scipy.linalg.svd(A, full_matrices=False, compute_uv=True, overwrite_a=overwrite,
+def qr_r(W, overwrite: bool = False):
+    """``np.triu(scipy.linalg.qr(W, mode="r", overwrite_a=overwrite)[0][:n])`` (W m × n, m >= n,
+    finite), bit for bit, without the GIL: dgeqrf with the workspace it asks for, as scipy's."""
+    np, sla, _ = _np()
+    m, n = np.shape(W)
+    done = None if m < n or n == 0 else _geqrf(W, overwrite)
+    if done is None:
+        return np.triu(sla.qr(W, mode="r", overwrite_a=overwrite, check_finite=True)[0][:n])
+    return np.triu(done[0][:n])
+
+
+def qr_q(W, overwrite: bool = False):
+    """``scipy.linalg.qr(W, mode="economic", overwrite_a=overwrite)[0]`` (W m × n, m >= n, finite):
+    the orthonormal factor, bit for bit, without the GIL: dgeqrf, then dorgqr on its output, each
+    with the workspace it asks for, as scipy's."""
+    np, sla, _ = _np()
+    m, n = np.shape(W)
+    fn = _lapack("dorgqr")
+    done = None if fn is None or m < n or n == 0 else _geqrf(W, overwrite)
+    if done is None:
+        return sla.qr(W, mode="economic", overwrite_a=overwrite, check_finite=True)[0]
+    a, tau = done
+    work, info = np.empty(1), _INT(0)
+    fn(_ref(m), _ref(n), _ref(n), _ptr(a), _ref(m), _ptr(tau), _ptr(work), _ref(-1), ctypes.byref(info))
+    lwork = int(np.int_(work[0].real))
+    work = np.empty(max(lwork, 1))
+    fn(_ref(m), _ref(n), _ref(n), _ptr(a), _ref(m), _ptr(tau), _ptr(work), _ref(lwork), ctypes.byref(info))
+    if info.value < 0:
+        raise ValueError(f"illegal value in {-info.value}th argument of internal gorgqr/gungqr")
+    return a
+
+
+def gesdd(A, compute_uv: bool, overwrite: bool = False, full: bool = False) -> tuple:
+    """(s, Vᵀ) of ``scipy.linalg.svd(A, full_matrices=full, compute_uv=True, overwrite_a=overwrite,
     check_finite=False)``, or (s, None) of ``svdvals`` where not ``compute_uv``, bit for bit, without
     the GIL: dgesdd with scipy's workspace (its ``dgesdd_lwork``)."""
     np, sla, lapack = _np()
     fn = _lapack("dgesdd")
     m, n = np.shape(A)
     k = min(m, n)
+    full = bool(full and compute_uv)
     if fn is None or k == 0:
         if compute_uv:
-            return tuple(sla.svd(A, full_matrices=False, overwrite_a=overwrite, check_finite=False)[1:])
+            return tuple(sla.svd(A, full_matrices=full, overwrite_a=overwrite, check_finite=False)[1:])
         return sla.svd(A, compute_uv=False, overwrite_a=overwrite, check_finite=False), None
     a = _fortran(A, overwrite)
-    work, info = lapack.dgesdd_lwork(m, n, compute_uv=int(compute_uv), full_matrices=int(not compute_uv))
+    work, info = lapack.dgesdd_lwork(m, n, compute_uv=int(compute_uv), full_matrices=int(full or not compute_uv))
     if info:
         raise ValueError(f"Internal work array size computation failed: {info}")
     lwork = int(work.real)
     s, iwork, work, info = np.empty(k), np.empty(8 * k, dtype=np.int32), np.empty(max(lwork, 1)), _INT(0)
-    u, vt = (np.empty((m, k), order="F"), np.empty((k, n), order="F")) if compute_uv else (np.empty(1), np.empty(1))
-    ldu, ldvt = (m, k) if compute_uv else (1, 1)
-    fn(ctypes.c_char_p(b"S" if compute_uv else b"N"), _ref(m), _ref(n), _ptr(a), _ref(m), _ptr(s), _ptr(u),
+    ucols, vrows = (m, n) if full else (k, k)
+    u, vt = (np.empty((m, ucols), order="F"), np.empty((vrows, n), order="F")) if compute_uv else (np.empty(1),
+                                                                                                   np.empty(1))
+    ldu, ldvt = (m, vrows) if compute_uv else (1, 1)
+    job = b"A" if full else (b"S" if compute_uv else b"N")
+    fn(ctypes.c_char_p(job), _ref(m), _ref(n), _ptr(a), _ref(m), _ptr(s), _ptr(u),
        _ref(ldu), _ptr(vt), _ref(ldvt), _ptr(work), _ref(lwork), _ptr(iwork), ctypes.byref(info), ctypes.c_size_t(1))
     if info.value > 0:
         raise np.linalg.LinAlgError("SVD did not converge")

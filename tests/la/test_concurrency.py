@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 from infsup_contact.cli import _fit_blas_threads, _threads_default
+from infsup_contact import memory
 from infsup_contact.la import openblas, threaded
 
 
@@ -56,11 +57,11 @@ def test_a_request_alone_gets_both_cores_side_by_side_one(monkeypatch):
 
 def test_freed_memory_is_reused_unless_malloc_is_configured(monkeypatch):
     monkeypatch.setenv("MALLOC_ARENA_MAX", "2")
-    assert threaded.reuse_freed_memory() is False
+    assert memory.reuse_freed_memory() is False
     monkeypatch.delenv("MALLOC_ARENA_MAX")
-    for var in [v for v in threaded.os.environ if v.startswith("MALLOC_")]:
+    for var in [v for v in memory.os.environ if v.startswith("MALLOC_")]:
         monkeypatch.delenv(var)
-    assert threaded.reuse_freed_memory() is True                                        # glibc (Linux)
+    assert memory.reuse_freed_memory() is True                                        # glibc (Linux)
 
 
 def test_concurrent_results_are_the_serial_ones_in_order():
@@ -145,21 +146,21 @@ def test_freed_memory_is_kept_for_the_whole_request_only_where_memory_is_plentif
     from infsup_contact import cli, resources
 
     calls = []
-    monkeypatch.setattr(threaded, "reuse_freed_memory", lambda bounded=False: calls.append(bounded) or True)
+    monkeypatch.setattr(memory, "reuse_freed_memory", lambda bounded=False: calls.append(bounded) or True)
     monkeypatch.setattr(resources, "available_bytes", lambda *a: available_gb * 1e9)
     cli._reuse_freed_memory(resources.Estimate(estimate_gb * 1e9, 1.0))
     assert calls == [bounded]
 
 
 def test_bounded_reuse_gives_freed_memory_back_at_a_stages_end(monkeypatch):
-    for var in [v for v in threaded.os.environ if v.startswith("MALLOC_")]:
+    for var in [v for v in memory.os.environ if v.startswith("MALLOC_")]:
         monkeypatch.delenv(var)
-    monkeypatch.setattr(threaded, "_bounded_reuse", False)
+    monkeypatch.setattr(memory, "_bounded_reuse", False)
     released = []
     libc = type("Libc", (), {"malloc_trim": staticmethod(released.append), "mallopt": staticmethod(lambda p, v: 1)})
     monkeypatch.setattr("ctypes.CDLL", lambda name: libc())      # glibc's calls recorded, not made
-    threaded.release_freed_memory()
+    memory.release_freed_memory()
     assert released == []                                         # glibc's default or unbounded reuse: nothing
-    assert threaded.reuse_freed_memory(bounded=True) is True
-    threaded.release_freed_memory()
+    assert memory.reuse_freed_memory(bounded=True) is True
+    memory.release_freed_memory()
     assert released == [0]

@@ -9,11 +9,10 @@ import scipy.linalg as sla
 from infsup_contact.discretization.spaces import registry
 from infsup_contact.discretization.face.shapes.square import SQUARE, SQUARE_TRIG
 from infsup_contact.discretization.face.partitions.tensor_grid import TensorPartition
-from infsup_contact.la import bottom, reflection
+from infsup_contact.la import bottom, reflection, threaded
 from infsup_contact.solvers import infsup, spectra, symmetry
 from infsup_contact.solvers.kernel import KernelDecision
 from infsup_contact.solvers.request import MeshOptions
-from helpers.one_thread import one_mkl_thread
 
 
 def _space(case, k, n, gamma=SQUARE):
@@ -145,7 +144,7 @@ def test_split_pencils_side_by_side_are_the_pencils_one_after_the_other(monkeypa
     factors = {nm: tuple(spectra.gram_factor(b) for b in split.blocks(_invariant_spd(split, seed, shift=0.2))[:-1])
                for nm, seed in (("H", 3), ("L2", 4))}
     monkeypatch.setenv("MKL_NUM_THREADS", "1")
-    with one_mkl_thread():  # every MKL call on one thread, as in the tasks
+    with threaded.as_task():  # every MKL call on one thread, as in the tasks
         serial = reflection.split_pencils(split, A, factors, parts, 6)
     monkeypatch.setenv("MKL_NUM_THREADS", "2")
     side_by_side = reflection.split_pencils(split, A, factors, parts, 6)

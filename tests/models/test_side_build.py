@@ -12,10 +12,9 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
-from infsup_contact.la import body_parity
+from infsup_contact.la import body_parity, threaded
 from infsup_contact.models import body_symmetry, membranes3d as m3
 from infsup_contact.models.membranes import laplace_stiffness
-from helpers.one_thread import one_mkl_thread
 
 
 def _same_arrays(a, b) -> bool:
@@ -152,7 +151,7 @@ def test_the_sums_and_the_mirrored_copies_side_by_side_are_the_serial_ones(monke
     out = {}
     for threads in ("1", "2"):
         monkeypatch.setenv("MKL_NUM_THREADS", threads)
-        with one_mkl_thread() if threads == "1" else nullcontext():  # MKL on one thread, as in the tasks
+        with threaded.as_task() if threads == "1" else nullcontext():  # MKL on one thread, as in the tasks
             side1 = m3.side_operator(bodies[0], 2)
             side2 = m3.mirror_side(side1, bodies[1], 2)
         out[threads] = [side1.schur, side1.steklov, side2.schur, side2.steklov]

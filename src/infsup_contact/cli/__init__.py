@@ -98,12 +98,12 @@ def _reuse_freed_memory(estimate) -> None:
     memory for reuse: no page faults on each new large block (k = 2, N = 32: 17 % of the CPU in the
     kernel, 3 % with it), for a higher peak (+6 % at N = 24, +18 % at N = 32); where it is not, keep
     it within a stage only (the sides, one multiplier space), given back at the stage's end (k = 2,
-    N = 36: 77.9 → 20.1 s sys for a peak 10 % above glibc's; :func:`..la.threaded.reuse_freed_memory`)."""
+    N = 36: 77.9 → 20.1 s sys for a peak 10 % above glibc's; :func:`..memory.reuse_freed_memory`)."""
     from ..resources import available_bytes
 
     avail = available_bytes()
     if estimate is not None and avail is not None:
-        from ..la.threaded import reuse_freed_memory
+        from ..memory import reuse_freed_memory
 
         reuse_freed_memory(bounded=2 * estimate.bytes > avail)
 

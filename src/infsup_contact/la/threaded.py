@@ -27,6 +27,7 @@ from __future__ import annotations
 import os
 import threading
 from concurrent.futures import ThreadPoolExecutor, wait
+from contextlib import contextmanager
 
 import numpy as np
 import scipy.sparse as sp
@@ -103,62 +104,20 @@ def use_threads(n: int) -> None:
         hook(n)
 
 
-M_TRIM_THRESHOLD, M_MMAP_MAX, M_ARENA_MAX = -1, -4, -8
-"""glibc's ``mallopt`` parameters (malloc.h)."""
-
-
-_bounded_reuse = False
-"""Whether :func:`release_freed_memory` gives the kept free memory back (:func:`reuse_freed_memory`
-with ``bounded``)."""
-
-
-def reuse_freed_memory(bounded: bool = False) -> bool:
-    """Keep freed memory in the process for the next allocation (glibc ``mallopt``: no ``mmap``
-    per large block, no trimming). A request allocates and frees dense blocks of 100 MB and more
-    many times over; by default each is a fresh ``mmap`` whose pages fault in zeroed one by one,
-    and the request spent 15 % of its CPU in the kernel (k = 2, N = 24: 7.1 s sys of 45.8 s,
-    689 k minor faults; with this 1.1 s, 342 k faults; N = 32: 4.9 s sys of 161 s). Transparent
-    huge pages are not the cause (``NUMPY_MADVISE_HUGEPAGE=0``: 7.5 s sys, 3.4 M faults): zeroing
-    fresh pages is. The price is a higher peak (freed blocks stay resident between reuses: peak RSS
-    1.78 GB against 1.68 at N = 24, 5.19 GB against ~4.4 at N = 32), so the command line applies it
-    only where memory is plentiful (``cli._reuse_freed_memory``). Left as it is where glibc is
-    absent or a ``MALLOC_*`` variable already says how; True if applied.
-
-    A thread other than the main one allocates from an arena of its own, whose heaps are 64 MB:
-    a larger block there is an ``mmap`` whatever ``M_MMAP_MAX`` says (k = 2, N = 32, two threads:
-    720 k faults and 11 s sys against 118 k and 6 s on one). So every thread allocates from the
-    main arena (``M_ARENA_MAX`` = 1): N = 24, two threads, 201 k → 97 k faults, 3.0 → 2.5 s sys,
-    peak 1.46 → 1.29 GB, the same user CPU-s (16.7, 17.2; run side by side on a loaded machine).
-
-    ``bounded``: freed memory is kept within a stage of the request only: at the stage's end
-    (:func:`release_freed_memory`, after the sides and after each multiplier space) what is free
-    goes back to the system, so the peak is the live memory plus one stage's churn at most. For
-    requests whose peak is too close to the available memory for unbounded reuse (k = 2, N = 36,
-    two threads, one space at a time: 77.9 → 20.1 s sys, 17 M → 0.42 M faults, peak 4.44 → 4.90 GB
-    against glibc's default; kept all along: 5.55 GB)."""
-    import ctypes
-
-    if any(v.startswith("MALLOC_") for v in os.environ):
-        return False
+@contextmanager
+def as_task():
+    """The calling thread as one of :func:`run_concurrently`'s tasks for the duration: one BLAS thread
+    of its own (MKL's local count), :func:`threads` 1, its concurrent calls in turn — beside work
+    that holds the cores (a body's factorization in another thread)."""
+    _worker.inside = True
+    for hook in LOCAL_THREADS_HOOKS:
+        hook(1)
     try:
-        libc = ctypes.CDLL(None)
-        mallopt = libc.mallopt
-    except (OSError, AttributeError):
-        return False
-    applied = (bool(mallopt(M_MMAP_MAX, 0)) and bool(mallopt(M_TRIM_THRESHOLD, 2 ** 31 - 1))
-               and bool(mallopt(M_ARENA_MAX, 1)))
-    global _bounded_reuse
-    _bounded_reuse = applied and bounded
-    return applied
-
-
-def release_freed_memory() -> None:
-    """Where :func:`reuse_freed_memory` was applied ``bounded``: give the free memory the process
-    keeps back to the system (glibc ``malloc_trim``; live blocks stay where they are). Else nothing."""
-    if _bounded_reuse:
-        import ctypes
-
-        ctypes.CDLL(None).malloc_trim(0)
+        yield
+    finally:
+        for hook in LOCAL_THREADS_HOOKS:
+            hook(0)
+        _worker.inside = False
 
 
 def run_concurrently(tasks, workers: int | None = None) -> list:
@@ -182,15 +141,8 @@ def run_concurrently(tasks, workers: int | None = None) -> list:
 
     def inside(task):
         def run():
-            _worker.inside = True
-            for hook in LOCAL_THREADS_HOOKS:
-                hook(1)
-            try:
+            with as_task():
                 return task()
-            finally:
-                for hook in LOCAL_THREADS_HOOKS:
-                    hook(0)
-                _worker.inside = False
         return run
 
     set_threads(1)

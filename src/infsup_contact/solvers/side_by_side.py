@@ -22,13 +22,13 @@ N = 36, 2 × 1.6 GB, two at a time; N = 48, 2 × 5.7 GB against about 17 GB avai
 one at a time: the peak stays the serial one). Where the request's progress is timed by phase
 (:func:`~infsup_contact.progress.timing`, the benchmark's breakdown), the concurrent spaces'
 phases count as one, :data:`PHASE`. Where the command line keeps freed memory within a stage
-only, each space's end is a stage's end (:func:`~infsup_contact.la.threaded.release_freed_memory`).
+only, each space's end is a stage's end (:func:`~infsup_contact.memory.release_freed_memory`).
 """
 from __future__ import annotations
 
 from .. import progress
-from ..memory import available_bytes
-from ..la.threaded import release_freed_memory, run_concurrently, threads
+from ..la.threaded import run_concurrently, threads
+from ..memory import available_bytes, release_freed_memory
 
 DENSE_COPIES = 8.0
 """Dense m × m float64 matrices one space holds at its peak (measured at k = 2 on the face,

@@ -31,7 +31,7 @@ from scipy.spatial import cKDTree
 
 from ..discretization.gamma.symmetry import isotypic_bases
 from ..la.reflection import symmetric_permutation
-from ..la.threaded import concurrent_map
+from ..la.threaded import concurrent_map, threads
 
 ENABLED = True
 """Whether the sides use their symmetries (False: the general route everywhere; the tests'
@@ -109,7 +109,10 @@ def _match(ref_points, ref_inv, points, inv, tree: cKDTree | None = None) -> np.
     if len(points) != len(ref_points) or len(points) < 2:
         return None
     tree = _reference_tree(ref_points, ref_inv) if tree is None else tree
-    dist, sigma = tree.query(np.column_stack([points, inv]), k=1, distance_upper_bound=MATCH_TOL)
+    # the query split over the request's threads (scipy's own, without the GIL; each point's
+    # nearest reference is the same however the points are shared out)
+    dist, sigma = tree.query(np.column_stack([points, inv]), k=1, distance_upper_bound=MATCH_TOL,
+                             workers=threads())
     if not np.all(np.isfinite(dist)):
         return None
     return sigma if np.unique(sigma).size == sigma.size else None

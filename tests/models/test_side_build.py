@@ -6,12 +6,14 @@ every element whose side takes the route; the new route is run in blocks smaller
 so that block boundaries are crossed."""
 from __future__ import annotations
 
+import threading
 from contextlib import nullcontext
 
 import numpy as np
 import pytest
 import scipy.sparse as sp
 
+from infsup_contact.errors import InputError
 from infsup_contact.la import body_parity, threaded
 from infsup_contact.models import body_symmetry, membranes3d as m3
 from infsup_contact.models.membranes import laplace_stiffness
@@ -158,3 +160,45 @@ def test_the_sums_and_the_mirrored_copies_side_by_side_are_the_serial_ones(monke
     assert side2.route == "mirror" and all(a is not None for a in out["2"])
     for a, b in zip(out["1"], out["2"]):
         assert a.shape == b.shape and np.array_equal(a, b)
+
+
+@pytest.mark.parametrize("element, k", (("hex", 2), ("tet", 1), ("hex20", 2)))
+def test_a_matching_pair_built_side_by_side_is_the_pair_built_in_turn(monkeypatch, element, k):
+    """``Model.matching_pair``: side 1's factorization in a thread of its own, beside side 2's
+    mesh, stiffness and mirror search, gives the sides of side_operator and mirror_side one after
+    the other, bit for bit (K, S, X, X's blocks, the routes). Hex and tet bodies take the thread
+    (seen); HEX20 bodies (scikit-fem) are built in turn."""
+    monkeypatch.setenv("MKL_NUM_THREADS", "2")
+    b1, b2 = (m3.subdomain_mesh("structured", 4, s, element=element) for s in (1, 2))
+    seen, factorized_side = [], m3.factorized_side
+    monkeypatch.setattr(m3, "factorized_side",
+                        lambda *a, **kw: seen.append(threading.current_thread().name) or factorized_side(*a, **kw))
+    pair = m3.matching_pair(b1, lambda: b2, k)
+    with threaded.as_task():  # the reference: one side after the other, on one thread
+        side1 = m3.side_operator(b1, k)
+        reference = (side1, m3.mirror_side(side1, b2, k))
+    assert seen[:1] == ([] if element == "hex20" else ["infsup-side1_0"])
+    assert [s.route for s in pair] == [s.route for s in reference] and pair[1].route == "mirror"
+    for got, want in zip(pair, reference):
+        assert _same_arrays(got.stiffness, want.stiffness)
+        for name in ("schur", "steklov", "free"):
+            a, b = getattr(got, name), getattr(want, name)
+            assert (a is None) == (b is None) and (a is None or np.array_equal(a, b))
+        assert len(got.steklov_parts or ()) == len(want.steklov_parts or ())
+        for (P, X), (P0, X0) in zip(got.steklov_parts or (), want.steklov_parts or ()):
+            assert _same_arrays(P.tocsr(), P0.tocsr()) and np.array_equal(X, X0)
+
+
+def test_a_failing_second_body_fails_the_pair_after_side_1_is_done(monkeypatch):
+    """An error in side 2's build is the pair's error, raised once side 1's factorization has
+    ended (its thread joined, nothing left running)."""
+    monkeypatch.setenv("MKL_NUM_THREADS", "2")
+    b1 = m3.subdomain_mesh("structured", 3, 1)
+
+    def broken():
+        raise InputError("N2", "a mesh", got="nothing")
+
+    before = threading.active_count()
+    with pytest.raises(InputError, match="N2"):
+        m3.matching_pair(b1, broken, 2)
+    assert threading.active_count() <= before

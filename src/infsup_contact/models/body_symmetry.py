@@ -235,13 +235,19 @@ class MirroredSolve:
         return self.solve1(w)[self.sigma]
 
 
-def mirrored_factors(side1, signature2, K2) -> tuple | None:
+SEARCH = "search"
+"""``sigma`` of :func:`mirrored_factors` not given: it looks for the mirror itself."""
+
+
+def mirrored_factors(side1, signature2, K2, sigma=SEARCH) -> tuple | None:
     """(S2, solve2, X2 or None, X2's parity blocks or None) of body 2 from side 1's (its
     ``signature`` attribute, its stiffness, schur, solve, steklov, steklov_parts) through the
-    checked mirror (:func:`mirror_permutation`), else None. X2 = X1[τ][:, τ], so its blocks are
-    side 1's with the rows of each P_c permuted (the X_c themselves shared)."""
+    checked mirror (:func:`mirror_permutation`; ``sigma``: its result for these bodies, where the
+    caller looked already), else None. X2 = X1[τ][:, τ], so its blocks are side 1's with the rows of
+    each P_c permuted (the X_c themselves shared)."""
     n_gamma = len(side1.trace.gamma_dofs)
-    sigma = mirror_permutation(getattr(side1, "signature", None), side1.stiffness, signature2, K2, n_gamma)
+    if isinstance(sigma, str) and sigma == SEARCH:
+        sigma = mirror_permutation(getattr(side1, "signature", None), side1.stiffness, signature2, K2, n_gamma)
     if sigma is None:
         return None
     n = sigma.size

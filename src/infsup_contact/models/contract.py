@@ -194,6 +194,10 @@ class Model:
         ``mirror_side(side1, mesh2, k) -> SideOperator``: Ω2's side of a matching pair, reusing
         Ω1's factorization where a mirror maps the bodies (checked; else built as
         ``side_operator``); None: every side is factorized.
+    matching_pair : callable or None
+        ``matching_pair(mesh1, make_mesh2, k) -> (side1, side2)``: the sides
+        ``side_operator(mesh1, k)`` and ``mirror_side(side1, make_mesh2(), k)`` give, with side 1's
+        factorization beside the build of side 2; None: one after the other.
     """
 
     name: str
@@ -210,6 +214,7 @@ class Model:
     families: tuple | None = None
     dim: int = 2
     mirror_side: Callable | None = None
+    matching_pair: Callable | None = None
     interface: Callable | None = None
     curving: tuple = ()
 
@@ -365,12 +370,12 @@ def extended(base: SideOperator, cls, **extra):
 
 
 def mirrored_side(side1: SideOperator, trace: GammaTrace, free: np.ndarray, K, signature, route: str = "auto",
-                  keep_factor: bool = False) -> SideOperator:
+                  keep_factor: bool = False, sigma=body_symmetry.SEARCH) -> SideOperator:
     """Body 2 of a matching pair from body 1's factorization: where a mirror maps body 2 onto
     body 1 and K is side 1's stiffness permuted, entry by entry
-    (:func:`~.body_symmetry.mirrored_factors`), S and the solves are side 1's permuted; else
-    :func:`factorized_side`."""
-    factors = body_symmetry.mirrored_factors(side1, signature, K)
+    (:func:`~.body_symmetry.mirrored_factors`; ``sigma``: its permutation, already looked for),
+    S and the solves are side 1's permuted; else :func:`factorized_side`."""
+    factors = body_symmetry.mirrored_factors(side1, signature, K, sigma)
     if factors is None:
         return factorized_side(trace, free, K, route, keep_factor, signature)
     S, solve, X, blocks = factors

@@ -53,6 +53,7 @@ from ..discretization.segment.arc import COUPLINGS
 from ..discretization.face.shapes.serendipity import SERENDIPITY
 from ..discretization.face.shapes.triangulated_square import TRIANGULATED
 from ..errors import InputError, check_prestress
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
 import scipy.sparse as sp
@@ -61,6 +62,7 @@ from .contract import Body, MaterialParam, Model, OptionalChoice
 from .membranes import field as membrane_field, interpolate as membrane_interpolate, laplace_stiffness
 from .contract import SideOperator, extended, factorized_side, mirrored_side
 from . import body_symmetry, hex20
+from ..la.threaded import as_task, threads
 
 ELEMENTS = ("hex", "tet")
 """Elements of the NGSolve bodies (the 3D elastic model's too)."""
@@ -211,6 +213,27 @@ def side_operator(body: Body, k: int, route: str = "auto", dirichlet: str = BETA
             raise InputError("element", "hex, tet (supports other than ∂Ω_i∖Γ, a narrower Γ); hex20 bodies: "
                              "β_h on all of ∂Ω_i∖Γ, a contact scene's far face by scene_side", got="hex20")
         return hex20.side_operator(body, k, route, keep_factor)
+    a = _assembled(body, k, dirichlet, gamma, keep_factor)
+    base = (factorized_side(a.trace, a.free, a.K, route, keep_factor, a.signature) if mirror_of is None else
+            mirrored_side(mirror_of, a.trace, a.free, a.K, a.signature, route, keep_factor))
+    return extended(base, MembraneSide, stiffness_all=a.K_all)
+
+
+@dataclass(frozen=True)
+class _Assembled:
+    """What NGSolve gives of one body (:func:`_assembled`): its trace on Γ, the free dofs (Γ last),
+    K on them, K on every dof (a side that solves) and the dofs' symmetry signature."""
+
+    trace: object
+    free: np.ndarray
+    K: sp.csc_matrix
+    K_all: sp.csr_matrix | None
+    signature: np.ndarray | None
+
+
+def _assembled(body: Body, k: int, dirichlet: str = BETA_DIRICHLET, gamma=None,
+               keep_factor: bool = False) -> _Assembled:
+    """The NGSolve part of :func:`side_operator` (curving, space, trace, stiffness, signature)."""
     if isinstance(body.interface, Cylinder):
         body.interface.curve(body.mesh, k)  # the isoparametric body: degree k is known here
     fes = displacement_space(body.mesh, k, dirichlet)
@@ -224,10 +247,31 @@ def side_operator(body: Body, k: int, route: str = "auto", dirichlet: str = BETA
     K_all = laplace_stiffness(fes) if keep_factor else None
     K = K_all[free][:, free].tocsc() if keep_factor else laplace_stiffness(fes, free)
     signature = body_symmetry.ngsolve_signature(fes)
-    signature = None if signature is None else signature[free]
-    base = (factorized_side(trace, free, K, route, keep_factor, signature) if mirror_of is None else
-            mirrored_side(mirror_of, trace, free, K, signature, route, keep_factor))
-    return extended(base, MembraneSide, stiffness_all=K_all)
+    return _Assembled(trace, free, K, K_all, None if signature is None else signature[free])
+
+
+def matching_pair(body1: Body, make_body2, k: int) -> tuple:
+    """(side 1, side 2) of a matching pair (``Model.matching_pair``): the sides
+    :func:`side_operator` and :func:`mirror_side` give, bit for bit, with side 1's factorization
+    (PARDISO, numpy; no NGSolve) in a thread of its own beside this thread's mesh and stiffness of
+    body 2 (NGSolve, in one thread at a time as ever) and its search for the mirror (k = 2,
+    N = 48: about 8 s of side 2's one-core work beside side 1's 40 s on two). This thread runs as
+    one task (:func:`~infsup_contact.la.threaded.as_task`: one BLAS thread, NGSolve's assembly
+    serial, bit for bit its task manager's). HEX20 and curved bodies, or a request on one
+    thread: one side after the other."""
+    if hex20.is_hex20(body1) or isinstance(body1.interface, Cylinder) or threads() < 2:
+        side1 = side_operator(body1, k)
+        return side1, mirror_side(side1, make_body2(), k)
+    a1 = _assembled(body1, k)
+    n_gamma = len(a1.trace.gamma_dofs)
+    with ThreadPoolExecutor(1, thread_name_prefix="infsup-side1") as pool:
+        factorized = pool.submit(factorized_side, a1.trace, a1.free, a1.K, signature=a1.signature)
+        with as_task():
+            a2 = _assembled(make_body2(), k)
+            sigma = body_symmetry.mirror_permutation(a1.signature, a1.K, a2.signature, a2.K, n_gamma)
+        side1 = extended(factorized.result(), MembraneSide, stiffness_all=None)
+    side2 = mirrored_side(side1, a2.trace, a2.free, a2.K, a2.signature, sigma=sigma)
+    return side1, extended(side2, MembraneSide, stiffness_all=None)
 
 
 def mirror_side(side1, body: Body, k: int):
@@ -294,7 +338,7 @@ MEMBRANES3D = Model("membranes3d", side_operator,
                     "contact face Γ = (0,1)^2x{1}; structured, perturbed or unstructured (tet) meshes, "
                     "N cells per direction or maxh = 1/N (--element)",
                     scene_side=scene_side, load=load, field=field, interpolate=interpolate,
-                    mirror_side=mirror_side,
+                    mirror_side=mirror_side, matching_pair=matching_pair,
                     params=tuple(MaterialParam(f"c{i + 1}", 1.0, lambda v, key: check_prestress(key, v),
                                                "1e-150 <= c <= 1e150", f"prestress c{i + 1} of Ω{i + 1}", side=i)
                                  for i in range(2)),

@@ -80,40 +80,57 @@ class SideCache:
         (:class:`~.request.BetaRequest`; ``checked``: the mesh builder does not check them again)
         or checked by the mesh builder."""
         key1, key2 = side_keys(model, family, k, n1, n2, mesh, gamma)
-        # one side after the other: building two sides side by side in threads aborted the process
-        # (NGSolve's meshing and assembly are not thread-safe); the parallel work is inside a side
-        # (a body's parity parts, PARDISO's threads)
-        side1 = self._get(key1, checked=checked)
+        # NGSolve in one thread at a time: building two sides side by side in threads aborted the
+        # process (its meshing and assembly are not thread-safe); the parallel work is inside a side
+        # (a body's parity parts, PARDISO's threads) and, on a matching pair, side 1's factorization
+        # beside side 2's mesh and stiffness (Model.matching_pair)
         mirror = n1 == n2 and getattr(model, "mirror_side", None) is not None
-        sides = [side1, self._get(key2, mirror_of=side1 if mirror else None, checked=checked)]
+        if mirror and getattr(model, "matching_pair", None) is not None and key1 not in self._ops:
+            progress.note(f"sides 1 and 2 (N1=N2={n1}): mesh, stiffness; side 1's factorization beside side 2's "
+                          "mesh and stiffness, side 1 mirrored")
+            sides = list(model.matching_pair(self._mesh(key1, checked), lambda: self._mesh(key2, checked), k))
+            self._keep(key1, sides[0])
+            self._use(key2)
+        else:
+            side1 = self._get(key1, checked=checked)
+            sides = [side1, self._get(key2, mirror_of=side1 if mirror else None, checked=checked)]
         return sides[0].trace.gamma.paired(sides)  # a Γ coupled by projection ties the two
+
+    def _mesh(self, key, checked: bool = False):
+        """The mesh of ``key``'s side (the model's builder, with the request's options and Γ)."""
+        model, family, k, n, side, mesh, gamma = key
+        kwargs = dict(mesh.kwargs(), checked=True) if checked else mesh.kwargs()
+        if gamma is not None:  # the request's Γ, the builder's own argument (Model.subdomain_mesh)
+            kwargs["gamma"] = gamma
+        # the model contract takes the options as keywords: unpacked here, and only here
+        return model.subdomain_mesh(family, n, side, **kwargs)
+
+    def _keep(self, key, op) -> None:
+        """Keep ``op`` for the uses of ``key`` still announced (:meth:`expect`), count this one."""
+        if self._uses_left[key] > 1:  # more uses announced: keep it for them
+            self._uses_left[key] -= 1
+            self._ops[key] = op
+        else:
+            self._uses_left.pop(key, None)
 
     def _get(self, key, mirror_of=None, checked: bool = False):
         """The operator of ``key``, cached or built; ``mirror_of``: side 1 of a matching pair, which
         a model with ``mirror_side`` turns into side 2 where a mirror maps the bodies (checked);
         ``checked``: the request checked the mesh arguments (:meth:`pair`)."""
         model, family, k, n, side, mesh, gamma = key
-        kwargs = dict(mesh.kwargs(), checked=True) if checked else mesh.kwargs()
-        if gamma is not None:  # the request's Γ, the builder's own argument (Model.subdomain_mesh)
-            kwargs["gamma"] = gamma
         mirror = getattr(model, "mirror_side", None) if mirror_of is not None else None
         if mirror is not None:
             # always the mirror on a matching pair, never kept for another pair: each pair's rows
             # stay a function of the pair (a cached side is the one a fresh build gives, bitwise)
             progress.note(f"side {side} of 2 (N{side}={n}): mesh, stiffness, side 1 mirrored")
-            op = mirror(mirror_of, model.subdomain_mesh(family, n, side, **kwargs), k)
+            op = mirror(mirror_of, self._mesh(key, checked), k)
             self._use(key)
             return op
         op = self._ops.pop(key, None)
         if op is None:
             progress.note(f"side {side} of 2 (N{side}={n}): mesh, stiffness, factorization")
-            # the model contract takes the options as keywords: unpacked here, and only here
-            op = model.side_operator(model.subdomain_mesh(family, n, side, **kwargs), k)
-        if self._uses_left[key] > 1:  # more uses announced: keep it for them
-            self._uses_left[key] -= 1
-            self._ops[key] = op
-        else:
-            self._uses_left.pop(key, None)
+            op = model.side_operator(self._mesh(key, checked), k)
+        self._keep(key, op)
         return op
 
     def _use(self, key) -> None:

@@ -258,6 +258,30 @@ def test_interface_terms_in_parity_blocks_give_the_rows_of_the_whole_terms(monke
         assert a["gap_over_roundoff"] == pytest.approx(b["gap_over_roundoff"], rel=1e-6)
 
 
+def test_the_sides_interface_terms_side_by_side_are_the_terms_in_turn(monkeypatch):
+    """The two sides' terms in parity blocks are computed as two concurrent tasks where the request
+    has two threads: from the same couplings, sides and split, the same blocks and bounds, bit for
+    bit, as one after the other on one thread."""
+    from infsup_contact.la import threaded
+    from infsup_contact.solvers import interface_operator
+
+    request = BetaRequest("structured", 2, 12, 12, ("DUAL-Q9",), ("omega2",), ((1.0, 1.0),), ("H",),
+                          model=MODELS["membranes3d"], mesh=MeshOptions())
+    given, terms = [], interface_operator._parity_terms
+    monkeypatch.setattr(interface_operator, "_parity_terms", lambda *a: given.append(a) or terms(*a))
+    beta_table(request)
+    assert given
+    monkeypatch.setenv("MKL_NUM_THREADS", "1")
+    with threaded.as_task():
+        in_turn = terms(*given[0])
+    monkeypatch.setenv("MKL_NUM_THREADS", "2")
+    side_by_side = terms(*given[0])
+    assert len(in_turn) == len(side_by_side) == 2
+    for a, b in zip(side_by_side, in_turn):
+        assert a.dropped == b.dropped and len(a.blocks) == len(b.blocks) == 4
+        assert all(np.array_equal(x, y) for x, y in zip(a.blocks, b.blocks))
+
+
 def _trace_rows(case, k, n):
     """(W, split, structural) of :func:`_kernel_problem` and the row components of the sides'
     parity parts on Γ (or None)."""

@@ -235,7 +235,7 @@ class MirroredSolve:
         return self.solve1(w)[self.sigma]
 
 
-SEARCH = "search"
+SEARCH = object()
 """``sigma`` of :func:`mirrored_factors` not given: it looks for the mirror itself."""
 
 
@@ -246,7 +246,7 @@ def mirrored_factors(side1, signature2, K2, sigma=SEARCH) -> tuple | None:
     caller looked already), else None. X2 = X1[τ][:, τ], so its blocks are side 1's with the rows of
     each P_c permuted (the X_c themselves shared)."""
     n_gamma = len(side1.trace.gamma_dofs)
-    if isinstance(sigma, str) and sigma == SEARCH:
+    if sigma is SEARCH:
         sigma = mirror_permutation(getattr(side1, "signature", None), side1.stiffness, signature2, K2, n_gamma)
     if sigma is None:
         return None

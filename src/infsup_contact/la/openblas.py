@@ -249,14 +249,23 @@ def _geqrf(W, overwrite: bool):
         return None
     a = _fortran(np.asarray_chkfinite(W), overwrite)
     m, n = a.shape
-    tau, work, info = np.empty(n), np.empty(1), _INT(0)
-    fn(_ref(m), _ref(n), _ptr(a), _ref(m), _ptr(tau), _ptr(work), _ref(-1), ctypes.byref(info))
-    lwork = int(np.int_(work[0].real))  # scipy's safecall: the query's value, truncated
-    work = np.empty(max(lwork, 1))
-    fn(_ref(m), _ref(n), _ptr(a), _ref(m), _ptr(tau), _ptr(work), _ref(lwork), ctypes.byref(info))
-    if info.value < 0:
-        raise ValueError(f"illegal value in {-info.value}th argument of internal geqrf")
+    tau = np.empty(n)
+    info = _with_workspace(fn, _ref(m), _ref(n), _ptr(a), _ref(m), _ptr(tau))
+    if info < 0:
+        raise ValueError(f"illegal value in {-info}th argument of internal geqrf")
     return a, tau
+
+
+def _with_workspace(fn, *args) -> int:
+    """``fn(*args, work, lwork, info)`` with the workspace a query (lwork = -1) asks for, as scipy's
+    ``safecall`` (the query's value truncated): info."""
+    np = _np()[0]
+    work, info = np.empty(1), _INT(0)
+    fn(*args, _ptr(work), _ref(-1), ctypes.byref(info))
+    lwork = int(np.int_(work[0].real))
+    work = np.empty(max(lwork, 1))
+    fn(*args, _ptr(work), _ref(lwork), ctypes.byref(info))
+    return int(info.value)
 
 
 def qr_r(W, overwrite: bool = False):
@@ -281,13 +290,9 @@ def qr_q(W, overwrite: bool = False):
     if done is None:
         return sla.qr(W, mode="economic", overwrite_a=overwrite, check_finite=True)[0]
     a, tau = done
-    work, info = np.empty(1), _INT(0)
-    fn(_ref(m), _ref(n), _ref(n), _ptr(a), _ref(m), _ptr(tau), _ptr(work), _ref(-1), ctypes.byref(info))
-    lwork = int(np.int_(work[0].real))
-    work = np.empty(max(lwork, 1))
-    fn(_ref(m), _ref(n), _ref(n), _ptr(a), _ref(m), _ptr(tau), _ptr(work), _ref(lwork), ctypes.byref(info))
-    if info.value < 0:
-        raise ValueError(f"illegal value in {-info.value}th argument of internal gorgqr/gungqr")
+    info = _with_workspace(fn, _ref(m), _ref(n), _ref(n), _ptr(a), _ref(m), _ptr(tau))
+    if info < 0:
+        raise ValueError(f"illegal value in {-info}th argument of internal gorgqr/gungqr")
     return a
 
 

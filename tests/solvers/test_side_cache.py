@@ -153,3 +153,73 @@ def test_the_sweeps_face_grams_stay_in_their_parity_blocks_and_rows_are_unchange
     assert assembled  # the eager route assembles them
     cols = [c for c in lazy.columns if not c.startswith("t_")]
     pd.testing.assert_frame_equal(lazy[cols], eager[cols], check_exact=True)
+
+
+class _Gate:
+    """An interface whose Grams wait at a barrier of two: two threads inside ``gram`` at once pass
+    it, one alone times out (``passed``); ``independent`` is what it says of every space."""
+
+    def __init__(self, independent):
+        import threading
+
+        self.barrier, self.passed, self.calls = threading.Barrier(2, timeout=1.0), [], 0
+        if independent is not None:
+            self.gram_independent = lambda space: independent
+
+    def partition_key(self, partition):
+        return tuple(partition)
+
+    def gram(self, space, norm, h_route="logkernel"):
+        import threading
+
+        self.calls += 1
+        try:
+            self.barrier.wait()
+            self.passed.append(True)
+        except threading.BrokenBarrierError:
+            self.passed.append(False)
+        return np.eye(2), {"n_max": 0}
+
+
+@pytest.mark.parametrize("independent, together", [(True, True), (False, False), (None, False)])
+def test_gram_cache_computes_only_independent_grams_side_by_side(independent, together):
+    """Grams the interface calls independent are computed by two threads at once; any other (or an
+    interface that says nothing) one at a time: the second waits until the first is stored."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    from infsup_contact.solvers.side_cache import GramCache
+
+    gate, grams = _Gate(independent), GramCache()
+    with ThreadPoolExecutor(2) as pool:
+        out = list(pool.map(lambda case: grams.gram(gate, case, 2, (0.0, 1.0), None, "H", "logkernel"), ["a", "b"]))
+    assert gate.calls == 2 and all(gate.passed) == together and len(grams) == 2
+    assert all(G.flags.writeable is False for G, _ in out)
+    assert grams.gram(gate, "a", 2, (0.0, 1.0), None, "H", "logkernel")[0] is out[0][0] and gate.calls == 2  # kept
+
+
+def test_gram_cache_keeps_the_first_of_two_equal_grams_made_at_once():
+    """Two threads asking the same independent Gram at once both compute it; the first stored is
+    the one both get and the one kept."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    from infsup_contact.solvers.side_cache import GramCache
+
+    gate, grams = _Gate(True), GramCache()
+    with ThreadPoolExecutor(2) as pool:
+        out = list(pool.map(lambda _: grams.gram(gate, "a", 2, (0.0, 1.0), None, "H", "logkernel"), range(2)))
+    assert gate.calls == 2 and all(gate.passed) and len(grams) == 1
+    assert out[0][0] is out[1][0]
+
+
+def test_the_face_says_its_tensor_spaces_grams_are_independent_and_its_cellwise_ones_are_not():
+    """The square's tensor spaces sum their own series (face/norms/tensor.py); its cellwise spaces
+    share the series of their piece space (face/norms/cellwise.py: a module's state)."""
+    from infsup_contact.discretization.face.partitions.tensor_grid import TensorPartition
+    from infsup_contact.discretization.face.shapes.square import SQUARE
+    from infsup_contact.discretization.spaces import registry
+
+    part = TensorPartition(np.linspace(0, 1, 5), np.linspace(0, 1, 5))
+    said = {case: SQUARE.gram_independent(registry.case_space(case, 2, part, SQUARE))
+            for case in ("T3", "R5.2", "T4", "DUAL", "DUAL-Q9", "DUAL-Q9-ALL", "TDUAL-Q9", "PWLIN-Q9")}
+    assert said == {"T3": True, "R5.2": True, "T4": True, "DUAL": True,
+                    "DUAL-Q9": False, "DUAL-Q9-ALL": False, "TDUAL-Q9": False, "PWLIN-Q9": False}

@@ -29,12 +29,13 @@ Richardson-extrapolated double sine series, most of a row's cost, so it is built
 what the next pair will be given; the computation is deterministic, so a cached Gram is
 bit for bit the one a fresh call would give (tested). It holds at most :data:`MAX_BYTES` of
 matrices and forgets the oldest first. Spaces run side by side (:mod:`.side_by_side`) ask it
-from two threads: one Gram is computed at a time (a lock), so an equal key is computed once and
-the series the spaces of one G_h share (``gamma.gram_session``, a module's state) is never
-written by two threads at once.
+from two threads: Grams are computed one at a time (a lock), so that the series the spaces of one
+G_h share (``gamma.gram_session``, a module's state) is never written by two threads at once;
+only those the interface calls independent (``gamma.gram_independent``) are computed beside others.
 """
 from __future__ import annotations
 
+import contextlib
 import threading
 from collections import Counter, OrderedDict
 
@@ -158,7 +159,8 @@ class GramCache:
         self._bytes = 0
         self.max_bytes = int(max_bytes)
         self.hits = 0
-        self._lock = threading.RLock()  # one Gram at a time: spaces side by side share the series
+        self._lock = threading.RLock()  # the Grams whose series spaces share: one at a time
+        self._table = threading.Lock()  # the table itself, held for a look-up or a store only
 
     def gram(self, gamma, case, k: int, partition, space, norm: str, h_route: str) -> tuple:
         """``gamma.gram(space, norm, h_route=h_route)``, from the cache when an equal
@@ -167,33 +169,51 @@ class GramCache:
         that is not a dense array or above a quarter of :attr:`max_bytes`. A Gram summed in
         parity blocks comes as its :class:`~infsup_contact.la.face_parity.ParityGram`, assembled
         where a consumer reads it densely (:func:`~infsup_contact.la.face_parity.deferred_assembly`).
-        Safe from several threads: one Gram is computed at a time."""
-        with self._lock:
-            return self._gram(gamma, case, k, partition, space, norm, h_route)
 
-    def _gram(self, gamma, case, k: int, partition, space, norm: str, h_route: str) -> tuple:
+        Safe from several threads (spaces side by side, :mod:`.side_by_side`): Grams are computed
+        one at a time, except those the interface calls independent of every other space's
+        (``gamma.gram_independent(space)``: the face's tensor spaces, numpy alone, no shared series),
+        which are computed beside any other (k = 2, N = 16: 7 of 12 spaces; two threads asking
+        the same one at once would both compute it, the same bits, and the first stored is kept)."""
         try:
             key = (gamma, case, int(k), gamma.partition_key(partition), norm, h_route)
             hash(key)
         except TypeError:
             return gamma.gram(space, norm, h_route=h_route)
-        hit = self._grams.get(key)
+        hit = self._lookup(key)
         if hit is not None:
-            self._grams.move_to_end(key)
-            self.hits += 1
             return hit
-        progress.note(f"Gram matrix G, norm {norm}")
-        with deferred_assembly():  # a Gram summed in parity blocks stays in them until read densely
-            G, info = gamma.gram(space, norm, h_route=h_route)
+        independent = getattr(gamma, "gram_independent", None)
+        with contextlib.nullcontext() if independent is not None and independent(space) else self._lock:
+            hit = self._lookup(key)  # made meanwhile by the thread that held the lock
+            if hit is not None:
+                return hit
+            progress.note(f"Gram matrix G, norm {norm}")
+            with deferred_assembly():  # a Gram summed in parity blocks stays in them until read densely
+                G, info = gamma.gram(space, norm, h_route=h_route)
+        return self._store(key, G, info)
+
+    def _lookup(self, key):
+        with self._table:
+            hit = self._grams.get(key)
+            if hit is not None:
+                self._grams.move_to_end(key)
+                self.hits += 1
+            return hit
+
+    def _store(self, key, G, info) -> tuple:
         if not isinstance(G, (np.ndarray, ParityGram)) or 4 * G.nbytes > self.max_bytes:
             return G, info
         for held in (G.blocks if isinstance(G, ParityGram) else (G,)):
             held.setflags(write=False)  # shared by later pairs: nobody may change it
-        self._grams[key] = (G, info)
-        self._bytes += G.nbytes
-        while self._bytes > self.max_bytes:
-            _, (old, _) = self._grams.popitem(last=False)
-            self._bytes -= old.nbytes
+        with self._table:
+            if key in self._grams:  # stored meanwhile by another thread: the same bits
+                return self._grams[key]
+            self._grams[key] = (G, info)
+            self._bytes += G.nbytes
+            while self._bytes > self.max_bytes:
+                _, (old, _) = self._grams.popitem(last=False)
+                self._bytes -= old.nbytes
         return G, info
 
     def __len__(self) -> int:

@@ -295,6 +295,11 @@ class Square(Interface):
             return gram_triangles(space, norm, **kwargs)
         return (gram if space.factors is not None else gram_cellwise)(space, norm, **kwargs)
 
+    def gram_independent(self, space) -> bool:
+        """Whether ``space``'s Grams share nothing with another space's (a tensor space: numpy alone,
+        no shared series), so two may be computed at once (:class:`~infsup_contact.solvers.side_cache.GramCache`)."""
+        return getattr(space, "factors", None) is not None  # :meth:`gram`'s tensor route
+
     def gram_session(self):
         """Spaces on one G_h that share a piece space reuse its series
         (:func:`~.face.norms.cellwise.shared_piece_sums`)."""

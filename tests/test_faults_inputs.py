@@ -598,3 +598,17 @@ def test_numpy_integer_scalars_are_the_integers_they_are():
         plain.drop(columns=[c for c in plain if c.startswith("t_")]))
     with pytest.raises(InputError):
         ic.beta(case="T3", k=np.float64(1.5), N1=4, N2=4)
+
+
+def test_an_input_error_survives_pickling_whole():
+    """A worker process's error reaches the parent as raised (solvers/side_by_side.py): the same
+    class, message, key, allowed values and value got; a subclass with its own constructor too."""
+    import pickle
+
+    from infsup_contact.errors import InputError
+    from infsup_contact.systems.file_checks import SystemFileError
+
+    for err in (InputError("N", "a positive integer", got=-3), SystemFileError("/tmp/A.mtx", "cut after 3 lines")):
+        back = pickle.loads(pickle.dumps(err))
+        assert type(back) is type(err) and str(back) == str(err) and back.args == err.args
+        assert (back.key, back.allowed, back.got) == (err.key, err.allowed, err.got)

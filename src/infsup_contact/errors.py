@@ -9,6 +9,19 @@ class InputError(ValueError):
         got_txt = "" if got is None else f" (got {got!r})"
         super().__init__(f"invalid {key}{got_txt}: expected {allowed}")
 
+    def __reduce__(self):
+        # pickled as it is (a worker process's error reaches the parent whole): its args and
+        # attributes, whatever the constructor of a subclass takes
+        return _restored, (type(self), self.args, dict(self.__dict__))
+
+
+def _restored(cls, args, state):
+    """An :class:`InputError` (or subclass) from its pickled args and attributes."""
+    error = cls.__new__(cls, *args)
+    error.args = args
+    error.__dict__.update(state)
+    return error
+
 
 C_RANGE = (1e-150, 1e150)
 """Allowed membrane prestress c_i. The interface operator scales like 1/c_i and the energy like

@@ -84,10 +84,12 @@ def reuse_freed_memory(bounded: bool = False) -> bool:
     return applied
 
 
-def release_freed_memory() -> None:
-    """Where :func:`reuse_freed_memory` was applied ``bounded``: give the free memory the process
-    keeps back to the system (glibc ``malloc_trim``; live blocks stay where they are). Else nothing."""
-    if _bounded_reuse:
+def release_freed_memory(always: bool = False) -> None:
+    """Where :func:`reuse_freed_memory` was applied ``bounded`` (or ``always``: before worker
+    processes fork, which allocate their own while the parent waits): give the free memory the
+    process keeps back to the system (glibc ``malloc_trim``; live blocks stay where they are). Else
+    nothing."""
+    if _bounded_reuse or always:
         import ctypes
 
         ctypes.CDLL(None).malloc_trim(0)

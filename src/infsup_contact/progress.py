@@ -215,6 +215,13 @@ def note(message: str) -> None:
         reporter.event(message)
 
 
+def detach() -> None:
+    """In a forked worker process (:mod:`infsup_contact.solvers.side_by_side`): report nothing and
+    time no phase (the parent says what finished and counts the workers' CPU in its phase)."""
+    global _reporter, _phases
+    _reporter, _phases = None, None
+
+
 def active() -> bool:
     """Whether a request's progress is being reported (an :mod:`infsup_contact.api` call: no)."""
     return _reporter is not None
@@ -250,11 +257,13 @@ _phase_stack: list = []
 
 
 def _clocks() -> list:
-    """[wall s, process CPU s, the process's peak resident bytes so far] now."""
+    """[wall s, CPU s of the process and of its ended worker processes, the process's peak resident
+    bytes so far] now (a worker's memory is its own: not in this peak)."""
     import resource
 
     peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024  # KiB on Linux
-    return [time.perf_counter(), time.process_time(), float(peak)]
+    workers = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return [time.perf_counter(), time.process_time() + workers.ru_utime + workers.ru_stime, float(peak)]
 
 
 @contextmanager

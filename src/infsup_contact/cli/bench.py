@@ -134,6 +134,13 @@ PLANE_STRAIN = ("elastic",)
 
 
 def _run_bench(args) -> None:
+    from ..solvers.side_by_side import worker_processes
+
+    with worker_processes():  # ours as the command line's beta runs it (solvers/side_by_side.py)
+        _bench(args)
+
+
+def _bench(args) -> None:
     import pandas as pd
 
     from .. import bench

@@ -114,8 +114,11 @@ def _run_beta(args) -> None:
 
         if args.manifest.norm not in ("given", "H"):  # H: the paper's norm, no caveat
             print(f"infsup-contact: note: {NORM_NOTES[args.manifest.norm]}", file=sys.stderr)
+    from ..solvers.side_by_side import worker_processes
+
     modes = None if args.worst_mode is None else []
-    frame = beta_frame(args, modes)
+    with worker_processes():  # one mesh pair: its spaces in forked workers (solvers/side_by_side.py)
+        frame = beta_frame(args, modes)
     if modes is not None:
         write_modes(args.worst_mode, mode_frame(modes))
     write_csv(frame, float_format="%.12g", output=args.output)

@@ -78,7 +78,7 @@ def beta_table(request: BetaRequest, side_cache: SideCache | None = None, modes:
             per_case = side_by_side.rows_by_case(  # two spaces at a time where the cores and memory allow
                 r.cases, lambda case: _case_rows_and_modes(r, case, g_h, sides, dim_w, trace_norms,
                                                            modes is not None, cache.grams),
-                dim_w, registry.case_name)
+                dim_w, registry.case_name, python_bound=gamma.dim == 2)  # a face's spaces: the GIL binds
             found = None if modes is None else [m for _, case_modes in per_case for m in case_modes]
             by_partition[key] = ([row for case_rows, _ in per_case for row in case_rows], found)
             if modes is not None:

@@ -15,6 +15,18 @@ runs alone: it makes what the others then only read (each side's explicit X_i, t
 at the common quadrature points). Every space computes what it computed alone, from the same
 operands: the rows are those of one space at a time (tested bit for bit at one BLAS thread).
 
+In worker processes where the command line asks (:func:`worker_processes`: ``beta`` and ``bench``, a
+request of one mesh pair, on Linux): after the first space, two forked processes take the others,
+each as one task (one BLAS thread), and send back their rows. Threads share Python's GIL, and a
+space holds it for much of its time (ARPACK's reverse-communication loops, scipy's sparse
+wrappers, the trace basis; about 3.6 of 8 s at k = 2, N = 24), so two threads run at about 1.4×
+one; two processes do not wait for each other (paired, one process each: ours 0.79× at N = 16,
+0.89× at N = 24). Fork shares the sides and what the first space made without a copy. The rows are
+those of the threads, bit for bit (tested); what a worker caches (its Grams, trace values) stays in
+it, so the route is for a request whose spaces ask each Gram once — a sweep of pairs sharing G_h
+keeps threads and its Gram cache. A worker that dies (killed, out of memory) fails the request
+with a message saying so. ``INFSUP_SPACE_PROCESSES=0`` keeps threads.
+
 Memory bounds it: a space holds a few dense m × m matrices at its peak (:data:`DENSE_COPIES`,
 m about dim(W1 + W2)), and two spaces run at once only where both working sets fit in
 :data:`MEMORY_SHARE` of the memory available when the spaces start (k = 2 on the face, 24 GB:
@@ -26,8 +38,16 @@ only, each space's end is a stage's end (:func:`~infsup_contact.memory.release_f
 """
 from __future__ import annotations
 
+import contextlib
+import multiprocessing
+import os
+import sys
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from concurrent.futures.process import BrokenProcessPool
+
 from .. import progress
-from ..la.threaded import run_concurrently, threads
+from ..la.openblas import set_threads
+from ..la.threaded import as_task, run_concurrently, threads
 from ..memory import available_bytes, release_freed_memory
 
 DENSE_COPIES = 8.0
@@ -37,6 +57,43 @@ MEMORY_SHARE = 0.5
 """Share of the available memory two spaces' working sets may take together."""
 PHASE = "spaces side by side"
 """The phase (:func:`~infsup_contact.progress.phase`) the concurrent spaces count in."""
+
+
+_PROCESSES = {"on": False}
+"""Whether :func:`rows_by_case` may run the spaces in worker processes (:func:`worker_processes`)."""
+_WORK: dict = {}
+"""What the forked workers read: the spaces' function and cases, set before the workers fork."""
+
+
+@contextlib.contextmanager
+def worker_processes():
+    """Inside: :func:`rows_by_case` may run the spaces after the first in two forked worker
+    processes (module text). The command line's ``beta`` and ``bench`` run in it; a library caller
+    keeps threads unless it asks."""
+    before = _PROCESSES["on"]
+    _PROCESSES["on"] = True
+    try:
+        yield
+    finally:
+        _PROCESSES["on"] = before
+
+
+PROCESSES_MAX_DIM = 2500
+"""Largest dim (about dim(W1 + W2)) whose spaces run in worker processes. Above it a space's work
+is mostly BLAS and sparse kernels that release the GIL, and the workers' fresh pages and unshared
+caches cost more than the GIL did (k = 2 on the face, ours paired with threads in one process:
+0.72× at N = 8, 0.73× N = 12, 0.80× N = 16, 0.95× N = 24 (dim 2,209), 1.06× N = 32 (dim 3,969),
+whose summed peak PSS also rose 2.8 → 3.8 GB)."""
+
+
+def processes_allowed(dim: int = 0, python_bound: bool = True) -> bool:
+    """Whether spaces of dimension about ``dim`` run in worker processes: asked
+    (:func:`worker_processes`), their work ``python_bound`` (a face's spaces: the GIL bounds two
+    threads; the segment's are cheap and gain nothing), ``dim`` ≤ :data:`PROCESSES_MAX_DIM`, not
+    refused by ``INFSUP_SPACE_PROCESSES=0``, on Linux where ``fork`` is available."""
+    return (_PROCESSES["on"] and python_bound and dim <= PROCESSES_MAX_DIM
+            and os.environ.get("INFSUP_SPACE_PROCESSES", "1") != "0"
+            and sys.platform.startswith("linux") and "fork" in multiprocessing.get_all_start_methods())
 
 
 def working_set(dim: int) -> float:
@@ -58,11 +115,13 @@ def space_workers(dim: int, n_spaces: int, available: float | None = None) -> in
     return 2
 
 
-def rows_by_case(cases, rows_of, dim: int, label=str) -> list:
+def rows_by_case(cases, rows_of, dim: int, label=str, python_bound: bool = False) -> list:
     """[rows_of(case) for case in cases], in the cases' order: the first case alone (it makes
     what the spaces share), the others two at a time where :func:`space_workers` allows,
-    each on one BLAS thread; else one after the other. ``dim``: about the spaces' dimension
-    (their working set, :func:`working_set`); ``label``: a case's name in the progress."""
+    each on one BLAS thread (in worker processes where :func:`processes_allowed`: ``python_bound``
+    says whether their work holds the GIL much, as a face's does); else one after the other.
+    ``dim``: about the spaces' dimension (their working set, :func:`working_set`); ``label``: a
+    case's name in the progress."""
     cases = list(cases)
     release_freed_memory()  # the sides' factorizations are done: what they freed goes back
 
@@ -75,7 +134,45 @@ def rows_by_case(cases, rows_of, dim: int, label=str) -> list:
     if workers < 2:
         return [released(case) for case in progress.steps(cases, "space", label)]
     first = [released(case) for case in progress.steps(cases[:1], "space", label)]
-    progress.note(f"{len(cases) - 1} spaces, {workers} at a time")
     with progress.phase(PHASE):
+        if processes_allowed(dim, python_bound):
+            progress.note(f"{len(cases) - 1} spaces, {workers} worker processes")
+            return first + _in_processes(cases[1:], released, workers, label)
+        progress.note(f"{len(cases) - 1} spaces, {workers} at a time")
         rest = run_concurrently([lambda case=case: released(case) for case in cases[1:]], workers=workers)
     return first + rest
+
+
+def _in_processes(cases, rows_of, workers: int, label) -> list:
+    """[rows_of(case) for case in cases] in ``workers`` forked processes, each case one task
+    (:func:`_task`), the results in the cases' order; every case runs to its end, then the first
+    failure in the cases' order is raised (as :func:`~infsup_contact.la.threaded.run_concurrently`)."""
+    _WORK.update(rows_of=rows_of, cases=list(cases))
+    release_freed_memory(always=True)  # the parent waits: the memory it kept for reuse is the workers'
+    try:
+        with ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("fork")) as pool:
+            futures = [pool.submit(_task, i) for i in range(len(cases))]
+            case_of = {future: case for future, case in zip(futures, cases)}
+            for done, future in enumerate(as_completed(futures), 1):
+                progress.note(f"space {label(case_of[future])} {'done' if future.exception() is None else 'failed'} "
+                              f"({done} of {len(cases)})")
+    finally:
+        _WORK.clear()
+    for case, future in zip(cases, futures):
+        error = future.exception()
+        if isinstance(error, BrokenProcessPool):
+            raise RuntimeError(f"a worker process running the multiplier spaces died (killed, or out of memory) "
+                               f"before space {label(case)} was done; INFSUP_SPACE_PROCESSES=0 runs them in "
+                               "threads") from error
+        if error is not None:
+            raise error
+    return [future.result() for future in futures]
+
+
+def _task(i: int):
+    """Case ``i`` of :data:`_WORK` in a forked worker, as one task of the threads' route (one BLAS
+    thread: the same bits), its progress not reported (the parent says what finished)."""
+    progress.detach()
+    set_threads(1)
+    with as_task():
+        return _WORK["rows_of"](_WORK["cases"][i])

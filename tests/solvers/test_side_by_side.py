@@ -14,7 +14,7 @@ import pytest
 
 from infsup_contact import progress
 from infsup_contact.errors import InputError
-from infsup_contact.la import bottom, threaded
+from infsup_contact.la import bottom, openblas, threaded
 from infsup_contact.models.membranes import MEMBRANES
 from infsup_contact.models.membranes3d import MEMBRANES3D
 from infsup_contact.solvers import infsup, side_by_side
@@ -23,6 +23,22 @@ from infsup_contact.solvers.request import BetaRequest, MeshOptions
 from infsup_contact.solvers.side_cache import SideCache
 
 CASE_ROWS = infsup._case_rows_and_modes
+
+
+@pytest.fixture
+def one_blas_thread(monkeypatch):
+    """MKL and OpenBLAS on one thread for the test: the rows are those of one space at a time, bit
+    for bit, at one BLAS thread (a serial reference on two MKL threads, MKL_NUM_THREADS=2 in the
+    environment, rounds otherwise)."""
+    mkl_before, blas_before = threaded.threads(), openblas.threads_now()
+    monkeypatch.setenv("MKL_NUM_THREADS", "1")
+    for hook in threaded.GLOBAL_THREADS_HOOKS:
+        hook(1)
+    openblas.set_threads(1)
+    yield
+    for hook in threaded.GLOBAL_THREADS_HOOKS:
+        hook(mkl_before)
+    openblas.set_threads(max(blas_before.values(), default=1))
 
 
 def _run(monkeypatch, request, workers, processes=False, log=None):
@@ -64,8 +80,8 @@ def _assert_bitwise(rows, modes, serial, serial_modes):
     (MEMBRANES3D, 1, 3, MeshOptions(element="tet"), None),
     (MEMBRANES, 2, 6, MeshOptions(), None),
 ])
-def test_two_spaces_at_a_time_give_the_rows_and_modes_of_one_at_a_time_bitwise(monkeypatch, model, k, n, mesh,
-                                                                                 dense_max):
+def test_two_spaces_at_a_time_give_the_rows_and_modes_of_one_at_a_time_bitwise(monkeypatch, one_blas_thread, model,
+                                                                                 k, n, mesh, dense_max):
     if dense_max is not None:
         monkeypatch.setattr(bottom, "DENSE_MAX_M", dense_max)
     request = BetaRequest("structured", k, n, n, None, ("omega2", "union"), ((1.0, 1.0), (1.0, 10.0)),
@@ -84,8 +100,9 @@ def test_two_spaces_at_a_time_give_the_rows_and_modes_of_one_at_a_time_bitwise(m
     (MEMBRANES3D, 2, 4, MeshOptions(element="hex"), 20),  # the large route: Lanczos, split, bottom kernel
     (MEMBRANES3D, 1, 3, MeshOptions(element="tet"), None),
 ])
-def test_spaces_in_worker_processes_give_the_rows_and_modes_of_one_at_a_time_bitwise(monkeypatch, tmp_path, model, k,
-                                                                                     n, mesh, dense_max):
+def test_spaces_in_worker_processes_give_the_rows_and_modes_of_one_at_a_time_bitwise(monkeypatch, one_blas_thread,
+                                                                                     tmp_path, model, k, n, mesh,
+                                                                                     dense_max):
     if dense_max is not None:
         monkeypatch.setattr(bottom, "DENSE_MAX_M", dense_max)
     request = BetaRequest("structured", k, n, n, None, ("omega2", "union"), ((1.0, 1.0), (1.0, 10.0)),

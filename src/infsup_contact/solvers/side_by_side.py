@@ -20,8 +20,8 @@ request of one mesh pair, on Linux): after the first space, two forked processes
 each as one task (one BLAS thread), and send back their rows. Threads share Python's GIL, and a
 space holds it for much of its time (ARPACK's reverse-communication loops, scipy's sparse
 wrappers, the trace basis; about 3.6 of 8 s at k = 2, N = 24), so two threads run at about 1.4×
-one; two processes do not wait for each other (paired, one process each: ours 0.79× at N = 16,
-0.89× at N = 24). Fork shares the sides and what the first space made without a copy. The rows are
+one; two processes do not wait for each other (ours 0.80× at N = 16, 0.87× at N = 20; small
+spaces only, :data:`PROCESSES_MAX_DIM`). Fork shares the sides and what the first space made without a copy. The rows are
 those of the threads, bit for bit (tested); what a worker caches (its Grams, trace values) stays in
 it, so the route is for a request whose spaces ask each Gram once — a sweep of pairs sharing G_h
 keeps threads and its Gram cache. A worker that dies (killed, out of memory) fails the request
@@ -78,12 +78,13 @@ def worker_processes():
         _PROCESSES["on"] = before
 
 
-PROCESSES_MAX_DIM = 2500
+PROCESSES_MAX_DIM = 2000
 """Largest dim (about dim(W1 + W2)) whose spaces run in worker processes. Above it a space's work
 is mostly BLAS and sparse kernels that release the GIL, and the workers' fresh pages and unshared
-caches cost more than the GIL did (k = 2 on the face, ours paired with threads in one process:
-0.72× at N = 8, 0.73× N = 12, 0.80× N = 16, 0.95× N = 24 (dim 2,209), 1.06× N = 32 (dim 3,969),
-whose summed peak PSS also rose 2.8 → 3.8 GB)."""
+caches cost as much as the GIL did, or more (k = 2 on the face, ours paired with threads in one
+process: 0.72× at N = 8, 0.73× N = 12, 0.80× N = 16, 0.87× N = 20 (dim 1,521); 0.95–0.97× at
+N = 24 (dim 2,209) for half again the CPU; 1.06× at N = 32, whose summed peak PSS also rose
+2.8 → 3.8 GB)."""
 
 
 def processes_allowed(dim: int = 0, python_bound: bool = True) -> bool:

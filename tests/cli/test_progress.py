@@ -134,3 +134,29 @@ def test_no_reporter_is_a_plain_loop():
     assert not progress.active()
     assert list(progress.steps(iter(range(3)), "x")) == [0, 1, 2]
     progress.note("nothing")
+
+
+def test_a_face_request_says_its_spaces_in_worker_processes_and_each_one_done(capsys, monkeypatch, no_delay):
+    """``beta`` on the face runs its spaces after the first in worker processes
+    (solvers/side_by_side.py) and says so, then each space as it finishes; stdout is the table the
+    threads give (``INFSUP_SPACE_PROCESSES=0``), the timings aside."""
+    import pandas as pd
+
+    from infsup_contact.solvers import side_by_side
+
+    if not side_by_side.sys.platform.startswith("linux"):
+        pytest.skip("worker processes are forked (Linux)")
+    monkeypatch.setattr(side_by_side, "space_workers", lambda dim, n, available=None: 2)
+    argv = ["beta", "--model", "membranes3d", "--case", "all", "--k", "2", "--N1", "2", "--N2", "2"]
+    code, out, err = _run(capsys, argv)
+    assert code == 0
+    where = [LINE.match(ln)["where"] or "" for ln in _lines(err)]
+    n = int(next(w for w in where if w.endswith("spaces, 2 worker processes")).split()[0])
+    done = [w for w in where if re.fullmatch(rf"space \S+ done \(\d+ of {n}\)", w)]
+    assert len(done) == n and len({w.split()[1] for w in done}) == n
+    monkeypatch.setenv("INFSUP_SPACE_PROCESSES", "0")
+    code, threads_out, err = _run(capsys, argv)
+    assert code == 0 and not any("worker processes" in ln for ln in _lines(err))
+    frames = [pd.read_csv(io.StringIO(csv)) for csv in (out, threads_out)]
+    frames = [f[[c for c in f.columns if not c.startswith("t_")]] for f in frames]
+    pd.testing.assert_frame_equal(*frames, check_exact=True)

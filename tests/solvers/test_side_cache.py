@@ -162,7 +162,7 @@ class _Gate:
     def __init__(self, independent):
         import threading
 
-        self.barrier, self.passed, self.calls = threading.Barrier(2, timeout=1.0), [], 0
+        self.barrier, self.passed, self.calls = threading.Barrier(2, timeout=0.5), [], 0
         if independent is not None:
             self.gram_independent = lambda space: independent
 

@@ -108,7 +108,7 @@ rule speed_accuracy:
         src=PACKAGE_SOURCES,
         bench=BENCH_SOURCES,
     params:
-        cc=lambda wc: config["contact"],
+        cc=speed_accuracy_config,  # the timed scene and c: a fit window's change reruns no timing
         repeats=lambda wc: config["benchmarks"].get("speed_accuracy_repeats", 3),
         budget=lambda wc: config["benchmarks"].get("speed_accuracy_budget_s", 10),
         scene=lambda wc: speed_accuracy_scene(config),

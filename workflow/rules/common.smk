@@ -70,6 +70,30 @@ def contact_tables(wildcards=None):
     return [f"results/tables/contact/{s}_{f}_k{k}.csv" for s, f, k in contact_jobs()]
 
 
+def contact_job_config(wildcards):
+    """What a contact job reads of ``contact``: its scene, the prestress c and the cases; not the
+    other scenes nor the fit window, whose change reruns the rates and what follows, never the solves
+    (Snakemake reruns a job whose params change; the reference's reference_N reaches a job as its input)."""
+    return _contact_subset(wildcards.scene, ("c", "cases"))
+
+
+def reference_job_config(wildcards):
+    """What the reference solve of a scene reads of ``contact``: the scene, c and reference_N."""
+    return _contact_subset(wildcards.scene, ("c", "reference_N"))
+
+
+def speed_accuracy_config(wildcards):
+    """What the speed/accuracy benchmark reads of ``contact`` beside its input table: the timed
+    scene (a scene kind is not in contact.scenes) and c."""
+    return _contact_subset(speed_accuracy_scene(config), ("c",))
+
+
+def _contact_subset(scene, keys):
+    cc = config["contact"]
+    return {"scenes": {name: spec for name, spec in cc["scenes"].items() if name == scene},
+            **{key: cc[key] for key in keys}}
+
+
 def contact_reference(wildcards):
     """The reference solve of this k (rule membranes_reference), for a scene measured against one."""
     if not scene_spec(config["contact"]["scenes"][wildcards.scene]["kind"]).needs_reference:

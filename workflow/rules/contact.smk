@@ -9,7 +9,7 @@ rule membranes_reference:
     input:
         PACKAGE_SOURCES,
     params:
-        cc=lambda wc: config["contact"],
+        cc=reference_job_config,  # its scene, c, reference_N: another key reruns no solve
     threads: 1
     resources:
         mem_mb=lambda wc: reference_mem_mb(wc) + (0 if workflow.local_exec else 500),  # + Snakemake in a cluster job
@@ -29,7 +29,7 @@ rule contact_job:
         src=PACKAGE_SOURCES,
         reference=contact_reference,
     params:
-        cc=lambda wc: config["contact"],
+        cc=contact_job_config,  # its scene, c, cases: another key reruns no solve
         ns=lambda wc: contact_ns(wc.scene),
     wildcard_constraints:
         k="[1-4]",

@@ -207,6 +207,7 @@ def test_the_path_took_effect(runs, name):
     assert probe["branch"] == machines.expected_mkl_branch(name)
 
 
+@pytest.mark.machines  # reads the sweeps of every path (~60 s): .ci/run's machines step
 def test_mkl_branches_change_the_digits_and_openblas_does_not(runs):
     """The MKL probe's digits (PARDISO's S and a solve): COMPATIBLE's differ from the default's
     (on the AMD EPYC of 2026-11 the default, AUTO and COMPATIBLE gave three distinct results;
@@ -221,6 +222,7 @@ def test_mkl_branches_change_the_digits_and_openblas_does_not(runs):
     assert openblas <= {mkl.get("mkl:default")}
 
 
+@pytest.mark.machines  # reads the sweeps of every path (~60 s): .ci/run's machines step
 def test_sweep_and_verdicts_identical_across_paths(runs):
     done = {n: f for n, f in runs.items() if f is not None}
     if len(done) < 2:

@@ -139,8 +139,12 @@ def test_sparse_couplings_and_their_scaling_are_the_dense_ones_bit_for_bit(setup
     from infsup_contact.solvers.kernel import scaled_couplings
 
     sides, spaces, k = setup
-    for chunk in (coupling._CHUNK_ENTRIES, 64):
-        monkeypatch.setattr(coupling, "_CHUNK_ENTRIES", chunk)
+    for pieces in (None, 5):  # one chunk (the default size), then five (one point each was 40 s on the tetrahedra)
+        made = []
+        if pieces:
+            monkeypatch.setattr(coupling, "_chunks",
+                                lambda n, dim: made.append(n) or [slice(i, min(i + -(-n // pieces), n))
+                                                                  for i in range(0, n, -(-n // pieces))])
         for space in spaces:
             dense = [coupling_matrix(s.trace, space, k, extra_degree=extra) for s in sides]
             sparse = [coupling_matrix(s.trace, space, k, extra_degree=extra, sparse=True) for s in sides]
@@ -149,6 +153,7 @@ def test_sparse_couplings_and_their_scaling_are_the_dense_ones_bit_for_bit(setup
             cols = np.linspace(0.5, 2.0, space.dim)
             W = scaled_couplings(sparse, rows, cols)
             assert sp.issparse(W) and np.array_equal(W.toarray(), scaled_couplings(dense, rows, cols))
+        assert not pieces or (made and min(made) >= pieces)  # every call chunked, in five
 
 
 @pytest.mark.parametrize("element,k,n", [("hex", 1, 4), ("hex", 2, 3), ("tet", 2, 3), ("hex20", 2, 3)])

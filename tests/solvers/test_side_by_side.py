@@ -31,13 +31,11 @@ def one_blas_thread(monkeypatch):
     for bit, at one BLAS thread (a serial reference on two MKL threads, MKL_NUM_THREADS=2 in the
     environment, rounds otherwise)."""
     mkl_before, blas_before = threaded.threads(), openblas.threads_now()
-    monkeypatch.setenv("MKL_NUM_THREADS", "1")
-    for hook in threaded.GLOBAL_THREADS_HOOKS:
-        hook(1)
+    monkeypatch.setenv("MKL_NUM_THREADS", str(mkl_before))  # the variable itself restored after the test
+    threaded.use_threads(1)
     openblas.set_threads(1)
     yield
-    for hook in threaded.GLOBAL_THREADS_HOOKS:
-        hook(mkl_before)
+    threaded.use_threads(mkl_before)
     openblas.set_threads(max(blas_before.values(), default=1))
 
 

@@ -87,7 +87,7 @@ N = 24 (dim 2,209) for half again the CPU; 1.06× at N = 32, whose summed peak P
 2.8 → 3.8 GB)."""
 
 
-def processes_allowed(dim: int = 0, python_bound: bool = True) -> bool:
+def processes_allowed(dim: int, python_bound: bool) -> bool:
     """Whether spaces of dimension about ``dim`` run in worker processes: asked
     (:func:`worker_processes`), their work ``python_bound`` (a face's spaces: the GIL bounds two
     threads; the segment's are cheap and gain nothing), ``dim`` ≤ :data:`PROCESSES_MAX_DIM`, not

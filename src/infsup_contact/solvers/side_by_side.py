@@ -10,19 +10,22 @@ where no space runs beside them). Two spaces at a time, each on one core
 What the spaces share is made safe for two threads where it lives: the Grams of a sweep are
 computed one at a time (:class:`~.side_cache.GramCache`, whose lock also guards the series the
 spaces of one G_h share), the sides' trace basis values once per point set
-(:meth:`~infsup_contact.discretization.gamma.trace.GammaTrace.cached_basis`). The first space
-runs alone: it makes what the others then only read (each side's explicit X_i, the trace basis
+(:meth:`~infsup_contact.discretization.gamma.trace.GammaTrace.cached_basis`). In threads the
+first space runs alone: it makes what the others then only read (each side's explicit X_i, the trace basis
 at the common quadrature points). Every space computes what it computed alone, from the same
 operands: the rows are those of one space at a time (tested bit for bit at one BLAS thread).
 
 In worker processes where the command line asks (:func:`worker_processes`: ``beta`` and ``bench``, a
-request of one mesh pair, on Linux): after the first space, two forked processes take the others,
-each as one task (one BLAS thread), and send back their rows. Threads share Python's GIL, and a
+request of one mesh pair, on Linux): two forked processes take every space, each space as one task
+(one BLAS thread), and send back their rows; no space runs alone first, since a worker's caches are
+its own anyway (each makes the trace values it needs), and a first space alone left a core idle
+(cold caches, k = 2 on the face, ours paired, every space in the workers against the first alone:
+0.94–0.97× at N = 16, 0.95–1.02× at N = 20; 0.77–0.96× at N = 24, where threads ran before). Threads share Python's GIL, and a
 space holds it for much of its time (ARPACK's reverse-communication loops, scipy's sparse
 wrappers, the trace basis; about 3.6 of 8 s at k = 2, N = 24), so two threads run at about 1.4×
-one; two processes do not wait for each other (ours 0.80× at N = 16, 0.87× at N = 20; small
-spaces only, :data:`PROCESSES_MAX_DIM`). Fork shares the sides and what the first space made without a copy. The rows are
-those of the threads, bit for bit (tested); what a worker caches (its Grams, trace values) stays in
+one; two processes do not wait for each other (ours 0.80× at N = 16, 0.87× at N = 20; spaces up to
+:data:`PROCESSES_MAX_DIM`). Fork shares the sides without a copy. The rows are those of one space
+at a time on one BLAS thread, bit for bit (tested); what a worker caches (its Grams, trace values) stays in
 it, so the route is for a request whose spaces ask each Gram once — a sweep of pairs sharing G_h
 keeps threads and its Gram cache. A worker that dies (killed, out of memory) fails the request
 with a message saying so. ``INFSUP_SPACE_PROCESSES=0`` keeps threads.
@@ -67,8 +70,7 @@ _WORK: dict = {}
 
 @contextlib.contextmanager
 def worker_processes():
-    """Inside: :func:`rows_by_case` may run the spaces after the first in two forked worker
-    processes (module text). The command line's ``beta`` and ``bench`` run in it; a library caller
+    """Inside: :func:`rows_by_case` may run the spaces in two forked worker processes (module text). The command line's ``beta`` and ``bench`` run in it; a library caller
     keeps threads unless it asks."""
     before = _PROCESSES["on"]
     _PROCESSES["on"] = True
@@ -78,13 +80,13 @@ def worker_processes():
         _PROCESSES["on"] = before
 
 
-PROCESSES_MAX_DIM = 2000
+PROCESSES_MAX_DIM = 2500
 """Largest dim (about dim(W1 + W2)) whose spaces run in worker processes. Above it a space's work
 is mostly BLAS and sparse kernels that release the GIL, and the workers' fresh pages and unshared
 caches cost as much as the GIL did, or more (k = 2 on the face, ours paired with threads in one
-process: 0.72× at N = 8, 0.73× N = 12, 0.80× N = 16, 0.87× N = 20 (dim 1,521); 0.95–0.97× at
-N = 24 (dim 2,209) for half again the CPU; 1.06× at N = 32, whose summed peak PSS also rose
-2.8 → 3.8 GB)."""
+process, the first space alone: 0.72× at N = 8, 0.73× N = 12, 0.80× N = 16, 0.87× N = 20
+(dim 1,521); 0.95–0.97× at N = 24 (dim 2,209) for half again the CPU, and 0.77–0.96× with every
+space in the workers; 1.06× at N = 32 (dim 4,225), whose summed peak PSS also rose 2.8 → 3.8 GB)."""
 
 
 def processes_allowed(dim: int, python_bound: bool) -> bool:
@@ -117,10 +119,11 @@ def space_workers(dim: int, n_spaces: int, available: float | None = None) -> in
 
 
 def rows_by_case(cases, rows_of, dim: int, label=str, python_bound: bool = False) -> list:
-    """[rows_of(case) for case in cases], in the cases' order: the first case alone (it makes
-    what the spaces share), the others two at a time where :func:`space_workers` allows,
-    each on one BLAS thread (in worker processes where :func:`processes_allowed`: ``python_bound``
-    says whether their work holds the GIL much, as a face's does); else one after the other.
+    """[rows_of(case) for case in cases], in the cases' order: where :func:`space_workers` allows
+    two at a time, every case in two worker processes where :func:`processes_allowed`
+    (``python_bound``: their work holds the GIL much, as a face's does), else the first case alone
+    (it makes what the spaces share) and the others in two threads, each on one BLAS thread; else
+    one after the other.
     ``dim``: about the spaces' dimension (their working set, :func:`working_set`); ``label``: a
     case's name in the progress."""
     cases = list(cases)
@@ -131,14 +134,15 @@ def rows_by_case(cases, rows_of, dim: int, label=str, python_bound: bool = False
         release_freed_memory()
         return out
 
+    if processes_allowed(dim, python_bound) and space_workers(dim, len(cases)) == 2:
+        with progress.phase(PHASE):  # every space in a worker: each makes its own shared values
+            progress.note(f"{len(cases)} spaces, 2 worker processes")
+            return _in_processes(cases, released, 2, label)
     workers = space_workers(dim, len(cases) - 1)
     if workers < 2:
         return [released(case) for case in progress.steps(cases, "space", label)]
     first = [released(case) for case in progress.steps(cases[:1], "space", label)]
     with progress.phase(PHASE):
-        if processes_allowed(dim, python_bound):
-            progress.note(f"{len(cases) - 1} spaces, {workers} worker processes")
-            return first + _in_processes(cases[1:], released, workers, label)
         progress.note(f"{len(cases) - 1} spaces, {workers} at a time")
         rest = run_concurrently([lambda case=case: released(case) for case in cases[1:]], workers=workers)
     return first + rest

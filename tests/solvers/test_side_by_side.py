@@ -178,3 +178,33 @@ def test_a_failing_space_raises_after_the_others_ran(monkeypatch):
         side_by_side.rows_by_case(["a", "bad", "b", "c"], rows_of, 10)
     assert sorted(done) == ["a", "b", "c"]
     assert side_by_side.rows_by_case(["a", "b", "c"], lambda c: [c], 10) == [["a"], ["b"], ["c"]]
+
+
+def test_spaces_sharing_a_series_form_one_task_longest_first():
+    series = {"a": None, "q9": "Q9", "b": None, "q9-all": "Q9", "pw": "P1", "t-q9": "Q9", "x": "X", "x2": "X"}
+    cases = list(series)
+    tasks = side_by_side.chains(cases, series.get)
+    assert tasks == [[1, 3, 5], [6, 7], [0], [2], [4]]  # the shared ones first, longest first; then alone
+    assert sorted(i for t in tasks for i in t) == list(range(len(cases)))  # every case once
+    assert side_by_side.chains(cases) == [[i] for i in range(len(cases))]  # no keys: each case alone
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="worker processes are forked (Linux)")
+def test_a_series_runs_in_one_worker_and_a_failure_in_it_raises_in_the_cases_order(monkeypatch):
+    monkeypatch.setattr(side_by_side, "space_workers", lambda dim, n, available=None: 2)
+
+    def rows_of(case):
+        if case.startswith("bad"):
+            raise InputError("case", "a good one", got=case)
+        _burn(0.05)
+        return [case, os.getpid()]
+
+    series = {"a": None, "s1": "S", "b": None, "s2": "S", "c": None, "s3": "S"}
+    with side_by_side.worker_processes():
+        rows = side_by_side.rows_by_case(list(series), rows_of, 10, python_bound=True, series=series.get)
+    assert [r[0] for r in rows] == list(series)  # the cases' order
+    assert len({r[1] for r in rows if series[r[0]]}) == 1 and os.getpid() not in {r[1] for r in rows}
+    bad = {"a": None, "s1": "S", "bad-s2": "S", "bad-b": None, "s3": "S"}
+    with side_by_side.worker_processes(), pytest.raises(InputError, match="bad-s2") as err:
+        side_by_side.rows_by_case(list(bad), rows_of, 10, python_bound=True, series=bad.get)
+    assert err.value.key == "case"  # the first failing case in the cases' order, whole

@@ -78,7 +78,8 @@ def beta_table(request: BetaRequest, side_cache: SideCache | None = None, modes:
             per_case = side_by_side.rows_by_case(  # two spaces at a time where the cores and memory allow
                 r.cases, lambda case: _case_rows_and_modes(r, case, g_h, sides, dim_w, trace_norms,
                                                            modes is not None, cache.grams),
-                dim_w, registry.case_name, python_bound=gamma.dim == 2)  # a face's spaces: the GIL binds
+                dim_w, registry.case_name, python_bound=gamma.dim == 2,  # a face's spaces: the GIL binds
+                series=lambda case: _series_key(case, r.k, g_h, gamma))
             found = None if modes is None else [m for _, case_modes in per_case for m in case_modes]
             by_partition[key] = ([row for case_rows, _ in per_case for row in case_rows], found)
             if modes is not None:
@@ -135,6 +136,18 @@ def _case_rows(r: BetaRequest, case, g_h, sides, dim_w: int, trace_norms, modes:
         if modes is not None:
             modes += worst_modes(route, S, rows[-len(r.norms):], space, gamma)
     return rows
+
+
+def _series_key(case, k: int, g_h, gamma):
+    """The key of the Gram series ``case`` shares with other spaces on G_h (the space's
+    ``series_key``: a face's cellwise spaces), else None; a space that fails to build here has
+    none (its worker meets the failure again and reports it in the cases' order)."""
+    if isinstance(case, SpaceSpec) and case.petrov_galerkin:
+        return None
+    try:
+        return getattr(_space(case, k, g_h, gamma), "series_key", None)
+    except Exception:  # noqa: BLE001 - only the order of the spaces depends on it
+        return None
 
 
 def _trace_norms(trace, k: int):

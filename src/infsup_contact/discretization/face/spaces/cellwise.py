@@ -197,6 +197,17 @@ class CellwiseFaceSpace(SpaceDefaults):
         return self.basis in ("standard", "transformed", "pwlin")
 
     @property
+    def series_key(self):
+        """What the partial sums of this space's H series depend on: its piece space P (the pieces,
+        the degree and continuity on them, :func:`~..norms.cellwise.piece_space`), not its basis.
+        Spaces with one key share those sums (:func:`~..norms.cellwise.shared_piece_sums`), so a β_h
+        request runs them one after the other in one worker (:mod:`~infsup_contact.solvers.side_by_side`);
+        None without tensor pieces."""
+        p = self.pieces
+        return None if p is None else (np.asarray(p.xs, float).tobytes(), np.asarray(p.ys, float).tobytes(),
+                                       self.piece_degree, bool(self.continuous))
+
+    @property
     def smooth_tail(self) -> bool:
         """Whether every basis function is continuous and vanishes on ∂Γ (sine coefficients
         ~ 1/(m² n²) in the tail, :func:`.face.norms.tensor.gram_h_face` exponent 4; else 2)."""

@@ -11,23 +11,23 @@ What the spaces share is made safe for two threads where it lives: the Grams of 
 computed one at a time (:class:`~.side_cache.GramCache`, whose lock also guards the series the
 spaces of one G_h share), the sides' trace basis values once per point set
 (:meth:`~infsup_contact.discretization.gamma.trace.GammaTrace.cached_basis`). In threads the
-first space runs alone: it makes what the others then only read (each side's explicit X_i, the trace basis
-at the common quadrature points). Every space computes what it computed alone, from the same
+first space runs alone: it makes what the others then only read (each side's explicit X_i, the
+trace basis at the common quadrature points). Every space computes what it computed alone, from the same
 operands: the rows are those of one space at a time (tested bit for bit at one BLAS thread).
 
 In worker processes where the command line asks (:func:`worker_processes`: ``beta`` and ``bench``, a
 request of one mesh pair, on Linux): two forked processes take every space, each space as one task
-(one BLAS thread; the spaces sharing a Gram series one after the other in one worker, :func:`chains`),
-and send back their rows; no space runs alone first, since a worker's caches are
-its own anyway (each makes the trace values it needs), and a first space alone left a core idle
-(cold caches, k = 2 on the face, ours paired, every space in the workers against the first alone:
-0.94–0.97× at N = 16, 0.95–1.02× at N = 20; 0.77–0.96× at N = 24, where threads ran before). Threads share Python's GIL, and a
-space holds it for much of its time (ARPACK's reverse-communication loops, scipy's sparse
+(one BLAS thread; the spaces sharing a Gram series one after the other in one worker,
+:func:`chains`), and send back their rows. No space runs alone first: a worker's caches are its
+own anyway (each makes the trace values it needs), and a first space alone left a core idle (cold
+caches, k = 2 on the face, ours paired, every space in the workers against the first alone:
+0.94–0.97× at N = 16, 0.95–1.02× at N = 20; 0.77–0.96× at N = 24, where threads ran before).
+Threads share Python's GIL, and a space holds it for much of its time (ARPACK's reverse-communication loops, scipy's sparse
 wrappers, the trace basis; about 3.6 of 8 s at k = 2, N = 24), so two threads run at about 1.4×
 one; two processes do not wait for each other (ours 0.80× at N = 16, 0.87× at N = 20; spaces up to
 :data:`PROCESSES_MAX_DIM`). Fork shares the sides without a copy. The rows are those of one space
-at a time on one BLAS thread, bit for bit (tested); what a worker caches (its Grams, trace values) stays in
-it, so the route is for a request whose spaces ask each Gram once — a sweep of pairs sharing G_h
+at a time on one BLAS thread, bit for bit (tested); what a worker caches (its Grams, trace
+values) stays in it, so the route is for a request whose spaces ask each Gram once — a sweep of pairs sharing G_h
 keeps threads and its Gram cache. A worker that dies (killed, out of memory) fails the request
 with a message saying so. ``INFSUP_SPACE_PROCESSES=0`` keeps threads.
 
@@ -71,8 +71,9 @@ _WORK: dict = {}
 
 @contextlib.contextmanager
 def worker_processes():
-    """Inside: :func:`rows_by_case` may run the spaces in two forked worker processes (module text). The command line's ``beta`` and ``bench`` run in it; a library caller
-    keeps threads unless it asks."""
+    """Inside: :func:`rows_by_case` may run the spaces in two forked worker processes (module
+    text). The command line's ``beta`` and ``bench`` run in it; a library caller keeps threads
+    unless it asks."""
     before = _PROCESSES["on"]
     _PROCESSES["on"] = True
     try:
@@ -179,12 +180,11 @@ def _in_processes(cases, rows_of, workers: int, label, tasks=None) -> list:
     try:
         with ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("fork")) as pool:
             futures = [pool.submit(_task, t) for t in range(len(tasks))]
-            done = 0
+            task_of, done = {future: task for future, task in zip(futures, tasks)}, 0
             for future in as_completed(futures):
-                names = ", ".join(label(cases[i]) for i in tasks[futures.index(future)])
-                done += len(tasks[futures.index(future)])
-                progress.note(f"space {names} {'done' if future.exception() is None else 'failed'} "
-                              f"({done} of {len(cases)})")
+                done += len(task_of[future])
+                progress.note(f"space {', '.join(label(cases[i]) for i in task_of[future])} "
+                              f"{'done' if future.exception() is None else 'failed'} ({done} of {len(cases)})")
     finally:
         _WORK.clear()
     by_case = {i: (t, j) for t, task in enumerate(tasks) for j, i in enumerate(task)}

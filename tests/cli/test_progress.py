@@ -137,8 +137,9 @@ def test_no_reporter_is_a_plain_loop():
 
 
 def test_a_face_request_says_its_spaces_in_worker_processes_and_each_one_done(capsys, monkeypatch, no_delay):
-    """``beta`` on the face runs its spaces after the first in worker processes
-    (solvers/side_by_side.py) and says so, then each space as it finishes; stdout is the table the
+    """``beta`` on the face runs its spaces in worker processes (solvers/side_by_side.py) and
+    says so, then each space as its task finishes (a task of the spaces sharing a Gram series
+    names each of them); stdout is the table the
     threads give (``INFSUP_SPACE_PROCESSES=0``), the timings aside."""
     import pandas as pd
 

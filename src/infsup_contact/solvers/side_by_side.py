@@ -182,9 +182,10 @@ def _in_processes(cases, rows_of, workers: int, label, tasks=None) -> list:
             futures = [pool.submit(_task, t) for t in range(len(tasks))]
             task_of, done = {future: task for future, task in zip(futures, tasks)}, 0
             for future in as_completed(futures):
-                done += len(task_of[future])
-                progress.note(f"space {', '.join(label(cases[i]) for i in task_of[future])} "
-                              f"{'done' if future.exception() is None else 'failed'} ({done} of {len(cases)})")
+                for i in task_of[future]:  # a task's spaces said one by one, as it ends
+                    done += 1
+                    progress.note(f"space {label(cases[i])} {'done' if future.exception() is None else 'failed'} "
+                                  f"({done} of {len(cases)})")
     finally:
         _WORK.clear()
     by_case = {i: (t, j) for t, task in enumerate(tasks) for j, i in enumerate(task)}

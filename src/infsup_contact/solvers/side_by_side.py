@@ -12,8 +12,8 @@ computed one at a time (:class:`~.side_cache.GramCache`, whose lock also guards 
 spaces of one G_h share), the sides' trace basis values once per point set
 (:meth:`~infsup_contact.discretization.gamma.trace.GammaTrace.cached_basis`). In threads the
 first space runs alone: it makes what the others then only read (each side's explicit X_i, the
-trace basis at the common quadrature points). Every space computes what it computed alone, from the same
-operands: the rows are those of one space at a time (tested bit for bit at one BLAS thread).
+trace basis at the common quadrature points). Every space computes what it computed alone, from
+the same operands: the rows are those of one space at a time (tested bit for bit at one BLAS thread).
 
 In worker processes where the command line asks (:func:`worker_processes`: ``beta`` and ``bench``, a
 request of one mesh pair, on Linux): two forked processes take every space, each space as one task
@@ -22,13 +22,13 @@ request of one mesh pair, on Linux): two forked processes take every space, each
 own anyway (each makes the trace values it needs), and a first space alone left a core idle (cold
 caches, k = 2 on the face, ours paired, every space in the workers against the first alone:
 0.94–0.97× at N = 16, 0.95–1.02× at N = 20; 0.77–0.96× at N = 24, where threads ran before).
-Threads share Python's GIL, and a space holds it for much of its time (ARPACK's reverse-communication loops, scipy's sparse
-wrappers, the trace basis; about 3.6 of 8 s at k = 2, N = 24), so two threads run at about 1.4×
+Threads share Python's GIL, and a space holds it for much of its time (ARPACK's
+reverse-communication loops, scipy's sparse wrappers, the trace basis; about 3.6 of 8 s at k = 2, N = 24), so two threads run at about 1.4×
 one; two processes do not wait for each other (ours 0.80× at N = 16, 0.87× at N = 20; spaces up to
 :data:`PROCESSES_MAX_DIM`). Fork shares the sides without a copy. The rows are those of one space
 at a time on one BLAS thread, bit for bit (tested); what a worker caches (its Grams, trace
-values) stays in it, so the route is for a request whose spaces ask each Gram once — a sweep of pairs sharing G_h
-keeps threads and its Gram cache. A worker that dies (killed, out of memory) fails the request
+values) stays in it, so the route is for a request whose spaces ask each Gram once — a sweep of
+pairs sharing G_h keeps threads and its Gram cache. A worker that dies (killed, out of memory) fails the request
 with a message saying so. ``INFSUP_SPACE_PROCESSES=0`` keeps threads.
 
 Memory bounds it: a space holds a few dense m × m matrices at its peak (:data:`DENSE_COPIES`,
@@ -168,13 +168,11 @@ def chains(cases, series=None) -> list:
     return shared + [[i] for i in range(len(cases)) if i not in grouped]
 
 
-def _in_processes(cases, rows_of, workers: int, label, tasks=None) -> list:
+def _in_processes(cases: list, rows_of, workers: int, label, tasks: list) -> list:
     """[rows_of(case) for case in cases] in ``workers`` forked processes, the ``tasks`` (lists of
-    case indices, :func:`chains`; default each case one task) each one :func:`_task`, the results in
-    the cases' order; every task runs to its end, then the first failure in the cases' order is
-    raised (as :func:`~infsup_contact.la.threaded.run_concurrently`)."""
-    cases = list(cases)
-    tasks = [[i] for i in range(len(cases))] if tasks is None else tasks
+    case indices, :func:`chains`) each one :func:`_task`, the results in the cases' order; every
+    task runs to its end, then the first failure in the cases' order is raised (as
+    :func:`~infsup_contact.la.threaded.run_concurrently`)."""
     _WORK.update(rows_of=rows_of, cases=cases, tasks=tasks)
     release_freed_memory(always=True)  # the parent waits: the memory it kept for reuse is the workers'
     try:
@@ -191,13 +189,13 @@ def _in_processes(cases, rows_of, workers: int, label, tasks=None) -> list:
     by_case = {i: (t, j) for t, task in enumerate(tasks) for j, i in enumerate(task)}
     for i, case in enumerate(cases):
         error = futures[by_case[i][0]].exception()
+        if isinstance(error, _CaseFailed):  # the task's own case failed, or another of its cases did
+            error = error.error if error.index == i else None
         if isinstance(error, BrokenProcessPool):
             raise RuntimeError(f"a worker process running the multiplier spaces died (killed, or out of memory) "
                                f"before space {label(case)} was done; INFSUP_SPACE_PROCESSES=0 runs them in "
                                "threads") from error
-        if isinstance(error, _CaseFailed) and error.index == i:
-            raise error.error
-        if error is not None and not isinstance(error, _CaseFailed):
+        if error is not None:
             raise error
     return [futures[t].result()[j] for t, j in (by_case[i] for i in range(len(cases)))]
 

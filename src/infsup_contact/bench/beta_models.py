@@ -85,8 +85,9 @@ FACE_BENCH = BetaBench(
                       "(+β with v1=0), every case × norm",
               "ours_core": "ours' engine from the assembled stiffness: Γ-last LU+Schur per body (parity parts)+"
                            "couplings+Grams+kernel decision+interface+pencils in blocks (+β with v1=0)",
-              "limit": "plain Cholesky (PARDISO) of each body's parity parts (one body on a mirrored pair) + "
-                       "one eigh per parity block of each (case,norm) (interface operators, Grams given)",
+              "limit": "plain Cholesky (PARDISO) of each body's parity parts, side by side (one body on a mirrored "
+                       "pair) + the eigenvalues of each parity block of each (case,norm), side by side (interface "
+                       "operators, Grams given)",
               **SCHUR_INCLUDES},
     extra_rows=schur_rows, limit_route=face_limit, core_route=beta_ours_engine)
 """The 3D membranes' face benchmark (``element`` is a mesh option of ``bench_beta``)."""

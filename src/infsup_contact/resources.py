@@ -49,7 +49,8 @@ START_SECONDS = 2.5
 
 @dataclass(frozen=True)
 class Estimate:
-    """Peak resident memory (bytes, interpreter included) and wall time (seconds) of a request."""
+    """Peak resident memory (bytes, interpreter included) and time (seconds: the CPU time of one core,
+    module text) of a request."""
 
     bytes: float
     seconds: float
@@ -60,7 +61,7 @@ class Estimate:
         return int(math.ceil(self.bytes / 1e6))
 
     def describe(self) -> str:
-        return f"~{human_bytes(self.bytes)} peak memory, ~{human_seconds(self.seconds)}"
+        return f"~{human_bytes(self.bytes)} peak memory, ~{human_seconds(self.seconds)} of CPU time"
 
 
 def human_bytes(n: float) -> str:

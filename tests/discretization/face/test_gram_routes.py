@@ -106,6 +106,28 @@ def test_other_bases_are_refused():
     assert all(np.array_equal(a, b) for a, b in zip(parity.in_bases(parity.bases), parity.blocks))
 
 
+def test_the_blocks_in_their_own_bases_are_copies_and_a_signed_permutation_is_gathered():
+    """in_bases of the Gram's own bases: the blocks' entries, bit for bit, in new arrays (a caller
+    may factorize them in place); a basis with columns swapped and one negated: the block with
+    those rows and columns swapped and negated, exactly."""
+    import scipy.sparse as sp
+
+    _, info = SQUARE.gram(_space("R5.2", 2, 4), "H")
+    parity = info["parity"]
+    own = parity.in_bases(parity.bases)
+    for a, b in zip(own, parity.blocks):
+        assert np.array_equal(a, b) and not np.shares_memory(a, b)
+        a[0, 0] += 1.0
+    assert not any(np.array_equal(a, b) for a, b in zip(own, parity.blocks))   # the Gram kept its own
+    Q = parity.bases[1].toarray()
+    p = np.arange(Q.shape[1])
+    p[[0, 1]] = [1, 0]
+    sign = np.ones(Q.shape[1])
+    sign[2] = -1.0
+    moved = parity.in_bases([parity.bases[0], sp.csr_matrix(Q[:, p] * sign), *parity.bases[2:]])
+    assert np.array_equal(moved[1], parity.blocks[1][np.ix_(p, p)] * np.outer(sign, sign))
+
+
 @pytest.mark.parametrize("case,k,n", [("R5.2", 2, 4), ("T3", 1, 6), ("DUAL", 2, 5)])
 def test_the_l2_blocks_are_the_split_of_the_l2_gram(case, k, n):
     """The L² Gram's parity blocks (tensor.l2_parity, Kronecker products of the 1D blocks) equal the

@@ -11,6 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from ....la import face_parity
+from ....la.threaded import concurrent_map
 from ...gamma.symmetry import induced_permutation, isotypic_bases, reflect
 from ...segment.norms import sine_coefficients
 from ...gamma.quadrature import gauss_legendre
@@ -41,6 +42,9 @@ def partial_gram_blocks(space, n_max: int, parities, weights_on) -> list:
     :class:`~.face_norms.SeparableWeights`), one for the four blocks."""
     n = np.arange(1, n_max + 1, dtype=float)
     index = (n[0::2], n[1::2])                      # odd m for even functions, even m for odd ones
-    coeffs = [[(Q.T @ sine_coefficients(f, idx))  # (dim_p, len(idx)) per parity p
-               for Q, idx in zip(q, index)] for f, q in zip(space.factors, parities)]
+    # (dim_p, len(idx)) per factor and parity p, the four side by side (numpy's kernels and the
+    # sparse product release the GIL: the same bits; k = 2, N = 48, n_max 4,608: 1.6-1.9x on two cores)
+    jobs = [(f, Q, idx) for f, q in zip(space.factors, parities) for Q, idx in zip(q, index)]
+    flat = concurrent_map(lambda job: job[1].T @ sine_coefficients(job[0], job[2]), jobs)
+    coeffs = [flat[:len(index)], flat[len(index):]]
     return face_parity.parity_blocks(coeffs, index, weights_on)

@@ -65,7 +65,7 @@ def _row(code: str, space: str, offset: int, group: pd.DataFrame, pred, verdicts
     ran = list(group.norm)
     if "norm_as_written" in group:  # a manifest that cannot describe its multipliers in H (FreeFEM's star-shaped
         # skeleton: `norm: given`, the L² mass) has no H certificate: its "H" row is that pencil, the next norm leads
-        written = dict(zip(group.norm, group.norm_as_written.fillna("H").astype(str)))
+        written = dict(zip(group.norm, group.norm_as_written.astype(object).fillna("H").astype(str)))
         ran = [n for n in ran if n != "H" or written.get(n) in ("H", "")] or ran
     norm = next((n for n in NORM_ORDER if n in ran), ran[0])
     r = group[group.norm == norm].iloc[0]

@@ -211,8 +211,6 @@ class ParityGram:
             idx, sign = P.indices, np.sign(P.data)  # column j of Q' is sign[j] times column idx[j] of Q_c
             if len(np.unique(idx)) != len(idx):
                 return None
-            if np.array_equal(idx, np.arange(len(idx))) and np.all(sign > 0):  # Q' = Q_c: G_c's entries as they are
-                out.append(self.blocks[c].copy())
-            else:
-                out.append(symmetric_permutation(self.blocks[c], idx) * np.multiply.outer(sign, sign))
+            block = symmetric_permutation(self.blocks[c], idx)
+            out.append(block if np.all(sign > 0) else block * np.multiply.outer(sign, sign))
         return out

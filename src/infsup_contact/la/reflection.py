@@ -173,6 +173,8 @@ def symmetric_permutation(A: np.ndarray, p: np.ndarray) -> np.ndarray:
     complement and Steklov matrix, :func:`~infsup_contact.models.body_symmetry.mirrored_factors`)."""
     A = np.asarray(A)
     p = np.asarray(p, dtype=np.intp)
+    if len(p) == len(A) and np.array_equal(p, np.arange(len(p))):  # the identity: the entries as they are
+        return A.copy()
     out = np.empty((len(p), len(p)), dtype=A.dtype)
     for i, row in enumerate(p):
         np.take(A[row], p, out=out[i])

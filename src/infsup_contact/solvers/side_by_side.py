@@ -23,13 +23,14 @@ own anyway (each makes the trace values it needs), and a first space alone left 
 caches, k = 2 on the face, ours paired, every space in the workers against the first alone:
 0.94–0.97× at N = 16, 0.95–1.02× at N = 20; 0.77–0.96× at N = 24, where threads ran before).
 Threads share Python's GIL, and a space holds it for much of its time (ARPACK's
-reverse-communication loops, scipy's sparse wrappers, the trace basis; about 3.6 of 8 s at k = 2, N = 24), so two threads run at about 1.4×
-one; two processes do not wait for each other (ours 0.80× at N = 16, 0.87× at N = 20; spaces up to
-:data:`PROCESSES_MAX_DIM`). Fork shares the sides without a copy. The rows are those of one space
-at a time on one BLAS thread, bit for bit (tested); what a worker caches (its Grams, trace
-values) stays in it, so the route is for a request whose spaces ask each Gram once — a sweep of
-pairs sharing G_h keeps threads and its Gram cache. A worker that dies (killed, out of memory) fails the request
-with a message saying so. ``INFSUP_SPACE_PROCESSES=0`` keeps threads.
+reverse-communication loops, scipy's sparse wrappers, the trace basis; about 3.6 of 8 s at k = 2,
+N = 24), so two threads run at about 1.4× one; two processes do not wait for each other (ours
+0.80× at N = 16, 0.87× at N = 20; spaces up to :data:`PROCESSES_MAX_DIM`). Fork shares the
+sides without a copy. The rows are those of one space at a time on one BLAS thread, bit for bit
+(tested); what a worker caches (its Grams, trace values) stays in it, so the route is for a
+request whose spaces ask each Gram once — a sweep of pairs sharing G_h keeps threads and its Gram
+cache. A worker that dies (killed, out of memory) fails the request with a message saying so.
+``INFSUP_SPACE_PROCESSES=0`` keeps threads.
 
 Memory bounds it: a space holds a few dense m × m matrices at its peak (:data:`DENSE_COPIES`,
 m about dim(W1 + W2)), and two spaces run at once only where both working sets fit in

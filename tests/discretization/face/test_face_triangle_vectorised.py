@@ -124,3 +124,21 @@ def test_coefficients_of_a_subset_of_dofs(s, continuous, vanish, dual):
     full = ftn.sine_coefficients_chunk(space, m, 15)
     ask = np.random.default_rng(5).permutation(space.dim)[: space.dim // 2]
     _close(ftn._coefficients(space, m, 15, dofs_out=ask), full[ask])
+
+
+@pytest.mark.parametrize("columns", [7, 64])
+@pytest.mark.parametrize("s,continuous,vanish,dual", [(0, False, False, False), (2, True, True, True),
+                                                      (1, True, False, False)])
+def test_column_blocks_and_late_columns_are_the_loop(monkeypatch, columns, s, continuous, vanish, dual):
+    """U and W U by blocks of columns n (uneven: 7 does not divide the columns; 64 leaves a short
+    last block at n_max = 150), and the columns n ≥ n_from only (the transposition's half): the
+    loop's coefficients, the same for every block width, bit for bit."""
+    monkeypatch.setattr(ftn, "_COLUMNS", columns)
+    space = TriangleSpace(PARTITIONS["interleaved"], s, continuous, vanish, dual)
+    m = np.arange(30, 37, dtype=float)
+    whole = _sine_coefficients_loop(space, m, 150)
+    _close(ftn.sine_coefficients_chunk(space, m, 150), whole)
+    late = ftn._coefficients(space, m, 150, n_from=41)
+    _close(late, whole[:, :, 40:])
+    monkeypatch.setattr(ftn, "_COLUMNS", 10 ** 6)  # one block: the same bits
+    assert np.array_equal(ftn._coefficients(space, m, 150, n_from=41), late)

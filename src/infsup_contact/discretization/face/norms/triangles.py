@@ -37,7 +37,7 @@ from ...segment.norms import N_MAX_CAP, gram_by_norm
 from ....la.richardson import _norm2
 
 #: Values (float64) per working array of :func:`sine_coefficients_chunk` (2^23: 64 MB): its
-#: output (dim × rows of m × n_max) and its stacked U (:func:`chunk_rows`).
+#: output (dim × rows of m × n_max; :func:`chunk_rows`).
 _BUDGET = 2 ** 23
 #: Columns n per product W U in :func:`_coefficients`: a block of the stacked U (about 7,000 rows at
 #: s = 2, N = 8, 64 columns: 3.5 MB) stays in the cache while the sparse product reads each of its
@@ -262,8 +262,10 @@ def _coefficients(space, m: np.ndarray, n_max: int, q: int | None = None, shapes
 
 
 def chunk_rows(space, n_max: int) -> int:
-    """Rows m per :func:`sine_coefficients_chunk` call: its output dim · rows · n_max and its
-    stacked U (4 nloc n_y rows per column width of the partition) within :data:`_BUDGET` values."""
+    """Rows m per :func:`sine_coefficients_chunk` call: its output dim · rows · n_max within
+    :data:`_BUDGET` values, and (4 nloc n_y rows per column width of the partition)
+    × rows × n_max, the stacked U it formed whole until 2026-12-08 (made by blocks of columns
+    since; kept in the count so that the blocks of m, hence the sums and their bits, stay as they were)."""
     widths = len(_width_groups(np.asarray(space.breakpoints.xs, float)))
     per_row = max(space.dim, 4 * space.n_local * space.shape[1] * widths) * n_max
     return int(min(n_max, max(1, _BUDGET // per_row)))

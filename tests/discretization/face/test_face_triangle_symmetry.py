@@ -106,3 +106,44 @@ def test_the_richardson_sums_grow_by_increments(monkeypatch, part, s, continuous
         for n in (12, 24, 48):
             fresh = ftn.partial_gram(space, n)
             assert np.abs(partial(n) - fresh).max() < 1e-13 * np.abs(fresh).max()
+
+
+def _grid_symmetries():
+    """π (point reflection) and σ (transposition) of a 5 × 5 grid of dofs, plus two dofs at the
+    centre that π fixes and σ swaps: every kind of orbit (σ-pairs of π-pairs with either sign,
+    π-pairs σ fixes or maps onto their partner, π-fixed dofs σ swaps or fixes)."""
+    idx = np.arange(25).reshape(5, 5)
+    pi = np.concatenate([idx[::-1, ::-1].ravel(), [25, 26]])
+    sigma = np.concatenate([idx.T.ravel(), [26, 25]])
+    return pi, sigma
+
+
+def test_klein_gram_is_the_reflected_gram_plus_its_transpose():
+    """KleinGram's S against ReflectedGram's H + H[σ, σ] from the same coefficients (any: the
+    identities hold for every H), to round-off; both are SPD sums of the same columns."""
+    from infsup_contact.discretization.face.symmetry import KleinGram, ReflectedGram
+
+    pi, sigma = _grid_symmetries()
+    coeffs = np.random.default_rng(5).standard_normal((pi.size, 6, 8))
+    m, n = np.arange(3.0, 9.0), np.arange(2.0, 10.0)
+    klein, halves = KleinGram(pi, sigma), ReflectedGram(pi)
+    assert sorted(klein.even_rows) == sorted(halves.even_rows)
+    for acc in (klein, halves):
+        acc.add(coeffs[acc.even_rows], m, n)
+    H = halves.gram()
+    expected = H + H[np.ix_(sigma, sigma)]
+    S = klein.gram()
+    assert np.abs(S - expected).max() <= 1e-13 * np.abs(expected).max()
+    assert np.abs(S - S.T).max() <= 1e-13 * np.abs(S).max()
+    assert sum(G.shape[0] for G in klein.G.values()) == klein.even_rows.size + klein.rep.size  # every coordinate once
+
+
+def test_klein_gram_refuses_a_transposition_that_does_not_commute():
+    from infsup_contact.discretization.face.symmetry import KleinGram
+    from infsup_contact.errors import InputError
+
+    pi, sigma = _grid_symmetries()
+    wrong = sigma.copy()
+    wrong[[0, 1, 5]] = wrong[[1, 5, 0]]  # not an involution any more
+    with pytest.raises(InputError, match="sigma"):
+        KleinGram(pi, wrong)

@@ -31,7 +31,7 @@ from scipy import sparse
 from ....errors import InputError
 from .tensor import extrapolated
 from ..partitions.quadrature import triangles_rule
-from ..symmetry import ReflectedGram, reflection, transposition
+from ..symmetry import KleinGram, ReflectedGram, reflection, transposition
 from ..spaces.triangles import lagrange_barycentric
 from ...segment.norms import N_MAX_CAP, gram_by_norm
 from ....la.richardson import _norm2
@@ -284,12 +284,13 @@ def partial_gram(space, n_max: int, n_min: int = 0) -> np.ndarray:
     (:mod:`.face.symmetry`): the transposition σ (μ_nm = μ_mn ∘ σ) sums n ≥ m only,
     H = Σ_{n>m} + ½ Σ_{n=m}, S = H + H[σ, σ] (half the coefficients and half the product); the
     point reflection sums H through its symmetric and antisymmetric halves (coefficients of about
-    half the dofs, a quarter of the product's flops). ``n_min`` > 0: only the terms with
+    half the dofs, a quarter of the product's flops), and with σ as well in the four components
+    of both (:class:`~.face.symmetry.KleinGram`: half that again; S itself, no σ sum after). ``n_min`` > 0: only the terms with
     max(m, n) > n_min, S(n_max) − S(n_min) (what the Richardson loop adds from one truncation to
     the next, :func:`incremental_partial_gram`)."""
     n = np.arange(1, n_max + 1, dtype=float)
     pi, sigma = _symmetries(space)
-    halves = None if pi is None else ReflectedGram(pi)
+    halves = None if pi is None else (ReflectedGram(pi) if sigma is None else KleinGram(pi, sigma))
     G = np.zeros((space.dim, space.dim))
     shapes = {}
     rows = chunk_rows(space, n_max)
@@ -316,7 +317,7 @@ def partial_gram(space, n_max: int, n_min: int = 0) -> np.ndarray:
         G += C @ C.T
     if halves is not None:
         G = halves.gram()
-    if sigma is not None:
+    if sigma is not None and not isinstance(halves, KleinGram):
         G = G + G[np.ix_(sigma, sigma)]
     return 0.5 * (G + G.T)
 

@@ -16,6 +16,8 @@ so in the orthonormal basis (e_g ± e_π(g))/√2 of the pairs g < π(g) (e_g fo
 g = π(g)) the columns with m + n even have no antisymmetric part and those with m + n odd no
 symmetric part: S = Σ w_mn μ_mn μ_mnᵀ is the sum of two Gram products of about half the rows
 on half the columns each, a quarter of the flops of the plain product (:class:`ReflectedGram`).
+Where the transposition maps the space onto itself too (every space of a uniform square grid),
+the four components of both halve that again (:class:`KleinGram`).
 """
 from __future__ import annotations
 

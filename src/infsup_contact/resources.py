@@ -177,12 +177,13 @@ TRI_GRAM_SECONDS = 2.2e-9
 """Seconds per n_local · T · n_max² of a triangle space's H Gram (``--element tet``, ``face.norms.
 triangles.gram_h_tri``: the sine coefficients of T triangles' n_local basis functions for all
 (m, n) ≤ n_max, over the partial sums n0, 2 n0, … n_max). Measured, one thread, ``beta --model
-membranes3d --element tet --case all --k 2 --N1 8 --N2 8`` (T = 128; the nine Grams 8.8 s):
-P2 1.9e-9 (n_max 768; its dual bases 2.7–3.0e-9), P1 1.7–3.8e-9, P0 3.2e-9 (1024). Before the
-sparse products by blocks of columns (2026-12-08) 5e-9: the Grams 14.6–15.2 s. Hexahedra:
-Kronecker products of 1D Grams."""
-TRI_GRAM_BYTES = 2 * 8 * 2 ** 23
-"""Its two working arrays (``triangles._BUDGET`` doubles each); measured 83 MB above the hexahedra's."""
+membranes3d --element tet --case all --k 2 --N1 8 --N2 8`` (T = 128; the nine Grams 8.8 s): P2
+1.9e-9 (n_max 768; its duals 2.7–3.0e-9), P1 1.7–3.8e-9, P0 3.2e-9 (1024); 5e-9 before 2026-12-08
+(the Grams 14.6–15.2 s). Hexahedra: Kronecker products of 1D Grams."""
+TRI_GRAM_BYTES = 8 * 2 ** 23
+"""Its working array (``triangles._BUDGET`` doubles: the coefficients of a block of m; the stacked
+U it also held whole until 2026-12-08 is made by blocks of columns since). Measured at N = 8, k = 2:
+335 MiB against 439 estimated with two arrays."""
 
 
 def tet_gram_seconds(k: int, n: int, n_spaces: int) -> float:

@@ -80,10 +80,12 @@ class ReflectedGram:
                 j0 = ((pm if same else 1 - pm) - int(n[0])) % 2  # n ≡ m (m + n even) or not
                 block = C[rows, k0::2, j0::2]
                 if block.size:
-                    self._accumulate(block.reshape(block.shape[0], -1), same)
+                    self._accumulate(block, same)
 
     def _accumulate(self, block: np.ndarray, same: bool) -> None:
-        self.G[same] += block @ block.T
+        """Add one strided block (rows, m of one parity, every other n) of columns to its half."""
+        flat = block.reshape(block.shape[0], -1)  # a copy: the block is a strided view
+        self.G[same] += flat @ flat.T
 
     def pair_bases(self) -> dict:
         """{True: Q_e, False: Q_o}: the orthonormal columns (e_g ± e_π(g))/√2 of the pairs (and
@@ -102,16 +104,14 @@ class ReflectedGram:
         """S in the dof basis: Q_e G_e Q_eᵀ + Q_o G_o Q_oᵀ (:meth:`pair_bases`), G_e and G_o
         scaled by the coordinates' :attr:`weights`."""
         Q = self.pair_bases()
-        return _sandwich_sum((Q[same], self.weights[same][:, None] * Gq * self.weights[same][None, :])
-                             for same, Gq in self.G.items())
+        return _sandwich_sum(self.dim, ((Q[same], self.weights[same][:, None] * Gq * self.weights[same][None, :])
+                             for same, Gq in self.G.items()))
 
 
-def _sandwich_sum(terms) -> np.ndarray:
+def _sandwich_sum(dim: int, terms) -> np.ndarray:
     """Σ V G Vᵀ over ``terms`` (V sparse dim × k, G dense k × k), dense dim × dim."""
-    out = None
+    out = np.zeros((dim, dim))
     for V, Gq in terms:
-        if out is None:
-            out = np.zeros((V.shape[0],) * 2)
         if Gq.size:
             T = np.asarray(V @ Gq)  # (dim, k)
             out += np.asarray(V @ T.T).T
@@ -131,8 +131,8 @@ class KleinGram(ReflectedGram):
     U_+ᵀ (H + T H Tᵀ) U_− = 0: S is two Gram products of about a quarter of the rows per parity of
     m + n, half the flops of :class:`ReflectedGram`, and no σ sum afterwards (:meth:`gram` is S).
     The rows :attr:`even_rows` come ordered so that every row of U_±ᵀ C is the sum or the
-    difference of two contiguous runs of C's rows (:meth:`add`: one pass from C's strided view,
-    where :class:`ReflectedGram` copies it): the pairs' representatives [a with s = +1, a with
+    difference of two contiguous runs of C's rows (:meth:`_accumulate`: one pass from C's strided
+    view, where :class:`ReflectedGram` copies it): the pairs' representatives [a with s = +1, a with
     s = −1, their images τ(a) in the same order, τ's fixed points with s = +1, then −1], then the
     reflection's fixed points [a, τ(a), τ's fixed points]."""
 
@@ -144,8 +144,9 @@ class KleinGram(ReflectedGram):
         image = np.minimum(sigma[rep], pi[sigma[rep]])          # τ on the pairs, by representative
         sign = np.where(sigma[rep] == image, 1.0, -1.0)          # of the antisymmetric coordinate
         a = [rep[(rep < image) & (sign == sg)] for sg in (1.0, -1.0)]
-        tau = dict(zip(rep, image))
-        b = [np.array([tau[x] for x in part], dtype=int) for part in a]
+        tau = np.empty(pi.size, dtype=int)
+        tau[rep] = image
+        b = [tau[part] for part in a]
         own = [rep[(rep == image) & (sign == sg)] for sg in (1.0, -1.0)]
         fa, ff = fixed[fixed < sigma[fixed]], fixed[fixed == sigma[fixed]]
         super().__init__(pi)
@@ -166,38 +167,31 @@ class KleinGram(ReflectedGram):
             (False, False): [(A_plus, B_plus, -1.0), (A_minus, B_minus, 1.0), (run(2 * na + own[0].size, own[1].size), None, 1.0)]}
         self.G = {key: np.zeros((sum(p[0].stop - p[0].start for p in parts),) * 2) for key, parts in self.components.items()}
 
-    def add(self, C: np.ndarray, m: np.ndarray, n: np.ndarray) -> None:
-        """:meth:`ReflectedGram.add` in the four components: C's rows in the order of :attr:`even_rows`."""
-        if np.any(np.diff(m) != 1) or np.any(np.diff(n) != 1):
-            raise InputError("m/n", "consecutive integers", got=(m, n))
-        for pm in (0, 1):  # the rows m ≡ pm (mod 2)
-            k0 = (pm - int(m[0])) % 2
-            for same in (True, False):
-                X = C[:, k0::2, ((pm if same else 1 - pm) - int(n[0])) % 2::2]  # m + n even (same) or odd
-                if not X.size:
-                    continue
-                for plus in (True, False):
-                    parts = self.components[(same, plus)]
-                    out = np.empty((self.G[(same, plus)].shape[0],) + X.shape[1:])
-                    row = 0
-                    for ra, rb, sg in parts:
-                        k = ra.stop - ra.start
-                        target = out[row:row + k]
-                        if rb is None:
-                            np.copyto(target, X[ra])
-                        else:
-                            (np.add if sg > 0 else np.subtract)(X[ra], X[rb], out=target)
-                        row += k
-                    if row:
-                        flat = out.reshape(row, -1)
-                        self.G[(same, plus)] += flat @ flat.T
+    def _accumulate(self, block: np.ndarray, same: bool) -> None:
+        """Add one strided block of columns (:meth:`ReflectedGram.add`; its rows those of
+        :attr:`even_rows`, or their first :attr:`rep`) to both σ components of its half: each row
+        of U_±ᵀ C written once, from two runs of the view."""
+        for plus in (True, False):
+            G = self.G[(same, plus)]
+            out, row = np.empty((G.shape[0],) + block.shape[1:]), 0
+            for ra, rb, sg in self.components[(same, plus)]:
+                target = out[row:row + ra.stop - ra.start]
+                if rb is None:
+                    np.copyto(target, block[ra])
+                else:
+                    (np.add if sg > 0 else np.subtract)(block[ra], block[rb], out=target)
+                row += ra.stop - ra.start
+            if row:
+                flat = out.reshape(row, -1)
+                G += flat @ flat.T
 
     def gram(self) -> np.ndarray:
         """S in the dof basis: Σ V (2 G) Vᵀ over the four components (2: S = H + P_σ H P_σᵀ),
         V = Q U D: the pairs' columns (:meth:`pair_bases`), the eigenspaces' (e_a ± e_b)/√2 with
         the 1/√2 :meth:`add` left out, and the coordinates' weights."""
         Q = self.pair_bases()
-        return _sandwich_sum((Q[same] @ self._basis(same, plus), 2.0 * Gq) for (same, plus), Gq in self.G.items())
+        return _sandwich_sum(self.dim, ((Q[same] @ self._basis(same, plus), 2.0 * Gq)
+                                       for (same, plus), Gq in self.G.items()))
 
     def _basis(self, same: bool, plus: bool) -> sparse.csr_matrix:
         weight = self.weights[same]
@@ -206,12 +200,10 @@ class KleinGram(ReflectedGram):
             ia = np.arange(ra.start, ra.stop)
             k = np.arange(col, col + ia.size)
             if rb is None:
-                rows.append(ia), cols.append(k), vals.append(weight[ia])
+                rows, cols, vals = rows + [ia], cols + [k], vals + [weight[ia]]
             else:
                 ib = np.arange(rb.start, rb.stop)
-                rows += [ia, ib]
-                cols += [k, k]
-                vals += [weight[ia] / 2.0, sg * weight[ib] / 2.0]
+                rows, cols, vals = rows + [ia, ib], cols + [k, k], vals + [weight[ia] / 2.0, sg * weight[ib] / 2.0]
             col += ia.size
         return sparse.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
                                  shape=(weight.size, col))

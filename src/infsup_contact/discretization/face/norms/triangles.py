@@ -263,12 +263,8 @@ def _coefficients(space, m: np.ndarray, n_max: int, q: int | None = None, shapes
 
 def chunk_rows(space, n_max: int) -> int:
     """Rows m per :func:`sine_coefficients_chunk` call: its output dim · rows · n_max within
-    :data:`_BUDGET` values, and (4 nloc n_y rows per column width of the partition)
-    × rows × n_max, the stacked U it formed whole until 2026-12-08 (made by blocks of columns
-    since; kept in the count so that the blocks of m, hence the sums and their bits, stay as they were)."""
-    widths = len(_width_groups(np.asarray(space.breakpoints.xs, float)))
-    per_row = max(space.dim, 4 * space.n_local * space.shape[1] * widths) * n_max
-    return int(min(n_max, max(1, _BUDGET // per_row)))
+    :data:`_BUDGET` values (the stacked U is made by blocks of :data:`_COLUMNS` columns)."""
+    return int(min(n_max, max(1, _BUDGET // (space.dim * n_max))))
 
 
 @lru_cache(maxsize=8)
